@@ -1,0 +1,334 @@
+//! Shaft drives (MODEL.md section 3): the paper's sine (eq 3), a sum of harmonics with phases,
+//! and tabulated speed or torque histories.
+
+use serde::{Deserialize, Serialize};
+use std::f64::consts::TAU;
+
+/// One harmonic of a speed profile: `A sin(2 pi f t + phase)`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Harmonic {
+    /// Amplitude `A` in rad/s.
+    pub amplitude_rad_s: f64,
+    /// Frequency `f` in Hz (> 0).
+    pub frequency_hz: f64,
+    /// Phase in rad.
+    pub phase_rad: f64,
+}
+
+/// A piecewise-linear table `y(t)`, held constant beyond its ends.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Table {
+    /// Strictly increasing times in s.
+    pub t_s: Vec<f64>,
+    /// Values at those times (unit given by the owner).
+    pub y: Vec<f64>,
+    /// Running integral of `y` from `t_s[0]` to each knot (unit of `y` times s).
+    integral: Vec<f64>,
+}
+
+/// Why a table is not usable.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TableError {
+    /// Fewer than two rows.
+    #[error("a table needs at least 2 rows, found {0}")]
+    TooShort(usize),
+    /// Times and values differ in length.
+    #[error("{0} times but {1} values")]
+    LengthMismatch(usize, usize),
+    /// A value is NaN or infinite.
+    #[error("row {0}: value is not finite")]
+    NotFinite(usize),
+    /// Times do not increase.
+    #[error("row {0}: time {1} s does not increase over the row before")]
+    NotIncreasing(usize, f64),
+}
+
+impl Table {
+    /// Builds a table from knots; times must be finite and strictly increasing.
+    pub fn new(t_s: Vec<f64>, y: Vec<f64>) -> Result<Table, TableError> {
+        if t_s.len() != y.len() {
+            return Err(TableError::LengthMismatch(t_s.len(), y.len()));
+        }
+        if t_s.len() < 2 {
+            return Err(TableError::TooShort(t_s.len()));
+        }
+        for i in 0..t_s.len() {
+            if !t_s[i].is_finite() || !y[i].is_finite() {
+                return Err(TableError::NotFinite(i));
+            }
+            if i > 0 && t_s[i] <= t_s[i - 1] {
+                return Err(TableError::NotIncreasing(i, t_s[i]));
+            }
+        }
+        let mut integral = vec![0.0; t_s.len()];
+        for i in 1..t_s.len() {
+            integral[i] = integral[i - 1] + 0.5 * (y[i] + y[i - 1]) * (t_s[i] - t_s[i - 1]);
+        }
+        Ok(Table { t_s, y, integral })
+    }
+
+    fn segment(&self, t: f64) -> usize {
+        // index i with t_s[i] <= t < t_s[i+1], clamped to the valid segments
+        let i = self.t_s.partition_point(|&x| x <= t);
+        i.saturating_sub(1).min(self.t_s.len() - 2)
+    }
+
+    /// Linearly interpolated value at `t` (held beyond the ends).
+    pub fn value(&self, t: f64) -> f64 {
+        let n = self.t_s.len();
+        if t <= self.t_s[0] {
+            return self.y[0];
+        }
+        if t >= self.t_s[n - 1] {
+            return self.y[n - 1];
+        }
+        let i = self.segment(t);
+        let w = (t - self.t_s[i]) / (self.t_s[i + 1] - self.t_s[i]);
+        self.y[i] + w * (self.y[i + 1] - self.y[i])
+    }
+
+    /// Slope `dy/dt` at `t` (0 beyond the ends; the right-hand slope at a knot).
+    pub fn slope(&self, t: f64) -> f64 {
+        let n = self.t_s.len();
+        if t < self.t_s[0] || t >= self.t_s[n - 1] {
+            return 0.0;
+        }
+        let i = self.segment(t);
+        (self.y[i + 1] - self.y[i]) / (self.t_s[i + 1] - self.t_s[i])
+    }
+
+    /// Exact integral of the interpolant from 0 to `t` (values before `t_s[0]` held).
+    pub fn integral_from_zero(&self, t: f64) -> f64 {
+        self.integral_to(t) - self.integral_to(0.0)
+    }
+
+    fn integral_to(&self, t: f64) -> f64 {
+        let n = self.t_s.len();
+        if t <= self.t_s[0] {
+            return (t - self.t_s[0]) * self.y[0];
+        }
+        if t >= self.t_s[n - 1] {
+            return self.integral[n - 1] + (t - self.t_s[n - 1]) * self.y[n - 1];
+        }
+        let i = self.segment(t);
+        let v = self.value(t);
+        self.integral[i] + 0.5 * (self.y[i] + v) * (t - self.t_s[i])
+    }
+}
+
+/// A shaft speed history `omega(t)` in rad/s, with `theta(0) = 0`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum SpeedProfile {
+    /// `omega_0 + sum_k A_k sin(2 pi f_k t + phase_k)`; the paper's eq (3) is one harmonic
+    /// with zero phase.
+    Harmonics {
+        /// Mean speed `omega_0` in rad/s.
+        omega0_rad_s: f64,
+        /// The harmonics.
+        harmonics: Vec<Harmonic>,
+    },
+    /// Tabulated speed in rad/s, linear between rows.
+    Table(Table),
+}
+
+impl SpeedProfile {
+    /// The paper's drive, eq (3): `omega_0 + A sin(2 pi f t)`.
+    pub fn sine(omega0_rad_s: f64, amplitude_rad_s: f64, frequency_hz: f64) -> SpeedProfile {
+        SpeedProfile::Harmonics {
+            omega0_rad_s,
+            harmonics: vec![Harmonic {
+                amplitude_rad_s,
+                frequency_hz,
+                phase_rad: 0.0,
+            }],
+        }
+    }
+
+    /// Shaft speed in rad/s at `t` s (Hu et al. eq (3) for one harmonic).
+    pub fn speed(&self, t: f64) -> f64 {
+        match self {
+            SpeedProfile::Harmonics {
+                omega0_rad_s,
+                harmonics,
+            } => {
+                omega0_rad_s
+                    + harmonics
+                        .iter()
+                        .map(|h| h.amplitude_rad_s * (TAU * h.frequency_hz * t + h.phase_rad).sin())
+                        .sum::<f64>()
+            }
+            SpeedProfile::Table(tab) => tab.value(t),
+        }
+    }
+
+    /// Shaft angle in rad at `t` s: the exact integral of [`Self::speed`] from 0.
+    pub fn angle(&self, t: f64) -> f64 {
+        match self {
+            SpeedProfile::Harmonics {
+                omega0_rad_s,
+                harmonics,
+            } => {
+                omega0_rad_s * t
+                    + harmonics
+                        .iter()
+                        .map(|h| {
+                            let w = TAU * h.frequency_hz;
+                            h.amplitude_rad_s / w * (h.phase_rad.cos() - (w * t + h.phase_rad).cos())
+                        })
+                        .sum::<f64>()
+            }
+            SpeedProfile::Table(tab) => tab.integral_from_zero(t),
+        }
+    }
+
+    /// Shaft angular acceleration in rad/s^2 at `t` s (the `2 pi f A cos(2 pi f t)` of eq (4)).
+    pub fn acceleration(&self, t: f64) -> f64 {
+        match self {
+            SpeedProfile::Harmonics { harmonics, .. } => harmonics
+                .iter()
+                .map(|h| {
+                    let w = TAU * h.frequency_hz;
+                    h.amplitude_rad_s * w * (w * t + h.phase_rad).cos()
+                })
+                .sum(),
+            SpeedProfile::Table(tab) => tab.slope(t),
+        }
+    }
+}
+
+/// What drives an inertial shaft (eq 4).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum ShaftExcitation {
+    /// Hu et al. eq (4): drive torque `J1 * d(omega_profile)/dt`, the shaft starting at the
+    /// profile's speed.
+    Profile(SpeedProfile),
+    /// A tabulated drive torque in N m (positive along the positive rotation).
+    Torque {
+        /// The torque history, N m.
+        table: Table,
+        /// Shaft speed at t = 0, rad/s.
+        initial_speed_rad_s: f64,
+    },
+}
+
+/// The shaft model (MODEL.md section 3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Shaft {
+    /// The shaft follows a speed history whatever the load (eq 3).
+    Prescribed(SpeedProfile),
+    /// The shaft is a body: `J1 omega' = T_drive + n F Rb - C1 omega` summed over couplings (eq 4).
+    Inertial {
+        /// `J1` in kg m^2 (> 0).
+        inertia_kg_m2: f64,
+        /// `C1` in N m s/rad (>= 0).
+        damping_n_m_s_rad: f64,
+        /// The drive.
+        excitation: ShaftExcitation,
+    },
+}
+
+impl Shaft {
+    /// Shaft speed at t = 0 in rad/s.
+    pub fn initial_speed_rad_s(&self) -> f64 {
+        match self {
+            Shaft::Prescribed(p) => p.speed(0.0),
+            Shaft::Inertial { excitation, .. } => match excitation {
+                ShaftExcitation::Profile(p) => p.speed(0.0),
+                ShaftExcitation::Torque {
+                    initial_speed_rad_s,
+                    ..
+                } => *initial_speed_rad_s,
+            },
+        }
+    }
+
+    /// Drive torque on an inertial shaft in N m at `t` (0 for a prescribed shaft).
+    pub fn drive_torque_n_m(&self, t: f64) -> f64 {
+        match self {
+            Shaft::Prescribed(_) => 0.0,
+            Shaft::Inertial {
+                inertia_kg_m2,
+                excitation,
+                ..
+            } => match excitation {
+                // Hu et al. eq (4): J1 * 2 pi f A cos(2 pi f t)
+                ShaftExcitation::Profile(p) => inertia_kg_m2 * p.acceleration(t),
+                ShaftExcitation::Torque { table, .. } => table.value(t),
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    /// The angle is the integral of the speed and the acceleration its derivative
+    /// (central differences, h = 1e-6 s: truncation error h^2 A w^3 / 6 ~ 1e-3 of A w).
+    #[test]
+    fn harmonics_are_consistent() {
+        let p = SpeedProfile::Harmonics {
+            omega0_rad_s: 100.0,
+            harmonics: vec![
+                Harmonic {
+                    amplitude_rad_s: 4.0,
+                    frequency_hz: 104.0,
+                    phase_rad: 0.3,
+                },
+                Harmonic {
+                    amplitude_rad_s: 1.0,
+                    frequency_hz: 208.0,
+                    phase_rad: -1.0,
+                },
+            ],
+        };
+        assert_eq!(p.angle(0.0), 0.0);
+        let h = 1e-6;
+        for i in 1..50 {
+            let t = i as f64 * 1.3e-3;
+            let dtheta = (p.angle(t + h) - p.angle(t - h)) / (2.0 * h);
+            assert_relative_eq!(dtheta, p.speed(t), max_relative = 1e-8);
+            let domega = (p.speed(t + h) - p.speed(t - h)) / (2.0 * h);
+            assert_relative_eq!(domega, p.acceleration(t), epsilon = 1e-3 * 4.0 * 1307.0);
+        }
+    }
+
+    #[test]
+    fn sine_is_eq3() {
+        let p = SpeedProfile::sine(200.0, 4.378, 104.0);
+        let t = 1.234e-3;
+        assert_relative_eq!(
+            p.speed(t),
+            200.0 + 4.378 * (TAU * 104.0 * t).sin(),
+            max_relative = 1e-15
+        );
+    }
+
+    /// The exact integral of a piecewise-linear table (trapezoids), including beyond the ends.
+    #[test]
+    fn table_integral_is_exact() {
+        let tab = Table::new(vec![0.0, 1.0, 3.0], vec![2.0, 4.0, 0.0]).unwrap();
+        assert_relative_eq!(tab.integral_from_zero(1.0), 3.0, max_relative = 1e-15);
+        assert_relative_eq!(tab.integral_from_zero(2.0), 3.0 + 3.0, max_relative = 1e-15);
+        assert_relative_eq!(tab.integral_from_zero(4.0), 3.0 + 4.0, max_relative = 1e-15);
+        assert_eq!(tab.slope(0.5), 2.0);
+        assert_eq!(tab.value(10.0), 0.0);
+    }
+
+    #[test]
+    fn bad_tables_are_rejected() {
+        assert!(matches!(
+            Table::new(vec![0.0], vec![1.0]),
+            Err(TableError::TooShort(1))
+        ));
+        assert!(matches!(
+            Table::new(vec![0.0, 0.0], vec![1.0, 2.0]),
+            Err(TableError::NotIncreasing(1, _))
+        ));
+        assert!(matches!(
+            Table::new(vec![0.0, 1.0], vec![1.0, f64::NAN]),
+            Err(TableError::NotFinite(1))
+        ));
+    }
+}

@@ -1,0 +1,120 @@
+//! The engine interface: what every engine emits (samples, impact events, a run report) and
+//! the [`Engine`] trait that both the reference and the multibody engine implement.
+
+use crate::impact::ImpactEvent;
+use serde::{Deserialize, Serialize};
+
+/// State of one disc's coupling at one instant.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct DiscSample {
+    /// Disc angle in rad (positive in the shaft's positive rotation).
+    pub angle_rad: f64,
+    /// Disc speed in rad/s.
+    pub speed_rad_s: f64,
+    /// Relative angle `phi = theta_s - theta_d` in rad (positive: the shaft leads).
+    pub rel_angle_rad: f64,
+    /// Metal penetration along the line of action in m (negative: a gap).
+    pub penetration_m: f64,
+    /// Closing speed along the line of action of the flank `phi` lies on, m/s (positive closing).
+    pub closing_speed_m_s: f64,
+    /// Per-tooth load in N, signed as eq (6) (negative when the shaft leads).
+    pub load_n: f64,
+    /// Spline torque on the disc in N m (`-n F Rb`, eq 5).
+    pub torque_n_m: f64,
+    /// Whether a contact event (film or metal) is in progress.
+    pub engaged: bool,
+    /// Stiffness `K` of the current contact event in N/m^1.5 (0 when not engaged).
+    pub stiffness: f64,
+    /// Per-tooth loads in N when the engine resolves teeth (empty for lumped engines).
+    pub tooth_loads_n: Vec<f64>,
+}
+
+/// The state of the whole pack at one instant.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Sample {
+    /// Time in s.
+    pub t_s: f64,
+    /// Shaft angle in rad.
+    pub shaft_angle_rad: f64,
+    /// Shaft speed in rad/s.
+    pub shaft_speed_rad_s: f64,
+    /// One entry per disc, in scene order.
+    pub discs: Vec<DiscSample>,
+}
+
+/// Receives what an engine produces, in time order.
+pub trait Observer {
+    /// A sample at the recording rate.
+    fn sample(&mut self, _sample: &Sample) {}
+    /// A completed impact event.
+    fn impact(&mut self, _event: &ImpactEvent) {}
+    /// Called now and then with the simulated time in s; returning `true` stops the run
+    /// early and cleanly (used for Ctrl-C).
+    fn progress(&mut self, _t_s: f64) -> bool {
+        false
+    }
+}
+
+/// An observer that keeps nothing.
+pub struct NullObserver;
+impl Observer for NullObserver {}
+
+/// Collects everything in memory (tests and small runs).
+#[derive(Debug, Default, Clone)]
+pub struct Collector {
+    /// All samples.
+    pub samples: Vec<Sample>,
+    /// All impact events in the order they closed.
+    pub impacts: Vec<ImpactEvent>,
+}
+
+impl Observer for Collector {
+    fn sample(&mut self, sample: &Sample) {
+        self.samples.push(sample.clone());
+    }
+    fn impact(&mut self, event: &ImpactEvent) {
+        self.impacts.push(*event);
+    }
+}
+
+/// What a finished (or stopped) run reports.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct RunStats {
+    /// Simulated time reached, s.
+    pub simulated_s: f64,
+    /// Accepted integration steps.
+    pub steps: u64,
+    /// Rejected steps (adaptive engines).
+    pub rejected_steps: u64,
+    /// Evaluations of the equations of motion.
+    pub rhs_evals: u64,
+    /// Whether the observer stopped the run early.
+    pub stopped_early: bool,
+}
+
+/// Why an engine could not finish.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EngineError {
+    /// The state became non-finite or the step size collapsed.
+    #[error("the simulation diverged at t = {t_s:.9} s: {reason}")]
+    Diverged {
+        /// Time of the last good state, s.
+        t_s: f64,
+        /// What went wrong.
+        reason: String,
+    },
+    /// The engine cannot run this model.
+    #[error("this engine cannot run the scene: {0}")]
+    Unsupported(String),
+}
+
+/// A simulation engine built from a scene.
+pub trait Engine {
+    /// Short name (`"reference"`, `"multibody"`).
+    fn name(&self) -> &'static str;
+    /// Names of the discs in output order.
+    fn disc_names(&self) -> Vec<String>;
+    /// Runs from t = 0 to `duration_s`, sending samples and impacts to `observer`. On error,
+    /// everything before the failure has already been delivered.
+    fn run(&mut self, duration_s: f64, observer: &mut dyn Observer) -> Result<RunStats, EngineError>;
+}
