@@ -1,11 +1,123 @@
 //! # clutchpack_scene
 //!
-//! TOML scene files -> validated, typed parameters ([`Scene`]), in two stages: `raw` mirrors
-//! the file (unknown keys are errors), then validation checks every rule and reports every
-//! problem at once with its key path, the bad value and the rule. `--set KEY=VALUE` overrides
-//! any key by the same dotted path as in the file (array items by index: `discs[2].oil.film_thickness_m`).
+//! TOML scene files -> validated, typed parameters ([`Scene`]) for the engines.
 //!
-//! (Implementation in progress: see the module docs once written.)
+//! What this crate does:
+//! - reads a scene file ([`load`]) or text ([`parse`]), applies `--set KEY=VALUE` overrides
+//!   ([`Override`]), and checks every value and every rule between values;
+//! - reports **every** problem at once ([`SceneError`], [`Problem`]), each as
+//!   `<file>: <key path> = <bad value>: <rule>`;
+//! - reads the CSV tables of tabulated drives;
+//! - documents every key for `--help` ([`keys_doc`]).
+//!
+//! What it does not do: run anything, choose an engine when the scene does not, or decide
+//! physics (the laws live in `clutchpack_model`).
+//!
+//! # The file format
+//! Keys are SI with a unit suffix; angles are in degrees only in keys ending `_deg` (converted
+//! to rad here), everything else is SI as named. Every number must be finite (TOML's `nan`
+//! and `inf` are rejected); an integer is accepted wherever a number is expected.
+//!
+//! ```toml
+//! name = "hu-table2"            # default: the file name without extension
+//! description = "Hu et al. Table 2"
+//!
+//! [simulation]
+//! duration_s = 0.3              # required, > 0
+//! engine = "reference"          # optional: "reference" | "multibody"
+//! record_rate_hz = 10000.0      # default 10000
+//! tolerance = 1e-9              # default 1e-9, in [1e-14, 1e-3]
+//! max_step_s = 1e-4             # default 1e-4
+//!
+//! [shaft]
+//! mode = "prescribed"           # default; or "inertial" with inertia_kg_m2 (required),
+//!                               # damping_n_m_s_rad (default 0)
+//!
+//! [drive]
+//! kind = "sine"                 # "sine" | "harmonics" | "speed_table" | "torque_table"
+//! omega0_rad_s = 200.0
+//! amplitude_rad_s = 4.378
+//! frequency_hz = 104.0
+//! phase_deg = 0.0               # default 0
+//!
+//! [defaults]                    # disc parameters shared by all discs
+//! inertia_kg_m2 = 0.156
+//! drag_n_m_s_rad = 0.01
+//! [defaults.spline]
+//! teeth = 154
+//! pitch_radius_m = 0.231
+//! pressure_angle_deg = 20.0
+//! backlash_m = 0.75e-3
+//! [defaults.contact]
+//! law = "paper"
+//! modulus_pa = 210e9
+//! curvature_radius_m = 1.75e-3
+//! loss_coefficient_s_m = 0.8
+//! [defaults.oil]
+//! film_thickness_m = 25e-6
+//! viscosity_pa_s = 289.1
+//! leakage_coefficient = 0.421
+//! width_m = 3e-3
+//! length_m = 3e-3
+//!
+//! [[discs]]                     # at least one; any [defaults] key may be overridden
+//! name = "disc-1"
+//! [[discs]]
+//! name = "disc-2"
+//! [discs.oil]
+//! film_thickness_m = 75e-6
+//! ```
+//!
+//! Drives: `sine` is Hu et al. eq (3) with a phase, mapped to one harmonic; `harmonics` takes
+//! `omega0_rad_s` and one `[[drive.harmonics]]` table per term (`amplitude_rad_s`,
+//! `frequency_hz`, `phase_deg`); `speed_table` and `torque_table` take `file`, a CSV file
+//! (relative to the scene file's folder) with a header row and columns `time_s` and
+//! `speed_rad_s` or `torque_n_m`. A torque table drives an inertial shaft only and needs
+//! `shaft.initial_speed_rad_s`. [`keys_doc`] lists every key with its unit, rule and default.
+//!
+//! Disc parameters resolve as: the disc's own value, else `[defaults]`, else the built-in
+//! default, else a "missing" problem at the disc's key path (`discs[1].spline.teeth`). The oil
+//! parameters (`viscosity_pa_s`, `leakage_coefficient`, `width_m`, `length_m`) are required
+//! only when the film carries load (`film_thickness_m > 0` and `law` not `"dry"`); otherwise
+//! absent ones are 0. With an oil law the film must be thinner than half the free play along
+//! the line of action (`h_o < g0 Rb`), and every disc must start inside the free play
+//! (`|phi0| Rb < g0 Rb - h_o`, `h_o` taken as 0 for the dry law).
+//!
+//! # Overrides
+//! `--set KEY=VALUE` overrides any key by its dotted path, array items by index from 0:
+//! `--set discs[2].oil.film_thickness_m=50e-6`. VALUE is TOML (`50e-6`, `"x"`, `{ a = 1 }`),
+//! or a string if it is not valid TOML (`--set drive.kind=sine`). Overrides apply to the
+//! parsed document in order, before validation; a key outside the schema, or an index past the
+//! end of an array, is a problem that names the key and says it came from `--set`.
+//!
+//! # Errors
+//! [`SceneError::Invalid`] displays one problem per line:
+//! ```text
+//! scenes/x.toml: discs[2].inertia_kg_m2 = -0.1: must be > 0
+//! scenes/x.toml: discs[1].spline.teeth: missing (required; set it in [discs.spline] or [defaults.spline])
+//! scenes/x.toml: discs[0].oil.thicknes_m: unknown key (expected one of: film_thickness_m, ...)
+//! scenes/x.toml: line 3 column 14: <TOML syntax message>
+//! ```
+//!
+//! # Architecture
+//! Two stages: `raw` mirrors the file (tables typed, values kept as written; unknown keys
+//! collected with `serde_ignored`), then `validate` converts to the typed model, collecting
+//! every problem. `schema` lists every key once; it drives the key reference, the "expected
+//! one of" lists and the `--set` key check.
+
+mod csv;
+mod error;
+mod overrides;
+mod raw;
+mod schema;
+mod validate;
+
+pub use error::{Problem, SceneError};
+pub use overrides::{Override, OverrideError};
+pub use schema::keys_doc;
+
+use std::path::Path;
+use toml::{Table, Value};
 
 use clutchpack_model::PackModel;
 use serde::{Deserialize, Serialize};
@@ -52,4 +164,215 @@ pub struct Scene {
     pub simulation: Simulation,
     /// The physical model.
     pub pack: PackModel,
+}
+
+/// Reads and validates the scene file at `path`, after applying `overrides` in order.
+/// Messages name the file as `path` is written; relative CSV paths resolve against the file's
+/// folder. The [`Scene`] holds SI values (degrees of `_deg` keys converted to rad).
+pub fn load(path: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let base_dir = path.parent().unwrap_or(Path::new(""));
+    parse(&text, &path.display().to_string(), base_dir, overrides)
+}
+
+/// Validates scene text. `origin` is the file name used in messages (its stem is the default
+/// scene name), `base_dir` the folder against which relative CSV paths resolve, `overrides`
+/// the `--set` overrides, applied in order before validation. The [`Scene`] holds SI values
+/// (degrees of `_deg` keys converted to rad); on error, every problem found is returned.
+pub fn parse(
+    text: &str,
+    origin: &str,
+    base_dir: &Path,
+    overrides: &[Override],
+) -> Result<Scene, SceneError> {
+    let invalid = |problems| SceneError::Invalid {
+        origin: origin.to_string(),
+        problems,
+    };
+    let mut doc: Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| invalid(vec![syntax_problem(text, &e)]))?;
+
+    let mut problems = Vec::new();
+    let applied = overrides::apply(&mut doc, overrides, &mut problems);
+    let voided = raw::check_structure(&mut doc, &mut problems);
+    let raw = deserialize_raw(doc, &mut problems);
+
+    let stem = Path::new(origin)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| origin.to_string());
+    let mut ck = validate::Checker::default();
+    let validated = raw.and_then(|raw| validate::validate(&raw, &stem, base_dir, &mut ck));
+    problems.append(&mut ck.problems);
+
+    // A table of the wrong type was reported once: its keys are not missing on top of that.
+    problems.retain(|p| {
+        !(p.value.is_none()
+            && p.rule.starts_with("missing")
+            && voided.iter().any(|v| is_under(&p.key, v)))
+    });
+    // Say which problems stem from a --set value.
+    for p in &mut problems {
+        let from_set = applied.iter().rev().find(|k| is_under(&p.key, k));
+        if let Some(k) = from_set {
+            p.rule.push_str(&format!(" (from --set {k}=...)"));
+        }
+    }
+
+    match validated {
+        Some(v) if problems.is_empty() => Ok(Scene {
+            name: v.name,
+            description: v.description,
+            source_text: text.to_string(),
+            overrides: overrides.iter().map(Override::to_string).collect(),
+            simulation: v.simulation,
+            pack: v.pack,
+        }),
+        _ => {
+            debug_assert!(
+                !problems.is_empty(),
+                "no model built but no problem reported"
+            );
+            Err(invalid(problems))
+        }
+    }
+}
+
+/// Whether `key` is `path` or a key inside it (`discs[1].oil.width_m` is under `discs[1]`).
+fn is_under(key: &str, path: &str) -> bool {
+    key.strip_prefix(path)
+        .is_some_and(|rest| rest.is_empty() || rest.starts_with(['.', '[']))
+}
+
+/// A TOML syntax error as `line L column C: message` (1-based, column in characters).
+fn syntax_problem(text: &str, e: &toml::de::Error) -> Problem {
+    let message = e.message().trim().replace('\n', " ");
+    match e.span() {
+        Some(span) => {
+            let before = &text[..span.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let column = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
+            Problem::new(format!("line {line} column {column}"), None, message)
+        }
+        None => Problem::new("TOML", None, message),
+    }
+}
+
+/// Stage one: the document -> raw structs. Unknown keys become problems. Deserialization
+/// cannot fail after [`raw::check_structure`]; should it, the failure is a problem too and
+/// `None` is returned.
+fn deserialize_raw(doc: Table, problems: &mut Vec<Problem>) -> Option<raw::RawScene> {
+    let mut unknown = Vec::new();
+    let mut collect = |path: serde_ignored::Path| unknown.push(ignored_path(&path));
+    let de = serde_ignored::Deserializer::new(Value::Table(doc), &mut collect);
+    let result: Result<raw::RawScene, _> = serde_path_to_error::deserialize(de);
+    for key in unknown {
+        let parent = key.rfind('.').map_or("", |i| &key[..i]);
+        let rule = format!(
+            "unknown key ({})",
+            schema::expected_text(&schema::normalize(parent))
+        );
+        problems.push(Problem::new(key, None, rule));
+    }
+    match result {
+        Ok(raw) => Some(raw),
+        Err(e) => {
+            let mut key = String::new();
+            for seg in e.path().iter() {
+                match seg {
+                    serde_path_to_error::Segment::Seq { index } => {
+                        key.push_str(&format!("[{index}]"))
+                    }
+                    serde_path_to_error::Segment::Map { key: k } => {
+                        if !key.is_empty() {
+                            key.push('.');
+                        }
+                        key.push_str(k);
+                    }
+                    _ => {}
+                }
+            }
+            problems.push(Problem::new(key, None, e.inner().message().to_string()));
+            None
+        }
+    }
+}
+
+/// A `serde_ignored` path as written in a scene file: `discs[0].oil.thicknes_m`.
+fn ignored_path(path: &serde_ignored::Path) -> String {
+    use serde_ignored::Path as P;
+    match path {
+        P::Root => String::new(),
+        P::Seq { parent, index } => format!("{}[{index}]", ignored_path(parent)),
+        P::Map { parent, key } => {
+            let p = ignored_path(parent);
+            if p.is_empty() {
+                key.clone()
+            } else {
+                format!("{p}.{key}")
+            }
+        }
+        P::Some { parent } | P::NewtypeStruct { parent } | P::NewtypeVariant { parent } => {
+            ignored_path(parent)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Puts `1` at a schema path, creating tables and one-item arrays of tables on the way.
+    fn insert(table: &mut Table, path: &str) {
+        let (head, rest) = match path.split_once('.') {
+            Some((h, r)) => (h, Some(r)),
+            None => (path, None),
+        };
+        match (head.strip_suffix("[]"), rest) {
+            (Some(name), Some(rest)) => {
+                let items = table
+                    .entry(name)
+                    .or_insert_with(|| Value::Array(vec![Value::Table(Table::new())]));
+                if let Some(Value::Table(item)) = items.as_array_mut().and_then(|a| a.first_mut()) {
+                    insert(item, rest);
+                }
+            }
+            (None, Some(rest)) => {
+                let child = table
+                    .entry(head)
+                    .or_insert_with(|| Value::Table(Table::new()));
+                insert(child.as_table_mut().expect("a table"), rest);
+            }
+            (_, None) => {
+                table.insert(head.to_string(), Value::Integer(1));
+            }
+        }
+    }
+
+    /// Every key of the schema (and so of `--help` and the `--set` check) is a field of the raw
+    /// structs: a document holding all of them deserializes with no unknown key.
+    #[test]
+    fn every_schema_key_is_read_by_the_raw_structs() {
+        let mut doc = Table::new();
+        for path in schema::all_paths() {
+            insert(&mut doc, path);
+        }
+        let mut problems = Vec::new();
+        assert!(raw::check_structure(&mut doc, &mut problems).is_empty());
+        assert!(deserialize_raw(doc, &mut problems).is_some());
+        assert!(problems.is_empty(), "{problems:?}");
+    }
+
+    #[test]
+    fn syntax_errors_are_located() {
+        let text = "a = 1\nb = [1,\n";
+        let e = text.parse::<Table>().unwrap_err();
+        let p = syntax_problem(text, &e);
+        assert!(p.key.starts_with("line "), "{p}");
+        assert!(!p.rule.contains('\n'));
+    }
 }

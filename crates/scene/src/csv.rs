@@ -1,0 +1,98 @@
+//! Tabulated drive histories: a small CSV reader for `drive.file`.
+//!
+//! The file has a header row naming its columns; the two columns used are found by name
+//! (`time_s` and `speed_rad_s` or `torque_n_m`), other columns are ignored. Fields are
+//! separated by commas; blank lines and lines starting with `#` are skipped; quoting is not
+//! supported (the file holds numbers only). Times are in s and must increase strictly; the
+//! table is held constant beyond its ends ([`clutchpack_model::Table`]).
+
+use clutchpack_model::{Table, TableError};
+use std::path::Path;
+
+/// Reads columns `time_s` and `value_column` of the CSV file at `path` into a table.
+/// `shown` is the file name used in messages (as written in the scene). The error is a
+/// one-line message naming the file and, where it applies, the line.
+pub(crate) fn read_table(path: &Path, shown: &str, value_column: &str) -> Result<Table, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    parse_table(&text, shown, value_column)
+}
+
+/// Parses CSV text (see [`read_table`]).
+pub(crate) fn parse_table(text: &str, shown: &str, value_column: &str) -> Result<Table, String> {
+    // (1-based line number, fields) of each non-blank, non-comment line
+    let mut rows = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
+        .map(|(n, l)| (n, l.split(',').map(str::trim).collect::<Vec<_>>()));
+    let (_, header) = rows
+        .next()
+        .ok_or_else(|| format!("{shown}: empty file (expected a header row)"))?;
+    let column = |name: &str| {
+        header.iter().position(|h| *h == name).ok_or_else(|| {
+            format!(
+                "{shown}: no column {name:?} in the header row (found: {})",
+                header.join(", ")
+            )
+        })
+    };
+    let (it, iy) = (column("time_s")?, column(value_column)?);
+    let (mut t, mut y, mut lines) = (Vec::new(), Vec::new(), Vec::new());
+    for (line, fields) in rows {
+        let field = |i: usize, name: &str| -> Result<f64, String> {
+            let f = fields
+                .get(i)
+                .ok_or_else(|| format!("{shown}: line {line}: no value in column {name:?}"))?;
+            f.parse::<f64>()
+                .map_err(|_| format!("{shown}: line {line}: {name} = {f:?} is not a number"))
+        };
+        t.push(field(it, "time_s")?);
+        y.push(field(iy, value_column)?);
+        lines.push(line);
+    }
+    Table::new(t, y).map_err(|e| match e {
+        TableError::NotFinite(i) => format!("{shown}: line {}: value is not finite", lines[i]),
+        TableError::NotIncreasing(i, ts) => format!(
+            "{shown}: line {}: time {ts} s does not increase over the row before",
+            lines[i]
+        ),
+        other => format!("{shown}: {other}"),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_named_columns_and_skips_comments() {
+        let t = parse_table(
+            "# a comment\nspeed_rad_s, time_s\n200, 0\n\n210, 0.1\n",
+            "d.csv",
+            "speed_rad_s",
+        )
+        .unwrap();
+        assert_eq!(t.t_s, [0.0, 0.1]);
+        assert_eq!(t.y, [200.0, 210.0]);
+    }
+
+    #[test]
+    fn errors_name_file_and_line() {
+        let e = parse_table("time_s,torque_n_m\n0,1\n0,2\n", "d.csv", "torque_n_m").unwrap_err();
+        assert_eq!(
+            e,
+            "d.csv: line 3: time 0 s does not increase over the row before"
+        );
+        let e = parse_table("time_s,torque_n_m\n0,x\n", "d.csv", "torque_n_m").unwrap_err();
+        assert!(e.contains("line 2") && e.contains("\"x\""), "{e}");
+        let e = parse_table("time_s,speed\n0,1\n", "d.csv", "speed_rad_s").unwrap_err();
+        assert!(e.contains("no column \"speed_rad_s\""), "{e}");
+        let e = parse_table("time_s,speed_rad_s\n0,1\n", "d.csv", "speed_rad_s").unwrap_err();
+        assert!(e.contains("at least 2 rows"), "{e}");
+        let e =
+            parse_table("time_s,speed_rad_s\n0,1\n1,nan\n", "d.csv", "speed_rad_s").unwrap_err();
+        assert_eq!(e, "d.csv: line 3: value is not finite");
+    }
+}

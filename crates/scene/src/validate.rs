@@ -1,0 +1,1010 @@
+//! Stage two: the raw file ([`crate::raw`]) -> validated model values.
+//!
+//! Every value is checked where it is written (its type, that it is finite, its range), then
+//! the rules between keys (which keys a drive kind or shaft mode takes, the oil parameters a
+//! film needs, the film and the start position against the free play). Each broken rule
+//! becomes one [`Problem`] with the key path, the value as written and the rule; checking goes
+//! on after a problem, so that one run lists them all. A value that is itself invalid is not
+//! used by the rules between keys (its problem is already reported).
+//!
+//! Disc parameters resolve in this order: the disc's own value, then `[defaults]`, then the
+//! built-in default; a required key found nowhere is reported as missing at the disc's key
+//! path (`discs[1].spline.teeth`). A bad value in `[defaults]` is reported once, at its
+//! `defaults.` path.
+
+use crate::csv;
+use crate::error::Problem;
+use crate::raw::{RawDisc, RawDrive, RawScene, RawShaft, RawSimulation};
+use crate::schema;
+use crate::{EngineChoice, Simulation};
+use clutchpack_model::{
+    DiscModel, Harmonic, Hertz, LawKind, OilFilm, PackModel, Shaft, ShaftExcitation, SpeedProfile,
+    SplineGeometry, Table, ToothLaw,
+};
+use std::path::Path;
+use toml::Value;
+
+/// The validated content of a scene file.
+pub(crate) struct Validated {
+    pub name: String,
+    pub description: String,
+    pub simulation: Simulation,
+    pub pack: PackModel,
+}
+
+/// The outcome of checking one value where it is written.
+#[derive(Debug, Clone, PartialEq)]
+enum Field<T> {
+    /// The key is not in the file.
+    Absent,
+    /// The key is there but its value breaks a rule (already reported).
+    Invalid,
+    /// The key is there and its value is good.
+    Valid(T),
+}
+
+impl<T> Field<T> {
+    /// The value, or `default` if absent; `None` if invalid.
+    fn or(self, default: T) -> Option<T> {
+        match self {
+            Field::Absent => Some(default),
+            Field::Invalid => None,
+            Field::Valid(v) => Some(v),
+        }
+    }
+
+    /// The value; reports `key: missing (hint)` if absent; `None` if absent or invalid.
+    fn required(self, ck: &mut Checker, key: &str, hint: &str) -> Option<T> {
+        match self {
+            Field::Absent => {
+                ck.report(key, None, format!("missing ({hint})"));
+                None
+            }
+            Field::Invalid => None,
+            Field::Valid(v) => Some(v),
+        }
+    }
+}
+
+/// The range rule of a number (every number must also be finite).
+#[derive(Debug, Clone, Copy)]
+enum Rule {
+    /// Any finite number.
+    Finite,
+    /// `> 0`.
+    Positive,
+    /// `>= 0`.
+    NonNegative,
+    /// In `[lo, hi]`, with the rule's text.
+    Closed(f64, f64, &'static str),
+    /// In `(lo, hi)`, with the rule's text.
+    Open(f64, f64, &'static str),
+}
+
+impl Rule {
+    fn holds(self, x: f64) -> bool {
+        match self {
+            Rule::Finite => true,
+            Rule::Positive => x > 0.0,
+            Rule::NonNegative => x >= 0.0,
+            Rule::Closed(lo, hi, _) => (lo..=hi).contains(&x),
+            Rule::Open(lo, hi, _) => x > lo && x < hi,
+        }
+    }
+
+    fn text(self) -> &'static str {
+        match self {
+            Rule::Finite => "must be a finite number",
+            Rule::Positive => "must be > 0",
+            Rule::NonNegative => "must be >= 0",
+            Rule::Closed(_, _, t) | Rule::Open(_, _, t) => t,
+        }
+    }
+}
+
+/// A value as written, in TOML syntax, for messages.
+fn show(v: &Value) -> String {
+    v.to_string()
+}
+
+/// Collects problems and checks single values.
+#[derive(Debug, Default)]
+pub(crate) struct Checker {
+    /// Every problem found so far.
+    pub problems: Vec<Problem>,
+}
+
+impl Checker {
+    fn report(&mut self, key: impl Into<String>, value: Option<String>, rule: impl Into<String>) {
+        self.problems.push(Problem::new(key, value, rule));
+    }
+
+    /// A finite number (an integer is accepted) that satisfies `rule`.
+    fn number(&mut self, key: &str, v: Option<&Value>, rule: Rule) -> Field<f64> {
+        let Some(v) = v else { return Field::Absent };
+        let x = match v {
+            Value::Float(x) => *x,
+            Value::Integer(i) => *i as f64,
+            _ => {
+                self.report(key, Some(show(v)), "must be a number");
+                return Field::Invalid;
+            }
+        };
+        if !x.is_finite() {
+            self.report(key, Some(show(v)), "must be a finite number");
+            Field::Invalid
+        } else if !rule.holds(x) {
+            self.report(key, Some(show(v)), rule.text());
+            Field::Invalid
+        } else {
+            Field::Valid(x)
+        }
+    }
+
+    /// An integer count, >= 1 (fits a `u32`).
+    fn count(&mut self, key: &str, v: Option<&Value>) -> Field<u32> {
+        let Some(v) = v else { return Field::Absent };
+        match v.as_integer().map(u32::try_from) {
+            Some(Ok(n)) if n >= 1 => Field::Valid(n),
+            _ => {
+                self.report(key, Some(show(v)), "must be an integer >= 1");
+                Field::Invalid
+            }
+        }
+    }
+
+    /// A string.
+    fn text(&mut self, key: &str, v: Option<&Value>) -> Field<String> {
+        let Some(v) = v else { return Field::Absent };
+        match v.as_str() {
+            Some(s) => Field::Valid(s.to_string()),
+            None => {
+                self.report(key, Some(show(v)), "must be a string");
+                Field::Invalid
+            }
+        }
+    }
+
+    /// One of the given names.
+    fn choice<T: Copy>(&mut self, key: &str, v: Option<&Value>, options: &[(&str, T)]) -> Field<T> {
+        let Some(v) = v else { return Field::Absent };
+        match options.iter().find(|(name, _)| v.as_str() == Some(name)) {
+            Some((_, t)) => Field::Valid(*t),
+            None => {
+                let names: Vec<String> = options.iter().map(|(n, _)| format!("\"{n}\"")).collect();
+                self.report(
+                    key,
+                    Some(show(v)),
+                    format!("must be one of: {}", names.join(", ")),
+                );
+                Field::Invalid
+            }
+        }
+    }
+
+    /// Reports a key that is present but not allowed in this configuration.
+    fn not_allowed(&mut self, key: &str, v: Option<&Value>, rule: &str) -> bool {
+        match v {
+            Some(v) => {
+                self.report(key, Some(show(v)), rule);
+                true
+            }
+            None => false,
+        }
+    }
+}
+
+/// Checks everything; `None` if any value needed to build the model is missing or invalid
+/// (the problems are in `ck`).
+pub(crate) fn validate(
+    raw: &RawScene,
+    file_stem: &str,
+    base_dir: &Path,
+    ck: &mut Checker,
+) -> Option<Validated> {
+    let name = ck.text("name", raw.name.as_ref()).or(file_stem.to_string());
+    let description = ck
+        .text("description", raw.description.as_ref())
+        .or(String::new());
+    let simulation = simulation(ck, raw.simulation.as_ref());
+    let (kind, drive) = drive(ck, raw.drive.as_ref(), base_dir);
+    let shaft = shaft(ck, raw.shaft.as_ref(), kind, drive);
+    let discs = discs(ck, raw.defaults.as_ref(), raw.discs.as_deref());
+    Some(Validated {
+        name: name?,
+        description: description?,
+        simulation: simulation?,
+        pack: PackModel {
+            shaft: shaft?,
+            discs: discs?,
+        },
+    })
+}
+
+/// `[simulation]`.
+fn simulation(ck: &mut Checker, raw: Option<&RawSimulation>) -> Option<Simulation> {
+    let empty = RawSimulation::default();
+    let r = raw.unwrap_or(&empty);
+    let duration = ck
+        .number(
+            "simulation.duration_s",
+            r.duration_s.as_ref(),
+            Rule::Positive,
+        )
+        .required(
+            ck,
+            "simulation.duration_s",
+            "required; set it in [simulation]",
+        );
+    let engine = match ck.choice(
+        "simulation.engine",
+        r.engine.as_ref(),
+        &[
+            ("reference", EngineChoice::Reference),
+            ("multibody", EngineChoice::Multibody),
+        ],
+    ) {
+        Field::Absent => Some(None),
+        Field::Invalid => None,
+        Field::Valid(e) => Some(Some(e)),
+    };
+    let rate = ck
+        .number(
+            "simulation.record_rate_hz",
+            r.record_rate_hz.as_ref(),
+            Rule::Positive,
+        )
+        .or(10_000.0);
+    let tolerance = ck
+        .number(
+            "simulation.tolerance",
+            r.tolerance.as_ref(),
+            Rule::Closed(1e-14, 1e-3, "must be in [1e-14, 1e-3]"),
+        )
+        .or(1e-9);
+    let max_step = ck
+        .number(
+            "simulation.max_step_s",
+            r.max_step_s.as_ref(),
+            Rule::Positive,
+        )
+        .or(1e-4);
+    Some(Simulation {
+        duration_s: duration?,
+        engine: engine?,
+        record_rate_hz: rate?,
+        tolerance: tolerance?,
+        max_step_s: max_step?,
+    })
+}
+
+/// `drive.kind`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum DriveKind {
+    Sine,
+    Harmonics,
+    SpeedTable,
+    TorqueTable,
+}
+
+impl DriveKind {
+    const ALL: [(&'static str, DriveKind); 4] = [
+        ("sine", DriveKind::Sine),
+        ("harmonics", DriveKind::Harmonics),
+        ("speed_table", DriveKind::SpeedTable),
+        ("torque_table", DriveKind::TorqueTable),
+    ];
+
+    fn name(self) -> &'static str {
+        DriveKind::ALL
+            .iter()
+            .find(|(_, k)| *k == self)
+            .map(|(n, _)| *n)
+            .unwrap_or("?")
+    }
+
+    /// The `[drive]` keys this kind takes besides `kind`.
+    fn keys(self) -> &'static [&'static str] {
+        match self {
+            DriveKind::Sine => &[
+                "omega0_rad_s",
+                "amplitude_rad_s",
+                "frequency_hz",
+                "phase_deg",
+            ],
+            DriveKind::Harmonics => &["omega0_rad_s", "harmonics"],
+            DriveKind::SpeedTable | DriveKind::TorqueTable => &["file"],
+        }
+    }
+}
+
+/// What the `[drive]` table describes.
+enum Drive {
+    /// A speed history (sine, harmonics, speed table).
+    Profile(SpeedProfile),
+    /// A torque history in N m (torque table).
+    Torque(Table),
+}
+
+/// `[drive]`: its kind (for the shaft's rules) and the drive itself.
+fn drive(
+    ck: &mut Checker,
+    raw: Option<&RawDrive>,
+    base_dir: &Path,
+) -> (Field<DriveKind>, Option<Drive>) {
+    let empty = RawDrive::default();
+    let r = raw.unwrap_or(&empty);
+    let kind_field = ck.choice("drive.kind", r.kind.as_ref(), &DriveKind::ALL);
+    let kind = match kind_field.clone() {
+        Field::Absent => {
+            ck.report(
+                "drive.kind",
+                None,
+                "missing (required: \"sine\", \"harmonics\", \"speed_table\" or \"torque_table\"; \
+                 set it in [drive])",
+            );
+            return (Field::Absent, None);
+        }
+        Field::Invalid => return (Field::Invalid, None),
+        Field::Valid(k) => k,
+    };
+
+    // Keys of other kinds are errors: they would be silently ignored otherwise.
+    let given: [(&str, Option<&Value>, bool); 6] = [
+        (
+            "omega0_rad_s",
+            r.omega0_rad_s.as_ref(),
+            r.omega0_rad_s.is_some(),
+        ),
+        (
+            "amplitude_rad_s",
+            r.amplitude_rad_s.as_ref(),
+            r.amplitude_rad_s.is_some(),
+        ),
+        (
+            "frequency_hz",
+            r.frequency_hz.as_ref(),
+            r.frequency_hz.is_some(),
+        ),
+        ("phase_deg", r.phase_deg.as_ref(), r.phase_deg.is_some()),
+        ("harmonics", None, r.harmonics.is_some()),
+        ("file", r.file.as_ref(), r.file.is_some()),
+    ];
+    for (key, value, present) in given {
+        if present && !kind.keys().contains(&key) {
+            ck.report(
+                format!("drive.{key}"),
+                value.map(show),
+                format!(
+                    "not used by drive.kind = \"{}\" (it takes: {})",
+                    kind.name(),
+                    kind.keys().join(", ")
+                ),
+            );
+        }
+    }
+
+    let required = |what: &str| {
+        format!(
+            "required with drive.kind = \"{}\"; set it in [drive]{what}",
+            kind.name()
+        )
+    };
+    let drive = match kind {
+        DriveKind::Sine => {
+            let omega0 = ck
+                .number("drive.omega0_rad_s", r.omega0_rad_s.as_ref(), Rule::Finite)
+                .required(ck, "drive.omega0_rad_s", &required(""));
+            let amplitude = ck
+                .number(
+                    "drive.amplitude_rad_s",
+                    r.amplitude_rad_s.as_ref(),
+                    Rule::Finite,
+                )
+                .required(ck, "drive.amplitude_rad_s", &required(""));
+            let frequency = ck
+                .number(
+                    "drive.frequency_hz",
+                    r.frequency_hz.as_ref(),
+                    Rule::Positive,
+                )
+                .required(ck, "drive.frequency_hz", &required(""));
+            let phase = ck
+                .number("drive.phase_deg", r.phase_deg.as_ref(), Rule::Finite)
+                .or(0.0);
+            (|| {
+                Some(Drive::Profile(SpeedProfile::Harmonics {
+                    omega0_rad_s: omega0?,
+                    harmonics: vec![Harmonic {
+                        amplitude_rad_s: amplitude?,
+                        frequency_hz: frequency?,
+                        phase_rad: phase?.to_radians(),
+                    }],
+                }))
+            })()
+        }
+        DriveKind::Harmonics => {
+            let omega0 = ck
+                .number("drive.omega0_rad_s", r.omega0_rad_s.as_ref(), Rule::Finite)
+                .required(ck, "drive.omega0_rad_s", &required(""));
+            let raw_harmonics = r.harmonics.as_deref().unwrap_or_default();
+            if raw_harmonics.is_empty() {
+                ck.report(
+                    "drive.harmonics",
+                    None,
+                    "missing (drive.kind = \"harmonics\" needs at least one [[drive.harmonics]] \
+                     entry with amplitude_rad_s and frequency_hz)",
+                );
+            }
+            let mut harmonics = Some(Vec::new());
+            for (i, h) in raw_harmonics.iter().enumerate() {
+                let key = |k: &str| format!("drive.harmonics[{i}].{k}");
+                let hint = "required; set it in [[drive.harmonics]]";
+                let amplitude = ck
+                    .number(
+                        &key("amplitude_rad_s"),
+                        h.amplitude_rad_s.as_ref(),
+                        Rule::Finite,
+                    )
+                    .required(ck, &key("amplitude_rad_s"), hint);
+                let frequency = ck
+                    .number(
+                        &key("frequency_hz"),
+                        h.frequency_hz.as_ref(),
+                        Rule::Positive,
+                    )
+                    .required(ck, &key("frequency_hz"), hint);
+                let phase = ck
+                    .number(&key("phase_deg"), h.phase_deg.as_ref(), Rule::Finite)
+                    .or(0.0);
+                match (amplitude, frequency, phase, harmonics.as_mut()) {
+                    (Some(a), Some(f), Some(p), Some(v)) => v.push(Harmonic {
+                        amplitude_rad_s: a,
+                        frequency_hz: f,
+                        phase_rad: p.to_radians(),
+                    }),
+                    _ => harmonics = None,
+                }
+            }
+            match (omega0, harmonics) {
+                (Some(omega0_rad_s), Some(harmonics)) if !harmonics.is_empty() => {
+                    Some(Drive::Profile(SpeedProfile::Harmonics {
+                        omega0_rad_s,
+                        harmonics,
+                    }))
+                }
+                _ => None,
+            }
+        }
+        DriveKind::SpeedTable | DriveKind::TorqueTable => {
+            let column = if kind == DriveKind::SpeedTable {
+                "speed_rad_s"
+            } else {
+                "torque_n_m"
+            };
+            let file = ck.text("drive.file", r.file.as_ref()).required(
+                ck,
+                "drive.file",
+                &required(&format!(
+                    " (a CSV file with columns time_s and {column}, relative to the scene \
+                     file's folder)"
+                )),
+            );
+            file.and_then(
+                |file| match csv::read_table(&base_dir.join(&file), &file, column) {
+                    Ok(table) if kind == DriveKind::SpeedTable => {
+                        Some(Drive::Profile(SpeedProfile::Table(table)))
+                    }
+                    Ok(table) => Some(Drive::Torque(table)),
+                    Err(message) => {
+                        ck.report("drive.file", r.file.as_ref().map(show), message);
+                        None
+                    }
+                },
+            )
+        }
+    };
+    (Field::Valid(kind), drive)
+}
+
+/// `shaft.mode`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum ShaftMode {
+    Prescribed,
+    Inertial,
+}
+
+/// `[shaft]`, combined with the drive.
+fn shaft(
+    ck: &mut Checker,
+    raw: Option<&RawShaft>,
+    kind: Field<DriveKind>,
+    drive: Option<Drive>,
+) -> Option<Shaft> {
+    let empty = RawShaft::default();
+    let r = raw.unwrap_or(&empty);
+    let mode = ck
+        .choice(
+            "shaft.mode",
+            r.mode.as_ref(),
+            &[
+                ("prescribed", ShaftMode::Prescribed),
+                ("inertial", ShaftMode::Inertial),
+            ],
+        )
+        .or(ShaftMode::Prescribed);
+
+    let inertial_only = "only allowed with shaft.mode = \"inertial\" (a prescribed shaft follows \
+                         its speed whatever the load)";
+    let (inertia, damping) = if mode == Some(ShaftMode::Prescribed) {
+        ck.not_allowed(
+            "shaft.inertia_kg_m2",
+            r.inertia_kg_m2.as_ref(),
+            inertial_only,
+        );
+        ck.not_allowed(
+            "shaft.damping_n_m_s_rad",
+            r.damping_n_m_s_rad.as_ref(),
+            inertial_only,
+        );
+        (None, None)
+    } else {
+        let inertia = ck
+            .number(
+                "shaft.inertia_kg_m2",
+                r.inertia_kg_m2.as_ref(),
+                Rule::Positive,
+            )
+            .required(
+                ck,
+                "shaft.inertia_kg_m2",
+                "required with shaft.mode = \"inertial\"; set it in [shaft]",
+            );
+        let damping = ck
+            .number(
+                "shaft.damping_n_m_s_rad",
+                r.damping_n_m_s_rad.as_ref(),
+                Rule::NonNegative,
+            )
+            .or(0.0);
+        (inertia, damping)
+    };
+
+    let torque_drive = kind == Field::Valid(DriveKind::TorqueTable);
+    let initial_speed = if torque_drive {
+        ck.number(
+            "shaft.initial_speed_rad_s",
+            r.initial_speed_rad_s.as_ref(),
+            Rule::Finite,
+        )
+        .required(
+            ck,
+            "shaft.initial_speed_rad_s",
+            "required with drive.kind = \"torque_table\" (a torque does not set the \
+                 starting speed); set it in [shaft]",
+        )
+    } else {
+        if let Field::Valid(k) = kind {
+            ck.not_allowed(
+                "shaft.initial_speed_rad_s",
+                r.initial_speed_rad_s.as_ref(),
+                &format!(
+                    "only allowed with drive.kind = \"torque_table\" (drive.kind = \"{}\" sets \
+                     the starting speed)",
+                    k.name()
+                ),
+            );
+        }
+        None
+    };
+    if torque_drive && mode == Some(ShaftMode::Prescribed) {
+        ck.report(
+            "drive.kind",
+            Some("\"torque_table\"".into()),
+            "needs shaft.mode = \"inertial\" (a prescribed shaft follows a speed, not a torque)",
+        );
+        return None;
+    }
+
+    match (mode?, drive?) {
+        (ShaftMode::Prescribed, Drive::Profile(p)) => Some(Shaft::Prescribed(p)),
+        (ShaftMode::Prescribed, Drive::Torque(_)) => None,
+        (ShaftMode::Inertial, drive) => Some(Shaft::Inertial {
+            inertia_kg_m2: inertia?,
+            damping_n_m_s_rad: damping?,
+            excitation: match drive {
+                Drive::Profile(p) => ShaftExcitation::Profile(p),
+                Drive::Torque(table) => ShaftExcitation::Torque {
+                    table,
+                    initial_speed_rad_s: initial_speed?,
+                },
+            },
+        }),
+    }
+}
+
+/// Disc parameters checked where they are written (in `[defaults]` or one `[[discs]]`).
+struct Params {
+    inertia: Field<f64>,
+    drag: Field<f64>,
+    angle: Field<f64>,
+    speed: Field<f64>,
+    teeth: Field<u32>,
+    pitch_radius: Field<f64>,
+    pressure_angle_deg: Field<f64>,
+    backlash: Field<f64>,
+    law: Field<LawKind>,
+    modulus: Field<f64>,
+    curvature: Field<f64>,
+    loss: Field<f64>,
+    film: Field<f64>,
+    viscosity: Field<f64>,
+    leakage: Field<f64>,
+    width: Field<f64>,
+    length: Field<f64>,
+    v_floor: Field<f64>,
+    h_min: Field<f64>,
+}
+
+/// Checks the parameters of one table (`prefix` is `defaults` or `discs[i]`).
+fn params(ck: &mut Checker, prefix: &str, r: &RawDisc) -> Params {
+    let key = |k: &str| format!("{prefix}.{k}");
+    let sp = r.spline.as_ref();
+    let co = r.contact.as_ref();
+    let oil = r.oil.as_ref();
+    Params {
+        inertia: ck.number(
+            &key("inertia_kg_m2"),
+            r.inertia_kg_m2.as_ref(),
+            Rule::Positive,
+        ),
+        drag: ck.number(
+            &key("drag_n_m_s_rad"),
+            r.drag_n_m_s_rad.as_ref(),
+            Rule::NonNegative,
+        ),
+        angle: ck.number(
+            &key("initial_rel_angle_rad"),
+            r.initial_rel_angle_rad.as_ref(),
+            Rule::Finite,
+        ),
+        speed: ck.number(
+            &key("initial_rel_speed_rad_s"),
+            r.initial_rel_speed_rad_s.as_ref(),
+            Rule::Finite,
+        ),
+        teeth: ck.count(&key("spline.teeth"), sp.and_then(|s| s.teeth.as_ref())),
+        pitch_radius: ck.number(
+            &key("spline.pitch_radius_m"),
+            sp.and_then(|s| s.pitch_radius_m.as_ref()),
+            Rule::Positive,
+        ),
+        pressure_angle_deg: ck.number(
+            &key("spline.pressure_angle_deg"),
+            sp.and_then(|s| s.pressure_angle_deg.as_ref()),
+            Rule::Open(0.0, 90.0, "must be in (0, 90) (exclusive)"),
+        ),
+        backlash: ck.number(
+            &key("spline.backlash_m"),
+            sp.and_then(|s| s.backlash_m.as_ref()),
+            Rule::Positive,
+        ),
+        law: ck.choice(
+            &key("contact.law"),
+            co.and_then(|c| c.law.as_ref()),
+            &[
+                ("paper", LawKind::Paper),
+                ("dry", LawKind::Dry),
+                ("squeeze", LawKind::Squeeze),
+            ],
+        ),
+        modulus: ck.number(
+            &key("contact.modulus_pa"),
+            co.and_then(|c| c.modulus_pa.as_ref()),
+            Rule::Positive,
+        ),
+        curvature: ck.number(
+            &key("contact.curvature_radius_m"),
+            co.and_then(|c| c.curvature_radius_m.as_ref()),
+            Rule::Positive,
+        ),
+        loss: ck.number(
+            &key("contact.loss_coefficient_s_m"),
+            co.and_then(|c| c.loss_coefficient_s_m.as_ref()),
+            Rule::NonNegative,
+        ),
+        film: ck.number(
+            &key("oil.film_thickness_m"),
+            oil.and_then(|o| o.film_thickness_m.as_ref()),
+            Rule::NonNegative,
+        ),
+        viscosity: ck.number(
+            &key("oil.viscosity_pa_s"),
+            oil.and_then(|o| o.viscosity_pa_s.as_ref()),
+            Rule::Positive,
+        ),
+        leakage: ck.number(
+            &key("oil.leakage_coefficient"),
+            oil.and_then(|o| o.leakage_coefficient.as_ref()),
+            Rule::Positive,
+        ),
+        width: ck.number(
+            &key("oil.width_m"),
+            oil.and_then(|o| o.width_m.as_ref()),
+            Rule::Positive,
+        ),
+        length: ck.number(
+            &key("oil.length_m"),
+            oil.and_then(|o| o.length_m.as_ref()),
+            Rule::Positive,
+        ),
+        v_floor: ck.number(
+            &key("oil.v_floor_m_s"),
+            oil.and_then(|o| o.v_floor_m_s.as_ref()),
+            Rule::Positive,
+        ),
+        h_min: ck.number(
+            &key("oil.h_min_m"),
+            oil.and_then(|o| o.h_min_m.as_ref()),
+            Rule::Positive,
+        ),
+    }
+}
+
+/// Where a disc's effective value came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Source {
+    Disc,
+    Defaults,
+    Builtin,
+}
+
+/// The disc's field if present, else the defaults' field (with its source).
+fn pick<T: Clone>(disc: &Field<T>, defaults: &Field<T>) -> Field<(T, Source)> {
+    match (disc, defaults) {
+        (Field::Valid(v), _) => Field::Valid((v.clone(), Source::Disc)),
+        (Field::Invalid, _) => Field::Invalid,
+        (Field::Absent, Field::Valid(v)) => Field::Valid((v.clone(), Source::Defaults)),
+        (Field::Absent, Field::Invalid) => Field::Invalid,
+        (Field::Absent, Field::Absent) => Field::Absent,
+    }
+}
+
+/// Where to set a disc key `k` (`spline.teeth` -> `[discs.spline] or [defaults.spline]`).
+fn where_to_set(k: &str) -> String {
+    match k.split_once('.') {
+        Some((section, _)) => format!("[discs.{section}] or [defaults.{section}]"),
+        None => "[[discs]] or [defaults]".to_string(),
+    }
+}
+
+/// A required disc parameter: the disc's, else the defaults'; missing is reported at
+/// `discs[i].k`.
+fn required<T: Clone>(
+    ck: &mut Checker,
+    i: usize,
+    k: &str,
+    disc: &Field<T>,
+    defaults: &Field<T>,
+) -> Option<T> {
+    pick(disc, defaults)
+        .required(
+            ck,
+            &format!("discs[{i}].{k}"),
+            &format!("required; set it in {}", where_to_set(k)),
+        )
+        .map(|(v, _)| v)
+}
+
+/// An optional disc parameter with a built-in default.
+fn optional<T: Clone>(disc: &Field<T>, defaults: &Field<T>, builtin: T) -> Option<(T, Source)> {
+    pick(disc, defaults).or((builtin, Source::Builtin))
+}
+
+/// ` (inherited from defaults.k)` when the value came from `[defaults]`.
+fn inherited(source: Source, k: &str) -> String {
+    if source == Source::Defaults {
+        format!(" (inherited from defaults.{k})")
+    } else {
+        String::new()
+    }
+}
+
+/// `[defaults]` and every `[[discs]]`.
+fn discs(
+    ck: &mut Checker,
+    defaults: Option<&RawDisc>,
+    raw: Option<&[RawDisc]>,
+) -> Option<Vec<DiscModel>> {
+    let empty = RawDisc::default();
+    let raw_defaults = defaults.unwrap_or(&empty);
+    if raw_defaults.name.is_some() {
+        ck.report(
+            "defaults.name",
+            None,
+            format!(
+                "unknown key ({}; a name belongs to each [[discs]] entry)",
+                schema::expected_text("defaults")
+            ),
+        );
+    }
+    let d = params(ck, "defaults", raw_defaults);
+    let raw = raw.unwrap_or_default();
+    if raw.is_empty() {
+        ck.report(
+            "discs",
+            None,
+            "missing (at least one [[discs]] entry is required)",
+        );
+        return None;
+    }
+
+    let mut out = Some(Vec::with_capacity(raw.len()));
+    let mut names: Vec<Option<String>> = Vec::with_capacity(raw.len());
+    for (i, r) in raw.iter().enumerate() {
+        let name_key = format!("discs[{i}].name");
+        let name = match ck.text(&name_key, r.name.as_ref()) {
+            Field::Valid(s) if s.trim().is_empty() => {
+                ck.report(&name_key, r.name.as_ref().map(show), "must not be empty");
+                None
+            }
+            f => f.or(format!("disc-{}", i + 1)),
+        };
+        if let Some(n) = &name {
+            if let Some(j) = names.iter().position(|m| m.as_ref() == Some(n)) {
+                ck.report(
+                    &name_key,
+                    Some(format!("{n:?}")),
+                    format!("names must be unique (discs[{j}] has the same name)"),
+                );
+            }
+        }
+        names.push(name.clone());
+        let own = params(ck, &format!("discs[{i}]"), r);
+        let disc = disc(ck, i, name, &own, &d);
+        match (disc, out.as_mut()) {
+            (Some(disc), Some(v)) => v.push(disc),
+            _ => out = None,
+        }
+    }
+    out
+}
+
+/// Resolves and cross-checks one disc.
+fn disc(
+    ck: &mut Checker,
+    i: usize,
+    name: Option<String>,
+    p: &Params,
+    d: &Params,
+) -> Option<DiscModel> {
+    let inertia = required(ck, i, "inertia_kg_m2", &p.inertia, &d.inertia);
+    let drag = optional(&p.drag, &d.drag, 0.0);
+    let angle = optional(&p.angle, &d.angle, 0.0);
+    let speed = optional(&p.speed, &d.speed, 0.0);
+    let teeth = required(ck, i, "spline.teeth", &p.teeth, &d.teeth);
+    let pitch = required(
+        ck,
+        i,
+        "spline.pitch_radius_m",
+        &p.pitch_radius,
+        &d.pitch_radius,
+    );
+    let alpha_deg = required(
+        ck,
+        i,
+        "spline.pressure_angle_deg",
+        &p.pressure_angle_deg,
+        &d.pressure_angle_deg,
+    );
+    let backlash = required(ck, i, "spline.backlash_m", &p.backlash, &d.backlash);
+    let law = optional(&p.law, &d.law, LawKind::Paper).map(|(l, _)| l);
+    let modulus = required(ck, i, "contact.modulus_pa", &p.modulus, &d.modulus);
+    let curvature = required(
+        ck,
+        i,
+        "contact.curvature_radius_m",
+        &p.curvature,
+        &d.curvature,
+    );
+    let loss = optional(&p.loss, &d.loss, 0.0);
+    let film = optional(&p.film, &d.film, 0.0);
+
+    // The film parameters are needed when a film carries load: thickness > 0, law not dry.
+    let needs_oil = matches!((law, film), (Some(l), Some((h, _))) if l != LawKind::Dry && h > 0.0);
+    let mut oil_param = |k: &str, disc: &Field<f64>, defaults: &Field<f64>| {
+        if needs_oil {
+            pick(disc, defaults)
+                .required(
+                    ck,
+                    &format!("discs[{i}].{k}"),
+                    &format!(
+                        "required when oil.film_thickness_m > 0 and contact.law is not \"dry\"; \
+                         set it in {}",
+                        where_to_set(k)
+                    ),
+                )
+                .map(|(v, _)| v)
+        } else {
+            optional(disc, defaults, 0.0).map(|(v, _)| v)
+        }
+    };
+    let viscosity = oil_param("oil.viscosity_pa_s", &p.viscosity, &d.viscosity);
+    let leakage = oil_param("oil.leakage_coefficient", &p.leakage, &d.leakage);
+    let width = oil_param("oil.width_m", &p.width, &d.width);
+    let length = oil_param("oil.length_m", &p.length, &d.length);
+    let v_floor = optional(&p.v_floor, &d.v_floor, 0.01);
+    let h_min = optional(&p.h_min, &d.h_min, 1e-6);
+
+    let spline = (|| {
+        Some(SplineGeometry {
+            teeth: teeth?,
+            pitch_radius_m: pitch?,
+            pressure_angle_rad: alpha_deg?.to_radians(),
+            backlash_m: backlash?,
+        })
+    })();
+
+    // The film and the start position against the free play, along the line of action.
+    let mut inside = true;
+    if let (Some(spline), Some(kind), Some((h_o, film_source)), Some((phi0, angle_source))) =
+        (spline, law, film, angle)
+    {
+        let half_play_m = spline.half_play_line_m();
+        let offset_m = if kind == LawKind::Dry { 0.0 } else { h_o };
+        if kind != LawKind::Dry && h_o >= half_play_m {
+            ck.report(
+                format!("discs[{i}].oil.film_thickness_m"),
+                Some(h_o.to_string()),
+                format!(
+                    "must be < g0 Rb = {half_play_m:.6e} m, half the free play along the line \
+                     of action (else both flanks engage at once){}",
+                    inherited(film_source, "oil.film_thickness_m")
+                ),
+            );
+            inside = false;
+        } else if phi0.abs() * spline.base_radius_m() >= half_play_m - offset_m {
+            let reach_m = half_play_m - offset_m;
+            ck.report(
+                format!("discs[{i}].initial_rel_angle_rad"),
+                Some(phi0.to_string()),
+                format!(
+                    "the disc must start inside the free play: |phi0| Rb must be < g0 Rb - h_o \
+                     = {reach_m:.6e} m, i.e. |phi0| < {:.6e} rad{}",
+                    reach_m / spline.base_radius_m(),
+                    inherited(angle_source, "initial_rel_angle_rad")
+                ),
+            );
+            inside = false;
+        }
+    }
+    if !inside {
+        return None;
+    }
+
+    Some(DiscModel {
+        name: name?,
+        spline: spline?,
+        law: ToothLaw {
+            kind: law?,
+            hertz: Hertz {
+                modulus_pa: modulus?,
+                curvature_radius_m: curvature?,
+                loss_coefficient_s_m: loss?.0,
+            },
+            oil: OilFilm {
+                thickness_m: film?.0,
+                viscosity_pa_s: viscosity?,
+                leakage_coefficient: leakage?,
+                width_m: width?,
+                length_m: length?,
+                v_floor_m_s: v_floor?.0,
+                h_min_m: h_min?.0,
+            },
+        },
+        inertia_kg_m2: inertia?,
+        drag_n_m_s_rad: drag?.0,
+        initial_rel_angle_rad: angle?.0,
+        initial_rel_speed_rad_s: speed?.0,
+    })
+}
