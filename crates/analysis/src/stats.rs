@@ -1,0 +1,284 @@
+//! Per-disc statistics of the impact peaks of one run.
+//!
+//! A run's impacts are chaotic in detail but stable in distribution (MODEL.md section 6), so
+//! runs are compared by the extremes and the upper tail of the peak loads: the largest
+//! positive and negative peaks, the 99th percentile of `|peak|` and the mean of the ten
+//! largest `|peak|`.
+
+use clutchpack_model::ImpactEvent;
+use serde::{Deserialize, Serialize};
+
+/// Number of impacts averaged by [`DiscStats::mean_top10_abs_n`].
+pub const TOP_N: usize = 10;
+
+/// Statistics of the impact peaks (`ImpactEvent::peak_n`) of one disc over one run.
+///
+/// Loads are per tooth in N, signed as in the model: negative when the shaft leads, positive
+/// when the disc leads.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DiscStats {
+    /// Disc name (from the scene).
+    pub name: String,
+    /// Largest positive peak (disc leads) in N; 0 if there is none.
+    pub max_positive_n: f64,
+    /// Most negative peak (shaft leads) in N, a value `<= 0`; 0 if there is none.
+    pub max_negative_n: f64,
+    /// 99th percentile of `|peak|` over the disc's impacts in N ([`percentile`]'s linear
+    /// interpolation, as numpy's default); 0 if there are no impacts.
+    pub p99_abs_n: f64,
+    /// Number of impacts.
+    pub impacts: usize,
+    /// Number of impacts with a positive peak (disc leads).
+    pub positive_impacts: usize,
+    /// Number of impacts with a negative peak (shaft leads).
+    pub negative_impacts: usize,
+    /// Mean of the [`TOP_N`] = 10 largest `|peak|` in N (of all of them if there are fewer);
+    /// 0 if there are no impacts.
+    pub mean_top10_abs_n: f64,
+}
+
+impl DiscStats {
+    /// Statistics of a disc without impacts: all zeros.
+    pub fn empty(name: impl Into<String>) -> DiscStats {
+        DiscStats {
+            name: name.into(),
+            max_positive_n: 0.0,
+            max_negative_n: 0.0,
+            p99_abs_n: 0.0,
+            impacts: 0,
+            positive_impacts: 0,
+            negative_impacts: 0,
+            mean_top10_abs_n: 0.0,
+        }
+    }
+
+    /// Statistics of the signed peak loads `peaks_n` (N) of one disc named `name`.
+    ///
+    /// NaN peaks are not counted (a finite run never produces them).
+    pub fn from_peaks(name: impl Into<String>, peaks_n: &[f64]) -> DiscStats {
+        let mut s = DiscStats::empty(name);
+        let mut abs: Vec<f64> = Vec::with_capacity(peaks_n.len());
+        for &p in peaks_n.iter().filter(|p| !p.is_nan()) {
+            s.impacts += 1;
+            if p > 0.0 {
+                s.positive_impacts += 1;
+                s.max_positive_n = s.max_positive_n.max(p);
+            } else if p < 0.0 {
+                s.negative_impacts += 1;
+                s.max_negative_n = s.max_negative_n.min(p);
+            }
+            abs.push(p.abs());
+        }
+        if abs.is_empty() {
+            return s;
+        }
+        abs.sort_by(f64::total_cmp);
+        s.p99_abs_n = percentile_sorted(&abs, 99.0);
+        let top = &abs[abs.len().saturating_sub(TOP_N)..];
+        s.mean_top10_abs_n = top.iter().sum::<f64>() / top.len() as f64;
+        s
+    }
+}
+
+/// Per-disc statistics of a run's impacts, one entry per disc in `names` order.
+///
+/// `ImpactEvent::disc` indexes `names`. A disc without impacts gets zeros. Impacts whose
+/// disc index is beyond `names` are not dropped: entries named `disc {index}` are appended
+/// for them, so the output has `max(names.len(), largest index + 1)` entries.
+pub fn disc_stats(names: &[String], impacts: &[ImpactEvent]) -> Vec<DiscStats> {
+    let n_discs = impacts
+        .iter()
+        .map(|e| e.disc + 1)
+        .max()
+        .unwrap_or(0)
+        .max(names.len());
+    let mut peaks: Vec<Vec<f64>> = vec![Vec::new(); n_discs];
+    for e in impacts {
+        peaks[e.disc].push(e.peak_n);
+    }
+    peaks
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let name = names.get(i).cloned().unwrap_or_else(|| format!("disc {i}"));
+            DiscStats::from_peaks(name, p)
+        })
+        .collect()
+}
+
+/// The `q`-th percentile (`q` in `[0, 100]`, clamped) of `values`, in their unit.
+///
+/// Definition: numpy's default `method = 'linear'` (Hyndman & Fan type 7). With the `n`
+/// values sorted ascending as `v[0] <= ... <= v[n-1]`, the position is `h = (n - 1) q / 100`
+/// and the result `v[floor(h)] + (h - floor(h)) (v[floor(h) + 1] - v[floor(h)])`: linear
+/// interpolation between the order statistics around `h`. So `q = 0` gives the minimum,
+/// `q = 100` the maximum and `q = 50` the median.
+///
+/// NaN values are ignored; an empty slice (or one of NaNs only) gives 0. A NaN `q` gives NaN.
+pub fn percentile(values: &[f64], q: f64) -> f64 {
+    if q.is_nan() {
+        return f64::NAN;
+    }
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| !x.is_nan()).collect();
+    v.sort_by(f64::total_cmp);
+    percentile_sorted(&v, q)
+}
+
+/// [`percentile`] of values already sorted ascending and free of NaN.
+fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
+    let n = sorted.len();
+    if n == 0 {
+        return 0.0;
+    }
+    let h = (n - 1) as f64 * q.clamp(0.0, 100.0) / 100.0;
+    let lo = (h.floor() as usize).min(n - 1);
+    let hi = (lo + 1).min(n - 1);
+    let frac = h - lo as f64;
+    if frac == 0.0 || lo == hi {
+        sorted[lo]
+    } else {
+        sorted[lo] + frac * (sorted[hi] - sorted[lo])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use clutchpack_model::Flank;
+
+    fn ev(disc: usize, peak_n: f64) -> ImpactEvent {
+        ImpactEvent {
+            disc,
+            t_on_s: 0.0,
+            t_peak_s: 0.0,
+            t_off_s: 0.0,
+            flank: if peak_n > 0.0 {
+                Flank::DiscLeads
+            } else {
+                Flank::ShaftLeads
+            },
+            v_on_m_s: 0.1,
+            peak_n,
+        }
+    }
+
+    /// Values printed by numpy 1.26, `np.percentile(v, q)` with the default method.
+    #[test]
+    fn percentile_matches_numpy_linear() {
+        // np.percentile([15, 20, 35, 40, 50], 40) = 29.0 (h = 1.6: 20 + 0.6 * 15)
+        assert_relative_eq!(percentile(&[15.0, 20.0, 35.0, 40.0, 50.0], 40.0), 29.0);
+        // np.percentile([1, 2, 3, 4], 99) = 3.97 (h = 2.97)
+        assert_relative_eq!(
+            percentile(&[1.0, 2.0, 3.0, 4.0], 99.0),
+            3.97,
+            max_relative = 1e-15
+        );
+        // np.percentile([10, 7, 4, 3, 2, 1], 50) = 3.5: unsorted input, median of an even count
+        assert_relative_eq!(percentile(&[10.0, 7.0, 4.0, 3.0, 2.0, 1.0], 50.0), 3.5);
+        // np.percentile([1, 2, 3, 4], 25) = 1.75
+        assert_relative_eq!(percentile(&[1.0, 2.0, 3.0, 4.0], 25.0), 1.75);
+        // np.percentile(range(101), 99) = 99.0: exactly on an order statistic
+        let r: Vec<f64> = (0..=100).map(f64::from).collect();
+        assert_eq!(percentile(&r, 99.0), 99.0);
+        // np.percentile(range(10), 99) = 8.91 (h = 8.91)
+        let r: Vec<f64> = (0..10).map(f64::from).collect();
+        assert_relative_eq!(percentile(&r, 99.0), 8.91, max_relative = 1e-15);
+    }
+
+    /// The ends and the degenerate cases: q = 0 / 100 are min / max, q is clamped, one value
+    /// is every percentile, an empty slice gives 0, NaN values are ignored.
+    #[test]
+    fn percentile_edges() {
+        let v = [-3.0, 5.0, 1.0];
+        assert_eq!(percentile(&v, 0.0), -3.0);
+        assert_eq!(percentile(&v, 100.0), 5.0);
+        assert_eq!(percentile(&v, -10.0), -3.0);
+        assert_eq!(percentile(&v, 250.0), 5.0);
+        assert_eq!(percentile(&[7.5], 37.0), 7.5);
+        assert_eq!(percentile(&[], 99.0), 0.0);
+        assert_eq!(percentile(&[f64::NAN, 2.0, 4.0], 50.0), 3.0);
+        assert!(percentile(&v, f64::NAN).is_nan());
+    }
+
+    /// A hand-made run of two discs: the signs pick the flank counts and extremes, |peak|
+    /// feeds the percentile and the top-10 mean (all hand-computed).
+    #[test]
+    fn disc_stats_of_a_hand_made_run() {
+        let names = vec!["d0".to_string(), "d1".to_string(), "idle".to_string()];
+        let mut impacts = vec![ev(0, -100.0), ev(1, 50.0), ev(0, 300.0), ev(0, -250.0)];
+        impacts.push(ev(0, 20.0));
+        // disc 1: twelve impacts 10, -20, 30, ..., -120 (alternating sign)
+        for k in 1..=11 {
+            let m = 10.0 * (k + 1) as f64;
+            impacts.push(ev(1, if k % 2 == 1 { -m } else { m }));
+        }
+        let s = disc_stats(&names, &impacts);
+        assert_eq!(s.len(), 3);
+
+        let d0 = &s[0];
+        assert_eq!(d0.name, "d0");
+        assert_eq!(
+            (d0.impacts, d0.positive_impacts, d0.negative_impacts),
+            (4, 2, 2)
+        );
+        assert_eq!(d0.max_positive_n, 300.0);
+        assert_eq!(d0.max_negative_n, -250.0);
+        // |peak| sorted: 20 100 250 300; h = 3 * 0.99 = 2.97 -> 250 + 0.97 * 50
+        assert_relative_eq!(d0.p99_abs_n, 298.5, max_relative = 1e-14);
+        assert_relative_eq!(d0.mean_top10_abs_n, 670.0 / 4.0);
+
+        // disc 1: the 50 above plus 20, 30, ..., 120: 12 impacts
+        let d1 = &s[1];
+        assert_eq!(d1.impacts, 12);
+        // positives: 50, 30, 50, 70, 90, 110 -> 6; negatives: 20, 40, ..., 120 -> 6
+        assert_eq!((d1.positive_impacts, d1.negative_impacts), (6, 6));
+        assert_eq!(d1.max_positive_n, 110.0);
+        assert_eq!(d1.max_negative_n, -120.0);
+        // top 10 of {20,30,40,50,50,60,...,120}: all but 20 and 30
+        let top: f64 = [
+            40.0, 50.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0, 110.0, 120.0,
+        ]
+        .iter()
+        .sum();
+        assert_relative_eq!(d1.mean_top10_abs_n, top / 10.0);
+        // sorted 12 values, h = 11 * 0.99 = 10.89: 110 + 0.89 * 10
+        assert_relative_eq!(d1.p99_abs_n, 118.9, max_relative = 1e-14);
+
+        assert_eq!(s[2], DiscStats::empty("idle"));
+    }
+
+    /// Empty input gives zeros, and impacts of unnamed discs get entries of their own.
+    #[test]
+    fn disc_stats_empty_and_unnamed() {
+        assert!(disc_stats(&[], &[]).is_empty());
+        let s = disc_stats(&["a".to_string()], &[]);
+        assert_eq!(s, vec![DiscStats::empty("a")]);
+        let s = disc_stats(&["a".to_string()], &[ev(2, -5.0)]);
+        assert_eq!(s.len(), 3);
+        assert_eq!(s[1], DiscStats::empty("disc 1"));
+        assert_eq!(s[2].name, "disc 2");
+        assert_eq!(s[2].max_negative_n, -5.0);
+        assert_eq!(s[2].max_positive_n, 0.0);
+    }
+
+    /// Only negative peaks: the positive maximum stays 0 (not the "largest" negative value).
+    #[test]
+    fn one_sided_runs_report_zero_on_the_other_side() {
+        let s = DiscStats::from_peaks("x", &[-3.0, -1.0]);
+        assert_eq!(s.max_positive_n, 0.0);
+        assert_eq!(s.max_negative_n, -3.0);
+        let s = DiscStats::from_peaks("x", &[3.0, 1.0]);
+        assert_eq!(s.max_negative_n, 0.0);
+        assert_eq!(s.max_positive_n, 3.0);
+    }
+
+    /// The statistics survive a JSON round trip unchanged, under their unit-suffixed names.
+    #[test]
+    fn serde_round_trip() {
+        let s = DiscStats::from_peaks("x", &[1.0, -2.0]);
+        let json = serde_json::to_string(&s).unwrap();
+        assert!(json.contains("\"max_negative_n\":-2.0"));
+        assert_eq!(serde_json::from_str::<DiscStats>(&json).unwrap(), s);
+    }
+}

@@ -1,0 +1,394 @@
+//! Tables of statistics and sweeps as aligned plain text, markdown or CSV.
+//!
+//! Every column header carries its unit: `max + [N]` in text and markdown, a unit suffix in
+//! CSV (`max_positive_n`), as for recorded fields elsewhere in clutchpack. Text and markdown
+//! round numbers to about four significant digits for reading; CSV keeps every digit
+//! (Rust's shortest round-trip form) for machines.
+
+use crate::stats::DiscStats;
+use crate::sweep::{Spread, SweepRow};
+use std::fmt::Write as _;
+
+/// How a table is rendered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum TableFormat {
+    /// Columns aligned with spaces under a dashed rule, for a terminal.
+    Text,
+    /// A GitHub-flavoured markdown table (numbers right-aligned).
+    Markdown,
+    /// Comma-separated values with one header line (RFC 4180 quoting).
+    Csv,
+}
+
+/// One column: its header and whether its cells are right-aligned (numbers).
+struct Col {
+    header: String,
+    right: bool,
+}
+
+fn col(header: impl Into<String>, right: bool) -> Col {
+    Col {
+        header: header.into(),
+        right,
+    }
+}
+
+/// The statistics of one run, one row per disc.
+///
+/// Columns (text and markdown): `disc`, `max + [N]`, `max - [N]`, `p99 abs [N]`,
+/// `top-10 mean abs [N]`, `impacts`, `+ impacts`, `- impacts`. CSV: `disc`,
+/// `max_positive_n`, `max_negative_n`, `p99_abs_n`, `mean_top10_abs_n`, `impacts`,
+/// `positive_impacts`, `negative_impacts` (the [`DiscStats`] field names).
+/// An empty `stats` gives the header alone.
+pub fn stats_table(stats: &[DiscStats], format: TableFormat) -> String {
+    if format == TableFormat::Csv {
+        let mut out = String::from(
+            "disc,max_positive_n,max_negative_n,p99_abs_n,mean_top10_abs_n,impacts,positive_impacts,negative_impacts\n",
+        );
+        for s in stats {
+            let _ = writeln!(
+                out,
+                "{},{:?},{:?},{:?},{:?},{},{},{}",
+                csv_field(&s.name),
+                s.max_positive_n,
+                s.max_negative_n,
+                s.p99_abs_n,
+                s.mean_top10_abs_n,
+                s.impacts,
+                s.positive_impacts,
+                s.negative_impacts
+            );
+        }
+        return out;
+    }
+    let cols = vec![
+        col("disc", false),
+        col("max + [N]", true),
+        col("max - [N]", true),
+        col("p99 abs [N]", true),
+        col("top-10 mean abs [N]", true),
+        col("impacts", true),
+        col("+ impacts", true),
+        col("- impacts", true),
+    ];
+    let rows: Vec<Vec<String>> = stats
+        .iter()
+        .map(|s| {
+            vec![
+                s.name.clone(),
+                fmt_num(s.max_positive_n),
+                fmt_num(s.max_negative_n),
+                fmt_num(s.p99_abs_n),
+                fmt_num(s.mean_top10_abs_n),
+                s.impacts.to_string(),
+                s.positive_impacts.to_string(),
+                s.negative_impacts.to_string(),
+            ]
+        })
+        .collect();
+    render(format, &cols, &rows)
+}
+
+/// The rows of a sweep, one line per (parameter value, disc).
+///
+/// `param` heads the value column as given: name it with its unit (`backlash_m`,
+/// `backlash [m]`). Text and markdown show `mean ± std` when any row has more than one
+/// ensemble member, adding `members` and `min .. max` range columns; with single runs only
+/// the values. Columns (those marked * with ensembles only): `param`, `disc`, `members`*,
+/// `max + [N]`, `max + range [N]`*, `max - [N]`, `max - range [N]`*, `p99 abs [N]`,
+/// `impacts`. CSV always has every number:
+/// `param`, `disc`, `members`, then `mean`, `std`, `min`, `max` of each of `max_positive_*_n`,
+/// `max_negative_*_n`, `p99_abs_*_n` and `impacts_*`.
+pub fn sweep_table(param: &str, rows: &[SweepRow], format: TableFormat) -> String {
+    if format == TableFormat::Csv {
+        let mut out = format!("{},disc,members", csv_field(param));
+        for q in ["max_positive", "max_negative", "p99_abs"] {
+            for s in ["mean", "std", "min", "max"] {
+                let _ = write!(out, ",{q}_{s}_n");
+            }
+        }
+        out.push_str(",impacts_mean,impacts_std,impacts_min,impacts_max\n");
+        for r in rows {
+            let _ = write!(
+                out,
+                "{:?},{},{}",
+                r.value,
+                csv_field(&r.disc),
+                r.max_positive.n
+            );
+            for s in [&r.max_positive, &r.max_negative, &r.p99_abs, &r.impacts] {
+                let _ = write!(out, ",{:?},{:?},{:?},{:?}", s.mean, s.std, s.min, s.max);
+            }
+            out.push('\n');
+        }
+        return out;
+    }
+    let ensembles = rows.iter().any(|r| r.max_positive.n > 1);
+    let mut cols = vec![col(param, true), col("disc", false)];
+    if ensembles {
+        cols.push(col("members", true));
+    }
+    cols.push(col("max + [N]", true));
+    if ensembles {
+        cols.push(col("max + range [N]", true));
+    }
+    cols.push(col("max - [N]", true));
+    if ensembles {
+        cols.push(col("max - range [N]", true));
+    }
+    cols.push(col("p99 abs [N]", true));
+    cols.push(col("impacts", true));
+    let cells: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            let mut c = vec![fmt_short(r.value), r.disc.clone()];
+            if ensembles {
+                c.push(r.max_positive.n.to_string());
+            }
+            c.push(mean_std(&r.max_positive));
+            if ensembles {
+                c.push(range(&r.max_positive));
+            }
+            c.push(mean_std(&r.max_negative));
+            if ensembles {
+                c.push(range(&r.max_negative));
+            }
+            c.push(mean_std(&r.p99_abs));
+            c.push(mean_std(&r.impacts));
+            c
+        })
+        .collect();
+    render(format, &cols, &cells)
+}
+
+/// `mean ± std`, or the mean alone for a single member.
+fn mean_std(s: &Spread) -> String {
+    if s.n > 1 {
+        format!("{} ± {}", fmt_num(s.mean), fmt_num(s.std))
+    } else {
+        fmt_num(s.mean)
+    }
+}
+
+/// `min .. max`, or `-` for a single member.
+fn range(s: &Spread) -> String {
+    if s.n > 1 {
+        format!("{} .. {}", fmt_num(s.min), fmt_num(s.max))
+    } else {
+        "-".to_string()
+    }
+}
+
+/// Renders text or markdown with columns padded to their widest cell.
+fn render(format: TableFormat, cols: &[Col], rows: &[Vec<String>]) -> String {
+    let escape = |s: &str| match format {
+        TableFormat::Markdown => s.replace('|', "\\|"),
+        _ => s.to_string(),
+    };
+    let header: Vec<String> = cols.iter().map(|c| escape(&c.header)).collect();
+    let rows: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| r.iter().map(|s| escape(s)).collect())
+        .collect();
+    let width = |s: &str| s.chars().count();
+    let widths: Vec<usize> = (0..cols.len())
+        .map(|i| {
+            rows.iter()
+                .map(|r| width(&r[i]))
+                .chain([width(&header[i]), 3])
+                .max()
+                .unwrap_or(3)
+        })
+        .collect();
+    let pad = |s: &str, i: usize| {
+        let fill = " ".repeat(widths[i] - width(s));
+        if cols[i].right {
+            format!("{fill}{s}")
+        } else {
+            format!("{s}{fill}")
+        }
+    };
+    let line = |cells: &[String]| -> String {
+        let padded: Vec<String> = cells.iter().enumerate().map(|(i, s)| pad(s, i)).collect();
+        match format {
+            TableFormat::Markdown => format!("| {} |\n", padded.join(" | ")),
+            _ => format!("{}\n", padded.join("  ").trim_end()),
+        }
+    };
+    let mut out = line(&header);
+    match format {
+        TableFormat::Markdown => {
+            let rules: Vec<String> = widths
+                .iter()
+                .zip(cols)
+                .map(|(&w, c)| {
+                    if c.right {
+                        format!("{}:", "-".repeat(w - 1))
+                    } else {
+                        "-".repeat(w)
+                    }
+                })
+                .collect();
+            let _ = writeln!(out, "| {} |", rules.join(" | "));
+        }
+        _ => {
+            let total = widths.iter().sum::<usize>() + 2 * widths.len().saturating_sub(1);
+            let _ = writeln!(out, "{}", "-".repeat(total));
+        }
+    }
+    for r in &rows {
+        out.push_str(&line(r));
+    }
+    out
+}
+
+/// A CSV field, quoted when it holds a comma, a quote or a line break.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// About four significant digits for reading (at least one decimal between 1e-3 and 1e6,
+/// scientific notation outside): `1234.5`, `12.35`, `0.1235`, `2.000e-5`.
+pub(crate) fn fmt_num(v: f64) -> String {
+    let a = v.abs();
+    if !v.is_finite() {
+        format!("{v}")
+    } else if v == 0.0 {
+        "0".to_string()
+    } else if (1e-3..1e6).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).clamp(1, 6) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
+/// Like [`fmt_num`] without trailing zeros (`2e-5`, `0.25`, `1000`): parameter values and
+/// axis ticks.
+pub(crate) fn fmt_short(v: f64) -> String {
+    let s = fmt_num(v);
+    let (mantissa, exp) = match s.find('e') {
+        Some(i) => s.split_at(i),
+        None => (s.as_str(), ""),
+    };
+    let mantissa = if mantissa.contains('.') {
+        mantissa.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        mantissa
+    };
+    format!("{mantissa}{exp}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sweep::{sweep_rows, SweepCase};
+
+    fn two_discs() -> Vec<DiscStats> {
+        vec![
+            DiscStats::from_peaks("disc 1", &[1234.5, -250.0, 20.0]),
+            DiscStats::from_peaks("outer, 2", &[]),
+        ]
+    }
+
+    /// Every format has the unit-carrying headers and the values.
+    #[test]
+    fn stats_table_formats() {
+        let s = two_discs();
+        let text = stats_table(&s, TableFormat::Text);
+        assert!(text.contains("max + [N]"), "{text}");
+        assert!(text.contains("max - [N]"));
+        assert!(text.contains("p99 abs [N]"));
+        assert!(text.contains("1234.5"));
+        assert!(text.contains("-250.0"));
+        // header, rule, two rows; all rows as wide as the rule at most
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 4);
+        assert!(lines[1].chars().all(|c| c == '-'));
+        // the numeric columns are right-aligned: the header ends where the numbers end
+        let end = lines[0].find("max + [N]").unwrap() + "max + [N]".len();
+        assert_eq!(&lines[2][end - 6..end], "1234.5");
+
+        let md = stats_table(&s, TableFormat::Markdown);
+        let lines: Vec<&str> = md.lines().collect();
+        assert!(lines[0].starts_with("| disc"));
+        assert!(lines[0].contains("| max + [N] |"));
+        assert!(lines[1].starts_with("| ---") && lines[1].contains("-:"));
+        assert!(lines[2].contains("| disc 1"));
+
+        let csv = stats_table(&s, TableFormat::Csv);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(
+            lines[0],
+            "disc,max_positive_n,max_negative_n,p99_abs_n,mean_top10_abs_n,impacts,positive_impacts,negative_impacts"
+        );
+        assert!(lines[1].starts_with("disc 1,1234.5,-250.0,"));
+        assert!(lines[1].ends_with(",3,2,1"));
+        assert_eq!(lines[2], "\"outer, 2\",0.0,0.0,0.0,0.0,0,0,0");
+    }
+
+    /// No rows: the header alone, no panic.
+    #[test]
+    fn empty_tables() {
+        for f in [TableFormat::Text, TableFormat::Markdown, TableFormat::Csv] {
+            assert!(stats_table(&[], f).contains("impacts"));
+            assert!(sweep_table("backlash_m", &[], f).contains("backlash_m"));
+        }
+    }
+
+    /// Sweeps: single runs show plain values; ensembles add members, mean ± std and ranges;
+    /// CSV always has every column.
+    #[test]
+    fn sweep_table_formats() {
+        let single = sweep_rows(&[SweepCase {
+            value: 20e-6,
+            members: vec![two_discs()],
+        }]);
+        let text = sweep_table("backlash [m]", &single, TableFormat::Text);
+        assert!(text.starts_with("backlash [m]"));
+        assert!(text.contains("2e-5"), "{text}");
+        assert!(!text.contains('±') && !text.contains("members"));
+
+        let ens = sweep_rows(&[SweepCase {
+            value: 20e-6,
+            members: vec![
+                vec![DiscStats::from_peaks("d", &[100.0, -50.0])],
+                vec![DiscStats::from_peaks("d", &[300.0, -70.0])],
+            ],
+        }]);
+        let md = sweep_table("backlash_m", &ens, TableFormat::Markdown);
+        assert!(md.contains("| members |"), "{md}");
+        assert!(md.contains("max + range [N]"));
+        assert!(md.contains("200.0 ± 141.4"));
+        assert!(md.contains("100.0 .. 300.0"));
+        assert!(md.contains("-60.00 ± 14.14"));
+
+        let csv = sweep_table("backlash_m", &ens, TableFormat::Csv);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert!(
+            lines[0].starts_with("backlash_m,disc,members,max_positive_mean_n,max_positive_std_n")
+        );
+        assert!(lines[0].ends_with("impacts_mean,impacts_std,impacts_min,impacts_max"));
+        assert_eq!(lines[0].split(',').count(), lines[1].split(',').count());
+        assert!(lines[1].starts_with("2e-5,d,2,200.0,"));
+    }
+
+    /// Number formatting for reading.
+    #[test]
+    fn number_formats() {
+        assert_eq!(fmt_num(1234.5), "1234.5");
+        assert_eq!(fmt_num(12.345), "12.35");
+        assert_eq!(fmt_num(-0.12345), "-0.1235");
+        assert_eq!(fmt_num(0.0), "0");
+        assert_eq!(fmt_num(2e-5), "2.000e-5");
+        assert_eq!(fmt_num(2.5e7), "2.500e7");
+        assert_eq!(fmt_short(2e-5), "2e-5");
+        assert_eq!(fmt_short(2.5e-5), "2.5e-5");
+        assert_eq!(fmt_short(1000.0), "1000");
+        assert_eq!(fmt_short(0.25), "0.25");
+    }
+}
