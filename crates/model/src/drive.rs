@@ -173,7 +173,8 @@ impl SpeedProfile {
                         .iter()
                         .map(|h| {
                             let w = TAU * h.frequency_hz;
-                            h.amplitude_rad_s / w * (h.phase_rad.cos() - (w * t + h.phase_rad).cos())
+                            h.amplitude_rad_s / w
+                                * (h.phase_rad.cos() - (w * t + h.phase_rad).cos())
                         })
                         .sum::<f64>()
             }

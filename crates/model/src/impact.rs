@@ -165,7 +165,12 @@ impl ImpactTracker {
 /// Detects the impacts in a sampled per-tooth load history (`t_s`, `load_n`, `v_n_m_s` of
 /// equal length) of disc `disc` with [`ImpactTracker::feed`]; an event still open at the last
 /// sample is closed there.
-pub fn detect_impacts(disc: usize, t_s: &[f64], load_n: &[f64], v_n_m_s: &[f64]) -> Vec<ImpactEvent> {
+pub fn detect_impacts(
+    disc: usize,
+    t_s: &[f64],
+    load_n: &[f64],
+    v_n_m_s: &[f64],
+) -> Vec<ImpactEvent> {
     let mut tr = ImpactTracker::new(disc);
     let mut out = Vec::new();
     for i in 0..t_s.len().min(load_n.len()).min(v_n_m_s.len()) {

@@ -40,7 +40,9 @@ pub use impact::{detect_impacts, ImpactEvent, ImpactTracker};
 pub use law::{ContactState, Engagement, Hertz, LawKind, OilFilm, ToothLaw};
 pub use pack::{DiscModel, PackModel};
 pub use spline::{Flank, SplineGeometry, ToothKinematics};
-pub use stream::{Collector, DiscSample, Engine, EngineError, NullObserver, Observer, RunStats, Sample};
+pub use stream::{
+    Collector, DiscSample, Engine, EngineError, NullObserver, Observer, RunStats, Sample,
+};
 
 /// Closed-form peak load of one free, undamped impact (MODEL.md section 4):
 /// `F_max = k^(2/5) (5/4 m_eff v0^2)^(3/5)` in N, for stiffness `k` (N/m^1.5), effective mass

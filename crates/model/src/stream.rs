@@ -116,5 +116,9 @@ pub trait Engine {
     fn disc_names(&self) -> Vec<String>;
     /// Runs from t = 0 to `duration_s`, sending samples and impacts to `observer`. On error,
     /// everything before the failure has already been delivered.
-    fn run(&mut self, duration_s: f64, observer: &mut dyn Observer) -> Result<RunStats, EngineError>;
+    fn run(
+        &mut self,
+        duration_s: f64,
+        observer: &mut dyn Observer,
+    ) -> Result<RunStats, EngineError>;
 }

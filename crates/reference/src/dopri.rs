@@ -142,20 +142,20 @@ impl Dopri5 {
         }
         f(t + C5 * h, yt, k5);
         for i in 0..n {
-            yt[i] = y[i]
-                + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
+            yt[i] =
+                y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
         }
         f(t + h, yt, k6);
         let yn = &mut self.y_new;
         for i in 0..n {
-            yn[i] = y[i]
-                + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
+            yn[i] =
+                y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
         }
         f(t + h, yn, k7);
         let mut sum = 0.0;
         for i in 0..n {
-            self.err[i] = h
-                * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
+            self.err[i] =
+                h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
             let sc = atol[i] + rtol * y[i].abs().max(yn[i].abs());
             let r = self.err[i] / sc;
             sum += r * r;
@@ -177,8 +177,8 @@ impl Dopri5 {
             d.r2[i] = ydiff;
             d.r3[i] = bspl;
             d.r4[i] = ydiff - h * k7[i] - bspl;
-            d.r5[i] = h
-                * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
+            d.r5[i] =
+                h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
         }
         d.t0 = t;
         d.h = h;

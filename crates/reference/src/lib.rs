@@ -35,6 +35,9 @@
 //! per step, and the dense output of the last two steps for the peak search. That is a small
 //! amount of code around the standard tableau (`dopri.rs`), tested against closed forms.
 
+// Index loops over state components mirror the equations; iterator chains would obscure them.
+#![allow(clippy::needless_range_loop)]
+
 pub mod dopri;
 
 use clutchpack_model::{
@@ -168,7 +171,8 @@ impl System<'_> {
             let f = self.load(i, y, &modes[i]);
             let omega_d = omega_s - y[k + 1];
             // Hu et al. eq (5)
-            let alpha_d = (d.spline.disc_torque_n_m(f) - d.drag_n_m_s_rad * omega_d) / d.inertia_kg_m2;
+            let alpha_d =
+                (d.spline.disc_torque_n_m(f) - d.drag_n_m_s_rad * omega_d) / d.inertia_kg_m2;
             dy[k] = y[k + 1];
             dy[k + 1] = alpha_s - alpha_d;
         }
@@ -364,7 +368,11 @@ impl Engine for ReferenceEngine {
                 let mut ta = t;
                 let mut found = None;
                 for q in 1..=4 {
-                    let tq = if q == 4 { t_end } else { t + h * q as f64 / 4.0 };
+                    let tq = if q == 4 {
+                        t_end
+                    } else {
+                        t + h * q as f64 / 4.0
+                    };
                     if q == 4 {
                         buf.copy_from_slice(&solver.y_new);
                     } else {
@@ -410,7 +418,11 @@ impl Engine for ReferenceEngine {
                 let tr = &mut tracks[i];
                 if f_new.abs() < tr.last_abs && tr.rising {
                     // The peak lies in the last two steps: golden-section search.
-                    let lo = if prev.h > 0.0 { prev.t0.max(tr.t_on) } else { cur.t0 };
+                    let lo = if prev.h > 0.0 {
+                        prev.t0.max(tr.t_on)
+                    } else {
+                        cur.t0
+                    };
                     let (tp, fp) = golden_peak(lo, t_new, |tt| {
                         eval2(&prev, &cur, tt, &mut buf);
                         sys.load(i, &buf, &modes[i])

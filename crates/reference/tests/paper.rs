@@ -48,9 +48,17 @@ fn first_impacts_match_the_independent_solver() {
         assert_eq!(c.impacts.len(), 5, "h_o = {h_o}: {:?}", c.impacts);
         for (e, (peak, t_ms)) in c.impacts.iter().zip(expected) {
             let rel = (e.peak_n - peak).abs() / peak.abs();
-            assert!(rel < 2e-3, "h_o = {h_o}: peak {} vs {peak} ({rel:e})", e.peak_n);
+            assert!(
+                rel < 2e-3,
+                "h_o = {h_o}: peak {} vs {peak} ({rel:e})",
+                e.peak_n
+            );
             let dt = (e.t_peak_s - t_ms * 1e-3).abs();
-            assert!(dt < 1e-6, "h_o = {h_o}: peak time {} vs {t_ms} ms", e.t_peak_s * 1e3);
+            assert!(
+                dt < 1e-6,
+                "h_o = {h_o}: peak time {} vs {t_ms} ms",
+                e.t_peak_s * 1e3
+            );
             assert_eq!(e.flank == Flank::ShaftLeads, peak < 0.0);
         }
         if h_o == 0.0 {
@@ -81,7 +89,10 @@ fn free_impact_matches_the_closed_form() {
             // start 0.1 um (along the line of action) before engagement, closing at v0
             disc.initial_rel_angle_rad = g0 - (h_o + 1e-7) / rb;
             disc.initial_rel_speed_rad_s = v0 / rb;
-            let k = disc.law.engage(&disc.spline.kinematics(g0, v0 / rb)).stiffness;
+            let k = disc
+                .law
+                .engage(&disc.spline.kinematics(g0, v0 / rb))
+                .stiffness;
             let m_eff = disc.spline.effective_mass_kg(disc.inertia_kg_m2);
             let pack = PackModel {
                 shaft: Shaft::Prescribed(SpeedProfile::sine(100.0, 0.0, 1.0)),
@@ -92,12 +103,18 @@ fn free_impact_matches_the_closed_form() {
             let peak = c.impacts[0].peak_n;
             let expected = free_impact_peak_n(k, m_eff, v0);
             let rel = (peak.abs() - expected).abs() / expected;
-            assert!(rel < 1e-3, "{kind:?} h_o={h_o} v0={v0}: {peak} vs {expected} ({rel:e})");
+            assert!(
+                rel < 1e-3,
+                "{kind:?} h_o={h_o} v0={v0}: {peak} vs {expected} ({rel:e})"
+            );
             assert!(peak < 0.0, "the shaft leads");
             let last = c.samples.last().unwrap();
             let rebound = -last.discs[0].closing_speed_m_s;
             let rel_v = (rebound - v0).abs() / v0;
-            assert!(rel_v < 1e-3, "{kind:?} h_o={h_o} v0={v0}: rebound {rebound} ({rel_v:e})");
+            assert!(
+                rel_v < 1e-3,
+                "{kind:?} h_o={h_o} v0={v0}: rebound {rebound} ({rel_v:e})"
+            );
         }
     }
 }
@@ -110,7 +127,10 @@ fn tolerance_refinement_converges() {
     let b = run(paper_pack(50e-6), 0.03, 1e-11, 100.0);
     assert!(a.impacts.len() >= 10);
     for (x, y) in a.impacts.iter().zip(&b.impacts).take(10) {
-        assert!((x.peak_n - y.peak_n).abs() < 1e-4 * y.peak_n.abs(), "{x:?} {y:?}");
+        assert!(
+            (x.peak_n - y.peak_n).abs() < 1e-4 * y.peak_n.abs(),
+            "{x:?} {y:?}"
+        );
         assert!((x.t_on_s - y.t_on_s).abs() < 1e-8);
     }
 }

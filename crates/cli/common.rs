@@ -1,0 +1,165 @@
+//! Shared helpers of the subcommands: scene loading, engine choice, the summary JSON.
+
+use anyhow::{Context, Result};
+use clutchpack_analysis::DiscStats;
+use clutchpack_model::{Engine, ImpactEvent, Observer, RunStats, Sample};
+use clutchpack_reference::ReferenceEngine;
+use clutchpack_scene::{EngineChoice, Override, Scene};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// The default scene, built into the binary so that `clutchpack run` works from anywhere.
+pub const DEFAULT_SCENE_TEXT: &str = include_str!("../../scenes/hu-table2.toml");
+/// The name the default scene is reported under.
+pub const DEFAULT_SCENE_NAME: &str = "scenes/hu-table2.toml (built in)";
+
+/// Marks an error as bad input (exit code 2).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadInput(pub String);
+
+/// Loads `path` (or the built-in default scene) with `--set` overrides.
+pub fn load_scene(path: Option<&Path>, sets: &[Override]) -> Result<Scene> {
+    let scene = match path {
+        Some(p) => clutchpack_scene::load(p, sets)?,
+        None => clutchpack_scene::parse(
+            DEFAULT_SCENE_TEXT,
+            DEFAULT_SCENE_NAME,
+            &std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+            sets,
+        )?,
+    };
+    Ok(scene)
+}
+
+/// Engine names accepted by `--engine`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum EngineArg {
+    /// The reduced torsional engine (fast; the paper's model for a whole pack).
+    Reference,
+    /// The rapier3d multibody engine (per tooth).
+    Multibody,
+}
+
+/// Builds the engine asked for on the command line, else by the scene, else the reference.
+pub fn make_engine(scene: &Scene, arg: Option<EngineArg>) -> Result<Box<dyn Engine + Send>> {
+    let choice = match arg {
+        Some(EngineArg::Reference) => EngineChoice::Reference,
+        Some(EngineArg::Multibody) => EngineChoice::Multibody,
+        None => scene.simulation.engine.unwrap_or(EngineChoice::Reference),
+    };
+    match choice {
+        EngineChoice::Reference => Ok(Box::new(ReferenceEngine::from_scene(scene))),
+        EngineChoice::Multibody => Err(BadInput(
+            "the multibody engine is not part of this build yet; use --engine reference".into(),
+        )
+        .into()),
+    }
+}
+
+/// Keeps the impacts of a run, and the per-disc load histories when asked.
+pub struct RunCollector {
+    pub impacts: Vec<ImpactEvent>,
+    /// Per disc: (t s, load N) samples, only when `keep_history`.
+    pub history: Vec<Vec<(f64, f64)>>,
+    pub keep_history: bool,
+    pub progress: Option<indicatif::ProgressBar>,
+}
+
+impl RunCollector {
+    pub fn new(discs: usize, keep_history: bool) -> RunCollector {
+        RunCollector {
+            impacts: Vec::new(),
+            history: vec![Vec::new(); discs],
+            keep_history,
+            progress: None,
+        }
+    }
+
+    /// Load histories with each impact's onset, peak and separation merged in, so that the
+    /// plotted spikes reach the located peaks whatever the sample rate.
+    pub fn histories_with_peaks(&self) -> Vec<Vec<(f64, f64)>> {
+        let mut h = self.history.clone();
+        for e in &self.impacts {
+            if let Some(v) = h.get_mut(e.disc) {
+                v.extend([(e.t_on_s, 0.0), (e.t_peak_s, e.peak_n), (e.t_off_s, 0.0)]);
+            }
+        }
+        for v in h.iter_mut() {
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
+        h
+    }
+}
+
+impl Observer for RunCollector {
+    fn sample(&mut self, s: &Sample) {
+        if self.keep_history {
+            for (i, d) in s.discs.iter().enumerate() {
+                self.history[i].push((s.t_s, d.load_n));
+            }
+        }
+    }
+    fn impact(&mut self, e: &ImpactEvent) {
+        self.impacts.push(*e);
+    }
+    fn progress(&mut self, t_s: f64) -> bool {
+        if let Some(p) = &self.progress {
+            p.set_position((t_s * 1e6) as u64);
+        }
+        false
+    }
+}
+
+/// `--summary-json` of a run.
+#[derive(Debug, Serialize)]
+pub struct RunSummary {
+    pub scene: String,
+    pub engine: String,
+    pub duration_s: f64,
+    pub wall_time_s: f64,
+    pub steps: u64,
+    pub rejected_steps: u64,
+    pub discs: Vec<DiscStats>,
+}
+
+impl RunSummary {
+    pub fn new(
+        scene: &Scene,
+        engine: &str,
+        stats: &RunStats,
+        wall_time_s: f64,
+        discs: Vec<DiscStats>,
+    ) -> RunSummary {
+        RunSummary {
+            scene: scene.name.clone(),
+            engine: engine.to_string(),
+            duration_s: stats.simulated_s,
+            wall_time_s,
+            steps: stats.steps,
+            rejected_steps: stats.rejected_steps,
+            discs,
+        }
+    }
+}
+
+/// Writes `value` as pretty JSON to `path`.
+pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
+    let text = serde_json::to_string_pretty(value)?;
+    std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))
+}
+
+/// A progress bar on stderr for a run of `duration_s` simulated seconds (hidden when stderr
+/// is not a terminal).
+pub fn time_progress(duration_s: f64, label: &str) -> indicatif::ProgressBar {
+    let pb = indicatif::ProgressBar::new((duration_s * 1e6) as u64);
+    pb.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{prefix} [{bar:30}] {msg} {percent:>3}% eta {eta}",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    pb.set_prefix(label.to_string());
+    pb
+}

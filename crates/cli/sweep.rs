@@ -1,0 +1,245 @@
+//! `clutchpack sweep`.
+
+use crate::common::{self, BadInput, EngineArg, RunCollector};
+use anyhow::{Context, Result};
+use clutchpack_analysis::{
+    disc_stats, sweep_fits, sweep_rows, sweep_table, DiscStats, PolyFit, SweepCase, SweepRow,
+    TableFormat,
+};
+use clutchpack_scene::{Override, Scene};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Arguments of `clutchpack sweep`.
+#[derive(clap::Args, Debug)]
+#[command(
+    after_help = "Example (the paper's Fig 3, with 16-member ensembles):\n  clutchpack sweep scenes/hu-table2.toml --param defaults.oil.film_thickness_m \\\n      --values 0,25e-6,50e-6,75e-6,100e-6 --ensemble 16 --plot fig3.png"
+)]
+pub struct SweepArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// The scene key to sweep, as a dotted path (`defaults.oil.film_thickness_m`).
+    #[arg(long, value_name = "KEY")]
+    pub param: String,
+    /// Comma-separated values of the parameter, in its unit (`0,25e-6,50e-6`).
+    #[arg(long, value_delimiter = ',', required = true, num_args = 1.., allow_negative_numbers = true)]
+    pub values: Vec<f64>,
+    /// Run each value as K cases whose discs start at K positions spread evenly across the
+    /// free play (the rattle is chaotic: report a mean and a spread, not one sample). With
+    /// K = 1 the scene's own initial positions are used.
+    #[arg(long, value_name = "K", default_value_t = 1)]
+    pub ensemble: usize,
+    /// Cases run in parallel (default: the number of cores).
+    #[arg(long, value_name = "J")]
+    pub jobs: Option<usize>,
+    /// Engine; default: the scene's, else `reference`.
+    #[arg(long, value_enum)]
+    pub engine: Option<EngineArg>,
+    /// Further overrides applied to every case (`KEY=VALUE`, repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<Override>,
+    /// Write the sweep table and fits as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub summary_json: Option<PathBuf>,
+    /// Plot the peaks against the parameter with quadratic fits (PNG or SVG).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+}
+
+#[derive(Serialize)]
+struct FitJson {
+    disc: String,
+    /// Coefficients c0, c1, c2 of max positive peak (N) = c0 + c1 x + c2 x^2.
+    max_positive: PolyFit,
+    /// Same for the max negative peak (N).
+    max_negative: PolyFit,
+}
+
+#[derive(Serialize)]
+struct SweepSummary {
+    scene: String,
+    engine: String,
+    param: String,
+    values: Vec<f64>,
+    ensemble: usize,
+    jobs: usize,
+    cases: usize,
+    wall_time_s: f64,
+    rows: Vec<SweepRow>,
+    fits: Vec<FitJson>,
+}
+
+/// The initial relative angles of ensemble member `k` of `count`: every disc at the same
+/// fraction `-1 + (2k + 1) / count` of 90 % of its free play (the half play less the film's
+/// engagement offset), so members are spread evenly and none starts in contact.
+pub fn ensemble_member(scene: &Scene, k: usize, count: usize) -> Scene {
+    let mut s = scene.clone();
+    if count <= 1 {
+        return s;
+    }
+    let frac = -1.0 + (2 * k + 1) as f64 / count as f64;
+    for d in s.pack.discs.iter_mut() {
+        let free =
+            d.spline.half_play_rad() - d.law.engagement_offset_m() / d.spline.base_radius_m();
+        d.initial_rel_angle_rad = frac * 0.9 * free;
+    }
+    s
+}
+
+pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
+    if a.ensemble == 0 {
+        return Err(BadInput("--ensemble must be at least 1".into()).into());
+    }
+    if a.values.iter().any(|v| !v.is_finite()) {
+        return Err(BadInput(format!(
+            "--values {:?}: every value must be finite",
+            a.values
+        ))
+        .into());
+    }
+    let jobs = a.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    if jobs == 0 {
+        return Err(BadInput("--jobs must be at least 1".into()).into());
+    }
+    // Load every case first, so that bad input is reported before any work.
+    let mut scenes = Vec::new();
+    for v in &a.values {
+        let mut sets = a.sets.clone();
+        sets.push(Override {
+            key: a.param.clone(),
+            value: format!("{v:e}"),
+        });
+        let scene = common::load_scene(Some(&a.scene), &sets)
+            .with_context(|| format!("case {} = {v}", a.param))?;
+        scenes.push(scene);
+    }
+    let engine_name = common::make_engine(&scenes[0], a.engine)?
+        .name()
+        .to_string();
+    let tasks: Vec<(usize, usize)> = (0..scenes.len())
+        .flat_map(|c| (0..a.ensemble).map(move |k| (c, k)))
+        .collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs)
+        .build()
+        .context("starting the worker threads")?;
+    let pb = indicatif::ProgressBar::new(tasks.len() as u64);
+    pb.set_style(
+        indicatif::ProgressStyle::with_template("sweep [{bar:30}] {pos}/{len} cases, eta {eta}")
+            .expect("static template")
+            .progress_chars("=> "),
+    );
+    let t0 = Instant::now();
+    let results: Vec<Result<Vec<DiscStats>>> = pool.install(|| {
+        tasks
+            .par_iter()
+            .map(|&(c, k)| {
+                let member = ensemble_member(&scenes[c], k, a.ensemble);
+                let mut engine = common::make_engine(&member, a.engine)?;
+                let names = engine.disc_names();
+                let mut obs = RunCollector::new(names.len(), false);
+                engine
+                    .run(member.simulation.duration_s, &mut obs)
+                    .with_context(|| format!("case {} = {}, member {k}", a.param, a.values[c]))?;
+                pb.inc(1);
+                Ok(disc_stats(&names, &obs.impacts))
+            })
+            .collect()
+    });
+    pb.finish_and_clear();
+    let wall = t0.elapsed().as_secs_f64();
+    let mut cases: Vec<SweepCase> = a
+        .values
+        .iter()
+        .map(|&value| SweepCase {
+            value,
+            members: Vec::new(),
+        })
+        .collect();
+    for (&(c, _), r) in tasks.iter().zip(results) {
+        cases[c].members.push(r?);
+    }
+    let rows = sweep_rows(&cases);
+    let degree = if a.values.len() >= 3 {
+        2
+    } else {
+        a.values.len().saturating_sub(1)
+    };
+    let fits = if degree >= 1 {
+        sweep_fits(&rows, degree).context("fitting the peaks")?
+    } else {
+        Vec::new()
+    };
+
+    println!(
+        "{}: {} cases ({} values x {} members) with the {} engine in {:.2} s wall on {} threads",
+        scenes[0].name,
+        tasks.len(),
+        a.values.len(),
+        a.ensemble,
+        engine_name,
+        wall,
+        jobs
+    );
+    println!(
+        "per-tooth peak loads against {} (ensemble mean, std, min..max)",
+        a.param
+    );
+    print!("{}", sweep_table(&a.param, &rows, TableFormat::Text));
+    for (disc, p, n) in &fits {
+        println!(
+            "{disc}: max + = {} (R^2 {:.3}); max - = {} (R^2 {:.3})",
+            poly_text(p),
+            p.r_squared,
+            poly_text(n),
+            n.r_squared
+        );
+    }
+    if let Some(path) = &a.plot {
+        clutchpack_analysis::plot_sweep(path, &a.param, &rows, &fits)
+            .with_context(|| format!("plotting {}", path.display()))?;
+    }
+    if let Some(path) = &a.summary_json {
+        let summary = SweepSummary {
+            scene: scenes[0].name.clone(),
+            engine: engine_name,
+            param: a.param.clone(),
+            values: a.values.clone(),
+            ensemble: a.ensemble,
+            jobs,
+            cases: tasks.len(),
+            wall_time_s: wall,
+            rows,
+            fits: fits
+                .into_iter()
+                .map(|(disc, max_positive, max_negative)| FitJson {
+                    disc,
+                    max_positive,
+                    max_negative,
+                })
+                .collect(),
+        };
+        common::write_json(path, &summary)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn poly_text(p: &PolyFit) -> String {
+    p.coefficients
+        .iter()
+        .enumerate()
+        .map(|(i, c)| match i {
+            0 => format!("{c:.4e}"),
+            1 => format!("{c:+.4e} x"),
+            _ => format!("{c:+.4e} x^{i}"),
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
