@@ -18,13 +18,13 @@ pub struct CheckArgs {
 
 pub fn check(a: CheckArgs) -> Result<ExitCode> {
     if a.keys {
-        println!("{}", clutchpack_scene::keys_doc());
+        out!("{}", clutchpack_scene::keys_doc());
         return Ok(ExitCode::SUCCESS);
     }
     let mut bad = 0;
     for p in &a.scenes {
         match clutchpack_scene::load(p, &[]) {
-            Ok(s) => println!(
+            Ok(s) => out!(
                 "{}: ok ({} discs, {} s)",
                 p.display(),
                 s.pack.discs.len(),

@@ -2,6 +2,21 @@
 //! runs engines, prints tables, writes files. Errors are printed once, with context, and
 //! mapped to exit codes: 0 success, 2 bad input (scene, arguments, files), 1 anything else.
 
+/// `println!` that ends the process quietly (exit 0) when stdout is a closed pipe
+/// (`clutchpack run | head`), instead of panicking.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let mut o = std::io::stdout().lock();
+        if let Err(e) = writeln!(o, $($arg)*) {
+            if e.kind() == std::io::ErrorKind::BrokenPipe {
+                std::process::exit(0);
+            }
+        }
+    }};
+}
+
+mod bench;
 mod check;
 mod common;
 mod run;
@@ -30,6 +45,9 @@ enum Command {
     /// Run a scene once per value of one parameter (optionally as ensembles) and fit the
     /// peaks against it (the paper's Fig 3).
     Sweep(sweep::SweepArgs),
+    /// Measure speed: the paper case per run, and the speed-up of a 16-case sweep on 2
+    /// threads over 1 (prints ratios; timing is never a test).
+    Bench(bench::BenchArgs),
     /// Validate scene files: exit 0 if all are valid, 2 with every problem listed if not.
     Check(check::CheckArgs),
 }
@@ -40,6 +58,7 @@ fn main() -> ExitCode {
         Command::Run(a) => run::run(a),
         Command::Sweep(a) => sweep::sweep(a),
         Command::Check(a) => check::check(a),
+        Command::Bench(a) => bench::bench(a),
     };
     match result {
         Ok(code) => code,

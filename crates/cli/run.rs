@@ -88,19 +88,23 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     if let Some(path) = &a.summary_json {
         common::write_json(path, &summary)?;
     }
-    println!(
+    out!(
         "{}: {:.3} s simulated with the {} engine in {:.3} s wall ({} steps)",
-        scene.name, run_stats.simulated_s, summary.engine, wall, run_stats.steps
+        scene.name,
+        run_stats.simulated_s,
+        summary.engine,
+        wall,
+        run_stats.steps
     );
-    println!("per-tooth impact loads (negative: the shaft leads; positive: the disc leads)");
-    print!("{}", stats_table(&stats, TableFormat::Text));
+    out!("per-tooth impact loads (negative: the shaft leads; positive: the disc leads)");
+    out!("{}", stats_table(&stats, TableFormat::Text).trim_end());
     if let Some(worst) = stats.iter().max_by(|x, y| {
         x.max_positive_n
             .max(-x.max_negative_n)
             .total_cmp(&y.max_positive_n.max(-y.max_negative_n))
     }) {
         if stats.len() > 1 {
-            println!(
+            out!(
                 "hardest hit: {} ({:.1} N)",
                 worst.name,
                 worst.max_positive_n.max(-worst.max_negative_n)

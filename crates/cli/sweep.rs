@@ -123,49 +123,22 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
     let engine_name = common::make_engine(&scenes[0], a.engine)?
         .name()
         .to_string();
-    let tasks: Vec<(usize, usize)> = (0..scenes.len())
-        .flat_map(|c| (0..a.ensemble).map(move |k| (c, k)))
-        .collect();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs)
-        .build()
-        .context("starting the worker threads")?;
-    let pb = indicatif::ProgressBar::new(tasks.len() as u64);
-    pb.set_style(
+    let show = indicatif::ProgressBar::new(0);
+    show.set_style(
         indicatif::ProgressStyle::with_template("sweep [{bar:30}] {pos}/{len} cases, eta {eta}")
             .expect("static template")
             .progress_chars("=> "),
     );
-    let t0 = Instant::now();
-    let results: Vec<Result<Vec<DiscStats>>> = pool.install(|| {
-        tasks
-            .par_iter()
-            .map(|&(c, k)| {
-                let member = ensemble_member(&scenes[c], k, a.ensemble);
-                let mut engine = common::make_engine(&member, a.engine)?;
-                let names = engine.disc_names();
-                let mut obs = RunCollector::new(names.len(), false);
-                engine
-                    .run(member.simulation.duration_s, &mut obs)
-                    .with_context(|| format!("case {} = {}, member {k}", a.param, a.values[c]))?;
-                pb.inc(1);
-                Ok(disc_stats(&names, &obs.impacts))
-            })
-            .collect()
-    });
-    pb.finish_and_clear();
-    let wall = t0.elapsed().as_secs_f64();
-    let mut cases: Vec<SweepCase> = a
-        .values
-        .iter()
-        .map(|&value| SweepCase {
-            value,
-            members: Vec::new(),
-        })
-        .collect();
-    for (&(c, _), r) in tasks.iter().zip(results) {
-        cases[c].members.push(r?);
-    }
+    let (cases, wall) = run_cases(
+        &scenes,
+        &a.values,
+        &a.param,
+        a.ensemble,
+        jobs,
+        a.engine,
+        Some(show),
+    )?;
+    let n_cases = a.values.len() * a.ensemble;
     let rows = sweep_rows(&cases);
     let degree = if a.values.len() >= 3 {
         2
@@ -178,23 +151,26 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         Vec::new()
     };
 
-    println!(
+    out!(
         "{}: {} cases ({} values x {} members) with the {} engine in {:.2} s wall on {} threads",
         scenes[0].name,
-        tasks.len(),
+        n_cases,
         a.values.len(),
         a.ensemble,
         engine_name,
         wall,
         jobs
     );
-    println!(
+    out!(
         "per-tooth peak loads against {} (ensemble mean, std, min..max)",
         a.param
     );
-    print!("{}", sweep_table(&a.param, &rows, TableFormat::Text));
+    out!(
+        "{}",
+        sweep_table(&a.param, &rows, TableFormat::Text).trim_end()
+    );
     for (disc, p, n) in &fits {
-        println!(
+        out!(
             "{disc}: max + = {} (R^2 {:.3}); max - = {} (R^2 {:.3})",
             poly_text(p),
             p.r_squared,
@@ -214,7 +190,7 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             values: a.values.clone(),
             ensemble: a.ensemble,
             jobs,
-            cases: tasks.len(),
+            cases: n_cases,
             wall_time_s: wall,
             rows,
             fits: fits
@@ -242,4 +218,56 @@ fn poly_text(p: &PolyFit) -> String {
         })
         .collect::<Vec<_>>()
         .join(" ")
+}
+
+/// Runs every (value, ensemble member) case on a pool of `jobs` threads; returns one
+/// [`SweepCase`] per value and the wall time in s. `progress`, if given, counts cases.
+pub fn run_cases(
+    scenes: &[Scene],
+    values: &[f64],
+    param: &str,
+    ensemble: usize,
+    jobs: usize,
+    engine: Option<EngineArg>,
+    progress: Option<indicatif::ProgressBar>,
+) -> Result<(Vec<SweepCase>, f64)> {
+    let tasks: Vec<(usize, usize)> = (0..scenes.len())
+        .flat_map(|c| (0..ensemble).map(move |k| (c, k)))
+        .collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs)
+        .build()
+        .context("starting the worker threads")?;
+    let pb = progress.unwrap_or_else(indicatif::ProgressBar::hidden);
+    pb.set_length(tasks.len() as u64);
+    let t0 = Instant::now();
+    let results: Vec<Result<Vec<DiscStats>>> = pool.install(|| {
+        tasks
+            .par_iter()
+            .map(|&(c, k)| {
+                let member = ensemble_member(&scenes[c], k, ensemble);
+                let mut engine = common::make_engine(&member, engine)?;
+                let names = engine.disc_names();
+                let mut obs = RunCollector::new(names.len(), false);
+                engine
+                    .run(member.simulation.duration_s, &mut obs)
+                    .with_context(|| format!("case {param} = {}, member {k}", values[c]))?;
+                pb.inc(1);
+                Ok(disc_stats(&names, &obs.impacts))
+            })
+            .collect()
+    });
+    pb.finish_and_clear();
+    let wall = t0.elapsed().as_secs_f64();
+    let mut cases: Vec<SweepCase> = values
+        .iter()
+        .map(|&value| SweepCase {
+            value,
+            members: Vec::new(),
+        })
+        .collect();
+    for (&(c, _), r) in tasks.iter().zip(results) {
+        cases[c].members.push(r?);
+    }
+    Ok((cases, wall))
 }
