@@ -1,0 +1,122 @@
+//! # clutchpack_record
+//!
+//! Recordings of clutchpack runs: MCAP files that Foxglove, PlotJuggler and Rerun open as
+//! they are, written from an engine's stream of [`Sample`](clutchpack_model::Sample)s and
+//! [`ImpactEvent`](clutchpack_model::ImpactEvent)s, and read back (robustly) into the same
+//! typed values for `replay`, `compare`, `export` and `plot`.
+//!
+//! ## What this crate does
+//! - [`Recorder`]: an [`Observer`](clutchpack_model::Observer) that streams a run into an
+//!   MCAP file: protobuf messages with embedded schemas, zstd chunks, message and chunk
+//!   indexes, a summary section; chunks flushed every [`RecordOptions::flush_messages`]
+//!   messages and at least every [`RecordOptions::flush_interval`] of wall time, so a killed
+//!   run leaves a file readable up to the last flush. [`RunInfo`] goes in as metadata
+//!   records and the scene file as an attachment, so a recording describes itself and can
+//!   be run again.
+//! - [`open`] / [`RecordingReader`]: topics, counts, time span, metadata, the stored summary
+//!   ([`RecordingInfo`]), and typed data: [`RecordingReader::samples`],
+//!   [`RecordingReader::load_histories`], [`RecordingReader::impacts`],
+//!   [`RecordingReader::disc_series`]. Truncated, corrupted, empty and foreign files give a
+//!   one-line reason ([`ReadError`], [`Damage`]) and never a panic; a killed run's file is
+//!   read up to its last complete chunk.
+//! - [`export_csv`]: one CSV per topic of ours.
+//! - [`serve`] (feature `serve`): plays a recording to Foxglove over its WebSocket protocol.
+//!
+//! ## What it does not do
+//! - Run engines, parse scenes or compute statistics beyond the stored summary: the CLI
+//!   fills [`RunInfo`] from the scene, and `clutchpack_analysis` does the statistics (its
+//!   `DiscStats` and our [`DiscSummary`] have the same fields and definitions).
+//! - Depend on rapier or on the engines: it knows only `clutchpack_model`'s stream types.
+//!
+//! ## Topics
+//! All messages are protobuf; log time = publish time = simulated time in ns (deterministic).
+//!
+//! | topic | schema | when | fields (units in names) |
+//! | --- | --- | --- | --- |
+//! | `/tf` | `foxglove.FrameTransforms` | each sample ([`RecordOptions::tf_interval_s`]) | `world` -> `shaft`, `world` -> `disc/<segment>`: rotation about +z, discs at `z_m` |
+//! | `/scene` | `foxglove.SceneUpdate` | t = 0, then every [`RecordOptions::scene_interval_s`] | shaft cylinder, disc annuli (triangle meshes), teeth coloured by load |
+//! | `/shaft` | `clutchpack.ShaftState` | each sample | `t_s, angle_rad, speed_rad_s` |
+//! | `/discs/<segment>/spline` | `clutchpack.SplineState` | each sample | `t_s, rel_angle_rad, closing_speed_m_s, penetration_m, load_n, torque_n_m, engaged, stiffness_n_m1_5, speed_rad_s, angle_rad, disc_index` |
+//! | `/discs/<segment>/teeth` | `clutchpack.ToothLoads` | each sample, if [`RecordOptions::per_tooth`] | `t_s, loads_n[], disc_index` |
+//! | `/impacts` | `clutchpack.Impact` | each impact, at `t_peak_s` | `disc, disc_index, t_on_s, t_peak_s, t_off_s, flank, v_on_m_s, peak_n` |
+//! | `/summary` | `clutchpack.RunSummary` | once, at the end | `t_end_s, discs[]{name, index, max_positive_n, max_negative_n, p99_abs_n, impacts, positive_impacts, negative_impacts, mean_top10_abs_n}` |
+//!
+//! `<segment>` is the disc's scene name made topic-safe by [`topic_segment`]. The
+//! `clutchpack.*` schemas are in `crates/record/proto/clutchpack.proto` (generated from
+//! [`proto`]). Metadata records: `clutchpack.run` (program, program_version, engine,
+//! scene_name, scene_file, scene_sha256, overrides, disc_names, recorder options, and
+//! `recorded_at_utc` unless deterministic), `clutchpack.solver`, `clutchpack.geometry`,
+//! `clutchpack.params`, and at the end `clutchpack.stats`. Attachment: the scene file,
+//! `application/toml`.
+//!
+//! ## Use
+//! ```no_run
+//! use clutchpack_record::{open, Recorder, RecordOptions, RunInfo};
+//! # fn engine_run(_: &mut dyn clutchpack_model::Observer) {}
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let info = RunInfo { engine: "reference".into(), ..Default::default() };
+//! let mut rec = Recorder::create("recordings/run.mcap", &info, &RecordOptions::default())?;
+//! engine_run(&mut rec); // the engine calls sample() and impact()
+//! let path = rec.finish(None)?; // None: store the recorder's own per-disc summary
+//!
+//! let reader = open(&path)?;
+//! if let Some(damage) = reader.damage() {
+//!     eprintln!("warning: {damage}");
+//! }
+//! for h in reader.load_histories() {
+//!     println!("{}: {} samples", h.name, h.t_s.len());
+//! }
+//! # Ok(()) }
+//! ```
+//!
+//! # Conventions
+//! - SI units, named in fields and keys (`load_n`, `t_s`); loads are per tooth, negative
+//!   when the shaft leads (Hu et al. eq (6)), as in `clutchpack_model`.
+//! - z is the shaft axis; positive rotation is the shaft's running direction (about +z).
+//! - Deterministic recordings ([`RecordOptions::deterministic`]) of the same stream are
+//!   byte-identical: no wall-clock data, single-threaded zstd, chunks cut by count and size.
+//! - Errors: [`RecordError`] for writing, [`ReadError`] for reading; each displays as one line.
+
+mod export;
+pub mod info;
+pub mod proto;
+mod read;
+pub mod scene;
+#[cfg(feature = "serve")]
+mod serve;
+mod summary;
+pub mod synthetic;
+pub mod topics;
+mod write;
+
+pub use export::export_csv;
+pub use info::{sha256_hex, DiscGeometry, RunInfo, ShaftGeometry};
+pub use read::{
+    from_bytes, open, open_complete, AttachmentInfo, Damage, DamageKind, DiscSeries, LoadHistory,
+    MessageView, ReadError, RecordingInfo, RecordingReader, TopicInfo,
+};
+#[cfg(feature = "serve")]
+pub use serve::{serve, ServeError, ServeOptions};
+pub use summary::{DiscSummary, RunSummary, TOP_N};
+pub use write::{log_time_ns, RecordError, RecordOptions, Recorder};
+
+/// A disc name made safe for a topic and frame name: every character other than
+/// `A-Z a-z 0-9 _ -` becomes `_` (an empty name becomes `_`). Repeated segments in one
+/// recording get `_<index>` appended.
+pub fn topic_segment(name: &str) -> String {
+    let s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if s.is_empty() {
+        "_".into()
+    } else {
+        s
+    }
+}

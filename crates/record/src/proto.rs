@@ -1,0 +1,754 @@
+//! Our own protobuf messages (package `clutchpack`), their descriptor, and the `.proto` text.
+//!
+//! The schema is defined once, in the tables of this module ([`MESSAGES`], [`ENUMS`]); from
+//! them come the `FileDescriptorProto` embedded in every recording ([`file_descriptor_set`])
+//! and the human-readable `proto/clutchpack.proto` ([`proto_text`], checked by a test). The
+//! encoders are the `prost`-derived structs below, whose tags a test checks against the tables.
+//! No `protoc` and no build script are needed.
+//!
+//! Field names carry their unit (`load_n`, `t_s`), so a plot of `/discs/d1/spline.load_n`
+//! says what it shows. Every message carries the simulated time `t_s` (also the MCAP log time,
+//! in ns), because PlotJuggler and Rerun can plot against a field as well as the log time.
+//!
+//! Schema evolution: never renumber or retype a field; add new fields with new numbers.
+
+use prost::Message as _;
+use prost_types::field_descriptor_proto::{Label, Type};
+use prost_types::{
+    DescriptorProto, EnumDescriptorProto, EnumValueDescriptorProto, FieldDescriptorProto,
+    FileDescriptorProto, FileDescriptorSet,
+};
+
+/// Protobuf package of our messages.
+pub const PACKAGE: &str = "clutchpack";
+/// File name of our messages inside the embedded `FileDescriptorSet`.
+pub const FILE_NAME: &str = "clutchpack.proto";
+
+/// Full schema name of [`ShaftState`] (topic `/shaft`).
+pub const SHAFT_STATE: &str = "clutchpack.ShaftState";
+/// Full schema name of [`SplineState`] (topics `/discs/<name>/spline`).
+pub const SPLINE_STATE: &str = "clutchpack.SplineState";
+/// Full schema name of [`ToothLoads`] (topics `/discs/<name>/teeth`).
+pub const TOOTH_LOADS: &str = "clutchpack.ToothLoads";
+/// Full schema name of [`Impact`] (topic `/impacts`).
+pub const IMPACT: &str = "clutchpack.Impact";
+/// Full schema name of [`RunSummary`] (topic `/summary`).
+pub const RUN_SUMMARY: &str = "clutchpack.RunSummary";
+
+/// The shaft at one sample (topic `/shaft`).
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct ShaftState {
+    /// Simulated time in s.
+    #[prost(double, tag = "1")]
+    pub t_s: f64,
+    /// Shaft angle in rad.
+    #[prost(double, tag = "2")]
+    pub angle_rad: f64,
+    /// Shaft speed in rad/s.
+    #[prost(double, tag = "3")]
+    pub speed_rad_s: f64,
+}
+
+/// One disc's spline coupling at one sample (topic `/discs/<name>/spline`); the fields of
+/// [`clutchpack_model::DiscSample`] but the per-tooth loads.
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct SplineState {
+    /// Simulated time in s.
+    #[prost(double, tag = "1")]
+    pub t_s: f64,
+    /// Relative angle `phi = theta_shaft - theta_disc` in rad (positive: the shaft leads).
+    #[prost(double, tag = "2")]
+    pub rel_angle_rad: f64,
+    /// Closing speed along the line of action in m/s (positive closing).
+    #[prost(double, tag = "3")]
+    pub closing_speed_m_s: f64,
+    /// Metal penetration along the line of action in m (negative: a gap).
+    #[prost(double, tag = "4")]
+    pub penetration_m: f64,
+    /// Per-tooth load in N (negative when the shaft leads, Hu et al. eq (6)).
+    #[prost(double, tag = "5")]
+    pub load_n: f64,
+    /// Spline torque on the disc in N m.
+    #[prost(double, tag = "6")]
+    pub torque_n_m: f64,
+    /// Whether a contact event (film or metal) is in progress.
+    #[prost(bool, tag = "7")]
+    pub engaged: bool,
+    /// Stiffness of the current contact event in N/m^1.5 (0 when not engaged).
+    #[prost(double, tag = "8")]
+    pub stiffness_n_m1_5: f64,
+    /// Disc speed in rad/s.
+    #[prost(double, tag = "9")]
+    pub speed_rad_s: f64,
+    /// Disc angle in rad.
+    #[prost(double, tag = "10")]
+    pub angle_rad: f64,
+    /// Index of the disc in the scene, from 0.
+    #[prost(uint32, tag = "11")]
+    pub disc_index: u32,
+}
+
+/// Per-tooth loads of one disc at one sample (topic `/discs/<name>/teeth`).
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct ToothLoads {
+    /// Simulated time in s.
+    #[prost(double, tag = "1")]
+    pub t_s: f64,
+    /// Load of each tooth in N, signed as `load_n`.
+    #[prost(double, repeated, tag = "2")]
+    pub loads_n: Vec<f64>,
+    /// Index of the disc in the scene, from 0.
+    #[prost(uint32, tag = "3")]
+    pub disc_index: u32,
+}
+
+/// Which flank is in contact (wire form of [`clutchpack_model::Flank`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, prost::Enumeration)]
+#[repr(i32)]
+pub enum Flank {
+    /// Not set (never written).
+    Unspecified = 0,
+    /// The shaft leads; the load is negative.
+    ShaftLeads = 1,
+    /// The disc leads; the load is positive.
+    DiscLeads = 2,
+}
+
+/// One impact (topic `/impacts`), logged at its peak time `t_peak_s`.
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct Impact {
+    /// Disc name.
+    #[prost(string, tag = "1")]
+    pub disc: String,
+    /// Index of the disc in the scene, from 0.
+    #[prost(uint32, tag = "2")]
+    pub disc_index: u32,
+    /// Onset in s.
+    #[prost(double, tag = "3")]
+    pub t_on_s: f64,
+    /// Time of the peak load in s.
+    #[prost(double, tag = "4")]
+    pub t_peak_s: f64,
+    /// Separation in s.
+    #[prost(double, tag = "5")]
+    pub t_off_s: f64,
+    /// Flank in contact.
+    #[prost(enumeration = "Flank", tag = "6")]
+    pub flank: i32,
+    /// Closing speed at onset in m/s.
+    #[prost(double, tag = "7")]
+    pub v_on_m_s: f64,
+    /// Signed peak per-tooth load in N.
+    #[prost(double, tag = "8")]
+    pub peak_n: f64,
+}
+
+/// Statistics of one disc's impact peaks (wire form of [`crate::DiscSummary`]).
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct DiscSummary {
+    /// Disc name.
+    #[prost(string, tag = "1")]
+    pub name: String,
+    /// Index of the disc in the scene, from 0.
+    #[prost(uint32, tag = "2")]
+    pub index: u32,
+    /// Largest positive peak in N (0 if none).
+    #[prost(double, tag = "3")]
+    pub max_positive_n: f64,
+    /// Most negative peak in N (<= 0; 0 if none).
+    #[prost(double, tag = "4")]
+    pub max_negative_n: f64,
+    /// 99th percentile of |peak| in N.
+    #[prost(double, tag = "5")]
+    pub p99_abs_n: f64,
+    /// Number of impacts.
+    #[prost(uint64, tag = "6")]
+    pub impacts: u64,
+    /// Impacts with a positive peak.
+    #[prost(uint64, tag = "7")]
+    pub positive_impacts: u64,
+    /// Impacts with a negative peak.
+    #[prost(uint64, tag = "8")]
+    pub negative_impacts: u64,
+    /// Mean of the 10 largest |peak| in N.
+    #[prost(double, tag = "9")]
+    pub mean_top10_abs_n: f64,
+}
+
+/// The run's summary (topic `/summary`, one message at the end of the run).
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct RunSummary {
+    /// Simulated time at the end of the run in s.
+    #[prost(double, tag = "1")]
+    pub t_end_s: f64,
+    /// One entry per disc, in scene order.
+    #[prost(message, repeated, tag = "2")]
+    pub discs: Vec<DiscSummary>,
+}
+
+/// Field type in the schema tables.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FieldType {
+    /// `double`
+    Double,
+    /// `bool`
+    Bool,
+    /// `uint32`
+    Uint32,
+    /// `uint64`
+    Uint64,
+    /// `string`
+    String,
+    /// An enum of this package, by short name.
+    Enum(&'static str),
+    /// A message of this package, by short name.
+    Message(&'static str),
+}
+
+/// One field of a message in the schema tables.
+#[derive(Debug, Clone, Copy)]
+pub struct FieldDef {
+    /// Field name (with its unit).
+    pub name: &'static str,
+    /// Field number (never changes).
+    pub number: i32,
+    /// Type.
+    pub ty: FieldType,
+    /// `repeated`.
+    pub repeated: bool,
+    /// One-line comment for the `.proto` text.
+    pub doc: &'static str,
+}
+
+/// One message in the schema tables.
+#[derive(Debug, Clone, Copy)]
+pub struct MessageDef {
+    /// Short name (`SplineState`).
+    pub name: &'static str,
+    /// Comment for the `.proto` text.
+    pub doc: &'static str,
+    /// Fields in number order.
+    pub fields: &'static [FieldDef],
+}
+
+/// One enum in the schema tables.
+#[derive(Debug, Clone, Copy)]
+pub struct EnumDef {
+    /// Short name.
+    pub name: &'static str,
+    /// Comment.
+    pub doc: &'static str,
+    /// Values (name, number).
+    pub values: &'static [(&'static str, i32)],
+}
+
+const fn f(name: &'static str, number: i32, ty: FieldType, doc: &'static str) -> FieldDef {
+    FieldDef {
+        name,
+        number,
+        ty,
+        repeated: false,
+        doc,
+    }
+}
+
+const fn rep(name: &'static str, number: i32, ty: FieldType, doc: &'static str) -> FieldDef {
+    FieldDef {
+        name,
+        number,
+        ty,
+        repeated: true,
+        doc,
+    }
+}
+
+use FieldType::{Bool, Double, Uint32, Uint64};
+
+/// The enums of package `clutchpack`.
+pub const ENUMS: &[EnumDef] = &[EnumDef {
+    name: "Flank",
+    doc: "Which flank is in contact.",
+    values: &[
+        ("FLANK_UNSPECIFIED", 0),
+        ("SHAFT_LEADS", 1),
+        ("DISC_LEADS", 2),
+    ],
+}];
+
+/// The messages of package `clutchpack`, in file order.
+pub const MESSAGES: &[MessageDef] = &[
+    MessageDef {
+        name: "ShaftState",
+        doc: "The shaft at one sample. Topic /shaft.",
+        fields: &[
+            f("t_s", 1, Double, "simulated time, s"),
+            f("angle_rad", 2, Double, "shaft angle, rad"),
+            f("speed_rad_s", 3, Double, "shaft speed, rad/s"),
+        ],
+    },
+    MessageDef {
+        name: "SplineState",
+        doc: "One disc's spline coupling at one sample. Topic /discs/<name>/spline.",
+        fields: &[
+            f("t_s", 1, Double, "simulated time, s"),
+            f(
+                "rel_angle_rad",
+                2,
+                Double,
+                "phi = theta_shaft - theta_disc, rad (positive: the shaft leads)",
+            ),
+            f(
+                "closing_speed_m_s",
+                3,
+                Double,
+                "closing speed along the line of action, m/s (positive closing)",
+            ),
+            f(
+                "penetration_m",
+                4,
+                Double,
+                "metal penetration along the line of action, m (negative: a gap)",
+            ),
+            f(
+                "load_n",
+                5,
+                Double,
+                "per-tooth load, N (negative when the shaft leads)",
+            ),
+            f("torque_n_m", 6, Double, "spline torque on the disc, N m"),
+            f(
+                "engaged",
+                7,
+                Bool,
+                "a contact event (film or metal) is in progress",
+            ),
+            f(
+                "stiffness_n_m1_5",
+                8,
+                Double,
+                "stiffness of the current contact event, N/m^1.5 (0 when not engaged)",
+            ),
+            f("speed_rad_s", 9, Double, "disc speed, rad/s"),
+            f("angle_rad", 10, Double, "disc angle, rad"),
+            f(
+                "disc_index",
+                11,
+                Uint32,
+                "index of the disc in the scene, from 0",
+            ),
+        ],
+    },
+    MessageDef {
+        name: "ToothLoads",
+        doc: "Per-tooth loads of one disc at one sample. Topic /discs/<name>/teeth.",
+        fields: &[
+            f("t_s", 1, Double, "simulated time, s"),
+            rep(
+                "loads_n",
+                2,
+                Double,
+                "load of each tooth, N (negative when the shaft leads)",
+            ),
+            f(
+                "disc_index",
+                3,
+                Uint32,
+                "index of the disc in the scene, from 0",
+            ),
+        ],
+    },
+    MessageDef {
+        name: "Impact",
+        doc: "One impact, logged at its peak time. Topic /impacts.",
+        fields: &[
+            f("disc", 1, FieldType::String, "disc name"),
+            f(
+                "disc_index",
+                2,
+                Uint32,
+                "index of the disc in the scene, from 0",
+            ),
+            f("t_on_s", 3, Double, "onset, s"),
+            f("t_peak_s", 4, Double, "time of the peak load, s"),
+            f("t_off_s", 5, Double, "separation, s"),
+            f("flank", 6, FieldType::Enum("Flank"), "flank in contact"),
+            f("v_on_m_s", 7, Double, "closing speed at onset, m/s"),
+            f("peak_n", 8, Double, "signed peak per-tooth load, N"),
+        ],
+    },
+    MessageDef {
+        name: "DiscSummary",
+        doc: "Statistics of one disc's impact peaks.",
+        fields: &[
+            f("name", 1, FieldType::String, "disc name"),
+            f("index", 2, Uint32, "index of the disc in the scene, from 0"),
+            f(
+                "max_positive_n",
+                3,
+                Double,
+                "largest positive peak, N (0 if none)",
+            ),
+            f(
+                "max_negative_n",
+                4,
+                Double,
+                "most negative peak, N (<= 0; 0 if none)",
+            ),
+            f(
+                "p99_abs_n",
+                5,
+                Double,
+                "99th percentile of |peak|, N (numpy's linear definition)",
+            ),
+            f("impacts", 6, Uint64, "number of impacts"),
+            f(
+                "positive_impacts",
+                7,
+                Uint64,
+                "impacts with a positive peak (disc leads)",
+            ),
+            f(
+                "negative_impacts",
+                8,
+                Uint64,
+                "impacts with a negative peak (shaft leads)",
+            ),
+            f(
+                "mean_top10_abs_n",
+                9,
+                Double,
+                "mean of the 10 largest |peak|, N",
+            ),
+        ],
+    },
+    MessageDef {
+        name: "RunSummary",
+        doc: "The run's per-disc summary, one message at the end of the run. Topic /summary.",
+        fields: &[
+            f(
+                "t_end_s",
+                1,
+                Double,
+                "simulated time at the end of the run, s",
+            ),
+            rep(
+                "discs",
+                2,
+                FieldType::Message("DiscSummary"),
+                "one entry per disc, in scene order",
+            ),
+        ],
+    },
+];
+
+fn json_name(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    let mut upper = false;
+    for c in name.chars() {
+        if c == '_' {
+            upper = true;
+        } else if upper {
+            out.extend(c.to_uppercase());
+            upper = false;
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// The `FileDescriptorProto` of `clutchpack.proto` (proto3, package `clutchpack`, no imports).
+pub fn file_descriptor() -> FileDescriptorProto {
+    let message_type = MESSAGES
+        .iter()
+        .map(|m| DescriptorProto {
+            name: Some(m.name.to_string()),
+            field: m
+                .fields
+                .iter()
+                .map(|fd| {
+                    let (ty, type_name) = match fd.ty {
+                        Double => (Type::Double, None),
+                        Bool => (Type::Bool, None),
+                        Uint32 => (Type::Uint32, None),
+                        Uint64 => (Type::Uint64, None),
+                        FieldType::String => (Type::String, None),
+                        FieldType::Enum(n) => (Type::Enum, Some(format!(".{PACKAGE}.{n}"))),
+                        FieldType::Message(n) => (Type::Message, Some(format!(".{PACKAGE}.{n}"))),
+                    };
+                    FieldDescriptorProto {
+                        name: Some(fd.name.to_string()),
+                        number: Some(fd.number),
+                        label: Some(if fd.repeated {
+                            Label::Repeated
+                        } else {
+                            Label::Optional
+                        } as i32),
+                        r#type: Some(ty as i32),
+                        type_name,
+                        json_name: Some(json_name(fd.name)),
+                        ..Default::default()
+                    }
+                })
+                .collect(),
+            ..Default::default()
+        })
+        .collect();
+    let enum_type = ENUMS
+        .iter()
+        .map(|e| EnumDescriptorProto {
+            name: Some(e.name.to_string()),
+            value: e
+                .values
+                .iter()
+                .map(|&(n, v)| EnumValueDescriptorProto {
+                    name: Some(n.to_string()),
+                    number: Some(v),
+                    options: None,
+                })
+                .collect(),
+            ..Default::default()
+        })
+        .collect();
+    FileDescriptorProto {
+        name: Some(FILE_NAME.to_string()),
+        package: Some(PACKAGE.to_string()),
+        message_type,
+        enum_type,
+        syntax: Some("proto3".to_string()),
+        ..Default::default()
+    }
+}
+
+/// The encoded `FileDescriptorSet` holding [`file_descriptor`]: the schema data of every
+/// `clutchpack.*` schema in a recording (MCAP schema encoding `protobuf`).
+pub fn file_descriptor_set() -> Vec<u8> {
+    FileDescriptorSet {
+        file: vec![file_descriptor()],
+    }
+    .encode_to_vec()
+}
+
+/// The `.proto` text of our messages, generated from the tables (the content of
+/// `crates/record/proto/clutchpack.proto`).
+pub fn proto_text() -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "// clutchpack recording messages. GENERATED from crates/record/src/proto.rs by its tests;\n\
+         // edit the tables there, then run `UPDATE_PROTO=1 cargo test -p clutchpack_record`.\n\
+         // Units are in the field names; times are simulated seconds.\n\
+         syntax = \"proto3\";\n\npackage {PACKAGE};"
+    );
+    for e in ENUMS {
+        let _ = writeln!(s, "\n// {}\nenum {} {{", e.doc, e.name);
+        for (n, v) in e.values {
+            let _ = writeln!(s, "  {n} = {v};");
+        }
+        s.push_str("}\n");
+    }
+    for m in MESSAGES {
+        let _ = writeln!(s, "\n// {}\nmessage {} {{", m.doc, m.name);
+        for fd in m.fields {
+            let ty = match fd.ty {
+                Double => "double",
+                Bool => "bool",
+                Uint32 => "uint32",
+                Uint64 => "uint64",
+                FieldType::String => "string",
+                FieldType::Enum(n) | FieldType::Message(n) => n,
+            };
+            let label = if fd.repeated { "repeated " } else { "" };
+            let _ = writeln!(
+                s,
+                "  {label}{ty} {} = {}; // {}",
+                fd.name, fd.number, fd.doc
+            );
+        }
+        s.push_str("}\n");
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Splits an encoded message into its (field number, wire type) keys, top level only.
+    fn keys(mut b: &[u8]) -> Vec<(u64, u64)> {
+        fn varint(b: &mut &[u8]) -> u64 {
+            let mut v = 0u64;
+            let mut shift = 0;
+            loop {
+                let byte = b[0];
+                *b = &b[1..];
+                v |= u64::from(byte & 0x7f) << shift;
+                if byte & 0x80 == 0 {
+                    return v;
+                }
+                shift += 7;
+            }
+        }
+        let mut out = Vec::new();
+        while !b.is_empty() {
+            let key = varint(&mut b);
+            let (num, wt) = (key >> 3, key & 7);
+            match wt {
+                0 => {
+                    varint(&mut b);
+                }
+                1 => b = &b[8..],
+                2 => {
+                    let n = varint(&mut b) as usize;
+                    b = &b[n..];
+                }
+                5 => b = &b[4..],
+                _ => panic!("unexpected wire type {wt}"),
+            }
+            out.push((num, wt));
+        }
+        out
+    }
+
+    fn wire_type(fd: &FieldDef) -> u64 {
+        if fd.repeated {
+            return 2; // packed scalars and messages are length-delimited
+        }
+        match fd.ty {
+            Double => 1,
+            Bool | Uint32 | Uint64 | FieldType::Enum(_) => 0,
+            FieldType::String | FieldType::Message(_) => 2,
+        }
+    }
+
+    fn check(name: &str, encoded: Vec<u8>) {
+        let def = MESSAGES.iter().find(|m| m.name == name).unwrap();
+        let got = keys(&encoded);
+        let want: Vec<(u64, u64)> = def
+            .fields
+            .iter()
+            .map(|fd| (fd.number as u64, wire_type(fd)))
+            .collect();
+        assert_eq!(
+            got, want,
+            "prost struct {name} disagrees with its descriptor table"
+        );
+    }
+
+    /// The prost-derived encoders put every field of the descriptor tables under the same
+    /// number and wire type (all fields set to non-default values, so all are encoded), so a
+    /// decoder that trusts the embedded descriptor reads what we wrote.
+    #[test]
+    fn encoders_match_the_descriptor_tables() {
+        check(
+            "ShaftState",
+            ShaftState {
+                t_s: 1.0,
+                angle_rad: 2.0,
+                speed_rad_s: 3.0,
+            }
+            .encode_to_vec(),
+        );
+        check(
+            "SplineState",
+            SplineState {
+                t_s: 1.0,
+                rel_angle_rad: 2.0,
+                closing_speed_m_s: 3.0,
+                penetration_m: 4.0,
+                load_n: 5.0,
+                torque_n_m: 6.0,
+                engaged: true,
+                stiffness_n_m1_5: 8.0,
+                speed_rad_s: 9.0,
+                angle_rad: 10.0,
+                disc_index: 11,
+            }
+            .encode_to_vec(),
+        );
+        check(
+            "ToothLoads",
+            ToothLoads {
+                t_s: 1.0,
+                loads_n: vec![1.0, 2.0],
+                disc_index: 3,
+            }
+            .encode_to_vec(),
+        );
+        check(
+            "Impact",
+            Impact {
+                disc: "a".into(),
+                disc_index: 2,
+                t_on_s: 3.0,
+                t_peak_s: 4.0,
+                t_off_s: 5.0,
+                flank: Flank::DiscLeads as i32,
+                v_on_m_s: 7.0,
+                peak_n: 8.0,
+            }
+            .encode_to_vec(),
+        );
+        let ds = DiscSummary {
+            name: "a".into(),
+            index: 2,
+            max_positive_n: 3.0,
+            max_negative_n: -4.0,
+            p99_abs_n: 5.0,
+            impacts: 6,
+            positive_impacts: 7,
+            negative_impacts: 8,
+            mean_top10_abs_n: 9.0,
+        };
+        check("DiscSummary", ds.encode_to_vec());
+        check(
+            "RunSummary",
+            RunSummary {
+                t_end_s: 1.0,
+                discs: vec![ds],
+            }
+            .encode_to_vec(),
+        );
+    }
+
+    /// Every message and enum of the tables is in the descriptor, with full type names that
+    /// resolve inside the file (a decoder builds its pool from this file alone).
+    #[test]
+    fn descriptor_is_self_contained() {
+        let fd = file_descriptor();
+        assert_eq!(fd.message_type.len(), MESSAGES.len());
+        let known: Vec<String> = MESSAGES
+            .iter()
+            .map(|m| m.name)
+            .chain(ENUMS.iter().map(|e| e.name))
+            .map(|n| format!(".{PACKAGE}.{n}"))
+            .collect();
+        for m in &fd.message_type {
+            for field in &m.field {
+                if let Some(t) = &field.type_name {
+                    assert!(known.contains(t), "{t} does not resolve");
+                }
+            }
+        }
+        let set = FileDescriptorSet::decode(file_descriptor_set().as_slice()).unwrap();
+        assert_eq!(set.file, vec![fd]);
+        for name in [SHAFT_STATE, SPLINE_STATE, TOOTH_LOADS, IMPACT, RUN_SUMMARY] {
+            let short = name.strip_prefix("clutchpack.").unwrap();
+            assert!(MESSAGES.iter().any(|m| m.name == short), "{name}");
+        }
+    }
+
+    /// `proto/clutchpack.proto` is the text generated from the tables (set `UPDATE_PROTO=1`
+    /// to rewrite it after a deliberate schema change).
+    #[test]
+    fn proto_file_is_up_to_date() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/proto/clutchpack.proto");
+        let text = proto_text();
+        if std::env::var_os("UPDATE_PROTO").is_some() {
+            std::fs::write(path, &text).unwrap();
+        }
+        let on_disk = std::fs::read_to_string(path).unwrap_or_default();
+        assert_eq!(on_disk, text, "{path} is stale: run with UPDATE_PROTO=1");
+    }
+}

@@ -1,0 +1,279 @@
+//! The 3D view: body poses (`/tf`, `foxglove.FrameTransforms`) and the pack's geometry
+//! (`/scene`, `foxglove.SceneUpdate`).
+//!
+//! Frames: `world` is fixed, z along the shaft axis. The shaft's frame `shaft` and each
+//! disc's frame `disc/<name>` sit on the axis (a disc's at its mid-plane `z_m`) and turn about
+//! +z by the body's angle. Entities are `frame_locked`, so they follow their frame. The first
+//! `/scene` message (at t = 0) holds the static bodies: the shaft cylinder with a stripe, and
+//! each disc as a triangle-mesh annulus with a rim marker. Later `/scene` messages replace one
+//! entity per disc, `disc/<name>/teeth`: its spline teeth as cubes coloured by the largest
+//! `|load_n|` since the previous update (grey = no load, yellow = half, red = the colour
+//! scale).
+
+use crate::info::{DiscGeometry, RunInfo};
+use foxglove::schemas::{
+    Color, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms, Point3, Pose,
+    Quaternion, SceneEntity, SceneUpdate, Timestamp, TriangleListPrimitive, Vector3,
+};
+use std::f64::consts::PI;
+
+/// The fixed frame.
+pub const WORLD_FRAME: &str = "world";
+/// The shaft's frame.
+pub const SHAFT_FRAME: &str = "shaft";
+
+/// The frame of the disc whose topic segment is `segment` (`disc/<segment>`).
+pub fn disc_frame(segment: &str) -> String {
+    format!("disc/{segment}")
+}
+
+/// Segments of the annulus meshes.
+const SEGMENTS: u32 = 64;
+/// Teeth drawn when a disc's tooth count is unknown (0).
+const MARKERS: u32 = 8;
+/// At most this many teeth are drawn per disc.
+const MAX_TEETH: u32 = 96;
+
+pub(crate) fn timestamp(log_time_ns: u64) -> Timestamp {
+    Timestamp::new(
+        (log_time_ns / 1_000_000_000).min(u64::from(u32::MAX)) as u32,
+        (log_time_ns % 1_000_000_000) as u32,
+    )
+}
+
+fn about_z(angle_rad: f64) -> Quaternion {
+    let h = 0.5 * angle_rad;
+    Quaternion {
+        x: 0.0,
+        y: 0.0,
+        z: h.sin(),
+        w: h.cos(),
+    }
+}
+
+fn v3(x: f64, y: f64, z: f64) -> Vector3 {
+    Vector3 { x, y, z }
+}
+
+fn pose(x: f64, y: f64, z: f64, angle_rad: f64) -> Option<Pose> {
+    Some(Pose {
+        position: Some(v3(x, y, z)),
+        orientation: Some(about_z(angle_rad)),
+    })
+}
+
+fn rgba(r: f64, g: f64, b: f64, a: f64) -> Option<Color> {
+    Some(Color { r, g, b, a })
+}
+
+/// The colour of a load level `x = |load| / scale`, clamped to 0..=1: grey at 0, yellow at
+/// 0.5, red at 1.
+pub fn load_color(x: f64) -> Color {
+    let x = if x.is_finite() {
+        x.clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    let (grey, yellow, red) = ([0.6, 0.6, 0.6], [1.0, 0.85, 0.0], [1.0, 0.0, 0.0]);
+    let (a, b, s) = if x < 0.5 {
+        (grey, yellow, x / 0.5)
+    } else {
+        (yellow, red, (x - 0.5) / 0.5)
+    };
+    let mix = |i: usize| a[i] + s * (b[i] - a[i]);
+    Color {
+        r: mix(0),
+        g: mix(1),
+        b: mix(2),
+        a: 1.0,
+    }
+}
+
+/// Poses of the shaft and the discs at `log_time_ns` (ns): rotations about +z by the angles
+/// (rad), discs at their `z_m`.
+pub(crate) fn frame_transforms(
+    log_time_ns: u64,
+    shaft_angle_rad: f64,
+    discs: &[(String, f64, f64)], // (frame, z_m, angle_rad)
+) -> FrameTransforms {
+    let ts = timestamp(log_time_ns);
+    let mut transforms = Vec::with_capacity(discs.len() + 1);
+    transforms.push(FrameTransform {
+        timestamp: Some(ts),
+        parent_frame_id: WORLD_FRAME.into(),
+        child_frame_id: SHAFT_FRAME.into(),
+        translation: Some(v3(0.0, 0.0, 0.0)),
+        rotation: Some(about_z(shaft_angle_rad)),
+    });
+    for (frame, z_m, angle) in discs {
+        transforms.push(FrameTransform {
+            timestamp: Some(ts),
+            parent_frame_id: WORLD_FRAME.into(),
+            child_frame_id: frame.clone(),
+            translation: Some(v3(0.0, 0.0, *z_m)),
+            rotation: Some(about_z(*angle)),
+        });
+    }
+    FrameTransforms { transforms }
+}
+
+/// The radial depth of a disc's drawn teeth in m.
+fn tooth_depth(d: &DiscGeometry) -> f64 {
+    (0.12 * d.inner_radius_m).min(0.5 * (d.outer_radius_m - d.inner_radius_m).abs())
+}
+
+/// A closed annulus (top, bottom, inner and outer walls) between radii `r0 < r1`, thickness
+/// `h`, centred on its frame's origin.
+fn annulus(r0: f64, r1: f64, h: f64, color: Option<Color>) -> TriangleListPrimitive {
+    let n = SEGMENTS;
+    let mut points = Vec::with_capacity(4 * n as usize);
+    // rings: 0 inner bottom, 1 outer bottom, 2 inner top, 3 outer top
+    for (r, z) in [(r0, -h / 2.0), (r1, -h / 2.0), (r0, h / 2.0), (r1, h / 2.0)] {
+        for i in 0..n {
+            let a = 2.0 * PI * f64::from(i) / f64::from(n);
+            points.push(Point3 {
+                x: r * a.cos(),
+                y: r * a.sin(),
+                z,
+            });
+        }
+    }
+    let idx = |ring: u32, i: u32| ring * n + i % n;
+    let mut indices = Vec::with_capacity(24 * n as usize);
+    for i in 0..n {
+        let j = i + 1;
+        for (a, b) in [(3, 2), (0, 1), (1, 3), (2, 0)] {
+            // quad between ring a and ring b, segment i..j
+            indices.extend_from_slice(&[idx(a, i), idx(b, i), idx(b, j)]);
+            indices.extend_from_slice(&[idx(a, i), idx(b, j), idx(a, j)]);
+        }
+    }
+    TriangleListPrimitive {
+        pose: pose(0.0, 0.0, 0.0, 0.0),
+        points,
+        color,
+        colors: Vec::new(),
+        indices,
+    }
+}
+
+fn entity(log_time_ns: u64, frame: &str, id: &str) -> SceneEntity {
+    SceneEntity {
+        timestamp: Some(timestamp(log_time_ns)),
+        frame_id: frame.into(),
+        id: id.into(),
+        lifetime: None,
+        frame_locked: true,
+        ..Default::default()
+    }
+}
+
+/// The static scene: shaft and disc bodies, plus the teeth at zero load.
+pub(crate) fn static_scene(info: &RunInfo, frames: &[String]) -> SceneUpdate {
+    let s = info.shaft_geometry();
+    let len = (s.z_max_m - s.z_min_m).abs().max(1e-6);
+    let zc = 0.5 * (s.z_max_m + s.z_min_m);
+    let mut shaft = entity(0, SHAFT_FRAME, "shaft");
+    shaft.cylinders.push(CylinderPrimitive {
+        pose: pose(0.0, 0.0, zc, 0.0),
+        size: Some(v3(2.0 * s.radius_m, 2.0 * s.radius_m, len)),
+        bottom_scale: 1.0,
+        top_scale: 1.0,
+        color: rgba(0.55, 0.58, 0.62, 1.0),
+    });
+    // a stripe along the shaft so its rotation shows
+    shaft.cubes.push(CubePrimitive {
+        pose: pose(s.radius_m, 0.0, zc, 0.0),
+        size: Some(v3(0.2 * s.radius_m, 0.2 * s.radius_m, len * 1.001)),
+        color: rgba(0.15, 0.3, 0.8, 1.0),
+    });
+    let mut entities = vec![shaft];
+    for (d, frame) in info.discs.iter().zip(frames) {
+        let mut e = entity(0, frame, frame);
+        let (r0, r1) = (
+            d.inner_radius_m.min(d.outer_radius_m),
+            d.outer_radius_m.max(d.inner_radius_m),
+        );
+        let h = d.thickness_m.abs().max(1e-6);
+        e.triangles
+            .push(annulus(r0, r1, h, rgba(0.62, 0.48, 0.32, 1.0)));
+        let w = 0.08 * (r1 - r0).max(1e-6);
+        e.cubes.push(CubePrimitive {
+            pose: pose(r1 - 2.0 * w, 0.0, 0.0, 0.0),
+            size: Some(v3(2.0 * w, w, h * 1.02)),
+            color: rgba(0.1, 0.1, 0.1, 1.0),
+        });
+        entities.push(e);
+    }
+    let mut update = SceneUpdate {
+        deletions: Vec::new(),
+        entities,
+    };
+    let zeros = vec![0.0; info.discs.len()];
+    update
+        .entities
+        .extend(teeth_scene(0, info, frames, &zeros).entities);
+    update
+}
+
+/// The teeth of every disc, coloured by `levels[i] = max |load| / scale` (0..=1).
+pub(crate) fn teeth_scene(
+    log_time_ns: u64,
+    info: &RunInfo,
+    frames: &[String],
+    levels: &[f64],
+) -> SceneUpdate {
+    let mut entities = Vec::with_capacity(info.discs.len());
+    for ((d, frame), &level) in info.discs.iter().zip(frames).zip(levels) {
+        let mut e = entity(log_time_ns, frame, &format!("{frame}/teeth"));
+        let n = if d.teeth == 0 {
+            MARKERS
+        } else {
+            d.teeth.min(MAX_TEETH)
+        };
+        let depth = tooth_depth(d).max(1e-6);
+        let r = d.inner_radius_m.min(d.outer_radius_m) - 0.5 * depth;
+        let width = 0.5 * 2.0 * PI * d.inner_radius_m.abs() / f64::from(n);
+        let color = Some(load_color(level));
+        for i in 0..n {
+            let a = 2.0 * PI * f64::from(i) / f64::from(n);
+            e.cubes.push(CubePrimitive {
+                pose: pose(r * a.cos(), r * a.sin(), 0.0, a),
+                size: Some(v3(depth, width.max(1e-6), d.thickness_m.abs().max(1e-6))),
+                color,
+            });
+        }
+        entities.push(e);
+    }
+    SceneUpdate {
+        deletions: Vec::new(),
+        entities,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The quaternion of a rotation about +z by 90 degrees maps x onto y, and the colour map
+    /// hits its three anchors.
+    #[test]
+    fn rotation_and_colours() {
+        let q = about_z(PI / 2.0);
+        // rotate (1, 0, 0): for a z-rotation, x' = 1 - 2 z^2, y' = 2 w z
+        assert!((1.0 - 2.0 * q.z * q.z).abs() < 1e-12);
+        assert!((2.0 * q.w * q.z - 1.0).abs() < 1e-12);
+        assert_eq!(load_color(0.0).r, 0.6);
+        assert_eq!((load_color(0.5).r, load_color(0.5).g), (1.0, 0.85));
+        assert_eq!((load_color(2.0).g, load_color(f64::NAN).g), (0.0, 0.0));
+    }
+
+    /// The annulus mesh indexes only its own points and has 8 triangles per segment.
+    #[test]
+    fn annulus_mesh_is_consistent() {
+        let m = annulus(0.03, 0.06, 0.002, None);
+        assert_eq!(m.points.len(), 4 * SEGMENTS as usize);
+        assert_eq!(m.indices.len(), 24 * SEGMENTS as usize);
+        assert!(m.indices.iter().all(|&i| (i as usize) < m.points.len()));
+    }
+}

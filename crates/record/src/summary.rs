@@ -1,0 +1,212 @@
+//! The per-disc summary stored on `/summary` at the end of a run.
+//!
+//! The statistics are those of `clutchpack_analysis::DiscStats` (same names, same
+//! definitions), computed from the impact peaks, so the CLI can convert one into the other
+//! field by field. This crate does not depend on the analysis crate.
+
+use crate::proto;
+use clutchpack_model::ImpactEvent;
+
+/// Number of impacts averaged by [`DiscSummary::mean_top10_abs_n`].
+pub const TOP_N: usize = 10;
+
+/// Statistics of the impact peaks (`ImpactEvent::peak_n`) of one disc over one run.
+///
+/// Loads are per tooth in N, signed as in the model: negative when the shaft leads, positive
+/// when the disc leads.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct DiscSummary {
+    /// Disc name (from the scene).
+    pub name: String,
+    /// Largest positive peak (disc leads) in N; 0 if there is none.
+    pub max_positive_n: f64,
+    /// Most negative peak (shaft leads) in N, a value `<= 0`; 0 if there is none.
+    pub max_negative_n: f64,
+    /// 99th percentile of `|peak|` in N (numpy's default `linear` definition); 0 without
+    /// impacts.
+    pub p99_abs_n: f64,
+    /// Number of impacts.
+    pub impacts: u64,
+    /// Number of impacts with a positive peak (disc leads).
+    pub positive_impacts: u64,
+    /// Number of impacts with a negative peak (shaft leads).
+    pub negative_impacts: u64,
+    /// Mean of the [`TOP_N`] = 10 largest `|peak|` in N (of all if fewer); 0 without impacts.
+    pub mean_top10_abs_n: f64,
+}
+
+impl DiscSummary {
+    /// Statistics of the signed peak loads `peaks_n` (N) of the disc `name`. NaN peaks are
+    /// not counted.
+    pub fn from_peaks(name: impl Into<String>, peaks_n: &[f64]) -> DiscSummary {
+        let mut s = DiscSummary {
+            name: name.into(),
+            ..Default::default()
+        };
+        let mut abs = Vec::with_capacity(peaks_n.len());
+        for &p in peaks_n.iter().filter(|p| !p.is_nan()) {
+            s.impacts += 1;
+            if p > 0.0 {
+                s.positive_impacts += 1;
+                s.max_positive_n = s.max_positive_n.max(p);
+            } else if p < 0.0 {
+                s.negative_impacts += 1;
+                s.max_negative_n = s.max_negative_n.min(p);
+            }
+            abs.push(p.abs());
+        }
+        if abs.is_empty() {
+            return s;
+        }
+        abs.sort_by(f64::total_cmp);
+        s.p99_abs_n = percentile_sorted(&abs, 99.0);
+        let top = &abs[abs.len().saturating_sub(TOP_N)..];
+        s.mean_top10_abs_n = top.iter().sum::<f64>() / top.len() as f64;
+        s
+    }
+}
+
+/// The `q`-th percentile (`q` in 0..=100) of ascending, NaN-free `sorted` values: numpy's
+/// `linear` method, position `h = (n - 1) q / 100` interpolated between its neighbours.
+fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
+    let n = sorted.len();
+    if n == 0 {
+        return 0.0;
+    }
+    let h = (n - 1) as f64 * q.clamp(0.0, 100.0) / 100.0;
+    let lo = (h.floor() as usize).min(n - 1);
+    let hi = (lo + 1).min(n - 1);
+    let frac = h - lo as f64;
+    if frac == 0.0 || lo == hi {
+        sorted[lo]
+    } else {
+        sorted[lo] + frac * (sorted[hi] - sorted[lo])
+    }
+}
+
+/// A run's summary: one [`DiscSummary`] per disc in scene order.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RunSummary {
+    /// Simulated time at the end of the run in s.
+    pub t_end_s: f64,
+    /// One entry per disc, in scene order.
+    pub discs: Vec<DiscSummary>,
+}
+
+impl RunSummary {
+    /// The summary of `impacts` for discs named `names` (`ImpactEvent::disc` indexes
+    /// `names`; impacts of an index beyond it get entries named `disc <index>`), at the end
+    /// time `t_end_s` (s).
+    pub fn from_impacts(names: &[String], impacts: &[ImpactEvent], t_end_s: f64) -> RunSummary {
+        let n = impacts
+            .iter()
+            .map(|e| e.disc + 1)
+            .max()
+            .unwrap_or(0)
+            .max(names.len());
+        let mut peaks = vec![Vec::new(); n];
+        for e in impacts {
+            peaks[e.disc].push(e.peak_n);
+        }
+        RunSummary {
+            t_end_s,
+            discs: peaks
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let name = names.get(i).cloned().unwrap_or_else(|| format!("disc {i}"));
+                    DiscSummary::from_peaks(name, p)
+                })
+                .collect(),
+        }
+    }
+
+    pub(crate) fn to_proto(&self) -> proto::RunSummary {
+        proto::RunSummary {
+            t_end_s: self.t_end_s,
+            discs: self
+                .discs
+                .iter()
+                .enumerate()
+                .map(|(i, d)| proto::DiscSummary {
+                    name: d.name.clone(),
+                    index: i as u32,
+                    max_positive_n: d.max_positive_n,
+                    max_negative_n: d.max_negative_n,
+                    p99_abs_n: d.p99_abs_n,
+                    impacts: d.impacts,
+                    positive_impacts: d.positive_impacts,
+                    negative_impacts: d.negative_impacts,
+                    mean_top10_abs_n: d.mean_top10_abs_n,
+                })
+                .collect(),
+        }
+    }
+
+    pub(crate) fn from_proto(p: proto::RunSummary) -> RunSummary {
+        RunSummary {
+            t_end_s: p.t_end_s,
+            discs: p
+                .discs
+                .into_iter()
+                .map(|d| DiscSummary {
+                    name: d.name,
+                    max_positive_n: d.max_positive_n,
+                    max_negative_n: d.max_negative_n,
+                    p99_abs_n: d.p99_abs_n,
+                    impacts: d.impacts,
+                    positive_impacts: d.positive_impacts,
+                    negative_impacts: d.negative_impacts,
+                    mean_top10_abs_n: d.mean_top10_abs_n,
+                })
+                .collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clutchpack_model::Flank;
+
+    fn ev(disc: usize, peak_n: f64) -> ImpactEvent {
+        ImpactEvent {
+            disc,
+            t_on_s: 0.0,
+            t_peak_s: 0.0,
+            t_off_s: 0.0,
+            flank: Flank::of(-peak_n),
+            v_on_m_s: 0.0,
+            peak_n,
+        }
+    }
+
+    /// Extremes, counts, numpy-linear p99 and the top-10 mean of a known set of peaks:
+    /// |peaks| = 1..=20, so p99 = 19 + 0.81 * 1 = 19.81 and the top ten average 15.5.
+    #[test]
+    fn statistics_of_known_peaks() {
+        let peaks: Vec<f64> = (1..=20)
+            .map(|i| if i % 2 == 0 { i as f64 } else { -(i as f64) })
+            .collect();
+        let s = DiscSummary::from_peaks("a", &peaks);
+        assert_eq!(s.impacts, 20);
+        assert_eq!(s.positive_impacts, 10);
+        assert_eq!(s.negative_impacts, 10);
+        assert_eq!(s.max_positive_n, 20.0);
+        assert_eq!(s.max_negative_n, -19.0);
+        assert!((s.p99_abs_n - 19.81).abs() < 1e-12);
+        assert!((s.mean_top10_abs_n - 15.5).abs() < 1e-12);
+    }
+
+    /// A disc without impacts gets zeros; an impact beyond the names gets its own entry.
+    #[test]
+    fn empty_discs_and_unknown_indices() {
+        let s = RunSummary::from_impacts(&["a".into()], &[ev(2, 5.0)], 1.0);
+        assert_eq!(s.discs.len(), 3);
+        assert_eq!(s.discs[0], DiscSummary::from_peaks("a", &[]));
+        assert_eq!(s.discs[0].p99_abs_n, 0.0);
+        assert_eq!(s.discs[2].name, "disc 2");
+        assert_eq!(s.discs[2].max_positive_n, 5.0);
+        assert_eq!(RunSummary::from_proto(s.to_proto()), s);
+    }
+}

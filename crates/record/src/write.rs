@@ -1,0 +1,674 @@
+//! Writing a recording: [`Recorder`], an [`Observer`] that streams an engine's samples and
+//! impact events into an MCAP file.
+
+use crate::info::{num, utc_text, RunInfo, META_STATS, SCENE_MEDIA_TYPE};
+use crate::scene::{self, disc_frame};
+use crate::summary::RunSummary;
+use crate::{proto, topic_segment, topics};
+use clutchpack_model::{Flank, ImpactEvent, Observer, RunStats, Sample};
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufWriter, Write as _};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// How a run is recorded. `RecordOptions::default()` is what `clutchpack run` uses.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordOptions {
+    /// Write no wall-clock data (no `recorded_at_utc`, `finished_at_utc`, `wall_s`, zero
+    /// attachment `create_time`) and end chunks only on message count and size, never on the
+    /// wall-clock timer, so that the same stream gives a byte-identical file. Default `false`.
+    pub deterministic: bool,
+    /// Also write `/discs/<name>/teeth` (per-tooth loads) for samples that carry them.
+    /// Default `false`.
+    pub per_tooth: bool,
+    /// Longest wall time between two chunk flushes; a killed run loses at most about this
+    /// much. Ignored when `deterministic`. Default 1 s.
+    pub flush_interval: Duration,
+    /// Flush the chunk after this many messages at most (deterministic). Default 100 000.
+    pub flush_messages: usize,
+    /// Target uncompressed chunk size in bytes: a chunk is ended once it is larger.
+    /// Default 1 MiB.
+    pub chunk_size_bytes: u64,
+    /// zstd level (1..=19; 0 = zstd's default, 3). Default 0.
+    pub compression_level: u32,
+    /// Simulated time between two `/tf` messages in s; 0 writes one per sample. Default 0.
+    pub tf_interval_s: f64,
+    /// Simulated time between two load-coloured `/scene` updates of the teeth in s; 0 writes
+    /// only the static scene at t = 0. Default 1e-3 s.
+    pub scene_interval_s: f64,
+    /// `|load_n|` in N drawn in full red in `/scene`; `None` uses the largest `|load_n|` seen
+    /// so far in the run. Default `None`.
+    pub load_color_scale_n: Option<f64>,
+}
+
+impl Default for RecordOptions {
+    fn default() -> Self {
+        RecordOptions {
+            deterministic: false,
+            per_tooth: false,
+            flush_interval: Duration::from_secs(1),
+            flush_messages: 100_000,
+            chunk_size_bytes: 1 << 20,
+            compression_level: 0,
+            tf_interval_s: 0.0,
+            scene_interval_s: 1e-3,
+            load_color_scale_n: None,
+        }
+    }
+}
+
+/// Why a recording could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    /// The file (or its folder) could not be created.
+    #[error("cannot create the recording {path}: {source}")]
+    Create {
+        /// The recording's path.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// Writing failed (disk full, I/O error); the file is readable up to the last flush.
+    #[error("cannot write the recording {path} ({what}): {source}")]
+    Write {
+        /// The recording's path.
+        path: PathBuf,
+        /// What was being written.
+        what: String,
+        /// The MCAP writer's error.
+        source: mcap::McapError,
+    },
+    /// The final flush of the file failed.
+    #[error("cannot close the recording {path}: {source}")]
+    Close {
+        /// The recording's path.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A sample does not fit the run info it was created with.
+    #[error("sample at t = {t_s} s has {got} discs, but the recording {path} was created for {expected}")]
+    DiscCount {
+        /// The recording's path.
+        path: PathBuf,
+        /// Time of the sample in s.
+        t_s: f64,
+        /// Discs in the sample.
+        got: usize,
+        /// Discs in the run info.
+        expected: usize,
+    },
+    /// A write after an earlier error (the first error is returned by `finish`).
+    #[error("the recording {path} failed earlier; nothing more is written")]
+    AlreadyFailed {
+        /// The recording's path.
+        path: PathBuf,
+    },
+}
+
+/// Simulated time `t_s` (s) as an MCAP log time in ns (negative and NaN times give 0).
+pub fn log_time_ns(t_s: f64) -> u64 {
+    if t_s.is_nan() || t_s <= 0.0 {
+        0
+    } else {
+        (t_s * 1e9).round().min(u64::MAX as f64) as u64
+    }
+}
+
+struct Channels {
+    tf: u16,
+    scene: u16,
+    shaft: u16,
+    spline: Vec<u16>,
+    teeth: Vec<u16>,
+    impacts: u16,
+    summary: u16,
+}
+
+/// Streams a run into an MCAP file. See the crate documentation for the topics.
+///
+/// Use it as the engine's [`Observer`] (or call [`Self::write_sample`] and
+/// [`Self::write_impact`]), then [`Self::finish`]. Errors met inside the observer methods are
+/// kept (the first one) and returned by `finish`; after an error nothing more is written, and
+/// [`Observer::progress`] returns `true` to stop the run. Dropping a recorder without
+/// `finish` still closes the file with its summary section, but without `/summary`.
+pub struct Recorder {
+    path: PathBuf,
+    writer: Option<mcap::Writer<BufWriter<File>>>,
+    options: RecordOptions,
+    info: RunInfo,
+    frames: Vec<String>,
+    names: Vec<String>,
+    ch: Channels,
+    sequences: BTreeMap<u16, u32>,
+    buf: Vec<u8>,
+    error: Option<RecordError>,
+    failed: bool,
+    last_flush: Instant,
+    started: Instant,
+    since_flush: usize,
+    next_tf_s: f64,
+    next_scene_s: f64,
+    max_abs_since_scene: Vec<f64>,
+    max_abs_run: f64,
+    peaks: Vec<Vec<f64>>,
+    last_t_s: f64,
+    messages: u64,
+    stats: Option<RunStats>,
+}
+
+impl Recorder {
+    /// Creates the recording at `path` (its folder is created if missing; an existing file is
+    /// replaced) and writes the header, the scene attachment, the metadata, the channels and
+    /// the static `/scene`, then flushes, so even a run killed at once leaves a valid prefix.
+    pub fn create(
+        path: impl AsRef<Path>,
+        info: &RunInfo,
+        options: &RecordOptions,
+    ) -> Result<Recorder, RecordError> {
+        let path = path.as_ref().to_path_buf();
+        let create_err = |source| RecordError::Create {
+            path: path.clone(),
+            source,
+        };
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(create_err)?;
+        }
+        let file = File::create(&path).map_err(create_err)?;
+        let write_err = |what: &str, source| RecordError::Write {
+            path: path.clone(),
+            what: what.to_string(),
+            source,
+        };
+        let opts = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .compression_level(options.compression_level)
+            // single-threaded zstd: the same bytes on every machine, no worker threads
+            .compression_threads(0)
+            .chunk_size(Some(options.chunk_size_bytes.max(1)))
+            .library(format!(
+                "clutchpack_record {} (mcap-rs {})",
+                env!("CARGO_PKG_VERSION"),
+                mcap::VERSION
+            ))
+            // chunks are built in memory and written whole: the file only ever grows by
+            // complete records, so a killed run leaves every flushed chunk readable
+            .disable_seeking(true);
+        let mut w = opts
+            .create(BufWriter::with_capacity(1 << 16, file))
+            .map_err(|e| write_err("header", e))?;
+
+        let wall_ns = if options.deterministic {
+            0
+        } else {
+            SystemTime::now()
+                .duration_since(UNIX_EPOCH)
+                .map(|d| d.as_nanos() as u64)
+                .unwrap_or(0)
+        };
+        w.attach(&mcap::Attachment {
+            log_time: 0,
+            create_time: wall_ns,
+            name: info.scene_file_name().to_string(),
+            media_type: SCENE_MEDIA_TYPE.to_string(),
+            data: Cow::Borrowed(info.scene_text.as_bytes()),
+        })
+        .map_err(|e| write_err("scene attachment", e))?;
+
+        let mut extra = vec![
+            (
+                "deterministic".to_string(),
+                options.deterministic.to_string(),
+            ),
+            ("per_tooth".to_string(), options.per_tooth.to_string()),
+            ("tf_interval_s".to_string(), num(options.tf_interval_s)),
+            (
+                "scene_interval_s".to_string(),
+                num(options.scene_interval_s),
+            ),
+        ];
+        if !options.deterministic {
+            extra.push((
+                "recorded_at_utc".to_string(),
+                utc_text(Duration::from_nanos(wall_ns)),
+            ));
+        }
+        for (name, metadata) in info.to_metadata(&extra) {
+            w.write_metadata(&mcap::records::Metadata { name, metadata })
+                .map_err(|e| write_err("metadata", e))?;
+        }
+
+        // schemas and channels
+        let fds = proto::file_descriptor_set();
+        let schema = |w: &mut mcap::Writer<_>, name: &str, data: &[u8]| {
+            w.add_schema(name, "protobuf", data)
+                .map_err(|e| write_err("schema", e))
+        };
+        use foxglove::Encode as _;
+        let fx = |s: Option<foxglove::Schema>| s.map(|s| s.data.into_owned()).unwrap_or_default();
+        let s_tf = schema(
+            &mut w,
+            "foxglove.FrameTransforms",
+            &fx(foxglove::schemas::FrameTransforms::get_schema()),
+        )?;
+        let s_scene = schema(
+            &mut w,
+            "foxglove.SceneUpdate",
+            &fx(foxglove::schemas::SceneUpdate::get_schema()),
+        )?;
+        let s_shaft = schema(&mut w, proto::SHAFT_STATE, &fds)?;
+        let s_spline = schema(&mut w, proto::SPLINE_STATE, &fds)?;
+        let s_teeth = schema(&mut w, proto::TOOTH_LOADS, &fds)?;
+        let s_impact = schema(&mut w, proto::IMPACT, &fds)?;
+        let s_summary = schema(&mut w, proto::RUN_SUMMARY, &fds)?;
+
+        let channel = |w: &mut mcap::Writer<_>,
+                       schema_id: u16,
+                       topic: &str,
+                       meta: BTreeMap<String, String>| {
+            w.add_channel(schema_id, topic, "protobuf", &meta)
+                .map_err(|e| write_err("channel", e))
+        };
+        let none = BTreeMap::new;
+        let tf = channel(&mut w, s_tf, topics::TF, none())?;
+        let scene_ch = channel(&mut w, s_scene, topics::SCENE, none())?;
+        let shaft = channel(&mut w, s_shaft, topics::SHAFT, none())?;
+        let names = info.disc_names();
+        let segments = unique_segments(&names);
+        let mut spline = Vec::with_capacity(names.len());
+        let mut teeth = Vec::new();
+        for (i, (name, seg)) in names.iter().zip(&segments).enumerate() {
+            let meta = || -> BTreeMap<String, String> {
+                [
+                    ("disc".to_string(), name.clone()),
+                    ("disc_index".to_string(), i.to_string()),
+                ]
+                .into()
+            };
+            spline.push(channel(&mut w, s_spline, &topics::spline(seg), meta())?);
+            if options.per_tooth {
+                teeth.push(channel(&mut w, s_teeth, &topics::teeth(seg), meta())?);
+            }
+        }
+        let impacts = channel(&mut w, s_impact, topics::IMPACTS, none())?;
+        let summary = channel(&mut w, s_summary, topics::SUMMARY, none())?;
+
+        let frames: Vec<String> = segments.iter().map(|s| disc_frame(s)).collect();
+        let n = names.len();
+        let mut rec = Recorder {
+            path,
+            writer: Some(w),
+            options: options.clone(),
+            info: info.clone(),
+            frames,
+            names,
+            ch: Channels {
+                tf,
+                scene: scene_ch,
+                shaft,
+                spline,
+                teeth,
+                impacts,
+                summary,
+            },
+            sequences: BTreeMap::new(),
+            buf: Vec::with_capacity(4096),
+            error: None,
+            failed: false,
+            last_flush: Instant::now(),
+            started: Instant::now(),
+            since_flush: 0,
+            next_tf_s: f64::NEG_INFINITY,
+            next_scene_s: if options.scene_interval_s > 0.0 {
+                options.scene_interval_s
+            } else {
+                f64::INFINITY
+            },
+            max_abs_since_scene: vec![0.0; n],
+            max_abs_run: 0.0,
+            peaks: vec![Vec::new(); n],
+            last_t_s: 0.0,
+            messages: 0,
+            stats: None,
+        };
+        let static_scene = scene::static_scene(&rec.info, &rec.frames);
+        rec.put(rec.ch.scene, 0, &static_scene, "/scene")?;
+        rec.flush()?;
+        Ok(rec)
+    }
+
+    /// The recording's path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Messages written so far.
+    pub fn messages(&self) -> u64 {
+        self.messages
+    }
+
+    /// The first error met by the [`Observer`] methods, if any (also returned by `finish`).
+    pub fn error(&self) -> Option<&RecordError> {
+        self.error.as_ref()
+    }
+
+    /// The summary of the impacts written so far (what `finish(None)` stores).
+    pub fn summary(&self) -> RunSummary {
+        let mut s = RunSummary {
+            t_end_s: self.last_t_s,
+            discs: Vec::with_capacity(self.peaks.len()),
+        };
+        for (i, p) in self.peaks.iter().enumerate() {
+            let name = self
+                .names
+                .get(i)
+                .cloned()
+                .unwrap_or_else(|| format!("disc {i}"));
+            s.discs.push(crate::DiscSummary::from_peaks(name, p));
+        }
+        s
+    }
+
+    /// Stores the engine's run statistics in the `clutchpack.stats` metadata written by
+    /// [`Self::finish`].
+    pub fn set_run_stats(&mut self, stats: &RunStats) {
+        self.stats = Some(stats.clone());
+    }
+
+    fn failed_err(&self) -> RecordError {
+        RecordError::AlreadyFailed {
+            path: self.path.clone(),
+        }
+    }
+
+    /// Encodes `msg` and writes it on `channel` at `log_time` (ns).
+    fn put<M: prost::Message>(
+        &mut self,
+        channel: u16,
+        log_time: u64,
+        msg: &M,
+        what: &str,
+    ) -> Result<(), RecordError> {
+        if self.failed {
+            return Err(self.failed_err());
+        }
+        let Some(w) = self.writer.as_mut() else {
+            return Err(self.failed_err());
+        };
+        self.buf.clear();
+        // encoding into a Vec cannot run out of space
+        let _ = msg.encode(&mut self.buf);
+        let seq = self.sequences.entry(channel).or_insert(0);
+        *seq = seq.wrapping_add(1);
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: *seq,
+            log_time,
+            publish_time: log_time,
+        };
+        if let Err(source) = w.write_to_known_channel(&header, &self.buf) {
+            self.failed = true;
+            return Err(RecordError::Write {
+                path: self.path.clone(),
+                what: what.to_string(),
+                source,
+            });
+        }
+        self.messages += 1;
+        self.since_flush += 1;
+        Ok(())
+    }
+
+    /// Ends the current chunk and flushes it to the file (it survives a SIGKILL from now on).
+    pub fn flush(&mut self) -> Result<(), RecordError> {
+        if self.failed {
+            return Err(self.failed_err());
+        }
+        if let Some(w) = self.writer.as_mut() {
+            if let Err(source) = w.flush() {
+                self.failed = true;
+                return Err(RecordError::Write {
+                    path: self.path.clone(),
+                    what: "flush".into(),
+                    source,
+                });
+            }
+        }
+        self.since_flush = 0;
+        self.last_flush = Instant::now();
+        Ok(())
+    }
+
+    fn maybe_flush(&mut self) -> Result<(), RecordError> {
+        if self.since_flush == 0 {
+            return Ok(());
+        }
+        let due = self.since_flush >= self.options.flush_messages.max(1)
+            || (!self.options.deterministic
+                && self.last_flush.elapsed() >= self.options.flush_interval);
+        if due {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    /// Writes one sample: `/shaft`, each disc's `/discs/<name>/spline` (and `teeth` when
+    /// asked for), `/tf` and `/scene` when due. Log time = `sample.t_s` in ns.
+    pub fn write_sample(&mut self, sample: &Sample) -> Result<(), RecordError> {
+        if self.failed {
+            return Err(self.failed_err());
+        }
+        let n = self.names.len();
+        if sample.discs.len() != n {
+            return Err(RecordError::DiscCount {
+                path: self.path.clone(),
+                t_s: sample.t_s,
+                got: sample.discs.len(),
+                expected: n,
+            });
+        }
+        let t = sample.t_s;
+        let lt = log_time_ns(t);
+        self.last_t_s = self.last_t_s.max(t);
+        self.put(
+            self.ch.shaft,
+            lt,
+            &proto::ShaftState {
+                t_s: t,
+                angle_rad: sample.shaft_angle_rad,
+                speed_rad_s: sample.shaft_speed_rad_s,
+            },
+            "/shaft",
+        )?;
+        for (i, d) in sample.discs.iter().enumerate() {
+            let msg = proto::SplineState {
+                t_s: t,
+                rel_angle_rad: d.rel_angle_rad,
+                closing_speed_m_s: d.closing_speed_m_s,
+                penetration_m: d.penetration_m,
+                load_n: d.load_n,
+                torque_n_m: d.torque_n_m,
+                engaged: d.engaged,
+                stiffness_n_m1_5: d.stiffness,
+                speed_rad_s: d.speed_rad_s,
+                angle_rad: d.angle_rad,
+                disc_index: i as u32,
+            };
+            self.put(self.ch.spline[i], lt, &msg, "spline")?;
+            if self.options.per_tooth && !d.tooth_loads_n.is_empty() {
+                let msg = proto::ToothLoads {
+                    t_s: t,
+                    loads_n: d.tooth_loads_n.clone(),
+                    disc_index: i as u32,
+                };
+                self.put(self.ch.teeth[i], lt, &msg, "teeth")?;
+            }
+            let a = d
+                .tooth_loads_n
+                .iter()
+                .fold(d.load_n.abs(), |m, x| m.max(x.abs()));
+            if a.is_finite() {
+                self.max_abs_since_scene[i] = self.max_abs_since_scene[i].max(a);
+                self.max_abs_run = self.max_abs_run.max(a);
+            }
+        }
+        if t >= self.next_tf_s {
+            self.next_tf_s = t + self.options.tf_interval_s.max(0.0);
+            let discs: Vec<(String, f64, f64)> = self
+                .frames
+                .iter()
+                .zip(&self.info.discs)
+                .zip(&sample.discs)
+                .map(|((f, g), d)| (f.clone(), g.z_m, d.angle_rad))
+                .collect();
+            let tf = scene::frame_transforms(lt, sample.shaft_angle_rad, &discs);
+            self.put(self.ch.tf, lt, &tf, "/tf")?;
+        }
+        if t >= self.next_scene_s {
+            let interval = self.options.scene_interval_s;
+            self.next_scene_s = ((t / interval).floor() + 1.0) * interval;
+            let scale = self
+                .options
+                .load_color_scale_n
+                .unwrap_or(self.max_abs_run)
+                .max(f64::MIN_POSITIVE);
+            let levels: Vec<f64> = self.max_abs_since_scene.iter().map(|a| a / scale).collect();
+            let update = scene::teeth_scene(lt, &self.info, &self.frames, &levels);
+            self.put(self.ch.scene, lt, &update, "/scene")?;
+            self.max_abs_since_scene.iter_mut().for_each(|a| *a = 0.0);
+        }
+        self.maybe_flush()
+    }
+
+    /// Writes one impact on `/impacts`, logged at its peak time `t_peak_s`.
+    pub fn write_impact(&mut self, e: &ImpactEvent) -> Result<(), RecordError> {
+        if self.failed {
+            return Err(self.failed_err());
+        }
+        if self.peaks.len() <= e.disc {
+            self.peaks.resize(e.disc + 1, Vec::new());
+        }
+        self.peaks[e.disc].push(e.peak_n);
+        let msg = proto::Impact {
+            disc: self
+                .names
+                .get(e.disc)
+                .cloned()
+                .unwrap_or_else(|| format!("disc {}", e.disc)),
+            disc_index: e.disc as u32,
+            t_on_s: e.t_on_s,
+            t_peak_s: e.t_peak_s,
+            t_off_s: e.t_off_s,
+            flank: match e.flank {
+                Flank::ShaftLeads => proto::Flank::ShaftLeads,
+                Flank::DiscLeads => proto::Flank::DiscLeads,
+            } as i32,
+            v_on_m_s: e.v_on_m_s,
+            peak_n: e.peak_n,
+        };
+        self.put(self.ch.impacts, log_time_ns(e.t_peak_s), &msg, "/impacts")?;
+        self.maybe_flush()
+    }
+
+    /// Writes `/summary` (the given one, or [`Self::summary`] when `None`), the run
+    /// statistics if set, and the summary section, then closes the file. Returns its path, or
+    /// the first error met while recording (the file is then closed as well as it can be).
+    pub fn finish(mut self, summary: Option<RunSummary>) -> Result<PathBuf, RecordError> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        if self.failed {
+            return Err(self.failed_err());
+        }
+        let summary = summary.unwrap_or_else(|| self.summary());
+        let lt = log_time_ns(self.last_t_s.max(summary.t_end_s));
+        self.put(self.ch.summary, lt, &summary.to_proto(), "/summary")?;
+        let path = self.path.clone();
+        let write_err = |what: &str, source| RecordError::Write {
+            path: path.clone(),
+            what: what.to_string(),
+            source,
+        };
+        let Some(mut w) = self.writer.take() else {
+            return Err(self.failed_err());
+        };
+        let mut meta = BTreeMap::new();
+        if let Some(s) = &self.stats {
+            meta.insert("simulated_s".into(), num(s.simulated_s));
+            meta.insert("steps".into(), s.steps.to_string());
+            meta.insert("rejected_steps".into(), s.rejected_steps.to_string());
+            meta.insert("rhs_evals".into(), s.rhs_evals.to_string());
+            meta.insert("stopped_early".into(), s.stopped_early.to_string());
+        }
+        meta.insert("messages".into(), self.messages.to_string());
+        if !self.options.deterministic {
+            meta.insert("wall_s".into(), num(self.started.elapsed().as_secs_f64()));
+            if let Ok(now) = SystemTime::now().duration_since(UNIX_EPOCH) {
+                meta.insert("finished_at_utc".into(), utc_text(now));
+            }
+        }
+        w.write_metadata(&mcap::records::Metadata {
+            name: META_STATS.into(),
+            metadata: meta,
+        })
+        .map_err(|e| write_err("stats metadata", e))?;
+        w.finish().map_err(|e| write_err("summary section", e))?;
+        let mut inner = w.into_inner();
+        inner.flush().map_err(|source| RecordError::Close {
+            path: path.clone(),
+            source,
+        })?;
+        Ok(path)
+    }
+
+    fn keep(&mut self, r: Result<(), RecordError>) {
+        if let Err(e) = r {
+            if self.error.is_none() {
+                self.error = Some(e);
+            }
+            self.failed = true;
+        }
+    }
+}
+
+impl Observer for Recorder {
+    fn sample(&mut self, sample: &Sample) {
+        if !self.failed {
+            let r = self.write_sample(sample);
+            self.keep(r);
+        }
+    }
+
+    fn impact(&mut self, event: &ImpactEvent) {
+        if !self.failed {
+            let r = self.write_impact(event);
+            self.keep(r);
+        }
+    }
+
+    /// Flushes when the wall-clock interval has passed; returns `true` (stop the run) once
+    /// writing has failed.
+    fn progress(&mut self, _t_s: f64) -> bool {
+        if !self.failed {
+            let r = self.maybe_flush();
+            self.keep(r);
+        }
+        self.failed
+    }
+}
+
+/// Topic segments of `names` ([`topic_segment`]), made unique by appending `_<index>` to
+/// repeats.
+pub(crate) fn unique_segments(names: &[String]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::with_capacity(names.len());
+    for (i, n) in names.iter().enumerate() {
+        let mut s = topic_segment(n);
+        if out.contains(&s) {
+            s = format!("{s}_{i}");
+        }
+        out.push(s);
+    }
+    out
+}

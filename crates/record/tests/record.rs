@@ -1,0 +1,480 @@
+//! Recordings written from a synthetic stream and read back: exact round trips, determinism,
+//! the Foxglove schemas, and robustness against truncated, corrupted, empty and foreign files.
+
+use clutchpack_model::{Collector, DiscSample, Observer, Sample};
+use clutchpack_record::synthetic::{synthetic_run, SyntheticRun};
+use clutchpack_record::{
+    export_csv, from_bytes, open, topics, DamageKind, ReadError, RecordError, RecordOptions,
+    Recorder, RecordingReader, RunSummary,
+};
+use std::path::PathBuf;
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("clutchpack_record");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn options() -> RecordOptions {
+    RecordOptions {
+        deterministic: true,
+        per_tooth: true,
+        // several chunks even for a small run
+        flush_messages: 200,
+        ..Default::default()
+    }
+}
+
+/// Records `run` to `name` with `opts` and returns the path.
+fn record(run: &SyntheticRun, name: &str, opts: &RecordOptions) -> PathBuf {
+    let path = tmp(name);
+    let mut rec = Recorder::create(&path, &run.info, opts).unwrap();
+    run.play(&mut rec);
+    assert!(rec.error().is_none());
+    rec.finish(None).unwrap()
+}
+
+fn small() -> SyntheticRun {
+    synthetic_run(400, 1e-5)
+}
+
+/// Samples (with per-tooth loads), impacts, the summary and the run info come back exactly
+/// as written: f64 values travel as protobuf doubles, bit for bit.
+#[test]
+fn round_trip_is_exact() {
+    let run = small();
+    assert!(
+        run.impacts.len() >= 4,
+        "the synthetic run has impacts on both discs"
+    );
+    let path = record(&run, "round_trip.mcap", &options());
+    let r = open(&path).unwrap();
+    assert!(r.is_complete(), "{:?}", r.damage());
+    r.require_complete().unwrap();
+    assert_eq!(r.samples(), run.samples);
+    assert_eq!(r.impacts(), {
+        // written in closing order; read back in file order (the same)
+        run.impacts.clone()
+    });
+    let t_end = run.samples.last().unwrap().t_s;
+    let want = RunSummary::from_impacts(&run.info.disc_names(), &run.impacts, t_end);
+    assert_eq!(r.summary(), Some(&want));
+    assert_eq!(r.summary_or_recomputed(), want);
+
+    let mut info = r.run_info().unwrap();
+    assert_eq!(info.shaft, Some(run.info.shaft_geometry()));
+    info.shaft = None;
+    assert_eq!(info, run.info);
+    assert_eq!(r.disc_names(), vec!["d1".to_string(), "disc 2".to_string()]);
+
+    let h = r.load_histories();
+    assert_eq!(h.len(), 2);
+    assert_eq!(h[1].name, "disc 2");
+    assert_eq!(h[1].t_s.len(), 400);
+    assert_eq!(h[1].load_n[123], run.samples[123].discs[1].load_n);
+
+    let i = r.info();
+    assert!(i.summary_section);
+    assert_eq!(i.start_s, Some(0.0));
+    assert!((i.end_s.unwrap() - 399e-5).abs() < 1e-12);
+    let n = |t: &str| i.topic(t).map(|t| t.messages).unwrap_or(0);
+    assert_eq!(n(topics::SHAFT), 400);
+    assert_eq!(n(topics::TF), 400);
+    assert_eq!(n("/discs/d1/spline"), 400);
+    assert_eq!(n("/discs/disc_2/spline"), 400);
+    assert_eq!(n("/discs/disc_2/teeth"), 400);
+    assert_eq!(n(topics::IMPACTS), run.impacts.len() as u64);
+    assert_eq!(n(topics::SUMMARY), 1);
+    // static scene at t = 0 plus one load update per simulated ms
+    assert_eq!(n(topics::SCENE), 1 + 3);
+    assert!(
+        i.chunks.unwrap() > 1,
+        "flush_messages cut the data into chunks"
+    );
+    let att = &i.attachments[0];
+    assert_eq!(att.name, "synthetic.toml");
+    assert_eq!(att.data, run.info.scene_text.as_bytes());
+    let meta = i.metadata("clutchpack.run").unwrap();
+    assert_eq!(
+        meta["scene_sha256"],
+        clutchpack_record::sha256_hex(run.info.scene_text.as_bytes())
+    );
+    assert_eq!(meta["engine"], "synthetic");
+    assert!(
+        !meta.contains_key("recorded_at_utc"),
+        "deterministic: no wall clock"
+    );
+}
+
+/// The transforms and the scene use Foxglove's well-known schemas by their exact names,
+/// and decode with the SDK's own types: one transform per body, rotating about +z by the
+/// body's angle, discs at their z.
+#[test]
+fn foxglove_schemas_and_transforms() {
+    use prost::Message as _;
+    let run = small();
+    let r = open(record(&run, "foxglove.mcap", &options())).unwrap();
+    let schema = |t: &str| r.info().topic(t).unwrap().schema_name.clone();
+    assert_eq!(schema("/tf"), "foxglove.FrameTransforms");
+    assert_eq!(schema("/scene"), "foxglove.SceneUpdate");
+    assert_eq!(schema("/discs/d1/spline"), "clutchpack.SplineState");
+    for t in &r.info().topics {
+        assert_eq!(t.schema_encoding, "protobuf", "{}", t.topic);
+        assert_eq!(t.message_encoding, "protobuf", "{}", t.topic);
+    }
+    let mut tfs = Vec::new();
+    let mut scenes = Vec::new();
+    r.for_each_message(|m| match m.topic {
+        "/tf" => tfs.push(foxglove::schemas::FrameTransforms::decode(m.data).unwrap()),
+        "/scene" => scenes.push(foxglove::schemas::SceneUpdate::decode(m.data).unwrap()),
+        _ => {}
+    });
+    let k = 250;
+    let tf = &tfs[k];
+    let s = &run.samples[k];
+    assert_eq!(tf.transforms.len(), 3);
+    assert_eq!(tf.transforms[0].child_frame_id, "shaft");
+    assert_eq!(tf.transforms[2].child_frame_id, "disc/disc_2");
+    assert_eq!(tf.transforms[2].parent_frame_id, "world");
+    let q = tf.transforms[2].rotation.unwrap();
+    let angle = 2.0 * q.z.atan2(q.w);
+    let d = (angle - s.discs[1].angle_rad).rem_euclid(2.0 * std::f64::consts::PI);
+    assert!(d.min(2.0 * std::f64::consts::PI - d) < 1e-12);
+    assert_eq!(tf.transforms[2].translation.unwrap().z, 0.004);
+    let first = &scenes[0];
+    let ids: Vec<&str> = first.entities.iter().map(|e| e.id.as_str()).collect();
+    assert!(
+        ids.contains(&"shaft") && ids.contains(&"disc/d1") && ids.contains(&"disc/disc_2/teeth")
+    );
+    assert!(first.entities.iter().all(|e| e.frame_locked));
+    // a later update colours the teeth: some loaded tooth is not grey
+    let later = &scenes[1];
+    assert!(later
+        .entities
+        .iter()
+        .flat_map(|e| &e.cubes)
+        .any(|c| c.color.unwrap().b < 0.5));
+}
+
+/// The same stream recorded twice with `deterministic` gives byte-identical files.
+#[test]
+fn deterministic_recordings_are_byte_identical() {
+    let run = small();
+    let a = std::fs::read(record(&run, "det_a.mcap", &options())).unwrap();
+    let b = std::fs::read(record(&run, "det_b.mcap", &options())).unwrap();
+    assert_eq!(a.len(), b.len());
+    assert!(a == b, "deterministic recordings differ");
+    // and a non-deterministic one carries its wall-clock metadata
+    let opts = RecordOptions {
+        deterministic: false,
+        ..options()
+    };
+    let r = open(record(&run, "wall.mcap", &opts)).unwrap();
+    assert!(r
+        .info()
+        .metadata("clutchpack.run")
+        .unwrap()
+        .contains_key("recorded_at_utc"));
+    assert!(r
+        .info()
+        .metadata("clutchpack.stats")
+        .unwrap()
+        .contains_key("wall_s"));
+}
+
+/// Cutting the file anywhere gives either an error or the messages of the whole chunks
+/// before the cut, never a panic; the recovered count never decreases as the cut moves on,
+/// and only the full file is complete.
+#[test]
+fn truncated_files_recover_whole_chunks() {
+    let run = small();
+    let bytes = std::fs::read(record(&run, "truncate.mcap", &options())).unwrap();
+    let total = open(tmp("truncate.mcap")).unwrap().info().messages;
+    let mut cuts: Vec<usize> = (0..bytes.len()).step_by(97).collect();
+    cuts.extend([
+        1,
+        7,
+        8,
+        9,
+        20,
+        100,
+        bytes.len() - 1,
+        bytes.len() - 8,
+        bytes.len() - 9,
+    ]);
+    cuts.sort();
+    let mut last = 0;
+    for cut in cuts {
+        match from_bytes("cut.mcap", bytes[..cut].to_vec()) {
+            Err(e) => {
+                assert!(cut < 64, "cut at {cut}: {e}");
+                let line = e.to_string();
+                assert!(!line.contains('\n'), "{line}");
+            }
+            Ok(r) => {
+                let d = r.damage().expect("a cut file is damaged");
+                assert_eq!(d.kind, DamageKind::Truncated, "cut at {cut}: {d}");
+                assert!(!d.to_string().contains('\n'));
+                let n = r.info().messages;
+                assert!(n >= last, "cut at {cut}: {n} < {last}");
+                assert!(n <= total);
+                last = n;
+                // what was recovered decodes
+                let _ = r.samples();
+                let _ = r.impacts();
+            }
+        }
+    }
+    assert!(last > total / 2, "most messages precede the last cuts");
+    let err = open(tmp("truncate.mcap")).unwrap();
+    assert!(err.is_complete());
+}
+
+/// A killed run: the file as it is on disk while the recorder is still running (some
+/// messages not yet flushed) holds exactly the messages written before the last flush.
+#[test]
+fn killed_run_keeps_everything_up_to_the_last_flush() {
+    let run = small();
+    let path = tmp("killed.mcap");
+    let mut rec = Recorder::create(&path, &run.info, &options()).unwrap();
+    for s in &run.samples[..150] {
+        rec.sample(s);
+    }
+    rec.flush().unwrap();
+    let flushed = rec.messages();
+    for s in &run.samples[150..170] {
+        rec.sample(s);
+    }
+    let on_disk = std::fs::read(&path).unwrap(); // what SIGKILL would leave
+    let r = from_bytes(&path, on_disk).unwrap();
+    let d = r.damage().unwrap();
+    assert_eq!(d.kind, DamageKind::Truncated);
+    assert!(d.reason.contains("no summary section"), "{d}");
+    assert_eq!(r.info().messages, flushed);
+    assert_eq!(r.samples(), run.samples[..150].to_vec());
+    assert!(r.summary().is_none());
+    assert!(
+        r.run_info().is_some(),
+        "metadata and scene precede the data"
+    );
+    let err = r.require_complete().unwrap_err();
+    assert!(matches!(err, ReadError::Damaged { .. }));
+    assert!(err.to_string().contains("recovered"), "{err}");
+    drop(rec);
+}
+
+/// A byte flipped inside a chunk is caught by the chunk CRC: a clean "corrupted" error,
+/// with the messages of the chunks before it recovered.
+#[test]
+fn bit_flip_in_a_chunk_is_a_clean_error() {
+    let run = small();
+    let path = record(&run, "flip.mcap", &options());
+    let bytes = std::fs::read(&path).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let chunks = &summary.chunk_indexes;
+    assert!(chunks.len() >= 3);
+    let c = &chunks[2];
+    let before: u64 = {
+        // messages of the first two chunks
+        let mut n = 0;
+        for ci in &chunks[..2] {
+            n += summary.stream_chunk(&bytes, ci).unwrap().count() as u64;
+        }
+        n
+    };
+    let mut bad = bytes.clone();
+    let at = (c.chunk_start_offset + c.chunk_length - c.compressed_size / 2) as usize;
+    bad[at] ^= 0x10;
+    let r = from_bytes("flip.mcap", bad).unwrap();
+    let d = r.damage().expect("damage found");
+    assert_eq!(d.kind, DamageKind::Corrupt);
+    assert!(
+        r.info().messages <= before,
+        "{} > {before}",
+        r.info().messages
+    );
+    let line = r.require_complete().unwrap_err().to_string();
+    assert!(line.contains("corrupted recording"), "{line}");
+    assert!(!line.contains('\n'));
+}
+
+/// Flipping any one byte of a small recording never panics, and never goes unnoticed
+/// outside the few bytes no check covers (record padding, the summary-offset section).
+#[test]
+fn any_single_byte_flip_is_handled() {
+    let run = synthetic_run(60, 1e-5);
+    let opts = RecordOptions {
+        flush_messages: 50,
+        ..options()
+    };
+    let bytes = std::fs::read(record(&run, "fuzz.mcap", &opts)).unwrap();
+    let mut unnoticed = 0;
+    for at in (0..bytes.len()).step_by(5) {
+        let mut bad = bytes.clone();
+        bad[at] ^= 0x41;
+        match from_bytes("fuzz.mcap", bad) {
+            Err(e) => assert!(!e.to_string().contains('\n')),
+            Ok(r) => {
+                if r.is_complete() {
+                    unnoticed += 1;
+                }
+                let _ = r.samples();
+                let _ = r.disc_series();
+            }
+        }
+    }
+    assert!(
+        unnoticed * 50 < bytes.len() / 5,
+        "{unnoticed} flips went unnoticed"
+    );
+}
+
+/// Empty, text and other foreign files give a one-line error that says what they are.
+#[test]
+fn empty_and_foreign_files() {
+    let e = from_bytes("empty.mcap", Vec::new()).unwrap_err();
+    assert!(matches!(e, ReadError::Empty { .. }));
+    assert!(e.to_string().contains("empty"), "{e}");
+    let e = from_bytes("notes.txt", b"hello, this is text\nline 2\n".to_vec()).unwrap_err();
+    assert!(matches!(e, ReadError::NotMcap { .. }));
+    assert!(e.to_string().contains("\"hello, this is text"), "{e}");
+    assert!(!e.to_string().contains('\n'));
+    let e = from_bytes("x.png", vec![0x89, b'P', b'N', b'G', 0, 1, 2, 3, 4, 5]).unwrap_err();
+    assert!(e.to_string().contains("89 50 4e 47"), "{e}");
+    let e = from_bytes("short.mcap", mcap::MAGIC[..5].to_vec()).unwrap_err();
+    assert!(matches!(e, ReadError::Damaged { .. }), "{e}");
+    let e = open(tmp("does-not-exist.mcap")).unwrap_err();
+    assert!(matches!(e, ReadError::Io { .. }));
+}
+
+/// A valid MCAP file from another program opens: its topics are listed, it has no run info
+/// and none of our data.
+#[test]
+fn foreign_mcap_opens_without_our_data() {
+    let path = tmp("foreign.mcap");
+    {
+        let mut w = mcap::Writer::new(std::io::BufWriter::new(
+            std::fs::File::create(&path).unwrap(),
+        ))
+        .unwrap();
+        let ch = w
+            .add_channel(0, "/chatter", "json", &Default::default())
+            .unwrap();
+        for i in 0..5u32 {
+            let header = mcap::records::MessageHeader {
+                channel_id: ch,
+                sequence: i,
+                log_time: u64::from(i) * 1000,
+                publish_time: 0,
+            };
+            w.write_to_known_channel(&header, b"{\"a\": 1}").unwrap();
+        }
+        w.finish().unwrap();
+    }
+    let r = open(&path).unwrap();
+    assert!(r.is_complete(), "{:?}", r.damage());
+    assert_eq!(r.info().topics[0].topic, "/chatter");
+    assert_eq!(r.info().messages, 5);
+    assert!(r.run_info().is_none());
+    assert!(r.samples().is_empty() && r.impacts().is_empty() && r.summary().is_none());
+}
+
+/// An error inside the observer methods is not lost: recording stops, `progress` asks the
+/// engine to stop, and `finish` returns the first error.
+#[test]
+fn observer_errors_reach_finish() {
+    let run = small();
+    let mut rec = Recorder::create(tmp("observer_error.mcap"), &run.info, &options()).unwrap();
+    rec.sample(&run.samples[0]);
+    rec.sample(&Sample {
+        t_s: 1e-5,
+        discs: vec![DiscSample::default()],
+        ..Default::default()
+    });
+    assert!(rec.progress(1e-5), "a failed recorder stops the run");
+    rec.sample(&run.samples[2]);
+    let e = rec.finish(None).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            RecordError::DiscCount {
+                got: 1,
+                expected: 2,
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
+/// Dropping a recorder without `finish` still leaves a complete file (summary section),
+/// just without `/summary`.
+#[test]
+fn dropped_recorder_closes_the_file() {
+    let run = small();
+    let path = tmp("dropped.mcap");
+    {
+        let mut rec = Recorder::create(&path, &run.info, &options()).unwrap();
+        run.play(&mut rec);
+    }
+    let r = open(&path).unwrap();
+    assert!(r.is_complete(), "{:?}", r.damage());
+    assert!(r.summary().is_none());
+    assert_eq!(r.samples().len(), run.samples.len());
+    assert_eq!(
+        r.summary_or_recomputed().discs,
+        RunSummary::from_impacts(&run.info.disc_names(), &run.impacts, 0.0).discs
+    );
+}
+
+/// `export_csv` writes one file per topic of ours; the spline CSV gives the loads back
+/// exactly.
+#[test]
+fn csv_export() {
+    let run = small();
+    let r: RecordingReader = open(record(&run, "export.mcap", &options())).unwrap();
+    let dir = tmp("export_csv");
+    let _ = std::fs::remove_dir_all(&dir);
+    let files = export_csv(&r, &dir).unwrap();
+    let names: Vec<String> = files
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    for want in [
+        "shaft.csv",
+        "spline_d1.csv",
+        "spline_disc_2.csv",
+        "teeth_d1.csv",
+        "teeth_disc_2.csv",
+        "impacts.csv",
+        "summary.csv",
+    ] {
+        assert!(
+            names.iter().any(|n| n == want),
+            "{want} missing from {names:?}"
+        );
+    }
+    let text = std::fs::read_to_string(dir.join("spline_disc_2.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "load_n").unwrap();
+    let loads: Vec<f64> = lines
+        .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
+        .collect();
+    let want: Vec<f64> = run.samples.iter().map(|s| s.discs[1].load_n).collect();
+    assert_eq!(loads, want);
+    let summary = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
+    assert_eq!(summary.lines().count(), 3);
+    let teeth = std::fs::read_to_string(dir.join("teeth_d1.csv")).unwrap();
+    assert!(teeth.starts_with("t_s,tooth_0_n,tooth_1_n"));
+}
+
+/// The Collector and the recorder see the same stream (sanity check of `play`).
+#[test]
+fn synthetic_play_delivers_everything() {
+    let run = small();
+    let mut c = Collector::default();
+    run.play(&mut c);
+    assert_eq!(c.samples, run.samples);
+    assert_eq!(c.impacts, run.impacts);
+}
