@@ -1,0 +1,814 @@
+//! [`MultibodyEngine`]: the run loop around the rapier world, the spline hook and the step
+//! controller; samples, impact events and the energy audit.
+
+use crate::hook::{Coupling, CouplingForces, RelativeState};
+use crate::integrate::{Kick, Load, LoadHistory};
+use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping, ToothResolution};
+use crate::stepping::{
+    contact_duration_s, coupling_step, profile_acceleration_bound, CouplingView,
+};
+use crate::world::{angle_about_z, World};
+use clutchpack_model::{
+    DiscSample, Engine, EngineError, ImpactTracker, LawKind, Observer, PackModel, RunStats, Sample,
+    Shaft, ShaftExcitation, SpeedProfile,
+};
+use clutchpack_scene::Scene;
+use rapier3d_f64::prelude::{RigidBody, Rotation, Vector};
+
+/// How often (in steps) the observer's `progress` is polled.
+const PROGRESS_EVERY: u64 = 1000;
+
+/// Energy bookkeeping of a run (J), for conservation checks: with no drag and `p = 0`,
+/// `drive_work_j + drag_work_j = (kinetic_j + contact_potential_j) - (initial_kinetic_j +
+/// initial_contact_potential_j)` up to the integrator's error.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EnergyAudit {
+    /// Work done by the drive since t = 0: for a prescribed shaft the work of the shaft on the
+    /// teeth, `sum T_spline_on_disc dtheta_s`; for an inertial shaft the work of the drive
+    /// torque on the shaft.
+    pub drive_work_j: f64,
+    /// Work of the oil drag on the discs and of the shaft damping (<= 0).
+    pub drag_work_j: f64,
+    /// Kinetic energy at t = 0: the discs, and the shaft when it is inertial.
+    pub initial_kinetic_j: f64,
+    /// Kinetic energy at the end of the run.
+    pub kinetic_j: f64,
+    /// Energy stored in the teeth at t = 0, `sum (2/5) K s^2.5` (a potential for `p = 0`).
+    pub initial_contact_potential_j: f64,
+    /// Energy stored in the teeth at the end of the run.
+    pub contact_potential_j: f64,
+}
+
+/// The rapier3d-f64 multibody engine (see the crate docs).
+#[derive(Debug, Clone)]
+pub struct MultibodyEngine {
+    pack: PackModel,
+    record_rate_hz: f64,
+    options: MultibodyOptions,
+    energy: EnergyAudit,
+    per_tooth: Vec<bool>,
+}
+
+/// Per-coupling event bookkeeping.
+#[derive(Debug, Clone, Default)]
+struct EventTrack {
+    tracker: ImpactTracker,
+    /// (t, depth, v_n) at the previous evaluation.
+    prev: Option<(f64, f64, f64)>,
+    /// The last two (t, load) of the open event, for the parabolic peak.
+    last: Option<(f64, f64)>,
+    before_last: Option<(f64, f64)>,
+    /// The step of the open event (adaptive stepping).
+    event_step_s: Option<f64>,
+}
+
+impl EventTrack {
+    /// Feeds the coupling's state at `t`; returns an event that closed.
+    fn update(
+        &mut self,
+        t: f64,
+        f: &CouplingForces,
+        contact_step: impl FnOnce(f64) -> f64,
+    ) -> Option<clutchpack_model::ImpactEvent> {
+        let depth = f.depth_m;
+        let v = f.kin.v_n_m_s;
+        let mut closed = None;
+        if depth > 0.0 {
+            if !self.tracker.is_open() {
+                let (t_on, v_on) = match self.prev {
+                    Some((t0, d0, v0)) if d0 <= 0.0 => {
+                        let w = -d0 / (depth - d0);
+                        (t0 + w * (t - t0), v0 + w * (v - v0))
+                    }
+                    _ => (t, v),
+                };
+                self.tracker.begin(t_on, f.kin.flank, v_on);
+                self.last = None;
+                self.before_last = None;
+                self.event_step_s = Some(contact_step(v_on));
+            }
+            self.push(t, f.load_n);
+        } else if self.tracker.is_open() {
+            let t_off = match self.prev {
+                Some((t0, d0, _)) if d0 > 0.0 => t0 + d0 / (d0 - depth) * (t - t0),
+                _ => t,
+            };
+            self.push(t, 0.0);
+            closed = self.tracker.end(t_off);
+            self.event_step_s = None;
+        }
+        self.prev = Some((t, depth, v));
+        closed
+    }
+
+    /// Observes a load sample and, when the previous sample was a local maximum of `|F|`, the
+    /// vertex of the parabola through the three samples around it (the peak between steps).
+    fn push(&mut self, t: f64, load: f64) {
+        self.tracker.observe(t, load);
+        if let (Some((t0, f0)), Some((t1, f1))) = (self.before_last, self.last) {
+            let (a0, a1, a2) = (f0.abs(), f1.abs(), load.abs());
+            if a1 > 0.0 && a1 >= a0 && a1 >= a2 && t2_ok(t0, t1, t) {
+                let d01 = (a1 - a0) / (t1 - t0);
+                let d12 = (a2 - a1) / (t - t1);
+                let curv = (d12 - d01) / (t - t0);
+                if curv < 0.0 {
+                    let tv = 0.5 * (t0 + t1) - d01 / (2.0 * curv);
+                    if (t0..=t).contains(&tv) {
+                        let av = a1 + d01 * (tv - t1) + curv * (tv - t0) * (tv - t1);
+                        self.tracker.observe(tv, f1.signum() * av);
+                    }
+                }
+            }
+        }
+        self.before_last = self.last;
+        self.last = Some((t, load));
+    }
+}
+
+fn t2_ok(t0: f64, t1: f64, t2: f64) -> bool {
+    t0 < t1 && t1 < t2
+}
+
+impl MultibodyEngine {
+    /// Builds the engine for a scene with the default options (adaptive stepping with the
+    /// scene's `max_step_s`, lumped teeth where exact).
+    pub fn from_scene(scene: &Scene) -> Result<MultibodyEngine, EngineError> {
+        let mut options = MultibodyOptions::default();
+        if let Stepping::Adaptive(a) = &mut options.stepping {
+            a.max_step_s = scene.simulation.max_step_s;
+        }
+        MultibodyEngine::with_options(scene, options)
+    }
+
+    /// Builds the engine for a scene with explicit options.
+    pub fn with_options(
+        scene: &Scene,
+        options: MultibodyOptions,
+    ) -> Result<MultibodyEngine, EngineError> {
+        MultibodyEngine::from_pack(scene.pack.clone(), scene.simulation.record_rate_hz, options)
+    }
+
+    /// Builds the engine for a pack model, emitting samples at `record_rate_hz`.
+    pub fn from_pack(
+        pack: PackModel,
+        record_rate_hz: f64,
+        options: MultibodyOptions,
+    ) -> Result<MultibodyEngine, EngineError> {
+        let bad = |m: String| Err(EngineError::Unsupported(m));
+        if !(record_rate_hz > 0.0 && record_rate_hz.is_finite()) {
+            return bad(format!("record rate {record_rate_hz} Hz: must be > 0"));
+        }
+        match options.stepping {
+            Stepping::Fixed { dt_s } if !(dt_s > 0.0 && dt_s.is_finite()) => {
+                return bad(format!("fixed step {dt_s} s: must be > 0"));
+            }
+            Stepping::Adaptive(a)
+                if !(a.max_step_s > 0.0
+                    && a.steps_per_contact > 1.0
+                    && a.approach_fraction > 0.0
+                    && a.approach_fraction < 1.0
+                    && a.min_step_s > 0.0) =>
+            {
+                return bad(format!("adaptive stepping {a:?}: needs max_step_s > 0, steps_per_contact > 1, approach_fraction in (0, 1), min_step_s > 0"));
+            }
+            _ => {}
+        }
+        let mut per_tooth = Vec::with_capacity(pack.discs.len());
+        for (i, d) in pack.discs.iter().enumerate() {
+            if d.law.kind == LawKind::Squeeze && d.law.oil.thickness_m > 0.0 {
+                return bad(format!(
+                    "discs[{i}]: the squeeze-film law is a damper with time constant m h^3 / (beta eta B^3 L) \
+                     (nanoseconds near metal contact), too stiff for the explicit multibody step; \
+                     use the reference engine"
+                ));
+            }
+            if d.spline.teeth == 0 || d.inertia_kg_m2.is_nan() || d.inertia_kg_m2 <= 0.0 {
+                return bad(format!("discs[{i}]: needs teeth > 0 and inertia > 0"));
+            }
+            per_tooth.push(match options.teeth {
+                ToothResolution::PerTooth => true,
+                // Concentric discs on a locked radial joint, no spacing errors: lumped is exact.
+                ToothResolution::Lumped | ToothResolution::Auto => false,
+            });
+        }
+        // Build once now so that a scene the world cannot hold fails here, not in `run`.
+        World::build(&pack, &options.shapes)?;
+        Ok(MultibodyEngine {
+            pack,
+            record_rate_hz,
+            options,
+            energy: EnergyAudit::default(),
+            per_tooth,
+        })
+    }
+
+    /// The options in force.
+    pub fn options(&self) -> &MultibodyOptions {
+        &self.options
+    }
+
+    /// The energy audit of the last run.
+    pub fn energy(&self) -> EnergyAudit {
+        self.energy
+    }
+}
+
+/// Reads the relative state of a disc in the shaft's frame. `omega_s` and `omega_d` are the
+/// speeds about the axis at the time of the poses (see [`synchronised`]).
+fn relative_state(
+    shaft: &RigidBody,
+    omega_s: f64,
+    disc: &RigidBody,
+    omega_d: f64,
+) -> RelativeState {
+    let qs = *shaft.rotation();
+    let qs_inv = qs.inverse();
+    let q_rel = qs_inv * *disc.rotation();
+    let d = qs_inv * (disc.translation() - shaft.translation());
+    let dv = qs_inv * (disc.linvel() - shaft.linvel());
+    let rate = dv - Vector::new(0.0, 0.0, omega_s).cross(d);
+    RelativeState {
+        phi: -angle_about_z(&q_rel),
+        dphi: omega_s - omega_d,
+        offset: [d.x, d.y],
+        offset_rate: [rate.x, rate.y],
+    }
+}
+
+/// Powers at one evaluation, for the trapezoidal energy audit.
+#[derive(Debug, Clone, Copy)]
+struct Powers {
+    t: f64,
+    theta_s: f64,
+    /// Sum of the teeth's torques on the discs, N m (prescribed shaft: work = torque x turn).
+    spline_torque: f64,
+    /// Power of the drive torque on an inertial shaft, W.
+    drive: f64,
+    /// Power of the drag and the shaft damping, W.
+    drag: f64,
+}
+
+/// The shaft as the run loop drives it.
+#[derive(Debug, Clone, Copy)]
+enum ShaftDrive<'a> {
+    /// Follows a speed profile exactly (eq 3).
+    Prescribed(&'a SpeedProfile),
+    /// A body (eq 4): inertia `J1`, damping `C1`.
+    Inertial { j1: f64, c1: f64 },
+}
+
+/// The state of one run: the world, the hook's memories, the events, the clock.
+struct Run<'a> {
+    pack: &'a PackModel,
+    world: World,
+    shaft: ShaftDrive<'a>,
+    /// Bound of the drive's shaft acceleration, rad/s^2.
+    shaft_accel_bound: f64,
+    couplings: Vec<Coupling>,
+    /// Effective mass per tooth of each coupling, kg (reduced with an inertial shaft).
+    m_eff: Vec<f64>,
+    tracks: Vec<EventTrack>,
+    /// The hook's results at `t` (filled by [`Run::evaluate`]).
+    rel: Vec<RelativeState>,
+    forces: Vec<CouplingForces>,
+    /// Powers at the last evaluation.
+    powers_before: Option<Powers>,
+    /// Physical loads at `t` (world frame) on each disc and on an inertial shaft.
+    disc_loads: Vec<Load>,
+    shaft_load: Load,
+    /// Their values at the two evaluations before, and the kicks for the next step.
+    disc_history: Vec<LoadHistory>,
+    shaft_history: LoadHistory,
+    disc_kicks: Vec<Kick>,
+    shaft_kick: Kick,
+    /// Disc speeds at `t` (synchronised with the poses), rad/s.
+    omega_d: Vec<f64>,
+    /// Time, unwrapped shaft angle and shaft speed.
+    t: f64,
+    theta_s: f64,
+    omega_s: f64,
+    /// Elastic energy in the teeth at `t`, J.
+    potential_j: f64,
+    energy: EnergyAudit,
+}
+
+impl<'a> Run<'a> {
+    fn new(
+        pack: &'a PackModel,
+        opts: &MultibodyOptions,
+        per_tooth: &[bool],
+    ) -> Result<Run<'a>, EngineError> {
+        let world = World::build(pack, &opts.shapes)?;
+        let couplings: Vec<Coupling> = pack
+            .discs
+            .iter()
+            .zip(per_tooth)
+            .map(|(d, &pt)| Coupling::new(d.spline, d.law, pt, &[]))
+            .collect();
+        let nd = couplings.len();
+        let tracks = (0..nd)
+            .map(|i| EventTrack {
+                tracker: ImpactTracker::new(i),
+                ..Default::default()
+            })
+            .collect();
+        let (shaft, shaft_accel_bound) = match &pack.shaft {
+            Shaft::Prescribed(p) => (ShaftDrive::Prescribed(p), profile_acceleration_bound(p)),
+            Shaft::Inertial {
+                inertia_kg_m2,
+                damping_n_m_s_rad,
+                excitation,
+            } => (
+                ShaftDrive::Inertial {
+                    j1: *inertia_kg_m2,
+                    c1: *damping_n_m_s_rad,
+                },
+                match excitation {
+                    ShaftExcitation::Profile(p) => profile_acceleration_bound(p),
+                    ShaftExcitation::Torque { table, .. } => {
+                        table.y.iter().fold(0.0, |m: f64, y| m.max(y.abs())) / inertia_kg_m2
+                    }
+                },
+            ),
+        };
+        let m_eff = pack
+            .discs
+            .iter()
+            .map(|d| {
+                let md = d.spline.effective_mass_kg(d.inertia_kg_m2);
+                match shaft {
+                    ShaftDrive::Prescribed(_) => md,
+                    ShaftDrive::Inertial { j1, .. } => {
+                        let ms = d.spline.effective_mass_kg(j1);
+                        md * ms / (md + ms)
+                    }
+                }
+            })
+            .collect();
+        Ok(Run {
+            pack,
+            world,
+            shaft,
+            shaft_accel_bound,
+            couplings,
+            m_eff,
+            tracks,
+            rel: Vec::with_capacity(nd),
+            forces: Vec::with_capacity(nd),
+            powers_before: None,
+            disc_loads: vec![[0.0; 6]; nd],
+            shaft_load: [0.0; 6],
+            disc_history: vec![LoadHistory::default(); nd],
+            shaft_history: LoadHistory::default(),
+            disc_kicks: vec![Kick::default(); nd],
+            shaft_kick: Kick::default(),
+            omega_d: Vec::with_capacity(nd),
+            t: 0.0,
+            theta_s: 0.0,
+            omega_s: pack.shaft.initial_speed_rad_s(),
+            potential_j: 0.0,
+            energy: EnergyAudit::default(),
+        })
+    }
+
+    /// Kinetic energy of the discs (and of an inertial shaft) at `t`, J: `sum J w^2 / 2` with
+    /// the synchronised speeds (the joint locks every other motion).
+    fn kinetic_energy(&self) -> f64 {
+        let mut e: f64 = self
+            .pack
+            .discs
+            .iter()
+            .zip(&self.omega_d)
+            .map(|(d, w)| 0.5 * d.inertia_kg_m2 * w * w)
+            .sum();
+        if let ShaftDrive::Inertial { j1, .. } = self.shaft {
+            e += 0.5 * j1 * self.omega_s * self.omega_s;
+        }
+        e
+    }
+
+    /// The hook at `t`: every coupling's relative state and tooth loads. Fails if the state
+    /// is not finite or the teeth passed through each other (|phi| beyond half a pitch).
+    fn evaluate(&mut self, t_last_good: f64) -> Result<(), EngineError> {
+        let shaft = &self.world.physics.bodies[self.world.shaft];
+        self.omega_s = match self.shaft {
+            ShaftDrive::Prescribed(p) => p.speed(self.t),
+            ShaftDrive::Inertial { j1, .. } => {
+                self.shaft_history
+                    .synchronised(self.t, shaft.angvel().z, 5, 1.0 / j1)
+            }
+        };
+        self.rel.clear();
+        self.forces.clear();
+        self.omega_d.clear();
+        self.potential_j = 0.0;
+        for (i, c) in self.couplings.iter_mut().enumerate() {
+            let disc = &self.world.physics.bodies[self.world.discs[i]];
+            let omega_d = self.disc_history[i].synchronised(
+                self.t,
+                disc.angvel().z,
+                5,
+                1.0 / self.pack.discs[i].inertia_kg_m2,
+            );
+            self.omega_d.push(omega_d);
+            let rel = relative_state(shaft, self.omega_s, disc, omega_d);
+            let limit = std::f64::consts::PI / c.spline.teeth as f64;
+            let diverged = |reason: String| EngineError::Diverged {
+                t_s: t_last_good,
+                reason: format!("disc {i}: {reason}"),
+            };
+            if !(rel.phi.abs() <= limit && rel.dphi.is_finite()) {
+                return Err(diverged(format!(
+                    "relative angle {} rad, speed {} rad/s (half a tooth pitch is {limit} rad)",
+                    rel.phi, rel.dphi
+                )));
+            }
+            let f = c.evaluate(&rel);
+            if !(f.load_n.is_finite() && f.moment[2].is_finite()) {
+                return Err(diverged(format!("tooth load {} N", f.load_n)));
+            }
+            self.potential_j += f.potential_j;
+            self.rel.push(rel);
+            self.forces.push(f);
+        }
+        self.audit_energy();
+        self.compute_loads();
+        Ok(())
+    }
+
+    /// The physical loads at `t` on every body (the drag, the teeth and their reactions, the
+    /// drive) and the kicks for the next step.
+    fn compute_loads(&mut self) {
+        let bodies = &self.world.physics.bodies;
+        let qs = *bodies[self.world.shaft].rotation();
+        let mut shaft_force = Vector::ZERO;
+        let mut shaft_torque = Vector::ZERO;
+        for (i, f) in self.forces.iter().enumerate() {
+            let d = &self.pack.discs[i];
+            // Hu et al. eq (5): drag -C2 omega_d.
+            let drag = -d.drag_n_m_s_rad * self.omega_d[i];
+            let f_local = Vector::new(f.force[0], f.force[1], 0.0);
+            let m_local = Vector::new(f.moment[0], f.moment[1], f.moment[2]);
+            // The hook's moment is about the axis point of the disc's mid-plane; the disc's
+            // centre sits at the offset e from it.
+            let e_local = Vector::new(self.rel[i].offset[0], self.rel[i].offset[1], 0.0);
+            let force = qs * f_local;
+            let torque = qs * (m_local - e_local.cross(f_local)) + Vector::new(0.0, 0.0, drag);
+            self.disc_loads[i] = [force.x, force.y, force.z, torque.x, torque.y, torque.z];
+            self.disc_kicks[i] = self.disc_history[i].kick(self.t, &self.disc_loads[i]);
+            // The reaction on the shaft, about its centre: -(m + a x F), a the mid-plane.
+            let a = Vector::new(0.0, 0.0, self.world.disc_axial_m[i]);
+            shaft_force -= force;
+            shaft_torque -= qs * (m_local + a.cross(f_local));
+        }
+        if let ShaftDrive::Inertial { c1, .. } = self.shaft {
+            // Hu et al. eq (4): the drive torque, the spline reactions, damping -C1 omega.
+            let drive = self.pack.shaft.drive_torque_n_m(self.t);
+            shaft_torque.z += drive - c1 * self.omega_s;
+            self.shaft_load = [
+                shaft_force.x,
+                shaft_force.y,
+                shaft_force.z,
+                shaft_torque.x,
+                shaft_torque.y,
+                shaft_torque.z,
+            ];
+            self.shaft_kick = self.shaft_history.kick(self.t, &self.shaft_load);
+        }
+    }
+
+    /// Adds the work done since the last evaluation (trapezoidal rule) to the energy audit.
+    fn audit_energy(&mut self) {
+        let (drive, shaft_damping) = match self.shaft {
+            ShaftDrive::Prescribed(_) => (0.0, 0.0),
+            ShaftDrive::Inertial { c1, .. } => (
+                self.pack.shaft.drive_torque_n_m(self.t) * self.omega_s,
+                -c1 * self.omega_s * self.omega_s,
+            ),
+        };
+        let drag: f64 = self
+            .pack
+            .discs
+            .iter()
+            .zip(&self.omega_d)
+            .map(|(d, w)| -d.drag_n_m_s_rad * w * w)
+            .sum();
+        let now = Powers {
+            t: self.t,
+            theta_s: self.theta_s,
+            spline_torque: self.forces.iter().map(|f| f.moment[2]).sum(),
+            drive,
+            drag: drag + shaft_damping,
+        };
+        if let Some(b) = self.powers_before {
+            let h = now.t - b.t;
+            self.energy.drive_work_j += match self.shaft {
+                ShaftDrive::Prescribed(_) => {
+                    0.5 * (b.spline_torque + now.spline_torque) * (now.theta_s - b.theta_s)
+                }
+                ShaftDrive::Inertial { .. } => 0.5 * (b.drive + now.drive) * h,
+            };
+            self.energy.drag_work_j += 0.5 * (b.drag + now.drag) * h;
+        }
+        self.powers_before = Some(now);
+    }
+
+    /// Feeds the impact trackers with the state at `t`.
+    fn track_events(&mut self, steps_per_contact: f64, observer: &mut dyn Observer) {
+        for (i, track) in self.tracks.iter_mut().enumerate() {
+            let law = &self.pack.discs[i].law;
+            let f = &self.forces[i];
+            let m = self.m_eff[i];
+            let step = |v| contact_duration_s(law, f.kin.flank, v, m) / steps_per_contact;
+            if let Some(e) = track.update(self.t, f, step) {
+                observer.impact(&e);
+            }
+        }
+    }
+
+    /// The sample at `t`.
+    fn sample(&self, tooth_loads: bool) -> Sample {
+        Sample {
+            t_s: self.t,
+            shaft_angle_rad: self.theta_s,
+            shaft_speed_rad_s: self.omega_s,
+            discs: (0..self.forces.len())
+                .map(|i| {
+                    let f = &self.forces[i];
+                    let phi = self.rel[i].phi;
+                    DiscSample {
+                        angle_rad: self.theta_s - phi,
+                        speed_rad_s: self.omega_d[i],
+                        rel_angle_rad: phi,
+                        penetration_m: f.kin.delta_m,
+                        closing_speed_m_s: f.kin.v_n_m_s,
+                        load_n: f.load_n,
+                        torque_n_m: f.moment[2],
+                        engaged: f.depth_m > 0.0,
+                        stiffness: f.stiffness,
+                        tooth_loads_n: if tooth_loads {
+                            self.couplings[i].tooth_loads_n()
+                        } else {
+                            Vec::new()
+                        },
+                    }
+                })
+                .collect(),
+        }
+    }
+
+    /// The step the adaptive controller wants at `t`, s, and whether it is a contact step.
+    fn desired_step(&self, a: &AdaptiveStepping) -> (f64, bool) {
+        let a_shaft = match self.shaft {
+            ShaftDrive::Prescribed(_) => self.shaft_accel_bound,
+            ShaftDrive::Inertial { j1, c1 } => {
+                // The drive, the damping, and the teeth's reactions at t (contacts elsewhere
+                // in the pack jolt the shaft).
+                let reaction: f64 = self.forces.iter().map(|f| f.moment[2].abs()).sum();
+                self.shaft_accel_bound + (c1 * self.omega_s.abs() + reaction) / j1
+            }
+        };
+        let mut want = a.max_step_s;
+        let mut contact = false;
+        for (i, d) in self.pack.discs.iter().enumerate() {
+            let a_disc = d.drag_n_m_s_rad * self.omega_d[i].abs() / d.inertia_kg_m2;
+            let view = CouplingView {
+                forces: &self.forces[i],
+                law: &d.law,
+                phi: self.rel[i].phi,
+                dphi: self.rel[i].dphi,
+                g0: d.spline.half_play_rad(),
+                rb: d.spline.base_radius_m(),
+                m_eff_kg: self.m_eff[i],
+                // 1 % over the bound: rounding must not make it optimistic.
+                rel_accel_bound: 1.01 * (a_shaft + a_disc),
+                event_step_s: self.tracks[i].event_step_s,
+            };
+            let (dt, c) = coupling_step(&view, a);
+            if dt < want {
+                want = dt;
+                contact = c;
+            }
+        }
+        (want, contact)
+    }
+
+    /// The step length, at most `h`, that lands exactly on the first contact onset or
+    /// separation within `h` of any coupling, if one falls in `(tiny, h)`.
+    ///
+    /// A step's outcome is known before it is taken: the forces are constant over it, so the
+    /// relative angle after a step of length `x` is
+    /// `phi + dtheta_s(x) - x (w_d + kick(x) a_d)`, `kick(x) = (h_{k-1} + x) / 2`, with `w_d`
+    /// rapier's (staggered) disc speed and `a_d` the disc's acceleration from the forces at `t`
+    /// (and likewise for an inertial shaft; a prescribed shaft turns by its profile). The
+    /// engagement depth along it is solved for zero by bracketed secant steps, to 1e-16 m.
+    /// Landing a step on each onset and separation keeps the `s^1.5` law's kink at `s = 0`
+    /// on step boundaries: within a step the force is smooth and the leapfrog keeps its second
+    /// order.
+    fn landing(&self, h: f64, tiny: f64) -> Option<f64> {
+        let bodies = &self.world.physics.bodies;
+        let theta_s0 = match self.shaft {
+            ShaftDrive::Prescribed(p) => p.angle(self.t),
+            ShaftDrive::Inertial { .. } => 0.0,
+        };
+        let w_s = bodies[self.world.shaft].angvel().z;
+        let turn_s = |x: f64| match self.shaft {
+            ShaftDrive::Prescribed(p) => p.angle(self.t + x) - theta_s0,
+            ShaftDrive::Inertial { j1, .. } => {
+                x * (w_s + self.shaft_kick.impulse_component(5, x) / j1)
+            }
+        };
+        let mut best: Option<f64> = None;
+        for (i, d) in self.pack.discs.iter().enumerate() {
+            if self.couplings[i].is_per_tooth() {
+                continue;
+            }
+            let f = &self.forces[i];
+            let w_d = bodies[self.world.discs[i]].angvel().z;
+            let kick = &self.disc_kicks[i];
+            let j = d.inertia_kg_m2;
+            let g0 = d.spline.half_play_rad();
+            let rb = d.spline.base_radius_m();
+            let offset = d.law.engagement_offset_m();
+            let phi0 = self.rel[i].phi;
+            let phi = |x: f64| phi0 + turn_s(x) - x * (w_d + kick.impulse_component(5, x) / j);
+            let engaged = f.depth_m > 0.0;
+            for flank in crate::hook::FLANKS {
+                if engaged && flank != f.kin.flank {
+                    continue;
+                }
+                let sigma = flank.phi_sign();
+                let depth = |x: f64| (sigma * phi(x) - g0) * rb + offset;
+                let d0 = depth(0.0);
+                let d1 = depth(h);
+                let crosses = if engaged {
+                    d0 > 0.0 && d1 <= 0.0
+                } else {
+                    d0 <= 0.0 && d1 > 0.0
+                };
+                if !crosses {
+                    continue;
+                }
+                let x = crate::stepping::bracketed_root(depth, 0.0, d0, h, d1, 1e-16);
+                if x > tiny && best.is_none_or(|b| x < b) {
+                    best = Some(x);
+                }
+            }
+        }
+        best
+    }
+
+    /// Resets and applies every body's forces for the step from `t` to `t_next`: each body's
+    /// kick over the step divided by its length (see `integrate.rs`).
+    fn apply_forces(&mut self, t_next: f64) {
+        let h = t_next - self.t;
+        let bodies = &mut self.world.physics.bodies;
+        let apply = |body: &mut RigidBody, l: Load| {
+            body.reset_forces(false);
+            body.reset_torques(false);
+            body.add_force(Vector::new(l[0], l[1], l[2]), false);
+            body.add_torque(Vector::new(l[3], l[4], l[5]), false);
+        };
+        for (i, kick) in self.disc_kicks.iter().enumerate() {
+            apply(&mut bodies[self.world.discs[i]], kick.applied(h));
+            self.disc_history[i].push(self.t, self.disc_loads[i]);
+        }
+        let shaft = &mut bodies[self.world.shaft];
+        match self.shaft {
+            ShaftDrive::Prescribed(p) => {
+                shaft.set_next_kinematic_rotation(Rotation::from_rotation_z(p.angle(t_next)));
+            }
+            ShaftDrive::Inertial { .. } => {
+                apply(shaft, self.shaft_kick.applied(h));
+                self.shaft_history.push(self.t, self.shaft_load);
+            }
+        }
+    }
+
+    /// Steps the world to `t_next` (after [`Run::apply_forces`]) and updates the shaft angle.
+    fn advance(&mut self, t_next: f64) {
+        let h = t_next - self.t;
+        let q_before = *self.world.physics.bodies[self.world.shaft].rotation();
+        self.world.step(h);
+        self.t = t_next;
+        self.theta_s = match self.shaft {
+            ShaftDrive::Prescribed(p) => p.angle(t_next),
+            ShaftDrive::Inertial { .. } => {
+                let q_after = *self.world.physics.bodies[self.world.shaft].rotation();
+                self.theta_s + angle_about_z(&(q_before.inverse() * q_after))
+            }
+        };
+    }
+}
+
+impl Engine for MultibodyEngine {
+    fn name(&self) -> &'static str {
+        "multibody"
+    }
+
+    fn disc_names(&self) -> Vec<String> {
+        self.pack.discs.iter().map(|d| d.name.clone()).collect()
+    }
+
+    fn run(
+        &mut self,
+        duration_s: f64,
+        observer: &mut dyn Observer,
+    ) -> Result<RunStats, EngineError> {
+        let opts = &self.options;
+        let mut run = Run::new(&self.pack, opts, &self.per_tooth)?;
+        let period = 1.0 / self.record_rate_hz;
+        let rec_time = |j: u64| j as f64 * period;
+        let mut rec_index: u64 = 0;
+        // Half of the current step: samples are taken at the step nearest to the grid when
+        // the step does not land on it (fixed steps, adaptive contact steps).
+        let mut half_step = match opts.stepping {
+            Stepping::Fixed { dt_s } => 0.5 * dt_s,
+            Stepping::Adaptive(_) => 0.0,
+        };
+        let steps_per_contact = match opts.stepping {
+            Stepping::Adaptive(a) => a.steps_per_contact,
+            Stepping::Fixed { .. } => AdaptiveStepping::default().steps_per_contact,
+        };
+        let mut steps: u64 = 0;
+        let mut stopped = false;
+        let mut t_last_good = 0.0;
+        loop {
+            run.evaluate(t_last_good)?;
+            t_last_good = run.t;
+            if steps == 0 {
+                run.energy.initial_contact_potential_j = run.potential_j;
+                run.energy.initial_kinetic_j = run.kinetic_energy();
+            }
+            run.track_events(steps_per_contact, observer);
+            if rec_time(rec_index) <= run.t + half_step {
+                observer.sample(&run.sample(opts.record_tooth_loads));
+                while rec_time(rec_index) <= run.t + half_step {
+                    rec_index += 1;
+                }
+            }
+            if steps > 0 && steps % PROGRESS_EVERY == 0 && observer.progress(run.t) {
+                stopped = true;
+            }
+            if stopped || run.t >= duration_s {
+                break;
+            }
+            let t = run.t;
+            let t_next = match opts.stepping {
+                Stepping::Fixed { dt_s } => ((steps + 1) as f64 * dt_s).min(duration_s),
+                Stepping::Adaptive(a) => {
+                    let (want, contact) = run.desired_step(&a);
+                    if want.is_nan() || want < a.min_step_s {
+                        return Err(EngineError::Diverged {
+                            t_s: t,
+                            reason: format!("the step size collapsed to {want} s"),
+                        });
+                    }
+                    // Free-flight steps land on the sampling grid; contact steps keep their
+                    // length (a varying step spoils the symplectic step's energy).
+                    half_step = if contact { 0.5 * want } else { 0.0 };
+                    let target = if contact {
+                        duration_s
+                    } else {
+                        rec_time(rec_index).min(duration_s)
+                    };
+                    let rem = target - t;
+                    let h = if want >= rem {
+                        rem
+                    } else if want > 0.5 * rem {
+                        0.5 * rem
+                    } else {
+                        want
+                    };
+                    // Never step over an onset or a separation: land on it.
+                    match run.landing(h, 1e-3 * h.min(want)) {
+                        Some(x) => {
+                            half_step = 0.5 * x;
+                            t + x
+                        }
+                        None if h == rem => target,
+                        None => t + h,
+                    }
+                }
+            };
+            run.apply_forces(t_next);
+            run.advance(t_next);
+            steps += 1;
+        }
+        for track in run.tracks.iter_mut() {
+            if let Some(e) = track.tracker.finish(run.t) {
+                observer.impact(&e);
+            }
+        }
+        run.energy.contact_potential_j = run.potential_j;
+        run.energy.kinetic_j = run.kinetic_energy();
+        self.energy = run.energy;
+        Ok(RunStats {
+            simulated_s: run.t,
+            steps,
+            rejected_steps: 0,
+            rhs_evals: steps + 1,
+            stopped_early: stopped,
+        })
+    }
+}

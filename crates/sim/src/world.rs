@@ -1,0 +1,257 @@
+//! The rapier3d-f64 world of a pack: a fixed housing, the shaft, and one dynamic body per disc
+//! on a cylindrical impulse joint (ARCHITECTURE.md "The multibody engine").
+//!
+//! The shaft axis is the world `+z` axis. Bodies carry no colliders: the spline teeth are our
+//! own force law, applied by the contact hook ([`crate::hook`]).
+
+use crate::options::BodyShapes;
+use clutchpack_model::{EngineError, PackModel, Shaft};
+use parry3d_f64::mass_properties::MassProperties;
+use rapier3d_f64::prelude::{
+    GenericJointBuilder, JointAxesMask, PhysicsWorld, RigidBody, RigidBodyBuilder, RigidBodyHandle,
+    Rotation, Vector,
+};
+use std::f64::consts::PI;
+
+/// The rapier world of one pack and the handles of its bodies.
+pub(crate) struct World {
+    /// All rapier state.
+    pub physics: PhysicsWorld,
+    /// The shaft: position-based kinematic (prescribed speed) or dynamic (eq 4).
+    pub shaft: RigidBodyHandle,
+    /// Whether the shaft is a dynamic body (an inertial shaft).
+    pub shaft_dynamic: bool,
+    /// One dynamic body per disc, in scene order.
+    pub discs: Vec<RigidBodyHandle>,
+    /// Axial position of each disc's mid-plane on the shaft, m.
+    pub disc_axial_m: Vec<f64>,
+}
+
+/// Outer radius in m of a flat annulus of inner radius `inner_m`, thickness `thickness_m` and
+/// density `density` whose inertia about its axis is `inertia`:
+/// `J = rho pi t (Ro^4 - Ri^4) / 2`.
+pub(crate) fn annulus_outer_radius(
+    inertia: f64,
+    inner_m: f64,
+    thickness_m: f64,
+    density: f64,
+) -> f64 {
+    (inner_m.powi(4) + 2.0 * inertia / (density * PI * thickness_m)).powf(0.25)
+}
+
+/// Mass properties of a disc about its centre, axis `+z`: a steel annulus from parry (inner
+/// radius the spline pitch radius, outer radius chosen so that the annulus has the scene's
+/// inertia), with the axial inertia then set to the scene's `J` exactly (parry's subtraction
+/// of two cylinders leaves a few ulps of rounding).
+pub(crate) fn disc_mass_properties(
+    inertia_kg_m2: f64,
+    inner_m: f64,
+    shapes: &BodyShapes,
+) -> MassProperties {
+    let half = 0.5 * shapes.disc_thickness_m;
+    let outer = annulus_outer_radius(
+        inertia_kg_m2,
+        inner_m,
+        shapes.disc_thickness_m,
+        shapes.density_kg_m3,
+    );
+    let annulus_y = MassProperties::from_cylinder(shapes.density_kg_m3, half, outer)
+        - MassProperties::from_cylinder(shapes.density_kg_m3, half, inner_m);
+    // parry's cylinders stand on +y; turn the annulus onto +z.
+    let to_z = rapier3d_f64::prelude::Pose::from_parts(
+        Vector::ZERO,
+        Rotation::from_rotation_arc(Vector::Y, Vector::Z),
+    );
+    let annulus = annulus_y.transform_by(&to_z);
+    let i = annulus.reconstruct_inertia_matrix();
+    MassProperties::with_principal_inertia_frame(
+        Vector::ZERO,
+        annulus.mass(),
+        Vector::new(i.x_axis.x, i.y_axis.y, inertia_kg_m2),
+        Rotation::IDENTITY,
+    )
+}
+
+/// Mass properties of an inertial shaft: a solid steel-like cylinder of radius `radius_m` and
+/// length `length_m` whose density is scaled so that its axial inertia is `J1`.
+fn shaft_mass_properties(inertia_kg_m2: f64, radius_m: f64, length_m: f64) -> MassProperties {
+    let density = 2.0 * inertia_kg_m2 / (PI * radius_m.powi(4) * length_m);
+    let to_z = rapier3d_f64::prelude::Pose::from_parts(
+        Vector::ZERO,
+        Rotation::from_rotation_arc(Vector::Y, Vector::Z),
+    );
+    let cyl = MassProperties::from_cylinder(density, 0.5 * length_m, radius_m).transform_by(&to_z);
+    let i = cyl.reconstruct_inertia_matrix();
+    MassProperties::with_principal_inertia_frame(
+        Vector::ZERO,
+        cyl.mass(),
+        Vector::new(i.x_axis.x, i.y_axis.y, inertia_kg_m2),
+        Rotation::IDENTITY,
+    )
+}
+
+/// A joint that keeps rotation about `+z` and the axial slide free and locks the two radial
+/// translations and the two tilts (a cylindrical joint), anchored at `anchor1` on body 1.
+fn cylindrical_joint(anchor1: Vector) -> GenericJointBuilder {
+    // The joint's free axis is its local X; put it on +z in both bodies.
+    GenericJointBuilder::new(
+        JointAxesMask::LIN_Y | JointAxesMask::LIN_Z | JointAxesMask::ANG_Y | JointAxesMask::ANG_Z,
+    )
+    .local_axis1(Vector::Z)
+    .local_axis2(Vector::Z)
+    .local_anchor1(anchor1)
+    .local_anchor2(Vector::ZERO)
+    .contacts_enabled(false)
+}
+
+impl World {
+    /// Builds the world at t = 0: shaft angle 0 at its initial speed, each disc at
+    /// `theta_d = -phi(0)` turning at `omega_s(0) - dphi(0)`.
+    pub fn build(pack: &PackModel, shapes: &BodyShapes) -> Result<World, EngineError> {
+        let mut physics = PhysicsWorld::new();
+        physics.gravity = Vector::ZERO;
+        let p = &mut physics.integration_parameters;
+        // ARCHITECTURE.md: with one iteration (= one substep) rapier is semi-implicit Euler.
+        p.num_solver_iterations = 1;
+        // No colliders: no CCD.
+        p.max_ccd_substeps = 0;
+
+        let omega0 = pack.shaft.initial_speed_rad_s();
+        let housing = physics.insert_body(RigidBodyBuilder::fixed());
+        let n = pack.discs.len();
+        let disc_axial_m: Vec<f64> = (0..n)
+            .map(|i| (i as f64 - 0.5 * (n as f64 - 1.0)) * shapes.disc_pitch_m)
+            .collect();
+
+        let (shaft, shaft_dynamic) = match &pack.shaft {
+            Shaft::Prescribed(_) => {
+                let rb = RigidBodyBuilder::kinematic_position_based()
+                    .can_sleep(false)
+                    .angvel(Vector::new(0.0, 0.0, omega0));
+                (physics.insert_body(rb), false)
+            }
+            Shaft::Inertial { inertia_kg_m2, .. } => {
+                let radius = pack
+                    .discs
+                    .iter()
+                    .map(|d| d.spline.pitch_radius_m)
+                    .fold(f64::INFINITY, f64::min);
+                let radius = if radius.is_finite() { radius } else { 0.05 };
+                let length = (n.max(1) as f64) * shapes.disc_pitch_m;
+                let rb = RigidBodyBuilder::dynamic()
+                    .can_sleep(false)
+                    .gyroscopic_forces_enabled(false)
+                    .allow_fast_rotation(true)
+                    .additional_mass_properties(shaft_mass_properties(
+                        *inertia_kg_m2,
+                        radius,
+                        length,
+                    ))
+                    .angvel(Vector::new(0.0, 0.0, omega0));
+                let h = physics.insert_body(rb);
+                // The housing holds the shaft on its axis: a revolute joint about +z.
+                let joint = GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
+                    .local_axis1(Vector::Z)
+                    .local_axis2(Vector::Z)
+                    .contacts_enabled(false);
+                physics.insert_impulse_joint(housing, h, joint);
+                (h, true)
+            }
+        };
+
+        let mut discs = Vec::with_capacity(n);
+        for (i, d) in pack.discs.iter().enumerate() {
+            let mprops = disc_mass_properties(d.inertia_kg_m2, d.spline.pitch_radius_m, shapes);
+            let rb = RigidBodyBuilder::dynamic()
+                .can_sleep(false)
+                .gyroscopic_forces_enabled(false)
+                .allow_fast_rotation(true)
+                .additional_mass_properties(mprops)
+                .translation(Vector::new(0.0, 0.0, disc_axial_m[i]))
+                .rotation(Vector::new(0.0, 0.0, -d.initial_rel_angle_rad))
+                .angvel(Vector::new(0.0, 0.0, omega0 - d.initial_rel_speed_rad_s));
+            let h = physics.insert_body(rb);
+            physics.insert_impulse_joint(
+                shaft,
+                h,
+                cylindrical_joint(Vector::new(0.0, 0.0, disc_axial_m[i])),
+            );
+            discs.push(h);
+        }
+        Ok(World {
+            physics,
+            shaft,
+            shaft_dynamic,
+            discs,
+            disc_axial_m,
+        })
+    }
+
+    /// Advances rapier by `dt` s, then restores the exponential map on the dynamic bodies'
+    /// rotations (see [`restore_exponential_map`]).
+    pub fn step(&mut self, dt: f64) {
+        self.physics.integration_parameters.dt = dt;
+        self.physics.step();
+        for &h in &self.discs {
+            restore_exponential_map(&mut self.physics.bodies[h], dt);
+        }
+        if self.shaft_dynamic {
+            restore_exponential_map(&mut self.physics.bodies[self.shaft], dt);
+        }
+    }
+}
+
+/// Corrects rapier's linearised rotation update to the exact one for the step's angular
+/// velocity.
+///
+/// Measured on rapier3d-f64 0.36.1 (`RigidBodyVelocity::integrate_linearized`): the new
+/// rotation is `normalize((1, w dt / 2) q)`, a turn of `2 atan(|w| dt / 2)` about `w` instead of
+/// `|w| dt`. The lag, `(|w| dt)^3 / 12` per step, is 6.7e-13 rad per 1 us step at 200 rad/s
+/// (150 nm per second at the pitch circle) and 6.7e-7 rad per 100 us step: far more than the
+/// backlash tolerates. The missing `|w| dt - 2 atan(|w| dt / 2)` is turned about the same axis,
+/// so the disc turns by exactly `w dt` (semi-implicit Euler on the angle).
+pub(crate) fn restore_exponential_map(body: &mut RigidBody, dt: f64) {
+    let w = body.angvel();
+    let speed = w.length();
+    if speed == 0.0 || !speed.is_finite() {
+        return;
+    }
+    let theta = speed * dt;
+    let deficit = theta - 2.0 * (0.5 * theta).atan();
+    if deficit == 0.0 {
+        return;
+    }
+    let fix = Rotation::from_axis_angle(w / speed, deficit);
+    let q = (fix * *body.rotation()).normalize();
+    body.set_rotation(q, false);
+}
+
+/// Rotation angle of `q` about `+z` in (-pi, pi], for rotations about `+z` (tilts are locked).
+pub(crate) fn angle_about_z(q: &Rotation) -> f64 {
+    2.0 * q.z.atan2(q.w)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    /// The annulus of MODEL.md section 4: J2 = 0.156 kg m^2 with inner radius 0.231 m and 3 mm
+    /// of steel needs an outer radius of about 0.290 m; parry's mass and transverse inertia
+    /// match the closed forms of an annulus (m = rho pi t (Ro^2 - Ri^2),
+    /// I_t = m (3 (Ro^2 + Ri^2) + t^2) / 12) to rounding, and the axial inertia is exact.
+    #[test]
+    fn disc_annulus_has_the_scene_inertia() {
+        let shapes = BodyShapes::default();
+        let ro = annulus_outer_radius(0.156, 0.231, 3e-3, 7850.0);
+        assert!((ro - 0.290).abs() < 1e-3, "Ro = {ro}");
+        let mp = disc_mass_properties(0.156, 0.231, &shapes);
+        let m = 7850.0 * PI * 3e-3 * (ro * ro - 0.231 * 0.231);
+        assert_relative_eq!(mp.mass(), m, max_relative = 1e-10);
+        let it = m * (3.0 * (ro * ro + 0.231 * 0.231) + 9e-6) / 12.0;
+        let i = mp.reconstruct_inertia_matrix();
+        assert_relative_eq!(i.x_axis.x, it, max_relative = 1e-9);
+        assert_relative_eq!(i.y_axis.y, it, max_relative = 1e-9);
+        assert_relative_eq!(i.z_axis.z, 0.156, max_relative = 1e-15);
+    }
+}
