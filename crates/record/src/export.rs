@@ -1,25 +1,25 @@
-//! `export --csv DIR`: one CSV file per topic of ours.
-//!
-//! | file | topic | columns |
-//! | --- | --- | --- |
-//! | `shaft.csv` | `/shaft` | `t_s,angle_rad,speed_rad_s` |
-//! | `spline_<segment>.csv` | `/discs/<segment>/spline` | `t_s,rel_angle_rad,closing_speed_m_s,penetration_m,load_n,torque_n_m,engaged,stiffness_n_m1_5,speed_rad_s,angle_rad` |
-//! | `teeth_<segment>.csv` | `/discs/<segment>/teeth` | `t_s,tooth_0_n,tooth_1_n,...` |
-//! | `impacts.csv` | `/impacts` | `disc,disc_index,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n` |
-//! | `summary.csv` | `/summary` | `disc,max_positive_n,max_negative_n,p99_abs_n,impacts,positive_impacts,negative_impacts,mean_top10_abs_n` |
-//!
-//! Numbers are written in Rust's shortest round-trip form (read back exactly); `engaged` is
-//! 0 or 1; `flank` is `shaft_leads` or `disc_leads`. `summary.csv` holds the stored summary,
-//! or for a run that did not finish the one recomputed from the recovered impacts.
-//! Files of topics without messages are not written (but for the shaft, impacts and summary).
+//! `export --csv DIR`: one CSV file per topic of ours (see [`export_csv`]).
 
 use crate::read::{ReadError, RecordingReader};
 use clutchpack_model::Flank;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Writes the CSV files described in the [module docs](self) into `dir` (created if
-/// missing) and returns their paths.
+/// Writes one CSV file per topic of ours into `dir` (created if missing) and returns their
+/// paths.
+///
+/// | file | topic | columns |
+/// | --- | --- | --- |
+/// | `shaft.csv` | `/shaft` | `t_s,angle_rad,speed_rad_s` |
+/// | `spline_<segment>.csv` | `/discs/<segment>/spline` | `t_s,rel_angle_rad,closing_speed_m_s,penetration_m,load_n,torque_n_m,engaged,stiffness_n_m1_5,speed_rad_s,angle_rad` |
+/// | `teeth_<segment>.csv` | `/discs/<segment>/teeth` | `t_s,tooth_0_n,tooth_1_n,...` |
+/// | `impacts.csv` | `/impacts` | `disc,disc_index,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n` |
+/// | `summary.csv` | `/summary` | `disc,max_positive_n,max_negative_n,p99_abs_n,impacts,positive_impacts,negative_impacts,mean_top10_abs_n` |
+///
+/// Numbers are written in Rust's shortest round-trip form (read back exactly); `engaged` is
+/// 0 or 1; `flank` is `shaft_leads` or `disc_leads`. `summary.csv` holds the stored summary,
+/// or for a run that did not finish the one recomputed from the recovered impacts.
+/// Files of topics without messages are not written (but for the shaft, impacts and summary).
 pub fn export_csv(
     reader: &RecordingReader,
     dir: impl AsRef<Path>,

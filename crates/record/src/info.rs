@@ -136,8 +136,8 @@ impl RunInfo {
         }
     }
 
-    /// The metadata records (name, key/values) that store this info; `wall` adds
-    /// `recorded_at_utc` (omitted in deterministic recordings).
+    /// The metadata records (name, key/values) that store this info; `extra_run` adds keys
+    /// to `clutchpack.run` (the recorder's options, `recorded_at_utc`).
     pub(crate) fn to_metadata(
         &self,
         extra_run: &[(String, String)],

@@ -20,7 +20,7 @@
 //!   one-line reason ([`ReadError`], [`Damage`]) and never a panic; a killed run's file is
 //!   read up to its last complete chunk.
 //! - [`export_csv`]: one CSV per topic of ours.
-//! - [`serve`] (feature `serve`): plays a recording to Foxglove over its WebSocket protocol.
+//! - `serve` (feature `serve`): plays a recording to Foxglove over its WebSocket protocol.
 //!
 //! ## What it does not do
 //! - Run engines, parse scenes or compute statistics beyond the stored summary: the CLI
@@ -76,6 +76,8 @@
 //! - Deterministic recordings ([`RecordOptions::deterministic`]) of the same stream are
 //!   byte-identical: no wall-clock data, single-threaded zstd, chunks cut by count and size.
 //! - Errors: [`RecordError`] for writing, [`ReadError`] for reading; each displays as one line.
+
+#![warn(missing_docs)]
 
 mod export;
 pub mod info;
