@@ -8,7 +8,8 @@
 //! each disc as a triangle-mesh annulus with a rim marker. Later `/scene` messages replace one
 //! entity per disc, `disc/<name>/teeth`: its spline teeth as cubes coloured by the largest
 //! `|load_n|` since the previous update (grey = no load, yellow = half, red = the colour
-//! scale).
+//! scale). An update holds only the discs whose colour changed (levels in steps of 1/16), so
+//! quiet stretches cost nothing.
 
 use crate::info::{DiscGeometry, RunInfo};
 use foxglove::schemas::{
@@ -142,10 +143,11 @@ fn annulus(r0: f64, r1: f64, h: f64, color: Option<Color>) -> TriangleListPrimit
     let mut indices = Vec::with_capacity(24 * n as usize);
     for i in 0..n {
         let j = i + 1;
+        // top, bottom, outer wall, inner wall: quads between rings a and b over segment
+        // i..j, wound counter-clockwise seen from outside (outward normals)
         for (a, b) in [(3, 2), (0, 1), (1, 3), (2, 0)] {
-            // quad between ring a and ring b, segment i..j
-            indices.extend_from_slice(&[idx(a, i), idx(b, i), idx(b, j)]);
-            indices.extend_from_slice(&[idx(a, i), idx(b, j), idx(a, j)]);
+            indices.extend_from_slice(&[idx(a, i), idx(b, j), idx(b, i)]);
+            indices.extend_from_slice(&[idx(a, i), idx(a, j), idx(b, j)]);
         }
     }
     TriangleListPrimitive {
@@ -209,22 +211,26 @@ pub(crate) fn static_scene(info: &RunInfo, frames: &[String]) -> SceneUpdate {
         deletions: Vec::new(),
         entities,
     };
-    let zeros = vec![0.0; info.discs.len()];
+    let zeros: Vec<(usize, f64)> = (0..info.discs.len()).map(|i| (i, 0.0)).collect();
     update
         .entities
         .extend(teeth_scene(0, info, frames, &zeros).entities);
     update
 }
 
-/// The teeth of every disc, coloured by `levels[i] = max |load| / scale` (0..=1).
+/// The teeth of the discs `levels` names, `(disc index, level)`, coloured by the level
+/// `max |load| / scale` (0..=1). The entities of other discs are left as they are.
 pub(crate) fn teeth_scene(
     log_time_ns: u64,
     info: &RunInfo,
     frames: &[String],
-    levels: &[f64],
+    levels: &[(usize, f64)],
 ) -> SceneUpdate {
-    let mut entities = Vec::with_capacity(info.discs.len());
-    for ((d, frame), &level) in info.discs.iter().zip(frames).zip(levels) {
+    let mut entities = Vec::with_capacity(levels.len());
+    for &(i, level) in levels {
+        let (Some(d), Some(frame)) = (info.discs.get(i), frames.get(i)) else {
+            continue;
+        };
         let mut e = entity(log_time_ns, frame, &format!("{frame}/teeth"));
         let n = if d.teeth == 0 {
             MARKERS
@@ -268,12 +274,33 @@ mod tests {
         assert_eq!((load_color(2.0).g, load_color(f64::NAN).g), (0.0, 0.0));
     }
 
-    /// The annulus mesh indexes only its own points and has 8 triangles per segment.
+    /// The annulus mesh is a closed surface with outward normals: by the divergence theorem
+    /// its signed volume `sum (p0 . (p1 x p2)) / 6` is the volume of the polygonal ring,
+    /// `n/2 sin(2 pi/n) (r1^2 - r0^2) h`, positive (a reversed winding would give it
+    /// negative, and a hole in the surface a different value).
     #[test]
-    fn annulus_mesh_is_consistent() {
-        let m = annulus(0.03, 0.06, 0.002, None);
+    fn annulus_mesh_is_closed_and_outward() {
+        let (r0, r1, h) = (0.03, 0.06, 0.002);
+        let m = annulus(r0, r1, h, None);
         assert_eq!(m.points.len(), 4 * SEGMENTS as usize);
         assert_eq!(m.indices.len(), 24 * SEGMENTS as usize);
-        assert!(m.indices.iter().all(|&i| (i as usize) < m.points.len()));
+        let p = |i: u32| {
+            let q = &m.points[i as usize];
+            [q.x, q.y, q.z]
+        };
+        let mut v = 0.0;
+        for t in m.indices.chunks(3) {
+            let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+            let cross = [
+                b[1] * c[2] - b[2] * c[1],
+                b[2] * c[0] - b[0] * c[2],
+                b[0] * c[1] - b[1] * c[0],
+            ];
+            v += (a[0] * cross[0] + a[1] * cross[1] + a[2] * cross[2]) / 6.0;
+        }
+        let n = f64::from(SEGMENTS);
+        let want = n / 2.0 * (2.0 * PI / n).sin() * (r1 * r1 - r0 * r0) * h;
+        assert!((v - want).abs() < 1e-12 * want.max(1.0), "{v} vs {want}");
+        assert!(v > 0.0);
     }
 }

