@@ -106,6 +106,8 @@ impl Observer for RunCollector {
     fn progress(&mut self, t_s: f64) -> bool {
         if let Some(p) = &self.progress {
             p.set_position((t_s * 1e6) as u64);
+            let wall = p.elapsed().as_secs_f64().max(1e-9);
+            p.set_message(format!("t = {t_s:.4} s, {:.3} simulated s per wall s", t_s / wall));
         }
         false
     }
