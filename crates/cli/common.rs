@@ -76,19 +76,26 @@ impl RunCollector {
         }
     }
 
-    /// Load histories with each impact's onset, peak and separation merged in, so that the
-    /// plotted spikes reach the located peaks whatever the sample rate.
+    /// Load histories with each impact's onset, peak and separation merged in (see
+    /// [`merge_peaks`]).
     pub fn histories_with_peaks(&self) -> Vec<Vec<(f64, f64)>> {
         let mut h = self.history.clone();
-        for e in &self.impacts {
-            if let Some(v) = h.get_mut(e.disc) {
-                v.extend([(e.t_on_s, 0.0), (e.t_peak_s, e.peak_n), (e.t_off_s, 0.0)]);
-            }
-        }
-        for v in h.iter_mut() {
-            v.sort_by(|a, b| a.0.total_cmp(&b.0));
-        }
+        merge_peaks(&mut h, &self.impacts);
         h
+    }
+}
+
+/// Merges each impact's onset (0 N), located peak and separation (0 N) into the sampled load
+/// histories `(t s, load N)` of its disc, in time order, so that plotted spikes reach the
+/// located peaks whatever the sample rate.
+pub fn merge_peaks(histories: &mut [Vec<(f64, f64)>], impacts: &[ImpactEvent]) {
+    for e in impacts {
+        if let Some(v) = histories.get_mut(e.disc) {
+            v.extend([(e.t_on_s, 0.0), (e.t_peak_s, e.peak_n), (e.t_off_s, 0.0)]);
+        }
+    }
+    for v in histories.iter_mut() {
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
     }
 }
 
@@ -107,7 +114,10 @@ impl Observer for RunCollector {
         if let Some(p) = &self.progress {
             p.set_position((t_s * 1e6) as u64);
             let wall = p.elapsed().as_secs_f64().max(1e-9);
-            p.set_message(format!("t = {t_s:.4} s, {:.3} simulated s per wall s", t_s / wall));
+            p.set_message(format!(
+                "t = {t_s:.4} s, {:.3} simulated s per wall s",
+                t_s / wall
+            ));
         }
         false
     }
@@ -164,4 +174,64 @@ pub fn time_progress(duration_s: f64, label: &str) -> indicatif::ProgressBar {
     );
     pb.set_prefix(label.to_string());
     pb
+}
+
+/// Steel density used to draw discs whose outer radius the scene does not give, kg/m^3.
+const STEEL_DENSITY_KG_M3: f64 = 7850.0;
+/// Disc thickness used to draw discs, m (the paper's 3 mm).
+const DRAWN_THICKNESS_M: f64 = 3e-3;
+
+/// What a recording stores about a run: the scene (text, name, overrides), the engine, the
+/// solver settings and the geometry drawn in the 3D view. A disc's drawn outer radius is that
+/// of a 3 mm steel annulus from its pitch radius with the scene's inertia.
+pub fn run_info(
+    scene: &Scene,
+    engine: &str,
+    scene_path: Option<&Path>,
+) -> clutchpack_record::RunInfo {
+    use clutchpack_record::{DiscGeometry, RunInfo};
+    let sim = &scene.simulation;
+    let mut solver = std::collections::BTreeMap::new();
+    solver.insert("tolerance".to_string(), sim.tolerance.to_string());
+    solver.insert("max_step_s".to_string(), sim.max_step_s.to_string());
+    let mut params = std::collections::BTreeMap::new();
+    params.insert("duration_s".to_string(), sim.duration_s.to_string());
+    params.insert("record_rate_hz".to_string(), sim.record_rate_hz.to_string());
+    let discs = scene
+        .pack
+        .discs
+        .iter()
+        .enumerate()
+        .map(|(i, d)| {
+            let ri = d.spline.pitch_radius_m;
+            // J = rho t pi / 2 (Ro^4 - Ri^4)
+            let ro = (ri.powi(4)
+                + 2.0 * d.inertia_kg_m2
+                    / (STEEL_DENSITY_KG_M3 * DRAWN_THICKNESS_M * std::f64::consts::PI))
+                .powf(0.25);
+            DiscGeometry {
+                name: d.name.clone(),
+                inner_radius_m: ri,
+                outer_radius_m: ro,
+                thickness_m: DRAWN_THICKNESS_M,
+                z_m: i as f64 * 4.0 * DRAWN_THICKNESS_M,
+                teeth: d.spline.teeth,
+            }
+        })
+        .collect();
+    RunInfo {
+        program_version: env!("CARGO_PKG_VERSION").to_string(),
+        engine: engine.to_string(),
+        scene_name: scene.name.clone(),
+        scene_file: scene_path
+            .and_then(|p| p.file_name())
+            .map(|f| f.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "hu-table2.toml".to_string()),
+        scene_text: scene.source_text.clone(),
+        overrides: scene.overrides.clone(),
+        solver,
+        params,
+        shaft: None,
+        discs,
+    }
 }

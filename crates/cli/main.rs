@@ -19,6 +19,7 @@ macro_rules! out {
 mod bench;
 mod check;
 mod common;
+mod recording;
 mod run;
 mod sweep;
 
@@ -45,6 +46,15 @@ enum Command {
     /// Run a scene once per value of one parameter (optionally as ensembles) and fit the
     /// peaks against it (the paper's Fig 3).
     Sweep(sweep::SweepArgs),
+    /// Describe a recording (topics, counts, time span, summary); `--serve` streams it to
+    /// Foxglove over WebSocket.
+    Replay(recording::ReplayArgs),
+    /// Compare per-disc impact loads across recordings (change against the first).
+    Compare(recording::CompareArgs),
+    /// Export a recording's topics as CSV files.
+    Export(recording::ExportArgs),
+    /// Plot a recording's per-disc load histories (PNG or SVG).
+    Plot(recording::PlotArgs),
     /// Measure speed: the paper case per run, and the speed-up of a 16-case sweep on 2
     /// threads over 1 (prints ratios; timing is never a test).
     Bench(bench::BenchArgs),
@@ -59,6 +69,10 @@ fn main() -> ExitCode {
         Command::Sweep(a) => sweep::sweep(a),
         Command::Check(a) => check::check(a),
         Command::Bench(a) => bench::bench(a),
+        Command::Replay(a) => recording::replay(a),
+        Command::Compare(a) => recording::compare(a),
+        Command::Export(a) => recording::export(a),
+        Command::Plot(a) => recording::plot(a),
     };
     match result {
         Ok(code) => code,

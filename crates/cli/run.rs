@@ -3,10 +3,14 @@
 use crate::common::{self, EngineArg, RunCollector, RunSummary};
 use anyhow::{Context, Result};
 use clutchpack_analysis::{disc_stats, stats_table, TableFormat};
+use clutchpack_model::{ImpactEvent, Observer, Sample};
+use clutchpack_record::{RecordOptions, Recorder};
 use clutchpack_scene::Override;
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Arguments of `clutchpack run`.
@@ -36,6 +40,23 @@ pub struct RunArgs {
     /// Plot the per-tooth load history of each disc (PNG or SVG by extension).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
+    /// The recording (MCAP); default `recordings/<scene>-<UTC time>.mcap`.
+    #[arg(long, value_name = "FILE", conflicts_with = "no_record")]
+    pub out: Option<PathBuf>,
+    /// Do not record.
+    #[arg(long)]
+    pub no_record: bool,
+    /// Sample rate of the recording and the load history in Hz (overrides
+    /// `simulation.record_rate_hz`).
+    #[arg(long, value_name = "HZ")]
+    pub record_rate: Option<f64>,
+    /// Record per-tooth loads where the engine resolves teeth (overrides
+    /// `simulation.record_per_tooth`).
+    #[arg(long)]
+    pub per_tooth: bool,
+    /// No wall-clock data in the recording: the same run gives a byte-identical file.
+    #[arg(long)]
+    pub deterministic: bool,
 }
 
 pub fn run(a: RunArgs) -> Result<ExitCode> {
@@ -46,18 +67,71 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             value: d.to_string(),
         });
     }
+    if let Some(r) = a.record_rate {
+        sets.push(Override {
+            key: "simulation.record_rate_hz".into(),
+            value: r.to_string(),
+        });
+    }
     let scene = common::load_scene(a.scene.as_deref(), &sets)?;
     let mut engine = common::make_engine(&scene, a.engine)?;
     let names = engine.disc_names();
     let duration = scene.simulation.duration_s;
-    let mut obs = RunCollector::new(names.len(), a.plot.is_some());
+    let mut collector = RunCollector::new(names.len(), a.plot.is_some());
     let pb = common::time_progress(duration, &scene.name);
-    obs.progress = Some(pb.clone());
+    collector.progress = Some(pb.clone());
+    let recorder = if a.no_record {
+        None
+    } else {
+        let path = a
+            .out
+            .clone()
+            .unwrap_or_else(|| default_recording_path(&scene.name));
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("creating the folder {}", dir.display()))?;
+        }
+        let info = common::run_info(&scene, engine.name(), a.scene.as_deref());
+        let opts = RecordOptions {
+            deterministic: a.deterministic,
+            per_tooth: a.per_tooth || scene.simulation.record_per_tooth,
+            ..RecordOptions::default()
+        };
+        Some(
+            Recorder::create(&path, &info, &opts)
+                .with_context(|| format!("creating the recording {}", path.display()))?,
+        )
+    };
+    let interrupted = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupted.clone();
+        // A second Ctrl-C while the handler is installed still stops the run (the flag is
+        // simply set again); failing to install it only loses the clean stop.
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
+    let mut obs = RunObserver {
+        collector,
+        recorder,
+        interrupted: interrupted.clone(),
+    };
     let t0 = Instant::now();
     let result = engine.run(duration, &mut obs);
     let wall = t0.elapsed().as_secs_f64();
     pb.finish_and_clear();
+    let RunObserver {
+        collector: obs,
+        recorder,
+        ..
+    } = obs;
     let stats = disc_stats(&names, &obs.impacts);
+    // Close the recording first: it holds everything before a failure or an interruption.
+    if let Some(mut rec) = recorder {
+        if let Ok(s) = &result {
+            rec.set_run_stats(s);
+        }
+        let path = rec.finish(None).context("finishing the recording")?;
+        eprintln!("recording: {}", path.display());
+    }
 
     // Write what we have even when the run failed, then report the failure.
     if let Some(path) = &a.impacts_csv {
@@ -74,6 +148,13 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             .with_context(|| format!("plotting {}", path.display()))?;
     }
     let run_stats = match result {
+        Ok(s) if s.stopped_early => {
+            eprintln!(
+                "interrupted at t = {:.6} s: the outputs hold the run up to there",
+                s.simulated_s
+            );
+            s
+        }
         Ok(s) => s,
         Err(e) => {
             return Err(anyhow::Error::new(e).context(format!(
@@ -133,4 +214,51 @@ fn write_impacts_csv(path: &PathBuf, names: &[String], obs: &RunCollector) -> Re
     }
     w.flush()
         .with_context(|| format!("writing {}", path.display()))
+}
+
+/// `recordings/<scene>-<UTC time>.mcap`.
+fn default_recording_path(scene: &str) -> PathBuf {
+    let stamp = humantime::format_rfc3339_seconds(std::time::SystemTime::now())
+        .to_string()
+        .replace([':', '-'], "");
+    let safe: String = scene
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    PathBuf::from("recordings").join(format!("{safe}-{stamp}.mcap"))
+}
+
+/// Feeds the collector and the recorder; stops the run on Ctrl-C.
+struct RunObserver {
+    collector: RunCollector,
+    recorder: Option<Recorder>,
+    interrupted: Arc<AtomicBool>,
+}
+
+impl Observer for RunObserver {
+    fn sample(&mut self, s: &Sample) {
+        self.collector.sample(s);
+        if let Some(r) = self.recorder.as_mut() {
+            r.sample(s);
+        }
+    }
+    fn impact(&mut self, e: &ImpactEvent) {
+        self.collector.impact(e);
+        if let Some(r) = self.recorder.as_mut() {
+            r.impact(e);
+        }
+    }
+    fn progress(&mut self, t_s: f64) -> bool {
+        let mut stop = self.collector.progress(t_s);
+        if let Some(r) = self.recorder.as_mut() {
+            stop |= r.progress(t_s);
+        }
+        stop || self.interrupted.load(Ordering::SeqCst)
+    }
 }

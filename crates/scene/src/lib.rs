@@ -28,6 +28,7 @@
 //! record_rate_hz = 10000.0      # default 10000
 //! tolerance = 1e-9              # default 1e-9, in [1e-14, 1e-3]
 //! max_step_s = 1e-4             # default 1e-4
+//! record_per_tooth = false       # default false
 //!
 //! [shaft]
 //! mode = "prescribed"           # default; or "inertial" with inertia_kg_m2 (required),
@@ -147,6 +148,9 @@ pub struct Simulation {
     /// Largest step of the adaptive integrators in s (> 0). Key `simulation.max_step_s`,
     /// default 1e-4.
     pub max_step_s: f64,
+    /// Whether recordings store per-tooth loads where the engine resolves teeth. Key
+    /// `simulation.record_per_tooth`, default false.
+    pub record_per_tooth: bool,
 }
 
 /// A validated scene: everything an engine needs, in SI units.

@@ -100,6 +100,7 @@ pub(crate) struct RawSimulation {
     pub record_rate_hz: Option<Value>,
     pub tolerance: Option<Value>,
     pub max_step_s: Option<Value>,
+    pub record_per_tooth: Option<Value>,
 }
 
 /// `[shaft]`.

@@ -38,6 +38,10 @@ const SCENE_KEYS: &[Key] = &[
         "relative tolerance of the adaptive integrator, in [1e-14, 1e-3]; default 1e-9",
     ),
     key("simulation.max_step_s", "s, > 0; default 1e-4"),
+    key(
+        "simulation.record_per_tooth",
+        "true | false; record per-tooth loads where the engine resolves teeth; default false",
+    ),
     key("shaft.mode", "\"prescribed\" (default) | \"inertial\""),
     key(
         "shaft.inertia_kg_m2",

@@ -182,6 +182,18 @@ impl Checker {
         }
     }
 
+    /// A boolean (`true` / `false`).
+    fn boolean(&mut self, key: &str, v: Option<&Value>) -> Field<bool> {
+        let Some(v) = v else { return Field::Absent };
+        match v.as_bool() {
+            Some(b) => Field::Valid(b),
+            None => {
+                self.report(key, Some(show(v)), "must be true or false");
+                Field::Invalid
+            }
+        }
+    }
+
     /// Reports a key that is present but not allowed in this configuration.
     fn not_allowed(&mut self, key: &str, v: Option<&Value>, rule: &str) -> bool {
         match v {
@@ -269,12 +281,16 @@ fn simulation(ck: &mut Checker, raw: Option<&RawSimulation>) -> Option<Simulatio
             Rule::Positive,
         )
         .or(1e-4);
+    let per_tooth = ck
+        .boolean("simulation.record_per_tooth", r.record_per_tooth.as_ref())
+        .or(false);
     Some(Simulation {
         duration_s: duration?,
         engine: engine?,
         record_rate_hz: rate?,
         tolerance: tolerance?,
         max_step_s: max_step?,
+        record_per_tooth: per_tooth?,
     })
 }
 

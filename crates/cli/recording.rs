@@ -1,0 +1,393 @@
+//! Reading recordings: `replay`, `compare`, `export`, `plot`.
+//!
+//! Every command reads the whole file it is given. A damaged file (truncated by a killed run,
+//! corrupted) is an error (exit 2) that says what was read and what was not, unless
+//! `--salvage` is given: then the command works on the messages recovered and warns.
+
+use crate::common::BadInput;
+use anyhow::{Context, Result};
+use clutchpack_analysis::{disc_stats, DiscStats};
+use clutchpack_record::RecordingReader;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Opens a recording; a damaged one is bad input unless `salvage`.
+pub fn open_recording(path: &Path, salvage: bool) -> Result<RecordingReader> {
+    let reader = clutchpack_record::open(path).map_err(|e| BadInput(e.to_string()))?;
+    if let Some(d) = reader.damage() {
+        if salvage {
+            eprintln!(
+                "warning: {}: {d}; using the recovered messages",
+                path.display()
+            );
+        } else {
+            return Err(BadInput(format!(
+                "{}: {d} (pass --salvage to use the recovered messages)",
+                path.display()
+            ))
+            .into());
+        }
+    }
+    Ok(reader)
+}
+
+/// Per-disc statistics of a recording, from its impact events (the same definitions as
+/// `clutchpack run`).
+pub fn recording_stats(reader: &RecordingReader) -> Vec<DiscStats> {
+    disc_stats(&reader.disc_names(), &reader.impacts())
+}
+
+/// Arguments of `clutchpack replay`.
+#[derive(clap::Args, Debug)]
+pub struct ReplayArgs {
+    /// The recording (.mcap).
+    pub file: PathBuf,
+    /// Work on the messages of a damaged file (killed run) instead of failing.
+    #[arg(long)]
+    pub salvage: bool,
+    /// Stream the recording over the Foxglove WebSocket protocol on 127.0.0.1, with
+    /// playback control, so that Foxglove can watch it live (open connection
+    /// ws://127.0.0.1:PORT).
+    #[arg(long)]
+    pub serve: bool,
+    /// Port of `--serve`.
+    #[arg(long, default_value_t = 8765)]
+    pub port: u16,
+}
+
+pub fn replay(a: ReplayArgs) -> Result<ExitCode> {
+    let reader = open_recording(&a.file, a.salvage)?;
+    let info = reader.info();
+    out!(
+        "{}: {} bytes, {} messages",
+        a.file.display(),
+        reader.file_bytes(),
+        info.messages
+    );
+    if let (Some(s), Some(e)) = (info.start_s, info.end_s) {
+        out!("time span: {s:.6} s .. {e:.6} s (simulated)");
+    }
+    if let Some(run) = info.metadata("clutchpack.run") {
+        for k in [
+            "engine",
+            "scene_name",
+            "scene_file",
+            "scene_sha256",
+            "program_version",
+            "overrides",
+        ] {
+            if let Some(v) = run.get(k) {
+                out!("{k}: {v}");
+            }
+        }
+    }
+    out!("topics:");
+    for t in &info.topics {
+        out!(
+            "  {:<32} {:<28} {:>9} messages",
+            t.topic,
+            t.schema_name,
+            t.messages
+        );
+    }
+    for att in &info.attachments {
+        out!(
+            "attachment: {} ({}, {} bytes)",
+            att.name,
+            att.media_type,
+            att.data.len()
+        );
+    }
+    let stats = recording_stats(&reader);
+    out!(
+        "per-tooth impact loads{}:",
+        if info.summary.is_some() {
+            ""
+        } else {
+            " (no stored summary: from the recovered impacts)"
+        }
+    );
+    out!(
+        "{}",
+        clutchpack_analysis::stats_table(&stats, clutchpack_analysis::TableFormat::Text).trim_end()
+    );
+    if a.serve {
+        serve(&a.file, a.port)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(feature = "serve")]
+fn serve(path: &Path, port: u16) -> Result<()> {
+    out!(
+        "serving {} on ws://127.0.0.1:{port} (Ctrl-C to stop)",
+        path.display()
+    );
+    let opts = clutchpack_record::ServeOptions {
+        port,
+        ..Default::default()
+    };
+    clutchpack_record::serve(path, &opts).context("serving the recording")?;
+    Ok(())
+}
+
+#[cfg(not(feature = "serve"))]
+fn serve(_path: &Path, _port: u16) -> Result<()> {
+    Err(
+        BadInput("this build has no WebSocket server: rebuild with `--features serve`".into())
+            .into(),
+    )
+}
+
+/// Output formats of `compare`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CompareFormat {
+    Table,
+    Markdown,
+    Csv,
+    Json,
+}
+
+/// Arguments of `clutchpack compare`.
+#[derive(clap::Args, Debug)]
+pub struct CompareArgs {
+    /// Recordings to compare; changes are reported against the first.
+    #[arg(required = true, num_args = 2..)]
+    pub files: Vec<PathBuf>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
+    pub format: CompareFormat,
+    /// Grouped bar chart of the peaks per disc and run (PNG or SVG).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+    /// Use the recovered messages of damaged files.
+    #[arg(long)]
+    pub salvage: bool,
+}
+
+/// One (run, disc) row of `compare`.
+#[derive(Debug, Serialize)]
+pub struct CompareRow {
+    pub run: String,
+    pub disc: String,
+    pub max_positive_n: f64,
+    pub max_negative_n: f64,
+    pub p99_abs_n: f64,
+    pub impacts: usize,
+    /// Change of max_positive_n against the first run's same disc, per cent.
+    pub max_positive_change_pct: Option<f64>,
+    /// Change of |max_negative_n| against the first run's same disc, per cent.
+    pub max_negative_change_pct: Option<f64>,
+    /// Change of p99_abs_n against the first run's same disc, per cent.
+    pub p99_abs_change_pct: Option<f64>,
+}
+
+fn pct(new: f64, old: f64) -> Option<f64> {
+    (old.abs() > 0.0).then(|| (new.abs() - old.abs()) / old.abs() * 100.0)
+}
+
+/// Builds the comparison rows of runs (name, stats), the first being the baseline.
+pub fn compare_rows(runs: &[(String, Vec<DiscStats>)]) -> Vec<CompareRow> {
+    let base = &runs[0].1;
+    let mut rows = Vec::new();
+    for (run, stats) in runs {
+        for s in stats {
+            let b = base.iter().find(|b| b.name == s.name);
+            rows.push(CompareRow {
+                run: run.clone(),
+                disc: s.name.clone(),
+                max_positive_n: s.max_positive_n,
+                max_negative_n: s.max_negative_n,
+                p99_abs_n: s.p99_abs_n,
+                impacts: s.impacts,
+                max_positive_change_pct: b.and_then(|b| pct(s.max_positive_n, b.max_positive_n)),
+                max_negative_change_pct: b.and_then(|b| pct(s.max_negative_n, b.max_negative_n)),
+                p99_abs_change_pct: b.and_then(|b| pct(s.p99_abs_n, b.p99_abs_n)),
+            });
+        }
+    }
+    rows
+}
+
+fn fmt_pct(p: Option<f64>) -> String {
+    p.map(|p| format!("{p:+.1} %"))
+        .unwrap_or_else(|| "-".into())
+}
+
+pub fn compare(a: CompareArgs) -> Result<ExitCode> {
+    let mut runs = Vec::new();
+    for f in &a.files {
+        let reader = open_recording(f, a.salvage)?;
+        runs.push((f.display().to_string(), recording_stats(&reader)));
+    }
+    let rows = compare_rows(&runs);
+    let header = [
+        "run",
+        "disc",
+        "max + [N]",
+        "change",
+        "max - [N]",
+        "change",
+        "p99 abs [N]",
+        "change",
+        "impacts",
+    ];
+    let cells: Vec<[String; 9]> = rows
+        .iter()
+        .map(|r| {
+            [
+                r.run.clone(),
+                r.disc.clone(),
+                format!("{:.1}", r.max_positive_n),
+                fmt_pct(r.max_positive_change_pct),
+                format!("{:.1}", r.max_negative_n),
+                fmt_pct(r.max_negative_change_pct),
+                format!("{:.1}", r.p99_abs_n),
+                fmt_pct(r.p99_abs_change_pct),
+                r.impacts.to_string(),
+            ]
+        })
+        .collect();
+    match a.format {
+        CompareFormat::Json => out!("{}", serde_json::to_string_pretty(&rows)?),
+        CompareFormat::Csv => {
+            out!("run,disc,max_positive_n,max_positive_change_pct,max_negative_n,max_negative_change_pct,p99_abs_n,p99_abs_change_pct,impacts");
+            for r in &rows {
+                let o = |p: Option<f64>| p.map(|p| p.to_string()).unwrap_or_default();
+                out!(
+                    "{},{},{},{},{},{},{},{},{}",
+                    r.run,
+                    r.disc,
+                    r.max_positive_n,
+                    o(r.max_positive_change_pct),
+                    r.max_negative_n,
+                    o(r.max_negative_change_pct),
+                    r.p99_abs_n,
+                    o(r.p99_abs_change_pct),
+                    r.impacts
+                );
+            }
+        }
+        CompareFormat::Markdown => {
+            out!("| {} |", header.join(" | "));
+            out!("|{}", "---|".repeat(header.len()));
+            for c in &cells {
+                out!("| {} |", c.join(" | "));
+            }
+        }
+        CompareFormat::Table => {
+            let mut w = header.map(|h| h.len());
+            for c in &cells {
+                for (i, x) in c.iter().enumerate() {
+                    w[i] = w[i].max(x.len());
+                }
+            }
+            let line = |c: &[String]| {
+                c.iter()
+                    .enumerate()
+                    .map(|(i, x)| {
+                        if i < 2 {
+                            format!("{x:<w$}", w = w[i])
+                        } else {
+                            format!("{x:>w$}", w = w[i])
+                        }
+                    })
+                    .collect::<Vec<_>>()
+                    .join("  ")
+            };
+            out!("{}", line(&header.map(String::from)));
+            out!(
+                "{}",
+                "-".repeat(w.iter().sum::<usize>() + 2 * (w.len() - 1))
+            );
+            for c in &cells {
+                out!("{}", line(c));
+            }
+            out!("changes are of the magnitudes against the first run, per cent");
+        }
+    }
+    if let Some(path) = &a.plot {
+        let mut discs: Vec<String> = Vec::new();
+        for (_, s) in &runs {
+            for d in s {
+                if !discs.contains(&d.name) {
+                    discs.push(d.name.clone());
+                }
+            }
+        }
+        let values: Vec<Vec<(f64, f64)>> = runs
+            .iter()
+            .map(|(_, s)| {
+                discs
+                    .iter()
+                    .map(|d| {
+                        s.iter()
+                            .find(|x| &x.name == d)
+                            .map(|x| (x.max_positive_n, x.max_negative_n))
+                            .unwrap_or((0.0, 0.0))
+                    })
+                    .collect()
+            })
+            .collect();
+        let names: Vec<String> = runs.iter().map(|(n, _)| n.clone()).collect();
+        clutchpack_analysis::plot_compare(path, &names, &discs, &values)
+            .with_context(|| format!("plotting {}", path.display()))?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Arguments of `clutchpack export`.
+#[derive(clap::Args, Debug)]
+pub struct ExportArgs {
+    /// The recording (.mcap).
+    pub file: PathBuf,
+    /// Folder for the CSV files (one per topic; created if needed).
+    #[arg(long, value_name = "DIR", required = true)]
+    pub csv: PathBuf,
+    /// Use the recovered messages of a damaged file.
+    #[arg(long)]
+    pub salvage: bool,
+}
+
+pub fn export(a: ExportArgs) -> Result<ExitCode> {
+    let reader = open_recording(&a.file, a.salvage)?;
+    let written = clutchpack_record::export_csv(&reader, &a.csv)?;
+    for p in &written {
+        out!("{}", p.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Arguments of `clutchpack plot`.
+#[derive(clap::Args, Debug)]
+pub struct PlotArgs {
+    /// The recording (.mcap).
+    pub file: PathBuf,
+    /// The figure (PNG or SVG by extension).
+    #[arg(short = 'o', long = "out", value_name = "FIG", required = true)]
+    pub out: PathBuf,
+    /// Use the recovered messages of a damaged file.
+    #[arg(long)]
+    pub salvage: bool,
+}
+
+pub fn plot(a: PlotArgs) -> Result<ExitCode> {
+    let reader = open_recording(&a.file, a.salvage)?;
+    let (names, mut histories): (Vec<String>, Vec<Vec<(f64, f64)>>) = reader
+        .load_histories()
+        .into_iter()
+        .map(|h| (h.name, h.t_s.into_iter().zip(h.load_n).collect()))
+        .unzip();
+    crate::common::merge_peaks(&mut histories, &reader.impacts());
+    let series: Vec<(String, Vec<(f64, f64)>)> = names.into_iter().zip(histories).collect();
+    let scene = reader
+        .info()
+        .metadata("clutchpack.run")
+        .and_then(|m| m.get("scene_name").cloned())
+        .unwrap_or_else(|| a.file.display().to_string());
+    clutchpack_analysis::plot_load_history(&a.out, &format!("{scene}: per-tooth load"), &series)
+        .with_context(|| format!("plotting {}", a.out.display()))?;
+    out!("{}", a.out.display());
+    Ok(ExitCode::SUCCESS)
+}
