@@ -2,7 +2,7 @@
 //! controller; samples, impact events and the energy audit.
 
 use crate::hook::{Coupling, CouplingForces, RelativeState};
-use crate::integrate::{Kick, Load, LoadHistory};
+use crate::integrate::{future_impulse, past_impulse, Kick, Load, LoadHistory, Motion};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping, ToothResolution};
 use crate::stepping::{
     contact_duration_s, coupling_step, profile_acceleration_bound, CouplingView,
@@ -276,11 +276,25 @@ struct Run<'a> {
     /// Physical loads at `t` (world frame) on each disc and on an inertial shaft.
     disc_loads: Vec<Load>,
     shaft_load: Load,
-    /// Their values at the two evaluations before, and the kicks for the next step.
+    /// Their values at the two evaluations before, and the kicks for the next step. These
+    /// leave out the teeth's torque about the axis, whose kick is integrated along the step
+    /// (`teeth_past`, `teeth_motion`).
     disc_history: Vec<LoadHistory>,
     shaft_history: LoadHistory,
     disc_kicks: Vec<Kick>,
     shaft_kick: Kick,
+    /// The full loads (teeth included) and their history, for the first estimate of the
+    /// synchronised speeds.
+    disc_full_loads: Vec<Load>,
+    shaft_full_load: Load,
+    disc_full_history: Vec<LoadHistory>,
+    shaft_full_history: LoadHistory,
+    /// `(t, phi, dphi, ddphi)` of each coupling at the last evaluation.
+    prev_motion: Vec<Option<(f64, f64, f64, f64)>>,
+    /// The teeth: the past half of their kick (N m s on the disc, about the axis) and the
+    /// relative motion at `t` for the future half.
+    teeth_past: Vec<f64>,
+    teeth_motion: Vec<Motion>,
     /// Disc speeds at `t` (synchronised with the poses), rad/s.
     omega_d: Vec<f64>,
     /// Time, unwrapped shaft angle and shaft speed.
@@ -362,6 +376,13 @@ impl<'a> Run<'a> {
             shaft_history: LoadHistory::default(),
             disc_kicks: vec![Kick::default(); nd],
             shaft_kick: Kick::default(),
+            disc_full_loads: vec![[0.0; 6]; nd],
+            shaft_full_load: [0.0; 6],
+            disc_full_history: vec![LoadHistory::default(); nd],
+            shaft_full_history: LoadHistory::default(),
+            prev_motion: vec![None; nd],
+            teeth_past: vec![0.0; nd],
+            teeth_motion: vec![Motion::default(); nd],
             omega_d: Vec::with_capacity(nd),
             t: 0.0,
             theta_s: 0.0,
@@ -390,26 +411,58 @@ impl<'a> Run<'a> {
     /// The hook at `t`: every coupling's relative state and tooth loads. Fails if the state
     /// is not finite or the teeth passed through each other (|phi| beyond half a pitch).
     fn evaluate(&mut self, t_last_good: f64) -> Result<(), EngineError> {
-        let shaft = &self.world.physics.bodies[self.world.shaft];
+        let bodies = &self.world.physics.bodies;
+        let shaft = &bodies[self.world.shaft];
+        // First estimates of the speeds at t: rapier's mean speeds plus the extrapolated
+        // accelerations over the last step.
         self.omega_s = match self.shaft {
             ShaftDrive::Prescribed(p) => p.speed(self.t),
             ShaftDrive::Inertial { j1, .. } => {
-                self.shaft_history
+                self.shaft_full_history
                     .synchronised(self.t, shaft.angvel().z, 5, 1.0 / j1)
             }
         };
+        // The teeth's torque integrated along the last step (the past half of the kick), which
+        // also gives the synchronised speeds without extrapolating across a kink.
+        let mut teeth_past_sum = 0.0;
+        for (i, c) in self.couplings.iter().enumerate() {
+            self.teeth_past[i] = 0.0;
+            let Some((t0, phi0, dphi0, _)) = self.prev_motion[i] else {
+                continue;
+            };
+            let disc = &bodies[self.world.discs[i]];
+            let j = self.pack.discs[i].inertia_kg_m2;
+            let est = self.disc_full_history[i].synchronised(self.t, disc.angvel().z, 5, 1.0 / j);
+            let rel = relative_state(shaft, self.omega_s, disc, est);
+            let h1 = self.t - t0;
+            if h1 > 0.0 {
+                self.teeth_past[i] =
+                    past_impulse((phi0, dphi0), (rel.phi, rel.dphi), h1, |p, d| {
+                        c.probe_torque(p, d)
+                    });
+                teeth_past_sum += self.teeth_past[i];
+            }
+        }
+        if let ShaftDrive::Inertial { j1, .. } = self.shaft {
+            if self.shaft_history.len() > 0 {
+                self.omega_s = shaft.angvel().z
+                    + (self.shaft_history.synchronised(self.t, 0.0, 5, 1.0) - teeth_past_sum) / j1;
+            }
+        }
         self.rel.clear();
         self.forces.clear();
         self.omega_d.clear();
         self.potential_j = 0.0;
         for (i, c) in self.couplings.iter_mut().enumerate() {
-            let disc = &self.world.physics.bodies[self.world.discs[i]];
-            let omega_d = self.disc_history[i].synchronised(
-                self.t,
-                disc.angvel().z,
-                5,
-                1.0 / self.pack.discs[i].inertia_kg_m2,
-            );
+            let disc = &bodies[self.world.discs[i]];
+            let j = self.pack.discs[i].inertia_kg_m2;
+            let mean = disc.angvel().z;
+            let omega_d = if self.prev_motion[i].is_some() {
+                mean + (self.teeth_past[i] + self.disc_history[i].synchronised(self.t, 0.0, 5, 1.0))
+                    / j
+            } else {
+                self.disc_full_history[i].synchronised(self.t, mean, 5, 1.0 / j)
+            };
             self.omega_d.push(omega_d);
             let rel = relative_state(shaft, self.omega_s, disc, omega_d);
             let limit = std::f64::consts::PI / c.spline.teeth as f64;
@@ -443,6 +496,8 @@ impl<'a> Run<'a> {
         let qs = *bodies[self.world.shaft].rotation();
         let mut shaft_force = Vector::ZERO;
         let mut shaft_torque = Vector::ZERO;
+        let mut shaft_torque_full = Vector::ZERO;
+        let mut disc_accel = vec![0.0; self.forces.len()];
         for (i, f) in self.forces.iter().enumerate() {
             let d = &self.pack.discs[i];
             // Hu et al. eq (5): drag -C2 omega_d.
@@ -454,27 +509,59 @@ impl<'a> Run<'a> {
             let e_local = Vector::new(self.rel[i].offset[0], self.rel[i].offset[1], 0.0);
             let force = qs * f_local;
             let torque = qs * (m_local - e_local.cross(f_local)) + Vector::new(0.0, 0.0, drag);
-            self.disc_loads[i] = [force.x, force.y, force.z, torque.x, torque.y, torque.z];
-            self.disc_kicks[i] = self.disc_history[i].kick(self.t, &self.disc_loads[i]);
+            self.disc_full_loads[i] = [force.x, force.y, force.z, torque.x, torque.y, torque.z];
+            disc_accel[i] = torque.z / d.inertia_kg_m2;
             // The reaction on the shaft, about its centre: -(m + a x F), a the mid-plane.
             let a = Vector::new(0.0, 0.0, self.world.disc_axial_m[i]);
+            let reaction = qs * (m_local + a.cross(f_local));
+            shaft_torque_full -= reaction;
+            // The teeth's torque about the axis is integrated along the step instead
+            // (`teeth_impulse`); the rest (radial forces, tilting moments, the moment of the
+            // radial force about an offset centre) goes through the polynomial kick.
+            let mut partial = self.disc_full_loads[i];
+            partial[5] -= f.moment[2];
+            self.disc_loads[i] = partial;
             shaft_force -= force;
-            shaft_torque -= qs * (m_local + a.cross(f_local));
+            shaft_torque -= reaction - Vector::new(0.0, 0.0, f.moment[2]);
+            self.disc_kicks[i] = self.disc_history[i].kick(self.t, &self.disc_loads[i]);
         }
-        if let ShaftDrive::Inertial { c1, .. } = self.shaft {
-            // Hu et al. eq (4): the drive torque, the spline reactions, damping -C1 omega.
-            let drive = self.pack.shaft.drive_torque_n_m(self.t);
-            shaft_torque.z += drive - c1 * self.omega_s;
-            self.shaft_load = [
-                shaft_force.x,
-                shaft_force.y,
-                shaft_force.z,
-                shaft_torque.x,
-                shaft_torque.y,
-                shaft_torque.z,
-            ];
-            self.shaft_kick = self.shaft_history.kick(self.t, &self.shaft_load);
+        let shaft_accel = match self.shaft {
+            ShaftDrive::Prescribed(p) => p.acceleration(self.t),
+            ShaftDrive::Inertial { j1, c1 } => {
+                // Hu et al. eq (4): the drive torque, the spline reactions, damping -C1 omega.
+                let drive = self.pack.shaft.drive_torque_n_m(self.t) - c1 * self.omega_s;
+                shaft_torque.z += drive;
+                shaft_torque_full.z += drive;
+                let l = |t: Vector| [shaft_force.x, shaft_force.y, shaft_force.z, t.x, t.y, t.z];
+                self.shaft_load = l(shaft_torque);
+                self.shaft_full_load = l(shaft_torque_full);
+                self.shaft_kick = self.shaft_history.kick(self.t, &self.shaft_load);
+                shaft_torque_full.z / j1
+            }
+        };
+        for (i, m) in self.teeth_motion.iter_mut().enumerate() {
+            let ddphi = shaft_accel - disc_accel[i];
+            let (jerk, jerk_step) = match self.prev_motion[i] {
+                Some((t0, _, _, dd0)) if self.t > t0 => {
+                    ((ddphi - dd0) / (self.t - t0), self.t - t0)
+                }
+                _ => (0.0, 0.0),
+            };
+            *m = Motion {
+                phi: self.rel[i].phi,
+                dphi: self.rel[i].dphi,
+                ddphi,
+                jerk,
+                jerk_step,
+            };
         }
+    }
+
+    /// The impulse of the teeth of coupling `i` on its disc about the axis over a step of
+    /// length `x` from `t` (both halves of the kick), N m s.
+    fn teeth_impulse(&self, i: usize, x: f64) -> f64 {
+        let c = &self.couplings[i];
+        self.teeth_past[i] + future_impulse(&self.teeth_motion[i], x, |p, d| c.probe_torque(p, d))
     }
 
     /// Adds the work done since the last evaluation (trapezoidal rule) to the energy audit.
@@ -615,15 +702,20 @@ impl<'a> Run<'a> {
         let turn_s = |x: f64| match self.shaft {
             ShaftDrive::Prescribed(p) => p.angle(self.t + x) - theta_s0,
             ShaftDrive::Inertial { j1, .. } => {
-                x * (w_s + self.shaft_kick.impulse_component(5, x) / j1)
+                let teeth: f64 = (0..self.couplings.len())
+                    .map(|i| self.teeth_impulse(i, x))
+                    .sum();
+                x * (w_s + (self.shaft_kick.impulse_component(5, x) - teeth) / j1)
             }
         };
         let mut best: Option<f64> = None;
         for (i, d) in self.pack.discs.iter().enumerate() {
-            if self.couplings[i].is_per_tooth() {
+            let f = &self.forces[i];
+            // Landing follows the concentric tooth: with radial play or spacing errors the
+            // first tooth to touch is another one.
+            if f.gap_margin_m > 0.0 {
                 continue;
             }
-            let f = &self.forces[i];
             let w_d = bodies[self.world.discs[i]].angvel().z;
             let kick = &self.disc_kicks[i];
             let j = d.inertia_kg_m2;
@@ -631,7 +723,10 @@ impl<'a> Run<'a> {
             let rb = d.spline.base_radius_m();
             let offset = d.law.engagement_offset_m();
             let phi0 = self.rel[i].phi;
-            let phi = |x: f64| phi0 + turn_s(x) - x * (w_d + kick.impulse_component(5, x) / j);
+            let phi = |x: f64| {
+                phi0 + turn_s(x)
+                    - x * (w_d + (kick.impulse_component(5, x) + self.teeth_impulse(i, x)) / j)
+            };
             let engaged = f.depth_m > 0.0;
             for flank in crate::hook::FLANKS {
                 if engaged && flank != f.kin.flank {
@@ -662,6 +757,9 @@ impl<'a> Run<'a> {
     /// kick over the step divided by its length (see `integrate.rs`).
     fn apply_forces(&mut self, t_next: f64) {
         let h = t_next - self.t;
+        let teeth: Vec<f64> = (0..self.couplings.len())
+            .map(|i| self.teeth_impulse(i, h) / h)
+            .collect();
         let bodies = &mut self.world.physics.bodies;
         let apply = |body: &mut RigidBody, l: Load| {
             body.reset_forces(false);
@@ -669,9 +767,16 @@ impl<'a> Run<'a> {
             body.add_force(Vector::new(l[0], l[1], l[2]), false);
             body.add_torque(Vector::new(l[3], l[4], l[5]), false);
         };
+        let mut teeth_on_shaft = 0.0;
         for (i, kick) in self.disc_kicks.iter().enumerate() {
-            apply(&mut bodies[self.world.discs[i]], kick.applied(h));
+            let mut load = kick.applied(h);
+            load[5] += teeth[i];
+            teeth_on_shaft -= teeth[i];
+            apply(&mut bodies[self.world.discs[i]], load);
             self.disc_history[i].push(self.t, self.disc_loads[i]);
+            self.disc_full_history[i].push(self.t, self.disc_full_loads[i]);
+            let m = &self.teeth_motion[i];
+            self.prev_motion[i] = Some((self.t, m.phi, m.dphi, m.ddphi));
         }
         let shaft = &mut bodies[self.world.shaft];
         match self.shaft {
@@ -679,8 +784,11 @@ impl<'a> Run<'a> {
                 shaft.set_next_kinematic_rotation(Rotation::from_rotation_z(p.angle(t_next)));
             }
             ShaftDrive::Inertial { .. } => {
-                apply(shaft, self.shaft_kick.applied(h));
+                let mut load = self.shaft_kick.applied(h);
+                load[5] += teeth_on_shaft;
+                apply(shaft, load);
                 self.shaft_history.push(self.t, self.shaft_load);
+                self.shaft_full_history.push(self.t, self.shaft_full_load);
             }
         }
     }

@@ -105,6 +105,8 @@ pub(crate) struct Coupling {
     lumped_load_n: f64,
     /// Largest spacing error, rad.
     max_phase_error_rad: f64,
+    /// The offset and its rate at the last evaluation (per-tooth couplings), for probes.
+    last_offset: ([f64; 2], [f64; 2]),
 }
 
 /// Advances one tooth's contact memory to `kin` and returns its signed load (N) and engagement
@@ -181,12 +183,8 @@ impl Coupling {
             max_phase_error_rad: phase_errors_rad
                 .iter()
                 .fold(0.0, |m: f64, e| m.max(e.abs())),
+            last_offset: ([0.0; 2], [0.0; 2]),
         }
-    }
-
-    /// Whether every tooth is resolved.
-    pub fn is_per_tooth(&self) -> bool {
-        !self.teeth.is_empty()
     }
 
     /// Signed loads of every tooth at the last evaluation, N (the lumped load `n` times for a
@@ -197,6 +195,49 @@ impl Coupling {
         } else {
             self.teeth.iter().map(|t| t.load_n).collect()
         }
+    }
+
+    /// The teeth's torque on the disc about the axis, N m, at a relative angle and speed
+    /// other than the evaluated one (the disc's offset held at its last value), without
+    /// advancing the contact memories: each tooth's event in progress if it is on the same
+    /// flank, else an event engaging at `dphi`. Used to integrate the teeth's torque along a
+    /// step (`integrate.rs`).
+    pub fn probe_torque(&self, phi: f64, dphi: f64) -> f64 {
+        let law = &self.law;
+        let load = |state: &ContactState, kin: &ToothKinematics| {
+            if law.engagement_depth_m(kin) <= 0.0 {
+                return 0.0;
+            }
+            let e = match state.engagement {
+                Some(e) if e.flank == kin.flank => e,
+                _ => law.engage(kin),
+            };
+            law.load_n(kin, &e)
+        };
+        if self.teeth.is_empty() {
+            let kin = self.spline.kinematics(phi, dphi);
+            return self.spline.disc_torque_n_m(load(&self.lumped, &kin));
+        }
+        let (sin_a, cos_a) = self.spline.pressure_angle_rad.sin_cos();
+        let r = self.spline.pitch_radius_m;
+        let ([ex, ey], [ex_dot, ey_dot]) = self.last_offset;
+        let mut moment = 0.0;
+        for tooth in &self.teeth {
+            let k0 = self.spline.kinematics(phi + tooth.phase_error_rad, dphi);
+            let sigma = k0.flank.phi_sign();
+            let u = [
+                sigma * cos_a * tooth.tangential[0] + sin_a * tooth.radial[0],
+                sigma * cos_a * tooth.tangential[1] + sin_a * tooth.radial[1],
+            ];
+            let k = ToothKinematics {
+                flank: k0.flank,
+                delta_m: k0.delta_m - (ex * u[0] + ey * u[1]),
+                v_n_m_s: k0.v_n_m_s - (ex_dot * u[0] + ey_dot * u[1]),
+            };
+            let f = load(&tooth.state, &k).abs();
+            moment += r * f * (tooth.radial[0] * u[1] - tooth.radial[1] * u[0]);
+        }
+        moment
     }
 
     /// Evaluates the tooth law for the relative state `rel`, advancing the contact memories.
@@ -239,6 +280,7 @@ impl Coupling {
         let r = self.spline.pitch_radius_m;
         let [ex, ey] = rel.offset;
         let [ex_dot, ey_dot] = rel.offset_rate;
+        self.last_offset = (rel.offset, rel.offset_rate);
         let mut force = [0.0; 2];
         let mut moment = [0.0; 3];
         let mut sum_load = 0.0;

@@ -48,8 +48,11 @@ impl Default for Stepping {
 pub struct AdaptiveStepping {
     /// Longest step in s (free flight). Default 1e-4 s (the scene's `simulation.max_step_s`).
     pub max_step_s: f64,
-    /// Steps per predicted contact duration (dimensionless, > 1). Default 64: about the
-    /// resolution of a fixed 1 us step on the paper's impacts (60-70 us).
+    /// Steps per predicted contact duration (dimensionless, > 1). Default 128. The error of an
+    /// impact falls as the cube of the step (`integrate.rs`): measured on the first 50 ms of
+    /// the paper case against fixed 0.1 us steps, the worst peak differs by 0.3 % at 64 steps
+    /// and 0.04 % at 128 (a grazing 34 N impact at h_o = 50 um; the rattle is chaotic, so
+    /// the differences of the early impacts grow), 0.01 % and 0.001 % on the first ten.
     pub steps_per_contact: f64,
     /// Fraction of the worst-case time to contact taken as one free-flight step, in (0, 1).
     /// Default 0.9: the approach to a contact takes a few geometrically shrinking steps.
@@ -63,7 +66,7 @@ impl Default for AdaptiveStepping {
     fn default() -> Self {
         AdaptiveStepping {
             max_step_s: 1e-4,
-            steps_per_contact: 64.0,
+            steps_per_contact: 128.0,
             approach_fraction: 0.9,
             min_step_s: 1e-12,
         }

@@ -280,12 +280,7 @@ fn adaptive_steps_give_the_impacts_of_fine_fixed_steps() {
     for h_o in [0.0, 25e-6, 50e-6] {
         let pack = paper_pack(LawKind::Paper, h_o, 0.8, 0.01);
         let (fine, _) = run(&pack, 1e4, fixed(1e-7), 50e-3);
-        let mut opts = adaptive();
-        opts.stepping = Stepping::Adaptive(AdaptiveStepping {
-            steps_per_contact: 256.0,
-            ..Default::default()
-        });
-        let (adapt, _) = run(&pack, 1e4, opts, 50e-3);
+        let (adapt, _) = run(&pack, 1e4, adaptive(), 50e-3);
         let a = impacts_before(&adapt, 50e-3);
         let f = impacts_before(&fine, 50e-3);
         let worst = a
