@@ -192,6 +192,10 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             );
         }
     }
+    if run_stats.stopped_early {
+        // 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
+        return Ok(ExitCode::from(130));
+    }
     Ok(ExitCode::SUCCESS)
 }
 
