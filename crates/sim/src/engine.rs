@@ -297,6 +297,8 @@ struct Run<'a> {
     teeth_motion: Vec<Motion>,
     /// Disc speeds at `t` (synchronised with the poses), rad/s.
     omega_d: Vec<f64>,
+    /// Time of the evaluation before the last step.
+    t_prev: Option<f64>,
     /// Time, unwrapped shaft angle and shaft speed.
     t: f64,
     theta_s: f64,
@@ -384,6 +386,7 @@ impl<'a> Run<'a> {
             teeth_past: vec![0.0; nd],
             teeth_motion: vec![Motion::default(); nd],
             omega_d: Vec::with_capacity(nd),
+            t_prev: None,
             t: 0.0,
             theta_s: 0.0,
             omega_s: pack.shaft.initial_speed_rad_s(),
@@ -446,7 +449,9 @@ impl<'a> Run<'a> {
         if let ShaftDrive::Inertial { j1, .. } = self.shaft {
             if self.shaft_history.len() > 0 {
                 self.omega_s = shaft.angvel().z
-                    + (self.shaft_history.synchronised(self.t, 0.0, 5, 1.0) - teeth_past_sum) / j1;
+                    + (self.shaft_history.synchronised(self.t, 0.0, 5, 1.0) + self.drive_past()
+                        - teeth_past_sum)
+                        / j1;
             }
         }
         self.rel.clear();
@@ -529,9 +534,11 @@ impl<'a> Run<'a> {
             ShaftDrive::Prescribed(p) => p.acceleration(self.t),
             ShaftDrive::Inertial { j1, c1 } => {
                 // Hu et al. eq (4): the drive torque, the spline reactions, damping -C1 omega.
-                let drive = self.pack.shaft.drive_torque_n_m(self.t) - c1 * self.omega_s;
-                shaft_torque.z += drive;
-                shaft_torque_full.z += drive;
+                // The drive is a known function of time: its kick is integrated exactly
+                // (`drive_impulse`), not extrapolated.
+                let damping = -c1 * self.omega_s;
+                shaft_torque.z += damping;
+                shaft_torque_full.z += damping + self.pack.shaft.drive_torque_n_m(self.t);
                 let l = |t: Vector| [shaft_force.x, shaft_force.y, shaft_force.z, t.x, t.y, t.z];
                 self.shaft_load = l(shaft_torque);
                 self.shaft_full_load = l(shaft_torque_full);
@@ -562,6 +569,31 @@ impl<'a> Run<'a> {
     fn teeth_impulse(&self, i: usize, x: f64) -> f64 {
         let c = &self.couplings[i];
         self.teeth_past[i] + future_impulse(&self.teeth_motion[i], x, |p, d| c.probe_torque(p, d))
+    }
+
+    /// The drive torque on an inertial shaft integrated against the rising ramp of the last
+    /// step (N m s; 0 before the first step or for a prescribed shaft).
+    fn drive_past(&self) -> f64 {
+        let Some(t0) = self.t_prev else {
+            return 0.0;
+        };
+        let h = self.t - t0;
+        if h <= 0.0 || matches!(self.shaft, ShaftDrive::Prescribed(_)) {
+            return 0.0;
+        }
+        crate::integrate::ramp_integral(t0, h, true, |t| self.pack.shaft.drive_torque_n_m(t))
+    }
+
+    /// The kick of the drive torque on an inertial shaft for a step of length `x` from `t`
+    /// (both halves, N m s).
+    fn drive_impulse(&self, x: f64) -> f64 {
+        if matches!(self.shaft, ShaftDrive::Prescribed(_)) {
+            return 0.0;
+        }
+        self.drive_past()
+            + crate::integrate::ramp_integral(self.t, x, false, |t| {
+                self.pack.shaft.drive_torque_n_m(t)
+            })
     }
 
     /// Adds the work done since the last evaluation (trapezoidal rule) to the energy audit.
@@ -705,9 +737,12 @@ impl<'a> Run<'a> {
                 let teeth: f64 = (0..self.couplings.len())
                     .map(|i| self.teeth_impulse(i, x))
                     .sum();
-                x * (w_s + (self.shaft_kick.impulse_component(5, x) - teeth) / j1)
+                x * (w_s
+                    + (self.shaft_kick.impulse_component(5, x) + self.drive_impulse(x) - teeth)
+                        / j1)
             }
         };
+        let turn_h = turn_s(h);
         let mut best: Option<f64> = None;
         for (i, d) in self.pack.discs.iter().enumerate() {
             let f = &self.forces[i];
@@ -723,10 +758,10 @@ impl<'a> Run<'a> {
             let rb = d.spline.base_radius_m();
             let offset = d.law.engagement_offset_m();
             let phi0 = self.rel[i].phi;
-            let phi = |x: f64| {
-                phi0 + turn_s(x)
-                    - x * (w_d + (kick.impulse_component(5, x) + self.teeth_impulse(i, x)) / j)
-            };
+            let turn_d =
+                |x: f64| x * (w_d + (kick.impulse_component(5, x) + self.teeth_impulse(i, x)) / j);
+            let phi = |x: f64| phi0 + turn_s(x) - turn_d(x);
+            let phi_h = phi0 + turn_h - turn_d(h);
             let engaged = f.depth_m > 0.0;
             for flank in crate::hook::FLANKS {
                 if engaged && flank != f.kin.flank {
@@ -734,8 +769,8 @@ impl<'a> Run<'a> {
                 }
                 let sigma = flank.phi_sign();
                 let depth = |x: f64| (sigma * phi(x) - g0) * rb + offset;
-                let d0 = depth(0.0);
-                let d1 = depth(h);
+                let d0 = (sigma * phi0 - g0) * rb + offset;
+                let d1 = (sigma * phi_h - g0) * rb + offset;
                 let crosses = if engaged {
                     d0 > 0.0 && d1 <= 0.0
                 } else {
@@ -760,6 +795,7 @@ impl<'a> Run<'a> {
         let teeth: Vec<f64> = (0..self.couplings.len())
             .map(|i| self.teeth_impulse(i, h) / h)
             .collect();
+        let drive = self.drive_impulse(h);
         let bodies = &mut self.world.physics.bodies;
         let apply = |body: &mut RigidBody, l: Load| {
             body.reset_forces(false);
@@ -785,7 +821,7 @@ impl<'a> Run<'a> {
             }
             ShaftDrive::Inertial { .. } => {
                 let mut load = self.shaft_kick.applied(h);
-                load[5] += teeth_on_shaft;
+                load[5] += teeth_on_shaft + drive / h;
                 apply(shaft, load);
                 self.shaft_history.push(self.t, self.shaft_load);
                 self.shaft_full_history.push(self.t, self.shaft_full_load);
@@ -798,6 +834,7 @@ impl<'a> Run<'a> {
         let h = t_next - self.t;
         let q_before = *self.world.physics.bodies[self.world.shaft].rotation();
         self.world.step(h);
+        self.t_prev = Some(self.t);
         self.t = t_next;
         self.theta_s = match self.shaft {
             ShaftDrive::Prescribed(p) => p.angle(t_next),

@@ -98,6 +98,19 @@ pub(crate) fn past_impulse(
         .sum()
 }
 
+/// `integral over [t0, t0 + h] of f(t) w(t) dt` with the rising ramp `w = (t - t0) / h`
+/// (`rising`) or the falling ramp `w = (t0 + h - t) / h`, by 3-point Gauss-Legendre: a half of
+/// the kick of a load known as a function of time (the drive torque of an inertial shaft).
+pub(crate) fn ramp_integral(t0: f64, h: f64, rising: bool, f: impl Fn(f64) -> f64) -> f64 {
+    GAUSS3
+        .iter()
+        .map(|&(n, w)| {
+            let ramp = if rising { n } else { 1.0 - n };
+            w * h * f(t0 + n * h) * ramp
+        })
+        .sum()
+}
+
 /// A physical load (force and torque, world frame) on one body at one instant, as six numbers:
 /// force x, y, z, torque x, y, z.
 pub(crate) type Load = [f64; 6];
