@@ -33,7 +33,7 @@
 //!
 //! | topic | schema | when | fields (units in names) |
 //! | --- | --- | --- | --- |
-//! | `/tf` | `foxglove.FrameTransforms` | each sample ([`RecordOptions::tf_interval_s`]) | `world` -> `shaft`, `world` -> `disc/<segment>`: rotation about +z, discs at `z_m` |
+//! | `/tf` | `foxglove.FrameTransforms` | every [`RecordOptions::tf_interval_s`] (0.1 ms) | `world` -> `shaft`, `world` -> `disc/<segment>`: rotation about +z, discs at `z_m` |
 //! | `/scene` | `foxglove.SceneUpdate` | t = 0, then every [`RecordOptions::scene_interval_s`] | shaft cylinder, disc annuli (triangle meshes), teeth coloured by load |
 //! | `/shaft` | `clutchpack.ShaftState` | each sample | `t_s, angle_rad, speed_rad_s` |
 //! | `/discs/<segment>/spline` | `clutchpack.SplineState` | each sample | `t_s, rel_angle_rad, closing_speed_m_s, penetration_m, load_n, torque_n_m, engaged, stiffness_n_m1_5, speed_rad_s, angle_rad, disc_index` |
@@ -74,7 +74,8 @@
 //!   when the shaft leads (Hu et al. eq (6)), as in `clutchpack_model`.
 //! - z is the shaft axis; positive rotation is the shaft's running direction (about +z).
 //! - Deterministic recordings ([`RecordOptions::deterministic`]) of the same stream are
-//!   byte-identical: no wall-clock data, single-threaded zstd, chunks cut by count and size.
+//!   byte-identical: no wall-clock data, zstd with a fixed job layout (one worker thread),
+//!   chunks cut by message count and size only.
 //! - Errors: [`RecordError`] for writing, [`ReadError`] for reading; each displays as one line.
 
 #![warn(missing_docs)]

@@ -118,6 +118,22 @@ pub(crate) fn frame_transforms(
     FrameTransforms { transforms }
 }
 
+/// Sets the time (ns) and the angles (rad) of transforms built by [`frame_transforms`] in
+/// place (the shaft first, then the discs in order), without allocating.
+pub(crate) fn update_transforms(
+    tf: &mut FrameTransforms,
+    log_time_ns: u64,
+    shaft_angle_rad: f64,
+    disc_angles_rad: impl Iterator<Item = f64>,
+) {
+    let ts = timestamp(log_time_ns);
+    let angles = std::iter::once(shaft_angle_rad).chain(disc_angles_rad);
+    for (t, angle) in tf.transforms.iter_mut().zip(angles) {
+        t.timestamp = Some(ts);
+        t.rotation = Some(about_z(angle));
+    }
+}
+
 /// The radial depth of a disc's drawn teeth in m.
 fn tooth_depth(d: &DiscGeometry) -> f64 {
     (0.12 * d.inner_radius_m).min(0.5 * (d.outer_radius_m - d.inner_radius_m).abs())

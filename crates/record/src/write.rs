@@ -33,7 +33,10 @@ pub struct RecordOptions {
     pub chunk_size_bytes: u64,
     /// zstd level (1..=19; 0 = zstd's default, 3). Default 0.
     pub compression_level: u32,
-    /// Simulated time between two `/tf` messages in s; 0 writes one per sample. Default 0.
+    /// Simulated time between two `/tf` messages in s; 0 writes one per sample. Default
+    /// 1e-4 s: poses at 10 kHz of simulated time are plenty for the 3D view (the exact
+    /// angles are on the spline topics at every sample), and `/tf` is the largest message.
+    /// Samples further apart than this get a `/tf` each.
     pub tf_interval_s: f64,
     /// Simulated time between two load-coloured `/scene` updates of the teeth in s (an
     /// update holds only the discs whose colour changed); 0 writes only the static scene at
@@ -53,7 +56,7 @@ impl Default for RecordOptions {
             flush_messages: 100_000,
             chunk_size_bytes: 1 << 20,
             compression_level: 0,
-            tf_interval_s: 0.0,
+            tf_interval_s: 1e-4,
             scene_interval_s: 1e-3,
             load_color_scale_n: None,
         }
@@ -142,6 +145,8 @@ pub struct Recorder {
     info: RunInfo,
     frames: Vec<String>,
     names: Vec<String>,
+    /// `/tf` message, updated in place each time
+    tf: foxglove::schemas::FrameTransforms,
     ch: Channels,
     sequences: BTreeMap<u16, u32>,
     buf: Vec<u8>,
@@ -188,8 +193,10 @@ impl Recorder {
         let opts = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             .compression_level(options.compression_level)
-            // single-threaded zstd: the same bytes on every machine, no worker threads
-            .compression_threads(0)
+            // one zstd worker thread: compression leaves the engine's thread (about a third
+            // of the recording cost), and zstd's multi-threaded output depends on its job
+            // size, not on the number of workers, so the bytes are the same on every machine
+            .compression_threads(1)
             .chunk_size(Some(options.chunk_size_bytes.max(1)))
             .library(format!(
                 "clutchpack_record {} (mcap-rs {})",
@@ -275,7 +282,7 @@ impl Recorder {
                 .map_err(|e| write_err("channel", e))
         };
         let none = BTreeMap::new;
-        let tf = channel(&mut w, s_tf, topics::TF, none())?;
+        let tf_ch = channel(&mut w, s_tf, topics::TF, none())?;
         let scene_ch = channel(&mut w, s_scene, topics::SCENE, none())?;
         let shaft = channel(&mut w, s_shaft, topics::SHAFT, none())?;
         let names = info.disc_names();
@@ -299,6 +306,12 @@ impl Recorder {
         let summary = channel(&mut w, s_summary, topics::SUMMARY, none())?;
 
         let frames: Vec<String> = segments.iter().map(|s| disc_frame(s)).collect();
+        let tf_discs: Vec<(String, f64, f64)> = frames
+            .iter()
+            .zip(&info.discs)
+            .map(|(f, g)| (f.clone(), g.z_m, 0.0))
+            .collect();
+        let tf = scene::frame_transforms(0, 0.0, &tf_discs);
         let n = names.len();
         let mut rec = Recorder {
             path,
@@ -307,8 +320,9 @@ impl Recorder {
             info: info.clone(),
             frames,
             names,
+            tf,
             ch: Channels {
-                tf,
+                tf: tf_ch,
                 scene: scene_ch,
                 shaft,
                 spline,
@@ -520,15 +534,16 @@ impl Recorder {
         }
         if t >= self.next_tf_s {
             self.next_tf_s = t + self.options.tf_interval_s.max(0.0);
-            let discs: Vec<(String, f64, f64)> = self
-                .frames
-                .iter()
-                .zip(&self.info.discs)
-                .zip(&sample.discs)
-                .map(|((f, g), d)| (f.clone(), g.z_m, d.angle_rad))
-                .collect();
-            let tf = scene::frame_transforms(lt, sample.shaft_angle_rad, &discs);
-            self.put(self.ch.tf, lt, &tf, "/tf")?;
+            scene::update_transforms(
+                &mut self.tf,
+                lt,
+                sample.shaft_angle_rad,
+                sample.discs.iter().map(|d| d.angle_rad),
+            );
+            let tf = std::mem::take(&mut self.tf);
+            let r = self.put(self.ch.tf, lt, &tf, "/tf");
+            self.tf = tf;
+            r?;
         }
         if t >= self.next_scene_s {
             let interval = self.options.scene_interval_s;
