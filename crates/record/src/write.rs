@@ -137,7 +137,8 @@ struct Channels {
 /// [`Self::write_impact`]), then [`Self::finish`]. Errors met inside the observer methods are
 /// kept (the first one) and returned by `finish`; after an error nothing more is written, and
 /// [`Observer::progress`] returns `true` to stop the run. Dropping a recorder without
-/// `finish` still closes the file with its summary section, but without `/summary`.
+/// `finish` still closes the file with its summary section, but without `/summary`; so call
+/// `finish` after an engine error or a Ctrl-C stop as well, to keep the summary of what ran.
 pub struct Recorder {
     path: PathBuf,
     writer: Option<mcap::Writer<BufWriter<File>>>,
