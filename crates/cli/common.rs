@@ -50,10 +50,10 @@ pub fn make_engine(scene: &Scene, arg: Option<EngineArg>) -> Result<Box<dyn Engi
     };
     match choice {
         EngineChoice::Reference => Ok(Box::new(ReferenceEngine::from_scene(scene))),
-        EngineChoice::Multibody => Err(BadInput(
-            "the multibody engine is not part of this build yet; use --engine reference".into(),
-        )
-        .into()),
+        EngineChoice::Multibody => match clutchpack_sim::MultibodyEngine::from_scene(scene) {
+            Ok(e) => Ok(Box::new(e)),
+            Err(e) => Err(BadInput(format!("{}: {e}", scene.name)).into()),
+        },
     }
 }
 
