@@ -192,7 +192,7 @@ impl MultibodyEngine {
             });
         }
         // Build once now so that a scene the world cannot hold fails here, not in `run`.
-        World::build(&pack, &options.shapes)?;
+        World::build(&pack, &options.shapes, options.mount)?;
         Ok(MultibodyEngine {
             pack,
             record_rate_hz,
@@ -214,12 +214,14 @@ impl MultibodyEngine {
 }
 
 /// Reads the relative state of a disc in the shaft's frame. `omega_s` and `omega_d` are the
-/// speeds about the axis at the time of the poses (see [`synchronised`]).
+/// speeds about the axis at the time of the poses; `owed` is the disc's turn about the axis not
+/// yet in its rapier pose (`world.rs`).
 fn relative_state(
     shaft: &RigidBody,
     omega_s: f64,
     disc: &RigidBody,
     omega_d: f64,
+    owed: f64,
 ) -> RelativeState {
     let qs = *shaft.rotation();
     let qs_inv = qs.inverse();
@@ -228,7 +230,7 @@ fn relative_state(
     let dv = qs_inv * (disc.linvel() - shaft.linvel());
     let rate = dv - Vector::new(0.0, 0.0, omega_s).cross(d);
     RelativeState {
-        phi: -angle_about_z(&q_rel),
+        phi: -(angle_about_z(&q_rel) + owed),
         dphi: omega_s - omega_d,
         offset: [d.x, d.y],
         offset_rate: [rate.x, rate.y],
@@ -299,6 +301,8 @@ struct Run<'a> {
     omega_d: Vec<f64>,
     /// Time of the evaluation before the last step.
     t_prev: Option<f64>,
+    /// Prescribed shaft: its angle at the end of the step being taken.
+    theta_next: f64,
     /// Time, unwrapped shaft angle and shaft speed.
     t: f64,
     theta_s: f64,
@@ -314,7 +318,7 @@ impl<'a> Run<'a> {
         opts: &MultibodyOptions,
         per_tooth: &[bool],
     ) -> Result<Run<'a>, EngineError> {
-        let world = World::build(pack, &opts.shapes)?;
+        let world = World::build(pack, &opts.shapes, opts.mount)?;
         let couplings: Vec<Coupling> = pack
             .discs
             .iter()
@@ -387,6 +391,7 @@ impl<'a> Run<'a> {
             teeth_motion: vec![Motion::default(); nd],
             omega_d: Vec::with_capacity(nd),
             t_prev: None,
+            theta_next: 0.0,
             t: 0.0,
             theta_s: 0.0,
             omega_s: pack.shaft.initial_speed_rad_s(),
@@ -436,7 +441,13 @@ impl<'a> Run<'a> {
             let disc = &bodies[self.world.discs[i]];
             let j = self.pack.discs[i].inertia_kg_m2;
             let est = self.disc_full_history[i].synchronised(self.t, disc.angvel().z, 5, 1.0 / j);
-            let rel = relative_state(shaft, self.omega_s, disc, est);
+            let rel = relative_state(
+                shaft,
+                self.omega_s,
+                disc,
+                est,
+                self.world.disc_turn_owed_z(i),
+            );
             let h1 = self.t - t0;
             if h1 > 0.0 {
                 self.teeth_past[i] =
@@ -469,7 +480,13 @@ impl<'a> Run<'a> {
                 self.disc_full_history[i].synchronised(self.t, mean, 5, 1.0 / j)
             };
             self.omega_d.push(omega_d);
-            let rel = relative_state(shaft, self.omega_s, disc, omega_d);
+            let rel = relative_state(
+                shaft,
+                self.omega_s,
+                disc,
+                omega_d,
+                self.world.disc_turn_owed_z(i),
+            );
             let limit = std::f64::consts::PI / c.spline.teeth as f64;
             let diverged = |reason: String| EngineError::Diverged {
                 t_s: t_last_good,
@@ -727,7 +744,7 @@ impl<'a> Run<'a> {
     fn landing(&self, h: f64, tiny: f64) -> Option<f64> {
         let bodies = &self.world.physics.bodies;
         let theta_s0 = match self.shaft {
-            ShaftDrive::Prescribed(p) => p.angle(self.t),
+            ShaftDrive::Prescribed(_) => self.theta_s,
             ShaftDrive::Inertial { .. } => 0.0,
         };
         let w_s = bodies[self.world.shaft].angvel().z;
@@ -817,7 +834,8 @@ impl<'a> Run<'a> {
         let shaft = &mut bodies[self.world.shaft];
         match self.shaft {
             ShaftDrive::Prescribed(p) => {
-                shaft.set_next_kinematic_rotation(Rotation::from_rotation_z(p.angle(t_next)));
+                self.theta_next = p.angle(t_next);
+                shaft.set_next_kinematic_rotation(Rotation::from_rotation_z(self.theta_next));
             }
             ShaftDrive::Inertial { .. } => {
                 let mut load = self.shaft_kick.applied(h);
@@ -837,7 +855,7 @@ impl<'a> Run<'a> {
         self.t_prev = Some(self.t);
         self.t = t_next;
         self.theta_s = match self.shaft {
-            ShaftDrive::Prescribed(p) => p.angle(t_next),
+            ShaftDrive::Prescribed(_) => self.theta_next,
             ShaftDrive::Inertial { .. } => {
                 let q_after = *self.world.physics.bodies[self.world.shaft].rotation();
                 self.theta_s + angle_about_z(&(q_before.inverse() * q_after))

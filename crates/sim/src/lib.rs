@@ -58,7 +58,9 @@
 //!   step the force is smooth.
 //! - **Exponential map.** Rapier turns a body by `2 atan(|w| h / 2)` per step (a linearised
 //!   quaternion update), not `|w| h`: 6.7e-7 rad per 100 us step at 200 rad/s, far more than
-//!   the backlash tolerates. The engine restores the exact turn after every step (`world.rs`).
+//!   the backlash tolerates. The engine restores the exact turn after every step (`world.rs`;
+//!   on the discs it is owed, and added when reading, until it reaches 1e-6 rad, since setting
+//!   a pose makes rapier recompute the body's world mass properties).
 //!
 //! The prescribed shaft is a position-based kinematic body set to the profile's exact angle at
 //! every step; its speed in the law is the profile's exact speed.
@@ -75,4 +77,6 @@ mod stepping;
 mod world;
 
 pub use engine::{EnergyAudit, MultibodyEngine};
-pub use options::{AdaptiveStepping, BodyShapes, MultibodyOptions, Stepping, ToothResolution};
+pub use options::{
+    AdaptiveStepping, BodyShapes, DiscMount, MultibodyOptions, Stepping, ToothResolution,
+};

@@ -110,6 +110,21 @@ impl Default for BodyShapes {
     }
 }
 
+/// How a disc is held on the shaft axis (rotation about it and the axial slide free).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DiscMount {
+    /// A generic impulse joint to the shaft locking the two radial translations and the two
+    /// tilts (ARCHITECTURE.md). The default.
+    #[default]
+    Joint,
+    /// Rapier's per-body locked axes (world x, y translations and rotations), no constraint
+    /// to solve. The same motion whenever the shaft's axis stays on the world z axis, which
+    /// it does here (a kinematic shaft, or a dynamic one on a revolute joint to the housing);
+    /// measured about 1.9x faster per step for 8 discs. Not for discs that must float
+    /// radially.
+    LockedAxes,
+}
+
 /// Options of the multibody engine.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct MultibodyOptions {
@@ -122,4 +137,6 @@ pub struct MultibodyOptions {
     pub record_tooth_loads: bool,
     /// Shapes of the bodies.
     pub shapes: BodyShapes,
+    /// How the discs are held on the axis.
+    pub mount: DiscMount,
 }
