@@ -359,18 +359,17 @@ fn describe_start(bytes: &[u8]) -> String {
 
 /// Decodes one message of a known schema; the error says why not.
 fn validate(v: &MessageView<'_>) -> Result<(), String> {
+    if v.message_encoding != "protobuf" || v.schema_encoding != "protobuf" {
+        return Ok(());
+    }
     let r = match v.schema_name {
         proto::SHAFT_STATE => proto::ShaftState::decode(v.data).map(drop),
         proto::SPLINE_STATE => proto::SplineState::decode(v.data).map(drop),
         proto::TOOTH_LOADS => proto::ToothLoads::decode(v.data).map(drop),
         proto::IMPACT => proto::Impact::decode(v.data).map(drop),
         proto::RUN_SUMMARY => proto::RunSummary::decode(v.data).map(drop),
-        "foxglove.FrameTransforms" if v.message_encoding == "protobuf" => {
-            foxglove::schemas::FrameTransforms::decode(v.data).map(drop)
-        }
-        "foxglove.SceneUpdate" if v.message_encoding == "protobuf" => {
-            foxglove::schemas::SceneUpdate::decode(v.data).map(drop)
-        }
+        "foxglove.FrameTransforms" => foxglove::schemas::FrameTransforms::decode(v.data).map(drop),
+        "foxglove.SceneUpdate" => foxglove::schemas::SceneUpdate::decode(v.data).map(drop),
         _ => Ok(()),
     };
     r.map_err(|e| {
@@ -667,6 +666,126 @@ impl RecordingReader {
         }
     }
 
+    /// What the file holds, as text for `clutchpack replay`: the file and its state, the run
+    /// (program, engine, scene and its hash, overrides), the topics with their schemas,
+    /// message counts and time spans, and the per-disc summary (stored, or recomputed from
+    /// the recovered impacts and marked so). Lines end with `\n`.
+    pub fn describe(&self) -> String {
+        use std::fmt::Write as _;
+        let mut s = String::new();
+        let i = &self.info;
+        let state = match &self.damage {
+            None => "complete".to_string(),
+            Some(d) => d.to_string(),
+        };
+        let _ = writeln!(
+            s,
+            "{} ({} bytes): {state}",
+            self.path.display(),
+            self.bytes.len()
+        );
+        if let Some(run) = self.info.metadata(crate::info::META_RUN) {
+            let g = |k: &str| run.get(k).map(String::as_str).unwrap_or("?");
+            let sha = g("scene_sha256");
+            let _ = writeln!(
+                s,
+                "run: {} {}, engine {}, scene {} ({}, sha256 {}), overrides {}",
+                g("program"),
+                g("program_version"),
+                g("engine"),
+                g("scene_name"),
+                g("scene_file"),
+                &sha[..sha.len().min(12)],
+                g("overrides")
+            );
+        }
+        match (i.start_s, i.end_s) {
+            (Some(a), Some(b)) => {
+                let _ = writeln!(
+                    s,
+                    "{} messages on {} topics, t = {} .. {} s",
+                    i.messages,
+                    i.topics.len(),
+                    short(a),
+                    short(b)
+                );
+            }
+            _ => {
+                let _ = writeln!(s, "no messages, {} topics", i.topics.len());
+            }
+        }
+        let w = i
+            .topics
+            .iter()
+            .map(|t| t.topic.len())
+            .max()
+            .unwrap_or(5)
+            .max(5);
+        let ws = i
+            .topics
+            .iter()
+            .map(|t| t.schema_name.len())
+            .max()
+            .unwrap_or(6)
+            .max(6);
+        let _ = writeln!(
+            s,
+            "  {:<w$}  {:<ws$}  {:>9}  span (s)",
+            "topic", "schema", "messages"
+        );
+        for t in &i.topics {
+            let span = if t.messages > 0 {
+                format!("{} .. {}", short(t.first_s), short(t.last_s))
+            } else {
+                "-".into()
+            };
+            let _ = writeln!(
+                s,
+                "  {:<w$}  {:<ws$}  {:>9}  {span}",
+                t.topic, t.schema_name, t.messages
+            );
+        }
+        let (summary, note) = match self.summary() {
+            Some(x) => (x.clone(), "stored"),
+            None => (
+                self.summary_or_recomputed(),
+                "recomputed from the recovered impacts",
+            ),
+        };
+        if !summary.discs.is_empty() {
+            let _ = writeln!(
+                s,
+                "summary ({note}; per-tooth loads in N, t_end = {} s):",
+                short(summary.t_end_s)
+            );
+            let wd = summary
+                .discs
+                .iter()
+                .map(|d| d.name.len())
+                .max()
+                .unwrap_or(4)
+                .max(4);
+            let _ = writeln!(
+                s,
+                "  {:<wd$}  {:>12}  {:>12}  {:>12}  {:>8}  {:>14}",
+                "disc", "max_positive", "max_negative", "p99_abs", "impacts", "mean_top10_abs"
+            );
+            for d in &summary.discs {
+                let _ = writeln!(
+                    s,
+                    "  {:<wd$}  {:>12.1}  {:>12.1}  {:>12.1}  {:>8}  {:>14.1}",
+                    d.name,
+                    d.max_positive_n,
+                    d.max_negative_n,
+                    d.p99_abs_n,
+                    d.impacts,
+                    d.mean_top10_abs_n
+                );
+            }
+        }
+        s
+    }
+
     /// The stored `/summary`, if the run finished.
     pub fn summary(&self) -> Option<&RunSummary> {
         self.info.summary.as_ref()
@@ -876,6 +995,18 @@ impl RecordingReader {
             out.push(sample);
         }
         out
+    }
+}
+
+/// A time in s with at most 9 decimals, trailing zeros dropped (`0.00399`, not
+/// `0.0039900000000000005`).
+fn short(x: f64) -> String {
+    let s = format!("{x:.9}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.to_string()
     }
 }
 

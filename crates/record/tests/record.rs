@@ -106,6 +106,12 @@ fn round_trip_is_exact() {
         !meta.contains_key("recorded_at_utc"),
         "deterministic: no wall clock"
     );
+    let text = r.describe();
+    assert!(text.contains("complete"), "{text}");
+    assert!(text.contains("engine synthetic"), "{text}");
+    assert!(text.contains("/discs/disc_2/spline"), "{text}");
+    assert!(text.contains("summary (stored"), "{text}");
+    assert!(text.contains("t = 0 .. 0.00399 s"), "{text}");
 }
 
 /// The transforms and the scene use Foxglove's well-known schemas by their exact names,
@@ -255,6 +261,7 @@ fn killed_run_keeps_everything_up_to_the_last_flush() {
     assert_eq!(r.info().messages, flushed);
     assert_eq!(r.samples(), run.samples[..150].to_vec());
     assert!(r.summary().is_none());
+    assert!(r.describe().contains("recomputed"), "{}", r.describe());
     assert!(
         r.run_info().is_some(),
         "metadata and scene precede the data"
