@@ -1,6 +1,8 @@
 //! Integration tests of the `clutchpack` binary: the paper's table from a sweep, the CLI
 //! outputs, and bad input. One test binary (as ripgrep does); each test states what it checks.
 
+mod cross_engine;
+
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
