@@ -110,7 +110,7 @@ pub use read::{
 #[cfg(feature = "serve")]
 pub use serve::{serve, ServeError, ServeOptions};
 pub use summary::{DiscSummary, RunSummary, TOP_N};
-pub use write::{log_time_ns, RecordError, RecordOptions, Recorder};
+pub use write::{default_path, log_time_ns, RecordError, RecordOptions, Recorder};
 
 /// A disc name made safe for a topic and frame name: every character other than
 /// `A-Z a-z 0-9 _ -` becomes `_` (an empty name becomes `_`). Repeated segments in one

@@ -112,6 +112,21 @@ pub enum RecordError {
     },
 }
 
+/// The default recording path `dir/<scene>-<UTC time>.mcap`, e.g.
+/// `recordings/paper-20261122T022900Z.mcap` for `now` = 2026-11-22 02:29:00 UTC; the scene
+/// name is made file-safe as a topic segment ([`topic_segment`](crate::topic_segment)).
+pub fn default_path(dir: impl AsRef<Path>, scene_name: &str, now: SystemTime) -> PathBuf {
+    let since = now.duration_since(UNIX_EPOCH).unwrap_or_default();
+    // 2026-11-22T02:29:00.000Z -> 20261122T022900Z
+    let t: String = utc_text(since)
+        .chars()
+        .take(19)
+        .filter(|c| c.is_ascii_digit() || *c == 'T')
+        .collect();
+    dir.as_ref()
+        .join(format!("{}-{t}Z.mcap", topic_segment(scene_name)))
+}
+
 /// Simulated time `t_s` (s) as an MCAP log time in ns (negative and NaN times give 0).
 pub fn log_time_ns(t_s: f64) -> u64 {
     if t_s.is_nan() || t_s <= 0.0 {
@@ -703,4 +718,29 @@ pub(crate) fn unique_segments(names: &[String]) -> Vec<String> {
         out.push(s);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A known instant gives a known, file-safe name.
+    #[test]
+    fn default_path_is_scene_and_utc_time() {
+        let now = UNIX_EPOCH + Duration::from_secs(1_795_314_540);
+        let p = default_path("recordings", "paper case", now);
+        assert_eq!(
+            p,
+            PathBuf::from("recordings/paper_case-20261122T022900Z.mcap")
+        );
+    }
+
+    /// Log times: simulated seconds to ns, rounded; nothing negative.
+    #[test]
+    fn log_times() {
+        assert_eq!(log_time_ns(1.5e-6), 1500);
+        assert_eq!(log_time_ns(-1.0), 0);
+        assert_eq!(log_time_ns(f64::NAN), 0);
+        assert_eq!(log_time_ns(0.1 + 0.2), 300_000_000);
+    }
 }
