@@ -57,7 +57,7 @@ fn bench_pack() -> PackModel {
     }
 }
 
-fn modes() -> Vec<(&'static str, Stepping, DiscMount)> {
+pub fn modes() -> Vec<(&'static str, Stepping, DiscMount)> {
     let adaptive = Stepping::Adaptive(AdaptiveStepping::default());
     let fixed = Stepping::Fixed { dt_s: 1e-6 };
     vec![
@@ -68,7 +68,7 @@ fn modes() -> Vec<(&'static str, Stepping, DiscMount)> {
     ]
 }
 
-fn run_once(stepping: Stepping, mount: DiscMount) -> (u64, usize) {
+pub fn run_once(stepping: Stepping, mount: DiscMount) -> (u64, usize) {
     let mut e = MultibodyEngine::from_pack(
         bench_pack(),
         1e4,

@@ -130,10 +130,14 @@ fn t2_ok(t0: f64, t1: f64, t2: f64) -> bool {
 }
 
 impl MultibodyEngine {
-    /// Builds the engine for a scene with the default options (adaptive stepping with the
-    /// scene's `max_step_s`, lumped teeth where exact).
+    /// Builds the engine for a scene with the default options: adaptive stepping with the
+    /// scene's `max_step_s`, lumped teeth where exact, per-tooth loads in the samples if the
+    /// scene asks for them (`simulation.record_per_tooth`).
     pub fn from_scene(scene: &Scene) -> Result<MultibodyEngine, EngineError> {
-        let mut options = MultibodyOptions::default();
+        let mut options = MultibodyOptions {
+            record_tooth_loads: scene.simulation.record_per_tooth,
+            ..Default::default()
+        };
         if let Stepping::Adaptive(a) = &mut options.stepping {
             a.max_step_s = scene.simulation.max_step_s;
         }

@@ -6,6 +6,7 @@ use clutchpack_model::{
     LawKind, Observer, OilFilm, PackModel, Shaft, ShaftExcitation, SpeedProfile, SplineGeometry,
     Table, ToothLaw,
 };
+use clutchpack_scene::{Scene, Simulation};
 use clutchpack_sim::{
     AdaptiveStepping, DiscMount, MultibodyEngine, MultibodyOptions, Stepping, ToothResolution,
 };
@@ -451,4 +452,41 @@ fn locked_axes_mount_equals_the_joint() {
     let ea = impacts_before(&a, 20e-3);
     assert!(ea.len() >= 7);
     assert_same_impacts(&impacts_before(&b, 20e-3), &ea, 1e-6, 0.0, 1e-9);
+}
+
+/// A scene drives the engine: its recording rate, its largest step (no free-flight step is
+/// longer, so at least duration / max_step steps; every sample of the 4 kHz grid) and its per-tooth
+/// recording switch; the engine names its discs after the scene.
+#[test]
+fn engine_follows_the_scene() {
+    let scene = Scene {
+        name: "paper".into(),
+        description: String::new(),
+        source_text: String::new(),
+        overrides: vec![],
+        simulation: Simulation {
+            duration_s: 5e-3,
+            engine: None,
+            record_rate_hz: 4e3,
+            tolerance: 1e-9,
+            max_step_s: 2e-5,
+            record_per_tooth: true,
+        },
+        pack: paper_pack(LawKind::Paper, 25e-6, 0.8, 0.01),
+    };
+    let mut e = MultibodyEngine::from_scene(&scene).unwrap();
+    assert_eq!(e.name(), "multibody");
+    assert_eq!(e.disc_names(), vec!["disc".to_string()]);
+    match e.options().stepping {
+        Stepping::Adaptive(a) => assert_eq!(a.max_step_s, 2e-5),
+        s => panic!("{s:?}"),
+    }
+    let mut c = Collector::default();
+    let stats = e.run(scene.simulation.duration_s, &mut c).unwrap();
+    assert!(stats.steps as f64 >= 5e-3 / 2e-5, "{stats:?}");
+    assert_eq!(c.samples.len(), 21);
+    assert!(c
+        .samples
+        .iter()
+        .all(|s| s.discs[0].tooth_loads_n.len() == 154));
 }
