@@ -127,6 +127,17 @@ pub fn default_path(dir: impl AsRef<Path>, scene_name: &str, now: SystemTime) ->
         .join(format!("{}-{t}Z.mcap", topic_segment(scene_name)))
 }
 
+/// The first multiple of `interval` (s) after `t` (s), less a hair, so that samples on the
+/// grid (`k dt` with rounding) land on their tick; `t` itself for a zero interval.
+fn next_tick(t: f64, interval: f64) -> f64 {
+    if interval > 0.0 {
+        let k = (t / interval + 1e-6).floor() + 1.0;
+        k * interval - 1e-6 * interval
+    } else {
+        t
+    }
+}
+
 /// Simulated time `t_s` (s) as an MCAP log time in ns (negative and NaN times give 0).
 pub fn log_time_ns(t_s: f64) -> u64 {
     if t_s.is_nan() || t_s <= 0.0 {
@@ -355,7 +366,7 @@ impl Recorder {
             since_flush: 0,
             next_tf_s: f64::NEG_INFINITY,
             next_scene_s: if options.scene_interval_s > 0.0 {
-                options.scene_interval_s
+                next_tick(0.0, options.scene_interval_s)
             } else {
                 f64::INFINITY
             },
@@ -549,7 +560,7 @@ impl Recorder {
             }
         }
         if t >= self.next_tf_s {
-            self.next_tf_s = t + self.options.tf_interval_s.max(0.0);
+            self.next_tf_s = next_tick(t, self.options.tf_interval_s);
             scene::update_transforms(
                 &mut self.tf,
                 lt,
@@ -562,8 +573,7 @@ impl Recorder {
             r?;
         }
         if t >= self.next_scene_s {
-            let interval = self.options.scene_interval_s;
-            self.next_scene_s = ((t / interval).floor() + 1.0) * interval;
+            self.next_scene_s = next_tick(t, self.options.scene_interval_s);
             let scale = self
                 .options
                 .load_color_scale_n
