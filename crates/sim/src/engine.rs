@@ -24,8 +24,8 @@ const PROGRESS_EVERY: u64 = 1000;
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct EnergyAudit {
     /// Work done by the drive since t = 0: for a prescribed shaft the work of the shaft on the
-    /// teeth, `sum T_spline_on_disc dtheta_s`; for an inertial shaft the work of the drive
-    /// torque on the shaft.
+    /// teeth, the teeth's torque on the discs integrated over the shaft's turn; for an
+    /// inertial shaft the work of the drive torque on the shaft (trapezoidal rule per step).
     pub drive_work_j: f64,
     /// Work of the oil drag on the discs and of the shaft damping (<= 0).
     pub drag_work_j: f64,
@@ -107,7 +107,7 @@ impl EventTrack {
         self.tracker.observe(t, load);
         if let (Some((t0, f0)), Some((t1, f1))) = (self.before_last, self.last) {
             let (a0, a1, a2) = (f0.abs(), f1.abs(), load.abs());
-            if a1 > 0.0 && a1 >= a0 && a1 >= a2 && t2_ok(t0, t1, t) {
+            if a1 > 0.0 && a1 >= a0 && a1 >= a2 && t0 < t1 && t1 < t {
                 let d01 = (a1 - a0) / (t1 - t0);
                 let d12 = (a2 - a1) / (t - t1);
                 let curv = (d12 - d01) / (t - t0);
@@ -123,10 +123,6 @@ impl EventTrack {
         self.before_last = self.last;
         self.last = Some((t, load));
     }
-}
-
-fn t2_ok(t0: f64, t1: f64, t2: f64) -> bool {
-    t0 < t1 && t1 < t2
 }
 
 impl MultibodyEngine {

@@ -8,14 +8,16 @@
 //!   position-based kinematic body following the prescribed speed, eq 3, or a dynamic body on
 //!   a revolute joint to the housing for an inertial shaft, eq 4), and one dynamic body per
 //!   friction disc joined to the shaft by a cylindrical impulse joint (rotation about `+z` and
-//!   axial slide free; radial translations and tilts locked). Each disc's mass and transverse
-//!   inertia come from a steel annulus (parry's cylinders; inner radius the spline pitch
-//!   radius, outer radius chosen so that the annulus has the scene's inertia); its inertia
-//!   about the axis is the scene's `J` exactly.
+//!   axial slide free; radial translations and tilts locked), or optionally held by rapier's
+//!   locked axes ([`DiscMount`], the same motion at about half the cost per step). Each
+//!   disc's mass and transverse inertia come from a steel annulus (parry's cylinders; inner
+//!   radius the spline pitch radius, outer radius chosen so that the annulus has the scene's
+//!   inertia); its inertia about the axis is the scene's `J` exactly.
 //! - Each step, the spline contact hook (`hook.rs`) reads every coupling's relative pose and
 //!   velocity, evaluates the model's tooth law per tooth (each tooth with its own contact
 //!   memory) and applies the forces along the teeth's lines of action. A concentric coupling
-//!   without spacing errors can be lumped (one tooth times `n`, exact there).
+//!   without spacing errors can be lumped (one tooth times `n`, exact there). The teeth's
+//!   torque is integrated along each step rather than sampled at its start (`integrate.rs`).
 //! - Implements [`clutchpack_model::Engine`]: samples at the scene's recording rate, impact
 //!   events with the model's definitions ([`clutchpack_model::ImpactTracker`]: onset where the
 //!   engagement depth becomes positive, the peak of `|F|`, separation where the depth falls
