@@ -695,7 +695,7 @@ impl RecordingReader {
                 g("engine"),
                 g("scene_name"),
                 g("scene_file"),
-                &sha[..sha.len().min(12)],
+                sha.chars().take(12).collect::<String>(),
                 g("overrides")
             );
         }

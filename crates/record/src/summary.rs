@@ -10,6 +10,9 @@ use clutchpack_model::ImpactEvent;
 /// Number of impacts averaged by [`DiscSummary::mean_top10_abs_n`].
 pub const TOP_N: usize = 10;
 
+/// Disc indices past the named discs that [`RunSummary::from_impacts`] still gives entries.
+pub const MAX_EXTRA_DISCS: usize = 1024;
+
 /// Statistics of the impact peaks (`ImpactEvent::peak_n`) of one disc over one run.
 ///
 /// Loads are per tooth in N, signed as in the model: negative when the shaft leads, positive
@@ -95,17 +98,21 @@ pub struct RunSummary {
 
 impl RunSummary {
     /// The summary of `impacts` for discs named `names` (`ImpactEvent::disc` indexes
-    /// `names`; impacts of an index beyond it get entries named `disc <index>`), at the end
-    /// time `t_end_s` (s).
+    /// `names`; impacts of an index beyond it get entries named `disc <index>`, up to
+    /// [`MAX_EXTRA_DISCS`] past the names, and impacts beyond that are not counted: a
+    /// foreign file's index cannot make this allocate without bound), at the end time
+    /// `t_end_s` (s).
     pub fn from_impacts(names: &[String], impacts: &[ImpactEvent], t_end_s: f64) -> RunSummary {
+        let limit = names.len() + MAX_EXTRA_DISCS;
         let n = impacts
             .iter()
             .map(|e| e.disc + 1)
+            .filter(|&n| n <= limit)
             .max()
             .unwrap_or(0)
             .max(names.len());
         let mut peaks = vec![Vec::new(); n];
-        for e in impacts {
+        for e in impacts.iter().filter(|e| e.disc < n) {
             peaks[e.disc].push(e.peak_n);
         }
         RunSummary {
@@ -201,8 +208,9 @@ mod tests {
     /// A disc without impacts gets zeros; an impact beyond the names gets its own entry.
     #[test]
     fn empty_discs_and_unknown_indices() {
-        let s = RunSummary::from_impacts(&["a".into()], &[ev(2, 5.0)], 1.0);
-        assert_eq!(s.discs.len(), 3);
+        let s =
+            RunSummary::from_impacts(&["a".into()], &[ev(2, 5.0), ev(usize::MAX / 2, 1.0)], 1.0);
+        assert_eq!(s.discs.len(), 3, "an absurd index is not counted");
         assert_eq!(s.discs[0], DiscSummary::from_peaks("a", &[]));
         assert_eq!(s.discs[0].p99_abs_n, 0.0);
         assert_eq!(s.discs[2].name, "disc 2");

@@ -604,10 +604,12 @@ impl Recorder {
         if self.failed {
             return Err(self.failed_err());
         }
-        if self.peaks.len() <= e.disc {
-            self.peaks.resize(e.disc + 1, Vec::new());
+        if e.disc < self.names.len() + crate::summary::MAX_EXTRA_DISCS {
+            if self.peaks.len() <= e.disc {
+                self.peaks.resize(e.disc + 1, Vec::new());
+            }
+            self.peaks[e.disc].push(e.peak_n);
         }
-        self.peaks[e.disc].push(e.peak_n);
         let msg = proto::Impact {
             disc: self
                 .names
