@@ -359,6 +359,22 @@ fn empty_and_foreign_files() {
     assert!(matches!(e, ReadError::Damaged { .. }), "{e}");
     let e = open(tmp("does-not-exist.mcap")).unwrap_err();
     assert!(matches!(e, ReadError::Io { .. }));
+    // the magic followed by noise: a clean "corrupted" or "truncated", whatever the noise
+    let mut x = 0x2545_f491_4f6c_dd1d_u64;
+    for len in [1usize, 9, 17, 100, 1000, 10_000] {
+        for _ in 0..20 {
+            let mut b = mcap::MAGIC.to_vec();
+            b.extend((0..len).map(|_| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                x as u8
+            }));
+            let r = from_bytes("noise.mcap", b).unwrap();
+            assert!(r.damage().is_some());
+            let _ = (r.describe(), r.samples(), r.impacts());
+        }
+    }
 }
 
 /// A valid MCAP file from another program opens: its topics are listed, it has no run info
