@@ -51,89 +51,49 @@ pub struct ReplayArgs {
     /// ws://127.0.0.1:PORT).
     #[arg(long)]
     pub serve: bool,
-    /// Port of `--serve`.
+    /// Port of `--serve` (0 picks a free one).
     #[arg(long, default_value_t = 8765)]
     pub port: u16,
+    /// Playback speed of `--serve` as a factor of simulated time (impacts last ~70 us: slow
+    /// motion helps).
+    #[arg(long, default_value_t = 0.01)]
+    pub speed: f32,
 }
 
 pub fn replay(a: ReplayArgs) -> Result<ExitCode> {
     let reader = open_recording(&a.file, a.salvage)?;
-    let info = reader.info();
-    out!(
-        "{}: {} bytes, {} messages",
-        a.file.display(),
-        reader.file_bytes(),
-        info.messages
-    );
-    if let (Some(s), Some(e)) = (info.start_s, info.end_s) {
-        out!("time span: {s:.6} s .. {e:.6} s (simulated)");
-    }
-    if let Some(run) = info.metadata("clutchpack.run") {
-        for k in [
-            "engine",
-            "scene_name",
-            "scene_file",
-            "scene_sha256",
-            "program_version",
-            "overrides",
-        ] {
-            if let Some(v) = run.get(k) {
-                out!("{k}: {v}");
-            }
-        }
-    }
-    out!("topics:");
-    for t in &info.topics {
-        out!(
-            "  {:<32} {:<28} {:>9} messages",
-            t.topic,
-            t.schema_name,
-            t.messages
-        );
-    }
-    for att in &info.attachments {
-        out!(
-            "attachment: {} ({}, {} bytes)",
-            att.name,
-            att.media_type,
-            att.data.len()
-        );
-    }
-    let stats = recording_stats(&reader);
-    out!(
-        "per-tooth impact loads{}:",
-        if info.summary.is_some() {
-            ""
-        } else {
-            " (no stored summary: from the recovered impacts)"
-        }
-    );
-    out!(
-        "{}",
-        clutchpack_analysis::stats_table(&stats, clutchpack_analysis::TableFormat::Text).trim_end()
-    );
+    out!("{}", reader.describe().trim_end());
     if a.serve {
-        serve(&a.file, a.port)?;
+        serve(&reader, a.port, a.speed)?;
     }
     Ok(ExitCode::SUCCESS)
 }
 
 #[cfg(feature = "serve")]
-fn serve(path: &Path, port: u16) -> Result<()> {
-    out!(
-        "serving {} on ws://127.0.0.1:{port} (Ctrl-C to stop)",
-        path.display()
-    );
+fn serve(reader: &RecordingReader, port: u16, speed: f32) -> Result<()> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
     let opts = clutchpack_record::ServeOptions {
         port,
+        speed,
         ..Default::default()
     };
-    clutchpack_record::serve(path, &opts).context("serving the recording")?;
+    clutchpack_record::serve(reader, &opts, &stop, |p| {
+        eprintln!(
+            "serving on ws://127.0.0.1:{p}: in Foxglove, Open connection > Foxglove WebSocket; Ctrl-C to stop"
+        )
+    })
+    .map_err(|e| anyhow::anyhow!("serving the recording: {e}"))?;
     Ok(())
 }
 
 #[cfg(not(feature = "serve"))]
-fn serve(_path: &Path, _port: u16) -> Result<()> {
+fn serve(_reader: &RecordingReader, _port: u16, _speed: f32) -> Result<()> {
     Err(
         BadInput("this build has no WebSocket server: rebuild with `--features serve`".into())
             .into(),

@@ -83,10 +83,9 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     let recorder = if a.no_record {
         None
     } else {
-        let path = a
-            .out
-            .clone()
-            .unwrap_or_else(|| default_recording_path(&scene.name));
+        let path = a.out.clone().unwrap_or_else(|| {
+            clutchpack_record::default_path("recordings", &scene.name, std::time::SystemTime::now())
+        });
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("creating the folder {}", dir.display()))?;
@@ -218,24 +217,6 @@ fn write_impacts_csv(path: &PathBuf, names: &[String], obs: &RunCollector) -> Re
     }
     w.flush()
         .with_context(|| format!("writing {}", path.display()))
-}
-
-/// `recordings/<scene>-<UTC time>.mcap`.
-fn default_recording_path(scene: &str) -> PathBuf {
-    let stamp = humantime::format_rfc3339_seconds(std::time::SystemTime::now())
-        .to_string()
-        .replace([':', '-'], "");
-    let safe: String = scene
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    PathBuf::from("recordings").join(format!("{safe}-{stamp}.mcap"))
 }
 
 /// Feeds the collector and the recorder; stops the run on Ctrl-C.
