@@ -96,10 +96,10 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             per_tooth: a.per_tooth || scene.simulation.record_per_tooth,
             ..RecordOptions::default()
         };
-        Some(
+        Some(ThreadedRecorder::start(
             Recorder::create(&path, &info, &opts)
                 .with_context(|| format!("creating the recording {}", path.display()))?,
-        )
+        ))
     };
     let interrupted = Arc::new(AtomicBool::new(false));
     {
@@ -124,7 +124,8 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     } = obs;
     let stats = disc_stats(&names, &obs.impacts);
     // Close the recording first: it holds everything before a failure or an interruption.
-    if let Some(mut rec) = recorder {
+    if let Some(rec) = recorder {
+        let mut rec = rec.join();
         if let Ok(s) = &result {
             rec.set_run_stats(s);
         }
@@ -219,30 +220,90 @@ fn write_impacts_csv(path: &PathBuf, names: &[String], obs: &RunCollector) -> Re
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// Feeds the collector and the recorder; stops the run on Ctrl-C.
+/// What the engine's thread hands to the recording thread.
+enum ToRecorder {
+    Sample(Sample),
+    Impact(ImpactEvent),
+    Progress(f64),
+}
+
+/// The recorder on its own thread: the engine's thread only clones each sample into a bounded
+/// channel, so encoding and writing the recording run beside the simulation instead of after
+/// each step (measured: the recording's cost moves off the engine's thread; see the issue note).
+struct ThreadedRecorder {
+    tx: std::sync::mpsc::SyncSender<ToRecorder>,
+    failed: Arc<AtomicBool>,
+    handle: std::thread::JoinHandle<Recorder>,
+}
+
+impl ThreadedRecorder {
+    fn start(mut rec: Recorder) -> ThreadedRecorder {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<ToRecorder>(8192);
+        let failed = Arc::new(AtomicBool::new(false));
+        let flag = failed.clone();
+        let handle = std::thread::spawn(move || {
+            for m in rx {
+                let stop = match m {
+                    ToRecorder::Sample(s) => {
+                        rec.sample(&s);
+                        // the wall-clock flush is checked on every message
+                        rec.progress(s.t_s)
+                    }
+                    ToRecorder::Impact(e) => {
+                        rec.impact(&e);
+                        false
+                    }
+                    ToRecorder::Progress(t) => rec.progress(t),
+                };
+                if stop {
+                    flag.store(true, Ordering::SeqCst);
+                }
+            }
+            rec
+        });
+        ThreadedRecorder { tx, failed, handle }
+    }
+
+    fn send(&self, m: ToRecorder) {
+        // A closed channel means the thread ended; join() reports why.
+        let _ = self.tx.send(m);
+    }
+
+    /// Waits for everything sent to be written and returns the recorder to finish it.
+    fn join(self) -> Recorder {
+        drop(self.tx);
+        match self.handle.join() {
+            Ok(r) => r,
+            Err(p) => std::panic::resume_unwind(p),
+        }
+    }
+}
+
+/// Feeds the collector and the recorder; stops the run on Ctrl-C or when recording failed.
 struct RunObserver {
     collector: RunCollector,
-    recorder: Option<Recorder>,
+    recorder: Option<ThreadedRecorder>,
     interrupted: Arc<AtomicBool>,
 }
 
 impl Observer for RunObserver {
     fn sample(&mut self, s: &Sample) {
         self.collector.sample(s);
-        if let Some(r) = self.recorder.as_mut() {
-            r.sample(s);
+        if let Some(r) = &self.recorder {
+            r.send(ToRecorder::Sample(s.clone()));
         }
     }
     fn impact(&mut self, e: &ImpactEvent) {
         self.collector.impact(e);
-        if let Some(r) = self.recorder.as_mut() {
-            r.impact(e);
+        if let Some(r) = &self.recorder {
+            r.send(ToRecorder::Impact(*e));
         }
     }
     fn progress(&mut self, t_s: f64) -> bool {
         let mut stop = self.collector.progress(t_s);
-        if let Some(r) = self.recorder.as_mut() {
-            stop |= r.progress(t_s);
+        if let Some(r) = &self.recorder {
+            r.send(ToRecorder::Progress(t_s));
+            stop |= r.failed.load(Ordering::SeqCst);
         }
         stop || self.interrupted.load(Ordering::SeqCst)
     }
