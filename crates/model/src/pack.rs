@@ -22,6 +22,47 @@ pub struct DiscModel {
     pub initial_rel_angle_rad: f64,
     /// Initial relative speed `omega_s(0) - omega_d(0)` in rad/s.
     pub initial_rel_speed_rad_s: f64,
+    /// Whether the disc may move radially on its spline (MODEL.md section 5): its joint to the
+    /// shaft frees the two radial translations and only the teeth hold it (involute teeth
+    /// push it back towards the axis under load). Default `false`: the radial translations
+    /// are locked (a concentric disc, or an eccentric one with [`Self::initial_offset_m`]).
+    #[serde(default)]
+    pub radial_float: bool,
+    /// Circumferential spacing error of each tooth pair at the pitch circle, in m, one per
+    /// tooth (`n` values) or empty for none (the default). Tooth `k` sits at the angle
+    /// `2 pi k / n` from the shaft frame's `+x` axis. Positive: the shaft's tooth `k` sits
+    /// ahead of its nominal place in the positive rotation, so it closes the shaft-leads gap
+    /// of that tooth pair and opens its disc-leads gap by this much at the pitch circle (by
+    /// `e_k cos(alpha)` along the line of action).
+    #[serde(default)]
+    pub tooth_spacing_errors_m: Vec<f64>,
+    /// Offset `(x, y)` of the disc's centre from the shaft axis at t = 0, in m, in the shaft's
+    /// frame (which is the world frame at t = 0: the shaft starts at angle 0). Default
+    /// `[0, 0]`. With [`Self::radial_float`] it is where the floating disc starts (moving
+    /// with the shaft); without, the disc runs eccentric, held at this offset in the shaft's
+    /// frame.
+    #[serde(default)]
+    pub initial_offset_m: [f64; 2],
+}
+
+impl DiscModel {
+    /// Whether the disc is concentric with rigid, error-free teeth: no radial float, no
+    /// offset, no spacing error. Then every tooth carries the same load and one rotational
+    /// degree of freedom with the lumped law (MODEL.md sections 1-3) describes it exactly;
+    /// otherwise only a per-tooth engine can (MODEL.md section 5).
+    pub fn is_concentric(&self) -> bool {
+        !self.radial_float
+            && self.initial_offset_m == [0.0, 0.0]
+            && self.tooth_spacing_errors_m.iter().all(|&e| e == 0.0)
+    }
+
+    /// Spacing error of tooth `k` as an angle at the pitch circle, rad (`e_k / R`; 0 when
+    /// the disc has no spacing errors).
+    pub fn tooth_phase_error_rad(&self, k: usize) -> f64 {
+        self.tooth_spacing_errors_m
+            .get(k)
+            .map_or(0.0, |e| e / self.spline.pitch_radius_m)
+    }
 }
 
 /// A shaft and the discs coupled to it.
@@ -31,4 +72,80 @@ pub struct PackModel {
     pub shaft: Shaft,
     /// The discs, each on its own spline coupling.
     pub discs: Vec<DiscModel>,
+}
+
+impl PackModel {
+    /// Whether a torsional model (one rotational degree of freedom per body, the lumped tooth
+    /// law) describes the pack exactly: every disc [`DiscModel::is_concentric`]. Engines
+    /// choose by it (the reference engine refuses a pack that is not).
+    pub fn is_torsional(&self) -> bool {
+        self.discs.iter().all(DiscModel::is_concentric)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::drive::SpeedProfile;
+    use crate::law::{Hertz, LawKind, OilFilm};
+
+    fn disc() -> DiscModel {
+        DiscModel {
+            name: "d".into(),
+            spline: SplineGeometry {
+                teeth: 4,
+                pitch_radius_m: 0.1,
+                pressure_angle_rad: 0.3,
+                backlash_m: 1e-3,
+            },
+            law: ToothLaw {
+                kind: LawKind::Dry,
+                hertz: Hertz {
+                    modulus_pa: 210e9,
+                    curvature_radius_m: 1e-3,
+                    loss_coefficient_s_m: 0.0,
+                },
+                oil: OilFilm {
+                    thickness_m: 0.0,
+                    viscosity_pa_s: 0.0,
+                    leakage_coefficient: 0.0,
+                    width_m: 0.0,
+                    length_m: 0.0,
+                    v_floor_m_s: 0.01,
+                    h_min_m: 1e-6,
+                },
+            },
+            inertia_kg_m2: 0.1,
+            drag_n_m_s_rad: 0.0,
+            initial_rel_angle_rad: 0.0,
+            initial_rel_speed_rad_s: 0.0,
+            radial_float: false,
+            tooth_spacing_errors_m: Vec::new(),
+            initial_offset_m: [0.0, 0.0],
+        }
+    }
+
+    /// Any radial float, offset or non-zero spacing error makes a disc non-concentric (and the
+    /// pack non-torsional); all-zero spacing errors are no errors.
+    #[test]
+    fn concentric_means_no_per_tooth_effect() {
+        let mut pack = PackModel {
+            shaft: Shaft::Prescribed(SpeedProfile::sine(100.0, 1.0, 10.0)),
+            discs: vec![disc()],
+        };
+        assert!(pack.is_torsional());
+        pack.discs[0].tooth_spacing_errors_m = vec![0.0; 4];
+        assert!(pack.is_torsional());
+        pack.discs[0].tooth_spacing_errors_m[2] = 2e-6;
+        assert!(!pack.is_torsional());
+        // 2 um at R = 0.1 m is 2e-5 rad
+        assert_eq!(pack.discs[0].tooth_phase_error_rad(2), 2e-6 / 0.1);
+        assert_eq!(pack.discs[0].tooth_phase_error_rad(1), 0.0);
+        let mut d = disc();
+        d.radial_float = true;
+        assert!(!d.is_concentric());
+        let mut d = disc();
+        d.initial_offset_m = [0.0, -1e-6];
+        assert!(!d.is_concentric());
+    }
 }

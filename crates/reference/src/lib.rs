@@ -247,14 +247,23 @@ struct DiscTrack {
 
 fn check_disc(d: &DiscModel) -> Result<(), EngineError> {
     let ok = d.inertia_kg_m2 > 0.0 && d.spline.teeth > 0 && d.spline.backlash_m > 0.0;
-    if ok {
-        Ok(())
-    } else {
-        Err(EngineError::Unsupported(format!(
+    if !ok {
+        return Err(EngineError::Unsupported(format!(
             "disc {}: inertia, teeth and backlash must be positive",
             d.name
-        )))
+        )));
     }
+    // One rotational DOF with the lumped law is exact only for a concentric disc with
+    // identical teeth (MODEL.md section 5).
+    if !d.is_concentric() {
+        return Err(EngineError::Unsupported(format!(
+            "disc {}: radial float, an initial offset or tooth spacing errors need the per-tooth \
+             multibody engine (the reference engine has one rotational degree of freedom per \
+             body and identical teeth)",
+            d.name
+        )));
+    }
+    Ok(())
 }
 
 impl Engine for ReferenceEngine {

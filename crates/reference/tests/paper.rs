@@ -180,3 +180,35 @@ fn inertial_shaft_conserves_angular_momentum() {
         assert!((l - l0).abs() < 1e-9 * l0, "{l} vs {l0} at {}", s.t_s);
     }
 }
+
+/// MODEL.md section 5: radial float, an offset or tooth spacing errors make the teeth carry
+/// different loads, which one rotational degree of freedom with the lumped law cannot
+/// represent; the engine refuses such a disc (`Unsupported`, naming it) instead of running a
+/// different model.
+#[test]
+fn per_tooth_effects_are_refused() {
+    let cases: [fn(&mut DiscModel); 3] = [
+        |d| d.radial_float = true,
+        |d| d.initial_offset_m = [10e-6, 0.0],
+        |d| {
+            d.tooth_spacing_errors_m = vec![0.0; 154];
+            d.tooth_spacing_errors_m[3] = 5e-6;
+        },
+    ];
+    for set in cases {
+        let mut pack = paper_pack(25e-6);
+        set(&mut pack.discs[0]);
+        let mut e = ReferenceEngine::new(pack, Settings::default());
+        let err = e.run(1e-3, &mut Collector::default()).unwrap_err();
+        assert!(
+            matches!(&err, EngineError::Unsupported(m) if m.contains("disc disc")),
+            "{err}"
+        );
+    }
+    // all-zero spacing errors are no errors
+    let mut pack = paper_pack(25e-6);
+    pack.discs[0].tooth_spacing_errors_m = vec![0.0; 154];
+    ReferenceEngine::new(pack, Settings::default())
+        .run(1e-3, &mut Collector::default())
+        .unwrap();
+}

@@ -44,6 +44,9 @@
 //! [defaults]                    # disc parameters shared by all discs
 //! inertia_kg_m2 = 0.156
 //! drag_n_m_s_rad = 0.01
+//! radial_float = false          # default false: radial translations locked (multibody only)
+//! tooth_spacing_errors_m = []   # m at the pitch circle, one per tooth or empty (default)
+//! initial_offset_m = [0.0, 0.0] # m, the centre's offset from the axis at t = 0 (default)
 //! [defaults.spline]
 //! teeth = 154
 //! pitch_radius_m = 0.231
@@ -82,7 +85,11 @@
 //! only when the film carries load (`film_thickness_m > 0` and `law` not `"dry"`); otherwise
 //! absent ones are 0. With an oil law the film must be thinner than half the free play along
 //! the line of action (`h_o < g0 Rb`), and every disc must start inside the free play
-//! (`|phi0| Rb < g0 Rb - h_o`, `h_o` taken as 0 for the dry law).
+//! (`|phi0| Rb < g0 Rb - h_o`, `h_o` taken as 0 for the dry law); with spacing errors or an
+//! offset every tooth must (`|phi0| Rb + max|e_k| cos(alpha) + |offset| < g0 Rb - h_o`).
+//! `tooth_spacing_errors_m` holds one number per tooth (`spline.teeth` of them) or none.
+//! Radial float, offsets and spacing errors are per-tooth effects (MODEL.md section 5): only
+//! the multibody engine runs them ([`clutchpack_model::PackModel::is_torsional`]).
 //!
 //! # Overrides
 //! `--set KEY=VALUE` overrides any key by its dotted path, array items by index from 0:

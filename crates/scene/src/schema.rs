@@ -96,6 +96,22 @@ const DISC_KEYS: &[Key] = &[
         "initial_rel_speed_rad_s",
         "rad/s, omega_shaft(0) - omega_disc(0); default 0",
     ),
+    key(
+        "radial_float",
+        "true | false; default false; the disc may move radially on its spline (multibody \
+         engine only)",
+    ),
+    key(
+        "tooth_spacing_errors_m",
+        "m, array of n finite numbers (one per tooth, tooth k at 2 pi k / n from the shaft's \
+         +x axis) or empty; default empty; circumferential spacing error at the pitch circle, \
+         positive closes the shaft-leads gap (multibody engine only)",
+    ),
+    key(
+        "initial_offset_m",
+        "m, [x, y] in the shaft's frame; default [0, 0]; the disc centre's offset from the \
+         axis at t = 0 (held there unless radial_float; multibody engine only)",
+    ),
     key("spline.teeth", "integer >= 1; required"),
     key("spline.pitch_radius_m", "m, > 0; required"),
     key("spline.pressure_angle_deg", "deg, in (0, 90); required"),

@@ -194,6 +194,41 @@ impl Checker {
         }
     }
 
+    /// An array of finite numbers (integers accepted), of length `len` if given. A bad item is
+    /// reported at its index (`key[3]`), a wrong length at `key`.
+    fn numbers(&mut self, key: &str, v: Option<&Value>, len: Option<usize>) -> Field<Vec<f64>> {
+        let Some(v) = v else { return Field::Absent };
+        let Some(items) = v.as_array() else {
+            self.report(key, Some(show(v)), "must be an array of numbers");
+            return Field::Invalid;
+        };
+        if let Some(n) = len {
+            if items.len() != n {
+                self.report(
+                    key,
+                    Some(show(v)),
+                    format!("must have exactly {n} numbers (it has {})", items.len()),
+                );
+                return Field::Invalid;
+            }
+        }
+        let mut out = Some(Vec::with_capacity(items.len()));
+        for (j, item) in items.iter().enumerate() {
+            match self.number(&format!("{key}[{j}]"), Some(item), Rule::Finite) {
+                Field::Valid(x) => {
+                    if let Some(o) = out.as_mut() {
+                        o.push(x)
+                    }
+                }
+                _ => out = None,
+            }
+        }
+        match out {
+            Some(o) => Field::Valid(o),
+            None => Field::Invalid,
+        }
+    }
+
     /// Reports a key that is present but not allowed in this configuration.
     fn not_allowed(&mut self, key: &str, v: Option<&Value>, rule: &str) -> bool {
         match v {
@@ -645,6 +680,9 @@ struct Params {
     drag: Field<f64>,
     angle: Field<f64>,
     speed: Field<f64>,
+    radial_float: Field<bool>,
+    spacing_errors: Field<Vec<f64>>,
+    offset: Field<Vec<f64>>,
     teeth: Field<u32>,
     pitch_radius: Field<f64>,
     pressure_angle_deg: Field<f64>,
@@ -688,6 +726,17 @@ fn params(ck: &mut Checker, prefix: &str, r: &RawDisc) -> Params {
             &key("initial_rel_speed_rad_s"),
             r.initial_rel_speed_rad_s.as_ref(),
             Rule::Finite,
+        ),
+        radial_float: ck.boolean(&key("radial_float"), r.radial_float.as_ref()),
+        spacing_errors: ck.numbers(
+            &key("tooth_spacing_errors_m"),
+            r.tooth_spacing_errors_m.as_ref(),
+            None,
+        ),
+        offset: ck.numbers(
+            &key("initial_offset_m"),
+            r.initial_offset_m.as_ref(),
+            Some(2),
         ),
         teeth: ck.count(&key("spline.teeth"), sp.and_then(|s| s.teeth.as_ref())),
         pitch_radius: ck.number(
@@ -898,6 +947,9 @@ fn disc(
     let drag = optional(&p.drag, &d.drag, 0.0);
     let angle = optional(&p.angle, &d.angle, 0.0);
     let speed = optional(&p.speed, &d.speed, 0.0);
+    let radial_float = optional(&p.radial_float, &d.radial_float, false);
+    let spacing_errors = optional(&p.spacing_errors, &d.spacing_errors, Vec::new());
+    let offset = optional(&p.offset, &d.offset, vec![0.0, 0.0]);
     let teeth = required(ck, i, "spline.teeth", &p.teeth, &d.teeth);
     let pitch = required(
         ck,
@@ -961,8 +1013,24 @@ fn disc(
         })
     })();
 
+    // One spacing error per tooth, or none.
+    let mut spacing_ok = true;
+    if let (Some(n), Some((errors, source))) = (teeth, spacing_errors.as_ref()) {
+        if !errors.is_empty() && errors.len() != n as usize {
+            ck.report(
+                format!("discs[{i}].tooth_spacing_errors_m"),
+                Some(format!("[...{} numbers]", errors.len())),
+                format!(
+                    "must have one number per tooth (spline.teeth = {n}) or be empty{}",
+                    inherited(*source, "tooth_spacing_errors_m")
+                ),
+            );
+            spacing_ok = false;
+        }
+    }
+
     // The film and the start position against the free play, along the line of action.
-    let mut inside = true;
+    let mut inside = spacing_ok;
     if let (Some(spline), Some(kind), Some((h_o, film_source)), Some((phi0, angle_source))) =
         (spline, law, film, angle)
     {
@@ -992,6 +1060,43 @@ fn disc(
                 ),
             );
             inside = false;
+        } else if let (Some((errors, errors_source)), Some((e, offset_source))) =
+            (spacing_errors.as_ref(), offset.as_ref())
+        {
+            // Every tooth must start inside the free play too: a spacing error e_k moves its
+            // gap by e_k cos(alpha) along the line of action, the offset by up to |e|.
+            let worst_error = errors.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let along = worst_error * spline.pressure_angle_rad.cos();
+            let offset_len = e[0].hypot(e[1]);
+            let reach_m = half_play_m - offset_m;
+            if inside && phi0.abs() * spline.base_radius_m() + along + offset_len >= reach_m {
+                let (key, value, source, k) = if offset_len > 0.0 {
+                    (
+                        "initial_offset_m",
+                        format!("[{}, {}]", e[0], e[1]),
+                        *offset_source,
+                        "initial_offset_m",
+                    )
+                } else {
+                    (
+                        "tooth_spacing_errors_m",
+                        format!("[...max |e| = {worst_error}]"),
+                        *errors_source,
+                        "tooth_spacing_errors_m",
+                    )
+                };
+                ck.report(
+                    format!("discs[{i}].{key}"),
+                    Some(value),
+                    format!(
+                        "every tooth must start inside the free play: |phi0| Rb + max|e_k| \
+                         cos(alpha) + |offset| = {:.6e} m must be < g0 Rb - h_o = {reach_m:.6e} m{}",
+                        phi0.abs() * spline.base_radius_m() + along + offset_len,
+                        inherited(source, k)
+                    ),
+                );
+                inside = false;
+            }
         }
     }
     if !inside {
@@ -1022,5 +1127,11 @@ fn disc(
         drag_n_m_s_rad: drag?.0,
         initial_rel_angle_rad: angle?.0,
         initial_rel_speed_rad_s: speed?.0,
+        radial_float: radial_float?.0,
+        tooth_spacing_errors_m: spacing_errors?.0,
+        initial_offset_m: {
+            let (e, _) = offset?;
+            [e[0], e[1]]
+        },
     })
 }

@@ -582,3 +582,72 @@ fn shipped_scenes_are_valid() {
         }
     }
 }
+
+/// Radial float, spacing errors and an initial offset (MODEL.md section 5) reach the model,
+/// from `[defaults]` or the disc, with their defaults (locked, none, centred).
+#[test]
+fn radial_float_spacing_errors_and_offset_reach_the_model() {
+    let s = parse_ok(PAPER, &[]);
+    assert!(!s.pack.discs[0].radial_float);
+    assert!(s.pack.discs[0].tooth_spacing_errors_m.is_empty());
+    assert_eq!(s.pack.discs[0].initial_offset_m, [0.0, 0.0]);
+    assert!(s.pack.is_torsional());
+
+    let errors: Vec<String> = (0..154).map(|k| format!("{}e-6", k % 5)).collect();
+    let s = parse_ok(
+        PAPER,
+        &[
+            "defaults.radial_float=true",
+            &format!("discs[1].tooth_spacing_errors_m=[{}]", errors.join(",")),
+            "discs[2].initial_offset_m=[10e-6, -5e-6]",
+        ],
+    );
+    assert!(s.pack.discs.iter().all(|d| d.radial_float));
+    assert_eq!(s.pack.discs[1].tooth_spacing_errors_m.len(), 154);
+    assert_eq!(s.pack.discs[1].tooth_spacing_errors_m[3], 3e-6);
+    assert_eq!(s.pack.discs[2].initial_offset_m, [10e-6, -5e-6]);
+    assert!(!s.pack.is_torsional());
+}
+
+/// Each kind of mistake in the new keys names its key, value and rule: a spacing error list
+/// of the wrong length (one per tooth), a bad item (at its index), an offset that is not two
+/// numbers, a non-boolean float switch, and errors or an offset that leave a tooth outside
+/// the free play (g0 Rb - h_o = 352 - 25 = 327 um along the line of action).
+#[test]
+fn bad_radial_keys_are_reported_with_key_value_and_rule() {
+    let e = parse_err(PAPER, &["discs[0].tooth_spacing_errors_m=[1e-6, 2e-6]"]);
+    let p = problem_at(&e, "discs[0].tooth_spacing_errors_m");
+    assert!(
+        p.rule.contains("one number per tooth (spline.teeth = 154)"),
+        "{p}"
+    );
+
+    let e = parse_err(PAPER, &["discs[0].tooth_spacing_errors_m=[1e-6, \"x\"]"]);
+    let p = problem_at(&e, "discs[0].tooth_spacing_errors_m[1]");
+    assert!(p.rule.starts_with("must be a number"), "{p}");
+
+    let e = parse_err(PAPER, &["defaults.initial_offset_m=[1e-6]"]);
+    let p = problem_at(&e, "defaults.initial_offset_m");
+    assert!(p.rule.contains("exactly 2 numbers"), "{p}");
+
+    let e = parse_err(PAPER, &["discs[1].radial_float=1"]);
+    let p = problem_at(&e, "discs[1].radial_float");
+    assert!(p.rule.starts_with("must be true or false"), "{p}");
+
+    let e = parse_err(PAPER, &["discs[0].initial_offset_m=[300e-6, 200e-6]"]);
+    let p = problem_at(&e, "discs[0].initial_offset_m");
+    assert!(
+        p.rule
+            .starts_with("every tooth must start inside the free play"),
+        "{p}"
+    );
+    // 320 um at the pitch circle is 301 um along the line of action: fits alone, not with
+    // a 30 um offset
+    let big: Vec<&str> = (0..154)
+        .map(|k| if k == 7 { "320e-6" } else { "0" })
+        .collect();
+    let set = format!("discs[0].tooth_spacing_errors_m=[{}]", big.join(","));
+    parse_ok(PAPER, &[&set]);
+    let e = parse_err(PAPER, &[&set, "discs[0].initial_offset_m=[30e-6, 0]"]);
+    problem_at(&e, "discs[0].initial_offset_m");
+}

@@ -50,6 +50,9 @@ fn bench_pack() -> PackModel {
         drag_n_m_s_rad: 0.0,
         initial_rel_angle_rad: 0.0,
         initial_rel_speed_rad_s: 0.0,
+        radial_float: false,
+        tooth_spacing_errors_m: Vec::new(),
+        initial_offset_m: [0.0, 0.0],
     };
     PackModel {
         shaft: Shaft::Prescribed(SpeedProfile::sine(100.0, 4.378, 104.0)),

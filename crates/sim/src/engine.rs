@@ -185,10 +185,32 @@ impl MultibodyEngine {
             if d.spline.teeth == 0 || d.inertia_kg_m2.is_nan() || d.inertia_kg_m2 <= 0.0 {
                 return bad(format!("discs[{i}]: needs teeth > 0 and inertia > 0"));
             }
+            if let Some(&e) = d.tooth_spacing_errors_m.iter().find(|e| !e.is_finite()) {
+                return bad(format!(
+                    "discs[{i}]: tooth spacing error {e} m: must be finite"
+                ));
+            }
+            if !d.tooth_spacing_errors_m.is_empty()
+                && d.tooth_spacing_errors_m.len() != d.spline.teeth as usize
+            {
+                return bad(format!(
+                    "discs[{i}]: {} tooth spacing errors for {} teeth: one per tooth or none",
+                    d.tooth_spacing_errors_m.len(),
+                    d.spline.teeth
+                ));
+            }
             per_tooth.push(match options.teeth {
                 ToothResolution::PerTooth => true,
                 // Concentric discs on a locked radial joint, no spacing errors: lumped is exact.
-                ToothResolution::Lumped | ToothResolution::Auto => false,
+                ToothResolution::Auto => !d.is_concentric(),
+                ToothResolution::Lumped if d.is_concentric() => false,
+                ToothResolution::Lumped => {
+                    return bad(format!(
+                        "discs[{i}]: lumped teeth are exact only for a concentric disc without \
+                         spacing errors (this one floats radially, is offset or has spacing \
+                         errors): use per-tooth resolution"
+                    ))
+                }
             });
         }
         // Build once now so that a scene the world cannot hold fails here, not in `run`.
@@ -323,7 +345,12 @@ impl<'a> Run<'a> {
             .discs
             .iter()
             .zip(per_tooth)
-            .map(|(d, &pt)| Coupling::new(d.spline, d.law, pt, &[]))
+            .map(|(d, &pt)| {
+                let errors: Vec<f64> = (0..d.tooth_spacing_errors_m.len())
+                    .map(|k| d.tooth_phase_error_rad(k))
+                    .collect();
+                Coupling::new(d.spline, d.law, pt, &errors)
+            })
             .collect();
         let nd = couplings.len();
         let tracks = (0..nd)
@@ -401,14 +428,20 @@ impl<'a> Run<'a> {
     }
 
     /// Kinetic energy of the discs (and of an inertial shaft) at `t`, J: `sum J w^2 / 2` with
-    /// the synchronised speeds (the joint locks every other motion).
+    /// the synchronised speeds, plus `m v^2 / 2` of the discs' centres (rapier's speed over
+    /// the last step: zero for a concentric disc, whose joint locks every other motion).
     fn kinetic_energy(&self) -> f64 {
+        let bodies = &self.world.physics.bodies;
         let mut e: f64 = self
             .pack
             .discs
             .iter()
             .zip(&self.omega_d)
-            .map(|(d, w)| 0.5 * d.inertia_kg_m2 * w * w)
+            .zip(&self.world.discs)
+            .map(|((d, w), &h)| {
+                let b = &bodies[h];
+                0.5 * d.inertia_kg_m2 * w * w + 0.5 * b.mass() * b.linvel().length_squared()
+            })
             .sum();
         if let ShaftDrive::Inertial { j1, .. } = self.shaft {
             e += 0.5 * j1 * self.omega_s * self.omega_s;
@@ -496,6 +529,13 @@ impl<'a> Run<'a> {
                 return Err(diverged(format!(
                     "relative angle {} rad, speed {} rad/s (half a tooth pitch is {limit} rad)",
                     rel.phi, rel.dphi
+                )));
+            }
+            let offset = rel.offset[0].hypot(rel.offset[1]);
+            let offset_limit = limit * c.spline.pitch_radius_m;
+            if !(offset <= offset_limit && rel.offset_rate.iter().all(|v| v.is_finite())) {
+                return Err(diverged(format!(
+                    "radial offset {offset} m (half a tooth pitch is {offset_limit} m)"
                 )));
             }
             let f = c.evaluate(&rel);
@@ -873,6 +913,8 @@ impl Engine for MultibodyEngine {
         self.pack.discs.iter().map(|d| d.name.clone()).collect()
     }
 
+    // `u64::is_multiple_of` needs Rust 1.87; the workspace's rust-version is 1.86.
+    #[allow(clippy::manual_is_multiple_of)]
     fn run(
         &mut self,
         duration_s: f64,

@@ -9,15 +9,20 @@
 //!   a revolute joint to the housing for an inertial shaft, eq 4), and one dynamic body per
 //!   friction disc joined to the shaft by a cylindrical impulse joint (rotation about `+z` and
 //!   axial slide free; radial translations and tilts locked), or optionally held by rapier's
-//!   locked axes ([`DiscMount`], the same motion at about half the cost per step). Each
+//!   locked axes ([`DiscMount`], the same motion at about half the cost per step). A disc
+//!   with `radial_float` has its radial translations free too (only the teeth hold it); an
+//!   eccentric disc (`initial_offset_m` without float) is held at its offset in the shaft's
+//!   frame by a cylindrical joint anchored there. Each
 //!   disc's mass and transverse inertia come from a steel annulus (parry's cylinders; inner
 //!   radius the spline pitch radius, outer radius chosen so that the annulus has the scene's
 //!   inertia); its inertia about the axis is the scene's `J` exactly.
 //! - Each step, the spline contact hook (`hook.rs`) reads every coupling's relative pose and
 //!   velocity, evaluates the model's tooth law per tooth (each tooth with its own contact
-//!   memory) and applies the forces along the teeth's lines of action. A concentric coupling
-//!   without spacing errors can be lumped (one tooth times `n`, exact there). The teeth's
-//!   torque is integrated along each step rather than sampled at its start (`integrate.rs`).
+//!   memory) and applies the forces along the teeth's lines of action, with each tooth's
+//!   spacing error and the disc's radial offset (MODEL.md section 5). A concentric coupling
+//!   without spacing errors is lumped (one tooth times `n`, exact there); any other is
+//!   resolved tooth by tooth ([`ToothResolution::Auto`]). The teeth's torque is integrated
+//!   along each step rather than sampled at its start (`integrate.rs`).
 //! - Implements [`clutchpack_model::Engine`]: samples at the scene's recording rate, impact
 //!   events with the model's definitions ([`clutchpack_model::ImpactTracker`]: onset where the
 //!   engagement depth becomes positive, the peak of `|F|`, separation where the depth falls
@@ -26,8 +31,11 @@
 //!
 //! ## What it does not do (yet)
 //! - Separator plates, the output drum, the piston and stack, plate friction (issue 3, step 3).
-//! - Radial float of a disc: the joint locks the radial translations, so the per-tooth hook
-//!   sees concentric discs; the hook itself handles offsets and spacing errors.
+//! - The radial motion of a floating disc is integrated by the polynomial kick of its forces
+//!   (second to third order), not along the step like the teeth's torque about the axis; its
+//!   radial speed in the law's damping is rapier's mean speed over the last step. Onsets of
+//!   per-tooth couplings are not landed on (the controller's worst-case gap covers them with
+//!   contact steps instead).
 //! - The squeeze-film law: its damper has a nanosecond time constant near metal contact, too
 //!   stiff for an explicit step; [`MultibodyEngine::from_scene`] refuses it (use the
 //!   reference engine).

@@ -120,8 +120,9 @@ pub enum DiscMount {
     /// Rapier's per-body locked axes (world x, y translations and rotations), no constraint
     /// to solve. The same motion whenever the shaft's axis stays on the world z axis, which
     /// it does here (a kinematic shaft, or a dynamic one on a revolute joint to the housing);
-    /// measured about 1.9x faster per step for 8 discs. Not for discs that must float
-    /// radially.
+    /// measured about 1.9x faster per step for 8 discs. A floating disc then has only its
+    /// tilts locked; an eccentric disc that does not float always gets a joint (its offset
+    /// turns with the shaft).
     LockedAxes,
 }
 

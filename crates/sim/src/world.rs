@@ -1,5 +1,6 @@
 //! The rapier3d-f64 world of a pack: a fixed housing, the shaft, and one dynamic body per disc
-//! on a cylindrical impulse joint (ARCHITECTURE.md "The multibody engine").
+//! on a cylindrical impulse joint (ARCHITECTURE.md "The multibody engine"), or on a joint that
+//! frees the radial translations too for a disc that floats radially (MODEL.md section 5).
 //!
 //! The shaft axis is the world `+z` axis. Bodies carry no colliders: the spline teeth are our
 //! own force law, applied by the contact hook ([`crate::hook`]).
@@ -112,6 +113,18 @@ fn cylindrical_joint(anchor1: Vector) -> GenericJointBuilder {
     .contacts_enabled(false)
 }
 
+/// A joint that locks only the two tilts: rotation about `+z`, the axial slide and both radial
+/// translations free (a disc floating radially on its spline, MODEL.md section 5; only the
+/// teeth hold it radially).
+fn floating_joint(anchor1: Vector) -> GenericJointBuilder {
+    GenericJointBuilder::new(JointAxesMask::ANG_Y | JointAxesMask::ANG_Z)
+        .local_axis1(Vector::Z)
+        .local_axis2(Vector::Z)
+        .local_anchor1(anchor1)
+        .local_anchor2(Vector::ZERO)
+        .contacts_enabled(false)
+}
+
 impl World {
     /// Builds the world at t = 0: shaft angle 0 at its initial speed, each disc at
     /// `theta_d = -phi(0)` turning at `omega_s(0) - dphi(0)`.
@@ -174,26 +187,42 @@ impl World {
         let mut discs = Vec::with_capacity(n);
         for (i, d) in pack.discs.iter().enumerate() {
             let mprops = disc_mass_properties(d.inertia_kg_m2, d.spline.pitch_radius_m, shapes);
+            let [ex, ey] = d.initial_offset_m;
+            // The centre starts at its offset in the shaft's frame (the world frame at t = 0),
+            // moving with the shaft: v = omega_0 z x e.
             let mut rb = RigidBodyBuilder::dynamic()
                 .can_sleep(false)
                 .gyroscopic_forces_enabled(false)
                 .allow_fast_rotation(true)
                 .additional_mass_properties(mprops)
-                .translation(Vector::new(0.0, 0.0, disc_axial_m[i]))
+                .translation(Vector::new(ex, ey, disc_axial_m[i]))
                 .rotation(Vector::new(0.0, 0.0, -d.initial_rel_angle_rad))
+                .linvel(Vector::new(-omega0 * ey, omega0 * ex, 0.0))
                 .angvel(Vector::new(0.0, 0.0, omega0 - d.initial_rel_speed_rad_s));
-            if mount == DiscMount::LockedAxes {
-                rb = rb.locked_axes(
+            // An eccentric disc that does not float is held at its offset in the shaft's
+            // frame, which turns: only a joint to the shaft can do that.
+            let eccentric = !d.radial_float && (ex != 0.0 || ey != 0.0);
+            let locked_axes = mount == DiscMount::LockedAxes && !eccentric;
+            if locked_axes {
+                // The shaft's axis is the world z axis (a kinematic shaft, or a dynamic one on
+                // a revolute joint to the housing), so world-locked axes hold the disc on it.
+                rb = rb.locked_axes(if d.radial_float {
+                    LockedAxes::ROTATION_LOCKED_X | LockedAxes::ROTATION_LOCKED_Y
+                } else {
                     LockedAxes::TRANSLATION_LOCKED_X
                         | LockedAxes::TRANSLATION_LOCKED_Y
                         | LockedAxes::ROTATION_LOCKED_X
-                        | LockedAxes::ROTATION_LOCKED_Y,
-                );
+                        | LockedAxes::ROTATION_LOCKED_Y
+                });
             }
             let h = physics.insert_body(rb);
-            if mount == DiscMount::Joint {
-                let anchor = Vector::new(0.0, 0.0, disc_axial_m[i]);
-                physics.insert_impulse_joint(shaft, h, cylindrical_joint(anchor));
+            if !locked_axes {
+                let joint = if d.radial_float {
+                    floating_joint(Vector::new(0.0, 0.0, disc_axial_m[i]))
+                } else {
+                    cylindrical_joint(Vector::new(ex, ey, disc_axial_m[i]))
+                };
+                physics.insert_impulse_joint(shaft, h, joint);
             }
             discs.push(h);
         }

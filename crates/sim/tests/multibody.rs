@@ -49,6 +49,9 @@ fn disc(name: &str, law: ToothLaw, inertia: f64, drag: f64, phi0: f64, dphi0: f6
         drag_n_m_s_rad: drag,
         initial_rel_angle_rad: phi0,
         initial_rel_speed_rad_s: dphi0,
+        radial_float: false,
+        tooth_spacing_errors_m: Vec::new(),
+        initial_offset_m: [0.0, 0.0],
     }
 }
 

@@ -41,6 +41,9 @@ pub fn paper_disc(h_o: f64) -> DiscModel {
         drag_n_m_s_rad: 0.01,
         initial_rel_angle_rad: 0.0,
         initial_rel_speed_rad_s: 0.0,
+        radial_float: false,
+        tooth_spacing_errors_m: Vec::new(),
+        initial_offset_m: [0.0, 0.0],
     }
 }
 
