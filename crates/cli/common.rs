@@ -41,12 +41,19 @@ pub enum EngineArg {
     Multibody,
 }
 
-/// Builds the engine asked for on the command line, else by the scene, else the reference.
+/// Builds the engine asked for on the command line, else by the scene, else the reference for
+/// a torsional pack and the multibody engine for one with per-tooth effects (radial float,
+/// offsets, spacing errors: `PackModel::is_torsional`), which only it can run.
 pub fn make_engine(scene: &Scene, arg: Option<EngineArg>) -> Result<Box<dyn Engine + Send>> {
+    let default = if scene.pack.is_torsional() {
+        EngineChoice::Reference
+    } else {
+        EngineChoice::Multibody
+    };
     let choice = match arg {
         Some(EngineArg::Reference) => EngineChoice::Reference,
         Some(EngineArg::Multibody) => EngineChoice::Multibody,
-        None => scene.simulation.engine.unwrap_or(EngineChoice::Reference),
+        None => scene.simulation.engine.unwrap_or(default),
     };
     match choice {
         EngineChoice::Reference => Ok(Box::new(ReferenceEngine::from_scene(scene))),
