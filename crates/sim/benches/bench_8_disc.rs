@@ -1,4 +1,5 @@
-//! The `bench-8-disc` case of issue 3: 8 identical friction discs on one shaft, 0.1 s.
+//! The `bench-8-disc` case of issue 3, read from `scenes/bench-8-disc.toml`: 8 identical
+//! friction discs on one shaft, 0.1 s.
 //!
 //! Each disc: a steel annulus (inner radius 0.231 m, outer 0.300 m, 3 mm, 7850 kg/m^3, so
 //! `J = rho pi t (Ro^4 - Ri^4) / 2 = 0.1943 kg m^2`), dry law with `r = 5 mm`, `p = 0.5 s/m`,
@@ -10,58 +11,25 @@
 //! microseconds per step and steps per impact once (the discs are identical and strike
 //! together, so the steps per impact are per impact of the whole pack).
 
-use clutchpack_model::{
-    Collector, DiscModel, Engine, Hertz, LawKind, OilFilm, PackModel, Shaft, SpeedProfile,
-    SplineGeometry, ToothLaw,
-};
+use clutchpack_model::{Collector, Engine};
+use clutchpack_scene::Scene;
 use clutchpack_sim::{AdaptiveStepping, DiscMount, MultibodyEngine, MultibodyOptions, Stepping};
 use criterion::{criterion_group, criterion_main, Criterion};
+use std::path::Path;
 use std::time::Instant;
 
-fn bench_pack() -> PackModel {
-    let (ri, ro, t, rho) = (0.231f64, 0.300f64, 3e-3, 7850.0);
-    let inertia = rho * std::f64::consts::PI * t * (ro.powi(4) - ri.powi(4)) / 2.0;
-    let disc = |i: usize| DiscModel {
-        name: format!("disc{}", i + 1),
-        spline: SplineGeometry {
-            teeth: 154,
-            pitch_radius_m: 0.231,
-            pressure_angle_rad: 20f64.to_radians(),
-            backlash_m: 0.75e-3,
-        },
-        law: ToothLaw {
-            kind: LawKind::Dry,
-            hertz: Hertz {
-                modulus_pa: 210e9,
-                curvature_radius_m: 5e-3,
-                loss_coefficient_s_m: 0.5,
-            },
-            oil: OilFilm {
-                thickness_m: 0.0,
-                viscosity_pa_s: 0.0,
-                leakage_coefficient: 0.421,
-                width_m: 3e-3,
-                length_m: 3e-3,
-                v_floor_m_s: 0.01,
-                h_min_m: 1e-6,
-            },
-        },
-        inertia_kg_m2: inertia,
-        drag_n_m_s_rad: 0.0,
-        initial_rel_angle_rad: 0.0,
-        initial_rel_speed_rad_s: 0.0,
-        radial_float: false,
-        tooth_spacing_errors_m: Vec::new(),
-        initial_offset_m: [0.0, 0.0],
-    };
-    PackModel {
-        shaft: Shaft::Prescribed(SpeedProfile::sine(100.0, 4.378, 104.0)),
-        discs: (0..8).map(disc).collect(),
-    }
+/// The scene file of the benchmark (the bench runs from the repository).
+fn bench_scene() -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/bench-8-disc.toml");
+    clutchpack_scene::load(&path, &[])
+        .unwrap_or_else(|e| panic!("the benchmark reads {}: {e}", path.display()))
 }
 
-pub fn modes() -> Vec<(&'static str, Stepping, DiscMount)> {
-    let adaptive = Stepping::Adaptive(AdaptiveStepping::default());
+pub fn modes(scene: &Scene) -> Vec<(&'static str, Stepping, DiscMount)> {
+    let adaptive = Stepping::Adaptive(AdaptiveStepping {
+        max_step_s: scene.simulation.max_step_s,
+        ..Default::default()
+    });
     let fixed = Stepping::Fixed { dt_s: 1e-6 };
     vec![
         ("adaptive, joints", adaptive, DiscMount::Joint),
@@ -71,10 +39,9 @@ pub fn modes() -> Vec<(&'static str, Stepping, DiscMount)> {
     ]
 }
 
-pub fn run_once(stepping: Stepping, mount: DiscMount) -> (u64, usize) {
-    let mut e = MultibodyEngine::from_pack(
-        bench_pack(),
-        1e4,
+pub fn run_once(scene: &Scene, stepping: Stepping, mount: DiscMount) -> (u64, usize) {
+    let mut e = MultibodyEngine::with_options(
+        scene,
         MultibodyOptions {
             stepping,
             mount,
@@ -83,26 +50,28 @@ pub fn run_once(stepping: Stepping, mount: DiscMount) -> (u64, usize) {
     )
     .expect("engine");
     let mut c = Collector::default();
-    let stats = e.run(0.1, &mut c).expect("run");
+    let stats = e.run(scene.simulation.duration_s, &mut c).expect("run");
     (stats.steps, c.impacts.len())
 }
 
 fn bench(c: &mut Criterion) {
+    let scene = bench_scene();
+    let discs = scene.pack.discs.len() as f64;
     let mut g = c.benchmark_group("bench-8-disc 0.1 s");
     g.sample_size(10);
-    for (name, stepping, mount) in modes() {
+    for (name, stepping, mount) in modes(&scene) {
         let start = Instant::now();
-        let (steps, impacts) = run_once(stepping, mount);
+        let (steps, impacts) = run_once(&scene, stepping, mount);
         let wall = start.elapsed().as_secs_f64();
         // The 8 discs are identical and start alike, so they strike together: an impact of
         // the pack is 8 disc impacts in the same steps.
-        let pack_impacts = impacts as f64 / 8.0;
+        let pack_impacts = impacts as f64 / discs;
         eprintln!(
             "{name}: {steps} steps, {pack_impacts} impacts per disc, {wall:.3} s, {:.2} us/step, {:.0} steps per impact",
             wall / steps as f64 * 1e6,
             steps as f64 / pack_impacts.max(1.0)
         );
-        g.bench_function(name, |b| b.iter(|| run_once(stepping, mount)));
+        g.bench_function(name, |b| b.iter(|| run_once(&scene, stepping, mount)));
     }
     g.finish();
 }
