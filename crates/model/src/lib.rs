@@ -28,6 +28,7 @@
 //! - Brancati R., Rocca E., Russo R., gear-rattle squeeze-film model (the `squeeze` law).
 //! - Cameron A., *Basic Lubrication Theory*: the leakage coefficient `beta`.
 
+pub mod clutch;
 pub mod drive;
 pub mod impact;
 pub mod law;
@@ -35,6 +36,9 @@ pub mod pack;
 pub mod spline;
 pub mod stream;
 
+pub use clutch::{
+    DrumModel, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackModel,
+};
 pub use drive::{Harmonic, Shaft, ShaftExcitation, SpeedProfile, Table, TableError};
 pub use impact::{detect_impacts, ImpactEvent, ImpactTracker};
 pub use law::{ContactState, Engagement, Hertz, LawKind, OilFilm, ToothLaw};

@@ -1,5 +1,6 @@
 //! The typed model of a pack as the engines see it: a shaft and its disc couplings.
 
+use crate::clutch::{DrumModel, StackModel};
 use crate::drive::Shaft;
 use crate::law::ToothLaw;
 use crate::spline::SplineGeometry;
@@ -65,21 +66,52 @@ impl DiscModel {
     }
 }
 
-/// A shaft and the discs coupled to it.
+/// A shaft and the discs coupled to it; in a whole pack (MODEL.md section 5) also the
+/// separator plates, the output drum and the axial stack.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PackModel {
     /// The shaft.
     pub shaft: Shaft,
-    /// The discs, each on its own spline coupling.
+    /// The friction discs, each on its own spline coupling to the shaft.
     pub discs: Vec<DiscModel>,
+    /// The separator plates, each on its own spline coupling to its carrier: the output drum
+    /// when there is one (a clutch), else the fixed housing (a brake). Their `spline`, `law`,
+    /// `initial_rel_angle_rad` (`theta_carrier - theta_plate`) and `initial_rel_speed_rad_s`
+    /// refer to that carrier. Default none. With a [`Self::stack`] there are
+    /// `discs.len() + 1` of them, alternating with the discs (`crate::clutch`).
+    #[serde(default)]
+    pub plates: Vec<DiscModel>,
+    /// The output drum of a clutch (the plates' carrier); `None` (default): the plates sit on
+    /// the housing (a brake).
+    #[serde(default)]
+    pub drum: Option<DrumModel>,
+    /// The piston, the axial stack and the friction faces between discs and plates; `None`
+    /// (default): no friction between them.
+    #[serde(default)]
+    pub stack: Option<StackModel>,
 }
 
 impl PackModel {
-    /// Whether a torsional model (one rotational degree of freedom per body, the lumped tooth
-    /// law) describes the pack exactly: every disc [`DiscModel::is_concentric`]. Engines
-    /// choose by it (the reference engine refuses a pack that is not).
+    /// Whether a torsional model of the paper's kind (one rotational degree of freedom per
+    /// friction disc on the shaft, the lumped tooth law) describes the pack exactly: every
+    /// disc [`DiscModel::is_concentric`], and no plates, drum or stack. Engines choose by it
+    /// (the reference engine refuses a pack that is not).
     pub fn is_torsional(&self) -> bool {
         self.discs.iter().all(DiscModel::is_concentric)
+            && self.plates.is_empty()
+            && self.drum.is_none()
+            && self.stack.is_none()
+    }
+
+    /// A pack of a shaft and friction discs only (no plates, drum or stack).
+    pub fn new(shaft: Shaft, discs: Vec<DiscModel>) -> PackModel {
+        PackModel {
+            shaft,
+            discs,
+            plates: Vec::new(),
+            drum: None,
+            stack: None,
+        }
     }
 }
 
@@ -132,6 +164,9 @@ mod tests {
         let mut pack = PackModel {
             shaft: Shaft::Prescribed(SpeedProfile::sine(100.0, 1.0, 10.0)),
             discs: vec![disc()],
+            plates: Vec::new(),
+            drum: None,
+            stack: None,
         };
         assert!(pack.is_torsional());
         pack.discs[0].tooth_spacing_errors_m = vec![0.0; 4];

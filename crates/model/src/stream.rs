@@ -1,6 +1,7 @@
 //! The engine interface: what every engine emits (samples, impact events, a run report) and
 //! the [`Engine`] trait that both the reference and the multibody engine implement.
 
+use crate::clutch::InterfaceSample;
 use crate::impact::ImpactEvent;
 use serde::{Deserialize, Serialize};
 
@@ -48,6 +49,10 @@ pub trait Observer {
     fn sample(&mut self, _sample: &Sample) {}
     /// A completed impact event.
     fn impact(&mut self, _event: &ImpactEvent) {}
+    /// The state of the stack's friction interfaces, at the same instants as the samples
+    /// (engines with a stack only; interface `m` lies between stack bodies `m` and `m + 1`,
+    /// see `crate::clutch`).
+    fn interfaces(&mut self, _t_s: f64, _interfaces: &[InterfaceSample]) {}
     /// Called now and then with the simulated time in s; returning `true` stops the run
     /// early and cleanly (used for Ctrl-C).
     fn progress(&mut self, _t_s: f64) -> bool {
@@ -66,6 +71,8 @@ pub struct Collector {
     pub samples: Vec<Sample>,
     /// All impact events in the order they closed.
     pub impacts: Vec<ImpactEvent>,
+    /// The friction interfaces' states with their times in s (engines with a stack).
+    pub interfaces: Vec<(f64, Vec<InterfaceSample>)>,
 }
 
 impl Observer for Collector {
@@ -74,6 +81,9 @@ impl Observer for Collector {
     }
     fn impact(&mut self, event: &ImpactEvent) {
         self.impacts.push(*event);
+    }
+    fn interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
+        self.interfaces.push((t_s, interfaces.to_vec()));
     }
 }
 

@@ -279,6 +279,13 @@ impl Engine for ReferenceEngine {
         for d in &self.pack.discs {
             check_disc(d)?;
         }
+        if !self.pack.plates.is_empty() || self.pack.drum.is_some() || self.pack.stack.is_some() {
+            return Err(EngineError::Unsupported(
+                "separator plates, an output drum and the clamped stack need the multibody \
+                 engine (the reference engine models friction discs on one shaft)"
+                    .into(),
+            ));
+        }
         let sys = System {
             pack: &self.pack,
             off: if matches!(self.pack.shaft, Shaft::Inertial { .. }) {

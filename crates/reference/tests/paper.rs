@@ -97,6 +97,9 @@ fn free_impact_matches_the_closed_form() {
             let pack = PackModel {
                 shaft: Shaft::Prescribed(SpeedProfile::sine(100.0, 0.0, 1.0)),
                 discs: vec![disc],
+                plates: Vec::new(),
+                drum: None,
+                stack: None,
             };
             let c = run(pack, 2e-4 / v0.min(1.0), 1e-9, 1e6);
             assert_eq!(c.impacts.len(), 1, "{kind:?} {h_o} {v0}");
@@ -171,6 +174,9 @@ fn inertial_shaft_conserves_angular_momentum() {
             excitation: ShaftExcitation::Profile(SpeedProfile::sine(100.0, 0.0, 1.0)),
         },
         discs: vec![disc],
+        plates: Vec::new(),
+        drum: None,
+        stack: None,
     };
     let c = run(pack, 0.02, 1e-10, 10_000.0);
     assert!(c.impacts.len() >= 3, "{}", c.impacts.len());
@@ -205,6 +211,13 @@ fn per_tooth_effects_are_refused() {
             "{err}"
         );
     }
+    // nor does it run plates, a drum or a stack
+    let mut pack = paper_pack(25e-6);
+    pack.plates.push(pack.discs[0].clone());
+    let err = ReferenceEngine::new(pack, Settings::default())
+        .run(1e-3, &mut Collector::default())
+        .unwrap_err();
+    assert!(matches!(err, EngineError::Unsupported(_)), "{err}");
     // all-zero spacing errors are no errors
     let mut pack = paper_pack(25e-6);
     pack.discs[0].tooth_spacing_errors_m = vec![0.0; 154];

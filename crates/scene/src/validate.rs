@@ -264,6 +264,9 @@ pub(crate) fn validate(
         pack: PackModel {
             shaft: shaft?,
             discs: discs?,
+            plates: Vec::new(),
+            drum: None,
+            stack: None,
         },
     })
 }

@@ -173,6 +173,9 @@ impl MultibodyEngine {
             }
             _ => {}
         }
+        if !pack.plates.is_empty() || pack.drum.is_some() || pack.stack.is_some() {
+            return bad("separator plates, the output drum and the stack are not built yet".into());
+        }
         let mut per_tooth = Vec::with_capacity(pack.discs.len());
         for (i, d) in pack.discs.iter().enumerate() {
             if d.law.kind == LawKind::Squeeze && d.law.oil.thickness_m > 0.0 {

@@ -60,6 +60,9 @@ fn paper_pack(kind: LawKind, h_o: f64, p: f64, drag: f64) -> PackModel {
     PackModel {
         shaft: Shaft::Prescribed(SpeedProfile::sine(200.0, 4.378, 104.0)),
         discs: vec![disc("disc", law(kind, h_o, p), 0.156, drag, 0.0, 0.0)],
+        plates: Vec::new(),
+        drum: None,
+        stack: None,
     }
 }
 
@@ -118,6 +121,9 @@ fn free_impact_matches_the_closed_form() {
                     phi0,
                     dphi0,
                 )],
+                plates: Vec::new(),
+                drum: None,
+                stack: None,
             };
             let (c, _) = run(&pack, 1e5, opts.clone(), 400e-6);
             assert_eq!(c.impacts.len(), 1, "{label} v0={v0}: {:?}", c.impacts);
@@ -326,6 +332,9 @@ fn inertial_shaft_conserves_angular_momentum() {
             disc("a", law(LawKind::Dry, 0.0, 0.5), 0.156, 0.0, 0.5 * g0, 4.0),
             disc("b", law(LawKind::Dry, 0.0, 0.5), 0.05, 0.0, -0.3 * g0, -6.0),
         ],
+        plates: Vec::new(),
+        drum: None,
+        stack: None,
     };
     for opts in [fixed(1e-6), adaptive()] {
         let (c, _) = run(&pack, 1e4, opts, 20e-3);

@@ -46,6 +46,9 @@ fn steady_pack(disc: DiscModel) -> PackModel {
             harmonics: vec![],
         }),
         discs: vec![disc],
+        plates: Vec::new(),
+        drum: None,
+        stack: None,
     }
 }
 
@@ -340,6 +343,9 @@ fn floating_disc_chatters_radially_in_the_rattle() {
     let pack = PackModel {
         shaft: Shaft::Prescribed(SpeedProfile::sine(200.0, 4.378, 104.0)),
         discs: vec![d],
+        plates: Vec::new(),
+        drum: None,
+        stack: None,
     };
     let run = |stepping: Stepping, duration: f64| {
         let opts = MultibodyOptions {

@@ -51,5 +51,8 @@ pub fn paper_pack(h_o: f64) -> PackModel {
     PackModel {
         shaft: Shaft::Prescribed(SpeedProfile::sine(200.0, 4.378, 104.0)),
         discs: vec![paper_disc(h_o)],
+        plates: Vec::new(),
+        drum: None,
+        stack: None,
     }
 }
