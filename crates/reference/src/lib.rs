@@ -332,6 +332,7 @@ impl Engine for ReferenceEngine {
         let mut prev = Dense::default();
         let mut cur = Dense::default();
         let mut buf = vec![0.0; n];
+        let mut y_new = vec![0.0; n];
         let rate = self.settings.record_rate_hz;
         let mut next_sample: u64 = 0;
         let sample_time = |k: u64| k as f64 / rate;
@@ -417,13 +418,11 @@ impl Engine for ReferenceEngine {
                 }
             }
             let t_new = event.map(|(te, _)| te).unwrap_or(t_end);
-            let y_new: Vec<f64> = if event.is_some() {
-                let mut v = vec![0.0; n];
-                cur.eval(t_new, &mut v);
-                v
+            if event.is_some() {
+                cur.eval(t_new, &mut y_new);
             } else {
-                solver.y_new.clone()
-            };
+                y_new.copy_from_slice(&solver.y_new);
+            }
 
             // Peaks of the open contact events.
             for i in 0..nd {
