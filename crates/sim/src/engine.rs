@@ -4,13 +4,14 @@
 use crate::hook::{Coupling, CouplingForces, RelativeState};
 use crate::integrate::{future_impulse, past_impulse, Kick, Load, LoadHistory, Motion};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping, ToothResolution};
+use crate::stack::Stack;
 use crate::stepping::{
     contact_duration_s, coupling_step, profile_acceleration_bound, CouplingView,
 };
-use crate::world::{angle_about_z, World};
+use crate::world::{angle_about_z, Carrier, World};
 use clutchpack_model::{
-    DiscSample, Engine, EngineError, ImpactTracker, LawKind, Observer, PackModel, RunStats, Sample,
-    Shaft, ShaftExcitation, SpeedProfile,
+    DiscModel, DiscSample, DrumModel, Engine, EngineError, ImpactTracker, LawKind, Observer,
+    PackModel, RunStats, Sample, Shaft, ShaftExcitation, SpeedProfile,
 };
 use clutchpack_scene::Scene;
 use rapier3d_f64::prelude::{RigidBody, Rotation, Vector};
@@ -19,17 +20,26 @@ use rapier3d_f64::prelude::{RigidBody, Rotation, Vector};
 const PROGRESS_EVERY: u64 = 1000;
 
 /// Energy bookkeeping of a run (J), for conservation checks: with no drag and `p = 0`,
-/// `drive_work_j + drag_work_j = (kinetic_j + contact_potential_j) - (initial_kinetic_j +
-/// initial_contact_potential_j)` up to the integrator's error.
+/// `drive_work_j + drag_work_j + stack_work_j + load_work_j = (kinetic_j +
+/// contact_potential_j) - (initial_kinetic_j + initial_contact_potential_j)` up to the
+/// integrator's error.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct EnergyAudit {
     /// Work done by the drive since t = 0: for a prescribed shaft the work of the shaft on the
-    /// teeth, the teeth's torque on the discs integrated over the shaft's turn; for an
+    /// teeth, the teeth's torque on the discs (those on the shaft) integrated over the shaft's
+    /// turn; for an
     /// inertial shaft the work of the drive torque on the shaft (trapezoidal rule per step).
     pub drive_work_j: f64,
-    /// Work of the oil drag on the discs and of the shaft damping (<= 0).
+    /// Work of the oil drag on the discs and plates, of the shaft damping and of the drum's
+    /// drag (<= 0).
     pub drag_work_j: f64,
-    /// Kinetic energy at t = 0: the discs, and the shaft when it is inertial.
+    /// Work of the stack on the discs and plates: face friction and open-gap drag (<= 0),
+    /// `sum Q (w_upper - w_lower)` per step with the step's mean speeds.
+    pub stack_work_j: f64,
+    /// Work of the drum's load torque (trapezoidal rule per step).
+    pub load_work_j: f64,
+    /// Kinetic energy at t = 0: the discs and plates, and the shaft and the drum when they are
+    /// inertial.
     pub initial_kinetic_j: f64,
     /// Kinetic energy at the end of the run.
     pub kinetic_j: f64,
@@ -173,31 +183,64 @@ impl MultibodyEngine {
             }
             _ => {}
         }
-        if !pack.plates.is_empty() || pack.drum.is_some() || pack.stack.is_some() {
-            return bad("separator plates, the output drum and the stack are not built yet".into());
+        if let Some(st) = &pack.stack {
+            if pack.discs.is_empty() || pack.plates.len() != pack.discs.len() + 1 {
+                return bad(format!(
+                    "a stack needs N friction discs and N + 1 separator plates ({} discs, {} \
+                     plates)",
+                    pack.discs.len(),
+                    pack.plates.len()
+                ));
+            }
+            let (ri, ro) = (st.face_inner_radius_m, st.face_outer_radius_m);
+            let gap_ok = st
+                .open_gap
+                .is_none_or(|g| g.gap_m > 0.0 && g.viscosity_pa_s >= 0.0);
+            let ok = ri > 0.0
+                && ro > ri
+                && st.piston.area_m2 > 0.0
+                && st.spline_friction >= 0.0
+                && gap_ok;
+            if !ok {
+                return bad(format!(
+                    "stack: needs 0 < face_inner_radius_m < face_outer_radius_m, piston area \
+                     > 0, spline friction >= 0, an open gap > 0 ({st:?})"
+                ));
+            }
         }
-        let mut per_tooth = Vec::with_capacity(pack.discs.len());
-        for (i, d) in pack.discs.iter().enumerate() {
+        if let Some(dr) = &pack.drum {
+            if pack.plates.is_empty() || dr.inertia_kg_m2.is_nan() || dr.inertia_kg_m2 <= 0.0 {
+                return bad(
+                    "an output drum needs separator plates on it and an inertia > 0".into(),
+                );
+            }
+        }
+        let n_discs = pack.discs.len();
+        let mut per_tooth = Vec::with_capacity(n_discs + pack.plates.len());
+        for (j, d) in pack.discs.iter().chain(&pack.plates).enumerate() {
+            let i = if j < n_discs {
+                format!("discs[{j}]")
+            } else {
+                format!("plates[{}]", j - n_discs)
+            };
             if d.law.kind == LawKind::Squeeze && d.law.oil.thickness_m > 0.0 {
                 return bad(format!(
-                    "discs[{i}]: the squeeze-film law is a damper with time constant m h^3 / (beta eta B^3 L) \
+                    "{i}: the squeeze-film law is a damper with time constant m h^3 / (beta eta B^3 L) \
                      (nanoseconds near metal contact), too stiff for the explicit multibody step; \
                      use the reference engine"
                 ));
             }
             if d.spline.teeth == 0 || d.inertia_kg_m2.is_nan() || d.inertia_kg_m2 <= 0.0 {
-                return bad(format!("discs[{i}]: needs teeth > 0 and inertia > 0"));
+                return bad(format!("{i}: needs teeth > 0 and inertia > 0"));
             }
             if let Some(&e) = d.tooth_spacing_errors_m.iter().find(|e| !e.is_finite()) {
-                return bad(format!(
-                    "discs[{i}]: tooth spacing error {e} m: must be finite"
-                ));
+                return bad(format!("{i}: tooth spacing error {e} m: must be finite"));
             }
             if !d.tooth_spacing_errors_m.is_empty()
                 && d.tooth_spacing_errors_m.len() != d.spline.teeth as usize
             {
                 return bad(format!(
-                    "discs[{i}]: {} tooth spacing errors for {} teeth: one per tooth or none",
+                    "{i}: {} tooth spacing errors for {} teeth: one per tooth or none",
                     d.tooth_spacing_errors_m.len(),
                     d.spline.teeth
                 ));
@@ -209,7 +252,7 @@ impl MultibodyEngine {
                 ToothResolution::Lumped if d.is_concentric() => false,
                 ToothResolution::Lumped => {
                     return bad(format!(
-                        "discs[{i}]: lumped teeth are exact only for a concentric disc without \
+                        "{i}: lumped teeth are exact only for a concentric disc without \
                          spacing errors (this one floats radially, is offset or has spacing \
                          errors): use per-tooth resolution"
                     ))
@@ -271,8 +314,10 @@ struct Powers {
     spline_torque: f64,
     /// Power of the drive torque on an inertial shaft, W.
     drive: f64,
-    /// Power of the drag and the shaft damping, W.
+    /// Power of the drag, the shaft damping and the drum's drag, W.
     drag: f64,
+    /// Power of the drum's load torque, W.
+    load: f64,
 }
 
 /// The shaft as the run loop drives it.
@@ -284,15 +329,41 @@ enum ShaftDrive<'a> {
     Inertial { j1: f64, c1: f64 },
 }
 
+/// The output drum as the run loop drives it: a body with inertia, a load torque and drag,
+/// carrying the separator plates.
+#[derive(Debug, Clone)]
+struct DrumRun {
+    model: DrumModel,
+    /// Speed at `t` (synchronised) and unwrapped angle, rad/s and rad.
+    omega: f64,
+    theta: f64,
+    /// The loads on it other than the teeth's torque about the axis, and their kick.
+    load: Load,
+    history: LoadHistory,
+    kick: Kick,
+    /// The full loads (teeth included), for the first estimate of its speed.
+    full_load: Load,
+    full_history: LoadHistory,
+    /// Acceleration at `t`, rad/s^2.
+    accel: f64,
+}
+
 /// The state of one run: the world, the hook's memories, the events, the clock.
+///
+/// Couplings are numbered as the engine's output: the friction discs (carrier: the shaft),
+/// then the separator plates (carrier: the drum, or the housing).
 struct Run<'a> {
     pack: &'a PackModel,
+    /// The coupled bodies' models: the discs, then the plates.
+    bodies: Vec<&'a DiscModel>,
     world: World,
     shaft: ShaftDrive<'a>,
     /// Bound of the drive's shaft acceleration, rad/s^2.
     shaft_accel_bound: f64,
+    drum: Option<DrumRun>,
+    stack: Option<Stack<'a>>,
     couplings: Vec<Coupling>,
-    /// Effective mass per tooth of each coupling, kg (reduced with an inertial shaft).
+    /// Effective mass per tooth of each coupling, kg (reduced with an inertial carrier).
     m_eff: Vec<f64>,
     tracks: Vec<EventTrack>,
     /// The hook's results at `t` (filled by [`Run::evaluate`]).
@@ -300,12 +371,12 @@ struct Run<'a> {
     forces: Vec<CouplingForces>,
     /// Powers at the last evaluation.
     powers_before: Option<Powers>,
-    /// Physical loads at `t` (world frame) on each disc and on an inertial shaft.
+    /// Physical loads at `t` (world frame) on each coupled body and on an inertial shaft.
     disc_loads: Vec<Load>,
     shaft_load: Load,
     /// Their values at the two evaluations before, and the kicks for the next step. These
     /// leave out the teeth's torque about the axis, whose kick is integrated along the step
-    /// (`teeth_past`, `teeth_motion`).
+    /// (`teeth_past`, `teeth_motion`), and the stack's torques, solved per step (`stack.rs`).
     disc_history: Vec<LoadHistory>,
     shaft_history: LoadHistory,
     disc_kicks: Vec<Kick>,
@@ -318,11 +389,11 @@ struct Run<'a> {
     shaft_full_history: LoadHistory,
     /// `(t, phi, dphi, ddphi)` of each coupling at the last evaluation.
     prev_motion: Vec<Option<(f64, f64, f64, f64)>>,
-    /// The teeth: the past half of their kick (N m s on the disc, about the axis) and the
+    /// The teeth: the past half of their kick (N m s on the body, about the axis) and the
     /// relative motion at `t` for the future half.
     teeth_past: Vec<f64>,
     teeth_motion: Vec<Motion>,
-    /// Disc speeds at `t` (synchronised with the poses), rad/s.
+    /// Body speeds at `t` (synchronised with the poses), rad/s.
     omega_d: Vec<f64>,
     /// Time of the evaluation before the last step.
     t_prev: Option<f64>,
@@ -344,8 +415,8 @@ impl<'a> Run<'a> {
         per_tooth: &[bool],
     ) -> Result<Run<'a>, EngineError> {
         let world = World::build(pack, &opts.shapes, opts.mount)?;
-        let couplings: Vec<Coupling> = pack
-            .discs
+        let bodies: Vec<&DiscModel> = pack.discs.iter().chain(&pack.plates).collect();
+        let couplings: Vec<Coupling> = bodies
             .iter()
             .zip(per_tooth)
             .map(|(d, &pt)| {
@@ -381,25 +452,48 @@ impl<'a> Run<'a> {
                 },
             ),
         };
-        let m_eff = pack
-            .discs
+        let m_eff = bodies
             .iter()
-            .map(|d| {
+            .zip(&world.carriers)
+            .map(|(d, carrier)| {
                 let md = d.spline.effective_mass_kg(d.inertia_kg_m2);
-                match shaft {
-                    ShaftDrive::Prescribed(_) => md,
-                    ShaftDrive::Inertial { j1, .. } => {
-                        let ms = d.spline.effective_mass_kg(j1);
-                        md * ms / (md + ms)
+                let carrier_inertia = match (carrier, shaft) {
+                    (Carrier::Shaft, ShaftDrive::Inertial { j1, .. }) => Some(j1),
+                    (Carrier::Drum, _) => pack.drum.map(|dr| dr.inertia_kg_m2),
+                    _ => None,
+                };
+                match carrier_inertia {
+                    Some(j) => {
+                        let mc = d.spline.effective_mass_kg(j);
+                        md * mc / (md + mc)
                     }
+                    None => md,
                 }
             })
             .collect();
+        let drum = pack.drum.map(|model| DrumRun {
+            model,
+            omega: model.initial_speed_rad_s,
+            theta: 0.0,
+            load: [0.0; 6],
+            history: LoadHistory::default(),
+            kick: Kick::default(),
+            full_load: [0.0; 6],
+            full_history: LoadHistory::default(),
+            accel: 0.0,
+        });
+        let stack = pack
+            .stack
+            .as_ref()
+            .map(|st| Stack::new(st, pack.discs.len()));
         Ok(Run {
             pack,
+            bodies,
             world,
             shaft,
             shaft_accel_bound,
+            drum,
+            stack,
             couplings,
             m_eff,
             tracks,
@@ -430,14 +524,60 @@ impl<'a> Run<'a> {
         })
     }
 
-    /// Kinetic energy of the discs (and of an inertial shaft) at `t`, J: `sum J w^2 / 2` with
-    /// the synchronised speeds, plus `m v^2 / 2` of the discs' centres (rapier's speed over
-    /// the last step: zero for a concentric disc, whose joint locks every other motion).
+    /// The stack's torque on coupling body `i` over the step being taken, N m (0 without a
+    /// stack).
+    fn stack_torque(&self, i: usize) -> f64 {
+        self.stack.as_ref().map_or(0.0, |s| s.torque_on(i))
+    }
+
+    /// The ramp integral of the stack's torque on body `i` over the last step (the step's
+    /// constant torque times half its length), N m s: its share of the speed synchronised
+    /// to `t`.
+    fn stack_past(&self, i: usize) -> f64 {
+        match (&self.stack, self.t_prev) {
+            (Some(s), Some(t0)) => {
+                let b = s.body.iter().position(|&b| b == i);
+                b.map_or(0.0, |b| s.torque[b] * 0.5 * (self.t - t0))
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The speed of coupling `i`'s carrier at `t`, rad/s.
+    fn carrier_speed(&self, i: usize) -> f64 {
+        match self.world.carriers[i] {
+            Carrier::Shaft => self.omega_s,
+            Carrier::Housing => 0.0,
+            Carrier::Drum => self.drum.as_ref().map_or(0.0, |d| d.omega),
+        }
+    }
+
+    /// The unwrapped angle of coupling `i`'s carrier at `t`, rad.
+    fn carrier_angle(&self, i: usize) -> f64 {
+        match self.world.carriers[i] {
+            Carrier::Shaft => self.theta_s,
+            Carrier::Housing => 0.0,
+            Carrier::Drum => self.drum.as_ref().map_or(0.0, |d| d.theta),
+        }
+    }
+
+    /// The rapier body of coupling `i`'s carrier.
+    fn carrier_body(&self, i: usize) -> rapier3d_f64::prelude::RigidBodyHandle {
+        match self.world.carriers[i] {
+            Carrier::Shaft => self.world.shaft,
+            Carrier::Housing => self.world.housing,
+            Carrier::Drum => self.world.drum.expect("a drum"),
+        }
+    }
+
+    /// Kinetic energy of the discs, the plates (and of an inertial shaft and the drum) at
+    /// `t`, J: `sum J w^2 / 2` with the synchronised speeds, plus `m v^2 / 2` of the bodies'
+    /// centres (rapier's speed over the last step: zero for a concentric body, whose joint
+    /// locks every other motion).
     fn kinetic_energy(&self) -> f64 {
         let bodies = &self.world.physics.bodies;
         let mut e: f64 = self
-            .pack
-            .discs
+            .bodies
             .iter()
             .zip(&self.omega_d)
             .zip(&self.world.discs)
@@ -449,11 +589,15 @@ impl<'a> Run<'a> {
         if let ShaftDrive::Inertial { j1, .. } = self.shaft {
             e += 0.5 * j1 * self.omega_s * self.omega_s;
         }
+        if let Some(d) = &self.drum {
+            e += 0.5 * d.model.inertia_kg_m2 * d.omega * d.omega;
+        }
         e
     }
 
-    /// The hook at `t`: every coupling's relative state and tooth loads. Fails if the state
-    /// is not finite or the teeth passed through each other (|phi| beyond half a pitch).
+    /// The hook at `t`: every coupling's relative state and tooth loads, then the stack's
+    /// clamp forces. Fails if the state is not finite or the teeth passed through each other
+    /// (|phi| beyond half a pitch).
     fn evaluate(&mut self, t_last_good: f64) -> Result<(), EngineError> {
         let bodies = &self.world.physics.bodies;
         let shaft = &bodies[self.world.shaft];
@@ -466,63 +610,119 @@ impl<'a> Run<'a> {
                     .synchronised(self.t, shaft.angvel().z, 5, 1.0 / j1)
             }
         };
+        if let (Some(d), Some(h)) = (self.drum.as_mut(), self.world.drum) {
+            d.omega = d.full_history.synchronised(
+                self.t,
+                bodies[h].angvel().z,
+                5,
+                1.0 / d.model.inertia_kg_m2,
+            );
+        }
         // The teeth's torque integrated along the last step (the past half of the kick), which
         // also gives the synchronised speeds without extrapolating across a kink.
-        let mut teeth_past_sum = 0.0;
-        for (i, c) in self.couplings.iter().enumerate() {
+        let mut teeth_past_shaft = 0.0;
+        let mut teeth_past_drum = 0.0;
+        for i in 0..self.couplings.len() {
             self.teeth_past[i] = 0.0;
             let Some((t0, phi0, dphi0, _)) = self.prev_motion[i] else {
                 continue;
             };
             let disc = &bodies[self.world.discs[i]];
-            let j = self.pack.discs[i].inertia_kg_m2;
-            let est = self.disc_full_history[i].synchronised(self.t, disc.angvel().z, 5, 1.0 / j);
+            let j = self.bodies[i].inertia_kg_m2;
+            let est = self.disc_full_history[i].synchronised(self.t, disc.angvel().z, 5, 1.0 / j)
+                + self.stack_past(i) / j;
             let rel = relative_state(
-                shaft,
-                self.omega_s,
+                &bodies[self.carrier_body(i)],
+                self.carrier_speed(i),
                 disc,
                 est,
                 self.world.disc_turn_owed_z(i),
             );
             let h1 = self.t - t0;
             if h1 > 0.0 {
+                let c = &self.couplings[i];
                 self.teeth_past[i] =
                     past_impulse((phi0, dphi0), (rel.phi, rel.dphi), h1, |p, d| {
                         c.probe_torque(p, d)
                     });
-                teeth_past_sum += self.teeth_past[i];
+                match self.world.carriers[i] {
+                    Carrier::Shaft => teeth_past_shaft += self.teeth_past[i],
+                    Carrier::Drum => teeth_past_drum += self.teeth_past[i],
+                    Carrier::Housing => {}
+                }
             }
         }
         if let ShaftDrive::Inertial { j1, .. } = self.shaft {
             if self.shaft_history.len() > 0 {
                 self.omega_s = shaft.angvel().z
                     + (self.shaft_history.synchronised(self.t, 0.0, 5, 1.0) + self.drive_past()
-                        - teeth_past_sum)
+                        - teeth_past_shaft)
                         / j1;
+            }
+        }
+        if let (Some(d), Some(h)) = (self.drum.as_mut(), self.world.drum) {
+            if d.history.len() > 0 {
+                d.omega = bodies[h].angvel().z
+                    + (d.history.synchronised(self.t, 0.0, 5, 1.0) - teeth_past_drum)
+                        / d.model.inertia_kg_m2;
             }
         }
         self.rel.clear();
         self.forces.clear();
         self.omega_d.clear();
         self.potential_j = 0.0;
-        for (i, c) in self.couplings.iter_mut().enumerate() {
+        for i in 0..self.couplings.len() {
             let disc = &bodies[self.world.discs[i]];
-            let j = self.pack.discs[i].inertia_kg_m2;
+            let j = self.bodies[i].inertia_kg_m2;
             let mean = disc.angvel().z;
             let omega_d = if self.prev_motion[i].is_some() {
-                mean + (self.teeth_past[i] + self.disc_history[i].synchronised(self.t, 0.0, 5, 1.0))
+                mean + (self.teeth_past[i]
+                    + self.disc_history[i].synchronised(self.t, 0.0, 5, 1.0)
+                    + self.stack_past(i))
                     / j
             } else {
                 self.disc_full_history[i].synchronised(self.t, mean, 5, 1.0 / j)
             };
             self.omega_d.push(omega_d);
+        }
+        // Bodies whose faces stuck over the last step turned as one body (their mean speeds
+        // were made equal, `stack.rs`): their speed at t is the group's, the momentum-weighted
+        // mean of the estimates (the stack's internal torques cancel in it).
+        if let Some(stack) = &self.stack {
+            let mut m = 0;
+            while m < stack.interfaces() {
+                if !stack.locked[m] {
+                    m += 1;
+                    continue;
+                }
+                let first = m;
+                while m < stack.interfaces() && stack.locked[m] {
+                    m += 1;
+                }
+                // stack bodies first..=m are locked together
+                let group = &stack.body[first..=m];
+                let (mut jw, mut jsum) = (0.0, 0.0);
+                for &i in group {
+                    let j = self.bodies[i].inertia_kg_m2;
+                    jw += j * self.omega_d[i];
+                    jsum += j;
+                }
+                for &i in group {
+                    self.omega_d[i] = jw / jsum;
+                }
+            }
+        }
+        for i in 0..self.couplings.len() {
+            let disc = &bodies[self.world.discs[i]];
+            let omega_d = self.omega_d[i];
             let rel = relative_state(
-                shaft,
-                self.omega_s,
+                &bodies[self.carrier_body(i)],
+                self.carrier_speed(i),
                 disc,
                 omega_d,
                 self.world.disc_turn_owed_z(i),
             );
+            let c = &mut self.couplings[i];
             let limit = std::f64::consts::PI / c.spline.teeth as f64;
             let diverged = |reason: String| EngineError::Diverged {
                 t_s: t_last_good,
@@ -549,22 +749,36 @@ impl<'a> Run<'a> {
             self.rel.push(rel);
             self.forces.push(f);
         }
+        if let Some(stack) = self.stack.as_mut() {
+            // The teeth's normal load n |F| = |torque| / Rb of each coupling.
+            let normal: Vec<f64> = self
+                .forces
+                .iter()
+                .zip(&self.bodies)
+                .map(|(f, d)| f.moment[2].abs() / d.spline.base_radius_m())
+                .collect();
+            stack.update(self.t, &normal, &self.omega_d);
+        }
         self.audit_energy();
         self.compute_loads();
         Ok(())
     }
 
     /// The physical loads at `t` on every body (the drag, the teeth and their reactions, the
-    /// drive) and the kicks for the next step.
+    /// drive, the drum's load) and the kicks for the next step.
     fn compute_loads(&mut self) {
         let bodies = &self.world.physics.bodies;
-        let qs = *bodies[self.world.shaft].rotation();
         let mut shaft_force = Vector::ZERO;
         let mut shaft_torque = Vector::ZERO;
         let mut shaft_torque_full = Vector::ZERO;
+        let mut drum_force = Vector::ZERO;
+        let mut drum_torque = Vector::ZERO;
+        let mut drum_torque_full = Vector::ZERO;
         let mut disc_accel = vec![0.0; self.forces.len()];
         for (i, f) in self.forces.iter().enumerate() {
-            let d = &self.pack.discs[i];
+            let d = self.bodies[i];
+            let carrier = self.world.carriers[i];
+            let qs = *bodies[self.carrier_body(i)].rotation();
             // Hu et al. eq (5): drag -C2 omega_d.
             let drag = -d.drag_n_m_s_rad * self.omega_d[i];
             let f_local = Vector::new(f.force[0], f.force[1], 0.0);
@@ -575,19 +789,38 @@ impl<'a> Run<'a> {
             let force = qs * f_local;
             let torque = qs * (m_local - e_local.cross(f_local)) + Vector::new(0.0, 0.0, drag);
             self.disc_full_loads[i] = [force.x, force.y, force.z, torque.x, torque.y, torque.z];
-            disc_accel[i] = torque.z / d.inertia_kg_m2;
-            // The reaction on the shaft, about its centre: -(m + a x F), a the mid-plane.
+            // The stack's torque over the step just taken stands for its torque at t.
+            let stack = match &self.stack {
+                Some(s) => s
+                    .body
+                    .iter()
+                    .position(|&b| b == i)
+                    .map_or(0.0, |b| s.torque[b]),
+                None => 0.0,
+            };
+            disc_accel[i] = (torque.z + stack) / d.inertia_kg_m2;
+            // The reaction on the carrier, about its centre: -(m + a x F), a the mid-plane.
             let a = Vector::new(0.0, 0.0, self.world.disc_axial_m[i]);
             let reaction = qs * (m_local + a.cross(f_local));
-            shaft_torque_full -= reaction;
             // The teeth's torque about the axis is integrated along the step instead
             // (`teeth_impulse`); the rest (radial forces, tilting moments, the moment of the
             // radial force about an offset centre) goes through the polynomial kick.
             let mut partial = self.disc_full_loads[i];
             partial[5] -= f.moment[2];
             self.disc_loads[i] = partial;
-            shaft_force -= force;
-            shaft_torque -= reaction - Vector::new(0.0, 0.0, f.moment[2]);
+            match carrier {
+                Carrier::Shaft => {
+                    shaft_torque_full -= reaction;
+                    shaft_force -= force;
+                    shaft_torque -= reaction - Vector::new(0.0, 0.0, f.moment[2]);
+                }
+                Carrier::Drum => {
+                    drum_torque_full -= reaction;
+                    drum_force -= force;
+                    drum_torque -= reaction - Vector::new(0.0, 0.0, f.moment[2]);
+                }
+                Carrier::Housing => {}
+            }
             self.disc_kicks[i] = self.disc_history[i].kick(self.t, &self.disc_loads[i]);
         }
         let shaft_accel = match self.shaft {
@@ -606,8 +839,28 @@ impl<'a> Run<'a> {
                 shaft_torque_full.z / j1
             }
         };
+        let drum_accel = match self.drum.as_mut() {
+            Some(dr) => {
+                // The drum: its load torque, its drag, the plates' spline reactions.
+                let own = dr.model.load_torque_n_m - dr.model.drag_n_m_s_rad * dr.omega;
+                drum_torque.z += own;
+                drum_torque_full.z += own;
+                let l = |t: Vector| [drum_force.x, drum_force.y, drum_force.z, t.x, t.y, t.z];
+                dr.load = l(drum_torque);
+                dr.full_load = l(drum_torque_full);
+                dr.kick = dr.history.kick(self.t, &dr.load);
+                dr.accel = drum_torque_full.z / dr.model.inertia_kg_m2;
+                dr.accel
+            }
+            None => 0.0,
+        };
         for (i, m) in self.teeth_motion.iter_mut().enumerate() {
-            let ddphi = shaft_accel - disc_accel[i];
+            let carrier_accel = match self.world.carriers[i] {
+                Carrier::Shaft => shaft_accel,
+                Carrier::Drum => drum_accel,
+                Carrier::Housing => 0.0,
+            };
+            let ddphi = carrier_accel - disc_accel[i];
             let (jerk, jerk_step) = match self.prev_motion[i] {
                 Some((t0, _, _, dd0)) if self.t > t0 => {
                     ((ddphi - dd0) / (self.t - t0), self.t - t0)
@@ -624,7 +877,7 @@ impl<'a> Run<'a> {
         }
     }
 
-    /// The impulse of the teeth of coupling `i` on its disc about the axis over a step of
+    /// The impulse of the teeth of coupling `i` on its body about the axis over a step of
     /// length `x` from `t` (both halves of the kick), N m s.
     fn teeth_impulse(&self, i: usize, x: f64) -> f64 {
         let c = &self.couplings[i];
@@ -666,18 +919,31 @@ impl<'a> Run<'a> {
             ),
         };
         let drag: f64 = self
-            .pack
-            .discs
+            .bodies
             .iter()
             .zip(&self.omega_d)
             .map(|(d, w)| -d.drag_n_m_s_rad * w * w)
             .sum();
+        let (drum_drag, load) = match &self.drum {
+            Some(d) => (
+                -d.model.drag_n_m_s_rad * d.omega * d.omega,
+                d.model.load_torque_n_m * d.omega,
+            ),
+            None => (0.0, 0.0),
+        };
         let now = Powers {
             t: self.t,
             theta_s: self.theta_s,
-            spline_torque: self.forces.iter().map(|f| f.moment[2]).sum(),
+            spline_torque: self
+                .forces
+                .iter()
+                .zip(&self.world.carriers)
+                .filter(|(_, c)| **c == Carrier::Shaft)
+                .map(|(f, _)| f.moment[2])
+                .sum(),
             drive,
-            drag: drag + shaft_damping,
+            drag: drag + shaft_damping + drum_drag,
+            load,
         };
         if let Some(b) = self.powers_before {
             let h = now.t - b.t;
@@ -688,6 +954,7 @@ impl<'a> Run<'a> {
                 ShaftDrive::Inertial { .. } => 0.5 * (b.drive + now.drive) * h,
             };
             self.energy.drag_work_j += 0.5 * (b.drag + now.drag) * h;
+            self.energy.load_work_j += 0.5 * (b.load + now.load) * h;
         }
         self.powers_before = Some(now);
     }
@@ -695,7 +962,7 @@ impl<'a> Run<'a> {
     /// Feeds the impact trackers with the state at `t`.
     fn track_events(&mut self, steps_per_contact: f64, observer: &mut dyn Observer) {
         for (i, track) in self.tracks.iter_mut().enumerate() {
-            let law = &self.pack.discs[i].law;
+            let law = &self.bodies[i].law;
             let f = &self.forces[i];
             let m = self.m_eff[i];
             let step = |v| contact_duration_s(law, f.kin.flank, v, m) / steps_per_contact;
@@ -716,7 +983,7 @@ impl<'a> Run<'a> {
                     let f = &self.forces[i];
                     let phi = self.rel[i].phi;
                     DiscSample {
-                        angle_rad: self.theta_s - phi,
+                        angle_rad: self.carrier_angle(i) - phi,
                         speed_rad_s: self.omega_d[i],
                         rel_angle_rad: phi,
                         penetration_m: f.kin.delta_m,
@@ -743,14 +1010,45 @@ impl<'a> Run<'a> {
             ShaftDrive::Inertial { j1, c1 } => {
                 // The drive, the damping, and the teeth's reactions at t (contacts elsewhere
                 // in the pack jolt the shaft).
-                let reaction: f64 = self.forces.iter().map(|f| f.moment[2].abs()).sum();
+                let reaction: f64 = self
+                    .forces
+                    .iter()
+                    .zip(&self.world.carriers)
+                    .filter(|(_, c)| **c == Carrier::Shaft)
+                    .map(|(f, _)| f.moment[2].abs())
+                    .sum();
                 self.shaft_accel_bound + (c1 * self.omega_s.abs() + reaction) / j1
             }
         };
+        let a_drum = match &self.drum {
+            Some(d) => {
+                let reaction: f64 = self
+                    .forces
+                    .iter()
+                    .zip(&self.world.carriers)
+                    .filter(|(_, c)| **c == Carrier::Drum)
+                    .map(|(f, _)| f.moment[2].abs())
+                    .sum();
+                (d.model.load_torque_n_m.abs() + d.model.drag_n_m_s_rad * d.omega.abs() + reaction)
+                    / d.model.inertia_kg_m2
+            }
+            None => 0.0,
+        };
         let mut want = a.max_step_s;
         let mut contact = false;
-        for (i, d) in self.pack.discs.iter().enumerate() {
-            let a_disc = d.drag_n_m_s_rad * self.omega_d[i].abs() / d.inertia_kg_m2;
+        for (i, d) in self.bodies.iter().enumerate() {
+            let stack = self.stack.as_ref().map_or(0.0, |s| {
+                s.body
+                    .iter()
+                    .position(|&b| b == i)
+                    .map_or(0.0, |_| s.torque_bound(i))
+            });
+            let a_disc = (d.drag_n_m_s_rad * self.omega_d[i].abs() + stack) / d.inertia_kg_m2;
+            let a_carrier = match self.world.carriers[i] {
+                Carrier::Shaft => a_shaft,
+                Carrier::Drum => a_drum,
+                Carrier::Housing => 0.0,
+            };
             let view = CouplingView {
                 forces: &self.forces[i],
                 law: &d.law,
@@ -760,7 +1058,7 @@ impl<'a> Run<'a> {
                 rb: d.spline.base_radius_m(),
                 m_eff_kg: self.m_eff[i],
                 // 1 % over the bound: rounding must not make it optimistic.
-                rel_accel_bound: 1.01 * (a_shaft + a_disc),
+                rel_accel_bound: 1.01 * (a_carrier + a_disc),
                 event_step_s: self.tracks[i].event_step_s,
             };
             let (dt, c) = coupling_step(&view, a);
@@ -772,14 +1070,37 @@ impl<'a> Run<'a> {
         (want, contact)
     }
 
+    /// Solves the stack's impulses for a step of length `h` from `t` (no-op without a stack):
+    /// every other load of the step is known, so each body's mean speed over the step
+    /// without the stack is too (`stack.rs`).
+    fn solve_stack(&mut self, h: f64) {
+        if self.stack.is_none() {
+            return;
+        }
+        let bodies = &self.world.physics.bodies;
+        let n = self.couplings.len();
+        let mut w_pred = vec![0.0; n];
+        let mut inv_j = vec![0.0; n];
+        for i in 0..n {
+            let j = self.bodies[i].inertia_kg_m2;
+            inv_j[i] = 1.0 / j;
+            w_pred[i] = bodies[self.world.discs[i]].angvel().z
+                + (self.disc_kicks[i].impulse_component(5, h) + self.teeth_impulse(i, h)) / j;
+        }
+        if let Some(s) = self.stack.as_mut() {
+            s.solve(h, &w_pred, &inv_j);
+        }
+    }
+
     /// The step length, at most `h`, that lands exactly on the first contact onset or
     /// separation within `h` of any coupling, if one falls in `(tiny, h)`.
     ///
     /// A step's outcome is known before it is taken: the forces are constant over it, so the
     /// relative angle after a step of length `x` is
-    /// `phi + dtheta_s(x) - x (w_d + kick(x) a_d)`, `kick(x) = (h_{k-1} + x) / 2`, with `w_d`
+    /// `phi + dtheta_c(x) - x (w_d + kick(x) a_d)`, `kick(x) = (h_{k-1} + x) / 2`, with `w_d`
     /// rapier's (staggered) disc speed and `a_d` the disc's acceleration from the forces at `t`
-    /// (and likewise for an inertial shaft; a prescribed shaft turns by its profile). The
+    /// (and likewise for an inertial carrier; a prescribed shaft turns by its profile, the
+    /// housing not at all). The stack's torque is the one solved for the step `h`. The
     /// engagement depth along it is solved for zero by bracketed secant steps, to 1e-16 m.
     /// Landing a step on each onset and separation keeps the `s^1.5` law's kink at `s = 0`
     /// on step boundaries: within a step the force is smooth and the leapfrog keeps its second
@@ -791,10 +1112,11 @@ impl<'a> Run<'a> {
             ShaftDrive::Inertial { .. } => 0.0,
         };
         let w_s = bodies[self.world.shaft].angvel().z;
-        let turn_s = |x: f64| match self.shaft {
+        let shaft_turn = |x: f64| match self.shaft {
             ShaftDrive::Prescribed(p) => p.angle(self.t + x) - theta_s0,
             ShaftDrive::Inertial { j1, .. } => {
                 let teeth: f64 = (0..self.couplings.len())
+                    .filter(|&i| self.world.carriers[i] == Carrier::Shaft)
                     .map(|i| self.teeth_impulse(i, x))
                     .sum();
                 x * (w_s
@@ -802,9 +1124,24 @@ impl<'a> Run<'a> {
                         / j1)
             }
         };
-        let turn_h = turn_s(h);
+        let drum_turn = |x: f64| match (&self.drum, self.world.drum) {
+            (Some(d), Some(hd)) => {
+                let teeth: f64 = (0..self.couplings.len())
+                    .filter(|&i| self.world.carriers[i] == Carrier::Drum)
+                    .map(|i| self.teeth_impulse(i, x))
+                    .sum();
+                x * (bodies[hd].angvel().z
+                    + (d.kick.impulse_component(5, x) - teeth) / d.model.inertia_kg_m2)
+            }
+            _ => 0.0,
+        };
+        let carrier_turn = |i: usize, x: f64| match self.world.carriers[i] {
+            Carrier::Shaft => shaft_turn(x),
+            Carrier::Drum => drum_turn(x),
+            Carrier::Housing => 0.0,
+        };
         let mut best: Option<f64> = None;
-        for (i, d) in self.pack.discs.iter().enumerate() {
+        for (i, d) in self.bodies.iter().enumerate() {
             let f = &self.forces[i];
             // Landing follows the concentric tooth: with radial play or spacing errors the
             // first tooth to touch is another one.
@@ -814,14 +1151,17 @@ impl<'a> Run<'a> {
             let w_d = bodies[self.world.discs[i]].angvel().z;
             let kick = &self.disc_kicks[i];
             let j = d.inertia_kg_m2;
+            let stack = self.stack_torque(i);
             let g0 = d.spline.half_play_rad();
             let rb = d.spline.base_radius_m();
             let offset = d.law.engagement_offset_m();
             let phi0 = self.rel[i].phi;
-            let turn_d =
-                |x: f64| x * (w_d + (kick.impulse_component(5, x) + self.teeth_impulse(i, x)) / j);
-            let phi = |x: f64| phi0 + turn_s(x) - turn_d(x);
-            let phi_h = phi0 + turn_h - turn_d(h);
+            let turn_d = |x: f64| {
+                x * (w_d
+                    + (kick.impulse_component(5, x) + self.teeth_impulse(i, x) + stack * x) / j)
+            };
+            let phi = |x: f64| phi0 + carrier_turn(i, x) - turn_d(x);
+            let phi_h = phi(h);
             let engaged = f.depth_m > 0.0;
             for flank in crate::hook::FLANKS {
                 if engaged && flank != f.kin.flank {
@@ -849,11 +1189,15 @@ impl<'a> Run<'a> {
     }
 
     /// Resets and applies every body's forces for the step from `t` to `t_next`: each body's
-    /// kick over the step divided by its length (see `integrate.rs`).
+    /// kick over the step divided by its length (see `integrate.rs`), and the stack's torques
+    /// solved for this step ([`Run::solve_stack`]).
     fn apply_forces(&mut self, t_next: f64) {
         let h = t_next - self.t;
         let teeth: Vec<f64> = (0..self.couplings.len())
             .map(|i| self.teeth_impulse(i, h) / h)
+            .collect();
+        let stack: Vec<f64> = (0..self.couplings.len())
+            .map(|i| self.stack_torque(i))
             .collect();
         let drive = self.drive_impulse(h);
         let bodies = &mut self.world.physics.bodies;
@@ -864,10 +1208,15 @@ impl<'a> Run<'a> {
             body.add_torque(Vector::new(l[3], l[4], l[5]), false);
         };
         let mut teeth_on_shaft = 0.0;
+        let mut teeth_on_drum = 0.0;
         for (i, kick) in self.disc_kicks.iter().enumerate() {
             let mut load = kick.applied(h);
-            load[5] += teeth[i];
-            teeth_on_shaft -= teeth[i];
+            load[5] += teeth[i] + stack[i];
+            match self.world.carriers[i] {
+                Carrier::Shaft => teeth_on_shaft -= teeth[i],
+                Carrier::Drum => teeth_on_drum -= teeth[i],
+                Carrier::Housing => {}
+            }
             apply(&mut bodies[self.world.discs[i]], load);
             self.disc_history[i].push(self.t, self.disc_loads[i]);
             self.disc_full_history[i].push(self.t, self.disc_full_loads[i]);
@@ -888,12 +1237,24 @@ impl<'a> Run<'a> {
                 self.shaft_full_history.push(self.t, self.shaft_full_load);
             }
         }
+        if let (Some(d), Some(hd)) = (self.drum.as_mut(), self.world.drum) {
+            let mut load = d.kick.applied(h);
+            load[5] += teeth_on_drum;
+            apply(&mut bodies[hd], load);
+            d.history.push(self.t, d.load);
+            d.full_history.push(self.t, d.full_load);
+        }
     }
 
-    /// Steps the world to `t_next` (after [`Run::apply_forces`]) and updates the shaft angle.
+    /// Steps the world to `t_next` (after [`Run::apply_forces`]) and updates the shaft and
+    /// drum angles and the stack's work.
     fn advance(&mut self, t_next: f64) {
         let h = t_next - self.t;
         let q_before = *self.world.physics.bodies[self.world.shaft].rotation();
+        let drum_before = self
+            .world
+            .drum
+            .map(|hd| *self.world.physics.bodies[hd].rotation());
         self.world.step(h);
         self.t_prev = Some(self.t);
         self.t = t_next;
@@ -904,6 +1265,18 @@ impl<'a> Run<'a> {
                 self.theta_s + angle_about_z(&(q_before.inverse() * q_after))
             }
         };
+        if let (Some(d), Some(hd), Some(q0)) = (self.drum.as_mut(), self.world.drum, drum_before) {
+            let q1 = *self.world.physics.bodies[hd].rotation();
+            d.theta += angle_about_z(&(q0.inverse() * q1));
+        }
+        if let Some(s) = &self.stack {
+            let bodies = &self.world.physics.bodies;
+            let w = |i: usize| bodies[self.world.discs[i]].angvel().z;
+            for m in 0..s.interfaces() {
+                let slip = w(s.body[m + 1]) - w(s.body[m]);
+                self.energy.stack_work_j += s.impulse[m] * slip;
+            }
+        }
     }
 }
 
@@ -913,7 +1286,12 @@ impl Engine for MultibodyEngine {
     }
 
     fn disc_names(&self) -> Vec<String> {
-        self.pack.discs.iter().map(|d| d.name.clone()).collect()
+        self.pack
+            .discs
+            .iter()
+            .chain(&self.pack.plates)
+            .map(|d| d.name.clone())
+            .collect()
     }
 
     // `u64::is_multiple_of` needs Rust 1.87; the workspace's rust-version is 1.86.
@@ -951,6 +1329,9 @@ impl Engine for MultibodyEngine {
             run.track_events(steps_per_contact, observer);
             if rec_time(rec_index) <= run.t + half_step {
                 observer.sample(&run.sample(opts.record_tooth_loads));
+                if let Some(s) = &run.stack {
+                    observer.interfaces(run.t, &s.samples());
+                }
                 while rec_time(rec_index) <= run.t + half_step {
                     rec_index += 1;
                 }
@@ -988,6 +1369,8 @@ impl Engine for MultibodyEngine {
                     } else {
                         want
                     };
+                    // The stack's torques for this step enter the landing's prediction.
+                    run.solve_stack(h);
                     // Never step over an onset or a separation: land on it.
                     match run.landing(h, 1e-3 * h.min(want)) {
                         Some(x) => {
@@ -999,6 +1382,11 @@ impl Engine for MultibodyEngine {
                     }
                 }
             };
+            // (Re)solve the stack for the step actually taken.
+            let h = t_next - t;
+            if run.stack.as_ref().is_some_and(|s| s.step_s() != h) {
+                run.solve_stack(h);
+            }
             run.apply_forces(t_next);
             run.advance(t_next);
             steps += 1;

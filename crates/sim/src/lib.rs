@@ -28,9 +28,21 @@
 //!   engagement depth becomes positive, the peak of `|F|`, separation where the depth falls
 //!   back), an energy audit ([`EnergyAudit`]).
 //! - Fixed steps (the check mode) or contact-aware adaptive steps ([`AdaptiveStepping`]).
+//! - The whole pack (MODEL.md section 5): separator plates, each a dynamic body on a
+//!   cylindrical joint to its carrier (the fixed housing of a brake, or the output drum of a
+//!   clutch: a dynamic body on a revolute joint to the housing, with inertia, load torque and
+//!   drag), with its own spline coupling and tooth law; and the stack hook (`stack.rs`): the
+//!   piston force, clamp forces reduced by axial spline friction, face friction
+//!   `mu(v) F R_eff` with exact stick-slip at velocity level, open-gap viscous drag. Plates
+//!   follow the discs in samples and impact events; the interfaces' slip, `mu`, clamp force
+//!   and torque go to [`clutchpack_model::Observer::interfaces`] at the sample times.
 //!
 //! ## What it does not do (yet)
-//! - Separator plates, the output drum, the piston and stack, plate friction (issue 3, step 3).
+//! - The axial motion of the stack: the clamp forces follow the piston and the teeth's loads
+//!   quasi-statically (`clutchpack_model::clutch`); no axial compliance, no gap closing.
+//! - Friction at the stack is first order in time (velocity-level, the torque constant over a
+//!   step): fine for slip and lock-up, not for the `s^1.5` impact (the teeth keep their
+//!   third-order treatment).
 //! - The radial motion of a floating disc is integrated by the polynomial kick of its forces
 //!   (second to third order), not along the step like the teeth's torque about the axis; its
 //!   radial speed in the law's damping is rapier's mean speed over the last step. Onsets of
@@ -83,6 +95,7 @@ pub mod engine;
 mod hook;
 mod integrate;
 pub mod options;
+mod stack;
 mod stepping;
 mod world;
 

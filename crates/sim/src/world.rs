@@ -14,6 +14,17 @@ use rapier3d_f64::prelude::{
 };
 use std::f64::consts::PI;
 
+/// The body a spline coupling joins a disc or plate to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Carrier {
+    /// The shaft (friction discs).
+    Shaft,
+    /// The fixed housing (separator plates of a brake).
+    Housing,
+    /// The output drum (separator plates of a clutch).
+    Drum,
+}
+
 /// The rapier world of one pack and the handles of its bodies.
 pub(crate) struct World {
     /// All rapier state.
@@ -22,9 +33,16 @@ pub(crate) struct World {
     pub shaft: RigidBodyHandle,
     /// Whether the shaft is a dynamic body (an inertial shaft).
     pub shaft_dynamic: bool,
-    /// One dynamic body per disc, in scene order.
+    /// The fixed housing.
+    pub housing: RigidBodyHandle,
+    /// The output drum of a clutch: a dynamic body on a revolute joint to the housing.
+    pub drum: Option<RigidBodyHandle>,
+    /// One dynamic body per spline-coupled body: the friction discs in scene order, then the
+    /// separator plates in scene order (the engine's coupling order).
     pub discs: Vec<RigidBodyHandle>,
-    /// Axial position of each disc's mid-plane on the shaft, m.
+    /// The carrier of each of them.
+    pub carriers: Vec<Carrier>,
+    /// Axial position of each one's mid-plane, m (discs and plates alternate in a stack).
     pub disc_axial_m: Vec<f64>,
     /// Turn owed to each disc by [`exponential_map_deficit`] and not yet applied to its
     /// rapier pose, as a scaled axis (rad). Readers add it ([`World::disc_turn_owed_z`]).
@@ -127,7 +145,8 @@ fn floating_joint(anchor1: Vector) -> GenericJointBuilder {
 
 impl World {
     /// Builds the world at t = 0: shaft angle 0 at its initial speed, each disc at
-    /// `theta_d = -phi(0)` turning at `omega_s(0) - dphi(0)`.
+    /// `theta_d = -phi(0)` turning at `omega_s(0) - dphi(0)`; each plate likewise relative to
+    /// its carrier (the housing at rest, or the drum at angle 0 and its initial speed).
     pub fn build(
         pack: &PackModel,
         shapes: &BodyShapes,
@@ -144,9 +163,28 @@ impl World {
         let omega0 = pack.shaft.initial_speed_rad_s();
         let housing = physics.insert_body(RigidBodyBuilder::fixed());
         let n = pack.discs.len();
-        let disc_axial_m: Vec<f64> = (0..n)
-            .map(|i| (i as f64 - 0.5 * (n as f64 - 1.0)) * shapes.disc_pitch_m)
-            .collect();
+        let np = pack.plates.len();
+        let disc_axial_m: Vec<f64> = if np == 0 {
+            (0..n)
+                .map(|i| (i as f64 - 0.5 * (n as f64 - 1.0)) * shapes.disc_pitch_m)
+                .collect()
+        } else {
+            // A stack: plate 0, disc 0, plate 1, ... (clutchpack_model::clutch), a pitch
+            // apart, centred on the origin.
+            let centre = 0.5 * ((n + np) as f64 - 1.0);
+            let at = |b: usize| (b as f64 - centre) * shapes.disc_pitch_m;
+            (0..n)
+                .map(|i| at(2 * i + 1))
+                .chain((0..np).map(|j| at(2 * j)))
+                .collect()
+        };
+        let mut carriers = vec![Carrier::Shaft; n];
+        let plate_carrier = if pack.drum.is_some() {
+            Carrier::Drum
+        } else {
+            Carrier::Housing
+        };
+        carriers.extend(std::iter::repeat_n(plate_carrier, np));
 
         let (shaft, shaft_dynamic) = match &pack.shaft {
             Shaft::Prescribed(_) => {
@@ -184,8 +222,46 @@ impl World {
             }
         };
 
-        let mut discs = Vec::with_capacity(n);
-        for (i, d) in pack.discs.iter().enumerate() {
+        let drum = match &pack.drum {
+            None => None,
+            Some(dr) => {
+                let radius = pack
+                    .plates
+                    .iter()
+                    .map(|p| p.spline.pitch_radius_m)
+                    .fold(0.0, f64::max)
+                    .max(0.05);
+                let length = ((n + np).max(1) as f64) * shapes.disc_pitch_m;
+                let rb = RigidBodyBuilder::dynamic()
+                    .can_sleep(false)
+                    .gyroscopic_forces_enabled(false)
+                    .allow_fast_rotation(true)
+                    .additional_mass_properties(shaft_mass_properties(
+                        dr.inertia_kg_m2,
+                        radius,
+                        length,
+                    ))
+                    .angvel(Vector::new(0.0, 0.0, dr.initial_speed_rad_s));
+                let h = physics.insert_body(rb);
+                let joint = GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
+                    .local_axis1(Vector::Z)
+                    .local_axis2(Vector::Z)
+                    .contacts_enabled(false);
+                physics.insert_impulse_joint(housing, h, joint);
+                Some(h)
+            }
+        };
+
+        let mut discs = Vec::with_capacity(n + np);
+        for (i, d) in pack.discs.iter().chain(&pack.plates).enumerate() {
+            let (carrier, omega_c) = match carriers[i] {
+                Carrier::Shaft => (shaft, omega0),
+                Carrier::Housing => (housing, 0.0),
+                Carrier::Drum => (
+                    drum.expect("a drum"),
+                    pack.drum.map_or(0.0, |dr| dr.initial_speed_rad_s),
+                ),
+            };
             let mprops = disc_mass_properties(d.inertia_kg_m2, d.spline.pitch_radius_m, shapes);
             let [ex, ey] = d.initial_offset_m;
             // The centre starts at its offset in the shaft's frame (the world frame at t = 0),
@@ -197,8 +273,8 @@ impl World {
                 .additional_mass_properties(mprops)
                 .translation(Vector::new(ex, ey, disc_axial_m[i]))
                 .rotation(Vector::new(0.0, 0.0, -d.initial_rel_angle_rad))
-                .linvel(Vector::new(-omega0 * ey, omega0 * ex, 0.0))
-                .angvel(Vector::new(0.0, 0.0, omega0 - d.initial_rel_speed_rad_s));
+                .linvel(Vector::new(-omega_c * ey, omega_c * ex, 0.0))
+                .angvel(Vector::new(0.0, 0.0, omega_c - d.initial_rel_speed_rad_s));
             // An eccentric disc that does not float is held at its offset in the shaft's
             // frame, which turns: only a joint to the shaft can do that.
             let eccentric = !d.radial_float && (ex != 0.0 || ey != 0.0);
@@ -222,7 +298,7 @@ impl World {
                 } else {
                     cylindrical_joint(Vector::new(ex, ey, disc_axial_m[i]))
                 };
-                physics.insert_impulse_joint(shaft, h, joint);
+                physics.insert_impulse_joint(carrier, h, joint);
             }
             discs.push(h);
         }
@@ -230,8 +306,11 @@ impl World {
             physics,
             shaft,
             shaft_dynamic,
+            housing,
+            drum,
             owed: vec![Vector::ZERO; discs.len()],
             discs,
+            carriers,
             disc_axial_m,
         })
     }
@@ -251,6 +330,11 @@ impl World {
         }
         if self.shaft_dynamic {
             let body = &mut self.physics.bodies[self.shaft];
+            let d = exponential_map_deficit(body, dt);
+            turn(body, d);
+        }
+        if let Some(h) = self.drum {
+            let body = &mut self.physics.bodies[h];
             let d = exponential_map_deficit(body, dt);
             turn(body, d);
         }
