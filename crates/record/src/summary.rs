@@ -1,14 +1,14 @@
 //! The per-disc summary stored on `/summary` at the end of a run.
 //!
-//! The statistics are those of `clutchpack_analysis::DiscStats` (same names, same
-//! definitions), computed from the impact peaks, so the CLI can convert one into the other
-//! field by field. This crate does not depend on the analysis crate.
+//! The statistics are computed by `clutchpack_analysis::DiscStats::from_peaks` (one
+//! definition of max, p99 and top-10 mean for the whole project) and stored in the shape of
+//! the `/summary` message.
 
 use crate::proto;
 use clutchpack_model::ImpactEvent;
 
-/// Number of impacts averaged by [`DiscSummary::mean_top10_abs_n`].
-pub const TOP_N: usize = 10;
+/// How many of the largest `|peak|` the "top" mean takes (10).
+pub use clutchpack_analysis::stats::TOP_N;
 
 /// Disc indices past the named discs that [`RunSummary::from_impacts`] still gives entries.
 pub const MAX_EXTRA_DISCS: usize = 1024;
@@ -42,48 +42,22 @@ impl DiscSummary {
     /// Statistics of the signed peak loads `peaks_n` (N) of the disc `name`. NaN peaks are
     /// not counted.
     pub fn from_peaks(name: impl Into<String>, peaks_n: &[f64]) -> DiscSummary {
-        let mut s = DiscSummary {
-            name: name.into(),
-            ..Default::default()
-        };
-        let mut abs = Vec::with_capacity(peaks_n.len());
-        for &p in peaks_n.iter().filter(|p| !p.is_nan()) {
-            s.impacts += 1;
-            if p > 0.0 {
-                s.positive_impacts += 1;
-                s.max_positive_n = s.max_positive_n.max(p);
-            } else if p < 0.0 {
-                s.negative_impacts += 1;
-                s.max_negative_n = s.max_negative_n.min(p);
-            }
-            abs.push(p.abs());
-        }
-        if abs.is_empty() {
-            return s;
-        }
-        abs.sort_by(f64::total_cmp);
-        s.p99_abs_n = percentile_sorted(&abs, 99.0);
-        let top = &abs[abs.len().saturating_sub(TOP_N)..];
-        s.mean_top10_abs_n = top.iter().sum::<f64>() / top.len() as f64;
-        s
+        DiscSummary::from(clutchpack_analysis::DiscStats::from_peaks(name, peaks_n))
     }
 }
 
-/// The `q`-th percentile (`q` in 0..=100) of ascending, NaN-free `sorted` values: numpy's
-/// `linear` method, position `h = (n - 1) q / 100` interpolated between its neighbours.
-fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
-    let n = sorted.len();
-    if n == 0 {
-        return 0.0;
-    }
-    let h = (n - 1) as f64 * q.clamp(0.0, 100.0) / 100.0;
-    let lo = (h.floor() as usize).min(n - 1);
-    let hi = (lo + 1).min(n - 1);
-    let frac = h - lo as f64;
-    if frac == 0.0 || lo == hi {
-        sorted[lo]
-    } else {
-        sorted[lo] + frac * (sorted[hi] - sorted[lo])
+impl From<clutchpack_analysis::DiscStats> for DiscSummary {
+    fn from(s: clutchpack_analysis::DiscStats) -> DiscSummary {
+        DiscSummary {
+            name: s.name,
+            max_positive_n: s.max_positive_n,
+            max_negative_n: s.max_negative_n,
+            p99_abs_n: s.p99_abs_n,
+            impacts: s.impacts as u64,
+            positive_impacts: s.positive_impacts as u64,
+            negative_impacts: s.negative_impacts as u64,
+            mean_top10_abs_n: s.mean_top10_abs_n,
+        }
     }
 }
 
