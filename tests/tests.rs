@@ -621,6 +621,8 @@ fn sigint_leaves_a_complete_recording() {
     assert_eq!(r["complete"], true, "{r}");
     assert!(r["summary"].is_object(), "{r}");
     assert!(r["messages"].as_u64().unwrap() > 100);
+    assert_eq!(r["topics"]["/tf"]["schema"], "foxglove.FrameTransforms");
+    assert_eq!(r["topics"]["/scene"]["schema"], "foxglove.SceneUpdate");
     let o = run(&["replay", f.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
