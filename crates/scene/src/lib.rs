@@ -72,6 +72,37 @@
 //! film_thickness_m = 75e-6
 //! ```
 //!
+//! A whole pack (MODEL.md section 5; multibody engine only) adds separator plates, an
+//! output drum and the clamped stack:
+//!
+//! ```toml
+//! [plate_defaults]              # the same keys as [defaults], for the plates; plates do not
+//! inertia_kg_m2 = 0.12          # inherit [defaults] (their spline is the carrier's)
+//! [[plates]]                    # N + 1 plates for N discs with a [stack]: plate, disc, ...
+//! name = "plate-1"
+//!
+//! [drum]                        # a clutch: the plates sit on the drum (else on the housing)
+//! inertia_kg_m2 = 0.5
+//! load_torque_n_m = -20.0       # default 0; drag_n_m_s_rad, initial_speed_rad_s default 0
+//!
+//! [stack]
+//! face_inner_radius_m = 0.235   # the friction faces' annulus
+//! face_outer_radius_m = 0.290
+//! piston_area_m2 = 0.012
+//! return_spring_n = 800.0       # default 0
+//! spline_friction_coefficient = 0.1   # default 0
+//! [stack.friction]              # kind = "stribeck" (default): static_mu, kinetic_mu,
+//! static_mu = 0.10              #   stribeck_speed_m_s, viscous_slope_s_m; or kind = "table"
+//! kinetic_mu = 0.13             #   with arrays slip_m_s (from 0) and mu
+//! [stack.pressure]              # kind = "constant" (pressure_pa) | "ramp" (start_s, rise_s,
+//! kind = "ramp"                 #   pressure_pa) | "table" (arrays times_s, values_pa)
+//! rise_s = 0.02
+//! pressure_pa = 8e5
+//! [stack.open_gap]              # optional: viscous drag across the gaps of an open pack
+//! viscosity_pa_s = 0.02
+//! gap_m = 0.1e-3
+//! ```
+//!
 //! Drives: `sine` is Hu et al. eq (3) with a phase, mapped to one harmonic; `harmonics` takes
 //! `omega0_rad_s` and one `[[drive.harmonics]]` table per term (`amplitude_rad_s`,
 //! `frequency_hz`, `phase_deg`); `speed_table` and `torque_table` take `file`, a CSV file

@@ -89,6 +89,69 @@ pub(crate) struct RawScene {
     pub discs: Option<Vec<RawDisc>>,
     /// Same keys as a disc except `name` (reported as unknown if present).
     pub defaults: Option<RawDisc>,
+    /// Separator plates: the same keys as a disc.
+    pub plates: Option<Vec<RawDisc>>,
+    /// Shared plate parameters, like `defaults` for the discs.
+    pub plate_defaults: Option<RawDisc>,
+    pub drum: Option<RawDrum>,
+    pub stack: Option<RawStack>,
+}
+
+/// `[drum]`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(expecting = "a table")]
+pub(crate) struct RawDrum {
+    pub inertia_kg_m2: Option<Value>,
+    pub load_torque_n_m: Option<Value>,
+    pub drag_n_m_s_rad: Option<Value>,
+    pub initial_speed_rad_s: Option<Value>,
+}
+
+/// `[stack]`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(expecting = "a table")]
+pub(crate) struct RawStack {
+    pub face_inner_radius_m: Option<Value>,
+    pub face_outer_radius_m: Option<Value>,
+    pub spline_friction_coefficient: Option<Value>,
+    pub piston_area_m2: Option<Value>,
+    pub return_spring_n: Option<Value>,
+    pub friction: Option<RawFriction>,
+    pub pressure: Option<RawPressure>,
+    pub open_gap: Option<RawOpenGap>,
+}
+
+/// `[stack.friction]`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(expecting = "a table")]
+pub(crate) struct RawFriction {
+    pub kind: Option<Value>,
+    pub static_mu: Option<Value>,
+    pub kinetic_mu: Option<Value>,
+    pub stribeck_speed_m_s: Option<Value>,
+    pub viscous_slope_s_m: Option<Value>,
+    pub slip_m_s: Option<Value>,
+    pub mu: Option<Value>,
+}
+
+/// `[stack.pressure]`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(expecting = "a table")]
+pub(crate) struct RawPressure {
+    pub kind: Option<Value>,
+    pub pressure_pa: Option<Value>,
+    pub start_s: Option<Value>,
+    pub rise_s: Option<Value>,
+    pub times_s: Option<Value>,
+    pub values_pa: Option<Value>,
+}
+
+/// `[stack.open_gap]`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(expecting = "a table")]
+pub(crate) struct RawOpenGap {
+    pub viscosity_pa_s: Option<Value>,
+    pub gap_m: Option<Value>,
 }
 
 /// `[simulation]`.

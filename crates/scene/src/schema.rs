@@ -82,6 +82,89 @@ const SCENE_KEYS: &[Key] = &[
         "discs[].name",
         "string; default \"disc-<i+1>\"; unique (only in [[discs]], not in [defaults])",
     ),
+    key(
+        "plates[].name",
+        "string; default \"plate-<j+1>\"; unique among discs and plates (only in [[plates]])",
+    ),
+    key(
+        "drum.inertia_kg_m2",
+        "kg m^2, > 0; required with [drum] (a clutch: the plates sit on the drum, else on \
+         the housing)",
+    ),
+    key(
+        "drum.load_torque_n_m",
+        "N m, on the drum about the axis (negative brakes it); default 0",
+    ),
+    key("drum.drag_n_m_s_rad", "N m s/rad, >= 0; default 0"),
+    key("drum.initial_speed_rad_s", "rad/s; default 0"),
+    key(
+        "stack.face_inner_radius_m",
+        "m, > 0; required with [stack] (friction faces, inner radius)",
+    ),
+    key(
+        "stack.face_outer_radius_m",
+        "m, > face_inner_radius_m; required with [stack]",
+    ),
+    key(
+        "stack.spline_friction_coefficient",
+        "dimensionless, >= 0; default 0 (axial spline friction holds back mu n |F| per body)",
+    ),
+    key("stack.piston_area_m2", "m^2, > 0; required with [stack]"),
+    key(
+        "stack.return_spring_n",
+        "N, >= 0; default 0 (piston force = p A - return spring, never < 0)",
+    ),
+    key("stack.friction.kind", "\"stribeck\" (default) | \"table\""),
+    key(
+        "stack.friction.static_mu",
+        "stribeck: mu at zero slip, > 0; required",
+    ),
+    key(
+        "stack.friction.kinetic_mu",
+        "stribeck: mu beyond the Stribeck speed, > 0; default static_mu",
+    ),
+    key(
+        "stack.friction.stribeck_speed_m_s",
+        "stribeck: m/s, > 0; default 1",
+    ),
+    key(
+        "stack.friction.viscous_slope_s_m",
+        "stribeck: s/m, >= 0; default 0 (mu rises by this per m/s of slip)",
+    ),
+    key(
+        "stack.friction.slip_m_s",
+        "table: m/s, array increasing from 0; required",
+    ),
+    key(
+        "stack.friction.mu",
+        "table: array of mu > 0, one per slip_m_s; required",
+    ),
+    key(
+        "stack.pressure.kind",
+        "required with [stack]: \"constant\" | \"ramp\" | \"table\"",
+    ),
+    key(
+        "stack.pressure.pressure_pa",
+        "Pa, >= 0; constant and ramp (the final pressure): required",
+    ),
+    key("stack.pressure.start_s", "ramp: s, >= 0; default 0"),
+    key("stack.pressure.rise_s", "ramp: s, > 0; required"),
+    key(
+        "stack.pressure.times_s",
+        "table: s, array increasing; required",
+    ),
+    key(
+        "stack.pressure.values_pa",
+        "table: Pa, array >= 0, one per times_s; required",
+    ),
+    key(
+        "stack.open_gap.viscosity_pa_s",
+        "Pa s, > 0; required with [stack.open_gap] (oil in the open gaps)",
+    ),
+    key(
+        "stack.open_gap.gap_m",
+        "m, > 0; required with [stack.open_gap] (axial gap per open interface)",
+    ),
 ];
 
 /// Disc parameters: allowed in `[defaults]` and in each `[[discs]]` entry.
@@ -155,7 +238,7 @@ pub(crate) fn all_paths() -> &'static [String] {
     static PATHS: OnceLock<Vec<String>> = OnceLock::new();
     PATHS.get_or_init(|| {
         let mut v: Vec<String> = SCENE_KEYS.iter().map(|k| k.path.to_string()).collect();
-        for prefix in ["defaults", "discs[]"] {
+        for prefix in ["defaults", "discs[]", "plate_defaults", "plates[]"] {
             v.extend(DISC_KEYS.iter().map(|k| format!("{prefix}.{}", k.path)));
         }
         v
@@ -250,7 +333,9 @@ pub fn keys_doc() -> String {
     }
     s.push_str(
         "Disc parameters, in [defaults] (shared by all discs) and in each [[discs]] entry \
-         (overrides [defaults]); at least one [[discs]]:\n",
+         (overrides [defaults]); at least one [[discs]]. Separator plates take the same keys \
+         in [plate_defaults] and [[plates]] (their spline and angles relative to their \
+         carrier: the drum, else the housing):\n",
     );
     for k in DISC_KEYS {
         let _ = writeln!(s, "  {:width$}{}", k.path, k.doc);
@@ -291,7 +376,11 @@ mod tests {
                 "shaft",
                 "drive",
                 "discs",
-                "defaults"
+                "plates",
+                "drum",
+                "stack",
+                "defaults",
+                "plate_defaults"
             ]
         );
         assert!(children("discs[].oil").contains(&"film_thickness_m"));

@@ -10,16 +10,22 @@
 //! Disc parameters resolve in this order: the disc's own value, then `[defaults]`, then the
 //! built-in default; a required key found nowhere is reported as missing at the disc's key
 //! path (`discs[1].spline.teeth`). A bad value in `[defaults]` is reported once, at its
-//! `defaults.` path.
+//! `defaults.` path. Plates resolve the same way through `[plate_defaults]`. The `[drum]`
+//! and `[stack]` tables are checked on their own, then against the bodies (a stack of N
+//! discs needs N + 1 plates, a drum needs plates).
 
 use crate::csv;
 use crate::error::Problem;
-use crate::raw::{RawDisc, RawDrive, RawScene, RawShaft, RawSimulation};
+use crate::raw::{
+    RawDisc, RawDrive, RawDrum, RawFriction, RawPressure, RawScene, RawShaft, RawSimulation,
+    RawStack,
+};
 use crate::schema;
 use crate::{EngineChoice, Simulation};
 use clutchpack_model::{
-    DiscModel, Harmonic, Hertz, LawKind, OilFilm, PackModel, Shaft, ShaftExcitation, SpeedProfile,
-    SplineGeometry, Table, ToothLaw,
+    DiscModel, DrumModel, FrictionCurve, Harmonic, Hertz, LawKind, OilFilm, OpenGap, PackModel,
+    Piston, PressureProfile, Shaft, ShaftExcitation, SpeedProfile, SplineGeometry, StackModel,
+    Table, TableError, ToothLaw,
 };
 use std::path::Path;
 use toml::Value;
@@ -256,7 +262,48 @@ pub(crate) fn validate(
     let simulation = simulation(ck, raw.simulation.as_ref());
     let (kind, drive) = drive(ck, raw.drive.as_ref(), base_dir);
     let shaft = shaft(ck, raw.shaft.as_ref(), kind, drive);
-    let discs = discs(ck, raw.defaults.as_ref(), raw.discs.as_deref());
+    let mut names = Vec::new();
+    let discs = bodies(
+        ck,
+        DISCS,
+        raw.defaults.as_ref(),
+        raw.discs.as_deref(),
+        true,
+        &mut names,
+    );
+    let plates = bodies(
+        ck,
+        PLATES,
+        raw.plate_defaults.as_ref(),
+        raw.plates.as_deref(),
+        false,
+        &mut names,
+    );
+    let drum = raw.drum.as_ref().map(|r| drum(ck, r));
+    let stack = raw.stack.as_ref().map(|r| stack(ck, r));
+    // The stack alternates plates and discs: N discs need N + 1 plates; a drum carries plates.
+    let n_discs = raw.discs.as_ref().map_or(0, Vec::len);
+    let n_plates = raw.plates.as_ref().map_or(0, Vec::len);
+    if raw.stack.is_some() && n_plates != n_discs + 1 {
+        ck.report(
+            "plates",
+            Some(format!("[...{n_plates} entries]")),
+            format!(
+                "a [stack] of {n_discs} discs needs {} [[plates]] entries (plate, disc, plate, \
+                 ..., plate)",
+                n_discs + 1
+            ),
+        );
+        return None;
+    }
+    if raw.drum.is_some() && n_plates == 0 {
+        ck.report(
+            "drum",
+            None,
+            "a [drum] carries the separator plates: add [[plates]] entries",
+        );
+        return None;
+    }
     Some(Validated {
         name: name?,
         description: description?,
@@ -264,10 +311,372 @@ pub(crate) fn validate(
         pack: PackModel {
             shaft: shaft?,
             discs: discs?,
-            plates: Vec::new(),
-            drum: None,
-            stack: None,
+            plates: plates?,
+            drum: drum.map_or(Some(None), |d| d.map(Some))?,
+            stack: stack.map_or(Some(None), |s| s.map(Some))?,
         },
+    })
+}
+
+/// `[drum]`.
+fn drum(ck: &mut Checker, r: &RawDrum) -> Option<DrumModel> {
+    let inertia = ck
+        .number(
+            "drum.inertia_kg_m2",
+            r.inertia_kg_m2.as_ref(),
+            Rule::Positive,
+        )
+        .required(
+            ck,
+            "drum.inertia_kg_m2",
+            "required with [drum]; set it there",
+        );
+    let load = ck
+        .number(
+            "drum.load_torque_n_m",
+            r.load_torque_n_m.as_ref(),
+            Rule::Finite,
+        )
+        .or(0.0);
+    let drag = ck
+        .number(
+            "drum.drag_n_m_s_rad",
+            r.drag_n_m_s_rad.as_ref(),
+            Rule::NonNegative,
+        )
+        .or(0.0);
+    let speed = ck
+        .number(
+            "drum.initial_speed_rad_s",
+            r.initial_speed_rad_s.as_ref(),
+            Rule::Finite,
+        )
+        .or(0.0);
+    Some(DrumModel {
+        inertia_kg_m2: inertia?,
+        load_torque_n_m: load?,
+        drag_n_m_s_rad: drag?,
+        initial_speed_rad_s: speed?,
+    })
+}
+
+/// Two arrays of the same length, the first strictly increasing: a table `y(x)`.
+fn table(
+    ck: &mut Checker,
+    (x_key, x): (&str, Option<&Value>),
+    (y_key, y): (&str, Option<&Value>),
+    y_rule: Rule,
+    hint: &str,
+) -> Option<Table> {
+    let xs = ck.numbers(x_key, x, None).required(ck, x_key, hint);
+    let ys = ck.numbers(y_key, y, None).required(ck, y_key, hint);
+    let (xs, ys) = (xs?, ys?);
+    let mut ok = true;
+    for (j, v) in ys.iter().enumerate() {
+        if !y_rule.holds(*v) {
+            ck.report(format!("{y_key}[{j}]"), Some(v.to_string()), y_rule.text());
+            ok = false;
+        }
+    }
+    if !ok {
+        return None;
+    }
+    match Table::new(xs.clone(), ys.clone()) {
+        Ok(t) => Some(t),
+        Err(e) => {
+            let key = match e {
+                TableError::NotIncreasing(j, _) => format!("{x_key}[{j}]"),
+                TableError::LengthMismatch(..) => y_key.to_string(),
+                _ => x_key.to_string(),
+            };
+            let rule = match e {
+                TableError::LengthMismatch(a, b) => {
+                    format!("must have one value per entry of {x_key} ({a}), has {b}")
+                }
+                TableError::NotIncreasing(..) => "must increase strictly".to_string(),
+                e => e.to_string(),
+            };
+            ck.report(key, None, rule);
+            None
+        }
+    }
+}
+
+/// `[stack]` with its `friction`, `pressure` and `open_gap` tables.
+fn stack(ck: &mut Checker, r: &RawStack) -> Option<StackModel> {
+    let hint = "required with [stack]; set it there";
+    let inner = ck
+        .number(
+            "stack.face_inner_radius_m",
+            r.face_inner_radius_m.as_ref(),
+            Rule::Positive,
+        )
+        .required(ck, "stack.face_inner_radius_m", hint);
+    let outer = ck
+        .number(
+            "stack.face_outer_radius_m",
+            r.face_outer_radius_m.as_ref(),
+            Rule::Positive,
+        )
+        .required(ck, "stack.face_outer_radius_m", hint);
+    if let (Some(ri), Some(ro)) = (inner, outer) {
+        if ro <= ri {
+            ck.report(
+                "stack.face_outer_radius_m",
+                Some(ro.to_string()),
+                format!("must be > stack.face_inner_radius_m = {ri}"),
+            );
+        }
+    }
+    let spline = ck
+        .number(
+            "stack.spline_friction_coefficient",
+            r.spline_friction_coefficient.as_ref(),
+            Rule::NonNegative,
+        )
+        .or(0.0);
+    let area = ck
+        .number(
+            "stack.piston_area_m2",
+            r.piston_area_m2.as_ref(),
+            Rule::Positive,
+        )
+        .required(ck, "stack.piston_area_m2", hint);
+    let spring = ck
+        .number(
+            "stack.return_spring_n",
+            r.return_spring_n.as_ref(),
+            Rule::NonNegative,
+        )
+        .or(0.0);
+
+    // friction
+    let empty_f = RawFriction::default();
+    let f = r.friction.as_ref().unwrap_or(&empty_f);
+    let kind = ck
+        .choice(
+            "stack.friction.kind",
+            f.kind.as_ref(),
+            &[("stribeck", false), ("table", true)],
+        )
+        .or(false);
+    let friction = match kind {
+        None => None,
+        Some(false) => {
+            for (k, v) in [("slip_m_s", &f.slip_m_s), ("mu", &f.mu)] {
+                ck.not_allowed(
+                    &format!("stack.friction.{k}"),
+                    v.as_ref(),
+                    "only allowed with stack.friction.kind = \"table\"",
+                );
+            }
+            let st = ck
+                .number(
+                    "stack.friction.static_mu",
+                    f.static_mu.as_ref(),
+                    Rule::Positive,
+                )
+                .required(
+                    ck,
+                    "stack.friction.static_mu",
+                    "required; set it in [stack.friction]",
+                );
+            let kin = ck
+                .number(
+                    "stack.friction.kinetic_mu",
+                    f.kinetic_mu.as_ref(),
+                    Rule::Positive,
+                )
+                .or(st.unwrap_or(0.1));
+            let vs = ck
+                .number(
+                    "stack.friction.stribeck_speed_m_s",
+                    f.stribeck_speed_m_s.as_ref(),
+                    Rule::Positive,
+                )
+                .or(1.0);
+            let c = ck
+                .number(
+                    "stack.friction.viscous_slope_s_m",
+                    f.viscous_slope_s_m.as_ref(),
+                    Rule::NonNegative,
+                )
+                .or(0.0);
+            (|| {
+                Some(FrictionCurve::Stribeck {
+                    static_mu: st?,
+                    kinetic_mu: kin?,
+                    stribeck_speed_m_s: vs?,
+                    viscous_slope_s_m: c?,
+                })
+            })()
+        }
+        Some(true) => {
+            for (k, v) in [
+                ("static_mu", &f.static_mu),
+                ("kinetic_mu", &f.kinetic_mu),
+                ("stribeck_speed_m_s", &f.stribeck_speed_m_s),
+                ("viscous_slope_s_m", &f.viscous_slope_s_m),
+            ] {
+                ck.not_allowed(
+                    &format!("stack.friction.{k}"),
+                    v.as_ref(),
+                    "only allowed with stack.friction.kind = \"stribeck\"",
+                );
+            }
+            let t = table(
+                ck,
+                ("stack.friction.slip_m_s", f.slip_m_s.as_ref()),
+                ("stack.friction.mu", f.mu.as_ref()),
+                Rule::Positive,
+                "required with stack.friction.kind = \"table\"; set it in [stack.friction]",
+            );
+            if let Some(t) = &t {
+                if t.t_s[0] != 0.0 {
+                    ck.report(
+                        "stack.friction.slip_m_s[0]",
+                        Some(t.t_s[0].to_string()),
+                        "must be 0 (the table starts at zero slip)",
+                    );
+                    return None;
+                }
+            }
+            t.map(FrictionCurve::Table)
+        }
+    };
+
+    // pressure
+    let empty_p = RawPressure::default();
+    let pr = r.pressure.as_ref().unwrap_or(&empty_p);
+    #[derive(Clone, Copy, PartialEq)]
+    enum PKind {
+        Constant,
+        Ramp,
+        Table,
+    }
+    let pkind = ck
+        .choice(
+            "stack.pressure.kind",
+            pr.kind.as_ref(),
+            &[
+                ("constant", PKind::Constant),
+                ("ramp", PKind::Ramp),
+                ("table", PKind::Table),
+            ],
+        )
+        .required(
+            ck,
+            "stack.pressure.kind",
+            "required with [stack]: \"constant\", \"ramp\" or \"table\"; set it in \
+             [stack.pressure]",
+        );
+    let allowed: &[&str] = match pkind {
+        Some(PKind::Constant) => &["pressure_pa"],
+        Some(PKind::Ramp) => &["pressure_pa", "start_s", "rise_s"],
+        Some(PKind::Table) => &["times_s", "values_pa"],
+        None => &["pressure_pa", "start_s", "rise_s", "times_s", "values_pa"],
+    };
+    for (k, v) in [
+        ("pressure_pa", &pr.pressure_pa),
+        ("start_s", &pr.start_s),
+        ("rise_s", &pr.rise_s),
+        ("times_s", &pr.times_s),
+        ("values_pa", &pr.values_pa),
+    ] {
+        if !allowed.contains(&k) {
+            ck.not_allowed(
+                &format!("stack.pressure.{k}"),
+                v.as_ref(),
+                "not used by this stack.pressure.kind",
+            );
+        }
+    }
+    let phint = "required for this stack.pressure.kind; set it in [stack.pressure]";
+    let pressure = match pkind {
+        None => None,
+        Some(PKind::Constant) => ck
+            .number(
+                "stack.pressure.pressure_pa",
+                pr.pressure_pa.as_ref(),
+                Rule::NonNegative,
+            )
+            .required(ck, "stack.pressure.pressure_pa", phint)
+            .map(|pressure_pa| PressureProfile::Constant { pressure_pa }),
+        Some(PKind::Ramp) => {
+            let p = ck
+                .number(
+                    "stack.pressure.pressure_pa",
+                    pr.pressure_pa.as_ref(),
+                    Rule::NonNegative,
+                )
+                .required(ck, "stack.pressure.pressure_pa", phint);
+            let start = ck
+                .number(
+                    "stack.pressure.start_s",
+                    pr.start_s.as_ref(),
+                    Rule::NonNegative,
+                )
+                .or(0.0);
+            let rise = ck
+                .number("stack.pressure.rise_s", pr.rise_s.as_ref(), Rule::Positive)
+                .required(ck, "stack.pressure.rise_s", phint);
+            (|| {
+                Some(PressureProfile::Ramp {
+                    start_s: start?,
+                    rise_s: rise?,
+                    pressure_pa: p?,
+                })
+            })()
+        }
+        Some(PKind::Table) => table(
+            ck,
+            ("stack.pressure.times_s", pr.times_s.as_ref()),
+            ("stack.pressure.values_pa", pr.values_pa.as_ref()),
+            Rule::NonNegative,
+            phint,
+        )
+        .map(PressureProfile::Table),
+    };
+
+    // open gaps
+    let open_gap = match &r.open_gap {
+        None => Some(None),
+        Some(g) => {
+            let ghint = "required with [stack.open_gap]; set it there";
+            let eta = ck
+                .number(
+                    "stack.open_gap.viscosity_pa_s",
+                    g.viscosity_pa_s.as_ref(),
+                    Rule::Positive,
+                )
+                .required(ck, "stack.open_gap.viscosity_pa_s", ghint);
+            let h = ck
+                .number("stack.open_gap.gap_m", g.gap_m.as_ref(), Rule::Positive)
+                .required(ck, "stack.open_gap.gap_m", ghint);
+            match (eta, h) {
+                (Some(viscosity_pa_s), Some(gap_m)) => Some(Some(OpenGap {
+                    viscosity_pa_s,
+                    gap_m,
+                })),
+                _ => None,
+            }
+        }
+    };
+    let (ri, ro) = (inner?, outer?);
+    if ro <= ri {
+        return None;
+    }
+    Some(StackModel {
+        face_inner_radius_m: ri,
+        face_outer_radius_m: ro,
+        friction: friction?,
+        piston: Piston {
+            area_m2: area?,
+            pressure: pressure?,
+            return_spring_n: spring?,
+        },
+        open_gap: open_gap?,
+        spline_friction: spline?,
     })
 }
 
@@ -838,19 +1247,45 @@ fn pick<T: Clone>(disc: &Field<T>, defaults: &Field<T>) -> Field<(T, Source)> {
     }
 }
 
+/// The two tables of a kind of body: the array of entries and its shared defaults
+/// (`[[discs]]` and `[defaults]`, or `[[plates]]` and `[plate_defaults]`).
+#[derive(Debug, Clone, Copy)]
+struct Sec {
+    /// The array of tables, `discs` or `plates`.
+    items: &'static str,
+    /// The defaults table, `defaults` or `plate_defaults`.
+    defaults: &'static str,
+    /// Default name prefix of an entry (`disc` -> `disc-1`).
+    name_prefix: &'static str,
+}
+
+const DISCS: Sec = Sec {
+    items: "discs",
+    defaults: "defaults",
+    name_prefix: "disc",
+};
+
+const PLATES: Sec = Sec {
+    items: "plates",
+    defaults: "plate_defaults",
+    name_prefix: "plate",
+};
+
 /// Where to set a disc key `k` (`spline.teeth` -> `[discs.spline] or [defaults.spline]`).
-fn where_to_set(k: &str) -> String {
+fn where_to_set(sec: Sec, k: &str) -> String {
+    let (items, defaults) = (sec.items, sec.defaults);
     match k.split_once('.') {
-        Some((section, _)) => format!("[discs.{section}] or [defaults.{section}]"),
-        None => "[[discs]] or [defaults]".to_string(),
+        Some((section, _)) => format!("[{items}.{section}] or [{defaults}.{section}]"),
+        None => format!("[[{items}]] or [{defaults}]"),
     }
 }
 
 /// A required disc parameter: the disc's, else the defaults'; missing is reported at
-/// `discs[i].k`.
+/// `item.k` (`discs[1].spline.teeth`).
 fn required<T: Clone>(
     ck: &mut Checker,
-    i: usize,
+    sec: Sec,
+    item: &str,
     k: &str,
     disc: &Field<T>,
     defaults: &Field<T>,
@@ -858,8 +1293,8 @@ fn required<T: Clone>(
     pick(disc, defaults)
         .required(
             ck,
-            &format!("discs[{i}].{k}"),
-            &format!("required; set it in {}", where_to_set(k)),
+            &format!("{item}.{k}"),
+            &format!("required; set it in {}", where_to_set(sec, k)),
         )
         .map(|(v, _)| v)
 }
@@ -870,66 +1305,74 @@ fn optional<T: Clone>(disc: &Field<T>, defaults: &Field<T>, builtin: T) -> Optio
 }
 
 /// ` (inherited from defaults.k)` when the value came from `[defaults]`.
-fn inherited(source: Source, k: &str) -> String {
+fn inherited(sec: Sec, source: Source, k: &str) -> String {
     if source == Source::Defaults {
-        format!(" (inherited from defaults.{k})")
+        format!(" (inherited from {}.{k})", sec.defaults)
     } else {
         String::new()
     }
 }
 
-/// `[defaults]` and every `[[discs]]`.
-fn discs(
+/// `[defaults]` and every `[[discs]]` (or `[plate_defaults]` and every `[[plates]]`).
+/// `names` holds the names taken so far, with the key of their entry (names are unique
+/// across discs and plates); `at_least_one` makes an empty array a problem.
+fn bodies(
     ck: &mut Checker,
+    sec: Sec,
     defaults: Option<&RawDisc>,
     raw: Option<&[RawDisc]>,
+    at_least_one: bool,
+    names: &mut Vec<(String, String)>,
 ) -> Option<Vec<DiscModel>> {
     let empty = RawDisc::default();
     let raw_defaults = defaults.unwrap_or(&empty);
     if raw_defaults.name.is_some() {
         ck.report(
-            "defaults.name",
+            format!("{}.name", sec.defaults),
             None,
             format!(
-                "unknown key ({}; a name belongs to each [[discs]] entry)",
-                schema::expected_text("defaults")
+                "unknown key ({}; a name belongs to each [[{}]] entry)",
+                schema::expected_text(sec.defaults),
+                sec.items
             ),
         );
     }
-    let d = params(ck, "defaults", raw_defaults);
+    let d = params(ck, sec.defaults, raw_defaults);
     let raw = raw.unwrap_or_default();
     if raw.is_empty() {
-        ck.report(
-            "discs",
-            None,
-            "missing (at least one [[discs]] entry is required)",
-        );
-        return None;
+        if at_least_one {
+            ck.report(
+                sec.items,
+                None,
+                format!("missing (at least one [[{}]] entry is required)", sec.items),
+            );
+            return None;
+        }
+        return Some(Vec::new());
     }
 
     let mut out = Some(Vec::with_capacity(raw.len()));
-    let mut names: Vec<Option<String>> = Vec::with_capacity(raw.len());
     for (i, r) in raw.iter().enumerate() {
-        let name_key = format!("discs[{i}].name");
+        let name_key = format!("{}[{i}].name", sec.items);
         let name = match ck.text(&name_key, r.name.as_ref()) {
             Field::Valid(s) if s.trim().is_empty() => {
                 ck.report(&name_key, r.name.as_ref().map(show), "must not be empty");
                 None
             }
-            f => f.or(format!("disc-{}", i + 1)),
+            f => f.or(format!("{}-{}", sec.name_prefix, i + 1)),
         };
         if let Some(n) = &name {
-            if let Some(j) = names.iter().position(|m| m.as_ref() == Some(n)) {
+            if let Some((_, other)) = names.iter().find(|(m, _)| m == n) {
                 ck.report(
                     &name_key,
                     Some(format!("{n:?}")),
-                    format!("names must be unique (discs[{j}] has the same name)"),
+                    format!("names must be unique ({other} has the same name)"),
                 );
             }
+            names.push((n.clone(), format!("{}[{i}]", sec.items)));
         }
-        names.push(name.clone());
-        let own = params(ck, &format!("discs[{i}]"), r);
-        let disc = disc(ck, i, name, &own, &d);
+        let own = params(ck, &format!("{}[{i}]", sec.items), r);
+        let disc = disc(ck, sec, i, name, &own, &d);
         match (disc, out.as_mut()) {
             (Some(disc), Some(v)) => v.push(disc),
             _ => out = None,
@@ -941,39 +1384,51 @@ fn discs(
 /// Resolves and cross-checks one disc.
 fn disc(
     ck: &mut Checker,
+    sec: Sec,
     i: usize,
     name: Option<String>,
     p: &Params,
     d: &Params,
 ) -> Option<DiscModel> {
-    let inertia = required(ck, i, "inertia_kg_m2", &p.inertia, &d.inertia);
+    let item = format!("{}[{i}]", sec.items);
+    let inertia = required(ck, sec, &item, "inertia_kg_m2", &p.inertia, &d.inertia);
     let drag = optional(&p.drag, &d.drag, 0.0);
     let angle = optional(&p.angle, &d.angle, 0.0);
     let speed = optional(&p.speed, &d.speed, 0.0);
     let radial_float = optional(&p.radial_float, &d.radial_float, false);
     let spacing_errors = optional(&p.spacing_errors, &d.spacing_errors, Vec::new());
     let offset = optional(&p.offset, &d.offset, vec![0.0, 0.0]);
-    let teeth = required(ck, i, "spline.teeth", &p.teeth, &d.teeth);
+    let teeth = required(ck, sec, &item, "spline.teeth", &p.teeth, &d.teeth);
     let pitch = required(
         ck,
-        i,
+        sec,
+        &item,
         "spline.pitch_radius_m",
         &p.pitch_radius,
         &d.pitch_radius,
     );
     let alpha_deg = required(
         ck,
-        i,
+        sec,
+        &item,
         "spline.pressure_angle_deg",
         &p.pressure_angle_deg,
         &d.pressure_angle_deg,
     );
-    let backlash = required(ck, i, "spline.backlash_m", &p.backlash, &d.backlash);
+    let backlash = required(
+        ck,
+        sec,
+        &item,
+        "spline.backlash_m",
+        &p.backlash,
+        &d.backlash,
+    );
     let law = optional(&p.law, &d.law, LawKind::Paper).map(|(l, _)| l);
-    let modulus = required(ck, i, "contact.modulus_pa", &p.modulus, &d.modulus);
+    let modulus = required(ck, sec, &item, "contact.modulus_pa", &p.modulus, &d.modulus);
     let curvature = required(
         ck,
-        i,
+        sec,
+        &item,
         "contact.curvature_radius_m",
         &p.curvature,
         &d.curvature,
@@ -988,11 +1443,11 @@ fn disc(
             pick(disc, defaults)
                 .required(
                     ck,
-                    &format!("discs[{i}].{k}"),
+                    &format!("{item}.{k}"),
                     &format!(
                         "required when oil.film_thickness_m > 0 and contact.law is not \"dry\"; \
                          set it in {}",
-                        where_to_set(k)
+                        where_to_set(sec, k)
                     ),
                 )
                 .map(|(v, _)| v)
@@ -1021,11 +1476,11 @@ fn disc(
     if let (Some(n), Some((errors, source))) = (teeth, spacing_errors.as_ref()) {
         if !errors.is_empty() && errors.len() != n as usize {
             ck.report(
-                format!("discs[{i}].tooth_spacing_errors_m"),
+                format!("{item}.tooth_spacing_errors_m"),
                 Some(format!("[...{} numbers]", errors.len())),
                 format!(
                     "must have one number per tooth (spline.teeth = {n}) or be empty{}",
-                    inherited(*source, "tooth_spacing_errors_m")
+                    inherited(sec, *source, "tooth_spacing_errors_m")
                 ),
             );
             spacing_ok = false;
@@ -1041,25 +1496,25 @@ fn disc(
         let offset_m = if kind == LawKind::Dry { 0.0 } else { h_o };
         if kind != LawKind::Dry && h_o >= half_play_m {
             ck.report(
-                format!("discs[{i}].oil.film_thickness_m"),
+                format!("{item}.oil.film_thickness_m"),
                 Some(h_o.to_string()),
                 format!(
                     "must be < g0 Rb = {half_play_m:.6e} m, half the free play along the line \
                      of action (else both flanks engage at once){}",
-                    inherited(film_source, "oil.film_thickness_m")
+                    inherited(sec, film_source, "oil.film_thickness_m")
                 ),
             );
             inside = false;
         } else if phi0.abs() * spline.base_radius_m() >= half_play_m - offset_m {
             let reach_m = half_play_m - offset_m;
             ck.report(
-                format!("discs[{i}].initial_rel_angle_rad"),
+                format!("{item}.initial_rel_angle_rad"),
                 Some(phi0.to_string()),
                 format!(
                     "the disc must start inside the free play: |phi0| Rb must be < g0 Rb - h_o \
                      = {reach_m:.6e} m, i.e. |phi0| < {:.6e} rad{}",
                     reach_m / spline.base_radius_m(),
-                    inherited(angle_source, "initial_rel_angle_rad")
+                    inherited(sec, angle_source, "initial_rel_angle_rad")
                 ),
             );
             inside = false;
@@ -1089,13 +1544,13 @@ fn disc(
                     )
                 };
                 ck.report(
-                    format!("discs[{i}].{key}"),
+                    format!("{item}.{key}"),
                     Some(value),
                     format!(
                         "every tooth must start inside the free play: |phi0| Rb + max|e_k| \
                          cos(alpha) + |offset| = {:.6e} m must be < g0 Rb - h_o = {reach_m:.6e} m{}",
                         phi0.abs() * spline.base_radius_m() + along + offset_len,
-                        inherited(source, k)
+                        inherited(sec, source, k)
                     ),
                 );
                 inside = false;

@@ -651,3 +651,158 @@ fn bad_radial_keys_are_reported_with_key_value_and_rule() {
     let e = parse_err(PAPER, &[&set, "discs[0].initial_offset_m=[30e-6, 0]"]);
     problem_at(&e, "discs[0].initial_offset_m");
 }
+
+/// A clutch (MODEL.md section 5): two discs on the shaft, three plates on a drum, the stack
+/// with a piston ramp, a Stribeck-like friction curve and open gaps.
+const CLUTCH: &str = r#"
+[simulation]
+duration_s = 0.1
+
+[drive]
+kind = "sine"
+omega0_rad_s = 100
+amplitude_rad_s = 0
+frequency_hz = 1
+
+[defaults]
+inertia_kg_m2 = 0.156
+[defaults.spline]
+teeth = 154
+pitch_radius_m = 0.231
+pressure_angle_deg = 20.0
+backlash_m = 0.75e-3
+[defaults.contact]
+law = "dry"
+modulus_pa = 210e9
+curvature_radius_m = 5e-3
+
+[plate_defaults]
+inertia_kg_m2 = 0.12
+[plate_defaults.spline]
+teeth = 120
+pitch_radius_m = 0.31
+pressure_angle_deg = 30.0
+backlash_m = 0.5e-3
+[plate_defaults.contact]
+law = "dry"
+modulus_pa = 210e9
+curvature_radius_m = 5e-3
+
+[[discs]]
+[[discs]]
+[[plates]]
+[[plates]]
+name = "middle"
+inertia_kg_m2 = 0.1
+[[plates]]
+
+[drum]
+inertia_kg_m2 = 0.5
+load_torque_n_m = -20
+
+[stack]
+face_inner_radius_m = 0.235
+face_outer_radius_m = 0.29
+piston_area_m2 = 0.012
+return_spring_n = 800
+spline_friction_coefficient = 0.1
+[stack.friction]
+static_mu = 0.1
+kinetic_mu = 0.13
+stribeck_speed_m_s = 0.5
+[stack.pressure]
+kind = "ramp"
+start_s = 0.01
+rise_s = 0.02
+pressure_pa = 8e5
+[stack.open_gap]
+viscosity_pa_s = 0.02
+gap_m = 0.1e-3
+"#;
+
+/// Plates, the drum and the stack reach the model: plates take [plate_defaults] (not the
+/// discs' [defaults]) and are named plate-<j+1>; the pressure ramp, the friction curve (its
+/// kinetic mu defaults to the static one) and the open gaps are read in SI.
+#[test]
+fn clutch_stack_reaches_the_model() {
+    let s = parse_ok(CLUTCH, &[]);
+    let p = &s.pack;
+    assert_eq!(p.discs.len(), 2);
+    assert_eq!(p.plates.len(), 3);
+    assert_eq!(p.plates[0].name, "plate-1");
+    assert_eq!(p.plates[1].name, "middle");
+    assert_eq!(p.plates[1].inertia_kg_m2, 0.1);
+    assert_eq!(p.plates[2].spline.teeth, 120);
+    assert_relative_eq!(p.plates[0].spline.pressure_angle_rad, 30f64.to_radians());
+    let drum = p.drum.unwrap();
+    assert_eq!((drum.inertia_kg_m2, drum.load_torque_n_m), (0.5, -20.0));
+    let st = p.stack.as_ref().unwrap();
+    assert_eq!(st.piston.return_spring_n, 800.0);
+    assert_relative_eq!(
+        st.piston.force_n(0.02),
+        4e5 * 0.012 - 800.0,
+        max_relative = 1e-12
+    );
+    assert_eq!(st.spline_friction, 0.1);
+    assert_eq!(st.friction.static_mu(), 0.1);
+    assert_eq!(st.open_gap.unwrap().gap_m, 0.1e-3);
+    assert!(!p.is_torsional());
+
+    let s = parse_ok(
+        CLUTCH,
+        &[
+            "stack.friction={ kind = \"table\", slip_m_s = [0, 1, 5], mu = [0.1, 0.12, 0.13] }",
+            "stack.pressure={ kind = \"table\", times_s = [0, 0.05], values_pa = [0, 1e6] }",
+        ],
+    );
+    let st = s.pack.stack.unwrap();
+    assert_relative_eq!(st.friction.mu(0.5), 0.11, max_relative = 1e-12);
+    assert_relative_eq!(
+        st.piston.pressure.pressure_pa(0.025),
+        5e5,
+        max_relative = 1e-12
+    );
+}
+
+/// Mistakes in the stack are named with key, value and rule: N discs need N + 1 plates, a
+/// drum needs plates, outer radius above inner, a table that does not increase, keys of
+/// another pressure kind, and a name shared by a disc and a plate.
+#[test]
+fn stack_mistakes_are_reported() {
+    let e = parse_err(&CLUTCH.replace("[[plates]]\nname = \"middle\"", "#"), &[]);
+    let p = problem_at(&e, "plates");
+    assert!(p.rule.contains("needs 3 [[plates]] entries"), "{p}");
+
+    let e = parse_err(
+        CLUTCH,
+        &[
+            "stack.face_outer_radius_m=0.2",
+            "stack.pressure.times_s=[0, 1]",
+            "plates[1].name=disc-2",
+        ],
+    );
+    assert!(problem_at(&e, "stack.face_outer_radius_m")
+        .rule
+        .starts_with("must be > stack.face_inner_radius_m"));
+    assert!(problem_at(&e, "stack.pressure.times_s")
+        .rule
+        .starts_with("not used by this stack.pressure.kind"));
+    let p = problem_at(&e, "plates[1].name");
+    assert!(p.rule.contains("discs[1] has the same name"), "{p}");
+
+    let e = parse_err(
+        CLUTCH,
+        &["stack.friction={ kind = \"table\", slip_m_s = [0, 2, 1], mu = [0.1, 0.12, 0.13] }"],
+    );
+    assert!(problem_at(&e, "stack.friction.slip_m_s[2]")
+        .rule
+        .starts_with("must increase strictly"));
+
+    // no plates and no stack, but a drum
+    let text = CLUTCH.split("[stack]").next().unwrap().replace(
+        "[[plates]]\n[[plates]]\nname = \"middle\"\ninertia_kg_m2 = 0.1\n[[plates]]\n",
+        "",
+    );
+    let e = parse_err(&text, &[]);
+    assert!(problem_at(&e, "drum").rule.contains("add [[plates]]"));
+}
