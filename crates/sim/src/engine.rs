@@ -392,6 +392,9 @@ struct Run<'a> {
     /// The teeth: the past half of their kick (N m s on the body, about the axis) and the
     /// relative motion at `t` for the future half.
     teeth_past: Vec<f64>,
+    /// The last `(x, teeth_impulse(i, x))` of each coupling since the last evaluation (the
+    /// step's impulse is asked for by the stack, the landing and the forces).
+    teeth_cache: Vec<std::cell::Cell<(f64, f64)>>,
     teeth_motion: Vec<Motion>,
     /// Body speeds at `t` (synchronised with the poses), rad/s.
     omega_d: Vec<f64>,
@@ -512,6 +515,7 @@ impl<'a> Run<'a> {
             shaft_full_history: LoadHistory::default(),
             prev_motion: vec![None; nd],
             teeth_past: vec![0.0; nd],
+            teeth_cache: vec![std::cell::Cell::new((f64::NAN, 0.0)); nd],
             teeth_motion: vec![Motion::default(); nd],
             omega_d: Vec::with_capacity(nd),
             t_prev: None,
@@ -854,6 +858,9 @@ impl<'a> Run<'a> {
             }
             None => 0.0,
         };
+        for c in &self.teeth_cache {
+            c.set((f64::NAN, 0.0));
+        }
         for (i, m) in self.teeth_motion.iter_mut().enumerate() {
             let carrier_accel = match self.world.carriers[i] {
                 Carrier::Shaft => shaft_accel,
@@ -880,8 +887,15 @@ impl<'a> Run<'a> {
     /// The impulse of the teeth of coupling `i` on its body about the axis over a step of
     /// length `x` from `t` (both halves of the kick), N m s.
     fn teeth_impulse(&self, i: usize, x: f64) -> f64 {
+        let (cx, cv) = self.teeth_cache[i].get();
+        if cx == x {
+            return cv;
+        }
         let c = &self.couplings[i];
-        self.teeth_past[i] + future_impulse(&self.teeth_motion[i], x, |p, d| c.probe_torque(p, d))
+        let v = self.teeth_past[i]
+            + future_impulse(&self.teeth_motion[i], x, |p, d| c.probe_torque(p, d));
+        self.teeth_cache[i].set((x, v));
+        v
     }
 
     /// The drive torque on an inertial shaft integrated against the rising ramp of the last
@@ -1135,7 +1149,12 @@ impl<'a> Run<'a> {
             }
             _ => 0.0,
         };
+        // The carriers' turns over the whole step, computed once (a drum's sums every plate's
+        // teeth).
+        let (shaft_turn_h, drum_turn_h) = (shaft_turn(h), drum_turn(h));
         let carrier_turn = |i: usize, x: f64| match self.world.carriers[i] {
+            Carrier::Shaft if x == h => shaft_turn_h,
+            Carrier::Drum if x == h => drum_turn_h,
             Carrier::Shaft => shaft_turn(x),
             Carrier::Drum => drum_turn(x),
             Carrier::Housing => 0.0,

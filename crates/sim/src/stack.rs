@@ -19,10 +19,16 @@
 //!   taken implicitly on the slip at the end of the step (backward Euler: stable for any
 //!   viscosity and step).
 //!
-//! All interfaces of the stack are coupled through the bodies they share; the impulses are
-//! found together by projected Gauss-Seidel sweeps along the stack (each sweep solves every
-//! interface for the current impulses of its neighbours, then clamps it to its bound), warm
-//! started from the last step, to a change of every slip speed below 1e-12 rad/s.
+//! All interfaces of the stack are coupled through the bodies they share. For a guess of
+//! which interfaces stick and which slip (and which way), the conditions are linear and
+//! tridiagonal along the stack and are solved directly; the guess starts from the last step
+//! and is corrected until consistent (a sticking face that needs more than its bound slips, a
+//! slipping face whose friction would drive the slip sticks), an active-set method that
+//! settles in one or two solves. Should the guesses cycle, projected Gauss-Seidel sweeps
+//! (each interface solved for its neighbours' impulses, then clamped to its bound), warm
+//! started from the last step, decide instead. (Gauss-Seidel alone converges slowly on a
+//! locked stack: measured about a hundred sweeps per step on six locked discs, 40 % of the
+//! run time.)
 
 // Index loops over the interfaces mirror the equations (interface m joins stack bodies m and
 // m + 1); iterator chains would obscure them.
@@ -30,8 +36,7 @@
 
 use clutchpack_model::{InterfaceSample, StackModel};
 
-/// Most Gauss-Seidel sweeps per step (a fully locked stack of 8 discs converges in about a
-/// hundred from a cold start, in a few when warm started).
+/// Most Gauss-Seidel sweeps per step (the fallback of the active-set solve).
 const MAX_SWEEPS: usize = 5000;
 
 /// The stack's state during a run.
@@ -146,6 +151,11 @@ impl<'a> Stack<'a> {
             })
             .collect();
         let k_gap = self.c_gap * h;
+        if let Some(q) = self.active_set(&w, &inv, &bound, k_gap) {
+            self.impulse = q;
+            self.finish(h, &bound);
+            return;
+        }
         for m in 0..n_if {
             let q = if self.clamp[m] > 0.0 {
                 self.impulse[m].clamp(-bound[m], bound[m])
@@ -187,6 +197,12 @@ impl<'a> Stack<'a> {
                 break;
             }
         }
+        self.finish(h, &bound);
+    }
+
+    /// The torques and lock flags of the solved impulses.
+    fn finish(&mut self, h: f64, bound: &[f64]) {
+        let n_if = self.interfaces();
         self.torque.iter_mut().for_each(|t| *t = 0.0);
         for m in 0..n_if {
             self.locked[m] = self.clamp[m] > 0.0 && self.impulse[m].abs() < bound[m];
@@ -194,6 +210,95 @@ impl<'a> Stack<'a> {
             self.torque[m + 1] += t;
             self.torque[m] -= t;
         }
+    }
+
+    /// The exact impulses for a guess of which interfaces stick and which slip (which way),
+    /// improved until the guess is consistent: each guess makes the conditions linear
+    /// (stick: no slip at the end of the step; slip: the bound, opposing the slip; open: the
+    /// implicit damper), a tridiagonal system along the stack solved directly; a sticking
+    /// interface that needs more than its bound slips, a slipping one whose friction would
+    /// drive the slip sticks. The guess starts from the last step, so in steady slip or lock
+    /// one solve does. `None` if the guesses cycle (then Gauss-Seidel sweeps decide).
+    fn active_set(&self, wp: &[f64], inv: &[f64], bound: &[f64], k_gap: f64) -> Option<Vec<f64>> {
+        #[derive(Clone, Copy, PartialEq)]
+        enum State {
+            Stick,
+            Slip(f64),
+            Open,
+        }
+        let n = bound.len();
+        let vp: Vec<f64> = (0..n).map(|m| wp[m + 1] - wp[m]).collect();
+        let mut state: Vec<State> = (0..n)
+            .map(|m| {
+                if self.clamp[m] <= 0.0 {
+                    State::Open
+                } else if self.locked[m] {
+                    State::Stick
+                } else if self.impulse[m] != 0.0 {
+                    State::Slip(self.impulse[m].signum())
+                } else {
+                    State::Slip(-vp[m].signum())
+                }
+            })
+            .collect();
+        let (mut a, mut b, mut c, mut d) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let mut q = vec![0.0; n];
+        let scale = wp.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        let tol = (1e-12f64).max(1e-15 * scale);
+        for _ in 0..2 * n + 4 {
+            for m in 0..n {
+                let s = inv[m] + inv[m + 1];
+                (a[m], b[m], c[m], d[m]) = match state[m] {
+                    State::Stick => (-inv[m], s, -inv[m + 1], -vp[m]),
+                    State::Slip(sigma) => (0.0, 1.0, 0.0, sigma * bound[m]),
+                    State::Open if k_gap > 0.0 => (
+                        -k_gap * inv[m],
+                        1.0 + k_gap * s,
+                        -k_gap * inv[m + 1],
+                        -k_gap * vp[m],
+                    ),
+                    State::Open => (0.0, 1.0, 0.0, 0.0),
+                };
+            }
+            // Thomas algorithm (the matrix is diagonally dominant)
+            for m in 1..n {
+                let w = a[m] / b[m - 1];
+                b[m] -= w * c[m - 1];
+                d[m] -= w * d[m - 1];
+            }
+            q[n - 1] = d[n - 1] / b[n - 1];
+            for m in (0..n - 1).rev() {
+                q[m] = (d[m] - c[m] * q[m + 1]) / b[m];
+            }
+            if !q.iter().all(|x| x.is_finite()) {
+                return None;
+            }
+            let mut changed = false;
+            for m in 0..n {
+                match state[m] {
+                    State::Stick if q[m].abs() > bound[m] => {
+                        state[m] = State::Slip(q[m].signum());
+                        changed = true;
+                    }
+                    State::Slip(sigma) => {
+                        let below = if m > 0 { q[m - 1] } else { 0.0 };
+                        let above = if m + 1 < n { q[m + 1] } else { 0.0 };
+                        let v = vp[m] + (inv[m] + inv[m + 1]) * q[m]
+                            - inv[m + 1] * above
+                            - inv[m] * below;
+                        if sigma * v > tol {
+                            state[m] = State::Stick;
+                            changed = true;
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            if !changed {
+                return Some(q);
+            }
+        }
+        None
     }
 
     /// The torque of the stack on coupling body `i` over the step being taken, N m.
