@@ -204,10 +204,12 @@ pub fn run_info(
     let mut params = std::collections::BTreeMap::new();
     params.insert("duration_s".to_string(), sim.duration_s.to_string());
     params.insert("record_rate_hz".to_string(), sim.record_rate_hz.to_string());
+    // The engines emit the separator plates after the discs: the recording draws both.
     let discs = scene
         .pack
         .discs
         .iter()
+        .chain(&scene.pack.plates)
         .enumerate()
         .map(|(i, d)| {
             let ri = d.spline.pitch_radius_m;
