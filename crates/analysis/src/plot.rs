@@ -826,7 +826,7 @@ mod tests {
                         let tau = t - k as f64 * 4e-3;
                         let width = 60e-6 * (1.0 + 0.2 * d as f64);
                         let amp = (400.0 + 150.0 * ((k * 7 + d * 3) % 5) as f64)
-                            * if (k + d) % 3 == 0 { 1.0 } else { -1.0 };
+                            * if (k + d).is_multiple_of(3) { 1.0 } else { -1.0 };
                         let f = if tau < width {
                             amp * (std::f64::consts::PI * tau / width).sin()
                         } else {
