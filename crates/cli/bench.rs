@@ -1,10 +1,14 @@
 //! `clutchpack bench`: speed figures as ratios and times, printed, never asserted.
 
 use crate::common::{self, RunCollector};
+use crate::run::run_recorded;
 use crate::sweep::run_cases;
 use anyhow::Result;
+use clutchpack_record::{RecordOptions, Recorder};
 use clutchpack_scene::Override;
 use std::process::ExitCode;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Arguments of `clutchpack bench`.
@@ -16,6 +20,10 @@ pub struct BenchArgs {
     /// Repetitions of each sweep timing (the best is reported).
     #[arg(long, default_value_t = 3)]
     pub repeats: usize,
+    /// Repetitions of each recording-overhead timing, recorded and not in turn (the medians
+    /// are reported); 0 skips that part.
+    #[arg(long, default_value_t = 7)]
+    pub record_runs: usize,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -85,5 +93,95 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         best[0] / best[1],
         if best[0] / best[1] >= 1.7 { "met" } else { "NOT met" }
     );
+
+    // 3. The cost of recording at the default rate: the same run with and without the
+    //    recorder (its thread, the default options, the file finished), in turn.
+    if a.record_runs > 0 {
+        let dir = std::env::temp_dir().join(format!("clutchpack-bench-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)?;
+        let cases: [(&str, Option<&str>, Option<f64>); 4] = [
+            ("paper case, 0.3 s", None, None),
+            ("paper case, 3 s", None, Some(3.0)),
+            (
+                "pack-4-rattle, 1 s",
+                Some("scenes/pack-4-rattle.toml"),
+                Some(1.0),
+            ),
+            (
+                "bench-8-disc (multibody), 0.1 s",
+                Some("scenes/bench-8-disc.toml"),
+                None,
+            ),
+        ];
+        for (label, file, duration) in cases {
+            let path = file.map(std::path::PathBuf::from);
+            if path.as_ref().is_some_and(|p| !p.exists()) {
+                out!("recording overhead, {label}: skipped (run from the repository root)");
+                continue;
+            }
+            let sets: Vec<Override> = duration
+                .map(|d| Override {
+                    key: "simulation.duration_s".into(),
+                    value: d.to_string(),
+                })
+                .into_iter()
+                .collect();
+            let scene = common::load_scene(path.as_deref(), &sets)?;
+            let (mut plain, mut recorded, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
+            let (mut engine_cpu, mut recorder_cpu) = (Vec::new(), Vec::new());
+            let mut plain_cpu = Vec::new();
+            let mut bytes = 0;
+            for k in 0..a.record_runs {
+                let mut pair = [0.0; 2];
+                for record in [false, true] {
+                    let mut engine = common::make_engine(&scene, None)?;
+                    let collector = RunCollector::new(engine.disc_names().len(), false);
+                    let out = dir.join(format!("run-{k}.mcap"));
+                    let recorder = if record {
+                        let info = common::run_info(&scene, engine.name(), path.as_deref());
+                        Some(Recorder::create(&out, &info, &RecordOptions::default())?)
+                    } else {
+                        None
+                    };
+                    let t0 = Instant::now();
+                    let done = run_recorded(
+                        engine.as_mut(),
+                        scene.simulation.duration_s,
+                        collector,
+                        recorder,
+                        Arc::new(AtomicBool::new(false)),
+                    )?;
+                    let wall = t0.elapsed().as_secs_f64();
+                    done.result?;
+                    pair[usize::from(record)] = wall;
+                    if record {
+                        recorded.push(wall);
+                        engine_cpu.push(done.engine_cpu_s);
+                        recorder_cpu.push(done.recorder_cpu_s);
+                        bytes = std::fs::metadata(&out).map(|m| m.len()).unwrap_or(0);
+                        let _ = std::fs::remove_file(&out);
+                    } else {
+                        plain.push(wall);
+                        plain_cpu.push(done.engine_cpu_s);
+                    }
+                }
+                ratios.push(pair[1] / pair[0]);
+            }
+            let (p, r, q) = (median(plain), median(recorded), median(ratios));
+            out!(
+                "recording overhead, {label} at {} Hz: {:.1} ms without, {:.1} ms with ({:.1} MB); median of the pairs' ratios {:+.1} %; target <= +10 %: {}; engine thread's CPU {:.1} ms without, {:.1} ms with; recording thread's CPU {:.0} % of the engine's",
+                scene.simulation.record_rate_hz,
+                p * 1e3,
+                r * 1e3,
+                bytes as f64 / 1e6,
+                (q - 1.0) * 100.0,
+                if q <= 1.1 { "met" } else { "NOT met" },
+                median(plain_cpu.clone()) * 1e3,
+                median(engine_cpu.clone()) * 1e3,
+                100.0 * median(recorder_cpu) / median(engine_cpu).max(1e-12)
+            );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
     Ok(ExitCode::SUCCESS)
 }

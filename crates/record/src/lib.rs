@@ -33,7 +33,7 @@
 //!
 //! | topic | schema | when | fields (units in names) |
 //! | --- | --- | --- | --- |
-//! | `/tf` | `foxglove.FrameTransforms` | every [`RecordOptions::tf_interval_s`] (0.1 ms) | `world` -> `shaft`, `world` -> `disc/<segment>`: rotation about +z, discs at `z_m` |
+//! | `/tf` | `foxglove.FrameTransforms` | every [`RecordOptions::tf_interval_s`] (0.2 ms) | `world` -> `shaft`, `world` -> `disc/<segment>`: rotation about +z, discs at `z_m` |
 //! | `/scene` | `foxglove.SceneUpdate` | t = 0, then every [`RecordOptions::scene_interval_s`] | shaft cylinder, disc annuli (triangle meshes), teeth coloured by load |
 //! | `/shaft` | `clutchpack.ShaftState` | each sample | `t_s, angle_rad, speed_rad_s` |
 //! | `/discs/<segment>/spline` | `clutchpack.SplineState` | each sample | `t_s, rel_angle_rad, closing_speed_m_s, penetration_m, load_n, torque_n_m, engaged, stiffness_n_m1_5, speed_rad_s, angle_rad, disc_index` |
@@ -70,20 +70,21 @@
 //! ```
 //!
 //! ## Cost
-//! Measured with `cargo bench -p clutchpack_record` and callgrind on the 2-core dev machine:
-//! writing costs about 1 us of the engine thread per message (mostly the MCAP writer's
-//! small writes into the zstd stream; compression itself runs on one zstd worker thread),
-//! so about 10-15 us per sample of an 8-disc pack (`/shaft`, eight spline messages, `/tf`
-//! every 0.1 ms), and about 40 bytes per message on disk. Memory stays flat with run
-//! length: one chunk (1 MiB) in memory, plus the chunk index and the impact peaks. Opening
-//! reads the whole file into memory and scans it at about 100-300 MB/s.
+//! Measured with `cargo bench -p clutchpack_record` on the 2-core dev machine: writing one
+//! sample of an 8-disc pack (`/shaft`, eight spline messages, `/tf` every 0.2 ms, the load
+//! collars every 1 ms) costs about 9 us, roughly 1 us per message, most of it the MCAP
+//! writer's seven small writes per message record into the zstd stream; about 40 bytes per
+//! message on disk. The CLI runs the recorder on its own thread (`clutchpack bench` reports
+//! its CPU time against the engine's and the wall-time overhead of recording). Memory stays
+//! flat with run length: one chunk (1 MiB) in memory, plus the chunk index and the impact
+//! peaks. Opening reads the whole file into memory and scans it at about 100-300 MB/s.
 //!
 //! # Conventions
 //! - SI units, named in fields and keys (`load_n`, `t_s`); loads are per tooth, negative
 //!   when the shaft leads (Hu et al. eq (6)), as in `clutchpack_model`.
 //! - z is the shaft axis; positive rotation is the shaft's running direction (about +z).
 //! - Deterministic recordings ([`RecordOptions::deterministic`]) of the same stream are
-//!   byte-identical: no wall-clock data, zstd with a fixed job layout (one worker thread),
+//!   byte-identical: no wall-clock data, single-threaded zstd,
 //!   chunks cut by message count and size only.
 //! - Errors: [`RecordError`] for writing, [`ReadError`] for reading; each displays as one line.
 

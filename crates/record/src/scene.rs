@@ -5,11 +5,20 @@
 //! disc's frame `disc/<name>` sit on the axis (a disc's at its mid-plane `z_m`) and turn about
 //! +z by the body's angle. Entities are `frame_locked`, so they follow their frame. The first
 //! `/scene` message (at t = 0) holds the static bodies: the shaft cylinder with a stripe, and
-//! each disc as a triangle-mesh annulus with a rim marker. Later `/scene` messages replace one
-//! entity per disc, `disc/<name>/teeth`: its spline teeth as cubes coloured by the largest
-//! `|load_n|` since the previous update (grey = no load, yellow = half, red = the colour
-//! scale). An update holds only the discs whose colour changed (levels in steps of 1/16), so
-//! quiet stretches cost nothing.
+//! each disc as a triangle-mesh annulus with a rim marker and its spline teeth (steel grey).
+//!
+//! Loads are shown by small entities that later `/scene` messages replace:
+//! - `disc/<name>/load`: a translucent collar over the disc's spline teeth, coloured by the
+//!   largest `|load_n|` since the previous update (grey = no load, yellow = half, red = the
+//!   colour scale). One primitive per disc, about 200 bytes.
+//! - `disc/<name>/teeth`, only for samples that carry per-tooth loads: the teeth redrawn as
+//!   cubes, each coloured by its own largest `|load|` since the previous update (about 130
+//!   bytes per tooth).
+//!
+//! An update holds only the discs whose colour changed (levels in steps of 1/16), so quiet
+//! stretches cost nothing. Redrawing every tooth for a lumped load (one colour for all) was
+//! measured at 10 kB per disc and update, 70 % of a recording's bytes and most of its
+//! writing time; the collar says the same in 200 bytes.
 
 use crate::info::{DiscGeometry, RunInfo};
 use foxglove::schemas::{
@@ -221,22 +230,59 @@ pub(crate) fn static_scene(info: &RunInfo, frames: &[String]) -> SceneUpdate {
             size: Some(v3(2.0 * w, w, h * 1.02)),
             color: rgba(0.1, 0.1, 0.1, 1.0),
         });
+        e.cubes.extend(tooth_cubes(d, |_| STEEL));
         entities.push(e);
     }
-    let mut update = SceneUpdate {
+    let zeros: Vec<(usize, f64)> = (0..info.discs.len()).map(|i| (i, 0.0)).collect();
+    entities.extend(load_scene(0, info, frames, &zeros).entities);
+    SceneUpdate {
         deletions: Vec::new(),
         entities,
-    };
-    let zeros: Vec<(usize, f64)> = (0..info.discs.len()).map(|i| (i, 0.0)).collect();
-    update
-        .entities
-        .extend(teeth_scene(0, info, frames, &zeros).entities);
-    update
+    }
 }
 
-/// The teeth of the discs `levels` names, `(disc index, level)`, coloured by the level
-/// `max |load| / scale` (0..=1). The entities of other discs are left as they are.
-pub(crate) fn teeth_scene(
+/// The colour of the teeth in the static scene.
+const STEEL: Color = Color {
+    r: 0.45,
+    g: 0.47,
+    b: 0.5,
+    a: 1.0,
+};
+
+/// Teeth drawn for a disc: its tooth count, or a few markers when unknown, at most
+/// [`MAX_TEETH`].
+pub(crate) fn drawn_teeth(d: &DiscGeometry) -> u32 {
+    if d.teeth == 0 {
+        MARKERS
+    } else {
+        d.teeth.min(MAX_TEETH)
+    }
+}
+
+/// The drawn teeth of `d` as cubes on the inner edge, tooth `k` coloured `color(k)`.
+fn tooth_cubes(d: &DiscGeometry, color: impl Fn(usize) -> Color) -> Vec<CubePrimitive> {
+    let n = drawn_teeth(d);
+    let depth = tooth_depth(d).max(1e-6);
+    let r = d.inner_radius_m.min(d.outer_radius_m) - 0.5 * depth;
+    let width = 0.5 * 2.0 * PI * d.inner_radius_m.abs() / f64::from(n);
+    let size = Some(v3(depth, width.max(1e-6), d.thickness_m.abs().max(1e-6)));
+    (0..n)
+        .map(|i| {
+            let a = 2.0 * PI * f64::from(i) / f64::from(n);
+            CubePrimitive {
+                pose: pose(r * a.cos(), r * a.sin(), 0.0, a),
+                size,
+                color: Some(color(i as usize)),
+            }
+        })
+        .collect()
+}
+
+/// The load collars of the discs `levels` names, `(disc index, level)`, coloured by the
+/// level `max |load| / scale` (0..=1): a translucent cylinder over each disc's spline teeth
+/// (radius the tooth root, a little thicker than the disc). Other discs' collars are left as
+/// they are.
+pub(crate) fn load_scene(
     log_time_ns: u64,
     info: &RunInfo,
     frames: &[String],
@@ -247,24 +293,44 @@ pub(crate) fn teeth_scene(
         let (Some(d), Some(frame)) = (info.discs.get(i), frames.get(i)) else {
             continue;
         };
-        let mut e = entity(log_time_ns, frame, &format!("{frame}/teeth"));
-        let n = if d.teeth == 0 {
-            MARKERS
-        } else {
-            d.teeth.min(MAX_TEETH)
+        let mut e = entity(log_time_ns, frame, &format!("{frame}/load"));
+        let r = d.inner_radius_m.min(d.outer_radius_m).abs().max(1e-6);
+        let h = 1.4 * d.thickness_m.abs().max(1e-6);
+        let mut color = load_color(level);
+        color.a = 0.55;
+        e.cylinders.push(CylinderPrimitive {
+            pose: pose(0.0, 0.0, 0.0, 0.0),
+            size: Some(v3(2.0 * r, 2.0 * r, h)),
+            bottom_scale: 1.0,
+            top_scale: 1.0,
+            color: Some(color),
+        });
+        entities.push(e);
+    }
+    SceneUpdate {
+        deletions: Vec::new(),
+        entities,
+    }
+}
+
+/// The per-tooth view of the discs `levels` names, `(disc index, level of each drawn tooth)`:
+/// the teeth redrawn as cubes, tooth `k` coloured by its level `max |load_k| / scale`
+/// (0..=1). Other discs' teeth are left as they are.
+pub(crate) fn teeth_scene(
+    log_time_ns: u64,
+    info: &RunInfo,
+    frames: &[String],
+    levels: &[(usize, &[f64])],
+) -> SceneUpdate {
+    let mut entities = Vec::with_capacity(levels.len());
+    for &(i, tooth_levels) in levels {
+        let (Some(d), Some(frame)) = (info.discs.get(i), frames.get(i)) else {
+            continue;
         };
-        let depth = tooth_depth(d).max(1e-6);
-        let r = d.inner_radius_m.min(d.outer_radius_m) - 0.5 * depth;
-        let width = 0.5 * 2.0 * PI * d.inner_radius_m.abs() / f64::from(n);
-        let color = Some(load_color(level));
-        for i in 0..n {
-            let a = 2.0 * PI * f64::from(i) / f64::from(n);
-            e.cubes.push(CubePrimitive {
-                pose: pose(r * a.cos(), r * a.sin(), 0.0, a),
-                size: Some(v3(depth, width.max(1e-6), d.thickness_m.abs().max(1e-6))),
-                color,
-            });
-        }
+        let mut e = entity(log_time_ns, frame, &format!("{frame}/teeth"));
+        e.cubes = tooth_cubes(d, |k| {
+            load_color(tooth_levels.get(k).copied().unwrap_or(0.0))
+        });
         entities.push(e);
     }
     SceneUpdate {

@@ -31,12 +31,15 @@ pub struct RecordOptions {
     /// Target uncompressed chunk size in bytes: a chunk is ended once it is larger.
     /// Default 1 MiB.
     pub chunk_size_bytes: u64,
-    /// zstd level (1..=19; 0 = zstd's default, 3). Default 0.
+    /// zstd level (1..=19; 0 = zstd's default, 3). Default 1, zstd's fastest: on a 3 s
+    /// paper-case run its file was 1.5 % larger than level 3's.
     pub compression_level: u32,
     /// Simulated time between two `/tf` messages in s; 0 writes one per sample. Default
-    /// 1e-4 s: poses at 10 kHz of simulated time are plenty for the 3D view (the exact
-    /// angles are on the spline topics at every sample), and `/tf` is the largest message.
-    /// Samples further apart than this get a `/tf` each.
+    /// 2e-4 s: 50 poses per second of replay at `replay --serve`'s default speed of 0.01,
+    /// smooth in the 3D view, while the exact angles are on the spline topics at every
+    /// sample. `/tf` is the largest message: one per 0.1 ms made the recording thread's CPU
+    /// time 90 % of the paper case engine's, one per 1 ms 56 %. Samples further apart than
+    /// this get a `/tf` each.
     pub tf_interval_s: f64,
     /// Simulated time between two load-coloured `/scene` updates of the teeth in s (an
     /// update holds only the discs whose colour changed); 0 writes only the static scene at
@@ -55,8 +58,8 @@ impl Default for RecordOptions {
             flush_interval: Duration::from_secs(1),
             flush_messages: 100_000,
             chunk_size_bytes: 1 << 20,
-            compression_level: 0,
-            tf_interval_s: 1e-4,
+            compression_level: 1,
+            tf_interval_s: 2e-4,
             scene_interval_s: 1e-3,
             load_color_scale_n: None,
         }
@@ -138,6 +141,11 @@ fn next_tick(t: f64, interval: f64) -> f64 {
     }
 }
 
+/// A colour level (0..=1) in steps of 1/16: a colour is sent again only when this changes.
+fn quantize(level: f64) -> u8 {
+    (level * 16.0).round() as u8
+}
+
 /// Simulated time `t_s` (s) as an MCAP log time in ns (negative and NaN times give 0).
 pub fn log_time_ns(t_s: f64) -> u64 {
     if t_s.is_nan() || t_s <= 0.0 {
@@ -185,8 +193,12 @@ pub struct Recorder {
     next_tf_s: f64,
     next_scene_s: f64,
     max_abs_since_scene: Vec<f64>,
-    /// colour level last sent per disc, in 1/16
+    /// colour level of the load collar last sent per disc, in 1/16
     scene_levels: Vec<u8>,
+    /// per disc, the largest `|load|` of each tooth since the last `/scene` (per-tooth only)
+    tooth_max_since_scene: Vec<Vec<f64>>,
+    /// per disc, the colour level last sent of each drawn tooth, in 1/16
+    tooth_levels: Vec<Vec<u8>>,
     max_abs_run: f64,
     peaks: Vec<Vec<f64>>,
     last_t_s: f64,
@@ -220,10 +232,12 @@ impl Recorder {
         let opts = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             .compression_level(options.compression_level)
-            // one zstd worker thread: compression leaves the engine's thread (about a third
-            // of the recording cost), and zstd's multi-threaded output depends on its job
-            // size, not on the number of workers, so the bytes are the same on every machine
-            .compression_threads(1)
+            // zstd in the writing thread itself (no worker): the recorder already runs beside
+            // the engine (the CLI's recording thread), and a zstd worker made a third busy
+            // thread on a 2-core machine plus a mutex round trip for each of the 7 small
+            // writes of every MCAP message record. Single-threaded zstd output is the same on
+            // every machine, which keeps deterministic recordings byte-identical.
+            .compression_threads(0)
             .chunk_size(Some(options.chunk_size_bytes.max(1)))
             .library(format!(
                 "clutchpack_record {} (mcap-rs {})",
@@ -372,6 +386,8 @@ impl Recorder {
             },
             max_abs_since_scene: vec![0.0; n],
             scene_levels: vec![0; n],
+            tooth_max_since_scene: vec![Vec::new(); n],
+            tooth_levels: vec![Vec::new(); n],
             max_abs_run: 0.0,
             peaks: vec![Vec::new(); n],
             last_t_s: 0.0,
@@ -558,6 +574,15 @@ impl Recorder {
                 self.max_abs_since_scene[i] = self.max_abs_since_scene[i].max(a);
                 self.max_abs_run = self.max_abs_run.max(a);
             }
+            if self.options.per_tooth && !d.tooth_loads_n.is_empty() {
+                let m = &mut self.tooth_max_since_scene[i];
+                m.resize(d.tooth_loads_n.len(), 0.0);
+                for (m, x) in m.iter_mut().zip(&d.tooth_loads_n) {
+                    if x.is_finite() {
+                        *m = m.max(x.abs());
+                    }
+                }
+            }
         }
         if t >= self.next_tf_s {
             self.next_tf_s = next_tick(t, self.options.tf_interval_s);
@@ -582,7 +607,7 @@ impl Recorder {
             let mut changed = Vec::new();
             for (i, a) in self.max_abs_since_scene.iter_mut().enumerate() {
                 let level = (*a / scale).clamp(0.0, 1.0);
-                let q = (level * 16.0).round() as u8;
+                let q = quantize(level);
                 if self.scene_levels.get(i) != Some(&q) {
                     changed.push((i, level));
                     if let Some(l) = self.scene_levels.get_mut(i) {
@@ -591,8 +616,44 @@ impl Recorder {
                 }
                 *a = 0.0;
             }
-            if !changed.is_empty() {
-                let update = scene::teeth_scene(lt, &self.info, &self.frames, &changed);
+            let mut update = scene::load_scene(lt, &self.info, &self.frames, &changed);
+            // per-tooth colours: drawn tooth k shows the largest load of the teeth it stands
+            // for (all of them when the disc has no more teeth than are drawn)
+            let mut teeth: Vec<(usize, Vec<f64>)> = Vec::new();
+            for (i, maxima) in self.tooth_max_since_scene.iter_mut().enumerate() {
+                let Some(d) = self.info.discs.get(i) else {
+                    continue;
+                };
+                if maxima.is_empty() {
+                    continue;
+                }
+                let drawn = scene::drawn_teeth(d) as usize;
+                let n = maxima.len();
+                let levels: Vec<f64> = (0..drawn)
+                    .map(|k| {
+                        let (lo, hi) =
+                            (k * n / drawn, ((k + 1) * n / drawn).max(k * n / drawn + 1));
+                        let m = maxima[lo.min(n - 1)..hi.min(n)]
+                            .iter()
+                            .fold(0.0_f64, |m, x| m.max(*x));
+                        (m / scale).clamp(0.0, 1.0)
+                    })
+                    .collect();
+                let q: Vec<u8> = levels.iter().map(|&l| quantize(l)).collect();
+                if self.tooth_levels[i] != q {
+                    self.tooth_levels[i] = q;
+                    teeth.push((i, levels));
+                }
+                maxima.iter_mut().for_each(|m| *m = 0.0);
+            }
+            if !teeth.is_empty() {
+                let refs: Vec<(usize, &[f64])> =
+                    teeth.iter().map(|(i, l)| (*i, l.as_slice())).collect();
+                update
+                    .entities
+                    .extend(scene::teeth_scene(lt, &self.info, &self.frames, &refs).entities);
+            }
+            if !update.entities.is_empty() {
                 self.put(self.ch.scene, lt, &update, "/scene")?;
             }
         }

@@ -152,16 +152,36 @@ fn foxglove_schemas_and_transforms() {
     let first = &scenes[0];
     let ids: Vec<&str> = first.entities.iter().map(|e| e.id.as_str()).collect();
     assert!(
-        ids.contains(&"shaft") && ids.contains(&"disc/d1") && ids.contains(&"disc/disc_2/teeth")
+        ids.contains(&"shaft") && ids.contains(&"disc/d1") && ids.contains(&"disc/disc_2/load"),
+        "{ids:?}"
     );
     assert!(first.entities.iter().all(|e| e.frame_locked));
-    // a later update colours the teeth: some loaded tooth is not grey
-    let later = &scenes[1];
-    assert!(later
-        .entities
+    // the static disc carries its teeth (synthetic discs have 24)
+    let d1 = first.entities.iter().find(|e| e.id == "disc/d1").unwrap();
+    assert_eq!(d1.cubes.len(), 1 + 24, "rim marker and teeth");
+    // later updates colour the load collars, and (per-tooth run) each tooth by its own load:
+    // the synthetic teeth carry loads rising with the tooth index (tooth 23 2.15 times tooth
+    // 0), so in a loaded update tooth 23 is hotter than tooth 0
+    let later: Vec<_> = scenes[1..].iter().flat_map(|s| &s.entities).collect();
+    let collar_red = later
         .iter()
-        .flat_map(|e| &e.cubes)
-        .any(|c| c.color.unwrap().b < 0.5));
+        .filter(|e| e.id.ends_with("/load"))
+        .flat_map(|e| &e.cylinders)
+        .any(|c| c.color.unwrap().b < 0.5);
+    assert!(collar_red, "a loaded collar is coloured");
+    // r - g - b rises monotonically from grey (-0.6) through yellow (0.15) to red (1)
+    let heat = |e: &foxglove::schemas::SceneEntity, k: usize| {
+        let c = e.cubes[k].color.unwrap();
+        c.r - c.g - c.b
+    };
+    let teeth: Vec<_> = later.iter().filter(|e| e.id == "disc/d1/teeth").collect();
+    assert!(!teeth.is_empty(), "per-tooth updates");
+    assert!(teeth.iter().all(|e| e.cubes.len() == 24));
+    assert!(
+        teeth.iter().any(|e| heat(e, 23) > heat(e, 0) + 0.1),
+        "tooth 23 carries more than tooth 0"
+    );
+    assert!(teeth.iter().all(|e| heat(e, 23) >= heat(e, 0) - 1e-12));
 }
 
 /// The same stream recorded twice with `deterministic` gives byte-identical files.
@@ -618,14 +638,14 @@ fn wall_clock_flush_bounds_the_loss() {
     rec.finish(None).unwrap();
 }
 
-/// By default `/tf` is decimated to one message per 0.1 ms of simulated time, while every
+/// By default `/tf` is decimated to one message per 0.2 ms of simulated time, while every
 /// other topic keeps every sample.
 #[test]
 fn default_tf_rate() {
     let run = small(); // 400 samples, 10 us apart
     let r = open(record(&run, "tf_rate.mcap", &RecordOptions::default())).unwrap();
     let n = |t: &str| r.info().topic(t).unwrap().messages;
-    assert_eq!(n("/tf"), 40, "one per 0.1 ms: t = 0, 0.1 ms, ..., 3.9 ms");
+    assert_eq!(n("/tf"), 20, "one per 0.2 ms: t = 0, 0.2 ms, ..., 3.8 ms");
     assert_eq!(n("/discs/d1/spline"), 400);
     assert_eq!(
         r.samples(),
