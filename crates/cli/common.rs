@@ -228,6 +228,26 @@ pub fn run_info(
             }
         })
         .collect();
+    // Stack order (clutchpack_model::clutch): plate 0, disc 0, plate 1, ..., disc N-1,
+    // plate N; interface m lies between stack bodies m and m + 1.
+    let interfaces = if scene.pack.stack.is_some() {
+        let body = |b: usize| {
+            let list = if b.is_multiple_of(2) {
+                &scene.pack.plates
+            } else {
+                &scene.pack.discs
+            };
+            list.get(b / 2).map(|d| d.name.clone()).unwrap_or_default()
+        };
+        (0..2 * scene.pack.discs.len())
+            .map(|m| clutchpack_record::FrictionInterface {
+                lower: body(m),
+                upper: body(m + 1),
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
     RunInfo {
         program_version: env!("CARGO_PKG_VERSION").to_string(),
         engine: engine.to_string(),
@@ -242,5 +262,6 @@ pub fn run_info(
         params,
         shaft: None,
         discs,
+        interfaces,
     }
 }

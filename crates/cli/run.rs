@@ -54,7 +54,9 @@ pub struct RunArgs {
     /// `simulation.record_per_tooth`).
     #[arg(long)]
     pub per_tooth: bool,
-    /// No wall-clock data in the recording: the same run gives a byte-identical file.
+    /// No wall-clock data in the recording: the same run gives a byte-identical file. Chunks
+    /// are then cut every 100 000 messages only, not every second of wall time, so a killed
+    /// deterministic run can lose more than the last second.
     #[arg(long)]
     pub deterministic: bool,
 }

@@ -35,6 +35,29 @@ pub struct DiscGeometry {
     pub teeth: u32,
 }
 
+/// One friction interface of the stack: the faces between two neighbouring bodies (a
+/// separator plate and a friction disc), named by the two bodies, the lower one (nearer the
+/// piston) first.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FrictionInterface {
+    /// Name of the body below the interface (nearer the piston).
+    pub lower: String,
+    /// Name of the body above it.
+    pub upper: String,
+}
+
+impl FrictionInterface {
+    /// `<lower>__<upper>` of the bodies' topic segments ([`crate::topic_segment`]): the
+    /// interface's topic segment, `/interfaces/<segment>`.
+    pub fn segment(&self) -> String {
+        format!(
+            "{}__{}",
+            crate::topic_segment(&self.lower),
+            crate::topic_segment(&self.upper)
+        )
+    }
+}
+
 /// Geometry of the shaft (a cylinder along z).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShaftGeometry {
@@ -70,6 +93,9 @@ pub struct RunInfo {
     pub shaft: Option<ShaftGeometry>,
     /// The discs, in scene order (the order of `Sample::discs`).
     pub discs: Vec<DiscGeometry>,
+    /// The stack's friction interfaces in stack order (the order of the engine's
+    /// interface samples); empty for a pack without a stack.
+    pub interfaces: Vec<FrictionInterface>,
 }
 
 impl RunInfo {
@@ -173,6 +199,13 @@ impl RunInfo {
             geo.insert(format!("disc.{i}.z_m"), num(d.z_m));
             geo.insert(format!("disc.{i}.teeth"), d.teeth.to_string());
         }
+        if !self.interfaces.is_empty() {
+            geo.insert("interfaces".into(), self.interfaces.len().to_string());
+            for (m, f) in self.interfaces.iter().enumerate() {
+                geo.insert(format!("interface.{m}.lower"), f.lower.clone());
+                geo.insert(format!("interface.{m}.upper"), f.upper.clone());
+            }
+        }
         vec![
             (META_RUN.to_string(), run),
             (META_SOLVER.to_string(), self.solver.clone()),
@@ -201,6 +234,7 @@ impl RunInfo {
             params: get(META_PARAMS).cloned().unwrap_or_default(),
             shaft: None,
             discs: Vec::new(),
+            interfaces: Vec::new(),
         };
         if let Some(geo) = get(META_GEOMETRY) {
             let f = |k: &str| geo.get(k).and_then(|v| v.parse::<f64>().ok());
@@ -229,6 +263,21 @@ impl RunInfo {
                         .get(&format!("disc.{i}.teeth"))
                         .and_then(|v| v.parse().ok())
                         .unwrap_or(0),
+                });
+            }
+            let n: usize = geo
+                .get("interfaces")
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(0);
+            for m in 0..n {
+                let s = |k: &str| {
+                    geo.get(&format!("interface.{m}.{k}"))
+                        .cloned()
+                        .unwrap_or_default()
+                };
+                info.interfaces.push(FrictionInterface {
+                    lower: s("lower"),
+                    upper: s("upper"),
                 });
             }
         }
@@ -318,6 +367,10 @@ mod tests {
                 thickness_m: 0.002,
                 z_m: 0.01,
                 teeth: 30,
+            }],
+            interfaces: vec![FrictionInterface {
+                lower: "plate 0".into(),
+                upper: "d1".into(),
             }],
         };
         let meta = info.to_metadata(&[]);

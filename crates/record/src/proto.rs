@@ -30,6 +30,8 @@ pub const SHAFT_STATE: &str = "clutchpack.ShaftState";
 pub const SPLINE_STATE: &str = "clutchpack.SplineState";
 /// Full schema name of [`ToothLoads`] (topics `/discs/<name>/teeth`).
 pub const TOOTH_LOADS: &str = "clutchpack.ToothLoads";
+/// Full schema name of [`InterfaceState`] (topics `/interfaces/<lower>__<upper>`).
+pub const INTERFACE_STATE: &str = "clutchpack.InterfaceState";
 /// Full schema name of [`Impact`] (topic `/impacts`).
 pub const IMPACT: &str = "clutchpack.Impact";
 /// Full schema name of [`RunSummary`] (topic `/summary`).
@@ -100,6 +102,37 @@ pub struct ToothLoads {
     /// Index of the disc in the scene, from 0.
     #[prost(uint32, tag = "3")]
     pub disc_index: u32,
+}
+
+/// One friction interface of the stack at one sample (topic `/interfaces/<lower>__<upper>`);
+/// the fields of [`clutchpack_model::InterfaceSample`].
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct InterfaceState {
+    /// Simulated time in s.
+    #[prost(double, tag = "1")]
+    pub t_s: f64,
+    /// Slip speed `omega_upper - omega_lower` in rad/s.
+    #[prost(double, tag = "2")]
+    pub slip_rad_s: f64,
+    /// Slip speed at the effective radius in m/s (same sign).
+    #[prost(double, tag = "3")]
+    pub slip_m_s: f64,
+    /// Friction coefficient in use (dimensionless; 0 for an open interface).
+    #[prost(double, tag = "4")]
+    pub mu: f64,
+    /// Clamp force in N (0: open).
+    #[prost(double, tag = "5")]
+    pub clamp_n: f64,
+    /// Torque of the interface on its upper body about +z in N m (the lower body gets the
+    /// opposite).
+    #[prost(double, tag = "6")]
+    pub torque_n_m: f64,
+    /// Whether the faces are locked together (no slip).
+    #[prost(bool, tag = "7")]
+    pub locked: bool,
+    /// Index of the interface along the stack, from 0 (between stack bodies `m` and `m + 1`).
+    #[prost(uint32, tag = "8")]
+    pub interface_index: u32,
 }
 
 /// Which flank is in contact (wire form of [`clutchpack_model::Flank`]).
@@ -354,6 +387,46 @@ pub const MESSAGES: &[MessageDef] = &[
                 3,
                 Uint32,
                 "index of the disc in the scene, from 0",
+            ),
+        ],
+    },
+    MessageDef {
+        name: "InterfaceState",
+        doc:
+            "One friction interface of the stack at one sample. Topic /interfaces/<lower>__<upper>.",
+        fields: &[
+            f("t_s", 1, Double, "simulated time, s"),
+            f(
+                "slip_rad_s",
+                2,
+                Double,
+                "slip speed omega_upper - omega_lower, rad/s",
+            ),
+            f(
+                "slip_m_s",
+                3,
+                Double,
+                "slip speed at the effective radius, m/s (same sign)",
+            ),
+            f(
+                "mu",
+                4,
+                Double,
+                "friction coefficient in use (0 for an open interface)",
+            ),
+            f("clamp_n", 5, Double, "clamp force, N (0: open)"),
+            f(
+                "torque_n_m",
+                6,
+                Double,
+                "torque on the upper body about +z, N m (the lower body gets the opposite)",
+            ),
+            f("locked", 7, Bool, "the faces are locked together (no slip)"),
+            f(
+                "interface_index",
+                8,
+                Uint32,
+                "index of the interface along the stack, from 0",
             ),
         ],
     },
@@ -677,6 +750,20 @@ mod tests {
             .encode_to_vec(),
         );
         check(
+            "InterfaceState",
+            InterfaceState {
+                t_s: 1.0,
+                slip_rad_s: 2.0,
+                slip_m_s: 3.0,
+                mu: 4.0,
+                clamp_n: 5.0,
+                torque_n_m: 6.0,
+                locked: true,
+                interface_index: 8,
+            }
+            .encode_to_vec(),
+        );
+        check(
             "Impact",
             Impact {
                 disc: "a".into(),
@@ -733,7 +820,14 @@ mod tests {
         }
         let set = FileDescriptorSet::decode(file_descriptor_set().as_slice()).unwrap();
         assert_eq!(set.file, vec![fd]);
-        for name in [SHAFT_STATE, SPLINE_STATE, TOOTH_LOADS, IMPACT, RUN_SUMMARY] {
+        for name in [
+            SHAFT_STATE,
+            SPLINE_STATE,
+            TOOTH_LOADS,
+            INTERFACE_STATE,
+            IMPACT,
+            RUN_SUMMARY,
+        ] {
             let short = name.strip_prefix("clutchpack.").unwrap();
             assert!(MESSAGES.iter().any(|m| m.name == short), "{name}");
         }

@@ -224,6 +224,21 @@ pub struct DiscSeries {
     pub teeth: Vec<proto::ToothLoads>,
 }
 
+/// One friction interface's recorded states (`/interfaces/<segment>`), in time order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InterfaceSeries {
+    /// The body below the interface (channel metadata `lower`).
+    pub lower: String,
+    /// The body above it (channel metadata `upper`).
+    pub upper: String,
+    /// Topic segment (`/interfaces/<segment>`).
+    pub segment: String,
+    /// Index of the interface along the stack.
+    pub index: usize,
+    /// The decoded messages.
+    pub states: Vec<proto::InterfaceState>,
+}
+
 /// One disc's per-tooth load history: what `plot` draws and `compare` needs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoadHistory {
@@ -366,6 +381,7 @@ fn validate(v: &MessageView<'_>) -> Result<(), String> {
         proto::SHAFT_STATE => proto::ShaftState::decode(v.data).map(drop),
         proto::SPLINE_STATE => proto::SplineState::decode(v.data).map(drop),
         proto::TOOTH_LOADS => proto::ToothLoads::decode(v.data).map(drop),
+        proto::INTERFACE_STATE => proto::InterfaceState::decode(v.data).map(drop),
         proto::IMPACT => proto::Impact::decode(v.data).map(drop),
         proto::RUN_SUMMARY => proto::RunSummary::decode(v.data).map(drop),
         "foxglove.FrameTransforms" => foxglove::schemas::FrameTransforms::decode(v.data).map(drop),
@@ -849,6 +865,44 @@ impl RecordingReader {
                 }
             }
         });
+        out
+    }
+
+    /// Every friction interface's states, in stack order (empty for a pack without a stack).
+    pub fn interface_series(&self) -> Vec<InterfaceSeries> {
+        let mut by_topic: BTreeMap<&str, InterfaceSeries> = BTreeMap::new();
+        for t in &self.info.topics {
+            if t.schema_name == proto::INTERFACE_STATE {
+                let meta = |k: &str| t.metadata.get(k).cloned().unwrap_or_default();
+                let segment = t
+                    .topic
+                    .strip_prefix(topics::INTERFACES_PREFIX)
+                    .unwrap_or(&t.topic)
+                    .to_string();
+                by_topic.insert(
+                    &t.topic,
+                    InterfaceSeries {
+                        lower: meta("lower"),
+                        upper: meta("upper"),
+                        segment,
+                        index: meta("interface_index").parse().unwrap_or(usize::MAX),
+                        states: Vec::new(),
+                    },
+                );
+            }
+        }
+        self.for_each_message(|v| {
+            if v.schema_name == proto::INTERFACE_STATE {
+                if let (Some(series), Ok(m)) = (
+                    by_topic.get_mut(v.topic),
+                    proto::InterfaceState::decode(v.data),
+                ) {
+                    series.states.push(m);
+                }
+            }
+        });
+        let mut out: Vec<InterfaceSeries> = by_topic.into_values().collect();
+        out.sort_by_key(|s| s.index);
         out
     }
 

@@ -2,8 +2,8 @@
 //! whose per-tooth loads are half-sine pulses of alternating sign, with the impacts detected
 //! from them by [`clutchpack_model::detect_impacts`]. No engine is involved.
 
-use crate::info::{DiscGeometry, RunInfo};
-use clutchpack_model::{detect_impacts, DiscSample, ImpactEvent, Sample};
+use crate::info::{DiscGeometry, FrictionInterface, RunInfo};
+use clutchpack_model::{detect_impacts, DiscSample, ImpactEvent, InterfaceSample, Sample};
 use std::f64::consts::PI;
 
 /// Samples and impacts of a synthetic run.
@@ -15,6 +15,8 @@ pub struct SyntheticRun {
     pub samples: Vec<Sample>,
     /// The impacts of both discs, ordered by their separation time.
     pub impacts: Vec<ImpactEvent>,
+    /// The one friction interface (between the two discs) at each sample's time (s).
+    pub interfaces: Vec<(f64, Vec<InterfaceSample>)>,
 }
 
 /// Teeth per disc in the synthetic run.
@@ -23,7 +25,9 @@ pub const TEETH: usize = 6;
 /// `n` samples every `dt_s` seconds (s) of two discs named `d1` and `disc 2` (a name that
 /// needs a topic-safe segment). Disc `i`'s load is a train of half-sine pulses of 0.6 ms
 /// every 1.5 ms, of peak `(500 + 100 i) N`, alternating in sign, and its teeth share it
-/// unevenly (`load (1 + 0.05 k)` for tooth `k`).
+/// unevenly (`load (1 + 0.05 k)` for tooth `k`). One friction interface joins the two discs:
+/// its clamp force ramps up at 1 MN/s, it slips at the discs' speed difference with
+/// `mu = 0.12` and locks from 2 ms on.
 pub fn synthetic_run(n: usize, dt_s: f64) -> SyntheticRun {
     let names = ["d1", "disc 2"];
     let info = RunInfo {
@@ -48,6 +52,10 @@ pub fn synthetic_run(n: usize, dt_s: f64) -> SyntheticRun {
                 teeth: 24,
             })
             .collect(),
+        interfaces: vec![FrictionInterface {
+            lower: names[0].into(),
+            upper: names[1].into(),
+        }],
     };
     let (period, width) = (1.5e-3, 0.6e-3);
     let load = |i: usize, t: f64| -> f64 {
@@ -97,6 +105,28 @@ pub fn synthetic_run(n: usize, dt_s: f64) -> SyntheticRun {
             discs,
         });
     }
+    let interfaces = samples
+        .iter()
+        .map(|s| {
+            let locked = s.t_s >= 2e-3;
+            let slip = if locked {
+                0.0
+            } else {
+                s.discs[1].speed_rad_s - s.discs[0].speed_rad_s
+            };
+            let (r_eff, clamp_n) = (0.045, 1e6 * s.t_s);
+            let mu = if locked { 0.0 } else { 0.12 };
+            let f = InterfaceSample {
+                slip_rad_s: slip,
+                slip_m_s: slip * r_eff,
+                mu,
+                clamp_n,
+                torque_n_m: -mu * clamp_n * r_eff * slip.signum(),
+                locked,
+            };
+            (s.t_s, vec![f])
+        })
+        .collect();
     let mut impacts = Vec::new();
     for i in 0..names.len() {
         let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
@@ -112,16 +142,18 @@ pub fn synthetic_run(n: usize, dt_s: f64) -> SyntheticRun {
         info,
         samples,
         impacts,
+        interfaces,
     }
 }
 
 impl SyntheticRun {
-    /// Feeds the run to `observer` in time order: each sample, then the impacts that closed
-    /// at or before it.
+    /// Feeds the run to `observer` in time order: each sample and its interfaces, then the
+    /// impacts that closed at or before it.
     pub fn play(&self, observer: &mut dyn clutchpack_model::Observer) {
         let mut next = 0;
-        for s in &self.samples {
+        for (s, (t, f)) in self.samples.iter().zip(&self.interfaces) {
             observer.sample(s);
+            observer.interfaces(*t, f);
             while next < self.impacts.len() && self.impacts[next].t_off_s <= s.t_s {
                 observer.impact(&self.impacts[next]);
                 next += 1;

@@ -23,3 +23,12 @@ pub fn spline(segment: &str) -> String {
 pub fn teeth(segment: &str) -> String {
     format!("{DISCS_PREFIX}{segment}/teeth")
 }
+
+/// Prefix of the friction interfaces' topics.
+pub const INTERFACES_PREFIX: &str = "/interfaces/";
+
+/// `/interfaces/<segment>`, `clutchpack.InterfaceState`; the segment of an interface is
+/// `<lower>__<upper>` of its two bodies' segments (see [`crate::FrictionInterface`]).
+pub fn interface(segment: &str) -> String {
+    format!("{INTERFACES_PREFIX}{segment}")
+}

@@ -5,7 +5,7 @@ use crate::info::{num, utc_text, RunInfo, META_STATS, SCENE_MEDIA_TYPE};
 use crate::scene::{self, disc_frame};
 use crate::summary::RunSummary;
 use crate::{proto, topic_segment, topics};
-use clutchpack_model::{Flank, ImpactEvent, Observer, RunStats, Sample};
+use clutchpack_model::{Flank, ImpactEvent, InterfaceSample, Observer, RunStats, Sample};
 use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -107,6 +107,18 @@ pub enum RecordError {
         /// Discs in the run info.
         expected: usize,
     },
+    /// The engine reports a different number of friction interfaces than the run info has.
+    #[error("interface sample at t = {t_s} s has {got} interfaces, but the recording {path} was created for {expected}")]
+    InterfaceCount {
+        /// The recording's path.
+        path: PathBuf,
+        /// Time of the sample in s.
+        t_s: f64,
+        /// Interfaces in the sample.
+        got: usize,
+        /// Interfaces in the run info.
+        expected: usize,
+    },
     /// A write after an earlier error (the first error is returned by `finish`).
     #[error("the recording {path} failed earlier; nothing more is written")]
     AlreadyFailed {
@@ -161,6 +173,7 @@ struct Channels {
     shaft: u16,
     spline: Vec<u16>,
     teeth: Vec<u16>,
+    interfaces: Vec<u16>,
     impacts: u16,
     summary: u16,
 }
@@ -312,6 +325,11 @@ impl Recorder {
         let s_shaft = schema(&mut w, proto::SHAFT_STATE, &fds)?;
         let s_spline = schema(&mut w, proto::SPLINE_STATE, &fds)?;
         let s_teeth = schema(&mut w, proto::TOOTH_LOADS, &fds)?;
+        let s_interface = if info.interfaces.is_empty() {
+            None
+        } else {
+            Some(schema(&mut w, proto::INTERFACE_STATE, &fds)?)
+        };
         let s_impact = schema(&mut w, proto::IMPACT, &fds)?;
         let s_summary = schema(&mut w, proto::RUN_SUMMARY, &fds)?;
 
@@ -343,6 +361,29 @@ impl Recorder {
                 teeth.push(channel(&mut w, s_teeth, &topics::teeth(seg), meta())?);
             }
         }
+        let mut interfaces = Vec::with_capacity(info.interfaces.len());
+        if let Some(s_interface) = s_interface {
+            let mut used: Vec<String> = Vec::new();
+            for (m, f) in info.interfaces.iter().enumerate() {
+                let mut seg = f.segment();
+                if used.contains(&seg) {
+                    seg = format!("{seg}_{m}");
+                }
+                let meta: BTreeMap<String, String> = [
+                    ("lower".to_string(), f.lower.clone()),
+                    ("upper".to_string(), f.upper.clone()),
+                    ("interface_index".to_string(), m.to_string()),
+                ]
+                .into();
+                interfaces.push(channel(
+                    &mut w,
+                    s_interface,
+                    &topics::interface(&seg),
+                    meta,
+                )?);
+                used.push(seg);
+            }
+        }
         let impacts = channel(&mut w, s_impact, topics::IMPACTS, none())?;
         let summary = channel(&mut w, s_summary, topics::SUMMARY, none())?;
 
@@ -368,6 +409,7 @@ impl Recorder {
                 shaft,
                 spline,
                 teeth,
+                interfaces,
                 impacts,
                 summary,
             },
@@ -660,6 +702,41 @@ impl Recorder {
         self.maybe_flush()
     }
 
+    /// Writes the stack's friction interfaces at `t_s` (s), one `/interfaces/<segment>`
+    /// message each, in the order of [`RunInfo::interfaces`].
+    pub fn write_interfaces(
+        &mut self,
+        t_s: f64,
+        interfaces: &[InterfaceSample],
+    ) -> Result<(), RecordError> {
+        if self.failed {
+            return Err(self.failed_err());
+        }
+        if interfaces.len() != self.ch.interfaces.len() {
+            return Err(RecordError::InterfaceCount {
+                path: self.path.clone(),
+                t_s,
+                got: interfaces.len(),
+                expected: self.ch.interfaces.len(),
+            });
+        }
+        let lt = log_time_ns(t_s);
+        for (m, f) in interfaces.iter().enumerate() {
+            let msg = proto::InterfaceState {
+                t_s,
+                slip_rad_s: f.slip_rad_s,
+                slip_m_s: f.slip_m_s,
+                mu: f.mu,
+                clamp_n: f.clamp_n,
+                torque_n_m: f.torque_n_m,
+                locked: f.locked,
+                interface_index: m as u32,
+            };
+            self.put(self.ch.interfaces[m], lt, &msg, "interface")?;
+        }
+        self.maybe_flush()
+    }
+
     /// Writes one impact on `/impacts`, logged at its peak time `t_peak_s`.
     pub fn write_impact(&mut self, e: &ImpactEvent) -> Result<(), RecordError> {
         if self.failed {
@@ -764,6 +841,13 @@ impl Observer for Recorder {
     fn impact(&mut self, event: &ImpactEvent) {
         if !self.failed {
             let r = self.write_impact(event);
+            self.keep(r);
+        }
+    }
+
+    fn interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
+        if !self.failed {
+            let r = self.write_interfaces(t_s, interfaces);
             self.keep(r);
         }
     }

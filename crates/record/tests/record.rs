@@ -69,6 +69,32 @@ fn round_trip_is_exact() {
     assert_eq!(info, run.info);
     assert_eq!(r.disc_names(), vec!["d1".to_string(), "disc 2".to_string()]);
 
+    // the friction interface: one topic named by its two bodies, every field exact
+    let f = r.interface_series();
+    assert_eq!(f.len(), 1);
+    assert_eq!((f[0].lower.as_str(), f[0].upper.as_str()), ("d1", "disc 2"));
+    assert_eq!(f[0].segment, "d1__disc_2");
+    let got: Vec<(f64, Vec<clutchpack_model::InterfaceSample>)> = f[0]
+        .states
+        .iter()
+        .map(|m| {
+            assert_eq!(m.interface_index, 0);
+            (
+                m.t_s,
+                vec![clutchpack_model::InterfaceSample {
+                    slip_rad_s: m.slip_rad_s,
+                    slip_m_s: m.slip_m_s,
+                    mu: m.mu,
+                    clamp_n: m.clamp_n,
+                    torque_n_m: m.torque_n_m,
+                    locked: m.locked,
+                }],
+            )
+        })
+        .collect();
+    assert_eq!(got, run.interfaces);
+    assert!(got.iter().any(|(_, f)| f[0].locked) && got.iter().any(|(_, f)| !f[0].locked));
+
     let h = r.load_histories();
     assert_eq!(h.len(), 2);
     assert_eq!(h[1].name, "disc 2");
@@ -85,6 +111,7 @@ fn round_trip_is_exact() {
     assert_eq!(n("/discs/d1/spline"), 400);
     assert_eq!(n("/discs/disc_2/spline"), 400);
     assert_eq!(n("/discs/disc_2/teeth"), 400);
+    assert_eq!(n("/interfaces/d1__disc_2"), 400);
     assert_eq!(n(topics::IMPACTS), run.impacts.len() as u64);
     assert_eq!(n(topics::SUMMARY), 1);
     // static scene at t = 0 plus load updates (at most one per simulated ms)
@@ -496,6 +523,7 @@ fn csv_export() {
         "spline_disc_2.csv",
         "teeth_d1.csv",
         "teeth_disc_2.csv",
+        "interface_d1__disc_2.csv",
         "impacts.csv",
         "summary.csv",
     ] {
@@ -517,6 +545,17 @@ fn csv_export() {
     assert_eq!(summary.lines().count(), 3);
     let teeth = std::fs::read_to_string(dir.join("teeth_d1.csv")).unwrap();
     assert!(teeth.starts_with("t_s,tooth_0_n,tooth_1_n"));
+    let f = std::fs::read_to_string(dir.join("interface_d1__disc_2.csv")).unwrap();
+    let mut lines = f.lines();
+    assert_eq!(
+        lines.next(),
+        Some("t_s,slip_rad_s,slip_m_s,mu,clamp_n,torque_n_m,locked")
+    );
+    let clamp: Vec<f64> = lines
+        .map(|l| l.split(',').nth(4).unwrap().parse().unwrap())
+        .collect();
+    let want: Vec<f64> = run.interfaces.iter().map(|(_, f)| f[0].clamp_n).collect();
+    assert_eq!(clamp, want);
 }
 
 /// The Collector and the recorder see the same stream (sanity check of `play`).
@@ -527,6 +566,7 @@ fn synthetic_play_delivers_everything() {
     run.play(&mut c);
     assert_eq!(c.samples, run.samples);
     assert_eq!(c.impacts, run.impacts);
+    assert_eq!(c.interfaces, run.interfaces);
 }
 
 /// The independent reader (the official Python `mcap` and `mcap-protobuf-support`
