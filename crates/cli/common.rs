@@ -204,7 +204,13 @@ pub fn run_info(
     let mut params = std::collections::BTreeMap::new();
     params.insert("duration_s".to_string(), sim.duration_s.to_string());
     params.insert("record_rate_hz".to_string(), sim.record_rate_hz.to_string());
-    // The engines emit the separator plates after the discs: the recording draws both.
+    // The engines emit the separator plates after the discs: the recording draws both. A
+    // friction disc's spline is its bore (teeth inside), a plate's its rim (teeth outside, on
+    // the housing or drum); each is an annulus of the scene's inertia. With a stack the
+    // bodies are drawn in stack order along the axis (plate 0, disc 0, plate 1, ...).
+    let n_discs = scene.pack.discs.len();
+    let stacked = scene.pack.stack.is_some() && scene.pack.plates.len() == n_discs + 1;
+    let (t, rho) = (DRAWN_THICKNESS_M, STEEL_DENSITY_KG_M3);
     let discs = scene
         .pack
         .discs
@@ -212,19 +218,31 @@ pub fn run_info(
         .chain(&scene.pack.plates)
         .enumerate()
         .map(|(i, d)| {
-            let ri = d.spline.pitch_radius_m;
-            // J = rho t pi / 2 (Ro^4 - Ri^4)
-            let ro = (ri.powi(4)
-                + 2.0 * d.inertia_kg_m2
-                    / (STEEL_DENSITY_KG_M3 * DRAWN_THICKNESS_M * std::f64::consts::PI))
-                .powf(0.25);
+            let plate = i >= n_discs;
+            let r_spline = d.spline.pitch_radius_m;
+            let (inner_radius_m, outer_radius_m) = if plate {
+                let ri =
+                    clutchpack_model::annulus_inner_radius_m(d.inertia_kg_m2, r_spline, t, rho)
+                        .unwrap_or(0.5 * r_spline);
+                (ri, r_spline)
+            } else {
+                let ro =
+                    clutchpack_model::annulus_outer_radius_m(d.inertia_kg_m2, r_spline, t, rho);
+                (r_spline, ro)
+            };
+            let slot = match (stacked, plate) {
+                (true, false) => 2 * i + 1,
+                (true, true) => 2 * (i - n_discs),
+                (false, _) => i,
+            };
             DiscGeometry {
                 name: d.name.clone(),
-                inner_radius_m: ri,
-                outer_radius_m: ro,
-                thickness_m: DRAWN_THICKNESS_M,
-                z_m: i as f64 * 4.0 * DRAWN_THICKNESS_M,
+                inner_radius_m,
+                outer_radius_m,
+                thickness_m: t,
+                z_m: slot as f64 * 4.0 * t,
                 teeth: d.spline.teeth,
+                teeth_outside: plate,
             }
         })
         .collect();

@@ -25,6 +25,7 @@ fn info() -> RunInfo {
                 thickness_m: 0.002,
                 z_m: 0.005 * i as f64,
                 teeth: 24,
+                teeth_outside: false,
             })
             .collect(),
         ..Default::default()

@@ -31,8 +31,11 @@ pub struct DiscGeometry {
     pub thickness_m: f64,
     /// Axial position of the disc's mid-plane along +z in m.
     pub z_m: f64,
-    /// Number of spline teeth (drawn on the inner edge; 0 draws a few markers instead).
+    /// Number of spline teeth (0 draws a few markers instead).
     pub teeth: u32,
+    /// The teeth are on the outer edge (a separator plate splined to a housing or drum)
+    /// rather than the inner one (a friction disc on the shaft).
+    pub teeth_outside: bool,
 }
 
 /// One friction interface of the stack: the faces between two neighbouring bodies (a
@@ -198,6 +201,9 @@ impl RunInfo {
             geo.insert(format!("disc.{i}.thickness_m"), num(d.thickness_m));
             geo.insert(format!("disc.{i}.z_m"), num(d.z_m));
             geo.insert(format!("disc.{i}.teeth"), d.teeth.to_string());
+            if d.teeth_outside {
+                geo.insert(format!("disc.{i}.teeth_outside"), "true".into());
+            }
         }
         if !self.interfaces.is_empty() {
             geo.insert("interfaces".into(), self.interfaces.len().to_string());
@@ -263,6 +269,9 @@ impl RunInfo {
                         .get(&format!("disc.{i}.teeth"))
                         .and_then(|v| v.parse().ok())
                         .unwrap_or(0),
+                    teeth_outside: geo
+                        .get(&format!("disc.{i}.teeth_outside"))
+                        .is_some_and(|v| v == "true"),
                 });
             }
             let n: usize = geo
@@ -350,6 +359,7 @@ mod tests {
                 thickness_m: 0.002,
                 z_m: 0.01,
                 teeth: 30,
+                teeth_outside: false,
             }],
             interfaces: vec![FrictionInterface {
                 lower: "plate 0".into(),

@@ -5,7 +5,10 @@
 //! disc's frame `disc/<name>` sit on the axis (a disc's at its mid-plane `z_m`) and turn about
 //! +z by the body's angle. Entities are `frame_locked`, so they follow their frame. The first
 //! `/scene` message (at t = 0) holds the static bodies: the shaft cylinder with a stripe, and
-//! each disc as a triangle-mesh annulus with a rim marker and its spline teeth (steel grey).
+//! each disc as a triangle-mesh annulus with a rim marker and its spline teeth (steel grey):
+//! inside the bore of a friction disc, outside the rim of a separator plate. The meshes come
+//! from parry3d-f64 (the geometry library under the multibody engine): the annulus as convex
+//! wedges (`ConvexPolyhedron` hulls), each tooth as a `Cuboid`, triangulated by parry.
 //!
 //! Loads are shown by small entities that later `/scene` messages replace:
 //! - `disc/<name>/load`: a translucent collar over the disc's spline teeth, coloured by the
@@ -25,6 +28,8 @@ use foxglove::schemas::{
     Color, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms, Point3, Pose,
     Quaternion, SceneEntity, SceneUpdate, Timestamp, TriangleListPrimitive, Vector3,
 };
+use parry3d_f64::math::Vector;
+use parry3d_f64::shape::{ConvexPolyhedron, Cuboid};
 use std::f64::consts::PI;
 
 /// The fixed frame.
@@ -145,43 +150,110 @@ pub(crate) fn update_transforms(
 
 /// The radial depth of a disc's drawn teeth in m.
 fn tooth_depth(d: &DiscGeometry) -> f64 {
-    (0.12 * d.inner_radius_m).min(0.5 * (d.outer_radius_m - d.inner_radius_m).abs())
+    let spline_r = if d.teeth_outside {
+        d.outer_radius_m
+    } else {
+        d.inner_radius_m
+    };
+    (0.12 * spline_r.abs()).min(0.5 * (d.outer_radius_m - d.inner_radius_m).abs())
 }
 
-/// A closed annulus (top, bottom, inner and outer walls) between radii `r0 < r1`, thickness
-/// `h`, centred on its frame's origin.
-fn annulus(r0: f64, r1: f64, h: f64, color: Option<Color>) -> TriangleListPrimitive {
-    let n = SEGMENTS;
-    let mut points = Vec::with_capacity(4 * n as usize);
-    // rings: 0 inner bottom, 1 outer bottom, 2 inner top, 3 outer top
-    for (r, z) in [(r0, -h / 2.0), (r1, -h / 2.0), (r0, h / 2.0), (r1, h / 2.0)] {
-        for i in 0..n {
-            let a = 2.0 * PI * f64::from(i) / f64::from(n);
-            points.push(Point3 {
-                x: r * a.cos(),
-                y: r * a.sin(),
-                z,
-            });
-        }
+/// The radial position in m of the centre of a disc's drawn teeth: inside its bore for a
+/// friction disc, outside its rim for a plate with an external spline.
+fn tooth_centre_radius(d: &DiscGeometry) -> f64 {
+    let depth = tooth_depth(d).max(1e-6);
+    if d.teeth_outside {
+        d.outer_radius_m.max(d.inner_radius_m) + 0.5 * depth
+    } else {
+        d.inner_radius_m.min(d.outer_radius_m) - 0.5 * depth
     }
-    let idx = |ring: u32, i: u32| ring * n + i % n;
-    let mut indices = Vec::with_capacity(24 * n as usize);
-    for i in 0..n {
-        let j = i + 1;
-        // top, bottom, outer wall, inner wall: quads between rings a and b over segment
-        // i..j, wound counter-clockwise seen from outside (outward normals)
-        for (a, b) in [(3, 2), (0, 1), (1, 3), (2, 0)] {
-            indices.extend_from_slice(&[idx(a, i), idx(b, j), idx(b, i)]);
-            indices.extend_from_slice(&[idx(a, i), idx(a, j), idx(b, j)]);
-        }
-    }
+}
+
+/// An empty triangle list in its frame, of one colour.
+fn mesh(color: Option<Color>) -> TriangleListPrimitive {
     TriangleListPrimitive {
         pose: pose(0.0, 0.0, 0.0, 0.0),
-        points,
+        points: Vec::new(),
         color,
         colors: Vec::new(),
-        indices,
+        indices: Vec::new(),
     }
+}
+
+/// Appends parry's triangulation `(points, triangles)` of a shape, each point moved by
+/// `place`, to `m`.
+fn append(
+    m: &mut TriangleListPrimitive,
+    (points, triangles): (Vec<Vector>, Vec<[u32; 3]>),
+    place: impl Fn(Vector) -> Vector,
+) {
+    let base = m.points.len() as u32;
+    m.points.extend(points.into_iter().map(|p| {
+        let q = place(p);
+        Point3 {
+            x: q.x,
+            y: q.y,
+            z: q.z,
+        }
+    }));
+    m.indices
+        .extend(triangles.iter().flat_map(|t| t.map(|i| i + base)));
+}
+
+/// A closed annulus between radii `r0 < r1`, thickness `h`, centred on its frame's origin:
+/// [`SEGMENTS`] convex wedges (parry's `ConvexPolyhedron` hulls of their eight corners),
+/// triangulated by parry with outward normals.
+fn annulus(r0: f64, r1: f64, h: f64, color: Option<Color>) -> TriangleListPrimitive {
+    let mut m = mesh(color);
+    for i in 0..SEGMENTS {
+        let (a0, a1) = (
+            2.0 * PI * f64::from(i) / f64::from(SEGMENTS),
+            2.0 * PI * f64::from(i + 1) / f64::from(SEGMENTS),
+        );
+        let mut corners = Vec::with_capacity(8);
+        for (r, a) in [(r0, a0), (r1, a0), (r0, a1), (r1, a1)] {
+            for z in [-0.5 * h, 0.5 * h] {
+                corners.push(Vector::new(r * a.cos(), r * a.sin(), z));
+            }
+        }
+        if let Some(wedge) = ConvexPolyhedron::from_convex_hull(&corners) {
+            append(&mut m, wedge.to_trimesh(), |p| p);
+        }
+    }
+    m
+}
+
+/// The drawn teeth of `d` as one mesh: parry cuboids (radial depth, half the pitch wide, the
+/// disc's thickness) placed round the spline and triangulated by parry.
+fn teeth_mesh(d: &DiscGeometry, color: Option<Color>) -> TriangleListPrimitive {
+    let n = drawn_teeth(d);
+    let mut m = mesh(color);
+    let (size, r) = (tooth_size(d), tooth_centre_radius(d));
+    let cuboid = Cuboid::new(Vector::new(0.5 * size.x, 0.5 * size.y, 0.5 * size.z));
+    for i in 0..n {
+        let a = 2.0 * PI * f64::from(i) / f64::from(n);
+        let (s, c) = a.sin_cos();
+        append(&mut m, cuboid.to_trimesh(), |p| {
+            Vector::new(r * c + p.x * c - p.y * s, r * s + p.x * s + p.y * c, p.z)
+        });
+    }
+    m
+}
+
+/// A drawn tooth's size in m: radial depth, width (half the pitch), thickness.
+fn tooth_size(d: &DiscGeometry) -> Vector3 {
+    let n = drawn_teeth(d);
+    let spline_r = if d.teeth_outside {
+        d.outer_radius_m
+    } else {
+        d.inner_radius_m
+    };
+    let width = 0.5 * 2.0 * PI * spline_r.abs() / f64::from(n);
+    v3(
+        tooth_depth(d).max(1e-6),
+        width.max(1e-6),
+        d.thickness_m.abs().max(1e-6),
+    )
 }
 
 fn entity(log_time_ns: u64, frame: &str, id: &str) -> SceneEntity {
@@ -230,7 +302,7 @@ pub(crate) fn static_scene(info: &RunInfo, frames: &[String]) -> SceneUpdate {
             size: Some(v3(2.0 * w, w, h * 1.02)),
             color: rgba(0.1, 0.1, 0.1, 1.0),
         });
-        e.cubes.extend(tooth_cubes(d, |_| STEEL));
+        e.triangles.push(teeth_mesh(d, Some(STEEL)));
         entities.push(e);
     }
     let zeros: Vec<(usize, f64)> = (0..info.discs.len()).map(|i| (i, 0.0)).collect();
@@ -259,19 +331,17 @@ pub(crate) fn drawn_teeth(d: &DiscGeometry) -> u32 {
     }
 }
 
-/// The drawn teeth of `d` as cubes on the inner edge, tooth `k` coloured `color(k)`.
+/// The drawn teeth of `d` as cubes round its spline, tooth `k` coloured `color(k)` (the
+/// per-tooth view, whose colours change; the static teeth are [`teeth_mesh`]).
 fn tooth_cubes(d: &DiscGeometry, color: impl Fn(usize) -> Color) -> Vec<CubePrimitive> {
     let n = drawn_teeth(d);
-    let depth = tooth_depth(d).max(1e-6);
-    let r = d.inner_radius_m.min(d.outer_radius_m) - 0.5 * depth;
-    let width = 0.5 * 2.0 * PI * d.inner_radius_m.abs() / f64::from(n);
-    let size = Some(v3(depth, width.max(1e-6), d.thickness_m.abs().max(1e-6)));
+    let (size, r) = (tooth_size(d), tooth_centre_radius(d));
     (0..n)
         .map(|i| {
             let a = 2.0 * PI * f64::from(i) / f64::from(n);
             CubePrimitive {
                 pose: pose(r * a.cos(), r * a.sin(), 0.0, a),
-                size,
+                size: Some(size),
                 color: Some(color(i as usize)),
             }
         })
@@ -294,7 +364,13 @@ pub(crate) fn load_scene(
             continue;
         };
         let mut e = entity(log_time_ns, frame, &format!("{frame}/load"));
-        let r = d.inner_radius_m.min(d.outer_radius_m).abs().max(1e-6);
+        let r = if d.teeth_outside {
+            d.outer_radius_m.max(d.inner_radius_m) + tooth_depth(d)
+        } else {
+            d.inner_radius_m.min(d.outer_radius_m)
+        }
+        .abs()
+        .max(1e-6);
         let h = 1.4 * d.thickness_m.abs().max(1e-6);
         let mut color = load_color(level);
         color.a = 0.55;
@@ -356,33 +432,89 @@ mod tests {
         assert_eq!((load_color(2.0).g, load_color(f64::NAN).g), (0.0, 0.0));
     }
 
-    /// The annulus mesh is a closed surface with outward normals: by the divergence theorem
-    /// its signed volume `sum (p0 . (p1 x p2)) / 6` is the volume of the polygonal ring,
-    /// `n/2 sin(2 pi/n) (r1^2 - r0^2) h`, positive (a reversed winding would give it
-    /// negative, and a hole in the surface a different value).
-    #[test]
-    fn annulus_mesh_is_closed_and_outward() {
-        let (r0, r1, h) = (0.03, 0.06, 0.002);
-        let m = annulus(r0, r1, h, None);
-        assert_eq!(m.points.len(), 4 * SEGMENTS as usize);
-        assert_eq!(m.indices.len(), 24 * SEGMENTS as usize);
+    /// Signed volume `sum (p0 . (p1 x p2)) / 6` of a triangle list: the enclosed volume for
+    /// a closed surface with outward normals (negative for inward ones).
+    fn signed_volume(m: &TriangleListPrimitive) -> f64 {
         let p = |i: u32| {
             let q = &m.points[i as usize];
             [q.x, q.y, q.z]
         };
-        let mut v = 0.0;
-        for t in m.indices.chunks(3) {
-            let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-            let cross = [
-                b[1] * c[2] - b[2] * c[1],
-                b[2] * c[0] - b[0] * c[2],
-                b[0] * c[1] - b[1] * c[0],
-            ];
-            v += (a[0] * cross[0] + a[1] * cross[1] + a[2] * cross[2]) / 6.0;
-        }
+        m.indices
+            .chunks(3)
+            .map(|t| {
+                let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+                let cross = [
+                    b[1] * c[2] - b[2] * c[1],
+                    b[2] * c[0] - b[0] * c[2],
+                    b[0] * c[1] - b[1] * c[0],
+                ];
+                (a[0] * cross[0] + a[1] * cross[1] + a[2] * cross[2]) / 6.0
+            })
+            .sum()
+    }
+
+    /// The annulus mesh (parry's hulls of the wedges) is closed with outward normals: by the
+    /// divergence theorem its signed volume is the volume of the polygonal ring,
+    /// `n/2 sin(2 pi/n) (r1^2 - r0^2) h`, positive (a reversed winding would make it
+    /// negative, a missing face or wedge a different value).
+    #[test]
+    fn annulus_mesh_is_closed_and_outward() {
+        let (r0, r1, h) = (0.03, 0.06, 0.002);
+        let m = annulus(r0, r1, h, None);
+        assert_eq!(
+            m.points.len(),
+            8 * SEGMENTS as usize,
+            "eight corners per wedge"
+        );
+        let v = signed_volume(&m);
         let n = f64::from(SEGMENTS);
         let want = n / 2.0 * (2.0 * PI / n).sin() * (r1 * r1 - r0 * r0) * h;
         assert!((v - want).abs() < 1e-12 * want.max(1.0), "{v} vs {want}");
         assert!(v > 0.0);
+    }
+
+    /// The teeth mesh holds one closed, outward parry cuboid per drawn tooth (total volume
+    /// `n` times a tooth's), inside the bore of a friction disc and outside the rim of a plate
+    /// with an external spline.
+    #[test]
+    fn teeth_sit_on_the_spline_side() {
+        let disc = DiscGeometry {
+            name: "d".into(),
+            inner_radius_m: 0.231,
+            outer_radius_m: 0.290,
+            thickness_m: 0.003,
+            z_m: 0.0,
+            teeth: 40,
+            teeth_outside: false,
+        };
+        let plate = DiscGeometry {
+            inner_radius_m: 0.235,
+            outer_radius_m: 0.305,
+            teeth_outside: true,
+            ..disc.clone()
+        };
+        for d in [&disc, &plate] {
+            let m = teeth_mesh(d, None);
+            let s = tooth_size(d);
+            let want = 40.0 * s.x * s.y * s.z;
+            let v = signed_volume(&m);
+            assert!((v - want).abs() < 1e-9 * want, "{v} vs {want}");
+            let radii: Vec<f64> = m.points.iter().map(|p| p.x.hypot(p.y)).collect();
+            let (lo, hi) = radii
+                .iter()
+                .fold((f64::INFINITY, 0.0_f64), |(a, b), &r| (a.min(r), b.max(r)));
+            if d.teeth_outside {
+                assert!(lo >= d.outer_radius_m - 1e-12, "plate teeth from {lo}");
+                assert!(
+                    hi > d.outer_radius_m + 0.9 * s.x,
+                    "they stand outside the rim"
+                );
+            } else {
+                // the root corners of a tooth reach just past the bore: hypot(Ri, w/2)
+                let root = d.inner_radius_m.hypot(0.5 * s.y);
+                assert!(hi <= root + 1e-12, "disc teeth up to {hi}");
+                assert!(lo < d.inner_radius_m - 0.9 * s.x, "they stand in the bore");
+            }
+        }
     }
 }

@@ -50,6 +50,7 @@ pub fn synthetic_run(n: usize, dt_s: f64) -> SyntheticRun {
                 thickness_m: 0.002,
                 z_m: 0.004 * i as f64,
                 teeth: 24,
+                teeth_outside: false,
             })
             .collect(),
         interfaces: vec![FrictionInterface {

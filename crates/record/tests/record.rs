@@ -183,9 +183,12 @@ fn foxglove_schemas_and_transforms() {
         "{ids:?}"
     );
     assert!(first.entities.iter().all(|e| e.frame_locked));
-    // the static disc carries its teeth (synthetic discs have 24)
+    // the static disc carries its body and its teeth (synthetic discs have 24) as parry
+    // meshes: 64 wedges of 8 corners, 24 cuboids of 8
     let d1 = first.entities.iter().find(|e| e.id == "disc/d1").unwrap();
-    assert_eq!(d1.cubes.len(), 1 + 24, "rim marker and teeth");
+    assert_eq!(d1.triangles.len(), 2, "body and teeth");
+    assert_eq!(d1.triangles[0].points.len(), 64 * 8);
+    assert_eq!(d1.triangles[1].points.len(), 24 * 8);
     // later updates colour the load collars, and (per-tooth run) each tooth by its own load:
     // the synthetic teeth carry loads rising with the tooth index (tooth 23 2.15 times tooth
     // 0), so in a loaded update tooth 23 is hotter than tooth 0

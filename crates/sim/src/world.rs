@@ -54,18 +54,6 @@ pub(crate) struct World {
 /// with 8 discs), while the owed turn, kept exactly, costs nothing to add when reading.
 const OWED_TURN_MAX_RAD: f64 = 1e-6;
 
-/// Outer radius in m of a flat annulus of inner radius `inner_m`, thickness `thickness_m` and
-/// density `density` whose inertia about its axis is `inertia`:
-/// `J = rho pi t (Ro^4 - Ri^4) / 2`.
-pub(crate) fn annulus_outer_radius(
-    inertia: f64,
-    inner_m: f64,
-    thickness_m: f64,
-    density: f64,
-) -> f64 {
-    (inner_m.powi(4) + 2.0 * inertia / (density * PI * thickness_m)).powf(0.25)
-}
-
 /// Mass properties of a disc about its centre, axis `+z`: a steel annulus from parry (inner
 /// radius the spline pitch radius, outer radius chosen so that the annulus has the scene's
 /// inertia), with the axial inertia then set to the scene's `J` exactly (parry's subtraction
@@ -76,7 +64,7 @@ pub(crate) fn disc_mass_properties(
     shapes: &BodyShapes,
 ) -> MassProperties {
     let half = 0.5 * shapes.disc_thickness_m;
-    let outer = annulus_outer_radius(
+    let outer = clutchpack_model::annulus_outer_radius_m(
         inertia_kg_m2,
         inner_m,
         shapes.disc_thickness_m,
@@ -396,7 +384,7 @@ mod tests {
     #[test]
     fn disc_annulus_has_the_scene_inertia() {
         let shapes = BodyShapes::default();
-        let ro = annulus_outer_radius(0.156, 0.231, 3e-3, 7850.0);
+        let ro = clutchpack_model::annulus_outer_radius_m(0.156, 0.231, 3e-3, 7850.0);
         assert!((ro - 0.290).abs() < 1e-3, "Ro = {ro}");
         let mp = disc_mass_properties(0.156, 0.231, &shapes);
         let m = 7850.0 * PI * 3e-3 * (ro * ro - 0.231 * 0.231);
