@@ -150,9 +150,12 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
                         collector,
                         recorder,
                         Arc::new(AtomicBool::new(false)),
-                    )?;
+                    );
                     let wall = t0.elapsed().as_secs_f64();
                     done.result?;
+                    if let Some(r) = done.recording {
+                        r?;
+                    }
                     pair[usize::from(record)] = wall;
                     if record {
                         recorded.push(wall);

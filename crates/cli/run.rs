@@ -111,14 +111,20 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
     }
     let t0 = Instant::now();
-    let done = run_recorded(engine.as_mut(), duration, collector, recorder, interrupted)?;
+    let done = run_recorded(engine.as_mut(), duration, collector, recorder, interrupted);
     let wall = t0.elapsed().as_secs_f64();
     pb.finish_and_clear();
     let (result, obs) = (done.result, done.collector);
     let stats = disc_stats(&names, &obs.impacts);
-    if let Some(path) = &done.recording {
-        eprintln!("recording: {}", path.display());
-    }
+    // A recording that could not be finished is reported after the other outputs are written.
+    let recording_error = match done.recording {
+        Some(Ok(path)) => {
+            eprintln!("recording: {}", path.display());
+            None
+        }
+        Some(Err(e)) => Some(e),
+        None => None,
+    };
 
     // Write what we have even when the run failed, then report the failure.
     if let Some(path) = &a.impacts_csv {
@@ -144,12 +150,15 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         }
         Ok(s) => s,
         Err(e) => {
+            if let Some(r) = recording_error {
+                eprintln!("error: {r:#}");
+            }
             return Err(anyhow::Error::new(e).context(format!(
                 "{} engine on {} ({} impacts kept before the failure)",
                 engine.name(),
                 scene.name,
                 obs.impacts.len()
-            )))
+            )));
         }
     };
     let summary = RunSummary::new(&scene, engine.name(), &run_stats, wall, stats.clone());
@@ -178,6 +187,9 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                 worst.max_positive_n.max(-worst.max_negative_n)
             );
         }
+    }
+    if let Some(e) = recording_error {
+        return Err(e);
     }
     if run_stats.stopped_early {
         // 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
@@ -213,8 +225,8 @@ pub(crate) struct RecordedRun {
     pub result: Result<clutchpack_model::RunStats, clutchpack_model::EngineError>,
     /// The impacts (and histories) collected on the engine's thread.
     pub collector: RunCollector,
-    /// The finished recording's path.
-    pub recording: Option<PathBuf>,
+    /// The finished recording's path, or why it could not be finished (`None`: no recorder).
+    pub recording: Option<Result<PathBuf>>,
     /// CPU time of the engine's thread during the run, s.
     pub engine_cpu_s: f64,
     /// CPU time of the recording thread, s (0 without a recorder).
@@ -224,15 +236,14 @@ pub(crate) struct RecordedRun {
 /// Runs `engine` for `duration_s` with `collector` on the engine's thread and `recorder` (if
 /// any) on a recording thread, then finishes the recording: with the engine's statistics
 /// when it ran, and in any case with everything recorded before a failure or a stop. Stops
-/// early and cleanly when `interrupted` is set. An error only for a recording that could
-/// not be finished.
+/// early and cleanly when `interrupted` is set.
 pub(crate) fn run_recorded(
     engine: &mut (dyn clutchpack_model::Engine + Send),
     duration_s: f64,
     collector: RunCollector,
     recorder: Option<Recorder>,
     interrupted: Arc<AtomicBool>,
-) -> Result<RecordedRun> {
+) -> RecordedRun {
     let mut obs = RunObserver {
         collector,
         recorder: recorder.map(ThreadedRecorder::start),
@@ -257,17 +268,17 @@ pub(crate) fn run_recorded(
             if let Ok(s) = &result {
                 rec.set_run_stats(s);
             }
-            Some(rec.finish(None).context("finishing the recording")?)
+            Some(rec.finish(None).context("finishing the recording"))
         }
         None => None,
     };
-    Ok(RecordedRun {
+    RecordedRun {
         result,
         collector,
         recording,
         engine_cpu_s,
         recorder_cpu_s,
-    })
+    }
 }
 
 /// What the engine's thread hands to the recording thread.
