@@ -70,6 +70,8 @@ struct EventTrack {
     before_last: Option<(f64, f64)>,
     /// The step of the open event (adaptive stepping).
     event_step_s: Option<f64>,
+    /// The onset of the open event, s.
+    event_t_on_s: Option<f64>,
 }
 
 impl EventTrack {
@@ -96,6 +98,7 @@ impl EventTrack {
                 self.last = None;
                 self.before_last = None;
                 self.event_step_s = Some(contact_step(v_on));
+                self.event_t_on_s = Some(t_on);
             }
             self.push(t, f.load_n);
         } else if self.tracker.is_open() {
@@ -106,6 +109,7 @@ impl EventTrack {
             self.push(t, 0.0);
             closed = self.tracker.end(t_off);
             self.event_step_s = None;
+            self.event_t_on_s = None;
         }
         self.prev = Some((t, depth, v));
         closed
@@ -177,9 +181,11 @@ impl MultibodyEngine {
                     && a.steps_per_contact > 1.0
                     && a.approach_fraction > 0.0
                     && a.approach_fraction < 1.0
-                    && a.min_step_s > 0.0) =>
+                    && a.min_step_s > 0.0
+                    && a.sustained_steps_per_period > std::f64::consts::PI
+                    && a.sustained_after > 1.0) =>
             {
-                return bad(format!("adaptive stepping {a:?}: needs max_step_s > 0, steps_per_contact > 1, approach_fraction in (0, 1), min_step_s > 0"));
+                return bad(format!("adaptive stepping {a:?}: needs max_step_s > 0, steps_per_contact > 1, approach_fraction in (0, 1), min_step_s > 0, sustained_steps_per_period > pi, sustained_after > 1"));
             }
             _ => {}
         }
@@ -1074,6 +1080,7 @@ impl<'a> Run<'a> {
                 // 1 % over the bound: rounding must not make it optimistic.
                 rel_accel_bound: 1.01 * (a_carrier + a_disc),
                 event_step_s: self.tracks[i].event_step_s,
+                event_age_s: self.tracks[i].event_t_on_s.map(|t_on| self.t - t_on),
             };
             let (dt, c) = coupling_step(&view, a);
             if dt < want {

@@ -62,6 +62,8 @@ pub(crate) struct CouplingView<'a> {
     pub rel_accel_bound: f64,
     /// Step of the contact event in progress, s (set at its onset).
     pub event_step_s: Option<f64>,
+    /// How long the contact event in progress has lasted, s.
+    pub event_age_s: Option<f64>,
 }
 
 /// The step the coupling allows, s, and whether it is a contact step (the coupling is in
@@ -71,14 +73,25 @@ pub(crate) fn coupling_step(c: &CouplingView<'_>, a: &AdaptiveStepping) -> (f64,
     let n = a.steps_per_contact;
     let f = c.forces;
     if f.depth_m > 0.0 {
-        // In contact: the event's step, and the local period of the linearised contact.
+        // In contact: the event's step, and the local period of the linearised contact; a
+        // sustained contact (longer than `sustained_after` predicted impacts) is resolved at
+        // `sustained_steps_per_period` per local period instead.
         let mut dt = c.event_step_s.unwrap_or(a.max_step_s);
+        let sustained = matches!(
+            (c.event_step_s, c.event_age_s),
+            (Some(step), Some(age)) if age > a.sustained_after * a.steps_per_contact * step
+        );
         if f.stiffness > 0.0 {
             let damp = damping_factor(c.law.hertz.loss_coefficient_s_m, f.kin.v_n_m_s).max(1.0);
             let k_lin = 1.5 * f.stiffness * damp * f.depth_m.sqrt();
             if k_lin > 0.0 {
-                let omega = (k_lin / c.m_eff_kg).sqrt();
-                dt = dt.min(std::f64::consts::TAU / (omega * n));
+                let period = std::f64::consts::TAU / (k_lin / c.m_eff_kg).sqrt();
+                dt = if sustained {
+                    let per_period = a.sustained_steps_per_period.min(n);
+                    (period / per_period).min(a.max_step_s)
+                } else {
+                    dt.min(period / n)
+                };
             }
         }
         return (dt, true);
@@ -165,6 +178,7 @@ pub(crate) fn bracketed_root(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::hook::CouplingForces;
     use clutchpack_model::{free_impact_compression_m, Hertz, LawKind, OilFilm};
 
     /// The predicted duration is the Hertz impact time: 2.943 s_max / v0 with
@@ -195,5 +209,80 @@ mod tests {
         assert!((t - 2.943 * s / v0).abs() < 1e-12 * t);
         // the paper's impacts last 60-70 us
         assert!(t > 40e-6 && t < 100e-6, "{t}");
+    }
+
+    /// In contact the step is the event's step bounded by the local period over
+    /// `steps_per_contact`; once the contact has outlasted `sustained_after` predicted
+    /// impacts it is the local period over `sustained_steps_per_period` (and never more than
+    /// `max_step_s`), whatever the event's step was.
+    #[test]
+    fn sustained_contacts_step_by_their_local_period() {
+        let law = ToothLaw {
+            kind: LawKind::Dry,
+            hertz: Hertz {
+                modulus_pa: 210e9,
+                curvature_radius_m: 1.75e-3,
+                loss_coefficient_s_m: 0.0,
+            },
+            oil: OilFilm {
+                thickness_m: 0.0,
+                viscosity_pa_s: 0.0,
+                leakage_coefficient: 0.421,
+                width_m: 3e-3,
+                length_m: 3e-3,
+                v_floor_m_s: 0.01,
+                h_min_m: 1e-6,
+            },
+        };
+        let h = law.hertz.coefficient();
+        let (m, depth) = (0.02, 1e-6);
+        let forces = CouplingForces {
+            kin: ToothKinematics {
+                flank: Flank::ShaftLeads,
+                delta_m: depth,
+                v_n_m_s: 0.0,
+            },
+            depth_m: depth,
+            load_n: -h * depth.powf(1.5),
+            force: [0.0; 2],
+            moment: [0.0; 3],
+            stiffness: h,
+            potential_j: 0.0,
+            gap_margin_m: 0.0,
+            speed_margin_m_s: 0.0,
+        };
+        // local period of m s'' = -H s^1.5 linearised at s: 2 pi / sqrt(1.5 H sqrt(s) / m)
+        let period = std::f64::consts::TAU / (1.5 * h * depth.sqrt() / m).sqrt();
+        let a = AdaptiveStepping::default();
+        let event_step = 1e-7;
+        let view = |age: f64| CouplingView {
+            forces: &forces,
+            law: &law,
+            phi: 0.0,
+            dphi: 0.0,
+            g0: 0.0,
+            rb: 0.2,
+            m_eff_kg: m,
+            rel_accel_bound: 0.0,
+            event_step_s: Some(event_step),
+            event_age_s: Some(age),
+        };
+        let young = a.sustained_after * a.steps_per_contact * event_step * 0.99;
+        let (dt, contact) = coupling_step(&view(young), &a);
+        assert!(contact);
+        assert_eq!(dt, event_step.min(period / a.steps_per_contact));
+        let old = young / 0.99 * 1.01;
+        let (dt, contact) = coupling_step(&view(old), &a);
+        assert!(contact);
+        assert!((dt - period / a.sustained_steps_per_period).abs() < 1e-15 * dt);
+        assert!(dt > 3.0 * event_step, "{dt} vs {event_step}");
+        let never = AdaptiveStepping {
+            sustained_after: f64::INFINITY,
+            ..a
+        };
+        assert_eq!(
+            coupling_step(&view(1.0), &never).0,
+            event_step.min(period / 128.0)
+        );
     }
 }
