@@ -1,8 +1,8 @@
 //! Shared helpers of the subcommands: scene loading, engine choice, the summary JSON.
 
 use anyhow::{Context, Result};
-use clutchpack_analysis::DiscStats;
-use clutchpack_model::{Engine, ImpactEvent, Observer, RunStats, Sample};
+use clutchpack_analysis::{DiscStats, InterfaceStats};
+use clutchpack_model::{Engine, ImpactEvent, InterfaceSample, Observer, RunStats, Sample};
 use clutchpack_reference::ReferenceEngine;
 use clutchpack_scene::{EngineChoice, Override, Scene};
 use serde::Serialize;
@@ -64,9 +64,11 @@ pub fn make_engine(scene: &Scene, arg: Option<EngineArg>) -> Result<Box<dyn Engi
     }
 }
 
-/// Keeps the impacts of a run, and the per-disc load histories when asked.
+/// Keeps the impacts of a run, the per-disc load histories when asked, and what each friction
+/// interface did (when named with [`RunCollector::with_interfaces`]).
 pub struct RunCollector {
     pub impacts: Vec<ImpactEvent>,
+    pub interfaces: Vec<InterfaceStats>,
     /// Per disc: (t s, load N) samples, only when `keep_history`.
     pub history: Vec<Vec<(f64, f64)>>,
     pub keep_history: bool,
@@ -77,10 +79,17 @@ impl RunCollector {
     pub fn new(discs: usize, keep_history: bool) -> RunCollector {
         RunCollector {
             impacts: Vec::new(),
+            interfaces: Vec::new(),
             history: vec![Vec::new(); discs],
             keep_history,
             progress: None,
         }
+    }
+
+    /// Also keeps the figures of the stack's friction interfaces, named in stack order.
+    pub fn with_interfaces(mut self, names: impl IntoIterator<Item = String>) -> RunCollector {
+        self.interfaces = names.into_iter().map(InterfaceStats::new).collect();
+        self
     }
 
     /// Load histories with each impact's onset, peak and separation merged in (see
@@ -117,6 +126,11 @@ impl Observer for RunCollector {
     fn impact(&mut self, e: &ImpactEvent) {
         self.impacts.push(*e);
     }
+    fn interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
+        for (st, f) in self.interfaces.iter_mut().zip(interfaces) {
+            st.update(t_s, f);
+        }
+    }
     fn progress(&mut self, t_s: f64) -> bool {
         if let Some(p) = &self.progress {
             p.set_position((t_s * 1e6) as u64);
@@ -140,6 +154,9 @@ pub struct RunSummary {
     pub steps: u64,
     pub rejected_steps: u64,
     pub discs: Vec<DiscStats>,
+    /// The stack's friction interfaces (absent for packs without one).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub interfaces: Vec<InterfaceStats>,
 }
 
 impl RunSummary {
@@ -158,6 +175,7 @@ impl RunSummary {
             steps: stats.steps,
             rejected_steps: stats.rejected_steps,
             discs,
+            interfaces: Vec::new(),
         }
     }
 }
@@ -181,6 +199,29 @@ pub fn time_progress(duration_s: f64, label: &str) -> indicatif::ProgressBar {
     );
     pb.set_prefix(label.to_string());
     pb
+}
+
+/// The stack's friction interfaces in stack order (empty without a stack). Stack order
+/// (`clutchpack_model::clutch`): plate 0, disc 0, plate 1, ..., disc N-1, plate N; interface
+/// m lies between stack bodies m and m + 1.
+pub fn friction_interfaces(scene: &Scene) -> Vec<clutchpack_record::FrictionInterface> {
+    if scene.pack.stack.is_none() {
+        return Vec::new();
+    }
+    let body = |b: usize| {
+        let list = if b.is_multiple_of(2) {
+            &scene.pack.plates
+        } else {
+            &scene.pack.discs
+        };
+        list.get(b / 2).map(|d| d.name.clone()).unwrap_or_default()
+    };
+    (0..2 * scene.pack.discs.len())
+        .map(|m| clutchpack_record::FrictionInterface {
+            lower: body(m),
+            upper: body(m + 1),
+        })
+        .collect()
 }
 
 /// Steel density used to draw discs whose outer radius the scene does not give, kg/m^3.
@@ -246,26 +287,7 @@ pub fn run_info(
             }
         })
         .collect();
-    // Stack order (clutchpack_model::clutch): plate 0, disc 0, plate 1, ..., disc N-1,
-    // plate N; interface m lies between stack bodies m and m + 1.
-    let interfaces = if scene.pack.stack.is_some() {
-        let body = |b: usize| {
-            let list = if b.is_multiple_of(2) {
-                &scene.pack.plates
-            } else {
-                &scene.pack.discs
-            };
-            list.get(b / 2).map(|d| d.name.clone()).unwrap_or_default()
-        };
-        (0..2 * scene.pack.discs.len())
-            .map(|m| clutchpack_record::FrictionInterface {
-                lower: body(m),
-                upper: body(m + 1),
-            })
-            .collect()
-    } else {
-        Vec::new()
-    };
+    let interfaces = friction_interfaces(scene);
     RunInfo {
         program_version: env!("CARGO_PKG_VERSION").to_string(),
         engine: engine.to_string(),

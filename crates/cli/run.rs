@@ -79,7 +79,11 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     let mut engine = common::make_engine(&scene, a.engine)?;
     let names = engine.disc_names();
     let duration = scene.simulation.duration_s;
-    let mut collector = RunCollector::new(names.len(), a.plot.is_some());
+    let mut collector = RunCollector::new(names.len(), a.plot.is_some()).with_interfaces(
+        common::friction_interfaces(&scene)
+            .into_iter()
+            .map(|f| format!("{}__{}", f.lower, f.upper)),
+    );
     let pb = common::time_progress(duration, &scene.name);
     collector.progress = Some(pb.clone());
     let recorder = if a.no_record {
@@ -161,7 +165,8 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             )));
         }
     };
-    let summary = RunSummary::new(&scene, engine.name(), &run_stats, wall, stats.clone());
+    let mut summary = RunSummary::new(&scene, engine.name(), &run_stats, wall, stats.clone());
+    summary.interfaces = obs.interfaces.clone();
     if let Some(path) = &a.summary_json {
         common::write_json(path, &summary)?;
     }
@@ -187,6 +192,13 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                 worst.max_positive_n.max(-worst.max_negative_n)
             );
         }
+    }
+    if !obs.interfaces.is_empty() {
+        out!("friction interfaces (from the piston side)");
+        out!(
+            "{}",
+            clutchpack_analysis::interface_table(&obs.interfaces, TableFormat::Text).trim_end()
+        );
     }
     if let Some(e) = recording_error {
         return Err(e);
@@ -462,6 +474,7 @@ impl Observer for RunObserver {
         }
     }
     fn interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
+        self.collector.interfaces(t_s, interfaces);
         if let Some(r) = &mut self.recorder {
             r.push(ToRecorder::Interfaces(t_s, interfaces.to_vec()));
         }

@@ -37,13 +37,15 @@
 #![warn(missing_docs)]
 
 pub mod fit;
+pub mod interfaces;
 pub mod plot;
 pub mod stats;
 pub mod sweep;
 pub mod table;
 
 pub use fit::{polyfit, FitError, PolyFit};
+pub use interfaces::InterfaceStats;
 pub use plot::{plot_compare, plot_load_history, plot_sweep, register_fonts, PlotError};
 pub use stats::{disc_stats, percentile, DiscStats};
 pub use sweep::{sweep_fits, sweep_rows, Spread, SweepCase, SweepRow};
-pub use table::{stats_table, sweep_table, TableFormat};
+pub use table::{interface_table, stats_table, sweep_table, TableFormat};

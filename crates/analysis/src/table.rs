@@ -5,6 +5,7 @@
 //! round numbers to about four significant digits for reading; CSV keeps every digit
 //! (Rust's shortest round-trip form) for machines.
 
+use crate::interfaces::InterfaceStats;
 use crate::stats::DiscStats;
 use crate::sweep::{Spread, SweepRow};
 use std::fmt::Write as _;
@@ -83,6 +84,54 @@ pub fn stats_table(stats: &[DiscStats], format: TableFormat) -> String {
                 s.impacts.to_string(),
                 s.positive_impacts.to_string(),
                 s.negative_impacts.to_string(),
+            ]
+        })
+        .collect();
+    render(format, &cols, &rows)
+}
+
+/// The friction interfaces of one run, one row each, in stack order.
+///
+/// Columns (text and markdown): `interface`, `max clamp [N]`, `max |torque| [N m]`,
+/// `locked since [s]` (`slipping` when the faces slip at the end), `heat [J]`. CSV:
+/// `interface`, `max_clamp_n`, `max_abs_torque_n_m`, `locked_since_s` (empty when
+/// slipping), `dissipated_j`.
+pub fn interface_table(stats: &[InterfaceStats], format: TableFormat) -> String {
+    if format == TableFormat::Csv {
+        let mut out =
+            String::from("interface,max_clamp_n,max_abs_torque_n_m,locked_since_s,dissipated_j\n");
+        for s in stats {
+            let _ = writeln!(
+                out,
+                "{},{:?},{:?},{},{:?}",
+                csv_field(&s.name),
+                s.max_clamp_n,
+                s.max_abs_torque_n_m,
+                s.locked_since_s
+                    .map(|t| format!("{t:?}"))
+                    .unwrap_or_default(),
+                s.dissipated_j
+            );
+        }
+        return out;
+    }
+    let cols = vec![
+        col("interface", false),
+        col("max clamp [N]", true),
+        col("max |torque| [N m]", true),
+        col("locked since [s]", true),
+        col("heat [J]", true),
+    ];
+    let rows: Vec<Vec<String>> = stats
+        .iter()
+        .map(|s| {
+            vec![
+                s.name.clone(),
+                fmt_num(s.max_clamp_n),
+                fmt_num(s.max_abs_torque_n_m),
+                s.locked_since_s
+                    .map_or_else(|| "slipping".to_string(), |t| format!("{t:.4}")),
+                fmt_num(s.dissipated_j),
             ]
         })
         .collect();

@@ -266,6 +266,9 @@ pub struct InterfaceSample {
     pub torque_n_m: f64,
     /// Whether the faces are locked together (no slip) during the last step.
     pub locked: bool,
+    /// Energy the interface has turned into heat since t = 0, J (>= 0): the work of its
+    /// friction (or open-gap drag) torque against the slip, summed step by step.
+    pub dissipated_j: f64,
 }
 
 #[cfg(test)]

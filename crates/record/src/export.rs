@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 /// | `shaft.csv` | `/shaft` | `t_s,angle_rad,speed_rad_s` |
 /// | `spline_<segment>.csv` | `/discs/<segment>/spline` | `t_s,rel_angle_rad,closing_speed_m_s,penetration_m,load_n,torque_n_m,engaged,stiffness_n_m1_5,speed_rad_s,angle_rad` |
 /// | `teeth_<segment>.csv` | `/discs/<segment>/teeth` | `t_s,tooth_0_n,tooth_1_n,...` |
-/// | `interface_<segment>.csv` | `/interfaces/<segment>` | `t_s,slip_rad_s,slip_m_s,mu,clamp_n,torque_n_m,locked` |
+/// | `interface_<segment>.csv` | `/interfaces/<segment>` | `t_s,slip_rad_s,slip_m_s,mu,clamp_n,torque_n_m,locked,dissipated_j` |
 /// | `impacts.csv` | `/impacts` | `disc,disc_index,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n` |
 /// | `summary.csv` | `/summary` | `disc,max_positive_n,max_negative_n,p99_abs_n,impacts,positive_impacts,negative_impacts,mean_top10_abs_n` |
 ///
@@ -97,18 +97,20 @@ pub fn export_csv(
         if f.states.is_empty() {
             continue;
         }
-        let mut s = String::from("t_s,slip_rad_s,slip_m_s,mu,clamp_n,torque_n_m,locked\n");
+        let mut s =
+            String::from("t_s,slip_rad_s,slip_m_s,mu,clamp_n,torque_n_m,locked,dissipated_j\n");
         for m in &f.states {
             let _ = writeln!(
                 s,
-                "{:?},{:?},{:?},{:?},{:?},{:?},{}",
+                "{:?},{:?},{:?},{:?},{:?},{:?},{},{:?}",
                 m.t_s,
                 m.slip_rad_s,
                 m.slip_m_s,
                 m.mu,
                 m.clamp_n,
                 m.torque_n_m,
-                u8::from(m.locked)
+                u8::from(m.locked),
+                m.dissipated_j
             );
         }
         put(&format!("interface_{}.csv", f.segment), s)?;

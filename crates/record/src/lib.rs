@@ -38,7 +38,7 @@
 //! | `/shaft` | `clutchpack.ShaftState` | each sample | `t_s, angle_rad, speed_rad_s` |
 //! | `/discs/<segment>/spline` | `clutchpack.SplineState` | each sample | `t_s, rel_angle_rad, closing_speed_m_s, penetration_m, load_n, torque_n_m, engaged, stiffness_n_m1_5, speed_rad_s, angle_rad, disc_index` |
 //! | `/discs/<segment>/teeth` | `clutchpack.ToothLoads` | each sample, if [`RecordOptions::per_tooth`] | `t_s, loads_n[], disc_index` |
-//! | `/interfaces/<lower>__<upper>` | `clutchpack.InterfaceState` | each sample, packs with a stack | `t_s, slip_rad_s, slip_m_s, mu, clamp_n, torque_n_m, locked, interface_index` |
+//! | `/interfaces/<lower>__<upper>` | `clutchpack.InterfaceState` | each sample, packs with a stack | `t_s, slip_rad_s, slip_m_s, mu, clamp_n, torque_n_m, locked, interface_index, dissipated_j` |
 //! | `/impacts` | `clutchpack.Impact` | each impact, at `t_peak_s` | `disc, disc_index, t_on_s, t_peak_s, t_off_s, flank, v_on_m_s, peak_n` |
 //! | `/summary` | `clutchpack.RunSummary` | once, at the end | `t_end_s, discs[]{name, index, max_positive_n, max_negative_n, p99_abs_n, impacts, positive_impacts, negative_impacts, mean_top10_abs_n}` |
 //!

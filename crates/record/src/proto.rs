@@ -133,6 +133,24 @@ pub struct InterfaceState {
     /// Index of the interface along the stack, from 0 (between stack bodies `m` and `m + 1`).
     #[prost(uint32, tag = "8")]
     pub interface_index: u32,
+    /// Energy the interface has dissipated since t = 0 in J (>= 0).
+    #[prost(double, tag = "9")]
+    pub dissipated_j: f64,
+}
+
+impl InterfaceState {
+    /// The model's view of this message (the index and the time are left out).
+    pub fn to_sample(&self) -> clutchpack_model::InterfaceSample {
+        clutchpack_model::InterfaceSample {
+            slip_rad_s: self.slip_rad_s,
+            slip_m_s: self.slip_m_s,
+            mu: self.mu,
+            clamp_n: self.clamp_n,
+            torque_n_m: self.torque_n_m,
+            locked: self.locked,
+            dissipated_j: self.dissipated_j,
+        }
+    }
 }
 
 /// Which flank is in contact (wire form of [`clutchpack_model::Flank`]).
@@ -427,6 +445,12 @@ pub const MESSAGES: &[MessageDef] = &[
                 8,
                 Uint32,
                 "index of the interface along the stack, from 0",
+            ),
+            f(
+                "dissipated_j",
+                9,
+                Double,
+                "energy the interface has turned into heat since t = 0, J (>= 0)",
             ),
         ],
     },
@@ -760,6 +784,7 @@ mod tests {
                 torque_n_m: 6.0,
                 locked: true,
                 interface_index: 8,
+                dissipated_j: 9.0,
             }
             .encode_to_vec(),
         );

@@ -799,7 +799,36 @@ impl RecordingReader {
                 );
             }
         }
+        let interfaces = self.interface_stats();
+        if !interfaces.is_empty() {
+            let _ = writeln!(s, "friction interfaces (from the piston side):");
+            let table = clutchpack_analysis::interface_table(
+                &interfaces,
+                clutchpack_analysis::TableFormat::Text,
+            );
+            for line in table.lines() {
+                let _ = writeln!(s, "  {line}");
+            }
+        }
         s
+    }
+
+    /// What each friction interface did over the recorded run ([`InterfaceStats`]), in
+    /// stack order; named `<lower>__<upper>`.
+    ///
+    /// [`InterfaceStats`]: clutchpack_analysis::InterfaceStats
+    pub fn interface_stats(&self) -> Vec<clutchpack_analysis::InterfaceStats> {
+        self.interface_series()
+            .iter()
+            .map(|f| {
+                let mut st =
+                    clutchpack_analysis::InterfaceStats::new(format!("{}__{}", f.lower, f.upper));
+                for m in &f.states {
+                    st.update(m.t_s, &m.to_sample());
+                }
+                st
+            })
+            .collect()
     }
 
     /// The stored `/summary`, if the run finished.

@@ -106,6 +106,7 @@ pub fn synthetic_run(n: usize, dt_s: f64) -> SyntheticRun {
             discs,
         });
     }
+    let mut heat_j = 0.0;
     let interfaces = samples
         .iter()
         .map(|s| {
@@ -117,13 +118,16 @@ pub fn synthetic_run(n: usize, dt_s: f64) -> SyntheticRun {
             };
             let (r_eff, clamp_n) = (0.045, 1e6 * s.t_s);
             let mu = if locked { 0.0 } else { 0.12 };
+            let torque_n_m = -mu * clamp_n * r_eff * slip.signum();
+            heat_j -= torque_n_m * slip * dt_s;
             let f = InterfaceSample {
                 slip_rad_s: slip,
                 slip_m_s: slip * r_eff,
                 mu,
                 clamp_n,
-                torque_n_m: -mu * clamp_n * r_eff * slip.signum(),
+                torque_n_m,
                 locked,
+                dissipated_j: heat_j,
             };
             (s.t_s, vec![f])
         })

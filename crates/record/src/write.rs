@@ -731,6 +731,7 @@ impl Recorder {
                 torque_n_m: f.torque_n_m,
                 locked: f.locked,
                 interface_index: m as u32,
+                dissipated_j: f.dissipated_j,
             };
             self.put(self.ch.interfaces[m], lt, &msg, "interface")?;
         }

@@ -88,6 +88,7 @@ fn round_trip_is_exact() {
                     clamp_n: m.clamp_n,
                     torque_n_m: m.torque_n_m,
                     locked: m.locked,
+                    dissipated_j: m.dissipated_j,
                 }],
             )
         })
@@ -552,7 +553,7 @@ fn csv_export() {
     let mut lines = f.lines();
     assert_eq!(
         lines.next(),
-        Some("t_s,slip_rad_s,slip_m_s,mu,clamp_n,torque_n_m,locked")
+        Some("t_s,slip_rad_s,slip_m_s,mu,clamp_n,torque_n_m,locked,dissipated_j")
     );
     let clamp: Vec<f64> = lines
         .map(|l| l.split(',').nth(4).unwrap().parse().unwrap())

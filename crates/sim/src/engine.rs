@@ -1295,12 +1295,15 @@ impl<'a> Run<'a> {
             let q1 = *self.world.physics.bodies[hd].rotation();
             d.theta += angle_about_z(&(q0.inverse() * q1));
         }
-        if let Some(s) = &self.stack {
+        if let Some(s) = self.stack.as_mut() {
             let bodies = &self.world.physics.bodies;
-            let w = |i: usize| bodies[self.world.discs[i]].angvel().z;
+            let discs = &self.world.discs;
+            let w = |i: usize| bodies[discs[i]].angvel().z;
             for m in 0..s.interfaces() {
                 let slip = w(s.body[m + 1]) - w(s.body[m]);
-                self.energy.stack_work_j += s.impulse[m] * slip;
+                let work = s.impulse[m] * slip;
+                self.energy.stack_work_j += work;
+                s.dissipated_j[m] -= work;
             }
         }
     }

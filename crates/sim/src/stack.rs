@@ -60,6 +60,10 @@ pub(crate) struct Stack<'a> {
     h: f64,
     /// Whether each interface sticks over that step.
     pub locked: Vec<bool>,
+    /// Energy each interface has dissipated since t = 0, J (>= 0): `-sum Q_m (w_upper -
+    /// w_lower)` over the steps, with the bodies' mean speeds of each step (kept by the
+    /// engine, which knows them after the step).
+    pub dissipated_j: Vec<f64>,
     /// Torque of the stack on each stack body (stack order) over that step, N m.
     pub torque: Vec<f64>,
 }
@@ -81,6 +85,7 @@ impl<'a> Stack<'a> {
             clamp: vec![0.0; n_if],
             slip: vec![0.0; n_if],
             impulse: vec![0.0; n_if],
+            dissipated_j: vec![0.0; n_if],
             h: 0.0,
             locked: vec![false; n_if],
             torque: vec![0.0; n_bodies],
@@ -329,6 +334,7 @@ impl<'a> Stack<'a> {
                         0.0
                     },
                     locked: self.locked[m],
+                    dissipated_j: self.dissipated_j[m],
                 }
             })
             .collect()

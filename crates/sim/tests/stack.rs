@@ -368,7 +368,8 @@ fn engagement_scene_locks_and_stops_the_rattle() {
 /// (`p = 0`) and no drag: the work of the shaft on the discs' teeth equals the energy the
 /// faces dissipate plus the change of kinetic and elastic energy, within 0.5 % of the work
 /// over 50 ms (measured 2.5e-4). The faces' work is `sum Q (w_upper - w_lower)`
-/// per step, with the step's own mean speeds: what rapier integrates.
+/// per step, with the step's own mean speeds: what rapier integrates; the interfaces'
+/// `dissipated_j` add up to it.
 #[test]
 fn work_of_the_drive_equals_friction_loss_plus_energy_change() {
     let mut p = pack(
@@ -384,8 +385,18 @@ fn work_of_the_drive_equals_friction_loss_plus_energy_change() {
         b.law.hertz.loss_coefficient_s_m = 0.0;
     }
     let mut e = MultibodyEngine::from_pack(p, 2e3, MultibodyOptions::default()).unwrap();
-    e.run(0.05, &mut Collector::default()).unwrap();
+    let mut c = Collector::default();
+    e.run(0.05, &mut c).unwrap();
     let a = e.energy();
+    // the interfaces' heat is what the faces' work takes out of the bodies, face by face
+    let (_, last) = c.interfaces.last().unwrap();
+    let heat: f64 = last.iter().map(|f| f.dissipated_j).sum();
+    assert!(last.iter().all(|f| f.dissipated_j > 0.0));
+    assert!(
+        (heat + a.stack_work_j).abs() <= 1e-12 * heat,
+        "{heat} J vs {}",
+        a.stack_work_j
+    );
     let de =
         a.kinetic_j + a.contact_potential_j - a.initial_kinetic_j - a.initial_contact_potential_j;
     let w = a.drive_work_j + a.drag_work_j + a.stack_work_j + a.load_work_j;
