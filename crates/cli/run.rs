@@ -82,7 +82,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     let mut collector = RunCollector::new(names.len(), a.plot.is_some()).with_interfaces(
         common::friction_interfaces(&scene)
             .into_iter()
-            .map(|f| format!("{}__{}", f.lower, f.upper)),
+            .map(|f| f.name()),
     );
     let pb = common::time_progress(duration, &scene.name);
     collector.progress = Some(pb.clone());

@@ -50,6 +50,11 @@ pub struct FrictionInterface {
 }
 
 impl FrictionInterface {
+    /// `<lower>__<upper>`: the interface's name in tables and summaries.
+    pub fn name(&self) -> String {
+        format!("{}__{}", self.lower, self.upper)
+    }
+
     /// `<lower>__<upper>` of the bodies' topic segments ([`crate::topic_segment`]): the
     /// interface's topic segment, `/interfaces/<segment>`.
     pub fn segment(&self) -> String {

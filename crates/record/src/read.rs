@@ -821,8 +821,12 @@ impl RecordingReader {
         self.interface_series()
             .iter()
             .map(|f| {
-                let mut st =
-                    clutchpack_analysis::InterfaceStats::new(format!("{}__{}", f.lower, f.upper));
+                let name = crate::FrictionInterface {
+                    lower: f.lower.clone(),
+                    upper: f.upper.clone(),
+                }
+                .name();
+                let mut st = clutchpack_analysis::InterfaceStats::new(name);
                 for m in &f.states {
                     st.update(m.t_s, &m.to_sample());
                 }

@@ -148,14 +148,19 @@ pub(crate) fn update_transforms(
     }
 }
 
-/// The radial depth of a disc's drawn teeth in m.
-fn tooth_depth(d: &DiscGeometry) -> f64 {
-    let spline_r = if d.teeth_outside {
+/// The radius of a disc's spline in m: its rim for a plate with an external spline, its
+/// bore for a friction disc.
+fn spline_radius(d: &DiscGeometry) -> f64 {
+    if d.teeth_outside {
         d.outer_radius_m
     } else {
         d.inner_radius_m
-    };
-    (0.12 * spline_r.abs()).min(0.5 * (d.outer_radius_m - d.inner_radius_m).abs())
+    }
+}
+
+/// The radial depth of a disc's drawn teeth in m.
+fn tooth_depth(d: &DiscGeometry) -> f64 {
+    (0.12 * spline_radius(d).abs()).min(0.5 * (d.outer_radius_m - d.inner_radius_m).abs())
 }
 
 /// The radial position in m of the centre of a disc's drawn teeth: inside its bore for a
@@ -243,12 +248,7 @@ fn teeth_mesh(d: &DiscGeometry, color: Option<Color>) -> TriangleListPrimitive {
 /// A drawn tooth's size in m: radial depth, width (half the pitch), thickness.
 fn tooth_size(d: &DiscGeometry) -> Vector3 {
     let n = drawn_teeth(d);
-    let spline_r = if d.teeth_outside {
-        d.outer_radius_m
-    } else {
-        d.inner_radius_m
-    };
-    let width = 0.5 * 2.0 * PI * spline_r.abs() / f64::from(n);
+    let width = 0.5 * 2.0 * PI * spline_radius(d).abs() / f64::from(n);
     v3(
         tooth_depth(d).max(1e-6),
         width.max(1e-6),

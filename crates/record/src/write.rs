@@ -363,12 +363,14 @@ impl Recorder {
         }
         let mut interfaces = Vec::with_capacity(info.interfaces.len());
         if let Some(s_interface) = s_interface {
-            let mut used: Vec<String> = Vec::new();
-            for (m, f) in info.interfaces.iter().enumerate() {
-                let mut seg = f.segment();
-                if used.contains(&seg) {
-                    seg = format!("{seg}_{m}");
-                }
+            // `<lower>__<upper>` is already topic-safe; repeats get `_<index>` as discs do
+            let names: Vec<String> = info.interfaces.iter().map(|f| f.segment()).collect();
+            for (m, (f, seg)) in info
+                .interfaces
+                .iter()
+                .zip(unique_segments(&names))
+                .enumerate()
+            {
                 let meta: BTreeMap<String, String> = [
                     ("lower".to_string(), f.lower.clone()),
                     ("upper".to_string(), f.upper.clone()),
@@ -381,7 +383,6 @@ impl Recorder {
                     &topics::interface(&seg),
                     meta,
                 )?);
-                used.push(seg);
             }
         }
         let impacts = channel(&mut w, s_impact, topics::IMPACTS, none())?;

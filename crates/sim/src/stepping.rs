@@ -181,11 +181,9 @@ mod tests {
     use crate::hook::CouplingForces;
     use clutchpack_model::{free_impact_compression_m, Hertz, LawKind, OilFilm};
 
-    /// The predicted duration is the Hertz impact time: 2.943 s_max / v0 with
-    /// s_max = (5/4 m v0^2 / H)^(2/5) (the same closed form written two ways; p = 0).
-    #[test]
-    fn duration_is_the_hertz_impact_time() {
-        let law = ToothLaw {
+    /// The paper's steel teeth (E = 210 GPa, R = 1.75 mm) under the dry law, lossless.
+    fn steel_dry_law() -> ToothLaw {
+        ToothLaw {
             kind: LawKind::Dry,
             hertz: Hertz {
                 modulus_pa: 210e9,
@@ -201,7 +199,14 @@ mod tests {
                 v_floor_m_s: 0.01,
                 h_min_m: 1e-6,
             },
-        };
+        }
+    }
+
+    /// The predicted duration is the Hertz impact time: 2.943 s_max / v0 with
+    /// s_max = (5/4 m v0^2 / H)^(2/5) (the same closed form written two ways; p = 0).
+    #[test]
+    fn duration_is_the_hertz_impact_time() {
+        let law = steel_dry_law();
         let m = 0.156 / (154.0 * (0.231 * 20f64.to_radians().cos()).powi(2));
         let v0 = 0.3;
         let s = free_impact_compression_m(law.hertz.coefficient(), m, v0);
@@ -217,23 +222,7 @@ mod tests {
     /// `max_step_s`), whatever the event's step was.
     #[test]
     fn sustained_contacts_step_by_their_local_period() {
-        let law = ToothLaw {
-            kind: LawKind::Dry,
-            hertz: Hertz {
-                modulus_pa: 210e9,
-                curvature_radius_m: 1.75e-3,
-                loss_coefficient_s_m: 0.0,
-            },
-            oil: OilFilm {
-                thickness_m: 0.0,
-                viscosity_pa_s: 0.0,
-                leakage_coefficient: 0.421,
-                width_m: 3e-3,
-                length_m: 3e-3,
-                v_floor_m_s: 0.01,
-                h_min_m: 1e-6,
-            },
-        };
+        let law = steel_dry_law();
         let h = law.hertz.coefficient();
         let (m, depth) = (0.02, 1e-6);
         let forces = CouplingForces {
