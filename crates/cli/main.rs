@@ -21,6 +21,7 @@ mod check;
 mod common;
 mod recording;
 mod run;
+mod signals;
 mod sweep;
 
 use clap::{Parser, Subcommand};

@@ -71,13 +71,7 @@ pub fn replay(a: ReplayArgs) -> Result<ExitCode> {
 
 #[cfg(feature = "serve")]
 fn serve(reader: &RecordingReader, port: u16, speed: f32) -> Result<()> {
-    use std::sync::atomic::{AtomicBool, Ordering};
-    use std::sync::Arc;
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-    }
+    let stop = crate::signals::flag();
     let opts = clutchpack_record::ServeOptions {
         port,
         speed,

@@ -107,13 +107,8 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                 .with_context(|| format!("creating the recording {}", path.display()))?,
         )
     };
-    let interrupted = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupted.clone();
-        // A second Ctrl-C while the handler is installed still stops the run (the flag is
-        // simply set again); failing to install it only loses the clean stop.
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-    }
+    // SIGINT, SIGTERM and SIGHUP stop the run cleanly (crate::signals).
+    let interrupted = crate::signals::flag();
     let t0 = Instant::now();
     let done = run_recorded(engine.as_mut(), duration, collector, recorder, interrupted);
     let wall = t0.elapsed().as_secs_f64();
@@ -147,7 +142,8 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     let run_stats = match result {
         Ok(s) if s.stopped_early => {
             eprintln!(
-                "interrupted at t = {:.6} s: the outputs hold the run up to there",
+                "interrupted ({}) at t = {:.6} s: the outputs hold the run up to there",
+                crate::signals::received_name(),
                 s.simulated_s
             );
             s
@@ -204,8 +200,8 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         return Err(e);
     }
     if run_stats.stopped_early {
-        // 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
-        return Ok(ExitCode::from(130));
+        // 128 + signal, as a shell reports a command stopped by that signal
+        return Ok(crate::signals::exit_code());
     }
     Ok(ExitCode::SUCCESS)
 }
