@@ -82,8 +82,7 @@ pub fn ensemble_member(scene: &Scene, k: usize, count: usize) -> Scene {
     }
     let frac = -1.0 + (2 * k + 1) as f64 / count as f64;
     for d in s.pack.discs.iter_mut() {
-        let free =
-            d.spline.half_play_rad() - d.law.engagement_offset_m() / d.spline.base_radius_m();
+        let free = d.spline.free_half_play_rad(d.law.engagement_offset_m());
         d.initial_rel_angle_rad = frac * 0.9 * free;
     }
     s

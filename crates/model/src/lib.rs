@@ -42,7 +42,9 @@ pub use clutch::{
 pub use drive::{Harmonic, Shaft, ShaftExcitation, SpeedProfile, Table, TableError};
 pub use impact::{detect_impacts, ImpactEvent, ImpactTracker};
 pub use law::{ContactState, Engagement, Hertz, LawKind, OilFilm, ToothLaw};
-pub use pack::{annulus_inner_radius_m, annulus_outer_radius_m, DiscModel, PackModel};
+pub use pack::{
+    annulus_inner_radius_m, annulus_outer_radius_m, DiscModel, NonTorsional, PackModel,
+};
 pub use spline::{Flank, SplineGeometry, ToothKinematics};
 pub use stream::{
     Collector, DiscSample, Engine, EngineError, NullObserver, Observer, RunStats, Sample,

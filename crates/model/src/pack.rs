@@ -66,6 +66,24 @@ impl DiscModel {
     }
 }
 
+/// A part of a pack that a torsional model (one rotational degree of freedom per friction
+/// disc, identical teeth) does not describe: only a per-tooth, multibody engine runs it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NonTorsional {
+    /// Disc `i` floats radially on its spline.
+    RadialFloat(usize),
+    /// Disc `i` starts off the axis.
+    InitialOffset(usize),
+    /// Disc `i` has tooth spacing errors.
+    SpacingErrors(usize),
+    /// The pack has separator plates.
+    Plates,
+    /// The pack has an output drum.
+    Drum,
+    /// The pack has a clamped stack.
+    Stack,
+}
+
 /// A shaft and the discs coupled to it; in a whole pack (MODEL.md section 5) also the
 /// separator plates, the output drum and the axial stack.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -97,10 +115,37 @@ impl PackModel {
     /// disc [`DiscModel::is_concentric`], and no plates, drum or stack. Engines choose by it
     /// (the reference engine refuses a pack that is not).
     pub fn is_torsional(&self) -> bool {
-        self.discs.iter().all(DiscModel::is_concentric)
-            && self.plates.is_empty()
-            && self.drum.is_none()
-            && self.stack.is_none()
+        self.non_torsional_parts().is_empty()
+    }
+
+    /// Every part of the pack that a torsional model does not describe (MODEL.md section 5),
+    /// in order: per disc its radial float, offset and spacing errors, then the plates, the
+    /// drum and the stack. Empty exactly when [`Self::is_torsional`]. The one statement of
+    /// what the reference engine cannot run; the CLI's engine choice and `check --engine`
+    /// read it.
+    pub fn non_torsional_parts(&self) -> Vec<NonTorsional> {
+        let mut out = Vec::new();
+        for (i, d) in self.discs.iter().enumerate() {
+            if d.radial_float {
+                out.push(NonTorsional::RadialFloat(i));
+            }
+            if d.initial_offset_m != [0.0, 0.0] {
+                out.push(NonTorsional::InitialOffset(i));
+            }
+            if d.tooth_spacing_errors_m.iter().any(|&e| e != 0.0) {
+                out.push(NonTorsional::SpacingErrors(i));
+            }
+        }
+        if !self.plates.is_empty() {
+            out.push(NonTorsional::Plates);
+        }
+        if self.drum.is_some() {
+            out.push(NonTorsional::Drum);
+        }
+        if self.stack.is_some() {
+            out.push(NonTorsional::Stack);
+        }
+        out
     }
 
     /// A pack of a shaft and friction discs only (no plates, drum or stack).

@@ -86,6 +86,20 @@ impl SplineGeometry {
         self.backlash_m / (2.0 * self.pitch_radius_m)
     }
 
+    /// The free play left on each side in rad when contact starts `engagement_offset_m` (m,
+    /// along the line of action) before the metal touches (the film thickness `h_o` of the
+    /// oil laws, [`crate::ToothLaw::engagement_offset_m`]): `g0 - h_o / Rb`. A disc starting
+    /// at `|phi| <` this is out of contact.
+    pub fn free_half_play_rad(&self, engagement_offset_m: f64) -> f64 {
+        self.half_play_rad() - engagement_offset_m / self.base_radius_m()
+    }
+
+    /// Tooth pitch at the pitch circle `2 pi R / n` in m: the backlash must be below it (a
+    /// gap wider than the pitch leaves no tooth).
+    pub fn tooth_pitch_m(&self) -> f64 {
+        std::f64::consts::TAU * self.pitch_radius_m / self.teeth as f64
+    }
+
     /// Metal clearance along the line of action with the disc centred, `g0 Rb`, in m.
     pub fn half_play_line_m(&self) -> f64 {
         self.half_play_rad() * self.base_radius_m()

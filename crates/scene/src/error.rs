@@ -46,13 +46,15 @@ impl fmt::Display for Problem {
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The scene file could not be read.
-    #[error("{}: cannot read the scene file: {source}", path.display())]
+    ///
+    /// The I/O error is part of the message and not a `source()`, so that a chain of causes
+    /// (`anyhow`'s `{:#}`) does not print it twice in one line.
+    #[error("{}: cannot read the scene file: {error}", path.display())]
     Read {
         /// The file.
         path: PathBuf,
         /// The I/O error.
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The scene was read but is not valid: every problem found, in file order as far as
     /// possible. Displayed one problem per line, each prefixed with the file name.

@@ -23,12 +23,12 @@
 //! description = "Hu et al. Table 2"
 //!
 //! [simulation]
-//! duration_s = 0.3              # required, > 0
+//! duration_s = 0.3              # required
 //! engine = "reference"          # optional: "reference" | "multibody"
-//! record_rate_hz = 10000.0      # default 10000
-//! tolerance = 1e-9              # default 1e-9, in [1e-14, 1e-3]
-//! max_step_s = 1e-4             # default 1e-4
-//! record_per_tooth = false       # default false
+//! record_rate_hz = 10000.0      # optional (every optional key has a default: keys_doc)
+//! tolerance = 1e-9              # optional
+//! max_step_s = 1e-4             # optional
+//! record_per_tooth = false     # optional
 //!
 //! [shaft]
 //! mode = "prescribed"           # default; or "inertial" with inertia_kg_m2 (required),
@@ -139,13 +139,22 @@
 //! ```
 //!
 //! # Architecture
-//! Two stages: `raw` mirrors the file (tables typed, values kept as written; unknown keys
-//! collected with `serde_ignored`), then `validate` converts to the typed model, collecting
-//! every problem. `schema` lists every key once; it drives the key reference, the "expected
-//! one of" lists and the `--set` key check.
+//! Each key is defined once, in `keys` (its table, name, unit, kind and range rule, default
+//! and meaning); that one definition makes the raw serde struct of its table, drives its
+//! check in the validation, the "expected one of" lists, the `--set` key check,
+//! [`keys_doc`] (`clutchpack check --keys`) and [`keys_markdown`] (the README's table). Two
+//! stages: the raw structs mirror the file (tables typed, values kept as written; unknown keys
+//! collected with `serde_ignored`), then `validate` (one module per section: simulation,
+//! drive and shaft, bodies, stack and drum) converts them to the typed model, collecting
+//! every problem. [`Scene::engine`] says which engine runs a scene, refusing a choice that
+//! cannot run it.
+
+#![warn(missing_docs)]
 
 mod csv;
+mod engine;
 mod error;
+mod keys;
 mod overrides;
 mod raw;
 mod schema;
@@ -153,7 +162,7 @@ mod validate;
 
 pub use error::{Problem, SceneError};
 pub use overrides::{Override, OverrideError};
-pub use schema::keys_doc;
+pub use schema::{keys_doc, keys_markdown};
 
 use std::path::Path;
 use toml::{Table, Value};
@@ -171,23 +180,23 @@ pub enum EngineChoice {
     Multibody,
 }
 
-/// Run settings of a scene (`[simulation]`).
+/// Run settings of a scene (`[simulation]`). The rules and defaults of the keys are those of
+/// [`keys_doc`] (`clutchpack check --keys`), defined once in the scene crate.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Simulation {
-    /// Simulated duration in s (> 0). Key `simulation.duration_s` (required).
+    /// Simulated duration in s (> 0). Key `simulation.duration_s`.
     pub duration_s: f64,
     /// Engine asked for by the scene, if any. Key `simulation.engine`.
     pub engine: Option<EngineChoice>,
-    /// Rate at which samples are emitted, Hz (> 0). Key `simulation.record_rate_hz`, default 10000.
+    /// Rate at which samples are emitted, Hz (> 0). Key `simulation.record_rate_hz`.
     pub record_rate_hz: f64,
-    /// Relative error tolerance of the adaptive reference integrator (dimensionless, in
-    /// [1e-14, 1e-3]). Key `simulation.tolerance`, default 1e-9.
+    /// Relative error tolerance of the adaptive integrators (dimensionless). Key
+    /// `simulation.tolerance`.
     pub tolerance: f64,
-    /// Largest step of the adaptive integrators in s (> 0). Key `simulation.max_step_s`,
-    /// default 1e-4.
+    /// Largest step of the adaptive integrators in s (> 0). Key `simulation.max_step_s`.
     pub max_step_s: f64,
     /// Whether recordings store per-tooth loads where the engine resolves teeth. Key
-    /// `simulation.record_per_tooth`, default false.
+    /// `simulation.record_per_tooth`.
     pub record_per_tooth: bool,
 }
 
@@ -212,9 +221,9 @@ pub struct Scene {
 /// Messages name the file as `path` is written; relative CSV paths resolve against the file's
 /// folder. The [`Scene`] holds SI values (degrees of `_deg` keys converted to rad).
 pub fn load(path: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+    let text = std::fs::read_to_string(path).map_err(|error| SceneError::Read {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     let base_dir = path.parent().unwrap_or(Path::new(""));
     parse(&text, &path.display().to_string(), base_dir, overrides)
@@ -307,11 +316,11 @@ fn syntax_problem(text: &str, e: &toml::de::Error) -> Problem {
 /// Stage one: the document -> raw structs. Unknown keys become problems. Deserialization
 /// cannot fail after [`raw::check_structure`]; should it, the failure is a problem too and
 /// `None` is returned.
-fn deserialize_raw(doc: Table, problems: &mut Vec<Problem>) -> Option<raw::RawScene> {
+fn deserialize_raw(doc: Table, problems: &mut Vec<Problem>) -> Option<keys::RawScene> {
     let mut unknown = Vec::new();
     let mut collect = |path: serde_ignored::Path| unknown.push(ignored_path(&path));
     let de = serde_ignored::Deserializer::new(Value::Table(doc), &mut collect);
-    let result: Result<raw::RawScene, _> = serde_path_to_error::deserialize(de);
+    let result: Result<keys::RawScene, _> = serde_path_to_error::deserialize(de);
     for key in unknown {
         let parent = key.rfind('.').map_or("", |i| &key[..i]);
         let rule = format!(

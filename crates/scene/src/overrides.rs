@@ -121,11 +121,23 @@ fn path_text(segs: &[Segment]) -> String {
     s
 }
 
-/// Reads an override's value: TOML if it parses, else the text as a string.
+/// Reads an override's value: TOML if it parses, else a number if Rust reads it as one (an
+/// integer beyond TOML's 64-bit range, such as `10000000000000000000` from `--duration
+/// 1e19`, is a float), else the text as a string.
 fn parse_value(text: &str) -> Value {
     match format!("v = {text}").parse::<Table>() {
         Ok(mut t) if t.len() == 1 => t.remove("v").unwrap_or_else(|| Value::String(text.into())),
-        _ => Value::String(text.to_string()),
+        _ => match text.trim().parse::<f64>() {
+            Ok(x)
+                if text
+                    .trim()
+                    .bytes()
+                    .all(|b| b.is_ascii_digit() || b"+-.eE".contains(&b)) =>
+            {
+                Value::Float(x)
+            }
+            _ => Value::String(text.to_string()),
+        },
     }
 }
 
@@ -294,6 +306,12 @@ mod tests {
         assert_eq!(parse_value("sine"), Value::String("sine".into()));
         assert_eq!(parse_value("\"sine\""), Value::String("sine".into()));
         assert!(parse_value("nan").as_float().unwrap().is_nan());
+        assert_eq!(
+            parse_value("10000000000000000000"),
+            Value::Float(1e19),
+            "beyond i64: a float, not a string"
+        );
+        assert_eq!(parse_value("1e"), Value::String("1e".into()));
     }
 
     #[test]

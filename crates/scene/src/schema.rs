@@ -1,248 +1,439 @@
-//! The list of every key a scene file may hold, with a one-line reference for each.
-//!
-//! This is the single source of truth for three things: the key reference printed by `--help`
-//! ([`keys_doc`]), the "expected one of" lists of unknown-key errors, and the check that a
-//! `--set` key exists. The raw structs in [`crate::raw`] must hold exactly these keys (a unit
-//! test checks that every key here deserializes without being reported as unknown).
+//! The machinery of the key definitions: what a key is ([`Key`]: name, unit, kind and rule,
+//! default, doc), the [`table!`] macro that turns one table's definitions into its raw serde
+//! struct and its key list, and what is derived from them: every key path of the file, the
+//! "expected one of" lists, the `--set` key check, `check --keys` ([`keys_doc`]) and the
+//! README table ([`keys_markdown`]). The definitions themselves are in [`crate::keys`].
 //!
 //! Paths are written as in the file, with `[]` standing for any index of an array of tables:
 //! `discs[].spline.teeth`.
 
 use std::sync::OnceLock;
+use toml::Value;
 
-/// One key of the file and its reference line (unit, rule, default).
-struct Key {
-    path: &'static str,
-    doc: &'static str,
+/// One key of a scene file: everything the parse, the validation and the documentation know
+/// about it. Written once, in [`crate::keys`], through [`table!`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Key {
+    /// The table's path relative to its body for body tables (`""`, `"spline"`), else from
+    /// the top (`"simulation"`, `"drive.harmonics[]"`); `""` at the top level.
+    pub table: &'static str,
+    /// The key's name in its table: `record_rate_hz`.
+    pub name: &'static str,
+    /// Unit as written in the reference (`"Hz"`, `"kg m^2"`), `""` for none.
+    pub unit: &'static str,
+    /// What kind of value it takes, with its range rule.
+    pub kind: Kind,
+    /// What an absent key means.
+    pub default: Dflt,
+    /// One line of meaning and of rules between keys (the rest of the reference line is
+    /// generated from `unit`, `kind` and `default`).
+    pub doc: &'static str,
 }
 
-const fn key(path: &'static str, doc: &'static str) -> Key {
-    Key { path, doc }
+/// What kind of value a key takes.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Kind {
+    /// A finite number (an integer is accepted) within a range.
+    Number(Rule),
+    /// An integer count, `>= 1` and `<= max`.
+    Count {
+        /// The largest count accepted (a plausibility bound).
+        max: u32,
+    },
+    /// `true` or `false`.
+    Bool,
+    /// A string.
+    Text,
+    /// One of these strings.
+    Choice(&'static [&'static str]),
+    /// An array of finite numbers.
+    Numbers,
 }
 
-/// Keys outside the disc parameters.
-const SCENE_KEYS: &[Key] = &[
-    key(
-        "name",
-        "string; default: the file name without its extension",
-    ),
-    key("description", "string; default: empty"),
-    key("simulation.duration_s", "s, required, > 0"),
-    key(
-        "simulation.engine",
-        "\"reference\" | \"multibody\"; optional (the CLI chooses if absent)",
-    ),
-    key("simulation.record_rate_hz", "Hz, > 0; default 10000"),
-    key(
-        "simulation.tolerance",
-        "relative tolerance of the adaptive integrator, in [1e-14, 1e-3]; default 1e-9",
-    ),
-    key("simulation.max_step_s", "s, > 0; default 1e-4"),
-    key(
-        "simulation.record_per_tooth",
-        "true | false; record per-tooth loads where the engine resolves teeth; default false",
-    ),
-    key("shaft.mode", "\"prescribed\" (default) | \"inertial\""),
-    key(
-        "shaft.inertia_kg_m2",
-        "kg m^2, > 0; required if inertial, an error if prescribed",
-    ),
-    key(
-        "shaft.damping_n_m_s_rad",
-        "N m s/rad, >= 0; default 0; inertial only",
-    ),
-    key(
-        "shaft.initial_speed_rad_s",
-        "rad/s; required with drive.kind = \"torque_table\", an error otherwise",
-    ),
-    key(
-        "drive.kind",
-        "required: \"sine\" | \"harmonics\" | \"speed_table\" | \"torque_table\"",
-    ),
-    key(
-        "drive.omega0_rad_s",
-        "rad/s, mean shaft speed; required for sine and harmonics",
-    ),
-    key("drive.amplitude_rad_s", "rad/s; sine: required"),
-    key("drive.frequency_hz", "Hz, > 0; sine: required"),
-    key("drive.phase_deg", "deg; sine: default 0"),
-    key(
-        "drive.harmonics[].amplitude_rad_s",
-        "rad/s; harmonics: one [[drive.harmonics]] per term, at least one; required",
-    ),
-    key("drive.harmonics[].frequency_hz", "Hz, > 0; required"),
-    key("drive.harmonics[].phase_deg", "deg; default 0"),
-    key(
-        "drive.file",
-        "CSV with a header row, relative to the scene file's folder; speed_table: columns \
-         time_s, speed_rad_s; torque_table: columns time_s, torque_n_m (needs shaft.mode = \
-         \"inertial\")",
-    ),
-    key(
-        "discs[].name",
-        "string; default \"disc-<i+1>\"; unique (only in [[discs]], not in [defaults])",
-    ),
-    key(
-        "plates[].name",
-        "string; default \"plate-<j+1>\"; unique among discs and plates (only in [[plates]])",
-    ),
-    key(
-        "drum.inertia_kg_m2",
-        "kg m^2, > 0; required with [drum] (a clutch: the plates sit on the drum, else on \
-         the housing)",
-    ),
-    key(
-        "drum.load_torque_n_m",
-        "N m, on the drum about the axis (negative brakes it); default 0",
-    ),
-    key("drum.drag_n_m_s_rad", "N m s/rad, >= 0; default 0"),
-    key("drum.initial_speed_rad_s", "rad/s; default 0"),
-    key(
-        "stack.face_inner_radius_m",
-        "m, > 0; required with [stack] (friction faces, inner radius)",
-    ),
-    key(
-        "stack.face_outer_radius_m",
-        "m, > face_inner_radius_m; required with [stack]",
-    ),
-    key(
-        "stack.spline_friction_coefficient",
-        "dimensionless, >= 0; default 0 (axial spline friction holds back mu n |F| per body)",
-    ),
-    key("stack.piston_area_m2", "m^2, > 0; required with [stack]"),
-    key(
-        "stack.return_spring_n",
-        "N, >= 0; default 0 (piston force = p A - return spring, never < 0)",
-    ),
-    key("stack.friction.kind", "\"stribeck\" (default) | \"table\""),
-    key(
-        "stack.friction.static_mu",
-        "stribeck: mu at zero slip, > 0; required",
-    ),
-    key(
-        "stack.friction.kinetic_mu",
-        "stribeck: mu beyond the Stribeck speed, > 0; default static_mu",
-    ),
-    key(
-        "stack.friction.stribeck_speed_m_s",
-        "stribeck: m/s, > 0; default 1",
-    ),
-    key(
-        "stack.friction.viscous_slope_s_m",
-        "stribeck: s/m, >= 0; default 0 (mu rises by this per m/s of slip)",
-    ),
-    key(
-        "stack.friction.slip_m_s",
-        "table: m/s, array increasing from 0; required",
-    ),
-    key(
-        "stack.friction.mu",
-        "table: array of mu > 0, one per slip_m_s; required",
-    ),
-    key(
-        "stack.pressure.kind",
-        "required with [stack]: \"constant\" | \"ramp\" | \"table\"",
-    ),
-    key(
-        "stack.pressure.pressure_pa",
-        "Pa, >= 0; constant and ramp (the final pressure): required",
-    ),
-    key("stack.pressure.start_s", "ramp: s, >= 0; default 0"),
-    key("stack.pressure.rise_s", "ramp: s, > 0; required"),
-    key(
-        "stack.pressure.times_s",
-        "table: s, array increasing; required",
-    ),
-    key(
-        "stack.pressure.values_pa",
-        "table: Pa, array >= 0, one per times_s; required",
-    ),
-    key(
-        "stack.open_gap.viscosity_pa_s",
-        "Pa s, > 0; required with [stack.open_gap] (oil in the open gaps)",
-    ),
-    key(
-        "stack.open_gap.gap_m",
-        "m, > 0; required with [stack.open_gap] (axial gap per open interface)",
-    ),
-];
+/// What an absent key means.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Dflt {
+    /// The key must be given.
+    Required,
+    /// Required, allowed or refused depending on other keys; the text says when.
+    When(&'static str),
+    /// This number.
+    Num(f64),
+    /// This boolean.
+    Bool(bool),
+    /// This choice.
+    Choice(&'static str),
+    /// A default derived from other values, described by the text.
+    Described(&'static str),
+}
 
-/// Disc parameters: allowed in `[defaults]` and in each `[[discs]]` entry.
-const DISC_KEYS: &[Key] = &[
-    key("inertia_kg_m2", "kg m^2, > 0; required"),
-    key("drag_n_m_s_rad", "N m s/rad, >= 0; default 0 (oil drag C2)"),
-    key(
-        "initial_rel_angle_rad",
-        "rad, phi(0) = theta_shaft - theta_disc; default 0; must lie inside the free play",
-    ),
-    key(
-        "initial_rel_speed_rad_s",
-        "rad/s, omega_shaft(0) - omega_disc(0); default 0",
-    ),
-    key(
-        "radial_float",
-        "true | false; default false; the disc may move radially on its spline (multibody \
-         engine only)",
-    ),
-    key(
-        "tooth_spacing_errors_m",
-        "m, array of n finite numbers (one per tooth, tooth k at 2 pi k / n from the shaft's \
-         +x axis) or empty; default empty; circumferential spacing error at the pitch circle, \
-         positive closes the shaft-leads gap (multibody engine only)",
-    ),
-    key(
-        "initial_offset_m",
-        "m, [x, y] in the shaft's frame; default [0, 0]; the disc centre's offset from the \
-         axis at t = 0 (held there unless radial_float; multibody engine only)",
-    ),
-    key("spline.teeth", "integer >= 1; required"),
-    key("spline.pitch_radius_m", "m, > 0; required"),
-    key("spline.pressure_angle_deg", "deg, in (0, 90); required"),
-    key(
-        "spline.backlash_m",
-        "m, > 0; required (total circumferential free play at the pitch circle)",
-    ),
-    key("contact.law", "\"paper\" (default) | \"dry\" | \"squeeze\""),
-    key(
-        "contact.modulus_pa",
-        "Pa, > 0; required (equivalent modulus E)",
-    ),
-    key(
-        "contact.curvature_radius_m",
-        "m, > 0; required (equivalent curvature radius r)",
-    ),
-    key(
-        "contact.loss_coefficient_s_m",
-        "s/m, >= 0; default 0 (impact loss p)",
-    ),
-    key(
-        "oil.film_thickness_m",
-        "m, >= 0; default 0; below half the free play along the line of action",
-    ),
-    key(
-        "oil.viscosity_pa_s",
-        "Pa s, > 0; required if film_thickness_m > 0 and law is not dry",
-    ),
-    key(
-        "oil.leakage_coefficient",
-        "dimensionless, > 0; required like viscosity_pa_s (beta)",
-    ),
-    key("oil.width_m", "m, > 0; required like viscosity_pa_s (B)"),
-    key("oil.length_m", "m, > 0; required like viscosity_pa_s (L)"),
-    key("oil.v_floor_m_s", "m/s, > 0; default 0.01"),
-    key("oil.h_min_m", "m, > 0; default 1e-6 (squeeze law)"),
-];
+/// The range rule of a number (every number must also be finite). Bounds print in the
+/// shortest form of [`fmt_bound`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Rule {
+    /// Any finite number.
+    Finite,
+    /// `> 0`.
+    Positive,
+    /// `>= 0`.
+    NonNegative,
+    /// In `[lo, hi]`.
+    Closed(f64, f64),
+    /// In `(lo, hi)`.
+    Open(f64, f64),
+    /// `> 0`, and within the plausibility bounds `[floor, ceil]` (see docs/DECISIONS.md,
+    /// "Plausibility bounds"): `floor` 0 or `ceil` infinite for none.
+    Bounded {
+        /// Smallest plausible value (0: any positive value).
+        floor: f64,
+        /// Largest plausible value (infinity: no ceiling).
+        ceil: f64,
+    },
+}
 
-/// Every key path of the schema, `[]` for array indices.
-pub(crate) fn all_paths() -> &'static [String] {
-    static PATHS: OnceLock<Vec<String>> = OnceLock::new();
-    PATHS.get_or_init(|| {
-        let mut v: Vec<String> = SCENE_KEYS.iter().map(|k| k.path.to_string()).collect();
-        for prefix in ["defaults", "discs[]", "plate_defaults", "plates[]"] {
-            v.extend(DISC_KEYS.iter().map(|k| format!("{prefix}.{}", k.path)));
+impl Rule {
+    /// `Ok` if `x` (finite) holds, else the rule it breaks, e.g. `must be > 0`. `unit` is the
+    /// key's unit, named after plausibility bounds.
+    pub fn check(self, x: f64, unit: &str) -> Result<(), String> {
+        let u = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        let ok = match self {
+            Rule::Finite => true,
+            Rule::Positive => x > 0.0,
+            Rule::NonNegative => x >= 0.0,
+            Rule::Closed(lo, hi) => (lo..=hi).contains(&x),
+            Rule::Open(lo, hi) => x > lo && x < hi,
+            Rule::Bounded { floor, ceil } => {
+                return if x <= 0.0 {
+                    Err("must be > 0".into())
+                } else if x < floor {
+                    Err(format!(
+                        "must be >= {}{u} (plausibility bound)",
+                        fmt_bound(floor)
+                    ))
+                } else if x > ceil {
+                    Err(format!(
+                        "must be <= {}{u} (plausibility bound)",
+                        fmt_bound(ceil)
+                    ))
+                } else {
+                    Ok(())
+                };
+            }
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(format!("must be {}", self.doc()))
         }
+    }
+
+    /// The rule for the reference: `> 0`, `in [1e-14, 1e-3]`.
+    pub fn doc(self) -> String {
+        match self {
+            Rule::Finite => "a finite number".into(),
+            Rule::Positive => "> 0".into(),
+            Rule::NonNegative => ">= 0".into(),
+            Rule::Closed(lo, hi) => format!("in [{}, {}]", fmt_bound(lo), fmt_bound(hi)),
+            Rule::Open(lo, hi) => {
+                format!("in ({}, {}) (exclusive)", fmt_bound(lo), fmt_bound(hi))
+            }
+            Rule::Bounded { floor, ceil } => {
+                let low = if floor > 0.0 {
+                    format!(">= {}", fmt_bound(floor))
+                } else {
+                    "> 0".into()
+                };
+                if ceil.is_finite() {
+                    format!("{low} and <= {}", fmt_bound(ceil))
+                } else {
+                    low
+                }
+            }
+        }
+    }
+}
+
+/// A number in its shortest round-trip form: `{}` or `{:e}`, whichever is shorter (`1e-14`,
+/// `0.1`, `90`, `1e6`, `1e308`); integers below 1e6 in full (`10000`).
+pub(crate) fn fmt_bound(x: f64) -> String {
+    let plain = format!("{x}");
+    if x.fract() == 0.0 && x.abs() < 1e6 {
+        return plain;
+    }
+    let sci = format!("{x:e}");
+    if sci.len() < plain.len() {
+        sci
+    } else {
+        plain
+    }
+}
+
+/// A number for messages: Rust's shortest round-trip `{}` for ordinary magnitudes, `{:e}`
+/// for huge or tiny ones (`1e308`, not 309 digits; `5e-324`).
+pub(crate) fn fmt_num(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-5..1e16).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// A value as written, in TOML syntax, for messages; huge or tiny floats in `{:e}` form.
+pub(crate) fn show(v: &Value) -> String {
+    fn plain(x: f64) -> bool {
+        x == 0.0 || !x.is_finite() || (1e-5..1e16).contains(&x.abs())
+    }
+    match v {
+        Value::Float(x) if !plain(*x) => format!("{x:e}"),
+        Value::Array(items)
+            if items
+                .iter()
+                .any(|i| matches!(i, Value::Float(x) if !plain(*x))) =>
+        {
+            let parts: Vec<String> = items.iter().map(show).collect();
+            format!("[{}]", parts.join(", "))
+        }
+        _ => v.to_string(),
+    }
+}
+
+impl Key {
+    /// The key's path relative to its table root: `spline.teeth`, `simulation.duration_s`.
+    pub fn rel(&self) -> String {
+        join(self.table, self.name)
+    }
+
+    /// The key's path under `at` (a body such as `discs[2]`, or `""`): `discs[2].spline.teeth`.
+    pub fn at(&self, at: &str) -> String {
+        join(at, &self.rel())
+    }
+
+    /// The default number; a bug if the key's default is not a number.
+    pub fn default_num(&self) -> f64 {
+        match self.default {
+            Dflt::Num(x) => x,
+            _ => panic!("key {} has no numeric default", self.rel()),
+        }
+    }
+
+    /// The default boolean; a bug if the key's default is not a boolean.
+    pub fn default_bool(&self) -> bool {
+        match self.default {
+            Dflt::Bool(b) => b,
+            _ => panic!("key {} has no boolean default", self.rel()),
+        }
+    }
+
+    /// The index of the default choice among the key's names; a bug if there is none.
+    pub fn default_choice(&self) -> usize {
+        match (self.kind, self.default) {
+            (Kind::Choice(names), Dflt::Choice(c)) => names
+                .iter()
+                .position(|n| *n == c)
+                .unwrap_or_else(|| panic!("key {}: default {c} is not a choice", self.rel())),
+            _ => panic!("key {} has no default choice", self.rel()),
+        }
+    }
+
+    /// The reference line: `Hz, > 0 and <= 1e6; default 10000; rate of the samples`.
+    pub fn doc_line(&self) -> String {
+        let mut parts = Vec::new();
+        let (unit, rule, default) = self.columns();
+        let first = match (unit.is_empty(), rule.is_empty()) {
+            (true, _) => rule,
+            (false, true) => unit,
+            (false, false) => format!("{unit}, {rule}"),
+        };
+        parts.push(first);
+        parts.push(default);
+        if !self.doc.is_empty() {
+            parts.push(self.doc.trim().to_string());
+        }
+        parts.retain(|p| !p.is_empty());
+        parts.join("; ")
+    }
+
+    /// The unit, rule and default columns of the reference.
+    pub fn columns(&self) -> (String, String, String) {
+        let rule = match self.kind {
+            Kind::Number(r) => r.doc(),
+            Kind::Count { max } => format!("integer >= 1 and <= {max}"),
+            Kind::Bool => "true | false".into(),
+            Kind::Text => "string".into(),
+            Kind::Choice(names) => names
+                .iter()
+                .map(|n| format!("\"{n}\""))
+                .collect::<Vec<_>>()
+                .join(" | "),
+            Kind::Numbers => "array of finite numbers".into(),
+        };
+        let default = match self.default {
+            Dflt::Required => "required".into(),
+            Dflt::When(t) | Dflt::Described(t) => t.to_string(),
+            Dflt::Num(x) => format!("default {}", fmt_bound(x)),
+            Dflt::Bool(b) => format!("default {b}"),
+            Dflt::Choice(c) => format!("default \"{c}\""),
+        };
+        (self.unit.to_string(), rule, default)
+    }
+}
+
+/// `a.b`, or `b` if `a` is empty.
+fn join(a: &str, b: &str) -> String {
+    if a.is_empty() {
+        b.to_string()
+    } else {
+        format!("{a}.{b}")
+    }
+}
+
+/// A table of the file as its raw struct: the keys it defines and their values as written.
+/// Implemented by [`table!`].
+pub(crate) trait RawTable {
+    /// The table path of this table's own keys (`Key::table`).
+    fn base() -> &'static str;
+    /// The value of `key` (of this table or of one of its sub-tables) as written.
+    fn value(&self, key: &Key) -> Option<&Value> {
+        self.get_in(Self::base(), key)
+    }
+    /// The value of `key` as written, looking into sub-tables by `key.table` relative to
+    /// `base` (the table path of `Self`'s own keys); `None` if absent.
+    fn get_in(&self, base: &str, key: &Key) -> Option<&Value>;
+    /// Every leaf key under `prefix` (the path of this table, `[]` for array items), in
+    /// definition order, sub-tables after their parent's leaves in the order declared.
+    fn paths(prefix: &str, out: &mut Vec<(String, &'static Key)>);
+}
+
+/// Defines one table of the scene file: its raw serde struct (every leaf an
+/// `Option<toml::Value>`, kept as written for the validation) and one [`Key`] per leaf, as an
+/// associated constant of the same name (`RawSimulation::record_rate_hz`), listed in file
+/// order by [`RawTable::keys`]. Sub-tables are declared as `name: table Type` or
+/// `name: array Type` (an array of tables) after `children`.
+///
+/// ```ignore
+/// table! {
+///     /// `[simulation]`.
+///     RawSimulation at "simulation" {
+///         /// simulated duration
+///         duration_s: "s", Kind::Number(Rule::Positive), Dflt::Required;
+///     }
+///     children { }
+/// }
+/// ```
+macro_rules! table {
+    (
+        $(#[doc = $tdoc:literal])*
+        $raw:ident at $path:literal {
+            $(
+                $(#[doc = $kdoc:literal])*
+                $field:ident : $unit:literal, $kind:expr, $default:expr;
+            )*
+        }
+        children { $( $child:ident : $how:ident $cty:ty ),* $(,)? }
+    ) => {
+        $(#[doc = $tdoc])*
+        #[derive(Debug, Default, serde::Deserialize)]
+        #[serde(expecting = "a table")]
+        pub(crate) struct $raw {
+            $( $(#[doc = $kdoc])* pub $field: Option<toml::Value>, )*
+            $( #[doc = concat!("The `", stringify!($child), "` sub-table(s).")]
+               pub $child: Option<$crate::schema::table!(@ty $how $cty)>, )*
+        }
+
+        #[allow(non_upper_case_globals, dead_code)]
+        impl $raw {
+            $(
+                $(#[doc = $kdoc])*
+                pub(crate) const $field: $crate::schema::Key = $crate::schema::Key {
+                    table: $path,
+                    name: stringify!($field),
+                    unit: $unit,
+                    kind: $kind,
+                    default: $default,
+                    doc: concat!($($kdoc),*),
+                };
+            )*
+            /// Every leaf key of this table, in file order.
+            pub(crate) const KEYS: &'static [$crate::schema::Key] = &[$(Self::$field),*];
+        }
+
+        impl $crate::schema::RawTable for $raw {
+            fn base() -> &'static str {
+                $path
+            }
+
+            #[allow(unused_variables)]
+            fn get_in(&self, base: &str, key: &$crate::schema::Key) -> Option<&toml::Value> {
+                if key.table == base {
+                    return match key.name {
+                        $( stringify!($field) => self.$field.as_ref(), )*
+                        _ => None,
+                    };
+                }
+                $(
+                    let sub = $crate::schema::table!(@join base, stringify!($child));
+                    if key.table == sub || key.table.starts_with(&format!("{sub}.")) {
+                        return $crate::schema::table!(@get $how self.$child, sub, key);
+                    }
+                )*
+                None
+            }
+
+            #[allow(unused_variables)]
+            fn paths(prefix: &str, out: &mut Vec<(String, &'static $crate::schema::Key)>) {
+                for k in Self::KEYS {
+                    let p = if prefix.is_empty() {
+                        k.name.to_string()
+                    } else {
+                        format!("{prefix}.{}", k.name)
+                    };
+                    out.push((p, k));
+                }
+                $(
+                    let p = $crate::schema::table!(@join prefix, stringify!($child));
+                    <$cty as $crate::schema::RawTable>::paths(
+                        &$crate::schema::table!(@item $how p),
+                        out,
+                    );
+                )*
+            }
+        }
+    };
+    (@ty table $t:ty) => { $t };
+    (@ty array $t:ty) => { Vec<$t> };
+    (@join $a:expr, $b:expr) => {
+        if $a.is_empty() { $b.to_string() } else { format!("{}.{}", $a, $b) }
+    };
+    (@item table $p:expr) => { $p };
+    (@item array $p:expr) => { format!("{}[]", $p) };
+    // Array items are looked into only for their shape: values are read item by item.
+    (@get table $v:expr, $sub:expr, $key:expr) => {
+        $v.as_ref().and_then(|t| $crate::schema::RawTable::get_in(t, &$sub, $key))
+    };
+    (@get array $v:expr, $sub:expr, $key:expr) => { None };
+}
+pub(crate) use table;
+
+/// Every key path of the file (`[]` for array indices) with its definition, in file order.
+/// A `name` belongs to the entries of an array of tables only (`discs[].name`), not to the
+/// shared `[defaults]` tables that take the same body keys.
+pub(crate) fn all_keys() -> &'static [(String, &'static Key)] {
+    static PATHS: OnceLock<Vec<(String, &'static Key)>> = OnceLock::new();
+    PATHS.get_or_init(|| {
+        let mut v = Vec::new();
+        <crate::keys::RawScene as RawTable>::paths("", &mut v);
+        v.retain(|(p, k)| k.name != "name" || !p.contains('.') || p.ends_with("[].name"));
         v
     })
+}
+
+/// Every key path of the schema, `[]` for array indices.
+pub(crate) fn all_paths() -> impl Iterator<Item = &'static str> {
+    all_keys().iter().map(|(p, _)| p.as_str())
 }
 
 /// `discs[2].oil.h_min_m` -> `discs[].oil.h_min_m`: indices replaced by `[]`.
@@ -266,7 +457,7 @@ pub(crate) fn normalize(path: &str) -> String {
 /// Whether a normalized path is a key of the schema or a table (or array) that holds keys.
 pub(crate) fn is_known(norm: &str) -> bool {
     norm.is_empty()
-        || all_paths().iter().any(|p| {
+        || all_paths().any(|p| {
             p == norm
                 || (p.starts_with(norm)
                     && matches!(p.as_bytes().get(norm.len()), Some(b'.' | b'[')))
@@ -275,13 +466,13 @@ pub(crate) fn is_known(norm: &str) -> bool {
 
 /// Whether a normalized path is a leaf key (holds a value, not keys).
 pub(crate) fn is_leaf(norm: &str) -> bool {
-    all_paths().iter().any(|p| p == norm)
+    all_paths().any(|p| p == norm)
 }
 
 /// Whether a normalized path is an array of tables (`discs`, `drive.harmonics`).
 pub(crate) fn is_array(norm: &str) -> bool {
     let prefix = format!("{norm}[]");
-    all_paths().iter().any(|p| p.starts_with(&prefix))
+    all_paths().any(|p| p.starts_with(&prefix))
 }
 
 /// The keys directly inside the table at a normalized path (`""` is the top level), in
@@ -290,7 +481,7 @@ pub(crate) fn children(parent_norm: &str) -> Vec<&'static str> {
     let mut out: Vec<&'static str> = Vec::new();
     for p in all_paths() {
         let rest = if parent_norm.is_empty() {
-            p.as_str()
+            p
         } else if let Some(r) = p
             .strip_prefix(parent_norm)
             .and_then(|r| r.strip_prefix('.'))
@@ -313,13 +504,42 @@ pub(crate) fn expected_text(parent_norm: &str) -> String {
     format!("expected one of: {}", children(parent_norm).join(", "))
 }
 
-/// A short reference of every scene key: unit, rule, default. Printed by `clutchpack --help`.
+/// The tables of body keys: `[defaults]` and each `[[discs]]` for the friction discs,
+/// `[plate_defaults]` and each `[[plates]]` for the separator plates.
+const BODY_TABLES: [&str; 4] = ["defaults", "discs[]", "plate_defaults", "plates[]"];
+
+/// The scene keys outside the body tables, with their full paths.
+fn scene_keys() -> impl Iterator<Item = &'static (String, &'static Key)> {
+    all_keys()
+        .iter()
+        .filter(|(p, _)| !BODY_TABLES.iter().any(|b| p.starts_with(&format!("{b}."))))
+}
+
+/// The body keys, relative to the body (`spline.teeth`, `name`), in definition order.
+pub(crate) fn body_keys() -> &'static [(String, &'static Key)] {
+    static KEYS: OnceLock<Vec<(String, &'static Key)>> = OnceLock::new();
+    KEYS.get_or_init(|| {
+        let mut v = Vec::new();
+        <crate::keys::RawBody as RawTable>::paths("", &mut v);
+        v
+    })
+}
+
+/// The text before the body keys in the references.
+const BODY_INTRO: &str = "Body parameters, in [defaults] (shared by all friction discs) and \
+    in each [[discs]] entry (overrides [defaults]); at least one [[discs]]. Separator plates \
+    take the same keys in [plate_defaults] and [[plates]] (their spline and angles relative to \
+    their carrier: the drum, else the housing); `name` only in [[discs]] and [[plates]] \
+    entries.";
+
+/// A short reference of every scene key: unit, rule, default, meaning. Printed by
+/// `clutchpack check --keys`; generated from the key definitions ([`crate::keys`]).
 pub fn keys_doc() -> String {
     use std::fmt::Write;
-    let width = SCENE_KEYS
-        .iter()
-        .chain(DISC_KEYS)
-        .map(|k| k.path.len())
+    let body = body_keys();
+    let width = scene_keys()
+        .map(|(p, _)| p.len())
+        .chain(body.iter().map(|(p, _)| p.len()))
         .max()
         .unwrap_or(0)
         + 2;
@@ -328,22 +548,49 @@ pub fn keys_doc() -> String {
         "Scene file keys (TOML; SI units named by the key's suffix; angles only in keys ending \
          _deg):\n",
     );
-    for k in SCENE_KEYS {
-        let _ = writeln!(s, "  {:width$}{}", k.path, k.doc);
+    for (p, k) in scene_keys() {
+        let _ = writeln!(s, "  {p:width$}{}", k.doc_line());
     }
-    s.push_str(
-        "Disc parameters, in [defaults] (shared by all discs) and in each [[discs]] entry \
-         (overrides [defaults]); at least one [[discs]]. Separator plates take the same keys \
-         in [plate_defaults] and [[plates]] (their spline and angles relative to their \
-         carrier: the drum, else the housing):\n",
-    );
-    for k in DISC_KEYS {
-        let _ = writeln!(s, "  {:width$}{}", k.path, k.doc);
+    s.push_str(BODY_INTRO);
+    s.push('\n');
+    for (p, k) in body {
+        let _ = writeln!(s, "  {p:width$}{}", k.doc_line());
     }
     s.push_str(
         "Override any key with --set KEY=VALUE (VALUE in TOML syntax, else a string), e.g. \
          --set discs[1].oil.film_thickness_m=50e-6\n",
     );
+    s
+}
+
+/// The README's scene-key table (Markdown), generated from the same definitions as
+/// [`keys_doc`]; printed by `clutchpack check --keys --markdown`. A test checks that the
+/// README holds exactly this text, so they cannot drift.
+pub fn keys_markdown() -> String {
+    use std::fmt::Write;
+    let cell = |t: &str| t.replace('|', "\\|");
+    let mut s = String::new();
+    let table = |s: &mut String, rows: &[(String, &Key)]| {
+        s.push_str("| key | unit | rule | default | meaning |\n|---|---|---|---|---|\n");
+        for (p, k) in rows {
+            let (unit, rule, default) = k.columns();
+            let _ = writeln!(
+                s,
+                "| `{p}` | {} | {} | {} | {} |",
+                cell(&unit),
+                cell(&rule),
+                cell(&default),
+                cell(k.doc.trim())
+            );
+        }
+    };
+    let scene: Vec<(String, &Key)> = scene_keys().map(|(p, k)| (p.clone(), *k)).collect();
+    table(&mut s, &scene);
+    s.push('\n');
+    s.push_str(BODY_INTRO);
+    s.push_str("\n\n");
+    let body: Vec<(String, &Key)> = body_keys().iter().map(|(p, k)| (p.clone(), *k)).collect();
+    table(&mut s, &body);
     s
 }
 
@@ -383,6 +630,7 @@ mod tests {
                 "plate_defaults"
             ]
         );
+        assert!(children("discs[]").contains(&"name"));
         assert!(children("discs[].oil").contains(&"film_thickness_m"));
         assert!(!children("defaults").contains(&"name"));
     }
@@ -390,12 +638,59 @@ mod tests {
     #[test]
     fn doc_lists_every_key() {
         let doc = keys_doc();
-        for k in SCENE_KEYS.iter().chain(DISC_KEYS) {
+        let md = keys_markdown();
+        for (p, _) in scene_keys() {
             assert!(
-                doc.contains(k.path),
-                "{} missing from the key reference",
-                k.path
+                doc.contains(p.as_str()),
+                "{p} missing from the key reference"
             );
+            assert!(md.contains(&format!("`{p}`")), "{p} missing from the table");
         }
+        for (p, _) in body_keys() {
+            assert!(
+                doc.contains(p.as_str()),
+                "{p} missing from the key reference"
+            );
+            assert!(md.contains(&format!("`{p}`")), "{p} missing from the table");
+        }
+    }
+
+    #[test]
+    fn numbers_print_short() {
+        assert_eq!(fmt_bound(1e-14), "1e-14");
+        assert_eq!(fmt_bound(1e-3), "1e-3");
+        assert_eq!(fmt_bound(90.0), "90");
+        assert_eq!(fmt_bound(0.1), "0.1");
+        assert_eq!(fmt_bound(1e6), "1e6");
+        assert_eq!(fmt_bound(10_000.0), "10000");
+        assert_eq!(fmt_num(1e308), "1e308");
+        assert_eq!(fmt_num(5e-324), "5e-324");
+        assert_eq!(fmt_num(-0.156), "-0.156");
+        assert_eq!(show(&Value::Float(1e308)), "1e308");
+        assert_eq!(show(&Value::Float(-0.001)), "-0.001");
+        assert_eq!(show(&Value::Float(0.0)), "0.0");
+    }
+
+    #[test]
+    fn rules_say_what_they_need() {
+        assert_eq!(Rule::Positive.check(-1.0, "m"), Err("must be > 0".into()));
+        assert_eq!(
+            Rule::Closed(1e-14, 1e-3).check(1.0, ""),
+            Err("must be in [1e-14, 1e-3]".into())
+        );
+        let b = Rule::Bounded {
+            floor: 1e-9,
+            ceil: 1e6,
+        };
+        assert_eq!(b.check(0.0, "s"), Err("must be > 0".into()));
+        assert_eq!(
+            b.check(1e-300, "s"),
+            Err("must be >= 1e-9 s (plausibility bound)".into())
+        );
+        assert_eq!(
+            b.check(1e9, "Hz"),
+            Err("must be <= 1e6 Hz (plausibility bound)".into())
+        );
+        assert!(b.check(1.0, "s").is_ok());
     }
 }

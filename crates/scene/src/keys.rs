@@ -1,0 +1,298 @@
+//! Every key of a scene file, defined once: its table, name, unit, kind and range rule,
+//! default and meaning. **This is the one place to add a key.** Each [`table!`] below
+//! defines one table's raw serde struct (read by [`crate::parse`]), one [`Key`] per leaf (read
+//! by the validation through `RawX::key_name`, for its rule, unit and default), and the lines
+//! of `clutchpack check --keys` and of the README's key table.
+//!
+//! To add a key to an existing table: add one line to its `table!` (doc comment, name, unit,
+//! kind with its rule, default), then use the value where the typed model is built (the
+//! section's module under [`crate::validate`]). To add a table: one more `table!` and one
+//! `children` entry in its parent.
+//!
+//! Plausibility bounds (`Rule::Bounded`, `Kind::Count`'s `max`) are explained in
+//! docs/DECISIONS.md, "Plausibility bounds".
+//!
+//! [`Key`]: crate::schema::Key
+
+use crate::schema::{table, Dflt, Kind, Rule};
+
+/// Longest simulated duration accepted, s (about 11.6 days).
+pub(crate) const MAX_DURATION_S: f64 = 1e6;
+/// Highest record rate accepted, Hz.
+pub(crate) const MAX_RECORD_RATE_HZ: f64 = 1e6;
+/// Most samples one run may emit (`duration_s * record_rate_hz`).
+pub(crate) const MAX_SAMPLES: f64 = 1e8;
+/// Smallest `max_step_s` accepted, s.
+pub(crate) const MIN_MAX_STEP_S: f64 = 1e-9;
+/// Smallest inertia of a body accepted, kg m^2.
+pub(crate) const MIN_INERTIA_KG_M2: f64 = 1e-9;
+/// Most teeth of one spline accepted.
+pub(crate) const MAX_TEETH: u32 = 10_000;
+
+/// Inertia of a body: `> 0` and at least [`MIN_INERTIA_KG_M2`].
+const INERTIA: Kind = Kind::Number(Rule::Bounded {
+    floor: MIN_INERTIA_KG_M2,
+    ceil: f64::INFINITY,
+});
+/// Any finite number.
+const FINITE: Kind = Kind::Number(Rule::Finite);
+/// `> 0`.
+const POSITIVE: Kind = Kind::Number(Rule::Positive);
+/// `>= 0`.
+const NON_NEGATIVE: Kind = Kind::Number(Rule::NonNegative);
+
+table! {
+    /// The whole file.
+    RawScene at "" {
+        /// the scene's name in tables and recordings
+        name: "", Kind::Text, Dflt::Described("default: the file name without its extension");
+        /// free text
+        description: "", Kind::Text, Dflt::Described("default: empty");
+    }
+    children {
+        simulation: table RawSimulation,
+        shaft: table RawShaft,
+        drive: table RawDrive,
+        discs: array RawBody,
+        plates: array RawBody,
+        drum: table RawDrum,
+        stack: table RawStack,
+        defaults: table RawBody,
+        plate_defaults: table RawBody,
+    }
+}
+
+table! {
+    /// `[simulation]`.
+    RawSimulation at "simulation" {
+        /// simulated duration; duration_s x record_rate_hz (the number of samples) is bounded too
+        duration_s: "s", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_DURATION_S }), Dflt::Required;
+        /// the engine that runs the scene (else --engine, else the CLI chooses: reference for a torsional pack, multibody otherwise)
+        engine: "", Kind::Choice(&["reference", "multibody"]), Dflt::Described("optional");
+        /// rate of the output samples (impacts are located exactly whatever it is)
+        record_rate_hz: "Hz", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_RECORD_RATE_HZ }), Dflt::Num(10_000.0);
+        /// relative tolerance of the adaptive integrators
+        tolerance: "", Kind::Number(Rule::Closed(1e-14, 1e-3)), Dflt::Num(1e-9);
+        /// longest step of the adaptive integrators
+        max_step_s: "s", Kind::Number(Rule::Bounded { floor: MIN_MAX_STEP_S, ceil: f64::INFINITY }), Dflt::Num(1e-4);
+        /// record per-tooth loads where the engine resolves teeth
+        record_per_tooth: "", Kind::Bool, Dflt::Bool(false);
+    }
+    children {}
+}
+
+table! {
+    /// `[shaft]`.
+    RawShaft at "shaft" {
+        /// "prescribed": the shaft follows the drive's speed; "inertial": the drive acts on its inertia
+        mode: "", Kind::Choice(&["prescribed", "inertial"]), Dflt::Choice("prescribed");
+        /// shaft inertia J1
+        inertia_kg_m2: "kg m^2", INERTIA, Dflt::When("required if inertial, an error if prescribed");
+        /// shaft damping C1 (inertial only)
+        damping_n_m_s_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
+        /// starting speed of the shaft
+        initial_speed_rad_s: "rad/s", FINITE, Dflt::When("required with drive.kind = \"torque_table\", an error otherwise");
+    }
+    children {}
+}
+
+table! {
+    /// `[drive]`.
+    RawDrive at "drive" {
+        /// what drives the shaft
+        kind: "", Kind::Choice(&["sine", "harmonics", "speed_table", "torque_table"]), Dflt::Required;
+        /// mean shaft speed
+        omega0_rad_s: "rad/s", FINITE, Dflt::When("required for sine and harmonics");
+        /// speed amplitude (Hu et al. eq (3))
+        amplitude_rad_s: "rad/s", FINITE, Dflt::When("sine: required");
+        /// excitation frequency
+        frequency_hz: "Hz", POSITIVE, Dflt::When("sine: required");
+        /// phase of the sine (sine only)
+        phase_deg: "deg", FINITE, Dflt::Num(0.0);
+        /// CSV with a header row, relative to the scene file's folder; speed_table: columns time_s, speed_rad_s; torque_table: columns time_s, torque_n_m (needs shaft.mode = "inertial")
+        file: "", Kind::Text, Dflt::When("required for speed_table and torque_table");
+    }
+    children {
+        harmonics: array RawHarmonic,
+    }
+}
+
+table! {
+    /// One `[[drive.harmonics]]` entry (drive.kind = "harmonics": at least one).
+    RawHarmonic at "drive.harmonics[]" {
+        /// amplitude of this term
+        amplitude_rad_s: "rad/s", FINITE, Dflt::Required;
+        /// frequency of this term
+        frequency_hz: "Hz", POSITIVE, Dflt::Required;
+        /// phase of this term
+        phase_deg: "deg", FINITE, Dflt::Num(0.0);
+    }
+    children {}
+}
+
+table! {
+    /// `[drum]`: the output drum of a clutch (the plates sit on it, else on the housing).
+    RawDrum at "drum" {
+        /// drum inertia
+        inertia_kg_m2: "kg m^2", INERTIA, Dflt::When("required with [drum]");
+        /// load on the drum about the axis (negative brakes it)
+        load_torque_n_m: "N m", FINITE, Dflt::Num(0.0);
+        /// drum drag
+        drag_n_m_s_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
+        /// starting speed of the drum
+        initial_speed_rad_s: "rad/s", FINITE, Dflt::Num(0.0);
+    }
+    children {}
+}
+
+table! {
+    /// `[stack]`: the piston, the clamped stack and its friction faces (multibody engine only).
+    RawStack at "stack" {
+        /// inner radius of the friction faces
+        face_inner_radius_m: "m", POSITIVE, Dflt::When("required with [stack]");
+        /// outer radius of the friction faces, > face_inner_radius_m
+        face_outer_radius_m: "m", POSITIVE, Dflt::When("required with [stack]");
+        /// axial spline friction holds back mu n |F| per body
+        spline_friction_coefficient: "", NON_NEGATIVE, Dflt::Num(0.0);
+        /// piston area
+        piston_area_m2: "m^2", POSITIVE, Dflt::When("required with [stack]");
+        /// piston force = p A - return spring, never < 0
+        return_spring_n: "N", NON_NEGATIVE, Dflt::Num(0.0);
+    }
+    children {
+        friction: table RawFriction,
+        pressure: table RawPressure,
+        open_gap: table RawOpenGap,
+    }
+}
+
+table! {
+    /// `[stack.friction]`.
+    RawFriction at "stack.friction" {
+        /// the friction law of the faces
+        kind: "", Kind::Choice(&["stribeck", "table"]), Dflt::Choice("stribeck");
+        /// mu at zero slip
+        static_mu: "", POSITIVE, Dflt::When("stribeck: required");
+        /// mu beyond the Stribeck speed
+        kinetic_mu: "", POSITIVE, Dflt::Described("stribeck: default static_mu");
+        /// the Stribeck speed (stribeck only)
+        stribeck_speed_m_s: "m/s", POSITIVE, Dflt::Num(1.0);
+        /// mu rises by this per m/s of slip (stribeck only)
+        viscous_slope_s_m: "s/m", NON_NEGATIVE, Dflt::Num(0.0);
+        /// slip speeds, increasing from 0
+        slip_m_s: "m/s", Kind::Numbers, Dflt::When("table: required");
+        /// mu > 0, one per slip_m_s
+        mu: "", Kind::Numbers, Dflt::When("table: required");
+    }
+    children {}
+}
+
+table! {
+    /// `[stack.pressure]`.
+    RawPressure at "stack.pressure" {
+        /// the piston pressure history
+        kind: "", Kind::Choice(&["constant", "ramp", "table"]), Dflt::When("required with [stack]");
+        /// the (final) pressure
+        pressure_pa: "Pa", NON_NEGATIVE, Dflt::When("constant and ramp: required");
+        /// when the rise starts (ramp only)
+        start_s: "s", NON_NEGATIVE, Dflt::Num(0.0);
+        /// rise time
+        rise_s: "s", POSITIVE, Dflt::When("ramp: required");
+        /// times, increasing
+        times_s: "s", Kind::Numbers, Dflt::When("table: required");
+        /// pressures >= 0, one per times_s
+        values_pa: "Pa", Kind::Numbers, Dflt::When("table: required");
+    }
+    children {}
+}
+
+table! {
+    /// `[stack.open_gap]`: viscous drag across the gaps of an open pack.
+    RawOpenGap at "stack.open_gap" {
+        /// oil in the open gaps
+        viscosity_pa_s: "Pa s", POSITIVE, Dflt::When("required with [stack.open_gap]");
+        /// axial gap per open interface
+        gap_m: "m", POSITIVE, Dflt::When("required with [stack.open_gap]");
+    }
+    children {}
+}
+
+table! {
+    /// A body's parameters: one `[[discs]]` or `[[plates]]` entry, or `[defaults]` /
+    /// `[plate_defaults]` (every key but `name`). Keys resolve as: the entry's, else the
+    /// defaults table's, else the built-in default.
+    RawBody at "" {
+        /// unique among discs and plates (only in [[discs]] and [[plates]] entries)
+        name: "", Kind::Text, Dflt::Described("default \"disc-<i+1>\" or \"plate-<j+1>\"");
+        /// body inertia J2
+        inertia_kg_m2: "kg m^2", INERTIA, Dflt::Required;
+        /// oil drag C2
+        drag_n_m_s_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
+        /// phi(0) = theta_shaft - theta_disc; must lie inside the free play
+        initial_rel_angle_rad: "rad", FINITE, Dflt::Num(0.0);
+        /// omega_shaft(0) - omega_disc(0)
+        initial_rel_speed_rad_s: "rad/s", FINITE, Dflt::Num(0.0);
+        /// the disc may move radially on its spline (multibody engine only)
+        radial_float: "", Kind::Bool, Dflt::Bool(false);
+        /// one per tooth (tooth k at 2 pi k / n from the shaft's +x axis) or none; circumferential spacing error at the pitch circle, positive closes the shaft-leads gap (multibody engine only)
+        tooth_spacing_errors_m: "m", Kind::Numbers, Dflt::Described("default empty");
+        /// [x, y] in the shaft's frame: the centre's offset from the axis at t = 0 (held there unless radial_float; multibody engine only)
+        initial_offset_m: "m", Kind::Numbers, Dflt::Described("default [0, 0]");
+    }
+    children {
+        spline: table RawSpline,
+        contact: table RawContact,
+        oil: table RawOil,
+    }
+}
+
+table! {
+    /// `spline` of a body.
+    RawSpline at "spline" {
+        /// number of teeth n
+        teeth: "", Kind::Count { max: MAX_TEETH }, Dflt::Required;
+        /// pitch radius R
+        pitch_radius_m: "m", POSITIVE, Dflt::Required;
+        /// pressure angle alpha
+        pressure_angle_deg: "deg", Kind::Number(Rule::Open(0.0, 90.0)), Dflt::Required;
+        /// total circumferential free play d at the pitch circle; below the tooth pitch 2 pi R / n
+        backlash_m: "m", POSITIVE, Dflt::Required;
+    }
+    children {}
+}
+
+table! {
+    /// `contact` of a body.
+    RawContact at "contact" {
+        /// the tooth law (MODEL.md section 2)
+        law: "", Kind::Choice(&["paper", "dry", "squeeze"]), Dflt::Choice("paper");
+        /// equivalent modulus E
+        modulus_pa: "Pa", POSITIVE, Dflt::Required;
+        /// equivalent curvature radius r
+        curvature_radius_m: "m", POSITIVE, Dflt::Required;
+        /// impact loss p
+        loss_coefficient_s_m: "s/m", NON_NEGATIVE, Dflt::Num(0.0);
+    }
+    children {}
+}
+
+table! {
+    /// `oil` of a body.
+    RawOil at "oil" {
+        /// film thickness h_o; below half the free play along the line of action
+        film_thickness_m: "m", NON_NEGATIVE, Dflt::Num(0.0);
+        /// oil viscosity
+        viscosity_pa_s: "Pa s", POSITIVE, Dflt::When("required if film_thickness_m > 0 and law is not dry");
+        /// leakage coefficient beta
+        leakage_coefficient: "", POSITIVE, Dflt::When("required like viscosity_pa_s");
+        /// film width B
+        width_m: "m", POSITIVE, Dflt::When("required like viscosity_pa_s");
+        /// film length L
+        length_m: "m", POSITIVE, Dflt::When("required like viscosity_pa_s");
+        /// floor of the held closing speed
+        v_floor_m_s: "m/s", POSITIVE, Dflt::Num(0.01);
+        /// smallest film of the squeeze law
+        h_min_m: "m", POSITIVE, Dflt::Num(1e-6);
+    }
+    children {}
+}

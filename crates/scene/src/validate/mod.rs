@@ -1,0 +1,325 @@
+//! Stage two: the raw file ([`crate::keys::RawScene`]) -> validated model values.
+//!
+//! Every value is checked where it is written against its key's definition ([`Key`]: its
+//! kind, that it is finite, its range), then the rules between keys (which keys a drive kind
+//! or shaft mode takes, the oil parameters a film needs, the film and the start position
+//! against the free play, the backlash against the tooth pitch, the number of samples). Each
+//! broken rule becomes one [`Problem`] with the key path, the value as written and the rule;
+//! checking goes on after a problem, so that one run lists them all. A value that is itself
+//! invalid is not used by the rules between keys (its problem is already reported).
+//!
+//! One module per section of the file: [`simulation`], [`drive`] (with the shaft),
+//! [`bodies`] (discs and plates) and [`stack`] (with the drum).
+
+mod bodies;
+mod drive;
+mod simulation;
+mod stack;
+
+use crate::error::Problem;
+use crate::keys::RawScene;
+use crate::schema::{show, Key, Kind, Rule};
+use crate::Simulation;
+use clutchpack_model::PackModel;
+use std::path::Path;
+use toml::Value;
+
+/// The validated content of a scene file.
+pub(crate) struct Validated {
+    pub name: String,
+    pub description: String,
+    pub simulation: Simulation,
+    pub pack: PackModel,
+}
+
+/// The outcome of checking one value where it is written.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Field<T> {
+    /// The key is not in the file.
+    Absent,
+    /// The key is there but its value breaks a rule (already reported).
+    Invalid,
+    /// The key is there and its value is good.
+    Valid(T),
+}
+
+impl<T> Field<T> {
+    /// The value, or `default` if absent; `None` if invalid.
+    pub fn or(self, default: T) -> Option<T> {
+        match self {
+            Field::Absent => Some(default),
+            Field::Invalid => None,
+            Field::Valid(v) => Some(v),
+        }
+    }
+
+    /// The value; reports `key: missing (hint)` if absent; `None` if absent or invalid.
+    pub fn required(self, ck: &mut Checker, key: &str, hint: &str) -> Option<T> {
+        match self {
+            Field::Absent => {
+                ck.report(key, None, format!("missing ({hint})"));
+                None
+            }
+            Field::Invalid => None,
+            Field::Valid(v) => Some(v),
+        }
+    }
+
+    /// `Absent` -> `Some(None)`, `Invalid` -> `None`, `Valid(v)` -> `Some(Some(v))`.
+    pub fn optional(self) -> Option<Option<T>> {
+        match self {
+            Field::Absent => Some(None),
+            Field::Invalid => None,
+            Field::Valid(v) => Some(Some(v)),
+        }
+    }
+}
+
+/// Collects problems and checks single values against their key's definition.
+#[derive(Debug, Default)]
+pub(crate) struct Checker {
+    /// Every problem found so far.
+    pub problems: Vec<Problem>,
+}
+
+impl Checker {
+    /// Records one problem.
+    pub fn report(
+        &mut self,
+        key: impl Into<String>,
+        value: Option<String>,
+        rule: impl Into<String>,
+    ) {
+        self.problems.push(Problem::new(key, value, rule));
+    }
+
+    /// A finite number (an integer is accepted) that satisfies `rule`; `unit` is named after
+    /// plausibility bounds.
+    pub fn number(&mut self, path: &str, v: Option<&Value>, rule: Rule, unit: &str) -> Field<f64> {
+        let Some(v) = v else { return Field::Absent };
+        let x = match v {
+            Value::Float(x) => *x,
+            Value::Integer(i) => *i as f64,
+            _ => {
+                self.report(path, Some(show(v)), "must be a number");
+                return Field::Invalid;
+            }
+        };
+        if !x.is_finite() {
+            self.report(path, Some(show(v)), "must be a finite number");
+            return Field::Invalid;
+        }
+        match rule.check(x, unit) {
+            Ok(()) => Field::Valid(x),
+            Err(text) => {
+                self.report(path, Some(show(v)), text);
+                Field::Invalid
+            }
+        }
+    }
+
+    /// A value of key `k` (a number key) at `path`.
+    pub fn num(&mut self, path: &str, v: Option<&Value>, k: &Key) -> Field<f64> {
+        match k.kind {
+            Kind::Number(rule) => self.number(path, v, rule, k.unit),
+            _ => unreachable!("{} is not a number key", k.rel()),
+        }
+    }
+
+    /// An integer count of key `k`, in `[1, max]` (fits a `u32`).
+    pub fn count(&mut self, path: &str, v: Option<&Value>, k: &Key) -> Field<u32> {
+        let Kind::Count { max } = k.kind else {
+            unreachable!("{} is not a count key", k.rel())
+        };
+        let Some(v) = v else { return Field::Absent };
+        match v.as_integer() {
+            Some(n) if n >= 1 && n <= i64::from(max) => Field::Valid(n as u32),
+            Some(n) if n > i64::from(max) => {
+                self.report(
+                    path,
+                    Some(show(v)),
+                    format!("must be an integer <= {max} (plausibility bound)"),
+                );
+                Field::Invalid
+            }
+            _ => {
+                self.report(path, Some(show(v)), "must be an integer >= 1");
+                Field::Invalid
+            }
+        }
+    }
+
+    /// A string.
+    pub fn text(&mut self, path: &str, v: Option<&Value>) -> Field<String> {
+        let Some(v) = v else { return Field::Absent };
+        match v.as_str() {
+            Some(s) => Field::Valid(s.to_string()),
+            None => {
+                self.report(path, Some(show(v)), "must be a string");
+                Field::Invalid
+            }
+        }
+    }
+
+    /// One of the names of key `k` (`Kind::Choice`), as the value of the same index in
+    /// `values`.
+    pub fn choice<T: Copy>(
+        &mut self,
+        path: &str,
+        v: Option<&Value>,
+        k: &Key,
+        values: &[T],
+    ) -> Field<T> {
+        let Kind::Choice(names) = k.kind else {
+            unreachable!("{} is not a choice key", k.rel())
+        };
+        debug_assert_eq!(names.len(), values.len(), "{}", k.rel());
+        let Some(v) = v else { return Field::Absent };
+        match names.iter().position(|n| v.as_str() == Some(n)) {
+            Some(i) => Field::Valid(values[i]),
+            None => {
+                let names: Vec<String> = names.iter().map(|n| format!("\"{n}\"")).collect();
+                self.report(
+                    path,
+                    Some(show(v)),
+                    format!("must be one of: {}", names.join(", ")),
+                );
+                Field::Invalid
+            }
+        }
+    }
+
+    /// A boolean (`true` / `false`).
+    pub fn boolean(&mut self, path: &str, v: Option<&Value>) -> Field<bool> {
+        let Some(v) = v else { return Field::Absent };
+        match v.as_bool() {
+            Some(b) => Field::Valid(b),
+            None => {
+                self.report(path, Some(show(v)), "must be true or false");
+                Field::Invalid
+            }
+        }
+    }
+
+    /// An array of finite numbers (integers accepted), of length `len` if given. A bad item is
+    /// reported at its index (`key[3]`), a wrong length at `key`.
+    pub fn numbers(
+        &mut self,
+        path: &str,
+        v: Option<&Value>,
+        len: Option<usize>,
+    ) -> Field<Vec<f64>> {
+        let Some(v) = v else { return Field::Absent };
+        let Some(items) = v.as_array() else {
+            self.report(path, Some(show(v)), "must be an array of numbers");
+            return Field::Invalid;
+        };
+        if let Some(n) = len {
+            if items.len() != n {
+                self.report(
+                    path,
+                    Some(show(v)),
+                    format!("must have exactly {n} numbers (it has {})", items.len()),
+                );
+                return Field::Invalid;
+            }
+        }
+        let mut out = Some(Vec::with_capacity(items.len()));
+        for (j, item) in items.iter().enumerate() {
+            match self.number(&format!("{path}[{j}]"), Some(item), Rule::Finite, "") {
+                Field::Valid(x) => {
+                    if let Some(o) = out.as_mut() {
+                        o.push(x)
+                    }
+                }
+                _ => out = None,
+            }
+        }
+        match out {
+            Some(o) => Field::Valid(o),
+            None => Field::Invalid,
+        }
+    }
+
+    /// Reports a key that is present but not allowed in this configuration.
+    pub fn not_allowed(&mut self, key: &str, v: Option<&Value>, rule: &str) -> bool {
+        match v {
+            Some(v) => {
+                self.report(key, Some(show(v)), rule);
+                true
+            }
+            None => false,
+        }
+    }
+}
+
+/// Checks everything; `None` if any value needed to build the model is missing or invalid
+/// (the problems are in `ck`).
+pub(crate) fn validate(
+    raw: &RawScene,
+    file_stem: &str,
+    base_dir: &Path,
+    ck: &mut Checker,
+) -> Option<Validated> {
+    let name = ck.text("name", raw.name.as_ref()).or(file_stem.to_string());
+    let description = ck
+        .text("description", raw.description.as_ref())
+        .or(String::new());
+    let simulation = simulation::simulation(ck, raw.simulation.as_ref());
+    let (kind, drive) = drive::drive(ck, raw.drive.as_ref(), base_dir);
+    let shaft = drive::shaft(ck, raw.shaft.as_ref(), kind, drive);
+    let mut names = Vec::new();
+    let discs = bodies::bodies(
+        ck,
+        bodies::DISCS,
+        raw.defaults.as_ref(),
+        raw.discs.as_deref(),
+        true,
+        &mut names,
+    );
+    let plates = bodies::bodies(
+        ck,
+        bodies::PLATES,
+        raw.plate_defaults.as_ref(),
+        raw.plates.as_deref(),
+        false,
+        &mut names,
+    );
+    let drum = raw.drum.as_ref().map(|r| stack::drum(ck, r));
+    let stack = raw.stack.as_ref().map(|r| stack::stack(ck, r));
+    // The stack alternates plates and discs: N discs need N + 1 plates; a drum carries plates.
+    let n_discs = raw.discs.as_ref().map_or(0, Vec::len);
+    let n_plates = raw.plates.as_ref().map_or(0, Vec::len);
+    if raw.stack.is_some() && n_plates != n_discs + 1 {
+        ck.report(
+            "plates",
+            Some(format!("[...{n_plates} entries]")),
+            format!(
+                "a [stack] of {n_discs} discs needs {} [[plates]] entries (plate, disc, plate, \
+                 ..., plate)",
+                n_discs + 1
+            ),
+        );
+        return None;
+    }
+    if raw.drum.is_some() && n_plates == 0 {
+        ck.report(
+            "drum",
+            None,
+            "a [drum] carries the separator plates: add [[plates]] entries",
+        );
+        return None;
+    }
+    Some(Validated {
+        name: name?,
+        description: description?,
+        simulation: simulation?,
+        pack: PackModel {
+            shaft: shaft?,
+            discs: discs?,
+            plates: plates?,
+            drum: drum.map_or(Some(None), |d| d.map(Some))?,
+            stack: stack.map_or(Some(None), |s| s.map(Some))?,
+        },
+    })
+}
