@@ -1,6 +1,7 @@
-//! `clutchpack check`.
+//! `clutchpack check`: validates scene files (and, with `--engine`, that the engine can run
+//! them) without running anything; `--keys` prints the reference of every scene key.
 
-use crate::common::BadInput;
+use crate::common::{BadInput, EngineArg};
 use anyhow::Result;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -11,24 +12,41 @@ pub struct CheckArgs {
     /// Scene files to validate.
     #[arg(required_unless_present = "keys")]
     pub scenes: Vec<PathBuf>,
+    /// Also check that this engine can run each scene (else the engine `run` would choose:
+    /// the scene's `simulation.engine`, else the one that fits the pack).
+    #[arg(long, value_enum)]
+    pub engine: Option<EngineArg>,
     /// Print the reference of every scene key and exit.
     #[arg(long)]
     pub keys: bool,
+    /// With `--keys`: print the reference as the README's Markdown table.
+    #[arg(long, requires = "keys")]
+    pub markdown: bool,
 }
 
 pub fn check(a: CheckArgs) -> Result<ExitCode> {
     if a.keys {
-        out!("{}", clutchpack_scene::keys_doc());
+        if a.markdown {
+            out!("{}", clutchpack_scene::keys_markdown());
+        } else {
+            out!("{}", clutchpack_scene::keys_doc());
+        }
         return Ok(ExitCode::SUCCESS);
     }
     let mut bad = 0;
     for p in &a.scenes {
-        match clutchpack_scene::load(p, &[]) {
-            Ok(s) => out!(
-                "{}: ok ({} discs, {} s)",
+        let origin = p.display().to_string();
+        let checked = clutchpack_scene::load(p, &[]).and_then(|s| {
+            let engine = s.engine(a.engine.map(EngineArg::choice), &origin)?;
+            Ok((s, engine))
+        });
+        match checked {
+            Ok((s, engine)) => out!(
+                "{}: ok ({} discs, {} s, {} engine)",
                 p.display(),
                 s.pack.discs.len(),
-                s.simulation.duration_s
+                s.simulation.duration_s,
+                engine.name()
             ),
             Err(e) => {
                 eprintln!("{e}");

@@ -41,20 +41,23 @@ pub enum EngineArg {
     Multibody,
 }
 
+impl EngineArg {
+    /// The scene crate's name for this engine.
+    pub fn choice(self) -> EngineChoice {
+        match self {
+            EngineArg::Reference => EngineChoice::Reference,
+            EngineArg::Multibody => EngineChoice::Multibody,
+        }
+    }
+}
+
 /// Builds the engine asked for on the command line, else by the scene, else the reference for
 /// a torsional pack and the multibody engine for one with per-tooth effects (radial float,
-/// offsets, spacing errors: `PackModel::is_torsional`), which only it can run.
+/// offsets, spacing errors: `PackModel::is_torsional`), which only it can run
+/// ([`Scene::engine`]); an engine that cannot run the scene is bad input.
 pub fn make_engine(scene: &Scene, arg: Option<EngineArg>) -> Result<Box<dyn Engine + Send>> {
-    let default = if scene.pack.is_torsional() {
-        EngineChoice::Reference
-    } else {
-        EngineChoice::Multibody
-    };
-    let choice = match arg {
-        Some(EngineArg::Reference) => EngineChoice::Reference,
-        Some(EngineArg::Multibody) => EngineChoice::Multibody,
-        None => scene.simulation.engine.unwrap_or(default),
-    };
+    // The scene crate's rule: refuses (bad input) an engine that cannot run the scene.
+    let choice = scene.engine(arg.map(EngineArg::choice), &scene.name)?;
     match choice {
         EngineChoice::Reference => Ok(Box::new(ReferenceEngine::from_scene(scene))),
         EngineChoice::Multibody => match clutchpack_sim::MultibodyEngine::from_scene(scene) {
