@@ -45,7 +45,10 @@ fn assert_engines_agree(file: &str, sets: &[&str], steps_per_contact: Option<f64
     let mut oracle = s.clone();
     oracle.simulation.tolerance = 1e-12;
     let reference = impacts(&mut ReferenceEngine::from_scene(&oracle), duration);
-    let mut options = MultibodyOptions::default();
+    let mut options = MultibodyOptions {
+        record_rate_hz: s.simulation.record_rate_hz,
+        ..MultibodyOptions::default()
+    };
     if let Some(spc) = steps_per_contact {
         options.stepping = Stepping::Adaptive(AdaptiveStepping {
             steps_per_contact: spc,
@@ -54,7 +57,7 @@ fn assert_engines_agree(file: &str, sets: &[&str], steps_per_contact: Option<f64
         });
     }
     let multibody = impacts(
-        &mut MultibodyEngine::with_options(&s, options).unwrap(),
+        &mut MultibodyEngine::new(s.pack.clone(), options).unwrap(),
         duration,
     );
     assert!(

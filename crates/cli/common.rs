@@ -60,7 +60,14 @@ pub fn make_engine(scene: &Scene, arg: Option<EngineArg>) -> Result<Box<dyn Engi
     let choice = scene.engine(arg.map(EngineArg::choice), &scene.name)?;
     match choice {
         EngineChoice::Reference => Ok(Box::new(ReferenceEngine::from_scene(scene))),
-        EngineChoice::Multibody => match clutchpack_sim::MultibodyEngine::from_scene(scene) {
+        EngineChoice::Multibody => match clutchpack_sim::MultibodyEngine::new(
+            scene.pack.clone(),
+            clutchpack_sim::MultibodyOptions::with_settings(
+                scene.simulation.record_rate_hz,
+                scene.simulation.max_step_s,
+                scene.simulation.record_per_tooth,
+            ),
+        ) {
             Ok(e) => Ok(Box::new(e)),
             Err(e) => Err(BadInput(format!("{}: {e}", scene.name)).into()),
         },

@@ -131,22 +131,9 @@ impl ImpactTracker {
             return;
         };
         let (t2, f2) = next;
-        let (a0, a1, a2) = (f0.abs(), f1.abs(), f2.abs());
-        if !(a1 >= a0 && a1 >= a2) {
+        let Some((tv, av)) = parabolic_peak((t0, f0.abs()), (t1, f1.abs()), (t2, f2.abs())) else {
             return;
-        }
-        // Lagrange parabola through the three points; vertex
-        let d01 = (a1 - a0) / (t1 - t0);
-        let d12 = (a2 - a1) / (t2 - t1);
-        let curv = (d12 - d01) / (t2 - t0);
-        if curv >= 0.0 {
-            return;
-        }
-        let tv = 0.5 * (t0 + t1) - d01 / (2.0 * curv);
-        if !(t0..=t2).contains(&tv) {
-            return;
-        }
-        let av = a1 + d01 * (tv - t1) + curv * (tv - t0) * (tv - t1);
+        };
         let sign = f1.signum();
         if let Some(e) = self.open.as_mut() {
             if av > e.peak_n.abs() {
@@ -160,6 +147,33 @@ impl ImpactTracker {
     pub fn finish(&mut self, t_s: f64) -> Option<ImpactEvent> {
         self.end(t_s)
     }
+}
+
+/// The peak between samples of a load's magnitude: the vertex `(t, |F|)` of the parabola
+/// through three samples `(t_s, |F| in N)` in time order. `None` unless the middle sample is
+/// the largest of the three, the parabola opens downward and its vertex lies within the
+/// samples' span. Used by [`ImpactTracker`] and by the engines that feed
+/// [`ImpactTracker::observe`] themselves.
+pub fn parabolic_peak(
+    (t0, a0): (f64, f64),
+    (t1, a1): (f64, f64),
+    (t2, a2): (f64, f64),
+) -> Option<(f64, f64)> {
+    if !(a1 >= a0 && a1 >= a2) {
+        return None;
+    }
+    // Lagrange parabola through the three points; vertex
+    let d01 = (a1 - a0) / (t1 - t0);
+    let d12 = (a2 - a1) / (t2 - t1);
+    let curv = (d12 - d01) / (t2 - t0);
+    if curv >= 0.0 {
+        return None;
+    }
+    let tv = 0.5 * (t0 + t1) - d01 / (2.0 * curv);
+    if !(t0..=t2).contains(&tv) {
+        return None;
+    }
+    Some((tv, a1 + d01 * (tv - t1) + curv * (tv - t0) * (tv - t1)))
 }
 
 /// Detects the impacts in a sampled per-tooth load history (`t_s`, `load_n`, `v_n_m_s` of

@@ -40,7 +40,7 @@ pub use clutch::{
     DrumModel, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackModel,
 };
 pub use drive::{Harmonic, Shaft, ShaftExcitation, SpeedProfile, Table, TableError};
-pub use impact::{detect_impacts, ImpactEvent, ImpactTracker};
+pub use impact::{detect_impacts, parabolic_peak, ImpactEvent, ImpactTracker};
 pub use law::{ContactState, Engagement, Hertz, LawKind, OilFilm, ToothLaw};
 pub use pack::{
     annulus_inner_radius_m, annulus_outer_radius_m, DiscModel, NonTorsional, PackModel,

@@ -40,9 +40,10 @@ pub fn modes(scene: &Scene) -> Vec<(&'static str, Stepping, DiscMount)> {
 }
 
 pub fn run_once(scene: &Scene, stepping: Stepping, mount: DiscMount) -> (u64, usize) {
-    let mut e = MultibodyEngine::with_options(
-        scene,
+    let mut e = MultibodyEngine::new(
+        scene.pack.clone(),
         MultibodyOptions {
+            record_rate_hz: scene.simulation.record_rate_hz,
             stepping,
             mount,
             ..Default::default()

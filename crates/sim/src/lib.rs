@@ -4,7 +4,8 @@
 //! teeth as our own force law applied tooth by tooth, and a contact-aware step.
 //!
 //! ## What this crate does
-//! - Builds a rapier world from a [`clutchpack_scene::Scene`]: a fixed housing, the shaft (a
+//! - Builds a rapier world from a [`clutchpack_model::PackModel`] and [`MultibodyOptions`]
+//!   (the record rate, the stepping; the CLI turns a scene into those): a fixed housing, the shaft (a
 //!   position-based kinematic body following the prescribed speed, eq 3, or a dynamic body on
 //!   a revolute joint to the housing for an inertial shaft, eq 4), and one dynamic body per
 //!   friction disc joined to the shaft by a cylindrical impulse joint (rotation about `+z` and
@@ -49,7 +50,7 @@
 //!   per-tooth couplings are not landed on (the controller's worst-case gap covers them with
 //!   contact steps instead).
 //! - The squeeze-film law: its damper has a nanosecond time constant near metal contact, too
-//!   stiff for an explicit step; [`MultibodyEngine::from_scene`] refuses it (use the
+//!   stiff for an explicit step; [`MultibodyEngine::new`] refuses it (use the
 //!   reference engine).
 //!
 //! ## Rapier facts this crate relies on (measured on rapier3d-f64 0.36.1)
@@ -101,5 +102,5 @@ mod world;
 
 pub use engine::{EnergyAudit, MultibodyEngine};
 pub use options::{
-    AdaptiveStepping, BodyShapes, DiscMount, MultibodyOptions, Stepping, ToothResolution,
+    AdaptiveStepping, BodyShapes, DiscMount, MultibodyOptions, Scheme, Stepping, ToothResolution,
 };

@@ -142,8 +142,11 @@ pub enum DiscMount {
 }
 
 /// Options of the multibody engine.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct MultibodyOptions {
+    /// Rate of the samples handed to the observer, Hz (> 0). Default 1e4 (the scenes'
+    /// `simulation.record_rate_hz` default).
+    pub record_rate_hz: f64,
     /// How time advances. Default: adaptive, with `max_step_s` from the scene.
     pub stepping: Stepping,
     /// How teeth are resolved. Default [`ToothResolution::Auto`].
@@ -155,4 +158,54 @@ pub struct MultibodyOptions {
     pub shapes: BodyShapes,
     /// How the discs are held on the axis.
     pub mount: DiscMount,
+    /// Which time-stepping scheme runs. Default [`Scheme::Auto`].
+    pub scheme: Scheme,
+}
+
+/// The engine's time-stepping scheme (crate docs, "Theory").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Scheme {
+    /// The multirate scheme wherever it applies (adaptive steps, a prescribed shaft, friction
+    /// discs only, concentric lumped couplings), the shared step otherwise. The default.
+    Auto,
+    /// Every body on one shared contact-aware step (the shortest any coupling needs).
+    #[default]
+    Shared,
+    /// The multirate scheme, or an error for a pack it cannot run.
+    Multirate,
+}
+
+impl Default for MultibodyOptions {
+    fn default() -> Self {
+        MultibodyOptions {
+            record_rate_hz: 1e4,
+            stepping: Stepping::default(),
+            teeth: ToothResolution::default(),
+            record_tooth_loads: false,
+            shapes: BodyShapes::default(),
+            mount: DiscMount::default(),
+            scheme: Scheme::default(),
+        }
+    }
+}
+
+impl MultibodyOptions {
+    /// The default options with a run's settings (what a scene's `[simulation]` gives):
+    /// samples at `record_rate_hz` (Hz), adaptive steps of at most `max_step_s` (s), every
+    /// tooth's load in the samples if `record_tooth_loads`.
+    pub fn with_settings(
+        record_rate_hz: f64,
+        max_step_s: f64,
+        record_tooth_loads: bool,
+    ) -> MultibodyOptions {
+        MultibodyOptions {
+            record_rate_hz,
+            record_tooth_loads,
+            stepping: Stepping::Adaptive(AdaptiveStepping {
+                max_step_s,
+                ..AdaptiveStepping::default()
+            }),
+            ..MultibodyOptions::default()
+        }
+    }
 }

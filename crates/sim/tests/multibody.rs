@@ -486,7 +486,7 @@ fn engine_follows_the_scene() {
         },
         pack: paper_pack(LawKind::Paper, 25e-6, 0.8, 0.01),
     };
-    let mut e = MultibodyEngine::from_scene(&scene).unwrap();
+    let mut e = engine_for(&scene).unwrap();
     assert_eq!(e.name(), "multibody");
     assert_eq!(e.disc_names(), vec!["disc".to_string()]);
     match e.options().stepping {
@@ -501,4 +501,20 @@ fn engine_follows_the_scene() {
         .samples
         .iter()
         .all(|s| s.discs[0].tooth_loads_n.len() == 154));
+}
+
+/// The engine for a scene with the default options and the scene's run settings (what the CLI
+/// builds).
+fn engine_for(
+    scene: &clutchpack_scene::Scene,
+) -> Result<MultibodyEngine, clutchpack_model::EngineError> {
+    let sim = &scene.simulation;
+    MultibodyEngine::new(
+        scene.pack.clone(),
+        clutchpack_sim::MultibodyOptions::with_settings(
+            sim.record_rate_hz,
+            sim.max_step_s,
+            sim.record_per_tooth,
+        ),
+    )
 }

@@ -338,7 +338,7 @@ fn engagement_scene_locks_and_stops_the_rattle() {
     let Ok(scene) = clutchpack_scene::load(&path, &[]) else {
         return; // the crate is built outside the repository
     };
-    let mut e = MultibodyEngine::from_scene(&scene).unwrap();
+    let mut e = engine_for(&scene).unwrap();
     let mut c = Collector::default();
     e.run(0.15, &mut c).unwrap();
     let lock = c
@@ -408,4 +408,20 @@ fn work_of_the_drive_equals_friction_loss_plus_energy_change() {
     );
     assert!(a.drive_work_j > 1.0 && a.stack_work_j < 0.0);
     assert!((w - de).abs() <= 5e-3 * a.drive_work_j);
+}
+
+/// The engine for a scene with the default options and the scene's run settings (what the CLI
+/// builds).
+fn engine_for(
+    scene: &clutchpack_scene::Scene,
+) -> Result<MultibodyEngine, clutchpack_model::EngineError> {
+    let sim = &scene.simulation;
+    MultibodyEngine::new(
+        scene.pack.clone(),
+        clutchpack_sim::MultibodyOptions::with_settings(
+            sim.record_rate_hz,
+            sim.max_step_s,
+            sim.record_per_tooth,
+        ),
+    )
 }

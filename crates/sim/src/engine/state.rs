@@ -1,0 +1,315 @@
+//! The world state of one run: the rapier world, the drives of the shaft and the drum, each
+//! body's loads and kicks, the couplings and their memories, the clock; and what is read from
+//! it (relative states, carriers, samples).
+
+use super::energy::{EnergyAudit, Powers};
+use super::events::EventTrack;
+use crate::hook::{Coupling, CouplingForces, RelativeState};
+use crate::integrate::{Kick, Load, LoadHistory, Motion};
+use crate::options::MultibodyOptions;
+use crate::stack::Stack;
+use crate::stepping::profile_acceleration_bound;
+use crate::world::{angle_about_z, Carrier, World};
+use clutchpack_model::{
+    DiscModel, DiscSample, DrumModel, EngineError, ImpactTracker, PackModel, Sample, Shaft,
+    ShaftExcitation, SpeedProfile,
+};
+use rapier3d_f64::prelude::{RigidBody, Vector};
+
+/// Reads the relative state of a disc in the shaft's frame. `omega_s` and `omega_d` are the
+/// speeds about the axis at the time of the poses; `owed` is the disc's turn about the axis not
+/// yet in its rapier pose (`world.rs`).
+pub(super) fn relative_state(
+    shaft: &RigidBody,
+    omega_s: f64,
+    disc: &RigidBody,
+    omega_d: f64,
+    owed: f64,
+) -> RelativeState {
+    let qs = *shaft.rotation();
+    let qs_inv = qs.inverse();
+    let q_rel = qs_inv * *disc.rotation();
+    let d = qs_inv * (disc.translation() - shaft.translation());
+    let dv = qs_inv * (disc.linvel() - shaft.linvel());
+    let rate = dv - Vector::new(0.0, 0.0, omega_s).cross(d);
+    RelativeState {
+        phi: -(angle_about_z(&q_rel) + owed),
+        dphi: omega_s - omega_d,
+        offset: [d.x, d.y],
+        offset_rate: [rate.x, rate.y],
+    }
+}
+
+/// The shaft as the run loop drives it.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum ShaftDrive<'a> {
+    /// Follows a speed profile exactly (eq 3).
+    Prescribed(&'a SpeedProfile),
+    /// A body (eq 4): inertia `J1`, damping `C1`.
+    Inertial { j1: f64, c1: f64 },
+}
+
+/// The output drum as the run loop drives it: a body with inertia, a load torque and drag,
+/// carrying the separator plates.
+/// The loads of one body (a disc, a plate, an inertial shaft, the drum) and their kick
+/// (`integrate.rs`).
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct BodyLoads {
+    /// Physical loads at `t` (world frame), leaving out the teeth's torque about the axis,
+    /// whose kick is integrated along the step (`Run::teeth_impulse`), and the stack's torque,
+    /// solved per step (`stack.rs`).
+    pub(super) load: Load,
+    /// Their values at the two evaluations before.
+    pub(super) history: LoadHistory,
+    /// The kick of `load` for the next step.
+    pub(super) kick: Kick,
+    /// The full loads (teeth included), for the first estimate of the synchronised speed.
+    pub(super) full: Load,
+    /// Their values at the two evaluations before.
+    pub(super) full_history: LoadHistory,
+}
+
+#[derive(Debug, Clone)]
+pub(super) struct DrumRun {
+    pub(super) model: DrumModel,
+    /// Speed at `t` (synchronised) and unwrapped angle, rad/s and rad.
+    pub(super) omega: f64,
+    pub(super) theta: f64,
+    /// Its loads and their kick.
+    pub(super) loads: BodyLoads,
+    /// Acceleration at `t`, rad/s^2.
+    pub(super) accel: f64,
+}
+
+/// The state of one run: the world, the hook's memories, the events, the clock.
+///
+/// Couplings are numbered as the engine's output: the friction discs (carrier: the shaft),
+/// then the separator plates (carrier: the drum, or the housing).
+pub(super) struct Run<'a> {
+    pub(super) pack: &'a PackModel,
+    /// The coupled bodies' models: the discs, then the plates.
+    pub(super) bodies: Vec<&'a DiscModel>,
+    pub(super) world: World,
+    pub(super) shaft: ShaftDrive<'a>,
+    /// Bound of the drive's shaft acceleration, rad/s^2.
+    pub(super) shaft_accel_bound: f64,
+    pub(super) drum: Option<DrumRun>,
+    pub(super) stack: Option<Stack<'a>>,
+    pub(super) couplings: Vec<Coupling>,
+    /// Effective mass per tooth of each coupling, kg (reduced with an inertial carrier).
+    pub(super) m_eff: Vec<f64>,
+    pub(super) tracks: Vec<EventTrack>,
+    /// The hook's results at `t` (filled by [`Run::evaluate`]).
+    pub(super) rel: Vec<RelativeState>,
+    pub(super) forces: Vec<CouplingForces>,
+    /// Powers at the last evaluation.
+    pub(super) powers_before: Option<Powers>,
+    /// The loads of each coupled body and of an inertial shaft (the drum keeps its own).
+    pub(super) loads: Vec<BodyLoads>,
+    pub(super) shaft_loads: BodyLoads,
+    /// `(t, phi, dphi, ddphi)` of each coupling at the last evaluation.
+    pub(super) prev_motion: Vec<Option<(f64, f64, f64, f64)>>,
+    /// The teeth: the past half of their kick (N m s on the body, about the axis) and the
+    /// relative motion at `t` for the future half.
+    pub(super) teeth_past: Vec<f64>,
+    /// The last `(x, teeth_impulse(i, x))` of each coupling since the last evaluation (the
+    /// step's impulse is asked for by the stack, the landing and the forces).
+    pub(super) teeth_cache: Vec<std::cell::Cell<(f64, f64)>>,
+    pub(super) teeth_motion: Vec<Motion>,
+    /// Body speeds at `t` (synchronised with the poses), rad/s.
+    pub(super) omega_d: Vec<f64>,
+    /// Time of the evaluation before the last step.
+    pub(super) t_prev: Option<f64>,
+    /// Prescribed shaft: its angle at the end of the step being taken.
+    pub(super) theta_next: f64,
+    /// Time, unwrapped shaft angle and shaft speed.
+    pub(super) t: f64,
+    pub(super) theta_s: f64,
+    pub(super) omega_s: f64,
+    /// Elastic energy in the teeth at `t`, J.
+    pub(super) potential_j: f64,
+    pub(super) energy: EnergyAudit,
+}
+
+impl<'a> Run<'a> {
+    pub(super) fn new(
+        pack: &'a PackModel,
+        opts: &MultibodyOptions,
+        per_tooth: &[bool],
+    ) -> Result<Run<'a>, EngineError> {
+        let world = World::build(pack, &opts.shapes, opts.mount)?;
+        let bodies: Vec<&DiscModel> = pack.discs.iter().chain(&pack.plates).collect();
+        let couplings: Vec<Coupling> = bodies
+            .iter()
+            .zip(per_tooth)
+            .map(|(d, &pt)| {
+                let errors: Vec<f64> = (0..d.tooth_spacing_errors_m.len())
+                    .map(|k| d.tooth_phase_error_rad(k))
+                    .collect();
+                Coupling::new(d.spline, d.law, pt, &errors)
+            })
+            .collect();
+        let nd = couplings.len();
+        let tracks = (0..nd)
+            .map(|i| EventTrack {
+                tracker: ImpactTracker::new(i),
+                ..Default::default()
+            })
+            .collect();
+        let (shaft, shaft_accel_bound) = match &pack.shaft {
+            Shaft::Prescribed(p) => (ShaftDrive::Prescribed(p), profile_acceleration_bound(p)),
+            Shaft::Inertial {
+                inertia_kg_m2,
+                damping_n_m_s_rad,
+                excitation,
+            } => (
+                ShaftDrive::Inertial {
+                    j1: *inertia_kg_m2,
+                    c1: *damping_n_m_s_rad,
+                },
+                match excitation {
+                    ShaftExcitation::Profile(p) => profile_acceleration_bound(p),
+                    ShaftExcitation::Torque { table, .. } => {
+                        table.y.iter().fold(0.0, |m: f64, y| m.max(y.abs())) / inertia_kg_m2
+                    }
+                },
+            ),
+        };
+        let m_eff = bodies
+            .iter()
+            .zip(&world.carriers)
+            .map(|(d, carrier)| {
+                let md = d.spline.effective_mass_kg(d.inertia_kg_m2);
+                let carrier_inertia = match (carrier, shaft) {
+                    (Carrier::Shaft, ShaftDrive::Inertial { j1, .. }) => Some(j1),
+                    (Carrier::Drum, _) => pack.drum.map(|dr| dr.inertia_kg_m2),
+                    _ => None,
+                };
+                match carrier_inertia {
+                    Some(j) => {
+                        let mc = d.spline.effective_mass_kg(j);
+                        md * mc / (md + mc)
+                    }
+                    None => md,
+                }
+            })
+            .collect();
+        let drum = pack.drum.map(|model| DrumRun {
+            model,
+            omega: model.initial_speed_rad_s,
+            theta: 0.0,
+            loads: BodyLoads::default(),
+            accel: 0.0,
+        });
+        let stack = pack
+            .stack
+            .as_ref()
+            .map(|st| Stack::new(st, pack.discs.len()));
+        Ok(Run {
+            pack,
+            bodies,
+            world,
+            shaft,
+            shaft_accel_bound,
+            drum,
+            stack,
+            couplings,
+            m_eff,
+            tracks,
+            rel: Vec::with_capacity(nd),
+            forces: Vec::with_capacity(nd),
+            powers_before: None,
+            loads: vec![BodyLoads::default(); nd],
+            shaft_loads: BodyLoads::default(),
+            prev_motion: vec![None; nd],
+            teeth_past: vec![0.0; nd],
+            teeth_cache: vec![std::cell::Cell::new((f64::NAN, 0.0)); nd],
+            teeth_motion: vec![Motion::default(); nd],
+            omega_d: Vec::with_capacity(nd),
+            t_prev: None,
+            theta_next: 0.0,
+            t: 0.0,
+            theta_s: 0.0,
+            omega_s: pack.shaft.initial_speed_rad_s(),
+            potential_j: 0.0,
+            energy: EnergyAudit::default(),
+        })
+    }
+
+    /// The stack's torque on coupling body `i` over the step being taken, N m (0 without a
+    /// stack).
+    pub(super) fn stack_torque(&self, i: usize) -> f64 {
+        self.stack.as_ref().map_or(0.0, |s| s.torque_on(i))
+    }
+
+    /// The ramp integral of the stack's torque on body `i` over the last step (the step's
+    /// constant torque times half its length), N m s: its share of the speed synchronised
+    /// to `t`.
+    pub(super) fn stack_past(&self, i: usize) -> f64 {
+        match (&self.stack, self.t_prev) {
+            (Some(s), Some(t0)) => {
+                let b = s.body.iter().position(|&b| b == i);
+                b.map_or(0.0, |b| s.torque[b] * 0.5 * (self.t - t0))
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The speed of coupling `i`'s carrier at `t`, rad/s.
+    pub(super) fn carrier_speed(&self, i: usize) -> f64 {
+        match self.world.carriers[i] {
+            Carrier::Shaft => self.omega_s,
+            Carrier::Housing => 0.0,
+            Carrier::Drum => self.drum.as_ref().map_or(0.0, |d| d.omega),
+        }
+    }
+
+    /// The unwrapped angle of coupling `i`'s carrier at `t`, rad.
+    pub(super) fn carrier_angle(&self, i: usize) -> f64 {
+        match self.world.carriers[i] {
+            Carrier::Shaft => self.theta_s,
+            Carrier::Housing => 0.0,
+            Carrier::Drum => self.drum.as_ref().map_or(0.0, |d| d.theta),
+        }
+    }
+
+    /// The rapier body of coupling `i`'s carrier.
+    pub(super) fn carrier_body(&self, i: usize) -> rapier3d_f64::prelude::RigidBodyHandle {
+        match self.world.carriers[i] {
+            Carrier::Shaft => self.world.shaft,
+            Carrier::Housing => self.world.housing,
+            Carrier::Drum => self.world.drum.expect("a drum"),
+        }
+    }
+
+    /// The sample at `t`.
+    pub(super) fn sample(&self, tooth_loads: bool) -> Sample {
+        Sample {
+            t_s: self.t,
+            shaft_angle_rad: self.theta_s,
+            shaft_speed_rad_s: self.omega_s,
+            discs: (0..self.forces.len())
+                .map(|i| {
+                    let f = &self.forces[i];
+                    let phi = self.rel[i].phi;
+                    DiscSample {
+                        angle_rad: self.carrier_angle(i) - phi,
+                        speed_rad_s: self.omega_d[i],
+                        rel_angle_rad: phi,
+                        penetration_m: f.kin.delta_m,
+                        closing_speed_m_s: f.kin.v_n_m_s,
+                        load_n: f.load_n,
+                        torque_n_m: f.moment[2],
+                        engaged: f.depth_m > 0.0,
+                        stiffness: f.stiffness,
+                        tooth_loads_n: if tooth_loads {
+                            self.couplings[i].tooth_loads_n()
+                        } else {
+                            Vec::new()
+                        },
+                    }
+                })
+                .collect(),
+        }
+    }
+}
