@@ -30,6 +30,7 @@
 
 pub mod clutch;
 pub mod drive;
+pub mod fatigue;
 pub mod impact;
 pub mod law;
 pub mod pack;
@@ -40,6 +41,7 @@ pub use clutch::{
     DrumModel, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackModel,
 };
 pub use drive::{Harmonic, Shaft, ShaftExcitation, SpeedProfile, Table, TableError};
+pub use fatigue::{FatigueError, Material, MinerRule, ToothForm};
 pub use impact::{detect_impacts, ImpactEvent, ImpactTracker};
 pub use law::{ContactState, Engagement, Hertz, LawKind, OilFilm, ToothLaw};
 pub use pack::{annulus_inner_radius_m, annulus_outer_radius_m, DiscModel, PackModel};
