@@ -13,6 +13,11 @@
 //!   and [`stats::percentile`] (numpy's default `linear` definition).
 //! - [`sweep`]: ensemble spreads ([`sweep::Spread`]) and one row per (parameter value, disc)
 //!   of a sweep ([`sweep::sweep_rows`]); [`sweep::sweep_fits`] fits the ensemble means.
+//! - [`cycles`]: turning points and rainflow counting (ASTM E1049-85) of signed per-tooth
+//!   load histories, range histograms, range-mean matrices and exceedance spectra.
+//! - [`fatigue`]: damage, damage rate, life and damage-equivalent load per disc and per tooth
+//!   of a run ([`fatigue::FatigueCollector`], [`fatigue::assess`]) and of an ensemble;
+//!   [`fatigue_plot`] draws the exceedance spectra and the per-tooth damage around a disc.
 //! - [`fit`]: least-squares polynomial fits with nalgebra ([`fit::polyfit`]), with `x`
 //!   centred and scaled so that parameters such as a backlash of `0..100e-6` m fit well.
 //! - [`table`]: aligned plain text, markdown and CSV tables, units in the headers.
@@ -36,6 +41,9 @@
 
 #![warn(missing_docs)]
 
+pub mod cycles;
+pub mod fatigue;
+pub mod fatigue_plot;
 pub mod fit;
 pub mod interfaces;
 pub mod plot;
@@ -43,6 +51,7 @@ pub mod stats;
 pub mod sweep;
 pub mod table;
 
+pub use fatigue::{assess, ensemble_fatigue, DiscFatigue, DiscFatigueSpread, FatigueCollector};
 pub use fit::{polyfit, FitError, PolyFit};
 pub use interfaces::InterfaceStats;
 pub use plot::{plot_compare, plot_load_history, plot_sweep, register_fonts, PlotError};

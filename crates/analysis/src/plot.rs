@@ -169,13 +169,13 @@ pub fn plot_compare(
 // backends
 
 /// A figure that can be drawn on any plotters backend.
-trait Figure {
+pub(crate) trait Figure {
     /// Draws on `root` (already the full image); a plotters error becomes its message.
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
 }
 
 /// Opens a PNG or SVG backend by `path`'s extension, draws `figure` and writes the file.
-fn render(path: &Path, size: (u32, u32), figure: &impl Figure) -> Result<(), PlotError> {
+pub(crate) fn render(path: &Path, size: (u32, u32), figure: &impl Figure) -> Result<(), PlotError> {
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
@@ -207,7 +207,7 @@ fn render(path: &Path, size: (u32, u32), figure: &impl Figure) -> Result<(), Plo
 // the figures
 
 /// The registered font family used for all text.
-const FONT: &str = "sans-serif";
+pub(crate) const FONT: &str = "sans-serif";
 
 /// Width of the legend panel to the right of the sweep and comparison charts, px.
 const LEGEND_W: u32 = 330;
@@ -226,12 +226,12 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(23, 190, 207),
 ];
 
-fn color(i: usize) -> RGBColor {
+pub(crate) fn color(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
 /// A plotters error as its message.
-fn msg(e: impl std::fmt::Display) -> String {
+pub(crate) fn msg(e: impl std::fmt::Display) -> String {
     e.to_string()
 }
 
@@ -300,7 +300,7 @@ fn thin(points: &[(f64, f64)], slices: usize) -> Vec<(f64, f64)> {
 }
 
 /// Writes "no data" in the middle of `area`.
-fn no_data<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>) -> Result<(), String> {
+pub(crate) fn no_data<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>) -> Result<(), String> {
     let (w, h) = area.dim_in_pixel();
     let style = TextStyle::from((FONT, 22).into_font())
         .color(&RGBColor(110, 110, 110))

@@ -31,6 +31,7 @@
 pub mod cases;
 pub mod clutch;
 pub mod drive;
+pub mod fatigue;
 pub mod impact;
 pub mod law;
 pub mod pack;
@@ -41,6 +42,7 @@ pub use clutch::{
     DrumModel, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackModel,
 };
 pub use drive::{Harmonic, Shaft, ShaftExcitation, SpeedProfile, Table, TableError};
+pub use fatigue::{FatigueError, Material, MinerRule, ToothForm};
 pub use impact::{detect_impacts, parabolic_peak, ImpactEvent, ImpactTracker};
 pub use law::{ContactState, Engagement, Hertz, LawKind, OilFilm, ToothLaw};
 pub use pack::{
