@@ -4,7 +4,7 @@
 //! rapier body, which carries the disc's state from one world step to the next.
 
 use super::state::{relative_state, Run, ShaftDrive};
-use crate::hook::{Coupling, RelativeState, FLANKS};
+use crate::hook::{Coupling, CouplingForces, RelativeState, FLANKS};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use crate::stepping::{bracketed_root, contact_duration_s, coupling_step, CouplingView};
 use clutchpack_model::{EngineError, ImpactEvent, PackModel, Shaft, SpeedProfile};
@@ -37,6 +37,42 @@ pub(super) fn unsupported(
     None
 }
 
+/// Sub-steps near a kink of the `s^1.5` law are at most this fraction of the time from the
+/// onset or to the separation (dimensionless). See [`graded_step`].
+const KINK_GRADE: f64 = 0.25;
+
+/// ... and at least the contact step over this (dimensionless).
+const KINK_FLOOR_DIVISOR: f64 = 64.0;
+
+/// The sub-step a coupling in contact takes, s, given the step controller's `want` (s): graded
+/// towards the law's two kinks.
+///
+/// At an onset the load grows as `t^1.5` from the landed onset (and falls as `(t_off - t)^1.5`
+/// to the separation), whose derivatives beyond the first are unbounded there: the classical
+/// method's error in the impulse of the step touching the kink is of order `h^2.5`, not `h^5`,
+/// and it dominates the whole impact's (measured on the 8-disc staggered pack at 128 steps
+/// per contact: the early onsets 1.7e-9 s off the reference at tolerance 1e-12, falling only
+/// as `h^2.5 .. h^3` with more steps). A graded mesh, `h <= KINK_GRADE * (t - t_on)` after
+/// the onset and `h <= KINK_GRADE * s / |v_n|` (the predicted time to separation) while the
+/// depth falls, never below `want / KINK_FLOOR_DIVISOR`, spreads that error over a few
+/// geometrically growing steps: measured 2.6e-11 s, 67x less, for about 30 more sub-steps per
+/// impact (`KINK_GRADE` 0.15 and 0.5 measured 2.4e-11 and 4.9e-11 s).
+fn graded_step(want: f64, f: &CouplingForces, age_s: Option<f64>) -> f64 {
+    if f.depth_m <= 0.0 {
+        return want;
+    }
+    let floor = want / KINK_FLOOR_DIVISOR;
+    let mut h = want;
+    if let Some(age) = age_s {
+        h = h.min((KINK_GRADE * age).max(floor));
+    }
+    let v = f.kin.v_n_m_s;
+    if v < 0.0 {
+        h = h.min((KINK_GRADE * f.depth_m / -v).max(floor));
+    }
+    h
+}
+
 /// One sub-step's outcome: the relative state at its end and the work done along it.
 #[derive(Debug, Clone, Copy)]
 struct SubStep {
@@ -50,9 +86,15 @@ struct SubStep {
     evals: u64,
 }
 
-/// The relative motion of one coupling on a prescribed shaft:
-/// `phi'' = a_s(t) - (T(phi, phi') - C2 omega_d) / J` with `omega_d = omega_s(t) - phi'`
-/// (Hu et al. eqs (3) and (5)).
+/// The relative motion of one coupling on a prescribed shaft, integrated as the disc's own
+/// motion `J omega_d' = T(phi, phi') - C2 omega_d` (Hu et al. eq (5)) with
+/// `phi = theta_s(t) - theta_d`, `phi' = omega_s(t) - omega_d` (eq (3): the shaft's angle and
+/// speed are the profile's, exact). Integrating the disc rather than the relative angle
+/// leaves the shaft's motion out of the truncation error: in free flight without drag the
+/// disc turns at a constant speed and the sub-step is exact whatever its length (integrating
+/// the relative angle with the classical method costs `a_s''' h^5 / 720` per step: at 104 Hz
+/// and 0.1 ms, 1e-11 rad, enough to move the onsets of a chaotic rattle by microseconds
+/// within 40 ms).
 struct Relative<'a> {
     profile: &'a SpeedProfile,
     coupling: &'a Coupling,
@@ -69,31 +111,36 @@ impl Relative<'_> {
         let p = self.profile;
         let (tm, te) = (t + 0.5 * h, t + h);
         let (w0, wm, we) = (p.speed(t), p.speed(tm), p.speed(te));
-        let (a0, am, ae) = (p.acceleration(t), p.acceleration(tm), p.acceleration(te));
-        // (phi'', teeth torque, disc speed) at a stage
-        let f = |ws: f64, as_: f64, phi: f64, dphi: f64| {
-            let torque = self.coupling.probe_torque(phi, dphi);
-            let wd = ws - dphi;
+        // The shaft's turn from t, exact.
+        let theta0 = p.angle(t);
+        let (sm, se) = (p.angle(tm) - theta0, p.angle(te) - theta0);
+        // The disc's speed at t; `th` below is its turn from t.
+        let u0 = w0 - dphi;
+        // (omega_d', teeth torque) at a stage: the shaft turned by `s` at speed `ws`, the
+        // disc turned by `th` at speed `u`.
+        let f = |s: f64, ws: f64, th: f64, u: f64| {
+            let torque = self.coupling.probe_torque(phi + s - th, ws - u);
             // Hu et al. eq (5): J omega_d' = T - C2 omega_d
-            (as_ - (torque - self.c2 * wd) * self.inv_j, torque, wd)
+            ((torque - self.c2 * u) * self.inv_j, torque)
         };
-        let (k1, t1, d1) = f(w0, a0, phi, dphi);
-        let (k2, t2, d2) = f(wm, am, phi + 0.5 * h * dphi, dphi + 0.5 * h * k1);
-        let (k3, t3, d3) = f(
-            wm,
-            am,
-            phi + 0.5 * h * dphi + 0.25 * h * h * k1,
-            dphi + 0.5 * h * k2,
-        );
-        let (k4, t4, d4) = f(we, ae, phi + h * dphi + 0.5 * h * h * k2, dphi + h * k3);
+        let hh = h * h;
+        let (k1, t1) = f(0.0, w0, 0.0, u0);
+        let u2 = u0 + 0.5 * h * k1;
+        let (k2, t2) = f(sm, wm, 0.5 * h * u0, u2);
+        let u3 = u0 + 0.5 * h * k2;
+        let (k3, t3) = f(sm, wm, 0.5 * h * u0 + 0.25 * hh * k1, u3);
+        let u4 = u0 + h * k3;
+        let (k4, t4) = f(se, we, h * u0 + 0.5 * hh * k2, u4);
         let h6 = h / 6.0;
+        // The classical method on the first-order system (angle, speed), written for the
+        // angle: the disc turns by h u0 + h^2/6 (k1 + k2 + k3).
+        let th = h * u0 + h * h6 * (k1 + k2 + k3);
+        let u1 = u0 + h6 * (k1 + 2.0 * (k2 + k3) + k4);
         SubStep {
-            // RK4 for a second-order equation (Runge-Kutta-Nystrom form of the classical
-            // method): phi gets h^2/6 (k1 + k2 + k3), phi' the usual weights.
-            phi: phi + h * dphi + h * h6 * (k1 + k2 + k3),
-            dphi: dphi + h6 * (k1 + 2.0 * (k2 + k3) + k4),
+            phi: phi + se - th,
+            dphi: we - u1,
             drive_j: h6 * (t1 * w0 + 2.0 * (t2 + t3) * wm + t4 * we),
-            drag_j: -self.c2 * h6 * (d1 * d1 + 2.0 * (d2 * d2 + d3 * d3) + d4 * d4),
+            drag_j: -self.c2 * h6 * (u0 * u0 + 2.0 * (u2 * u2 + u3 * u3) + u4 * u4),
             evals: 4,
         }
     }
@@ -234,6 +281,7 @@ impl<'a> Run<'a> {
                 event_age_s: self.tracks[i].event_t_on_s.map(|t_on| t - t_on),
             };
             let (want, _) = coupling_step(&view, a);
+            let want = graded_step(want, &f, self.tracks[i].event_t_on_s.map(|t_on| t - t_on));
             if want.is_nan() || want < a.min_step_s {
                 return Err(EngineError::Diverged {
                     t_s: t,
