@@ -147,7 +147,7 @@ impl MultibodyEngine {
         // Build once now so that a scene the world cannot hold fails here, not in `run`.
         World::build(&pack, &options.shapes, options.mount)?;
         let multirate_refused = match options.scheme {
-            Scheme::Shared => Some("the shared step was asked for"),
+            Scheme::Shared => Some("asked for"),
             Scheme::Auto | Scheme::Multirate => multirate::unsupported(&pack, &options, &per_tooth),
         };
         if let (Scheme::Multirate, Some(why)) = (options.scheme, multirate_refused) {
@@ -184,13 +184,34 @@ impl MultibodyEngine {
         self.multirate_refused.is_none()
     }
 
-    /// Which scheme runs this pack and why, in words (for the CLI to print).
-    pub fn scheme(&self) -> String {
-        match self.multirate_refused {
-            None => "multirate: the world steps at free-flight length, each disc's spline \
-                     coupling sub-steps its own contacts"
-                .to_string(),
-            Some(why) => format!("shared step: {why}"),
+    /// Which time-stepping scheme runs this pack and why, in one line of words for `run` to
+    /// print, e.g. `multirate scheme (automatic: a prescribed shaft and concentric friction
+    /// discs only, so the discs are independent within a world step): ...` or `shared step
+    /// (automatic: an inertial shaft (eq 4) couples ...): ...`.
+    pub fn scheme_explanation(&self) -> String {
+        let shared = "every body advances with one contact-aware step, the shortest any \
+                      coupling needs";
+        match (self.multirate_refused, self.options.stepping) {
+            (None, Stepping::Adaptive(a)) => {
+                let how = match self.options.scheme {
+                    Scheme::Multirate => "asked for",
+                    _ => "automatic",
+                };
+                format!(
+                    "multirate scheme ({how}: a prescribed shaft and concentric friction discs \
+                     only, so the discs are independent within a world step): the rapier world \
+                     steps at up to {} s, each disc's spline coupling sub-steps its own \
+                     contacts ({} steps per contact, classical Runge-Kutta)",
+                    a.max_step_s, a.steps_per_contact
+                )
+            }
+            (Some(why), _) if self.options.scheme == Scheme::Shared => {
+                format!("shared step ({why}): {shared}")
+            }
+            (why, _) => format!(
+                "shared step (automatic: {}): {shared}",
+                why.unwrap_or("fixed steps")
+            ),
         }
     }
 

@@ -76,6 +76,8 @@ fn graded_step(want: f64, f: &CouplingForces, age_s: Option<f64>) -> f64 {
 /// One sub-step's outcome: the relative state at its end and the work done along it.
 #[derive(Debug, Clone, Copy)]
 struct SubStep {
+    /// The shaft at its end.
+    shaft: ShaftAt,
     phi: f64,
     dphi: f64,
     /// Work of the shaft on the teeth, `integral T dtheta_s`, J.
@@ -107,13 +109,13 @@ struct Relative<'a> {
 impl Relative<'_> {
     /// One classical Runge-Kutta step of length `h` from `(phi, dphi)` at `t`, with the work
     /// of the drive and the drag integrated by the same stages (the augmented system).
-    fn rk4(&self, t: f64, phi: f64, dphi: f64, h: f64) -> SubStep {
+    fn rk4(&self, t: f64, shaft: ShaftAt, phi: f64, dphi: f64, h: f64) -> SubStep {
         let p = self.profile;
         let (tm, te) = (t + 0.5 * h, t + h);
-        let (w0, wm, we) = (p.speed(t), p.speed(tm), p.speed(te));
+        let (mid, end) = (ShaftAt::of(p, tm), ShaftAt::of(p, te));
+        let (w0, wm, we) = (shaft.speed, mid.speed, end.speed);
         // The shaft's turn from t, exact.
-        let theta0 = p.angle(t);
-        let (sm, se) = (p.angle(tm) - theta0, p.angle(te) - theta0);
+        let (sm, se) = (mid.angle - shaft.angle, end.angle - shaft.angle);
         // The disc's speed at t; `th` below is its turn from t.
         let u0 = w0 - dphi;
         // (omega_d', teeth torque) at a stage: the shaft turned by `s` at speed `ws`, the
@@ -137,11 +139,30 @@ impl Relative<'_> {
         let th = h * u0 + h * h6 * (k1 + k2 + k3);
         let u1 = u0 + h6 * (k1 + 2.0 * (k2 + k3) + k4);
         SubStep {
+            shaft: end,
             phi: phi + se - th,
             dphi: we - u1,
             drive_j: h6 * (t1 * w0 + 2.0 * (t2 + t3) * wm + t4 * we),
             drag_j: -self.c2 * h6 * (u0 * u0 + 2.0 * (u2 * u2 + u3 * u3) + u4 * u4),
             evals: 4,
+        }
+    }
+}
+
+/// The prescribed shaft at one time: its speed (rad/s) and unwrapped angle (rad), each
+/// evaluated once (a sub-step's end is the next one's start; the profile's trigonometry was a
+/// third of the scheme's time).
+#[derive(Debug, Clone, Copy)]
+struct ShaftAt {
+    speed: f64,
+    angle: f64,
+}
+
+impl ShaftAt {
+    fn of(p: &SpeedProfile, t: f64) -> ShaftAt {
+        ShaftAt {
+            speed: p.speed(t),
+            angle: p.angle(t),
         }
     }
 }
@@ -263,9 +284,10 @@ impl<'a> Run<'a> {
         let m_eff = self.m_eff[i];
         let mut t = self.t;
         let (mut phi, mut dphi) = (self.rel[i].phi, self.rel[i].dphi);
+        let mut shaft = ShaftAt::of(profile, t);
         while t < t1 {
             let f = self.forces[i];
-            let wd = profile.speed(t) - dphi;
+            let wd = shaft.speed - dphi;
             let view = CouplingView {
                 forces: &f,
                 law: &d.law,
@@ -302,7 +324,7 @@ impl<'a> Run<'a> {
                 inv_j,
                 c2: d.drag_n_m_s_rad,
             };
-            let mut step = rel.rk4(t, phi, dphi, h);
+            let mut step = rel.rk4(t, shaft, phi, dphi, h);
             // Never step over an onset or a separation: land on it (the `s^1.5` law's kink
             // then falls on a sub-step boundary and the step keeps its order).
             let engaged = f.depth_m > 0.0;
@@ -326,7 +348,7 @@ impl<'a> Run<'a> {
                 let x = bracketed_root(
                     |x| {
                         evals.set(evals.get() + 4);
-                        depth(rel.rk4(t, phi, dphi, x).phi)
+                        depth(rel.rk4(t, shaft, phi, dphi, x).phi)
                     },
                     0.0,
                     d0,
@@ -337,13 +359,14 @@ impl<'a> Run<'a> {
                 counts.evals += evals.get();
                 if x > tiny && x < h {
                     h = x;
-                    step = rel.rk4(t, phi, dphi, x);
+                    step = rel.rk4(t, shaft, phi, dphi, x);
                     counts.evals += 4;
                 }
             }
             t = if h == rem { t1 } else { t + h };
             phi = step.phi;
             dphi = step.dphi;
+            shaft = step.shaft;
             counts.substeps += 1;
             counts.evals += step.evals + 1;
             self.energy.drive_work_j += step.drive_j;
@@ -433,7 +456,8 @@ mod tests {
             let h = duration / n as f64;
             let (mut phi, mut dphi, mut drag) = (0.0, -w0, 0.0);
             for k in 0..n {
-                let s = rel.rk4(k as f64 * h, phi, dphi, h);
+                let t = k as f64 * h;
+                let s = rel.rk4(t, ShaftAt::of(&profile, t), phi, dphi, h);
                 (phi, dphi, drag) = (s.phi, s.dphi, drag + s.drag_j);
             }
             let wd = w0 * (-r * duration).exp();
