@@ -409,6 +409,40 @@ mod tests {
     use super::*;
     use clutchpack_model::{Hertz, LawKind, OilFilm, SplineGeometry, ToothLaw};
 
+    /// The graded sub-step: the floor at an onset, a quarter of the contact's age after it,
+    /// the controller's step once that is longer, a quarter of the predicted time to
+    /// separation (depth over the opening speed) while the depth falls, nothing in free flight
+    /// or while the depth grows.
+    #[test]
+    fn sub_steps_are_graded_at_the_kinks() {
+        let forces = |depth_m: f64, v_n_m_s: f64| CouplingForces {
+            kin: clutchpack_model::ToothKinematics {
+                flank: clutchpack_model::Flank::ShaftLeads,
+                delta_m: depth_m,
+                v_n_m_s,
+            },
+            depth_m,
+            load_n: 0.0,
+            force: [0.0; 2],
+            moment: [0.0; 3],
+            stiffness: 0.0,
+            potential_j: 0.0,
+            gap_margin_m: 0.0,
+            speed_margin_m_s: 0.0,
+        };
+        let want = 64e-8;
+        let growing = forces(1e-7, 0.5);
+        assert_eq!(graded_step(want, &growing, Some(0.0)), 1e-8);
+        assert_eq!(graded_step(want, &growing, Some(8e-7)), 2e-7);
+        assert_eq!(graded_step(want, &growing, Some(1e-5)), want);
+        assert_eq!(graded_step(want, &growing, None), want);
+        // 1e-7 m at 0.5 m/s: 2e-7 s to the separation
+        let falling = forces(1e-7, -0.5);
+        assert_eq!(graded_step(want, &falling, Some(1e-5)), 0.25 * 2e-7);
+        assert_eq!(graded_step(want, &forces(1e-12, -0.5), Some(1e-5)), 1e-8);
+        assert_eq!(graded_step(want, &forces(-1e-7, -0.5), Some(0.0)), want);
+    }
+
     /// A disc in free flight inside the backlash of a shaft at rest, slowed by its drag:
     /// `omega_d = w0 e^(-r t)`, `r = C2 / J`, so `phi = -w0 (1 - e^(-r t)) / r` and the drag's
     /// work equals the change of kinetic energy, `J (omega_d^2 - w0^2) / 2`. The classical
