@@ -44,10 +44,12 @@ fn main() {
     if let Some((e, stats, impacts)) = last {
         println!("{}", e.scheme_explanation());
         println!(
-            "{n} discs, {duration} s: {} world steps, {} coupling sub-steps, {impacts} impacts, \
+            "{n} discs, {duration} s: {} world steps, {} coupling sub-steps, {} tooth-law \
+             evaluations, {impacts} impacts, \
              {:.2} ms wall per run",
             stats.steps,
             e.coupling_substeps(),
+            stats.rhs_evals,
             wall * 1e3
         );
     }
