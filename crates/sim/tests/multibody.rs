@@ -540,3 +540,51 @@ fn engine_for(
         ),
     )
 }
+
+/// The scheme is chosen automatically and explained (issue 9): the multirate scheme on a
+/// prescribed shaft with concentric friction discs, the shared step with the reason on an
+/// inertial shaft, on fixed steps and when asked for; asking for the multirate scheme where it
+/// cannot run is refused with the reason.
+#[test]
+fn scheme_is_chosen_and_explained() {
+    use clutchpack_model::cases::staggered_pack;
+    let explain = |pack: PackModel, opts: MultibodyOptions| {
+        let e = MultibodyEngine::new(pack, opts).expect("engine");
+        (e.is_multirate(), e.scheme_explanation())
+    };
+    let (multirate, why) = explain(staggered_pack(2), adaptive());
+    assert!(multirate, "{why}");
+    assert!(
+        why.starts_with("multirate scheme (automatic: a prescribed shaft"),
+        "{why}"
+    );
+    let (multirate, why) = explain(staggered_pack(2), shared());
+    assert!(!multirate, "{why}");
+    assert!(why.starts_with("shared step (asked for)"), "{why}");
+    let (multirate, why) = explain(staggered_pack(2), fixed(1e-6));
+    assert!(!multirate, "{why}");
+    assert!(
+        why.starts_with("shared step (automatic: fixed steps"),
+        "{why}"
+    );
+    let mut inertial = staggered_pack(2);
+    inertial.shaft = Shaft::Inertial {
+        inertia_kg_m2: 0.3,
+        damping_n_m_s_rad: 0.0,
+        excitation: ShaftExcitation::Profile(SpeedProfile::sine(100.0, 4.378, 104.0)),
+    };
+    let (multirate, why) = explain(inertial.clone(), adaptive());
+    assert!(!multirate, "{why}");
+    assert!(
+        why.starts_with("shared step (automatic: an inertial shaft"),
+        "{why}"
+    );
+    let asked = MultibodyOptions {
+        scheme: Scheme::Multirate,
+        ..adaptive()
+    };
+    match MultibodyEngine::new(inertial, asked) {
+        Err(EngineError::Unsupported(m)) => assert!(m.contains("an inertial shaft"), "{m}"),
+        other => panic!("{other:?}"),
+    }
+}
