@@ -28,6 +28,8 @@
 //! - Brancati R., Rocca E., Russo R., gear-rattle squeeze-film model (the `squeeze` law).
 //! - Cameron A., *Basic Lubrication Theory*: the leakage coefficient `beta`.
 
+#![warn(missing_docs)]
+
 pub mod cases;
 pub mod clutch;
 pub mod drive;
