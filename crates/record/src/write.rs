@@ -470,7 +470,7 @@ impl Recorder {
                 .get(i)
                 .cloned()
                 .unwrap_or_else(|| format!("disc {i}"));
-            s.discs.push(crate::DiscSummary::from_peaks(name, p));
+            s.discs.push(crate::DiscStats::from_peaks(name, p));
         }
         s
     }
