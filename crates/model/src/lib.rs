@@ -41,7 +41,8 @@ pub mod spline;
 pub mod stream;
 
 pub use clutch::{
-    DrumModel, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackModel,
+    DrumModel, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackBody,
+    StackModel,
 };
 pub use drive::{Harmonic, Shaft, ShaftExcitation, SpeedProfile, Table, TableError};
 pub use fatigue::{FatigueError, Material, MinerRule, ToothForm};

@@ -36,7 +36,6 @@
 //! amount of code around the standard tableau (`dopri.rs`), tested against closed forms.
 
 #![warn(missing_docs)]
-
 // Index loops over state components mirror the equations; iterator chains would obscure them.
 #![allow(clippy::needless_range_loop)]
 
