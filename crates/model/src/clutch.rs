@@ -286,7 +286,7 @@ impl StackBody {
     /// The body at stack position `b` (from the piston, 0-based): plate `b/2` for even `b`,
     /// disc `(b-1)/2` for odd `b`.
     pub fn at(b: usize) -> StackBody {
-        if b % 2 == 0 {
+        if b.is_multiple_of(2) {
             StackBody::Plate(b / 2)
         } else {
             StackBody::Disc(b / 2)

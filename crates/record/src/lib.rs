@@ -95,11 +95,15 @@ mod export;
 pub mod info;
 pub mod proto;
 mod read;
-pub mod scene;
 #[cfg(feature = "serve")]
 mod serve;
 mod summary;
+mod view3d;
+// Test fixture for this crate's tests, benches and examples (integration tests are other
+// crates, so it stays `pub`); not part of the API.
+#[doc(hidden)]
 pub mod synthetic;
+mod threaded;
 pub mod topics;
 mod write;
 
@@ -113,6 +117,7 @@ pub use read::{
 #[cfg(feature = "serve")]
 pub use serve::{serve, ServeError, ServeOptions};
 pub use summary::{DiscStats, RunSummary, MAX_EXTRA_DISCS, TOP_N};
+pub use threaded::ThreadedRecorder;
 pub use write::{default_path, log_time_ns, RecordError, RecordOptions, Recorder};
 
 /// A disc name made safe for a topic and frame name: every character other than
