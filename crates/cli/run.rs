@@ -214,7 +214,7 @@ fn write_impacts_csv(path: &PathBuf, names: &[String], obs: &RunCollector) -> Re
         writeln!(
             w,
             "{},{:.9},{:.9},{:.9},{},{:.6},{:.4}",
-            names[e.disc],
+            clutchpack_analysis::csv_field(&names[e.disc]),
             e.t_on_s,
             e.t_peak_s,
             e.t_off_s,
