@@ -758,3 +758,34 @@ fn stack_recordings_carry_the_friction_interfaces() {
     );
     assert!(checked > 500, "{checked} slipping samples checked");
 }
+
+/// A disc name holding a comma and a quote does not break the impacts CSV: the field is
+/// quoted (RFC 4180, quotes doubled), so every row still has seven fields.
+#[test]
+fn impacts_csv_quotes_names() {
+    let d = scratch("csv_names");
+    let scene = d.join("odd-name.toml");
+    let text = std::fs::read_to_string("scenes/hu-table2.toml")
+        .unwrap()
+        .replace("name = \"disc\"", "name = 'a,b \"c\"'");
+    std::fs::write(&scene, text).unwrap();
+    let csv = d.join("i.csv");
+    let o = run(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--duration",
+        "0.03",
+        "--impacts-csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    assert!(!rows.is_empty(), "the run has impacts");
+    for row in rows {
+        let rest = row
+            .strip_prefix("\"a,b \"\"c\"\"\",")
+            .unwrap_or_else(|| panic!("name not quoted: {row}"));
+        assert_eq!(rest.split(',').count(), 6, "{row}");
+    }
+}

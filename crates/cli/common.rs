@@ -2,7 +2,9 @@
 
 use anyhow::{Context, Result};
 use clutchpack_analysis::{DiscStats, InterfaceStats};
-use clutchpack_model::{Engine, ImpactEvent, InterfaceSample, Observer, RunStats, Sample};
+use clutchpack_model::{
+    Engine, ImpactEvent, InterfaceSample, Observer, RunStats, Sample, StackBody,
+};
 use clutchpack_reference::ReferenceEngine;
 use clutchpack_scene::{EngineChoice, Override, Scene};
 use serde::Serialize;
@@ -219,12 +221,11 @@ pub fn friction_interfaces(scene: &Scene) -> Vec<clutchpack_record::FrictionInte
         return Vec::new();
     }
     let body = |b: usize| {
-        let list = if b.is_multiple_of(2) {
-            &scene.pack.plates
-        } else {
-            &scene.pack.discs
+        let (list, k) = match StackBody::at(b) {
+            StackBody::Plate(j) => (&scene.pack.plates, j),
+            StackBody::Disc(i) => (&scene.pack.discs, i),
         };
-        list.get(b / 2).map(|d| d.name.clone()).unwrap_or_default()
+        list.get(k).map(|d| d.name.clone()).unwrap_or_default()
     };
     (0..2 * scene.pack.discs.len())
         .map(|m| clutchpack_record::FrictionInterface {
@@ -282,8 +283,8 @@ pub fn run_info(
                 (r_spline, ro)
             };
             let slot = match (stacked, plate) {
-                (true, false) => 2 * i + 1,
-                (true, true) => 2 * (i - n_discs),
+                (true, false) => StackBody::Disc(i).position(),
+                (true, true) => StackBody::Plate(i - n_discs).position(),
                 (false, _) => i,
             };
             DiscGeometry {

@@ -19,6 +19,7 @@ macro_rules! out {
 mod bench;
 mod check;
 mod common;
+mod describe;
 mod recording;
 mod run;
 mod signals;

@@ -62,7 +62,7 @@ pub struct ReplayArgs {
 
 pub fn replay(a: ReplayArgs) -> Result<ExitCode> {
     let reader = open_recording(&a.file, a.salvage)?;
-    out!("{}", reader.describe().trim_end());
+    out!("{}", crate::describe::describe(&reader).trim_end());
     if a.serve {
         serve(&reader, a.port, a.speed)?;
     }

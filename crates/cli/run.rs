@@ -3,8 +3,8 @@
 use crate::common::{self, EngineArg, RunCollector, RunSummary};
 use anyhow::{Context, Result};
 use clutchpack_analysis::{disc_stats, stats_table, TableFormat};
-use clutchpack_model::{DiscSample, ImpactEvent, InterfaceSample, Observer, Sample};
-use clutchpack_record::{RecordOptions, Recorder};
+use clutchpack_model::{ImpactEvent, InterfaceSample, Observer, Sample};
+use clutchpack_record::{RecordOptions, Recorder, ThreadedRecorder};
 use clutchpack_scene::Override;
 use std::io::Write;
 use std::path::PathBuf;
@@ -214,7 +214,7 @@ fn write_impacts_csv(path: &PathBuf, names: &[String], obs: &RunCollector) -> Re
         writeln!(
             w,
             "{},{:.9},{:.9},{:.9},{},{:.6},{:.4}",
-            names[e.disc],
+            clutchpack_analysis::csv_field(&names[e.disc]),
             e.t_on_s,
             e.t_peak_s,
             e.t_off_s,
@@ -289,166 +289,6 @@ pub(crate) fn run_recorded(
     }
 }
 
-/// What the engine's thread hands to the recording thread.
-enum ToRecorder {
-    Sample(Sample),
-    Impact(ImpactEvent),
-    Interfaces(f64, Vec<InterfaceSample>),
-}
-
-/// Items per batch handed to the recording thread. Handing over every sample on its own
-/// woke the recording thread 10 000 times per simulated second (a futex call each), which
-/// slowed the engine's thread more than the encoding did. Measured with `clutchpack bench`
-/// on a 3 s paper case: the engine thread's CPU time grew by 7 % with batches of 32 and by
-/// 3.5 % with 256; a batch is at most 2.6 ms of simulated time at 10 kHz, and a slow engine
-/// hands over what it has at each progress call (every 1024 steps) anyway.
-const BATCH: usize = 256;
-
-/// The recorder on its own thread: the engine's thread only copies each sample into a batch
-/// and hands full batches over a bounded channel, so encoding, compressing and writing run
-/// beside the simulation. Emptied batches come back on a second channel and their samples'
-/// buffers are reused, so the engine's thread neither allocates nor frees per sample.
-struct ThreadedRecorder {
-    tx: std::sync::mpsc::SyncSender<Vec<ToRecorder>>,
-    back: std::sync::mpsc::Receiver<Vec<ToRecorder>>,
-    batch: Vec<ToRecorder>,
-    /// items of `batch` in use; those beyond are spare buffers
-    len: usize,
-    failed: Arc<AtomicBool>,
-    /// gives back the recorder and the thread's CPU time in s
-    handle: std::thread::JoinHandle<(Recorder, f64)>,
-}
-
-/// Copies `src` into `dst` field by field, reusing `dst`'s buffers (a derived `clone_from`
-/// would allocate anew). Destructured so that a new field of `Sample` fails to compile here.
-fn copy_sample(dst: &mut Sample, src: &Sample) {
-    let Sample {
-        t_s,
-        shaft_angle_rad,
-        shaft_speed_rad_s,
-        discs,
-    } = src;
-    dst.t_s = *t_s;
-    dst.shaft_angle_rad = *shaft_angle_rad;
-    dst.shaft_speed_rad_s = *shaft_speed_rad_s;
-    dst.discs.truncate(discs.len());
-    let n = dst.discs.len();
-    for (d, s) in dst.discs.iter_mut().zip(discs) {
-        let loads = std::mem::take(&mut d.tooth_loads_n);
-        *d = DiscSample {
-            tooth_loads_n: loads,
-            ..*s
-        };
-        d.tooth_loads_n.clear();
-        d.tooth_loads_n.extend_from_slice(&s.tooth_loads_n);
-    }
-    dst.discs.extend(discs[n..].iter().cloned());
-}
-
-impl ThreadedRecorder {
-    fn start(mut rec: Recorder) -> ThreadedRecorder {
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<ToRecorder>>(64);
-        let (back_tx, back) = std::sync::mpsc::channel::<Vec<ToRecorder>>();
-        let failed = Arc::new(AtomicBool::new(false));
-        let flag = failed.clone();
-        let worker = move || {
-            let cpu = cpu_time::ThreadTime::try_now().ok();
-            for batch in rx {
-                let mut t_s = None;
-                for m in &batch {
-                    match m {
-                        ToRecorder::Sample(s) => {
-                            rec.sample(s);
-                            t_s = Some(s.t_s);
-                        }
-                        ToRecorder::Impact(e) => rec.impact(e),
-                        ToRecorder::Interfaces(t, i) => rec.interfaces(*t, i),
-                    }
-                }
-                // the wall-clock flush is checked once per batch
-                if rec.progress(t_s.unwrap_or(0.0)) {
-                    flag.store(true, Ordering::SeqCst);
-                }
-                // the engine's thread may be gone already; the batch is then dropped here
-                let _ = back_tx.send(batch);
-            }
-            let cpu_s = cpu
-                .and_then(|c| c.try_elapsed().ok())
-                .map_or(0.0, |d| d.as_secs_f64());
-            (rec, cpu_s)
-        };
-        let handle = std::thread::Builder::new()
-            .name("recorder".into())
-            .spawn(worker)
-            .expect("spawning the recorder thread");
-        ThreadedRecorder {
-            tx,
-            back,
-            batch: Vec::with_capacity(BATCH),
-            len: 0,
-            failed,
-            handle,
-        }
-    }
-
-    /// The next free slot of the batch: a spare one (to be overwritten) or a new one.
-    fn slot(&mut self) -> Option<&mut ToRecorder> {
-        let i = self.len;
-        self.len += 1;
-        self.batch.get_mut(i)
-    }
-
-    fn push_sample(&mut self, s: &Sample) {
-        match self.slot() {
-            Some(ToRecorder::Sample(dst)) => copy_sample(dst, s),
-            Some(other) => *other = ToRecorder::Sample(s.clone()),
-            None => self.batch.push(ToRecorder::Sample(s.clone())),
-        }
-        self.send_if_full();
-    }
-
-    fn push(&mut self, m: ToRecorder) {
-        match self.slot() {
-            Some(slot) => *slot = m,
-            None => self.batch.push(m),
-        }
-        self.send_if_full();
-    }
-
-    fn send_if_full(&mut self) {
-        if self.len >= BATCH {
-            self.send();
-        }
-    }
-
-    /// Hands the batch to the recording thread and takes a returned one (or a new one).
-    fn send(&mut self) {
-        if self.len == 0 {
-            return;
-        }
-        self.batch.truncate(self.len);
-        let next = self
-            .back
-            .try_recv()
-            .unwrap_or_else(|_| Vec::with_capacity(BATCH));
-        let full = std::mem::replace(&mut self.batch, next);
-        self.len = 0;
-        // A closed channel means the thread ended; join() reports why.
-        let _ = self.tx.send(full);
-    }
-
-    /// Waits for everything pushed to be written and returns the recorder to finish it, and
-    /// the recording thread's CPU time in s.
-    fn join(mut self) -> (Recorder, f64) {
-        self.send();
-        drop(self.tx);
-        match self.handle.join() {
-            Ok(r) => r,
-            Err(p) => std::panic::resume_unwind(p),
-        }
-    }
-}
-
 /// Feeds the collector and the recorder; stops the run on Ctrl-C or when recording failed.
 struct RunObserver {
     collector: RunCollector,
@@ -466,13 +306,13 @@ impl Observer for RunObserver {
     fn impact(&mut self, e: &ImpactEvent) {
         self.collector.impact(e);
         if let Some(r) = &mut self.recorder {
-            r.push(ToRecorder::Impact(*e));
+            r.push_impact(e);
         }
     }
     fn interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
         self.collector.interfaces(t_s, interfaces);
         if let Some(r) = &mut self.recorder {
-            r.push(ToRecorder::Interfaces(t_s, interfaces.to_vec()));
+            r.push_interfaces(t_s, interfaces);
         }
     }
     fn progress(&mut self, t_s: f64) -> bool {
@@ -481,7 +321,7 @@ impl Observer for RunObserver {
             // hand over what is pending, so a slow engine's samples reach the file (and its
             // wall-clock flush) without waiting for a full batch
             r.send();
-            stop |= r.failed.load(Ordering::SeqCst);
+            stop |= r.failed();
         }
         stop || self.interrupted.load(Ordering::SeqCst)
     }

@@ -57,4 +57,4 @@ pub use interfaces::InterfaceStats;
 pub use plot::{plot_compare, plot_load_history, plot_sweep, register_fonts, PlotError};
 pub use stats::{disc_stats, percentile, DiscStats};
 pub use sweep::{sweep_fits, sweep_rows, Spread, SweepCase, SweepRow};
-pub use table::{interface_table, stats_table, sweep_table, TableFormat};
+pub use table::{csv_field, interface_table, stats_table, sweep_table, TableFormat};

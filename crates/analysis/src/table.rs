@@ -291,8 +291,9 @@ fn render(format: TableFormat, cols: &[Col], rows: &[Vec<String>]) -> String {
     out
 }
 
-/// A CSV field, quoted when it holds a comma, a quote or a line break.
-fn csv_field(s: &str) -> String {
+/// A CSV field (RFC 4180): quoted, with doubled quotes, when it holds a comma, a quote or a
+/// line break; as is otherwise. The one CSV quoting of the project (tables, exports, impacts).
+pub fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {

@@ -271,6 +271,46 @@ pub struct InterfaceSample {
     pub dissipated_j: f64,
 }
 
+/// A body of the stack by its kind and index: the one definition of stack order (plate 0,
+/// disc 0, plate 1, ..., disc `N-1`, plate `N`; module docs), used by the engines, the
+/// recording's drawing and the naming of the friction interfaces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StackBody {
+    /// Separator plate `j` (`0..=N`).
+    Plate(usize),
+    /// Friction disc `i` (`0..N`).
+    Disc(usize),
+}
+
+impl StackBody {
+    /// The body at stack position `b` (from the piston, 0-based): plate `b/2` for even `b`,
+    /// disc `(b-1)/2` for odd `b`.
+    pub fn at(b: usize) -> StackBody {
+        if b.is_multiple_of(2) {
+            StackBody::Plate(b / 2)
+        } else {
+            StackBody::Disc(b / 2)
+        }
+    }
+
+    /// The stack position of this body (inverse of [`StackBody::at`]).
+    pub fn position(self) -> usize {
+        match self {
+            StackBody::Plate(j) => 2 * j,
+            StackBody::Disc(i) => 2 * i + 1,
+        }
+    }
+
+    /// The index of this body in the engines' body list of a pack of `n_discs` discs: the
+    /// discs first, then the plates.
+    pub fn body_index(self, n_discs: usize) -> usize {
+        match self {
+            StackBody::Plate(j) => n_discs + j,
+            StackBody::Disc(i) => i,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -390,5 +430,25 @@ mod tests {
         assert_eq!(f, [900.0, 700.0, 650.0, 350.0]);
         s.clamp_forces_n(500.0, &q, &mut f);
         assert_eq!(f, [400.0, 200.0, 150.0, 0.0]);
+    }
+
+    /// Stack order round-trips and interleaves plates and discs, plates at both ends.
+    #[test]
+    fn stack_order() {
+        let n = 3;
+        let order: Vec<StackBody> = (0..2 * n + 1).map(StackBody::at).collect();
+        assert_eq!(order[0], StackBody::Plate(0));
+        assert_eq!(order[1], StackBody::Disc(0));
+        assert_eq!(order[2 * n], StackBody::Plate(n));
+        for (b, body) in order.iter().enumerate() {
+            assert_eq!(body.position(), b);
+        }
+        let mut idx: Vec<usize> = order.iter().map(|b| b.body_index(n)).collect();
+        idx.sort();
+        assert_eq!(
+            idx,
+            (0..2 * n + 1).collect::<Vec<_>>(),
+            "every body exactly once"
+        );
     }
 }

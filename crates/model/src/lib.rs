@@ -17,6 +17,23 @@
 //! - Penetration `delta` and closing speed `v_n` are measured along the line of action
 //!   (tangent to the base circle `Rb = R cos(alpha)`); `v_n > 0` while closing.
 //!
+//! ## Two-sided elements: one sign convention
+//! Every element that acts between two bodies (a spline coupling, a friction interface) has a
+//! side **a** and a side **b**. The project's one convention, as the Modelica Standard
+//! Library's for every two-sided element: the relative motion is **b minus a**
+//! (`rel = theta_b - theta_a`, `rel' = omega_b - omega_a`), and the torque an element reports
+//! is the torque **on b** (a receives the opposite). Each element's reported quantities in it:
+//!
+//! | element | side a | side b | reported relative motion | reported torque or load |
+//! | --- | --- | --- | --- | --- |
+//! | spline coupling ([`SplineGeometry`], [`DiscSample`]) | the carrier: shaft for a friction disc, housing or drum for a plate | the disc or plate | `phi = theta_a - theta_b = -rel` (the paper's eq 6 sign, kept so every load matches Hu et al.) | `spline_torque_n_m` on b `= -n F Rb`; per-tooth load `F` **positive when b leads** (`rel > g0`), negative when a leads |
+//! | friction interface `m` ([`InterfaceSample`]) | stack body `m` (piston side, [`StackBody::at`]) | stack body `m + 1` | `slip_rad_s = omega_b - omega_a = rel'` | `torque_n_m` on b (opposes `slip` while it slips) |
+//!
+//! So the only exception to "b minus a" is the spline's `phi`, which keeps the paper's sign;
+//! its torque still follows the rule (reported on b). Heat is never negative:
+//! `-torque_n_m * slip_rad_s >= 0` for a friction interface, and the coupling's film and
+//! impact damping dissipate `>= 0` on either flank.
+//!
 //! # References
 //! - Hu Z., Wang S., Song M., Xu Y., Ning K., *The influence of oil film thickness on the gear
 //!   impact dynamics of friction disc*. Eqs (1)-(2): Hertz law with impact damping; (3) drive;
@@ -27,6 +44,8 @@
 //!   omits).
 //! - Brancati R., Rocca E., Russo R., gear-rattle squeeze-film model (the `squeeze` law).
 //! - Cameron A., *Basic Lubrication Theory*: the leakage coefficient `beta`.
+
+#![warn(missing_docs)]
 
 pub mod cases;
 pub mod clutch;
@@ -39,7 +58,8 @@ pub mod spline;
 pub mod stream;
 
 pub use clutch::{
-    DrumModel, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackModel,
+    DrumModel, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackBody,
+    StackModel,
 };
 pub use drive::{Harmonic, Shaft, ShaftExcitation, SpeedProfile, Table, TableError};
 pub use fatigue::{FatigueError, Material, MinerRule, ToothForm};

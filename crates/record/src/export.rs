@@ -1,6 +1,7 @@
 //! `export --csv DIR`: one CSV file per topic of ours (see [`export_csv`]).
 
 use crate::read::{ReadError, RecordingReader};
+use clutchpack_analysis::csv_field;
 use clutchpack_model::Flank;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -130,7 +131,7 @@ pub fn export_csv(
         let _ = writeln!(
             s,
             "{},{},{:?},{:?},{:?},{flank},{:?},{:?}",
-            csv_text(&name),
+            csv_field(&name),
             e.disc,
             e.t_on_s,
             e.t_peak_s,
@@ -148,7 +149,7 @@ pub fn export_csv(
         let _ = writeln!(
             s,
             "{},{:?},{:?},{:?},{},{},{},{:?}",
-            csv_text(&d.name),
+            csv_field(&d.name),
             d.max_positive_n,
             d.max_negative_n,
             d.p99_abs_n,
@@ -160,13 +161,4 @@ pub fn export_csv(
     }
     put("summary.csv", s)?;
     Ok(written)
-}
-
-/// A CSV field: quoted (with doubled quotes) when it holds a comma, quote or line break.
-fn csv_text(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }

@@ -24,8 +24,8 @@
 //!
 //! ## What it does not do
 //! - Run engines, parse scenes or compute statistics beyond the stored summary: the CLI
-//!   fills [`RunInfo`] from the scene, and `clutchpack_analysis` does the statistics (its
-//!   `DiscStats` and our [`DiscSummary`] have the same fields and definitions).
+//!   fills [`RunInfo`] from the scene, and `clutchpack_analysis` does the statistics (the summary's
+//!   per-disc entry is its [`DiscStats`]).
 //! - Depend on rapier or on the engines: it knows only `clutchpack_model`'s stream types.
 //!
 //! ## Topics
@@ -95,11 +95,15 @@ mod export;
 pub mod info;
 pub mod proto;
 mod read;
-pub mod scene;
 #[cfg(feature = "serve")]
 mod serve;
 mod summary;
+mod view3d;
+// Test fixture for this crate's tests, benches and examples (integration tests are other
+// crates, so it stays `pub`); not part of the API.
+#[doc(hidden)]
 pub mod synthetic;
+mod threaded;
 pub mod topics;
 mod write;
 
@@ -112,7 +116,8 @@ pub use read::{
 };
 #[cfg(feature = "serve")]
 pub use serve::{serve, ServeError, ServeOptions};
-pub use summary::{DiscSummary, RunSummary, MAX_EXTRA_DISCS, TOP_N};
+pub use summary::{DiscStats, RunSummary, MAX_EXTRA_DISCS, TOP_N};
+pub use threaded::ThreadedRecorder;
 pub use write::{default_path, log_time_ns, RecordError, RecordOptions, Recorder};
 
 /// A disc name made safe for a topic and frame name: every character other than

@@ -239,7 +239,7 @@ pub struct RunSummary {
 
 /// Field type in the schema tables.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FieldType {
+pub(crate) enum FieldType {
     /// `double`
     Double,
     /// `bool`
@@ -258,7 +258,7 @@ pub enum FieldType {
 
 /// One field of a message in the schema tables.
 #[derive(Debug, Clone, Copy)]
-pub struct FieldDef {
+pub(crate) struct FieldDef {
     /// Field name (with its unit).
     pub name: &'static str,
     /// Field number (never changes).
@@ -273,7 +273,7 @@ pub struct FieldDef {
 
 /// One message in the schema tables.
 #[derive(Debug, Clone, Copy)]
-pub struct MessageDef {
+pub(crate) struct MessageDef {
     /// Short name (`SplineState`).
     pub name: &'static str,
     /// Comment for the `.proto` text.
@@ -284,7 +284,7 @@ pub struct MessageDef {
 
 /// One enum in the schema tables.
 #[derive(Debug, Clone, Copy)]
-pub struct EnumDef {
+pub(crate) struct EnumDef {
     /// Short name.
     pub name: &'static str,
     /// Comment.
@@ -316,7 +316,7 @@ const fn rep(name: &'static str, number: i32, ty: FieldType, doc: &'static str) 
 use FieldType::{Bool, Double, Uint32, Uint64};
 
 /// The enums of package `clutchpack`.
-pub const ENUMS: &[EnumDef] = &[EnumDef {
+pub(crate) const ENUMS: &[EnumDef] = &[EnumDef {
     name: "Flank",
     doc: "Which flank is in contact.",
     values: &[
@@ -327,7 +327,7 @@ pub const ENUMS: &[EnumDef] = &[EnumDef {
 }];
 
 /// The messages of package `clutchpack`, in file order.
-pub const MESSAGES: &[MessageDef] = &[
+pub(crate) const MESSAGES: &[MessageDef] = &[
     MessageDef {
         name: "ShaftState",
         doc: "The shaft at one sample. Topic /shaft.",
@@ -555,7 +555,7 @@ fn json_name(name: &str) -> String {
 }
 
 /// The `FileDescriptorProto` of `clutchpack.proto` (proto3, package `clutchpack`, no imports).
-pub fn file_descriptor() -> FileDescriptorProto {
+pub(crate) fn file_descriptor() -> FileDescriptorProto {
     let message_type = MESSAGES
         .iter()
         .map(|m| DescriptorProto {
@@ -619,7 +619,7 @@ pub fn file_descriptor() -> FileDescriptorProto {
 
 /// The encoded `FileDescriptorSet` holding [`file_descriptor`]: the schema data of every
 /// `clutchpack.*` schema in a recording (MCAP schema encoding `protobuf`).
-pub fn file_descriptor_set() -> Vec<u8> {
+pub(crate) fn file_descriptor_set() -> Vec<u8> {
     FileDescriptorSet {
         file: vec![file_descriptor()],
     }
@@ -628,7 +628,9 @@ pub fn file_descriptor_set() -> Vec<u8> {
 
 /// The `.proto` text of our messages, generated from the tables (the content of
 /// `crates/record/proto/clutchpack.proto`).
-pub fn proto_text() -> String {
+// Only the test that keeps `proto/clutchpack.proto` in step calls it.
+#[cfg_attr(not(test), allow(dead_code))]
+pub(crate) fn proto_text() -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let _ = writeln!(

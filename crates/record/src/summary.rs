@@ -1,10 +1,11 @@
 //! The per-disc summary stored on `/summary` at the end of a run.
 //!
-//! The statistics are computed by `clutchpack_analysis::DiscStats::from_peaks` (one
-//! definition of max, p99 and top-10 mean for the whole project) and stored in the shape of
-//! the `/summary` message.
+//! A disc's entry is `clutchpack_analysis::DiscStats` itself (one definition of max, p99 and
+//! top-10 mean for the whole project); this module only converts it to and from the
+//! `/summary` message.
 
 use crate::proto;
+pub use clutchpack_analysis::DiscStats;
 use clutchpack_model::ImpactEvent;
 
 /// How many of the largest `|peak|` the "top" mean takes (10).
@@ -13,61 +14,13 @@ pub use clutchpack_analysis::stats::TOP_N;
 /// Disc indices past the named discs that [`RunSummary::from_impacts`] still gives entries.
 pub const MAX_EXTRA_DISCS: usize = 1024;
 
-/// Statistics of the impact peaks (`ImpactEvent::peak_n`) of one disc over one run.
-///
-/// Loads are per tooth in N, signed as in the model: negative when the shaft leads, positive
-/// when the disc leads.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct DiscSummary {
-    /// Disc name (from the scene).
-    pub name: String,
-    /// Largest positive peak (disc leads) in N; 0 if there is none.
-    pub max_positive_n: f64,
-    /// Most negative peak (shaft leads) in N, a value `<= 0`; 0 if there is none.
-    pub max_negative_n: f64,
-    /// 99th percentile of `|peak|` in N (numpy's default `linear` definition); 0 without
-    /// impacts.
-    pub p99_abs_n: f64,
-    /// Number of impacts.
-    pub impacts: u64,
-    /// Number of impacts with a positive peak (disc leads).
-    pub positive_impacts: u64,
-    /// Number of impacts with a negative peak (shaft leads).
-    pub negative_impacts: u64,
-    /// Mean of the [`TOP_N`] = 10 largest `|peak|` in N (of all if fewer); 0 without impacts.
-    pub mean_top10_abs_n: f64,
-}
-
-impl DiscSummary {
-    /// Statistics of the signed peak loads `peaks_n` (N) of the disc `name`. NaN peaks are
-    /// not counted.
-    pub fn from_peaks(name: impl Into<String>, peaks_n: &[f64]) -> DiscSummary {
-        DiscSummary::from(clutchpack_analysis::DiscStats::from_peaks(name, peaks_n))
-    }
-}
-
-impl From<clutchpack_analysis::DiscStats> for DiscSummary {
-    fn from(s: clutchpack_analysis::DiscStats) -> DiscSummary {
-        DiscSummary {
-            name: s.name,
-            max_positive_n: s.max_positive_n,
-            max_negative_n: s.max_negative_n,
-            p99_abs_n: s.p99_abs_n,
-            impacts: s.impacts as u64,
-            positive_impacts: s.positive_impacts as u64,
-            negative_impacts: s.negative_impacts as u64,
-            mean_top10_abs_n: s.mean_top10_abs_n,
-        }
-    }
-}
-
-/// A run's summary: one [`DiscSummary`] per disc in scene order.
+/// A run's summary: one [`DiscStats`] per disc in scene order.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct RunSummary {
     /// Simulated time at the end of the run in s.
     pub t_end_s: f64,
     /// One entry per disc, in scene order.
-    pub discs: Vec<DiscSummary>,
+    pub discs: Vec<DiscStats>,
 }
 
 impl RunSummary {
@@ -96,7 +49,7 @@ impl RunSummary {
                 .enumerate()
                 .map(|(i, p)| {
                     let name = names.get(i).cloned().unwrap_or_else(|| format!("disc {i}"));
-                    DiscSummary::from_peaks(name, p)
+                    DiscStats::from_peaks(name, p)
                 })
                 .collect(),
         }
@@ -115,9 +68,9 @@ impl RunSummary {
                     max_positive_n: d.max_positive_n,
                     max_negative_n: d.max_negative_n,
                     p99_abs_n: d.p99_abs_n,
-                    impacts: d.impacts,
-                    positive_impacts: d.positive_impacts,
-                    negative_impacts: d.negative_impacts,
+                    impacts: d.impacts as u64,
+                    positive_impacts: d.positive_impacts as u64,
+                    negative_impacts: d.negative_impacts as u64,
                     mean_top10_abs_n: d.mean_top10_abs_n,
                 })
                 .collect(),
@@ -130,14 +83,15 @@ impl RunSummary {
             discs: p
                 .discs
                 .into_iter()
-                .map(|d| DiscSummary {
+                .map(|d| DiscStats {
                     name: d.name,
                     max_positive_n: d.max_positive_n,
                     max_negative_n: d.max_negative_n,
                     p99_abs_n: d.p99_abs_n,
-                    impacts: d.impacts,
-                    positive_impacts: d.positive_impacts,
-                    negative_impacts: d.negative_impacts,
+                    // A count in a foreign file beyond usize saturates rather than wraps.
+                    impacts: usize::try_from(d.impacts).unwrap_or(usize::MAX),
+                    positive_impacts: usize::try_from(d.positive_impacts).unwrap_or(usize::MAX),
+                    negative_impacts: usize::try_from(d.negative_impacts).unwrap_or(usize::MAX),
                     mean_top10_abs_n: d.mean_top10_abs_n,
                 })
                 .collect(),
@@ -169,7 +123,7 @@ mod tests {
         let peaks: Vec<f64> = (1..=20)
             .map(|i| if i % 2 == 0 { i as f64 } else { -(i as f64) })
             .collect();
-        let s = DiscSummary::from_peaks("a", &peaks);
+        let s = DiscStats::from_peaks("a", &peaks);
         assert_eq!(s.impacts, 20);
         assert_eq!(s.positive_impacts, 10);
         assert_eq!(s.negative_impacts, 10);
@@ -185,7 +139,7 @@ mod tests {
         let s =
             RunSummary::from_impacts(&["a".into()], &[ev(2, 5.0), ev(usize::MAX / 2, 1.0)], 1.0);
         assert_eq!(s.discs.len(), 3, "an absurd index is not counted");
-        assert_eq!(s.discs[0], DiscSummary::from_peaks("a", &[]));
+        assert_eq!(s.discs[0], DiscStats::from_peaks("a", &[]));
         assert_eq!(s.discs[0].p99_abs_n, 0.0);
         assert_eq!(s.discs[2].name, "disc 2");
         assert_eq!(s.discs[2].max_positive_n, 5.0);

@@ -2,8 +2,8 @@
 //! impact events into an MCAP file.
 
 use crate::info::{num, utc_text, RunInfo, META_STATS, SCENE_MEDIA_TYPE};
-use crate::scene::{self, disc_frame};
 use crate::summary::RunSummary;
+use crate::view3d::{self, disc_frame};
 use crate::{proto, topic_segment, topics};
 use clutchpack_model::{Flank, ImpactEvent, InterfaceSample, Observer, RunStats, Sample};
 use std::borrow::Cow;
@@ -394,7 +394,7 @@ impl Recorder {
             .zip(&info.discs)
             .map(|(f, g)| (f.clone(), g.z_m, 0.0))
             .collect();
-        let tf = scene::frame_transforms(0, 0.0, &tf_discs);
+        let tf = view3d::frame_transforms(0, 0.0, &tf_discs);
         let n = names.len();
         let mut rec = Recorder {
             path,
@@ -437,7 +437,7 @@ impl Recorder {
             messages: 0,
             stats: None,
         };
-        let static_scene = scene::static_scene(&rec.info, &rec.frames);
+        let static_scene = view3d::static_scene(&rec.info, &rec.frames);
         rec.put(rec.ch.scene, 0, &static_scene, "/scene")?;
         rec.flush()?;
         Ok(rec)
@@ -470,7 +470,7 @@ impl Recorder {
                 .get(i)
                 .cloned()
                 .unwrap_or_else(|| format!("disc {i}"));
-            s.discs.push(crate::DiscSummary::from_peaks(name, p));
+            s.discs.push(crate::DiscStats::from_peaks(name, p));
         }
         s
     }
@@ -629,7 +629,7 @@ impl Recorder {
         }
         if t >= self.next_tf_s {
             self.next_tf_s = next_tick(t, self.options.tf_interval_s);
-            scene::update_transforms(
+            view3d::update_transforms(
                 &mut self.tf,
                 lt,
                 sample.shaft_angle_rad,
@@ -659,7 +659,7 @@ impl Recorder {
                 }
                 *a = 0.0;
             }
-            let mut update = scene::load_scene(lt, &self.info, &self.frames, &changed);
+            let mut update = view3d::load_scene(lt, &self.info, &self.frames, &changed);
             // per-tooth colours: drawn tooth k shows the largest load of the teeth it stands
             // for (all of them when the disc has no more teeth than are drawn)
             let mut teeth: Vec<(usize, Vec<f64>)> = Vec::new();
@@ -670,7 +670,7 @@ impl Recorder {
                 if maxima.is_empty() {
                     continue;
                 }
-                let drawn = scene::drawn_teeth(d) as usize;
+                let drawn = view3d::drawn_teeth(d) as usize;
                 let n = maxima.len();
                 let levels: Vec<f64> = (0..drawn)
                     .map(|k| {
@@ -694,7 +694,7 @@ impl Recorder {
                     teeth.iter().map(|(i, l)| (*i, l.as_slice())).collect();
                 update
                     .entities
-                    .extend(scene::teeth_scene(lt, &self.info, &self.frames, &refs).entities);
+                    .extend(view3d::teeth_scene(lt, &self.info, &self.frames, &refs).entities);
             }
             if !update.entities.is_empty() {
                 self.put(self.ch.scene, lt, &update, "/scene")?;

@@ -35,6 +35,7 @@
 //! per step, and the dense output of the last two steps for the peak search. That is a small
 //! amount of code around the standard tableau (`dopri.rs`), tested against closed forms.
 
+#![warn(missing_docs)]
 // Index loops over state components mirror the equations; iterator chains would obscure them.
 #![allow(clippy::needless_range_loop)]
 

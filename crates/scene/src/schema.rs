@@ -533,7 +533,7 @@ const BODY_INTRO: &str = "Body parameters, in [defaults] (shared by all friction
     entries.";
 
 /// A short reference of every scene key: unit, rule, default, meaning. Printed by
-/// `clutchpack check --keys`; generated from the key definitions ([`crate::keys`]).
+/// `clutchpack check --keys`; generated from the key definitions (`keys.rs`).
 pub fn keys_doc() -> String {
     use std::fmt::Write;
     let body = body_keys();

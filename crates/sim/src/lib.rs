@@ -146,6 +146,8 @@
 //! Those of [`clutchpack_model`]: SI units, the shaft axis is `+z`, `phi = theta_s - theta_d`,
 //! per-tooth loads negative when the shaft leads.
 
+#![warn(missing_docs)]
+
 pub mod engine;
 mod hook;
 mod integrate;

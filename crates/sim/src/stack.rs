@@ -34,7 +34,7 @@
 // m + 1); iterator chains would obscure them.
 #![allow(clippy::needless_range_loop)]
 
-use clutchpack_model::{InterfaceSample, StackModel};
+use clutchpack_model::{InterfaceSample, StackBody, StackModel};
 
 /// Most Gauss-Seidel sweeps per step (the fallback of the active-set solve).
 const MAX_SWEEPS: usize = 5000;
@@ -73,7 +73,7 @@ impl<'a> Stack<'a> {
     /// discs, then the plates).
     pub fn new(model: &'a StackModel, n_discs: usize) -> Stack<'a> {
         let body = (0..2 * n_discs + 1)
-            .map(|b| if b % 2 == 0 { n_discs + b / 2 } else { b / 2 })
+            .map(|b| StackBody::at(b).body_index(n_discs))
             .collect();
         let n_if = 2 * n_discs;
         let n_bodies = 2 * n_discs + 1;

@@ -6,7 +6,7 @@
 //! own force law, applied by the contact hook ([`crate::hook`]).
 
 use crate::options::{BodyShapes, DiscMount};
-use clutchpack_model::{EngineError, PackModel, Shaft};
+use clutchpack_model::{EngineError, PackModel, Shaft, StackBody};
 use parry3d_f64::mass_properties::MassProperties;
 use rapier3d_f64::prelude::{
     GenericJointBuilder, JointAxesMask, LockedAxes, PhysicsWorld, RigidBody, RigidBodyBuilder,
@@ -162,8 +162,8 @@ impl World {
             let centre = 0.5 * ((n + np) as f64 - 1.0);
             let at = |b: usize| (b as f64 - centre) * shapes.disc_pitch_m;
             (0..n)
-                .map(|i| at(2 * i + 1))
-                .chain((0..np).map(|j| at(2 * j)))
+                .map(|i| at(StackBody::Disc(i).position()))
+                .chain((0..np).map(|j| at(StackBody::Plate(j).position())))
                 .collect()
         };
         let mut carriers = vec![Carrier::Shaft; n];

@@ -1,0 +1,184 @@
+//! The text of `clutchpack replay`: what a recording holds, for a reader at a terminal.
+
+use clutchpack_record::RecordingReader;
+
+/// What the file holds, as text for `clutchpack replay`: the file and its state, the run
+/// (program, engine, scene and its hash, overrides), the topics with their schemas,
+/// message counts and time spans, and the per-disc summary (stored, or recomputed from
+/// the recovered impacts and marked so). Lines end with `\n`.
+pub fn describe(r: &RecordingReader) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let i = r.info();
+    let state = match r.damage() {
+        None => "complete".to_string(),
+        Some(d) => d.to_string(),
+    };
+    let _ = writeln!(
+        s,
+        "{} ({} bytes): {state}",
+        r.path().display(),
+        r.file_bytes()
+    );
+    if let Some(run) = i.metadata(clutchpack_record::info::META_RUN) {
+        let g = |k: &str| run.get(k).map(String::as_str).unwrap_or("?");
+        let sha = g("scene_sha256");
+        let _ = writeln!(
+            s,
+            "run: {} {}, engine {}, scene {} ({}, sha256 {}), overrides {}",
+            g("program"),
+            g("program_version"),
+            g("engine"),
+            g("scene_name"),
+            g("scene_file"),
+            sha.chars().take(12).collect::<String>(),
+            g("overrides")
+        );
+    }
+    match (i.start_s, i.end_s) {
+        (Some(a), Some(b)) => {
+            let _ = writeln!(
+                s,
+                "{} messages on {} topics, t = {} .. {} s",
+                i.messages,
+                i.topics.len(),
+                short(a),
+                short(b)
+            );
+        }
+        _ => {
+            let _ = writeln!(s, "no messages, {} topics", i.topics.len());
+        }
+    }
+    let w = i
+        .topics
+        .iter()
+        .map(|t| t.topic.len())
+        .max()
+        .unwrap_or(5)
+        .max(5);
+    let ws = i
+        .topics
+        .iter()
+        .map(|t| t.schema_name.len())
+        .max()
+        .unwrap_or(6)
+        .max(6);
+    let _ = writeln!(
+        s,
+        "  {:<w$}  {:<ws$}  {:>9}  span (s)",
+        "topic", "schema", "messages"
+    );
+    for t in &i.topics {
+        let span = if t.messages > 0 {
+            format!("{} .. {}", short(t.first_s), short(t.last_s))
+        } else {
+            "-".into()
+        };
+        let _ = writeln!(
+            s,
+            "  {:<w$}  {:<ws$}  {:>9}  {span}",
+            t.topic, t.schema_name, t.messages
+        );
+    }
+    let (summary, note) = match r.summary() {
+        Some(x) => (x.clone(), "stored"),
+        None => (
+            r.summary_or_recomputed(),
+            "recomputed from the recovered impacts",
+        ),
+    };
+    if !summary.discs.is_empty() {
+        let _ = writeln!(
+            s,
+            "summary ({note}; per-tooth loads in N, t_end = {} s):",
+            short(summary.t_end_s)
+        );
+        let wd = summary
+            .discs
+            .iter()
+            .map(|d| d.name.len())
+            .max()
+            .unwrap_or(4)
+            .max(4);
+        let _ = writeln!(
+            s,
+            "  {:<wd$}  {:>12}  {:>12}  {:>12}  {:>8}  {:>14}",
+            "disc", "max_positive", "max_negative", "p99_abs", "impacts", "mean_top10_abs"
+        );
+        for d in &summary.discs {
+            let _ = writeln!(
+                s,
+                "  {:<wd$}  {:>12.1}  {:>12.1}  {:>12.1}  {:>8}  {:>14.1}",
+                d.name,
+                d.max_positive_n,
+                d.max_negative_n,
+                d.p99_abs_n,
+                d.impacts,
+                d.mean_top10_abs_n
+            );
+        }
+    }
+    let interfaces = r.interface_stats();
+    if !interfaces.is_empty() {
+        let _ = writeln!(s, "friction interfaces (from the piston side):");
+        let table = clutchpack_analysis::interface_table(
+            &interfaces,
+            clutchpack_analysis::TableFormat::Text,
+        );
+        for line in table.lines() {
+            let _ = writeln!(s, "  {line}");
+        }
+    }
+    s
+}
+
+/// A time in s with at most 9 decimals, trailing zeros dropped (`0.00399`, not
+/// `0.0039900000000000005`).
+fn short(x: f64) -> String {
+    let s = format!("{x:.9}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clutchpack_record::synthetic::synthetic_run;
+    use clutchpack_record::{open, RecordOptions, Recorder};
+
+    /// The text names the file's state, the engine, every topic, the stored summary and the
+    /// time span (0 .. 399 samples of 10 us, printed without float noise).
+    #[test]
+    fn describes_a_complete_recording() {
+        let run = synthetic_run(400, 1e-5);
+        let dir = std::env::temp_dir().join(format!("clutchpack-describe-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("describe.mcap");
+        let opts = RecordOptions {
+            deterministic: true,
+            ..Default::default()
+        };
+        let mut rec = Recorder::create(&path, &run.info, &opts).unwrap();
+        run.play(&mut rec);
+        let path = rec.finish(None).unwrap();
+        let text = describe(&open(&path).unwrap());
+        std::fs::remove_dir_all(&dir).ok();
+        assert!(text.contains("complete"), "{text}");
+        assert!(text.contains("engine synthetic"), "{text}");
+        assert!(text.contains("/discs/disc_2/spline"), "{text}");
+        assert!(text.contains("summary (stored"), "{text}");
+        assert!(text.contains("t = 0 .. 0.00399 s"), "{text}");
+    }
+
+    #[test]
+    fn short_times() {
+        assert_eq!(short(0.0039900000000000005), "0.00399");
+        assert_eq!(short(-0.0), "0");
+        assert_eq!(short(2.0), "2");
+    }
+}
