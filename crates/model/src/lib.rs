@@ -28,6 +28,7 @@
 //! - Brancati R., Rocca E., Russo R., gear-rattle squeeze-film model (the `squeeze` law).
 //! - Cameron A., *Basic Lubrication Theory*: the leakage coefficient `beta`.
 
+pub mod cases;
 pub mod clutch;
 pub mod drive;
 pub mod impact;

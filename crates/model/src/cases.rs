@@ -1,0 +1,278 @@
+//! Named test cases with known answers, built in code (independent of the scene parser), so
+//! that every engine's tests, benches and the CLI's benchmark run the same definitions: the
+//! paper case (MODEL.md section 4), the closed-form free impact, the benchmark disc of
+//! `scenes/bench-8-disc.toml` and the staggered N-disc pack of issue 9.
+//!
+//! Every value here is either from Hu et al. Table 2, from MODEL.md section 4's assumed
+//! values, or from `scenes/bench-8-disc.toml`; each function says which.
+
+use crate::drive::{Shaft, SpeedProfile};
+use crate::law::{Hertz, LawKind, OilFilm, ToothLaw};
+use crate::pack::{DiscModel, PackModel};
+use crate::spline::{Flank, SplineGeometry};
+
+/// Mean shaft speed of the paper case, rad/s (MODEL.md section 4, assumed).
+pub const PAPER_OMEGA0_RAD_S: f64 = 200.0;
+/// Fluctuation amplitude `A` of the paper case, rad/s (Table 2).
+pub const PAPER_AMPLITUDE_RAD_S: f64 = 4.378;
+/// Fluctuation frequency `f` of the paper case, Hz (Table 2).
+pub const PAPER_FREQUENCY_HZ: f64 = 104.0;
+/// Disc inertia `J2` of the paper case, kg m^2 (MODEL.md section 4, assumed: a steel annulus
+/// 0.231 to 0.290 m, 3 mm thick).
+pub const PAPER_INERTIA_KG_M2: f64 = 0.156;
+/// Oil drag `C2` on the paper case's disc, N m s/rad (MODEL.md section 4, assumed).
+pub const PAPER_DRAG_N_M_S_RAD: f64 = 0.01;
+
+/// The spline of Hu et al. Table 2: `n = 154`, `R = 0.231 m`, `alpha = 20 deg`,
+/// `d = 0.75 mm`.
+pub fn paper_spline() -> SplineGeometry {
+    SplineGeometry {
+        teeth: 154,
+        pitch_radius_m: 0.231,
+        pressure_angle_rad: 20f64.to_radians(),
+        backlash_m: 0.75e-3,
+    }
+}
+
+/// The paper's tooth law of kind `kind` with film thickness `h_o_m` (m): Table 2's `E`,
+/// `eta`, `beta`, and MODEL.md section 4's assumed `r = 1.75 mm`, `p = 0.8 s/m`,
+/// `B = L = 3 mm`, `v_floor = 0.01 m/s` (and `h_min = 1 um` for the squeeze law).
+pub fn paper_law(kind: LawKind, h_o_m: f64) -> ToothLaw {
+    ToothLaw {
+        kind,
+        hertz: Hertz {
+            modulus_pa: 210e9,
+            curvature_radius_m: 1.75e-3,
+            loss_coefficient_s_m: 0.8,
+        },
+        oil: OilFilm {
+            thickness_m: h_o_m,
+            viscosity_pa_s: 289.1,
+            leakage_coefficient: 0.421,
+            width_m: 3e-3,
+            length_m: 3e-3,
+            v_floor_m_s: 0.01,
+            h_min_m: 1e-6,
+        },
+    }
+}
+
+/// The paper's drive, eq (3): `omega = 200 + 4.378 sin(2 pi 104 t)` rad/s.
+pub fn paper_drive() -> SpeedProfile {
+    SpeedProfile::sine(
+        PAPER_OMEGA0_RAD_S,
+        PAPER_AMPLITUDE_RAD_S,
+        PAPER_FREQUENCY_HZ,
+    )
+}
+
+/// The paper case's disc (named `"disc"`) with the paper law at film thickness `h_o_m` (m),
+/// centred in the backlash at the shaft's speed.
+pub fn paper_disc(h_o_m: f64) -> DiscModel {
+    DiscModel {
+        name: "disc".into(),
+        spline: paper_spline(),
+        law: paper_law(LawKind::Paper, h_o_m),
+        inertia_kg_m2: PAPER_INERTIA_KG_M2,
+        drag_n_m_s_rad: PAPER_DRAG_N_M_S_RAD,
+        initial_rel_angle_rad: 0.0,
+        initial_rel_speed_rad_s: 0.0,
+        radial_float: false,
+        tooth_spacing_errors_m: Vec::new(),
+        initial_offset_m: [0.0, 0.0],
+    }
+}
+
+/// The paper case (MODEL.md section 4): [`paper_disc`] on a shaft prescribed by
+/// [`paper_drive`], at film thickness `h_o_m` (m).
+pub fn paper_pack(h_o_m: f64) -> PackModel {
+    PackModel::new(Shaft::Prescribed(paper_drive()), vec![paper_disc(h_o_m)])
+}
+
+/// The first five impacts of the paper case at `h_o = 0` as MODEL.md section 4 gives them
+/// (an independent solver at tight tolerance, rounded to 5-6 digits): `(signed per-tooth
+/// peak N, time of the peak ms)`; a negative peak means the shaft leads.
+pub const PAPER_FIRST_IMPACTS_0UM: [(f64, f64); 5] = [
+    (-637.25, 1.11283),
+    (505.69, 3.79487),
+    (406.64, 5.24908),
+    (223.43, 6.68250),
+    (-742.83, 8.93890),
+];
+
+/// The first five impacts of the paper case at `h_o = 25 um` (MODEL.md section 4), as
+/// [`PAPER_FIRST_IMPACTS_0UM`].
+pub const PAPER_FIRST_IMPACTS_25UM: [(f64, f64); 5] = [
+    (-562.01, 1.07505),
+    (432.57, 3.80995),
+    (344.31, 5.22235),
+    (186.73, 6.59753),
+    (-638.10, 8.89408),
+];
+
+/// Onset and separation of the first contact of the paper case at `h_o = 0`, ms (MODEL.md
+/// section 4).
+pub const PAPER_FIRST_CONTACT_0UM_MS: (f64, f64) = (1.08545, 1.16034);
+
+/// The published peaks of the paper case (per tooth, N): `(h_o m, max positive, max
+/// negative)` (MODEL.md section 4; a correct implementation lands within about 10 %).
+pub const PAPER_PUBLISHED_PEAKS: [(f64, f64, f64); 3] = [
+    (0.0, 945.39, -976.42),
+    (25e-6, 867.6, -867.8),
+    (50e-6, 503.1, -503.5),
+];
+
+/// One free, undamped impact with its closed-form answer (MODEL.md section 4).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FreeImpact {
+    /// The pack: the paper disc with no drag and `p = 0`, on a shaft at a constant
+    /// 100 rad/s, starting 0.1 um (along the line of action) before engagement on the
+    /// shaft-leads flank, closing at `v0`.
+    pub pack: PackModel,
+    /// Closing speed `v0` at engagement, m/s.
+    pub v0_m_s: f64,
+    /// Stiffness `K` of the event, N/m^1.5 (the law's, with `dv = v0`).
+    pub stiffness: f64,
+    /// Effective mass `m_eff = J2 / (n Rb^2)`, kg.
+    pub m_eff_kg: f64,
+    /// Closed-form peak per-tooth load magnitude, N: `K^(2/5) (5/4 m_eff v0^2)^(3/5)`. The
+    /// shaft leads, so the engines report it negative.
+    pub peak_n: f64,
+    /// The flank struck.
+    pub flank: Flank,
+}
+
+/// The free impact of the paper disc under law `kind` at film thickness `h_o_m` (m), closing
+/// at `v0_m_s` (m/s): no drive fluctuation, no drag, no loss (`p = 0`). The contact is
+/// conservative, so the disc leaves at `v0` too.
+pub fn free_impact(kind: LawKind, h_o_m: f64, v0_m_s: f64) -> FreeImpact {
+    let mut disc = paper_disc(h_o_m);
+    disc.law = paper_law(kind, h_o_m);
+    disc.law.hertz.loss_coefficient_s_m = 0.0;
+    disc.drag_n_m_s_rad = 0.0;
+    let rb = disc.spline.base_radius_m();
+    let g0 = disc.spline.half_play_rad();
+    // start 0.1 um (along the line of action) before engagement, closing at v0
+    disc.initial_rel_angle_rad = g0 - (h_o_m + 1e-7) / rb;
+    disc.initial_rel_speed_rad_s = v0_m_s / rb;
+    let stiffness = disc
+        .law
+        .engage(&disc.spline.kinematics(g0, v0_m_s / rb))
+        .stiffness;
+    let m_eff_kg = disc.spline.effective_mass_kg(disc.inertia_kg_m2);
+    FreeImpact {
+        pack: PackModel::new(
+            Shaft::Prescribed(SpeedProfile::sine(100.0, 0.0, 1.0)),
+            vec![disc],
+        ),
+        v0_m_s,
+        stiffness,
+        m_eff_kg,
+        peak_n: crate::free_impact_peak_n(stiffness, m_eff_kg, v0_m_s),
+        flank: Flank::ShaftLeads,
+    }
+}
+
+/// Inertia of the benchmark disc, kg m^2: a steel annulus (7850 kg/m^3), inner radius
+/// 0.231 m, outer 0.300 m, 3 mm thick (`scenes/bench-8-disc.toml`).
+pub const BENCH_INERTIA_KG_M2: f64 = 0.194306;
+
+/// The benchmark's drive: `omega = 100 + 4.378 sin(2 pi 104 t)` rad/s
+/// (`scenes/bench-8-disc.toml`).
+pub fn bench_drive() -> SpeedProfile {
+    SpeedProfile::sine(100.0, PAPER_AMPLITUDE_RAD_S, PAPER_FREQUENCY_HZ)
+}
+
+/// The disc of `scenes/bench-8-disc.toml`, named `name`: the paper's spline, the dry law with
+/// `E = 210 GPa`, `r = 5 mm`, `p = 0.5 s/m` (the oil fields are the paper's and unused),
+/// [`BENCH_INERTIA_KG_M2`], no drag, centred in the backlash at the shaft's speed.
+pub fn bench_disc(name: &str) -> DiscModel {
+    let mut law = paper_law(LawKind::Dry, 0.0);
+    law.hertz.curvature_radius_m = 5e-3;
+    law.hertz.loss_coefficient_s_m = 0.5;
+    DiscModel {
+        name: name.into(),
+        spline: paper_spline(),
+        law,
+        inertia_kg_m2: BENCH_INERTIA_KG_M2,
+        drag_n_m_s_rad: 0.0,
+        initial_rel_angle_rad: 0.0,
+        initial_rel_speed_rad_s: 0.0,
+        radial_float: false,
+        tooth_spacing_errors_m: Vec::new(),
+        initial_offset_m: [0.0, 0.0],
+    }
+}
+
+/// `scenes/bench-8-disc.toml` with `n` discs (`disc-1` ... `disc-n`): all centred, so they
+/// strike in step and cost what one disc costs (a case no real pack is in).
+pub fn bench_pack(n: usize) -> PackModel {
+    PackModel::new(
+        Shaft::Prescribed(bench_drive()),
+        (1..=n).map(|k| bench_disc(&format!("disc-{k}"))).collect(),
+    )
+}
+
+/// Initial relative angle of disc `i` (0-based) of `n` staggered discs, rad, for a half play
+/// `g0_rad` (rad): `phi_i = -0.8 g0 (2 (i + 1/2) / n - 1)`, evenly spread across +-0.8 of the
+/// free play (issue 9).
+pub fn staggered_rel_angle_rad(i: usize, n: usize, g0_rad: f64) -> f64 {
+    -0.8 * g0_rad * (2.0 * (i as f64 + 0.5) / n as f64 - 1.0)
+}
+
+/// The staggered pack of issue 9: `n` benchmark discs ([`bench_disc`], `disc-1` ...
+/// `disc-n`) on the benchmark's prescribed shaft, disc `i` started at
+/// [`staggered_rel_angle_rad`] at rest relative to the shaft, so that they strike out of
+/// step, as the discs of a real pack do. `scenes/staggered-8.toml` and
+/// `scenes/staggered-16.toml` are this pack for 8 and 16 discs.
+pub fn staggered_pack(n: usize) -> PackModel {
+    let g0 = paper_spline().half_play_rad();
+    PackModel::new(
+        Shaft::Prescribed(bench_drive()),
+        (0..n)
+            .map(|i| {
+                let mut d = bench_disc(&format!("disc-{}", i + 1));
+                d.initial_rel_angle_rad = staggered_rel_angle_rad(i, n, g0);
+                d
+            })
+            .collect(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The staggered angles are symmetric about 0, strictly decreasing, inside +-0.8 g0, and
+    /// a single disc sits centred.
+    #[test]
+    fn staggered_angles_spread_across_the_play() {
+        let g0 = paper_spline().half_play_rad();
+        assert_eq!(staggered_rel_angle_rad(0, 1, g0), 0.0);
+        let p = staggered_pack(8);
+        let phi: Vec<f64> = p.discs.iter().map(|d| d.initial_rel_angle_rad).collect();
+        assert!((phi[0] - -0.8 * g0 * (1.0 / 8.0 - 1.0)).abs() < 1e-18);
+        for i in 0..8 {
+            assert!((phi[i] + phi[7 - i]).abs() < 1e-18);
+            assert!(phi[i].abs() < 0.8 * g0);
+        }
+        assert!(phi.windows(2).all(|w| w[1] < w[0]));
+        assert_eq!(p.discs[7].name, "disc-8");
+        assert!(p.is_torsional());
+    }
+
+    /// The free impact starts 0.1 um before engagement on the shaft-leads flank, and its
+    /// closed form is the model crate's.
+    #[test]
+    fn free_impact_starts_just_before_contact() {
+        let c = free_impact(LawKind::Dry, 0.0, 0.5);
+        let d = &c.pack.discs[0];
+        let kin = d
+            .spline
+            .kinematics(d.initial_rel_angle_rad, d.initial_rel_speed_rad_s);
+        assert_eq!(kin.flank, Flank::ShaftLeads);
+        assert!((d.law.engagement_depth_m(&kin) + 1e-7).abs() < 1e-15);
+        assert!((kin.v_n_m_s - 0.5).abs() < 1e-15);
+        assert_eq!(c.stiffness, d.law.hertz.coefficient());
+    }
+}
