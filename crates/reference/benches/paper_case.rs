@@ -2,12 +2,10 @@
 //! the default settings and samples at 20 kHz discarded. Target: under 30 ms per run on the
 //! 2-core CI machine (release build).
 
+use clutchpack_model::cases::paper_pack;
 use clutchpack_model::*;
 use clutchpack_reference::{ReferenceEngine, Settings};
 use criterion::{criterion_group, criterion_main, Criterion};
-
-#[path = "../tests/common/mod.rs"]
-mod common;
 
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("paper_case_0.3s");
@@ -16,7 +14,7 @@ fn bench(c: &mut Criterion) {
         g.bench_function(format!("h_o={:.0}um", h_o * 1e6), |b| {
             b.iter(|| {
                 let mut e = ReferenceEngine::new(
-                    common::paper_pack(h_o),
+                    paper_pack(h_o),
                     Settings {
                         record_rate_hz: 20_000.0,
                         ..Settings::default()

@@ -1,10 +1,12 @@
 //! The reference engine against closed forms and the independent figures of MODEL.md
 //! section 4.
 
-mod common;
+use clutchpack_model::cases::{
+    free_impact, paper_disc, paper_pack, PAPER_FIRST_CONTACT_0UM_MS, PAPER_FIRST_IMPACTS_0UM,
+    PAPER_FIRST_IMPACTS_25UM,
+};
 use clutchpack_model::*;
 use clutchpack_reference::{ReferenceEngine, Settings};
-use common::*;
 
 fn run(pack: PackModel, duration: f64, tol: f64, rate: f64) -> Collector {
     let mut e = ReferenceEngine::new(
@@ -20,30 +22,16 @@ fn run(pack: PackModel, duration: f64, tol: f64, rate: f64) -> Collector {
     c
 }
 
-/// (peak N, peak time ms) of the first five impacts, MODEL.md section 4 (an independent
-/// solver at tight tolerance).
-const FIRST_IMPACTS_0UM: [(f64, f64); 5] = [
-    (-637.25, 1.11283),
-    (505.69, 3.79487),
-    (406.64, 5.24908),
-    (223.43, 6.68250),
-    (-742.83, 8.93890),
-];
-const FIRST_IMPACTS_25UM: [(f64, f64); 5] = [
-    (-562.01, 1.07505),
-    (432.57, 3.80995),
-    (344.31, 5.22235),
-    (186.73, 6.59753),
-    (-638.10, 8.89408),
-];
-
 /// The deterministic start of the paper case: each of the first five peaks within 0.2 % and
 /// its time within 1 us of MODEL.md (whose figures are rounded to 5-6 digits, i.e. about
 /// 0.002 % and 0.005 us); the first contact of the dry case also starts and ends where
 /// MODEL.md says (1.08545 ms, 1.16034 ms).
 #[test]
 fn first_impacts_match_the_independent_solver() {
-    for (h_o, expected) in [(0.0, FIRST_IMPACTS_0UM), (25e-6, FIRST_IMPACTS_25UM)] {
+    for (h_o, expected) in [
+        (0.0, PAPER_FIRST_IMPACTS_0UM),
+        (25e-6, PAPER_FIRST_IMPACTS_25UM),
+    ] {
         let c = run(paper_pack(h_o), 0.0095, 1e-9, 1000.0);
         assert_eq!(c.impacts.len(), 5, "h_o = {h_o}: {:?}", c.impacts);
         for (e, (peak, t_ms)) in c.impacts.iter().zip(expected) {
@@ -62,8 +50,9 @@ fn first_impacts_match_the_independent_solver() {
             assert_eq!(e.flank == Flank::ShaftLeads, peak < 0.0);
         }
         if h_o == 0.0 {
-            assert!((c.impacts[0].t_on_s - 1.08545e-3).abs() < 1e-8);
-            assert!((c.impacts[0].t_off_s - 1.16034e-3).abs() < 1e-8);
+            let (t_on_ms, t_off_ms) = PAPER_FIRST_CONTACT_0UM_MS;
+            assert!((c.impacts[0].t_on_s - t_on_ms * 1e-3).abs() < 1e-8);
+            assert!((c.impacts[0].t_off_s - t_off_ms * 1e-3).abs() < 1e-8);
         }
     }
 }
@@ -80,28 +69,9 @@ fn free_impact_matches_the_closed_form() {
         (LawKind::Paper, 50e-6),
     ] {
         for v0 in [0.25, 0.5, 1.0, 2.0] {
-            let mut disc = paper_disc(h_o);
-            disc.law = paper_law(kind, h_o);
-            disc.law.hertz.loss_coefficient_s_m = 0.0;
-            disc.drag_n_m_s_rad = 0.0;
-            let rb = disc.spline.base_radius_m();
-            let g0 = disc.spline.half_play_rad();
-            // start 0.1 um (along the line of action) before engagement, closing at v0
-            disc.initial_rel_angle_rad = g0 - (h_o + 1e-7) / rb;
-            disc.initial_rel_speed_rad_s = v0 / rb;
-            let k = disc
-                .law
-                .engage(&disc.spline.kinematics(g0, v0 / rb))
-                .stiffness;
-            let m_eff = disc.spline.effective_mass_kg(disc.inertia_kg_m2);
-            let pack = PackModel {
-                shaft: Shaft::Prescribed(SpeedProfile::sine(100.0, 0.0, 1.0)),
-                discs: vec![disc],
-                plates: Vec::new(),
-                drum: None,
-                stack: None,
-            };
-            let c = run(pack, 2e-4 / v0.min(1.0), 1e-9, 1e6);
+            let case = free_impact(kind, h_o, v0);
+            let (k, m_eff) = (case.stiffness, case.m_eff_kg);
+            let c = run(case.pack, 2e-4 / v0.min(1.0), 1e-9, 1e6);
             assert_eq!(c.impacts.len(), 1, "{kind:?} {h_o} {v0}");
             let peak = c.impacts[0].peak_n;
             let expected = free_impact_peak_n(k, m_eff, v0);
