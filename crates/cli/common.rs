@@ -45,20 +45,51 @@ pub enum EngineArg {
 /// a torsional pack and the multibody engine for one with per-tooth effects (radial float,
 /// offsets, spacing errors: `PackModel::is_torsional`), which only it can run.
 pub fn make_engine(scene: &Scene, arg: Option<EngineArg>) -> Result<Box<dyn Engine + Send>> {
+    choose_engine(scene, arg).map(|(engine, _)| engine)
+}
+
+/// [`make_engine`], with one line saying which engine and scheme run and why, e.g.
+/// `engine: reference (multirate: prescribed shaft, no stack; 8 independent discs on 2
+/// threads), chosen by the scene (simulation.engine)`.
+pub fn choose_engine(
+    scene: &Scene,
+    arg: Option<EngineArg>,
+) -> Result<(Box<dyn Engine + Send>, String)> {
     let default = if scene.pack.is_torsional() {
         EngineChoice::Reference
     } else {
         EngineChoice::Multibody
     };
-    let choice = match arg {
-        Some(EngineArg::Reference) => EngineChoice::Reference,
-        Some(EngineArg::Multibody) => EngineChoice::Multibody,
-        None => scene.simulation.engine.unwrap_or(default),
+    let (choice, why) = match (arg, scene.simulation.engine) {
+        (Some(EngineArg::Reference), _) => (EngineChoice::Reference, "asked by --engine"),
+        (Some(EngineArg::Multibody), _) => (EngineChoice::Multibody, "asked by --engine"),
+        (None, Some(c)) => (c, "chosen by the scene (simulation.engine)"),
+        (None, None) if default == EngineChoice::Reference => (
+            default,
+            "the default for a torsional pack (concentric discs on one shaft)",
+        ),
+        (None, None) => (
+            default,
+            "the only engine for per-tooth effects, plates or a stack",
+        ),
     };
+    let sim = &scene.simulation;
     match choice {
-        EngineChoice::Reference => Ok(Box::new(ReferenceEngine::from_scene(scene))),
+        EngineChoice::Reference => {
+            let settings = clutchpack_reference::Settings {
+                tolerance: sim.tolerance,
+                max_step_s: sim.max_step_s,
+                record_rate_hz: sim.record_rate_hz,
+            };
+            let engine = ReferenceEngine::new(scene.pack.clone(), settings);
+            let line = format!("engine: reference ({}), {why}", engine.describe());
+            Ok((Box::new(engine), line))
+        }
         EngineChoice::Multibody => match clutchpack_sim::MultibodyEngine::from_scene(scene) {
-            Ok(e) => Ok(Box::new(e)),
+            Ok(e) => Ok((
+                Box::new(e),
+                format!("engine: multibody (rapier3d, per tooth), {why}"),
+            )),
             Err(e) => Err(BadInput(format!("{}: {e}", scene.name)).into()),
         },
     }
