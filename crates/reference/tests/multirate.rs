@@ -233,3 +233,37 @@ fn a_stop_request_ends_a_multirate_run_with_complete_samples() {
     assert!(last.t_s <= stats.simulated_s + 1e-12);
     assert!(obs.0.samples.iter().all(|s| s.discs.len() == 8));
 }
+
+/// `scenes/staggered-8-disc.toml` and `staggered-16-disc.toml` are the model's
+/// `staggered_pack(8)` and `(16)`: the same disc angles (to the 17 digits written) and the
+/// same impacts over 20 ms.
+#[test]
+fn shipped_staggered_scenes_are_the_model_case() {
+    for n in [8, 16] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("../../scenes/staggered-{n}-disc.toml"));
+        let scene = clutchpack_scene::load(&path, &[]).unwrap();
+        let case = staggered_pack(n);
+        assert_eq!(scene.pack.discs.len(), n);
+        for (a, b) in scene.pack.discs.iter().zip(&case.discs) {
+            assert_eq!(a.name, b.name);
+            let d = (a.initial_rel_angle_rad - b.initial_rel_angle_rad).abs();
+            assert!(
+                d <= 1e-16,
+                "{n}: {} {} vs {}",
+                a.name,
+                a.initial_rel_angle_rad,
+                b.initial_rel_angle_rad
+            );
+            assert_eq!(a.initial_rel_speed_rad_s, 0.0);
+        }
+        let from_file = run(
+            ReferenceEngine::new(scene.pack.clone(), settings(1e-9)),
+            0.02,
+        )
+        .0;
+        let from_case = run(ReferenceEngine::new(case, settings(1e-9)), 0.02).0;
+        assert!(from_file.impacts.len() >= n);
+        assert_eq!(from_file.impacts, from_case.impacts);
+    }
+}
