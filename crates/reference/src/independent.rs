@@ -56,8 +56,9 @@ impl DiscRun<'_> {
 /// dispatch, the merge) is small, short enough that a stop request acts within 0.5 s.
 const WINDOW_WALL_MIN_S: f64 = 0.02;
 const WINDOW_WALL_MAX_S: f64 = 0.1;
-/// Most disc samples buffered per window (about 100 bytes each).
-const MAX_BUFFERED_SAMPLES: f64 = 2e5;
+/// Most disc samples buffered per window (about 100 bytes each: 2 MB, about what a core's
+/// caches hold, so the merge reads them from cache).
+const MAX_BUFFERED_SAMPLES: f64 = 2e4;
 
 pub(crate) fn run(
     pack: &PackModel,
