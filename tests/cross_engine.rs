@@ -13,7 +13,7 @@
 //! checked with 512 steps per contact (0.14 us off).
 
 use clutchpack_model::{Collector, Engine, ImpactEvent};
-use clutchpack_reference::ReferenceEngine;
+use clutchpack_reference::{ReferenceEngine, Scheme, Settings};
 use clutchpack_scene::Override;
 use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Stepping};
 use std::path::Path;
@@ -42,13 +42,14 @@ fn impacts(engine: &mut dyn Engine, duration: f64) -> Vec<ImpactEvent> {
 fn assert_engines_agree(file: &str, sets: &[&str], steps_per_contact: Option<f64>) {
     let s = scene(file, sets);
     let duration = s.simulation.duration_s;
-    let mut oracle = s.clone();
-    oracle.simulation.tolerance = 1e-12;
-    let reference = impacts(&mut ReferenceEngine::from_scene(&oracle), duration);
-    let mut options = MultibodyOptions {
+    let oracle = Settings {
+        tolerance: 1e-12,
+        max_step_s: s.simulation.max_step_s,
         record_rate_hz: s.simulation.record_rate_hz,
-        ..MultibodyOptions::default()
     };
+    let mut oracle = ReferenceEngine::new(s.pack.clone(), oracle).with_scheme(Scheme::Monolithic);
+    let reference = impacts(&mut oracle, duration);
+    let mut options = MultibodyOptions::default();
     if let Some(spc) = steps_per_contact {
         options.stepping = Stepping::Adaptive(AdaptiveStepping {
             steps_per_contact: spc,
@@ -157,7 +158,8 @@ mod staggered {
             ..Settings::default()
         };
         impacts(
-            &mut ReferenceEngine::new(staggered_pack(8), settings),
+            &mut ReferenceEngine::new(staggered_pack(8), settings)
+                .with_scheme(clutchpack_reference::Scheme::Monolithic),
             DURATION_S,
         )
     }
