@@ -170,6 +170,10 @@ fn fmt_pct(p: Option<f64>) -> String {
 }
 
 pub fn compare(a: CompareArgs) -> Result<ExitCode> {
+    if let Some(r) = crate::study::compare_hook(&a.files) {
+        return r; // two study folders: ensembles compared with confidence intervals
+    }
+    eprintln!("{}", crate::study::ONE_SAMPLE_NOTE);
     let mut runs = Vec::new();
     for f in &a.files {
         let reader = open_recording(f, a.salvage)?;
