@@ -360,12 +360,18 @@ pub fn free_play_rad(d: &clutchpack_model::DiscModel) -> f64 {
     free.max(0.0)
 }
 
-/// A number as TOML: integers without a fraction (`154`), else the shortest round-trip form.
+/// A number as TOML: integers without a fraction (`154`), else the shortest round-trip form
+/// (`0.2`, `2.5e-5` where the decimal form would be long).
 pub fn number_text(v: f64) -> String {
     if v.fract() == 0.0 && v.abs() < 1e15 {
         format!("{}", v as i64)
     } else {
-        format!("{v:e}")
+        let plain = format!("{v}");
+        if plain.len() <= 12 {
+            plain
+        } else {
+            format!("{v:e}")
+        }
     }
 }
 
@@ -1109,7 +1115,7 @@ high = 0.02
         assert_eq!(s.case(10), s.case(10));
         assert_ne!(s.case(10).values[2], s.case(11).values[2]);
         let sc = s.scene(&s.case(17)).unwrap();
-        assert_eq!(sc.pack.discs[0].oil.film_thickness_m, 25e-6);
+        assert_eq!(sc.pack.discs[0].law.oil.thickness_m, 25e-6);
     }
 
     #[test]
