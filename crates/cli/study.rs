@@ -114,6 +114,10 @@ pub struct SubmitArgs {
     /// Wait for the merge job to end (sbatch --wait).
     #[arg(long)]
     pub wait: bool,
+    /// Submit the shards held (`sbatch --hold`): nothing starts until
+    /// `scontrol release <array job id>`.
+    #[arg(long)]
+    pub hold: bool,
     /// Kubernetes: container image with clutchpack on its PATH.
     #[arg(long, default_value = "clutchpack:latest")]
     pub image: String,
@@ -515,10 +519,21 @@ fn submit(a: SubmitArgs) -> Result<ExitCode> {
         let id = String::from_utf8_lossy(&o.stdout).trim().to_string();
         Ok(id.split(';').next().unwrap_or_default().to_string())
     };
-    let aid = sbatch(&["--parsable", &arr_path.display().to_string()])?;
+    let arr_arg = arr_path.display().to_string();
+    let mut aargs = vec!["--parsable"];
+    if a.hold {
+        aargs.push("--hold");
+    }
+    aargs.push(&arr_arg);
+    let aid = sbatch(&aargs)?;
     out!(
-        "submitted shards as job array {aid} ({} of {shards} shards)",
-        j.array
+        "submitted shards as job array {aid} ({} of {shards} shards){}",
+        j.array,
+        if a.hold {
+            format!(", held: scontrol release {aid}")
+        } else {
+            String::new()
+        }
     );
     let dep = format!("--dependency=afterok:{aid}");
     let mut margs = vec!["--parsable", &dep, "--kill-on-invalid-dep=yes"];

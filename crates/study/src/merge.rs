@@ -345,3 +345,284 @@ fn csv_field(s: &str) -> String {
         s.to_string()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::part::{read_part, run_shard, CaseOutput, RunResult, Shard};
+    use crate::spec::{parse, Study};
+    use clutchpack_scene::Scene;
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    use std::time::Duration;
+
+    /// A study of 2 design points x 3 members with a random draw and spread placement.
+    fn study() -> Study {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+        parse(
+            r#"
+[study]
+scene = "hu-table2.toml"
+seed = 11
+[ensemble]
+members = 3
+[[factor]]
+key = "defaults.oil.film_thickness_m"
+values = [0, 25e-6]
+[[random]]
+key = "defaults.drag_n_m_s_rad"
+dist = "uniform"
+low = 0.005
+high = 0.02
+"#,
+            "fake.toml",
+            &dir,
+        )
+        .unwrap()
+    }
+
+    /// A stand-in engine: statistics that are a pure function of the case's scene (film,
+    /// drag, initial angle), so that two runs agree exactly only if their scenes do.
+    fn fake(scene: &Scene, _stop: &AtomicBool) -> RunResult {
+        let d = &scene.pack.discs[0];
+        let peak = 1000.0 - 4e6 * d.law.oil.thickness_m
+            + 1e4 * d.drag_n_m_s_rad
+            + 1e5 * d.initial_rel_angle_rad;
+        Ok(Some(CaseOutput {
+            discs: vec![DiscStats {
+                max_positive_n: peak,
+                max_negative_n: -peak / 3.0,
+                impacts: 7,
+                ..DiscStats::empty(d.name.clone())
+            }],
+            steps: 100,
+            rejected_steps: 1,
+            simulated_s: scene.simulation.duration_s,
+        }))
+    }
+
+    fn fresh(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!(
+            "clutchpack_study_{}_{name}",
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&d);
+        d
+    }
+
+    fn run(study: &Study, dir: &Path, shard: Shard, jobs: usize) -> crate::ShardOutcome {
+        let stop = AtomicBool::new(false);
+        run_shard(
+            study,
+            dir,
+            shard,
+            jobs,
+            &stop,
+            Duration::from_secs(60),
+            &fake,
+            &|_, _| {},
+        )
+        .unwrap()
+    }
+
+    /// Case k's numbers are a function of the study and k only: the table of the whole study
+    /// run as one shard on 1 thread equals the table of 3 shards on 2 threads, byte for byte;
+    /// and every random draw differs between cases (the streams are not shared).
+    #[test]
+    fn the_table_does_not_depend_on_shards_or_threads() {
+        let s = study();
+        let one = fresh("one");
+        run(&s, &one, Shard { index: 0, count: 1 }, 1);
+        let three = fresh("three");
+        for i in 0..3 {
+            run(&s, &three, Shard { index: i, count: 3 }, 2);
+        }
+        let (a, b) = (collect(&one).unwrap(), collect(&three).unwrap());
+        assert_eq!(a.records.len(), 6);
+        assert_eq!(a.csv(), b.csv());
+        assert_eq!(a.summary_csv(), b.summary_csv());
+        let drags: Vec<f64> = a.records.iter().map(|r| r.values[1]).collect();
+        for (i, x) in drags.iter().enumerate() {
+            assert!((0.005..0.02).contains(x));
+            assert!(!drags[..i].contains(x), "draw {i} repeats: {drags:?}");
+        }
+        // the header line names the columns of the module doc, in order
+        let head = a.csv().lines().next().unwrap().to_string();
+        assert_eq!(
+            head,
+            "case,design_point,member,defaults.oil.film_thickness_m,defaults.drag_n_m_s_rad,\
+             initial_fraction,disc.peak_abs_n,disc.max_positive_n,disc.max_negative_n,\
+             disc.p99_abs_n,disc.mean_top10_abs_n,disc.impacts,steps,rejected_steps,\
+             simulated_s,error"
+        );
+        let _ = std::fs::remove_dir_all(one);
+        let _ = std::fs::remove_dir_all(three);
+    }
+
+    /// A missing shard and an unfinished one are both reported, by index; parts of another
+    /// study are refused.
+    #[test]
+    fn merge_names_missing_and_unfinished_shards() {
+        let s = study();
+        let dir = fresh("missing");
+        for i in [0, 2, 3] {
+            run(&s, &dir, Shard { index: i, count: 5 }, 1);
+        }
+        // shard 3's part loses a case: written but unfinished (as after a stop)
+        let p3 = dir.join(Shard { index: 3, count: 5 }.file_name());
+        let mut part = read_part(&p3).unwrap();
+        part.records.clear();
+        part.complete = false;
+        std::fs::write(&p3, serde_json::to_string(&part).unwrap()).unwrap();
+        match collect(&dir) {
+            Err(MergeError::Missing { count, missing }) => {
+                assert_eq!((count, missing.clone()), (5, vec![1, 3, 4]));
+                assert_eq!(array_syntax(&missing), "1,3-4");
+            }
+            other => panic!("expected missing shards, got {other:?}"),
+        }
+        // a part of another study (other seed, so other hash) in the same folder
+        let mut other = s.clone();
+        other.hash = "0123456789abcdef".into();
+        run(&other, &dir, Shard { index: 1, count: 5 }, 1);
+        assert!(matches!(collect(&dir), Err(MergeError::Mixed { .. })));
+        assert!(matches!(
+            collect(&fresh("empty-and-absent")),
+            Err(MergeError::Part(_))
+        ));
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    /// A stop after two cases leaves a valid, unfinished part with exactly the finished cases;
+    /// the rerun runs only the others and the table equals an uninterrupted run's.
+    #[test]
+    fn a_stopped_shard_resumes_with_the_missing_cases_only() {
+        let s = study();
+        let dir = fresh("resume");
+        let stop = AtomicBool::new(false);
+        let calls = AtomicUsize::new(0);
+        let stopping = |scene: &Scene, st: &AtomicBool| {
+            if calls.fetch_add(1, Ordering::SeqCst) == 1 {
+                stop.store(true, Ordering::SeqCst);
+            }
+            fake(scene, st)
+        };
+        let shard = Shard { index: 0, count: 1 };
+        let o = run_shard(
+            &s,
+            &dir,
+            shard,
+            1,
+            &stop,
+            Duration::ZERO,
+            &stopping,
+            &|_, _| {},
+        )
+        .unwrap();
+        assert_eq!((o.ran, o.complete), (2, false));
+        let part = read_part(&dir.join(shard.file_name())).unwrap();
+        assert_eq!(part.records.iter().map(|r| r.case).collect::<Vec<_>>(), [0, 1]);
+        assert!(!part.complete);
+        assert!(matches!(collect(&dir), Err(MergeError::Missing { .. })));
+        let calls_before = calls.load(Ordering::SeqCst);
+        stop.store(false, Ordering::SeqCst);
+        let o = run_shard(
+            &s,
+            &dir,
+            shard,
+            2,
+            &stop,
+            Duration::ZERO,
+            &stopping,
+            &|_, _| {},
+        )
+        .unwrap();
+        assert_eq!((o.skipped, o.ran, o.complete), (2, 4, true));
+        assert_eq!(calls.load(Ordering::SeqCst) - calls_before, 4);
+        let whole = fresh("resume-whole");
+        run(&s, &whole, shard, 1);
+        assert_eq!(collect(&dir).unwrap().csv(), collect(&whole).unwrap().csv());
+        let _ = std::fs::remove_dir_all(dir);
+        let _ = std::fs::remove_dir_all(whole);
+    }
+
+    /// A case whose engine fails or panics is a row with its error and null statistics; the
+    /// shard goes on, and the summary counts it as failed.
+    #[test]
+    fn failed_cases_are_rows() {
+        let s = study();
+        let dir = fresh("failed");
+        let flaky = |scene: &Scene, st: &AtomicBool| {
+            let d = &scene.pack.discs[0];
+            if d.initial_rel_angle_rad > 0.0 && d.law.oil.thickness_m > 0.0 {
+                panic!("engine exploded");
+            }
+            if d.initial_rel_angle_rad < 0.0 && d.law.oil.thickness_m > 0.0 {
+                return Err("diverged at t = 0.1 s".to_string());
+            }
+            fake(scene, st)
+        };
+        let stop = AtomicBool::new(false);
+        let shard = Shard { index: 0, count: 1 };
+        let o = run_shard(
+            &s,
+            &dir,
+            shard,
+            1,
+            &stop,
+            Duration::ZERO,
+            &flaky,
+            &|_, _| {},
+        )
+        .unwrap();
+        assert_eq!((o.ran, o.failed, o.complete), (6, 2, true));
+        let m = collect(&dir).unwrap();
+        let csv = m.csv();
+        let rows: Vec<&str> = csv.lines().collect();
+        // case 3 = design point 1 member 0 (fraction -2/3): the error; case 5 the panic
+        assert!(rows[4].ends_with(",0,0,0,diverged at t = 0.1 s"), "{}", rows[4]);
+        assert!(rows[6].ends_with("panic: engine exploded"), "{}", rows[6]);
+        assert!(rows[4].contains(",,,,,,"), "null statistics: {}", rows[4]);
+        let summary = m.summary_csv();
+        let line = summary
+            .lines()
+            .find(|l| l.starts_with("1,") && l.contains(",peak_abs_n,"))
+            .unwrap();
+        // design point 1: n = 1 (member 1 ran), failed = 2
+        assert!(line.contains(",peak_abs_n,1,2,"), "{line}");
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    /// The summary's numbers by hand: design point 0's three peaks, their mean, sample std
+    /// and t interval with 2 degrees of freedom (t = 4.302653).
+    #[test]
+    fn summary_rows_by_hand() {
+        let s = study();
+        let dir = fresh("summary");
+        run(&s, &dir, Shard { index: 0, count: 1 }, 1);
+        let m = collect(&dir).unwrap();
+        let v: Vec<f64> = m
+            .records
+            .iter()
+            .filter(|r| r.design_point == 0)
+            .map(|r| r.discs[0].max_positive_n)
+            .collect();
+        assert_eq!(v.len(), 3);
+        let mean = (v[0] + v[1] + v[2]) / 3.0;
+        let std = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
+        let half = 4.302653 * std / 3f64.sqrt();
+        let summary = m.summary_csv();
+        let line = summary
+            .lines()
+            .find(|l| l.starts_with("0,") && l.contains(",peak_abs_n,"))
+            .unwrap();
+        let f: Vec<&str> = line.split(',').collect();
+        // design_point, film, disc, statistic, n, failed, mean, std, min, max, lo, hi
+        let num = |i: usize| f[i].parse::<f64>().unwrap();
+        assert_eq!(f[4], "3");
+        assert!((num(6) - mean).abs() < 1e-9 * mean);
+        assert!((num(7) - std).abs() < 1e-9 * std);
+        assert!((num(10) - (mean - half)).abs() < 1e-9 * mean);
+        assert!((num(11) - (mean + half)).abs() < 1e-9 * mean);
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}

@@ -121,3 +121,110 @@ fn is_stat(name: &str, m: &Merged) -> bool {
         .iter()
         .any(|d| name.starts_with(d.as_str()) && name[d.len()..].starts_with('.'))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::part::{CaseRecord, StudyHeader};
+    use clutchpack_analysis::DiscStats;
+    use parquet::file::reader::{FileReader, SerializedFileReader};
+    use parquet::record::Field;
+
+    /// Two cases, one failed: read back with the crate's own row reader (pyarrow's reading is
+    /// the integration test's), the schema is the documented one (names, INT64/DOUBLE/UTF8,
+    /// statistics and `error` optional) and every cell equals the CSV's.
+    #[test]
+    fn the_table_reads_back_with_its_schema_and_nulls() {
+        let ok = CaseRecord {
+            case: 0,
+            design_point: 0,
+            member: 0,
+            values: vec![25e-6],
+            discs: vec![DiscStats {
+                max_positive_n: 812.5,
+                max_negative_n: -901.25,
+                impacts: 42,
+                ..DiscStats::empty("d1")
+            }],
+            steps: 1000,
+            rejected_steps: 3,
+            simulated_s: 0.3,
+            wall_s: 0.1,
+            error: None,
+        };
+        let bad = CaseRecord {
+            case: 1,
+            member: 1,
+            discs: Vec::new(),
+            steps: 0,
+            rejected_steps: 0,
+            simulated_s: 0.0,
+            error: Some("diverged, \"badly\"".into()),
+            ..ok.clone()
+        };
+        let m = Merged {
+            header: StudyHeader {
+                name: "t".into(),
+                hash: "h".into(),
+                cases: 2,
+                members: 2,
+                columns: vec!["defaults.oil.film_thickness_m".into()],
+                design_factors: 1,
+                outputs: vec!["peak_abs_n".into(), "impacts".into()],
+            },
+            records: vec![ok, bad],
+            discs: vec!["d1".into()],
+        };
+        let path = std::env::temp_dir().join(format!("clutchpack_study_{}.parquet", std::process::id()));
+        write_results(&path, &m).unwrap();
+        let r = SerializedFileReader::new(std::fs::File::open(&path).unwrap()).unwrap();
+        let schema = r.metadata().file_metadata().schema_descr_ptr();
+        let cols: Vec<(String, PhysicalType, bool)> = schema
+            .columns()
+            .iter()
+            .map(|c| {
+                (
+                    c.name().to_string(),
+                    c.physical_type(),
+                    c.self_type().is_optional(),
+                )
+            })
+            .collect();
+        use PhysicalType::*;
+        let want = [
+            ("case", INT64, false),
+            ("design_point", INT64, false),
+            ("member", INT64, false),
+            ("defaults.oil.film_thickness_m", DOUBLE, false),
+            ("d1.peak_abs_n", DOUBLE, true),
+            ("d1.impacts", INT64, true),
+            ("steps", INT64, false),
+            ("rejected_steps", INT64, false),
+            ("simulated_s", DOUBLE, false),
+            ("error", BYTE_ARRAY, true),
+        ];
+        assert_eq!(cols.len(), want.len());
+        for ((n, t, o), (wn, wt, wo)) in cols.iter().zip(want) {
+            assert_eq!((n.as_str(), *t, *o), (wn, wt, wo));
+        }
+        let rows: Vec<Vec<Field>> = r
+            .get_row_iter(None)
+            .unwrap()
+            .map(|row| {
+                row.unwrap()
+                    .get_column_iter()
+                    .map(|(_, f)| f.clone())
+                    .collect()
+            })
+            .collect();
+        assert_eq!(rows.len(), 2);
+        assert_eq!(rows[0][4], Field::Double(901.25));
+        assert_eq!(rows[0][5], Field::Long(42));
+        assert_eq!(rows[0][9], Field::Null);
+        assert_eq!(rows[1][4], Field::Null);
+        assert_eq!(rows[1][5], Field::Null);
+        assert_eq!(rows[1][9], Field::Str("diverged, \"badly\"".into()));
+        assert!(m.csv().lines().nth(2).unwrap().ends_with(",,,0,0,0,\"diverged, \"\"badly\"\"\""));
+        let _ = std::fs::remove_file(path);
+    }
+}
