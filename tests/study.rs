@@ -118,8 +118,8 @@ fn three_shards_merge_to_the_unsharded_table() {
 #[test]
 fn sigterm_mid_shard_leaves_a_valid_part_and_the_rerun_finishes_it() {
     let dir = scratch("study-sigterm");
-    // 3 x 4 cases of 0.3 s: several seconds on one thread
-    let s = small_study(&dir, 0.3, 4);
+    // 3 x 4 cases of 3 s simulated: several seconds on one thread
+    let s = small_study(&dir, 3.0, 4);
     let out = dir.join("out");
     let mut child = bin()
         .args(["study", "run", "--jobs", "1", "--out"])
@@ -129,30 +129,42 @@ fn sigterm_mid_shard_leaves_a_valid_part_and_the_rerun_finishes_it() {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    let part = out.join("part-00000-of-00001.json");
-    // wait until the first flush of the part (2 cases or more), at most 60 s
-    let t0 = std::time::Instant::now();
-    let done = |p: &Path| -> usize {
-        std::fs::read_to_string(p)
-            .ok()
-            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-            .map_or(0, |v| v["records"].as_array().map_or(0, |a| a.len()))
-    };
-    while done(&part) < 1 && t0.elapsed().as_secs() < 60 {
-        std::thread::sleep(std::time::Duration::from_millis(100));
-    }
+    // the progress lines on stderr: signal once the first case has finished
+    let (tx, rx) = std::sync::mpsc::channel::<String>();
+    let err = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        use std::io::BufRead;
+        let mut all = String::new();
+        for line in std::io::BufReader::new(err).lines().map_while(Result::ok) {
+            let _ = tx.send(line.clone());
+            all.push_str(&line);
+            all.push('\n');
+        }
+        all
+    });
+    let first = rx
+        .iter()
+        .find(|l| l.contains(": 1/12 cases"))
+        .expect("a progress line after the first case");
     assert!(
         child.try_wait().unwrap().is_none(),
-        "the shard ended before the signal: make it longer"
+        "the shard ended before the signal: make it longer ({first})"
     );
     let k = std::process::Command::new("kill")
         .args(["-TERM", &child.id().to_string()])
         .status()
         .unwrap();
     assert!(k.success());
-    let o = child.wait_with_output().unwrap();
-    assert_eq!(o.status.code(), Some(143), "{}", stderr(&o));
-    assert!(stderr(&o).contains("stopped by SIGTERM"), "{}", stderr(&o));
+    let status = child.wait().unwrap();
+    let err = reader.join().unwrap();
+    assert_eq!(status.code(), Some(143), "{err}");
+    assert!(err.contains("stopped by SIGTERM"), "{err}");
+    let part = out.join("part-00000-of-00001.json");
+    let done = |p: &Path| -> usize {
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+        v["records"].as_array().unwrap().len()
+    };
     let kept = done(&part);
     assert!((1..12).contains(&kept), "{kept} cases in the part");
     let m = study(&["merge"], &[&out]);
