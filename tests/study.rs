@@ -173,7 +173,11 @@ fn sigterm_mid_shard_leaves_a_valid_part_and_the_rerun_finishes_it() {
     let again = study(&["run", "--jobs", "2", "--out"], &[&out, &s]);
     ok(&again, "rerun");
     let want = format!("{kept} skipped (already done), {} run", 12 - kept);
-    assert!(stderr(&again).contains(&want), "{want} in {}", stderr(&again));
+    assert!(
+        stderr(&again).contains(&want),
+        "{want} in {}",
+        stderr(&again)
+    );
     ok(&study(&["merge"], &[&out]), "merge after the rerun");
     let whole = one_machine(&dir, &s);
     assert_eq!(
@@ -236,14 +240,22 @@ grade = 12
     let s = small_study(&dir, 0.01, 1);
     let o = study(&["run", "--shard", "auto", "--out"], &[&dir.join("o"), &s]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("--shard auto needs --shards N"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--shard auto needs --shards N"),
+        "{}",
+        stderr(&o)
+    );
     let o = study(&["run", "--shard", "3/3", "--out"], &[&dir.join("o"), &s]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("shard 3 of 3"), "{}", stderr(&o));
     std::fs::write(&f, "[study]\nscene = \n").unwrap();
     let o = study(&["run", "--out"], &[&dir.join("o"), &f]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("bad.toml: line 2 column"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("bad.toml: line 2 column"),
+        "{}",
+        stderr(&o)
+    );
     assert!(!dir.join("o").exists());
 }
 
@@ -275,20 +287,29 @@ fn shard_auto_reads_the_array_index() {
     assert!(stderr(&o).contains("shard 7 of 3"), "{}", stderr(&o));
 }
 
-/// The Parquet table opens in pyarrow (when the test's Python environment has it) with the
-/// documented column names and types.
+/// The Parquet table opens in pyarrow with the documented column names and types. Python:
+/// `$CLUTCHPACK_PYTHON`, else the tests' environment (target/pyenv, tests/python/setup.sh) if
+/// it has pyarrow, else `python3`; skipped loudly without pyarrow unless
+/// `CLUTCHPACK_REQUIRE_PYARROW=1`.
 #[test]
 fn parquet_opens_in_pyarrow() {
-    let py = std::env::var("CLUTCHPACK_PYTHON").unwrap_or_else(|_| "python3".into());
-    let has = std::process::Command::new(&py)
-        .args(["-c", "import pyarrow.parquet"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !has {
+    let has = |py: &str| {
+        std::process::Command::new(py)
+            .args(["-c", "import pyarrow.parquet"])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    let pyenv = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/pyenv/bin/python");
+    let py = match std::env::var("CLUTCHPACK_PYTHON") {
+        Ok(p) => p,
+        Err(_) if has(&pyenv.display().to_string()) => pyenv.display().to_string(),
+        Err(_) => "python3".into(),
+    };
+    if !has(&py) {
         eprintln!("SKIPPED: no pyarrow in {py} (set CLUTCHPACK_PYTHON to a python with pyarrow)");
         assert!(
-            std::env::var_os("CLUTCHPACK_REQUIRE_PYARROW").is_none(),
-            "CLUTCHPACK_REQUIRE_PYARROW is set but {py} has no pyarrow"
+            std::env::var("CLUTCHPACK_REQUIRE_PYARROW").as_deref() != Ok("1"),
+            "CLUTCHPACK_REQUIRE_PYARROW=1 but {py} has no pyarrow"
         );
         return;
     }
