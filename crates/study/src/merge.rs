@@ -401,10 +401,8 @@ high = 0.02
     }
 
     fn fresh(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!(
-            "clutchpack_study_{}_{name}",
-            std::process::id()
-        ));
+        let d =
+            std::env::temp_dir().join(format!("clutchpack_study_{}_{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&d);
         d
     }
@@ -520,7 +518,10 @@ high = 0.02
         .unwrap();
         assert_eq!((o.ran, o.complete), (2, false));
         let part = read_part(&dir.join(shard.file_name())).unwrap();
-        assert_eq!(part.records.iter().map(|r| r.case).collect::<Vec<_>>(), [0, 1]);
+        assert_eq!(
+            part.records.iter().map(|r| r.case).collect::<Vec<_>>(),
+            [0, 1]
+        );
         assert!(!part.complete);
         assert!(matches!(collect(&dir), Err(MergeError::Missing { .. })));
         let calls_before = calls.load(Ordering::SeqCst);
@@ -579,7 +580,11 @@ high = 0.02
         let csv = m.csv();
         let rows: Vec<&str> = csv.lines().collect();
         // case 3 = design point 1 member 0 (fraction -2/3): the error; case 5 the panic
-        assert!(rows[4].ends_with(",0,0,0,diverged at t = 0.1 s"), "{}", rows[4]);
+        assert!(
+            rows[4].ends_with(",0,0,0,diverged at t = 0.1 s"),
+            "{}",
+            rows[4]
+        );
         assert!(rows[6].ends_with("panic: engine exploded"), "{}", rows[6]);
         assert!(rows[4].contains(",,,,,,"), "null statistics: {}", rows[4]);
         let summary = m.summary_csv();

@@ -175,7 +175,8 @@ mod tests {
             records: vec![ok, bad],
             discs: vec!["d1".into()],
         };
-        let path = std::env::temp_dir().join(format!("clutchpack_study_{}.parquet", std::process::id()));
+        let path =
+            std::env::temp_dir().join(format!("clutchpack_study_{}.parquet", std::process::id()));
         write_results(&path, &m).unwrap();
         let r = SerializedFileReader::new(std::fs::File::open(&path).unwrap()).unwrap();
         let schema = r.metadata().file_metadata().schema_descr_ptr();
@@ -224,7 +225,12 @@ mod tests {
         assert_eq!(rows[1][4], Field::Null);
         assert_eq!(rows[1][5], Field::Null);
         assert_eq!(rows[1][9], Field::Str("diverged, \"badly\"".into()));
-        assert!(m.csv().lines().nth(2).unwrap().ends_with(",,,0,0,0,\"diverged, \"\"badly\"\"\""));
+        assert!(m
+            .csv()
+            .lines()
+            .nth(2)
+            .unwrap()
+            .ends_with(",,,0,0,0,\"diverged, \"\"badly\"\"\""));
         let _ = std::fs::remove_file(path);
     }
 }

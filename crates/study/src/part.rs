@@ -73,7 +73,8 @@ pub struct CaseRecord {
     pub rejected_steps: u64,
     /// Simulated time reached, s.
     pub simulated_s: f64,
-    /// Wall time of the case, s (not part of the results table: it depends on the machine).
+    /// Wall time of the engine's run of the case, s (not part of the results table: it depends
+    /// on the machine).
     pub wall_s: f64,
     /// Why the case failed; `None` for a case that ran.
     pub error: Option<String>,
@@ -370,9 +371,11 @@ pub fn run_case(
     run: &(dyn Fn(&Scene, &AtomicBool) -> RunResult + Sync),
 ) -> Option<CaseRecord> {
     let case = study.case(k);
-    let t = Instant::now();
+    // the case's wall time is the engine's: building the scene counts as study overhead
+    let mut t = Instant::now();
     let result = match study.scene(&case) {
         Ok(scene) => {
+            t = Instant::now();
             match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&scene, stop))) {
                 Ok(r) => r,
                 Err(p) => Err(format!(

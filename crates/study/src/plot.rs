@@ -71,11 +71,11 @@ pub fn plot_main_effects(path: &Path, m: &Merged) -> Result<(), PlotError> {
         .ok_or_else(|| err("no successful case to plot".into()))?;
     let effects = main_effects(m, disc);
     let title = format!(
-        "{}: main effects on the peak of {} (hardest hit), mean and 95 % CI",
+        "{}: peak of {} (hardest hit), mean and 95 % CI",
         m.header.name, m.discs[disc]
     );
     let n = effects.len().max(1);
-    let size = ((420 * n).max(640) as u32, 460u32);
+    let size = ((420 * n).max(720) as u32, 460u32);
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
