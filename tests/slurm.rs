@@ -22,7 +22,10 @@ const LIMIT: Duration = Duration::from_secs(240);
 
 /// The cluster's slurm.conf if Slurm is installed and the cluster answers; else why not.
 fn cluster() -> Result<PathBuf, String> {
-    let installed = Command::new("sbatch").arg("--version").env("SLURM_CONF", "/dev/null").output();
+    let installed = Command::new("sbatch")
+        .arg("--version")
+        .env("SLURM_CONF", "/dev/null")
+        .output();
     // (every Slurm client, even --version, wants a config; /dev/null makes it answer at once)
     if installed.is_err() {
         return Err("sbatch is not installed (run .ci/slurm-setup start as root)".into());
@@ -31,9 +34,7 @@ fn cluster() -> Result<PathBuf, String> {
         Some(c) => PathBuf::from(c),
         None if Path::new(SETUP_CONF).exists() => PathBuf::from(SETUP_CONF),
         None => {
-            return Err(
-                "SLURM_CONF is not set and .ci/slurm-setup has not run (no cluster)".into(),
-            )
+            return Err("SLURM_CONF is not set and .ci/slurm-setup has not run (no cluster)".into())
         }
     };
     if !conf.exists() {
@@ -70,7 +71,9 @@ fn submit(conf: &Path, study_file: &Path, out: &Path, extra: &[&str]) -> Output 
     let mut c = Command::new("timeout");
     c.arg(LIMIT.as_secs().to_string())
         .arg(env!("CARGO_BIN_EXE_clutchpack"))
-        .args(["study", "submit", "--slurm", "--shards", "4", "--time", "00:05:00"])
+        .args([
+            "study", "submit", "--slurm", "--shards", "4", "--time", "00:05:00",
+        ])
         .args(["--merge-time", "00:05:00", "--out"])
         .arg(out)
         .args(extra)
@@ -82,7 +85,9 @@ fn submit(conf: &Path, study_file: &Path, out: &Path, extra: &[&str]) -> Output 
 
 /// The job id after `prefix` in `submit`'s output (`... job array 12 (...`).
 fn job_id(text: &str, prefix: &str) -> String {
-    let at = text.find(prefix).unwrap_or_else(|| panic!("{prefix:?} not in {text}"));
+    let at = text
+        .find(prefix)
+        .unwrap_or_else(|| panic!("{prefix:?} not in {text}"));
     text[at + prefix.len()..]
         .split(|c: char| !c.is_ascii_digit())
         .next()
@@ -94,7 +99,11 @@ fn job_id(text: &str, prefix: &str) -> String {
 fn wait_gone(conf: &Path, jobs: &[&str]) {
     let t0 = Instant::now();
     loop {
-        let o = slurm(conf, "squeue", &["-h", "-o", "%i %T", "-j", &jobs.join(",")]);
+        let o = slurm(
+            conf,
+            "squeue",
+            &["-h", "-o", "%i %T", "-j", &jobs.join(",")],
+        );
         let text = stdout(&o);
         if text.trim().is_empty() || !o.status.success() {
             return;
@@ -146,7 +155,11 @@ fn slurm_array_study_equals_one_machine_and_resubmits_a_cancelled_shard() {
     let merge_log = std::fs::read_dir(a.join("logs"))
         .unwrap()
         .filter_map(|e| e.ok())
-        .any(|e| e.file_name().to_string_lossy().starts_with("ci-small-merge-"));
+        .any(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .starts_with("ci-small-merge-")
+        });
     assert!(merge_log, "the merge job wrote its log");
     assert_eq!(
         std::fs::read(a.join("results.csv")).unwrap(),
@@ -178,7 +191,11 @@ fn slurm_array_study_equals_one_machine_and_resubmits_a_cancelled_shard() {
     let m = study(&["merge"], &[&b]);
     assert_eq!(m.status.code(), Some(3), "{}", stderr(&m));
     assert!(stdout(&m).contains("--array=2"), "{}", stdout(&m));
-    assert!(stderr(&m).contains("1 of 4 shards missing or unfinished: 2"), "{}", stderr(&m));
+    assert!(
+        stderr(&m).contains("1 of 4 shards missing or unfinished: 2"),
+        "{}",
+        stderr(&m)
+    );
 
     // 3. resubmit index 2 only: its merge job completes the study
     let o = submit(&conf, &s, &b, &["--array", "2", "--wait"]);
