@@ -121,7 +121,8 @@ pub struct SubmitArgs {
     /// Kubernetes: container image with clutchpack on its PATH.
     #[arg(long, default_value = "clutchpack:latest")]
     pub image: String,
-    /// Kubernetes: the ReadWriteMany PersistentVolumeClaim holding the study and the output.
+    /// Kubernetes: the ReadWriteMany PersistentVolumeClaim mounted at /work, the pods' working
+    /// folder; it holds the study, its scene and the output (relative paths start there).
     #[arg(long, default_value = "clutchpack-work")]
     pub claim: String,
 }
@@ -448,11 +449,16 @@ fn submit(a: SubmitArgs) -> Result<ExitCode> {
     };
     let exe = std::env::current_exe().context("finding the clutchpack executable")?;
     if a.k8s {
+        // paths as given: relative ones resolve in the pods' working folder, the claim
+        let k8s_out = a
+            .out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("{}-out", study.name)));
         let j = scheduler::K8sJob {
             name: &study.name,
             image: &a.image,
-            study: &study_path.display().to_string(),
-            out: &out.display().to_string(),
+            study: &a.study.display().to_string(),
+            out: &k8s_out.display().to_string(),
             shards,
             parallelism: shards.min(16),
             cpus: a.cpus_per_task,

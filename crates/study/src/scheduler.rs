@@ -125,9 +125,9 @@ pub struct K8sJob<'a> {
     pub name: &'a str,
     /// Container image with clutchpack on its PATH.
     pub image: &'a str,
-    /// The study file's path inside the container.
+    /// The study file's path inside the container (relative paths start at [`K8S_WORKDIR`]).
     pub study: &'a str,
-    /// The output folder inside the container (a shared volume).
+    /// The output folder inside the container (relative paths start at [`K8S_WORKDIR`]).
     pub out: &'a str,
     /// Number of shards (completions).
     pub shards: u64,
@@ -135,9 +135,13 @@ pub struct K8sJob<'a> {
     pub parallelism: u64,
     /// CPUs per pod.
     pub cpus: u32,
-    /// The PersistentVolumeClaim (ReadWriteMany) mounted at `out` and holding the study.
+    /// The PersistentVolumeClaim (ReadWriteMany) mounted at [`K8S_WORKDIR`], the pods' working
+    /// folder: it holds the study, its scene and the output folder.
     pub claim: &'a str,
 }
+
+/// Where the pods mount the claim, and their working folder.
+pub const K8S_WORKDIR: &str = "/work";
 
 /// A DNS-1123 label from `s`.
 pub fn dns_label(s: &str) -> String {
@@ -166,6 +170,7 @@ fn k8s_pod(j: &K8sJob, args: &[String], cpus: u32) -> String {
           image: {image}
           command: [\"clutchpack\"]
           args: [{args}]
+          workingDir: {workdir}
           resources:
             requests:
               cpu: \"{cpus}\"
@@ -173,7 +178,7 @@ fn k8s_pod(j: &K8sJob, args: &[String], cpus: u32) -> String {
               cpu: \"{cpus}\"
           volumeMounts:
             - name: work
-              mountPath: {out}
+              mountPath: {workdir}
       volumes:
         - name: work
           persistentVolumeClaim:
@@ -181,7 +186,7 @@ fn k8s_pod(j: &K8sJob, args: &[String], cpus: u32) -> String {
 ",
         image = j.image,
         args = args.join(", "),
-        out = j.out,
+        workdir = K8S_WORKDIR,
         claim = j.claim,
     )
 }
@@ -282,5 +287,6 @@ mod tests {
         });
         assert!(k.contains("completionMode: Indexed") && k.contains("completions: 8"));
         assert!(k.contains("name: mc-study-shards"));
+        assert!(k.contains("workingDir: /work") && k.contains("mountPath: /work"));
     }
 }
