@@ -23,6 +23,7 @@ mod describe;
 mod recording;
 mod run;
 mod signals;
+mod study;
 mod sweep;
 
 use clap::{Parser, Subcommand};
@@ -60,6 +61,9 @@ enum Command {
     /// Measure speed: the paper case per run, and the speed-up of a 16-case sweep on 2
     /// threads over 1 (prints ratios; timing is never a test).
     Bench(bench::BenchArgs),
+    /// Studies: many cases of a scene (design factors, random draws, ensembles), sharded over
+    /// threads and Slurm or Kubernetes job arrays, merged into Parquet and CSV tables.
+    Study(study::StudyArgs),
     /// Validate scene files: exit 0 if all are valid, 2 with every problem listed if not.
     Check(check::CheckArgs),
 }
@@ -70,6 +74,7 @@ fn main() -> ExitCode {
         Command::Run(a) => run::run(a),
         Command::Sweep(a) => sweep::sweep(a),
         Command::Check(a) => check::check(a),
+        Command::Study(a) => study::study(a),
         Command::Bench(a) => bench::bench(a),
         Command::Replay(a) => recording::replay(a),
         Command::Compare(a) => recording::compare(a),

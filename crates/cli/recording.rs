@@ -170,11 +170,16 @@ fn fmt_pct(p: Option<f64>) -> String {
 }
 
 pub fn compare(a: CompareArgs) -> Result<ExitCode> {
+    if let Some(r) = crate::study::compare_hook(&a.files) {
+        return r; // two study folders: ensembles compared with confidence intervals
+    }
     let mut runs = Vec::new();
     for f in &a.files {
         let reader = open_recording(f, a.salvage)?;
         runs.push((f.display().to_string(), recording_stats(&reader)));
     }
+    // after reading: a bad file's error stays the only line
+    eprintln!("{}", crate::study::ONE_SAMPLE_NOTE);
     let rows = compare_rows(&runs);
     let header = [
         "run",
