@@ -1,8 +1,8 @@
 //! Our own protobuf messages (package `clutchpack`), their descriptor, and the `.proto` text.
 //!
-//! The schema is defined once, in the tables of this module ([`MESSAGES`], [`ENUMS`]); from
-//! them come the `FileDescriptorProto` embedded in every recording ([`file_descriptor_set`])
-//! and the human-readable `proto/clutchpack.proto` ([`proto_text`], checked by a test). The
+//! The schema is defined once, in the tables of this module (`MESSAGES`, `ENUMS`); from
+//! them come the `FileDescriptorProto` embedded in every recording (`file_descriptor_set`)
+//! and the human-readable `proto/clutchpack.proto` (`proto_text`, checked by a test). The
 //! encoders are the `prost`-derived structs below, whose tags a test checks against the tables.
 //! No `protoc` and no build script are needed.
 //!
@@ -194,7 +194,7 @@ pub struct Impact {
     pub peak_n: f64,
 }
 
-/// Statistics of one disc's impact peaks (wire form of [`crate::DiscSummary`]).
+/// Statistics of one disc's impact peaks (wire form of `clutchpack_analysis::DiscStats`).
 #[derive(Clone, PartialEq, prost::Message)]
 pub struct DiscSummary {
     /// Disc name.
