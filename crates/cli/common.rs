@@ -58,19 +58,44 @@ impl EngineArg {
 /// offsets, spacing errors: `PackModel::is_torsional`), which only it can run
 /// ([`Scene::engine`]); an engine that cannot run the scene is bad input.
 pub fn make_engine(scene: &Scene, arg: Option<EngineArg>) -> Result<Box<dyn Engine + Send>> {
+    choose_engine(scene, arg).map(|(engine, _)| engine)
+}
+
+/// [`make_engine`], with one line saying which engine and scheme run and why, e.g.
+/// `engine: reference (multirate: prescribed shaft, no stack; 8 independent discs on 2
+/// threads), the default for a torsional pack (concentric discs on one shaft)`.
+pub fn choose_engine(
+    scene: &Scene,
+    arg: Option<EngineArg>,
+) -> Result<(Box<dyn Engine + Send>, String)> {
+    let asked = arg.map(EngineArg::choice);
     // The scene crate's rule: refuses (bad input) an engine that cannot run the scene.
-    let choice = scene.engine(arg.map(EngineArg::choice), &scene.name)?;
+    let choice = scene.engine(asked, &scene.name)?;
+    let why = scene.engine_reason(asked);
+    let sim = &scene.simulation;
     match choice {
-        EngineChoice::Reference => Ok(Box::new(ReferenceEngine::from_scene(scene))),
+        EngineChoice::Reference => {
+            let settings = clutchpack_reference::Settings {
+                tolerance: sim.tolerance,
+                max_step_s: sim.max_step_s,
+                record_rate_hz: sim.record_rate_hz,
+            };
+            let engine = ReferenceEngine::new(scene.pack.clone(), settings);
+            let line = format!("engine: reference ({}), {why}", engine.describe());
+            Ok((Box::new(engine), line))
+        }
         EngineChoice::Multibody => match clutchpack_sim::MultibodyEngine::new(
             scene.pack.clone(),
             clutchpack_sim::MultibodyOptions::with_settings(
-                scene.simulation.record_rate_hz,
-                scene.simulation.max_step_s,
-                scene.simulation.record_per_tooth,
+                sim.record_rate_hz,
+                sim.max_step_s,
+                sim.record_per_tooth,
             ),
         ) {
-            Ok(e) => Ok(Box::new(e)),
+            Ok(e) => {
+                let line = format!("engine: multibody ({}), {why}", e.scheme_explanation());
+                Ok((Box::new(e), line))
+            }
             Err(e) => Err(BadInput(format!("{}: {e}", scene.name)).into()),
         },
     }

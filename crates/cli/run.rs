@@ -117,7 +117,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     }
     let inputs: Vec<&std::path::Path> = a.scene.as_deref().into_iter().collect();
     crate::outputs::check_outputs(&outs, &inputs)?;
-    let mut engine = common::make_engine(&scene, a.engine)?;
+    let (mut engine, engine_line) = common::choose_engine(&scene, a.engine)?;
     let names = engine.disc_names();
     let duration = scene.simulation.duration_s;
     let mut collector = RunCollector::new(names.len(), a.plot.is_some()).with_interfaces(
@@ -216,6 +216,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         wall,
         run_stats.steps
     );
+    out!("{engine_line}");
     out!("per-tooth impact loads (negative: the shaft leads; positive: the disc leads)");
     out!("{}", stats_table(&stats, TableFormat::Text).trim_end());
     if let Some(worst) = stats.iter().max_by(|x, y| {
