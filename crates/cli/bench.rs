@@ -2,7 +2,7 @@
 
 use crate::common::{self, RunCollector};
 use crate::run::run_recorded;
-use crate::sweep::run_cases;
+use crate::sweep::run_cases_until;
 use anyhow::Result;
 use clutchpack_model::cases::staggered_pack;
 use clutchpack_model::{Engine, PackModel};
@@ -10,7 +10,7 @@ use clutchpack_record::{RecordOptions, Recorder};
 use clutchpack_reference::{ReferenceEngine, Scheme};
 use clutchpack_scene::Override;
 use std::process::ExitCode;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -51,6 +51,16 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     if a.pack_only {
         return staggered_packs(a.pack_runs).map(|()| ExitCode::SUCCESS);
     }
+    // SIGINT, SIGTERM and SIGHUP stop the bench between (or inside recorded) runs: the
+    // figures printed so far stand, the exit code is 128 + signal
+    let stop = crate::signals::flag();
+    let stopped = || {
+        let s = stop.load(Ordering::SeqCst);
+        if s {
+            eprintln!("interrupted ({})", crate::signals::received_name());
+        }
+        s
+    };
 
     // 1. The paper case, 0.3 s simulated, one disc, h_o = 0 (the built-in default scene).
     let scene = common::load_scene(None, &[])?;
@@ -58,6 +68,9 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     let mut steps = 0;
     let mut impacts = 0;
     for _ in 0..a.runs.max(1) {
+        if stopped() {
+            return Ok(crate::signals::exit_code());
+        }
         let mut engine = common::make_engine(&scene, None)?;
         let mut obs = RunCollector::new(1, false);
         let t0 = Instant::now();
@@ -93,7 +106,11 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     let mut best = [f64::INFINITY; 2];
     for _ in 0..a.repeats.max(1) {
         for (i, jobs) in [1usize, 2].into_iter().enumerate() {
-            let (_, wall) = run_cases(&scenes, &values, param, 4, jobs, None, None)?;
+            let (_, wall, unfinished) =
+                run_cases_until(&scenes, &values, param, 4, jobs, None, None, &stop)?;
+            if unfinished > 0 || stopped() {
+                return Ok(crate::signals::exit_code());
+            }
             best[i] = best[i].min(wall);
         }
     }
@@ -144,6 +161,10 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
             let mut plain_cpu = Vec::new();
             let mut bytes = 0;
             for k in 0..a.record_runs {
+                if stopped() {
+                    let _ = std::fs::remove_dir_all(&dir);
+                    return Ok(crate::signals::exit_code());
+                }
                 let mut pair = [0.0; 2];
                 for record in [false, true] {
                     let mut engine = common::make_engine(&scene, None)?;
@@ -161,7 +182,7 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
                         scene.simulation.duration_s,
                         collector,
                         recorder,
-                        Arc::new(AtomicBool::new(false)),
+                        Arc::clone(&stop),
                     );
                     let wall = t0.elapsed().as_secs_f64();
                     done.result?;

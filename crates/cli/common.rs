@@ -1,6 +1,6 @@
 //! Shared helpers of the subcommands: scene loading, engine choice, the summary JSON.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clutchpack_analysis::{DiscStats, InterfaceStats};
 use clutchpack_model::{
     Engine, ImpactEvent, InterfaceSample, Observer, RunStats, Sample, StackBody,
@@ -220,7 +220,8 @@ impl RunSummary {
 /// Writes `value` as pretty JSON to `path`.
 pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
     let text = serde_json::to_string_pretty(value)?;
-    std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))
+    // whole or not at all (crate::outputs)
+    crate::outputs::write_text(path, &(text + "\n"))
 }
 
 /// A progress bar on stderr for a run of `duration_s` simulated seconds (hidden when stderr

@@ -5,6 +5,7 @@
 //! `--salvage` is given: then the command works on the messages recovered and warns.
 
 use crate::common::BadInput;
+use crate::outputs::Output;
 use anyhow::{Context, Result};
 use clutchpack_analysis::{disc_stats, DiscStats};
 use clutchpack_record::RecordingReader;
@@ -16,6 +17,14 @@ use std::process::ExitCode;
 pub fn open_recording(path: &Path, salvage: bool) -> Result<RecordingReader> {
     let reader = clutchpack_record::open(path).map_err(|e| BadInput(e.to_string()))?;
     if let Some(d) = reader.damage() {
+        if salvage && reader.info().messages == 0 {
+            // nothing to work on: not a success
+            return Err(BadInput(format!(
+                "{}: {d}; --salvage recovered no message",
+                path.display()
+            ))
+            .into());
+        }
         if salvage {
             eprintln!(
                 "warning: {}: {d}; using the recovered messages",
@@ -112,7 +121,8 @@ pub struct CompareArgs {
     /// Output format.
     #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
     pub format: CompareFormat,
-    /// Grouped bar chart of the peaks per disc and run (PNG or SVG).
+    /// Grouped bar chart of the peaks per disc and run (PNG or SVG; an existing FILE is
+    /// replaced).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
     /// Use the recovered messages of damaged files.
@@ -173,10 +183,28 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
     if let Some(r) = crate::study::compare_hook(&a.files) {
         return r; // two study folders: ensembles compared with confidence intervals
     }
+    if let Some(p) = &a.plot {
+        let inputs: Vec<&Path> = a.files.iter().map(PathBuf::as_path).collect();
+        crate::outputs::check_outputs(
+            &[Output {
+                flag: "--plot",
+                path: p,
+            }],
+            &inputs,
+        )?;
+    }
     let mut runs = Vec::new();
     for f in &a.files {
         let reader = open_recording(f, a.salvage)?;
-        runs.push((f.display().to_string(), recording_stats(&reader)));
+        let stats = recording_stats(&reader);
+        if stats.is_empty() {
+            // say so rather than leaving the run out silently
+            eprintln!(
+                "warning: {}: no disc was recovered; the run has no rows below",
+                f.display()
+            );
+        }
+        runs.push((f.display().to_string(), stats));
     }
     // after reading: a bad file's error stays the only line
     eprintln!("{}", crate::study::ONE_SAMPLE_NOTE);
@@ -290,8 +318,10 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
             })
             .collect();
         let names: Vec<String> = runs.iter().map(|(n, _)| n.clone()).collect();
-        clutchpack_analysis::plot_compare(path, &names, &discs, &values)
-            .with_context(|| format!("plotting {}", path.display()))?;
+        crate::outputs::write_with(path, |tmp| {
+            clutchpack_analysis::plot_compare(tmp, &names, &discs, &values)
+                .with_context(|| format!("plotting {}", path.display()))
+        })?;
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -301,7 +331,8 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
 pub struct ExportArgs {
     /// The recording (.mcap).
     pub file: PathBuf,
-    /// Folder for the CSV files (one per topic; created if needed).
+    /// Folder for the CSV files (one per topic; created if needed; existing files of the
+    /// same names are replaced, each written whole).
     #[arg(long, value_name = "DIR", required = true)]
     pub csv: PathBuf,
     /// Use the recovered messages of a damaged file.
@@ -310,10 +341,24 @@ pub struct ExportArgs {
 }
 
 pub fn export(a: ExportArgs) -> Result<ExitCode> {
+    if a.csv.exists() && !a.csv.is_dir() {
+        return Err(BadInput(format!("--csv {}: is not a folder", a.csv.display())).into());
+    }
+    // SIGINT, SIGTERM and SIGHUP stop the export between files: those written are complete
+    let stop = crate::signals::flag();
     let reader = open_recording(&a.file, a.salvage)?;
-    let written = clutchpack_record::export_csv(&reader, &a.csv)?;
+    let written = clutchpack_record::export_csv_until(&reader, &a.csv, &stop)
+        .map_err(|e| BadInput(e.to_string()))?;
     for p in &written {
         out!("{}", p.display());
+    }
+    if stop.load(std::sync::atomic::Ordering::SeqCst) {
+        eprintln!(
+            "interrupted ({}): {} files written",
+            crate::signals::received_name(),
+            written.len()
+        );
+        return Ok(crate::signals::exit_code());
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -323,7 +368,7 @@ pub fn export(a: ExportArgs) -> Result<ExitCode> {
 pub struct PlotArgs {
     /// The recording (.mcap).
     pub file: PathBuf,
-    /// The figure (PNG or SVG by extension).
+    /// The figure (PNG or SVG by extension; an existing FIG is replaced).
     #[arg(short = 'o', long = "out", value_name = "FIG", required = true)]
     pub out: PathBuf,
     /// Use the recovered messages of a damaged file.
@@ -332,6 +377,13 @@ pub struct PlotArgs {
 }
 
 pub fn plot(a: PlotArgs) -> Result<ExitCode> {
+    crate::outputs::check_outputs(
+        &[Output {
+            flag: "--out",
+            path: &a.out,
+        }],
+        &[a.file.as_path()],
+    )?;
     let reader = open_recording(&a.file, a.salvage)?;
     let (names, mut histories): (Vec<String>, Vec<Vec<(f64, f64)>>) = reader
         .load_histories()
@@ -345,8 +397,11 @@ pub fn plot(a: PlotArgs) -> Result<ExitCode> {
         .metadata("clutchpack.run")
         .and_then(|m| m.get("scene_name").cloned())
         .unwrap_or_else(|| a.file.display().to_string());
-    clutchpack_analysis::plot_load_history(&a.out, &format!("{scene}: per-tooth load"), &series)
-        .with_context(|| format!("plotting {}", a.out.display()))?;
+    let title = format!("{scene}: per-tooth load");
+    crate::outputs::write_with(&a.out, |tmp| {
+        clutchpack_analysis::plot_load_history(tmp, &title, &series)
+            .with_context(|| format!("plotting {}", a.out.display()))
+    })?;
     out!("{}", a.out.display());
     Ok(ExitCode::SUCCESS)
 }

@@ -93,6 +93,7 @@
 
 mod export;
 pub mod info;
+pub mod output;
 pub mod proto;
 mod read;
 #[cfg(feature = "serve")]
@@ -107,8 +108,9 @@ mod threaded;
 pub mod topics;
 mod write;
 
-pub use export::export_csv;
+pub use export::{export_csv, export_csv_until};
 pub use info::{sha256_hex, DiscGeometry, FrictionInterface, RunInfo, ShaftGeometry};
+pub use output::{write_whole, PendingFile, Replace};
 pub use read::{
     from_bytes, open, open_complete, AttachmentInfo, Damage, DamageKind, DiscSeries,
     InterfaceSeries, LoadHistory, MessageView, ReadError, RecordingInfo, RecordingReader,
