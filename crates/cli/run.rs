@@ -34,6 +34,10 @@ pub struct RunArgs {
     /// Write the run summary as JSON.
     #[arg(long, value_name = "FILE")]
     pub summary_json: Option<PathBuf>,
+    /// Write the counted cycles of each disc as JSON: exact (range, count) pairs, range
+    /// histogram, range-mean matrix, exceedance spectrum, and per resolved tooth its ranges.
+    #[arg(long, value_name = "FILE")]
+    pub fatigue_json: Option<PathBuf>,
     /// Write one CSV row per impact: disc,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n.
     #[arg(long, value_name = "FILE")]
     pub impacts_csv: Option<PathBuf>,
@@ -79,11 +83,13 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     let mut engine = common::make_engine(&scene, a.engine)?;
     let names = engine.disc_names();
     let duration = scene.simulation.duration_s;
-    let mut collector = RunCollector::new(names.len(), a.plot.is_some()).with_interfaces(
-        common::friction_interfaces(&scene)
-            .into_iter()
-            .map(|f| f.name()),
-    );
+    let mut collector = RunCollector::new(names.len(), a.plot.is_some())
+        .with_interfaces(
+            common::friction_interfaces(&scene)
+                .into_iter()
+                .map(|f| f.name()),
+        )
+        .with_fatigue(&scene);
     let pb = common::time_progress(duration, &scene.name);
     collector.progress = Some(pb.clone());
     let recorder = if a.no_record {
@@ -163,6 +169,16 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     };
     let mut summary = RunSummary::new(&scene, engine.name(), &run_stats, wall, stats.clone());
     summary.interfaces = obs.interfaces.clone();
+    summary.fatigue = obs.assess_fatigue(&names, run_stats.simulated_s);
+    if let Some(path) = &a.fatigue_json {
+        let histories = obs.fatigue.clone().finish(names.len());
+        let cycles: Vec<_> = names
+            .iter()
+            .zip(&histories)
+            .map(|(n, h)| clutchpack_analysis::disc_cycles(n, h, run_stats.simulated_s))
+            .collect();
+        common::write_json(path, &cycles)?;
+    }
     if let Some(path) = &a.summary_json {
         common::write_json(path, &summary)?;
     }
@@ -188,6 +204,16 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                 worst.max_positive_n.max(-worst.max_negative_n)
             );
         }
+    }
+    if !summary.fatigue.is_empty() {
+        out!(
+            "fatigue of the spline teeth at this duty ({} rule below the knee; life at D = D_crit; MODEL.md section 7)",
+            summary.fatigue[0].rule.name()
+        );
+        out!(
+            "{}",
+            clutchpack_analysis::fatigue_table(&summary.fatigue, TableFormat::Text).trim_end()
+        );
     }
     if !obs.interfaces.is_empty() {
         out!("friction interfaces (from the piston side)");
@@ -273,10 +299,17 @@ pub(crate) fn run_recorded(
         Some(rec) => {
             let (mut rec, cpu_s) = rec.join();
             recorder_cpu_s = cpu_s;
+            let mut summary = rec.summary();
             if let Ok(s) = &result {
                 rec.set_run_stats(s);
+                // the teeth's fatigue over the duty that ran, beside the peak statistics
+                let names: Vec<String> = summary.discs.iter().map(|d| d.name.clone()).collect();
+                let fatigue = collector.assess_fatigue(&names, s.simulated_s);
+                for (d, f) in summary.discs.iter_mut().zip(&fatigue) {
+                    d.fatigue = Some(clutchpack_record::FatigueSummary::from(f));
+                }
             }
-            Some(rec.finish(None).context("finishing the recording"))
+            Some(rec.finish(Some(summary)).context("finishing the recording"))
         }
         None => None,
     };

@@ -3,8 +3,8 @@
 use crate::common::{self, BadInput, EngineArg, RunCollector};
 use anyhow::{Context, Result};
 use clutchpack_analysis::{
-    disc_stats, sweep_fits, sweep_rows, sweep_table, DiscStats, PolyFit, SweepCase, SweepRow,
-    TableFormat,
+    disc_stats, ensemble_fatigue, fatigue_spread_table, sweep_fits, sweep_rows, sweep_table,
+    DiscFatigue, DiscFatigueSpread, DiscStats, PolyFit, SweepCase, SweepRow, TableFormat,
 };
 use clutchpack_scene::{Override, Scene};
 use rayon::prelude::*;
@@ -70,6 +70,14 @@ struct SweepSummary {
     wall_time_s: f64,
     rows: Vec<SweepRow>,
     fits: Vec<FitJson>,
+    /// Per value: each disc's damage rate over the members (mean, spread) and life.
+    fatigue: Vec<FatigueJson>,
+}
+
+#[derive(Serialize)]
+struct FatigueJson {
+    value: f64,
+    discs: Vec<DiscFatigueSpread>,
 }
 
 /// The initial relative angles of ensemble member `k` of `count`: every disc at the same
@@ -128,7 +136,7 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             .expect("static template")
             .progress_chars("=> "),
     );
-    let (cases, wall) = run_cases(
+    let (cases, fatigue, wall) = run_cases_with_fatigue(
         &scenes,
         &a.values,
         &a.param,
@@ -177,6 +185,25 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             n.r_squared
         );
     }
+    let fatigue: Vec<(f64, Vec<DiscFatigueSpread>)> = a
+        .values
+        .iter()
+        .zip(&scenes)
+        .zip(&fatigue)
+        .map(|((&v, scene), members)| {
+            let d_crit: Vec<f64> = scene
+                .fatigue
+                .iter()
+                .map(|f| f.material.critical_damage)
+                .collect();
+            (v, ensemble_fatigue(members, &d_crit))
+        })
+        .collect();
+    out!("fatigue of the spline teeth against {} (damage rate per hour: ensemble mean, std, min..max; life at the mean rate, and at the largest..smallest rate)", a.param);
+    out!(
+        "{}",
+        fatigue_spread_table(Some(&a.param), &fatigue, TableFormat::Text).trim_end()
+    );
     if let Some(path) = &a.plot {
         clutchpack_analysis::plot_sweep(path, &a.param, &rows, &fits)
             .with_context(|| format!("plotting {}", path.display()))?;
@@ -192,6 +219,10 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             cases: n_cases,
             wall_time_s: wall,
             rows,
+            fatigue: fatigue
+                .into_iter()
+                .map(|(value, discs)| FatigueJson { value, discs })
+                .collect(),
             fits: fits
                 .into_iter()
                 .map(|(disc, max_positive, max_negative)| FitJson {
@@ -230,6 +261,23 @@ pub fn run_cases(
     engine: Option<EngineArg>,
     progress: Option<indicatif::ProgressBar>,
 ) -> Result<(Vec<SweepCase>, f64)> {
+    run_cases_with_fatigue(scenes, values, param, ensemble, jobs, engine, progress)
+        .map(|(cases, _, wall)| (cases, wall))
+}
+
+/// Fatigue of each member of each value: `[value][member][disc]`.
+pub type MemberFatigue = Vec<Vec<Vec<DiscFatigue>>>;
+
+/// [`run_cases`], with the teeth's fatigue of every member (`[value][member][disc]`).
+pub fn run_cases_with_fatigue(
+    scenes: &[Scene],
+    values: &[f64],
+    param: &str,
+    ensemble: usize,
+    jobs: usize,
+    engine: Option<EngineArg>,
+    progress: Option<indicatif::ProgressBar>,
+) -> Result<(Vec<SweepCase>, MemberFatigue, f64)> {
     let tasks: Vec<(usize, usize)> = (0..scenes.len())
         .flat_map(|c| (0..ensemble).map(move |k| (c, k)))
         .collect();
@@ -240,19 +288,23 @@ pub fn run_cases(
     let pb = progress.unwrap_or_else(indicatif::ProgressBar::hidden);
     pb.set_length(tasks.len() as u64);
     let t0 = Instant::now();
-    let results: Vec<Result<Vec<DiscStats>>> = pool.install(|| {
+    type Member = (Vec<DiscStats>, Vec<DiscFatigue>);
+    let results: Vec<Result<Member>> = pool.install(|| {
         tasks
             .par_iter()
             .map(|&(c, k)| {
                 let member = ensemble_member(&scenes[c], k, ensemble);
                 let mut engine = common::make_engine(&member, engine)?;
                 let names = engine.disc_names();
-                let mut obs = RunCollector::new(names.len(), false);
-                engine
+                let mut obs = RunCollector::new(names.len(), false).with_fatigue(&member);
+                let stats = engine
                     .run(member.simulation.duration_s, &mut obs)
                     .with_context(|| format!("case {param} = {}, member {k}", values[c]))?;
                 pb.inc(1);
-                Ok(disc_stats(&names, &obs.impacts))
+                Ok((
+                    disc_stats(&names, &obs.impacts),
+                    obs.assess_fatigue(&names, stats.simulated_s),
+                ))
             })
             .collect()
     });
@@ -265,8 +317,11 @@ pub fn run_cases(
             members: Vec::new(),
         })
         .collect();
+    let mut fatigue: MemberFatigue = vec![Vec::new(); values.len()];
     for (&(c, _), r) in tasks.iter().zip(results) {
-        cases[c].members.push(r?);
+        let (stats, f) = r?;
+        cases[c].members.push(stats);
+        fatigue[c].push(f);
     }
-    Ok((cases, wall))
+    Ok((cases, fatigue, wall))
 }

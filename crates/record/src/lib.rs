@@ -112,7 +112,7 @@ pub use read::{
 };
 #[cfg(feature = "serve")]
 pub use serve::{serve, ServeError, ServeOptions};
-pub use summary::{DiscSummary, RunSummary, MAX_EXTRA_DISCS, TOP_N};
+pub use summary::{DiscSummary, FatigueSummary, RunSummary, MAX_EXTRA_DISCS, TOP_N};
 pub use write::{default_path, log_time_ns, RecordError, RecordOptions, Recorder};
 
 /// A disc name made safe for a topic and frame name: every character other than

@@ -798,6 +798,35 @@ impl RecordingReader {
                     d.mean_top10_abs_n
                 );
             }
+            if summary.discs.iter().any(|d| d.fatigue.is_some()) {
+                let _ = writeln!(
+                    s,
+                    "fatigue of the spline teeth (stored; MODEL.md section 7, at this duty):"
+                );
+                let _ = writeln!(
+                    s,
+                    "  {:<wd$}  {:>12}  {:>10}  {:>10}  {:>12}  {:>16}",
+                    "disc", "damage [1/h]", "life [h]", "S_eq [N]", "max sigma_F", "worst tooth"
+                );
+                let life =
+                    |h: Option<f64>| h.map_or("unlimited".to_string(), |h| format!("{h:.3e}"));
+                for d in &summary.discs {
+                    let Some(f) = &d.fatigue else { continue };
+                    let worst = f
+                        .worst_tooth
+                        .map_or("-".to_string(), |(k, l, _)| format!("{k}: {} h", life(l)));
+                    let _ = writeln!(
+                        s,
+                        "  {:<wd$}  {:>12.4e}  {:>10}  {:>10.1}  {:>8.1} MPa  {:>16}",
+                        d.name,
+                        f.damage_rate_per_h,
+                        life(f.life_h),
+                        f.eq_load_range_n,
+                        f.max_root_stress_pa * 1e-6,
+                        worst
+                    );
+                }
+            }
         }
         let interfaces = self.interface_stats();
         if !interfaces.is_empty() {

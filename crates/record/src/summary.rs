@@ -36,6 +36,41 @@ pub struct DiscSummary {
     pub negative_impacts: u64,
     /// Mean of the [`TOP_N`] = 10 largest `|peak|` in N (of all if fewer); 0 without impacts.
     pub mean_top10_abs_n: f64,
+    /// Fatigue of the disc's spline teeth (MODEL.md section 7); `None` in recordings written
+    /// without it (older files, runs that failed).
+    pub fatigue: Option<FatigueSummary>,
+}
+
+/// The fatigue figures of one disc kept in the recording's `/summary`
+/// (`clutchpack_analysis::DiscFatigue` in short).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FatigueSummary {
+    /// Damage per hour of the simulated duty, 1/h (>= 0).
+    pub damage_rate_per_h: f64,
+    /// Life in hours at this duty; `None`: unlimited (no damage).
+    pub life_h: Option<f64>,
+    /// Damage-equivalent load range for one hour at the knee's cycles, N.
+    pub eq_load_range_n: f64,
+    /// Largest tooth-root bending stress of the run, Pa.
+    pub max_root_stress_pa: f64,
+    /// The most damaged resolved tooth: (index, life in h or `None` if unlimited), with
+    /// the number of resolved teeth; `None` when the engine did not resolve teeth.
+    pub worst_tooth: Option<(u32, Option<f64>, u32)>,
+}
+
+impl From<&clutchpack_analysis::DiscFatigue> for FatigueSummary {
+    fn from(d: &clutchpack_analysis::DiscFatigue) -> FatigueSummary {
+        FatigueSummary {
+            damage_rate_per_h: d.lumped.damage_rate_per_h,
+            life_h: d.lumped.life_h,
+            eq_load_range_n: d.lumped.eq_load_range_n,
+            max_root_stress_pa: d.max_root_stress_pa,
+            worst_tooth: d
+                .teeth
+                .as_ref()
+                .map(|t| (t.worst_tooth as u32, t.worst.life_h, t.damage.len() as u32)),
+        }
+    }
 }
 
 impl DiscSummary {
@@ -57,6 +92,7 @@ impl From<clutchpack_analysis::DiscStats> for DiscSummary {
             positive_impacts: s.positive_impacts as u64,
             negative_impacts: s.negative_impacts as u64,
             mean_top10_abs_n: s.mean_top10_abs_n,
+            fatigue: None,
         }
     }
 }
@@ -109,16 +145,28 @@ impl RunSummary {
                 .discs
                 .iter()
                 .enumerate()
-                .map(|(i, d)| proto::DiscSummary {
-                    name: d.name.clone(),
-                    index: i as u32,
-                    max_positive_n: d.max_positive_n,
-                    max_negative_n: d.max_negative_n,
-                    p99_abs_n: d.p99_abs_n,
-                    impacts: d.impacts,
-                    positive_impacts: d.positive_impacts,
-                    negative_impacts: d.negative_impacts,
-                    mean_top10_abs_n: d.mean_top10_abs_n,
+                .map(|(i, d)| {
+                    let f = d.fatigue.unwrap_or_default();
+                    let (worst_tooth, worst_life, teeth) = f.worst_tooth.unwrap_or((0, None, 0));
+                    proto::DiscSummary {
+                        fatigue: d.fatigue.is_some(),
+                        damage_rate_per_h: f.damage_rate_per_h,
+                        life_h: f.life_h.unwrap_or(0.0),
+                        eq_load_range_n: f.eq_load_range_n,
+                        max_root_stress_pa: f.max_root_stress_pa,
+                        teeth,
+                        worst_tooth,
+                        worst_tooth_life_h: worst_life.unwrap_or(0.0),
+                        name: d.name.clone(),
+                        index: i as u32,
+                        max_positive_n: d.max_positive_n,
+                        max_negative_n: d.max_negative_n,
+                        p99_abs_n: d.p99_abs_n,
+                        impacts: d.impacts,
+                        positive_impacts: d.positive_impacts,
+                        negative_impacts: d.negative_impacts,
+                        mean_top10_abs_n: d.mean_top10_abs_n,
+                    }
                 })
                 .collect(),
         }
@@ -131,6 +179,17 @@ impl RunSummary {
                 .discs
                 .into_iter()
                 .map(|d| DiscSummary {
+                    fatigue: d.fatigue.then(|| {
+                        let life = |h: f64| (h > 0.0).then_some(h);
+                        FatigueSummary {
+                            damage_rate_per_h: d.damage_rate_per_h,
+                            life_h: life(d.life_h),
+                            eq_load_range_n: d.eq_load_range_n,
+                            max_root_stress_pa: d.max_root_stress_pa,
+                            worst_tooth: (d.teeth > 0)
+                                .then(|| (d.worst_tooth, life(d.worst_tooth_life_h), d.teeth)),
+                        }
+                    }),
                     name: d.name,
                     max_positive_n: d.max_positive_n,
                     max_negative_n: d.max_negative_n,
@@ -190,5 +249,22 @@ mod tests {
         assert_eq!(s.discs[2].name, "disc 2");
         assert_eq!(s.discs[2].max_positive_n, 5.0);
         assert_eq!(RunSummary::from_proto(s.to_proto()), s);
+        // fatigue figures round-trip; unlimited lives stay unlimited
+        let mut f = s.clone();
+        f.discs[0].fatigue = Some(FatigueSummary {
+            damage_rate_per_h: 0.0,
+            life_h: None,
+            eq_load_range_n: 0.0,
+            max_root_stress_pa: 0.0,
+            worst_tooth: None,
+        });
+        f.discs[2].fatigue = Some(FatigueSummary {
+            damage_rate_per_h: 2e-3,
+            life_h: Some(500.0),
+            eq_load_range_n: 321.0,
+            max_root_stress_pa: 4e8,
+            worst_tooth: Some((17, Some(250.0), 154)),
+        });
+        assert_eq!(RunSummary::from_proto(f.to_proto()), f);
     }
 }
