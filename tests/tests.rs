@@ -2,6 +2,7 @@
 //! outputs, and bad input. One test binary (as ripgrep does); each test states what it checks.
 
 mod cross_engine;
+mod fatigue;
 mod reliability;
 mod slurm;
 mod study;

@@ -106,8 +106,11 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     let mut best = [f64::INFINITY; 2];
     for _ in 0..a.repeats.max(1) {
         for (i, jobs) in [1usize, 2].into_iter().enumerate() {
-            let (_, wall, unfinished) =
-                run_cases_until(&scenes, &values, param, 4, jobs, None, None, &stop)?;
+            let crate::sweep::CaseRuns {
+                wall_s: wall,
+                unfinished,
+                ..
+            } = run_cases_until(&scenes, &values, param, 4, jobs, None, None, &stop)?;
             if unfinished > 0 || stopped() {
                 return Ok(crate::signals::exit_code());
             }

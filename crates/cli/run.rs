@@ -36,6 +36,11 @@ pub struct RunArgs {
     /// Write the run summary as JSON (an existing FILE is replaced).
     #[arg(long, value_name = "FILE")]
     pub summary_json: Option<PathBuf>,
+    /// Write the counted cycles of each disc as JSON: exact (range, count) pairs, range
+    /// histogram, range-mean matrix, exceedance spectrum, and per resolved tooth its ranges
+    /// (an existing FILE is replaced).
+    #[arg(long, value_name = "FILE")]
+    pub fatigue_json: Option<PathBuf>,
     /// Write one CSV row per impact: disc,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n (an
     /// existing FILE is replaced).
     #[arg(long, value_name = "FILE")]
@@ -108,6 +113,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     for (flag, p) in [
         ("--out", record_path.as_deref()),
         ("--summary-json", a.summary_json.as_deref()),
+        ("--fatigue-json", a.fatigue_json.as_deref()),
         ("--impacts-csv", a.impacts_csv.as_deref()),
         ("--plot", a.plot.as_deref()),
     ] {
@@ -120,11 +126,13 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     let (mut engine, engine_line) = common::choose_engine(&scene, a.engine)?;
     let names = engine.disc_names();
     let duration = scene.simulation.duration_s;
-    let mut collector = RunCollector::new(names.len(), a.plot.is_some()).with_interfaces(
-        common::friction_interfaces(&scene)
-            .into_iter()
-            .map(|f| f.name()),
-    );
+    let mut collector = RunCollector::new(names.len(), a.plot.is_some())
+        .with_interfaces(
+            common::friction_interfaces(&scene)
+                .into_iter()
+                .map(|f| f.name()),
+        )
+        .with_fatigue(&scene);
     let pb = common::time_progress(duration, &scene.name);
     collector.progress = Some(pb.clone());
     let recorder = if let Some(path) = record_path {
@@ -205,6 +213,16 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     };
     let mut summary = RunSummary::new(&scene, engine.name(), &run_stats, wall, stats.clone());
     summary.interfaces = obs.interfaces.clone();
+    summary.fatigue = obs.assess_fatigue(&names, run_stats.simulated_s);
+    if let Some(path) = &a.fatigue_json {
+        let histories = obs.fatigue.clone().finish(names.len());
+        let cycles: Vec<_> = names
+            .iter()
+            .zip(&histories)
+            .map(|(n, h)| clutchpack_analysis::disc_cycles(n, h, run_stats.simulated_s))
+            .collect();
+        common::write_json(path, &cycles)?;
+    }
     if let Some(path) = &a.summary_json {
         common::write_json(path, &summary)?;
     }
@@ -231,6 +249,16 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                 worst.max_positive_n.max(-worst.max_negative_n)
             );
         }
+    }
+    if !summary.fatigue.is_empty() {
+        out!(
+            "fatigue of the spline teeth at this duty ({} rule below the knee; life at D = D_crit; MODEL.md section 7)",
+            summary.fatigue[0].rule.name()
+        );
+        out!(
+            "{}",
+            clutchpack_analysis::fatigue_table(&summary.fatigue, TableFormat::Text).trim_end()
+        );
     }
     if !obs.interfaces.is_empty() {
         out!("friction interfaces (from the piston side)");
@@ -314,10 +342,18 @@ pub(crate) fn run_recorded(
         Some(rec) => {
             let (mut rec, cpu_s) = rec.join();
             recorder_cpu_s = cpu_s;
+            let mut summary = rec.summary();
             if let Ok(s) = &result {
                 rec.set_run_stats(s);
+                // the teeth's fatigue over the duty that ran, beside the peak statistics
+                let names: Vec<String> = summary.discs.iter().map(|d| d.name.clone()).collect();
+                let fatigue = collector.assess_fatigue(&names, s.simulated_s);
+                summary.fatigue = fatigue
+                    .iter()
+                    .map(|f| Some(clutchpack_record::FatigueSummary::from(f)))
+                    .collect();
             }
-            Some(rec.finish(None).context("finishing the recording"))
+            Some(rec.finish(Some(summary)).context("finishing the recording"))
         }
         None => None,
     };

@@ -3,8 +3,8 @@
 use crate::common::{self, BadInput, EngineArg, RunCollector};
 use anyhow::{Context, Result};
 use clutchpack_analysis::{
-    disc_stats, sweep_fits, sweep_rows, sweep_table, DiscStats, PolyFit, SweepCase, SweepRow,
-    TableFormat,
+    disc_stats, ensemble_fatigue, fatigue_spread_table, sweep_fits, sweep_rows, sweep_table,
+    DiscFatigue, DiscFatigueSpread, DiscStats, PolyFit, SweepCase, SweepRow, TableFormat,
 };
 use clutchpack_model::{ImpactEvent, InterfaceSample, Observer, Sample};
 use clutchpack_scene::{Override, Scene};
@@ -74,6 +74,14 @@ struct SweepSummary {
     wall_time_s: f64,
     rows: Vec<SweepRow>,
     fits: Vec<FitJson>,
+    /// Per value: each disc's damage rate over the members (mean, spread) and life.
+    fatigue: Vec<FatigueJson>,
+}
+
+#[derive(Serialize)]
+struct FatigueJson {
+    value: f64,
+    discs: Vec<DiscFatigueSpread>,
 }
 
 /// The initial relative angles of ensemble member `k` of `count`: every disc at the same
@@ -146,7 +154,12 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
     );
     // SIGINT, SIGTERM and SIGHUP stop the sweep: the cases done so far are reported.
     let stop = crate::signals::flag();
-    let (cases, wall, unfinished) = run_cases_until(
+    let CaseRuns {
+        cases,
+        fatigue,
+        wall_s: wall,
+        unfinished,
+    } = run_cases_until(
         &scenes,
         &a.values,
         &a.param,
@@ -164,11 +177,13 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             n_cases - unfinished
         );
     }
-    // values whose every member was stopped are left out of the table and the fits
-    let cases: Vec<SweepCase> = cases
-        .into_iter()
-        .filter(|c| !c.members.is_empty())
+    // values whose every member was stopped are left out of the tables and the fits
+    let kept: Vec<usize> = (0..cases.len())
+        .filter(|&i| !cases[i].members.is_empty())
         .collect();
+    let fatigue: MemberFatigue = kept.iter().map(|&i| fatigue[i].clone()).collect();
+    let kept_scenes: Vec<&Scene> = kept.iter().map(|&i| &scenes[i]).collect();
+    let cases: Vec<SweepCase> = kept.iter().map(|&i| cases[i].clone()).collect();
     let rows = sweep_rows(&cases);
     let degree = if cases.len() >= 3 {
         2
@@ -208,6 +223,25 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             n.r_squared
         );
     }
+    let fatigue: Vec<(f64, Vec<DiscFatigueSpread>)> = cases
+        .iter()
+        .map(|c| c.value)
+        .zip(kept_scenes)
+        .zip(&fatigue)
+        .map(|((v, scene), members)| {
+            let d_crit: Vec<f64> = scene
+                .fatigue
+                .iter()
+                .map(|f| f.material.critical_damage)
+                .collect();
+            (v, ensemble_fatigue(members, &d_crit))
+        })
+        .collect();
+    out!("fatigue of the spline teeth against {} (damage rate per hour: ensemble mean, std, min..max; life at the mean rate, and at the largest..smallest rate)", a.param);
+    out!(
+        "{}",
+        fatigue_spread_table(Some(&a.param), &fatigue, TableFormat::Text).trim_end()
+    );
     if let Some(path) = &a.plot {
         crate::outputs::write_with(path, |tmp| {
             clutchpack_analysis::plot_sweep(tmp, &a.param, &rows, &fits)
@@ -225,6 +259,10 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             cases: n_cases,
             wall_time_s: wall,
             rows,
+            fatigue: fatigue
+                .into_iter()
+                .map(|(value, discs)| FatigueJson { value, discs })
+                .collect(),
             fits: fits
                 .into_iter()
                 .map(|(disc, max_positive, max_negative)| FitJson {
@@ -293,15 +331,30 @@ pub fn run_cases(
     progress: Option<indicatif::ProgressBar>,
 ) -> Result<(Vec<SweepCase>, f64)> {
     let never = AtomicBool::new(false);
-    let (cases, wall, _) = run_cases_until(
+    let r = run_cases_until(
         scenes, values, param, ensemble, jobs, engine, progress, &never,
     )?;
-    Ok((cases, wall))
+    Ok((r.cases, r.wall_s))
+}
+
+/// Fatigue of each member of each value: `[value][member][disc]`.
+pub type MemberFatigue = Vec<Vec<Vec<DiscFatigue>>>;
+
+/// What [`run_cases_until`] ran.
+pub struct CaseRuns {
+    /// One [`SweepCase`] per value, with the members that finished.
+    pub cases: Vec<SweepCase>,
+    /// The teeth's fatigue of every finished member, `[value][member][disc]`.
+    pub fatigue: MemberFatigue,
+    /// Wall time in s.
+    pub wall_s: f64,
+    /// Members stopped or never started because `stop` was set.
+    pub unfinished: usize,
 }
 
 /// [`run_cases`] that stops when `stop` is set: cases not started are skipped and running
-/// ones stop at their engine's next progress call; neither is in the result. Also returns
-/// the number of such unfinished cases.
+/// ones stop at their engine's next progress call; neither is in the result, and
+/// [`CaseRuns::unfinished`] counts them.
 #[allow(clippy::too_many_arguments)]
 pub fn run_cases_until(
     scenes: &[Scene],
@@ -312,7 +365,7 @@ pub fn run_cases_until(
     engine: Option<EngineArg>,
     progress: Option<indicatif::ProgressBar>,
     stop: &AtomicBool,
-) -> Result<(Vec<SweepCase>, f64, usize)> {
+) -> Result<CaseRuns> {
     let tasks: Vec<(usize, usize)> = (0..scenes.len())
         .flat_map(|c| (0..ensemble).map(move |k| (c, k)))
         .collect();
@@ -323,7 +376,8 @@ pub fn run_cases_until(
     let pb = progress.unwrap_or_else(indicatif::ProgressBar::hidden);
     pb.set_length(tasks.len() as u64);
     let t0 = Instant::now();
-    let results: Vec<Result<Option<Vec<DiscStats>>>> = pool.install(|| {
+    type Member = (Vec<DiscStats>, Vec<DiscFatigue>);
+    let results: Vec<Result<Option<Member>>> = pool.install(|| {
         tasks
             .par_iter()
             .map(|&(c, k)| {
@@ -333,7 +387,7 @@ pub fn run_cases_until(
                 let member = ensemble_member(&scenes[c], k, ensemble);
                 let mut engine = common::make_engine(&member, engine)?;
                 let names = engine.disc_names();
-                let mut obs = RunCollector::new(names.len(), false);
+                let mut obs = RunCollector::new(names.len(), false).with_fatigue(&member);
                 let run = engine
                     .run(
                         member.simulation.duration_s,
@@ -347,7 +401,10 @@ pub fn run_cases_until(
                     return Ok(None);
                 }
                 pb.inc(1);
-                Ok(Some(disc_stats(&names, &obs.impacts)))
+                Ok(Some((
+                    disc_stats(&names, &obs.impacts),
+                    obs.assess_fatigue(&names, run.simulated_s),
+                )))
             })
             .collect()
     });
@@ -361,11 +418,20 @@ pub fn run_cases_until(
         })
         .collect();
     let mut unfinished = 0;
+    let mut fatigue: MemberFatigue = vec![Vec::new(); values.len()];
     for (&(c, _), r) in tasks.iter().zip(results) {
         match r? {
-            Some(m) => cases[c].members.push(m),
+            Some((stats, f)) => {
+                cases[c].members.push(stats);
+                fatigue[c].push(f);
+            }
             None => unfinished += 1,
         }
     }
-    Ok((cases, wall, unfinished))
+    Ok(CaseRuns {
+        cases,
+        fatigue,
+        wall_s: wall,
+        unfinished,
+    })
 }

@@ -118,7 +118,7 @@ pub use read::{
 };
 #[cfg(feature = "serve")]
 pub use serve::{serve, ServeError, ServeOptions};
-pub use summary::{DiscStats, RunSummary, MAX_EXTRA_DISCS, TOP_N};
+pub use summary::{DiscStats, FatigueSummary, RunSummary, MAX_EXTRA_DISCS, TOP_N};
 pub use threaded::ThreadedRecorder;
 pub use write::{default_path, log_time_ns, RecordError, RecordOptions, Recorder};
 

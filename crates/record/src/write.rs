@@ -502,6 +502,7 @@ impl Recorder {
         let mut s = RunSummary {
             t_end_s: self.last_t_s,
             discs: Vec::with_capacity(self.peaks.len()),
+            fatigue: Vec::new(),
         };
         for (i, p) in self.peaks.iter().enumerate() {
             let name = self
