@@ -71,6 +71,7 @@ pub use pack::{
 pub use spline::{Flank, SplineGeometry, ToothKinematics};
 pub use stream::{
     Collector, DiscSample, Engine, EngineError, NullObserver, Observer, RunStats, Sample,
+    STALL_SPAN_S, STALL_STEPS,
 };
 
 /// Closed-form peak load of one free, undamped impact (MODEL.md section 4):

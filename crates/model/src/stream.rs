@@ -102,6 +102,15 @@ pub struct RunStats {
     pub stopped_early: bool,
 }
 
+/// Steps per block of the engines' stall check (see [`STALL_SPAN_S`]).
+pub const STALL_STEPS: u64 = 1 << 16;
+/// Least simulated time, s, a block of [`STALL_STEPS`] adaptive steps must advance; an engine
+/// whose steps fall below that (a mean step under 6e-11 s) stops with
+/// [`EngineError::Diverged`]. Real packs stay far above it (the paper case's steps inside a
+/// contact are about 1e-7 s); a law made stiff by a value far outside practice (a loss
+/// coefficient of 1e19 s/m, a drive at 1e19 Hz) falls below it and would run for days.
+pub const STALL_SPAN_S: f64 = 4e-6;
+
 /// Why an engine could not finish.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum EngineError {

@@ -39,14 +39,21 @@ struct DiscRun<'a> {
 }
 
 impl DiscRun<'_> {
-    /// Integrates until the disc's time reaches `t_w` (s) or the end of the run.
-    fn advance(&mut self, t_w: f64, duration_s: f64) {
+    /// Integrates until the disc's time reaches `t_w` (s) or the end of the run, or until
+    /// the wall clock passes `deadline` (so that a stop request is seen even when the
+    /// steps become very small).
+    fn advance(&mut self, t_w: f64, duration_s: f64, deadline: Instant) {
+        let mut n: u32 = 0;
         while self.error.is_none() && self.stepper.t < t_w && self.stepper.t < duration_s {
             if let Err(e) = self
                 .stepper
                 .step(duration_s, &mut self.out, &mut no_external)
             {
                 self.error = Some(e);
+            }
+            n = n.wrapping_add(1);
+            if n.is_multiple_of(256) && Instant::now() > deadline {
+                break;
             }
         }
     }
@@ -56,6 +63,8 @@ impl DiscRun<'_> {
 /// dispatch, the merge) is small, short enough that a stop request acts within 0.5 s.
 const WINDOW_WALL_MIN_S: f64 = 0.02;
 const WINDOW_WALL_MAX_S: f64 = 0.1;
+/// Wall time after which a window is cut short, s.
+const WINDOW_WALL_CUT_S: f64 = 0.25;
 /// Most disc samples buffered per window (about 100 bytes each: 2 MB, about what a core's
 /// caches hold, so the merge reads them from cache).
 const MAX_BUFFERED_SAMPLES: f64 = 2e4;
@@ -92,13 +101,22 @@ pub(crate) fn run(
     let mut stopped = false;
     let mut failure: Option<EngineError> = None;
     while t_w < duration_s {
-        t_w = (t_w + window).min(duration_s);
+        let target = (t_w + window).min(duration_s);
         let wall = Instant::now();
+        let deadline = wall + std::time::Duration::from_secs_f64(WINDOW_WALL_CUT_S);
         if parallel {
-            runs.par_iter_mut().for_each(|r| r.advance(t_w, duration_s));
+            runs.par_iter_mut()
+                .for_each(|r| r.advance(target, duration_s, deadline));
         } else {
-            runs.iter_mut().for_each(|r| r.advance(t_w, duration_s));
+            runs.iter_mut()
+                .for_each(|r| r.advance(target, duration_s, deadline));
         }
+        // a window cut short by the deadline ends where the slowest disc got to
+        t_w = runs
+            .iter()
+            .filter(|r| r.error.is_none())
+            .map(|r| r.stepper.t.min(target))
+            .fold(target, f64::min);
         let wall = wall.elapsed().as_secs_f64();
         if wall < WINDOW_WALL_MIN_S {
             window = (2.0 * window).min(cap);
@@ -121,7 +139,11 @@ pub(crate) fn run(
         let mut next_impact = 0;
         loop {
             let ts = next_k as f64 / rate;
-            if ts > limit {
+            // a disc that failed before its first step has no sample at t = 0
+            let ready = runs
+                .iter()
+                .all(|r| r.out.samples.front().is_some_and(|&(k, _)| k == next_k));
+            if ts > limit || !ready {
                 break;
             }
             while next_impact < pending.len() && pending[next_impact].t_off_s < ts {
@@ -132,13 +154,9 @@ pub(crate) fn run(
             sample.shaft_angle_rad = shaft.angle(ts);
             sample.shaft_speed_rad_s = shaft.speed(ts);
             for (r, d) in runs.iter_mut().zip(sample.discs.iter_mut()) {
-                let (k, s) = r
-                    .out
-                    .samples
-                    .pop_front()
-                    .expect("every disc has reached the window's end");
-                debug_assert_eq!(k, next_k);
-                *d = s;
+                if let Some((_, s)) = r.out.samples.pop_front() {
+                    *d = s;
+                }
             }
             obs.sample(&sample);
             next_k += 1;

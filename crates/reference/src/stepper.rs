@@ -97,7 +97,11 @@ pub(crate) struct Stepper<'a> {
     y_new: Vec<f64>,
     dy: Vec<f64>,
     pub stats: RunStats,
+    /// Time at the start of the current block of [`STALL_BLOCK`] steps, s.
+    block_t0: f64,
 }
+
+use clutchpack_model::{STALL_SPAN_S, STALL_STEPS as STALL_BLOCK};
 
 impl<'a> Stepper<'a> {
     /// Starts `sys` at t = 0 from its initial state; a disc may start inside a contact event.
@@ -122,6 +126,7 @@ impl<'a> Stepper<'a> {
             y_new: vec![0.0; n],
             dy: vec![0.0; n],
             stats: RunStats::default(),
+            block_t0: 0.0,
             y,
             sys,
         };
@@ -395,6 +400,19 @@ impl<'a> Stepper<'a> {
         }
         self.h = next_step(h, err);
         self.stats.simulated_s = self.t;
+        if self.stats.steps.is_multiple_of(STALL_BLOCK) {
+            if self.t - self.block_t0 < STALL_SPAN_S {
+                return Err(EngineError::Diverged {
+                    t_s: self.t,
+                    reason: format!(
+                        "{STALL_BLOCK} steps advanced only {:.3e} s: the contact is stiffer than \
+                         the engine can integrate (check the contact and oil values)",
+                        self.t - self.block_t0
+                    ),
+                });
+            }
+            self.block_t0 = self.t;
+        }
         Ok(switch)
     }
 }

@@ -35,6 +35,17 @@ const INERTIA: Kind = Kind::Number(Rule::Bounded {
     floor: MIN_INERTIA_KG_M2,
     ceil: f64::INFINITY,
 });
+/// Largest speed magnitude accepted, rad/s (about 950 000 rpm).
+pub(crate) const MAX_SPEED_RAD_S: f64 = 1e5;
+/// A speed in rad/s: within +-[`MAX_SPEED_RAD_S`].
+const SPEED: Kind = Kind::Number(Rule::Closed(-MAX_SPEED_RAD_S, MAX_SPEED_RAD_S));
+/// Highest drive frequency accepted, Hz (torsional excitation of a driveline is below 1e4 Hz).
+pub(crate) const MAX_FREQUENCY_HZ: f64 = 1e5;
+/// A drive frequency in Hz: `> 0` and at most [`MAX_FREQUENCY_HZ`].
+const FREQUENCY: Kind = Kind::Number(Rule::Bounded {
+    floor: 0.0,
+    ceil: MAX_FREQUENCY_HZ,
+});
 /// Any finite number.
 const FINITE: Kind = Kind::Number(Rule::Finite);
 /// `> 0`.
@@ -92,7 +103,7 @@ table! {
         /// shaft damping C1 (inertial only)
         damping_n_m_s_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
         /// starting speed of the shaft
-        initial_speed_rad_s: "rad/s", FINITE, Dflt::When("required with drive.kind = \"torque_table\", an error otherwise");
+        initial_speed_rad_s: "rad/s", SPEED, Dflt::When("required with drive.kind = \"torque_table\", an error otherwise");
     }
     children {}
 }
@@ -103,11 +114,11 @@ table! {
         /// what drives the shaft
         kind: "", Kind::Choice(&["sine", "harmonics", "speed_table", "torque_table"]), Dflt::Required;
         /// mean shaft speed
-        omega0_rad_s: "rad/s", FINITE, Dflt::When("required for sine and harmonics");
+        omega0_rad_s: "rad/s", SPEED, Dflt::When("required for sine and harmonics");
         /// speed amplitude (Hu et al. eq (3))
-        amplitude_rad_s: "rad/s", FINITE, Dflt::When("sine: required");
+        amplitude_rad_s: "rad/s", SPEED, Dflt::When("sine: required");
         /// excitation frequency
-        frequency_hz: "Hz", POSITIVE, Dflt::When("sine: required");
+        frequency_hz: "Hz", FREQUENCY, Dflt::When("sine: required");
         /// phase of the sine (sine only)
         phase_deg: "deg", FINITE, Dflt::Num(0.0);
         /// CSV with a header row, relative to the scene file's folder; speed_table: columns time_s, speed_rad_s; torque_table: columns time_s, torque_n_m (needs shaft.mode = "inertial")
@@ -122,9 +133,9 @@ table! {
     /// One `[[drive.harmonics]]` entry (drive.kind = "harmonics": at least one).
     RawHarmonic at "drive.harmonics[]" {
         /// amplitude of this term
-        amplitude_rad_s: "rad/s", FINITE, Dflt::Required;
+        amplitude_rad_s: "rad/s", SPEED, Dflt::Required;
         /// frequency of this term
-        frequency_hz: "Hz", POSITIVE, Dflt::Required;
+        frequency_hz: "Hz", FREQUENCY, Dflt::Required;
         /// phase of this term
         phase_deg: "deg", FINITE, Dflt::Num(0.0);
     }
@@ -141,7 +152,7 @@ table! {
         /// drum drag
         drag_n_m_s_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
         /// starting speed of the drum
-        initial_speed_rad_s: "rad/s", FINITE, Dflt::Num(0.0);
+        initial_speed_rad_s: "rad/s", SPEED, Dflt::Num(0.0);
     }
     children {}
 }
@@ -232,7 +243,7 @@ table! {
         /// phi(0) = theta_shaft - theta_disc; must lie inside the free play
         initial_rel_angle_rad: "rad", FINITE, Dflt::Num(0.0);
         /// omega_shaft(0) - omega_disc(0)
-        initial_rel_speed_rad_s: "rad/s", FINITE, Dflt::Num(0.0);
+        initial_rel_speed_rad_s: "rad/s", SPEED, Dflt::Num(0.0);
         /// the disc may move radially on its spline (multibody engine only)
         radial_float: "", Kind::Bool, Dflt::Bool(false);
         /// one per tooth (tooth k at 2 pi k / n from the shaft's +x axis) or none; circumferential spacing error at the pitch circle, positive closes the shaft-leads gap (multibody engine only)

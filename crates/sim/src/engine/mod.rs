@@ -284,6 +284,8 @@ impl MultibodyEngine {
         let mut steps: u64 = 0;
         let mut stopped = false;
         let mut t_last_good = 0.0;
+        // simulated time at the start of the stall check's current block, s
+        let mut stall_t0 = 0.0;
         // A step costs about the same per body: poll the stop every PROGRESS_BODY_STEPS
         // body-steps.
         let progress_every = (PROGRESS_BODY_STEPS / (run.couplings.len() as u64).max(1)).max(1);
@@ -306,6 +308,25 @@ impl MultibodyEngine {
             }
             if steps > 0 && steps.is_multiple_of(progress_every) && observer.progress(run.t) {
                 stopped = true;
+            }
+            if steps > 0
+                && steps.is_multiple_of(clutchpack_model::STALL_STEPS)
+                && matches!(opts.stepping, Stepping::Adaptive(_))
+            {
+                // adaptive steps far below any real pack's: stop rather than run for days
+                let span = run.t - stall_t0;
+                if span < clutchpack_model::STALL_SPAN_S {
+                    return Err(EngineError::Diverged {
+                        t_s: run.t,
+                        reason: format!(
+                            "{} steps advanced only {span:.3e} s: a coupling is stiffer, or the \
+                             drive faster, than the engine can integrate (check the contact, oil \
+                             and drive values)",
+                            clutchpack_model::STALL_STEPS
+                        ),
+                    });
+                }
+                stall_t0 = run.t;
             }
             if stopped || run.t >= duration_s {
                 break;
