@@ -288,9 +288,8 @@ fn shard_auto_reads_the_array_index() {
 }
 
 /// The Parquet table opens in pyarrow with the documented column names and types. Python:
-/// `$CLUTCHPACK_PYTHON`, else the tests' environment (target/pyenv, tests/python/setup.sh) if
-/// it has pyarrow, else `python3`; skipped loudly without pyarrow unless
-/// `CLUTCHPACK_REQUIRE_PYARROW=1`.
+/// `$CLUTCHPACK_PYTHON`, else the tests' environment (target/pyenv, which tests/python/setup.sh
+/// installs with pyarrow); skipped loudly without pyarrow unless `CLUTCHPACK_REQUIRE_PYARROW=1`.
 #[test]
 fn parquet_opens_in_pyarrow() {
     let has = |py: &str| {
@@ -299,11 +298,9 @@ fn parquet_opens_in_pyarrow() {
             .output()
             .is_ok_and(|o| o.status.success())
     };
-    let pyenv = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/pyenv/bin/python");
     let py = match std::env::var("CLUTCHPACK_PYTHON") {
         Ok(p) => p,
-        Err(_) if has(&pyenv.display().to_string()) => pyenv.display().to_string(),
-        Err(_) => "python3".into(),
+        Err(_) => crate::python_reader().display().to_string(),
     };
     if !has(&py) {
         eprintln!("SKIPPED: no pyarrow in {py} (set CLUTCHPACK_PYTHON to a python with pyarrow)");

@@ -554,14 +554,21 @@ fn bad_recordings_exit_2_with_one_line() {
 
 /// Path of the independent reader's python (tests/python/setup.sh installs the official
 /// `mcap` and `mcap-protobuf-support` packages into target/pyenv).
+/// Also rainflow, numpy (tests/fatigue.rs) and pyarrow (tests/study.rs). Installed once per
+/// test run: the tests that need it wait for the first (two setup.sh at once would both
+/// rebuild the environment).
 fn python_reader() -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let o = Command::new("bash")
-        .arg(root.join("tests/python/setup.sh"))
-        .output()
-        .expect("bash runs");
-    assert!(o.status.success(), "setup.sh: {}", stderr(&o));
-    PathBuf::from(String::from_utf8(o.stdout).unwrap().trim())
+    static PY: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    PY.get_or_init(|| {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let o = Command::new("bash")
+            .arg(root.join("tests/python/setup.sh"))
+            .output()
+            .expect("bash runs");
+        assert!(o.status.success(), "setup.sh: {}", stderr(&o));
+        PathBuf::from(String::from_utf8(o.stdout).unwrap().trim())
+    })
+    .clone()
 }
 
 fn read_independently(file: &Path, allow_truncated: bool) -> Value {
