@@ -3,8 +3,12 @@
 
 /// Body poses, `foxglove.FrameTransforms`.
 pub const TF: &str = "/tf";
-/// Pack geometry and load colours, `foxglove.SceneUpdate`.
+/// The pack's static geometry, `foxglove.SceneUpdate`: one message at t = 0 and nothing
+/// after it, so that "the latest message" of this topic is always the whole pack.
 pub const SCENE: &str = "/scene";
+/// Load colours over the teeth, `foxglove.SceneUpdate`: every message holds every disc's
+/// colour, so that its latest message restores them all.
+pub const SCENE_LOADS: &str = "/scene/loads";
 /// Shaft angle and speed, `clutchpack.ShaftState`.
 pub const SHAFT: &str = "/shaft";
 /// Impact events, `clutchpack.Impact`.
@@ -17,6 +21,14 @@ pub const DISCS_PREFIX: &str = "/discs/";
 /// `/discs/<segment>/spline`, `clutchpack.SplineState`.
 pub fn spline(segment: &str) -> String {
     format!("{DISCS_PREFIX}{segment}/spline")
+}
+
+/// `/discs/<segment>/impacts`, `clutchpack.Impact`: the disc's impacts, each logged at its
+/// peak time `t_peak_s` with its exact located peak load `peak_n` (the same messages as on
+/// [`IMPACTS`]), so that a plot of `peak_n` shows the true peaks that the sampled `load_n`
+/// can miss (a contact lasts about as long as a sample interval).
+pub fn disc_impacts(segment: &str) -> String {
+    format!("{DISCS_PREFIX}{segment}/impacts")
 }
 
 /// `/discs/<segment>/teeth`, `clutchpack.ToothLoads`.

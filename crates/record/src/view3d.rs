@@ -1,32 +1,40 @@
-//! The 3D view: body poses (`/tf`, `foxglove.FrameTransforms`) and the pack's geometry
-//! (`/scene`, `foxglove.SceneUpdate`).
+//! The 3D view: body poses (`/tf`, `foxglove.FrameTransforms`), the pack's geometry
+//! (`/scene`, `foxglove.SceneUpdate`) and its load colours (`/scene/loads`, the same schema).
 //!
 //! Frames: `world` is fixed, z along the shaft axis. The shaft's frame `shaft` and each
 //! disc's frame `disc/<name>` sit on the axis (a disc's at its mid-plane `z_m`) and turn about
-//! +z by the body's angle. Entities are `frame_locked`, so they follow their frame. The first
-//! `/scene` message (at t = 0) holds the static bodies: the shaft cylinder with a stripe, and
-//! each disc as a triangle-mesh annulus with a rim marker and its spline teeth (steel grey):
-//! inside the bore of a friction disc, outside the rim of a separator plate. The meshes come
-//! from parry3d-f64 (the geometry library under the multibody engine): the annulus as convex
-//! wedges (`ConvexPolyhedron` hulls), each tooth as a `Cuboid`, triangulated by parry.
+//! +z by the body's angle. Entities are `frame_locked`, so they follow their frame.
 //!
-//! Loads are shown by small entities that later `/scene` messages replace:
-//! - `disc/<name>/load`: a translucent collar over the disc's spline teeth, coloured by the
-//!   largest `|load_n|` since the previous update (grey = no load, yellow = half, red = the
-//!   colour scale). One primitive per disc, about 200 bytes.
+//! **Static bodies and load colours are on separate topics**, so that a viewer that restores
+//! "the latest message of each topic" after a seek or on opening (Foxglove, Lichtblick) always
+//! has the whole pack. `/scene` holds one message at t = 0 with the static bodies and nothing
+//! else is ever sent on it: the shaft cylinder with a stripe, and each disc as a
+//! triangle-mesh annulus with a rim marker and its spline teeth (steel grey): inside the bore
+//! of a friction disc, outside the rim of a separator plate. The meshes come from parry3d-f64
+//! (the geometry library under the multibody engine): the annulus as convex wedges
+//! (`ConvexPolyhedron` hulls), each tooth as a `Cuboid`, triangulated by parry. Teeth are
+//! drawn as they are, one per tooth, up to [`MAX_TEETH`] per disc. The shaft is drawn over
+//! the discs' axial span plus a margin ([`drawn_shaft`]) unless the run info gives its
+//! geometry.
+//!
+//! `/scene/loads` holds the load colours, and **every message carries every disc**, so that
+//! its latest message alone restores all colours:
+//! - `disc/<name>/load`: a translucent ring over the disc's spline teeth (a line loop as
+//!   wide as the teeth are deep, about 400 bytes), coloured by the largest `|load_n|` since
+//!   the previous update (grey = no load, yellow = half, red = the colour scale).
 //! - `disc/<name>/teeth`, only for samples that carry per-tooth loads: the teeth redrawn as
-//!   cubes, each coloured by its own largest `|load|` since the previous update (about 130
-//!   bytes per tooth).
+//!   cubes, each coloured by its own largest `|load|` (about 130 bytes per tooth).
 //!
-//! An update holds only the discs whose colour changed (levels in steps of 1/16), so quiet
+//! A message is sent only when some colour changed (levels in steps of 1/16), so quiet
 //! stretches cost nothing. Redrawing every tooth for a lumped load (one colour for all) was
 //! measured at 10 kB per disc and update, 70 % of a recording's bytes and most of its
-//! writing time; the collar says the same in 200 bytes.
+//! writing time; the ring says the same in a few hundred bytes.
 
-use crate::info::{DiscGeometry, RunInfo};
+use crate::info::{DiscGeometry, RunInfo, ShaftGeometry};
 use foxglove::schemas::{
-    Color, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms, Point3, Pose,
-    Quaternion, SceneEntity, SceneUpdate, Timestamp, TriangleListPrimitive, Vector3,
+    line_primitive, Color, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms,
+    LinePrimitive, Point3, Pose, Quaternion, SceneEntity, SceneUpdate, Timestamp,
+    TriangleListPrimitive, Vector3,
 };
 use parry3d_f64::math::Vector;
 use parry3d_f64::shape::{ConvexPolyhedron, Cuboid};
@@ -46,8 +54,12 @@ pub fn disc_frame(segment: &str) -> String {
 const SEGMENTS: u32 = 64;
 /// Teeth drawn when a disc's tooth count is unknown (0).
 const MARKERS: u32 = 8;
-/// At most this many teeth are drawn per disc.
-const MAX_TEETH: u32 = 96;
+/// At most this many teeth are drawn per disc (a disc with more is drawn with this many,
+/// evenly spaced). Real splines have up to about 150 teeth; the static teeth mesh costs about
+/// 340 bytes per tooth, once per recording.
+pub const MAX_TEETH: u32 = 400;
+/// Segments of a load ring (a line loop).
+const RING_SEGMENTS: u32 = 32;
 
 pub(crate) fn timestamp(log_time_ns: u64) -> Timestamp {
     Timestamp::new(
@@ -269,7 +281,7 @@ fn entity(log_time_ns: u64, frame: &str, id: &str) -> SceneEntity {
 
 /// The static scene: shaft and disc bodies, plus the teeth at zero load.
 pub(crate) fn static_scene(info: &RunInfo, frames: &[String]) -> SceneUpdate {
-    let s = info.shaft_geometry();
+    let s = drawn_shaft(info);
     let len = (s.z_max_m - s.z_min_m).abs().max(1e-6);
     let zc = 0.5 * (s.z_max_m + s.z_min_m);
     let mut shaft = entity(0, SHAFT_FRAME, "shaft");
@@ -305,11 +317,39 @@ pub(crate) fn static_scene(info: &RunInfo, frames: &[String]) -> SceneUpdate {
         e.triangles.push(teeth_mesh(d, Some(STEEL)));
         entities.push(e);
     }
-    let zeros: Vec<(usize, f64)> = (0..info.discs.len()).map(|i| (i, 0.0)).collect();
-    entities.extend(load_scene(0, info, frames, &zeros).entities);
     SceneUpdate {
         deletions: Vec::new(),
         entities,
+    }
+}
+
+/// The shaft as drawn: the run info's geometry when given; otherwise the derived radius over
+/// the discs' axial span plus a margin of a quarter of that span (at least two disc
+/// thicknesses) on each side, so that a thin pack is not drawn on a long rod.
+pub(crate) fn drawn_shaft(info: &RunInfo) -> ShaftGeometry {
+    let s = info.shaft_geometry();
+    if info.shaft.is_some() || info.discs.is_empty() {
+        return s;
+    }
+    let (lo, hi, h) = info.discs.iter().fold(
+        (f64::INFINITY, f64::NEG_INFINITY, 0.0_f64),
+        |(lo, hi, h), d| {
+            let t = 0.5 * d.thickness_m.abs();
+            (
+                lo.min(d.z_m - t),
+                hi.max(d.z_m + t),
+                h.max(d.thickness_m.abs()),
+            )
+        },
+    );
+    if !(lo.is_finite() && hi.is_finite()) {
+        return s;
+    }
+    let margin = (0.25 * (hi - lo)).max(2.0 * h).max(1e-6);
+    ShaftGeometry {
+        radius_m: s.radius_m,
+        z_min_m: lo - margin,
+        z_max_m: hi + margin,
     }
 }
 
@@ -348,10 +388,19 @@ fn tooth_cubes(d: &DiscGeometry, color: impl Fn(usize) -> Color) -> Vec<CubePrim
         .collect()
 }
 
-/// The load collars of the discs `levels` names, `(disc index, level)`, coloured by the
-/// level `max |load| / scale` (0..=1): a translucent cylinder over each disc's spline teeth
-/// (radius the tooth root, a little thicker than the disc). Other discs' collars are left as
-/// they are.
+/// The radial band of a disc's drawn teeth in m, `(root side, tip side)`: inside the bore
+/// of a friction disc, outside the rim of a plate.
+fn teeth_band(d: &DiscGeometry) -> (f64, f64) {
+    let c = tooth_centre_radius(d);
+    let half = 0.5 * tooth_depth(d).max(1e-6);
+    (c - half, c + half)
+}
+
+/// The load rings of the discs `levels` names, `(disc index, level)`, coloured by the level
+/// `max |load| / scale` (0..=1): a translucent line loop of [`RING_SEGMENTS`] points at the
+/// middle of the disc's teeth, a little wider than the teeth are deep, so it lies over the
+/// teeth and leaves the bore open. The recorder passes every disc, so that one message
+/// restores all colours.
 pub(crate) fn load_scene(
     log_time_ns: u64,
     info: &RunInfo,
@@ -364,22 +413,28 @@ pub(crate) fn load_scene(
             continue;
         };
         let mut e = entity(log_time_ns, frame, &format!("{frame}/load"));
-        let r = if d.teeth_outside {
-            d.outer_radius_m.max(d.inner_radius_m) + tooth_depth(d)
-        } else {
-            d.inner_radius_m.min(d.outer_radius_m)
-        }
-        .abs()
-        .max(1e-6);
-        let h = 1.4 * d.thickness_m.abs().max(1e-6);
+        let (a, b) = teeth_band(d);
+        let r = 0.5 * (a + b);
         let mut color = load_color(level);
-        color.a = 0.55;
-        e.cylinders.push(CylinderPrimitive {
+        color.a = 0.8;
+        e.lines.push(LinePrimitive {
+            r#type: line_primitive::Type::LineLoop as i32,
             pose: pose(0.0, 0.0, 0.0, 0.0),
-            size: Some(v3(2.0 * r, 2.0 * r, h)),
-            bottom_scale: 1.0,
-            top_scale: 1.0,
+            thickness: 1.3 * (b - a).abs().max(1e-6),
+            scale_invariant: false,
+            points: (0..RING_SEGMENTS)
+                .map(|k| {
+                    let t = 2.0 * PI * f64::from(k) / f64::from(RING_SEGMENTS);
+                    Point3 {
+                        x: r * t.cos(),
+                        y: r * t.sin(),
+                        z: 0.0,
+                    }
+                })
+                .collect(),
             color: Some(color),
+            colors: Vec::new(),
+            indices: Vec::new(),
         });
         entities.push(e);
     }

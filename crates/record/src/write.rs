@@ -176,6 +176,10 @@ struct Channels {
     interfaces: Vec<u16>,
     impacts: u16,
     summary: u16,
+    /// `/scene/loads`: the load colours, every disc in each message
+    scene_loads: u16,
+    /// `/discs/<segment>/impacts`: each disc's impacts at their peak times
+    disc_impacts: Vec<u16>,
 }
 
 /// Streams a run into an MCAP file. See the crate documentation for the topics.
@@ -212,6 +216,11 @@ pub struct Recorder {
     tooth_max_since_scene: Vec<Vec<f64>>,
     /// per disc, the colour level last sent of each drawn tooth, in 1/16
     tooth_levels: Vec<Vec<u8>>,
+    /// colour level (0..=1) of each disc's load ring as last sent, re-sent with every update
+    ring_levels: Vec<f64>,
+    /// per disc, the colour level (0..=1) of each drawn tooth as last sent (per-tooth only),
+    /// re-sent with every update
+    tooth_levels_sent: Vec<Vec<f64>>,
     max_abs_run: f64,
     peaks: Vec<Vec<f64>>,
     last_t_s: f64,
@@ -387,6 +396,17 @@ impl Recorder {
         }
         let impacts = channel(&mut w, s_impact, topics::IMPACTS, none())?;
         let summary = channel(&mut w, s_summary, topics::SUMMARY, none())?;
+        // viewer channels, after the others so that those keep their ids
+        let scene_loads = channel(&mut w, s_scene, topics::SCENE_LOADS, none())?;
+        let mut disc_impacts = Vec::with_capacity(names.len());
+        for (i, (name, seg)) in names.iter().zip(&segments).enumerate() {
+            let meta: BTreeMap<String, String> = [
+                ("disc".to_string(), name.clone()),
+                ("disc_index".to_string(), i.to_string()),
+            ]
+            .into();
+            disc_impacts.push(channel(&mut w, s_impact, &topics::disc_impacts(seg), meta)?);
+        }
 
         let frames: Vec<String> = segments.iter().map(|s| disc_frame(s)).collect();
         let tf_discs: Vec<(String, f64, f64)> = frames
@@ -413,6 +433,8 @@ impl Recorder {
                 interfaces,
                 impacts,
                 summary,
+                scene_loads,
+                disc_impacts,
             },
             sequences: BTreeMap::new(),
             buf: Vec::with_capacity(4096),
@@ -431,6 +453,8 @@ impl Recorder {
             scene_levels: vec![0; n],
             tooth_max_since_scene: vec![Vec::new(); n],
             tooth_levels: vec![Vec::new(); n],
+            ring_levels: vec![0.0; n],
+            tooth_levels_sent: vec![Vec::new(); n],
             max_abs_run: 0.0,
             peaks: vec![Vec::new(); n],
             last_t_s: 0.0,
@@ -439,6 +463,8 @@ impl Recorder {
         };
         let static_scene = view3d::static_scene(&rec.info, &rec.frames);
         rec.put(rec.ch.scene, 0, &static_scene, "/scene")?;
+        let rings = view3d::load_scene(0, &rec.info, &rec.frames, &rec.all_rings());
+        rec.put(rec.ch.scene_loads, 0, &rings, "/scene/loads")?;
         rec.flush()?;
         Ok(rec)
     }
@@ -647,19 +673,21 @@ impl Recorder {
                 .load_color_scale_n
                 .unwrap_or(self.max_abs_run)
                 .max(f64::MIN_POSITIVE);
-            let mut changed = Vec::new();
+            let mut changed = false;
             for (i, a) in self.max_abs_since_scene.iter_mut().enumerate() {
                 let level = (*a / scale).clamp(0.0, 1.0);
                 let q = quantize(level);
                 if self.scene_levels.get(i) != Some(&q) {
-                    changed.push((i, level));
+                    changed = true;
                     if let Some(l) = self.scene_levels.get_mut(i) {
                         *l = q;
+                    }
+                    if let Some(l) = self.ring_levels.get_mut(i) {
+                        *l = level;
                     }
                 }
                 *a = 0.0;
             }
-            let mut update = view3d::load_scene(lt, &self.info, &self.frames, &changed);
             // per-tooth colours: drawn tooth k shows the largest load of the teeth it stands
             // for (all of them when the disc has no more teeth than are drawn)
             let mut teeth: Vec<(usize, Vec<f64>)> = Vec::new();
@@ -689,18 +717,32 @@ impl Recorder {
                 }
                 maxima.iter_mut().for_each(|m| *m = 0.0);
             }
-            if !teeth.is_empty() {
-                let refs: Vec<(usize, &[f64])> =
-                    teeth.iter().map(|(i, l)| (*i, l.as_slice())).collect();
+            if changed || !teeth.is_empty() {
+                // every disc's ring and teeth, so that the latest message restores all colours
+                let mut update =
+                    view3d::load_scene(lt, &self.info, &self.frames, &self.all_rings());
+                for (i, levels) in teeth {
+                    self.tooth_levels_sent[i] = levels;
+                }
+                let refs: Vec<(usize, &[f64])> = self
+                    .tooth_levels_sent
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, l)| !l.is_empty())
+                    .map(|(i, l)| (i, l.as_slice()))
+                    .collect();
                 update
                     .entities
                     .extend(view3d::teeth_scene(lt, &self.info, &self.frames, &refs).entities);
-            }
-            if !update.entities.is_empty() {
-                self.put(self.ch.scene, lt, &update, "/scene")?;
+                self.put(self.ch.scene_loads, lt, &update, "/scene/loads")?;
             }
         }
         self.maybe_flush()
+    }
+
+    /// `(disc index, level)` of every disc's load ring as last sent.
+    fn all_rings(&self) -> Vec<(usize, f64)> {
+        self.ring_levels.iter().copied().enumerate().collect()
     }
 
     /// Writes the stack's friction interfaces at `t_s` (s), one `/interfaces/<segment>`
@@ -768,6 +810,9 @@ impl Recorder {
             peak_n: e.peak_n,
         };
         self.put(self.ch.impacts, log_time_ns(e.t_peak_s), &msg, "/impacts")?;
+        if let Some(&ch) = self.ch.disc_impacts.get(e.disc) {
+            self.put(ch, log_time_ns(e.t_peak_s), &msg, "impacts")?;
+        }
         self.maybe_flush()
     }
 
