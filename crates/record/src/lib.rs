@@ -42,7 +42,7 @@
 //! | `/interfaces/<lower>__<upper>` | `clutchpack.InterfaceState` | each sample, packs with a stack | `t_s, slip_rad_s, slip_m_s, mu, clamp_n, torque_n_m, locked, interface_index, dissipated_j` |
 //! | `/impacts` | `clutchpack.Impact` | each impact, at `t_peak_s` | `disc, disc_index, t_on_s, t_peak_s, t_off_s, flank, v_on_m_s, peak_n` |
 //! | `/discs/<segment>/impacts` | `clutchpack.Impact` | each impact of that disc, at `t_peak_s` | the same messages as `/impacts`: a per-disc series of the exact located peaks |
-//! | `/summary` | `clutchpack.RunSummary` | once, at the end | `t_end_s, discs[]{name, index, max_positive_n, max_negative_n, p99_abs_n, impacts, positive_impacts, negative_impacts, mean_top10_abs_n}` |
+//! | `/summary` | `clutchpack.RunSummary` | once, written at the end, logged at t = 0 (so viewers show it on open) | `t_end_s, discs[]{name, index, max_positive_n, max_negative_n, p99_abs_n, impacts, positive_impacts, negative_impacts, mean_top10_abs_n}` |
 //!
 //! `<segment>` is the disc's scene name made topic-safe by [`topic_segment`]. The
 //! `clutchpack.*` schemas are in `crates/record/proto/clutchpack.proto` (generated from

@@ -13,7 +13,8 @@ pub const SCENE_LOADS: &str = "/scene/loads";
 pub const SHAFT: &str = "/shaft";
 /// Impact events, `clutchpack.Impact`.
 pub const IMPACTS: &str = "/impacts";
-/// Per-disc summary at the end of the run, `clutchpack.RunSummary`.
+/// Per-disc summary of the run, `clutchpack.RunSummary`: written when the run ends, logged
+/// at t = 0 so that a viewer shows it from the start.
 pub const SUMMARY: &str = "/summary";
 /// Prefix of the per-disc topics.
 pub const DISCS_PREFIX: &str = "/discs/";

@@ -827,8 +827,9 @@ impl Recorder {
             return Err(self.failed_err());
         }
         let summary = summary.unwrap_or_else(|| self.summary());
-        let lt = log_time_ns(self.last_t_s.max(summary.t_end_s));
-        self.put(self.ch.summary, lt, &summary.to_proto(), "/summary")?;
+        // logged at t = 0 although written last: viewers open a file at its start and show
+        // the latest message of each topic, so the summary is there from the first frame
+        self.put(self.ch.summary, 0, &summary.to_proto(), "/summary")?;
         let path = self.path.clone();
         let write_err = |what: &str, source| RecordError::Write {
             path: path.clone(),
