@@ -487,6 +487,91 @@ mod tests {
         assert_eq!((load_color(2.0).g, load_color(f64::NAN).g), (0.0, 0.0));
     }
 
+    fn disc(teeth: u32, z_m: f64) -> DiscGeometry {
+        DiscGeometry {
+            name: "d".into(),
+            inner_radius_m: 0.05,
+            outer_radius_m: 0.08,
+            thickness_m: 0.002,
+            z_m,
+            teeth,
+            teeth_outside: false,
+        }
+    }
+
+    /// Teeth are drawn as many as the disc has, up to [`MAX_TEETH`]; an unknown count gets
+    /// [`MARKERS`].
+    #[test]
+    fn teeth_are_drawn_as_they_are_up_to_the_cap() {
+        assert_eq!(drawn_teeth(&disc(150, 0.0)), 150);
+        assert_eq!(drawn_teeth(&disc(MAX_TEETH, 0.0)), MAX_TEETH);
+        assert_eq!(drawn_teeth(&disc(MAX_TEETH + 1, 0.0)), MAX_TEETH);
+        assert_eq!(drawn_teeth(&disc(0, 0.0)), MARKERS);
+    }
+
+    /// Without a given shaft, the shaft spans the discs plus a quarter of their span (at
+    /// least two disc thicknesses) at each end: a 36 mm pack gets a 54 mm shaft, not one a
+    /// disc diameter longer at each end.
+    #[test]
+    fn the_shaft_is_scaled_to_the_pack() {
+        let info = RunInfo {
+            discs: (0..10)
+                .map(|k| disc(30, 0.001 + 0.00377 * f64::from(k)))
+                .collect(),
+            ..Default::default()
+        };
+        // discs span z = 0 .. 0.03593 + 0.001
+        let (lo, hi) = (0.0, 0.00377 * 9.0 + 0.002);
+        let s = drawn_shaft(&info);
+        let m = 0.25 * (hi - lo);
+        assert!((s.z_min_m - (lo - m)).abs() < 1e-12, "{s:?}");
+        assert!((s.z_max_m - (hi + m)).abs() < 1e-12, "{s:?}");
+        assert_eq!(s.radius_m, info.shaft_geometry().radius_m);
+        // one thin disc: two thicknesses each side
+        let one = RunInfo {
+            discs: vec![disc(30, 0.0)],
+            ..Default::default()
+        };
+        let s = drawn_shaft(&one);
+        assert!((s.z_max_m - 0.005).abs() < 1e-12 && (s.z_min_m + 0.005).abs() < 1e-12);
+        // a given shaft is drawn as given
+        let given = ShaftGeometry {
+            radius_m: 0.01,
+            z_min_m: -1.0,
+            z_max_m: 1.0,
+        };
+        let info = RunInfo {
+            shaft: Some(given.clone()),
+            ..info
+        };
+        assert_eq!(drawn_shaft(&info), given);
+    }
+
+    /// Every disc's load ring lies over its teeth: a closed loop at the middle of the teeth
+    /// band, as wide as the band and a little more, coloured by the level.
+    #[test]
+    fn load_rings_lie_over_the_teeth() {
+        let info = RunInfo {
+            discs: vec![disc(30, 0.0), disc(30, 0.01)],
+            ..Default::default()
+        };
+        let frames = ["disc/a".to_string(), "disc/b".to_string()];
+        let u = load_scene(5, &info, &frames, &[(0, 0.0), (1, 1.0)]);
+        assert_eq!(u.entities.len(), 2);
+        let (a, b) = teeth_band(&info.discs[0]);
+        assert!(b <= 0.05 + 1e-12 && a < b, "inside the bore: {a} {b}");
+        for (e, level) in u.entities.iter().zip([0.0, 1.0]) {
+            let l = &e.lines[0];
+            assert_eq!(l.r#type, line_primitive::Type::LineLoop as i32);
+            assert_eq!(l.points.len(), RING_SEGMENTS as usize);
+            for p in &l.points {
+                assert!((p.x.hypot(p.y) - 0.5 * (a + b)).abs() < 1e-12);
+            }
+            assert!((l.thickness - 1.3 * (b - a)).abs() < 1e-12);
+            assert_eq!(l.color.unwrap().g, load_color(level).g);
+        }
+    }
+
     /// Signed volume `sum (p0 . (p1 x p2)) / 6` of a triangle list: the enclosed volume for
     /// a closed surface with outward normals (negative for inward ones).
     fn signed_volume(m: &TriangleListPrimitive) -> f64 {
