@@ -29,13 +29,16 @@
 //! - Depend on rapier or on the engines: it knows only `clutchpack_model`'s stream types.
 //!
 //! ## Topics
-//! All messages are protobuf; log time = publish time = simulated time in ns (deterministic).
+//! All messages are protobuf but `/joints` (ROS 2 CDR, for Rerun); log time = publish time =
+//! simulated time in ns (deterministic).
 //!
 //! | topic | schema | when | fields (units in names) |
 //! | --- | --- | --- | --- |
 //! | `/tf` | `foxglove.FrameTransforms` | every [`RecordOptions::tf_interval_s`] (0.2 ms) | `world` -> `shaft`, `world` -> `disc/<segment>`: rotation about +z, discs at `z_m` |
 //! | `/scene` | `foxglove.SceneUpdate` | once, at t = 0 | the static pack: shaft cylinder, disc annuli (triangle meshes) with their teeth |
 //! | `/scene/loads` | `foxglove.SceneUpdate` | t = 0, then every [`RecordOptions::scene_interval_s`] when a colour changed | every disc's load ring over its teeth coloured by load (per-tooth runs: each tooth by its own load) |
+//! | `/pack/<frame>` | `foxglove.PointCloud` | once, at t = 0 | the same pack as points in each body's frame, for Rerun (which does not draw scene updates) |
+//! | `/joints` | `sensor_msgs/msg/JointState` (`ros2msg`, `cdr`) | each sample | one joint per disc: `position` = `rel_angle_rad`, `velocity` = shaft minus disc speed (rad/s), `effort` = `load_n`; Rerun plots it with no setup |
 //! | `/shaft` | `clutchpack.ShaftState` | each sample | `t_s, angle_rad, speed_rad_s` |
 //! | `/discs/<segment>/spline` | `clutchpack.SplineState` | each sample | `t_s, rel_angle_rad, closing_speed_m_s, penetration_m, load_n, torque_n_m, engaged, stiffness_n_m1_5, speed_rad_s, angle_rad, disc_index` |
 //! | `/discs/<segment>/teeth` | `clutchpack.ToothLoads` | each sample, if [`RecordOptions::per_tooth`] | `t_s, loads_n[], disc_index` |
@@ -97,6 +100,7 @@ mod export;
 pub mod info;
 pub mod proto;
 mod read;
+mod ros2;
 #[cfg(feature = "serve")]
 mod serve;
 mod summary;

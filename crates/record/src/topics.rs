@@ -9,6 +9,22 @@ pub const SCENE: &str = "/scene";
 /// Load colours over the teeth, `foxglove.SceneUpdate`: every message holds every disc's
 /// colour, so that its latest message restores them all.
 pub const SCENE_LOADS: &str = "/scene/loads";
+/// The spline couplings as joints, `sensor_msgs/msg/JointState` (ROS 2, CDR), one message
+/// per sample: one joint per disc, named by the disc; `position` = `rel_angle_rad`,
+/// `velocity` = shaft minus disc speed in rad/s, `effort` = `load_n` (N per tooth). For
+/// viewers that plot well-known messages without configuration (Rerun: a time series per
+/// field, one line per disc).
+pub const JOINTS: &str = "/joints";
+/// Prefix of the point-cloud pack (`foxglove.PointCloud`, one per body, at t = 0), for
+/// viewers that draw point clouds but not `foxglove.SceneUpdate` (Rerun).
+pub const PACK_PREFIX: &str = "/pack/";
+
+/// `/pack/<frame>`: the point cloud of the body whose frame is `frame` (`shaft`,
+/// `disc/<segment>`).
+pub fn pack(frame: &str) -> String {
+    format!("{PACK_PREFIX}{frame}")
+}
+
 /// Shaft angle and speed, `clutchpack.ShaftState`.
 pub const SHAFT: &str = "/shaft";
 /// Impact events, `clutchpack.Impact`.

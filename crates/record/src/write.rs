@@ -180,6 +180,8 @@ struct Channels {
     scene_loads: u16,
     /// `/discs/<segment>/impacts`: each disc's impacts at their peak times
     disc_impacts: Vec<u16>,
+    /// `/joints`: `sensor_msgs/msg/JointState`, for Rerun's plots
+    joints: u16,
 }
 
 /// Streams a run into an MCAP file. See the crate documentation for the topics.
@@ -221,6 +223,10 @@ pub struct Recorder {
     /// per disc, the colour level (0..=1) of each drawn tooth as last sent (per-tooth only),
     /// re-sent with every update
     tooth_levels_sent: Vec<Vec<f64>>,
+    /// `/joints` message buffer
+    joint_buf: Vec<u8>,
+    /// `/joints` values (position, velocity, effort per disc), reused
+    joint_values: [Vec<f64>; 3],
     max_abs_run: f64,
     peaks: Vec<Vec<f64>>,
     last_t_s: f64,
@@ -407,8 +413,30 @@ impl Recorder {
             .into();
             disc_impacts.push(channel(&mut w, s_impact, &topics::disc_impacts(seg), meta)?);
         }
-
+        // for Rerun, which maps these to its own archetypes (crate::ros2, view3d::pack_points)
+        let s_joints = w
+            .add_schema(
+                crate::ros2::JOINT_STATE,
+                "ros2msg",
+                crate::ros2::JOINT_STATE_SCHEMA.as_bytes(),
+            )
+            .map_err(|e| write_err("schema", e))?;
+        let joints = w
+            .add_channel(s_joints, topics::JOINTS, "cdr", &none())
+            .map_err(|e| write_err("channel", e))?;
+        let s_cloud = schema(
+            &mut w,
+            "foxglove.PointCloud",
+            &fx(foxglove::schemas::PointCloud::get_schema()),
+        )?;
         let frames: Vec<String> = segments.iter().map(|s| disc_frame(s)).collect();
+        let mut clouds = Vec::with_capacity(frames.len() + 1);
+        for (frame, cloud) in view3d::pack_points(info, &frames) {
+            clouds.push((
+                channel(&mut w, s_cloud, &topics::pack(&frame), none())?,
+                cloud,
+            ));
+        }
         let tf_discs: Vec<(String, f64, f64)> = frames
             .iter()
             .zip(&info.discs)
@@ -435,6 +463,7 @@ impl Recorder {
                 summary,
                 scene_loads,
                 disc_impacts,
+                joints,
             },
             sequences: BTreeMap::new(),
             buf: Vec::with_capacity(4096),
@@ -455,6 +484,8 @@ impl Recorder {
             tooth_levels: vec![Vec::new(); n],
             ring_levels: vec![0.0; n],
             tooth_levels_sent: vec![Vec::new(); n],
+            joint_buf: Vec::with_capacity(256),
+            joint_values: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
             max_abs_run: 0.0,
             peaks: vec![Vec::new(); n],
             last_t_s: 0.0,
@@ -465,6 +496,9 @@ impl Recorder {
         rec.put(rec.ch.scene, 0, &static_scene, "/scene")?;
         let rings = view3d::load_scene(0, &rec.info, &rec.frames, &rec.all_rings());
         rec.put(rec.ch.scene_loads, 0, &rings, "/scene/loads")?;
+        for (ch, cloud) in clouds {
+            rec.put(ch, 0, &cloud, "/pack")?;
+        }
         rec.flush()?;
         Ok(rec)
     }
@@ -521,15 +555,20 @@ impl Recorder {
         msg: &M,
         what: &str,
     ) -> Result<(), RecordError> {
+        self.buf.clear();
+        // encoding into a Vec cannot run out of space
+        let _ = msg.encode(&mut self.buf);
+        self.put_buf(channel, log_time, what)
+    }
+
+    /// Writes the bytes in `self.buf` as a message on `channel` at `log_time` (ns).
+    fn put_buf(&mut self, channel: u16, log_time: u64, what: &str) -> Result<(), RecordError> {
         if self.failed {
             return Err(self.failed_err());
         }
         let Some(w) = self.writer.as_mut() else {
             return Err(self.failed_err());
         };
-        self.buf.clear();
-        // encoding into a Vec cannot run out of space
-        let _ = msg.encode(&mut self.buf);
         let seq = self.sequences.entry(channel).or_insert(0);
         *seq = seq.wrapping_add(1);
         let header = mcap::records::MessageHeader {
@@ -653,6 +692,7 @@ impl Recorder {
                 }
             }
         }
+        self.write_joints(lt, sample)?;
         if t >= self.next_tf_s {
             self.next_tf_s = next_tick(t, self.options.tf_interval_s);
             view3d::update_transforms(
@@ -738,6 +778,24 @@ impl Recorder {
             }
         }
         self.maybe_flush()
+    }
+
+    /// Writes `/joints` for a sample: per disc the relative angle (rad), the shaft's minus
+    /// the disc's speed (rad/s) and the tooth load (N).
+    fn write_joints(&mut self, lt: u64, sample: &Sample) -> Result<(), RecordError> {
+        let [pos, vel, eff] = &mut self.joint_values;
+        for (i, d) in sample.discs.iter().enumerate().take(pos.len()) {
+            pos[i] = d.rel_angle_rad;
+            vel[i] = sample.shaft_speed_rad_s - d.speed_rad_s;
+            eff[i] = d.load_n;
+        }
+        let mut buf = std::mem::take(&mut self.joint_buf);
+        crate::ros2::joint_state(&mut buf, lt, &self.names, pos, vel, eff);
+        std::mem::swap(&mut self.buf, &mut buf);
+        let r = self.put_buf(self.ch.joints, lt, "/joints");
+        std::mem::swap(&mut self.buf, &mut buf);
+        self.joint_buf = buf;
+        r
     }
 
     /// `(disc index, level)` of every disc's load ring as last sent.

@@ -133,3 +133,54 @@ fn impact_peak_series_equals_the_impacts_csv_peak_for_peak() {
     // the repeats are not counted as impacts of their own
     assert_eq!(open(&path).unwrap().impacts(), run.impacts);
 }
+
+/// For Rerun, which maps well-known messages to its own archetypes: `/joints`
+/// (`sensor_msgs/msg/JointState`, ROS 2 CDR) carries one message per sample whose `effort`
+/// (its last field: the final `8 n` bytes) is each disc's `load_n`, and `/pack/<frame>` one
+/// `foxglove.PointCloud` per body at t = 0 in that body's frame.
+#[test]
+fn rerun_topics_carry_the_loads_and_the_pack() {
+    let (run, path) = recorded("rerun.mcap");
+    let r = open(&path).unwrap();
+    let t = r.info().topic(topics::JOINTS).unwrap();
+    assert_eq!(
+        (t.schema_name.as_str(), t.schema_encoding.as_str()),
+        ("sensor_msgs/msg/JointState", "ros2msg")
+    );
+    assert_eq!(t.message_encoding, "cdr");
+    let m = by_topic(&path);
+    let joints = &m[topics::JOINTS];
+    assert_eq!(joints.len(), run.samples.len());
+    for ((t, data), s) in joints.iter().zip(&run.samples) {
+        assert_eq!(*t, log_time_ns(s.t_s));
+        let n = s.discs.len();
+        let effort: Vec<f64> = data[data.len() - 8 * n..]
+            .chunks(8)
+            .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        let want: Vec<f64> = s.discs.iter().map(|d| d.load_n).collect();
+        assert_eq!(effort, want);
+        // and the count before them
+        let count = &data[data.len() - 8 * n - 4..data.len() - 8 * n];
+        assert!(
+            count == (n as u32).to_le_bytes() || {
+                // padding to 8 may sit between the count and the values
+                let c = &data[data.len() - 8 * n - 8..data.len() - 8 * n - 4];
+                c == (n as u32).to_le_bytes()
+            }
+        );
+    }
+    for (topic, frame) in [
+        ("/pack/shaft", "shaft"),
+        ("/pack/disc/d1", "disc/d1"),
+        ("/pack/disc/disc_2", "disc/disc_2"),
+    ] {
+        let msgs = &m[topic];
+        assert_eq!(msgs.len(), 1, "{topic}");
+        assert_eq!(msgs[0].0, 0);
+        let cloud = foxglove::schemas::PointCloud::decode(msgs[0].1.as_slice()).unwrap();
+        assert_eq!(cloud.frame_id, frame);
+        assert_eq!(cloud.point_stride, 16);
+        assert!(cloud.data.len() > 16 * 100 && cloud.data.len() % 16 == 0);
+    }
+}
