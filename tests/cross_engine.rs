@@ -13,7 +13,7 @@
 //! checked with 512 steps per contact (0.14 us off).
 
 use clutchpack_model::{Collector, Engine, ImpactEvent};
-use clutchpack_reference::ReferenceEngine;
+use clutchpack_reference::{ReferenceEngine, Scheme, Settings};
 use clutchpack_scene::Override;
 use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Stepping};
 use std::path::Path;
@@ -42,13 +42,14 @@ fn impacts(engine: &mut dyn Engine, duration: f64) -> Vec<ImpactEvent> {
 fn assert_engines_agree(file: &str, sets: &[&str], steps_per_contact: Option<f64>) {
     let s = scene(file, sets);
     let duration = s.simulation.duration_s;
-    let mut oracle = s.clone();
-    oracle.simulation.tolerance = 1e-12;
-    let reference = impacts(&mut ReferenceEngine::from_scene(&oracle), duration);
-    let mut options = MultibodyOptions {
+    let oracle = Settings {
+        tolerance: 1e-12,
+        max_step_s: s.simulation.max_step_s,
         record_rate_hz: s.simulation.record_rate_hz,
-        ..MultibodyOptions::default()
     };
+    let mut oracle = ReferenceEngine::new(s.pack.clone(), oracle).with_scheme(Scheme::Monolithic);
+    let reference = impacts(&mut oracle, duration);
+    let mut options = MultibodyOptions::default();
     if let Some(spc) = steps_per_contact {
         options.stepping = Stepping::Adaptive(AdaptiveStepping {
             steps_per_contact: spc,
@@ -129,4 +130,103 @@ fn paper_case_50um() {
 #[test]
 fn four_disc_pack() {
     assert_engines_agree("scenes/pack-4-rattle.toml", &[], Some(512.0));
+}
+
+/// Issue 9: the multibody engine's two schemes on the 8-disc staggered pack
+/// (`clutchpack_model::cases::staggered_pack`, discs striking out of step) over 50 ms, impact
+/// by impact against the reference engine at tolerance 1e-12 (the oracle: 1e-12 and 1e-13
+/// agree to 4e-9 s in onset and 1.4e-6 in peak here): the same impacts on the same flanks,
+/// every peak within 0.1 % and every onset within 1 us (the issue's limits).
+///
+/// The pack is chaotic like the four-disc one: disc 5 (index 4) amplifies early differences
+/// a thousandfold by 40-50 ms. The multirate scheme (the default for this pack) runs at its
+/// defaults, 128 steps per contact graded at the kinks (measured 8.9e-8 s and 3.0e-5 worst);
+/// the shared step at its default 128 is 1.3 us off at 48.9 ms (its early onsets 1e-9 s off),
+/// so it is checked at 512 steps per contact, as the four-disc pack is (8.2e-8 s, 2.7e-5).
+mod staggered {
+    use super::impacts;
+    use clutchpack_model::cases::staggered_pack;
+    use clutchpack_model::ImpactEvent;
+    use clutchpack_reference::{ReferenceEngine, Settings};
+    use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping};
+
+    const DURATION_S: f64 = 0.05;
+
+    fn oracle() -> Vec<ImpactEvent> {
+        let settings = Settings {
+            tolerance: 1e-12,
+            ..Settings::default()
+        };
+        impacts(
+            &mut ReferenceEngine::new(staggered_pack(8), settings)
+                .with_scheme(clutchpack_reference::Scheme::Monolithic),
+            DURATION_S,
+        )
+    }
+
+    fn multibody(scheme: Scheme, steps_per_contact: f64) -> (Vec<ImpactEvent>, bool) {
+        let options = MultibodyOptions {
+            scheme,
+            stepping: Stepping::Adaptive(AdaptiveStepping {
+                steps_per_contact,
+                ..AdaptiveStepping::default()
+            }),
+            ..MultibodyOptions::default()
+        };
+        let mut e = MultibodyEngine::new(staggered_pack(8), options).unwrap();
+        (impacts(&mut e, DURATION_S), e.is_multirate())
+    }
+
+    fn assert_agree(scheme: Scheme, steps_per_contact: f64) {
+        let reference = oracle();
+        let (multibody, multirate) = multibody(scheme, steps_per_contact);
+        assert_eq!(multirate, scheme == Scheme::Multirate);
+        // every disc strikes again and again within 50 ms
+        assert!(reference.len() >= 8 * 15, "{}", reference.len());
+        assert_eq!(
+            reference.len(),
+            multibody.len(),
+            "{scheme:?}: impact counts"
+        );
+        let (mut worst_rel, mut worst_dt) = (0.0f64, 0.0f64);
+        for (r, m) in reference.iter().zip(&multibody) {
+            assert_eq!(
+                (r.disc, r.flank),
+                (m.disc, m.flank),
+                "{scheme:?}: {r:?} vs {m:?}"
+            );
+            let rel = (r.peak_n - m.peak_n).abs() / r.peak_n.abs();
+            assert!(
+                rel <= 1e-3,
+                "{scheme:?}: peak {} vs {} ({r:?})",
+                r.peak_n,
+                m.peak_n
+            );
+            let dt = (r.t_on_s - m.t_on_s).abs();
+            assert!(
+                dt <= 1e-6,
+                "{scheme:?}: onset {} vs {} ({r:?})",
+                r.t_on_s,
+                m.t_on_s
+            );
+            worst_rel = worst_rel.max(rel);
+            worst_dt = worst_dt.max(dt);
+        }
+        println!(
+            "staggered-8 {scheme:?}: {} impacts, worst peak difference {worst_rel:.2e} \
+             relative, worst onset {worst_dt:.2e} s",
+            reference.len()
+        );
+    }
+
+    #[test]
+    fn multirate_scheme_agrees_with_the_reference() {
+        let defaults = AdaptiveStepping::default();
+        assert_agree(Scheme::Multirate, defaults.steps_per_contact);
+    }
+
+    #[test]
+    fn shared_step_agrees_with_the_reference() {
+        assert_agree(Scheme::Shared, 512.0);
+    }
 }

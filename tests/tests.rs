@@ -2,6 +2,10 @@
 //! outputs, and bad input. One test binary (as ripgrep does); each test states what it checks.
 
 mod cross_engine;
+mod fatigue;
+mod reliability;
+mod slurm;
+mod study;
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -628,14 +632,22 @@ fn sigint_leaves_a_complete_recording() {
 }
 
 /// SIGKILL mid-way: the file is truncated, but the chunks flushed (at least once per second
-/// of wall time) are there. After 3.5 s the independent reader recovers and decodes every
+/// of wall time) are there. The recording is written as `<stem>.partial-<pid>-<k>.mcap` and
+/// renamed when complete (issue 10), so a killed run leaves nothing under the final name and
+/// the partial file beside it. After 3.5 s the independent reader recovers and decodes every
 /// message of the flushed chunks, from t = 0; our own reader refuses the file
 /// (exit 2) unless --salvage, and with it gives the same count.
 #[test]
 fn sigkill_leaves_a_file_readable_up_to_the_last_flush() {
     let d = scratch("sigkill");
-    let (status, f) = signal_run(&d, "-KILL", 3.5);
+    let (status, target) = signal_run(&d, "-KILL", 3.5);
     assert_eq!(status.code(), None, "killed by a signal");
+    assert!(!target.exists(), "nothing under the final name");
+    let f = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.to_string_lossy().contains("-KILL.partial-"))
+        .expect("the partial recording");
     let r = read_independently(&f, true);
     assert_eq!(r["complete"], false, "{r}");
     let n = r["messages"].as_u64().unwrap();

@@ -2,12 +2,15 @@
 
 use crate::common::{self, RunCollector};
 use crate::run::run_recorded;
-use crate::sweep::run_cases;
+use crate::sweep::run_cases_until;
 use anyhow::Result;
+use clutchpack_model::cases::staggered_pack;
+use clutchpack_model::{Engine, PackModel};
 use clutchpack_record::{RecordOptions, Recorder};
+use clutchpack_reference::{ReferenceEngine, Scheme};
 use clutchpack_scene::Override;
 use std::process::ExitCode;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -24,6 +27,12 @@ pub struct BenchArgs {
     /// are reported); 0 skips that part.
     #[arg(long, default_value_t = 7)]
     pub record_runs: usize,
+    /// Repetitions of each staggered-pack timing (the median is reported); 0 skips that part.
+    #[arg(long, default_value_t = 3)]
+    pub pack_runs: usize,
+    /// Only the staggered-pack part (skips the paper case, the sweep and the recording cost).
+    #[arg(long)]
+    pub pack_only: bool,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -39,6 +48,19 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         out!("warning: a debug build; run `cargo run --release -- bench` for meaningful figures");
     }
     out!("machine: {cores} cores available");
+    if a.pack_only {
+        return staggered_packs(a.pack_runs).map(|()| ExitCode::SUCCESS);
+    }
+    // SIGINT, SIGTERM and SIGHUP stop the bench between (or inside recorded) runs: the
+    // figures printed so far stand, the exit code is 128 + signal
+    let stop = crate::signals::flag();
+    let stopped = || {
+        let s = stop.load(Ordering::SeqCst);
+        if s {
+            eprintln!("interrupted ({})", crate::signals::received_name());
+        }
+        s
+    };
 
     // 1. The paper case, 0.3 s simulated, one disc, h_o = 0 (the built-in default scene).
     let scene = common::load_scene(None, &[])?;
@@ -46,6 +68,9 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     let mut steps = 0;
     let mut impacts = 0;
     for _ in 0..a.runs.max(1) {
+        if stopped() {
+            return Ok(crate::signals::exit_code());
+        }
         let mut engine = common::make_engine(&scene, None)?;
         let mut obs = RunCollector::new(1, false);
         let t0 = Instant::now();
@@ -81,7 +106,14 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     let mut best = [f64::INFINITY; 2];
     for _ in 0..a.repeats.max(1) {
         for (i, jobs) in [1usize, 2].into_iter().enumerate() {
-            let (_, wall) = run_cases(&scenes, &values, param, 4, jobs, None, None)?;
+            let crate::sweep::CaseRuns {
+                wall_s: wall,
+                unfinished,
+                ..
+            } = run_cases_until(&scenes, &values, param, 4, jobs, None, None, &stop)?;
+            if unfinished > 0 || stopped() {
+                return Ok(crate::signals::exit_code());
+            }
             best[i] = best[i].min(wall);
         }
     }
@@ -132,6 +164,10 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
             let mut plain_cpu = Vec::new();
             let mut bytes = 0;
             for k in 0..a.record_runs {
+                if stopped() {
+                    let _ = std::fs::remove_dir_all(&dir);
+                    return Ok(crate::signals::exit_code());
+                }
                 let mut pair = [0.0; 2];
                 for record in [false, true] {
                     let mut engine = common::make_engine(&scene, None)?;
@@ -149,7 +185,7 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
                         scene.simulation.duration_s,
                         collector,
                         recorder,
-                        Arc::new(AtomicBool::new(false)),
+                        Arc::clone(&stop),
                     );
                     let wall = t0.elapsed().as_secs_f64();
                     done.result?;
@@ -186,5 +222,118 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         }
         let _ = std::fs::remove_dir_all(&dir);
     }
+    staggered_packs(a.pack_runs)?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// One engine configuration of the staggered-pack benchmark.
+struct PackEngine {
+    label: &'static str,
+    /// Largest pack it is timed on.
+    max_discs: usize,
+    make: fn(PackModel) -> Result<Box<dyn Engine>>,
+}
+
+/// Simulated time of each staggered-pack run, s (issue 9's table).
+const PACK_DURATION_S: f64 = 0.1;
+
+fn reference_engine(pack: PackModel, scheme: Scheme, parallel: bool) -> Box<dyn Engine> {
+    Box::new(
+        ReferenceEngine::new(pack, clutchpack_reference::Settings::default())
+            .with_scheme(scheme)
+            .with_parallel(parallel),
+    )
+}
+
+/// 4. The cost of a pack whose discs strike out of step (`cases::staggered_pack`, the pack
+///    of `scenes/staggered-*-disc.toml`), per disc, as the pack grows: N = 1, 4, 16 and 64
+///    discs for 0.1 s, each engine with the settings `run` gives it (record rate 10 kHz,
+///    default tolerance or stepping), the samples reduced as `run --no-record` does.
+fn staggered_packs(runs: usize) -> Result<()> {
+    if runs == 0 {
+        return Ok(());
+    }
+    let engines = [
+        PackEngine {
+            label: "reference, multirate (the default)",
+            max_discs: 64,
+            make: |p| Ok(reference_engine(p, Scheme::Multirate, true)),
+        },
+        PackEngine {
+            label: "reference, multirate, 1 thread",
+            max_discs: 64,
+            make: |p| Ok(reference_engine(p, Scheme::Multirate, false)),
+        },
+        PackEngine {
+            label: "reference, monolithic (before issue 9)",
+            max_discs: 64,
+            make: |p| Ok(reference_engine(p, Scheme::Monolithic, false)),
+        },
+        PackEngine {
+            label: "multibody (default stepping)",
+            max_discs: 16,
+            make: |p| {
+                let options = clutchpack_sim::MultibodyOptions::default();
+                Ok(Box::new(clutchpack_sim::MultibodyEngine::from_pack(
+                    p, 10_000.0, options,
+                )?))
+            },
+        },
+    ];
+    out!(
+        "staggered packs (cases::staggered_pack: N discs across +-0.8 of the free play, {PACK_DURATION_S} s; {runs} rounds over the sizes); growth = wall per disc / wall per disc at N = 1"
+    );
+    for e in &engines {
+        let sizes: Vec<usize> = [1usize, 4, 16, 64]
+            .into_iter()
+            .filter(|&n| n <= e.max_discs)
+            .collect();
+        // Round robin over the sizes, so that a change of the machine's load between the
+        // sizes' timings (a shared machine) does not pass for a growth; the small packs run
+        // several times per round (up to `max_discs / n`, at most 16), so that each round
+        // times about the same amount of work for every size.
+        let mut per_disc: Vec<Vec<f64>> = vec![Vec::new(); sizes.len()];
+        let mut counts = vec![(0u64, 0usize); sizes.len()];
+        for _ in 0..runs {
+            for (j, &n) in sizes.iter().enumerate() {
+                for _ in 0..(e.max_discs / n).clamp(1, 16) {
+                    let mut engine = (e.make)(staggered_pack(n))?;
+                    let mut obs = RunCollector::new(n, false);
+                    let t0 = Instant::now();
+                    let s = engine.run(PACK_DURATION_S, &mut obs)?;
+                    per_disc[j].push(t0.elapsed().as_secs_f64() / n as f64);
+                    counts[j] = (s.steps, obs.impacts.len());
+                }
+            }
+        }
+        let base = median(per_disc[0].clone());
+        for (j, &n) in sizes.iter().enumerate() {
+            let (steps, impacts) = counts[j];
+            let samples = per_disc[j].len();
+            let per_disc = median(std::mem::take(&mut per_disc[j]));
+            let growth = per_disc / base;
+            let target = if n == e.max_discs && n > 1 {
+                if growth <= 1.3 {
+                    "; target <= 1.3x: met"
+                } else {
+                    "; target <= 1.3x: NOT met"
+                }
+            } else {
+                ""
+            };
+            out!(
+                "  {:<38} N = {n:>2}: {:>8.1} ms, {:>6.2} ms per disc (median of {samples}), growth {growth:>5.2}x; {steps} steps ({}), {impacts} impacts, {:.0} steps per impact{target}",
+                e.label,
+                per_disc * n as f64 * 1e3,
+                per_disc * 1e3,
+                if e.label.starts_with("reference, multirate") {
+                    "summed over the discs"
+                } else {
+                    "shared by the discs"
+                },
+                steps as f64 / impacts.max(1) as f64
+            );
+        }
+    }
+    Ok(())
 }

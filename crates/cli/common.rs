@@ -1,9 +1,10 @@
 //! Shared helpers of the subcommands: scene loading, engine choice, the summary JSON.
 
-use anyhow::{Context, Result};
-use clutchpack_analysis::{DiscStats, InterfaceStats};
+use anyhow::Result;
+use clutchpack_analysis::{DiscFatigue, DiscStats, FatigueCollector, InterfaceStats};
 use clutchpack_model::{
-    Engine, ImpactEvent, InterfaceSample, Observer, RunStats, Sample, StackBody,
+    Engine, FatigueParams, ImpactEvent, InterfaceSample, Observer, RunStats, Sample,
+    SplineGeometry, StackBody,
 };
 use clutchpack_reference::ReferenceEngine;
 use clutchpack_scene::{EngineChoice, Override, Scene};
@@ -58,19 +59,44 @@ impl EngineArg {
 /// offsets, spacing errors: `PackModel::is_torsional`), which only it can run
 /// ([`Scene::engine`]); an engine that cannot run the scene is bad input.
 pub fn make_engine(scene: &Scene, arg: Option<EngineArg>) -> Result<Box<dyn Engine + Send>> {
+    choose_engine(scene, arg).map(|(engine, _)| engine)
+}
+
+/// [`make_engine`], with one line saying which engine and scheme run and why, e.g.
+/// `engine: reference (multirate: prescribed shaft, no stack; 8 independent discs on 2
+/// threads), the default for a torsional pack (concentric discs on one shaft)`.
+pub fn choose_engine(
+    scene: &Scene,
+    arg: Option<EngineArg>,
+) -> Result<(Box<dyn Engine + Send>, String)> {
+    let asked = arg.map(EngineArg::choice);
     // The scene crate's rule: refuses (bad input) an engine that cannot run the scene.
-    let choice = scene.engine(arg.map(EngineArg::choice), &scene.name)?;
+    let choice = scene.engine(asked, &scene.name)?;
+    let why = scene.engine_reason(asked);
+    let sim = &scene.simulation;
     match choice {
-        EngineChoice::Reference => Ok(Box::new(ReferenceEngine::from_scene(scene))),
+        EngineChoice::Reference => {
+            let settings = clutchpack_reference::Settings {
+                tolerance: sim.tolerance,
+                max_step_s: sim.max_step_s,
+                record_rate_hz: sim.record_rate_hz,
+            };
+            let engine = ReferenceEngine::new(scene.pack.clone(), settings);
+            let line = format!("engine: reference ({}), {why}", engine.describe());
+            Ok((Box::new(engine), line))
+        }
         EngineChoice::Multibody => match clutchpack_sim::MultibodyEngine::new(
             scene.pack.clone(),
             clutchpack_sim::MultibodyOptions::with_settings(
-                scene.simulation.record_rate_hz,
-                scene.simulation.max_step_s,
-                scene.simulation.record_per_tooth,
+                sim.record_rate_hz,
+                sim.max_step_s,
+                sim.record_per_tooth,
             ),
         ) {
-            Ok(e) => Ok(Box::new(e)),
+            Ok(e) => {
+                let line = format!("engine: multibody ({}), {why}", e.scheme_explanation());
+                Ok((Box::new(e), line))
+            }
             Err(e) => Err(BadInput(format!("{}: {e}", scene.name)).into()),
         },
     }
@@ -85,6 +111,11 @@ pub struct RunCollector {
     pub history: Vec<Vec<(f64, f64)>>,
     pub keep_history: bool,
     pub progress: Option<indicatif::ProgressBar>,
+    /// The load histories' turning points for the teeth's fatigue (MODEL.md section 7).
+    pub fatigue: FatigueCollector,
+    /// Spline and fatigue parameters of each coupling (engine order), set by
+    /// [`RunCollector::with_fatigue`]; empty: no fatigue in the recording's summary.
+    pub fatigue_params: Vec<(SplineGeometry, FatigueParams)>,
 }
 
 impl RunCollector {
@@ -95,7 +126,26 @@ impl RunCollector {
             history: vec![Vec::new(); discs],
             keep_history,
             progress: None,
+            fatigue: FatigueCollector::new(),
+            fatigue_params: Vec::new(),
         }
+    }
+
+    /// Also assesses the teeth's fatigue with the scene's parameters ([`fatigue_params`]).
+    pub fn with_fatigue(mut self, scene: &Scene) -> RunCollector {
+        self.fatigue_params = fatigue_params(scene);
+        self
+    }
+
+    /// The fatigue of every coupling (named `names`) over `duration_s` of simulated duty,
+    /// from the histories collected so far.
+    pub fn assess_fatigue(&self, names: &[String], duration_s: f64) -> Vec<DiscFatigue> {
+        assess_fatigue(
+            self.fatigue.clone(),
+            &self.fatigue_params,
+            names,
+            duration_s,
+        )
     }
 
     /// Also keeps the figures of the stack's friction interfaces, named in stack order.
@@ -129,6 +179,7 @@ pub fn merge_peaks(histories: &mut [Vec<(f64, f64)>], impacts: &[ImpactEvent]) {
 
 impl Observer for RunCollector {
     fn sample(&mut self, s: &Sample) {
+        self.fatigue.sample(s);
         if self.keep_history {
             for (i, d) in s.discs.iter().enumerate() {
                 self.history[i].push((s.t_s, d.load_n));
@@ -137,6 +188,7 @@ impl Observer for RunCollector {
     }
     fn impact(&mut self, e: &ImpactEvent) {
         self.impacts.push(*e);
+        self.fatigue.impact(e);
     }
     fn interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
         for (st, f) in self.interfaces.iter_mut().zip(interfaces) {
@@ -156,6 +208,46 @@ impl Observer for RunCollector {
     }
 }
 
+/// The spline and fatigue parameters of each coupling of `scene`, in the engines' order
+/// (discs, then plates).
+pub fn fatigue_params(scene: &Scene) -> Vec<(SplineGeometry, FatigueParams)> {
+    scene
+        .pack
+        .discs
+        .iter()
+        .chain(&scene.pack.plates)
+        .enumerate()
+        .map(|(i, d)| (d.spline, scene.fatigue.get(i).copied().unwrap_or_default()))
+        .collect()
+}
+
+/// The fatigue of every coupling named `names` from the histories of `collector`, with
+/// `params` per coupling (defaults past its end), over `duration_s` of simulated duty.
+pub fn assess_fatigue(
+    collector: FatigueCollector,
+    params: &[(SplineGeometry, FatigueParams)],
+    names: &[String],
+    duration_s: f64,
+) -> Vec<DiscFatigue> {
+    let histories = collector.finish(names.len());
+    names
+        .iter()
+        .zip(&histories)
+        .enumerate()
+        .filter_map(|(i, (name, h))| {
+            let (spline, p) = params.get(i)?;
+            Some(clutchpack_analysis::assess(
+                name,
+                h,
+                spline,
+                &p.form,
+                &p.material,
+                duration_s,
+            ))
+        })
+        .collect()
+}
+
 /// `--summary-json` of a run.
 #[derive(Debug, Serialize)]
 pub struct RunSummary {
@@ -169,6 +261,10 @@ pub struct RunSummary {
     /// The stack's friction interfaces (absent for packs without one).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub interfaces: Vec<InterfaceStats>,
+    /// Fatigue of each disc's spline teeth (MODEL.md section 7): damage, damage rate per
+    /// hour of this duty, life in hours, damage-equivalent load; per tooth where the engine
+    /// resolved teeth.
+    pub fatigue: Vec<DiscFatigue>,
 }
 
 impl RunSummary {
@@ -188,6 +284,7 @@ impl RunSummary {
             rejected_steps: stats.rejected_steps,
             discs,
             interfaces: Vec::new(),
+            fatigue: Vec::new(),
         }
     }
 }
@@ -195,7 +292,8 @@ impl RunSummary {
 /// Writes `value` as pretty JSON to `path`.
 pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
     let text = serde_json::to_string_pretty(value)?;
-    std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))
+    // whole or not at all (crate::outputs)
+    crate::outputs::write_text(path, &(text + "\n"))
 }
 
 /// A progress bar on stderr for a run of `duration_s` simulated seconds (hidden when stderr

@@ -118,6 +118,36 @@ pub fn describe(r: &RecordingReader) -> String {
                 d.mean_top10_abs_n
             );
         }
+        if !summary.fatigue.is_empty() {
+            let _ = writeln!(
+                s,
+                "fatigue of the spline teeth (stored; MODEL.md section 7, at this duty):"
+            );
+            let _ = writeln!(
+                s,
+                "  {:<wd$}  {:>12}  {:>10}  {:>10}  {:>12}  {:>16}",
+                "disc", "damage [1/h]", "life [h]", "S_eq [N]", "max sigma_F", "worst tooth"
+            );
+            let life = |h: Option<f64>| h.map_or("unlimited".to_string(), |h| format!("{h:.3e}"));
+            for (i, d) in summary.discs.iter().enumerate() {
+                let Some(f) = summary.fatigue_of(i) else {
+                    continue;
+                };
+                let worst = f
+                    .worst_tooth
+                    .map_or("-".to_string(), |(k, l, _)| format!("{k}: {} h", life(l)));
+                let _ = writeln!(
+                    s,
+                    "  {:<wd$}  {:>12.4e}  {:>10}  {:>10.1}  {:>8.1} MPa  {:>16}",
+                    d.name,
+                    f.damage_rate_per_h,
+                    life(f.life_h),
+                    f.eq_load_range_n,
+                    f.max_root_stress_pa * 1e-6,
+                    worst
+                );
+            }
+        }
     }
     let interfaces = r.interface_stats();
     if !interfaces.is_empty() {

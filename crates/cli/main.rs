@@ -3,26 +3,41 @@
 //! mapped to exit codes: 0 success, 2 bad input (scene, arguments, files), 1 anything else.
 
 /// `println!` that ends the process quietly (exit 0) when stdout is a closed pipe
-/// (`clutchpack run | head`), instead of panicking.
+/// (`clutchpack run | head`), instead of panicking. Any other write error (a full disk, a
+/// redirection to `/dev/full`) is reported once on stderr and makes the command fail (exit
+/// 1) once it has written its other outputs ([`STDOUT_FAILED`]).
 macro_rules! out {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
         let mut o = std::io::stdout().lock();
-        if let Err(e) = writeln!(o, $($arg)*) {
+        if let Err(e) = writeln!(o, $($arg)*).and_then(|()| o.flush()) {
             if e.kind() == std::io::ErrorKind::BrokenPipe {
                 std::process::exit(0);
             }
+            $crate::stdout_failed(&e);
         }
     }};
+}
+
+/// Set when writing to standard output failed (other than a closed pipe).
+static STDOUT_FAILED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Records a failed write to standard output and reports the first one.
+fn stdout_failed(e: &std::io::Error) {
+    if !STDOUT_FAILED.swap(true, std::sync::atomic::Ordering::SeqCst) {
+        eprintln!("error: writing to standard output: {e}");
+    }
 }
 
 mod bench;
 mod check;
 mod common;
 mod describe;
+mod outputs;
 mod recording;
 mod run;
 mod signals;
+mod study;
 mod sweep;
 
 use clap::{Parser, Subcommand};
@@ -60,6 +75,9 @@ enum Command {
     /// Measure speed: the paper case per run, and the speed-up of a 16-case sweep on 2
     /// threads over 1 (prints ratios; timing is never a test).
     Bench(bench::BenchArgs),
+    /// Studies: many cases of a scene (design factors, random draws, ensembles), sharded over
+    /// threads and Slurm or Kubernetes job arrays, merged into Parquet and CSV tables.
+    Study(study::StudyArgs),
     /// Validate scene files: exit 0 if all are valid, 2 with every problem listed if not.
     Check(check::CheckArgs),
 }
@@ -70,6 +88,7 @@ fn main() -> ExitCode {
         Command::Run(a) => run::run(a),
         Command::Sweep(a) => sweep::sweep(a),
         Command::Check(a) => check::check(a),
+        Command::Study(a) => study::study(a),
         Command::Bench(a) => bench::bench(a),
         Command::Replay(a) => recording::replay(a),
         Command::Compare(a) => recording::compare(a),
@@ -77,6 +96,8 @@ fn main() -> ExitCode {
         Command::Plot(a) => recording::plot(a),
     };
     match result {
+        // a command that could not write its results to stdout did not succeed
+        Ok(_) if STDOUT_FAILED.load(std::sync::atomic::Ordering::SeqCst) => ExitCode::from(1),
         Ok(code) => code,
         Err(e) => {
             let bad_input = e.chain().any(|c| c.is::<common::BadInput>())

@@ -5,6 +5,7 @@
 //! `--salvage` is given: then the command works on the messages recovered and warns.
 
 use crate::common::BadInput;
+use crate::outputs::Output;
 use anyhow::{Context, Result};
 use clutchpack_analysis::{disc_stats, DiscStats};
 use clutchpack_record::RecordingReader;
@@ -16,6 +17,14 @@ use std::process::ExitCode;
 pub fn open_recording(path: &Path, salvage: bool) -> Result<RecordingReader> {
     let reader = clutchpack_record::open(path).map_err(|e| BadInput(e.to_string()))?;
     if let Some(d) = reader.damage() {
+        if salvage && reader.info().messages == 0 {
+            // nothing to work on: not a success
+            return Err(BadInput(format!(
+                "{}: {d}; --salvage recovered no message",
+                path.display()
+            ))
+            .into());
+        }
         if salvage {
             eprintln!(
                 "warning: {}: {d}; using the recovered messages",
@@ -117,7 +126,8 @@ pub struct CompareArgs {
     /// Output format.
     #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
     pub format: CompareFormat,
-    /// Grouped bar chart of the peaks per disc and run (PNG or SVG).
+    /// Grouped bar chart of the peaks per disc and run (PNG or SVG; an existing FILE is
+    /// replaced).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
     /// Use the recovered messages of damaged files.
@@ -140,18 +150,35 @@ pub struct CompareRow {
     pub max_negative_change_pct: Option<f64>,
     /// Change of p99_abs_n against the first run's same disc, per cent.
     pub p99_abs_change_pct: Option<f64>,
+    /// Life of the disc's teeth at the run's duty in h, from the recording's stored summary
+    /// (`None`: unlimited, or not stored).
+    pub life_h: Option<f64>,
+    /// Whether the recording stored the disc's fatigue (older recordings did not).
+    pub fatigue_stored: bool,
+    /// Change of the life against the first run's same disc, per cent (`None` when either
+    /// life is unlimited or not stored).
+    pub life_change_pct: Option<f64>,
 }
 
 fn pct(new: f64, old: f64) -> Option<f64> {
     (old.abs() > 0.0).then(|| (new.abs() - old.abs()) / old.abs() * 100.0)
 }
 
-/// Builds the comparison rows of runs (name, stats), the first being the baseline.
-pub fn compare_rows(runs: &[(String, Vec<DiscStats>)]) -> Vec<CompareRow> {
+/// Stored fatigue of each disc of a recording, by name.
+type Lives = Vec<(String, Option<clutchpack_record::FatigueSummary>)>;
+
+/// Builds the comparison rows of runs (name, stats, stored fatigue), the first being the
+/// baseline.
+pub fn compare_rows(runs: &[(String, Vec<DiscStats>, Lives)]) -> Vec<CompareRow> {
     let base = &runs[0].1;
+    let base_lives = &runs[0].2;
+    let life_of =
+        |lives: &Lives, name: &str| lives.iter().find(|(n, _)| n == name).and_then(|(_, f)| *f);
     let mut rows = Vec::new();
-    for (run, stats) in runs {
+    for (run, stats, lives) in runs {
         for s in stats {
+            let f = life_of(lives, &s.name);
+            let bf = life_of(base_lives, &s.name);
             let b = base.iter().find(|b| b.name == s.name);
             rows.push(CompareRow {
                 run: run.clone(),
@@ -163,6 +190,12 @@ pub fn compare_rows(runs: &[(String, Vec<DiscStats>)]) -> Vec<CompareRow> {
                 max_positive_change_pct: b.and_then(|b| pct(s.max_positive_n, b.max_positive_n)),
                 max_negative_change_pct: b.and_then(|b| pct(s.max_negative_n, b.max_negative_n)),
                 p99_abs_change_pct: b.and_then(|b| pct(s.p99_abs_n, b.p99_abs_n)),
+                life_h: f.and_then(|f| f.life_h),
+                fatigue_stored: f.is_some(),
+                life_change_pct: match (f.and_then(|f| f.life_h), bf.and_then(|f| f.life_h)) {
+                    (Some(new), Some(old)) => pct(new, old),
+                    _ => None,
+                },
             });
         }
     }
@@ -175,11 +208,44 @@ fn fmt_pct(p: Option<f64>) -> String {
 }
 
 pub fn compare(a: CompareArgs) -> Result<ExitCode> {
+    if let Some(r) = crate::study::compare_hook(&a.files) {
+        return r; // two study folders: ensembles compared with confidence intervals
+    }
+    if let Some(p) = &a.plot {
+        let inputs: Vec<&Path> = a.files.iter().map(PathBuf::as_path).collect();
+        crate::outputs::check_outputs(
+            &[Output {
+                flag: "--plot",
+                path: p,
+            }],
+            &inputs,
+        )?;
+    }
     let mut runs = Vec::new();
     for f in &a.files {
         let reader = open_recording(f, a.salvage)?;
-        runs.push((f.display().to_string(), recording_stats(&reader)));
+        let stats = recording_stats(&reader);
+        if stats.is_empty() {
+            // say so rather than leaving the run out silently
+            eprintln!(
+                "warning: {}: no disc was recovered; the run has no rows below",
+                f.display()
+            );
+        }
+        let lives: Lives = reader
+            .summary()
+            .map(|s| {
+                s.discs
+                    .iter()
+                    .enumerate()
+                    .map(|(i, d)| (d.name.clone(), s.fatigue_of(i).copied()))
+                    .collect()
+            })
+            .unwrap_or_default();
+        runs.push((f.display().to_string(), stats, lives));
     }
+    // after reading: a bad file's error stays the only line
+    eprintln!("{}", crate::study::ONE_SAMPLE_NOTE);
     let rows = compare_rows(&runs);
     let header = [
         "run",
@@ -191,8 +257,14 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
         "p99 abs [N]",
         "change",
         "impacts",
+        "life [h]",
+        "change",
     ];
-    let cells: Vec<[String; 9]> = rows
+    let life = |r: &CompareRow| match (r.fatigue_stored, r.life_h) {
+        (false, _) => "-".to_string(),
+        (true, h) => clutchpack_analysis::fatigue::format_life_h(h),
+    };
+    let cells: Vec<[String; 11]> = rows
         .iter()
         .map(|r| {
             [
@@ -205,17 +277,19 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
                 format!("{:.1}", r.p99_abs_n),
                 fmt_pct(r.p99_abs_change_pct),
                 r.impacts.to_string(),
+                life(r),
+                fmt_pct(r.life_change_pct),
             ]
         })
         .collect();
     match a.format {
         CompareFormat::Json => out!("{}", serde_json::to_string_pretty(&rows)?),
         CompareFormat::Csv => {
-            out!("run,disc,max_positive_n,max_positive_change_pct,max_negative_n,max_negative_change_pct,p99_abs_n,p99_abs_change_pct,impacts");
+            out!("run,disc,max_positive_n,max_positive_change_pct,max_negative_n,max_negative_change_pct,p99_abs_n,p99_abs_change_pct,impacts,life_h,life_change_pct");
             for r in &rows {
                 let o = |p: Option<f64>| p.map(|p| p.to_string()).unwrap_or_default();
                 out!(
-                    "{},{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{},{},{}",
                     r.run,
                     r.disc,
                     r.max_positive_n,
@@ -224,7 +298,9 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
                     o(r.max_negative_change_pct),
                     r.p99_abs_n,
                     o(r.p99_abs_change_pct),
-                    r.impacts
+                    r.impacts,
+                    o(r.life_h),
+                    o(r.life_change_pct)
                 );
             }
         }
@@ -263,12 +339,12 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
             for c in &cells {
                 out!("{}", line(c));
             }
-            out!("changes are of the magnitudes against the first run, per cent");
+            out!("changes are of the magnitudes against the first run, per cent; life: of the teeth at the run's duty (stored in the recording; - if not stored)");
         }
     }
     if let Some(path) = &a.plot {
         let mut discs: Vec<String> = Vec::new();
-        for (_, s) in &runs {
+        for (_, s, _) in &runs {
             for d in s {
                 if !discs.contains(&d.name) {
                     discs.push(d.name.clone());
@@ -277,7 +353,7 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
         }
         let values: Vec<Vec<(f64, f64)>> = runs
             .iter()
-            .map(|(_, s)| {
+            .map(|(_, s, _)| {
                 discs
                     .iter()
                     .map(|d| {
@@ -289,9 +365,11 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
                     .collect()
             })
             .collect();
-        let names: Vec<String> = runs.iter().map(|(n, _)| n.clone()).collect();
-        clutchpack_analysis::plot_compare(path, &names, &discs, &values)
-            .with_context(|| format!("plotting {}", path.display()))?;
+        let names: Vec<String> = runs.iter().map(|(n, _, _)| n.clone()).collect();
+        crate::outputs::write_with(path, |tmp| {
+            clutchpack_analysis::plot_compare(tmp, &names, &discs, &values)
+                .with_context(|| format!("plotting {}", path.display()))
+        })?;
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -301,7 +379,8 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
 pub struct ExportArgs {
     /// The recording (.mcap).
     pub file: PathBuf,
-    /// Folder for the CSV files (one per topic; created if needed).
+    /// Folder for the CSV files (one per topic; created if needed; existing files of the
+    /// same names are replaced, each written whole).
     #[arg(long, value_name = "DIR", required = true)]
     pub csv: PathBuf,
     /// Use the recovered messages of a damaged file.
@@ -310,10 +389,24 @@ pub struct ExportArgs {
 }
 
 pub fn export(a: ExportArgs) -> Result<ExitCode> {
+    if a.csv.exists() && !a.csv.is_dir() {
+        return Err(BadInput(format!("--csv {}: is not a folder", a.csv.display())).into());
+    }
+    // SIGINT, SIGTERM and SIGHUP stop the export between files: those written are complete
+    let stop = crate::signals::flag();
     let reader = open_recording(&a.file, a.salvage)?;
-    let written = clutchpack_record::export_csv(&reader, &a.csv)?;
+    let written = clutchpack_record::export_csv_until(&reader, &a.csv, &stop)
+        .map_err(|e| BadInput(e.to_string()))?;
     for p in &written {
         out!("{}", p.display());
+    }
+    if stop.load(std::sync::atomic::Ordering::SeqCst) {
+        eprintln!(
+            "interrupted ({}): {} files written",
+            crate::signals::received_name(),
+            written.len()
+        );
+        return Ok(crate::signals::exit_code());
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -323,16 +416,123 @@ pub fn export(a: ExportArgs) -> Result<ExitCode> {
 pub struct PlotArgs {
     /// The recording (.mcap).
     pub file: PathBuf,
-    /// The figure (PNG or SVG by extension).
+    /// The figure (PNG or SVG by extension; an existing FIG is replaced).
     #[arg(short = 'o', long = "out", value_name = "FIG", required = true)]
     pub out: PathBuf,
     /// Use the recovered messages of a damaged file.
     #[arg(long)]
     pub salvage: bool,
+    /// Draw the fatigue figure instead of the load history: the exceedance spectra of the
+    /// contact peaks of all discs (impacts per hour above each load, log-log) and, for discs
+    /// with recorded per-tooth loads, the damage of each tooth around the disc (polar).
+    #[arg(long)]
+    pub spectrum: bool,
+}
+
+/// The teeth's fatigue of a recorded run, from its samples and impacts with the tooth form
+/// and material of the recorded scene (with its overrides); without fatigue figures when the
+/// scene cannot be read back (a warning says so).
+pub fn recorded_fatigue(
+    reader: &RecordingReader,
+) -> (
+    Vec<String>,
+    Vec<clutchpack_analysis::fatigue::DiscHistories>,
+    Vec<clutchpack_analysis::DiscFatigue>,
+    f64,
+) {
+    let names = reader.disc_names();
+    let samples = reader.samples();
+    let impacts = reader.impacts();
+    let duration = reader
+        .summary()
+        .map(|s| s.t_end_s)
+        .or(reader.info().end_s)
+        .unwrap_or(0.0);
+    let scene = reader.run_info().and_then(|info| {
+        let sets: Vec<clutchpack_scene::Override> = info
+            .overrides
+            .iter()
+            .filter_map(|o| o.parse().ok())
+            .collect();
+        match clutchpack_scene::parse(&info.scene_text, &info.scene_file, Path::new("."), &sets) {
+            Ok(s) => Some(s),
+            Err(e) => {
+                eprintln!(
+                    "warning: the recorded scene does not read back ({e}); no damage figures"
+                );
+                None
+            }
+        }
+    });
+    let params = scene
+        .as_ref()
+        .map(crate::common::fatigue_params)
+        .unwrap_or_default();
+    let collector = clutchpack_analysis::FatigueCollector::replay(&samples, &impacts);
+    let histories = collector.clone().finish(names.len());
+    let fatigue = names
+        .iter()
+        .zip(&histories)
+        .enumerate()
+        .filter_map(|(i, (name, h))| {
+            let (spline, p) = params.get(i)?;
+            Some(clutchpack_analysis::assess(
+                name,
+                h,
+                spline,
+                &p.form,
+                &p.material,
+                duration,
+            ))
+        })
+        .collect();
+    (names, histories, fatigue, duration)
+}
+
+fn plot_spectrum(reader: &RecordingReader, a: &PlotArgs) -> Result<ExitCode> {
+    let (names, histories, fatigue, duration) = recorded_fatigue(reader);
+    let spectra: Vec<(String, Vec<(f64, f64)>)> = names
+        .iter()
+        .zip(&histories)
+        .map(|(n, h)| {
+            (
+                n.clone(),
+                clutchpack_analysis::cycles::exceedance_spectrum(&h.lumped.peaks, duration),
+            )
+        })
+        .collect();
+    let teeth: Vec<(String, Vec<f64>)> = fatigue
+        .iter()
+        .filter_map(|d| d.teeth.as_ref().map(|t| (d.name.clone(), t.damage.clone())))
+        .collect();
+    let scene = reader
+        .info()
+        .metadata("clutchpack.run")
+        .and_then(|m| m.get("scene_name").cloned())
+        .unwrap_or_else(|| a.file.display().to_string());
+    clutchpack_analysis::fatigue_plot::plot_spectrum(
+        &a.out,
+        &format!("{scene}: tooth load spectra and damage"),
+        &spectra,
+        &teeth,
+    )
+    .with_context(|| format!("plotting {}", a.out.display()))?;
+    out!("{}", a.out.display());
+    Ok(ExitCode::SUCCESS)
 }
 
 pub fn plot(a: PlotArgs) -> Result<ExitCode> {
+    crate::outputs::check_outputs(
+        &[Output {
+            flag: "--out",
+            path: &a.out,
+        }],
+        &[a.file.as_path()],
+    )?;
     let reader = open_recording(&a.file, a.salvage)?;
+    if a.spectrum {
+        return plot_spectrum(&reader, &a);
+    }
     let (names, mut histories): (Vec<String>, Vec<Vec<(f64, f64)>>) = reader
         .load_histories()
         .into_iter()
@@ -345,8 +545,11 @@ pub fn plot(a: PlotArgs) -> Result<ExitCode> {
         .metadata("clutchpack.run")
         .and_then(|m| m.get("scene_name").cloned())
         .unwrap_or_else(|| a.file.display().to_string());
-    clutchpack_analysis::plot_load_history(&a.out, &format!("{scene}: per-tooth load"), &series)
-        .with_context(|| format!("plotting {}", a.out.display()))?;
+    let title = format!("{scene}: per-tooth load");
+    crate::outputs::write_with(&a.out, |tmp| {
+        clutchpack_analysis::plot_load_history(tmp, &title, &series)
+            .with_context(|| format!("plotting {}", a.out.display()))
+    })?;
     out!("{}", a.out.display());
     Ok(ExitCode::SUCCESS)
 }

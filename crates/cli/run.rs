@@ -1,13 +1,15 @@
 //! `clutchpack run`.
 
+use crate::common::BadInput;
 use crate::common::{self, EngineArg, RunCollector, RunSummary};
+use crate::outputs::Output;
 use anyhow::{Context, Result};
 use clutchpack_analysis::{disc_stats, stats_table, TableFormat};
 use clutchpack_model::{ImpactEvent, InterfaceSample, Observer, Sample};
+use clutchpack_record::Replace;
 use clutchpack_record::{RecordOptions, Recorder, ThreadedRecorder};
 use clutchpack_scene::Override;
-use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -31,16 +33,28 @@ pub struct RunArgs {
     /// Simulated duration in s (overrides `simulation.duration_s`).
     #[arg(long, value_name = "S")]
     pub duration: Option<f64>,
-    /// Write the run summary as JSON.
+    /// Write the run summary as JSON (an existing FILE is replaced).
     #[arg(long, value_name = "FILE")]
     pub summary_json: Option<PathBuf>,
-    /// Write one CSV row per impact: disc,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n.
+    /// Write the counted cycles of each disc as JSON: exact (range, count) pairs, range
+    /// histogram, range-mean matrix, exceedance spectrum, and per resolved tooth its ranges
+    /// (an existing FILE is replaced).
+    #[arg(long, value_name = "FILE")]
+    pub fatigue_json: Option<PathBuf>,
+    /// Write one CSV row per impact: disc,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n (an
+    /// existing FILE is replaced).
     #[arg(long, value_name = "FILE")]
     pub impacts_csv: Option<PathBuf>,
-    /// Plot the per-tooth load history of each disc (PNG or SVG by extension).
+    /// Plot the per-tooth load history of each disc (PNG or SVG by extension; an existing
+    /// FILE is replaced).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-    /// The recording (MCAP); default `recordings/<scene>-<UTC time>.mcap`.
+    /// The recording (MCAP; its folder is created if missing, an existing FILE is replaced).
+    /// Default: a new `recordings/<scene>-<UTC time to the ms>.mcap` (`-2`, `-3`, ... appended
+    /// if taken; never replaces a file). It is written as `<stem>.partial-<pid>-<k>.mcap` and
+    /// renamed when complete; a killed run leaves that file (read it with `--salvage`).
+    /// Every output path is checked before the run: a folder, FIFO or device, two outputs
+    /// naming one file, or an output naming the scene file is refused (exit 2).
     #[arg(long, value_name = "FILE", conflicts_with = "no_record")]
     pub out: Option<PathBuf>,
     /// Do not record.
@@ -76,26 +90,58 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         });
     }
     let scene = common::load_scene(a.scene.as_deref(), &sets)?;
-    let mut engine = common::make_engine(&scene, a.engine)?;
+    // Every output checked before any work (crate::outputs); the recording's folder is made.
+    let record_path = (!a.no_record).then(|| {
+        a.out.clone().unwrap_or_else(|| {
+            clutchpack_record::default_path("recordings", &scene.name, std::time::SystemTime::now())
+        })
+    });
+    if let Some(dir) = record_path
+        .as_deref()
+        .and_then(|p| p.parent())
+        .filter(|d| !d.as_os_str().is_empty())
+    {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            BadInput(format!(
+                "--out {}: cannot create the folder {}: {e}",
+                record_path.as_deref().unwrap_or(dir).display(),
+                dir.display()
+            ))
+        })?;
+    }
+    let mut outs = Vec::new();
+    for (flag, p) in [
+        ("--out", record_path.as_deref()),
+        ("--summary-json", a.summary_json.as_deref()),
+        ("--fatigue-json", a.fatigue_json.as_deref()),
+        ("--impacts-csv", a.impacts_csv.as_deref()),
+        ("--plot", a.plot.as_deref()),
+    ] {
+        if let Some(path) = p {
+            outs.push(Output { flag, path });
+        }
+    }
+    let inputs: Vec<&std::path::Path> = a.scene.as_deref().into_iter().collect();
+    crate::outputs::check_outputs(&outs, &inputs)?;
+    let (mut engine, engine_line) = common::choose_engine(&scene, a.engine)?;
     let names = engine.disc_names();
     let duration = scene.simulation.duration_s;
-    let mut collector = RunCollector::new(names.len(), a.plot.is_some()).with_interfaces(
-        common::friction_interfaces(&scene)
-            .into_iter()
-            .map(|f| f.name()),
-    );
+    let mut collector = RunCollector::new(names.len(), a.plot.is_some())
+        .with_interfaces(
+            common::friction_interfaces(&scene)
+                .into_iter()
+                .map(|f| f.name()),
+        )
+        .with_fatigue(&scene);
     let pb = common::time_progress(duration, &scene.name);
     collector.progress = Some(pb.clone());
-    let recorder = if a.no_record {
-        None
-    } else {
-        let path = a.out.clone().unwrap_or_else(|| {
-            clutchpack_record::default_path("recordings", &scene.name, std::time::SystemTime::now())
-        });
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("creating the folder {}", dir.display()))?;
-        }
+    let recorder = if let Some(path) = record_path {
+        // an explicit --out replaces an existing file (documented); a default name never does
+        let replace = if a.out.is_some() {
+            Replace::Existing
+        } else {
+            Replace::Never
+        };
         let info = common::run_info(&scene, engine.name(), a.scene.as_deref());
         let opts = RecordOptions {
             deterministic: a.deterministic,
@@ -103,9 +149,11 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             ..RecordOptions::default()
         };
         Some(
-            Recorder::create(&path, &info, &opts)
+            Recorder::create_output(&path, replace, &info, &opts)
                 .with_context(|| format!("creating the recording {}", path.display()))?,
         )
+    } else {
+        None
     };
     // SIGINT, SIGTERM and SIGHUP stop the run cleanly (crate::signals).
     let interrupted = crate::signals::flag();
@@ -136,8 +184,10 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             .zip(obs.histories_with_peaks())
             .collect();
         let title = format!("{}: per-tooth load ({} engine)", scene.name, engine.name());
-        clutchpack_analysis::plot_load_history(path, &title, &series)
-            .with_context(|| format!("plotting {}", path.display()))?;
+        crate::outputs::write_with(path, |tmp| {
+            clutchpack_analysis::plot_load_history(tmp, &title, &series)
+                .with_context(|| format!("plotting {}", path.display()))
+        })?;
     }
     let run_stats = match result {
         Ok(s) if s.stopped_early => {
@@ -163,6 +213,16 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     };
     let mut summary = RunSummary::new(&scene, engine.name(), &run_stats, wall, stats.clone());
     summary.interfaces = obs.interfaces.clone();
+    summary.fatigue = obs.assess_fatigue(&names, run_stats.simulated_s);
+    if let Some(path) = &a.fatigue_json {
+        let histories = obs.fatigue.clone().finish(names.len());
+        let cycles: Vec<_> = names
+            .iter()
+            .zip(&histories)
+            .map(|(n, h)| clutchpack_analysis::disc_cycles(n, h, run_stats.simulated_s))
+            .collect();
+        common::write_json(path, &cycles)?;
+    }
     if let Some(path) = &a.summary_json {
         common::write_json(path, &summary)?;
     }
@@ -174,6 +234,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         wall,
         run_stats.steps
     );
+    out!("{engine_line}");
     out!("per-tooth impact loads (negative: the shaft leads; positive: the disc leads)");
     out!("{}", stats_table(&stats, TableFormat::Text).trim_end());
     if let Some(worst) = stats.iter().max_by(|x, y| {
@@ -188,6 +249,16 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                 worst.max_positive_n.max(-worst.max_negative_n)
             );
         }
+    }
+    if !summary.fatigue.is_empty() {
+        out!(
+            "fatigue of the spline teeth at this duty ({} rule below the knee; life at D = D_crit; MODEL.md section 7)",
+            summary.fatigue[0].rule.name()
+        );
+        out!(
+            "{}",
+            clutchpack_analysis::fatigue_table(&summary.fatigue, TableFormat::Text).trim_end()
+        );
     }
     if !obs.interfaces.is_empty() {
         out!("friction interfaces (from the piston side)");
@@ -206,10 +277,9 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn write_impacts_csv(path: &PathBuf, names: &[String], obs: &RunCollector) -> Result<()> {
-    let f = std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut w = std::io::BufWriter::new(f);
-    writeln!(w, "disc,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n")?;
+fn write_impacts_csv(path: &Path, names: &[String], obs: &RunCollector) -> Result<()> {
+    use std::fmt::Write as _;
+    let mut w = String::from("disc,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n\n");
     for e in &obs.impacts {
         writeln!(
             w,
@@ -223,8 +293,7 @@ fn write_impacts_csv(path: &PathBuf, names: &[String], obs: &RunCollector) -> Re
             e.peak_n
         )?;
     }
-    w.flush()
-        .with_context(|| format!("writing {}", path.display()))
+    crate::outputs::write_text(path, &w)
 }
 
 /// What [`run_recorded`] gives back.
@@ -273,10 +342,18 @@ pub(crate) fn run_recorded(
         Some(rec) => {
             let (mut rec, cpu_s) = rec.join();
             recorder_cpu_s = cpu_s;
+            let mut summary = rec.summary();
             if let Ok(s) = &result {
                 rec.set_run_stats(s);
+                // the teeth's fatigue over the duty that ran, beside the peak statistics
+                let names: Vec<String> = summary.discs.iter().map(|d| d.name.clone()).collect();
+                let fatigue = collector.assess_fatigue(&names, s.simulated_s);
+                summary.fatigue = fatigue
+                    .iter()
+                    .map(|f| Some(clutchpack_record::FatigueSummary::from(f)))
+                    .collect();
             }
-            Some(rec.finish(None).context("finishing the recording"))
+            Some(rec.finish(Some(summary)).context("finishing the recording"))
         }
         None => None,
     };

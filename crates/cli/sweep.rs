@@ -3,14 +3,16 @@
 use crate::common::{self, BadInput, EngineArg, RunCollector};
 use anyhow::{Context, Result};
 use clutchpack_analysis::{
-    disc_stats, sweep_fits, sweep_rows, sweep_table, DiscStats, PolyFit, SweepCase, SweepRow,
-    TableFormat,
+    disc_stats, ensemble_fatigue, fatigue_spread_table, sweep_fits, sweep_rows, sweep_table,
+    DiscFatigue, DiscFatigueSpread, DiscStats, PolyFit, SweepCase, SweepRow, TableFormat,
 };
+use clutchpack_model::{ImpactEvent, InterfaceSample, Observer, Sample};
 use clutchpack_scene::{Override, Scene};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Arguments of `clutchpack sweep`.
@@ -32,7 +34,8 @@ pub struct SweepArgs {
     /// K = 1 the scene's own initial positions are used.
     #[arg(long, value_name = "K", default_value_t = 1)]
     pub ensemble: usize,
-    /// Cases run in parallel (default: the number of cores).
+    /// Cases run in parallel (default: the number of cores); at most the number of cases
+    /// and [`MAX_JOBS`].
     #[arg(long, value_name = "J")]
     pub jobs: Option<usize>,
     /// Engine; default: the scene's, else `reference`.
@@ -41,10 +44,11 @@ pub struct SweepArgs {
     /// Further overrides applied to every case (`KEY=VALUE`, repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub sets: Vec<Override>,
-    /// Write the sweep table and fits as JSON.
+    /// Write the sweep table and fits as JSON (an existing FILE is replaced).
     #[arg(long, value_name = "FILE")]
     pub summary_json: Option<PathBuf>,
-    /// Plot the peaks against the parameter with quadratic fits (PNG or SVG).
+    /// Plot the peaks against the parameter with quadratic fits (PNG or SVG; an existing FILE
+    /// is replaced).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
 }
@@ -70,6 +74,14 @@ struct SweepSummary {
     wall_time_s: f64,
     rows: Vec<SweepRow>,
     fits: Vec<FitJson>,
+    /// Per value: each disc's damage rate over the members (mean, spread) and life.
+    fatigue: Vec<FatigueJson>,
+}
+
+#[derive(Serialize)]
+struct FatigueJson {
+    value: f64,
+    discs: Vec<DiscFatigueSpread>,
 }
 
 /// The initial relative angles of ensemble member `k` of `count`: every disc at the same
@@ -107,6 +119,18 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
     if jobs == 0 {
         return Err(BadInput("--jobs must be at least 1".into()).into());
     }
+    // never more threads than cases (nor than a sane maximum)
+    let jobs = jobs.min(a.values.len() * a.ensemble).clamp(1, MAX_JOBS);
+    let mut outs = Vec::new();
+    for (flag, p) in [
+        ("--summary-json", a.summary_json.as_deref()),
+        ("--plot", a.plot.as_deref()),
+    ] {
+        if let Some(path) = p {
+            outs.push(crate::outputs::Output { flag, path });
+        }
+    }
+    crate::outputs::check_outputs(&outs, &[a.scene.as_path()])?;
     // Load every case first, so that bad input is reported before any work.
     let mut scenes = Vec::new();
     for v in &a.values {
@@ -128,7 +152,14 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             .expect("static template")
             .progress_chars("=> "),
     );
-    let (cases, wall) = run_cases(
+    // SIGINT, SIGTERM and SIGHUP stop the sweep: the cases done so far are reported.
+    let stop = crate::signals::flag();
+    let CaseRuns {
+        cases,
+        fatigue,
+        wall_s: wall,
+        unfinished,
+    } = run_cases_until(
         &scenes,
         &a.values,
         &a.param,
@@ -136,13 +167,28 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         jobs,
         a.engine,
         Some(show),
+        &stop,
     )?;
     let n_cases = a.values.len() * a.ensemble;
+    if unfinished > 0 {
+        eprintln!(
+            "interrupted ({}): {} of {n_cases} cases finished; the table and outputs hold those",
+            crate::signals::received_name(),
+            n_cases - unfinished
+        );
+    }
+    // values whose every member was stopped are left out of the tables and the fits
+    let kept: Vec<usize> = (0..cases.len())
+        .filter(|&i| !cases[i].members.is_empty())
+        .collect();
+    let fatigue: MemberFatigue = kept.iter().map(|&i| fatigue[i].clone()).collect();
+    let kept_scenes: Vec<&Scene> = kept.iter().map(|&i| &scenes[i]).collect();
+    let cases: Vec<SweepCase> = kept.iter().map(|&i| cases[i].clone()).collect();
     let rows = sweep_rows(&cases);
-    let degree = if a.values.len() >= 3 {
+    let degree = if cases.len() >= 3 {
         2
     } else {
-        a.values.len().saturating_sub(1)
+        cases.len().saturating_sub(1)
     };
     let fits = if degree >= 1 {
         sweep_fits(&rows, degree).context("fitting the peaks")?
@@ -177,9 +223,30 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             n.r_squared
         );
     }
+    let fatigue: Vec<(f64, Vec<DiscFatigueSpread>)> = cases
+        .iter()
+        .map(|c| c.value)
+        .zip(kept_scenes)
+        .zip(&fatigue)
+        .map(|((v, scene), members)| {
+            let d_crit: Vec<f64> = scene
+                .fatigue
+                .iter()
+                .map(|f| f.material.critical_damage)
+                .collect();
+            (v, ensemble_fatigue(members, &d_crit))
+        })
+        .collect();
+    out!("fatigue of the spline teeth against {} (damage rate per hour: ensemble mean, std, min..max; life at the mean rate, and at the largest..smallest rate)", a.param);
+    out!(
+        "{}",
+        fatigue_spread_table(Some(&a.param), &fatigue, TableFormat::Text).trim_end()
+    );
     if let Some(path) = &a.plot {
-        clutchpack_analysis::plot_sweep(path, &a.param, &rows, &fits)
-            .with_context(|| format!("plotting {}", path.display()))?;
+        crate::outputs::write_with(path, |tmp| {
+            clutchpack_analysis::plot_sweep(tmp, &a.param, &rows, &fits)
+                .with_context(|| format!("plotting {}", path.display()))
+        })?;
     }
     if let Some(path) = &a.summary_json {
         let summary = SweepSummary {
@@ -192,6 +259,10 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             cases: n_cases,
             wall_time_s: wall,
             rows,
+            fatigue: fatigue
+                .into_iter()
+                .map(|(value, discs)| FatigueJson { value, discs })
+                .collect(),
             fits: fits
                 .into_iter()
                 .map(|(disc, max_positive, max_negative)| FitJson {
@@ -203,7 +274,35 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         };
         common::write_json(path, &summary)?;
     }
+    if unfinished > 0 {
+        // 128 + signal, as a shell reports a command stopped by that signal
+        return Ok(crate::signals::exit_code());
+    }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The most threads `sweep --jobs` starts (more only cost memory and start-up time).
+pub const MAX_JOBS: usize = 256;
+
+/// A case's observer that also stops the engine when `stop` is set (a signal).
+struct Stoppable<'a> {
+    inner: &'a mut RunCollector,
+    stop: &'a AtomicBool,
+}
+
+impl Observer for Stoppable<'_> {
+    fn sample(&mut self, s: &Sample) {
+        self.inner.sample(s);
+    }
+    fn impact(&mut self, e: &ImpactEvent) {
+        self.inner.impact(e);
+    }
+    fn interfaces(&mut self, t_s: f64, i: &[InterfaceSample]) {
+        self.inner.interfaces(t_s, i);
+    }
+    fn progress(&mut self, t_s: f64) -> bool {
+        self.inner.progress(t_s) || self.stop.load(Ordering::SeqCst)
+    }
 }
 
 fn poly_text(p: &PolyFit) -> String {
@@ -221,6 +320,7 @@ fn poly_text(p: &PolyFit) -> String {
 
 /// Runs every (value, ensemble member) case on a pool of `jobs` threads; returns one
 /// [`SweepCase`] per value and the wall time in s. `progress`, if given, counts cases.
+#[allow(dead_code)] // for callers without a stop flag
 pub fn run_cases(
     scenes: &[Scene],
     values: &[f64],
@@ -230,6 +330,42 @@ pub fn run_cases(
     engine: Option<EngineArg>,
     progress: Option<indicatif::ProgressBar>,
 ) -> Result<(Vec<SweepCase>, f64)> {
+    let never = AtomicBool::new(false);
+    let r = run_cases_until(
+        scenes, values, param, ensemble, jobs, engine, progress, &never,
+    )?;
+    Ok((r.cases, r.wall_s))
+}
+
+/// Fatigue of each member of each value: `[value][member][disc]`.
+pub type MemberFatigue = Vec<Vec<Vec<DiscFatigue>>>;
+
+/// What [`run_cases_until`] ran.
+pub struct CaseRuns {
+    /// One [`SweepCase`] per value, with the members that finished.
+    pub cases: Vec<SweepCase>,
+    /// The teeth's fatigue of every finished member, `[value][member][disc]`.
+    pub fatigue: MemberFatigue,
+    /// Wall time in s.
+    pub wall_s: f64,
+    /// Members stopped or never started because `stop` was set.
+    pub unfinished: usize,
+}
+
+/// [`run_cases`] that stops when `stop` is set: cases not started are skipped and running
+/// ones stop at their engine's next progress call; neither is in the result, and
+/// [`CaseRuns::unfinished`] counts them.
+#[allow(clippy::too_many_arguments)]
+pub fn run_cases_until(
+    scenes: &[Scene],
+    values: &[f64],
+    param: &str,
+    ensemble: usize,
+    jobs: usize,
+    engine: Option<EngineArg>,
+    progress: Option<indicatif::ProgressBar>,
+    stop: &AtomicBool,
+) -> Result<CaseRuns> {
     let tasks: Vec<(usize, usize)> = (0..scenes.len())
         .flat_map(|c| (0..ensemble).map(move |k| (c, k)))
         .collect();
@@ -240,19 +376,35 @@ pub fn run_cases(
     let pb = progress.unwrap_or_else(indicatif::ProgressBar::hidden);
     pb.set_length(tasks.len() as u64);
     let t0 = Instant::now();
-    let results: Vec<Result<Vec<DiscStats>>> = pool.install(|| {
+    type Member = (Vec<DiscStats>, Vec<DiscFatigue>);
+    let results: Vec<Result<Option<Member>>> = pool.install(|| {
         tasks
             .par_iter()
             .map(|&(c, k)| {
+                if stop.load(Ordering::SeqCst) {
+                    return Ok(None);
+                }
                 let member = ensemble_member(&scenes[c], k, ensemble);
                 let mut engine = common::make_engine(&member, engine)?;
                 let names = engine.disc_names();
-                let mut obs = RunCollector::new(names.len(), false);
-                engine
-                    .run(member.simulation.duration_s, &mut obs)
+                let mut obs = RunCollector::new(names.len(), false).with_fatigue(&member);
+                let run = engine
+                    .run(
+                        member.simulation.duration_s,
+                        &mut Stoppable {
+                            inner: &mut obs,
+                            stop,
+                        },
+                    )
                     .with_context(|| format!("case {param} = {}, member {k}", values[c]))?;
+                if run.stopped_early {
+                    return Ok(None);
+                }
                 pb.inc(1);
-                Ok(disc_stats(&names, &obs.impacts))
+                Ok(Some((
+                    disc_stats(&names, &obs.impacts),
+                    obs.assess_fatigue(&names, run.simulated_s),
+                )))
             })
             .collect()
     });
@@ -265,8 +417,21 @@ pub fn run_cases(
             members: Vec::new(),
         })
         .collect();
+    let mut unfinished = 0;
+    let mut fatigue: MemberFatigue = vec![Vec::new(); values.len()];
     for (&(c, _), r) in tasks.iter().zip(results) {
-        cases[c].members.push(r?);
+        match r? {
+            Some((stats, f)) => {
+                cases[c].members.push(stats);
+                fatigue[c].push(f);
+            }
+            None => unfinished += 1,
+        }
     }
-    Ok((cases, wall))
+    Ok(CaseRuns {
+        cases,
+        fatigue,
+        wall_s: wall,
+        unfinished,
+    })
 }

@@ -51,7 +51,10 @@ pub mod stats;
 pub mod sweep;
 pub mod table;
 
-pub use fatigue::{assess, ensemble_fatigue, DiscFatigue, DiscFatigueSpread, FatigueCollector};
+pub use fatigue::{
+    assess, disc_cycles, ensemble_fatigue, fatigue_spread_table, fatigue_table, DiscCycles,
+    DiscFatigue, DiscFatigueSpread, FatigueCollector,
+};
 pub use fit::{polyfit, FitError, PolyFit};
 pub use interfaces::InterfaceStats;
 pub use plot::{plot_compare, plot_load_history, plot_sweep, register_fonts, PlotError};

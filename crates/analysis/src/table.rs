@@ -22,12 +22,12 @@ pub enum TableFormat {
 }
 
 /// One column: its header and whether its cells are right-aligned (numbers).
-struct Col {
+pub(crate) struct Col {
     header: String,
     right: bool,
 }
 
-fn col(header: impl Into<String>, right: bool) -> Col {
+pub(crate) fn col(header: impl Into<String>, right: bool) -> Col {
     Col {
         header: header.into(),
         right,
@@ -229,7 +229,7 @@ fn range(s: &Spread) -> String {
 }
 
 /// Renders text or markdown with columns padded to their widest cell.
-fn render(format: TableFormat, cols: &[Col], rows: &[Vec<String>]) -> String {
+pub(crate) fn render(format: TableFormat, cols: &[Col], rows: &[Vec<String>]) -> String {
     let escape = |s: &str| match format {
         TableFormat::Markdown => s.replace('|', "\\|"),
         _ => s.to_string(),

@@ -223,8 +223,8 @@ pub fn staggered_rel_angle_rad(i: usize, n: usize, g0_rad: f64) -> f64 {
 /// The staggered pack of issue 9: `n` benchmark discs ([`bench_disc`], `disc-1` ...
 /// `disc-n`) on the benchmark's prescribed shaft, disc `i` started at
 /// [`staggered_rel_angle_rad`] at rest relative to the shaft, so that they strike out of
-/// step, as the discs of a real pack do. `scenes/staggered-8.toml` and
-/// `scenes/staggered-16.toml` are this pack for 8 and 16 discs.
+/// step, as the discs of a real pack do. `scenes/staggered-8-disc.toml` and
+/// `scenes/staggered-16-disc.toml` are this pack for 8 and 16 discs.
 pub fn staggered_pack(n: usize) -> PackModel {
     let g0 = paper_spline().half_play_rad();
     PackModel::new(

@@ -37,37 +37,37 @@
 use crate::spline::SplineGeometry;
 use serde::{Deserialize, Serialize};
 
-/// A bad tooth-form or material value: the key it came from, the value and the rule.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{key} = {value}: {rule}")]
-pub struct FatigueError {
-    /// The key path the value belongs to (e.g. `defaults.fatigue.face_width_m`).
-    pub key: String,
-    /// The offending value as written.
-    pub value: String,
-    /// What was expected.
-    pub rule: String,
-}
+/// Default form factor `Y_F` (ASSUMED; see [`ToothForm::form_factor`]).
+pub const DEFAULT_FORM_FACTOR: f64 = 2.1;
+/// Default stress correction factor `Y_S` (ASSUMED; see [`ToothForm::stress_correction`]).
+pub const DEFAULT_STRESS_CORRECTION: f64 = 2.0;
+/// Default axial load distribution factor `K_l` (see [`ToothForm::load_distribution`]).
+pub const DEFAULT_LOAD_DISTRIBUTION: f64 = 1.0;
+/// Default engaged face width `b` in m (the paper's 3 mm disc).
+pub const DEFAULT_FACE_WIDTH_M: f64 = 3e-3;
+/// Default working depth `h_w` in m (ASSUMED; see [`ToothForm::working_depth_m`]).
+pub const DEFAULT_WORKING_DEPTH_M: f64 = 2.7e-3;
+/// Default endurance limit `S_D` as a stress amplitude in Pa (ASSUMED; see
+/// [`Material::endurance_amplitude_pa`]).
+pub const DEFAULT_ENDURANCE_AMPLITUDE_PA: f64 = 315e6;
+/// Default cycles at the knee `N_D` (see [`Material::knee_cycles`]).
+pub const DEFAULT_KNEE_CYCLES: f64 = 3e6;
+/// Default Basquin exponent `k` (ASSUMED; see [`Material::slope`]).
+pub const DEFAULT_SLOPE: f64 = 6.2;
+/// Default rule below the knee (see [`Material::rule`]).
+pub const DEFAULT_MINER_RULE: MinerRule = MinerRule::Haibach;
+/// Default damage sum at failure `D_crit` (see [`Material::critical_damage`]).
+pub const DEFAULT_CRITICAL_DAMAGE: f64 = 1.0;
 
-fn check(
-    errors: &mut Vec<FatigueError>,
-    prefix: &str,
-    name: &str,
-    value: f64,
-    ok: bool,
-    rule: &str,
-) {
-    if !ok || !value.is_finite() {
-        errors.push(FatigueError {
-            key: if prefix.is_empty() {
-                name.to_string()
-            } else {
-                format!("{prefix}.{name}")
-            },
-            value: value.to_string(),
-            rule: rule.to_string(),
-        });
-    }
+/// The fatigue parameters of one body's spline teeth: tooth form and material. The scene
+/// keys `fatigue.*` and `material.*` of a body (validated by `clutchpack_scene`, which holds
+/// the rules of every value).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct FatigueParams {
+    /// Tooth form (root stress and flank pressure factors).
+    pub form: ToothForm,
+    /// S-N curve and failure criterion.
+    pub material: Material,
 }
 
 /// The tooth form of a spline coupling, as far as the root stress and flank pressure need it.
@@ -98,61 +98,12 @@ pub struct ToothForm {
 impl Default for ToothForm {
     fn default() -> Self {
         ToothForm {
-            form_factor: 2.1,
-            stress_correction: 2.0,
-            load_distribution: 1.0,
-            face_width_m: 3e-3,
-            working_depth_m: 2.7e-3,
+            form_factor: DEFAULT_FORM_FACTOR,
+            stress_correction: DEFAULT_STRESS_CORRECTION,
+            load_distribution: DEFAULT_LOAD_DISTRIBUTION,
+            face_width_m: DEFAULT_FACE_WIDTH_M,
+            working_depth_m: DEFAULT_WORKING_DEPTH_M,
         }
-    }
-}
-
-impl ToothForm {
-    /// Every value that breaks its rule, named `prefix.key` (empty when all are valid).
-    pub fn problems(&self, prefix: &str) -> Vec<FatigueError> {
-        let mut e = Vec::new();
-        let v = self;
-        check(
-            &mut e,
-            prefix,
-            "form_factor",
-            v.form_factor,
-            v.form_factor > 0.0,
-            "must be > 0 (dimensionless)",
-        );
-        check(
-            &mut e,
-            prefix,
-            "stress_correction_factor",
-            v.stress_correction,
-            v.stress_correction >= 1.0,
-            "must be >= 1 (dimensionless: a notch raises the stress)",
-        );
-        check(
-            &mut e,
-            prefix,
-            "load_distribution_factor",
-            v.load_distribution,
-            v.load_distribution >= 1.0,
-            "must be >= 1 (peak over mean line load)",
-        );
-        check(
-            &mut e,
-            prefix,
-            "face_width_m",
-            v.face_width_m,
-            v.face_width_m > 0.0,
-            "must be > 0 m",
-        );
-        check(
-            &mut e,
-            prefix,
-            "working_depth_m",
-            v.working_depth_m,
-            v.working_depth_m > 0.0,
-            "must be > 0 m",
-        );
-        e
     }
 }
 
@@ -177,7 +128,7 @@ impl MinerRule {
     ];
 
     /// The name used in scene files and tables (`original`, `elementary`, `haibach`).
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             MinerRule::Original => "original",
             MinerRule::Elementary => "elementary",
@@ -216,55 +167,16 @@ pub struct Material {
 impl Default for Material {
     fn default() -> Self {
         Material {
-            endurance_amplitude_pa: 315e6,
-            knee_cycles: 3e6,
-            slope: 6.2,
-            rule: MinerRule::Haibach,
-            critical_damage: 1.0,
+            endurance_amplitude_pa: DEFAULT_ENDURANCE_AMPLITUDE_PA,
+            knee_cycles: DEFAULT_KNEE_CYCLES,
+            slope: DEFAULT_SLOPE,
+            rule: DEFAULT_MINER_RULE,
+            critical_damage: DEFAULT_CRITICAL_DAMAGE,
         }
     }
 }
 
 impl Material {
-    /// Every value that breaks its rule, named `prefix.key` (empty when all are valid).
-    pub fn problems(&self, prefix: &str) -> Vec<FatigueError> {
-        let mut e = Vec::new();
-        let v = self;
-        check(
-            &mut e,
-            prefix,
-            "endurance_amplitude_pa",
-            v.endurance_amplitude_pa,
-            v.endurance_amplitude_pa > 0.0,
-            "must be > 0 Pa (a stress amplitude)",
-        );
-        check(
-            &mut e,
-            prefix,
-            "knee_cycles",
-            v.knee_cycles,
-            v.knee_cycles > 0.0,
-            "must be > 0 (cycles)",
-        );
-        check(
-            &mut e,
-            prefix,
-            "slope",
-            v.slope,
-            v.slope > 1.0,
-            "must be > 1 (Basquin exponent k; Haibach's 2k - 1 must exceed k)",
-        );
-        check(
-            &mut e,
-            prefix,
-            "critical_damage",
-            v.critical_damage,
-            v.critical_damage > 0.0,
-            "must be > 0 (Miner sum at failure)",
-        );
-        e
-    }
-
     /// Cycles to failure `N(S)` at a stress amplitude `amplitude_pa` (Pa, >= 0); infinite for
     /// zero amplitude and, with Miner original, below the knee.
     pub fn cycles_to_failure(&self, amplitude_pa: f64) -> f64 {
@@ -508,33 +420,6 @@ mod tests {
             miner_damage([(s_eq, mat.knee_cycles)], &mat),
             miner_damage(spectrum, &mat),
             max_relative = 1e-12
-        );
-    }
-
-    /// Bad values are reported with their key, value and rule; the defaults are valid.
-    #[test]
-    fn bad_values_name_key_value_and_rule() {
-        assert!(ToothForm::default().problems("defaults.fatigue").is_empty());
-        assert!(Material::default().problems("defaults.material").is_empty());
-        let f = ToothForm {
-            face_width_m: -1e-3,
-            stress_correction: f64::NAN,
-            ..Default::default()
-        };
-        let p = f.problems("discs[1].fatigue");
-        assert_eq!(p.len(), 2);
-        assert_eq!(p[0].key, "discs[1].fatigue.stress_correction_factor");
-        assert_eq!(
-            p[1].to_string(),
-            "discs[1].fatigue.face_width_m = -0.001: must be > 0 m"
-        );
-        let m = Material {
-            slope: 1.0,
-            ..Default::default()
-        };
-        assert_eq!(
-            m.problems("defaults.material")[0].key,
-            "defaults.material.slope"
         );
     }
 }

@@ -62,7 +62,7 @@ pub use clutch::{
     StackModel,
 };
 pub use drive::{Harmonic, Shaft, ShaftExcitation, SpeedProfile, Table, TableError};
-pub use fatigue::{FatigueError, Material, MinerRule, ToothForm};
+pub use fatigue::{FatigueParams, Material, MinerRule, ToothForm};
 pub use impact::{detect_impacts, parabolic_peak, ImpactEvent, ImpactTracker};
 pub use law::{ContactState, Engagement, Hertz, LawKind, OilFilm, ToothLaw};
 pub use pack::{

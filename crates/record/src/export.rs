@@ -5,6 +5,7 @@ use clutchpack_analysis::csv_field;
 use clutchpack_model::Flank;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Writes one CSV file per topic of ours into `dir` (created if missing) and returns their
 /// paths.
@@ -26,6 +27,16 @@ pub fn export_csv(
     reader: &RecordingReader,
     dir: impl AsRef<Path>,
 ) -> Result<Vec<PathBuf>, ReadError> {
+    export_csv_until(reader, dir, &AtomicBool::new(false))
+}
+
+/// [`export_csv`] that stops before the next file once `stop` is set (a signal): the files
+/// written until then are complete (each is written whole) and returned.
+pub fn export_csv_until(
+    reader: &RecordingReader,
+    dir: impl AsRef<Path>,
+    stop: &AtomicBool,
+) -> Result<Vec<PathBuf>, ReadError> {
     let dir = dir.as_ref();
     std::fs::create_dir_all(dir).map_err(|source| ReadError::Export {
         path: dir.to_path_buf(),
@@ -33,8 +44,12 @@ pub fn export_csv(
     })?;
     let mut written = Vec::new();
     let mut put = |name: &str, text: String| -> Result<(), ReadError> {
+        if stop.load(Ordering::SeqCst) {
+            return Ok(());
+        }
         let path = dir.join(name);
-        std::fs::write(&path, text).map_err(|source| ReadError::Export {
+        // whole or not at all: a temporary sibling renamed into place
+        crate::output::write_whole(&path, text.as_bytes()).map_err(|source| ReadError::Export {
             path: path.clone(),
             source,
         })?;

@@ -98,6 +98,7 @@
 
 mod export;
 pub mod info;
+pub mod output;
 pub mod proto;
 mod read;
 mod ros2;
@@ -113,8 +114,9 @@ mod threaded;
 pub mod topics;
 mod write;
 
-pub use export::export_csv;
+pub use export::{export_csv, export_csv_until};
 pub use info::{sha256_hex, DiscGeometry, FrictionInterface, RunInfo, ShaftGeometry};
+pub use output::{write_whole, PendingFile, Replace};
 pub use read::{
     from_bytes, open, open_complete, AttachmentInfo, Damage, DamageKind, DiscSeries,
     InterfaceSeries, LoadHistory, MessageView, ReadError, RecordingInfo, RecordingReader,
@@ -122,7 +124,7 @@ pub use read::{
 };
 #[cfg(feature = "serve")]
 pub use serve::{serve, ServeError, ServeOptions};
-pub use summary::{DiscStats, RunSummary, MAX_EXTRA_DISCS, TOP_N};
+pub use summary::{DiscStats, FatigueSummary, RunSummary, MAX_EXTRA_DISCS, TOP_N};
 pub use threaded::ThreadedRecorder;
 pub use write::{default_path, log_time_ns, RecordError, RecordOptions, Recorder};
 

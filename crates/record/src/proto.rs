@@ -1,8 +1,8 @@
 //! Our own protobuf messages (package `clutchpack`), their descriptor, and the `.proto` text.
 //!
-//! The schema is defined once, in the tables of this module ([`MESSAGES`], [`ENUMS`]); from
-//! them come the `FileDescriptorProto` embedded in every recording ([`file_descriptor_set`])
-//! and the human-readable `proto/clutchpack.proto` ([`proto_text`], checked by a test). The
+//! The schema is defined once, in the tables of this module (`MESSAGES`, `ENUMS`); from
+//! them come the `FileDescriptorProto` embedded in every recording (`file_descriptor_set`)
+//! and the human-readable `proto/clutchpack.proto` (`proto_text`, checked by a test). The
 //! encoders are the `prost`-derived structs below, whose tags a test checks against the tables.
 //! No `protoc` and no build script are needed.
 //!
@@ -194,7 +194,7 @@ pub struct Impact {
     pub peak_n: f64,
 }
 
-/// Statistics of one disc's impact peaks (wire form of [`crate::DiscSummary`]).
+/// Statistics of one disc's impact peaks (wire form of `clutchpack_analysis::DiscStats`).
 #[derive(Clone, PartialEq, prost::Message)]
 pub struct DiscSummary {
     /// Disc name.
@@ -224,6 +224,30 @@ pub struct DiscSummary {
     /// Mean of the 10 largest |peak| in N.
     #[prost(double, tag = "9")]
     pub mean_top10_abs_n: f64,
+    /// Whether the fatigue fields 11.. are set (false in files written before them).
+    #[prost(bool, tag = "10")]
+    pub fatigue: bool,
+    /// Damage per hour of the simulated duty, 1/h (MODEL.md section 7).
+    #[prost(double, tag = "11")]
+    pub damage_rate_per_h: f64,
+    /// Life in hours at this duty; 0 when unlimited (no damage).
+    #[prost(double, tag = "12")]
+    pub life_h: f64,
+    /// Damage-equivalent load range for one hour at the knee's cycles, N.
+    #[prost(double, tag = "13")]
+    pub eq_load_range_n: f64,
+    /// Largest tooth-root bending stress, Pa.
+    #[prost(double, tag = "14")]
+    pub max_root_stress_pa: f64,
+    /// Number of resolved teeth (0: the engine did not resolve teeth).
+    #[prost(uint32, tag = "15")]
+    pub teeth: u32,
+    /// Index of the most damaged resolved tooth.
+    #[prost(uint32, tag = "16")]
+    pub worst_tooth: u32,
+    /// Life of the most damaged resolved tooth in hours; 0 when unlimited.
+    #[prost(double, tag = "17")]
+    pub worst_tooth_life_h: f64,
 }
 
 /// The run's summary (topic `/summary`, one message at the end of the run).
@@ -515,6 +539,44 @@ pub(crate) const MESSAGES: &[MessageDef] = &[
                 9,
                 Double,
                 "mean of the 10 largest |peak|, N",
+            ),
+            f(
+                "fatigue",
+                10,
+                Bool,
+                "whether the fatigue fields 11.. are set",
+            ),
+            f(
+                "damage_rate_per_h",
+                11,
+                Double,
+                "tooth damage per hour of the simulated duty, 1/h",
+            ),
+            f("life_h", 12, Double, "life at this duty, h (0: unlimited)"),
+            f(
+                "eq_load_range_n",
+                13,
+                Double,
+                "damage-equivalent load range for one hour at N_D cycles, N",
+            ),
+            f(
+                "max_root_stress_pa",
+                14,
+                Double,
+                "largest tooth-root bending stress, Pa",
+            ),
+            f("teeth", 15, Uint32, "resolved teeth (0: none)"),
+            f(
+                "worst_tooth",
+                16,
+                Uint32,
+                "index of the most damaged resolved tooth",
+            ),
+            f(
+                "worst_tooth_life_h",
+                17,
+                Double,
+                "life of the most damaged resolved tooth, h (0: unlimited)",
             ),
         ],
     },
@@ -814,6 +876,14 @@ mod tests {
             positive_impacts: 7,
             negative_impacts: 8,
             mean_top10_abs_n: 9.0,
+            fatigue: true,
+            damage_rate_per_h: 11.0,
+            life_h: 12.0,
+            eq_load_range_n: 13.0,
+            max_root_stress_pa: 14.0,
+            teeth: 15,
+            worst_tooth: 16,
+            worst_tooth_life_h: 17.0,
         };
         check("DiscSummary", ds.encode_to_vec());
         check(

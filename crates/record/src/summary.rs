@@ -14,13 +14,49 @@ pub use clutchpack_analysis::stats::TOP_N;
 /// Disc indices past the named discs that [`RunSummary::from_impacts`] still gives entries.
 pub const MAX_EXTRA_DISCS: usize = 1024;
 
-/// A run's summary: one [`DiscStats`] per disc in scene order.
+/// The fatigue figures of one disc kept in the recording's `/summary`
+/// (`clutchpack_analysis::DiscFatigue` in short).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FatigueSummary {
+    /// Damage per hour of the simulated duty, 1/h (>= 0).
+    pub damage_rate_per_h: f64,
+    /// Life in hours at this duty; `None`: unlimited (no damage).
+    pub life_h: Option<f64>,
+    /// Damage-equivalent load range for one hour at the knee's cycles, N.
+    pub eq_load_range_n: f64,
+    /// Largest tooth-root bending stress of the run, Pa.
+    pub max_root_stress_pa: f64,
+    /// The most damaged resolved tooth: (index, life in h or `None` if unlimited), with
+    /// the number of resolved teeth; `None` when the engine did not resolve teeth.
+    pub worst_tooth: Option<(u32, Option<f64>, u32)>,
+}
+
+impl From<&clutchpack_analysis::DiscFatigue> for FatigueSummary {
+    fn from(d: &clutchpack_analysis::DiscFatigue) -> FatigueSummary {
+        FatigueSummary {
+            damage_rate_per_h: d.lumped.damage_rate_per_h,
+            life_h: d.lumped.life_h,
+            eq_load_range_n: d.lumped.eq_load_range_n,
+            max_root_stress_pa: d.max_root_stress_pa,
+            worst_tooth: d
+                .teeth
+                .as_ref()
+                .map(|t| (t.worst_tooth as u32, t.worst.life_h, t.damage.len() as u32)),
+        }
+    }
+}
+
+/// A run's summary: one [`DiscStats`] per disc in scene order, and the discs' fatigue when
+/// the run assessed it.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct RunSummary {
     /// Simulated time at the end of the run in s.
     pub t_end_s: f64,
     /// One entry per disc, in scene order.
     pub discs: Vec<DiscStats>,
+    /// The fatigue of each disc's spline teeth (MODEL.md section 7), in the order of
+    /// `discs`; empty when the run did not assess fatigue (older files, failed runs).
+    pub fatigue: Vec<Option<FatigueSummary>>,
 }
 
 impl RunSummary {
@@ -52,7 +88,13 @@ impl RunSummary {
                     DiscStats::from_peaks(name, p)
                 })
                 .collect(),
+            fatigue: Vec::new(),
         }
+    }
+
+    /// The fatigue of disc `i`, if the run assessed it.
+    pub fn fatigue_of(&self, i: usize) -> Option<&FatigueSummary> {
+        self.fatigue.get(i).and_then(Option::as_ref)
     }
 
     pub(crate) fn to_proto(&self) -> proto::RunSummary {
@@ -62,24 +104,58 @@ impl RunSummary {
                 .discs
                 .iter()
                 .enumerate()
-                .map(|(i, d)| proto::DiscSummary {
-                    name: d.name.clone(),
-                    index: i as u32,
-                    max_positive_n: d.max_positive_n,
-                    max_negative_n: d.max_negative_n,
-                    p99_abs_n: d.p99_abs_n,
-                    impacts: d.impacts as u64,
-                    positive_impacts: d.positive_impacts as u64,
-                    negative_impacts: d.negative_impacts as u64,
-                    mean_top10_abs_n: d.mean_top10_abs_n,
+                .map(|(i, d)| {
+                    let fatigue = self.fatigue_of(i);
+                    let f = fatigue.copied().unwrap_or_default();
+                    let (worst_tooth, worst_life, teeth) = f.worst_tooth.unwrap_or((0, None, 0));
+                    proto::DiscSummary {
+                        fatigue: fatigue.is_some(),
+                        damage_rate_per_h: f.damage_rate_per_h,
+                        life_h: f.life_h.unwrap_or(0.0),
+                        eq_load_range_n: f.eq_load_range_n,
+                        max_root_stress_pa: f.max_root_stress_pa,
+                        teeth,
+                        worst_tooth,
+                        worst_tooth_life_h: worst_life.unwrap_or(0.0),
+                        name: d.name.clone(),
+                        index: i as u32,
+                        max_positive_n: d.max_positive_n,
+                        max_negative_n: d.max_negative_n,
+                        p99_abs_n: d.p99_abs_n,
+                        impacts: d.impacts as u64,
+                        positive_impacts: d.positive_impacts as u64,
+                        negative_impacts: d.negative_impacts as u64,
+                        mean_top10_abs_n: d.mean_top10_abs_n,
+                    }
                 })
                 .collect(),
         }
     }
 
     pub(crate) fn from_proto(p: proto::RunSummary) -> RunSummary {
+        let life = |h: f64| (h > 0.0).then_some(h);
+        let fatigue: Vec<Option<FatigueSummary>> = p
+            .discs
+            .iter()
+            .map(|d| {
+                d.fatigue.then(|| FatigueSummary {
+                    damage_rate_per_h: d.damage_rate_per_h,
+                    life_h: life(d.life_h),
+                    eq_load_range_n: d.eq_load_range_n,
+                    max_root_stress_pa: d.max_root_stress_pa,
+                    worst_tooth: (d.teeth > 0)
+                        .then(|| (d.worst_tooth, life(d.worst_tooth_life_h), d.teeth)),
+                })
+            })
+            .collect();
         RunSummary {
             t_end_s: p.t_end_s,
+            // a file without fatigue keeps the list empty, as the run that wrote it had it
+            fatigue: if fatigue.iter().any(Option::is_some) {
+                fatigue
+            } else {
+                Vec::new()
+            },
             discs: p
                 .discs
                 .into_iter()
@@ -144,5 +220,23 @@ mod tests {
         assert_eq!(s.discs[2].name, "disc 2");
         assert_eq!(s.discs[2].max_positive_n, 5.0);
         assert_eq!(RunSummary::from_proto(s.to_proto()), s);
+        // fatigue figures round-trip; unlimited lives stay unlimited
+        let mut f = s.clone();
+        f.fatigue = vec![None; 3];
+        f.fatigue[0] = Some(FatigueSummary {
+            damage_rate_per_h: 0.0,
+            life_h: None,
+            eq_load_range_n: 0.0,
+            max_root_stress_pa: 0.0,
+            worst_tooth: None,
+        });
+        f.fatigue[2] = Some(FatigueSummary {
+            damage_rate_per_h: 2e-3,
+            life_h: Some(500.0),
+            eq_load_range_n: 321.0,
+            max_root_stress_pa: 4e8,
+            worst_tooth: Some((17, Some(250.0), 154)),
+        });
+        assert_eq!(RunSummary::from_proto(f.to_proto()), f);
     }
 }

@@ -2,6 +2,7 @@
 //! impact events into an MCAP file.
 
 use crate::info::{num, utc_text, RunInfo, META_STATS, SCENE_MEDIA_TYPE};
+use crate::output::{PendingFile, Replace};
 use crate::summary::RunSummary;
 use crate::view3d::{self, disc_frame};
 use crate::{proto, topic_segment, topics};
@@ -127,16 +128,19 @@ pub enum RecordError {
     },
 }
 
-/// The default recording path `dir/<scene>-<UTC time>.mcap`, e.g.
-/// `recordings/paper-20261122T022900Z.mcap` for `now` = 2026-11-22 02:29:00 UTC; the scene
-/// name is made file-safe as a topic segment ([`topic_segment`](crate::topic_segment)).
+/// The default recording path `dir/<scene>-<UTC time to the millisecond>.mcap`, e.g.
+/// `recordings/paper-20261122T022900.250Z.mcap` for `now` = 2026-11-22 02:29:00.25 UTC; the
+/// scene name is made file-safe as a topic segment ([`topic_segment`](crate::topic_segment)).
+/// Two runs in the same millisecond get the same name here: write default names with
+/// [`Recorder::create_output`] and [`Replace::Never`], which takes the next free
+/// `<name>-2.mcap`, ... atomically.
 pub fn default_path(dir: impl AsRef<Path>, scene_name: &str, now: SystemTime) -> PathBuf {
     let since = now.duration_since(UNIX_EPOCH).unwrap_or_default();
-    // 2026-11-22T02:29:00.000Z -> 20261122T022900Z
+    // 2026-11-22T02:29:00.250Z -> 20261122T022900.250Z
     let t: String = utc_text(since)
         .chars()
-        .take(19)
-        .filter(|c| c.is_ascii_digit() || *c == 'T')
+        .take(23)
+        .filter(|c| c.is_ascii_digit() || *c == 'T' || *c == '.')
         .collect();
     dir.as_ref()
         .join(format!("{}-{t}Z.mcap", topic_segment(scene_name)))
@@ -193,7 +197,10 @@ struct Channels {
 /// `finish` still closes the file with its summary section, but without `/summary`; so call
 /// `finish` after an engine error or a Ctrl-C stop as well, to keep the summary of what ran.
 pub struct Recorder {
+    /// The file being written (the temporary file of an output made with `create_output`).
     path: PathBuf,
+    /// Where `finish` moves the file (`create_output` only).
+    pending: Option<PendingFile>,
     writer: Option<mcap::Writer<BufWriter<File>>>,
     options: RecordOptions,
     info: RunInfo,
@@ -252,6 +259,37 @@ impl Recorder {
             std::fs::create_dir_all(dir).map_err(create_err)?;
         }
         let file = File::create(&path).map_err(create_err)?;
+        Recorder::start(path, file, None, info, options)
+    }
+
+    /// Creates the recording as an output written whole: into a new temporary file beside
+    /// `target` (`<stem>.partial-<pid>-<k>.mcap`, see [`PendingFile`]), moved into place by
+    /// [`Self::finish`] (replacing an existing `target` only with [`Replace::Existing`];
+    /// with [`Replace::Never`] under the first free `<stem>-<k>.mcap`). A run killed before
+    /// `finish` leaves the temporary file, readable up to its last flush.
+    pub fn create_output(
+        target: impl AsRef<Path>,
+        replace: Replace,
+        info: &RunInfo,
+        options: &RecordOptions,
+    ) -> Result<Recorder, RecordError> {
+        let target = target.as_ref();
+        let (pending, file) =
+            PendingFile::create(target, replace).map_err(|source| RecordError::Create {
+                path: target.to_path_buf(),
+                source,
+            })?;
+        let path = pending.tmp_path().to_path_buf();
+        Recorder::start(path, file, Some(pending), info, options)
+    }
+
+    fn start(
+        path: PathBuf,
+        file: File,
+        pending: Option<PendingFile>,
+        info: &RunInfo,
+        options: &RecordOptions,
+    ) -> Result<Recorder, RecordError> {
         let write_err = |what: &str, source| RecordError::Write {
             path: path.clone(),
             what: what.to_string(),
@@ -446,6 +484,7 @@ impl Recorder {
         let n = names.len();
         let mut rec = Recorder {
             path,
+            pending,
             writer: Some(w),
             options: options.clone(),
             info: info.clone(),
@@ -523,6 +562,7 @@ impl Recorder {
         let mut s = RunSummary {
             t_end_s: self.last_t_s,
             discs: Vec::with_capacity(self.peaks.len()),
+            fatigue: Vec::new(),
         };
         for (i, p) in self.peaks.iter().enumerate() {
             let name = self
@@ -923,7 +963,13 @@ impl Recorder {
             path: path.clone(),
             source,
         })?;
-        Ok(path)
+        drop(inner);
+        match self.pending.take() {
+            Some(p) => p
+                .commit()
+                .map_err(|source| RecordError::Close { path, source }),
+            None => Ok(path),
+        }
     }
 
     fn keep(&mut self, r: Result<(), RecordError>) {
@@ -994,8 +1040,10 @@ mod tests {
         let p = default_path("recordings", "paper case", now);
         assert_eq!(
             p,
-            PathBuf::from("recordings/paper_case-20261122T022900Z.mcap")
+            PathBuf::from("recordings/paper_case-20261122T022900.000Z.mcap")
         );
+        let p = default_path("r", "x", now + Duration::from_millis(250));
+        assert_eq!(p, PathBuf::from("r/x-20261122T022900.250Z.mcap"));
     }
 
     /// Log times: simulated seconds to ns, rounded; nothing negative.

@@ -58,12 +58,41 @@ pub struct Dense {
 }
 
 impl Dense {
-    /// End of the step, s.
-    pub fn t1(&self) -> f64 {
-        self.t0 + self.h
+    /// Inserts two components (zero) at index `k`: a disc joins the system at the end of
+    /// this step, so its interpolant is never evaluated.
+    pub fn insert2(&mut self, k: usize) {
+        if self.r1.len() < k {
+            return;
+        }
+        for v in [
+            &mut self.r1,
+            &mut self.r2,
+            &mut self.r3,
+            &mut self.r4,
+            &mut self.r5,
+        ] {
+            v.splice(k..k, [0.0, 0.0]);
+        }
     }
 
-    /// Interpolated state at `t` (within the step) into `out`.
+    /// Removes the two components at index `k` (a disc leaves the system).
+    pub fn remove2(&mut self, k: usize) {
+        if self.r1.len() < k + 2 {
+            return;
+        }
+        for v in [
+            &mut self.r1,
+            &mut self.r2,
+            &mut self.r3,
+            &mut self.r4,
+            &mut self.r5,
+        ] {
+            v.drain(k..k + 2);
+        }
+    }
+
+    /// Interpolated state at `t` (within the step) into `out` (its first `out.len()`
+    /// components).
     pub fn eval(&self, t: f64, out: &mut [f64]) {
         let th = if self.h > 0.0 {
             ((t - self.t0) / self.h).clamp(0.0, 1.0)
@@ -101,14 +130,20 @@ impl Dopri5 {
         }
     }
 
+    /// Resizes the workspace to dimension `n` (the derivative at the start of the next step
+    /// must be set again).
+    pub fn resize(&mut self, n: usize) {
+        for v in self.k.iter_mut() {
+            v.resize(n, 0.0);
+        }
+        for v in [&mut self.ytmp, &mut self.y_new, &mut self.err] {
+            v.resize(n, 0.0);
+        }
+    }
+
     /// `f(t, y)` at the start of the next step (call after a restart or at t = 0).
     pub fn set_start_derivative(&mut self, dy: &[f64]) {
         self.k[0].copy_from_slice(dy);
-    }
-
-    /// The derivative at the start of the step.
-    pub fn start_derivative(&self) -> &[f64] {
-        &self.k[0]
     }
 
     /// Tries a step of size `h` from `(t, y)`. Fills `y_new` and returns the scaled RMS error

@@ -50,6 +50,19 @@ impl Scene {
         })
     }
 
+    /// Why [`Scene::engine`] chooses what it does, for `run`'s engine line: "asked by
+    /// --engine", "chosen by the scene (simulation.engine)", or the default's reason.
+    pub fn engine_reason(&self, asked: Option<EngineChoice>) -> &'static str {
+        match (asked, self.simulation.engine) {
+            (Some(_), _) => "asked by --engine",
+            (None, Some(_)) => "chosen by the scene (simulation.engine)",
+            (None, None) if self.pack.non_torsional_parts().is_empty() => {
+                "the default for a torsional pack (concentric discs on one shaft)"
+            }
+            (None, None) => "the only engine for per-tooth effects, plates or a stack",
+        }
+    }
+
     /// `part` as a problem at its key: the reference engine (chosen by `why`) cannot run it.
     fn reference_problem(&self, part: NonTorsional, why: &str) -> Problem {
         let disc = |i: usize, k: &str| format!("discs[{i}].{k}");

@@ -15,6 +15,7 @@
 //! [`Key`]: crate::schema::Key
 
 use crate::schema::{table, Dflt, Kind, Rule};
+use clutchpack_model::fatigue as fat;
 
 /// Longest simulated duration accepted, s (about 11.6 days).
 pub(crate) const MAX_DURATION_S: f64 = 1e6;
@@ -243,6 +244,8 @@ table! {
         spline: table RawSpline,
         contact: table RawContact,
         oil: table RawOil,
+        fatigue: table RawToothForm,
+        material: table RawMaterial,
     }
 }
 
@@ -293,6 +296,44 @@ table! {
         v_floor_m_s: "m/s", POSITIVE, Dflt::Num(0.01);
         /// smallest film of the squeeze law
         h_min_m: "m", POSITIVE, Dflt::Num(1e-6);
+    }
+    children {}
+}
+
+table! {
+    /// `fatigue` of a body: the tooth form for the root stress and flank pressure (MODEL.md
+    /// section 7; ISO 6336-3's factors applied to the spline tooth). Defaults ASSUMED for the
+    /// paper's disc (docs/DECISIONS.md, "Fatigue").
+    RawToothForm at "fatigue" {
+        /// tooth form factor Y_F of sigma_F = F_t / (b m) Y_F Y_S K_l; ASSUMED default: ISO 6336-3 for a rack-like 20 deg tooth
+        form_factor: "", POSITIVE, Dflt::Num(fat::DEFAULT_FORM_FACTOR);
+        /// stress correction factor Y_S (root fillet notch); ASSUMED default: ISO 6336-3, basic rack fillet
+        stress_correction_factor: "", Kind::Number(Rule::AtLeast(1.0)), Dflt::Num(fat::DEFAULT_STRESS_CORRECTION);
+        /// axial load distribution factor K_l: peak over mean line load along the face
+        load_distribution_factor: "", Kind::Number(Rule::AtLeast(1.0)), Dflt::Num(fat::DEFAULT_LOAD_DISTRIBUTION);
+        /// engaged face width b (the disc's thickness)
+        face_width_m: "m", POSITIVE, Dflt::Num(fat::DEFAULT_FACE_WIDTH_M);
+        /// working depth h_w of the flank pressure p = F_t / (b h_w); ASSUMED default 0.9 m of the paper's 3 mm module
+        working_depth_m: "m", POSITIVE, Dflt::Num(fat::DEFAULT_WORKING_DEPTH_M);
+    }
+    children {}
+}
+
+table! {
+    /// `material` of a body: the S-N curve of the tooth root (Basquin with a knee) and the
+    /// failure criterion (MODEL.md section 7). Defaults ASSUMED for a through-hardened steel
+    /// disc core (ISO 6336-5 MQ; docs/DECISIONS.md, "Fatigue").
+    RawMaterial at "material" {
+        /// endurance limit S_D as a root stress amplitude at knee_cycles; ASSUMED default: sigma_Flim of through-hardened steel (ISO 6336-5 MQ)
+        endurance_amplitude_pa: "Pa", POSITIVE, Dflt::Num(fat::DEFAULT_ENDURANCE_AMPLITUDE_PA);
+        /// cycles N_D at the knee of the S-N curve
+        knee_cycles: "", POSITIVE, Dflt::Num(fat::DEFAULT_KNEE_CYCLES);
+        /// Basquin exponent k above the knee, N = N_D (S_D / S)^k; ASSUMED default from ISO 6336-3's life factor
+        slope: "", Kind::Number(Rule::Above(1.0)), Dflt::Num(fat::DEFAULT_SLOPE);
+        /// below the knee: no damage (original), slope k (elementary) or slope 2k - 1 (haibach)
+        miner_rule: "", Kind::Choice(&["original", "elementary", "haibach"]), Dflt::Choice(fat::DEFAULT_MINER_RULE.name());
+        /// Miner damage sum at failure D_crit
+        critical_damage: "", POSITIVE, Dflt::Num(fat::DEFAULT_CRITICAL_DAMAGE);
     }
     children {}
 }

@@ -215,6 +215,12 @@ pub struct Scene {
     pub simulation: Simulation,
     /// The physical model.
     pub pack: PackModel,
+    /// The fatigue parameters of each body's spline teeth (keys `fatigue.*` and `material.*`
+    /// of `[defaults]` and each `[[discs]]`, then of `[plate_defaults]` and each
+    /// `[[plates]]`): one per disc, then one per plate, in the order engines number their
+    /// couplings (`ImpactEvent::disc`).
+    #[serde(default)]
+    pub fatigue: Vec<clutchpack_model::FatigueParams>,
 }
 
 /// Reads and validates the scene file at `path`, after applying `overrides` in order.
@@ -282,6 +288,7 @@ pub fn parse(
             overrides: overrides.iter().map(Override::to_string).collect(),
             simulation: v.simulation,
             pack: v.pack,
+            fatigue: v.fatigue,
         }),
         _ => {
             debug_assert!(

@@ -167,9 +167,9 @@ pub struct MultibodyOptions {
 pub enum Scheme {
     /// The multirate scheme wherever it applies (adaptive steps, a prescribed shaft, friction
     /// discs only, concentric lumped couplings), the shared step otherwise. The default.
+    #[default]
     Auto,
     /// Every body on one shared contact-aware step (the shortest any coupling needs).
-    #[default]
     Shared,
     /// The multirate scheme, or an error for a pack it cannot run.
     Multirate,

@@ -280,6 +280,10 @@ impl World {
                 });
             }
             let h = physics.insert_body(rb);
+            // Now rather than at the first step: the multirate scheme reads the disc's
+            // inertia from its mass properties before the world has stepped.
+            let body = &mut physics.bodies[h];
+            body.recompute_mass_properties_from_colliders(&physics.colliders);
             if !locked_axes {
                 let joint = if d.radial_float {
                     floating_joint(Vector::new(0.0, 0.0, disc_axial_m[i]))

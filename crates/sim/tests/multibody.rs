@@ -8,7 +8,8 @@ use clutchpack_model::{
 };
 use clutchpack_scene::{Scene, Simulation};
 use clutchpack_sim::{
-    AdaptiveStepping, DiscMount, MultibodyEngine, MultibodyOptions, Stepping, ToothResolution,
+    AdaptiveStepping, DiscMount, MultibodyEngine, MultibodyOptions, Scheme, Stepping,
+    ToothResolution,
 };
 
 fn paper_spline() -> SplineGeometry {
@@ -73,10 +74,19 @@ fn fixed(dt_s: f64) -> MultibodyOptions {
     }
 }
 
+/// Adaptive steps: the multirate scheme on the prescribed-shaft packs here (`Scheme::Auto`).
 fn adaptive() -> MultibodyOptions {
     MultibodyOptions {
         stepping: Stepping::Adaptive(AdaptiveStepping::default()),
         ..Default::default()
+    }
+}
+
+/// Adaptive steps on the shared step, the scheme of every pack the multirate one cannot run.
+fn shared() -> MultibodyOptions {
+    MultibodyOptions {
+        scheme: Scheme::Shared,
+        ..adaptive()
     }
 }
 
@@ -97,12 +107,17 @@ fn run(
 /// (infinitely heavy side, no drive), no drag, dry law, `p = 0`; the disc closes on the
 /// shaft-leads flank at `v0` along the line of action from 5 us before contact. The peak
 /// per-tooth load is `F_max = H^(2/5) (5/4 m_eff v0^2)^(3/5)` with `m_eff = J / (n Rb^2)` and
-/// the disc rebounds at `v0`. Tolerance 0.1 % on both (issue 3); measured: within 1e-6 at
-/// fixed 1 us steps and 2e-7 with adaptive steps (the kick integrates the teeth's force along
-/// each step, `integrate.rs`).
+/// the disc rebounds at `v0`. Tolerance 0.1 % on both (issue 3); measured: within 6e-7 at
+/// fixed 1 us steps, 2.3e-8 with the shared adaptive step (the kick integrates the teeth's
+/// force along each step, `integrate.rs`) and 4.2e-8 with the multirate scheme (sub-steps
+/// graded at the kinks).
 #[test]
 fn free_impact_matches_the_closed_form() {
-    for (label, opts) in [("fixed 1 us", fixed(1e-6)), ("adaptive", adaptive())] {
+    for (label, opts) in [
+        ("fixed 1 us", fixed(1e-6)),
+        ("adaptive, multirate", adaptive()),
+        ("adaptive, shared step", shared()),
+    ] {
         for v0 in [0.05, 0.3, 1.0] {
             let g = paper_spline();
             let rb = g.base_radius_m();
@@ -260,12 +275,14 @@ fn per_tooth_path_equals_the_lumped_path() {
 /// Energy (issue 3): without drag and with p = 0 (dry law: a conservative contact) the work
 /// done by the prescribed shaft on the teeth over a 50 ms rattle under the paper's drive
 /// equals the change of the disc's kinetic energy plus the energy stored in the teeth, within
-/// 0.5 % of the work (measured: 1.3e-5 at fixed 1 us steps, 1e-6 adaptive). The work is the
-/// teeth's torque integrated over the shaft's exact turn (trapezoidal rule per step); the
-/// kinetic energy is `J w^2 / 2` with the disc speed synchronised to the step's end.
+/// 0.5 % of the work (measured: 1.3e-5 at fixed 1 us steps, 7.7e-7 on the shared adaptive
+/// step, 5.8e-11 with the multirate scheme). The work is the teeth's torque integrated over
+/// the shaft's exact turn (trapezoidal rule per step; the multirate scheme's Runge-Kutta
+/// stages); the kinetic energy is `J w^2 / 2` with the disc speed synchronised to the step's
+/// end.
 #[test]
 fn drive_work_equals_the_change_of_energy() {
-    for opts in [fixed(1e-6), adaptive()] {
+    for opts in [fixed(1e-6), adaptive(), shared()] {
         let pack = paper_pack(LawKind::Dry, 0.0, 0.0, 0.0);
         let (c, e) = run(&pack, 1e4, opts, 50e-3);
         assert!(c.impacts.len() >= 10, "a rattle: {}", c.impacts.len());
@@ -276,8 +293,10 @@ fn drive_work_equals_the_change_of_energy() {
         let w = a.drive_work_j + a.drag_work_j;
         let gross: f64 = c.impacts.len() as f64;
         println!(
-            "{:?}: W = {w} J, dE = {de} J, impacts {gross}",
-            e.options().stepping
+            "{:?} {:?}: W = {w} J, dE = {de} J, rel {:e}, impacts {gross}",
+            e.options().stepping,
+            e.is_multirate(),
+            (w - de) / w
         );
         assert_eq!(a.drag_work_j, 0.0);
         assert!(w.abs() > 1.0, "the drive does work: {w}");
@@ -287,27 +306,30 @@ fn drive_work_equals_the_change_of_energy() {
 
 /// Adaptive stepping (issue 3): the first 50 ms of the paper case at h_o = 0, 25 and 50 um
 /// give the same impacts as a fixed 0.1 us step: every peak within 0.2 %, every onset within
-/// 2 us. Measured: worst peaks 1.2e-4, 2.4e-5 and 3.8e-4 (the last a grazing 34 N impact late
-/// in the chaotic rattle; the first ten impacts agree to 1e-5).
+/// 2 us, with both schemes. Measured: worst peaks 1.2e-4, 2.3e-5 and 3.7e-4 on the shared
+/// step (the last a grazing 34 N impact late in the chaotic rattle; the first ten impacts
+/// agree to 1e-5), 5.8e-6, 1.4e-6 and 4.4e-6 with the multirate scheme.
 #[test]
 fn adaptive_steps_give_the_impacts_of_fine_fixed_steps() {
     for h_o in [0.0, 25e-6, 50e-6] {
         let pack = paper_pack(LawKind::Paper, h_o, 0.8, 0.01);
         let (fine, _) = run(&pack, 1e4, fixed(1e-7), 50e-3);
-        let (adapt, _) = run(&pack, 1e4, adaptive(), 50e-3);
-        let a = impacts_before(&adapt, 50e-3);
         let f = impacts_before(&fine, 50e-3);
-        let worst = a
-            .iter()
-            .zip(&f)
-            .map(|(x, y)| ((x.peak_n - y.peak_n) / y.peak_n).abs())
-            .fold(0.0, f64::max);
-        println!(
-            "h_o = {h_o}: {} impacts, worst peak difference {worst:e}",
-            f.len()
-        );
         assert!(f.len() >= 15, "{}", f.len());
-        assert_same_impacts(&a, &f, 2e-3, 0.0, 2e-6);
+        for (label, opts) in [("multirate", adaptive()), ("shared step", shared())] {
+            let (adapt, _) = run(&pack, 1e4, opts, 50e-3);
+            let a = impacts_before(&adapt, 50e-3);
+            let worst = a
+                .iter()
+                .zip(&f)
+                .map(|(x, y)| ((x.peak_n - y.peak_n) / y.peak_n).abs())
+                .fold(0.0, f64::max);
+            println!(
+                "h_o = {h_o}, {label}: {} impacts, worst peak difference {worst:e}",
+                f.len()
+            );
+            assert_same_impacts(&a, &f, 2e-3, 0.0, 2e-6);
+        }
     }
 }
 
@@ -485,6 +507,7 @@ fn engine_follows_the_scene() {
             record_per_tooth: true,
         },
         pack: paper_pack(LawKind::Paper, 25e-6, 0.8, 0.01),
+        fatigue: vec![],
     };
     let mut e = engine_for(&scene).unwrap();
     assert_eq!(e.name(), "multibody");
@@ -517,4 +540,52 @@ fn engine_for(
             sim.record_per_tooth,
         ),
     )
+}
+
+/// The scheme is chosen automatically and explained (issue 9): the multirate scheme on a
+/// prescribed shaft with concentric friction discs, the shared step with the reason on an
+/// inertial shaft, on fixed steps and when asked for; asking for the multirate scheme where it
+/// cannot run is refused with the reason.
+#[test]
+fn scheme_is_chosen_and_explained() {
+    use clutchpack_model::cases::staggered_pack;
+    let explain = |pack: PackModel, opts: MultibodyOptions| {
+        let e = MultibodyEngine::new(pack, opts).expect("engine");
+        (e.is_multirate(), e.scheme_explanation())
+    };
+    let (multirate, why) = explain(staggered_pack(2), adaptive());
+    assert!(multirate, "{why}");
+    assert!(
+        why.starts_with("multirate scheme (automatic: a prescribed shaft"),
+        "{why}"
+    );
+    let (multirate, why) = explain(staggered_pack(2), shared());
+    assert!(!multirate, "{why}");
+    assert!(why.starts_with("shared step (asked for)"), "{why}");
+    let (multirate, why) = explain(staggered_pack(2), fixed(1e-6));
+    assert!(!multirate, "{why}");
+    assert!(
+        why.starts_with("shared step (automatic: fixed steps"),
+        "{why}"
+    );
+    let mut inertial = staggered_pack(2);
+    inertial.shaft = Shaft::Inertial {
+        inertia_kg_m2: 0.3,
+        damping_n_m_s_rad: 0.0,
+        excitation: ShaftExcitation::Profile(SpeedProfile::sine(100.0, 4.378, 104.0)),
+    };
+    let (multirate, why) = explain(inertial.clone(), adaptive());
+    assert!(!multirate, "{why}");
+    assert!(
+        why.starts_with("shared step (automatic: an inertial shaft"),
+        "{why}"
+    );
+    let asked = MultibodyOptions {
+        scheme: Scheme::Multirate,
+        ..adaptive()
+    };
+    match MultibodyEngine::new(inertial, asked) {
+        Err(EngineError::Unsupported(m)) => assert!(m.contains("an inertial shaft"), "{m}"),
+        other => panic!("{other:?}"),
+    }
 }

@@ -4,10 +4,16 @@
 //! "streaming" read), checking every chunk's CRC before using any of its messages, the data
 //! section's CRC, the summary section's CRC and the message counts in the summary. Every
 //! message of our own and of the two Foxglove schemas is decoded on the way, so a file that
-//! opens cleanly decodes completely. The scan stops at the first error; what was read before
-//! it (whole chunks only) stays usable and [`RecordingReader::damage`] says what happened, so
-//! a run killed mid-way (no summary section) is still read message by message. Nothing in
-//! here panics on bad input.
+//! opens cleanly decodes completely. At the first error [`RecordingReader::damage`] records
+//! what happened (strict readers refuse the file on it), and the scan resynchronises: it
+//! looks for the next chunk record after the last good record (a chunk header whose lengths
+//! agree with each other and with the file, then the chunk's CRC) and reads on from there, so
+//! a flipped bit in the scene attachment or in one chunk loses only that record, not every
+//! chunk after it. Schemas and channels come from the summary section too when the footer is
+//! intact, so messages of a chunk whose channel was defined in a lost chunk still decode.
+//! Whole chunks only are used; [`Damage`] says how many regions and bytes were skipped. A run
+//! killed mid-way (no summary section) is read up to its last complete chunk. Nothing in here
+//! panics on bad input.
 
 use crate::info::RunInfo;
 use crate::proto;
@@ -53,8 +59,8 @@ pub enum ReadError {
     Damaged {
         /// The file.
         path: PathBuf,
-        /// What was read and what was not.
-        damage: Damage,
+        /// What was read and what was not (boxed: it is large next to the other errors).
+        damage: Box<Damage>,
     },
     /// An export file could not be written.
     #[error("cannot write {path}: {source}")]
@@ -92,6 +98,13 @@ pub struct Damage {
     pub topics: usize,
     /// Log time of the last recovered message in s.
     pub last_t_s: Option<f64>,
+    /// Damaged regions skipped by resynchronising on the next chunk (0: the scan stopped at
+    /// the damage).
+    pub skipped_regions: u64,
+    /// Bytes skipped in those regions.
+    pub skipped_bytes: u64,
+    /// Messages lost, when the file's summary section (its message count) could be read.
+    pub lost_messages: Option<u64>,
 }
 
 impl fmt::Display for Damage {
@@ -105,10 +118,22 @@ impl fmt::Display for Damage {
             "{what}: {} (at byte {} of {}); recovered {} messages on {} topics",
             self.reason, self.at_byte, self.file_bytes, self.messages, self.topics
         )?;
-        match self.last_t_s {
-            Some(t) => write!(f, " up to t = {t} s, the rest is unreadable"),
-            None => write!(f, ", the rest is unreadable"),
+        if let Some(t) = self.last_t_s {
+            write!(f, " up to t = {t} s")?;
         }
+        if self.skipped_regions == 0 {
+            write!(f, ", the rest is unreadable")?;
+        } else {
+            write!(
+                f,
+                ", reading on past {} damaged region(s) ({} bytes skipped)",
+                self.skipped_regions, self.skipped_bytes
+            )?;
+        }
+        if let Some(n) = self.lost_messages {
+            write!(f, "; {n} messages lost")?;
+        }
+        Ok(())
     }
 }
 
@@ -242,6 +267,26 @@ struct Scan {
     channels: BTreeMap<u16, ChannelRec>,
     counts: BTreeMap<u16, (u64, u64, u64)>,
     error: Option<(DamageKind, String, u64)>,
+    /// Damaged regions skipped and their bytes.
+    skipped: (u64, u64),
+    /// The message count of the summary section's statistics, if read.
+    expected_messages: Option<u64>,
+}
+
+/// Where one pass of the linear reader ended.
+struct PassEnd {
+    /// The error that stopped it, if any: kind, reason, bytes read.
+    error: Option<(DamageKind, String, u64)>,
+    /// File offset just after the last record that was read whole (where the damage starts).
+    last_good: usize,
+}
+
+/// What a pass carries over to the next one.
+#[derive(Default)]
+struct PassState {
+    data_end: bool,
+    footer: bool,
+    stats: Option<mcap::records::Statistics>,
 }
 
 /// Opens the recording at `path`.
@@ -285,8 +330,14 @@ pub fn from_bytes(path: impl Into<PathBuf>, bytes: Vec<u8>) -> Result<RecordingR
             messages: 0,
             topics: 0,
             last_t_s: None,
+            skipped_regions: 0,
+            skipped_bytes: 0,
+            lost_messages: None,
         };
-        return Err(ReadError::Damaged { path, damage });
+        return Err(ReadError::Damaged {
+            path,
+            damage: Box::new(damage),
+        });
     }
     if !bytes.starts_with(magic) {
         return Err(ReadError::NotMcap {
@@ -303,6 +354,11 @@ pub fn from_bytes(path: impl Into<PathBuf>, bytes: Vec<u8>) -> Result<RecordingR
         messages: scan.info.messages,
         topics: scan.info.topics.iter().filter(|t| t.messages > 0).count(),
         last_t_s: scan.info.end_s,
+        skipped_regions: scan.skipped.0,
+        skipped_bytes: scan.skipped.1,
+        lost_messages: scan
+            .expected_messages
+            .map(|n| n.saturating_sub(scan.info.messages)),
     });
     Ok(RecordingReader {
         path,
@@ -388,7 +444,9 @@ fn describe_mcap_error(e: &mcap::McapError, data_end: bool) -> (DamageKind, Stri
 }
 
 /// Scans `bytes` (which start with the MCAP magic), calling `on_message` for each of the
-/// first `limit` messages; stops at the first error of the file or of `on_message`.
+/// first `limit` messages. The first error of the file or of `on_message` is kept in
+/// `Scan::error`; the scan then resynchronises on the next intact chunk (see the module
+/// documentation) and reads on.
 fn scan(
     bytes: &[u8],
     limit: u64,
@@ -400,68 +458,49 @@ fn scan(
         channels: BTreeMap::new(),
         counts: BTreeMap::new(),
         error: None,
+        skipped: (0, 0),
+        expected_messages: None,
     };
-    let mut reader = LinearReader::new_with_options(
-        LinearReaderOptions::default()
-            .with_prevalidate_chunk_crcs(true)
-            .with_validate_chunk_crcs(true)
-            .with_validate_data_section_crc(true)
-            .with_validate_summary_section_crc(true)
-            .with_check_finishes_after_end_magic(true)
-            .with_record_length_limit(bytes.len().max(256 << 20)),
-    );
+    let mut st = PassState::default();
+    let mut start = 0usize;
     let mut pos = 0usize;
-    let mut data_end = false;
-    let mut footer = false;
-    let mut stats: Option<mcap::records::Statistics> = None;
     loop {
-        let event = match reader.next_event() {
-            None => break,
-            Some(Ok(e)) => e,
-            Some(Err(e)) => {
-                let (kind, reason) = describe_mcap_error(&e, data_end);
-                s.error = Some((kind, reason, pos as u64));
+        let end = scan_pass(bytes, start, &mut s, &mut st, limit, on_message);
+        pos = pos.max(end.last_good);
+        let Some(err) = end.error else { break };
+        if s.error.is_none() {
+            s.error = Some(err.clone());
+            // the summary section (if the footer is intact) knows every schema and channel
+            // and how many messages there are
+            preload_summary(bytes, &mut s);
+        }
+        if st.data_end {
+            break; // damage in the summary section: no data after it
+        }
+        // resynchronise on the next plausible chunk (or metadata record) after the last good record (strictly
+        // after this pass's start, so that every pass makes progress); a pass that fails at
+        // once on it moves the search on by a byte
+        match next_chunk(bytes, end.last_good.max(start + 1)) {
+            Some(o) => {
+                if o > end.last_good {
+                    s.skipped.0 += 1;
+                    s.skipped.1 += (o - end.last_good) as u64;
+                }
+                start = o;
+            }
+            None => {
+                // nothing intact after the damage: the rest of the file is skipped
+                if end.last_good < bytes.len() && s.skipped.0 > 0 {
+                    s.skipped.1 += (bytes.len() - end.last_good) as u64;
+                }
                 break;
             }
-        };
-        match event {
-            LinearReadEvent::ReadRequest(n) => {
-                let take = n.min(bytes.len() - pos);
-                reader.insert(take).copy_from_slice(&bytes[pos..pos + take]);
-                reader.notify_read(take);
-                pos += take;
-            }
-            LinearReadEvent::Record { opcode, data } => {
-                let record = match mcap::parse_record(opcode, data) {
-                    Ok(r) => r,
-                    Err(e) => {
-                        let (kind, reason) = describe_mcap_error(&e, data_end);
-                        s.error = Some((
-                            kind,
-                            format!("a record (opcode {opcode:#04x}) does not parse: {reason}"),
-                            pos as u64,
-                        ));
-                        break;
-                    }
-                };
-                if data_end {
-                    // the summary section repeats schemas and channels; keep its statistics
-                    match record {
-                        Record::Statistics(st) => stats = Some(st),
-                        Record::Footer(_) => footer = true,
-                        _ => {}
-                    }
-                    continue;
-                }
-                if let Err(reason) = on_record(&mut s, record, limit, on_message) {
-                    s.error = Some((DamageKind::Corrupt, reason, pos as u64));
-                    break;
-                }
-                if opcode == mcap::records::op::DATA_END {
-                    data_end = true;
-                }
-            }
         }
+    }
+    let footer = st.footer;
+    let stats = st.stats;
+    if let (Some(st), true) = (&stats, s.error.is_some()) {
+        s.expected_messages = Some(st.message_count);
     }
     if s.error.is_none() {
         if !footer {
@@ -503,6 +542,215 @@ fn scan(
         });
     }
     s
+}
+
+/// One pass of the linear reader over `bytes[start..]` (`start` = 0: the whole file, with its
+/// magic; otherwise the offset of a chunk record found by [`next_chunk`]).
+fn scan_pass(
+    bytes: &[u8],
+    start: usize,
+    s: &mut Scan,
+    st: &mut PassState,
+    limit: u64,
+    on_message: &mut dyn FnMut(&MessageView<'_>) -> Result<(), String>,
+) -> PassEnd {
+    let resumed = start > 0;
+    let mut reader = LinearReader::new_with_options(
+        LinearReaderOptions::default()
+            .with_skip_start_magic(resumed)
+            .with_prevalidate_chunk_crcs(true)
+            .with_validate_chunk_crcs(true)
+            // the data section's CRC covers it from its start: not checkable after a skip
+            .with_validate_data_section_crc(!resumed)
+            .with_validate_summary_section_crc(true)
+            .with_check_finishes_after_end_magic(true)
+            .with_record_length_limit(bytes.len().max(256 << 20)),
+    );
+    let mut pos = start;
+    let mut last_good = start;
+    let fail = |kind, reason, pos: usize, last_good| PassEnd {
+        error: Some((kind, reason, pos as u64)),
+        last_good,
+    };
+    loop {
+        let event = match reader.next_event() {
+            None => break,
+            Some(Ok(e)) => e,
+            Some(Err(e)) => {
+                let (kind, reason) = describe_mcap_error(&e, st.data_end);
+                return fail(kind, reason, pos, last_good);
+            }
+        };
+        match event {
+            LinearReadEvent::ReadRequest(n) => {
+                let take = n.min(bytes.len() - pos);
+                reader.insert(take).copy_from_slice(&bytes[pos..pos + take]);
+                reader.notify_read(take);
+                pos += take;
+            }
+            LinearReadEvent::Record { opcode, data } => {
+                let record = match mcap::parse_record(opcode, data) {
+                    Ok(r) => r,
+                    Err(e) => {
+                        let (kind, reason) = describe_mcap_error(&e, st.data_end);
+                        let reason =
+                            format!("a record (opcode {opcode:#04x}) does not parse: {reason}");
+                        return fail(kind, reason, pos, last_good);
+                    }
+                };
+                if st.data_end {
+                    // the summary section repeats schemas and channels; keep its statistics
+                    match record {
+                        Record::Statistics(x) => st.stats = Some(x),
+                        Record::Footer(_) => st.footer = true,
+                        _ => {}
+                    }
+                    last_good = pos;
+                    continue;
+                }
+                if let Err(reason) = on_record(s, record, limit, on_message) {
+                    return fail(DamageKind::Corrupt, reason, pos, last_good);
+                }
+                if opcode == mcap::records::op::DATA_END {
+                    st.data_end = true;
+                }
+                last_good = pos;
+            }
+        }
+    }
+    PassEnd {
+        error: None,
+        last_good: pos,
+    }
+}
+
+/// The offset of the first plausible chunk or metadata record at or after `from`. A chunk:
+/// the chunk opcode, then a record length that fits in the file and agrees with the chunk
+/// header's compression name (none, `zstd` or `lz4`) and compressed size; its CRC is checked
+/// when it is read. A metadata record (the run's statistics follow the last chunk): a length
+/// that fits and agrees with its name's and its map's lengths.
+fn next_chunk(bytes: &[u8], from: usize) -> Option<usize> {
+    use mcap::records::op;
+    let mut o = from;
+    while o < bytes.len() {
+        o += bytes[o..]
+            .iter()
+            .position(|&b| b == op::CHUNK || b == op::METADATA)?;
+        let rest = &bytes[o..];
+        let ok = if rest[0] == op::CHUNK {
+            plausible_chunk(rest)
+        } else {
+            plausible_metadata(rest)
+        };
+        if ok {
+            return Some(o);
+        }
+        o += 1;
+    }
+    None
+}
+
+/// Whether `rest` starts with a metadata record whose lengths agree (see [`next_chunk`]).
+fn plausible_metadata(rest: &[u8]) -> bool {
+    let le32 = |b: &[u8]| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as u64;
+    if rest.len() < 9 + 8 {
+        return false;
+    }
+    let len = u64::from_le_bytes(rest[1..9].try_into().unwrap_or([0xff; 8]));
+    if len < 8 || len > (rest.len() - 9) as u64 {
+        return false;
+    }
+    let body = &rest[9..9 + len as usize];
+    let name = le32(&body[0..4]);
+    if name > len - 8 {
+        return false;
+    }
+    let n = name as usize;
+    4 + name + 4 + le32(&body[4 + n..8 + n]) == len
+}
+
+/// Whether `rest` starts with a chunk record whose lengths agree (see [`next_chunk`]).
+fn plausible_chunk(rest: &[u8]) -> bool {
+    let le64 = |b: &[u8]| u64::from_le_bytes(b.try_into().unwrap_or([0xff; 8]));
+    // opcode, record length, then the fixed chunk header: start, end, uncompressed size and
+    // CRC, compression name length
+    if rest.len() < 9 + 32 {
+        return false;
+    }
+    let len = le64(&rest[1..9]);
+    if len > (rest.len() - 9) as u64 {
+        return false;
+    }
+    let h = &rest[9..];
+    let clen = u32::from_le_bytes([h[28], h[29], h[30], h[31]]) as usize;
+    if clen > 4 || h.len() < 32 + clen + 8 {
+        return false;
+    }
+    if !matches!(&h[32..32 + clen], b"" | b"zstd" | b"lz4") {
+        return false;
+    }
+    let csize = le64(&h[32 + clen..40 + clen]);
+    (40 + clen as u64).checked_add(csize) == Some(len)
+}
+
+/// Reads the schemas, channels and statistics of the summary section, if the footer at the
+/// end of `bytes` is intact, into `s` (what the data section defined is kept), so that a
+/// resynchronised scan decodes chunks whose channels were defined in a lost one, and knows
+/// how many messages were lost.
+fn preload_summary(bytes: &[u8], s: &mut Scan) {
+    use mcap::records::op;
+    let n = bytes.len();
+    // footer record: opcode, length 20, summary start, summary offset start, CRC; then magic
+    let footer_len = 9 + 20;
+    if n < mcap::MAGIC.len() * 2 + footer_len || !bytes.ends_with(mcap::MAGIC) {
+        return;
+    }
+    let f = n - mcap::MAGIC.len() - footer_len;
+    if bytes[f] != op::FOOTER {
+        return;
+    }
+    let start = u64::from_le_bytes(bytes[f + 9..f + 17].try_into().unwrap_or([0; 8]));
+    let Ok(mut p) = usize::try_from(start) else {
+        return;
+    };
+    if p == 0 || p >= f {
+        return;
+    }
+    while p + 9 <= f {
+        let len = u64::from_le_bytes(bytes[p + 1..p + 9].try_into().unwrap_or([0xff; 8]));
+        let Some(end) = usize::try_from(len)
+            .ok()
+            .and_then(|l| (p + 9).checked_add(l))
+        else {
+            return;
+        };
+        if end > f {
+            return;
+        }
+        match mcap::parse_record(bytes[p], &bytes[p + 9..end]) {
+            Ok(Record::Schema { header, data }) if header.id != 0 => {
+                s.schemas.entry(header.id).or_insert(SchemaRec {
+                    name: header.name,
+                    encoding: header.encoding,
+                    data: data.into_owned(),
+                });
+            }
+            Ok(Record::Channel(c)) => {
+                if c.schema_id == 0 || s.schemas.contains_key(&c.schema_id) {
+                    s.channels.entry(c.id).or_insert(ChannelRec {
+                        topic: c.topic,
+                        schema_id: c.schema_id,
+                        message_encoding: c.message_encoding,
+                        metadata: c.metadata,
+                    });
+                }
+            }
+            Ok(Record::Statistics(st)) => s.expected_messages = Some(st.message_count),
+            Ok(_) => {}
+            Err(_) => return,
+        }
+        p = end;
+    }
 }
 
 fn on_record(
@@ -638,7 +886,7 @@ impl RecordingReader {
             None => Ok(()),
             Some(d) => Err(ReadError::Damaged {
                 path: self.path.clone(),
-                damage: d.clone(),
+                damage: Box::new(d.clone()),
             }),
         }
     }

@@ -10,9 +10,15 @@
 //! the free play.
 
 use super::{Checker, Field};
-use crate::keys::{RawBody as B, RawContact as C, RawOil as O, RawSpline as Sp};
+use crate::keys::{
+    RawBody as B, RawContact as C, RawMaterial as M, RawOil as O, RawSpline as Sp,
+    RawToothForm as F,
+};
 use crate::schema::{body_keys, fmt_num, show, Key, Kind, RawTable};
-use clutchpack_model::{DiscModel, Hertz, LawKind, OilFilm, SplineGeometry, ToothLaw};
+use clutchpack_model::{
+    DiscModel, FatigueParams, Hertz, LawKind, Material, MinerRule, OilFilm, SplineGeometry,
+    ToothForm, ToothLaw,
+};
 
 /// A body value checked where it is written, of the kind of its key.
 #[derive(Debug, Clone, PartialEq)]
@@ -188,7 +194,8 @@ fn inherited(sec: Sec, source: Source, k: &Key) -> String {
 
 /// `[defaults]` and every `[[discs]]` (or `[plate_defaults]` and every `[[plates]]`).
 /// `names` holds the names taken so far, with the key of their entry (names are unique
-/// across discs and plates); `at_least_one` makes an empty array a problem.
+/// across discs and plates); `at_least_one` makes an empty array a problem. Each body comes
+/// with the fatigue parameters of its teeth.
 pub(super) fn bodies(
     ck: &mut Checker,
     sec: Sec,
@@ -196,7 +203,7 @@ pub(super) fn bodies(
     raw: Option<&[B]>,
     at_least_one: bool,
     names: &mut Vec<(String, String)>,
-) -> Option<Vec<DiscModel>> {
+) -> Option<Vec<(DiscModel, FatigueParams)>> {
     let empty = B::default();
     let raw_defaults = defaults.unwrap_or(&empty);
     if raw_defaults.name.is_some() {
@@ -292,8 +299,45 @@ impl Body<'_> {
         pick(&self.own.num(k), &self.defaults.num(k)).or((k.default_num(), Source::Builtin))
     }
 
+    /// The fatigue parameters of the body's teeth (`fatigue.*`, `material.*`): every value
+    /// is checked by its key's rule where it is written; no rules between them.
+    fn fatigue(&self) -> Option<FatigueParams> {
+        let rules = [
+            MinerRule::Original,
+            MinerRule::Elementary,
+            MinerRule::Haibach,
+        ];
+        let rule = pick(
+            &self.own.choice(&M::miner_rule),
+            &self.defaults.choice(&M::miner_rule),
+        )
+        .or((M::miner_rule.default_choice(), Source::Builtin))
+        .map(|(i, _)| rules[i]);
+        let n = |k: &Key| self.num(k).map(|(v, _)| v);
+        Some(FatigueParams {
+            form: ToothForm {
+                form_factor: n(&F::form_factor)?,
+                stress_correction: n(&F::stress_correction_factor)?,
+                load_distribution: n(&F::load_distribution_factor)?,
+                face_width_m: n(&F::face_width_m)?,
+                working_depth_m: n(&F::working_depth_m)?,
+            },
+            material: Material {
+                endurance_amplitude_pa: n(&M::endurance_amplitude_pa)?,
+                knee_cycles: n(&M::knee_cycles)?,
+                slope: n(&M::slope)?,
+                rule: rule?,
+                critical_damage: n(&M::critical_damage)?,
+            },
+        })
+    }
+
     /// Resolves and cross-checks the body.
-    fn resolve(&self, ck: &mut Checker, name: Option<String>) -> Option<DiscModel> {
+    fn resolve(
+        &self,
+        ck: &mut Checker,
+        name: Option<String>,
+    ) -> Option<(DiscModel, FatigueParams)> {
         let (sec, item) = (self.sec, self.item.as_str());
         let (own, d) = (self.own, self.defaults);
         let inertia = self.required(ck, &B::inertia_kg_m2, Params::num);
@@ -473,11 +517,12 @@ impl Body<'_> {
                 }
             }
         }
+        let fatigue = self.fatigue();
         if !inside {
             return None;
         }
 
-        Some(DiscModel {
+        let disc = DiscModel {
             name: name?,
             spline: spline?,
             law: ToothLaw {
@@ -507,6 +552,7 @@ impl Body<'_> {
                 let (e, _) = offset?;
                 [e[0], e[1]]
             },
-        })
+        };
+        Some((disc, fatigue?))
     }
 }

@@ -30,6 +30,7 @@ pub(crate) struct Validated {
     pub description: String,
     pub simulation: Simulation,
     pub pack: PackModel,
+    pub fatigue: Vec<clutchpack_model::FatigueParams>,
 }
 
 /// The outcome of checking one value where it is written.
@@ -310,14 +311,17 @@ pub(crate) fn validate(
         );
         return None;
     }
+    let (discs, disc_fatigue): (Vec<_>, Vec<_>) = discs?.into_iter().unzip();
+    let (plates, plate_fatigue): (Vec<_>, Vec<_>) = plates?.into_iter().unzip();
     Some(Validated {
+        fatigue: disc_fatigue.into_iter().chain(plate_fatigue).collect(),
         name: name?,
         description: description?,
         simulation: simulation?,
         pack: PackModel {
             shaft: shaft?,
-            discs: discs?,
-            plates: plates?,
+            discs,
+            plates,
             drum: drum.map_or(Some(None), |d| d.map(Some))?,
             stack: stack.map_or(Some(None), |s| s.map(Some))?,
         },

@@ -147,7 +147,7 @@ impl MultibodyEngine {
         // Build once now so that a scene the world cannot hold fails here, not in `run`.
         World::build(&pack, &options.shapes, options.mount)?;
         let multirate_refused = match options.scheme {
-            Scheme::Shared => Some("the shared step was asked for"),
+            Scheme::Shared => Some("asked for"),
             Scheme::Auto | Scheme::Multirate => multirate::unsupported(&pack, &options, &per_tooth),
         };
         if let (Scheme::Multirate, Some(why)) = (options.scheme, multirate_refused) {
@@ -184,13 +184,34 @@ impl MultibodyEngine {
         self.multirate_refused.is_none()
     }
 
-    /// Which scheme runs this pack and why, in words (for the CLI to print).
-    pub fn scheme(&self) -> String {
-        match self.multirate_refused {
-            None => "multirate: the world steps at free-flight length, each disc's spline \
-                     coupling sub-steps its own contacts"
-                .to_string(),
-            Some(why) => format!("shared step: {why}"),
+    /// Which time-stepping scheme runs this pack and why, in one line of words for `run` to
+    /// print, e.g. `multirate scheme (automatic: a prescribed shaft and concentric friction
+    /// discs only, so the discs are independent within a world step): ...` or `shared step
+    /// (automatic: an inertial shaft (eq 4) couples ...): ...`.
+    pub fn scheme_explanation(&self) -> String {
+        let shared = "every body advances with one contact-aware step, the shortest any \
+                      coupling needs";
+        match (self.multirate_refused, self.options.stepping) {
+            (None, Stepping::Adaptive(a)) => {
+                let how = match self.options.scheme {
+                    Scheme::Multirate => "asked for",
+                    _ => "automatic",
+                };
+                format!(
+                    "multirate scheme ({how}: a prescribed shaft and concentric friction discs \
+                     only, so the discs are independent within a world step): the rapier world \
+                     steps at up to {} s, each disc's spline coupling sub-steps its own \
+                     contacts ({} steps per contact, classical Runge-Kutta)",
+                    a.max_step_s, a.steps_per_contact
+                )
+            }
+            (Some(why), _) if self.options.scheme == Scheme::Shared => {
+                format!("shared step ({why}): {shared}")
+            }
+            (why, _) => format!(
+                "shared step (automatic: {}): {shared}",
+                why.unwrap_or("fixed steps")
+            ),
         }
     }
 
@@ -392,9 +413,7 @@ impl MultibodyEngine {
             if stopped || run.t >= duration_s {
                 break;
             }
-            let t1 = (run.t + a.max_step_s)
-                .min(rec_time(rec_index))
-                .min(duration_s);
+            let t1 = world_step_end(run.t, a.max_step_s, rec_time(rec_index), duration_s);
             run.read_relative_states();
             run.multirate_step(t1, &a, &mut counts, &mut closed)?;
             // Events in the order they closed across the couplings.
@@ -420,5 +439,39 @@ impl MultibodyEngine {
             rhs_evals: counts.evals,
             stopped_early: stopped,
         })
+    }
+}
+
+/// The end of the multirate scheme's next world step from `t` (s): a free-flight step of
+/// `max_step_s`, landing exactly on the next sample time `grid_s` and on the end of the run
+/// `end_s` when they come within it. "Within" allows a millionth of a step of rounding: taking
+/// `t + max_step_s` a rounding error short of the grid would leave a world step of 1e-19 s,
+/// and the impact tracker's parabola through samples that close is meaningless.
+fn world_step_end(t: f64, max_step_s: f64, grid_s: f64, end_s: f64) -> f64 {
+    let reach = t + max_step_s * (1.0 + 1e-6);
+    if end_s <= reach && end_s <= grid_s {
+        end_s
+    } else if grid_s <= reach {
+        grid_s
+    } else {
+        t + max_step_s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::world_step_end;
+
+    /// The world step lands on the sampling grid and the end of the run, never a rounding
+    /// error short of them.
+    #[test]
+    fn world_steps_land_on_the_grid_and_the_end() {
+        // 21 steps of 1e-4 s add up to a hair under 21 * 1e-4
+        let t = (0..21).fold(0.0, |t, _| t + 1e-4);
+        let grid = 22.0 * 1e-4;
+        assert_eq!(world_step_end(t, 1e-4, grid, 1.0), grid);
+        assert_eq!(world_step_end(0.0, 1e-4, 5e-4, 1.0), 1e-4);
+        assert_eq!(world_step_end(0.0, 1e-4, 5e-4, 0.5e-4), 0.5e-4);
+        assert_eq!(world_step_end(0.0, 1e-4, 1e-4, 1e-4), 1e-4);
     }
 }

@@ -4,7 +4,7 @@
 //! rapier body, which carries the disc's state from one world step to the next.
 
 use super::state::{relative_state, Run, ShaftDrive};
-use crate::hook::{Coupling, RelativeState, FLANKS};
+use crate::hook::{Coupling, CouplingForces, RelativeState, FLANKS};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use crate::stepping::{bracketed_root, contact_duration_s, coupling_step, CouplingView};
 use clutchpack_model::{EngineError, ImpactEvent, PackModel, Shaft, SpeedProfile};
@@ -37,9 +37,47 @@ pub(super) fn unsupported(
     None
 }
 
+/// Sub-steps near a kink of the `s^1.5` law are at most this fraction of the time from the
+/// onset or to the separation (dimensionless). See [`graded_step`].
+const KINK_GRADE: f64 = 0.25;
+
+/// ... and at least the contact step over this (dimensionless).
+const KINK_FLOOR_DIVISOR: f64 = 64.0;
+
+/// The sub-step a coupling in contact takes, s, given the step controller's `want` (s): graded
+/// towards the law's two kinks.
+///
+/// At an onset the load grows as `t^1.5` from the landed onset (and falls as `(t_off - t)^1.5`
+/// to the separation), whose derivatives beyond the first are unbounded there: the classical
+/// method's error in the impulse of the step touching the kink is of order `h^2.5`, not `h^5`,
+/// and it dominates the whole impact's (measured on the 8-disc staggered pack at 128 steps
+/// per contact: the early onsets 1.7e-9 s off the reference at tolerance 1e-12, falling only
+/// as `h^2.5 .. h^3` with more steps). A graded mesh, `h <= KINK_GRADE * (t - t_on)` after
+/// the onset and `h <= KINK_GRADE * s / |v_n|` (the predicted time to separation) while the
+/// depth falls, never below `want / KINK_FLOOR_DIVISOR`, spreads that error over a few
+/// geometrically growing steps: measured 2.6e-11 s, 67x less, for about 30 more sub-steps per
+/// impact (`KINK_GRADE` 0.15 and 0.5 measured 2.4e-11 and 4.9e-11 s).
+fn graded_step(want: f64, f: &CouplingForces, age_s: Option<f64>) -> f64 {
+    if f.depth_m <= 0.0 {
+        return want;
+    }
+    let floor = want / KINK_FLOOR_DIVISOR;
+    let mut h = want;
+    if let Some(age) = age_s {
+        h = h.min((KINK_GRADE * age).max(floor));
+    }
+    let v = f.kin.v_n_m_s;
+    if v < 0.0 {
+        h = h.min((KINK_GRADE * f.depth_m / -v).max(floor));
+    }
+    h
+}
+
 /// One sub-step's outcome: the relative state at its end and the work done along it.
 #[derive(Debug, Clone, Copy)]
 struct SubStep {
+    /// The shaft at its end.
+    shaft: ShaftAt,
     phi: f64,
     dphi: f64,
     /// Work of the shaft on the teeth, `integral T dtheta_s`, J.
@@ -50,9 +88,15 @@ struct SubStep {
     evals: u64,
 }
 
-/// The relative motion of one coupling on a prescribed shaft:
-/// `phi'' = a_s(t) - (T(phi, phi') - C2 omega_d) / J` with `omega_d = omega_s(t) - phi'`
-/// (Hu et al. eqs (3) and (5)).
+/// The relative motion of one coupling on a prescribed shaft, integrated as the disc's own
+/// motion `J omega_d' = T(phi, phi') - C2 omega_d` (Hu et al. eq (5)) with
+/// `phi = theta_s(t) - theta_d`, `phi' = omega_s(t) - omega_d` (eq (3): the shaft's angle and
+/// speed are the profile's, exact). Integrating the disc rather than the relative angle
+/// leaves the shaft's motion out of the truncation error: in free flight without drag the
+/// disc turns at a constant speed and the sub-step is exact whatever its length (integrating
+/// the relative angle with the classical method costs `a_s''' h^5 / 720` per step: at 104 Hz
+/// and 0.1 ms, 1e-11 rad, enough to move the onsets of a chaotic rattle by microseconds
+/// within 40 ms).
 struct Relative<'a> {
     profile: &'a SpeedProfile,
     coupling: &'a Coupling,
@@ -65,36 +109,60 @@ struct Relative<'a> {
 impl Relative<'_> {
     /// One classical Runge-Kutta step of length `h` from `(phi, dphi)` at `t`, with the work
     /// of the drive and the drag integrated by the same stages (the augmented system).
-    fn rk4(&self, t: f64, phi: f64, dphi: f64, h: f64) -> SubStep {
+    fn rk4(&self, t: f64, shaft: ShaftAt, phi: f64, dphi: f64, h: f64) -> SubStep {
         let p = self.profile;
         let (tm, te) = (t + 0.5 * h, t + h);
-        let (w0, wm, we) = (p.speed(t), p.speed(tm), p.speed(te));
-        let (a0, am, ae) = (p.acceleration(t), p.acceleration(tm), p.acceleration(te));
-        // (phi'', teeth torque, disc speed) at a stage
-        let f = |ws: f64, as_: f64, phi: f64, dphi: f64| {
-            let torque = self.coupling.probe_torque(phi, dphi);
-            let wd = ws - dphi;
+        let (mid, end) = (ShaftAt::of(p, tm), ShaftAt::of(p, te));
+        let (w0, wm, we) = (shaft.speed, mid.speed, end.speed);
+        // The shaft's turn from t, exact.
+        let (sm, se) = (mid.angle - shaft.angle, end.angle - shaft.angle);
+        // The disc's speed at t; `th` below is its turn from t.
+        let u0 = w0 - dphi;
+        // (omega_d', teeth torque) at a stage: the shaft turned by `s` at speed `ws`, the
+        // disc turned by `th` at speed `u`.
+        let f = |s: f64, ws: f64, th: f64, u: f64| {
+            let torque = self.coupling.probe_torque(phi + s - th, ws - u);
             // Hu et al. eq (5): J omega_d' = T - C2 omega_d
-            (as_ - (torque - self.c2 * wd) * self.inv_j, torque, wd)
+            ((torque - self.c2 * u) * self.inv_j, torque)
         };
-        let (k1, t1, d1) = f(w0, a0, phi, dphi);
-        let (k2, t2, d2) = f(wm, am, phi + 0.5 * h * dphi, dphi + 0.5 * h * k1);
-        let (k3, t3, d3) = f(
-            wm,
-            am,
-            phi + 0.5 * h * dphi + 0.25 * h * h * k1,
-            dphi + 0.5 * h * k2,
-        );
-        let (k4, t4, d4) = f(we, ae, phi + h * dphi + 0.5 * h * h * k2, dphi + h * k3);
+        let hh = h * h;
+        let (k1, t1) = f(0.0, w0, 0.0, u0);
+        let u2 = u0 + 0.5 * h * k1;
+        let (k2, t2) = f(sm, wm, 0.5 * h * u0, u2);
+        let u3 = u0 + 0.5 * h * k2;
+        let (k3, t3) = f(sm, wm, 0.5 * h * u0 + 0.25 * hh * k1, u3);
+        let u4 = u0 + h * k3;
+        let (k4, t4) = f(se, we, h * u0 + 0.5 * hh * k2, u4);
         let h6 = h / 6.0;
+        // The classical method on the first-order system (angle, speed), written for the
+        // angle: the disc turns by h u0 + h^2/6 (k1 + k2 + k3).
+        let th = h * u0 + h * h6 * (k1 + k2 + k3);
+        let u1 = u0 + h6 * (k1 + 2.0 * (k2 + k3) + k4);
         SubStep {
-            // RK4 for a second-order equation (Runge-Kutta-Nystrom form of the classical
-            // method): phi gets h^2/6 (k1 + k2 + k3), phi' the usual weights.
-            phi: phi + h * dphi + h * h6 * (k1 + k2 + k3),
-            dphi: dphi + h6 * (k1 + 2.0 * (k2 + k3) + k4),
+            shaft: end,
+            phi: phi + se - th,
+            dphi: we - u1,
             drive_j: h6 * (t1 * w0 + 2.0 * (t2 + t3) * wm + t4 * we),
-            drag_j: -self.c2 * h6 * (d1 * d1 + 2.0 * (d2 * d2 + d3 * d3) + d4 * d4),
+            drag_j: -self.c2 * h6 * (u0 * u0 + 2.0 * (u2 * u2 + u3 * u3) + u4 * u4),
             evals: 4,
+        }
+    }
+}
+
+/// The prescribed shaft at one time: its speed (rad/s) and unwrapped angle (rad), each
+/// evaluated once (a sub-step's end is the next one's start; the profile's trigonometry was a
+/// third of the scheme's time).
+#[derive(Debug, Clone, Copy)]
+struct ShaftAt {
+    speed: f64,
+    angle: f64,
+}
+
+impl ShaftAt {
+    fn of(p: &SpeedProfile, t: f64) -> ShaftAt {
+        ShaftAt {
+            speed: p.speed(t),
+            angle: p.angle(t),
         }
     }
 }
@@ -216,9 +284,10 @@ impl<'a> Run<'a> {
         let m_eff = self.m_eff[i];
         let mut t = self.t;
         let (mut phi, mut dphi) = (self.rel[i].phi, self.rel[i].dphi);
+        let mut shaft = ShaftAt::of(profile, t);
         while t < t1 {
             let f = self.forces[i];
-            let wd = profile.speed(t) - dphi;
+            let wd = shaft.speed - dphi;
             let view = CouplingView {
                 forces: &f,
                 law: &d.law,
@@ -234,6 +303,7 @@ impl<'a> Run<'a> {
                 event_age_s: self.tracks[i].event_t_on_s.map(|t_on| t - t_on),
             };
             let (want, _) = coupling_step(&view, a);
+            let want = graded_step(want, &f, self.tracks[i].event_t_on_s.map(|t_on| t - t_on));
             if want.is_nan() || want < a.min_step_s {
                 return Err(EngineError::Diverged {
                     t_s: t,
@@ -254,7 +324,7 @@ impl<'a> Run<'a> {
                 inv_j,
                 c2: d.drag_n_m_s_rad,
             };
-            let mut step = rel.rk4(t, phi, dphi, h);
+            let mut step = rel.rk4(t, shaft, phi, dphi, h);
             // Never step over an onset or a separation: land on it (the `s^1.5` law's kink
             // then falls on a sub-step boundary and the step keeps its order).
             let engaged = f.depth_m > 0.0;
@@ -278,7 +348,7 @@ impl<'a> Run<'a> {
                 let x = bracketed_root(
                     |x| {
                         evals.set(evals.get() + 4);
-                        depth(rel.rk4(t, phi, dphi, x).phi)
+                        depth(rel.rk4(t, shaft, phi, dphi, x).phi)
                     },
                     0.0,
                     d0,
@@ -289,13 +359,14 @@ impl<'a> Run<'a> {
                 counts.evals += evals.get();
                 if x > tiny && x < h {
                     h = x;
-                    step = rel.rk4(t, phi, dphi, x);
+                    step = rel.rk4(t, shaft, phi, dphi, x);
                     counts.evals += 4;
                 }
             }
             t = if h == rem { t1 } else { t + h };
             phi = step.phi;
             dphi = step.dphi;
+            shaft = step.shaft;
             counts.substeps += 1;
             counts.evals += step.evals + 1;
             self.energy.drive_work_j += step.drive_j;
@@ -337,6 +408,40 @@ impl<'a> Run<'a> {
 mod tests {
     use super::*;
     use clutchpack_model::{Hertz, LawKind, OilFilm, SplineGeometry, ToothLaw};
+
+    /// The graded sub-step: the floor at an onset, a quarter of the contact's age after it,
+    /// the controller's step once that is longer, a quarter of the predicted time to
+    /// separation (depth over the opening speed) while the depth falls, nothing in free flight
+    /// or while the depth grows.
+    #[test]
+    fn sub_steps_are_graded_at_the_kinks() {
+        let forces = |depth_m: f64, v_n_m_s: f64| CouplingForces {
+            kin: clutchpack_model::ToothKinematics {
+                flank: clutchpack_model::Flank::ShaftLeads,
+                delta_m: depth_m,
+                v_n_m_s,
+            },
+            depth_m,
+            load_n: 0.0,
+            force: [0.0; 2],
+            moment: [0.0; 3],
+            stiffness: 0.0,
+            potential_j: 0.0,
+            gap_margin_m: 0.0,
+            speed_margin_m_s: 0.0,
+        };
+        let want = 64e-8;
+        let growing = forces(1e-7, 0.5);
+        assert_eq!(graded_step(want, &growing, Some(0.0)), 1e-8);
+        assert_eq!(graded_step(want, &growing, Some(8e-7)), 2e-7);
+        assert_eq!(graded_step(want, &growing, Some(1e-5)), want);
+        assert_eq!(graded_step(want, &growing, None), want);
+        // 1e-7 m at 0.5 m/s: 2e-7 s to the separation
+        let falling = forces(1e-7, -0.5);
+        assert_eq!(graded_step(want, &falling, Some(1e-5)), 0.25 * 2e-7);
+        assert_eq!(graded_step(want, &forces(1e-12, -0.5), Some(1e-5)), 1e-8);
+        assert_eq!(graded_step(want, &forces(-1e-7, -0.5), Some(0.0)), want);
+    }
 
     /// A disc in free flight inside the backlash of a shaft at rest, slowed by its drag:
     /// `omega_d = w0 e^(-r t)`, `r = C2 / J`, so `phi = -w0 (1 - e^(-r t)) / r` and the drag's
@@ -385,7 +490,8 @@ mod tests {
             let h = duration / n as f64;
             let (mut phi, mut dphi, mut drag) = (0.0, -w0, 0.0);
             for k in 0..n {
-                let s = rel.rk4(k as f64 * h, phi, dphi, h);
+                let t = k as f64 * h;
+                let s = rel.rk4(t, ShaftAt::of(&profile, t), phi, dphi, h);
                 (phi, dphi, drag) = (s.phi, s.dphi, drag + s.drag_j);
             }
             let wd = w0 * (-r * duration).exp();

@@ -1,0 +1,263 @@
+//! Output paths, checked before any work and written whole.
+//!
+//! Every command checks all its output paths before it starts ([`check_outputs`]): the folder
+//! exists (the recording's is created) and takes a new file, the path is not a folder, a FIFO
+//! or a device, no two outputs name the same file and no output names an input (the scene
+//! being run). A problem is bad input (exit 2) naming the flag and the path, found in
+//! milliseconds rather than after a long simulation. Every output is then written to a
+//! temporary sibling and renamed into place when complete ([`write_text`], [`write_with`],
+//! `clutchpack_record::Recorder::create_output`), so a reader sees the old file or the
+//! complete new one, never half of one.
+
+use crate::common::BadInput;
+use anyhow::{Context, Result};
+use std::path::{Path, PathBuf};
+
+/// One output of a command: the flag that named it (for messages) and its path.
+pub struct Output<'a> {
+    pub flag: &'a str,
+    pub path: &'a Path,
+}
+
+/// The parent folder of `path` (`.` for a bare file name).
+fn folder(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// A comparable identity of `path`: its canonical folder joined with its file name (the file
+/// itself need not exist).
+fn identity(path: &Path) -> Option<PathBuf> {
+    let dir = folder(path).canonicalize().ok()?;
+    let name = path.file_name()?;
+    let full = dir.join(name);
+    // an existing file may be a symbolic link to another
+    Some(full.canonicalize().unwrap_or(full))
+}
+
+/// Checks one output path; see the module documentation.
+fn check_one(o: &Output<'_>) -> Result<()> {
+    let (flag, path) = (o.flag, o.path);
+    let bad = |why: String| -> anyhow::Error {
+        BadInput(format!("{flag} {}: {why}", path.display())).into()
+    };
+    if path.as_os_str().is_empty() || path.file_name().is_none() {
+        return Err(bad("names no file".into()));
+    }
+    if let Ok(meta) = std::fs::metadata(path) {
+        if meta.is_dir() {
+            return Err(bad("is a folder; give a file path".into()));
+        }
+        if !meta.is_file() {
+            return Err(bad(
+                "exists and is not a regular file (a FIFO, device or socket); outputs are \
+                 written to a temporary file and renamed into place, so give a regular file path"
+                    .into(),
+            ));
+        }
+    }
+    let dir = folder(path);
+    match std::fs::metadata(&dir) {
+        Ok(m) if m.is_dir() => {}
+        Ok(_) => return Err(bad(format!("{} is not a folder", dir.display()))),
+        Err(_) => return Err(bad(format!("the folder {} does not exist", dir.display()))),
+    }
+    // the real test of writability: create (and remove) a new file in the folder
+    let probe = dir.join(format!(".clutchpack-probe-{}", std::process::id()));
+    match std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+    {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
+        Err(e) => {
+            return Err(bad(format!(
+                "cannot create a file in the folder {}: {e}",
+                dir.display()
+            )))
+        }
+    }
+    Ok(())
+}
+
+/// Checks every output before the command does any work: each path (see the module
+/// documentation), no two outputs the same file, no output the same file as an input.
+/// Errors are bad input (exit 2) naming the flag and the path.
+pub fn check_outputs(outputs: &[Output<'_>], inputs: &[&Path]) -> Result<()> {
+    for o in outputs {
+        check_one(o)?;
+    }
+    let ids: Vec<Option<PathBuf>> = outputs.iter().map(|o| identity(o.path)).collect();
+    for (i, a) in outputs.iter().enumerate() {
+        let Some(ia) = &ids[i] else { continue };
+        for (j, b) in outputs.iter().enumerate().skip(i + 1) {
+            if ids[j].as_ref() == Some(ia) {
+                return Err(BadInput(format!(
+                    "{} {} and {} {} name the same file: each output needs its own path",
+                    a.flag,
+                    a.path.display(),
+                    b.flag,
+                    b.path.display()
+                ))
+                .into());
+            }
+        }
+        for input in inputs {
+            let same = input.canonicalize().ok().as_ref() == Some(ia);
+            if same {
+                return Err(BadInput(format!(
+                    "{} {} is an input of this command ({}): refusing to overwrite it",
+                    a.flag,
+                    a.path.display(),
+                    input.display()
+                ))
+                .into());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Writes `text` to `path` whole (temporary sibling, renamed into place).
+pub fn write_text(path: &Path, text: &str) -> Result<()> {
+    clutchpack_record::write_whole(path, text.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
+}
+
+/// Lets `write` produce the file at a temporary sibling path of `path` (same extension, for
+/// writers that choose the format by extension, like the plots), then renames it into place;
+/// removes the temporary file if `write` fails.
+pub fn write_with(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let (pending, file) =
+        clutchpack_record::PendingFile::create(path, clutchpack_record::Replace::Existing)
+            .with_context(|| format!("creating {}", path.display()))?;
+    drop(file);
+    let tmp = pending.tmp_path().to_path_buf();
+    match write(&tmp) {
+        Ok(()) => {
+            pending
+                .commit()
+                .with_context(|| format!("writing {}", path.display()))?;
+            Ok(())
+        }
+        Err(e) => {
+            pending.discard();
+            Err(e.context(format!("writing {}", path.display())))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("cp-outputs-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn is_bad_input(e: &anyhow::Error) -> bool {
+        e.chain().any(|c| c.is::<BadInput>())
+    }
+
+    /// Two flags naming one file, an output naming the input, a folder, a missing folder:
+    /// each refused as bad input naming the flag; distinct new files pass.
+    #[test]
+    fn outputs_that_would_clobber_each_other_or_an_input_are_refused() {
+        let d = dir("clobber");
+        let scene = d.join("my.toml");
+        std::fs::write(&scene, "x").unwrap();
+        let r = d.join("r.mcap");
+        let same = d.join(".").join("r.mcap");
+        let e = check_outputs(
+            &[
+                Output {
+                    flag: "--out",
+                    path: &r,
+                },
+                Output {
+                    flag: "--impacts-csv",
+                    path: &same,
+                },
+            ],
+            &[],
+        )
+        .unwrap_err();
+        assert!(
+            is_bad_input(&e) && e.to_string().contains("--impacts-csv"),
+            "{e}"
+        );
+        let e = check_outputs(
+            &[Output {
+                flag: "--out",
+                path: &scene,
+            }],
+            &[&scene],
+        )
+        .unwrap_err();
+        assert!(is_bad_input(&e) && e.to_string().contains("input"), "{e}");
+        let e = check_outputs(
+            &[Output {
+                flag: "--plot",
+                path: &d,
+            }],
+            &[],
+        )
+        .unwrap_err();
+        assert!(is_bad_input(&e) && e.to_string().contains("folder"), "{e}");
+        let missing = d.join("no/such/x.json");
+        let e = check_outputs(
+            &[Output {
+                flag: "--summary-json",
+                path: &missing,
+            }],
+            &[],
+        )
+        .unwrap_err();
+        assert!(
+            is_bad_input(&e) && e.to_string().contains("does not exist"),
+            "{e}"
+        );
+        let c = d.join("c.csv");
+        check_outputs(
+            &[
+                Output {
+                    flag: "--out",
+                    path: &r,
+                },
+                Output {
+                    flag: "--impacts-csv",
+                    path: &c,
+                },
+            ],
+            &[&scene],
+        )
+        .unwrap();
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    /// A character device (here /dev/null) is refused: renaming over it would be wrong.
+    #[test]
+    fn a_device_or_fifo_is_not_an_output() {
+        let e = check_outputs(
+            &[Output {
+                flag: "--summary-json",
+                path: Path::new("/dev/null"),
+            }],
+            &[],
+        )
+        .unwrap_err();
+        assert!(
+            is_bad_input(&e) && e.to_string().contains("not a regular file"),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,269 @@
+//! The multirate scheme against the monolithic one (its oracle, issue 9): the same impacts,
+//! impact by impact, on packs whose discs strike out of step, and a merged output stream in
+//! time order.
+//!
+//! Tolerances: both schemes run at tolerance 1e-12 (issue 9); every peak must agree within
+//! 0.1 % and every onset within 1 us (issue 9's limits). Both solve the same equations with
+//! the same error control, so they differ by integration error only: measured, at most
+//! 1.4e-6 relative in a peak and 4e-9 s in an onset on the staggered pack, 1.3e-5 and 9e-9 s
+//! on pack-4-rattle. A difference beyond the limits means the schemes solve different
+//! equations (a missed or spurious event, a wrong coupling). Rattling packs are sensitive to
+//! small errors (a grazing contact decides whether the next impact happens): at the default
+//! tolerance 1e-9 the staggered pack's onsets drift 1.7 us from the oracle's by 30 ms, which
+//! is why the comparison is made at 1e-12, where the monolithic scheme agrees with itself at
+//! 1e-13 to the same 4e-9 s.
+
+use clutchpack_model::cases::{bench_drive, staggered_pack};
+use clutchpack_model::*;
+use clutchpack_reference::{ReferenceEngine, Scheme, Settings};
+use std::path::Path;
+
+fn settings(tolerance: f64) -> Settings {
+    Settings {
+        tolerance,
+        ..Settings::default()
+    }
+}
+
+fn run(engine: ReferenceEngine, duration: f64) -> (Collector, RunStats) {
+    let mut engine = engine;
+    let mut c = Collector::default();
+    let stats = engine.run(duration, &mut c).unwrap();
+    (c, stats)
+}
+
+/// Impacts sorted by disc, then onset.
+fn by_disc(c: &Collector) -> Vec<ImpactEvent> {
+    let mut v = c.impacts.clone();
+    v.sort_by(|a, b| (a.disc, a.t_on_s).partial_cmp(&(b.disc, b.t_on_s)).unwrap());
+    v
+}
+
+/// Runs `pack` for `duration` s with the monolithic oracle and with `other` (both at
+/// tolerance 1e-12) and asserts the impacts agree one by one; returns the number of impacts
+/// and the other run's output.
+fn assert_schemes_agree(
+    label: &str,
+    pack: PackModel,
+    other: Scheme,
+    duration: f64,
+) -> (usize, Collector) {
+    let oracle =
+        ReferenceEngine::new(pack.clone(), settings(1e-12)).with_scheme(Scheme::Monolithic);
+    let (oc, os) = run(oracle, duration);
+    let (mc, ms) = run(
+        ReferenceEngine::new(pack, settings(1e-12)).with_scheme(other),
+        duration,
+    );
+    assert_same_impacts(label, &oc, &mc);
+    println!(
+        "{label}: steps: monolithic {}, {other:?} {}",
+        os.steps, ms.steps
+    );
+    (oc.impacts.len(), mc)
+}
+
+/// Asserts that `a` and `b` hold the same impacts: same count, disc and flank, every peak
+/// within 0.1 % and every onset within 1 us.
+fn assert_same_impacts(label: &str, a: &Collector, b: &Collector) {
+    let (o, m) = (by_disc(a), by_disc(b));
+    assert!(o.len() >= 8, "{label}: only {} impacts", o.len());
+    assert_eq!(o.len(), m.len(), "{label}: impact counts differ");
+    let (mut worst_rel, mut worst_dt): (f64, f64) = (0.0, 0.0);
+    for (r, x) in o.iter().zip(&m) {
+        assert_eq!(
+            (r.disc, r.flank),
+            (x.disc, x.flank),
+            "{label}: {r:?} vs {x:?}"
+        );
+        let rel = (r.peak_n - x.peak_n).abs() / r.peak_n.abs();
+        assert!(
+            rel <= 1e-3,
+            "{label}: peak {} vs {} ({r:?} vs {x:?})",
+            r.peak_n,
+            x.peak_n
+        );
+        let dt = (r.t_on_s - x.t_on_s).abs();
+        assert!(
+            dt <= 1e-6,
+            "{label}: disc {} onset {} vs {}",
+            r.disc,
+            r.t_on_s,
+            x.t_on_s
+        );
+        worst_rel = worst_rel.max(rel);
+        worst_dt = worst_dt.max(dt);
+    }
+    println!(
+        "{label}: {} impacts, worst peak difference {worst_rel:.2e} relative, worst onset \
+         {worst_dt:.2e} s",
+        o.len()
+    );
+}
+
+/// The merged stream of the multirate scheme is what an observer of one solver would see:
+/// samples on the output grid in order, each with every disc, and every impact delivered
+/// after the last sample at or before its end and before the next one.
+fn assert_time_ordered(label: &str, c: &Collector, nd: usize, rate: f64, duration: f64) {
+    let expected = (duration * rate).floor() as usize + 1;
+    assert_eq!(c.samples.len(), expected, "{label}: sample count");
+    for (k, s) in c.samples.iter().enumerate() {
+        assert!(
+            (s.t_s - k as f64 / rate).abs() < 1e-15,
+            "{label}: sample {k} at {}",
+            s.t_s
+        );
+        assert_eq!(s.discs.len(), nd);
+    }
+    for w in c.impacts.windows(2) {
+        assert!(
+            w[0].t_off_s <= w[1].t_off_s,
+            "{label}: impacts out of order: {w:?}"
+        );
+    }
+}
+
+/// Issue 9: the 8-disc staggered pack (prescribed shaft) over 50 ms: every disc an
+/// independent ODE with its own steps, merged; the same impacts as the monolithic oracle.
+#[test]
+fn staggered_8_disc_pack_matches_the_monolithic_oracle() {
+    let (n, c) = assert_schemes_agree("staggered-8", staggered_pack(8), Scheme::Multirate, 0.05);
+    assert!(n >= 32, "{n}");
+    assert_time_ordered(
+        "staggered-8",
+        &c,
+        8,
+        Settings::default().record_rate_hz,
+        0.05,
+    );
+}
+
+/// Issue 9: `scenes/pack-4-rattle.toml` (four different discs, some in oil) over 50 ms.
+#[test]
+fn pack_4_rattle_matches_the_monolithic_oracle() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/pack-4-rattle.toml");
+    let scene = clutchpack_scene::load(&path, &[]).unwrap();
+    let pack = scene.pack.clone();
+    assert!(matches!(pack.shaft, Shaft::Prescribed(_)));
+    assert_schemes_agree("pack-4-rattle", pack, Scheme::Multirate, 0.05);
+}
+
+/// Issue 9: an inertial shaft (eq 4) over 50 ms: the bodies are coupled through the
+/// contacting couplings, which the multirate scheme integrates with the shaft while the free
+/// discs follow their closed form.
+///
+/// The pack: two staggered benchmark discs on a shaft of `J1 = 2 kg m^2` (about five times a
+/// disc's inertia) driven by eq (4) with the benchmark's profile. Why not eight discs: a free
+/// shaft lets the pack drift, the discs' impacts become slow grazing ones, and the trajectory
+/// loses its predictability fast: the monolithic scheme at 1e-12 and at 1e-13 already
+/// disagree beyond 1 us after about 30 ms for 8 discs (J1 = 0.5, 2 or 5 kg m^2) and for 4, so
+/// no scheme can be held to these limits there. This pack's trajectory is determined to them
+/// over 50 ms, which the test checks first (the oracle against itself at 1e-13).
+#[test]
+fn inertial_shaft_pack_matches_the_monolithic_oracle() {
+    let mut pack = staggered_pack(2);
+    pack.shaft = Shaft::Inertial {
+        inertia_kg_m2: 2.0,
+        damping_n_m_s_rad: 0.0,
+        excitation: ShaftExcitation::Profile(bench_drive()),
+    };
+    let tighter =
+        ReferenceEngine::new(pack.clone(), settings(1e-13)).with_scheme(Scheme::Monolithic);
+    let oracle =
+        ReferenceEngine::new(pack.clone(), settings(1e-12)).with_scheme(Scheme::Monolithic);
+    assert_same_impacts(
+        "inertial-2, oracle 1e-12 vs 1e-13",
+        &run(oracle, 0.05).0,
+        &run(tighter, 0.05).0,
+    );
+    let (n, c) = assert_schemes_agree("inertial-2", pack, Scheme::Multirate, 0.05);
+    assert!(n >= 30, "{n}");
+    assert_time_ordered(
+        "inertial-2",
+        &c,
+        2,
+        Settings::default().record_rate_hz,
+        0.05,
+    );
+}
+
+/// Spreading the independent discs over threads changes nothing: the parallel and serial
+/// multirate runs produce identical samples and impacts (bit for bit: each disc's
+/// integration is the same sequence of floating-point operations either way).
+#[test]
+fn parallel_and_serial_multirate_runs_are_identical() {
+    let pack = staggered_pack(8);
+    let a = run(ReferenceEngine::new(pack.clone(), settings(1e-9)), 0.02).0;
+    let b = run(
+        ReferenceEngine::new(pack, settings(1e-9)).with_parallel(false),
+        0.02,
+    )
+    .0;
+    assert_eq!(a.impacts, b.impacts);
+    assert_eq!(a.samples, b.samples);
+}
+
+/// A stop request (the observer's `progress` returning true) ends a multirate run cleanly
+/// with complete samples (every disc in every sample) up to where it stopped.
+#[test]
+fn a_stop_request_ends_a_multirate_run_with_complete_samples() {
+    struct StopAt(Collector, f64);
+    impl Observer for StopAt {
+        fn sample(&mut self, s: &Sample) {
+            self.0.sample(s)
+        }
+        fn impact(&mut self, e: &ImpactEvent) {
+            self.0.impact(e)
+        }
+        fn progress(&mut self, t: f64) -> bool {
+            t >= self.1
+        }
+    }
+    let mut obs = StopAt(Collector::default(), 0.01);
+    let stats = ReferenceEngine::new(staggered_pack(8), settings(1e-9))
+        .run(1.0, &mut obs)
+        .unwrap();
+    assert!(stats.stopped_early);
+    assert!(
+        stats.simulated_s >= 0.01 && stats.simulated_s < 1.0,
+        "{}",
+        stats.simulated_s
+    );
+    let last = obs.0.samples.last().unwrap();
+    assert!(last.t_s <= stats.simulated_s + 1e-12);
+    assert!(obs.0.samples.iter().all(|s| s.discs.len() == 8));
+}
+
+/// `scenes/staggered-8-disc.toml` and `staggered-16-disc.toml` are the model's
+/// `staggered_pack(8)` and `(16)`: the same disc angles (to the 17 digits written) and the
+/// same impacts over 20 ms.
+#[test]
+fn shipped_staggered_scenes_are_the_model_case() {
+    for n in [8, 16] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("../../scenes/staggered-{n}-disc.toml"));
+        let scene = clutchpack_scene::load(&path, &[]).unwrap();
+        let case = staggered_pack(n);
+        assert_eq!(scene.pack.discs.len(), n);
+        for (a, b) in scene.pack.discs.iter().zip(&case.discs) {
+            assert_eq!(a.name, b.name);
+            let d = (a.initial_rel_angle_rad - b.initial_rel_angle_rad).abs();
+            assert!(
+                d <= 1e-16,
+                "{n}: {} {} vs {}",
+                a.name,
+                a.initial_rel_angle_rad,
+                b.initial_rel_angle_rad
+            );
+            assert_eq!(a.initial_rel_speed_rad_s, 0.0);
+        }
+        let from_file = run(
+            ReferenceEngine::new(scene.pack.clone(), settings(1e-9)),
+            0.02,
+        )
+        .0;
+        let from_case = run(ReferenceEngine::new(case, settings(1e-9)), 0.02).0;
+        assert!(from_file.impacts.len() >= n);
+        assert_eq!(from_file.impacts, from_case.impacts);
+    }
+}

@@ -1,0 +1,292 @@
+//! Batch scripts for clusters: a Slurm job array of shards with a dependent merge job, and the
+//! Kubernetes equivalent (an Indexed Job and a merge Job).
+//!
+//! Every shard runs `clutchpack study run STUDY --out DIR --shard auto --shards N`; the array
+//! index picks the shard (`SLURM_ARRAY_TASK_ID`, `JOB_COMPLETION_INDEX`), `N` is always
+//! explicit. The scripts `exec` clutchpack, so that the scheduler's warning signal
+//! (`--signal=B:TERM@S`: SIGTERM to the batch shell S seconds before the time limit) reaches
+//! clutchpack itself, which stops starting cases, writes its part with the finished ones and
+//! exits; a resubmission of the same index runs only the rest.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// What the Slurm scripts need.
+#[derive(Debug, Clone)]
+pub struct SlurmJob<'a> {
+    /// Job name prefix.
+    pub name: &'a str,
+    /// The clutchpack executable (absolute).
+    pub exe: &'a Path,
+    /// The study file (absolute).
+    pub study: &'a Path,
+    /// The output folder (absolute; on shared storage).
+    pub out: &'a Path,
+    /// Number of shards N.
+    pub shards: u64,
+    /// The array indexes to submit, in `--array` syntax (`0-3`, or `1,3` for a resubmission).
+    pub array: String,
+    /// `--time` of a shard (Slurm syntax).
+    pub time: &'a str,
+    /// `--time` of the merge job.
+    pub merge_time: &'a str,
+    /// `--partition`, if any.
+    pub partition: Option<&'a str>,
+    /// `--cpus-per-task` of a shard.
+    pub cpus_per_task: u32,
+    /// Seconds before the time limit at which a shard gets SIGTERM.
+    pub signal_s: u32,
+}
+
+fn sh_quote(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "/._-+=:,@%".contains(c))
+    {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', "'\\''"))
+    }
+}
+
+fn q(p: &Path) -> String {
+    sh_quote(&p.display().to_string())
+}
+
+/// The shard array's batch script.
+pub fn slurm_array_script(j: &SlurmJob) -> String {
+    let mut s = String::from("#!/bin/bash\n");
+    let logs = j.out.join("logs");
+    let _ = writeln!(
+        s,
+        "#SBATCH --job-name={}",
+        sh_quote(&format!("{}-shard", j.name))
+    );
+    let _ = writeln!(s, "#SBATCH --array={}", j.array);
+    let _ = writeln!(s, "#SBATCH --time={}", j.time);
+    let _ = writeln!(s, "#SBATCH --cpus-per-task={}", j.cpus_per_task);
+    if let Some(p) = j.partition {
+        let _ = writeln!(s, "#SBATCH --partition={}", sh_quote(p));
+    }
+    let _ = writeln!(s, "#SBATCH --output={}", q(&logs.join("%x-%A_%a.out")));
+    // SIGTERM to the batch shell (which exec makes clutchpack) before the time limit
+    let _ = writeln!(s, "#SBATCH --signal=B:TERM@{}", j.signal_s);
+    let _ = writeln!(s, "#SBATCH --chdir={}", q(j.out));
+    s.push_str("# One shard of the study per array task; clutchpack takes the shard index from\n");
+    s.push_str("# SLURM_ARRAY_TASK_ID and its threads from SLURM_CPUS_PER_TASK.\n");
+    let _ = writeln!(
+        s,
+        "exec {} study run {} --out {} --shard auto --shards {}",
+        q(j.exe),
+        q(j.study),
+        q(j.out),
+        j.shards
+    );
+    s
+}
+
+/// The merge job's batch script (submitted with `--dependency=afterok:<array job>`).
+pub fn slurm_merge_script(j: &SlurmJob) -> String {
+    let mut s = String::from("#!/bin/bash\n");
+    let _ = writeln!(
+        s,
+        "#SBATCH --job-name={}",
+        sh_quote(&format!("{}-merge", j.name))
+    );
+    let _ = writeln!(s, "#SBATCH --time={}", j.merge_time);
+    let _ = writeln!(s, "#SBATCH --cpus-per-task=1");
+    if let Some(p) = j.partition {
+        let _ = writeln!(s, "#SBATCH --partition={}", sh_quote(p));
+    }
+    let _ = writeln!(
+        s,
+        "#SBATCH --output={}",
+        q(&j.out.join("logs").join("%x-%j.out"))
+    );
+    let _ = writeln!(s, "#SBATCH --kill-on-invalid-dep=yes");
+    let _ = writeln!(s, "#SBATCH --chdir={}", q(j.out));
+    let _ = writeln!(s, "exec {} study merge {}", q(j.exe), q(j.out));
+    s
+}
+
+/// The command lines that submit the two scripts (what `--dry-run` prints).
+pub fn slurm_submit_commands(array_script: &Path, merge_script: &Path) -> String {
+    format!(
+        "aid=$(sbatch --parsable {})\naid=${{aid%%;*}}\nsbatch --parsable --dependency=afterok:$aid --kill-on-invalid-dep=yes {}\n",
+        q(array_script),
+        q(merge_script)
+    )
+}
+
+/// What the Kubernetes manifests need.
+#[derive(Debug, Clone)]
+pub struct K8sJob<'a> {
+    /// Job name prefix (a DNS label).
+    pub name: &'a str,
+    /// Container image with clutchpack on its PATH.
+    pub image: &'a str,
+    /// The study file's path inside the container (relative paths start at [`K8S_WORKDIR`]).
+    pub study: &'a str,
+    /// The output folder inside the container (relative paths start at [`K8S_WORKDIR`]).
+    pub out: &'a str,
+    /// Number of shards (completions).
+    pub shards: u64,
+    /// Pods at once.
+    pub parallelism: u64,
+    /// CPUs per pod.
+    pub cpus: u32,
+    /// The PersistentVolumeClaim (ReadWriteMany) mounted at [`K8S_WORKDIR`], the pods' working
+    /// folder: it holds the study, its scene and the output folder.
+    pub claim: &'a str,
+}
+
+/// Where the pods mount the claim, and their working folder.
+pub const K8S_WORKDIR: &str = "/work";
+
+/// A DNS-1123 label from `s`.
+pub fn dns_label(s: &str) -> String {
+    let mut l: String = s
+        .to_ascii_lowercase()
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+        .collect();
+    l.truncate(50);
+    let l = l.trim_matches('-').to_string();
+    if l.is_empty() {
+        "study".into()
+    } else {
+        l
+    }
+}
+
+fn k8s_pod(j: &K8sJob, args: &[String], cpus: u32) -> String {
+    let args: Vec<String> = args.iter().map(|a| format!("\"{a}\"")).collect();
+    format!(
+        "  template:
+    spec:
+      restartPolicy: Never
+      containers:
+        - name: clutchpack
+          image: {image}
+          command: [\"clutchpack\"]
+          args: [{args}]
+          workingDir: {workdir}
+          resources:
+            requests:
+              cpu: \"{cpus}\"
+            limits:
+              cpu: \"{cpus}\"
+          volumeMounts:
+            - name: work
+              mountPath: {workdir}
+      volumes:
+        - name: work
+          persistentVolumeClaim:
+            claimName: {claim}
+",
+        image = j.image,
+        args = args.join(", "),
+        workdir = K8S_WORKDIR,
+        claim = j.claim,
+    )
+}
+
+/// The Indexed Job of the shards: pod `i` runs shard `i` (`JOB_COMPLETION_INDEX`); a failed
+/// pod is retried with the same index. A pod gets SIGTERM on deletion or eviction and
+/// `terminationGracePeriodSeconds` to write its part.
+pub fn k8s_indexed_job(j: &K8sJob) -> String {
+    let args = [
+        "study".to_string(),
+        "run".into(),
+        j.study.into(),
+        "--out".into(),
+        j.out.into(),
+        "--shard".into(),
+        "auto".into(),
+        "--shards".into(),
+        j.shards.to_string(),
+    ];
+    format!(
+        "apiVersion: batch/v1
+kind: Job
+metadata:
+  name: {name}-shards
+spec:
+  completionMode: Indexed
+  completions: {n}
+  parallelism: {par}
+  backoffLimitPerIndex: 2
+{pod}",
+        name = dns_label(j.name),
+        n = j.shards,
+        par = j.parallelism,
+        pod = k8s_pod(j, &args, j.cpus)
+    )
+}
+
+/// The merge Job: start it once the shards' Job is `Complete`
+/// (`kubectl wait --for=condition=complete job/<name>-shards`); Kubernetes has no dependency
+/// between Jobs.
+pub fn k8s_merge_job(j: &K8sJob) -> String {
+    let args = ["study".to_string(), "merge".into(), j.out.into()];
+    format!(
+        "apiVersion: batch/v1
+kind: Job
+metadata:
+  name: {name}-merge
+spec:
+  backoffLimit: 1
+{pod}",
+        name = dns_label(j.name),
+        pod = k8s_pod(j, &args, 1)
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn array_script_has_the_options_that_matter() {
+        let j = SlurmJob {
+            name: "mc",
+            exe: Path::new("/opt/cp/clutchpack"),
+            study: Path::new("/shared/s.toml"),
+            out: Path::new("/shared/out dir"),
+            shards: 4,
+            array: "0-3".into(),
+            time: "00:10:00",
+            merge_time: "00:05:00",
+            partition: Some("short"),
+            cpus_per_task: 2,
+            signal_s: 60,
+        };
+        let a = slurm_array_script(&j);
+        for want in [
+            "#SBATCH --array=0-3",
+            "#SBATCH --signal=B:TERM@60",
+            "#SBATCH --output='/shared/out dir/logs/%x-%A_%a.out'",
+            "#SBATCH --partition=short",
+            "exec /opt/cp/clutchpack study run /shared/s.toml --out '/shared/out dir' --shard auto --shards 4",
+        ] {
+            assert!(a.contains(want), "{want} not in\n{a}");
+        }
+        let m = slurm_merge_script(&j);
+        assert!(m.contains("--kill-on-invalid-dep=yes") && m.contains("study merge"));
+        let c = slurm_submit_commands(Path::new("/a.sh"), Path::new("/m.sh"));
+        assert!(c.contains("--dependency=afterok:$aid"));
+        let k = k8s_indexed_job(&K8sJob {
+            name: "MC study",
+            image: "img",
+            study: "/work/s.toml",
+            out: "/work/out",
+            shards: 8,
+            parallelism: 4,
+            cpus: 2,
+            claim: "pvc",
+        });
+        assert!(k.contains("completionMode: Indexed") && k.contains("completions: 8"));
+        assert!(k.contains("name: mc-study-shards"));
+        assert!(k.contains("workingDir: /work") && k.contains("mountPath: /work"));
+    }
+}
