@@ -67,23 +67,28 @@ pub struct ReplayArgs {
     /// motion helps).
     #[arg(long, default_value_t = 0.01)]
     pub speed: f32,
+    /// With `--serve`: wait for the viewer's play button instead of playing as soon as a
+    /// viewer subscribes.
+    #[arg(long)]
+    pub paused: bool,
 }
 
 pub fn replay(a: ReplayArgs) -> Result<ExitCode> {
     let reader = open_recording(&a.file, a.salvage)?;
     out!("{}", crate::describe::describe(&reader).trim_end());
     if a.serve {
-        serve(&reader, a.port, a.speed)?;
+        serve(&reader, a.port, a.speed, a.paused)?;
     }
     Ok(ExitCode::SUCCESS)
 }
 
 #[cfg(feature = "serve")]
-fn serve(reader: &RecordingReader, port: u16, speed: f32) -> Result<()> {
+fn serve(reader: &RecordingReader, port: u16, speed: f32, paused: bool) -> Result<()> {
     let stop = crate::signals::flag();
     let opts = clutchpack_record::ServeOptions {
         port,
         speed,
+        autoplay: !paused,
         ..Default::default()
     };
     clutchpack_record::serve(reader, &opts, &stop, |p| {
@@ -96,7 +101,7 @@ fn serve(reader: &RecordingReader, port: u16, speed: f32) -> Result<()> {
 }
 
 #[cfg(not(feature = "serve"))]
-fn serve(_reader: &RecordingReader, _port: u16, _speed: f32) -> Result<()> {
+fn serve(_reader: &RecordingReader, _port: u16, _speed: f32, _paused: bool) -> Result<()> {
     Err(
         BadInput("this build has no WebSocket server: rebuild with `--features serve`".into())
             .into(),

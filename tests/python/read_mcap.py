@@ -51,6 +51,7 @@ try:
     )
     from mcap.stream_reader import StreamReader
     from mcap_protobuf.decoder import DecoderFactory
+    from mcap_ros2.decoder import DecoderFactory as Ros2DecoderFactory
 except ImportError as e:  # pragma: no cover
     print(f"read_mcap.py: missing package ({e}); run tests/python/setup.sh", file=sys.stderr)
     sys.exit(1)
@@ -91,7 +92,7 @@ def check_magic(path):
 
 def stream_pass(path, report):
     """Reads every record from the start, decoding every message. Returns (complete, error)."""
-    factory = DecoderFactory()
+    factories = [DecoderFactory(), Ros2DecoderFactory()]
     schemas = {}
     channels = {}
     decoders = {}
@@ -132,7 +133,17 @@ def stream_pass(path, report):
                     schema = schemas.get(channel.schema_id)
                     decoder = decoders.get(channel.id)
                     if decoder is None:
-                        decoder = factory.decoder_for(channel.message_encoding, schema)
+                        decoder = next(
+                            (
+                                d
+                                for d in (
+                                    f.decoder_for(channel.message_encoding, schema)
+                                    for f in factories
+                                )
+                                if d is not None
+                            ),
+                            None,
+                        )
                         if decoder is None:
                             raise Failure(
                                 f"no decoder for {channel.topic} (message encoding "
@@ -190,7 +201,7 @@ def stream_pass(path, report):
 def indexed_pass(path, report, stats):
     """Reads a complete file through its summary section and indexes, decoding every message."""
     with open(path, "rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        reader = make_reader(f, decoder_factories=[DecoderFactory(), Ros2DecoderFactory()])
         summary = reader.get_summary()
         if summary is None:
             raise Failure("the file has a footer but no summary section")

@@ -29,18 +29,23 @@
 //! - Depend on rapier or on the engines: it knows only `clutchpack_model`'s stream types.
 //!
 //! ## Topics
-//! All messages are protobuf; log time = publish time = simulated time in ns (deterministic).
+//! All messages are protobuf but `/joints` (ROS 2 CDR, for Rerun); log time = publish time =
+//! simulated time in ns (deterministic).
 //!
 //! | topic | schema | when | fields (units in names) |
 //! | --- | --- | --- | --- |
 //! | `/tf` | `foxglove.FrameTransforms` | every [`RecordOptions::tf_interval_s`] (0.2 ms) | `world` -> `shaft`, `world` -> `disc/<segment>`: rotation about +z, discs at `z_m` |
-//! | `/scene` | `foxglove.SceneUpdate` | t = 0, then every [`RecordOptions::scene_interval_s`] | shaft cylinder, disc annuli (triangle meshes) with their teeth; then load collars over the teeth coloured by load (per-tooth runs: each tooth by its own load) |
+//! | `/scene` | `foxglove.SceneUpdate` | once, at t = 0 | the static pack: shaft cylinder, disc annuli (triangle meshes) with their teeth |
+//! | `/scene/loads` | `foxglove.SceneUpdate` | t = 0, then every [`RecordOptions::scene_interval_s`] when a colour changed | every disc's load ring over its teeth coloured by load (per-tooth runs: each tooth by its own load) |
+//! | `/pack/<frame>` | `foxglove.PointCloud` | once, at t = 0 | the same pack as points in each body's frame, for Rerun (which does not draw scene updates) |
+//! | `/joints` | `sensor_msgs/msg/JointState` (`ros2msg`, `cdr`) | each sample | one joint per disc: `position` = `rel_angle_rad`, `velocity` = shaft minus disc speed (rad/s), `effort` = `load_n`; Rerun plots it with no setup |
 //! | `/shaft` | `clutchpack.ShaftState` | each sample | `t_s, angle_rad, speed_rad_s` |
 //! | `/discs/<segment>/spline` | `clutchpack.SplineState` | each sample | `t_s, rel_angle_rad, closing_speed_m_s, penetration_m, load_n, torque_n_m, engaged, stiffness_n_m1_5, speed_rad_s, angle_rad, disc_index` |
 //! | `/discs/<segment>/teeth` | `clutchpack.ToothLoads` | each sample, if [`RecordOptions::per_tooth`] | `t_s, loads_n[], disc_index` |
 //! | `/interfaces/<lower>__<upper>` | `clutchpack.InterfaceState` | each sample, packs with a stack | `t_s, slip_rad_s, slip_m_s, mu, clamp_n, torque_n_m, locked, interface_index, dissipated_j` |
 //! | `/impacts` | `clutchpack.Impact` | each impact, at `t_peak_s` | `disc, disc_index, t_on_s, t_peak_s, t_off_s, flank, v_on_m_s, peak_n` |
-//! | `/summary` | `clutchpack.RunSummary` | once, at the end | `t_end_s, discs[]{name, index, max_positive_n, max_negative_n, p99_abs_n, impacts, positive_impacts, negative_impacts, mean_top10_abs_n}` |
+//! | `/discs/<segment>/impacts` | `clutchpack.Impact` | each impact of that disc, at `t_peak_s` | the same messages as `/impacts`: a per-disc series of the exact located peaks |
+//! | `/summary` | `clutchpack.RunSummary` | once, written at the end, logged at t = 0 (so viewers show it on open) | `t_end_s, discs[]{name, index, max_positive_n, max_negative_n, p99_abs_n, impacts, positive_impacts, negative_impacts, mean_top10_abs_n}` |
 //!
 //! `<segment>` is the disc's scene name made topic-safe by [`topic_segment`]. The
 //! `clutchpack.*` schemas are in `crates/record/proto/clutchpack.proto` (generated from
@@ -96,6 +101,7 @@ pub mod info;
 pub mod output;
 pub mod proto;
 mod read;
+mod ros2;
 #[cfg(feature = "serve")]
 mod serve;
 mod summary;

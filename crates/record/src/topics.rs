@@ -3,13 +3,34 @@
 
 /// Body poses, `foxglove.FrameTransforms`.
 pub const TF: &str = "/tf";
-/// Pack geometry and load colours, `foxglove.SceneUpdate`.
+/// The pack's static geometry, `foxglove.SceneUpdate`: one message at t = 0 and nothing
+/// after it, so that "the latest message" of this topic is always the whole pack.
 pub const SCENE: &str = "/scene";
+/// Load colours over the teeth, `foxglove.SceneUpdate`: every message holds every disc's
+/// colour, so that its latest message restores them all.
+pub const SCENE_LOADS: &str = "/scene/loads";
+/// The spline couplings as joints, `sensor_msgs/msg/JointState` (ROS 2, CDR), one message
+/// per sample: one joint per disc, named by the disc; `position` = `rel_angle_rad`,
+/// `velocity` = shaft minus disc speed in rad/s, `effort` = `load_n` (N per tooth). For
+/// viewers that plot well-known messages without configuration (Rerun: a time series per
+/// field, one line per disc).
+pub const JOINTS: &str = "/joints";
+/// Prefix of the point-cloud pack (`foxglove.PointCloud`, one per body, at t = 0), for
+/// viewers that draw point clouds but not `foxglove.SceneUpdate` (Rerun).
+pub const PACK_PREFIX: &str = "/pack/";
+
+/// `/pack/<frame>`: the point cloud of the body whose frame is `frame` (`shaft`,
+/// `disc/<segment>`).
+pub fn pack(frame: &str) -> String {
+    format!("{PACK_PREFIX}{frame}")
+}
+
 /// Shaft angle and speed, `clutchpack.ShaftState`.
 pub const SHAFT: &str = "/shaft";
 /// Impact events, `clutchpack.Impact`.
 pub const IMPACTS: &str = "/impacts";
-/// Per-disc summary at the end of the run, `clutchpack.RunSummary`.
+/// Per-disc summary of the run, `clutchpack.RunSummary`: written when the run ends, logged
+/// at t = 0 so that a viewer shows it from the start.
 pub const SUMMARY: &str = "/summary";
 /// Prefix of the per-disc topics.
 pub const DISCS_PREFIX: &str = "/discs/";
@@ -17,6 +38,14 @@ pub const DISCS_PREFIX: &str = "/discs/";
 /// `/discs/<segment>/spline`, `clutchpack.SplineState`.
 pub fn spline(segment: &str) -> String {
     format!("{DISCS_PREFIX}{segment}/spline")
+}
+
+/// `/discs/<segment>/impacts`, `clutchpack.Impact`: the disc's impacts, each logged at its
+/// peak time `t_peak_s` with its exact located peak load `peak_n` (the same messages as on
+/// [`IMPACTS`]), so that a plot of `peak_n` shows the true peaks that the sampled `load_n`
+/// can miss (a contact lasts about as long as a sample interval).
+pub fn disc_impacts(segment: &str) -> String {
+    format!("{DISCS_PREFIX}{segment}/impacts")
 }
 
 /// `/discs/<segment>/teeth`, `clutchpack.ToothLoads`.

@@ -1,32 +1,40 @@
-//! The 3D view: body poses (`/tf`, `foxglove.FrameTransforms`) and the pack's geometry
-//! (`/scene`, `foxglove.SceneUpdate`).
+//! The 3D view: body poses (`/tf`, `foxglove.FrameTransforms`), the pack's geometry
+//! (`/scene`, `foxglove.SceneUpdate`) and its load colours (`/scene/loads`, the same schema).
 //!
 //! Frames: `world` is fixed, z along the shaft axis. The shaft's frame `shaft` and each
 //! disc's frame `disc/<name>` sit on the axis (a disc's at its mid-plane `z_m`) and turn about
-//! +z by the body's angle. Entities are `frame_locked`, so they follow their frame. The first
-//! `/scene` message (at t = 0) holds the static bodies: the shaft cylinder with a stripe, and
-//! each disc as a triangle-mesh annulus with a rim marker and its spline teeth (steel grey):
-//! inside the bore of a friction disc, outside the rim of a separator plate. The meshes come
-//! from parry3d-f64 (the geometry library under the multibody engine): the annulus as convex
-//! wedges (`ConvexPolyhedron` hulls), each tooth as a `Cuboid`, triangulated by parry.
+//! +z by the body's angle. Entities are `frame_locked`, so they follow their frame.
 //!
-//! Loads are shown by small entities that later `/scene` messages replace:
-//! - `disc/<name>/load`: a translucent collar over the disc's spline teeth, coloured by the
-//!   largest `|load_n|` since the previous update (grey = no load, yellow = half, red = the
-//!   colour scale). One primitive per disc, about 200 bytes.
+//! **Static bodies and load colours are on separate topics**, so that a viewer that restores
+//! "the latest message of each topic" after a seek or on opening (Foxglove, Lichtblick) always
+//! has the whole pack. `/scene` holds one message at t = 0 with the static bodies and nothing
+//! else is ever sent on it: the shaft cylinder with a stripe, and each disc as a
+//! triangle-mesh annulus with a rim marker and its spline teeth (steel grey): inside the bore
+//! of a friction disc, outside the rim of a separator plate. The meshes come from parry3d-f64
+//! (the geometry library under the multibody engine): the annulus as convex wedges
+//! (`ConvexPolyhedron` hulls), each tooth as a `Cuboid`, triangulated by parry. Teeth are
+//! drawn as they are, one per tooth, up to [`MAX_TEETH`] per disc. The shaft is drawn over
+//! the discs' axial span plus a margin ([`drawn_shaft`]) unless the run info gives its
+//! geometry.
+//!
+//! `/scene/loads` holds the load colours, and **every message carries every disc**, so that
+//! its latest message alone restores all colours:
+//! - `disc/<name>/load`: a translucent ring over the disc's spline teeth (a line loop as
+//!   wide as the teeth are deep, about 400 bytes), coloured by the largest `|load_n|` since
+//!   the previous update (grey = no load, yellow = half, red = the colour scale).
 //! - `disc/<name>/teeth`, only for samples that carry per-tooth loads: the teeth redrawn as
-//!   cubes, each coloured by its own largest `|load|` since the previous update (about 130
-//!   bytes per tooth).
+//!   cubes, each coloured by its own largest `|load|` (about 130 bytes per tooth).
 //!
-//! An update holds only the discs whose colour changed (levels in steps of 1/16), so quiet
+//! A message is sent only when some colour changed (levels in steps of 1/16), so quiet
 //! stretches cost nothing. Redrawing every tooth for a lumped load (one colour for all) was
 //! measured at 10 kB per disc and update, 70 % of a recording's bytes and most of its
-//! writing time; the collar says the same in 200 bytes.
+//! writing time; the ring says the same in a few hundred bytes.
 
-use crate::info::{DiscGeometry, RunInfo};
+use crate::info::{DiscGeometry, RunInfo, ShaftGeometry};
 use foxglove::schemas::{
-    Color, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms, Point3, Pose,
-    Quaternion, SceneEntity, SceneUpdate, Timestamp, TriangleListPrimitive, Vector3,
+    line_primitive, packed_element_field, Color, CubePrimitive, CylinderPrimitive, FrameTransform,
+    FrameTransforms, LinePrimitive, PackedElementField, Point3, PointCloud, Pose, Quaternion,
+    SceneEntity, SceneUpdate, Timestamp, TriangleListPrimitive, Vector3,
 };
 use parry3d_f64::math::Vector;
 use parry3d_f64::shape::{ConvexPolyhedron, Cuboid};
@@ -46,8 +54,12 @@ pub fn disc_frame(segment: &str) -> String {
 const SEGMENTS: u32 = 64;
 /// Teeth drawn when a disc's tooth count is unknown (0).
 const MARKERS: u32 = 8;
-/// At most this many teeth are drawn per disc.
-const MAX_TEETH: u32 = 96;
+/// At most this many teeth are drawn per disc (a disc with more is drawn with this many,
+/// evenly spaced). Real splines have up to about 150 teeth; the static teeth mesh costs about
+/// 340 bytes per tooth, once per recording.
+pub const MAX_TEETH: u32 = 400;
+/// Segments of a load ring (a line loop).
+const RING_SEGMENTS: u32 = 32;
 
 pub(crate) fn timestamp(log_time_ns: u64) -> Timestamp {
     Timestamp::new(
@@ -269,7 +281,7 @@ fn entity(log_time_ns: u64, frame: &str, id: &str) -> SceneEntity {
 
 /// The static scene: shaft and disc bodies, plus the teeth at zero load.
 pub(crate) fn static_scene(info: &RunInfo, frames: &[String]) -> SceneUpdate {
-    let s = info.shaft_geometry();
+    let s = drawn_shaft(info);
     let len = (s.z_max_m - s.z_min_m).abs().max(1e-6);
     let zc = 0.5 * (s.z_max_m + s.z_min_m);
     let mut shaft = entity(0, SHAFT_FRAME, "shaft");
@@ -305,11 +317,39 @@ pub(crate) fn static_scene(info: &RunInfo, frames: &[String]) -> SceneUpdate {
         e.triangles.push(teeth_mesh(d, Some(STEEL)));
         entities.push(e);
     }
-    let zeros: Vec<(usize, f64)> = (0..info.discs.len()).map(|i| (i, 0.0)).collect();
-    entities.extend(load_scene(0, info, frames, &zeros).entities);
     SceneUpdate {
         deletions: Vec::new(),
         entities,
+    }
+}
+
+/// The shaft as drawn: the run info's geometry when given; otherwise the derived radius over
+/// the discs' axial span plus a margin of a quarter of that span (at least two disc
+/// thicknesses) on each side, so that a thin pack is not drawn on a long rod.
+pub(crate) fn drawn_shaft(info: &RunInfo) -> ShaftGeometry {
+    let s = info.shaft_geometry();
+    if info.shaft.is_some() || info.discs.is_empty() {
+        return s;
+    }
+    let (lo, hi, h) = info.discs.iter().fold(
+        (f64::INFINITY, f64::NEG_INFINITY, 0.0_f64),
+        |(lo, hi, h), d| {
+            let t = 0.5 * d.thickness_m.abs();
+            (
+                lo.min(d.z_m - t),
+                hi.max(d.z_m + t),
+                h.max(d.thickness_m.abs()),
+            )
+        },
+    );
+    if !(lo.is_finite() && hi.is_finite()) {
+        return s;
+    }
+    let margin = (0.25 * (hi - lo)).max(2.0 * h).max(1e-6);
+    ShaftGeometry {
+        radius_m: s.radius_m,
+        z_min_m: lo - margin,
+        z_max_m: hi + margin,
     }
 }
 
@@ -348,10 +388,19 @@ fn tooth_cubes(d: &DiscGeometry, color: impl Fn(usize) -> Color) -> Vec<CubePrim
         .collect()
 }
 
-/// The load collars of the discs `levels` names, `(disc index, level)`, coloured by the
-/// level `max |load| / scale` (0..=1): a translucent cylinder over each disc's spline teeth
-/// (radius the tooth root, a little thicker than the disc). Other discs' collars are left as
-/// they are.
+/// The radial band of a disc's drawn teeth in m, `(root side, tip side)`: inside the bore
+/// of a friction disc, outside the rim of a plate.
+fn teeth_band(d: &DiscGeometry) -> (f64, f64) {
+    let c = tooth_centre_radius(d);
+    let half = 0.5 * tooth_depth(d).max(1e-6);
+    (c - half, c + half)
+}
+
+/// The load rings of the discs `levels` names, `(disc index, level)`, coloured by the level
+/// `max |load| / scale` (0..=1): a translucent line loop of [`RING_SEGMENTS`] points at the
+/// middle of the disc's teeth, a little wider than the teeth are deep, so it lies over the
+/// teeth and leaves the bore open. The recorder passes every disc, so that one message
+/// restores all colours.
 pub(crate) fn load_scene(
     log_time_ns: u64,
     info: &RunInfo,
@@ -364,22 +413,28 @@ pub(crate) fn load_scene(
             continue;
         };
         let mut e = entity(log_time_ns, frame, &format!("{frame}/load"));
-        let r = if d.teeth_outside {
-            d.outer_radius_m.max(d.inner_radius_m) + tooth_depth(d)
-        } else {
-            d.inner_radius_m.min(d.outer_radius_m)
-        }
-        .abs()
-        .max(1e-6);
-        let h = 1.4 * d.thickness_m.abs().max(1e-6);
+        let (a, b) = teeth_band(d);
+        let r = 0.5 * (a + b);
         let mut color = load_color(level);
-        color.a = 0.55;
-        e.cylinders.push(CylinderPrimitive {
+        color.a = 0.8;
+        e.lines.push(LinePrimitive {
+            r#type: line_primitive::Type::LineLoop as i32,
             pose: pose(0.0, 0.0, 0.0, 0.0),
-            size: Some(v3(2.0 * r, 2.0 * r, h)),
-            bottom_scale: 1.0,
-            top_scale: 1.0,
+            thickness: 1.3 * (b - a).abs().max(1e-6),
+            scale_invariant: false,
+            points: (0..RING_SEGMENTS)
+                .map(|k| {
+                    let t = 2.0 * PI * f64::from(k) / f64::from(RING_SEGMENTS);
+                    Point3 {
+                        x: r * t.cos(),
+                        y: r * t.sin(),
+                        z: 0.0,
+                    }
+                })
+                .collect(),
             color: Some(color),
+            colors: Vec::new(),
+            indices: Vec::new(),
         });
         entities.push(e);
     }
@@ -415,6 +470,121 @@ pub(crate) fn teeth_scene(
     }
 }
 
+/// Points round the circle of radius `r` per [`PointCloud`] face ring.
+const CLOUD_AROUND: u32 = 120;
+
+/// One point of a [`PointCloud`]: position in m (f32 x, y, z) and colour (u8 r, g, b, a).
+fn push_point(data: &mut Vec<u8>, x: f64, y: f64, z: f64, c: [u8; 4]) {
+    for v in [x, y, z] {
+        data.extend_from_slice(&(v as f32).to_le_bytes());
+    }
+    data.extend_from_slice(&c);
+}
+
+/// A point cloud in `frame` from packed points (16 bytes each, see [`push_point`]).
+fn cloud(frame: &str, data: Vec<u8>) -> PointCloud {
+    use packed_element_field::NumericType;
+    let field = |name: &str, offset: u32, t: NumericType| PackedElementField {
+        name: name.into(),
+        offset,
+        r#type: t as i32,
+    };
+    PointCloud {
+        timestamp: Some(timestamp(0)),
+        frame_id: frame.into(),
+        pose: pose(0.0, 0.0, 0.0, 0.0),
+        point_stride: 16,
+        fields: vec![
+            field("x", 0, NumericType::Float32),
+            field("y", 4, NumericType::Float32),
+            field("z", 8, NumericType::Float32),
+            field("red", 12, NumericType::Uint8),
+            field("green", 13, NumericType::Uint8),
+            field("blue", 14, NumericType::Uint8),
+            field("alpha", 15, NumericType::Uint8),
+        ],
+        data: data.into(),
+    }
+}
+
+/// Points on the surface of the annulus `r0..r1`, thickness `h`, centred on its frame: both
+/// faces on seven rings from `r0` to `r1` and both rims, [`CLOUD_AROUND`] points round.
+fn annulus_points(data: &mut Vec<u8>, r0: f64, r1: f64, h: f64, c: [u8; 4]) {
+    let rings = 6u32;
+    for k in 0..CLOUD_AROUND {
+        let a = 2.0 * PI * f64::from(k) / f64::from(CLOUD_AROUND);
+        let (s, co) = a.sin_cos();
+        for j in 0..=rings {
+            let r = r0 + (r1 - r0) * f64::from(j) / f64::from(rings.max(1));
+            for z in [-0.5 * h, 0.5 * h] {
+                push_point(data, r * co, r * s, z, c);
+            }
+        }
+        for r in [r0, r1] {
+            push_point(data, r * co, r * s, 0.0, c);
+        }
+    }
+}
+
+/// The pack as point clouds, one per body: `(frame, cloud)` for the shaft (its surface and
+/// the blue stripe) and each disc (both faces, rims, and the corners and centre of each drawn
+/// tooth), in the bodies' own frames so that they turn with `/tf`. For viewers that draw
+/// `foxglove.PointCloud` but not `foxglove.SceneUpdate` (Rerun decodes it as `Points3D`).
+/// About 1 700 points (27 kB) per disc plus 9 per tooth, written once at t = 0.
+pub(crate) fn pack_points(info: &RunInfo, frames: &[String]) -> Vec<(String, PointCloud)> {
+    let grey = [140, 148, 158, 255];
+    let mut out = Vec::with_capacity(info.discs.len() + 1);
+    let s = drawn_shaft(info);
+    let mut data = Vec::new();
+    let len = (s.z_max_m - s.z_min_m).abs();
+    let along = 24u32;
+    for k in 0..CLOUD_AROUND {
+        let a = 2.0 * PI * f64::from(k) / f64::from(CLOUD_AROUND);
+        let stripe = !(CLOUD_AROUND / 24..=CLOUD_AROUND - CLOUD_AROUND / 24).contains(&k);
+        let c = if stripe { [38, 77, 204, 255] } else { grey };
+        for j in 0..=along {
+            let z = s.z_min_m + len * f64::from(j) / f64::from(along);
+            push_point(&mut data, s.radius_m * a.cos(), s.radius_m * a.sin(), z, c);
+        }
+    }
+    out.push((SHAFT_FRAME.to_string(), cloud(SHAFT_FRAME, data)));
+    for (d, frame) in info.discs.iter().zip(frames) {
+        let mut data = Vec::new();
+        let (r0, r1) = (
+            d.inner_radius_m.min(d.outer_radius_m),
+            d.outer_radius_m.max(d.inner_radius_m),
+        );
+        let h = d.thickness_m.abs().max(1e-6);
+        annulus_points(&mut data, r0, r1, h, [158, 122, 82, 255]);
+        let n = drawn_teeth(d);
+        let (size, r) = (tooth_size(d), tooth_centre_radius(d));
+        let steel = [115, 120, 128, 255];
+        for i in 0..n {
+            let a = 2.0 * PI * f64::from(i) / f64::from(n);
+            let (sn, cs) = a.sin_cos();
+            let mut put = |u: f64, v: f64, z: f64| {
+                push_point(
+                    &mut data,
+                    r * cs + u * cs - v * sn,
+                    r * sn + u * sn + v * cs,
+                    z,
+                    steel,
+                )
+            };
+            put(0.0, 0.0, 0.0);
+            for u in [-0.5 * size.x, 0.5 * size.x] {
+                for v in [-0.5 * size.y, 0.5 * size.y] {
+                    for z in [-0.5 * size.z, 0.5 * size.z] {
+                        put(u, v, z);
+                    }
+                }
+            }
+        }
+        out.push((frame.clone(), cloud(frame, data)));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -430,6 +600,91 @@ mod tests {
         assert_eq!(load_color(0.0).r, 0.6);
         assert_eq!((load_color(0.5).r, load_color(0.5).g), (1.0, 0.85));
         assert_eq!((load_color(2.0).g, load_color(f64::NAN).g), (0.0, 0.0));
+    }
+
+    fn disc(teeth: u32, z_m: f64) -> DiscGeometry {
+        DiscGeometry {
+            name: "d".into(),
+            inner_radius_m: 0.05,
+            outer_radius_m: 0.08,
+            thickness_m: 0.002,
+            z_m,
+            teeth,
+            teeth_outside: false,
+        }
+    }
+
+    /// Teeth are drawn as many as the disc has, up to [`MAX_TEETH`]; an unknown count gets
+    /// [`MARKERS`].
+    #[test]
+    fn teeth_are_drawn_as_they_are_up_to_the_cap() {
+        assert_eq!(drawn_teeth(&disc(150, 0.0)), 150);
+        assert_eq!(drawn_teeth(&disc(MAX_TEETH, 0.0)), MAX_TEETH);
+        assert_eq!(drawn_teeth(&disc(MAX_TEETH + 1, 0.0)), MAX_TEETH);
+        assert_eq!(drawn_teeth(&disc(0, 0.0)), MARKERS);
+    }
+
+    /// Without a given shaft, the shaft spans the discs plus a quarter of their span (at
+    /// least two disc thicknesses) at each end: a 36 mm pack gets a 54 mm shaft, not one a
+    /// disc diameter longer at each end.
+    #[test]
+    fn the_shaft_is_scaled_to_the_pack() {
+        let info = RunInfo {
+            discs: (0..10)
+                .map(|k| disc(30, 0.001 + 0.00377 * f64::from(k)))
+                .collect(),
+            ..Default::default()
+        };
+        // discs span z = 0 .. 0.03593 + 0.001
+        let (lo, hi) = (0.0, 0.00377 * 9.0 + 0.002);
+        let s = drawn_shaft(&info);
+        let m = 0.25 * (hi - lo);
+        assert!((s.z_min_m - (lo - m)).abs() < 1e-12, "{s:?}");
+        assert!((s.z_max_m - (hi + m)).abs() < 1e-12, "{s:?}");
+        assert_eq!(s.radius_m, info.shaft_geometry().radius_m);
+        // one thin disc: two thicknesses each side
+        let one = RunInfo {
+            discs: vec![disc(30, 0.0)],
+            ..Default::default()
+        };
+        let s = drawn_shaft(&one);
+        assert!((s.z_max_m - 0.005).abs() < 1e-12 && (s.z_min_m + 0.005).abs() < 1e-12);
+        // a given shaft is drawn as given
+        let given = ShaftGeometry {
+            radius_m: 0.01,
+            z_min_m: -1.0,
+            z_max_m: 1.0,
+        };
+        let info = RunInfo {
+            shaft: Some(given.clone()),
+            ..info
+        };
+        assert_eq!(drawn_shaft(&info), given);
+    }
+
+    /// Every disc's load ring lies over its teeth: a closed loop at the middle of the teeth
+    /// band, as wide as the band and a little more, coloured by the level.
+    #[test]
+    fn load_rings_lie_over_the_teeth() {
+        let info = RunInfo {
+            discs: vec![disc(30, 0.0), disc(30, 0.01)],
+            ..Default::default()
+        };
+        let frames = ["disc/a".to_string(), "disc/b".to_string()];
+        let u = load_scene(5, &info, &frames, &[(0, 0.0), (1, 1.0)]);
+        assert_eq!(u.entities.len(), 2);
+        let (a, b) = teeth_band(&info.discs[0]);
+        assert!(b <= 0.05 + 1e-12 && a < b, "inside the bore: {a} {b}");
+        for (e, level) in u.entities.iter().zip([0.0, 1.0]) {
+            let l = &e.lines[0];
+            assert_eq!(l.r#type, line_primitive::Type::LineLoop as i32);
+            assert_eq!(l.points.len(), RING_SEGMENTS as usize);
+            for p in &l.points {
+                assert!((p.x.hypot(p.y) - 0.5 * (a + b)).abs() < 1e-12);
+            }
+            assert!((l.thickness - 1.3 * (b - a)).abs() < 1e-12);
+            assert_eq!(l.color.unwrap().g, load_color(level).g);
+        }
     }
 
     /// Signed volume `sum (p0 . (p1 x p2)) / 6` of a triangle list: the enclosed volume for

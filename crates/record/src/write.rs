@@ -180,6 +180,12 @@ struct Channels {
     interfaces: Vec<u16>,
     impacts: u16,
     summary: u16,
+    /// `/scene/loads`: the load colours, every disc in each message
+    scene_loads: u16,
+    /// `/discs/<segment>/impacts`: each disc's impacts at their peak times
+    disc_impacts: Vec<u16>,
+    /// `/joints`: `sensor_msgs/msg/JointState`, for Rerun's plots
+    joints: u16,
 }
 
 /// Streams a run into an MCAP file. See the crate documentation for the topics.
@@ -219,6 +225,15 @@ pub struct Recorder {
     tooth_max_since_scene: Vec<Vec<f64>>,
     /// per disc, the colour level last sent of each drawn tooth, in 1/16
     tooth_levels: Vec<Vec<u8>>,
+    /// colour level (0..=1) of each disc's load ring as last sent, re-sent with every update
+    ring_levels: Vec<f64>,
+    /// per disc, the colour level (0..=1) of each drawn tooth as last sent (per-tooth only),
+    /// re-sent with every update
+    tooth_levels_sent: Vec<Vec<f64>>,
+    /// `/joints` message buffer
+    joint_buf: Vec<u8>,
+    /// `/joints` values (position, velocity, effort per disc), reused
+    joint_values: [Vec<f64>; 3],
     max_abs_run: f64,
     peaks: Vec<Vec<f64>>,
     last_t_s: f64,
@@ -425,8 +440,41 @@ impl Recorder {
         }
         let impacts = channel(&mut w, s_impact, topics::IMPACTS, none())?;
         let summary = channel(&mut w, s_summary, topics::SUMMARY, none())?;
-
+        // viewer channels, after the others so that those keep their ids
+        let scene_loads = channel(&mut w, s_scene, topics::SCENE_LOADS, none())?;
+        let mut disc_impacts = Vec::with_capacity(names.len());
+        for (i, (name, seg)) in names.iter().zip(&segments).enumerate() {
+            let meta: BTreeMap<String, String> = [
+                ("disc".to_string(), name.clone()),
+                ("disc_index".to_string(), i.to_string()),
+            ]
+            .into();
+            disc_impacts.push(channel(&mut w, s_impact, &topics::disc_impacts(seg), meta)?);
+        }
+        // for Rerun, which maps these to its own archetypes (crate::ros2, view3d::pack_points)
+        let s_joints = w
+            .add_schema(
+                crate::ros2::JOINT_STATE,
+                "ros2msg",
+                crate::ros2::JOINT_STATE_SCHEMA.as_bytes(),
+            )
+            .map_err(|e| write_err("schema", e))?;
+        let joints = w
+            .add_channel(s_joints, topics::JOINTS, "cdr", &none())
+            .map_err(|e| write_err("channel", e))?;
+        let s_cloud = schema(
+            &mut w,
+            "foxglove.PointCloud",
+            &fx(foxglove::schemas::PointCloud::get_schema()),
+        )?;
         let frames: Vec<String> = segments.iter().map(|s| disc_frame(s)).collect();
+        let mut clouds = Vec::with_capacity(frames.len() + 1);
+        for (frame, cloud) in view3d::pack_points(info, &frames) {
+            clouds.push((
+                channel(&mut w, s_cloud, &topics::pack(&frame), none())?,
+                cloud,
+            ));
+        }
         let tf_discs: Vec<(String, f64, f64)> = frames
             .iter()
             .zip(&info.discs)
@@ -452,6 +500,9 @@ impl Recorder {
                 interfaces,
                 impacts,
                 summary,
+                scene_loads,
+                disc_impacts,
+                joints,
             },
             sequences: BTreeMap::new(),
             buf: Vec::with_capacity(4096),
@@ -470,6 +521,10 @@ impl Recorder {
             scene_levels: vec![0; n],
             tooth_max_since_scene: vec![Vec::new(); n],
             tooth_levels: vec![Vec::new(); n],
+            ring_levels: vec![0.0; n],
+            tooth_levels_sent: vec![Vec::new(); n],
+            joint_buf: Vec::with_capacity(256),
+            joint_values: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
             max_abs_run: 0.0,
             peaks: vec![Vec::new(); n],
             last_t_s: 0.0,
@@ -478,6 +533,11 @@ impl Recorder {
         };
         let static_scene = view3d::static_scene(&rec.info, &rec.frames);
         rec.put(rec.ch.scene, 0, &static_scene, "/scene")?;
+        let rings = view3d::load_scene(0, &rec.info, &rec.frames, &rec.all_rings());
+        rec.put(rec.ch.scene_loads, 0, &rings, "/scene/loads")?;
+        for (ch, cloud) in clouds {
+            rec.put(ch, 0, &cloud, "/pack")?;
+        }
         rec.flush()?;
         Ok(rec)
     }
@@ -535,15 +595,20 @@ impl Recorder {
         msg: &M,
         what: &str,
     ) -> Result<(), RecordError> {
+        self.buf.clear();
+        // encoding into a Vec cannot run out of space
+        let _ = msg.encode(&mut self.buf);
+        self.put_buf(channel, log_time, what)
+    }
+
+    /// Writes the bytes in `self.buf` as a message on `channel` at `log_time` (ns).
+    fn put_buf(&mut self, channel: u16, log_time: u64, what: &str) -> Result<(), RecordError> {
         if self.failed {
             return Err(self.failed_err());
         }
         let Some(w) = self.writer.as_mut() else {
             return Err(self.failed_err());
         };
-        self.buf.clear();
-        // encoding into a Vec cannot run out of space
-        let _ = msg.encode(&mut self.buf);
         let seq = self.sequences.entry(channel).or_insert(0);
         *seq = seq.wrapping_add(1);
         let header = mcap::records::MessageHeader {
@@ -667,6 +732,7 @@ impl Recorder {
                 }
             }
         }
+        self.write_joints(lt, sample)?;
         if t >= self.next_tf_s {
             self.next_tf_s = next_tick(t, self.options.tf_interval_s);
             view3d::update_transforms(
@@ -687,19 +753,21 @@ impl Recorder {
                 .load_color_scale_n
                 .unwrap_or(self.max_abs_run)
                 .max(f64::MIN_POSITIVE);
-            let mut changed = Vec::new();
+            let mut changed = false;
             for (i, a) in self.max_abs_since_scene.iter_mut().enumerate() {
                 let level = (*a / scale).clamp(0.0, 1.0);
                 let q = quantize(level);
                 if self.scene_levels.get(i) != Some(&q) {
-                    changed.push((i, level));
+                    changed = true;
                     if let Some(l) = self.scene_levels.get_mut(i) {
                         *l = q;
+                    }
+                    if let Some(l) = self.ring_levels.get_mut(i) {
+                        *l = level;
                     }
                 }
                 *a = 0.0;
             }
-            let mut update = view3d::load_scene(lt, &self.info, &self.frames, &changed);
             // per-tooth colours: drawn tooth k shows the largest load of the teeth it stands
             // for (all of them when the disc has no more teeth than are drawn)
             let mut teeth: Vec<(usize, Vec<f64>)> = Vec::new();
@@ -729,18 +797,50 @@ impl Recorder {
                 }
                 maxima.iter_mut().for_each(|m| *m = 0.0);
             }
-            if !teeth.is_empty() {
-                let refs: Vec<(usize, &[f64])> =
-                    teeth.iter().map(|(i, l)| (*i, l.as_slice())).collect();
+            if changed || !teeth.is_empty() {
+                // every disc's ring and teeth, so that the latest message restores all colours
+                let mut update =
+                    view3d::load_scene(lt, &self.info, &self.frames, &self.all_rings());
+                for (i, levels) in teeth {
+                    self.tooth_levels_sent[i] = levels;
+                }
+                let refs: Vec<(usize, &[f64])> = self
+                    .tooth_levels_sent
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, l)| !l.is_empty())
+                    .map(|(i, l)| (i, l.as_slice()))
+                    .collect();
                 update
                     .entities
                     .extend(view3d::teeth_scene(lt, &self.info, &self.frames, &refs).entities);
-            }
-            if !update.entities.is_empty() {
-                self.put(self.ch.scene, lt, &update, "/scene")?;
+                self.put(self.ch.scene_loads, lt, &update, "/scene/loads")?;
             }
         }
         self.maybe_flush()
+    }
+
+    /// Writes `/joints` for a sample: per disc the relative angle (rad), the shaft's minus
+    /// the disc's speed (rad/s) and the tooth load (N).
+    fn write_joints(&mut self, lt: u64, sample: &Sample) -> Result<(), RecordError> {
+        let [pos, vel, eff] = &mut self.joint_values;
+        for (i, d) in sample.discs.iter().enumerate().take(pos.len()) {
+            pos[i] = d.rel_angle_rad;
+            vel[i] = sample.shaft_speed_rad_s - d.speed_rad_s;
+            eff[i] = d.load_n;
+        }
+        let mut buf = std::mem::take(&mut self.joint_buf);
+        crate::ros2::joint_state(&mut buf, lt, &self.names, pos, vel, eff);
+        std::mem::swap(&mut self.buf, &mut buf);
+        let r = self.put_buf(self.ch.joints, lt, "/joints");
+        std::mem::swap(&mut self.buf, &mut buf);
+        self.joint_buf = buf;
+        r
+    }
+
+    /// `(disc index, level)` of every disc's load ring as last sent.
+    fn all_rings(&self) -> Vec<(usize, f64)> {
+        self.ring_levels.iter().copied().enumerate().collect()
     }
 
     /// Writes the stack's friction interfaces at `t_s` (s), one `/interfaces/<segment>`
@@ -808,6 +908,9 @@ impl Recorder {
             peak_n: e.peak_n,
         };
         self.put(self.ch.impacts, log_time_ns(e.t_peak_s), &msg, "/impacts")?;
+        if let Some(&ch) = self.ch.disc_impacts.get(e.disc) {
+            self.put(ch, log_time_ns(e.t_peak_s), &msg, "impacts")?;
+        }
         self.maybe_flush()
     }
 
@@ -822,8 +925,9 @@ impl Recorder {
             return Err(self.failed_err());
         }
         let summary = summary.unwrap_or_else(|| self.summary());
-        let lt = log_time_ns(self.last_t_s.max(summary.t_end_s));
-        self.put(self.ch.summary, lt, &summary.to_proto(), "/summary")?;
+        // logged at t = 0 although written last: viewers open a file at its start and show
+        // the latest message of each topic, so the summary is there from the first frame
+        self.put(self.ch.summary, 0, &summary.to_proto(), "/summary")?;
         let path = self.path.clone();
         let write_err = |what: &str, source| RecordError::Write {
             path: path.clone(),

@@ -115,8 +115,14 @@ fn round_trip_is_exact() {
     assert_eq!(n("/interfaces/d1__disc_2"), 400);
     assert_eq!(n(topics::IMPACTS), run.impacts.len() as u64);
     assert_eq!(n(topics::SUMMARY), 1);
-    // static scene at t = 0 plus load updates (at most one per simulated ms)
-    assert!((2..=4).contains(&n(topics::SCENE)), "{}", n(topics::SCENE));
+    // the static scene once, at t = 0; load colours at t = 0 plus updates (at most one per
+    // simulated ms) on their own topic
+    assert_eq!(n(topics::SCENE), 1);
+    assert!(
+        (2..=4).contains(&n(topics::SCENE_LOADS)),
+        "{}",
+        n(topics::SCENE_LOADS)
+    );
     assert!(
         i.chunks.unwrap() > 1,
         "flush_messages cut the data into chunks"
@@ -155,14 +161,19 @@ fn foxglove_schemas_and_transforms() {
     assert_eq!(schema("/scene"), "foxglove.SceneUpdate");
     assert_eq!(schema("/discs/d1/spline"), "clutchpack.SplineState");
     for t in &r.info().topics {
-        assert_eq!(t.schema_encoding, "protobuf", "{}", t.topic);
-        assert_eq!(t.message_encoding, "protobuf", "{}", t.topic);
+        // but /joints, a ROS 2 message for Rerun (checked in tests/viewer.rs)
+        if t.topic != topics::JOINTS {
+            assert_eq!(t.schema_encoding, "protobuf", "{}", t.topic);
+            assert_eq!(t.message_encoding, "protobuf", "{}", t.topic);
+        }
     }
     let mut tfs = Vec::new();
     let mut scenes = Vec::new();
+    let mut loads = Vec::new();
     r.for_each_message(|m| match m.topic {
         "/tf" => tfs.push(foxglove::schemas::FrameTransforms::decode(m.data).unwrap()),
         "/scene" => scenes.push(foxglove::schemas::SceneUpdate::decode(m.data).unwrap()),
+        "/scene/loads" => loads.push(foxglove::schemas::SceneUpdate::decode(m.data).unwrap()),
         _ => {}
     });
     let k = 250;
@@ -177,12 +188,22 @@ fn foxglove_schemas_and_transforms() {
     let d = (angle - s.discs[1].angle_rad).rem_euclid(2.0 * std::f64::consts::PI);
     assert!(d.min(2.0 * std::f64::consts::PI - d) < 1e-12);
     assert_eq!(tf.transforms[2].translation.unwrap().z, 0.004);
+    // the static pack is the one message of /scene; every /scene/loads message holds every
+    // disc's load ring, so the latest one alone restores the colours after a seek
+    assert_eq!(scenes.len(), 1);
     let first = &scenes[0];
     let ids: Vec<&str> = first.entities.iter().map(|e| e.id.as_str()).collect();
     assert!(
-        ids.contains(&"shaft") && ids.contains(&"disc/d1") && ids.contains(&"disc/disc_2/load"),
+        ids.contains(&"shaft") && ids.contains(&"disc/d1") && ids.contains(&"disc/disc_2"),
         "{ids:?}"
     );
+    for l in &loads {
+        let ids: Vec<&str> = l.entities.iter().map(|e| e.id.as_str()).collect();
+        assert!(
+            ids.contains(&"disc/d1/load") && ids.contains(&"disc/disc_2/load"),
+            "{ids:?}"
+        );
+    }
     assert!(first.entities.iter().all(|e| e.frame_locked));
     // the static disc carries its body and its teeth (synthetic discs have 24) as parry
     // meshes: 64 wedges of 8 corners, 24 cuboids of 8
@@ -190,14 +211,14 @@ fn foxglove_schemas_and_transforms() {
     assert_eq!(d1.triangles.len(), 2, "body and teeth");
     assert_eq!(d1.triangles[0].points.len(), 64 * 8);
     assert_eq!(d1.triangles[1].points.len(), 24 * 8);
-    // later updates colour the load collars, and (per-tooth run) each tooth by its own load:
+    // later updates colour the load rings, and (per-tooth run) each tooth by its own load:
     // the synthetic teeth carry loads rising with the tooth index (tooth 23 2.15 times tooth
     // 0), so in a loaded update tooth 23 is hotter than tooth 0
-    let later: Vec<_> = scenes[1..].iter().flat_map(|s| &s.entities).collect();
+    let later: Vec<_> = loads[1..].iter().flat_map(|s| &s.entities).collect();
     let collar_red = later
         .iter()
         .filter(|e| e.id.ends_with("/load"))
-        .flat_map(|e| &e.cylinders)
+        .flat_map(|e| &e.lines)
         .any(|c| c.color.unwrap().b < 0.5);
     assert!(collar_red, "a loaded collar is coloured");
     // r - g - b rises monotonically from grey (-0.6) through yellow (0.15) to red (1)

@@ -182,7 +182,8 @@ impl RecordingReader {
     pub fn impacts(&self) -> Vec<ImpactEvent> {
         let mut out = Vec::new();
         self.for_each_message(|v| {
-            if v.schema_name == proto::IMPACT {
+            // `/discs/<segment>/impacts` repeat these per disc for plots
+            if v.schema_name == proto::IMPACT && v.topic == topics::IMPACTS {
                 if let Ok(m) = proto::Impact::decode(v.data) {
                     out.push(ImpactEvent {
                         disc: m.disc_index as usize,
