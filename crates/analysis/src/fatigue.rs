@@ -593,7 +593,7 @@ fn mean_std(s: &Spread) -> String {
 /// The fatigue of ensembles: one row per (parameter value, disc); `param` names the first
 /// column (`None`: no parameter column, one ensemble).
 ///
-/// Columns (text and markdown): [`param`], `disc`, `members`, `damage [1/h]` (mean ± std of
+/// Columns (text and markdown): `param` (when given), `disc`, `members`, `damage [1/h]` (mean ± std of
 /// the members' damage rates), `damage range [1/h]` (min .. max), `life [h]` (at the mean
 /// rate), `life range [h]` (at the largest .. the smallest rate), `S_eq [N]` (mean ± std).
 /// CSV: `damage_rate_{mean,std,min,max}_per_h`, `life_at_mean_rate_h`, `life_min_h`,

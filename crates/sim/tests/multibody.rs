@@ -2,9 +2,8 @@
 //! "Must show"). Run in release: `cargo test -p clutchpack_sim --release`.
 
 use clutchpack_model::{
-    free_impact_peak_n, Collector, DiscModel, Engine, EngineError, Flank, Hertz, ImpactEvent,
-    LawKind, Observer, OilFilm, PackModel, Shaft, ShaftExcitation, SpeedProfile, SplineGeometry,
-    Table, ToothLaw,
+    cases, free_impact_peak_n, Collector, DiscModel, Engine, EngineError, Flank, ImpactEvent,
+    LawKind, Observer, PackModel, Shaft, ShaftExcitation, SpeedProfile, Table, ToothLaw,
 };
 use clutchpack_scene::{Scene, Simulation};
 use clutchpack_sim::{
@@ -12,39 +11,18 @@ use clutchpack_sim::{
     ToothResolution,
 };
 
-fn paper_spline() -> SplineGeometry {
-    SplineGeometry {
-        teeth: 154,
-        pitch_radius_m: 0.231,
-        pressure_angle_rad: 20f64.to_radians(),
-        backlash_m: 0.75e-3,
-    }
-}
-
+/// The paper's tooth law (`cases::paper_law`) with the impact loss `p` (s/m) in place of
+/// MODEL.md's 0.8.
 fn law(kind: LawKind, h_o: f64, p: f64) -> ToothLaw {
-    ToothLaw {
-        kind,
-        hertz: Hertz {
-            modulus_pa: 210e9,
-            curvature_radius_m: 1.75e-3,
-            loss_coefficient_s_m: p,
-        },
-        oil: OilFilm {
-            thickness_m: h_o,
-            viscosity_pa_s: 289.1,
-            leakage_coefficient: 0.421,
-            width_m: 3e-3,
-            length_m: 3e-3,
-            v_floor_m_s: 0.01,
-            h_min_m: 1e-6,
-        },
-    }
+    let mut l = cases::paper_law(kind, h_o);
+    l.hertz.loss_coefficient_s_m = p;
+    l
 }
 
 fn disc(name: &str, law: ToothLaw, inertia: f64, drag: f64, phi0: f64, dphi0: f64) -> DiscModel {
     DiscModel {
         name: name.into(),
-        spline: paper_spline(),
+        spline: cases::paper_spline(),
         law,
         inertia_kg_m2: inertia,
         drag_n_m_s_rad: drag,
@@ -56,15 +34,13 @@ fn disc(name: &str, law: ToothLaw, inertia: f64, drag: f64, phi0: f64, dphi0: f6
     }
 }
 
-/// MODEL.md section 4: the paper case, one disc, prescribed shaft.
+/// MODEL.md section 4: the paper case (`cases::paper_pack`) with the law `kind`, film `h_o`
+/// (m), impact loss `p` (s/m) and drag `drag` (N m s/rad).
 fn paper_pack(kind: LawKind, h_o: f64, p: f64, drag: f64) -> PackModel {
-    PackModel {
-        shaft: Shaft::Prescribed(SpeedProfile::sine(200.0, 4.378, 104.0)),
-        discs: vec![disc("disc", law(kind, h_o, p), 0.156, drag, 0.0, 0.0)],
-        plates: Vec::new(),
-        drum: None,
-        stack: None,
-    }
+    let mut pack = cases::paper_pack(h_o);
+    pack.discs[0].law = law(kind, h_o, p);
+    pack.discs[0].drag_n_m_s_rad = drag;
+    pack
 }
 
 fn fixed(dt_s: f64) -> MultibodyOptions {
@@ -119,7 +95,7 @@ fn free_impact_matches_the_closed_form() {
         ("adaptive, shared step", shared()),
     ] {
         for v0 in [0.05, 0.3, 1.0] {
-            let g = paper_spline();
+            let g = cases::paper_spline();
             let rb = g.base_radius_m();
             let dphi0 = v0 / rb;
             let phi0 = g.half_play_rad() - 5e-6 * v0 / rb;
@@ -340,7 +316,7 @@ fn adaptive_steps_give_the_impacts_of_fine_fixed_steps() {
 #[test]
 fn inertial_shaft_conserves_angular_momentum() {
     let zero = Table::new(vec![0.0, 1.0], vec![0.0, 0.0]).unwrap();
-    let g0 = paper_spline().half_play_rad();
+    let g0 = cases::paper_spline().half_play_rad();
     let pack = PackModel {
         shaft: Shaft::Inertial {
             inertia_kg_m2: 0.3,
@@ -391,7 +367,7 @@ fn samples_are_on_the_recording_grid() {
             let t = k as f64 / 2e3;
             // adaptive contact steps sample at the nearest step (< 1 us away)
             assert!((s.t_s - t).abs() < 1e-6, "{} vs {t}", s.t_s);
-            let p = SpeedProfile::sine(200.0, 4.378, 104.0);
+            let p = cases::paper_drive();
             assert!((s.shaft_speed_rad_s - p.speed(s.t_s)).abs() < 1e-12);
             assert!((s.shaft_angle_rad - p.angle(s.t_s)).abs() < 1e-12);
             let d = &s.discs[0];
@@ -450,7 +426,7 @@ fn squeeze_law_is_refused() {
 /// torque is integrated to third order; measured error below 1e-10).
 #[test]
 fn inertial_shaft_follows_eq_4() {
-    let profile = SpeedProfile::sine(200.0, 4.378, 104.0);
+    let profile = cases::paper_drive();
     let mut pack = paper_pack(LawKind::Paper, 25e-6, 0.8, 0.0);
     let j1 = 2.0 * 0.156;
     pack.shaft = Shaft::Inertial {

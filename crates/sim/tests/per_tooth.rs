@@ -3,38 +3,20 @@
 //! `cargo test -p clutchpack_sim --release --test per_tooth`.
 
 use clutchpack_model::{
-    Collector, DiscModel, Engine, Hertz, LawKind, OilFilm, PackModel, Shaft, SpeedProfile,
+    cases, Collector, DiscModel, Engine, LawKind, OilFilm, PackModel, Shaft, SpeedProfile,
     SplineGeometry, ToothLaw,
 };
 use clutchpack_sim::{MultibodyEngine, MultibodyOptions, Stepping};
 
 fn spline() -> SplineGeometry {
-    SplineGeometry {
-        teeth: 154,
-        pitch_radius_m: 0.231,
-        pressure_angle_rad: 20f64.to_radians(),
-        backlash_m: 0.75e-3,
-    }
+    cases::paper_spline()
 }
 
+/// The paper's dry law (`cases::paper_law`) with the impact loss `p` (s/m).
 fn dry(p: f64) -> ToothLaw {
-    ToothLaw {
-        kind: LawKind::Dry,
-        hertz: Hertz {
-            modulus_pa: 210e9,
-            curvature_radius_m: 1.75e-3,
-            loss_coefficient_s_m: p,
-        },
-        oil: OilFilm {
-            thickness_m: 0.0,
-            viscosity_pa_s: 0.0,
-            leakage_coefficient: 0.421,
-            width_m: 3e-3,
-            length_m: 3e-3,
-            v_floor_m_s: 0.01,
-            h_min_m: 1e-6,
-        },
-    }
+    let mut l = cases::paper_law(LawKind::Dry, 0.0);
+    l.hertz.loss_coefficient_s_m = p;
+    l
 }
 
 /// A disc on a shaft turning steadily at 200 rad/s, held on the shaft-leads flank by its
@@ -52,18 +34,12 @@ fn steady_pack(disc: DiscModel) -> PackModel {
     }
 }
 
+/// The paper case's disc (`cases::paper_disc`), dry, with drag `drag` and impact loss `p`.
 fn base_disc(drag: f64, p: f64) -> DiscModel {
     DiscModel {
-        name: "disc".into(),
-        spline: spline(),
         law: dry(p),
-        inertia_kg_m2: 0.156,
         drag_n_m_s_rad: drag,
-        initial_rel_angle_rad: 0.0,
-        initial_rel_speed_rad_s: 0.0,
-        radial_float: false,
-        tooth_spacing_errors_m: Vec::new(),
-        initial_offset_m: [0.0, 0.0],
+        ..cases::paper_disc(0.0)
     }
 }
 
@@ -341,7 +317,7 @@ fn floating_disc_chatters_radially_in_the_rattle() {
     d.radial_float = true;
     d.initial_offset_m = [0.1e-6, 0.0];
     let pack = PackModel {
-        shaft: Shaft::Prescribed(SpeedProfile::sine(200.0, 4.378, 104.0)),
+        shaft: Shaft::Prescribed(cases::paper_drive()),
         discs: vec![d],
         plates: Vec::new(),
         drum: None,

@@ -4,21 +4,16 @@
 //! stack`.
 
 use clutchpack_model::{
-    clutch::effective_radius_m, Collector, DiscModel, DrumModel, Engine, FrictionCurve, Hertz,
-    LawKind, OilFilm, PackModel, Piston, PressureProfile, Shaft, SpeedProfile, SplineGeometry,
-    StackModel, ToothLaw,
+    cases, clutch::effective_radius_m, Collector, DiscModel, DrumModel, Engine, FrictionCurve,
+    Hertz, LawKind, OilFilm, PackModel, Piston, PressureProfile, Shaft, SpeedProfile, StackModel,
+    ToothLaw,
 };
 use clutchpack_sim::{MultibodyEngine, MultibodyOptions};
 
 fn body(name: &str, inertia: f64, drag: f64) -> DiscModel {
     DiscModel {
         name: name.into(),
-        spline: SplineGeometry {
-            teeth: 154,
-            pitch_radius_m: 0.231,
-            pressure_angle_rad: 20f64.to_radians(),
-            backlash_m: 0.75e-3,
-        },
+        spline: cases::paper_spline(),
         law: ToothLaw {
             kind: LawKind::Dry,
             hertz: Hertz {
