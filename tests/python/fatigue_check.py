@@ -29,6 +29,7 @@ import numpy as np
 import rainflow
 from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
+from mcap_ros2.decoder import DecoderFactory as Ros2DecoderFactory
 
 SUSTAINED = 4
 REL = 1e-12
@@ -47,10 +48,13 @@ def fail(msg):
 def read(path):
     impacts, loads, teeth = {}, {}, {}
     with open(path, "rb") as f:
+        # every topic is decoded (the ROS 2 /joints for Rerun too); impacts are taken from
+        # /impacts only, as /discs/<disc>/impacts repeats them per disc
         for schema, channel, message, m in make_reader(
-                f, decoder_factories=[DecoderFactory()]).iter_decoded_messages():
+                f, decoder_factories=[DecoderFactory(), Ros2DecoderFactory()]
+        ).iter_decoded_messages():
             name = schema.name
-            if name == "clutchpack.Impact":
+            if name == "clutchpack.Impact" and channel.topic == "/impacts":
                 impacts.setdefault(m.disc_index, []).append(
                     (m.t_on_s, m.t_peak_s, m.t_off_s, m.peak_n))
             elif name == "clutchpack.SplineState":

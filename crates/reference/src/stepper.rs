@@ -6,6 +6,7 @@ use crate::dopri::{next_step, Dense, Dopri5};
 use crate::system::System;
 use crate::Settings;
 use clutchpack_model::{DiscModel, Engagement, EngineError, ImpactEvent, ImpactTracker, RunStats};
+use clutchpack_model::{STALL_SPAN_S, STALL_STEPS as STALL_BLOCK};
 
 /// Receives what a [`Stepper`] produces.
 pub(crate) trait Sink {
@@ -100,8 +101,6 @@ pub(crate) struct Stepper<'a> {
     /// Time at the start of the current block of [`STALL_BLOCK`] steps, s.
     block_t0: f64,
 }
-
-use clutchpack_model::{STALL_SPAN_S, STALL_STEPS as STALL_BLOCK};
 
 impl<'a> Stepper<'a> {
     /// Starts `sys` at t = 0 from its initial state; a disc may start inside a contact event.
