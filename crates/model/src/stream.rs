@@ -28,6 +28,11 @@ pub struct DiscSample {
     pub stiffness: f64,
     /// Per-tooth loads in N when the engine resolves teeth (empty for lumped engines).
     pub tooth_loads_n: Vec<f64>,
+    /// Offset of the disc's centre from the shaft axis in m, `[x, y]` in the shaft's frame
+    /// (radial float, an eccentric start); `[0, 0]` for engines with one rotational degree of
+    /// freedom per body.
+    #[serde(default)]
+    pub center_offset_m: [f64; 2],
 }
 
 /// The state of the whole pack at one instant.

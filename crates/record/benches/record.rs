@@ -56,6 +56,7 @@ fn sample(k: u64, teeth: usize) -> Sample {
                     engaged: load != 0.0,
                     stiffness: 3e9,
                     tooth_loads_n: vec![load; teeth],
+                    center_offset_m: [0.0, 0.0],
                 }
             })
             .collect(),

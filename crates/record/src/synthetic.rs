@@ -96,6 +96,7 @@ pub fn synthetic_run(n: usize, dt_s: f64) -> SyntheticRun {
                     engaged: f != 0.0,
                     stiffness: if f != 0.0 { 3e9 } else { 0.0 },
                     tooth_loads_n: (0..TEETH).map(|k| f * (1.0 + 0.05 * k as f64)).collect(),
+                    center_offset_m: [0.0, 0.0],
                 }
             })
             .collect();

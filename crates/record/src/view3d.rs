@@ -144,19 +144,27 @@ pub(crate) fn frame_transforms(
     FrameTransforms { transforms }
 }
 
-/// Sets the time (ns) and the angles (rad) of transforms built by [`frame_transforms`] in
-/// place (the shaft first, then the discs in order), without allocating.
+/// Sets the time (ns), the angles (rad) and the discs' radial positions of transforms built by
+/// [`frame_transforms`] in place (the shaft first, then the discs in order), without
+/// allocating. A disc's centre offset `[x, y]` (m) is in the shaft's frame; the transform
+/// places it in the world frame (rotated by the shaft's angle), keeping the disc's axial
+/// position.
 pub(crate) fn update_transforms(
     tf: &mut FrameTransforms,
     log_time_ns: u64,
     shaft_angle_rad: f64,
-    disc_angles_rad: impl Iterator<Item = f64>,
+    discs: impl Iterator<Item = (f64, [f64; 2])>,
 ) {
     let ts = timestamp(log_time_ns);
-    let angles = std::iter::once(shaft_angle_rad).chain(disc_angles_rad);
-    for (t, angle) in tf.transforms.iter_mut().zip(angles) {
+    let (s, c) = shaft_angle_rad.sin_cos();
+    let poses = std::iter::once((shaft_angle_rad, None)).chain(discs.map(|(a, o)| (a, Some(o))));
+    for (t, (angle, offset)) in tf.transforms.iter_mut().zip(poses) {
         t.timestamp = Some(ts);
         t.rotation = Some(about_z(angle));
+        if let (Some([x, y]), Some(tr)) = (offset, t.translation.as_mut()) {
+            tr.x = c * x - s * y;
+            tr.y = s * x + c * y;
+        }
     }
 }
 
@@ -588,6 +596,23 @@ pub(crate) fn pack_points(info: &RunInfo, frames: &[String]) -> Vec<(String, Poi
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A disc's centre offset, given in the shaft's frame, lands in the world frame rotated by
+    /// the shaft's angle: an offset of 1 mm along the shaft's x at a shaft angle of 90 deg is
+    /// 1 mm along the world's y. The axial position is kept; the shaft stays on the axis.
+    #[test]
+    fn disc_offsets_follow_the_shaft_into_the_world_frame() {
+        let mut tf = frame_transforms(0, 0.0, &[("disc/a".into(), 0.01, 0.0)]);
+        update_transforms(&mut tf, 5, PI / 2.0, [(0.3, [1e-3, 0.0])].into_iter());
+        let shaft = tf.transforms[0].translation.as_ref().unwrap();
+        assert_eq!((shaft.x, shaft.y, shaft.z), (0.0, 0.0, 0.0));
+        let d = tf.transforms[1].translation.as_ref().unwrap();
+        assert!(d.x.abs() < 1e-18, "{d:?}");
+        assert!((d.y - 1e-3).abs() < 1e-18, "{d:?}");
+        assert_eq!(d.z, 0.01);
+        let q = tf.transforms[1].rotation.as_ref().unwrap();
+        assert!((2.0 * q.w * q.z - 0.3f64.sin()).abs() < 1e-12);
+    }
 
     /// The quaternion of a rotation about +z by 90 degrees maps x onto y, and the colour map
     /// hits its three anchors.

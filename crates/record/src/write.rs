@@ -739,7 +739,10 @@ impl Recorder {
                 &mut self.tf,
                 lt,
                 sample.shaft_angle_rad,
-                sample.discs.iter().map(|d| d.angle_rad),
+                sample
+                    .discs
+                    .iter()
+                    .map(|d| (d.angle_rad, d.center_offset_m)),
             );
             let tf = std::mem::take(&mut self.tf);
             let r = self.put(self.ch.tf, lt, &tf, "/tf");

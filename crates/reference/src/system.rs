@@ -184,5 +184,6 @@ pub(crate) fn disc_sample(
         engaged: mode.is_some(),
         stiffness: mode.map(|e| e.stiffness).unwrap_or(0.0),
         tooth_loads_n: Vec::new(),
+        center_offset_m: [0.0, 0.0],
     }
 }

@@ -158,6 +158,12 @@ fn floating_disc_centres_itself_and_shares_the_load() {
         o.net_force_early
     );
     assert!(o.net_force_early > 1e-2 * n_f, "the disc starts off-centre");
+    // and the sampled centre offset (what the recording's /tf shows) has shrunk towards 0
+    let off = last.discs[0].center_offset_m;
+    assert!(
+        off[0].hypot(off[1]) < 0.1 * 20e-6f64.hypot(10e-6),
+        "centre offset at 60 ms: {off:?} m"
+    );
     assert!(net < 1e-6 * n_f, "net radial force {net} N");
     for (k, &l) in loads.iter().enumerate() {
         assert!(
@@ -293,6 +299,12 @@ fn eccentric_disc_loads_follow_the_hand_calculation() {
         .max_by(|&a, &b| hand[a].total_cmp(&hand[b]))
         .unwrap();
     assert_eq!(most, most_hand);
+    // the samples carry the centre's offset (shaft frame) that the recording's /tf shows
+    let off = o.last.as_ref().unwrap().discs[0].center_offset_m;
+    assert!(
+        (off[0] - e[0]).abs() < 1e-9 && (off[1] - e[1]).abs() < 1e-9,
+        "sampled centre offset {off:?} m, set {e:?} m"
+    );
 }
 
 /// A floating disc in the paper's rattle (MODEL.md section 4 drive, 25 um film) does not stay

@@ -264,6 +264,7 @@ impl RecordingReader {
                     engaged: s.engaged,
                     stiffness: s.stiffness_n_m1_5,
                     tooth_loads_n,
+                    center_offset_m: [0.0, 0.0],
                 });
             }
             out.push(sample);

@@ -307,6 +307,7 @@ impl<'a> Run<'a> {
                         } else {
                             Vec::new()
                         },
+                        center_offset_m: self.rel[i].offset,
                     }
                 })
                 .collect(),
