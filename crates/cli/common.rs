@@ -229,10 +229,19 @@ pub fn assess_fatigue(
     names: &[String],
     duration_s: f64,
 ) -> Vec<DiscFatigue> {
-    let histories = collector.finish(names.len());
+    assess_histories(&collector.finish(names.len()), params, names, duration_s)
+}
+
+/// The fatigue of each coupling from its finished `histories` (see [`assess_fatigue`]).
+pub fn assess_histories(
+    histories: &[clutchpack_analysis::fatigue::DiscHistories],
+    params: &[(SplineGeometry, FatigueParams)],
+    names: &[String],
+    duration_s: f64,
+) -> Vec<DiscFatigue> {
     names
         .iter()
-        .zip(&histories)
+        .zip(histories)
         .enumerate()
         .filter_map(|(i, (name, h))| {
             let (spline, p) = params.get(i)?;

@@ -470,22 +470,7 @@ pub fn recorded_fatigue(
         .unwrap_or_default();
     let collector = clutchpack_analysis::FatigueCollector::replay(&samples, &impacts);
     let histories = collector.clone().finish(names.len());
-    let fatigue = names
-        .iter()
-        .zip(&histories)
-        .enumerate()
-        .filter_map(|(i, (name, h))| {
-            let (spline, p) = params.get(i)?;
-            Some(clutchpack_analysis::assess(
-                name,
-                h,
-                spline,
-                &p.form,
-                &p.material,
-                duration,
-            ))
-        })
-        .collect();
+    let fatigue = crate::common::assess_histories(&histories, &params, &names, duration);
     (names, histories, fatigue, duration)
 }
 

@@ -682,12 +682,7 @@ mod tests {
     use clutchpack_model::{DiscSample, Flank};
 
     fn paper() -> SplineGeometry {
-        SplineGeometry {
-            teeth: 154,
-            pitch_radius_m: 0.231,
-            pressure_angle_rad: 20f64.to_radians(),
-            backlash_m: 0.75e-3,
-        }
+        clutchpack_model::cases::paper_spline()
     }
 
     fn event(t_on: f64, t_peak: f64, t_off: f64, peak: f64) -> ImpactEvent {

@@ -273,12 +273,7 @@ mod tests {
     use approx::assert_relative_eq;
 
     fn paper() -> SplineGeometry {
-        SplineGeometry {
-            teeth: 154,
-            pitch_radius_m: 0.231,
-            pressure_angle_rad: 20f64.to_radians(),
-            backlash_m: 0.75e-3,
-        }
+        crate::cases::paper_spline()
     }
 
     /// MODEL.md section 7's numbers for the paper's disc: m = 2 x 0.231 / 154 = 3.0 mm, and
