@@ -77,7 +77,7 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         let s = engine.run(scene.simulation.duration_s, &mut obs)?;
         times.push(t0.elapsed().as_secs_f64());
         steps = s.steps;
-        impacts = obs.impacts.len();
+        impacts = obs.impact_count();
     }
     let t = median(times);
     out!(
@@ -302,7 +302,7 @@ fn staggered_packs(runs: usize) -> Result<()> {
                     let t0 = Instant::now();
                     let s = engine.run(PACK_DURATION_S, &mut obs)?;
                     per_disc[j].push(t0.elapsed().as_secs_f64() / n as f64);
-                    counts[j] = (s.steps, obs.impacts.len());
+                    counts[j] = (s.steps, obs.impact_count());
                 }
             }
         }

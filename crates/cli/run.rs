@@ -4,12 +4,12 @@ use crate::common::BadInput;
 use crate::common::{self, EngineArg, RunCollector, RunSummary};
 use crate::outputs::Output;
 use anyhow::{Context, Result};
-use clutchpack_analysis::{disc_stats, stats_table, TableFormat};
+use clutchpack_analysis::{stats_table, TableFormat};
 use clutchpack_model::{ImpactEvent, InterfaceSample, Observer, Sample};
 use clutchpack_record::Replace;
 use clutchpack_record::{RecordOptions, Recorder, ThreadedRecorder};
 use clutchpack_scene::Override;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -38,15 +38,16 @@ pub struct RunArgs {
     pub summary_json: Option<PathBuf>,
     /// Write the counted cycles of each disc as JSON: exact (range, count) pairs, range
     /// histogram, range-mean matrix, exceedance spectrum, and per resolved tooth its ranges
-    /// (an existing FILE is replaced).
+    /// (an existing FILE is replaced). Keeps every cycle in memory until the run ends.
     #[arg(long, value_name = "FILE")]
     pub fatigue_json: Option<PathBuf>,
     /// Write one CSV row per impact: disc,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n (an
-    /// existing FILE is replaced).
+    /// existing FILE is replaced). Written as the impacts close; a stopped or failed run
+    /// leaves the rows up to there.
     #[arg(long, value_name = "FILE")]
     pub impacts_csv: Option<PathBuf>,
     /// Plot the per-tooth load history of each disc (PNG or SVG by extension; an existing
-    /// FILE is replaced).
+    /// FILE is replaced). Keeps every sample in memory until the run ends.
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
     /// The recording (MCAP; its folder is created if missing, an existing FILE is replaced).
@@ -76,6 +77,11 @@ pub struct RunArgs {
 }
 
 pub fn run(a: RunArgs) -> Result<ExitCode> {
+    // SIGINT, SIGTERM and SIGHUP stop the run cleanly (crate::signals); installed first, so
+    // that a signal while a large pack's engine and recording are being set up (about 1 s
+    // of CPU for 2 000 discs) stops the run at its start with complete outputs instead of
+    // killing the process with a half-made recording
+    let interrupted = crate::signals::flag();
     let mut sets = a.sets.clone();
     if let Some(d) = a.duration {
         sets.push(Override {
@@ -132,7 +138,10 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                 .into_iter()
                 .map(|f| f.name()),
         )
-        .with_fatigue(&scene);
+        .with_fatigue(&scene, a.fatigue_json.is_some());
+    if let Some(path) = &a.impacts_csv {
+        collector = collector.with_impacts_csv(path, &names)?;
+    }
     let pb = common::time_progress(duration, &scene.name);
     collector.progress = Some(pb.clone());
     let recorder = if let Some(path) = record_path {
@@ -155,14 +164,11 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     } else {
         None
     };
-    // SIGINT, SIGTERM and SIGHUP stop the run cleanly (crate::signals).
-    let interrupted = crate::signals::flag();
     let t0 = Instant::now();
     let done = run_recorded(engine.as_mut(), duration, collector, recorder, interrupted);
     let wall = t0.elapsed().as_secs_f64();
     pb.finish_and_clear();
-    let (result, obs) = (done.result, done.collector);
-    let stats = disc_stats(&names, &obs.impacts);
+    let (result, mut obs) = (done.result, done.collector);
     // A recording that could not be finished is reported after the other outputs are written.
     let recording_error = match done.recording {
         Some(Ok(path)) => {
@@ -174,9 +180,8 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     };
 
     // Write what we have even when the run failed, then report the failure.
-    if let Some(path) = &a.impacts_csv {
-        write_impacts_csv(path, &names, &obs)?;
-    }
+    obs.finish_impacts_csv()?;
+    let stats = obs.disc_stats(&names)?;
     if let Some(path) = &a.plot {
         let series: Vec<(String, Vec<(f64, f64)>)> = names
             .iter()
@@ -207,7 +212,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                 "{} engine on {} ({} impacts kept before the failure)",
                 engine.name(),
                 scene.name,
-                obs.impacts.len()
+                obs.impact_count()
             )));
         }
     };
@@ -277,25 +282,6 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn write_impacts_csv(path: &Path, names: &[String], obs: &RunCollector) -> Result<()> {
-    use std::fmt::Write as _;
-    let mut w = String::from("disc,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n\n");
-    for e in &obs.impacts {
-        writeln!(
-            w,
-            "{},{:.9},{:.9},{:.9},{},{:.6},{:.4}",
-            clutchpack_analysis::csv_field(&names[e.disc]),
-            e.t_on_s,
-            e.t_peak_s,
-            e.t_off_s,
-            e.flank.label(),
-            e.v_on_m_s,
-            e.peak_n
-        )?;
-    }
-    crate::outputs::write_text(path, &w)
-}
-
 /// What [`run_recorded`] gives back.
 pub(crate) struct RecordedRun {
     /// The engine's result.
@@ -342,7 +328,15 @@ pub(crate) fn run_recorded(
         Some(rec) => {
             let (mut rec, cpu_s) = rec.join();
             recorder_cpu_s = cpu_s;
-            let mut summary = rec.summary();
+            // the file is finished even if the peaks kept on disk cannot be read back
+            let mut summary = rec.summary().unwrap_or_else(|e| {
+                eprintln!("warning: {e}; the recording's /summary has no impact statistics");
+                clutchpack_record::RunSummary {
+                    t_end_s: result.as_ref().map_or(0.0, |s| s.simulated_s),
+                    discs: Vec::new(),
+                    fatigue: Vec::new(),
+                }
+            });
             if let Ok(s) = &result {
                 rec.set_run_stats(s);
                 // the teeth's fatigue over the duty that ran, beside the peak statistics

@@ -3,7 +3,7 @@
 use crate::common::{self, BadInput, EngineArg};
 use crate::signals;
 use anyhow::{Context, Result};
-use clutchpack_analysis::disc_stats;
+use clutchpack_analysis::PeakStats;
 use clutchpack_model::{ImpactEvent, Observer};
 use clutchpack_scene::Scene;
 use clutchpack_study::merge::Merged;
@@ -152,15 +152,16 @@ pub fn load_study(path: &Path) -> Result<Study> {
     clutchpack_study::load(path).map_err(|e| BadInput(e.to_string()).into())
 }
 
-/// Keeps the impacts; asks the engine to stop when `stop` is set.
+/// Keeps the impact peaks (bounded memory: `PeakStats`); asks the engine to stop when `stop`
+/// is set.
 struct CaseObserver<'a> {
-    impacts: Vec<ImpactEvent>,
+    peaks: PeakStats,
     stop: &'a AtomicBool,
 }
 
 impl Observer for CaseObserver<'_> {
     fn impact(&mut self, e: &ImpactEvent) {
-        self.impacts.push(*e);
+        self.peaks.push(e.disc, e.peak_n);
     }
     fn progress(&mut self, _t_s: f64) -> bool {
         self.stop.load(Ordering::Relaxed)
@@ -172,7 +173,7 @@ pub fn run_scene(scene: &Scene, engine: Option<EngineArg>, stop: &AtomicBool) ->
     let mut e = common::make_engine(scene, engine).map_err(|e| format!("{e:#}"))?;
     let names = e.disc_names();
     let mut obs = CaseObserver {
-        impacts: Vec::new(),
+        peaks: PeakStats::new(),
         stop,
     };
     let stats = e
@@ -182,7 +183,10 @@ pub fn run_scene(scene: &Scene, engine: Option<EngineArg>, stop: &AtomicBool) ->
         return Ok(None);
     }
     Ok(Some(CaseOutput {
-        discs: disc_stats(&names, &obs.impacts),
+        discs: obs
+            .peaks
+            .stats(&names)
+            .map_err(|e| format!("reading back the impact peaks kept on disk: {e}"))?,
         steps: stats.steps,
         rejected_steps: stats.rejected_steps,
         simulated_s: stats.simulated_s,

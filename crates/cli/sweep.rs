@@ -3,8 +3,8 @@
 use crate::common::{self, BadInput, EngineArg, RunCollector};
 use anyhow::{Context, Result};
 use clutchpack_analysis::{
-    disc_stats, ensemble_fatigue, fatigue_spread_table, sweep_fits, sweep_rows, sweep_table,
-    DiscFatigue, DiscFatigueSpread, DiscStats, PolyFit, SweepCase, SweepRow, TableFormat,
+    ensemble_fatigue, fatigue_spread_table, sweep_fits, sweep_rows, sweep_table, DiscFatigue,
+    DiscFatigueSpread, DiscStats, PolyFit, SweepCase, SweepRow, TableFormat,
 };
 use clutchpack_model::{ImpactEvent, InterfaceSample, Observer, Sample};
 use clutchpack_scene::{Override, Scene};
@@ -387,7 +387,7 @@ pub fn run_cases_until(
                 let member = ensemble_member(&scenes[c], k, ensemble);
                 let mut engine = common::make_engine(&member, engine)?;
                 let names = engine.disc_names();
-                let mut obs = RunCollector::new(names.len(), false).with_fatigue(&member);
+                let mut obs = RunCollector::new(names.len(), false).with_fatigue(&member, false);
                 let run = engine
                     .run(
                         member.simulation.duration_s,
@@ -402,7 +402,7 @@ pub fn run_cases_until(
                 }
                 pb.inc(1);
                 Ok(Some((
-                    disc_stats(&names, &obs.impacts),
+                    obs.disc_stats(&names)?,
                     obs.assess_fatigue(&names, run.simulated_s),
                 )))
             })

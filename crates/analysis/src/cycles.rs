@@ -53,9 +53,14 @@ impl Cycle {
 /// Turning points of a history fed one value at a time: the same points as
 /// [`turning_points`] without keeping the history (a per-tooth history of a long run holds
 /// millions of samples but only a few points per impact). Non-finite values are skipped.
+///
+/// [`Self::push`] hands back each point as soon as it is known to be a turning point (the
+/// first value at once, every other one when the history turns after it); [`Self::last`] is
+/// the final point of the history fed so far. Nothing is kept but the last value, so a
+/// counter that takes the points as they come ([`Rainflow`]) holds memory that does not grow
+/// with the history.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TurningPoints {
-    points: Vec<f64>,
     /// the last value fed (plateaus collapse onto it)
     current: Option<f64>,
     /// direction of the last change: +1 rising, -1 falling, 0 none yet
@@ -69,36 +74,41 @@ impl TurningPoints {
         TurningPoints::default()
     }
 
-    /// Feeds the next value of the history.
-    pub fn push(&mut self, x: f64) {
+    /// Feeds the next value of the history; returns the point this value confirms as a
+    /// turning point, if any (the first value, or the previous value where the history
+    /// turns).
+    pub fn push(&mut self, x: f64) -> Option<f64> {
         if !x.is_finite() {
-            return;
+            return None;
         }
         self.fed += 1;
+        let mut confirmed = None;
         match self.current {
-            None => self.points.push(x),
+            None => confirmed = Some(x),
             Some(c) => {
                 if x == c {
-                    return;
+                    return None;
                 }
                 let d = if x > c { 1 } else { -1 };
                 if self.direction != 0 && d != self.direction {
-                    self.points.push(c);
+                    confirmed = Some(c);
                 }
                 self.direction = d;
             }
         }
         self.current = Some(x);
+        confirmed
     }
 
-    /// The turning points so far, with the last value fed as the final point (a history of
-    /// two or more values always ends on its last value; a single value is one point).
-    pub fn points(&self) -> Vec<f64> {
-        let mut p = self.points.clone();
+    /// The final point of the history fed so far: its last value when two or more values
+    /// were fed (a history of two or more values always ends on its last value; a single
+    /// value is one point, already handed back by [`Self::push`]).
+    pub fn last(&self) -> Option<f64> {
         if self.fed >= 2 {
-            p.push(self.current.unwrap_or(0.0));
+            self.current
+        } else {
+            None
         }
-        p
     }
 }
 
@@ -106,21 +116,29 @@ impl TurningPoints {
 /// (plateaus collapsed), and its last value. Non-finite values are skipped.
 pub fn turning_points(history: &[f64]) -> Vec<f64> {
     let mut t = TurningPoints::new();
-    for &x in history {
-        t.push(x);
-    }
-    t.points()
+    let mut out: Vec<f64> = history.iter().filter_map(|&x| t.push(x)).collect();
+    out.extend(t.last());
+    out
 }
 
-/// Rainflow counting of a sequence of turning points by ASTM E1049-85 section 5.4.4 (the
-/// three-point method), the residue counted as half cycles. Cycles come in the order they
-/// are counted. Feeding a raw history gives the same cycles as its turning points only when
-/// it has no interior points that are not turning points: pass it through
-/// [`turning_points`] first.
-pub fn rainflow(points: &[f64]) -> Vec<Cycle> {
-    let mut out = Vec::new();
-    let mut stack: Vec<f64> = Vec::with_capacity(64);
-    for &p in points {
+/// Rainflow counting fed one turning point at a time (ASTM E1049-85 section 5.4.4, the
+/// three-point method; see [`rainflow`]): each cycle is handed out as soon as it is counted,
+/// and only the points not yet counted (the residue, a handful for a load history that keeps
+/// returning to zero) are kept.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Rainflow {
+    stack: Vec<f64>,
+}
+
+impl Rainflow {
+    /// No points yet.
+    pub fn new() -> Rainflow {
+        Rainflow::default()
+    }
+
+    /// Takes the next turning point; calls `out` with each cycle it completes.
+    pub fn push(&mut self, p: f64, mut out: impl FnMut(Cycle)) {
+        let stack = &mut self.stack;
         stack.push(p);
         while stack.len() >= 3 {
             let n = stack.len();
@@ -132,7 +150,7 @@ pub fn rainflow(points: &[f64]) -> Vec<Cycle> {
             }
             if n == 3 {
                 // (e): Y contains the starting point S: half a cycle, discard S
-                out.push(Cycle {
+                out(Cycle {
                     from: stack[0],
                     to: stack[1],
                     count: 0.5,
@@ -140,7 +158,7 @@ pub fn rainflow(points: &[f64]) -> Vec<Cycle> {
                 stack.remove(0);
             } else {
                 // (f): a full cycle; discard its peak and valley
-                out.push(Cycle {
+                out(Cycle {
                     from: stack[n - 3],
                     to: stack[n - 2],
                     count: 1.0,
@@ -149,14 +167,37 @@ pub fn rainflow(points: &[f64]) -> Vec<Cycle> {
             }
         }
     }
-    // (g): the residue, each range a half cycle
-    for w in stack.windows(2) {
-        out.push(Cycle {
-            from: w[0],
-            to: w[1],
-            count: 0.5,
-        });
+
+    /// Ends the history: the residue's ranges as half cycles (ASTM E1049 5.4.4 (g)), handed
+    /// to `out` in order.
+    pub fn finish(self, mut out: impl FnMut(Cycle)) {
+        for w in self.stack.windows(2) {
+            out(Cycle {
+                from: w[0],
+                to: w[1],
+                count: 0.5,
+            });
+        }
     }
+
+    /// Points held (the residue so far).
+    pub fn held(&self) -> usize {
+        self.stack.len()
+    }
+}
+
+/// Rainflow counting of a sequence of turning points by ASTM E1049-85 section 5.4.4 (the
+/// three-point method), the residue counted as half cycles. Cycles come in the order they
+/// are counted. Feeding a raw history gives the same cycles as its turning points only when
+/// it has no interior points that are not turning points: pass it through
+/// [`turning_points`] first.
+pub fn rainflow(points: &[f64]) -> Vec<Cycle> {
+    let mut out = Vec::new();
+    let mut r = Rainflow::new();
+    for &p in points {
+        r.push(p, |c| out.push(c));
+    }
+    r.finish(|c| out.push(c));
     out
 }
 
@@ -437,10 +478,19 @@ mod tests {
             assert_eq!(top, span, "case {case}");
             let twice: f64 = c.iter().map(|c| 2.0 * c.count).sum();
             assert_eq!(twice, (tp.len() - 1) as f64, "case {case}");
-            // and streaming equals batch
-            let mut s = TurningPoints::new();
-            h.iter().for_each(|&x| s.push(x));
-            assert_eq!(s.points(), tp);
+            // the streamed points equal the definition applied to the whole history:
+            // plateaus collapsed, then the ends and every strict local extremum
+            let mut flat: Vec<f64> = h.clone();
+            flat.dedup();
+            let mut naive = vec![flat[0]];
+            for w in flat.windows(3) {
+                if (w[1] - w[0]) * (w[2] - w[1]) < 0.0 {
+                    naive.push(w[1]);
+                }
+            }
+            // two or more values always end on the last one (n >= 2 here)
+            naive.push(*flat.last().unwrap());
+            assert_eq!(tp, naive, "case {case}");
         }
     }
 

@@ -7,6 +7,8 @@
 
 use clutchpack_model::ImpactEvent;
 use serde::{Deserialize, Serialize};
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 /// Number of impacts averaged by [`DiscStats::mean_top10_abs_n`].
 pub const TOP_N: usize = 10;
@@ -59,24 +61,205 @@ impl DiscStats {
         let mut s = DiscStats::empty(name);
         let mut abs: Vec<f64> = Vec::with_capacity(peaks_n.len());
         for &p in peaks_n.iter().filter(|p| !p.is_nan()) {
-            s.impacts += 1;
-            if p > 0.0 {
-                s.positive_impacts += 1;
-                s.max_positive_n = s.max_positive_n.max(p);
-            } else if p < 0.0 {
-                s.negative_impacts += 1;
-                s.max_negative_n = s.max_negative_n.min(p);
-            }
+            s.count(p);
             abs.push(p.abs());
         }
-        if abs.is_empty() {
-            return s;
-        }
         abs.sort_by(f64::total_cmp);
-        s.p99_abs_n = percentile_sorted(&abs, 99.0);
-        let top = &abs[abs.len().saturating_sub(TOP_N)..];
-        s.mean_top10_abs_n = top.iter().sum::<f64>() / top.len() as f64;
+        s.finish_top(&abs);
         s
+    }
+
+    /// Counts one signed peak (N, not NaN) in the counts and extremes.
+    fn count(&mut self, p: f64) {
+        self.impacts += 1;
+        if p > 0.0 {
+            self.positive_impacts += 1;
+            self.max_positive_n = self.max_positive_n.max(p);
+        } else if p < 0.0 {
+            self.negative_impacts += 1;
+            self.max_negative_n = self.max_negative_n.min(p);
+        }
+    }
+
+    /// Sets the 99th percentile and the top-10 mean from `top`, the largest `|peak|` of the
+    /// `self.impacts` counted, sorted ascending, at least [`top_needed`] of them.
+    fn finish_top(&mut self, top: &[f64]) {
+        if top.is_empty() {
+            return;
+        }
+        self.p99_abs_n = percentile_of_top(top, self.impacts, 99.0);
+        let ten = &top[top.len().saturating_sub(TOP_N)..];
+        self.mean_top10_abs_n = ten.iter().sum::<f64>() / ten.len() as f64;
+    }
+}
+
+/// How many of the largest of `n` values the 99th percentile and the top-10 mean need.
+fn top_needed(n: usize) -> usize {
+    if n == 0 {
+        return 0;
+    }
+    let (lo, _, _) = percentile_index(n, 99.0);
+    (n - lo).max(TOP_N).min(n)
+}
+
+/// `|peak|` values held in memory by [`PeakStats`] before they go to its temporary file
+/// (12 bytes each: 196 kB).
+pub const PEAKS_IN_MEMORY: usize = 16_384;
+
+/// Per-disc statistics ([`DiscStats`]) of impact peaks taken one at a time, in memory that
+/// does not grow with the run.
+///
+/// Counts and extremes are kept as they come. The exact 99th percentile needs every
+/// `|peak|`: up to [`PEAKS_IN_MEMORY`] of them are held in memory, the rest go to an unnamed
+/// temporary file (in `TMPDIR`, removed by the system when the run ends, however it ends),
+/// read back once by [`Self::stats`] keeping only each disc's top 1 % (at least ten). The
+/// figures equal [`disc_stats`] of the same peaks exactly. If the temporary file cannot be
+/// created or written (no space), the values stay in memory: nothing is lost.
+#[derive(Debug, Default)]
+pub struct PeakStats {
+    discs: Vec<DiscStats>,
+    /// (disc, |peak| N) not yet written to the file
+    held: Vec<(u32, f64)>,
+    file: Option<std::fs::File>,
+    /// the file failed: hold everything
+    in_memory_only: bool,
+}
+
+/// Bytes of one (disc u32, |peak| f64) record of the temporary file.
+const RECORD_BYTES: usize = 12;
+
+impl PeakStats {
+    /// No peaks yet.
+    pub fn new() -> PeakStats {
+        PeakStats::default()
+    }
+
+    /// Impacts counted so far.
+    pub fn impacts(&self) -> usize {
+        self.discs.iter().map(|d| d.impacts).sum()
+    }
+
+    /// Takes one impact's signed peak `peak_n` (N) of disc `disc`; NaN is not counted.
+    pub fn push(&mut self, disc: usize, peak_n: f64) {
+        if peak_n.is_nan() {
+            return;
+        }
+        if self.discs.len() <= disc {
+            self.discs.resize_with(disc + 1, || DiscStats::empty(""));
+        }
+        self.discs[disc].count(peak_n);
+        self.held.push((disc as u32, peak_n.abs()));
+        if self.held.len() >= PEAKS_IN_MEMORY && !self.in_memory_only {
+            if let Err(_e) = self.spill() {
+                // no temporary space: keep the values in memory rather than lose them
+                self.in_memory_only = true;
+            }
+        }
+    }
+
+    /// Whether some values went to the temporary file.
+    pub fn spilled(&self) -> bool {
+        self.file.is_some()
+    }
+
+    fn spill(&mut self) -> std::io::Result<()> {
+        use std::io::{Seek, SeekFrom, Write};
+        if self.file.is_none() {
+            self.file = Some(tempfile::tempfile()?);
+        }
+        let mut bytes = Vec::with_capacity(self.held.len() * RECORD_BYTES);
+        for &(d, v) in &self.held {
+            bytes.extend_from_slice(&d.to_le_bytes());
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        if let Some(mut f) = self.file.as_ref() {
+            // reading (Self::stats) may have moved the offset: always append
+            f.seek(SeekFrom::End(0))?;
+            f.write_all(&bytes)?;
+        }
+        self.held.clear();
+        Ok(())
+    }
+
+    /// The statistics so far, one entry per disc in `names` order (as [`disc_stats`]: discs
+    /// without impacts get zeros, impacts of discs past `names` get entries `disc {index}`).
+    ///
+    /// Errors only when the temporary file cannot be read back.
+    pub fn stats(&self, names: &[String]) -> std::io::Result<Vec<DiscStats>> {
+        let n = self.discs.len().max(names.len());
+        let need: Vec<usize> = (0..n)
+            .map(|i| top_needed(self.discs.get(i).map_or(0, |d| d.impacts)))
+            .collect();
+        // each disc's largest |peak| in a min-heap of bounded size
+        let mut tops: Vec<BinaryHeap<Reverse<Ordered>>> = need
+            .iter()
+            .map(|&k| BinaryHeap::with_capacity(k + 1))
+            .collect();
+        let mut take = |d: usize, v: f64| {
+            let (heap, k) = (&mut tops[d], need[d]);
+            heap.push(Reverse(Ordered(v)));
+            if heap.len() > k {
+                heap.pop();
+            }
+        };
+        if let Some(mut f) = self.file.as_ref() {
+            use std::io::{Read, Seek, SeekFrom};
+            f.seek(SeekFrom::Start(0))?;
+            let mut r = std::io::BufReader::with_capacity(1 << 16, f);
+            let mut rec = [0u8; RECORD_BYTES];
+            loop {
+                match r.read_exact(&mut rec) {
+                    Ok(()) => {}
+                    Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => break,
+                    Err(e) => return Err(e),
+                }
+                let d = u32::from_le_bytes([rec[0], rec[1], rec[2], rec[3]]) as usize;
+                let mut v = [0u8; 8];
+                v.copy_from_slice(&rec[4..]);
+                if d < n {
+                    take(d, f64::from_le_bytes(v));
+                }
+            }
+        }
+        for &(d, v) in &self.held {
+            take(d as usize, v);
+        }
+        Ok(tops
+            .into_iter()
+            .enumerate()
+            .map(|(i, heap)| {
+                let mut s = self
+                    .discs
+                    .get(i)
+                    .cloned()
+                    .unwrap_or_else(|| DiscStats::empty(""));
+                s.name = names.get(i).cloned().unwrap_or_else(|| format!("disc {i}"));
+                let mut top: Vec<f64> = heap.into_iter().map(|Reverse(Ordered(v))| v).collect();
+                top.sort_by(f64::total_cmp);
+                s.finish_top(&top);
+                s
+            })
+            .collect())
+    }
+}
+
+/// An `f64` ordered by [`f64::total_cmp`] (for the heaps of [`PeakStats::stats`]).
+#[derive(Debug, Clone, Copy)]
+struct Ordered(f64);
+impl PartialEq for Ordered {
+    fn eq(&self, o: &Self) -> bool {
+        self.0.total_cmp(&o.0).is_eq()
+    }
+}
+impl Eq for Ordered {}
+impl PartialOrd for Ordered {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Ordered {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&o.0)
     }
 }
 
@@ -126,18 +309,32 @@ pub fn percentile(values: &[f64], q: f64) -> f64 {
 
 /// [`percentile`] of values already sorted ascending and free of NaN.
 fn percentile_sorted(sorted: &[f64], q: f64) -> f64 {
-    let n = sorted.len();
-    if n == 0 {
-        return 0.0;
-    }
+    percentile_of_top(sorted, sorted.len(), q)
+}
+
+/// The order statistics around the `q`-th percentile of `n` values: (lower index, upper
+/// index, interpolation fraction), [`percentile`]'s definition.
+fn percentile_index(n: usize, q: f64) -> (usize, usize, f64) {
     let h = (n - 1) as f64 * q.clamp(0.0, 100.0) / 100.0;
     let lo = (h.floor() as usize).min(n - 1);
     let hi = (lo + 1).min(n - 1);
-    let frac = h - lo as f64;
+    (lo, hi, h - lo as f64)
+}
+
+/// [`percentile`] of `n` values of which `top` holds the largest, sorted ascending (all of
+/// them, or at least the ones from the percentile's lower index on).
+fn percentile_of_top(top: &[f64], n: usize, q: f64) -> f64 {
+    if n == 0 || top.is_empty() {
+        return 0.0;
+    }
+    let (lo, hi, frac) = percentile_index(n, q);
+    // sorted[i] of all n values is top[i - skipped]
+    let skipped = n - top.len();
+    let at = |i: usize| top[i.saturating_sub(skipped).min(top.len() - 1)];
     if frac == 0.0 || lo == hi {
-        sorted[lo]
+        at(lo)
     } else {
-        sorted[lo] + frac * (sorted[hi] - sorted[lo])
+        at(lo) + frac * (at(hi) - at(lo))
     }
 }
 
@@ -280,5 +477,41 @@ mod tests {
         let json = serde_json::to_string(&s).unwrap();
         assert!(json.contains("\"max_negative_n\":-2.0"));
         assert_eq!(serde_json::from_str::<DiscStats>(&json).unwrap(), s);
+    }
+
+    /// The bounded accumulator gives exactly the statistics of the whole list
+    /// ([`disc_stats`]), below and far above its in-memory limit (values in the temporary
+    /// file), with ties, discs without impacts and impacts past the names; asked mid-run and
+    /// fed on, it still appends (the read-back moves the file offset).
+    #[test]
+    fn peak_stats_equal_the_whole_list_in_and_beyond_memory() {
+        let mut rng = 12345u64;
+        let mut next = move || {
+            rng = rng
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let names: Vec<String> = ["a", "b", "c"].iter().map(|s| s.to_string()).collect();
+        for total in [0, 7, 1000, 3 * PEAKS_IN_MEMORY + 17] {
+            let mut acc = PeakStats::new();
+            let mut events = Vec::new();
+            for k in 0..total {
+                // disc 1 never hits; disc 3 is past the names; rounded loads tie often
+                let disc = [0, 2, 2, 3][k % 4];
+                let peak = ((next() - 0.5) * 2000.0).round();
+                acc.push(disc, peak);
+                events.push(ev(disc, peak));
+                if k == total / 2 {
+                    assert_eq!(acc.stats(&names).unwrap(), disc_stats(&names, &events));
+                }
+            }
+            acc.push(0, f64::NAN);
+            assert_eq!(acc.spilled(), total > PEAKS_IN_MEMORY, "{total}");
+            assert_eq!(acc.impacts(), total);
+            let want = disc_stats(&names, &events);
+            assert_eq!(acc.stats(&names).unwrap(), want, "{total} impacts");
+            assert_eq!(want.len(), if total > 3 { 4 } else { 3 });
+        }
     }
 }

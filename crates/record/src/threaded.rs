@@ -27,6 +27,14 @@ enum ToRecorder {
 /// hands over what it has at each progress call (every 1024 steps) anyway.
 const BATCH: usize = 256;
 
+/// Full batches that may wait for the recording thread. When the engine outruns the
+/// recorder (a long pack run: the recorder is the slower of the two), the queue fills and
+/// holds this many batches for the rest of the run: 64 batches of a 4-disc pack's samples
+/// were about 9 MB, which showed as memory that grew with the run length (15 MB at 3 s
+/// simulated, 21-26 MB from 30 s on); 8 keep about 1 MB in flight and still smooth the
+/// recorder's chunk writes.
+const QUEUED_BATCHES: usize = 8;
+
 /// The recorder on its own thread: the engine's thread only copies each sample into a batch
 /// and hands full batches over a bounded channel, so encoding, compressing and writing run
 /// beside the simulation. Emptied batches come back on a second channel and their samples'
@@ -71,7 +79,7 @@ fn copy_sample(dst: &mut Sample, src: &Sample) {
 impl ThreadedRecorder {
     /// Starts the recording thread that writes into `rec`.
     pub fn start(mut rec: Recorder) -> ThreadedRecorder {
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<ToRecorder>>(64);
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<ToRecorder>>(QUEUED_BATCHES);
         let (back_tx, back) = std::sync::mpsc::channel::<Vec<ToRecorder>>();
         let failed = Arc::new(AtomicBool::new(false));
         let flag = failed.clone();

@@ -235,7 +235,8 @@ pub struct Recorder {
     /// `/joints` values (position, velocity, effort per disc), reused
     joint_values: [Vec<f64>; 3],
     max_abs_run: f64,
-    peaks: Vec<Vec<f64>>,
+    /// every impact peak, for the summary (bounded memory: long runs keep them on disk)
+    peaks: clutchpack_analysis::PeakStats,
     last_t_s: f64,
     messages: u64,
     stats: Option<RunStats>,
@@ -526,7 +527,7 @@ impl Recorder {
             joint_buf: Vec::with_capacity(256),
             joint_values: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
             max_abs_run: 0.0,
-            peaks: vec![Vec::new(); n],
+            peaks: clutchpack_analysis::PeakStats::new(),
             last_t_s: 0.0,
             messages: 0,
             stats: None,
@@ -557,22 +558,23 @@ impl Recorder {
         self.error.as_ref()
     }
 
-    /// The summary of the impacts written so far (what `finish(None)` stores).
-    pub fn summary(&self) -> RunSummary {
-        let mut s = RunSummary {
+    /// The summary of the impacts written so far (what `finish(None)` stores). Errors only
+    /// when the peaks kept on disk (a long run, see `clutchpack_analysis::PeakStats`) cannot
+    /// be read back.
+    pub fn summary(&self) -> Result<RunSummary, RecordError> {
+        let discs = self
+            .peaks
+            .stats(&self.names)
+            .map_err(|source| RecordError::Write {
+                path: self.path.clone(),
+                what: "the impact peaks kept in a temporary file".to_string(),
+                source: mcap::McapError::Io(source),
+            })?;
+        Ok(RunSummary {
             t_end_s: self.last_t_s,
-            discs: Vec::with_capacity(self.peaks.len()),
+            discs,
             fatigue: Vec::new(),
-        };
-        for (i, p) in self.peaks.iter().enumerate() {
-            let name = self
-                .names
-                .get(i)
-                .cloned()
-                .unwrap_or_else(|| format!("disc {i}"));
-            s.discs.push(crate::DiscStats::from_peaks(name, p));
-        }
-        s
+        })
     }
 
     /// Stores the engine's run statistics in the `clutchpack.stats` metadata written by
@@ -888,10 +890,7 @@ impl Recorder {
             return Err(self.failed_err());
         }
         if e.disc < self.names.len() + crate::summary::MAX_EXTRA_DISCS {
-            if self.peaks.len() <= e.disc {
-                self.peaks.resize(e.disc + 1, Vec::new());
-            }
-            self.peaks[e.disc].push(e.peak_n);
+            self.peaks.push(e.disc, e.peak_n);
         }
         let msg = proto::Impact {
             disc: self
@@ -927,7 +926,10 @@ impl Recorder {
         if self.failed {
             return Err(self.failed_err());
         }
-        let summary = summary.unwrap_or_else(|| self.summary());
+        let summary = match summary {
+            Some(s) => s,
+            None => self.summary()?,
+        };
         // logged at t = 0 although written last: viewers open a file at its start and show
         // the latest message of each topic, so the summary is there from the first frame
         self.put(self.ch.summary, 0, &summary.to_proto(), "/summary")?;
