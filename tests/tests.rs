@@ -554,7 +554,8 @@ fn bad_recordings_exit_2_with_one_line() {
 
 /// Path of the independent reader's python (tests/python/setup.sh installs the official
 /// `mcap` and `mcap-protobuf-support` packages into target/pyenv).
-/// Also rainflow, numpy (tests/fatigue.rs) and pyarrow (tests/study.rs). Installed once per
+/// Also rainflow, numpy (tests/fatigue.rs), pyarrow (tests/study.rs) and the Rerun CLI
+/// (rerun-sdk: [`rerun_cli`]). Installed once per
 /// test run: the tests that need it wait for the first (two setup.sh at once would both
 /// rebuild the environment).
 fn python_reader() -> PathBuf {
@@ -806,5 +807,87 @@ fn impacts_csv_quotes_names() {
             .strip_prefix("\"a,b \"\"c\"\"\",")
             .unwrap_or_else(|| panic!("name not quoted: {row}"));
         assert_eq!(rest.split(',').count(), 6, "{row}");
+    }
+}
+
+/// The Rerun CLI of the `rerun-sdk` wheel (tests/python/requirements.txt) beside the
+/// independent reader's python.
+fn rerun_cli() -> PathBuf {
+    let py = python_reader();
+    py.with_file_name("rerun")
+}
+
+/// Rerun 0.41's own checks pass on fresh recordings of a clutch (plates, friction
+/// interfaces: pack-6-engagement, reference engine) and of an eccentric disc (multibody
+/// engine, radial float in `/tf`): `rerun mcap check --full` reports every topic `ok` with no
+/// issue (timelines that disagree on row order, chunks out of order on a timeline), and the
+/// `.rrd` that `rerun mcap convert` makes of the file passes `rerun rrd verify`.
+#[test]
+fn rerun_checks_our_recordings_clean() {
+    let d = scratch("rerun_check");
+    let rerun = rerun_cli();
+    for (scene, duration) in [
+        ("scenes/pack-6-engagement.toml", "0.05"),
+        ("scenes/eccentric-disc.toml", "0.01"),
+    ] {
+        let name = Path::new(scene).file_stem().unwrap().to_str().unwrap();
+        let mcap = d.join(format!("{name}.mcap"));
+        record(&mcap, &[scene, "--duration", duration]);
+        let o = Command::new(&rerun)
+            .args(["mcap", "check", "--full"])
+            .arg(&mcap)
+            .output()
+            .expect("rerun runs");
+        let text = format!("{}{}", stdout(&o), stderr(&o));
+        assert!(o.status.success(), "rerun mcap check {name}: {text}");
+        // the table: "Status  ID  Chunks  Topic  Issues", a rule, one row per topic
+        let rows: Vec<&str> = text
+            .lines()
+            .skip_while(|l| !l.starts_with("Status"))
+            .skip(2)
+            .filter(|l| !l.trim().is_empty())
+            .collect();
+        // our own count: "<n> messages on <k> topics, t = ..."
+        let info = stdout(&run(&["replay", mcap.to_str().unwrap()]));
+        let topics: usize = info
+            .split(" topics")
+            .next()
+            .and_then(|s| s.rsplit(' ').next())
+            .and_then(|k| k.parse().ok())
+            .unwrap_or_else(|| panic!("no topic count in: {info}"));
+        assert!(topics >= 10, "{name}: {topics} topics");
+        assert!(
+            rows.len() >= topics,
+            "{name}: {} rows for {topics} topics:\n{text}",
+            rows.len()
+        );
+        for row in &rows {
+            let cols: Vec<&str> = row.split_whitespace().collect();
+            assert_eq!(cols.first(), Some(&"ok"), "{name}: {row}");
+            assert_eq!(cols.last(), Some(&"—"), "{name}: {row}");
+        }
+        let rrd = d.join(format!("{name}.rrd"));
+        let o = Command::new(&rerun)
+            .args(["mcap", "convert"])
+            .arg(&mcap)
+            .arg("-o")
+            .arg(&rrd)
+            .output()
+            .expect("rerun runs");
+        assert!(
+            o.status.success(),
+            "rerun mcap convert {name}: {}",
+            stderr(&o)
+        );
+        let o = Command::new(&rerun)
+            .args(["rrd", "verify"])
+            .arg(&rrd)
+            .output()
+            .expect("rerun runs");
+        let text = format!("{}{}", stdout(&o), stderr(&o));
+        assert!(
+            o.status.success() && text.contains("verified without error"),
+            "rerun rrd verify {name}: {text}"
+        );
     }
 }

@@ -237,9 +237,40 @@ pub struct Recorder {
     max_abs_run: f64,
     /// every impact peak, for the summary (bounded memory: long runs keep them on disk)
     peaks: clutchpack_analysis::PeakStats,
+    /// impacts not yet written, in peak-time order (see `write_impact`)
+    held_impacts: std::collections::BinaryHeap<std::cmp::Reverse<HeldImpact>>,
+    /// per disc: the time of its last sample without a contact in progress, s
+    last_free_t_s: Vec<f64>,
     last_t_s: f64,
     messages: u64,
     stats: Option<RunStats>,
+}
+
+/// Impacts held for ordering at most (about 5 MB): beyond, the earliest is written even if
+/// an earlier peak may still come (a contact held for the whole run, e.g. a locked disc).
+const MAX_HELD_IMPACTS: usize = 1 << 16;
+
+/// An impact waiting to be written, ordered by peak time.
+#[derive(Debug, Clone, Copy)]
+struct HeldImpact(ImpactEvent);
+impl PartialEq for HeldImpact {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o).is_eq()
+    }
+}
+impl Eq for HeldImpact {}
+impl PartialOrd for HeldImpact {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for HeldImpact {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.0
+            .t_peak_s
+            .total_cmp(&o.0.t_peak_s)
+            .then(self.0.disc.cmp(&o.0.disc))
+    }
 }
 
 impl Recorder {
@@ -528,6 +559,8 @@ impl Recorder {
             joint_values: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
             max_abs_run: 0.0,
             peaks: clutchpack_analysis::PeakStats::new(),
+            held_impacts: std::collections::BinaryHeap::new(),
+            last_free_t_s: vec![f64::NEG_INFINITY; n],
             last_t_s: 0.0,
             messages: 0,
             stats: None,
@@ -822,7 +855,12 @@ impl Recorder {
                 self.put(self.ch.scene_loads, lt, &update, "/scene/loads")?;
             }
         }
-        self.maybe_flush()
+        for (free, d) in self.last_free_t_s.iter_mut().zip(&sample.discs) {
+            if !d.engaged {
+                *free = t;
+            }
+        }
+        self.release_impacts(self.safe_impact_time_s())
     }
 
     /// Writes `/joints` for a sample: per disc the relative angle (rad), the shaft's minus
@@ -892,6 +930,44 @@ impl Recorder {
         if e.disc < self.names.len() + crate::summary::MAX_EXTRA_DISCS {
             self.peaks.push(e.disc, e.peak_n);
         }
+        // Impacts are logged at their peak but handed over when their contact closes, so a
+        // long contact's impact comes after shorter ones that peaked later; written as they
+        // come, `/impacts` went back in time across chunks (Rerun's `mcap check` reports
+        // that). They wait here until no earlier peak can come, at most MAX_HELD_IMPACTS.
+        self.held_impacts.push(std::cmp::Reverse(HeldImpact(*e)));
+        let mut until = self.safe_impact_time_s();
+        if self.held_impacts.len() > MAX_HELD_IMPACTS {
+            until = until.max(self.held_impacts.peek().map_or(until, |h| h.0 .0.t_peak_s));
+        }
+        self.release_impacts(until)
+    }
+
+    /// The latest peak time up to which no impact can still arrive: engines hand over an
+    /// impact when its contact closes, after the samples before that, so a later impact peaks
+    /// after the last sample, or inside a contact already in progress, which began after its
+    /// disc's last free sample.
+    fn safe_impact_time_s(&self) -> f64 {
+        self.last_free_t_s
+            .iter()
+            .fold(self.last_t_s, |m, &t| m.min(t))
+    }
+
+    /// Writes the held impacts that peak at or before `until_s` (s), in peak-time order.
+    fn release_impacts(&mut self, until_s: f64) -> Result<(), RecordError> {
+        while self
+            .held_impacts
+            .peek()
+            .is_some_and(|h| h.0 .0.t_peak_s <= until_s)
+        {
+            if let Some(std::cmp::Reverse(HeldImpact(e))) = self.held_impacts.pop() {
+                self.put_impact(&e)?;
+            }
+        }
+        self.maybe_flush()
+    }
+
+    /// Writes one impact on `/impacts` and its disc's topic, logged at its peak time.
+    fn put_impact(&mut self, e: &ImpactEvent) -> Result<(), RecordError> {
         let msg = proto::Impact {
             disc: self
                 .names
@@ -913,7 +989,7 @@ impl Recorder {
         if let Some(&ch) = self.ch.disc_impacts.get(e.disc) {
             self.put(ch, log_time_ns(e.t_peak_s), &msg, "impacts")?;
         }
-        self.maybe_flush()
+        Ok(())
     }
 
     /// Writes `/summary` (the given one, or [`Self::summary`] when `None`), the run
@@ -926,6 +1002,7 @@ impl Recorder {
         if self.failed {
             return Err(self.failed_err());
         }
+        self.release_impacts(f64::INFINITY)?;
         let summary = match summary {
             Some(s) => s,
             None => self.summary()?,
