@@ -1,19 +1,37 @@
 //! Reading a recording: [`open`] and [`RecordingReader`].
 //!
-//! The file is read into memory and scanned once, record by record, from the start (the MCAP
-//! "streaming" read), checking every chunk's CRC before using any of its messages, the data
-//! section's CRC, the summary section's CRC and the message counts in the summary. Every
-//! message of our own and of the two Foxglove schemas is decoded on the way, so a file that
-//! opens cleanly decodes completely. At the first error [`RecordingReader::damage`] records
-//! what happened (strict readers refuse the file on it), and the scan resynchronises: it
-//! looks for the next chunk record after the last good record (a chunk header whose lengths
-//! agree with each other and with the file, then the chunk's CRC) and reads on from there, so
-//! a flipped bit in the scene attachment or in one chunk loses only that record, not every
-//! chunk after it. Schemas and channels come from the summary section too when the footer is
-//! intact, so messages of a chunk whose channel was defined in a lost chunk still decode.
-//! Whole chunks only are used; [`Damage`] says how many regions and bytes were skipped. A run
-//! killed mid-way (no summary section) is read up to its last complete chunk. Nothing in here
-//! panics on bad input.
+//! The file is scanned once, record by record, from the start (the MCAP "streaming" read),
+//! checking every chunk's CRC before using any of its messages, the data section's CRC, the
+//! summary section's CRC and the message counts in the summary. Every message of our own and
+//! of the two Foxglove schemas is decoded on the way, so a file that opens cleanly decodes
+//! completely. At the first error [`RecordingReader::damage`] records what happened (strict
+//! readers refuse the file on it), and the scan resynchronises: it seeks back to the last good
+//! record and searches forward, one block at a time, for the next chunk record (a chunk header
+//! whose lengths agree with each other and with the file, then the chunk's CRC) and reads on
+//! from there, so a flipped bit in the scene attachment or in one chunk loses only that
+//! record, not every chunk after it. Schemas and channels come from the summary section too
+//! when the footer is intact, so messages of a chunk whose channel was defined in a lost chunk
+//! still decode. Whole chunks only are used; [`Damage`] says how many regions and bytes were
+//! skipped. A run killed mid-way (no summary section) is read up to its last complete chunk.
+//! Nothing in here panics on bad input.
+//!
+//! # Memory
+//!
+//! The file is never held: the scan feeds the MCAP linear reader from a buffered file in
+//! blocks ([`ReadOptions::block_bytes`], 1 MiB), so memory is bounded by the largest record
+//! (a chunk, compressed and decompressed: about 1 MiB each for ours) plus what the scan
+//! reports (topics, metadata, the scene attachment), whatever the file's size. A damaged
+//! record length can make the reader buffer up to the rest of the file before the record is
+//! found bad; the record length limit is the file's size (at least 256 MiB). The reader keeps
+//! the path and size, and every pass over the messages
+//! ([`RecordingReader::for_each_message`]) reads the file again, as it was at open (bytes
+//! appended since are not read). A file shortened, removed or rewritten in between is
+//! reported, never a panic: [`RecordingReader::try_for_each_message`] returns
+//! [`ReadError::Reread`]; [`RecordingReader::for_each_message`] keeps it for
+//! [`RecordingReader::reread_error`]. What the series methods return is held whole
+//! ([`RecordingReader::samples`] holds every sample); [`crate::export_csv`] and
+//! [`RecordingReader::interface_stats`] stream. [`from_bytes`] reads a recording held in
+//! memory (tests) and keeps it.
 
 use crate::info::RunInfo;
 use crate::proto;
