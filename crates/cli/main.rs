@@ -64,13 +64,14 @@ enum Command {
     /// peaks against it (the paper's Fig 3).
     Sweep(sweep::SweepArgs),
     /// Describe a recording (topics, counts, time span, summary); `--serve` streams it to
-    /// Foxglove over WebSocket.
+    /// Foxglove over WebSocket (holding every message in memory).
     Replay(recording::ReplayArgs),
     /// Compare per-disc impact loads across recordings (change against the first).
     Compare(recording::CompareArgs),
     /// Export a recording's topics as CSV files.
     Export(recording::ExportArgs),
-    /// Plot a recording's per-disc load histories (PNG or SVG).
+    /// Plot a recording's per-disc load histories (PNG or SVG); holds every sample of every
+    /// disc in memory (what it draws).
     Plot(recording::PlotArgs),
     /// Measure speed: the paper case per run, and the speed-up of a 16-case sweep on 2
     /// threads over 1 (prints ratios; timing is never a test).

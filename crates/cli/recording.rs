@@ -1,8 +1,13 @@
 //! Reading recordings: `replay`, `compare`, `export`, `plot`.
 //!
-//! Every command reads the whole file it is given. A damaged file (truncated by a killed run,
-//! corrupted) is an error (exit 2) that says what was read and what was not, unless
-//! `--salvage` is given: then the command works on the messages recovered and warns.
+//! Every command reads the whole file it is given, streaming: the reader holds one chunk at a
+//! time and reads the file again for each pass over its messages, so `replay` (the text
+//! description) and `export --csv` take memory that does not grow with the recording; `plot`
+//! and `compare` keep what they draw or rank (`plot` every sample of every disc, `compare`
+//! the impacts). A damaged file (truncated by a killed run, corrupted) is an error (exit 2)
+//! that says what was read and what was not, unless `--salvage` is given: then the command
+//! works on the messages recovered and warns. A file that changes under a command (removed,
+//! shortened) is an error too, never a partial result.
 
 use crate::common::BadInput;
 use crate::outputs::Output;
@@ -41,6 +46,15 @@ pub fn open_recording(path: &Path, salvage: bool) -> Result<RecordingReader> {
     Ok(reader)
 }
 
+/// `Err` (bad input naming the file) if a pass over the recording's messages could not read
+/// the file again (it changed since it was opened).
+pub fn reread_ok(reader: &RecordingReader) -> Result<()> {
+    match reader.reread_error() {
+        None => Ok(()),
+        Some(e) => Err(BadInput(e.to_string()).into()),
+    }
+}
+
 /// Per-disc statistics of a recording, from its impact events (the same definitions as
 /// `clutchpack run`).
 pub fn recording_stats(reader: &RecordingReader) -> Vec<DiscStats> {
@@ -75,7 +89,9 @@ pub struct ReplayArgs {
 
 pub fn replay(a: ReplayArgs) -> Result<ExitCode> {
     let reader = open_recording(&a.file, a.salvage)?;
-    out!("{}", crate::describe::describe(&reader).trim_end());
+    let text = crate::describe::describe(&reader);
+    reread_ok(&reader)?;
+    out!("{}", text.trim_end());
     if a.serve {
         serve(&reader, a.port, a.speed, a.paused)?;
     }
@@ -225,6 +241,7 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
     for f in &a.files {
         let reader = open_recording(f, a.salvage)?;
         let stats = recording_stats(&reader);
+        reread_ok(&reader)?;
         if stats.is_empty() {
             // say so rather than leaving the run out silently
             eprintln!(
@@ -476,6 +493,7 @@ pub fn recorded_fatigue(
 
 fn plot_spectrum(reader: &RecordingReader, a: &PlotArgs) -> Result<ExitCode> {
     let (names, histories, fatigue, duration) = recorded_fatigue(reader);
+    reread_ok(reader)?;
     let spectra: Vec<(String, Vec<(f64, f64)>)> = names
         .iter()
         .zip(&histories)
@@ -524,6 +542,7 @@ pub fn plot(a: PlotArgs) -> Result<ExitCode> {
         .map(|h| (h.name, h.t_s.into_iter().zip(h.load_n).collect()))
         .unzip();
     crate::common::merge_peaks(&mut histories, &reader.impacts());
+    reread_ok(&reader)?;
     let series: Vec<(String, Vec<(f64, f64)>)> = names.into_iter().zip(histories).collect();
     let scene = reader
         .info()

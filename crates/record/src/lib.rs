@@ -83,7 +83,10 @@
 //! message on disk. The CLI runs the recorder on its own thread (`clutchpack bench` reports
 //! its CPU time against the engine's and the wall-time overhead of recording). Memory stays
 //! flat with run length: one chunk (1 MiB) in memory, plus the chunk index and the impact
-//! peaks. Opening reads the whole file into memory and scans it at about 100-300 MB/s.
+//! peaks. Reading streams too: opening scans the file in blocks, holding one chunk at a time,
+//! and every later pass ([`RecordingReader::for_each_message`]) reads the file again, so a
+//! reader's memory does not grow with the file (the series that return every sample, such
+//! as [`RecordingReader::samples`], do).
 //!
 //! # Conventions
 //! - SI units, named in fields and keys (`load_n`, `t_s`); loads are per tooth, negative
@@ -118,9 +121,9 @@ pub use export::{export_csv, export_csv_until};
 pub use info::{sha256_hex, DiscGeometry, FrictionInterface, RunInfo, ShaftGeometry};
 pub use output::{write_whole, PendingFile, Replace};
 pub use read::{
-    from_bytes, open, open_complete, AttachmentInfo, Damage, DamageKind, DiscSeries,
-    InterfaceSeries, LoadHistory, MessageView, ReadError, RecordingInfo, RecordingReader,
-    TopicInfo,
+    from_bytes, from_bytes_with, open, open_complete, open_with, AttachmentInfo, Damage,
+    DamageKind, DiscSeries, InterfaceSeries, LoadHistory, MessageView, ReadError, ReadOptions,
+    RecordingInfo, RecordingReader, TopicInfo,
 };
 #[cfg(feature = "serve")]
 pub use serve::{serve, ServeError, ServeOptions};

@@ -4,8 +4,8 @@
 use clutchpack_model::{Collector, DiscSample, Observer, Sample};
 use clutchpack_record::synthetic::{synthetic_run, SyntheticRun};
 use clutchpack_record::{
-    export_csv, from_bytes, open, topics, DamageKind, ReadError, RecordError, RecordOptions,
-    Recorder, RecordingReader, RunSummary,
+    export_csv, from_bytes, from_bytes_with, open, open_with, topics, DamageKind, ReadError,
+    ReadOptions, RecordError, RecordOptions, Recorder, RecordingReader, RunSummary,
 };
 use std::path::PathBuf;
 
@@ -464,6 +464,142 @@ fn damaged_recordings_salvage_every_intact_chunk() {
     let d = r.damage().expect("the attachment's CRC catches it");
     assert_eq!(r.info().messages, total, "{d}");
     assert_eq!(d.lost_messages, Some(0), "{d}");
+}
+
+/// Every message a reader hands over, as (channel, log time, bytes).
+fn messages_of(r: &RecordingReader) -> Vec<(u16, u64, Vec<u8>)> {
+    let mut v = Vec::new();
+    r.try_for_each_message(|m| v.push((m.channel_id, m.log_time_ns, m.data.to_vec())))
+        .unwrap();
+    v
+}
+
+/// The reader streams (issue 10): read from disk in blocks of 61 bytes, far smaller than a
+/// chunk, a complete file, a truncated copy and a copy with a byte flipped in a chunk (the
+/// resynchronising search, in 61-byte windows) give the same info, damage, messages and
+/// samples as the reader of the bytes in memory with its default 1 MiB block.
+#[test]
+fn small_blocks_read_like_memory() {
+    let run = small();
+    let path = record(&run, "blocks.mcap", &options());
+    let bytes = std::fs::read(&path).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    assert!(summary.chunk_indexes.len() >= 4);
+    let c = &summary.chunk_indexes[2];
+    let mut flipped = bytes.clone();
+    flipped[(c.chunk_start_offset + c.chunk_length / 2) as usize] ^= 0x04;
+    let cut = bytes[..bytes.len() * 2 / 3].to_vec();
+    let small_blocks = ReadOptions { block_bytes: 61 };
+    for (name, b) in [("whole", bytes.clone()), ("cut", cut), ("flip", flipped)] {
+        assert!(
+            b.len() > 100 * small_blocks.block_bytes,
+            "{name}: {}",
+            b.len()
+        );
+        let file = tmp(&format!("blocks-{name}.mcap"));
+        std::fs::write(&file, &b).unwrap();
+        let mem = from_bytes(&file, b.clone()).unwrap();
+        let disk = open_with(&file, &small_blocks).unwrap();
+        let mem_small = from_bytes_with(&file, b.clone(), &small_blocks).unwrap();
+        for r in [&disk, &mem_small] {
+            // Debug: topics without messages have NaN spans
+            assert_eq!(
+                format!("{:?}", r.info()),
+                format!("{:?}", mem.info()),
+                "{name}"
+            );
+            assert_eq!(r.damage(), mem.damage(), "{name}");
+            assert_eq!(r.file_bytes(), b.len() as u64, "{name}");
+        }
+        let want = messages_of(&mem);
+        assert_eq!(want.len() as u64, mem.info().messages, "{name}");
+        assert_eq!(messages_of(&disk), want, "{name}");
+        assert_eq!(messages_of(&mem_small), want, "{name}");
+        assert_eq!(disk.samples(), mem.samples(), "{name}");
+        assert!(disk.reread_error().is_none(), "{name}");
+        match name {
+            "whole" => assert!(disk.is_complete()),
+            "cut" => {
+                let d = disk.damage().unwrap();
+                assert_eq!(d.kind, DamageKind::Truncated, "{d}");
+                assert!(
+                    d.messages > 0 && d.messages < summary.stats.as_ref().unwrap().message_count
+                );
+            }
+            _ => {
+                let d = disk.damage().unwrap();
+                assert_eq!(d.kind, DamageKind::Corrupt, "{d}");
+                assert_eq!(d.skipped_regions, 1, "{d}");
+                assert!(d.lost_messages.is_some_and(|n| n > 0), "{d}");
+            }
+        }
+    }
+}
+
+/// The reader does not hold the file: each pass reads it again. A file that grew since it
+/// was opened (a run still recording) gives the same messages; one shortened or removed
+/// gives an error naming it (kept for `reread_error` by `for_each_message`), never a panic.
+#[test]
+fn passes_read_the_file_again() {
+    let run = small();
+    let src = record(&run, "reread-src.mcap", &options());
+    let path = tmp("reread.mcap");
+    std::fs::copy(&src, &path).unwrap();
+    let r = open(&path).unwrap();
+    let want = messages_of(&r);
+    // grown: appended bytes are not read
+    let mut f = std::fs::OpenOptions::new()
+        .append(true)
+        .open(&path)
+        .unwrap();
+    std::io::Write::write_all(&mut f, &[0x42; 1000]).unwrap();
+    drop(f);
+    assert_eq!(messages_of(&r), want);
+    // shortened
+    let bytes = std::fs::read(&src).unwrap();
+    std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
+    let e = r.try_for_each_message(|_| {}).unwrap_err();
+    assert!(matches!(e, ReadError::Reread { .. }), "{e}");
+    assert!(
+        e.to_string().contains("reread.mcap") && e.to_string().contains("changed"),
+        "{e}"
+    );
+    assert!(r.reread_error().is_none(), "try_ does not keep the error");
+    let n = r.samples().len();
+    assert!(n < run.samples.len(), "{n}");
+    let e = r.reread_error().expect("for_each_message keeps the error");
+    assert!(e.to_string().contains("reread.mcap"), "{e}");
+    // same length, other bytes: fewer messages recovered than at open
+    let mut other = bytes.clone();
+    for b in &mut other[bytes.len() / 4..bytes.len() / 2] {
+        *b ^= 0x5a;
+    }
+    std::fs::write(&path, &other).unwrap();
+    let e = r.try_for_each_message(|_| {}).unwrap_err();
+    assert!(e.to_string().contains("messages read again"), "{e}");
+    // removed
+    std::fs::remove_file(&path).unwrap();
+    let e = r.try_for_each_message(|_| {}).unwrap_err();
+    assert!(e.to_string().contains("cannot read the file again"), "{e}");
+    assert!(r.impacts().is_empty());
+}
+
+/// A FIFO is refused at once (reading it would block, and a pass could not read it again),
+/// with an error naming it.
+#[cfg(unix)]
+#[test]
+fn a_fifo_is_not_a_recording() {
+    let fifo = tmp("fifo.mcap");
+    let _ = std::fs::remove_file(&fifo);
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    let e = open(&fifo).unwrap_err();
+    assert!(matches!(e, ReadError::NotAFile { .. }), "{e}");
+    assert!(e.to_string().contains("fifo.mcap"), "{e}");
+    std::fs::remove_file(&fifo).unwrap();
 }
 
 /// Flipping any one byte of a small recording never panics, and never goes unnoticed

@@ -1,19 +1,37 @@
 //! Reading a recording: [`open`] and [`RecordingReader`].
 //!
-//! The file is read into memory and scanned once, record by record, from the start (the MCAP
-//! "streaming" read), checking every chunk's CRC before using any of its messages, the data
-//! section's CRC, the summary section's CRC and the message counts in the summary. Every
-//! message of our own and of the two Foxglove schemas is decoded on the way, so a file that
-//! opens cleanly decodes completely. At the first error [`RecordingReader::damage`] records
-//! what happened (strict readers refuse the file on it), and the scan resynchronises: it
-//! looks for the next chunk record after the last good record (a chunk header whose lengths
-//! agree with each other and with the file, then the chunk's CRC) and reads on from there, so
-//! a flipped bit in the scene attachment or in one chunk loses only that record, not every
-//! chunk after it. Schemas and channels come from the summary section too when the footer is
-//! intact, so messages of a chunk whose channel was defined in a lost chunk still decode.
-//! Whole chunks only are used; [`Damage`] says how many regions and bytes were skipped. A run
-//! killed mid-way (no summary section) is read up to its last complete chunk. Nothing in here
-//! panics on bad input.
+//! The file is scanned once, record by record, from the start (the MCAP "streaming" read),
+//! checking every chunk's CRC before using any of its messages, the data section's CRC, the
+//! summary section's CRC and the message counts in the summary. Every message of our own and
+//! of the two Foxglove schemas is decoded on the way, so a file that opens cleanly decodes
+//! completely. At the first error [`RecordingReader::damage`] records what happened (strict
+//! readers refuse the file on it), and the scan resynchronises: it seeks back to the last good
+//! record and searches forward, one block at a time, for the next chunk record (a chunk header
+//! whose lengths agree with each other and with the file, then the chunk's CRC) and reads on
+//! from there, so a flipped bit in the scene attachment or in one chunk loses only that
+//! record, not every chunk after it. Schemas and channels come from the summary section too
+//! when the footer is intact, so messages of a chunk whose channel was defined in a lost chunk
+//! still decode. Whole chunks only are used; [`Damage`] says how many regions and bytes were
+//! skipped. A run killed mid-way (no summary section) is read up to its last complete chunk.
+//! Nothing in here panics on bad input.
+//!
+//! # Memory
+//!
+//! The file is never held: the scan feeds the MCAP linear reader from a buffered file in
+//! blocks ([`ReadOptions::block_bytes`], 1 MiB), so memory is bounded by the largest record
+//! (a chunk, compressed and decompressed: about 1 MiB each for ours) plus what the scan
+//! reports (topics, metadata, the scene attachment), whatever the file's size. A damaged
+//! record length can make the reader buffer up to the rest of the file before the record is
+//! found bad; the record length limit is the file's size (at least 256 MiB). The reader keeps
+//! the path and size, and every pass over the messages
+//! ([`RecordingReader::for_each_message`]) reads the file again, as it was at open (bytes
+//! appended since are not read). A file shortened, removed or rewritten in between is
+//! reported, never a panic: [`RecordingReader::try_for_each_message`] returns
+//! [`ReadError::Reread`]; [`RecordingReader::for_each_message`] keeps it for
+//! [`RecordingReader::reread_error`]. What the series methods return is held whole
+//! ([`RecordingReader::samples`] holds every sample); [`crate::export_csv`] and
+//! [`RecordingReader::interface_stats`] stream. [`from_bytes`] reads a recording held in
+//! memory (tests) and keeps it.
 
 use crate::info::RunInfo;
 use crate::proto;
@@ -23,10 +41,14 @@ use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOp
 use prost::Message as _;
 use std::collections::BTreeMap;
 use std::fmt;
+use std::io::{BufReader, Cursor, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
 
 mod series;
-use series::segment_of;
+pub(crate) use series::impact_event;
+pub(crate) use series::segment_of;
 pub use series::{DiscSeries, InterfaceSeries, LoadHistory};
 
 /// Why a recording could not be read (each variant displays as one line).
@@ -39,6 +61,14 @@ pub enum ReadError {
         path: PathBuf,
         /// The I/O error.
         source: std::io::Error,
+    },
+    /// The path is not a regular file (a FIFO, a device, a socket).
+    #[error(
+        "{path} is not a regular file (a FIFO, device or socket): a recording is read from a file"
+    )]
+    NotAFile {
+        /// The path.
+        path: PathBuf,
     },
     /// The file is empty.
     #[error("{path} is empty (0 bytes): not an MCAP recording")]
@@ -61,6 +91,15 @@ pub enum ReadError {
         path: PathBuf,
         /// What was read and what was not (boxed: it is large next to the other errors).
         damage: Box<Damage>,
+    },
+    /// The file could not be read again after it was opened (it was removed, shortened or
+    /// rewritten): see [`RecordingReader::reread_error`].
+    #[error("{path}: {reason}")]
+    Reread {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong, in words.
+        reason: String,
     },
     /// An export file could not be written.
     #[error("cannot write {path}: {source}")]
@@ -236,13 +275,84 @@ pub struct MessageView<'a> {
     pub data: &'a [u8],
 }
 
+/// How a recording is read: the size of the blocks read from the file at a time.
+///
+/// The defaults suit every use; a small block is for tests (it exercises the reassembly of
+/// records from many reads and the windowed search of the resynchronisation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReadOptions {
+    /// Bytes read from the file at a time (at least 1), and the window of the forward search
+    /// for the next chunk after damage. Default 1 MiB.
+    pub block_bytes: usize,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            block_bytes: 1 << 20,
+        }
+    }
+}
+
 /// An opened recording. See [`open`].
+///
+/// It holds what the first scan found ([`RecordingInfo`], [`Damage`]) and the file's path and
+/// size, not the file: [`RecordingReader::for_each_message`] (and every series built on it)
+/// reads the file again. A reader made by [`from_bytes`] keeps its bytes instead.
 #[derive(Debug)]
 pub struct RecordingReader {
     path: PathBuf,
-    bytes: Vec<u8>,
+    file_bytes: u64,
+    /// The recording given to [`from_bytes`] (`None`: read from `path`).
+    memory: Option<Vec<u8>>,
+    options: ReadOptions,
     info: RecordingInfo,
     damage: Option<Damage>,
+    /// Why the last [`RecordingReader::for_each_message`] could not read the file again.
+    reread_error: Mutex<Option<String>>,
+}
+
+/// A byte source the scan reads from: the file ([`open`]) or memory ([`from_bytes`]).
+trait Source: Read + Seek {}
+impl<T: Read + Seek> Source for T {}
+
+/// A source with its size (as at open: nothing after it is read) and the block size.
+struct Input<'a> {
+    src: &'a mut dyn Source,
+    len: u64,
+    block: usize,
+    /// Stops the scan after the record being read once set (a signal).
+    stop: Option<&'a AtomicBool>,
+}
+
+impl Input<'_> {
+    fn seek(&mut self, at: u64) -> std::io::Result<()> {
+        self.src.seek(SeekFrom::Start(at)).map(drop)
+    }
+
+    /// Fills `buf` from the current position; fewer bytes only at the end of the source.
+    fn fill(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let mut n = 0;
+        while n < buf.len() {
+            match self.src.read(&mut buf[n..]) {
+                Ok(0) => break,
+                Ok(k) => n += k,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(e),
+            }
+        }
+        Ok(n)
+    }
+
+    /// Up to `n` bytes at `at` (fewer at the end of the source).
+    fn read_at(&mut self, at: u64, n: usize) -> std::io::Result<Vec<u8>> {
+        let n = n.min(self.len.saturating_sub(at).try_into().unwrap_or(usize::MAX));
+        let mut buf = vec![0; n];
+        self.seek(at)?;
+        let got = self.fill(&mut buf)?;
+        buf.truncate(got);
+        Ok(buf)
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -278,7 +388,9 @@ struct PassEnd {
     /// The error that stopped it, if any: kind, reason, bytes read.
     error: Option<(DamageKind, String, u64)>,
     /// File offset just after the last record that was read whole (where the damage starts).
-    last_good: usize,
+    last_good: u64,
+    /// Whether the message limit was reached (the rest of the file is not wanted).
+    done: bool,
 }
 
 /// What a pass carries over to the next one.
@@ -289,19 +401,38 @@ struct PassState {
     stats: Option<mcap::records::Statistics>,
 }
 
-/// Opens the recording at `path`.
+/// Opens the recording at `path` and scans it once (see the module documentation).
 ///
-/// Errors only when nothing can be read: the file cannot be read, is empty, or is not MCAP
-/// (a foreign file). A truncated or corrupted MCAP file opens, with what could be read before
-/// the damage, and [`RecordingReader::damage`] set; use [`RecordingReader::require_complete`]
-/// (or [`open_complete`]) to treat that as an error.
+/// Errors only when nothing can be read: the file cannot be read, is not a regular file (a
+/// FIFO, device or socket: it could not be read twice), is empty, or is not MCAP (a foreign
+/// file). A truncated or corrupted MCAP file opens, with what could be read before the
+/// damage, and [`RecordingReader::damage`] set; use [`RecordingReader::require_complete`]
+/// (or [`open_complete`]) to treat that as an error. Memory does not grow with the file: it
+/// is read in blocks, and only its largest record (a chunk, decompressed) is held at once.
 pub fn open(path: impl AsRef<Path>) -> Result<RecordingReader, ReadError> {
+    open_with(path, &ReadOptions::default())
+}
+
+/// [`open`] with explicit [`ReadOptions`].
+pub fn open_with(
+    path: impl AsRef<Path>,
+    options: &ReadOptions,
+) -> Result<RecordingReader, ReadError> {
     let path = path.as_ref().to_path_buf();
-    let bytes = std::fs::read(&path).map_err(|source| ReadError::Io {
+    let io = |source| ReadError::Io {
         path: path.clone(),
         source,
-    })?;
-    from_bytes(path, bytes)
+    };
+    let meta = std::fs::metadata(&path).map_err(io)?;
+    if !meta.is_file() && !meta.is_dir() {
+        // a FIFO would block (or be consumed by the first read), a device never ends
+        return Err(ReadError::NotAFile { path });
+    }
+    let file = std::fs::File::open(&path).map_err(io)?;
+    // a folder opens on Linux and fails at the first read: the error names it
+    let len = file.metadata().map_err(io)?.len();
+    let mut src = BufReader::with_capacity(options.block_bytes.clamp(1, 64 << 10), file);
+    read_source(path, &mut src, len, options)
 }
 
 /// [`open`], then [`RecordingReader::require_complete`].
@@ -311,22 +442,53 @@ pub fn open_complete(path: impl AsRef<Path>) -> Result<RecordingReader, ReadErro
     Ok(r)
 }
 
-/// Reads a recording held in memory; `path` is only used in messages.
+/// Reads a recording held in memory (kept by the reader); `path` is only used in messages.
 pub fn from_bytes(path: impl Into<PathBuf>, bytes: Vec<u8>) -> Result<RecordingReader, ReadError> {
+    from_bytes_with(path, bytes, &ReadOptions::default())
+}
+
+/// [`from_bytes`] with explicit [`ReadOptions`].
+pub fn from_bytes_with(
+    path: impl Into<PathBuf>,
+    bytes: Vec<u8>,
+    options: &ReadOptions,
+) -> Result<RecordingReader, ReadError> {
     let path = path.into();
-    if bytes.is_empty() {
+    let len = bytes.len() as u64;
+    let mut src = Cursor::new(bytes);
+    let mut r = read_source(path, &mut src, len, options)?;
+    r.memory = Some(src.into_inner());
+    Ok(r)
+}
+
+/// The first scan of a recording: checks its start, then scans it whole.
+fn read_source(
+    path: PathBuf,
+    src: &mut dyn Source,
+    len: u64,
+    options: &ReadOptions,
+) -> Result<RecordingReader, ReadError> {
+    let io = |source| ReadError::Io {
+        path: path.clone(),
+        source,
+    };
+    let mut input = Input {
+        src,
+        len,
+        block: options.block_bytes.max(1),
+        stop: None,
+    };
+    let head = input.read_at(0, 24).map_err(io)?;
+    if head.is_empty() {
         return Err(ReadError::Empty { path });
     }
     let magic = mcap::MAGIC;
-    if bytes.len() < magic.len() && magic.starts_with(&bytes) {
+    if head.len() < magic.len() && magic.starts_with(&head) {
         let damage = Damage {
             kind: DamageKind::Truncated,
-            reason: format!(
-                "the file holds only {} bytes of the MCAP magic",
-                bytes.len()
-            ),
-            at_byte: bytes.len() as u64,
-            file_bytes: bytes.len() as u64,
+            reason: format!("the file holds only {} bytes of the MCAP magic", head.len()),
+            at_byte: head.len() as u64,
+            file_bytes: len,
             messages: 0,
             topics: 0,
             last_t_s: None,
@@ -339,18 +501,18 @@ pub fn from_bytes(path: impl Into<PathBuf>, bytes: Vec<u8>) -> Result<RecordingR
             damage: Box::new(damage),
         });
     }
-    if !bytes.starts_with(magic) {
+    if !head.starts_with(magic) {
         return Err(ReadError::NotMcap {
             path,
-            start: describe_start(&bytes),
+            start: describe_start(&head),
         });
     }
-    let scan = scan(&bytes, u64::MAX, &mut |v| validate(v));
+    let scan = scan(&mut input, u64::MAX, &mut |v| validate(v)).map_err(io)?;
     let damage = scan.error.as_ref().map(|(kind, reason, at)| Damage {
         kind: *kind,
         reason: reason.clone(),
         at_byte: *at,
-        file_bytes: bytes.len() as u64,
+        file_bytes: len,
         messages: scan.info.messages,
         topics: scan.info.topics.iter().filter(|t| t.messages > 0).count(),
         last_t_s: scan.info.end_s,
@@ -362,9 +524,12 @@ pub fn from_bytes(path: impl Into<PathBuf>, bytes: Vec<u8>) -> Result<RecordingR
     });
     Ok(RecordingReader {
         path,
-        bytes,
+        file_bytes: len,
+        memory: None,
+        options: *options,
         info: scan.info,
         damage,
+        reread_error: Mutex::new(None),
     })
 }
 
@@ -443,15 +608,16 @@ fn describe_mcap_error(e: &mcap::McapError, data_end: bool) -> (DamageKind, Stri
     }
 }
 
-/// Scans `bytes` (which start with the MCAP magic), calling `on_message` for each of the
+/// Scans `input` (which starts with the MCAP magic), calling `on_message` for each of the
 /// first `limit` messages. The first error of the file or of `on_message` is kept in
 /// `Scan::error`; the scan then resynchronises on the next intact chunk (see the module
-/// documentation) and reads on.
+/// documentation) and reads on. With a finite `limit` it stops once it has handed over that
+/// many messages. Errors only when the source cannot be read.
 fn scan(
-    bytes: &[u8],
+    input: &mut Input<'_>,
     limit: u64,
     on_message: &mut dyn FnMut(&MessageView<'_>) -> Result<(), String>,
-) -> Scan {
+) -> std::io::Result<Scan> {
     let mut s = Scan {
         info: RecordingInfo::default(),
         schemas: BTreeMap::new(),
@@ -462,36 +628,40 @@ fn scan(
         expected_messages: None,
     };
     let mut st = PassState::default();
-    let mut start = 0usize;
-    let mut pos = 0usize;
+    let mut start = 0u64;
+    let mut pos = 0u64;
+    let len = input.len;
     loop {
-        let end = scan_pass(bytes, start, &mut s, &mut st, limit, on_message);
+        let end = scan_pass(input, start, &mut s, &mut st, limit, on_message)?;
         pos = pos.max(end.last_good);
+        if end.done {
+            return Ok(s);
+        }
         let Some(err) = end.error else { break };
         if s.error.is_none() {
             s.error = Some(err.clone());
             // the summary section (if the footer is intact) knows every schema and channel
             // and how many messages there are
-            preload_summary(bytes, &mut s);
+            preload_summary(input, &mut s)?;
         }
         if st.data_end {
             break; // damage in the summary section: no data after it
         }
-        // resynchronise on the next plausible chunk (or metadata record) after the last good record (strictly
-        // after this pass's start, so that every pass makes progress); a pass that fails at
-        // once on it moves the search on by a byte
-        match next_chunk(bytes, end.last_good.max(start + 1)) {
+        // resynchronise on the next plausible chunk (or metadata record) after the last good
+        // record (strictly after this pass's start, so that every pass makes progress); a
+        // pass that fails at once on it moves the search on by a byte
+        match next_chunk(input, end.last_good.max(start + 1))? {
             Some(o) => {
                 if o > end.last_good {
                     s.skipped.0 += 1;
-                    s.skipped.1 += (o - end.last_good) as u64;
+                    s.skipped.1 += o - end.last_good;
                 }
                 start = o;
             }
             None => {
                 // nothing intact after the damage: the rest of the file is skipped
-                if end.last_good < bytes.len() && s.skipped.0 > 0 {
-                    s.skipped.1 += (bytes.len() - end.last_good) as u64;
+                if end.last_good < len && s.skipped.0 > 0 {
+                    s.skipped.1 += len - end.last_good;
                 }
                 break;
             }
@@ -504,11 +674,7 @@ fn scan(
     }
     if s.error.is_none() {
         if !footer {
-            s.error = Some((
-                DamageKind::Truncated,
-                "the file has no footer".into(),
-                pos as u64,
-            ));
+            s.error = Some((DamageKind::Truncated, "the file has no footer".into(), pos));
         } else if let Some(st) = &stats {
             if st.message_count != s.info.messages && limit == u64::MAX {
                 s.error = Some((
@@ -517,7 +683,7 @@ fn scan(
                         "the summary counts {} messages but the data section holds {}",
                         st.message_count, s.info.messages
                     ),
-                    pos as u64,
+                    pos,
                 ));
             }
         }
@@ -541,20 +707,23 @@ fn scan(
             last_s: if n > 0 { last as f64 * 1e-9 } else { f64::NAN },
         });
     }
-    s
+    Ok(s)
 }
 
-/// One pass of the linear reader over `bytes[start..]` (`start` = 0: the whole file, with its
-/// magic; otherwise the offset of a chunk record found by [`next_chunk`]).
+/// One pass of the linear reader over the input from `start` (0: the whole file, with its
+/// magic; otherwise the offset of a chunk record found by [`next_chunk`]), fed in blocks of
+/// at most `input.block` bytes: the reader holds one record (a chunk, decompressed) at a
+/// time, never the file.
 fn scan_pass(
-    bytes: &[u8],
-    start: usize,
+    input: &mut Input<'_>,
+    start: u64,
     s: &mut Scan,
     st: &mut PassState,
     limit: u64,
     on_message: &mut dyn FnMut(&MessageView<'_>) -> Result<(), String>,
-) -> PassEnd {
+) -> std::io::Result<PassEnd> {
     let resumed = start > 0;
+    let len = input.len;
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default()
             .with_skip_start_magic(resumed)
@@ -564,13 +733,17 @@ fn scan_pass(
             .with_validate_data_section_crc(!resumed)
             .with_validate_summary_section_crc(true)
             .with_check_finishes_after_end_magic(true)
-            .with_record_length_limit(bytes.len().max(256 << 20)),
+            .with_record_length_limit(usize::try_from(len).unwrap_or(usize::MAX).max(256 << 20)),
     );
+    input.seek(start)?;
     let mut pos = start;
     let mut last_good = start;
-    let fail = |kind, reason, pos: usize, last_good| PassEnd {
-        error: Some((kind, reason, pos as u64)),
-        last_good,
+    let fail = |kind, reason, pos: u64, last_good| {
+        Ok(PassEnd {
+            error: Some((kind, reason, pos)),
+            last_good,
+            done: false,
+        })
     };
     loop {
         let event = match reader.next_event() {
@@ -583,10 +756,12 @@ fn scan_pass(
         };
         match event {
             LinearReadEvent::ReadRequest(n) => {
-                let take = n.min(bytes.len() - pos);
-                reader.insert(take).copy_from_slice(&bytes[pos..pos + take]);
-                reader.notify_read(take);
-                pos += take;
+                // never past the size at open (a file still being written grows)
+                let rest = usize::try_from(len.saturating_sub(pos)).unwrap_or(usize::MAX);
+                let take = n.min(input.block).min(rest);
+                let got = input.fill(reader.insert(take))?;
+                reader.notify_read(got);
+                pos += got as u64;
             }
             LinearReadEvent::Record { opcode, data } => {
                 let record = match mcap::parse_record(opcode, data) {
@@ -615,75 +790,122 @@ fn scan_pass(
                     st.data_end = true;
                 }
                 last_good = pos;
+                let stopped = input.stop.is_some_and(|x| x.load(Ordering::SeqCst));
+                if stopped || (limit != u64::MAX && s.info.messages >= limit) {
+                    return Ok(PassEnd {
+                        error: None,
+                        last_good,
+                        done: true,
+                    });
+                }
             }
         }
     }
-    PassEnd {
+    Ok(PassEnd {
         error: None,
         last_good: pos,
-    }
+        done: false,
+    })
 }
+
+/// The most bytes [`plausible_chunk`] looks at: opcode, record length, the fixed chunk
+/// header, a compression name of at most 4 bytes and the compressed size.
+const CHUNK_PROBE: usize = 9 + 32 + 4 + 8;
 
 /// The offset of the first plausible chunk or metadata record at or after `from`. A chunk:
 /// the chunk opcode, then a record length that fits in the file and agrees with the chunk
 /// header's compression name (none, `zstd` or `lz4`) and compressed size; its CRC is checked
 /// when it is read. A metadata record (the run's statistics follow the last chunk): a length
-/// that fits and agrees with its name's and its map's lengths.
-fn next_chunk(bytes: &[u8], from: usize) -> Option<usize> {
+/// that fits and agrees with its name's and its map's lengths. The file is searched in
+/// windows of one block (plus the few bytes a candidate's header needs).
+fn next_chunk(input: &mut Input<'_>, from: u64) -> std::io::Result<Option<u64>> {
     use mcap::records::op;
+    let len = input.len;
+    let w = input.block;
     let mut o = from;
-    while o < bytes.len() {
-        o += bytes[o..]
-            .iter()
-            .position(|&b| b == op::CHUNK || b == op::METADATA)?;
-        let rest = &bytes[o..];
-        let ok = if rest[0] == op::CHUNK {
-            plausible_chunk(rest)
-        } else {
-            plausible_metadata(rest)
-        };
-        if ok {
-            return Some(o);
+    while o < len {
+        let win = input.read_at(o, w + CHUNK_PROBE)?;
+        if win.is_empty() {
+            break; // the source is shorter than at open
         }
-        o += 1;
+        let scan_to = win.len().min(w);
+        let mut i = 0;
+        while i < scan_to {
+            let Some(k) = win[i..scan_to]
+                .iter()
+                .position(|&b| b == op::CHUNK || b == op::METADATA)
+            else {
+                break;
+            };
+            i += k;
+            let at = o + i as u64;
+            let head = &win[i..];
+            let avail = len - at;
+            let ok = if head[0] == op::CHUNK {
+                plausible_chunk(head, avail)
+            } else {
+                plausible_metadata(input, at, head, avail)?
+            };
+            if ok {
+                return Ok(Some(at));
+            }
+            i += 1;
+        }
+        o += scan_to as u64;
     }
-    None
+    Ok(None)
 }
 
-/// Whether `rest` starts with a metadata record whose lengths agree (see [`next_chunk`]).
-fn plausible_metadata(rest: &[u8]) -> bool {
+/// Whether the record at `at` (whose first bytes are `head`, `avail` bytes left in the file)
+/// is a metadata record whose lengths agree (see [`next_chunk`]).
+fn plausible_metadata(
+    input: &mut Input<'_>,
+    at: u64,
+    head: &[u8],
+    avail: u64,
+) -> std::io::Result<bool> {
     let le32 = |b: &[u8]| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as u64;
-    if rest.len() < 9 + 8 {
-        return false;
+    if avail < 9 + 8 || head.len() < 9 + 8 {
+        return Ok(false);
     }
-    let len = u64::from_le_bytes(rest[1..9].try_into().unwrap_or([0xff; 8]));
-    if len < 8 || len > (rest.len() - 9) as u64 {
-        return false;
+    let len = u64::from_le_bytes(head[1..9].try_into().unwrap_or([0xff; 8]));
+    if len < 8 || len > avail - 9 {
+        return Ok(false);
     }
-    let body = &rest[9..9 + len as usize];
-    let name = le32(&body[0..4]);
+    let name = le32(&head[9..13]);
     if name > len - 8 {
-        return false;
+        return Ok(false);
     }
-    let n = name as usize;
-    4 + name + 4 + le32(&body[4 + n..8 + n]) == len
+    // the map's length follows the name: in the window, or read from the file
+    let map_at = 9 + 4 + name as usize;
+    let map_len = if head.len() >= map_at + 4 {
+        le32(&head[map_at..map_at + 4])
+    } else {
+        let b = input.read_at(at + map_at as u64, 4)?;
+        if b.len() < 4 {
+            return Ok(false);
+        }
+        le32(&b)
+    };
+    Ok(4 + name + 4 + map_len == len)
 }
 
-/// Whether `rest` starts with a chunk record whose lengths agree (see [`next_chunk`]).
-fn plausible_chunk(rest: &[u8]) -> bool {
+/// Whether `head` (at least [`CHUNK_PROBE`] bytes, or all `avail` bytes left in the file)
+/// starts with a chunk record whose lengths agree (see [`next_chunk`]).
+fn plausible_chunk(head: &[u8], avail: u64) -> bool {
     let le64 = |b: &[u8]| u64::from_le_bytes(b.try_into().unwrap_or([0xff; 8]));
     // opcode, record length, then the fixed chunk header: start, end, uncompressed size and
     // CRC, compression name length
-    if rest.len() < 9 + 32 {
+    if avail < 9 + 32 || head.len() < 9 + 32 {
         return false;
     }
-    let len = le64(&rest[1..9]);
-    if len > (rest.len() - 9) as u64 {
+    let len = le64(&head[1..9]);
+    if len > avail - 9 {
         return false;
     }
-    let h = &rest[9..];
+    let h = &head[9..];
     let clen = u32::from_le_bytes([h[28], h[29], h[30], h[31]]) as usize;
-    if clen > 4 || h.len() < 32 + clen + 8 {
+    if clen > 4 || avail - 9 < (32 + clen + 8) as u64 || h.len() < 32 + clen + 8 {
         return false;
     }
     if !matches!(&h[32..32 + clen], b"" | b"zstd" | b"lz4") {
@@ -694,40 +916,47 @@ fn plausible_chunk(rest: &[u8]) -> bool {
 }
 
 /// Reads the schemas, channels and statistics of the summary section, if the footer at the
-/// end of `bytes` is intact, into `s` (what the data section defined is kept), so that a
+/// end of the file is intact, into `s` (what the data section defined is kept), so that a
 /// resynchronised scan decodes chunks whose channels were defined in a lost one, and knows
-/// how many messages were lost.
-fn preload_summary(bytes: &[u8], s: &mut Scan) {
+/// how many messages were lost. The section is read record by record.
+fn preload_summary(input: &mut Input<'_>, s: &mut Scan) -> std::io::Result<()> {
     use mcap::records::op;
-    let n = bytes.len();
+    let n = input.len;
     // footer record: opcode, length 20, summary start, summary offset start, CRC; then magic
     let footer_len = 9 + 20;
-    if n < mcap::MAGIC.len() * 2 + footer_len || !bytes.ends_with(mcap::MAGIC) {
-        return;
+    let tail_len = (footer_len + mcap::MAGIC.len()) as u64;
+    if n < mcap::MAGIC.len() as u64 + tail_len {
+        return Ok(());
     }
-    let f = n - mcap::MAGIC.len() - footer_len;
-    if bytes[f] != op::FOOTER {
-        return;
+    let f = n - tail_len;
+    let tail = input.read_at(f, tail_len as usize)?;
+    if tail.len() as u64 != tail_len || !tail.ends_with(mcap::MAGIC) || tail[0] != op::FOOTER {
+        return Ok(());
     }
-    let start = u64::from_le_bytes(bytes[f + 9..f + 17].try_into().unwrap_or([0; 8]));
-    let Ok(mut p) = usize::try_from(start) else {
-        return;
-    };
+    let mut p = u64::from_le_bytes(tail[9..17].try_into().unwrap_or([0; 8]));
     if p == 0 || p >= f {
-        return;
+        return Ok(());
     }
+    input.seek(p)?;
+    let mut body = Vec::new();
     while p + 9 <= f {
-        let len = u64::from_le_bytes(bytes[p + 1..p + 9].try_into().unwrap_or([0xff; 8]));
-        let Some(end) = usize::try_from(len)
-            .ok()
-            .and_then(|l| (p + 9).checked_add(l))
-        else {
-            return;
+        let mut head = [0u8; 9];
+        if input.fill(&mut head)? < 9 {
+            return Ok(());
+        }
+        let len = u64::from_le_bytes(head[1..9].try_into().unwrap_or([0xff; 8]));
+        let Some(end) = (p + 9).checked_add(len) else {
+            return Ok(());
         };
         if end > f {
-            return;
+            return Ok(());
         }
-        match mcap::parse_record(bytes[p], &bytes[p + 9..end]) {
+        // bounded by the summary section (checked just above)
+        body.resize(len as usize, 0);
+        if input.fill(&mut body)? < body.len() {
+            return Ok(());
+        }
+        match mcap::parse_record(head[0], &body) {
             Ok(Record::Schema { header, data }) if header.id != 0 => {
                 s.schemas.entry(header.id).or_insert(SchemaRec {
                     name: header.name,
@@ -747,10 +976,11 @@ fn preload_summary(bytes: &[u8], s: &mut Scan) {
             }
             Ok(Record::Statistics(st)) => s.expected_messages = Some(st.message_count),
             Ok(_) => {}
-            Err(_) => return,
+            Err(_) => return Ok(()),
         }
         p = end;
     }
+    Ok(())
 }
 
 fn on_record(
@@ -861,7 +1091,7 @@ impl RecordingReader {
 
     /// The file's size in bytes.
     pub fn file_bytes(&self) -> u64 {
-        self.bytes.len() as u64
+        self.file_bytes
     }
 
     /// What the recording holds (as far as it could be read).
@@ -936,11 +1166,111 @@ impl RecordingReader {
         by_index.into_values().collect()
     }
 
-    /// Calls `f` for every message read at open, in file order.
-    pub fn for_each_message(&self, mut f: impl FnMut(&MessageView<'_>)) {
-        let _ = scan(&self.bytes, self.info.messages, &mut |v| {
+    /// Calls `f` for every message read at open, in file order, reading the file again.
+    ///
+    /// The file is read as at open: the messages recovered then, the damaged regions
+    /// skipped as then. It may have grown since (a run still recording appends whole chunks);
+    /// if it cannot be read again (removed, shortened, rewritten so that fewer messages are
+    /// recovered), `f` sees the messages up to the problem and the reason is kept for
+    /// [`RecordingReader::reread_error`] (which commands that must not give partial results
+    /// check), rather than returned: the series built on this method stay plain vectors.
+    /// Use [`RecordingReader::try_for_each_message`] to get the error at once.
+    pub fn for_each_message(&self, f: impl FnMut(&MessageView<'_>)) {
+        let result = self.try_for_each_message(f);
+        if let Err(e) = result {
+            let reason = match e {
+                ReadError::Reread { reason, .. } => reason,
+                other => other.to_string(),
+            };
+            if let Ok(mut slot) = self.reread_error.lock() {
+                slot.get_or_insert(reason);
+            }
+        }
+    }
+
+    /// [`RecordingReader::for_each_message`] that returns [`ReadError::Reread`] (naming the
+    /// file) when the file cannot be read again as it was at open; `f` has then seen the
+    /// messages up to the problem.
+    pub fn try_for_each_message(&self, f: impl FnMut(&MessageView<'_>)) -> Result<(), ReadError> {
+        self.for_each_message_until(None, f)
+    }
+
+    /// [`RecordingReader::try_for_each_message`] that stops after the message being handed
+    /// over once `stop` is set (a signal; not an error).
+    pub(crate) fn for_each_message_until(
+        &self,
+        stop: Option<&AtomicBool>,
+        mut f: impl FnMut(&MessageView<'_>),
+    ) -> Result<(), ReadError> {
+        let fail = |reason: String| ReadError::Reread {
+            path: self.path.clone(),
+            reason,
+        };
+        let want = self.info.messages;
+        if want == 0 {
+            return Ok(());
+        }
+        let mut seen = 0u64;
+        let mut on_message = |v: &MessageView<'_>| {
+            seen += 1;
             f(v);
             Ok(())
-        });
+        };
+        let block = self.options.block_bytes.max(1);
+        let scanned = match &self.memory {
+            Some(bytes) => {
+                let mut src = Cursor::new(bytes.as_slice());
+                let mut input = Input {
+                    src: &mut src,
+                    len: self.file_bytes,
+                    block,
+                    stop,
+                };
+                scan(&mut input, want, &mut on_message)
+            }
+            None => {
+                let file = std::fs::File::open(&self.path)
+                    .map_err(|e| fail(format!("cannot read the file again: {e}")))?;
+                let now = file
+                    .metadata()
+                    .map_err(|e| fail(format!("cannot read the file again: {e}")))?
+                    .len();
+                if now < self.file_bytes {
+                    return Err(fail(format!(
+                        "the file changed since it was opened: it holds {now} bytes, {} at open",
+                        self.file_bytes
+                    )));
+                }
+                let mut src = BufReader::with_capacity(block.min(64 << 10), file);
+                let mut input = Input {
+                    src: &mut src,
+                    len: self.file_bytes,
+                    block,
+                    stop,
+                };
+                scan(&mut input, want, &mut on_message)
+            }
+        };
+        scanned.map_err(|e| fail(format!("cannot read the file again: {e}")))?;
+        let stopped = stop.is_some_and(|x| x.load(Ordering::SeqCst));
+        if seen < want && !stopped {
+            return Err(fail(format!(
+                "the file changed since it was opened: {seen} of its {want} messages read again"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Why a [`RecordingReader::for_each_message`] (or a series built on it:
+    /// [`RecordingReader::samples`], [`RecordingReader::impacts`], ...) could not read the
+    /// file again, as [`ReadError::Reread`] naming the file; `None` if every re-read was
+    /// whole. Commands check it before they report, so that a file changed under them is an
+    /// error rather than a partial result.
+    pub fn reread_error(&self) -> Option<ReadError> {
+        let slot = self.reread_error.lock().ok()?;
+        slot.as_ref().map(|reason| ReadError::Reread {
+            path: self.path.clone(),
+            reason: reason.clone(),
+        })
     }
 }

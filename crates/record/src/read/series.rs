@@ -53,28 +53,72 @@ pub struct LoadHistory {
 
 impl RecordingReader {
     /// What each friction interface did over the recorded run ([`InterfaceStats`]), in
-    /// stack order; named `<lower>__<upper>`.
+    /// stack order; named `<lower>__<upper>`. Streams: no state is kept, only the statistics.
     ///
     /// [`InterfaceStats`]: clutchpack_analysis::InterfaceStats
     pub fn interface_stats(&self) -> Vec<clutchpack_analysis::InterfaceStats> {
-        self.interface_series()
-            .iter()
-            .map(|f| {
+        let mut by_topic: BTreeMap<&str, (usize, clutchpack_analysis::InterfaceStats)> = self
+            .interface_topics()
+            .into_iter()
+            .map(|(topic, f)| {
                 let name = crate::FrictionInterface {
-                    lower: f.lower.clone(),
-                    upper: f.upper.clone(),
+                    lower: f.lower,
+                    upper: f.upper,
                 }
                 .name();
-                let mut st = clutchpack_analysis::InterfaceStats::new(name);
-                for m in &f.states {
+                (
+                    topic,
+                    (f.index, clutchpack_analysis::InterfaceStats::new(name)),
+                )
+            })
+            .collect();
+        if by_topic.is_empty() {
+            return Vec::new();
+        }
+        self.for_each_message(|v| {
+            if v.schema_name == proto::INTERFACE_STATE {
+                if let (Some((_, st)), Ok(m)) = (
+                    by_topic.get_mut(v.topic),
+                    proto::InterfaceState::decode(v.data),
+                ) {
                     st.update(m.t_s, &m.to_sample());
                 }
-                st
-            })
-            .collect()
+            }
+        });
+        let mut out: Vec<(usize, clutchpack_analysis::InterfaceStats)> =
+            by_topic.into_values().collect();
+        out.sort_by_key(|(i, _)| *i);
+        out.into_iter().map(|(_, st)| st).collect()
     }
 
-    /// The shaft states (`/shaft`) in file order.
+    /// The friction interface topics (by topic name) with their series, states empty.
+    fn interface_topics(&self) -> BTreeMap<&str, InterfaceSeries> {
+        let mut by_topic = BTreeMap::new();
+        for t in &self.info.topics {
+            if t.schema_name == proto::INTERFACE_STATE {
+                let meta = |k: &str| t.metadata.get(k).cloned().unwrap_or_default();
+                let segment = t
+                    .topic
+                    .strip_prefix(topics::INTERFACES_PREFIX)
+                    .unwrap_or(&t.topic)
+                    .to_string();
+                by_topic.insert(
+                    t.topic.as_str(),
+                    InterfaceSeries {
+                        lower: meta("lower"),
+                        upper: meta("upper"),
+                        segment,
+                        index: meta("interface_index").parse().unwrap_or(usize::MAX),
+                        states: Vec::new(),
+                    },
+                );
+            }
+        }
+        by_topic
+    }
+
+    /// The shaft states (`/shaft`) in file order. Holds them all (one per sample): for
+    /// commands that need the whole history; [`RecordingReader::for_each_message`] streams.
     pub fn shaft_states(&self) -> Vec<proto::ShaftState> {
         let mut out = Vec::new();
         self.for_each_message(|v| {
@@ -88,27 +132,11 @@ impl RecordingReader {
     }
 
     /// Every friction interface's states, in stack order (empty for a pack without a stack).
+    /// Holds every state in memory (one pass over the file).
     pub fn interface_series(&self) -> Vec<InterfaceSeries> {
-        let mut by_topic: BTreeMap<&str, InterfaceSeries> = BTreeMap::new();
-        for t in &self.info.topics {
-            if t.schema_name == proto::INTERFACE_STATE {
-                let meta = |k: &str| t.metadata.get(k).cloned().unwrap_or_default();
-                let segment = t
-                    .topic
-                    .strip_prefix(topics::INTERFACES_PREFIX)
-                    .unwrap_or(&t.topic)
-                    .to_string();
-                by_topic.insert(
-                    &t.topic,
-                    InterfaceSeries {
-                        lower: meta("lower"),
-                        upper: meta("upper"),
-                        segment,
-                        index: meta("interface_index").parse().unwrap_or(usize::MAX),
-                        states: Vec::new(),
-                    },
-                );
-            }
+        let mut by_topic = self.interface_topics();
+        if by_topic.is_empty() {
+            return Vec::new();
         }
         self.for_each_message(|v| {
             if v.schema_name == proto::INTERFACE_STATE {
@@ -126,6 +154,8 @@ impl RecordingReader {
     }
 
     /// Every disc's spline states (and per-tooth loads when recorded), in disc-index order.
+    /// Holds them all (one per disc and sample): for commands that need the whole history
+    /// (`plot`); [`RecordingReader::for_each_message`] streams.
     pub fn disc_series(&self) -> Vec<DiscSeries> {
         let names = self.disc_names();
         let mut by_index: BTreeMap<u32, DiscSeries> = BTreeMap::new();
@@ -166,7 +196,8 @@ impl RecordingReader {
         by_index.into_values().collect()
     }
 
-    /// Each disc's per-tooth load history (t in s, load in N), in disc-index order.
+    /// Each disc's per-tooth load history (t in s, load in N), in disc-index order: what
+    /// `plot` draws, so every sample of every disc is held.
     pub fn load_histories(&self) -> Vec<LoadHistory> {
         self.disc_series()
             .into_iter()
@@ -178,33 +209,15 @@ impl RecordingReader {
             .collect()
     }
 
-    /// The impact events (`/impacts`) in file order (the order they closed).
+    /// The impact events (`/impacts`) in file order (the order they closed). Holds them all
+    /// (a few tens of bytes each: about 2000 per simulated second of a rattling 4-disc pack).
     pub fn impacts(&self) -> Vec<ImpactEvent> {
         let mut out = Vec::new();
         self.for_each_message(|v| {
             // `/discs/<segment>/impacts` repeat these per disc for plots
             if v.schema_name == proto::IMPACT && v.topic == topics::IMPACTS {
                 if let Ok(m) = proto::Impact::decode(v.data) {
-                    out.push(ImpactEvent {
-                        disc: m.disc_index as usize,
-                        t_on_s: m.t_on_s,
-                        t_peak_s: m.t_peak_s,
-                        t_off_s: m.t_off_s,
-                        flank: match proto::Flank::try_from(m.flank) {
-                            Ok(proto::Flank::DiscLeads) => Flank::DiscLeads,
-                            Ok(proto::Flank::ShaftLeads) => Flank::ShaftLeads,
-                            // unset: the sign of the load says it (eq (6))
-                            _ => {
-                                if m.peak_n > 0.0 {
-                                    Flank::DiscLeads
-                                } else {
-                                    Flank::ShaftLeads
-                                }
-                            }
-                        },
-                        v_on_m_s: m.v_on_m_s,
-                        peak_n: m.peak_n,
-                    });
+                    out.push(impact_event(&m));
                 }
             }
         });
@@ -226,7 +239,8 @@ impl RecordingReader {
 
     /// The samples, rebuilt from `/shaft` and the disc topics (the k-th message of each makes
     /// the k-th sample). A sample only partly recovered (cut by a truncation) is left out;
-    /// `tooth_loads_n` is empty unless per-tooth loads were recorded.
+    /// `tooth_loads_n` is empty unless per-tooth loads were recorded. Holds every sample
+    /// (`plot --spectrum` replays them through the fatigue collector).
     pub fn samples(&self) -> Vec<Sample> {
         let shaft = self.shaft_states();
         let discs = self.disc_series();
@@ -273,8 +287,32 @@ impl RecordingReader {
     }
 }
 
+/// An `/impacts` message as the model's impact event.
+pub(crate) fn impact_event(m: &proto::Impact) -> ImpactEvent {
+    ImpactEvent {
+        disc: m.disc_index as usize,
+        t_on_s: m.t_on_s,
+        t_peak_s: m.t_peak_s,
+        t_off_s: m.t_off_s,
+        flank: match proto::Flank::try_from(m.flank) {
+            Ok(proto::Flank::DiscLeads) => Flank::DiscLeads,
+            Ok(proto::Flank::ShaftLeads) => Flank::ShaftLeads,
+            // unset: the sign of the load says it (eq (6))
+            _ => {
+                if m.peak_n > 0.0 {
+                    Flank::DiscLeads
+                } else {
+                    Flank::ShaftLeads
+                }
+            }
+        },
+        v_on_m_s: m.v_on_m_s,
+        peak_n: m.peak_n,
+    }
+}
+
 /// The `<segment>` of `/discs/<segment>/...`.
-pub(super) fn segment_of(topic: &str) -> &str {
+pub(crate) fn segment_of(topic: &str) -> &str {
     let rest = topic.strip_prefix(topics::DISCS_PREFIX).unwrap_or(topic);
     rest.split('/').next().unwrap_or(rest)
 }
