@@ -14,6 +14,10 @@ pub(crate) trait Sink {
     fn sample(&mut self, k: u64, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]);
     /// A completed impact event.
     fn impact(&mut self, e: ImpactEvent);
+    /// The disc in `slot` at `t` (s), at a step inside its contact event, its onset or the
+    /// step that closes it, with the system's state `y` and the mode the disc had along the
+    /// step (`Observer::contact_sample`).
+    fn contact(&mut self, slot: usize, t: f64, sys: &System, y: &[f64], mode: &Option<Engagement>);
 }
 
 /// What ended an accepted step besides its length.
@@ -39,6 +43,8 @@ pub(crate) struct DiscTrack {
     rising: bool,
     /// Onset of the current event, s.
     t_on: f64,
+    /// Whether the onset's contact sample is still to be sent (at the start of the next step).
+    onset_pending: bool,
 }
 
 impl DiscTrack {
@@ -48,6 +54,7 @@ impl DiscTrack {
             last_abs: 0.0,
             rising: false,
             t_on: 0.0,
+            onset_pending: false,
         }
     }
 }
@@ -148,6 +155,7 @@ impl<'a> Stepper<'a> {
         tr.t_on = t;
         tr.last_abs = 0.0;
         tr.rising = true;
+        tr.onset_pending = true;
     }
 
     /// Restarts the integration at `(t, y)` after a change of mode or of the system.
@@ -223,6 +231,13 @@ impl<'a> Stepper<'a> {
         external: &mut impl FnMut(f64, f64, &Dense) -> Option<(f64, usize)>,
     ) -> Result<Switch, EngineError> {
         let t = self.t;
+        // The located onsets of the events opened since the last step: their first contact
+        // samples (after the grid samples up to `t`, sent by the last step).
+        for (i, tr) in self.tracks.iter_mut().enumerate() {
+            if std::mem::take(&mut tr.onset_pending) {
+                sink.contact(i, t, &self.sys, &self.y, &self.modes[i]);
+            }
+        }
         let (err, h) = loop {
             let h = self.h.min(self.max_step).min(end - t);
             self.h = h;
@@ -370,6 +385,13 @@ impl<'a> Stepper<'a> {
                 sink.sample(self.next_sample, ts, sys, buf, &self.modes);
             }
             self.next_sample += 1;
+        }
+        // Contact samples at the step's end for the discs in contact along it (this includes
+        // the step that ends on a separation: its end is the located `t_off`).
+        for i in 0..sys.ids.len() {
+            if self.modes[i].is_some() {
+                sink.contact(i, t_new, sys, &self.y_new, &self.modes[i]);
+            }
         }
 
         self.stats.steps += 1;
