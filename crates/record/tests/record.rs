@@ -817,3 +817,95 @@ fn default_tf_rate() {
         "per_tooth is off by default"
     );
 }
+
+/// Issue 13 item 3: `/discs/<name>/load` carries each disc's load at every sample and at the
+/// contact samples in between, in time order, exactly as sent; the samples read back as
+/// before (the contact samples are not samples); without `contact_samples` the topic is
+/// absent.
+#[test]
+fn contact_samples_round_trip_on_the_load_topic() {
+    let run = small();
+    // three contact samples per disc between consecutive samples, with known values
+    let contact = |k: usize, j: usize, disc: usize| -> (f64, DiscSample) {
+        let (t0, t1) = (run.samples[k - 1].t_s, run.samples[k].t_s);
+        let t = t0 + (t1 - t0) * (j + 1) as f64 / 4.0;
+        let d = DiscSample {
+            load_n: -(k as f64) * 10.0 - j as f64 - 0.25 * disc as f64,
+            rel_angle_rad: 1e-3 * k as f64 + 1e-5 * j as f64,
+            engaged: true,
+            ..Default::default()
+        };
+        (t, d)
+    };
+    let play = |rec: &mut Recorder| {
+        for (k, s) in run.samples.iter().enumerate() {
+            if k > 0 {
+                for disc in 0..2 {
+                    for j in 0..3 {
+                        let (t, d) = contact(k, j, disc);
+                        rec.contact_sample(disc, t, &d);
+                    }
+                }
+            }
+            rec.sample(s);
+            rec.interfaces(run.interfaces[k].0, &run.interfaces[k].1);
+        }
+        for e in &run.impacts {
+            rec.impact(e);
+        }
+    };
+    let path = tmp("contact_samples.mcap");
+    let mut rec = Recorder::create(&path, &run.info, &options()).unwrap();
+    play(&mut rec);
+    assert!(rec.error().is_none());
+    let path = rec.finish(None).unwrap();
+    let r = open(&path).unwrap();
+    assert_eq!(r.samples(), run.samples, "the samples are unchanged");
+    let loads = r.dense_loads();
+    assert_eq!(loads.len(), 2);
+    let n = run.samples.len();
+    for (disc, series) in loads.iter().enumerate() {
+        assert_eq!(series.len(), n + 3 * (n - 1), "disc {disc}");
+        assert!(
+            series.windows(2).all(|w| w[0].t_s <= w[1].t_s),
+            "time order"
+        );
+        let mut it = series.iter();
+        for (k, s) in run.samples.iter().enumerate() {
+            if k > 0 {
+                for j in 0..3 {
+                    let (t, d) = contact(k, j, disc);
+                    let m = it.next().unwrap();
+                    assert!(m.contact_step && m.disc_index as usize == disc);
+                    assert_eq!(
+                        (m.t_s, m.load_n, m.rel_angle_rad),
+                        (t, d.load_n, d.rel_angle_rad)
+                    );
+                }
+            }
+            let m = it.next().unwrap();
+            assert!(!m.contact_step);
+            let d = &s.discs[disc];
+            assert_eq!(
+                (m.t_s, m.load_n, m.rel_angle_rad),
+                (s.t_s, d.load_n, d.rel_angle_rad)
+            );
+        }
+    }
+    let topic = topics::load("disc_2");
+    let info = r.info().topic(&topic).expect("the load topic of `disc 2`");
+    assert_eq!(info.messages as usize, n + 3 * (n - 1));
+
+    // off: no load topic, the rest as before
+    let off = RecordOptions {
+        contact_samples: false,
+        ..options()
+    };
+    let path = tmp("contact_samples_off.mcap");
+    let mut rec = Recorder::create(&path, &run.info, &off).unwrap();
+    play(&mut rec);
+    let r = open(&rec.finish(None).unwrap()).unwrap();
+    assert!(r.dense_loads().is_empty());
+    assert!(r.info().topic(&topic).is_none());
+    assert_eq!(r.samples(), run.samples);
+}
