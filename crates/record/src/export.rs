@@ -14,13 +14,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// | --- | --- | --- |
 /// | `shaft.csv` | `/shaft` | `t_s,angle_rad,speed_rad_s` |
 /// | `spline_<segment>.csv` | `/discs/<segment>/spline` | `t_s,rel_angle_rad,closing_speed_m_s,penetration_m,load_n,torque_n_m,engaged,stiffness_n_m1_5,speed_rad_s,angle_rad` |
+/// | `load_<segment>.csv` | `/discs/<segment>/load` | `t_s,load_n,rel_angle_rad,contact_step` |
 /// | `teeth_<segment>.csv` | `/discs/<segment>/teeth` | `t_s,tooth_0_n,tooth_1_n,...` |
 /// | `interface_<segment>.csv` | `/interfaces/<segment>` | `t_s,slip_rad_s,slip_m_s,mu,clamp_n,torque_n_m,locked,dissipated_j` |
 /// | `impacts.csv` | `/impacts` | `disc,disc_index,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n` |
 /// | `summary.csv` | `/summary` | `disc,max_positive_n,max_negative_n,p99_abs_n,impacts,positive_impacts,negative_impacts,mean_top10_abs_n` |
 ///
 /// Numbers are written in Rust's shortest round-trip form (read back exactly); `engaged` is
-/// 0 or 1, as is `locked`; `flank` is `shaft_leads` or `disc_leads`. `summary.csv` holds the stored summary,
+/// 0 or 1, as are `locked` and `contact_step`; `flank` is `shaft_leads` or `disc_leads`. `summary.csv` holds the stored summary,
 /// or for a run that did not finish the one recomputed from the recovered impacts.
 /// Files of topics without messages are not written (but for the shaft, impacts and summary).
 pub fn export_csv(
@@ -107,6 +108,29 @@ pub fn export_csv_until(
             }
             put(&format!("teeth_{}.csv", d.segment), s)?;
         }
+    }
+
+    let segments: std::collections::BTreeMap<usize, String> = reader
+        .disc_series()
+        .into_iter()
+        .map(|d| (d.index, d.segment))
+        .collect();
+    for (i, series) in reader.dense_loads().iter().enumerate() {
+        let Some(segment) = segments.get(&i).filter(|_| !series.is_empty()) else {
+            continue;
+        };
+        let mut s = String::from("t_s,load_n,rel_angle_rad,contact_step\n");
+        for m in series {
+            let _ = writeln!(
+                s,
+                "{:?},{:?},{:?},{}",
+                m.t_s,
+                m.load_n,
+                m.rel_angle_rad,
+                u8::from(m.contact_step)
+            );
+        }
+        put(&format!("load_{segment}.csv"), s)?;
     }
 
     for f in reader.interface_series() {

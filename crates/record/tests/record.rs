@@ -640,6 +640,8 @@ fn csv_export() {
         "spline_disc_2.csv",
         "teeth_d1.csv",
         "teeth_disc_2.csv",
+        "load_d1.csv",
+        "load_disc_2.csv",
         "interface_d1__disc_2.csv",
         "impacts.csv",
         "summary.csv",
@@ -657,6 +659,15 @@ fn csv_export() {
         .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
         .collect();
     let want: Vec<f64> = run.samples.iter().map(|s| s.discs[1].load_n).collect();
+    assert_eq!(loads, want);
+    // the dense load series: here the samples' loads only (the synthetic run has no
+    // contact samples)
+    let text = std::fs::read_to_string(dir.join("load_disc_2.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("t_s,load_n,rel_angle_rad,contact_step"));
+    let loads: Vec<f64> = lines
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
     assert_eq!(loads, want);
     let summary = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
     assert_eq!(summary.lines().count(), 3);
