@@ -915,7 +915,7 @@ fn contact_samples_round_trip_on_the_load_topic() {
     let path = tmp("contact_samples_off.mcap");
     let mut rec = Recorder::create(&path, &run.info, &off).unwrap();
     play(&mut rec);
-    let r = open(&rec.finish(None).unwrap()).unwrap();
+    let r = open(rec.finish(None).unwrap()).unwrap();
     assert!(r.dense_loads().is_empty());
     assert!(r.info().topic(&topic).is_none());
     assert_eq!(r.samples(), run.samples);
