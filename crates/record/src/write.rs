@@ -735,7 +735,12 @@ impl Recorder {
                 disc_index: i as u32,
             };
             self.put(self.ch.spline[i], lt, &msg, "spline")?;
-            if let Some(&ch) = self.ch.load.get(i) {
+            // the samples with a load (or in a contact) and the first: in between the load
+            // is 0, which the series' line draws from a contact's closing point (0 N) to
+            // the next onset (0 N) without them
+            let first = t <= 0.0 || self.messages_on(self.ch.load.get(i)) == 0;
+            if let (Some(&ch), true) = (self.ch.load.get(i), first || d.engaged || d.load_n != 0.0)
+            {
                 let msg = proto::LoadSample {
                     t_s: t,
                     load_n: d.load_n,
@@ -860,6 +865,11 @@ impl Recorder {
             }
         }
         self.maybe_flush()
+    }
+
+    /// Messages written so far on channel `ch` (0 for `None`).
+    fn messages_on(&self, ch: Option<&u16>) -> u32 {
+        ch.and_then(|c| self.sequences.get(c)).copied().unwrap_or(0)
     }
 
     /// Writes disc `disc`'s state `d` at `t_s` (s), a step inside one of its contacts

@@ -45,7 +45,16 @@ pub(crate) struct DiscTrack {
     t_on: f64,
     /// Whether the onset's contact sample is still to be sent (at the start of the next step).
     onset_pending: bool,
+    /// Steps taken inside the current event.
+    contact_steps: u32,
 }
+
+/// Every this many steps inside a contact is sent as a contact sample (and the step that ends
+/// on the separation). The steps inside a contact are about 60 (the paper case, tolerance
+/// 1e-9) and already denser where the load bends (the error control): every second one gives
+/// about 30 points per contact, the largest within 0.5 % of the located peak (measured 0.25 %
+/// on the paper case, `tests/contact_samples.rs`), at half the recording's cost of every step.
+const CONTACT_SAMPLE_EVERY: u32 = 2;
 
 impl DiscTrack {
     fn new(id: usize) -> DiscTrack {
@@ -55,6 +64,7 @@ impl DiscTrack {
             rising: false,
             t_on: 0.0,
             onset_pending: false,
+            contact_steps: 0,
         }
     }
 }
@@ -156,6 +166,7 @@ impl<'a> Stepper<'a> {
         tr.last_abs = 0.0;
         tr.rising = true;
         tr.onset_pending = true;
+        tr.contact_steps = 0;
     }
 
     /// Restarts the integration at `(t, y)` after a change of mode or of the system.
@@ -386,11 +397,17 @@ impl<'a> Stepper<'a> {
             }
             self.next_sample += 1;
         }
-        // Contact samples at the step's end for the discs in contact along it (this includes
-        // the step that ends on a separation: its end is the located `t_off`).
+        // Contact samples at the step's end for the discs in contact along it, every
+        // CONTACT_SAMPLE_EVERY-th step and the step that ends on a separation (its end is the
+        // located `t_off`).
         for i in 0..sys.ids.len() {
             if self.modes[i].is_some() {
-                sink.contact(i, t_new, sys, &self.y_new, &self.modes[i]);
+                let tr = &mut self.tracks[i];
+                tr.contact_steps += 1;
+                let closes = event.is_some_and(|(_, j)| j == i);
+                if closes || tr.contact_steps.is_multiple_of(CONTACT_SAMPLE_EVERY) {
+                    sink.contact(i, t_new, sys, &self.y_new, &self.modes[i]);
+                }
             }
         }
 
