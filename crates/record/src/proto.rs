@@ -263,10 +263,10 @@ pub struct RunSummary {
     pub discs: Vec<DiscSummary>,
 }
 
-/// One disc's per-tooth load at one instant (topic `/discs/<name>/load`): at every regular
-/// sample and, in between, at the engine's steps inside each contact (see
-/// [`clutchpack_model::Observer::contact_sample`]), in time order, so that one plot line
-/// shows each contact pulse's shape and its peak.
+/// One disc's per-tooth load at one instant (topic `/discs/<name>/load`): at the engine's
+/// steps inside each contact (see [`clutchpack_model::Observer::contact_sample`]) and at the
+/// regular samples with a load (the first sample too; between contacts the load is 0), in
+/// time order, so that one plot line shows each contact pulse's shape and its peak.
 #[derive(Clone, PartialEq, prost::Message)]
 pub struct LoadSample {
     /// Simulated time in s.
