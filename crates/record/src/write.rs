@@ -54,8 +54,8 @@ pub struct RecordOptions {
     /// Write `/discs/<name>/load`: each disc's load at the engine's contact samples
     /// ([`Observer::contact_sample`]) and at the samples with a load (and the first; in
     /// between the load is 0), the series that shows the contact pulses and their peaks.
-    /// Default `true`: on `pack-4-rattle` over 3 s it made the file 66 % larger (23.1 MB
-    /// against 13.9 MB) and the run about 14 % longer in wall time (docs/DECISIONS.md).
+    /// Default `true`: on `pack-4-rattle` over 3 s it made the file 68 % larger (23.4 MB
+    /// against 13.9 MB) and the run about 15 % longer (docs/DECISIONS.md).
     pub contact_samples: bool,
 }
 
