@@ -5,7 +5,7 @@ use crate::common::{self, EngineArg, RunCollector, RunSummary};
 use crate::outputs::Output;
 use anyhow::{Context, Result};
 use clutchpack_analysis::{stats_table, TableFormat};
-use clutchpack_model::{ImpactEvent, InterfaceSample, Observer, Sample};
+use clutchpack_model::{DiscSample, ImpactEvent, InterfaceSample, Observer, Sample};
 use clutchpack_record::Replace;
 use clutchpack_record::{RecordOptions, Recorder, ThreadedRecorder};
 use clutchpack_scene::Override;
@@ -69,6 +69,11 @@ pub struct RunArgs {
     /// `simulation.record_per_tooth`).
     #[arg(long)]
     pub per_tooth: bool,
+    /// Do not record the dense contact samples (`/discs/<disc>/load`: each disc's load at
+    /// the samples and at the engine's steps inside every contact, the series whose plot
+    /// reaches the impact peaks); overrides `simulation.record_contact_samples`.
+    #[arg(long)]
+    pub no_contact_samples: bool,
     /// No wall-clock data in the recording: the same run gives a byte-identical file. Chunks
     /// are then cut every 100 000 messages only, not every second of wall time, so a killed
     /// deterministic run can lose more than the last second.
@@ -155,6 +160,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         let opts = RecordOptions {
             deterministic: a.deterministic,
             per_tooth: a.per_tooth || scene.simulation.record_per_tooth,
+            contact_samples: !a.no_contact_samples && scene.simulation.record_contact_samples,
             ..RecordOptions::default()
         };
         Some(
@@ -384,6 +390,12 @@ impl Observer for RunObserver {
         self.collector.interfaces(t_s, interfaces);
         if let Some(r) = &mut self.recorder {
             r.push_interfaces(t_s, interfaces);
+        }
+    }
+    fn contact_sample(&mut self, disc: usize, t_s: f64, state: &DiscSample) {
+        self.collector.contact_sample(disc, t_s, state);
+        if let Some(r) = &mut self.recorder {
+            r.push_contact_sample(disc, t_s, state);
         }
     }
     fn progress(&mut self, t_s: f64) -> bool {

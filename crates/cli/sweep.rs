@@ -300,6 +300,9 @@ impl Observer for Stoppable<'_> {
     fn interfaces(&mut self, t_s: f64, i: &[InterfaceSample]) {
         self.inner.interfaces(t_s, i);
     }
+    fn contact_sample(&mut self, disc: usize, t_s: f64, state: &clutchpack_model::DiscSample) {
+        self.inner.contact_sample(disc, t_s, state);
+    }
     fn progress(&mut self, t_s: f64) -> bool {
         self.inner.progress(t_s) || self.stop.load(Ordering::SeqCst)
     }

@@ -58,6 +58,21 @@ pub trait Observer {
     /// (engines with a stack only; interface `m` lies between stack bodies `m` and `m + 1`,
     /// see `crate::clutch`).
     fn interfaces(&mut self, _t_s: f64, _interfaces: &[InterfaceSample]) {}
+    /// The state of disc `disc` (index in [`Sample::discs`], scene order) at time `t_s` (s)
+    /// at an integration step inside one of its contact events: the dense history of the
+    /// contacts that the record-rate [`Observer::sample`]s are too sparse to resolve (a contact
+    /// lasts about as long as a sample interval). Units and signs are those of
+    /// [`DiscSample`] (`load_n` per tooth in N, negative when the shaft leads, eq (6));
+    /// `tooth_loads_n` may be empty.
+    ///
+    /// An engine sends, for each contact event (film or metal), the state at its located
+    /// onset, at accepted steps (or sub-steps, thinned to a few dozen per contact, see the
+    /// engine's docs) while it is in progress, and at the step that closes it, so that every
+    /// point lies in `[t_on_s, t_off_s]` of one of the disc's [`ImpactEvent`]s. For each disc
+    /// these calls and the disc's entries of the [`Observer::sample`]s come in non-decreasing
+    /// time order together (the calls of different discs may interleave out of time order).
+    /// They do not replace the samples: statistics and fatigue use the regular samples only.
+    fn contact_sample(&mut self, _disc: usize, _t_s: f64, _state: &DiscSample) {}
     /// Called now and then with the simulated time in s; returning `true` stops the run
     /// early and cleanly (used for Ctrl-C).
     fn progress(&mut self, _t_s: f64) -> bool {
@@ -78,6 +93,9 @@ pub struct Collector {
     pub impacts: Vec<ImpactEvent>,
     /// The friction interfaces' states with their times in s (engines with a stack).
     pub interfaces: Vec<(f64, Vec<InterfaceSample>)>,
+    /// The contact samples `(disc, t s, state)` in the order they came
+    /// ([`Observer::contact_sample`]).
+    pub contacts: Vec<(usize, f64, DiscSample)>,
 }
 
 impl Observer for Collector {
@@ -89,6 +107,9 @@ impl Observer for Collector {
     }
     fn interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
         self.interfaces.push((t_s, interfaces.to_vec()));
+    }
+    fn contact_sample(&mut self, disc: usize, t_s: f64, state: &DiscSample) {
+        self.contacts.push((disc, t_s, state.clone()));
     }
 }
 

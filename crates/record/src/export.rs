@@ -23,6 +23,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// | `shaft.csv` | `/shaft` | `t_s,angle_rad,speed_rad_s` |
 /// | `spline_<segment>.csv` | `/discs/<segment>/spline` | `t_s,rel_angle_rad,closing_speed_m_s,penetration_m,load_n,torque_n_m,engaged,stiffness_n_m1_5,speed_rad_s,angle_rad` |
 /// | `teeth_<segment>.csv` | `/discs/<segment>/teeth` | `t_s,tooth_0_n,tooth_1_n,...` |
+/// | `load_<segment>.csv` | `/discs/<segment>/load` | `t_s,load_n,rel_angle_rad,contact_step` |
 /// | `interface_<segment>.csv` | `/interfaces/<segment>` | `t_s,slip_rad_s,slip_m_s,mu,clamp_n,torque_n_m,locked,dissipated_j` |
 /// | `impacts.csv` | `/impacts` | `disc,disc_index,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n` |
 /// | `summary.csv` | `/summary` | `disc,max_positive_n,max_negative_n,p99_abs_n,impacts,positive_impacts,negative_impacts,mean_top10_abs_n` |
@@ -134,6 +135,8 @@ struct DiscFiles {
     segment: String,
     spline: Option<Csv>,
     teeth: Option<Csv>,
+    /// The dense load series (samples with a load and contact samples).
+    load: Option<Csv>,
     /// The most and fewest teeth of a per-tooth row.
     teeth_n: (usize, usize),
 }
@@ -243,6 +246,32 @@ impl<'a> Export<'a> {
                 )
                 .map_err(|e| c.error(e))
             }
+            proto::LOAD_SAMPLE => {
+                let Ok(m) = proto::LoadSample::decode(v.data) else {
+                    return Ok(());
+                };
+                let dir = self.dir;
+                let d = self.disc(m.disc_index, v.topic);
+                if d.load.is_none() {
+                    let path = dir.join(format!("load_{}.csv", d.segment));
+                    d.load = Some(Csv::create(
+                        &path,
+                        "t_s,load_n,rel_angle_rad,contact_step\n",
+                    )?);
+                }
+                let Some(c) = d.load.as_mut() else {
+                    return Ok(());
+                };
+                writeln!(
+                    c.w,
+                    "{:?},{:?},{:?},{}",
+                    m.t_s,
+                    m.load_n,
+                    m.rel_angle_rad,
+                    u8::from(m.contact_step)
+                )
+                .map_err(|e| c.error(e))
+            }
             proto::TOOTH_LOADS => {
                 let Ok(m) = proto::ToothLoads::decode(v.data) else {
                     return Ok(());
@@ -342,6 +371,7 @@ impl<'a> Export<'a> {
             segment: segment_of(topic).to_string(),
             spline: None,
             teeth: None,
+            load: None,
             teeth_n: (0, 0),
         })
     }
@@ -352,6 +382,7 @@ impl<'a> Export<'a> {
         for d in self.discs.into_values() {
             files.extend(d.spline);
             files.extend(d.teeth);
+            files.extend(d.load);
         }
         let mut interfaces: Vec<(usize, Csv)> = self
             .interfaces

@@ -36,6 +36,8 @@ pub const INTERFACE_STATE: &str = "clutchpack.InterfaceState";
 pub const IMPACT: &str = "clutchpack.Impact";
 /// Full schema name of [`RunSummary`] (topic `/summary`).
 pub const RUN_SUMMARY: &str = "clutchpack.RunSummary";
+/// Full schema name of [`LoadSample`] (topics `/discs/<name>/load`).
+pub const LOAD_SAMPLE: &str = "clutchpack.LoadSample";
 
 /// The shaft at one sample (topic `/shaft`).
 #[derive(Clone, PartialEq, prost::Message)]
@@ -259,6 +261,30 @@ pub struct RunSummary {
     /// One entry per disc, in scene order.
     #[prost(message, repeated, tag = "2")]
     pub discs: Vec<DiscSummary>,
+}
+
+/// One disc's per-tooth load at one instant (topic `/discs/<name>/load`): at the engine's
+/// steps inside each contact (see [`clutchpack_model::Observer::contact_sample`]) and at the
+/// regular samples with a load (the first sample too; between contacts the load is 0), in
+/// time order, so that one plot line shows each contact pulse's shape and its peak.
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct LoadSample {
+    /// Simulated time in s.
+    #[prost(double, tag = "1")]
+    pub t_s: f64,
+    /// Per-tooth load in N (negative when the shaft leads, Hu et al. eq (6)).
+    #[prost(double, tag = "2")]
+    pub load_n: f64,
+    /// Relative angle `phi = theta_shaft - theta_disc` in rad (positive: the shaft leads).
+    #[prost(double, tag = "3")]
+    pub rel_angle_rad: f64,
+    /// `true` for a step inside a contact, `false` for a regular sample (the same instant as
+    /// the spline topic's message).
+    #[prost(bool, tag = "4")]
+    pub contact_step: bool,
+    /// Index of the disc in the scene, from 0.
+    #[prost(uint32, tag = "5")]
+    pub disc_index: u32,
 }
 
 /// Field type in the schema tables.
@@ -598,6 +624,37 @@ pub(crate) const MESSAGES: &[MessageDef] = &[
             ),
         ],
     },
+    MessageDef {
+        name: "LoadSample",
+        doc: "One disc's per-tooth load at a regular sample or a step inside a contact, in time order. Topic /discs/<name>/load.",
+        fields: &[
+            f("t_s", 1, Double, "simulated time, s"),
+            f(
+                "load_n",
+                2,
+                Double,
+                "per-tooth load, N (negative when the shaft leads)",
+            ),
+            f(
+                "rel_angle_rad",
+                3,
+                Double,
+                "phi = theta_shaft - theta_disc, rad (positive: the shaft leads)",
+            ),
+            f(
+                "contact_step",
+                4,
+                Bool,
+                "true: a step inside a contact; false: a regular sample",
+            ),
+            f(
+                "disc_index",
+                5,
+                Uint32,
+                "index of the disc in the scene, from 0",
+            ),
+        ],
+    },
 ];
 
 fn json_name(name: &str) -> String {
@@ -866,6 +923,17 @@ mod tests {
             }
             .encode_to_vec(),
         );
+        check(
+            "LoadSample",
+            LoadSample {
+                t_s: 1.0,
+                load_n: 2.0,
+                rel_angle_rad: 3.0,
+                contact_step: true,
+                disc_index: 5,
+            }
+            .encode_to_vec(),
+        );
         let ds = DiscSummary {
             name: "a".into(),
             index: 2,
@@ -924,6 +992,7 @@ mod tests {
             INTERFACE_STATE,
             IMPACT,
             RUN_SUMMARY,
+            LOAD_SAMPLE,
         ] {
             let short = name.strip_prefix("clutchpack.").unwrap();
             assert!(MESSAGES.iter().any(|m| m.name == short), "{name}");

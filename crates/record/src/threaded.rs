@@ -3,7 +3,7 @@
 //! batch and hands full batches over a bounded channel.
 //!
 //! A [`ThreadedRecorder`] is fed by an engine's observer (`sample`, `impact`, `interfaces`,
-//! and [`ThreadedRecorder::send`] at each progress call); [`ThreadedRecorder::join`] waits
+//! `contact_sample`, and [`ThreadedRecorder::send`] at each progress call); [`ThreadedRecorder::join`] waits
 //! for everything to be written and gives the [`Recorder`] back to be finished, with the
 //! recording thread's CPU time.
 
@@ -17,6 +17,8 @@ enum ToRecorder {
     Sample(Sample),
     Impact(ImpactEvent),
     Interfaces(f64, Vec<InterfaceSample>),
+    /// `(disc, t s, state)` of a contact sample.
+    Contact(usize, f64, DiscSample),
 }
 
 /// Items per batch handed to the recording thread. Handing over every sample on its own
@@ -95,6 +97,7 @@ impl ThreadedRecorder {
                         }
                         ToRecorder::Impact(e) => rec.impact(e),
                         ToRecorder::Interfaces(t, i) => rec.interfaces(*t, i),
+                        ToRecorder::Contact(i, t, d) => rec.contact_sample(*i, *t, d),
                     }
                 }
                 // the wall-clock flush is checked once per batch
@@ -131,6 +134,29 @@ impl ThreadedRecorder {
     /// Hands the friction interfaces' states at `t_s` (s) to the recording thread (batched).
     pub fn push_interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
         self.push(ToRecorder::Interfaces(t_s, interfaces.to_vec()));
+    }
+
+    /// Hands disc `disc`'s contact sample at `t_s` (s) to the recording thread (batched;
+    /// [`Observer::contact_sample`]).
+    pub fn push_contact_sample(&mut self, disc: usize, t_s: f64, state: &DiscSample) {
+        match self.slot() {
+            Some(ToRecorder::Contact(i, t, dst)) => {
+                *i = disc;
+                *t = t_s;
+                let loads = std::mem::take(&mut dst.tooth_loads_n);
+                *dst = DiscSample {
+                    tooth_loads_n: loads,
+                    ..*state
+                };
+                dst.tooth_loads_n.clear();
+                dst.tooth_loads_n.extend_from_slice(&state.tooth_loads_n);
+            }
+            Some(other) => *other = ToRecorder::Contact(disc, t_s, state.clone()),
+            None => self
+                .batch
+                .push(ToRecorder::Contact(disc, t_s, state.clone())),
+        }
+        self.send_if_full();
     }
 
     /// Whether writing failed (the recorder's own error is given by `finish` after

@@ -48,6 +48,17 @@ pub fn disc_impacts(segment: &str) -> String {
     format!("{DISCS_PREFIX}{segment}/impacts")
 }
 
+/// `/discs/<segment>/load`, `clutchpack.LoadSample`: the disc's per-tooth load at the
+/// engine's steps inside each contact (about 30 points per contact:
+/// [`clutchpack_model::Observer::contact_sample`]) and at the samples with a load (and the
+/// first; between contacts the load is 0), in time order: the one series whose plot shows
+/// each contact pulse's shape and reaches its located peak (within 0.3 % on the paper case), where the sampled `load_n` of [`spline`] under-reads by 10-25 %. Written
+/// unless the recording was made without contact samples
+/// ([`crate::RecordOptions::contact_samples`]).
+pub fn load(segment: &str) -> String {
+    format!("{DISCS_PREFIX}{segment}/load")
+}
+
 /// `/discs/<segment>/teeth`, `clutchpack.ToothLoads`.
 pub fn teeth(segment: &str) -> String {
     format!("{DISCS_PREFIX}{segment}/teeth")

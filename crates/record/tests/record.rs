@@ -776,6 +776,8 @@ fn csv_export() {
         "spline_disc_2.csv",
         "teeth_d1.csv",
         "teeth_disc_2.csv",
+        "load_d1.csv",
+        "load_disc_2.csv",
         "interface_d1__disc_2.csv",
         "impacts.csv",
         "summary.csv",
@@ -793,6 +795,22 @@ fn csv_export() {
         .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
         .collect();
     let want: Vec<f64> = run.samples.iter().map(|s| s.discs[1].load_n).collect();
+    assert_eq!(loads, want);
+    // the dense load series: here the samples' nonzero loads only (the synthetic run has no
+    // contact samples), and the first
+    let text = std::fs::read_to_string(dir.join("load_disc_2.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("t_s,load_n,rel_angle_rad,contact_step"));
+    let loads: Vec<f64> = lines
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    let want: Vec<f64> = run
+        .samples
+        .iter()
+        .enumerate()
+        .filter(|(k, s)| *k == 0 || s.discs[1].engaged || s.discs[1].load_n != 0.0)
+        .map(|(_, s)| s.discs[1].load_n)
+        .collect();
     assert_eq!(loads, want);
     let summary = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
     assert_eq!(summary.lines().count(), 3);
@@ -1025,4 +1043,110 @@ fn impacts_are_written_in_peak_time_order() {
         }
     });
     assert!(last.contains_key(topics::IMPACTS));
+}
+
+/// Issue 13 item 3: `/discs/<name>/load` carries each disc's load at the contact samples and
+/// at the samples with a load (or engaged, or the first), in time order, exactly as sent; the
+/// samples read back as before (the contact samples are not samples); without
+/// `contact_samples` the topic is absent.
+#[test]
+fn contact_samples_round_trip_on_the_load_topic() {
+    let run = small();
+    // three contact samples per disc between consecutive samples, with known values
+    let contact = |k: usize, j: usize, disc: usize| -> (f64, DiscSample) {
+        let (t0, t1) = (run.samples[k - 1].t_s, run.samples[k].t_s);
+        let t = t0 + (t1 - t0) * (j + 1) as f64 / 4.0;
+        let d = DiscSample {
+            load_n: -(k as f64) * 10.0 - j as f64 - 0.25 * disc as f64,
+            rel_angle_rad: 1e-3 * k as f64 + 1e-5 * j as f64,
+            engaged: true,
+            ..Default::default()
+        };
+        (t, d)
+    };
+    let play = |rec: &mut Recorder| {
+        for (k, s) in run.samples.iter().enumerate() {
+            if k > 0 {
+                for disc in 0..2 {
+                    for j in 0..3 {
+                        let (t, d) = contact(k, j, disc);
+                        rec.contact_sample(disc, t, &d);
+                    }
+                }
+            }
+            rec.sample(s);
+            rec.interfaces(run.interfaces[k].0, &run.interfaces[k].1);
+        }
+        for e in &run.impacts {
+            rec.impact(e);
+        }
+    };
+    let path = tmp("contact_samples.mcap");
+    let mut rec = Recorder::create(&path, &run.info, &options()).unwrap();
+    play(&mut rec);
+    assert!(rec.error().is_none());
+    let path = rec.finish(None).unwrap();
+    let r = open(&path).unwrap();
+    assert_eq!(r.samples(), run.samples, "the samples are unchanged");
+    let loads = r.dense_loads();
+    assert_eq!(loads.len(), 2);
+    let n = run.samples.len();
+    let written = |s: &Sample, disc: usize| {
+        let d = &s.discs[disc];
+        s.t_s == 0.0 || d.engaged || d.load_n != 0.0
+    };
+    let mut counts = Vec::new();
+    for (disc, series) in loads.iter().enumerate() {
+        let regular = run.samples.iter().filter(|s| written(s, disc)).count();
+        assert!(
+            regular > 1 && regular < n,
+            "disc {disc}: {regular} of {n}: some loads are 0"
+        );
+        assert_eq!(series.len(), regular + 3 * (n - 1), "disc {disc}");
+        counts.push(series.len());
+        assert!(
+            series.windows(2).all(|w| w[0].t_s <= w[1].t_s),
+            "time order"
+        );
+        let mut it = series.iter();
+        for (k, s) in run.samples.iter().enumerate() {
+            if k > 0 {
+                for j in 0..3 {
+                    let (t, d) = contact(k, j, disc);
+                    let m = it.next().unwrap();
+                    assert!(m.contact_step && m.disc_index as usize == disc);
+                    assert_eq!(
+                        (m.t_s, m.load_n, m.rel_angle_rad),
+                        (t, d.load_n, d.rel_angle_rad)
+                    );
+                }
+            }
+            if !written(s, disc) {
+                continue;
+            }
+            let m = it.next().unwrap();
+            assert!(!m.contact_step);
+            let d = &s.discs[disc];
+            assert_eq!(
+                (m.t_s, m.load_n, m.rel_angle_rad),
+                (s.t_s, d.load_n, d.rel_angle_rad)
+            );
+        }
+    }
+    let topic = topics::load("disc_2");
+    let info = r.info().topic(&topic).expect("the load topic of `disc 2`");
+    assert_eq!(info.messages as usize, counts[1]);
+
+    // off: no load topic, the rest as before
+    let off = RecordOptions {
+        contact_samples: false,
+        ..options()
+    };
+    let path = tmp("contact_samples_off.mcap");
+    let mut rec = Recorder::create(&path, &run.info, &off).unwrap();
+    play(&mut rec);
+    let r = open(rec.finish(None).unwrap()).unwrap();
+    assert!(r.dense_loads().is_empty());
+    assert!(r.info().topic(&topic).is_none());
+    assert_eq!(r.samples(), run.samples);
 }

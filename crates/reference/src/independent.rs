@@ -19,6 +19,8 @@ struct Buffer {
     samples: VecDeque<(u64, DiscSample)>,
     /// Impacts in the order they closed.
     impacts: Vec<ImpactEvent>,
+    /// `(t s, the disc's state)` of its contact samples, in order.
+    contacts: VecDeque<(f64, DiscSample)>,
 }
 
 impl Sink for Buffer {
@@ -28,6 +30,24 @@ impl Sink for Buffer {
     }
     fn impact(&mut self, e: ImpactEvent) {
         self.impacts.push(e);
+    }
+    fn contact(&mut self, slot: usize, t: f64, sys: &System, y: &[f64], mode: &Option<Engagement>) {
+        self.contacts
+            .push_back((t, sys.disc_sample(t, slot, y, mode)));
+    }
+}
+
+/// Sends the contact samples of every disc up to `t` (s) inclusive, disc by disc (each in
+/// time order; `Observer::contact_sample`).
+fn send_contacts(runs: &mut [DiscRun], t: f64, obs: &mut dyn Observer) {
+    for (i, r) in runs.iter_mut().enumerate() {
+        while let Some((tc, _)) = r.out.contacts.front() {
+            if *tc > t {
+                break;
+            }
+            let (tc, d) = r.out.contacts.pop_front().expect("a front");
+            obs.contact_sample(i, tc, &d);
+        }
     }
 }
 
@@ -150,6 +170,8 @@ pub(crate) fn run(
                 obs.impact(&pending[next_impact]);
                 next_impact += 1;
             }
+            // each disc's contact samples up to this sample first: one time order per disc
+            send_contacts(&mut runs, ts, obs);
             sample.t_s = ts;
             sample.shaft_angle_rad = shaft.angle(ts);
             sample.shaft_speed_rad_s = shaft.speed(ts);
@@ -161,6 +183,8 @@ pub(crate) fn run(
             obs.sample(&sample);
             next_k += 1;
         }
+        // the contact samples before the next sample (which the next window sends)
+        send_contacts(&mut runs, limit.min(next_k as f64 / rate).next_down(), obs);
         while next_impact < pending.len() && pending[next_impact].t_off_s <= limit {
             obs.impact(&pending[next_impact]);
             next_impact += 1;
@@ -178,6 +202,7 @@ pub(crate) fn run(
     for e in &pending {
         obs.impact(e);
     }
+    send_contacts(&mut runs, f64::INFINITY, obs);
     let mut stats = RunStats::default();
     for r in runs.iter_mut() {
         let mut rest = Buffer::default();

@@ -254,6 +254,10 @@ impl Sink for ObserverSink<'_> {
     fn impact(&mut self, e: ImpactEvent) {
         self.obs.impact(&e);
     }
+    fn contact(&mut self, slot: usize, t: f64, sys: &System, y: &[f64], mode: &Option<Engagement>) {
+        let d = sys.disc_sample(t, slot, y, mode);
+        self.obs.contact_sample(sys.ids[slot], t, &d);
+    }
 }
 
 /// No events outside the system.

@@ -14,6 +14,10 @@ pub(crate) trait Sink {
     fn sample(&mut self, k: u64, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]);
     /// A completed impact event.
     fn impact(&mut self, e: ImpactEvent);
+    /// The disc in `slot` at `t` (s), at a step inside its contact event, its onset or the
+    /// step that closes it, with the system's state `y` and the mode the disc had along the
+    /// step (`Observer::contact_sample`).
+    fn contact(&mut self, slot: usize, t: f64, sys: &System, y: &[f64], mode: &Option<Engagement>);
 }
 
 /// What ended an accepted step besides its length.
@@ -39,7 +43,26 @@ pub(crate) struct DiscTrack {
     rising: bool,
     /// Onset of the current event, s.
     t_on: f64,
+    /// Whether the onset's contact sample is still to be sent (at the start of the next step).
+    onset_pending: bool,
+    /// Steps taken inside the current event.
+    contact_steps: u32,
+    /// Time of the last contact sample sent, s.
+    last_contact_t: f64,
+    /// Whether the end of the current step goes out as a contact sample whatever the thinning
+    /// (the load's maximum lies in this step or the last).
+    contact_due: bool,
 }
+
+/// Every this many steps inside a contact is sent as a contact sample, and the step that ends
+/// on the separation, and both ends of the steps around the load's maximum (the step where
+/// `|F|` stops rising and the one before). The steps inside a contact are about 60 (the
+/// paper case, tolerance 1e-9) and already denser where the load bends (the error control):
+/// every second one gives about 30 points per contact at half the recording's cost of every
+/// step, and the steps around the peak keep its largest point as close to the located peak
+/// as every step would (measured 0.13 % on the paper case, `tests/contact_samples.rs`;
+/// grazing film contacts of `pack-4-rattle` with 8 steps in all were 2.8 % low without them).
+const CONTACT_SAMPLE_EVERY: u32 = 2;
 
 impl DiscTrack {
     fn new(id: usize) -> DiscTrack {
@@ -48,6 +71,10 @@ impl DiscTrack {
             last_abs: 0.0,
             rising: false,
             t_on: 0.0,
+            onset_pending: false,
+            contact_steps: 0,
+            last_contact_t: f64::NEG_INFINITY,
+            contact_due: false,
         }
     }
 }
@@ -148,6 +175,9 @@ impl<'a> Stepper<'a> {
         tr.t_on = t;
         tr.last_abs = 0.0;
         tr.rising = true;
+        tr.onset_pending = true;
+        tr.contact_steps = 0;
+        tr.contact_due = false;
     }
 
     /// Restarts the integration at `(t, y)` after a change of mode or of the system.
@@ -223,6 +253,14 @@ impl<'a> Stepper<'a> {
         external: &mut impl FnMut(f64, f64, &Dense) -> Option<(f64, usize)>,
     ) -> Result<Switch, EngineError> {
         let t = self.t;
+        // The located onsets of the events opened since the last step: their first contact
+        // samples (after the grid samples up to `t`, sent by the last step).
+        for (i, tr) in self.tracks.iter_mut().enumerate() {
+            if std::mem::take(&mut tr.onset_pending) {
+                sink.contact(i, t, &self.sys, &self.y, &self.modes[i]);
+                tr.last_contact_t = t;
+            }
+        }
         let (err, h) = loop {
             let h = self.h.min(self.max_step).min(end - t);
             self.h = h;
@@ -351,6 +389,13 @@ impl<'a> Stepper<'a> {
                 });
                 tr.tracker.observe(tp, fp);
                 tr.rising = false;
+                // The steps around the peak: the last step's end if the thinning skipped it
+                // (before this step's grid samples, so in time order) and this step's end.
+                if t > tr.last_contact_t {
+                    sink.contact(i, t, sys, &self.y, mode);
+                    tr.last_contact_t = t;
+                }
+                tr.contact_due = true;
             } else if f_new.abs() >= tr.last_abs {
                 tr.rising = true;
             }
@@ -370,6 +415,21 @@ impl<'a> Stepper<'a> {
                 sink.sample(self.next_sample, ts, sys, buf, &self.modes);
             }
             self.next_sample += 1;
+        }
+        // Contact samples at the step's end for the discs in contact along it, every
+        // CONTACT_SAMPLE_EVERY-th step and the step that ends on a separation (its end is the
+        // located `t_off`).
+        for i in 0..sys.ids.len() {
+            if self.modes[i].is_some() {
+                let tr = &mut self.tracks[i];
+                tr.contact_steps += 1;
+                let closes = event.is_some_and(|(_, j)| j == i);
+                let due = std::mem::take(&mut tr.contact_due);
+                if closes || due || tr.contact_steps.is_multiple_of(CONTACT_SAMPLE_EVERY) {
+                    sink.contact(i, t_new, sys, &self.y_new, &self.modes[i]);
+                    tr.last_contact_t = t_new;
+                }
+            }
         }
 
         self.stats.steps += 1;

@@ -89,6 +89,8 @@ table! {
         max_step_s: "s", Kind::Number(Rule::Bounded { floor: MIN_MAX_STEP_S, ceil: f64::INFINITY }), Dflt::Num(1e-4);
         /// record per-tooth loads where the engine resolves teeth
         record_per_tooth: "", Kind::Bool, Dflt::Bool(false);
+        /// record each disc's load at the engine's steps inside every contact too (/discs/<disc>/load: the plotted pulses reach the impact peaks)
+        record_contact_samples: "", Kind::Bool, Dflt::Bool(true);
     }
     children {}
 }

@@ -29,6 +29,7 @@
 //! tolerance = 1e-9              # optional
 //! max_step_s = 1e-4             # optional
 //! record_per_tooth = false     # optional
+//! record_contact_samples = true # optional
 //!
 //! [shaft]
 //! mode = "prescribed"           # default; or "inertial" with inertia_kg_m2 (required),
@@ -198,6 +199,9 @@ pub struct Simulation {
     /// Whether recordings store per-tooth loads where the engine resolves teeth. Key
     /// `simulation.record_per_tooth`.
     pub record_per_tooth: bool,
+    /// Whether recordings store each disc's load at the engine's steps inside its contacts
+    /// (`/discs/<disc>/load`). Key `simulation.record_contact_samples`.
+    pub record_contact_samples: bool,
 }
 
 /// A validated scene: everything an engine needs, in SI units.

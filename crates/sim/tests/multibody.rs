@@ -481,6 +481,7 @@ fn engine_follows_the_scene() {
             tolerance: 1e-9,
             max_step_s: 2e-5,
             record_per_tooth: true,
+            record_contact_samples: true,
         },
         pack: paper_pack(LawKind::Paper, 25e-6, 0.8, 0.01),
         fatigue: vec![],

@@ -196,6 +196,26 @@ impl RecordingReader {
         by_index.into_values().collect()
     }
 
+    /// Each disc's dense load series (`/discs/<name>/load`: the samples' loads and, in
+    /// between, the contact samples', in file order, which is time order), indexed by disc
+    /// index (empty for a disc without the topic, e.g. a recording made without contact
+    /// samples). [`Self::samples`] and [`Self::load_histories`] do not include them.
+    pub fn dense_loads(&self) -> Vec<Vec<proto::LoadSample>> {
+        let mut out: Vec<Vec<proto::LoadSample>> = Vec::new();
+        self.for_each_message(|v| {
+            if v.schema_name == proto::LOAD_SAMPLE {
+                if let Ok(m) = proto::LoadSample::decode(v.data) {
+                    let i = m.disc_index as usize;
+                    if out.len() <= i {
+                        out.resize(i + 1, Vec::new());
+                    }
+                    out[i].push(m);
+                }
+            }
+        });
+        out
+    }
+
     /// Each disc's per-tooth load history (t in s, load in N), in disc-index order: what
     /// `plot` draws, so every sample of every disc is held.
     pub fn load_histories(&self) -> Vec<LoadHistory> {

@@ -30,6 +30,12 @@ pub(super) fn simulation(ck: &mut Checker, raw: Option<&S>) -> Option<Simulation
     let per_tooth = ck
         .boolean(&S::record_per_tooth.rel(), r.record_per_tooth.as_ref())
         .or(S::record_per_tooth.default_bool());
+    let contact_samples = ck
+        .boolean(
+            &S::record_contact_samples.rel(),
+            r.record_contact_samples.as_ref(),
+        )
+        .or(S::record_contact_samples.default_bool());
     // Every sample is emitted to the observers (and recorded): their number is bounded.
     if let (Some(d), Some(f)) = (duration, rate) {
         let samples = d * f;
@@ -58,5 +64,6 @@ pub(super) fn simulation(ck: &mut Checker, raw: Option<&S>) -> Option<Simulation
         tolerance: tolerance?,
         max_step_s: max_step?,
         record_per_tooth: per_tooth?,
+        record_contact_samples: contact_samples?,
     })
 }

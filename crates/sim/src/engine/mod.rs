@@ -414,6 +414,7 @@ impl MultibodyEngine {
         let mut rec_index: u64 = 0;
         let mut counts = multirate::Counts::default();
         let mut closed = Vec::new();
+        let mut contacts = Vec::new();
         let mut steps: u64 = 0;
         let mut stopped = false;
         // The state at t = 0, as the shared step reads it.
@@ -436,11 +437,17 @@ impl MultibodyEngine {
             }
             let t1 = world_step_end(run.t, a.max_step_s, rec_time(rec_index), duration_s);
             run.read_relative_states();
-            run.multirate_step(t1, &a, &mut counts, &mut closed)?;
+            run.multirate_step(t1, &a, &mut counts, &mut closed, &mut contacts)?;
             // Events in the order they closed across the couplings.
             closed.sort_by(|x, y| x.t_off_s.total_cmp(&y.t_off_s));
             for e in closed.drain(..) {
                 observer.impact(&e);
+            }
+            // The sub-steps' contact samples, all in (t, t1], before the sample at t1; a
+            // stable sort keeps each coupling's order and interleaves the couplings in time.
+            contacts.sort_by(|x, y| x.1.total_cmp(&y.1));
+            for (i, t, s) in contacts.drain(..) {
+                observer.contact_sample(i, t, &s);
             }
             steps += 1;
         }

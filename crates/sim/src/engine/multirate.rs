@@ -3,11 +3,11 @@
 //! its own contact-aware sub-steps; the tooth impulse of the step is handed to the disc's
 //! rapier body, which carries the disc's state from one world step to the next.
 
-use super::state::{relative_state, Run, ShaftDrive};
+use super::state::{disc_sample, relative_state, Run, ShaftDrive};
 use crate::hook::{Coupling, CouplingForces, RelativeState, FLANKS};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use crate::stepping::{bracketed_root, contact_duration_s, coupling_step, CouplingView};
-use clutchpack_model::{EngineError, ImpactEvent, PackModel, Shaft, SpeedProfile};
+use clutchpack_model::{DiscSample, EngineError, ImpactEvent, PackModel, Shaft, SpeedProfile};
 use rapier3d_f64::prelude::{Rotation, Vector};
 
 /// Why the multirate scheme cannot run this pack with these options (`None`: it can).
@@ -190,13 +190,16 @@ impl<'a> Run<'a> {
     /// Advances the run from `t` to `t1` by the multirate scheme: every coupling sub-steps its
     /// relative motion over `[t, t1]`, then the rapier world takes one step of `t1 - t` with
     /// each disc's tooth impulse. Impact events that closed go to `closed` (in the order they
-    /// closed within each coupling).
+    /// closed within each coupling), the contact samples `(coupling, t s, state)` of the
+    /// sub-steps to `contacts` (in time order within each coupling; see
+    /// `EventTrack::contact_sample_due`).
     pub(super) fn multirate_step(
         &mut self,
         t1: f64,
         a: &AdaptiveStepping,
         counts: &mut Counts,
         closed: &mut Vec<ImpactEvent>,
+        contacts: &mut Vec<(usize, f64, DiscSample)>,
     ) -> Result<(), EngineError> {
         let t0 = self.t;
         let h = t1 - t0;
@@ -207,7 +210,7 @@ impl<'a> Run<'a> {
         self.potential_j = 0.0;
         for i in 0..self.couplings.len() {
             let phi0 = self.rel[i].phi;
-            self.integrate_coupling(i, t1, a, counts, closed)?;
+            self.integrate_coupling(i, t1, a, counts, closed, contacts)?;
             let (phi1, dphi1) = (self.rel[i].phi, self.rel[i].dphi);
             self.omega_d[i] = omega_s1 - dphi1;
             self.potential_j += self.forces[i].potential_j;
@@ -270,6 +273,7 @@ impl<'a> Run<'a> {
         a: &AdaptiveStepping,
         counts: &mut Counts,
         closed: &mut Vec<ImpactEvent>,
+        contacts: &mut Vec<(usize, f64, DiscSample)>,
     ) -> Result<(), EngineError> {
         let d = self.bodies[i];
         let profile = self.profile();
@@ -396,8 +400,19 @@ impl<'a> Run<'a> {
             self.rel[i] = rel_state;
             let steps_per_contact = a.steps_per_contact;
             let step_of = |v| contact_duration_s(&d.law, f.kin.flank, v, m_eff) / steps_per_contact;
-            if let Some(e) = self.tracks[i].update(t, &f, step_of) {
+            let was_open = self.tracks[i].tracker.is_open();
+            let ended = self.tracks[i].update(t, &f, step_of);
+            if let Some(e) = ended {
                 closed.push(e);
+            }
+            if self.tracks[i].contact_sample_due(t, was_open, steps_per_contact) {
+                let omega_d = shaft.speed - dphi;
+                contacts.push((
+                    i,
+                    // the closing state at the separation (`contact_sample_due`)
+                    ended.map_or(t, |e| e.t_off_s),
+                    disc_sample(&f, &rel_state, shaft.angle, omega_d, Vec::new()),
+                ));
             }
         }
         Ok(())

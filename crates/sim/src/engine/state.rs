@@ -289,28 +289,48 @@ impl<'a> Run<'a> {
             shaft_angle_rad: self.theta_s,
             shaft_speed_rad_s: self.omega_s,
             discs: (0..self.forces.len())
-                .map(|i| {
-                    let f = &self.forces[i];
-                    let phi = self.rel[i].phi;
-                    DiscSample {
-                        angle_rad: self.carrier_angle(i) - phi,
-                        speed_rad_s: self.omega_d[i],
-                        rel_angle_rad: phi,
-                        penetration_m: f.kin.delta_m,
-                        closing_speed_m_s: f.kin.v_n_m_s,
-                        load_n: f.load_n,
-                        torque_n_m: f.moment[2],
-                        engaged: f.depth_m > 0.0,
-                        stiffness: f.stiffness,
-                        tooth_loads_n: if tooth_loads {
-                            self.couplings[i].tooth_loads_n()
-                        } else {
-                            Vec::new()
-                        },
-                        center_offset_m: self.rel[i].offset,
-                    }
-                })
+                .map(|i| self.disc_sample(i, tooth_loads))
                 .collect(),
         }
+    }
+
+    /// Coupling `i`'s state at `t` (per-tooth loads only when `tooth_loads`).
+    pub(super) fn disc_sample(&self, i: usize, tooth_loads: bool) -> DiscSample {
+        let tooth_loads_n = if tooth_loads {
+            self.couplings[i].tooth_loads_n()
+        } else {
+            Vec::new()
+        };
+        disc_sample(
+            &self.forces[i],
+            &self.rel[i],
+            self.carrier_angle(i),
+            self.omega_d[i],
+            tooth_loads_n,
+        )
+    }
+}
+
+/// A coupling's state: its forces `f`, relative state `rel`, the carrier's angle (rad), the
+/// disc's speed (rad/s) and the per-tooth loads (N, empty when not resolved or not asked).
+pub(super) fn disc_sample(
+    f: &CouplingForces,
+    rel: &RelativeState,
+    carrier_angle_rad: f64,
+    omega_d_rad_s: f64,
+    tooth_loads_n: Vec<f64>,
+) -> DiscSample {
+    DiscSample {
+        angle_rad: carrier_angle_rad - rel.phi,
+        speed_rad_s: omega_d_rad_s,
+        rel_angle_rad: rel.phi,
+        penetration_m: f.kin.delta_m,
+        closing_speed_m_s: f.kin.v_n_m_s,
+        load_n: f.load_n,
+        torque_n_m: f.moment[2],
+        engaged: f.depth_m > 0.0,
+        stiffness: f.stiffness,
+        tooth_loads_n,
+        center_offset_m: rel.offset,
     }
 }
