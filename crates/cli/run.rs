@@ -398,6 +398,13 @@ impl Observer for RunObserver {
             r.push_contact_sample(disc, t_s, state);
         }
     }
+    fn wants_contact_samples(&self) -> bool {
+        self.collector.wants_contact_samples()
+            || self
+                .recorder
+                .as_ref()
+                .is_some_and(ThreadedRecorder::wants_contact_samples)
+    }
     fn progress(&mut self, t_s: f64) -> bool {
         let mut stop = self.collector.progress(t_s);
         if let Some(r) = &mut self.recorder {

@@ -303,6 +303,9 @@ impl Observer for Stoppable<'_> {
     fn contact_sample(&mut self, disc: usize, t_s: f64, state: &clutchpack_model::DiscSample) {
         self.inner.contact_sample(disc, t_s, state);
     }
+    fn wants_contact_samples(&self) -> bool {
+        self.inner.wants_contact_samples()
+    }
     fn progress(&mut self, t_s: f64) -> bool {
         self.inner.progress(t_s) || self.stop.load(Ordering::SeqCst)
     }

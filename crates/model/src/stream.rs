@@ -73,6 +73,12 @@ pub trait Observer {
     /// time order together (the calls of different discs may interleave out of time order).
     /// They do not replace the samples: statistics and fatigue use the regular samples only.
     fn contact_sample(&mut self, _disc: usize, _t_s: f64, _state: &DiscSample) {}
+    /// Whether this observer takes [`Observer::contact_sample`]s; engines build and buffer
+    /// them only then (asked once, at the start of a run). Default `false`: statistics,
+    /// sweeps and benches run without their cost.
+    fn wants_contact_samples(&self) -> bool {
+        false
+    }
     /// Called now and then with the simulated time in s; returning `true` stops the run
     /// early and cleanly (used for Ctrl-C).
     fn progress(&mut self, _t_s: f64) -> bool {
@@ -110,6 +116,9 @@ impl Observer for Collector {
     }
     fn contact_sample(&mut self, disc: usize, t_s: f64, state: &DiscSample) {
         self.contacts.push((disc, t_s, state.clone()));
+    }
+    fn wants_contact_samples(&self) -> bool {
+        true
     }
 }
 

@@ -48,6 +48,8 @@ pub struct ThreadedRecorder {
     /// items of `batch` in use; those beyond are spare buffers
     len: usize,
     failed: Arc<AtomicBool>,
+    /// the recorder's `Observer::wants_contact_samples`
+    wants_contacts: bool,
     /// gives back the recorder and the thread's CPU time in s
     handle: std::thread::JoinHandle<(Recorder, f64)>,
 }
@@ -84,6 +86,7 @@ impl ThreadedRecorder {
         let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<ToRecorder>>(QUEUED_BATCHES);
         let (back_tx, back) = std::sync::mpsc::channel::<Vec<ToRecorder>>();
         let failed = Arc::new(AtomicBool::new(false));
+        let wants_contacts = rec.wants_contact_samples();
         let flag = failed.clone();
         let worker = move || {
             let cpu = cpu_time::ThreadTime::try_now().ok();
@@ -122,6 +125,7 @@ impl ThreadedRecorder {
             batch: Vec::with_capacity(BATCH),
             len: 0,
             failed,
+            wants_contacts,
             handle,
         }
     }
@@ -134,6 +138,13 @@ impl ThreadedRecorder {
     /// Hands the friction interfaces' states at `t_s` (s) to the recording thread (batched).
     pub fn push_interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
         self.push(ToRecorder::Interfaces(t_s, interfaces.to_vec()));
+    }
+
+    /// Whether the recorder takes contact samples ([`RecordOptions::contact_samples`]).
+    ///
+    /// [`RecordOptions::contact_samples`]: crate::RecordOptions::contact_samples
+    pub fn wants_contact_samples(&self) -> bool {
+        self.wants_contacts
     }
 
     /// Hands disc `disc`'s contact sample at `t_s` (s) to the recording thread (batched;

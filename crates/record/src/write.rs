@@ -1178,6 +1178,11 @@ impl Observer for Recorder {
         }
     }
 
+    /// With [`RecordOptions::contact_samples`].
+    fn wants_contact_samples(&self) -> bool {
+        self.options.contact_samples
+    }
+
     /// Flushes when the wall-clock interval has passed; returns `true` (stop the run) once
     /// writing has failed.
     fn progress(&mut self, _t_s: f64) -> bool {

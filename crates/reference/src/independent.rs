@@ -21,6 +21,8 @@ struct Buffer {
     impacts: Vec<ImpactEvent>,
     /// `(t s, the disc's state)` of its contact samples, in order.
     contacts: VecDeque<(f64, DiscSample)>,
+    /// Whether the observer takes contact samples (else none are kept).
+    wants_contacts: bool,
 }
 
 impl Sink for Buffer {
@@ -32,6 +34,9 @@ impl Sink for Buffer {
         self.impacts.push(e);
     }
     fn contact(&mut self, slot: usize, t: f64, sys: &System, y: &[f64], mode: &Option<Engagement>) {
+        if !self.wants_contacts {
+            return;
+        }
         self.contacts
             .push_back((t, sys.disc_sample(t, slot, y, mode)));
     }
@@ -97,10 +102,14 @@ pub(crate) fn run(
     obs: &mut dyn Observer,
 ) -> Result<RunStats, EngineError> {
     let nd = pack.discs.len();
+    let wants_contacts = obs.wants_contact_samples();
     let mut runs: Vec<DiscRun> = (0..nd)
         .map(|i| DiscRun {
             stepper: Stepper::new(System::new(pack, vec![i]), settings),
-            out: Buffer::default(),
+            out: Buffer {
+                wants_contacts,
+                ..Buffer::default()
+            },
             error: None,
         })
         .collect();

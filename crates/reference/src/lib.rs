@@ -255,6 +255,9 @@ impl Sink for ObserverSink<'_> {
         self.obs.impact(&e);
     }
     fn contact(&mut self, slot: usize, t: f64, sys: &System, y: &[f64], mode: &Option<Engagement>) {
+        if !self.obs.wants_contact_samples() {
+            return;
+        }
         let d = sys.disc_sample(t, slot, y, mode);
         self.obs.contact_sample(sys.ids[slot], t, &d);
     }

@@ -48,6 +48,9 @@ impl Observer for Ordered {
         self.at(disc, t_s, "contact sample");
         self.c.contact_sample(disc, t_s, state);
     }
+    fn wants_contact_samples(&self) -> bool {
+        true
+    }
 }
 
 fn run(pack: PackModel, scheme: Scheme, duration: f64) -> Collector {
@@ -169,4 +172,38 @@ fn multi_disc_contact_samples_reach_the_located_peaks() {
         "inertial: {} impacts, worst {worst:.2e}, {per:.1} points per contact",
         c.impacts.len()
     );
+}
+
+/// Collects like [`Collector`] but does not ask for contact samples.
+#[derive(Default)]
+struct NotAsking(Collector);
+
+impl Observer for NotAsking {
+    fn sample(&mut self, s: &Sample) {
+        self.0.sample(s);
+    }
+    fn impact(&mut self, e: &ImpactEvent) {
+        self.0.impact(e);
+    }
+    fn contact_sample(&mut self, disc: usize, t_s: f64, state: &DiscSample) {
+        self.0.contact_sample(disc, t_s, state);
+    }
+}
+
+/// An observer that does not ask for contact samples (`wants_contact_samples`, false by
+/// default: statistics, sweeps, benches) gets none, and exactly the samples and impacts of
+/// one that asks: the contact samples are extra output, never a change of the integration.
+#[test]
+fn contact_samples_only_when_asked() {
+    let pack = staggered_pack(4);
+    for scheme in [Scheme::Multirate, Scheme::Monolithic] {
+        let asked = run(pack.clone(), scheme, 0.05);
+        let mut e = ReferenceEngine::new(pack.clone(), Settings::default()).with_scheme(scheme);
+        let mut plain = NotAsking::default();
+        e.run(0.05, &mut plain).unwrap();
+        assert!(!asked.contacts.is_empty(), "{scheme:?}");
+        assert!(plain.0.contacts.is_empty(), "{scheme:?}");
+        assert_eq!(plain.0.samples, asked.samples, "{scheme:?}");
+        assert_eq!(plain.0.impacts, asked.impacts, "{scheme:?}");
+    }
 }

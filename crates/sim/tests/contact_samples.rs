@@ -48,6 +48,9 @@ impl Observer for Ordered {
         self.at(disc, t_s, "contact sample");
         self.c.contact_sample(disc, t_s, state);
     }
+    fn wants_contact_samples(&self) -> bool {
+        true
+    }
 }
 
 fn run(pack: PackModel, scheme: Scheme, duration: f64) -> Collector {

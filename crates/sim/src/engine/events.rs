@@ -133,7 +133,8 @@ impl Run<'_> {
             if let Some(e) = &closed {
                 observer.impact(e);
             }
-            if track.contact_sample_due(self.t, was_open, steps_per_contact) {
+            if self.contact_samples && track.contact_sample_due(self.t, was_open, steps_per_contact)
+            {
                 // the state that closed the event is sent at its separation (see
                 // `contact_sample_due`)
                 let t = closed.map_or(self.t, |e| e.t_off_s);

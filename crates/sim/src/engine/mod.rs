@@ -268,6 +268,7 @@ impl MultibodyEngine {
     ) -> Result<RunStats, EngineError> {
         let opts = &self.options;
         let mut run = Run::new(&self.pack, opts, &self.per_tooth)?;
+        run.contact_samples = observer.wants_contact_samples();
         let period = 1.0 / opts.record_rate_hz;
         let rec_time = |j: u64| j as f64 * period;
         let mut rec_index: u64 = 0;
@@ -409,6 +410,7 @@ impl MultibodyEngine {
     ) -> Result<RunStats, EngineError> {
         let opts = &self.options;
         let mut run = Run::new(&self.pack, opts, &self.per_tooth)?;
+        run.contact_samples = observer.wants_contact_samples();
         let period = 1.0 / opts.record_rate_hz;
         let rec_time = |j: u64| j as f64 * period;
         let mut rec_index: u64 = 0;

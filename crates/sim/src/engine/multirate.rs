@@ -405,7 +405,9 @@ impl<'a> Run<'a> {
             if let Some(e) = ended {
                 closed.push(e);
             }
-            if self.tracks[i].contact_sample_due(t, was_open, steps_per_contact) {
+            if self.contact_samples
+                && self.tracks[i].contact_sample_due(t, was_open, steps_per_contact)
+            {
                 let omega_d = shaft.speed - dphi;
                 contacts.push((
                     i,

@@ -99,6 +99,8 @@ pub(super) struct Run<'a> {
     /// Effective mass per tooth of each coupling, kg (reduced with an inertial carrier).
     pub(super) m_eff: Vec<f64>,
     pub(super) tracks: Vec<EventTrack>,
+    /// Whether the observer takes contact samples (`Observer::wants_contact_samples`).
+    pub(super) contact_samples: bool,
     /// The hook's results at `t` (filled by [`Run::evaluate`]).
     pub(super) rel: Vec<RelativeState>,
     pub(super) forces: Vec<CouplingForces>,
@@ -216,6 +218,7 @@ impl<'a> Run<'a> {
             couplings,
             m_eff,
             tracks,
+            contact_samples: false,
             rel: Vec::with_capacity(nd),
             forces: Vec::with_capacity(nd),
             powers_before: None,
