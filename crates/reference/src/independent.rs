@@ -90,8 +90,9 @@ const WINDOW_WALL_MIN_S: f64 = 0.02;
 const WINDOW_WALL_MAX_S: f64 = 0.1;
 /// Wall time after which a window is cut short, s.
 const WINDOW_WALL_CUT_S: f64 = 0.25;
-/// Most disc samples buffered per window (about 100 bytes each: 2 MB, about what a core's
-/// caches hold, so the merge reads them from cache).
+/// Most disc samples, record-rate and contact samples together, buffered per window (about
+/// 100 bytes each: 2 MB, about what a core's caches hold, so the merge reads them from
+/// cache; and memory that does not grow with a run's density of contacts).
 const MAX_BUFFERED_SAMPLES: f64 = 2e4;
 
 pub(crate) fn run(
@@ -147,10 +148,16 @@ pub(crate) fn run(
             .map(|r| r.stepper.t.min(target))
             .fold(target, f64::min);
         let wall = wall.elapsed().as_secs_f64();
-        if wall < WINDOW_WALL_MIN_S {
-            window = (2.0 * window).min(cap);
-        } else if wall > WINDOW_WALL_MAX_S {
+        // what the window left to merge: its samples and, when asked for, its contact
+        // samples (about 30 per contact, not bounded by `cap`)
+        let buffered = runs
+            .iter()
+            .map(|r| r.out.samples.len() + r.out.contacts.len())
+            .sum::<usize>() as f64;
+        if wall > WINDOW_WALL_MAX_S || buffered > MAX_BUFFERED_SAMPLES {
             window *= 0.5;
+        } else if wall < WINDOW_WALL_MIN_S && 2.0 * buffered <= MAX_BUFFERED_SAMPLES {
+            window = (2.0 * window).min(cap);
         }
         // Deliver everything up to `limit`: the window's end, or the last good time of the
         // earliest disc that failed.
