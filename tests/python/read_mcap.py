@@ -90,6 +90,21 @@ def check_magic(path):
         raise Failure(f"not an MCAP file (it starts with {head!r})")
 
 
+def chunk_runs_past_end(path, at):
+    """Whether a chunk record starts at byte `at` whose stated length runs past the end of the
+    file: the chunk a killed run was writing (the recorder writes a chunk in place, its length
+    a placeholder until the chunk ends), which the reader refuses by its length before it
+    reaches the end of the file."""
+    if at < 0:
+        return False
+    with open(path, "rb") as g:
+        g.seek(at)
+        head = g.read(9)
+    if len(head) < 9 or head[0] != 0x06:  # the Chunk opcode
+        return False
+    return at + 9 + int.from_bytes(head[1:9], "little") > os.path.getsize(path)
+
+
 def stream_pass(path, report):
     """Reads every record from the start, decoding every message. Returns (complete, error)."""
     factories = [DecoderFactory(), Ros2DecoderFactory()]
@@ -188,7 +203,11 @@ def stream_pass(path, report):
         except Exception as e:
             # a reader that stopped at the end of the file met a truncation; anywhere else,
             # bad bytes
-            at_end = f.tell() >= os.path.getsize(path) or isinstance(e, mcap_exceptions.EndOfFile)
+            at_end = (
+                f.tell() >= os.path.getsize(path)
+                or isinstance(e, mcap_exceptions.EndOfFile)
+                or chunk_runs_past_end(path, f.tell() - 9)
+            )
             what = f"{type(e).__name__}: {e}"
             if at_end:
                 return False, stats, f"the file ends early (truncated) after {report['messages']} messages ({what})", True

@@ -82,8 +82,10 @@
 //! writer's seven small writes per message record into the zstd stream; about 40 bytes per
 //! message on disk. The CLI runs the recorder on its own thread (`clutchpack bench` reports
 //! its CPU time against the engine's and the wall-time overhead of recording). Memory stays
-//! flat with run length: one chunk (1 MiB) in memory, plus the chunk index and the impact
-//! peaks. Reading streams too: opening scans the file in blocks, holding one chunk at a time,
+//! flat with run length: chunks (4 MiB uncompressed) are compressed straight into the file,
+//! and what is held is the open chunk's message indexes, the impact peaks and heaps of
+//! bounded size, and the chunk index (about 0.7 kB per chunk, which the `mcap` writer holds
+//! until the summary section). Reading streams too: opening scans the file in blocks, holding one chunk at a time,
 //! and every later pass ([`RecordingReader::for_each_message`]) reads the file again, so a
 //! reader's memory does not grow with the file (the series that return every sample, such
 //! as [`RecordingReader::samples`], do).

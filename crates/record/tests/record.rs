@@ -347,6 +347,48 @@ fn killed_run_keeps_everything_up_to_the_last_flush() {
     drop(rec);
 }
 
+/// A run killed while a chunk is being compressed into the file: chunks are written in
+/// place (their header is a placeholder until the chunk ends), so the file then ends in a
+/// chunk record that claims more bytes than the file has. Everything up to the last flush
+/// is read back exactly, and the partial chunk is reported as a truncation.
+#[test]
+fn killed_mid_chunk_keeps_the_flushed_chunks() {
+    let run = synthetic_run(20_000, 1e-5);
+    let path = tmp("killed-mid-chunk.mcap");
+    let opts = RecordOptions {
+        // no chunk ends by itself in this test: only the explicit flush below
+        chunk_size_bytes: 1 << 30,
+        flush_messages: usize::MAX,
+        ..options()
+    };
+    let mut rec = Recorder::create(&path, &run.info, &opts).unwrap();
+    let flushed_at = 300;
+    for s in &run.samples[..flushed_at] {
+        rec.sample(s);
+    }
+    rec.flush().unwrap();
+    let flushed = rec.messages();
+    let flushed_len = std::fs::metadata(&path).unwrap().len();
+    // write on until part of the next chunk has reached the file (the compressor and the
+    // file buffer hold some before they write)
+    let mut written = flushed_at;
+    while std::fs::metadata(&path).unwrap().len() < flushed_len + (256 << 10) {
+        assert!(
+            written < run.samples.len(),
+            "the open chunk never reached the file"
+        );
+        rec.sample(&run.samples[written]);
+        written += 1;
+    }
+    let on_disk = std::fs::read(&path).unwrap(); // what SIGKILL would leave
+    let r = from_bytes(&path, on_disk).unwrap();
+    let d = r.damage().unwrap();
+    assert_eq!(d.kind, DamageKind::Truncated, "{d}");
+    assert_eq!(r.info().messages, flushed);
+    assert_eq!(r.samples(), run.samples[..flushed_at].to_vec());
+    drop(rec);
+}
+
 /// A byte flipped inside a chunk is caught by the chunk CRC: a clean "corrupted" error,
 /// with the messages of every other chunk recovered (the scan resynchronises on the next
 /// chunk, issue 10): exactly the flipped chunk's messages are lost.

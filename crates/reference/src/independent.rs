@@ -91,9 +91,12 @@ const WINDOW_WALL_MAX_S: f64 = 0.1;
 /// Wall time after which a window is cut short, s.
 const WINDOW_WALL_CUT_S: f64 = 0.25;
 /// Most disc samples, record-rate and contact samples together, buffered per window (about
-/// 100 bytes each: 2 MB, about what a core's caches hold, so the merge reads them from
-/// cache; and memory that does not grow with a run's density of contacts).
-const MAX_BUFFERED_SAMPLES: f64 = 2e4;
+/// 60 bytes each: 240 kB, which a core's caches hold, so the merge reads them from cache;
+/// and memory that does not grow with a run's density of contacts). A window is checked
+/// after it ran, so one disc's buffer may briefly hold up to about this many. With 2e4 the
+/// buffers of a 4-disc recorded run held about 0.5 MB per disc once a dense window had come,
+/// which a 300 s run met and a 3 s run did not.
+const MAX_BUFFERED_SAMPLES: f64 = 4e3;
 
 pub(crate) fn run(
     pack: &PackModel,

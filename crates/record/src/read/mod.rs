@@ -19,7 +19,7 @@
 //!
 //! The file is never held: the scan feeds the MCAP linear reader from a buffered file in
 //! blocks ([`ReadOptions::block_bytes`], 1 MiB), so memory is bounded by the largest record
-//! (a chunk, compressed and decompressed: about 1 MiB each for ours) plus what the scan
+//! (a chunk, compressed and decompressed: at most about 4 MiB for ours) plus what the scan
 //! reports (topics, metadata, the scene attachment), whatever the file's size. A damaged
 //! record length can make the reader buffer up to the rest of the file before the record is
 //! found bad; the record length limit is the file's size (at least 256 MiB). The reader keeps
@@ -750,7 +750,14 @@ fn scan_pass(
             None => break,
             Some(Ok(e)) => e,
             Some(Err(e)) => {
-                let (kind, reason) = describe_mcap_error(&e, st.data_end);
+                let (kind, reason) = if chunk_runs_past_end(input, last_good)? {
+                    (
+                        DamageKind::Truncated,
+                        "the file ends inside a chunk (no summary section: the run did not finish, or the copy is partial)".into(),
+                    )
+                } else {
+                    describe_mcap_error(&e, st.data_end)
+                };
                 return fail(kind, reason, pos, last_good);
             }
         };
@@ -818,6 +825,22 @@ const CHUNK_PROBE: usize = 9 + 32 + 4 + 8;
 /// when it is read. A metadata record (the run's statistics follow the last chunk): a length
 /// that fits and agrees with its name's and its map's lengths. The file is searched in
 /// windows of one block (plus the few bytes a candidate's header needs).
+/// Whether a chunk record starts at `at` whose stated length runs past the end of the file:
+/// the chunk a killed run was writing (the recorder writes a chunk in place, its length a
+/// placeholder until the chunk ends) or the last chunk of a partial copy.
+fn chunk_runs_past_end(input: &mut Input<'_>, at: u64) -> std::io::Result<bool> {
+    let head = input.read_at(at, 9)?;
+    Ok(match head.split_first() {
+        Some((&op, len)) if op == mcap::records::op::CHUNK && len.len() == 8 => {
+            let mut b = [0u8; 8];
+            b.copy_from_slice(len);
+            let record_len = u64::from_le_bytes(b);
+            at.saturating_add(9).saturating_add(record_len) > input.len
+        }
+        _ => false,
+    })
+}
+
 fn next_chunk(input: &mut Input<'_>, from: u64) -> std::io::Result<Option<u64>> {
     use mcap::records::op;
     let len = input.len;
