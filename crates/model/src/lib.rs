@@ -48,6 +48,7 @@
 #![warn(missing_docs)]
 
 pub mod cases;
+pub mod checks;
 pub mod clutch;
 pub mod drive;
 pub mod fatigue;

@@ -1,57 +1,16 @@
 //! Issue 13 item 3: the dense contact samples (`Observer::contact_sample`) of the multibody
-//! engine's schemes (multirate sub-steps, shared steps) resolve each impact's shape: their largest |load| within a contact is its located peak to
-//! within [`PEAK_TOLERANCE`], every point lies inside a contact window of its disc, and each
-//! disc's points come in time order with its regular samples.
+//! engine's schemes (multirate sub-steps, shared steps) resolve each impact's shape: their
+//! largest |load| within a contact is its located peak to within [`PEAK_TOLERANCE`], every
+//! point lies inside a contact window of its disc, and each disc's points come in time order
+//! with its regular samples (`clutchpack_model::checks`, shared with the reference engine).
 
 use clutchpack_model::cases::{paper_pack, staggered_pack};
+use clutchpack_model::checks::{check_contact_samples, OrderedCollector};
 use clutchpack_model::*;
 use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping};
 
 /// Largest relative shortfall of the densest contact sample below the located peak.
 const PEAK_TOLERANCE: f64 = 0.02;
-
-/// A [`Collector`] that also checks that each disc's samples and contact samples come in
-/// non-decreasing time order together.
-#[derive(Default)]
-struct Ordered {
-    c: Collector,
-    last: Vec<f64>,
-    out_of_order: Vec<String>,
-}
-
-impl Ordered {
-    fn at(&mut self, disc: usize, t: f64, what: &str) {
-        if self.last.len() <= disc {
-            self.last.resize(disc + 1, f64::NEG_INFINITY);
-        }
-        if t < self.last[disc] {
-            self.out_of_order.push(format!(
-                "disc {disc}: {what} at {t} s after {} s",
-                self.last[disc]
-            ));
-        }
-        self.last[disc] = t;
-    }
-}
-
-impl Observer for Ordered {
-    fn sample(&mut self, s: &Sample) {
-        for d in 0..s.discs.len() {
-            self.at(d, s.t_s, "sample");
-        }
-        self.c.sample(s);
-    }
-    fn impact(&mut self, e: &ImpactEvent) {
-        self.c.impact(e);
-    }
-    fn contact_sample(&mut self, disc: usize, t_s: f64, state: &DiscSample) {
-        self.at(disc, t_s, "contact sample");
-        self.c.contact_sample(disc, t_s, state);
-    }
-    fn wants_contact_samples(&self) -> bool {
-        true
-    }
-}
 
 fn run(pack: PackModel, scheme: Scheme, duration: f64) -> Collector {
     let opts = MultibodyOptions {
@@ -60,77 +19,22 @@ fn run(pack: PackModel, scheme: Scheme, duration: f64) -> Collector {
         ..Default::default()
     };
     let mut e = MultibodyEngine::from_pack(pack, 1e4, opts).expect("engine");
-    let mut o = Ordered::default();
+    let mut o = OrderedCollector::default();
     e.run(duration, &mut o).unwrap();
     assert!(
         o.out_of_order.is_empty(),
         "{:?}",
         &o.out_of_order[..o.out_of_order.len().min(5)]
     );
-    o.c
+    o.collector
 }
 
-/// Checks the contact samples of `c` against its impacts (see the module docs); returns the
-/// worst relative peak shortfall and the mean number of points per contact.
+/// Checks the contact samples of `c` against its impacts ([`check_contact_samples`]);
+/// returns the worst relative peak shortfall and the mean number of points per contact.
 fn check(label: &str, c: &Collector, nd: usize) -> (f64, f64) {
-    assert!(!c.impacts.is_empty(), "{label}: no impacts");
-    // (the order together with the regular samples is checked by `Ordered` as they come)
-    for d in 0..nd {
-        let ts: Vec<f64> = c
-            .contacts
-            .iter()
-            .filter(|(i, _, _)| *i == d)
-            .map(|(_, t, _)| *t)
-            .collect();
-        assert!(
-            ts.windows(2).all(|w| w[0] <= w[1]),
-            "{label}: disc {d}'s contact samples are out of time order"
-        );
-    }
-    let mut worst: f64 = 0.0;
-    let mut points = 0usize;
-    for e in &c.impacts {
-        let inside: Vec<&(usize, f64, DiscSample)> = c
-            .contacts
-            .iter()
-            .filter(|(i, t, _)| *i == e.disc && *t >= e.t_on_s && *t <= e.t_off_s)
-            .collect();
-        points += inside.len();
-        let max = inside
-            .iter()
-            .map(|(_, _, s)| s.load_n)
-            .fold(0.0_f64, |m, f| if f.abs() > m.abs() { f } else { m });
-        let short = (e.peak_n.abs() - max.abs()) / e.peak_n.abs();
-        assert!(
-            short <= PEAK_TOLERANCE && max.signum() == e.peak_n.signum(),
-            "{label}: impact at {:.6} s of disc {}: densest |load| {max} N, located peak {} N \
-             ({} points)",
-            e.t_peak_s,
-            e.disc,
-            e.peak_n,
-            inside.len()
-        );
-        // never above the located peak (it is the maximum of the same trajectory)
-        assert!(
-            max.abs() <= e.peak_n.abs() * (1.0 + 1e-9),
-            "{label}: {max} > {}",
-            e.peak_n
-        );
-        worst = worst.max(short);
-    }
-    // every point inside a contact window of its disc
-    for (d, t, s) in &c.contacts {
-        let ok = c
-            .impacts
-            .iter()
-            .any(|e| e.disc == *d && *t >= e.t_on_s && *t <= e.t_off_s);
-        assert!(
-            ok,
-            "{label}: disc {d}'s contact sample at {t} s ({} N) is in no contact window",
-            s.load_n
-        );
-    }
-    (worst, points as f64 / c.impacts.len() as f64)
+    let fit =
+        check_contact_samples(c, nd, PEAK_TOLERANCE).unwrap_or_else(|e| panic!("{label}: {e}"));
+    (fit.worst_shortfall, fit.points_per_contact)
 }
 
 /// The paper case (one disc, prescribed shaft) at the three film thicknesses of MODEL.md
