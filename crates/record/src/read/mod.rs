@@ -1240,17 +1240,8 @@ impl RecordingReader {
             Ok(())
         };
         let block = self.options.block_bytes.max(1);
-        let scanned = match &self.memory {
-            Some(bytes) => {
-                let mut src = Cursor::new(bytes.as_slice());
-                let mut input = Input {
-                    src: &mut src,
-                    len: self.file_bytes,
-                    block,
-                    stop,
-                };
-                scan(&mut input, want, &mut on_message)
-            }
+        let mut src: Box<dyn Source + '_> = match &self.memory {
+            Some(bytes) => Box::new(Cursor::new(bytes.as_slice())),
             None => {
                 let file = std::fs::File::open(&self.path)
                     .map_err(|e| fail(format!("cannot read the file again: {e}")))?;
@@ -1264,16 +1255,16 @@ impl RecordingReader {
                         self.file_bytes
                     )));
                 }
-                let mut src = BufReader::with_capacity(block.min(64 << 10), file);
-                let mut input = Input {
-                    src: &mut src,
-                    len: self.file_bytes,
-                    block,
-                    stop,
-                };
-                scan(&mut input, want, &mut on_message)
+                Box::new(BufReader::with_capacity(block.min(64 << 10), file))
             }
         };
+        let mut input = Input {
+            src: &mut *src,
+            len: self.file_bytes,
+            block,
+            stop,
+        };
+        let scanned = scan(&mut input, want, &mut on_message);
         scanned.map_err(|e| fail(format!("cannot read the file again: {e}")))?;
         let stopped = stop.is_some_and(|x| x.load(Ordering::SeqCst));
         if seen < want && !stopped {
