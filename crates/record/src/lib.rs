@@ -85,10 +85,11 @@
 //! flat with run length: chunks (4 MiB uncompressed) are compressed straight into the file,
 //! and what is held is the open chunk's message indexes, the impact peaks and heaps of
 //! bounded size, and the chunk index (about 0.7 kB per chunk, which the `mcap` writer holds
-//! until the summary section). Reading streams too: opening scans the file in blocks, holding one chunk at a time,
-//! and every later pass ([`RecordingReader::for_each_message`]) reads the file again, so a
-//! reader's memory does not grow with the file (the series that return every sample, such
-//! as [`RecordingReader::samples`], do).
+//! until the summary section). Reading streams too: opening scans the file in blocks,
+//! holding one chunk at a time, and every later pass
+//! ([`RecordingReader::for_each_message`]) reads the file again, so a reader's memory does
+//! not grow with the file (the series that return every sample, such as
+//! [`RecordingReader::samples`], do).
 //!
 //! # Conventions
 //! - SI units, named in fields and keys (`load_n`, `t_s`); loads are per tooth, negative

@@ -819,12 +819,6 @@ fn scan_pass(
 /// header, a compression name of at most 4 bytes and the compressed size.
 const CHUNK_PROBE: usize = 9 + 32 + 4 + 8;
 
-/// The offset of the first plausible chunk or metadata record at or after `from`. A chunk:
-/// the chunk opcode, then a record length that fits in the file and agrees with the chunk
-/// header's compression name (none, `zstd` or `lz4`) and compressed size; its CRC is checked
-/// when it is read. A metadata record (the run's statistics follow the last chunk): a length
-/// that fits and agrees with its name's and its map's lengths. The file is searched in
-/// windows of one block (plus the few bytes a candidate's header needs).
 /// Whether a chunk record starts at `at` whose stated length runs past the end of the file:
 /// the chunk a killed run was writing (the recorder writes a chunk in place, its length a
 /// placeholder until the chunk ends) or the last chunk of a partial copy.
@@ -841,6 +835,12 @@ fn chunk_runs_past_end(input: &mut Input<'_>, at: u64) -> std::io::Result<bool> 
     })
 }
 
+/// The offset of the first plausible chunk or metadata record at or after `from`. A chunk:
+/// the chunk opcode, then a record length that fits in the file and agrees with the chunk
+/// header's compression name (none, `zstd` or `lz4`) and compressed size; its CRC is checked
+/// when it is read. A metadata record (the run's statistics follow the last chunk): a length
+/// that fits and agrees with its name's and its map's lengths. The file is searched in
+/// windows of one block (plus the few bytes a candidate's header needs).
 fn next_chunk(input: &mut Input<'_>, from: u64) -> std::io::Result<Option<u64>> {
     use mcap::records::op;
     let len = input.len;
