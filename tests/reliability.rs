@@ -306,6 +306,38 @@ fn stdout_write_errors_fail_the_command() {
     assert!(stderr(&o).contains("standard output"), "{}", stderr(&o));
 }
 
+/// Standard error that cannot be written (`2>/dev/full`) is no panic: the recorded run
+/// still writes its table and a complete recording and exits 0; with standard output full
+/// too, it fails with exit 1 (not 101, a panic, which `eprintln!` gave).
+#[test]
+fn stderr_write_errors_are_no_panic() {
+    let d = scratch("rel-stderr-full");
+    let full = || {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap()
+    };
+    let f = d.join("r.mcap");
+    let o = bin()
+        .args(["run", "--duration", "0.01", "--out", f.to_str().unwrap()])
+        .stderr(full())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    assert!(stdout(&o).contains("disc"), "{}", stdout(&o));
+    let o = run(&["replay", f.to_str().unwrap()]);
+    assert!(o.status.success(), "complete: {}", stderr(&o));
+    let o = bin()
+        .args(["run", "--duration", "0.01", "--out"])
+        .arg(d.join("r2.mcap"))
+        .stdout(full())
+        .stderr(full())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+}
+
 /// Reproducers 10 and 11 (rules on main, checked here end to end): a spline whose backlash
 /// is not below the tooth pitch, a step or inertia no engine can use, a duration beyond the
 /// bound, and a scene the chosen engine cannot run are refused before the run, exit 2 with

@@ -19,6 +19,17 @@ macro_rules! out {
     }};
 }
 
+/// `eprintln!` that ignores a failed write: standard error is where failures are reported,
+/// so when it cannot be written (a full disk, `2>/dev/full`, a closed pipe) there is nowhere
+/// left to say so, and the command goes on to write its other outputs and exit with its own
+/// code rather than panic (exit 101). Shadows the standard macro in every module below.
+macro_rules! eprintln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 /// Set when writing to standard output failed (other than a closed pipe).
 static STDOUT_FAILED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 

@@ -202,11 +202,20 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     }
     let run_stats = match result {
         Ok(s) if s.stopped_early => {
-            eprintln!(
-                "interrupted ({}) at t = {:.6} s: the outputs hold the run up to there",
-                crate::signals::received_name(),
-                s.simulated_s
-            );
+            if crate::signals::received().is_none() && recording_error.is_some() {
+                // the recorder failed (a full disk): the run stopped for that, not a signal
+                eprintln!(
+                    "stopped at t = {:.6} s because the recording failed (below): the other \
+                     outputs hold the run up to there",
+                    s.simulated_s
+                );
+            } else {
+                eprintln!(
+                    "interrupted ({}) at t = {:.6} s: the outputs hold the run up to there",
+                    crate::signals::received_name(),
+                    s.simulated_s
+                );
+            }
             s
         }
         Ok(s) => s,

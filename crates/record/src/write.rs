@@ -81,34 +81,49 @@ impl Default for RecordOptions {
     }
 }
 
+/// An error and its causes on one line ("a: b: c"). The I/O errors inside a
+/// [`RecordError`] are its message's end rather than its `source()`, so that a reporter that
+/// prints the whole chain (`anyhow`'s `{:#}`) says each cause once: with them as sources it
+/// printed "I/O error from writing, or reading a compression stream" twice.
+fn causes(e: &dyn std::error::Error) -> String {
+    let mut out = e.to_string();
+    let mut next = e.source();
+    while let Some(c) = next {
+        out.push_str(": ");
+        out.push_str(&c.to_string());
+        next = c.source();
+    }
+    out
+}
+
 /// Why a recording could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum RecordError {
     /// The file (or its folder) could not be created.
-    #[error("cannot create the recording {path}: {source}")]
+    #[error("cannot create the recording {path}: {}", causes(cause))]
     Create {
         /// The recording's path.
         path: PathBuf,
         /// The I/O error.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// Writing failed (disk full, I/O error); the file is readable up to the last flush.
-    #[error("cannot write the recording {path} ({what}): {source}")]
+    #[error("cannot write the recording {path} ({what}): {}", causes(cause))]
     Write {
         /// The recording's path.
         path: PathBuf,
         /// What was being written.
         what: String,
         /// The MCAP writer's error.
-        source: mcap::McapError,
+        cause: mcap::McapError,
     },
     /// The final flush of the file failed.
-    #[error("cannot close the recording {path}: {source}")]
+    #[error("cannot close the recording {path}: {}", causes(cause))]
     Close {
         /// The recording's path.
         path: PathBuf,
         /// The I/O error.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// A sample does not fit the run info it was created with.
     #[error("sample at t = {t_s} s has {got} discs, but the recording {path} was created for {expected}")]
@@ -300,9 +315,9 @@ impl Recorder {
         options: &RecordOptions,
     ) -> Result<Recorder, RecordError> {
         let path = path.as_ref().to_path_buf();
-        let create_err = |source| RecordError::Create {
+        let create_err = |cause| RecordError::Create {
             path: path.clone(),
-            source,
+            cause,
         };
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(create_err)?;
@@ -324,9 +339,9 @@ impl Recorder {
     ) -> Result<Recorder, RecordError> {
         let target = target.as_ref();
         let (pending, file) =
-            PendingFile::create(target, replace).map_err(|source| RecordError::Create {
+            PendingFile::create(target, replace).map_err(|cause| RecordError::Create {
                 path: target.to_path_buf(),
-                source,
+                cause,
             })?;
         let path = pending.tmp_path().to_path_buf();
         Recorder::start(path, file, Some(pending), info, options)
@@ -339,10 +354,10 @@ impl Recorder {
         info: &RunInfo,
         options: &RecordOptions,
     ) -> Result<Recorder, RecordError> {
-        let write_err = |what: &str, source| RecordError::Write {
+        let write_err = |what: &str, cause| RecordError::Write {
             path: path.clone(),
             what: what.to_string(),
-            source,
+            cause,
         };
         let opts = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
@@ -641,7 +656,7 @@ impl Recorder {
             .map_err(|source| RecordError::Write {
                 path: self.path.clone(),
                 what: "the impact peaks kept in a temporary file".to_string(),
-                source: mcap::McapError::Io(source),
+                cause: mcap::McapError::Io(source),
             })?;
         Ok(RunSummary {
             t_end_s: self.last_t_s,
@@ -697,7 +712,7 @@ impl Recorder {
             return Err(RecordError::Write {
                 path: self.path.clone(),
                 what: what.to_string(),
-                source,
+                cause: source,
             });
         }
         self.messages += 1;
@@ -716,7 +731,7 @@ impl Recorder {
                 return Err(RecordError::Write {
                     path: self.path.clone(),
                     what: "flush".into(),
-                    source,
+                    cause: source,
                 });
             }
         }
@@ -1106,10 +1121,10 @@ impl Recorder {
         // the latest message of each topic, so the summary is there from the first frame
         self.put(self.ch.summary, 0, &summary.to_proto(), "/summary")?;
         let path = self.path.clone();
-        let write_err = |what: &str, source| RecordError::Write {
+        let write_err = |what: &str, cause| RecordError::Write {
             path: path.clone(),
             what: what.to_string(),
-            source,
+            cause,
         };
         let Some(mut w) = self.writer.take() else {
             return Err(self.failed_err());
@@ -1136,15 +1151,15 @@ impl Recorder {
         .map_err(|e| write_err("stats metadata", e))?;
         w.finish().map_err(|e| write_err("summary section", e))?;
         let mut inner = w.into_inner();
-        inner.flush().map_err(|source| RecordError::Close {
+        inner.flush().map_err(|cause| RecordError::Close {
             path: path.clone(),
-            source,
+            cause,
         })?;
         drop(inner);
         match self.pending.take() {
             Some(p) => p
                 .commit()
-                .map_err(|source| RecordError::Close { path, source }),
+                .map_err(|cause| RecordError::Close { path, cause }),
             None => Ok(path),
         }
     }
