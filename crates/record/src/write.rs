@@ -380,7 +380,7 @@ impl Recorder {
             // kept chunks at 1 MiB and so the chunk index growing with the run. A killed
             // run still leaves every flushed chunk readable: what follows the last one is a
             // chunk record whose length is a placeholder, which the readers find to run past
-            // the end of the file (`killed_run_keeps_everything_up_to_the_last_flush`).
+            // the end of the file (`killed_mid_chunk_keeps_the_flushed_chunks`).
             .disable_seeking(false);
         let mut w = opts
             .create(BufWriter::with_capacity(1 << 16, file))
