@@ -396,17 +396,7 @@ mod tests {
     use super::*;
     use clutchpack_model::Flank;
 
-    /// A fixed pseudo-random generator (PCG-style LCG), so the property tests are repeatable.
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::Lcg;
 
     /// ASTM E1049-85 (2011) Fig. 6's worked example: the history
     /// [-2, 1, -3, 5, -1, 3, -4, 4, -2] gives exactly (3, 0.5), (4, 1.5), (6, 0.5), (8, 1.0),

@@ -968,13 +968,8 @@ mod tests {
         const IMPACTS: usize = 20_000;
         let mut keeping = FatigueCollector::new();
         let mut summing = FatigueCollector::summing(vec![(c, mat)], false);
-        let mut rng = 0x9e3779b97f4a7c15u64;
-        let mut uniform = move || {
-            rng = rng
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::Lcg(0x9e3779b97f4a7c15);
+        let mut uniform = move || rng.next();
         let mut t = 0.0;
         let mut most_held = 0;
         for _ in 0..IMPACTS {

@@ -51,6 +51,23 @@ pub mod stats;
 pub mod sweep;
 pub mod table;
 
+/// A fixed pseudo-random generator (PCG-style LCG) for the property tests of this crate, so
+/// that they are repeatable.
+#[cfg(test)]
+pub(crate) struct Lcg(pub(crate) u64);
+
+#[cfg(test)]
+impl Lcg {
+    /// The next value, uniform in [0, 1).
+    pub(crate) fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 pub use fatigue::{
     assess, disc_cycles, ensemble_fatigue, fatigue_spread_table, fatigue_table, DiscCycles,
     DiscFatigue, DiscFatigueSpread, FatigueCollector,

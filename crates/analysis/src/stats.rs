@@ -487,13 +487,8 @@ mod tests {
     /// fed on, it still appends (the read-back moves the file offset).
     #[test]
     fn peak_stats_equal_the_whole_list_in_and_beyond_memory() {
-        let mut rng = 12345u64;
-        let mut next = move || {
-            rng = rng
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::Lcg(12345);
+        let mut next = move || rng.next();
         let names: Vec<String> = ["a", "b", "c"].iter().map(|s| s.to_string()).collect();
         for total in [0, 7, 1000, 3 * PEAKS_IN_MEMORY + 17] {
             let mut acc = PeakStats::new();

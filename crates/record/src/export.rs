@@ -103,6 +103,20 @@ impl Csv {
         Ok(csv)
     }
 
+    /// The CSV in `slot`, created at `target()` with `header` on first use (a per-disc or
+    /// per-interface file exists only if its topic has a message).
+    fn lazy<'a>(
+        slot: &'a mut Option<Csv>,
+        target: impl FnOnce() -> PathBuf,
+        header: &str,
+    ) -> Result<&'a mut Csv, ReadError> {
+        let c = match slot.take() {
+            Some(c) => c,
+            None => Csv::create(&target(), header)?,
+        };
+        Ok(slot.insert(c))
+    }
+
     fn error(&self, source: std::io::Error) -> ReadError {
         ReadError::Export {
             path: self.pending.target().to_path_buf(),
@@ -220,16 +234,12 @@ impl<'a> Export<'a> {
                 };
                 let dir = self.dir;
                 let d = self.disc(m.disc_index, v.topic);
-                if d.spline.is_none() {
-                    let path = dir.join(format!("spline_{}.csv", d.segment));
-                    d.spline = Some(Csv::create(
-                        &path,
-                        "t_s,rel_angle_rad,closing_speed_m_s,penetration_m,load_n,torque_n_m,engaged,stiffness_n_m1_5,speed_rad_s,angle_rad\n",
-                    )?);
-                }
-                let Some(c) = d.spline.as_mut() else {
-                    return Ok(());
-                };
+                let segment = &d.segment;
+                let c = Csv::lazy(
+                    &mut d.spline,
+                    || dir.join(format!("spline_{segment}.csv")),
+                    "t_s,rel_angle_rad,closing_speed_m_s,penetration_m,load_n,torque_n_m,engaged,stiffness_n_m1_5,speed_rad_s,angle_rad\n",
+                )?;
                 writeln!(
                     c.w,
                     "{:?},{:?},{:?},{:?},{:?},{:?},{},{:?},{:?},{:?}",
@@ -252,16 +262,12 @@ impl<'a> Export<'a> {
                 };
                 let dir = self.dir;
                 let d = self.disc(m.disc_index, v.topic);
-                if d.load.is_none() {
-                    let path = dir.join(format!("load_{}.csv", d.segment));
-                    d.load = Some(Csv::create(
-                        &path,
-                        "t_s,load_n,rel_angle_rad,contact_step\n",
-                    )?);
-                }
-                let Some(c) = d.load.as_mut() else {
-                    return Ok(());
-                };
+                let segment = &d.segment;
+                let c = Csv::lazy(
+                    &mut d.load,
+                    || dir.join(format!("load_{segment}.csv")),
+                    "t_s,load_n,rel_angle_rad,contact_step\n",
+                )?;
                 writeln!(
                     c.w,
                     "{:?},{:?},{:?},{}",
@@ -303,16 +309,12 @@ impl<'a> Export<'a> {
                 let Ok(m) = proto::InterfaceState::decode(v.data) else {
                     return Ok(());
                 };
-                if file.is_none() {
-                    let path = self.dir.join(format!("interface_{segment}.csv"));
-                    *file = Some(Csv::create(
-                        &path,
-                        "t_s,slip_rad_s,slip_m_s,mu,clamp_n,torque_n_m,locked,dissipated_j\n",
-                    )?);
-                }
-                let Some(c) = file.as_mut() else {
-                    return Ok(());
-                };
+                let dir = self.dir;
+                let c = Csv::lazy(
+                    file,
+                    || dir.join(format!("interface_{segment}.csv")),
+                    "t_s,slip_rad_s,slip_m_s,mu,clamp_n,torque_n_m,locked,dissipated_j\n",
+                )?;
                 writeln!(
                     c.w,
                     "{:?},{:?},{:?},{:?},{:?},{:?},{},{:?}",
