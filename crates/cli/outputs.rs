@@ -17,6 +17,53 @@ use std::path::{Path, PathBuf};
 pub struct Output<'a> {
     pub flag: &'a str,
     pub path: &'a Path,
+    /// A figure: its format must follow from its extension (`.png`, `.svg`).
+    pub figure: bool,
+}
+
+impl<'a> Output<'a> {
+    /// A file output (any format).
+    pub fn file(flag: &'a str, path: &'a Path) -> Output<'a> {
+        Output {
+            flag,
+            path,
+            figure: false,
+        }
+    }
+
+    /// A figure output: `.png` or `.svg`.
+    pub fn figure(flag: &'a str, path: &'a Path) -> Output<'a> {
+        Output {
+            flag,
+            path,
+            figure: true,
+        }
+    }
+}
+
+/// Creates the folder of an output (`flag` names it in messages) and its parents; a file in
+/// the way is said as such, not as the OS's "File exists". Bad input (exit 2) on failure.
+pub fn create_folder(flag: &str, path: &Path) -> Result<()> {
+    let dir = folder(path);
+    if let Some(blocker) = dir
+        .ancestors()
+        .find(|a| std::fs::metadata(a).is_ok_and(|m| !m.is_dir()))
+    {
+        return Err(BadInput(format!(
+            "{flag} {}: {} is a file, not a folder",
+            path.display(),
+            blocker.display()
+        ))
+        .into());
+    }
+    std::fs::create_dir_all(&dir).map_err(|e| {
+        BadInput(format!(
+            "{flag} {}: cannot create the folder {}: {e}",
+            path.display(),
+            dir.display()
+        ))
+        .into()
+    })
 }
 
 /// The parent folder of `path` (`.` for a bare file name).
@@ -46,6 +93,22 @@ fn check_one(o: &Output<'_>) -> Result<()> {
     if path.as_os_str().is_empty() || path.file_name().is_none() {
         return Err(bad("names no file".into()));
     }
+    let name_len = path.file_name().map_or(0, |n| n.len());
+    if name_len > clutchpack_record::NAME_MAX_BYTES {
+        return Err(bad(format!(
+            "the file name has {name_len} bytes; a file name may have at most {}",
+            clutchpack_record::NAME_MAX_BYTES
+        )));
+    }
+    if o.figure {
+        if let Err(clutchpack_analysis::PlotError::UnsupportedFormat { extension, .. }) =
+            clutchpack_analysis::figure_format(path)
+        {
+            return Err(bad(format!(
+                "a figure is written as .png or .svg, chosen by the extension (got {extension:?})"
+            )));
+        }
+    }
     if let Ok(meta) = std::fs::metadata(path) {
         if meta.is_dir() {
             return Err(bad("is a folder; give a file path".into()));
@@ -64,8 +127,9 @@ fn check_one(o: &Output<'_>) -> Result<()> {
         Ok(_) => return Err(bad(format!("{} is not a folder", dir.display()))),
         Err(_) => return Err(bad(format!("the folder {} does not exist", dir.display()))),
     }
-    // the real test of writability: create (and remove) a new file in the folder
-    let probe = dir.join(format!(".clutchpack-probe-{}", std::process::id()));
+    // the real test of writability: create (and remove) a new file in the folder, under the
+    // longest temporary name the output will be written to
+    let probe = clutchpack_record::partial_path(path, usize::MAX);
     match std::fs::OpenOptions::new()
         .write(true)
         .create_new(true)
@@ -179,14 +243,8 @@ mod tests {
         let same = d.join(".").join("r.mcap");
         let e = check_outputs(
             &[
-                Output {
-                    flag: "--out",
-                    path: &r,
-                },
-                Output {
-                    flag: "--impacts-csv",
-                    path: &same,
-                },
+                Output::file("--out", &r),
+                Output::file("--impacts-csv", &same),
             ],
             &[],
         )
@@ -195,49 +253,19 @@ mod tests {
             is_bad_input(&e) && e.to_string().contains("--impacts-csv"),
             "{e}"
         );
-        let e = check_outputs(
-            &[Output {
-                flag: "--out",
-                path: &scene,
-            }],
-            &[&scene],
-        )
-        .unwrap_err();
+        let e = check_outputs(&[Output::file("--out", &scene)], &[&scene]).unwrap_err();
         assert!(is_bad_input(&e) && e.to_string().contains("input"), "{e}");
-        let e = check_outputs(
-            &[Output {
-                flag: "--plot",
-                path: &d,
-            }],
-            &[],
-        )
-        .unwrap_err();
+        let e = check_outputs(&[Output::file("--plot", &d)], &[]).unwrap_err();
         assert!(is_bad_input(&e) && e.to_string().contains("folder"), "{e}");
         let missing = d.join("no/such/x.json");
-        let e = check_outputs(
-            &[Output {
-                flag: "--summary-json",
-                path: &missing,
-            }],
-            &[],
-        )
-        .unwrap_err();
+        let e = check_outputs(&[Output::file("--summary-json", &missing)], &[]).unwrap_err();
         assert!(
             is_bad_input(&e) && e.to_string().contains("does not exist"),
             "{e}"
         );
         let c = d.join("c.csv");
         check_outputs(
-            &[
-                Output {
-                    flag: "--out",
-                    path: &r,
-                },
-                Output {
-                    flag: "--impacts-csv",
-                    path: &c,
-                },
-            ],
+            &[Output::file("--out", &r), Output::file("--impacts-csv", &c)],
             &[&scene],
         )
         .unwrap();
@@ -248,10 +276,7 @@ mod tests {
     #[test]
     fn a_device_or_fifo_is_not_an_output() {
         let e = check_outputs(
-            &[Output {
-                flag: "--summary-json",
-                path: Path::new("/dev/null"),
-            }],
+            &[Output::file("--summary-json", Path::new("/dev/null"))],
             &[],
         )
         .unwrap_err();

@@ -229,13 +229,7 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
     }
     if let Some(p) = &a.plot {
         let inputs: Vec<&Path> = a.files.iter().map(PathBuf::as_path).collect();
-        crate::outputs::check_outputs(
-            &[Output {
-                flag: "--plot",
-                path: p,
-            }],
-            &inputs,
-        )?;
+        crate::outputs::check_outputs(&[Output::figure("--plot", p)], &inputs)?;
     }
     let mut runs = Vec::new();
     for f in &a.files {
@@ -525,13 +519,7 @@ fn plot_spectrum(reader: &RecordingReader, a: &PlotArgs) -> Result<ExitCode> {
 }
 
 pub fn plot(a: PlotArgs) -> Result<ExitCode> {
-    crate::outputs::check_outputs(
-        &[Output {
-            flag: "--out",
-            path: &a.out,
-        }],
-        &[a.file.as_path()],
-    )?;
+    crate::outputs::check_outputs(&[Output::figure("--out", &a.out)], &[a.file.as_path()])?;
     let reader = open_recording(&a.file, a.salvage)?;
     if a.spectrum {
         return plot_spectrum(&reader, &a);

@@ -1,6 +1,5 @@
 //! `clutchpack run`.
 
-use crate::common::BadInput;
 use crate::common::{self, EngineArg, RunCollector, RunSummary};
 use crate::outputs::Output;
 use anyhow::{Context, Result};
@@ -107,18 +106,8 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             clutchpack_record::default_path("recordings", &scene.name, std::time::SystemTime::now())
         })
     });
-    if let Some(dir) = record_path
-        .as_deref()
-        .and_then(|p| p.parent())
-        .filter(|d| !d.as_os_str().is_empty())
-    {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            BadInput(format!(
-                "--out {}: cannot create the folder {}: {e}",
-                record_path.as_deref().unwrap_or(dir).display(),
-                dir.display()
-            ))
-        })?;
+    if let Some(p) = record_path.as_deref() {
+        crate::outputs::create_folder("--out", p)?;
     }
     let mut outs = Vec::new();
     for (flag, p) in [
@@ -129,7 +118,11 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         ("--plot", a.plot.as_deref()),
     ] {
         if let Some(path) = p {
-            outs.push(Output { flag, path });
+            outs.push(if flag == "--plot" {
+                Output::figure(flag, path)
+            } else {
+                Output::file(flag, path)
+            });
         }
     }
     let inputs: Vec<&std::path::Path> = a.scene.as_deref().into_iter().collect();

@@ -475,8 +475,8 @@ fn submit(a: SubmitArgs) -> Result<ExitCode> {
         }
         let dir = out.join("k8s");
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-        std::fs::write(dir.join("shards-job.yaml"), job)?;
-        std::fs::write(dir.join("merge-job.yaml"), merge)?;
+        crate::outputs::write_text(&dir.join("shards-job.yaml"), &job)?;
+        crate::outputs::write_text(&dir.join("merge-job.yaml"), &merge)?;
         let name = scheduler::dns_label(&study.name);
         out!("wrote {}/shards-job.yaml and merge-job.yaml; apply with:\n  kubectl apply -f {0}/shards-job.yaml\n  kubectl wait --for=condition=complete --timeout=24h job/{name}-shards\n  kubectl apply -f {0}/merge-job.yaml", dir.display());
         return Ok(ExitCode::SUCCESS);
@@ -494,26 +494,28 @@ fn submit(a: SubmitArgs) -> Result<ExitCode> {
         cpus_per_task: a.cpus_per_task,
         signal_s: a.signal_before,
     };
+    let script_error =
+        |e: scheduler::ScriptError| -> anyhow::Error { BadInput(e.to_string()).into() };
     let (arr, mrg) = (
-        scheduler::slurm_array_script(&j),
-        scheduler::slurm_merge_script(&j),
+        scheduler::slurm_array_script(&j).map_err(script_error)?,
+        scheduler::slurm_merge_script(&j).map_err(script_error)?,
     );
     let dir = out.join("slurm");
     let (arr_path, mrg_path) = (dir.join("shards.sbatch"), dir.join("merge.sbatch"));
+    let submit = scheduler::slurm_submit_commands(&arr_path, &mrg_path).map_err(script_error)?;
     if a.dry_run {
         out!(
-            "# {}\n{arr}\n# {}\n{mrg}\n# submit:\n{}",
+            "# {}\n{arr}\n# {}\n{mrg}\n# submit:\n{submit}",
             arr_path.display(),
             mrg_path.display(),
-            scheduler::slurm_submit_commands(&arr_path, &mrg_path)
         );
         return Ok(ExitCode::SUCCESS);
     }
     for d in [&dir, &out.join("logs")] {
         std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
     }
-    std::fs::write(&arr_path, arr)?;
-    std::fs::write(&mrg_path, mrg)?;
+    crate::outputs::write_text(&arr_path, &arr)?;
+    crate::outputs::write_text(&mrg_path, &mrg)?;
     let sbatch = |args: &[&str]| -> Result<String> {
         let o = std::process::Command::new("sbatch")
             .args(args)

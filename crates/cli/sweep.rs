@@ -127,7 +127,11 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         ("--plot", a.plot.as_deref()),
     ] {
         if let Some(path) = p {
-            outs.push(crate::outputs::Output { flag, path });
+            outs.push(if flag == "--plot" {
+                crate::outputs::Output::figure(flag, path)
+            } else {
+                crate::outputs::Output::file(flag, path)
+            });
         }
     }
     crate::outputs::check_outputs(&outs, &[a.scene.as_path()])?;

@@ -74,7 +74,10 @@ pub use fatigue::{
 };
 pub use fit::{polyfit, FitError, PolyFit};
 pub use interfaces::InterfaceStats;
-pub use plot::{plot_compare, plot_load_history, plot_sweep, register_fonts, PlotError};
+pub use plot::{
+    figure_format, plot_compare, plot_load_history, plot_sweep, register_fonts, FigureFormat,
+    PlotError,
+};
 pub use stats::{disc_stats, percentile, DiscStats, PeakStats};
 pub use sweep::{sweep_fits, sweep_rows, Spread, SweepCase, SweepRow};
 pub use table::{csv_field, interface_table, stats_table, sweep_table, TableFormat};

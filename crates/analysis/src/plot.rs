@@ -174,25 +174,42 @@ pub(crate) trait Figure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
 }
 
-/// Opens a PNG or SVG backend by `path`'s extension, draws `figure` and writes the file.
-pub(crate) fn render(path: &Path, size: (u32, u32), figure: &impl Figure) -> Result<(), PlotError> {
+/// A figure file's format, from its extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FigureFormat {
+    /// `.png` (either case): a bitmap.
+    Png,
+    /// `.svg` (either case): a vector drawing.
+    Svg,
+}
+
+/// The format a figure written to `path` would have, from its extension (`.png` or `.svg`,
+/// either case); any other extension is [`PlotError::UnsupportedFormat`]. Commands call it
+/// before any work, so that a figure they cannot write never costs a simulation.
+pub fn figure_format(path: &Path) -> Result<FigureFormat, PlotError> {
     let extension = path
         .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    if extension != "png" && extension != "svg" {
-        return Err(PlotError::UnsupportedFormat {
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match extension.as_str() {
+        "png" => Ok(FigureFormat::Png),
+        "svg" => Ok(FigureFormat::Svg),
+        _ => Err(PlotError::UnsupportedFormat {
             path: path.to_path_buf(),
             extension,
-        });
+        }),
     }
+}
+
+/// Opens a PNG or SVG backend by `path`'s extension, draws `figure` and writes the file.
+pub(crate) fn render(path: &Path, size: (u32, u32), figure: &impl Figure) -> Result<(), PlotError> {
+    let format = figure_format(path)?;
     register_fonts()?;
     let failed = |message: String| PlotError::Draw {
         path: path.to_path_buf(),
         message,
     };
-    if extension == "png" {
+    if format == FigureFormat::Png {
         let root = BitMapBackend::new(path, size).into_drawing_area();
         figure.draw(&root).map_err(failed)?;
         root.present().map_err(|e| failed(e.to_string()))

@@ -122,7 +122,7 @@ mod write;
 
 pub use export::{export_csv, export_csv_until};
 pub use info::{sha256_hex, DiscGeometry, FrictionInterface, RunInfo, ShaftGeometry};
-pub use output::{write_whole, PendingFile, Replace};
+pub use output::{partial_path, write_whole, PendingFile, Replace, NAME_MAX_BYTES};
 pub use read::{
     from_bytes, from_bytes_with, open, open_complete, open_with, AttachmentInfo, Damage,
     DamageKind, DiscSeries, InterfaceSeries, LoadHistory, MessageView, ReadError, ReadOptions,

@@ -37,22 +37,44 @@ pub struct PendingFile {
 
 static COUNTER: AtomicUsize = AtomicUsize::new(0);
 
+/// The longest file name, in bytes, that the file systems we write to accept (ext4, XFS,
+/// Btrfs, tmpfs, NFS: `NAME_MAX` = 255).
+pub const NAME_MAX_BYTES: usize = 255;
+
 /// The temporary sibling of `target` for this process: `<stem>.partial-<pid>-<k>.<ext>`
 /// (the extension kept, so that format-by-extension writers such as the plotter still work).
+/// When that name would be longer than [`NAME_MAX_BYTES`] (a target name that the file system
+/// accepts but leaves no room for the suffix), the stem is cut to fit and a hash of the whole
+/// stem keeps names of different targets apart: `<cut stem>~<16 hex>.partial-<pid>-<k>.<ext>`.
 pub fn partial_path(target: &Path, k: usize) -> PathBuf {
     let stem = target
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "output".into());
-    let name = match target.extension() {
-        Some(ext) => format!(
-            "{stem}.partial-{}-{k}.{}",
-            std::process::id(),
-            ext.to_string_lossy()
-        ),
-        None => format!("{stem}.partial-{}-{k}", std::process::id()),
-    };
-    target.with_file_name(name)
+    let ext = target
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    let suffix = format!(".partial-{}-{k}{ext}", std::process::id());
+    let stem = fit_stem(&stem, NAME_MAX_BYTES.saturating_sub(suffix.len()));
+    target.with_file_name(format!("{stem}{suffix}"))
+}
+
+/// `stem` if it has at most `room` bytes, else its longest prefix (on a character boundary)
+/// that leaves room for `~` and 16 hex digits of a hash of the whole stem.
+fn fit_stem(stem: &str, room: usize) -> String {
+    use std::hash::{Hash, Hasher};
+    if stem.len() <= room {
+        return stem.to_string();
+    }
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    stem.hash(&mut h);
+    let tag = format!("~{:016x}", h.finish());
+    let mut cut = room.saturating_sub(tag.len());
+    while !stem.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    format!("{}{tag}", &stem[..cut])
 }
 
 /// `<stem>-<k>.<ext>` beside `target`.
@@ -212,6 +234,31 @@ mod tests {
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
         d
+    }
+
+    /// A target name of 250 bytes (the file system takes up to 255) still gets a temporary
+    /// sibling that the file system accepts, and commits under its own name; two long names
+    /// that differ only at the end get different temporary names (issue 25, reproducer 3).
+    #[test]
+    fn long_target_names_get_temporary_names_that_fit() {
+        let d = dir("long");
+        let a = d.join(format!("{}a.mcap", "x".repeat(245)));
+        let b = d.join(format!("{}b.mcap", "x".repeat(245)));
+        assert_eq!(a.file_name().unwrap().len(), 251);
+        let (ta, tb) = (partial_path(&a, 0), partial_path(&b, 0));
+        for t in [&ta, &tb] {
+            let n = t.file_name().unwrap().len();
+            assert!(n <= NAME_MAX_BYTES, "{n}");
+            assert!(t.to_string_lossy().ends_with(".mcap"));
+        }
+        assert_ne!(ta, tb);
+        write_whole(&a, b"long").unwrap();
+        assert_eq!(std::fs::read(&a).unwrap(), b"long");
+        // a multi-byte character across the cut is not split
+        let c = d.join(format!("{}.csv", "é".repeat(120)));
+        let tc = partial_path(&c, 0);
+        assert!(tc.file_name().unwrap().len() <= NAME_MAX_BYTES);
+        let _ = std::fs::remove_dir_all(&d);
     }
 
     /// The target appears only at the commit; `Never` keeps an existing file and takes the

@@ -38,84 +38,126 @@ pub struct SlurmJob<'a> {
     pub signal_s: u32,
 }
 
-fn sh_quote(s: &str) -> String {
+/// A value that cannot go into a generated script or manifest.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{what} {value:?}: {rule}")]
+pub struct ScriptError {
+    /// What the value is (`the output folder`, `--time`).
+    pub what: String,
+    /// The value.
+    pub value: String,
+    /// Why it is refused.
+    pub rule: String,
+}
+
+/// The one shell quoting of every value a batch script holds: a word of safe characters as it
+/// is, anything else in single quotes (`'` written as `'\''`). A control character (a line
+/// break above all) is refused: on an `#SBATCH` line, which the shell reads as a comment and
+/// Slurm parses itself, no quoting would stop a line break from starting a shell command.
+pub fn sh_quote(what: &str, s: &str) -> Result<String, ScriptError> {
+    if let Some(c) = s.chars().find(|c| c.is_control()) {
+        return Err(ScriptError {
+            what: what.to_string(),
+            value: s.to_string(),
+            rule: format!(
+                "holds the control character {:?}; a batch script takes no control characters",
+                c
+            ),
+        });
+    }
     if !s.is_empty()
         && s.chars()
             .all(|c| c.is_ascii_alphanumeric() || "/._-+=:,@%".contains(c))
     {
-        s.to_string()
+        Ok(s.to_string())
     } else {
-        format!("'{}'", s.replace('\'', "'\\''"))
+        Ok(format!("'{}'", s.replace('\'', "'\\''")))
     }
 }
 
-fn q(p: &Path) -> String {
-    sh_quote(&p.display().to_string())
+fn q(what: &str, p: &Path) -> Result<String, ScriptError> {
+    sh_quote(what, &p.display().to_string())
 }
 
-/// The shard array's batch script.
-pub fn slurm_array_script(j: &SlurmJob) -> String {
+/// The shard array's batch script; a value that cannot be quoted safely is an error naming it.
+pub fn slurm_array_script(j: &SlurmJob) -> Result<String, ScriptError> {
     let mut s = String::from("#!/bin/bash\n");
     let logs = j.out.join("logs");
     let _ = writeln!(
         s,
         "#SBATCH --job-name={}",
-        sh_quote(&format!("{}-shard", j.name))
+        sh_quote("the study name", &format!("{}-shard", j.name))?
     );
-    let _ = writeln!(s, "#SBATCH --array={}", j.array);
-    let _ = writeln!(s, "#SBATCH --time={}", j.time);
+    let _ = writeln!(s, "#SBATCH --array={}", sh_quote("--array", &j.array)?);
+    let _ = writeln!(s, "#SBATCH --time={}", sh_quote("--time", j.time)?);
     let _ = writeln!(s, "#SBATCH --cpus-per-task={}", j.cpus_per_task);
     if let Some(p) = j.partition {
-        let _ = writeln!(s, "#SBATCH --partition={}", sh_quote(p));
+        let _ = writeln!(s, "#SBATCH --partition={}", sh_quote("--partition", p)?);
     }
-    let _ = writeln!(s, "#SBATCH --output={}", q(&logs.join("%x-%A_%a.out")));
+    let _ = writeln!(
+        s,
+        "#SBATCH --output={}",
+        q("the output folder", &logs.join("%x-%A_%a.out"))?
+    );
     // SIGTERM to the batch shell (which exec makes clutchpack) before the time limit
     let _ = writeln!(s, "#SBATCH --signal=B:TERM@{}", j.signal_s);
-    let _ = writeln!(s, "#SBATCH --chdir={}", q(j.out));
+    let _ = writeln!(s, "#SBATCH --chdir={}", q("the output folder", j.out)?);
     s.push_str("# One shard of the study per array task; clutchpack takes the shard index from\n");
     s.push_str("# SLURM_ARRAY_TASK_ID and its threads from SLURM_CPUS_PER_TASK.\n");
     let _ = writeln!(
         s,
         "exec {} study run {} --out {} --shard auto --shards {}",
-        q(j.exe),
-        q(j.study),
-        q(j.out),
+        q("the clutchpack executable", j.exe)?,
+        q("the study file", j.study)?,
+        q("the output folder", j.out)?,
         j.shards
     );
-    s
+    Ok(s)
 }
 
 /// The merge job's batch script (submitted with `--dependency=afterok:<array job>`).
-pub fn slurm_merge_script(j: &SlurmJob) -> String {
+pub fn slurm_merge_script(j: &SlurmJob) -> Result<String, ScriptError> {
     let mut s = String::from("#!/bin/bash\n");
     let _ = writeln!(
         s,
         "#SBATCH --job-name={}",
-        sh_quote(&format!("{}-merge", j.name))
+        sh_quote("the study name", &format!("{}-merge", j.name))?
     );
-    let _ = writeln!(s, "#SBATCH --time={}", j.merge_time);
+    let _ = writeln!(
+        s,
+        "#SBATCH --time={}",
+        sh_quote("--merge-time", j.merge_time)?
+    );
     let _ = writeln!(s, "#SBATCH --cpus-per-task=1");
     if let Some(p) = j.partition {
-        let _ = writeln!(s, "#SBATCH --partition={}", sh_quote(p));
+        let _ = writeln!(s, "#SBATCH --partition={}", sh_quote("--partition", p)?);
     }
     let _ = writeln!(
         s,
         "#SBATCH --output={}",
-        q(&j.out.join("logs").join("%x-%j.out"))
+        q("the output folder", &j.out.join("logs").join("%x-%j.out"))?
     );
     let _ = writeln!(s, "#SBATCH --kill-on-invalid-dep=yes");
-    let _ = writeln!(s, "#SBATCH --chdir={}", q(j.out));
-    let _ = writeln!(s, "exec {} study merge {}", q(j.exe), q(j.out));
-    s
+    let _ = writeln!(s, "#SBATCH --chdir={}", q("the output folder", j.out)?);
+    let _ = writeln!(
+        s,
+        "exec {} study merge {}",
+        q("the clutchpack executable", j.exe)?,
+        q("the output folder", j.out)?
+    );
+    Ok(s)
 }
 
 /// The command lines that submit the two scripts (what `--dry-run` prints).
-pub fn slurm_submit_commands(array_script: &Path, merge_script: &Path) -> String {
-    format!(
+pub fn slurm_submit_commands(
+    array_script: &Path,
+    merge_script: &Path,
+) -> Result<String, ScriptError> {
+    Ok(format!(
         "aid=$(sbatch --parsable {})\naid=${{aid%%;*}}\nsbatch --parsable --dependency=afterok:$aid --kill-on-invalid-dep=yes {}\n",
-        q(array_script),
-        q(merge_script)
-    )
+        q("the shards script", array_script)?,
+        q("the merge script", merge_script)?
+    ))
 }
 
 /// What the Kubernetes manifests need.
@@ -159,36 +201,38 @@ pub fn dns_label(s: &str) -> String {
     }
 }
 
-fn k8s_pod(j: &K8sJob, args: &[String], cpus: u32) -> String {
-    let args: Vec<String> = args.iter().map(|a| format!("\"{a}\"")).collect();
-    format!(
-        "  template:
-    spec:
-      restartPolicy: Never
-      containers:
-        - name: clutchpack
-          image: {image}
-          command: [\"clutchpack\"]
-          args: [{args}]
-          workingDir: {workdir}
-          resources:
-            requests:
-              cpu: \"{cpus}\"
-            limits:
-              cpu: \"{cpus}\"
-          volumeMounts:
-            - name: work
-              mountPath: {workdir}
-      volumes:
-        - name: work
-          persistentVolumeClaim:
-            claimName: {claim}
-",
-        image = j.image,
-        args = args.join(", "),
-        workdir = K8S_WORKDIR,
-        claim = j.claim,
-    )
+/// The pod template of both Jobs, as a serde value: every string the user gave (image, claim,
+/// paths, name) is a JSON string written by serde_json, never text pasted into a manifest.
+fn k8s_pod(j: &K8sJob, args: &[String], cpus: u32) -> serde_json::Value {
+    serde_json::json!({
+        "spec": {
+            "restartPolicy": "Never",
+            "containers": [{
+                "name": "clutchpack",
+                "image": j.image,
+                "command": ["clutchpack"],
+                "args": args,
+                "workingDir": K8S_WORKDIR,
+                "resources": {
+                    "requests": { "cpu": cpus.to_string() },
+                    "limits": { "cpu": cpus.to_string() },
+                },
+                "volumeMounts": [{ "name": "work", "mountPath": K8S_WORKDIR }],
+            }],
+            "volumes": [{
+                "name": "work",
+                "persistentVolumeClaim": { "claimName": j.claim },
+            }],
+        }
+    })
+}
+
+/// A manifest as text: JSON, which is YAML (1.2 is a superset of JSON), so `kubectl apply -f`
+/// reads it whatever the file's extension, and no value can break out of its string.
+fn manifest(v: &serde_json::Value) -> String {
+    let mut s = serde_json::to_string_pretty(v).unwrap_or_default();
+    s.push('\n');
+    s
 }
 
 /// The Indexed Job of the shards: pod `i` runs shard `i` (`JOB_COMPLETION_INDEX`); a failed
@@ -206,22 +250,18 @@ pub fn k8s_indexed_job(j: &K8sJob) -> String {
         "--shards".into(),
         j.shards.to_string(),
     ];
-    format!(
-        "apiVersion: batch/v1
-kind: Job
-metadata:
-  name: {name}-shards
-spec:
-  completionMode: Indexed
-  completions: {n}
-  parallelism: {par}
-  backoffLimitPerIndex: 2
-{pod}",
-        name = dns_label(j.name),
-        n = j.shards,
-        par = j.parallelism,
-        pod = k8s_pod(j, &args, j.cpus)
-    )
+    manifest(&serde_json::json!({
+        "apiVersion": "batch/v1",
+        "kind": "Job",
+        "metadata": { "name": format!("{}-shards", dns_label(j.name)) },
+        "spec": {
+            "completionMode": "Indexed",
+            "completions": j.shards,
+            "parallelism": j.parallelism,
+            "backoffLimitPerIndex": 2,
+            "template": k8s_pod(j, &args, j.cpus),
+        }
+    }))
 }
 
 /// The merge Job: start it once the shards' Job is `Complete`
@@ -229,17 +269,15 @@ spec:
 /// between Jobs.
 pub fn k8s_merge_job(j: &K8sJob) -> String {
     let args = ["study".to_string(), "merge".into(), j.out.into()];
-    format!(
-        "apiVersion: batch/v1
-kind: Job
-metadata:
-  name: {name}-merge
-spec:
-  backoffLimit: 1
-{pod}",
-        name = dns_label(j.name),
-        pod = k8s_pod(j, &args, 1)
-    )
+    manifest(&serde_json::json!({
+        "apiVersion": "batch/v1",
+        "kind": "Job",
+        "metadata": { "name": format!("{}-merge", dns_label(j.name)) },
+        "spec": {
+            "backoffLimit": 1,
+            "template": k8s_pod(j, &args, 1),
+        }
+    }))
 }
 
 #[cfg(test)]
@@ -261,7 +299,7 @@ mod tests {
             cpus_per_task: 2,
             signal_s: 60,
         };
-        let a = slurm_array_script(&j);
+        let a = slurm_array_script(&j).unwrap();
         for want in [
             "#SBATCH --array=0-3",
             "#SBATCH --signal=B:TERM@60",
@@ -271,9 +309,9 @@ mod tests {
         ] {
             assert!(a.contains(want), "{want} not in\n{a}");
         }
-        let m = slurm_merge_script(&j);
+        let m = slurm_merge_script(&j).unwrap();
         assert!(m.contains("--kill-on-invalid-dep=yes") && m.contains("study merge"));
-        let c = slurm_submit_commands(Path::new("/a.sh"), Path::new("/m.sh"));
+        let c = slurm_submit_commands(Path::new("/a.sh"), Path::new("/m.sh")).unwrap();
         assert!(c.contains("--dependency=afterok:$aid"));
         let k = k8s_indexed_job(&K8sJob {
             name: "MC study",
@@ -285,8 +323,12 @@ mod tests {
             cpus: 2,
             claim: "pvc",
         });
-        assert!(k.contains("completionMode: Indexed") && k.contains("completions: 8"));
-        assert!(k.contains("name: mc-study-shards"));
-        assert!(k.contains("workingDir: /work") && k.contains("mountPath: /work"));
+        let k: serde_json::Value = serde_json::from_str(&k).unwrap();
+        assert_eq!(k["spec"]["completionMode"], "Indexed");
+        assert_eq!(k["spec"]["completions"], 8);
+        assert_eq!(k["metadata"]["name"], "mc-study-shards");
+        let c = &k["spec"]["template"]["spec"]["containers"][0];
+        assert_eq!(c["workingDir"], "/work");
+        assert_eq!(c["volumeMounts"][0]["mountPath"], "/work");
     }
 }

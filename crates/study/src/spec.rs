@@ -515,6 +515,19 @@ fn join(prefix: &str, k: &str) -> String {
     }
 }
 
+/// What a study name may be: it names the Slurm jobs, the Kubernetes Jobs (a DNS label once
+/// lowercased) and the default output folder, so it is an identifier, not text.
+pub const NAME_RULE: &str =
+    "1 to 63 letters, digits, '-', '_' or '.', not starting with '-' or '.'";
+
+/// Whether `s` follows [`NAME_RULE`].
+pub fn is_study_name(s: &str) -> bool {
+    (1..=63).contains(&s.len())
+        && !s.starts_with(['-', '.'])
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
+}
+
 /// The most cases a study may have (indexes are u64, but a table of more rows than this is not
 /// what a study file is for).
 pub const MAX_CASES: u64 = 100_000_000;
@@ -563,15 +576,31 @@ pub fn parse(text: &str, file: &str, dir: &Path) -> Result<Study, SpecError> {
         );
     }
     ck.unknown("study", st, &["name", "scene", "engine", "seed", "outputs"]);
-    let name = ck
-        .string("study.name", st.get("name"))
-        .map(str::to_string)
-        .unwrap_or_else(|| {
-            Path::new(file)
+    let name = match ck.string("study.name", st.get("name")) {
+        Some(n) => {
+            if !is_study_name(n) {
+                ck.bad("study.name", st.get("name"), format!("must be {NAME_RULE}"));
+            }
+            n.to_string()
+        }
+        None => {
+            let stem = Path::new(file)
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_else(|| "study".into())
-        });
+                .unwrap_or_else(|| "study".into());
+            if st.get("name").is_none() && !is_study_name(&stem) {
+                ck.bad(
+                    "study.name",
+                    None,
+                    format!(
+                        "missing, and the file name {stem:?} it defaults to is not a study \
+                         name: set study.name ({NAME_RULE})"
+                    ),
+                );
+            }
+            stem
+        }
+    };
     let scene_rel = ck.string("study.scene", st.get("scene"));
     if st.get("scene").is_none() && doc.get("study").is_some() {
         ck.bad(
