@@ -114,12 +114,48 @@ fn main() -> ExitCode {
         Err(e) => {
             let bad_input = e.chain().any(|c| c.is::<common::BadInput>())
                 || e.chain().any(|c| c.is::<clutchpack_scene::SceneError>());
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_text(&e));
             if bad_input {
                 ExitCode::from(2)
             } else {
                 ExitCode::from(1)
             }
         }
+    }
+}
+
+/// An error and its causes on one line, `outer: cause: cause`, without repeating a cause whose
+/// text the line already holds (an error that prints its source in its own message, as
+/// `PartError::Io` does, would otherwise show it twice).
+fn error_text(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
+}
+
+#[cfg(test)]
+mod tests {
+    /// `error: nope: No such file or directory (os error 2): No such file or directory (os
+    /// error 2)` was printed for `study merge nope` (issue 25, reproducer 12).
+    #[test]
+    fn causes_are_printed_once() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        let e = anyhow::Error::new(clutchpack_study::part::PartError::Io {
+            path: "nope".into(),
+            source: io,
+        })
+        .context("merging");
+        assert_eq!(super::error_text(&e), "merging: nope: no such file");
+        let e = anyhow::anyhow!("inner").context("outer");
+        assert_eq!(super::error_text(&e), "outer: inner");
     }
 }

@@ -311,6 +311,12 @@ fn run(a: RunArgs) -> Result<ExitCode> {
         clutchpack_study::part::PartError::OtherStudy { .. } => BadInput(e.to_string()).into(),
         e => anyhow::Error::from(e),
     })?;
+    if let Some((to, reason)) = &outcome.set_aside {
+        eprintln!(
+            "warning: {label}: the part was damaged ({reason}); moved to {} and its cases ran again",
+            to.display()
+        );
+    }
     let overhead = (outcome.wall_s * jobs as f64 - outcome.case_wall_s).max(0.0);
     eprintln!(
         "{label}: {} cases, {} skipped (already done), {} run, {} failed; {:.2} s wall, engine {:.2} s over {jobs} threads; part {}{}",
@@ -346,9 +352,26 @@ fn run(a: RunArgs) -> Result<ExitCode> {
 pub const EXIT_MISSING: u8 = 3;
 
 fn merge(a: MergeArgs) -> Result<ExitCode> {
+    if !a.dir.is_dir() {
+        return Err(BadInput(format!(
+            "{}: not a folder (expected the --out folder of `study run` or `study submit`)",
+            a.dir.display()
+        ))
+        .into());
+    }
     let m = match clutchpack_study::collect(&a.dir) {
         Ok(m) => m,
-        Err(MergeError::Missing { count, missing }) => {
+        Err(MergeError::Missing {
+            count,
+            missing,
+            set_aside,
+        }) => {
+            for (to, reason) in &set_aside {
+                eprintln!(
+                    "warning: a damaged part ({reason}) was moved to {}; its shard runs again",
+                    to.display()
+                );
+            }
             eprintln!(
                 "error: {}: {} of {count} shards missing or unfinished: {}",
                 a.dir.display(),
@@ -371,8 +394,16 @@ fn merge(a: MergeArgs) -> Result<ExitCode> {
     write("summary.csv", &m.summary_csv())?;
     let pq = a.dir.join("results.parquet");
     let tmp = a.dir.join("results.parquet.tmp");
-    clutchpack_study::parquet::write_results(&tmp, &m)?;
-    std::fs::rename(&tmp, &pq).with_context(|| format!("writing {}", pq.display()))?;
+    let written = clutchpack_study::parquet::write_results(&tmp, &m)
+        .map_err(anyhow::Error::from)
+        .and_then(|()| {
+            std::fs::rename(&tmp, &pq).with_context(|| format!("writing {}", pq.display()))
+        });
+    if written.is_err() {
+        // a full disk: leave no temporary file behind
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written?;
     let failed = m.records.iter().filter(|r| r.error.is_some()).count();
     let plot = a.dir.join(format!("main-effects.{}", a.plot_format));
     let plotted = if failed < m.records.len() {

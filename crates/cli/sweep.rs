@@ -100,9 +100,29 @@ pub fn ensemble_member(scene: &Scene, k: usize, count: usize) -> Scene {
     s
 }
 
+/// The most cases (values x members) one sweep runs: every case's statistics are held in
+/// memory until the table is printed.
+pub const MAX_SWEEP_CASES: usize = 1_000_000;
+
 pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
-    if a.ensemble == 0 {
-        return Err(BadInput("--ensemble must be at least 1".into()).into());
+    if a.ensemble == 0 || a.ensemble > MAX_SWEEP_CASES {
+        return Err(BadInput(format!(
+            "--ensemble {}: expected an integer in 1..={MAX_SWEEP_CASES}",
+            a.ensemble
+        ))
+        .into());
+    }
+    match a.values.len().checked_mul(a.ensemble) {
+        Some(n) if n <= MAX_SWEEP_CASES => {}
+        _ => {
+            return Err(BadInput(format!(
+                "{} values x {} members: a sweep may have at most {MAX_SWEEP_CASES} cases \
+                 (a study file runs more, in shards)",
+                a.values.len(),
+                a.ensemble
+            ))
+            .into())
+        }
     }
     if a.values.iter().any(|v| !v.is_finite()) {
         return Err(BadInput(format!(

@@ -25,8 +25,22 @@ pub(crate) const MAX_RECORD_RATE_HZ: f64 = 1e6;
 pub(crate) const MAX_SAMPLES: f64 = 1e8;
 /// Smallest `max_step_s` accepted, s.
 pub(crate) const MIN_MAX_STEP_S: f64 = 1e-9;
-/// Smallest inertia of a body accepted, kg m^2.
-pub(crate) const MIN_INERTIA_KG_M2: f64 = 1e-9;
+/// Smallest inertia of a body accepted, kg m^2 (a 10 g ring of 14 mm radius).
+pub(crate) const MIN_INERTIA_KG_M2: f64 = 1e-6;
+/// Largest pitch radius of a spline accepted, m (the largest wet brakes are below 1 m).
+pub(crate) const MAX_PITCH_RADIUS_M: f64 = 5.0;
+/// Largest equivalent modulus accepted, Pa (ten times diamond's).
+pub(crate) const MAX_MODULUS_PA: f64 = 1e13;
+/// Largest equivalent curvature radius accepted, m.
+pub(crate) const MAX_CURVATURE_RADIUS_M: f64 = 10.0;
+/// Range of the endurance limit accepted, Pa (polymers to the strongest steels, with margin).
+pub(crate) const ENDURANCE_RANGE_PA: (f64, f64) = (1e6, 1e10);
+/// Largest S-N slope accepted (ISO 6336-3's steepest is about 17; Haibach doubles it).
+pub(crate) const MAX_SN_SLOPE: f64 = 50.0;
+/// Range of the knee of the S-N curve accepted, cycles.
+pub(crate) const KNEE_CYCLES_RANGE: (f64, f64) = (1e3, 1e10);
+/// Largest Miner damage sum at failure accepted.
+pub(crate) const MAX_CRITICAL_DAMAGE: f64 = 10.0;
 /// Most teeth of one spline accepted.
 pub(crate) const MAX_TEETH: u32 = 10_000;
 
@@ -268,7 +282,7 @@ table! {
         /// number of teeth n
         teeth: "", Kind::Count { max: MAX_TEETH }, Dflt::Required;
         /// pitch radius R
-        pitch_radius_m: "m", POSITIVE, Dflt::Required;
+        pitch_radius_m: "m", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_PITCH_RADIUS_M }), Dflt::Required;
         /// pressure angle alpha
         pressure_angle_deg: "deg", Kind::Number(Rule::Open(0.0, 90.0)), Dflt::Required;
         /// total circumferential free play d at the pitch circle; below the tooth pitch 2 pi R / n
@@ -283,9 +297,9 @@ table! {
         /// the tooth law (MODEL.md section 2)
         law: "", Kind::Choice(&["paper", "dry", "squeeze"]), Dflt::Choice("paper");
         /// equivalent modulus E
-        modulus_pa: "Pa", POSITIVE, Dflt::Required;
+        modulus_pa: "Pa", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_MODULUS_PA }), Dflt::Required;
         /// equivalent curvature radius r
-        curvature_radius_m: "m", POSITIVE, Dflt::Required;
+        curvature_radius_m: "m", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_CURVATURE_RADIUS_M }), Dflt::Required;
         /// impact loss p
         loss_coefficient_s_m: "s/m", NON_NEGATIVE, Dflt::Num(0.0);
     }
@@ -338,15 +352,15 @@ table! {
     /// disc core (ISO 6336-5 MQ; docs/DECISIONS.md, "Fatigue").
     RawMaterial at "material" {
         /// endurance limit S_D as a root stress amplitude at knee_cycles; ASSUMED default: sigma_Flim of through-hardened steel (ISO 6336-5 MQ)
-        endurance_amplitude_pa: "Pa", POSITIVE, Dflt::Num(fat::DEFAULT_ENDURANCE_AMPLITUDE_PA);
+        endurance_amplitude_pa: "Pa", Kind::Number(Rule::Bounded { floor: ENDURANCE_RANGE_PA.0, ceil: ENDURANCE_RANGE_PA.1 }), Dflt::Num(fat::DEFAULT_ENDURANCE_AMPLITUDE_PA);
         /// cycles N_D at the knee of the S-N curve
-        knee_cycles: "", POSITIVE, Dflt::Num(fat::DEFAULT_KNEE_CYCLES);
+        knee_cycles: "", Kind::Number(Rule::Bounded { floor: KNEE_CYCLES_RANGE.0, ceil: KNEE_CYCLES_RANGE.1 }), Dflt::Num(fat::DEFAULT_KNEE_CYCLES);
         /// Basquin exponent k above the knee, N = N_D (S_D / S)^k; ASSUMED default from ISO 6336-3's life factor
-        slope: "", Kind::Number(Rule::Above(1.0)), Dflt::Num(fat::DEFAULT_SLOPE);
+        slope: "", Kind::Number(Rule::Open(1.0, MAX_SN_SLOPE)), Dflt::Num(fat::DEFAULT_SLOPE);
         /// below the knee: no damage (original), slope k (elementary) or slope 2k - 1 (haibach)
         miner_rule: "", Kind::Choice(&["original", "elementary", "haibach"]), Dflt::Choice(fat::DEFAULT_MINER_RULE.name());
         /// Miner damage sum at failure D_crit
-        critical_damage: "", POSITIVE, Dflt::Num(fat::DEFAULT_CRITICAL_DAMAGE);
+        critical_damage: "", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_CRITICAL_DAMAGE }), Dflt::Num(fat::DEFAULT_CRITICAL_DAMAGE);
     }
     children {}
 }

@@ -79,8 +79,6 @@ pub(crate) enum Rule {
     NonNegative,
     /// `>= lo`.
     AtLeast(f64),
-    /// `> lo`.
-    Above(f64),
     /// In `[lo, hi]`.
     Closed(f64, f64),
     /// In `(lo, hi)`.
@@ -109,7 +107,6 @@ impl Rule {
             Rule::Positive => x > 0.0,
             Rule::NonNegative => x >= 0.0,
             Rule::AtLeast(lo) => x >= lo,
-            Rule::Above(lo) => x > lo,
             Rule::Closed(lo, hi) => (lo..=hi).contains(&x),
             Rule::Open(lo, hi) => x > lo && x < hi,
             Rule::Bounded { floor, ceil } => {
@@ -144,7 +141,6 @@ impl Rule {
             Rule::Positive => "> 0".into(),
             Rule::NonNegative => ">= 0".into(),
             Rule::AtLeast(lo) => format!(">= {}", fmt_bound(lo)),
-            Rule::Above(lo) => format!("> {}", fmt_bound(lo)),
             Rule::Closed(lo, hi) => format!("in [{}, {}]", fmt_bound(lo), fmt_bound(hi)),
             Rule::Open(lo, hi) => {
                 format!("in ({}, {}) (exclusive)", fmt_bound(lo), fmt_bound(hi))
@@ -183,7 +179,7 @@ pub(crate) fn fmt_bound(x: f64) -> String {
 /// A number for messages: Rust's shortest round-trip `{}` for ordinary magnitudes, `{:e}`
 /// for huge or tiny ones (`1e308`, not 309 digits; `5e-324`).
 pub(crate) fn fmt_num(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() || (1e-5..1e16).contains(&x.abs()) {
+    if x == 0.0 || !x.is_finite() || (1e-5..1e9).contains(&x.abs()) {
         format!("{x}")
     } else {
         format!("{x:e}")
@@ -193,7 +189,7 @@ pub(crate) fn fmt_num(x: f64) -> String {
 /// A value as written, in TOML syntax, for messages; huge or tiny floats in `{:e}` form.
 pub(crate) fn show(v: &Value) -> String {
     fn plain(x: f64) -> bool {
-        x == 0.0 || !x.is_finite() || (1e-5..1e16).contains(&x.abs())
+        x == 0.0 || !x.is_finite() || (1e-5..1e9).contains(&x.abs())
     }
     match v {
         Value::Float(x) if !plain(*x) => format!("{x:e}"),

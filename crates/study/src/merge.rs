@@ -38,10 +38,12 @@ pub struct Merged {
 #[derive(Debug, thiserror::Error)]
 pub enum MergeError {
     /// No part in the folder.
-    #[error("{}: no study parts (part-*-of-*.json) in this folder", dir.display())]
+    #[error("{}: no study parts (part-*-of-*.json) in this folder{}", dir.display(), damaged_note(set_aside))]
     NoParts {
         /// The folder.
         dir: PathBuf,
+        /// Damaged parts moved aside: (new path, why they did not parse).
+        set_aside: Vec<(PathBuf, String)>,
     },
     /// A part file could not be read.
     #[error(transparent)]
@@ -61,7 +63,22 @@ pub enum MergeError {
         count: u64,
         /// Indexes of the missing or incomplete shards, ascending.
         missing: Vec<u64>,
+        /// Damaged parts moved aside (their shards are among `missing`): (new path, why they
+        /// did not parse).
+        set_aside: Vec<(PathBuf, String)>,
     },
+}
+
+/// `" (damaged parts moved aside: X.damaged)"`, or nothing.
+fn damaged_note(set_aside: &[(PathBuf, String)]) -> String {
+    if set_aside.is_empty() {
+        return String::new();
+    }
+    let names: Vec<String> = set_aside
+        .iter()
+        .map(|(p, _)| p.display().to_string())
+        .collect();
+    format!(" (damaged parts moved aside: {})", names.join(", "))
 }
 
 /// Reads every part in `dir` and checks that they are the shards `0..N` of one study, all
@@ -84,11 +101,22 @@ pub fn collect(dir: &Path) -> Result<Merged, MergeError> {
         })
         .collect();
     paths.sort();
+    let mut set_aside = Vec::new();
     for p in &paths {
-        parts.push(read_part(p)?);
+        match read_part(p) {
+            Ok(part) => parts.push(part),
+            // a damaged part is moved aside: its shard is then missing and runs again
+            Err(PartError::Damaged { reason, .. }) => {
+                set_aside.push((crate::part::set_aside(p)?, reason));
+            }
+            Err(e) => return Err(e.into()),
+        }
     }
     let Some(first) = parts.first() else {
-        return Err(MergeError::NoParts { dir: dir.into() });
+        return Err(MergeError::NoParts {
+            dir: dir.into(),
+            set_aside,
+        });
     };
     let (header, count) = (first.study.clone(), first.shard.count);
     for p in &parts {
@@ -113,7 +141,11 @@ pub fn collect(dir: &Path) -> Result<Merged, MergeError> {
         .filter(|i| !parts.iter().any(|p| p.shard.index == *i && p.complete))
         .collect();
     if !missing.is_empty() {
-        return Err(MergeError::Missing { count, missing });
+        return Err(MergeError::Missing {
+            count,
+            missing,
+            set_aside,
+        });
     }
     let mut records: Vec<CaseRecord> = parts.into_iter().flat_map(|p| p.records).collect();
     records.sort_by_key(|r| r.case);
@@ -472,7 +504,7 @@ high = 0.02
         part.complete = false;
         std::fs::write(&p3, serde_json::to_string(&part).unwrap()).unwrap();
         match collect(&dir) {
-            Err(MergeError::Missing { count, missing }) => {
+            Err(MergeError::Missing { count, missing, .. }) => {
                 assert_eq!((count, missing.clone()), (5, vec![1, 3, 4]));
                 assert_eq!(array_syntax(&missing), "1,3-4");
             }

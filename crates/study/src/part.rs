@@ -150,6 +150,15 @@ pub enum PartError {
         /// Why.
         reason: String,
     },
+    /// A part file that does not parse (cut short, overwritten): moved aside by
+    /// [`set_aside`] and its cases run again.
+    #[error("{}: damaged part file: {reason}", path.display())]
+    Damaged {
+        /// The file.
+        path: PathBuf,
+        /// Why it does not parse.
+        reason: String,
+    },
     /// A part of another study (other hash) where this one's should be.
     #[error("{}: a part of another study (hash {found}, this study's is {expected}); use another --out folder or delete it", path.display())]
     OtherStudy {
@@ -162,13 +171,22 @@ pub enum PartError {
     },
 }
 
-/// Reads a part file.
+/// Reads a part file. A file that is not a regular file (a FIFO, a folder) is refused
+/// before it is opened, so nothing blocks on it; a file that does not parse is
+/// [`PartError::Damaged`].
 pub fn read_part(path: &Path) -> Result<Part, PartError> {
-    let text = std::fs::read_to_string(path).map_err(|source| PartError::Io {
+    let io = |source| PartError::Io {
         path: path.into(),
         source,
-    })?;
-    let part: Part = serde_json::from_str(&text).map_err(|e| PartError::Bad {
+    };
+    if !std::fs::metadata(path).map_err(io)?.is_file() {
+        return Err(PartError::Bad {
+            path: path.into(),
+            reason: "not a regular file".into(),
+        });
+    }
+    let bytes = std::fs::read(path).map_err(io)?;
+    let part: Part = serde_json::from_slice(&bytes).map_err(|e| PartError::Damaged {
         path: path.into(),
         reason: e.to_string(),
     })?;
@@ -181,6 +199,23 @@ pub fn read_part(path: &Path) -> Result<Part, PartError> {
     Ok(part)
 }
 
+/// Moves a damaged part aside to `<name>.damaged` (or `<name>.damaged.K`, never over an
+/// earlier one) so that its shard runs again; returns the new path.
+pub fn set_aside(path: &Path) -> Result<PathBuf, PartError> {
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    let mut to = path.with_file_name(format!("{name}.damaged"));
+    let mut k = 1;
+    while to.exists() {
+        to = path.with_file_name(format!("{name}.damaged.{k}"));
+        k += 1;
+    }
+    std::fs::rename(path, &to).map_err(|source| PartError::Io {
+        path: path.into(),
+        source,
+    })?;
+    Ok(to)
+}
+
 /// Writes `value` as JSON to `path` atomically: a temporary file in the same folder, flushed
 /// to disk, then renamed over `path`.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PartError> {
@@ -190,11 +225,18 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PartError> {
         source,
     };
     let tmp = path.with_extension(format!("tmp.{}", std::process::id()));
-    let mut f = std::fs::File::create(&tmp).map_err(io)?;
-    f.write_all(bytes).map_err(io)?;
-    f.sync_all().map_err(io)?;
-    drop(f);
-    std::fs::rename(&tmp, path).map_err(io)
+    let written = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        drop(f);
+        std::fs::rename(&tmp, path)
+    })();
+    if written.is_err() {
+        // a full disk or a lost folder: leave no temporary file behind
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written.map_err(io)
 }
 
 fn write_part(path: &Path, part: &Part) -> Result<(), PartError> {
@@ -224,6 +266,9 @@ pub struct ShardOutcome {
     pub case_wall_s: f64,
     /// Wall time of the shard, s.
     pub wall_s: f64,
+    /// A damaged part found at the start: where it was moved and why it did not parse (its
+    /// cases ran again).
+    pub set_aside: Option<(PathBuf, String)>,
 }
 
 /// What a case runner returns: `Ok(None)` when it was stopped by `stop` (the case is not
@@ -252,8 +297,19 @@ pub fn run_shard(
     let path = out.join(shard.file_name());
     let header = StudyHeader::of(study);
     let mut records = Vec::new();
-    if path.exists() {
-        let old = read_part(&path)?;
+    let mut set_aside_to = None;
+    let old = if path.exists() {
+        match read_part(&path) {
+            Err(PartError::Damaged { reason, .. }) => {
+                set_aside_to = Some((set_aside(&path)?, reason));
+                None
+            }
+            other => Some(other?),
+        }
+    } else {
+        None
+    };
+    if let Some(old) = old {
         if old.study.hash != header.hash {
             return Err(PartError::OtherStudy {
                 path,
@@ -310,6 +366,7 @@ pub fn run_shard(
         complete: records.len() == all.len(),
         case_wall_s: case_wall,
         wall_s: t0.elapsed().as_secs_f64(),
+        set_aside: set_aside_to,
     })
 }
 

@@ -211,13 +211,17 @@ pub const GRADE_KEY: &str = "spacing.grade";
 
 impl Study {
     /// Number of design points (product of the factors' level counts; 1 without factors).
+    /// Saturates at `u64::MAX` (a parsed study has at most [`MAX_CASES`] cases).
     pub fn design_points(&self) -> u64 {
-        self.factors.iter().map(|f| f.levels.len() as u64).product()
+        self.factors
+            .iter()
+            .try_fold(1u64, |n, f| n.checked_mul(f.levels.len() as u64))
+            .unwrap_or(u64::MAX)
     }
 
-    /// Number of cases.
+    /// Number of cases. Saturates at `u64::MAX` (a parsed study has at most [`MAX_CASES`]).
     pub fn cases(&self) -> u64 {
-        self.design_points() * self.members
+        self.design_points().saturating_mul(self.members)
     }
 
     /// The table columns that describe a case: the design factors, the random keys, then
@@ -463,12 +467,21 @@ impl Ck {
         }
     }
 
-    fn count(&mut self, key: &str, v: Option<&Value>, min: i64) -> Option<u64> {
+    /// A count in `min..=max` (bounded before anything is allocated from it).
+    fn count(&mut self, key: &str, v: Option<&Value>, min: u64, max: u64) -> Option<u64> {
         match v {
             None => None,
-            Some(Value::Integer(i)) if *i >= min => Some(*i as u64),
+            Some(Value::Integer(i))
+                if u64::try_from(*i).is_ok_and(|i| (min..=max).contains(&i)) =>
+            {
+                Some(*i as u64)
+            }
             Some(other) => {
-                self.bad(key, Some(other), format!("must be an integer >= {min}"));
+                self.bad(
+                    key,
+                    Some(other),
+                    format!("must be an integer in {min}..={max}"),
+                );
                 None
             }
         }
@@ -531,6 +544,9 @@ pub fn is_study_name(s: &str) -> bool {
 /// The most cases a study may have (indexes are u64, but a table of more rows than this is not
 /// what a study file is for).
 pub const MAX_CASES: u64 = 100_000_000;
+
+/// The most levels one factor may have (`linear`/`log` counts; the levels are held in memory).
+pub const MAX_LEVELS: u64 = 1_000_000;
 
 /// Validates study text. `file` names the file in messages, `dir` is the folder that the
 /// scene path is relative to. Every problem is reported at once, including those the scene
@@ -661,7 +677,7 @@ pub fn parse(text: &str, file: &str, dir: &Path) -> Result<Study, SpecError> {
         &["members", "initial_positions", "drive_phase"],
     );
     let members = ck
-        .count("ensemble.members", en.get("members"), 1)
+        .count("ensemble.members", en.get("members"), 1, MAX_CASES)
         .unwrap_or(1);
     let placement = match ck.choice(
         "ensemble.initial_positions",
@@ -980,10 +996,23 @@ pub fn parse(text: &str, file: &str, dir: &Path) -> Result<Study, SpecError> {
         hash: String::new(),
     };
     if study.cases() > MAX_CASES {
+        let mut terms: Vec<String> = study
+            .factors
+            .iter()
+            .map(|f| format!("{} ({})", f.levels.len(), f.key))
+            .collect();
+        terms.push(format!("{} (ensemble.members)", study.members));
+        let total = match study.cases() {
+            u64::MAX => "more than 2^64".to_string(),
+            n => n.to_string(),
+        };
         ck.bad(
             "factor",
             None,
-            format!("{} cases: more than {MAX_CASES}", study.cases()),
+            format!(
+                "{} = {total} cases; a study may have at most {MAX_CASES}",
+                terms.join(" x ")
+            ),
         );
     }
     if scene_rel.is_some() {
@@ -1072,7 +1101,7 @@ fn range(ck: &mut Ck, key: &str, v: &Value, log: bool) -> Option<Vec<f64>> {
     };
     let from = ck.number(&format!("{key}[0]"), Some(&a[0]));
     let to = ck.number(&format!("{key}[1]"), Some(&a[1]));
-    let count = ck.count(&format!("{key}[2]"), Some(&a[2]), 1);
+    let count = ck.count(&format!("{key}[2]"), Some(&a[2]), 1, MAX_LEVELS);
     let (from, to, count) = (from?, to?, count?);
     if log && (from <= 0.0 || to <= 0.0) {
         ck.bad(key, Some(v), "a log range needs from > 0 and to > 0");
@@ -1173,7 +1202,7 @@ std = -1
         .to_string();
         for want in [
             "t.toml: study.engine = \"fast\": must be one of: reference, multibody",
-            "ensemble.members = 0: must be an integer >= 1",
+            "ensemble.members = 0: must be an integer in 1..=100000000",
             "factor[0].log = [0, 0.0001, 3]: a log range needs from > 0",
             "random[0].std = -1: must be > 0",
         ] {

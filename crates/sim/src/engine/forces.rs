@@ -150,7 +150,7 @@ impl Run<'_> {
             };
             if !(rel.phi.abs() <= limit && rel.dphi.is_finite()) {
                 return Err(diverged(format!(
-                    "relative angle {} rad, speed {} rad/s (half a tooth pitch is {limit} rad)",
+                    "relative angle {:.6e} rad, speed {:.6e} rad/s (half a tooth pitch is {limit:.6e} rad)",
                     rel.phi, rel.dphi
                 )));
             }
@@ -158,12 +158,12 @@ impl Run<'_> {
             let offset_limit = limit * c.spline.pitch_radius_m;
             if !(offset <= offset_limit && rel.offset_rate.iter().all(|v| v.is_finite())) {
                 return Err(diverged(format!(
-                    "radial offset {offset} m (half a tooth pitch is {offset_limit} m)"
+                    "radial offset {offset:.6e} m (half a tooth pitch is {offset_limit:.6e} m)"
                 )));
             }
             let f = c.evaluate(&rel);
             if !(f.load_n.is_finite() && f.moment[2].is_finite()) {
-                return Err(diverged(format!("tooth load {} N", f.load_n)));
+                return Err(diverged(format!("tooth load {:.6e} N", f.load_n)));
             }
             self.potential_j += f.potential_j;
             self.rel.push(rel);

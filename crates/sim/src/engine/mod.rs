@@ -340,7 +340,7 @@ impl MultibodyEngine {
                     if want.is_nan() || want < a.min_step_s {
                         return Err(EngineError::Diverged {
                             t_s: t,
-                            reason: format!("the step size collapsed to {want} s"),
+                            reason: format!("the step size collapsed to {want:.3e} s"),
                         });
                     }
                     // Free-flight steps land on the sampling grid; contact steps keep their

@@ -311,7 +311,7 @@ impl<'a> Run<'a> {
             if want.is_nan() || want < a.min_step_s {
                 return Err(EngineError::Diverged {
                     t_s: t,
-                    reason: format!("disc {i}: the sub-step collapsed to {want} s"),
+                    reason: format!("disc {i}: the sub-step collapsed to {want:.3e} s"),
                 });
             }
             let rem = t1 - t;
@@ -379,8 +379,8 @@ impl<'a> Run<'a> {
                 return Err(EngineError::Diverged {
                     t_s: t,
                     reason: format!(
-                        "disc {i}: relative angle {phi} rad, speed {dphi} rad/s (half a tooth \
-                         pitch is {limit} rad)"
+                        "disc {i}: relative angle {phi:.6e} rad, speed {dphi:.6e} rad/s (half a tooth \
+                         pitch is {limit:.6e} rad)"
                     ),
                 });
             }
@@ -393,7 +393,7 @@ impl<'a> Run<'a> {
             if !(f.load_n.is_finite() && f.moment[2].is_finite()) {
                 return Err(EngineError::Diverged {
                     t_s: t,
-                    reason: format!("disc {i}: tooth load {} N", f.load_n),
+                    reason: format!("disc {i}: tooth load {:.6e} N", f.load_n),
                 });
             }
             self.forces[i] = f;
