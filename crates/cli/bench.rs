@@ -10,7 +10,7 @@ use clutchpack_record::{RecordOptions, Recorder};
 use clutchpack_reference::{ReferenceEngine, Scheme};
 use clutchpack_scene::Override;
 use std::process::ExitCode;
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -48,11 +48,8 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         out!("warning: a debug build; run `cargo run --release -- bench` for meaningful figures");
     }
     out!("machine: {cores} cores available");
-    if a.pack_only {
-        return staggered_packs(a.pack_runs).map(|()| ExitCode::SUCCESS);
-    }
-    // SIGINT, SIGTERM and SIGHUP stop the bench between (or inside recorded) runs: the
-    // figures printed so far stand, the exit code is 128 + signal
+    // SIGINT, SIGTERM and SIGHUP stop the bench inside a run (every engine polls the flag
+    // within milliseconds): the figures printed so far stand, the exit code is 128 + signal
     let stop = crate::signals::flag();
     let stopped = || {
         let s = stop.load(Ordering::SeqCst);
@@ -61,6 +58,14 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         }
         s
     };
+    if a.pack_only {
+        staggered_packs(a.pack_runs, &stop)?;
+        return Ok(if stopped() {
+            crate::signals::exit_code()
+        } else {
+            ExitCode::SUCCESS
+        });
+    }
 
     // 1. The paper case, 0.3 s simulated, one disc, h_o = 0 (the built-in default scene).
     let scene = common::load_scene(None, &[])?;
@@ -72,9 +77,12 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
             return Ok(crate::signals::exit_code());
         }
         let mut engine = common::make_engine(&scene, None)?;
-        let mut obs = RunCollector::new(1, false);
+        let mut obs = RunCollector::new(1, false).with_stop(Arc::clone(&stop));
         let t0 = Instant::now();
         let s = engine.run(scene.simulation.duration_s, &mut obs)?;
+        if stopped() {
+            return Ok(crate::signals::exit_code());
+        }
         times.push(t0.elapsed().as_secs_f64());
         steps = s.steps;
         impacts = obs.impact_count();
@@ -222,8 +230,12 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         }
         let _ = std::fs::remove_dir_all(&dir);
     }
-    staggered_packs(a.pack_runs)?;
-    Ok(ExitCode::SUCCESS)
+    staggered_packs(a.pack_runs, &stop)?;
+    Ok(if stopped() {
+        crate::signals::exit_code()
+    } else {
+        ExitCode::SUCCESS
+    })
 }
 
 /// One engine configuration of the staggered-pack benchmark.
@@ -249,7 +261,7 @@ fn reference_engine(pack: PackModel, scheme: Scheme, parallel: bool) -> Box<dyn 
 ///    of `scenes/staggered-*-disc.toml`), per disc, as the pack grows: N = 1, 4, 16 and 64
 ///    discs for 0.1 s, each engine with the settings `run` gives it (record rate 10 kHz,
 ///    default tolerance or stepping), the samples reduced as `run --no-record` does.
-fn staggered_packs(runs: usize) -> Result<()> {
+fn staggered_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     if runs == 0 {
         return Ok(());
     }
@@ -298,9 +310,13 @@ fn staggered_packs(runs: usize) -> Result<()> {
             for (j, &n) in sizes.iter().enumerate() {
                 for _ in 0..(e.max_discs / n).clamp(1, 16) {
                     let mut engine = (e.make)(staggered_pack(n))?;
-                    let mut obs = RunCollector::new(n, false);
+                    let mut obs = RunCollector::new(n, false).with_stop(Arc::clone(stop));
                     let t0 = Instant::now();
                     let s = engine.run(PACK_DURATION_S, &mut obs)?;
+                    if stop.load(Ordering::SeqCst) {
+                        // the figures printed so far stand
+                        return Ok(());
+                    }
                     per_disc[j].push(t0.elapsed().as_secs_f64() / n as f64);
                     counts[j] = (s.steps, obs.impact_count());
                 }

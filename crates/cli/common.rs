@@ -10,6 +10,8 @@ use clutchpack_reference::ReferenceEngine;
 use clutchpack_scene::{EngineChoice, Override, Scene};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 /// The default scene, built into the binary so that `clutchpack run` works from anywhere.
 pub const DEFAULT_SCENE_TEXT: &str = include_str!("../../scenes/hu-table2.toml");
@@ -126,9 +128,17 @@ pub struct RunCollector {
     pub fatigue_params: Vec<(SplineGeometry, FatigueParams)>,
     /// The impacts CSV being written, if asked.
     csv: Option<ImpactsCsv>,
+    /// Asks the engine to stop when set (a stop signal); see [`RunCollector::with_stop`].
+    stop: Option<Arc<AtomicBool>>,
 }
 
 impl RunCollector {
+    /// Stops the run (cleanly, at the engine's next progress poll) once `stop` is set.
+    pub fn with_stop(mut self, stop: Arc<AtomicBool>) -> RunCollector {
+        self.stop = Some(stop);
+        self
+    }
+
     pub fn new(discs: usize, keep_history: bool) -> RunCollector {
         RunCollector {
             impacts: Vec::new(),
@@ -140,6 +150,7 @@ impl RunCollector {
             fatigue: FatigueCollector::new(),
             fatigue_params: Vec::new(),
             csv: None,
+            stop: None,
         }
     }
 
@@ -343,7 +354,9 @@ impl Observer for RunCollector {
                 t_s / wall
             ));
         }
-        false
+        self.stop
+            .as_ref()
+            .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
     }
 }
 

@@ -406,8 +406,12 @@ pub fn export(a: ExportArgs) -> Result<ExitCode> {
     // SIGINT, SIGTERM and SIGHUP stop the export between files: those written are complete
     let stop = crate::signals::flag();
     let reader = open_recording(&a.file, a.salvage)?;
-    let written = clutchpack_record::export_csv_until(&reader, &a.csv, &stop)
-        .map_err(|e| BadInput(e.to_string()))?;
+    let written =
+        clutchpack_record::export_csv_until(&reader, &a.csv, &stop).map_err(|e| match e {
+            // the input was fine: writing the CSV failed (a full disk, a lost folder): exit 1
+            e @ clutchpack_record::ReadError::Export { .. } => anyhow::Error::from(e),
+            e => BadInput(e.to_string()).into(),
+        })?;
     for p in &written {
         out!("{}", p.display());
     }

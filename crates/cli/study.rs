@@ -598,13 +598,16 @@ fn compare(a: CompareArgs) -> Result<ExitCode> {
         clutchpack_study::collect(d).map_err(|e| BadInput(format!("{}: {e}", d.display())).into())
     };
     let (ma, mb) = (load(&a.a)?, load(&a.b)?);
-    out!("{}", compare_text(&ma, &mb, &a.stat));
+    let text = compare_text(&ma, &mb, &a.stat).map_err(BadInput)?;
+    out!("{text}");
     Ok(ExitCode::SUCCESS)
 }
 
 /// The per-disc comparison of two merged studies: each disc's `stat` over every successful
 /// case of each (an ensemble), the change of the mean with Welch's 95 % interval.
-pub fn compare_text(a: &Merged, b: &Merged, stat: &str) -> String {
+/// The comparison table of `stat` per disc, or why there is nothing to compare (no disc of
+/// one study in the other with values of `stat` on both sides).
+pub fn compare_text(a: &Merged, b: &Merged, stat: &str) -> Result<String, String> {
     let mut s = format!(
         "{stat} per disc: {} ({} cases) -> {} ({} cases); change of the mean with its 95 % CI (Welch)\n",
         a.header.name,
@@ -616,6 +619,7 @@ pub fn compare_text(a: &Merged, b: &Merged, stat: &str) -> String {
         "{:<12} {:>22} {:>22} {:>26} {:>9}  {}\n",
         "disc", "A mean +- CI", "B mean +- CI", "change +- CI", "change", "significant?"
     ));
+    let mut rows = 0;
     for (i, d) in a.discs.iter().enumerate() {
         let Some(j) = b.discs.iter().position(|x| x == d) else {
             continue;
@@ -626,6 +630,7 @@ pub fn compare_text(a: &Merged, b: &Merged, stat: &str) -> String {
         ) else {
             continue;
         };
+        rows += 1;
         let pm = |m: f64, h: f64| format!("{m:.1} +- {h:.1}");
         match welch(&sa, &sb) {
             Some(w) => s.push_str(&format!(
@@ -646,7 +651,20 @@ pub fn compare_text(a: &Merged, b: &Merged, stat: &str) -> String {
             )),
         }
     }
-    s
+    if rows == 0 {
+        return Err(format!(
+            "{} and {} have nothing to compare: no disc is in both with values of {stat} \
+             (discs of {}: {}; of {}: {}; a statistic is compared where both studies kept it \
+             in study.outputs)",
+            a.header.name,
+            b.header.name,
+            a.header.name,
+            a.discs.join(", "),
+            b.header.name,
+            b.discs.join(", ")
+        ));
+    }
+    Ok(s)
 }
 
 /// `compare`'s hook: two study output folders are compared as ensembles.

@@ -96,6 +96,30 @@ fn causes(e: &dyn std::error::Error) -> String {
     out
 }
 
+/// Whether an I/O error says the disk is full or the quota exhausted (ENOSPC, EDQUOT).
+pub fn is_disk_full(e: &std::io::Error) -> bool {
+    matches!(
+        e.kind(),
+        std::io::ErrorKind::StorageFull | std::io::ErrorKind::QuotaExceeded
+    )
+}
+
+impl RecordError {
+    /// Whether writing failed because the disk is full (see [`is_disk_full`]).
+    pub fn is_disk_full(&self) -> bool {
+        match self {
+            RecordError::Create { cause, .. } | RecordError::Close { cause, .. } => {
+                is_disk_full(cause)
+            }
+            RecordError::Write {
+                cause: mcap::McapError::Io(cause),
+                ..
+            } => is_disk_full(cause),
+            _ => false,
+        }
+    }
+}
+
 /// Why a recording could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum RecordError {
@@ -1105,7 +1129,22 @@ impl Recorder {
     /// Writes `/summary` (the given one, or [`Self::summary`] when `None`), the run
     /// statistics if set, and the summary section, then closes the file. Returns its path, or
     /// the first error met while recording (the file is then closed as well as it can be).
+    ///
+    /// When the disk is full (or the quota exhausted) the temporary file is removed: what it
+    /// holds cannot be completed, and leaving it would keep the space taken.
     pub fn finish(mut self, summary: Option<RunSummary>) -> Result<PathBuf, RecordError> {
+        let result = self.finish_inner(summary);
+        if let Err(e) = &result {
+            if e.is_disk_full() {
+                if let Some(p) = self.pending.take() {
+                    p.discard();
+                }
+            }
+        }
+        result
+    }
+
+    fn finish_inner(&mut self, summary: Option<RunSummary>) -> Result<PathBuf, RecordError> {
         if let Some(e) = self.error.take() {
             return Err(e);
         }

@@ -13,8 +13,8 @@ use std::path::Path;
 /// `shown` is the file name used in messages (as written in the scene). The error is a
 /// one-line message naming the file and, where it applies, the line.
 pub(crate) fn read_table(path: &Path, shown: &str, value_column: &str) -> Result<Table, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let text =
+        crate::read_input(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     parse_table(&text, shown, value_column)
 }
 

@@ -227,11 +227,29 @@ pub struct Scene {
     pub fatigue: Vec<clutchpack_model::FatigueParams>,
 }
 
+/// Reads an input text file (a scene, a CSV table, a study file) whole. A path that is not a
+/// regular file is refused before it is opened: a FIFO with no writer would block (and ignore
+/// every stop signal), a device would never end.
+pub fn read_input(path: &Path) -> std::io::Result<String> {
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            if meta.is_dir() {
+                "a folder, not a file"
+            } else {
+                "not a regular file (a FIFO, a socket or a device)"
+            },
+        ));
+    }
+    std::fs::read_to_string(path)
+}
+
 /// Reads and validates the scene file at `path`, after applying `overrides` in order.
 /// Messages name the file as `path` is written; relative CSV paths resolve against the file's
 /// folder. The [`Scene`] holds SI values (degrees of `_deg` keys converted to rad).
 pub fn load(path: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|error| SceneError::Read {
+    let text = read_input(path).map_err(|error| SceneError::Read {
         path: path.to_path_buf(),
         error,
     })?;

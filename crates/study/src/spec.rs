@@ -3,7 +3,7 @@
 
 use crate::rng::Stream;
 use crate::tolerance::{self, PitchDistribution};
-use clutchpack_scene::{Override, Scene, SceneError};
+use clutchpack_scene::{EngineChoice, Override, Scene, SceneError};
 use sha2::{Digest, Sha256};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -381,7 +381,7 @@ pub fn number_text(v: f64) -> String {
 
 /// Reads and validates a study file.
 pub fn load(path: &Path) -> Result<Study, SpecError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SpecError::Read {
+    let text = clutchpack_scene::read_input(path).map_err(|source| SpecError::Read {
         path: path.to_path_buf(),
         source,
     })?;
@@ -1016,7 +1016,7 @@ pub fn parse(text: &str, file: &str, dir: &Path) -> Result<Study, SpecError> {
         );
     }
     if scene_rel.is_some() {
-        match std::fs::read_to_string(&study.scene_path) {
+        match clutchpack_scene::read_input(&study.scene_path) {
             Ok(t) => study.scene_text = t,
             Err(e) => ck.bad(
                 "study.scene",
@@ -1034,7 +1034,8 @@ pub fn parse(text: &str, file: &str, dir: &Path) -> Result<Study, SpecError> {
     let mut probes: Vec<(String, Option<String>, Case)> =
         vec![("study.scene".into(), None, study.case(0))];
     for (i, f) in study.factors.iter().enumerate() {
-        for (j, &l) in f.levels.iter().enumerate() {
+        for j in probe_levels(&f.levels) {
+            let l = f.levels[j];
             let mut c = study.case(0);
             c.values[i] = l;
             probes.push((
@@ -1044,8 +1045,23 @@ pub fn parse(text: &str, file: &str, dir: &Path) -> Result<Study, SpecError> {
             ));
         }
     }
-    for (p, value, case) in probes {
-        if let Err(e) = study.scene(&case) {
+    // ... and the study's engine must be able to run each of them (`clutchpack check
+    // --engine`'s rule): a study of spacing errors on the reference engine would only fail
+    // every case.
+    let engine = match study.engine.as_deref() {
+        Some("reference") => Some(EngineChoice::Reference),
+        Some("multibody") => Some(EngineChoice::Multibody),
+        _ => None,
+    };
+    let origin = study.scene_path.display().to_string();
+    for (k, (p, value, case)) in probes.into_iter().enumerate() {
+        let checked = study.scene(&case).and_then(|scene| {
+            if k == 0 {
+                spacing_discs_exist(&mut ck, &study, &scene);
+            }
+            scene.engine(engine, &origin).map(|_| ())
+        });
+        if let Err(e) = checked {
             for sp in scene_problems(&e) {
                 ck.bad_text(&p, value.clone(), format!("the scene rejects it: {sp}"));
             }
@@ -1064,6 +1080,50 @@ pub fn parse(text: &str, file: &str, dir: &Path) -> Result<Study, SpecError> {
         .map(|b| format!("{b:02x}"))
         .collect();
     Ok(study)
+}
+
+/// The most levels of one factor whose scenes the validation builds (each is parsed and
+/// validated in full); a longer list is probed at this many evenly spaced levels, its
+/// smallest and largest among them.
+const MAX_PROBED_LEVELS: usize = 1000;
+
+/// Indexes of the levels of one factor that the validation probes: all of them up to
+/// [`MAX_PROBED_LEVELS`], else that many evenly spaced ones plus the smallest and the largest
+/// (a scene's rules are bounds, which a range's extremes test).
+fn probe_levels(levels: &[f64]) -> Vec<usize> {
+    let n = levels.len();
+    if n <= MAX_PROBED_LEVELS {
+        return (0..n).collect();
+    }
+    let mut idx: Vec<usize> = (0..MAX_PROBED_LEVELS)
+        .map(|k| k * (n - 1) / (MAX_PROBED_LEVELS - 1))
+        .collect();
+    let by = |a: &usize, b: &usize| levels[*a].total_cmp(&levels[*b]);
+    idx.extend((0..n).min_by(by));
+    idx.extend((0..n).max_by(by));
+    idx.sort_unstable();
+    idx.dedup();
+    idx
+}
+
+/// `spacing.discs` must name discs of the scene.
+fn spacing_discs_exist(ck: &mut Ck, study: &Study, scene: &Scene) {
+    let n = scene.pack.discs.len();
+    let Some(list) = study.spacing.as_ref().and_then(|sp| sp.discs.as_ref()) else {
+        return;
+    };
+    for (j, &i) in list.iter().enumerate() {
+        if i >= n {
+            ck.bad_text(
+                &format!("spacing.discs[{j}]"),
+                Some(i.to_string()),
+                format!(
+                    "must be a disc index of the scene, 0..={} (it has {n} discs)",
+                    n.saturating_sub(1)
+                ),
+            );
+        }
+    }
 }
 
 impl Ck {
