@@ -387,7 +387,7 @@ impl Rng {
 /// One mutation of a scene text: a value replaced by a hostile one, a line dropped or
 /// doubled, or a key renamed.
 fn mutate(text: &str, rng: &mut Rng) -> String {
-    const VALUES: [&str; 22] = [
+    const VALUES: [&str; 28] = [
         "0",
         "-1",
         "1e308",
@@ -410,6 +410,13 @@ fn mutate(text: &str, rng: &mut Rng) -> String {
         "2",
         "1e6",
         "[1, 2]",
+        // issue 25: tiny and huge physical values, counts at and past i64's end
+        "1e-9",
+        "1e9",
+        "1e-308",
+        "9223372036854775807",
+        "4611686018427387905",
+        "-9223372036854775808",
     ];
     let mut lines: Vec<String> = text.lines().map(String::from).collect();
     let with_value: Vec<usize> = (0..lines.len())
@@ -449,6 +456,8 @@ fn mutate(text: &str, rng: &mut Rng) -> String {
 /// printed: a scene the rules accept whose engine diverges (exit 1, "diverged"), e.g. a
 /// loss coefficient of 1e19 s/m, which the engine's stall check stops within a second (the
 /// contact values have no joint plausibility rule; docs/DECISIONS.md, "Plausibility bounds").
+/// Issue 25 added tiny and huge physical values and counts at i64's ends to the values, and
+/// that a run that exits 0 prints no `inf` or `NaN`.
 #[test]
 fn mutated_scenes_give_exit_0_or_2_and_never_a_panic() {
     let d = scratch("rel-fuzz");
@@ -527,6 +536,14 @@ fn mutated_scenes_give_exit_0_or_2_and_never_a_panic() {
             f.display(),
             o.status
         );
+        // issue 25: a result is finite or refused, never `inf` or `NaN` with exit 0
+        if o.status.success() {
+            let out = stdout(&o);
+            let bad = out
+                .split(|c: char| c.is_whitespace() || c == ',')
+                .find(|w| matches!(w.to_ascii_lowercase().as_str(), "inf" | "-inf" | "nan"));
+            assert!(bad.is_none(), "run {}: printed {bad:?}:\n{out}", f.display());
+        }
     }
     if !diverged.is_empty() {
         eprintln!("accepted but diverged at once (known gap): {diverged:?}");

@@ -3,6 +3,7 @@
 
 mod cross_engine;
 mod fatigue;
+mod hardening;
 mod reliability;
 mod slurm;
 mod study;

@@ -14,6 +14,7 @@ use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 
 /// One output of a command: the flag that named it (for messages) and its path.
+#[derive(Clone, Copy)]
 pub struct Output<'a> {
     pub flag: &'a str,
     pub path: &'a Path,

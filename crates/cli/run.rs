@@ -106,9 +106,6 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             clutchpack_record::default_path("recordings", &scene.name, std::time::SystemTime::now())
         })
     });
-    if let Some(p) = record_path.as_deref() {
-        crate::outputs::create_folder("--out", p)?;
-    }
     let mut outs = Vec::new();
     for (flag, p) in [
         ("--out", record_path.as_deref()),
@@ -126,6 +123,12 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         }
     }
     let inputs: Vec<&std::path::Path> = a.scene.as_deref().into_iter().collect();
+    // the other outputs first, so that a refused one leaves no recording folder behind
+    let others: Vec<Output> = outs.iter().filter(|o| o.flag != "--out").cloned().collect();
+    crate::outputs::check_outputs(&others, &inputs)?;
+    if let Some(p) = record_path.as_deref() {
+        crate::outputs::create_folder("--out", p)?;
+    }
     crate::outputs::check_outputs(&outs, &inputs)?;
     let (mut engine, engine_line) = common::choose_engine(&scene, a.engine)?;
     let names = engine.disc_names();

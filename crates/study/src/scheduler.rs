@@ -331,4 +331,216 @@ mod tests {
         assert_eq!(c["workingDir"], "/work");
         assert_eq!(c["volumeMounts"][0]["mountPath"], "/work");
     }
+
+    /// Strings of every character class a path or name could hold: shell metacharacters,
+    /// quotes, globs, spaces, non-ASCII, a leading dash, YAML and JSON syntax; and control
+    /// characters, which the quoting refuses.
+    fn hostile_strings() -> Vec<String> {
+        let mut v: Vec<String> = (0x20u8..0x7f).map(|c| format!("a{}b", c as char)).collect();
+        v.extend(
+            [
+                "",
+                " ",
+                "'",
+                "''",
+                "\"",
+                "'\\''",
+                "$(touch PWNED)",
+                "`touch PWNED`",
+                "${HOME}",
+                "a; touch PWNED",
+                "a && touch PWNED",
+                "a | tee x",
+                "*",
+                "?[a]",
+                "~root",
+                "-rf",
+                "--evil",
+                "a\", \"--evil",
+                "key: value",
+                "- item",
+                "{a: [1, 2]}",
+                "&anchor *alias !tag %YAML #comment",
+                "café 日本 🚀",
+                "\u{a0}\u{2028}\u{feff}",
+                "back\\slash\\",
+                "/some/other/dir/evil",
+            ]
+            .iter()
+            .map(|s| s.to_string()),
+        );
+        for c in ['\n', '\r', '\t', '\0', '\u{7f}', '\u{1b}', '\u{85}'] {
+            v.push(format!("x{c}touch PWNED{c}#"));
+        }
+        v
+    }
+
+    /// Every hostile string either is refused (exactly those holding a control character) or
+    /// comes back byte for byte from bash, as one word.
+    #[test]
+    fn shell_quoting_round_trips_every_character_class_or_refuses_it() {
+        let strings = hostile_strings();
+        let mut script = String::from("printf '%s\\0'");
+        let mut kept = Vec::new();
+        for s in &strings {
+            match sh_quote("a value", s) {
+                Ok(q) => {
+                    script.push(' ');
+                    script.push_str(&q);
+                    kept.push(s.clone());
+                }
+                Err(e) => {
+                    assert!(s.chars().any(|c| c.is_control()), "{s:?} refused: {e}");
+                    assert!(e.to_string().contains("control character"), "{e}");
+                }
+            }
+        }
+        assert_eq!(kept.len(), strings.len() - 7, "only the control characters are refused");
+        let dir = std::env::temp_dir().join(format!("cp-quote-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let o = std::process::Command::new("bash")
+            .arg("-c")
+            .arg(&script)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let got: Vec<String> = o
+            .stdout
+            .split(|b| *b == 0)
+            .map(|w| String::from_utf8(w.to_vec()).unwrap())
+            .collect();
+        // printf ends every word with NUL: one empty piece after the last
+        assert_eq!(&got[..got.len() - 1], &kept[..]);
+        assert!(!dir.join("PWNED").exists());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// The shards and merge scripts with every hostile string as the study, the output folder
+    /// and the partition: each passes `bash -n`, and run by bash (as sbatch does) with a stand-in
+    /// executable it hands clutchpack exactly the study and folder it was given; names with a
+    /// control character are refused. No file is created by the script itself.
+    #[test]
+    fn batch_scripts_parse_and_pass_every_value_as_one_word() {
+        let dir = std::env::temp_dir().join(format!("cp-scripts-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let exe = dir.join("echo args");
+        std::fs::write(&exe, "#!/bin/sh\nprintf '%s\\0' \"$@\"\n").unwrap();
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&exe, std::fs::Permissions::from_mode(0o755)).unwrap();
+        for s in hostile_strings() {
+            let (study, out) = (dir.join(format!("{s}.toml")), dir.join(&s));
+            let j = SlurmJob {
+                name: &s,
+                exe: &exe,
+                study: &study,
+                out: &out,
+                shards: 2,
+                array: "0-1".into(),
+                time: "00:10:00",
+                merge_time: "00:05:00",
+                partition: Some(&s),
+                cpus_per_task: 1,
+                signal_s: 60,
+            };
+            let (a, m) = match (slurm_array_script(&j), slurm_merge_script(&j)) {
+                (Ok(a), Ok(m)) => (a, m),
+                (a, m) => {
+                    assert!(s.chars().any(|c| c.is_control()), "{s:?}: {a:?} {m:?}");
+                    continue;
+                }
+            };
+            for script in [&a, &m] {
+                let n = std::process::Command::new("bash")
+                    .args(["-n", "-c", script])
+                    .output()
+                    .unwrap();
+                assert!(n.status.success(), "bash -n on {s:?}:\n{script}");
+                // every #SBATCH line stays one comment line
+                assert!(script.lines().all(|l| l.starts_with('#') || l.starts_with("exec ")));
+            }
+            let o = std::process::Command::new("bash")
+                .arg("-c")
+                .arg(&a)
+                .current_dir(&dir)
+                .output()
+                .unwrap();
+            assert!(o.status.success(), "{s:?}: {}", String::from_utf8_lossy(&o.stderr));
+            let words: Vec<String> = o
+                .stdout
+                .split(|b| *b == 0)
+                .map(|w| String::from_utf8(w.to_vec()).unwrap())
+                .collect();
+            let want = [
+                "study",
+                "run",
+                &study.display().to_string(),
+                "--out",
+                &out.display().to_string(),
+                "--shard",
+                "auto",
+                "--shards",
+                "2",
+                "",
+            ]
+            .map(String::from);
+            assert_eq!(words, want, "{s:?}");
+        }
+        let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+        assert_eq!(left.len(), 1, "only the stand-in executable: {left:?}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// The Kubernetes manifests with every hostile string as the name, the image, the claim,
+    /// the study and the folder, read back by a YAML parser: one document each, the values
+    /// where they were put, byte for byte, and the name a DNS label.
+    #[test]
+    fn manifests_read_back_by_a_yaml_parser_hold_every_value_as_given() {
+        use yaml_rust2::YamlLoader;
+        for s in hostile_strings() {
+            let j = K8sJob {
+                name: &s,
+                image: &s,
+                study: &s,
+                out: &s,
+                shards: 3,
+                parallelism: 3,
+                cpus: 2,
+                claim: &s,
+            };
+            for (text, args) in [
+                (
+                    k8s_indexed_job(&j),
+                    vec!["study", "run", &s, "--out", &s, "--shard", "auto", "--shards", "3"],
+                ),
+                (k8s_merge_job(&j), vec!["study", "merge", &s]),
+            ] {
+                let docs = YamlLoader::load_from_str(&text)
+                    .unwrap_or_else(|e| panic!("{s:?}: {e}\n{text}"));
+                assert_eq!(docs.len(), 1, "{s:?}");
+                let d = &docs[0];
+                let c = &d["spec"]["template"]["spec"]["containers"][0];
+                let got: Vec<&str> = c["args"]
+                    .as_vec()
+                    .unwrap()
+                    .iter()
+                    .map(|a| a.as_str().unwrap())
+                    .collect();
+                assert_eq!(got, args, "{s:?}");
+                assert_eq!(c["image"].as_str(), Some(s.as_str()));
+                let claim = &d["spec"]["template"]["spec"]["volumes"][0]["persistentVolumeClaim"];
+                assert_eq!(claim["claimName"].as_str(), Some(s.as_str()));
+                let name = d["metadata"]["name"].as_str().unwrap();
+                assert!(
+                    name.len() <= 63
+                        && name
+                            .chars()
+                            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
+                        && !name.starts_with('-'),
+                    "{name:?}"
+                );
+            }
+        }
+    }
 }
