@@ -94,8 +94,14 @@ fn study_names_that_would_inject_are_refused_at_submit_and_run() {
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
     let text = stdout(&o);
-    assert!(text.contains("#SBATCH --job-name=mc_2026.v1-a-shard"), "{text}");
-    let n = Command::new("bash").args(["-n", "-c", &text]).status().unwrap();
+    assert!(
+        text.contains("#SBATCH --job-name=mc_2026.v1-a-shard"),
+        "{text}"
+    );
+    let n = Command::new("bash")
+        .args(["-n", "-c", &text])
+        .status()
+        .unwrap();
     assert!(n.success());
 }
 
@@ -118,7 +124,9 @@ fn outputs_are_checked_before_the_run_and_long_names_work() {
         (
             vec![
                 "--out".into(),
-                d.join(format!("{}.mcap", "n".repeat(260))).display().to_string(),
+                d.join(format!("{}.mcap", "n".repeat(260)))
+                    .display()
+                    .to_string(),
             ],
             "255",
         ),
@@ -172,7 +180,10 @@ fn huge_counts_are_refused_before_anything_is_allocated() {
             k,
         ]);
         let err = exit_2(&o, k);
-        assert!(err.contains("--ensemble") || err.contains("ensemble"), "{err}");
+        assert!(
+            err.contains("--ensemble") || err.contains("ensemble"),
+            "{err}"
+        );
     }
     // 2 values x 600 000 members: each allowed, the product not
     let o = run(&[
@@ -191,12 +202,18 @@ fn huge_counts_are_refused_before_anything_is_allocated() {
     let base = std::fs::read_to_string(small_study(&d, 0.01, 2)).unwrap();
     let studies = [
         (
-            base.replace("values = [0, 25e-6, 50e-6]", "linear = [0, 1e-6, 9223372036854775807]"),
+            base.replace(
+                "values = [0, 25e-6, 50e-6]",
+                "linear = [0, 1e-6, 9223372036854775807]",
+            ),
             "factor[0].linear[2] = 9223372036854775807: must be an integer in 1..=1000000",
         ),
         (
             base.replace("members = 2", "members = 4611686018427387905")
-                .replace("values = [0, 25e-6, 50e-6]", "values = [0, 1e-6, 2e-6, 3e-6]"),
+                .replace(
+                    "values = [0, 25e-6, 50e-6]",
+                    "values = [0, 1e-6, 2e-6, 3e-6]",
+                ),
             "ensemble.members = 4611686018427387905: must be an integer in 1..=100000000",
         ),
         (
@@ -240,11 +257,23 @@ fn huge_counts_are_refused_before_anything_is_allocated() {
 #[test]
 fn implausible_physical_values_are_refused_with_the_step_they_need() {
     for (set, want) in [
-        ("discs[0].inertia_kg_m2=1e-9", "must be >= 1e-6 kg m^2 (plausibility bound)"),
-        ("defaults.contact.modulus_pa=1e308", "must be <= 1e13 Pa (plausibility bound)"),
+        (
+            "discs[0].inertia_kg_m2=1e-9",
+            "must be >= 1e-6 kg m^2 (plausibility bound)",
+        ),
+        (
+            "defaults.contact.modulus_pa=1e308",
+            "must be <= 1e13 Pa (plausibility bound)",
+        ),
         ("defaults.drag_n_m_s_rad=1e9", "drag time constant J / C"),
-        ("defaults.spline.pitch_radius_m=4294967296", "must be <= 5 m"),
-        ("defaults.material.endurance_amplitude_pa=1e-308", "must be >= 1e6 Pa"),
+        (
+            "defaults.spline.pitch_radius_m=4294967296",
+            "must be <= 5 m",
+        ),
+        (
+            "defaults.material.endurance_amplitude_pa=1e-308",
+            "must be >= 1e6 Pa",
+        ),
         ("defaults.material.slope=1e6", "must be in (1, 50)"),
         ("defaults.material.knee_cycles=1e-300", "must be >= 1000"),
     ] {
@@ -272,7 +301,10 @@ fn implausible_physical_values_are_refused_with_the_step_they_need() {
         "defaults.contact.law=\"dry\"",
     ]);
     let err = exit_2(&o, "tiny disc");
-    assert!(err.contains("would last") && err.contains("need steps of about"), "{err}");
+    assert!(
+        err.contains("would last") && err.contains("need steps of about"),
+        "{err}"
+    );
 }
 
 /// Reproducer 8: a damaged part is moved to `.damaged`, with a line saying so, and its cases
@@ -326,19 +358,39 @@ fn studies_are_validated_through_their_engine_and_compare_needs_common_ground() 
         &format!("scene = \"{}\"", repo("scenes/bench-8-disc.toml")),
     );
     let f = d.join("ref.toml");
-    std::fs::write(&f, spacing.replace("engine = \"multibody\"", "engine = \"reference\"")).unwrap();
-    let o = bin().args(["study", "run", "--out"]).arg(d.join("o1")).arg(&f).output().unwrap();
+    std::fs::write(
+        &f,
+        spacing.replace("engine = \"multibody\"", "engine = \"reference\""),
+    )
+    .unwrap();
+    let o = bin()
+        .args(["study", "run", "--out"])
+        .arg(d.join("o1"))
+        .arg(&f)
+        .output()
+        .unwrap();
     let err = exit_2(&o, "spacing on the reference engine");
-    assert!(err.contains("tooth_spacing_errors_m") && err.contains("reference engine"), "{err}");
+    assert!(
+        err.contains("tooth_spacing_errors_m") && err.contains("reference engine"),
+        "{err}"
+    );
     let f = d.join("one.toml");
     std::fs::write(
         &f,
         spacing
-            .replace(&repo("scenes/bench-8-disc.toml"), &repo("scenes/hu-table2.toml"))
+            .replace(
+                &repo("scenes/bench-8-disc.toml"),
+                &repo("scenes/hu-table2.toml"),
+            )
             .replace("[spacing]", "[spacing]\ndiscs = [0, 7]"),
     )
     .unwrap();
-    let o = bin().args(["study", "run", "--out"]).arg(d.join("o2")).arg(&f).output().unwrap();
+    let o = bin()
+        .args(["study", "run", "--out"])
+        .arg(d.join("o2"))
+        .arg(&f)
+        .output()
+        .unwrap();
     let err = exit_2(&o, "spacing.discs");
     assert!(err.contains("spacing.discs[1] = 7"), "{err}");
     assert!(!d.join("o1").exists() && !d.join("o2").exists());
@@ -362,7 +414,12 @@ fn studies_are_validated_through_their_engine_and_compare_needs_common_ground() 
         let text = String::from_utf8_lossy(&text).replace("\"disc\"", "\"other\"");
         std::fs::write(b.join(p.file_name().unwrap()), text).unwrap();
     }
-    let o = bin().args(["study", "compare"]).arg(&a).arg(&b).output().unwrap();
+    let o = bin()
+        .args(["study", "compare"])
+        .arg(&a)
+        .arg(&b)
+        .output()
+        .unwrap();
     let err = exit_2(&o, "compare");
     assert!(err.contains("nothing to compare"), "{err}");
 }
@@ -374,7 +431,11 @@ fn studies_are_validated_through_their_engine_and_compare_needs_common_ground() 
 fn bench_stops_on_a_signal_and_fifos_never_block() {
     let d = scratch("hard-fifo");
     let fifo = d.join("scene.toml");
-    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
     let wait = |mut c: std::process::Child| {
         // a hang guard, not a speed assertion
         let t0 = Instant::now();
@@ -387,7 +448,11 @@ fn bench_stops_on_a_signal_and_fifos_never_block() {
         }
         c.wait_with_output().unwrap()
     };
-    for args in [vec!["run"], vec!["study", "run", "--out", "x"], vec!["check"]] {
+    for args in [
+        vec!["run"],
+        vec!["study", "run", "--out", "x"],
+        vec!["check"],
+    ] {
         let c = bin()
             .args(&args)
             .arg(&fifo)
@@ -433,5 +498,8 @@ fn bench_stops_on_a_signal_and_fifos_never_block() {
     let o = wait(c);
     assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
     assert!(stderr(&o).contains("interrupted (SIGINT)"));
-    assert!(!stdout(&o).contains("growth"), "stopped before the pack section");
+    assert!(
+        !stdout(&o).contains("growth"),
+        "stopped before the pack section"
+    );
 }

@@ -542,7 +542,11 @@ fn mutated_scenes_give_exit_0_or_2_and_never_a_panic() {
             let bad = out
                 .split(|c: char| c.is_whitespace() || c == ',')
                 .find(|w| matches!(w.to_ascii_lowercase().as_str(), "inf" | "-inf" | "nan"));
-            assert!(bad.is_none(), "run {}: printed {bad:?}:\n{out}", f.display());
+            assert!(
+                bad.is_none(),
+                "run {}: printed {bad:?}:\n{out}",
+                f.display()
+            );
         }
     }
     if !diverged.is_empty() {

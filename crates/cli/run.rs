@@ -286,6 +286,19 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     if let Some(e) = recording_error {
         return Err(e);
     }
+    if let Some((disc, what)) = summary
+        .fatigue
+        .iter()
+        .find_map(|f| f.non_finite().map(|w| (&f.name, w)))
+    {
+        // every output is written; the figures that overflowed are not a result
+        eprintln!(
+            "error: the fatigue of {disc} overflowed ({what} is not finite): the loads or the \
+             S-N curve are outside what the assessment can represent; check [fatigue] and \
+             [material]"
+        );
+        return Ok(ExitCode::from(1));
+    }
     if run_stats.stopped_early {
         // 128 + signal, as a shell reports a command stopped by that signal
         return Ok(crate::signals::exit_code());

@@ -517,6 +517,43 @@ pub struct DiscFatigue {
     pub teeth: Option<TeethFatigue>,
 }
 
+impl Assessment {
+    /// The first of its figures that is not finite (`inf` or `NaN`), by name.
+    pub fn non_finite(&self) -> Option<&'static str> {
+        [
+            ("damage", self.damage),
+            ("damage rate", self.damage_rate_per_h),
+            ("life", self.life_h.unwrap_or(0.0)),
+            ("S_eq", self.eq_load_range_n),
+            ("sigma_eq", self.eq_stress_amplitude_pa),
+            ("cycles", self.cycles),
+        ]
+        .into_iter()
+        .find(|(_, v)| !v.is_finite())
+        .map(|(n, _)| n)
+    }
+}
+
+impl DiscFatigue {
+    /// The first of its figures that is not finite, by name: a load or an S-N curve outside
+    /// what f64 holds (a result is finite or refused, never printed as `inf` with exit 0).
+    pub fn non_finite(&self) -> Option<&'static str> {
+        if !self.max_root_stress_pa.is_finite() {
+            return Some("max sigma_F");
+        }
+        if !self.max_flank_pressure_pa.is_finite() {
+            return Some("max p");
+        }
+        self.lumped.non_finite().or_else(|| {
+            self.teeth.as_ref().and_then(|t| {
+                t.worst
+                    .non_finite()
+                    .or((!t.mean_damage.is_finite()).then_some("tooth damage"))
+            })
+        })
+    }
+}
+
 /// Fatigue of a disc from its histories, spline, tooth form and material, over `duration_s`.
 pub fn assess(
     name: &str,

@@ -39,6 +39,12 @@ pub(crate) const ENDURANCE_RANGE_PA: (f64, f64) = (1e6, 1e10);
 pub(crate) const MAX_SN_SLOPE: f64 = 50.0;
 /// Range of the knee of the S-N curve accepted, cycles.
 pub(crate) const KNEE_CYCLES_RANGE: (f64, f64) = (1e3, 1e10);
+/// Range of a tooth's face width and working depth accepted, m.
+pub(crate) const TOOTH_SIZE_RANGE_M: (f64, f64) = (1e-5, 1.0);
+/// Largest ISO 6336-3 factor (form, stress correction, load distribution) accepted.
+pub(crate) const MAX_TOOTH_FACTOR: f64 = 10.0;
+/// Smallest pitch radius of a spline accepted, m.
+pub(crate) const MIN_PITCH_RADIUS_M: f64 = 1e-3;
 /// Largest Miner damage sum at failure accepted.
 pub(crate) const MAX_CRITICAL_DAMAGE: f64 = 10.0;
 /// Most teeth of one spline accepted.
@@ -282,7 +288,7 @@ table! {
         /// number of teeth n
         teeth: "", Kind::Count { max: MAX_TEETH }, Dflt::Required;
         /// pitch radius R
-        pitch_radius_m: "m", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_PITCH_RADIUS_M }), Dflt::Required;
+        pitch_radius_m: "m", Kind::Number(Rule::Bounded { floor: MIN_PITCH_RADIUS_M, ceil: MAX_PITCH_RADIUS_M }), Dflt::Required;
         /// pressure angle alpha
         pressure_angle_deg: "deg", Kind::Number(Rule::Open(0.0, 90.0)), Dflt::Required;
         /// total circumferential free play d at the pitch circle; below the tooth pitch 2 pi R / n
@@ -333,15 +339,15 @@ table! {
     /// paper's disc (docs/DECISIONS.md, "Fatigue").
     RawToothForm at "fatigue" {
         /// tooth form factor Y_F of sigma_F = F_t / (b m) Y_F Y_S K_l; ASSUMED default: ISO 6336-3 for a rack-like 20 deg tooth
-        form_factor: "", POSITIVE, Dflt::Num(fat::DEFAULT_FORM_FACTOR);
+        form_factor: "", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_TOOTH_FACTOR }), Dflt::Num(fat::DEFAULT_FORM_FACTOR);
         /// stress correction factor Y_S (root fillet notch); ASSUMED default: ISO 6336-3, basic rack fillet
-        stress_correction_factor: "", Kind::Number(Rule::AtLeast(1.0)), Dflt::Num(fat::DEFAULT_STRESS_CORRECTION);
+        stress_correction_factor: "", Kind::Number(Rule::Closed(1.0, MAX_TOOTH_FACTOR)), Dflt::Num(fat::DEFAULT_STRESS_CORRECTION);
         /// axial load distribution factor K_l: peak over mean line load along the face
-        load_distribution_factor: "", Kind::Number(Rule::AtLeast(1.0)), Dflt::Num(fat::DEFAULT_LOAD_DISTRIBUTION);
+        load_distribution_factor: "", Kind::Number(Rule::Closed(1.0, MAX_TOOTH_FACTOR)), Dflt::Num(fat::DEFAULT_LOAD_DISTRIBUTION);
         /// engaged face width b (the disc's thickness)
-        face_width_m: "m", POSITIVE, Dflt::Num(fat::DEFAULT_FACE_WIDTH_M);
+        face_width_m: "m", Kind::Number(Rule::Bounded { floor: TOOTH_SIZE_RANGE_M.0, ceil: TOOTH_SIZE_RANGE_M.1 }), Dflt::Num(fat::DEFAULT_FACE_WIDTH_M);
         /// working depth h_w of the flank pressure p = F_t / (b h_w); ASSUMED default 0.9 m of the paper's 3 mm module
-        working_depth_m: "m", POSITIVE, Dflt::Num(fat::DEFAULT_WORKING_DEPTH_M);
+        working_depth_m: "m", Kind::Number(Rule::Bounded { floor: TOOTH_SIZE_RANGE_M.0, ceil: TOOTH_SIZE_RANGE_M.1 }), Dflt::Num(fat::DEFAULT_WORKING_DEPTH_M);
     }
     children {}
 }

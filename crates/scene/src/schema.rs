@@ -77,8 +77,6 @@ pub(crate) enum Rule {
     Positive,
     /// `>= 0`.
     NonNegative,
-    /// `>= lo`.
-    AtLeast(f64),
     /// In `[lo, hi]`.
     Closed(f64, f64),
     /// In `(lo, hi)`.
@@ -106,7 +104,6 @@ impl Rule {
             Rule::Finite => true,
             Rule::Positive => x > 0.0,
             Rule::NonNegative => x >= 0.0,
-            Rule::AtLeast(lo) => x >= lo,
             Rule::Closed(lo, hi) => (lo..=hi).contains(&x),
             Rule::Open(lo, hi) => x > lo && x < hi,
             Rule::Bounded { floor, ceil } => {
@@ -140,7 +137,6 @@ impl Rule {
             Rule::Finite => "a finite number".into(),
             Rule::Positive => "> 0".into(),
             Rule::NonNegative => ">= 0".into(),
-            Rule::AtLeast(lo) => format!(">= {}", fmt_bound(lo)),
             Rule::Closed(lo, hi) => format!("in [{}, {}]", fmt_bound(lo), fmt_bound(hi)),
             Rule::Open(lo, hi) => {
                 format!("in ({}, {}) (exclusive)", fmt_bound(lo), fmt_bound(hi))

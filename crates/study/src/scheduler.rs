@@ -395,7 +395,11 @@ mod tests {
                 }
             }
         }
-        assert_eq!(kept.len(), strings.len() - 7, "only the control characters are refused");
+        assert_eq!(
+            kept.len(),
+            strings.len() - 7,
+            "only the control characters are refused"
+        );
         let dir = std::env::temp_dir().join(format!("cp-quote-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let o = std::process::Command::new("bash")
@@ -458,7 +462,9 @@ mod tests {
                     .unwrap();
                 assert!(n.status.success(), "bash -n on {s:?}:\n{script}");
                 // every #SBATCH line stays one comment line
-                assert!(script.lines().all(|l| l.starts_with('#') || l.starts_with("exec ")));
+                assert!(script
+                    .lines()
+                    .all(|l| l.starts_with('#') || l.starts_with("exec ")));
             }
             let o = std::process::Command::new("bash")
                 .arg("-c")
@@ -466,7 +472,11 @@ mod tests {
                 .current_dir(&dir)
                 .output()
                 .unwrap();
-            assert!(o.status.success(), "{s:?}: {}", String::from_utf8_lossy(&o.stderr));
+            assert!(
+                o.status.success(),
+                "{s:?}: {}",
+                String::from_utf8_lossy(&o.stderr)
+            );
             let words: Vec<String> = o
                 .stdout
                 .split(|b| *b == 0)
@@ -512,7 +522,9 @@ mod tests {
             for (text, args) in [
                 (
                     k8s_indexed_job(&j),
-                    vec!["study", "run", &s, "--out", &s, "--shard", "auto", "--shards", "3"],
+                    vec![
+                        "study", "run", &s, "--out", &s, "--shard", "auto", "--shards", "3",
+                    ],
                 ),
                 (k8s_merge_job(&j), vec!["study", "merge", &s]),
             ] {
