@@ -582,7 +582,7 @@ fn resolvable(ck: &mut Checker, item: &str, disc: &DiscModel) -> bool {
     );
     let m_eff = disc.spline.effective_mass_kg(disc.inertia_kg_m2);
     let t_c = clutchpack_model::free_impact_duration_s(h, m_eff, PLAUSIBLE_CLOSING_SPEED_M_S);
-    if !(t_c >= MIN_IMPACT_DURATION_S) {
+    if t_c.is_nan() || t_c < MIN_IMPACT_DURATION_S {
         ck.report(
             B::inertia_kg_m2.at(item),
             Some(fmt_num(disc.inertia_kg_m2)),
@@ -601,7 +601,7 @@ fn resolvable(ck: &mut Checker, item: &str, disc: &DiscModel) -> bool {
         ok = false;
     }
     let tau = disc.inertia_kg_m2 / disc.drag_n_m_s_rad;
-    if !(tau >= MIN_DRAG_TIME_S) {
+    if tau.is_nan() || tau < MIN_DRAG_TIME_S {
         ck.report(
             B::drag_n_m_s_rad.at(item),
             Some(fmt_num(disc.drag_n_m_s_rad)),
