@@ -105,7 +105,7 @@ pub fn is_disk_full(e: &std::io::Error) -> bool {
 }
 
 impl RecordError {
-    /// Whether writing failed because the disk is full (see [`is_disk_full`]).
+    /// Whether writing failed because the disk is full or the quota exhausted (ENOSPC, EDQUOT).
     pub fn is_disk_full(&self) -> bool {
         match self {
             RecordError::Create { cause, .. } | RecordError::Close { cause, .. } => {
