@@ -122,7 +122,7 @@ fn bad_material_or_tooth_form_exits_2() {
         ),
         (
             "discs[0].fatigue.stress_correction_factor=0.5",
-            "discs[0].fatigue.stress_correction_factor = 0.5: must be >= 1",
+            "discs[0].fatigue.stress_correction_factor = 0.5: must be in [1, 10]",
         ),
         (
             "defaults.material.miner_rule=\"basquin\"",

@@ -215,7 +215,7 @@ grade = 12
     let e = stderr(&o);
     for want in [
         "bad.toml: study.engine = \"fastest\": must be one of: reference, multibody",
-        "bad.toml: ensemble.members = 0: must be an integer >= 1",
+        "bad.toml: ensemble.members = 0: must be an integer in 1..=100000000",
         "bad.toml: factor[0].log = [0, 0.0001, 3]: a log range needs from > 0",
         "bad.toml: random[0].dist = \"gamma\": must be one of: uniform, normal, truncated_normal",
         "bad.toml: spacing.grade = 12: must be a tolerance class of ISO 1328-1:2013",

@@ -841,12 +841,13 @@ fn rerun_checks_our_recordings_clean() {
             .expect("rerun runs");
         let text = format!("{}{}", stdout(&o), stderr(&o));
         assert!(o.status.success(), "rerun mcap check {name}: {text}");
-        // the table: "Status  ID  Chunks  Topic  Issues", a rule, one row per topic
+        // the table: "Status  ID  Chunks  Topic  Issues", a rule, one row per topic, up to the
+        // first blank line (rerun's first run on a machine prints a welcome text after it)
         let rows: Vec<&str> = text
             .lines()
             .skip_while(|l| !l.starts_with("Status"))
             .skip(2)
-            .filter(|l| !l.trim().is_empty())
+            .take_while(|l| !l.trim().is_empty())
             .collect();
         // our own count: "<n> messages on <k> topics, t = ..."
         let info = stdout(&run(&["replay", mcap.to_str().unwrap()]));
