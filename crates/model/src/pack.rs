@@ -76,12 +76,12 @@ pub enum NonTorsional {
     InitialOffset(usize),
     /// Disc `i` has tooth spacing errors.
     SpacingErrors(usize),
-    /// The pack has separator plates.
-    Plates,
-    /// The pack has an output drum.
-    Drum,
-    /// The pack has a clamped stack.
-    Stack,
+    /// The pack's piston clamps the stack at some time (its largest pressure pushes past the
+    /// return spring): friction faces with stick and slip, which the torsional engine does
+    /// not run yet (an open stack, every interface an oil gap, it does).
+    ClampedStack,
+    /// Plate `j` floats radially, starts off the axis or has spacing errors.
+    PlatePerTooth(usize),
 }
 
 /// A shaft and the discs coupled to it; in a whole pack (MODEL.md section 5) also the
@@ -110,19 +110,18 @@ pub struct PackModel {
 }
 
 impl PackModel {
-    /// Whether a torsional model of the paper's kind (one rotational degree of freedom per
-    /// friction disc on the shaft, the lumped tooth law) describes the pack exactly: every
-    /// disc [`DiscModel::is_concentric`], and no plates, drum or stack. Engines choose by it
-    /// (the reference engine refuses a pack that is not).
+    /// Whether a torsional model (one rotational degree of freedom per body: shaft, discs,
+    /// plates, drum; the lumped tooth law) describes the pack and the reference engine runs
+    /// it: every disc and plate [`DiscModel::is_concentric`], and no stack that clamps.
+    /// Engines choose by it (the reference engine refuses a pack that is not).
     pub fn is_torsional(&self) -> bool {
         self.non_torsional_parts().is_empty()
     }
 
-    /// Every part of the pack that a torsional model does not describe (MODEL.md section 5),
-    /// in order: per disc its radial float, offset and spacing errors, then the plates, the
-    /// drum and the stack. Empty exactly when [`Self::is_torsional`]. The one statement of
-    /// what the reference engine cannot run; the CLI's engine choice and `check --engine`
-    /// read it.
+    /// Every part of the pack that the torsional engine does not run (MODEL.md section 5), in
+    /// order: per disc its radial float, offset and spacing errors, then a stack whose piston
+    /// clamps. Empty exactly when [`Self::is_torsional`]. The one statement of what the
+    /// reference engine cannot run; the CLI's engine choice and `check --engine` read it.
     pub fn non_torsional_parts(&self) -> Vec<NonTorsional> {
         let mut out = Vec::new();
         for (i, d) in self.discs.iter().enumerate() {
@@ -136,14 +135,13 @@ impl PackModel {
                 out.push(NonTorsional::SpacingErrors(i));
             }
         }
-        if !self.plates.is_empty() {
-            out.push(NonTorsional::Plates);
+        for (j, p) in self.plates.iter().enumerate() {
+            if !p.is_concentric() {
+                out.push(NonTorsional::PlatePerTooth(j));
+            }
         }
-        if self.drum.is_some() {
-            out.push(NonTorsional::Drum);
-        }
-        if self.stack.is_some() {
-            out.push(NonTorsional::Stack);
+        if self.stack.as_ref().is_some_and(|s| s.piston.ever_clamps()) {
+            out.push(NonTorsional::ClampedStack);
         }
         out
     }

@@ -205,10 +205,17 @@ impl ReferenceEngine {
         self.scheme
     }
 
+    /// Whether the pack has separator plates, a drum or a stack: it then runs monolithic (one
+    /// step sequence for every body; the open gaps couple neighbours).
+    fn is_whole(&self) -> bool {
+        !self.pack.plates.is_empty() || self.pack.drum.is_some() || self.pack.stack.is_some()
+    }
+
     /// Whether the discs run in parallel: the multirate scheme on a prescribed shaft with
     /// parallelism allowed, at least two discs and more than one rayon thread.
     fn runs_parallel(&self) -> bool {
         self.scheme == Scheme::Multirate
+            && !self.is_whole()
             && matches!(self.pack.shaft, Shaft::Prescribed(_))
             && self.parallel
             && self.pack.discs.len() >= PARALLEL_MIN_DISCS
@@ -220,6 +227,23 @@ impl ReferenceEngine {
     pub fn describe(&self) -> String {
         let nd = self.pack.discs.len();
         let discs = if nd == 1 { "disc" } else { "discs" };
+        if self.is_whole() {
+            let np = self.pack.plates.len();
+            let carrier = if self.pack.drum.is_some() {
+                "the drum"
+            } else {
+                "the housing"
+            };
+            let stack = if self.pack.stack.is_some() {
+                ", the open stack's oil gaps coupling neighbours"
+            } else {
+                ""
+            };
+            return format!(
+                "monolithic: one step sequence for the shaft, {nd} {discs} and {np} plates on \
+                 {carrier}{stack} (a whole pack runs monolithic)"
+            );
+        }
         match (self.scheme, &self.pack.shaft) {
             (Scheme::Monolithic, _) => {
                 format!(
@@ -250,6 +274,9 @@ struct ObserverSink<'o> {
 impl Sink for ObserverSink<'_> {
     fn sample(&mut self, _k: u64, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]) {
         self.obs.sample(&sys.sample(t, y, modes));
+        if sys.interfaces() > 0 {
+            self.obs.interfaces(t, &sys.interface_samples(t, y));
+        }
     }
     fn impact(&mut self, e: ImpactEvent) {
         self.obs.impact(&e);
@@ -275,7 +302,7 @@ fn run_monolithic(
     duration_s: f64,
     obs: &mut dyn Observer,
 ) -> Result<RunStats, EngineError> {
-    let nd = pack.discs.len();
+    let nd = pack.discs.len() + pack.plates.len();
     let mut st = Stepper::new(System::new(pack, (0..nd).collect()), settings);
     let mut sink = ObserverSink { obs };
     // A step costs O(N): poll the observer about every 1024 disc-steps (a stop acts within
@@ -302,23 +329,35 @@ impl Engine for ReferenceEngine {
     }
 
     fn disc_names(&self) -> Vec<String> {
-        self.pack.discs.iter().map(|d| d.name.clone()).collect()
+        // the engines' body order: the discs, then the plates
+        self.pack
+            .discs
+            .iter()
+            .chain(&self.pack.plates)
+            .map(|d| d.name.clone())
+            .collect()
     }
 
     fn run(&mut self, duration_s: f64, obs: &mut dyn Observer) -> Result<RunStats, EngineError> {
-        for d in &self.pack.discs {
+        for d in self.pack.discs.iter().chain(&self.pack.plates) {
             stepper::check_disc(d)?;
         }
-        if !self.pack.plates.is_empty() || self.pack.drum.is_some() || self.pack.stack.is_some() {
+        if self
+            .pack
+            .stack
+            .as_ref()
+            .is_some_and(|s| s.piston.ever_clamps())
+        {
             return Err(EngineError::Unsupported(
-                "separator plates, an output drum and the clamped stack need the multibody \
-                 engine (the reference engine models friction discs on one shaft)"
+                "a piston that clamps the stack needs stick and slip of the friction faces: \
+                 the multibody engine runs it (the reference engine runs open stacks, every \
+                 interface an oil gap)"
                     .into(),
             ));
         }
         let (pack, settings) = (&self.pack, &self.settings);
         match (self.scheme, &pack.shaft) {
-            (Scheme::Multirate, _) if pack.discs.is_empty() => {
+            (Scheme::Multirate, _) if pack.discs.is_empty() || self.is_whole() => {
                 run_monolithic(pack, settings, duration_s, obs)
             }
             (Scheme::Monolithic, _) => run_monolithic(pack, settings, duration_s, obs),
