@@ -142,16 +142,6 @@ pub enum PressureProfile {
 }
 
 impl PressureProfile {
-    /// The largest pressure of the whole history, Pa (the ramp's final pressure, the table's
-    /// largest row).
-    pub fn max_pressure_pa(&self) -> f64 {
-        match self {
-            PressureProfile::Constant { pressure_pa }
-            | PressureProfile::Ramp { pressure_pa, .. } => pressure_pa.max(0.0),
-            PressureProfile::Table(t) => t.values().iter().copied().fold(0.0, f64::max),
-        }
-    }
-
     /// Pressure at `t_s`, Pa.
     pub fn pressure_pa(&self, t_s: f64) -> f64 {
         match self {
@@ -179,12 +169,6 @@ pub struct Piston {
 }
 
 impl Piston {
-    /// Whether the piston ever pushes on the stack: `p A > F_rs` at the history's largest
-    /// pressure. A pack whose piston never does is open for good: every interface an oil gap.
-    pub fn ever_clamps(&self) -> bool {
-        self.pressure.max_pressure_pa() * self.area_m2 > self.return_spring_n
-    }
-
     /// Piston force on the stack at `t_s`, N (>= 0): `max(0, p(t) A - F_rs)`.
     pub fn force_n(&self, t_s: f64) -> f64 {
         (self.pressure.pressure_pa(t_s) * self.area_m2 - self.return_spring_n).max(0.0)

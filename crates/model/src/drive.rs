@@ -67,11 +67,6 @@ impl Table {
         Ok(Table { t_s, y, integral })
     }
 
-    /// The table's values at its rows (in the table's unit).
-    pub fn values(&self) -> &[f64] {
-        &self.y
-    }
-
     fn segment(&self, t: f64) -> usize {
         // index i with t_s[i] <= t < t_s[i+1], clamped to the valid segments
         let i = self.t_s.partition_point(|&x| x <= t);

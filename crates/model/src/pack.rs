@@ -76,10 +76,6 @@ pub enum NonTorsional {
     InitialOffset(usize),
     /// Disc `i` has tooth spacing errors.
     SpacingErrors(usize),
-    /// The pack's piston clamps the stack at some time (its largest pressure pushes past the
-    /// return spring): friction faces with stick and slip, which the torsional engine does
-    /// not run yet (an open stack, every interface an oil gap, it does).
-    ClampedStack,
     /// Plate `j` floats radially, starts off the axis or has spacing errors.
     PlatePerTooth(usize),
 }
@@ -111,16 +107,17 @@ pub struct PackModel {
 
 impl PackModel {
     /// Whether a torsional model (one rotational degree of freedom per body: shaft, discs,
-    /// plates, drum; the lumped tooth law) describes the pack and the reference engine runs
-    /// it: every disc and plate [`DiscModel::is_concentric`], and no stack that clamps.
+    /// plates, drum; the lumped tooth law; the stack's faces with exact stick and slip)
+    /// describes the pack and the reference engine runs it: every disc and plate
+    /// [`DiscModel::is_concentric`].
     /// Engines choose by it (the reference engine refuses a pack that is not).
     pub fn is_torsional(&self) -> bool {
         self.non_torsional_parts().is_empty()
     }
 
     /// Every part of the pack that the torsional engine does not run (MODEL.md section 5), in
-    /// order: per disc its radial float, offset and spacing errors, then a stack whose piston
-    /// clamps. Empty exactly when [`Self::is_torsional`]. The one statement of what the
+    /// order: per disc its radial float, offset and spacing errors, then each plate with any of
+    /// them. Empty exactly when [`Self::is_torsional`]. The one statement of what the
     /// reference engine cannot run; the CLI's engine choice and `check --engine` read it.
     pub fn non_torsional_parts(&self) -> Vec<NonTorsional> {
         let mut out = Vec::new();
@@ -139,9 +136,6 @@ impl PackModel {
             if !p.is_concentric() {
                 out.push(NonTorsional::PlatePerTooth(j));
             }
-        }
-        if self.stack.as_ref().is_some_and(|s| s.piston.ever_clamps()) {
-            out.push(NonTorsional::ClampedStack);
         }
         out
     }

@@ -174,7 +174,7 @@ pub(crate) fn run(
                 sample: &mut sample,
             };
             let free = &free;
-            st.step(duration_s, &mut sink, &mut |t0, t1, d| {
+            st.step(duration_s, &mut sink, &mut |_, _, t0, t1, d| {
                 probe(pack, free, t0, t1, d)
             })?
         };

@@ -122,7 +122,7 @@ mod system;
 use clutchpack_model::{
     Engagement, Engine, EngineError, ImpactEvent, Observer, PackModel, RunStats, Shaft,
 };
-use stepper::{Sink, Stepper};
+use stepper::{Sink, Stepper, Switch};
 use system::System;
 
 /// Integration and output settings of the reference engine.
@@ -275,7 +275,7 @@ impl Sink for ObserverSink<'_> {
     fn sample(&mut self, _k: u64, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]) {
         self.obs.sample(&sys.sample(t, y, modes));
         if sys.interfaces() > 0 {
-            self.obs.interfaces(t, &sys.interface_samples(t, y));
+            self.obs.interfaces(t, &sys.interface_samples(t, y, modes));
         }
     }
     fn impact(&mut self, e: ImpactEvent) {
@@ -291,11 +291,18 @@ impl Sink for ObserverSink<'_> {
 }
 
 /// No events outside the system.
-pub(crate) fn no_external(_t0: f64, _t1: f64, _d: &dopri::Dense) -> Option<(f64, usize)> {
+pub(crate) fn no_external(
+    _sys: &System,
+    _modes: &[Option<Engagement>],
+    _t0: f64,
+    _t1: f64,
+    _d: &dopri::Dense,
+) -> Option<(f64, usize)> {
     None
 }
 
-/// The monolithic scheme: one stepper for the shaft and every disc.
+/// The monolithic scheme: one stepper for the shaft and every disc (and, on a whole pack,
+/// every plate, the drum and the stack's faces with their stick-slip events).
 fn run_monolithic(
     pack: &PackModel,
     settings: &Settings,
@@ -304,13 +311,33 @@ fn run_monolithic(
 ) -> Result<RunStats, EngineError> {
     let nd = pack.discs.len() + pack.plates.len();
     let mut st = Stepper::new(System::new(pack, (0..nd).collect()), settings);
+    if pack.stack.is_some() {
+        // the faces' modes at t = 0, from the piston on
+        for m in 0..st.sys.faces.len() {
+            let (t, modes) = (st.t, st.modes.clone());
+            st.sys.settle_face(m, t, &mut st.y, &modes);
+        }
+        st.restart();
+    }
     let mut sink = ObserverSink { obs };
     // A step costs O(N): poll the observer about every 1024 disc-steps (a stop acts within
     // a few ms of wall time whatever the pack).
     let poll = (1024 / nd.max(1)).max(1) as u64;
     let mut stopped = false;
+    let mut buf = vec![0.0; st.sys.dim()];
     while st.t < duration_s {
-        st.step(duration_s, &mut sink, &mut no_external)?;
+        let switch = if pack.stack.is_some() {
+            st.step(duration_s, &mut sink, &mut |sys, modes, t0, t1, d| {
+                face_event(sys, modes, t0, t1, d, &mut buf)
+            })?
+        } else {
+            st.step(duration_s, &mut sink, &mut no_external)?
+        };
+        if let Switch::External(m) = switch {
+            let (t, modes) = (st.t, st.modes.clone());
+            st.sys.settle_face(m, t, &mut st.y, &modes);
+            st.restart();
+        }
         if st.stats.steps.is_multiple_of(poll) && sink.obs.progress(st.t) {
             stopped = true;
             break;
@@ -321,6 +348,59 @@ fn run_monolithic(
     stats.simulated_s = st.t;
     stats.stopped_early = stopped;
     Ok(stats)
+}
+
+/// The earliest stick-slip event of the stack's faces inside the step `[t0, t1]` (dense output
+/// `d`), as `(time, interface)`: each face's switching condition
+/// ([`System::face_switches`]) probed at the step's quarter points, the first crossing
+/// bisected to 1e-13 s (as the contact events are).
+fn face_event(
+    sys: &System,
+    modes: &[Option<Engagement>],
+    t0: f64,
+    t1: f64,
+    d: &dopri::Dense,
+    buf: &mut Vec<f64>,
+) -> Option<(f64, usize)> {
+    buf.resize(sys.dim(), 0.0);
+    let eval = |t: f64, buf: &mut Vec<f64>| {
+        d.eval(t, buf);
+        let c = sys.carriers(t, buf, modes);
+        sys.stack_eval(t, buf, modes, &c)
+    };
+    let mut ta = t0;
+    for q in 1..=4 {
+        let tq = if q == 4 {
+            t1
+        } else {
+            t0 + (t1 - t0) * q as f64 / 4.0
+        };
+        let ev = eval(tq, buf);
+        let fired: Vec<usize> = (0..sys.faces.len())
+            .filter(|&m| sys.face_switches(m, &ev))
+            .collect();
+        if !fired.is_empty() {
+            // the earliest of the faces that fired in (ta, tq]
+            let mut best: Option<(f64, usize)> = None;
+            for m in fired {
+                let (mut a, mut b) = (ta, tq);
+                while b - a > 1e-13 {
+                    let mid = 0.5 * (a + b);
+                    if sys.face_switches(m, &eval(mid, buf)) {
+                        b = mid;
+                    } else {
+                        a = mid;
+                    }
+                }
+                if best.is_none_or(|(tb, _)| b < tb) {
+                    best = Some((b, m));
+                }
+            }
+            return best;
+        }
+        ta = tq;
+    }
+    None
 }
 
 impl Engine for ReferenceEngine {
@@ -341,19 +421,6 @@ impl Engine for ReferenceEngine {
     fn run(&mut self, duration_s: f64, obs: &mut dyn Observer) -> Result<RunStats, EngineError> {
         for d in self.pack.discs.iter().chain(&self.pack.plates) {
             stepper::check_disc(d)?;
-        }
-        if self
-            .pack
-            .stack
-            .as_ref()
-            .is_some_and(|s| s.piston.ever_clamps())
-        {
-            return Err(EngineError::Unsupported(
-                "a piston that clamps the stack needs stick and slip of the friction faces: \
-                 the multibody engine runs it (the reference engine runs open stacks, every \
-                 interface an oil gap)"
-                    .into(),
-            ));
         }
         let (pack, settings) = (&self.pack, &self.settings);
         match (self.scheme, &pack.shaft) {

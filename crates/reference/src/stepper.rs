@@ -243,14 +243,21 @@ impl<'a> Stepper<'a> {
     }
 
     /// Takes one accepted step towards `end` (s): locates the earliest mode switch inside it
-    /// (and the earliest event `external(t0, t1, dense)` reports, as `(time, id)`), refines
+    /// (and the earliest event `external(system, modes, t0, t1, dense)` reports, as `(time,
+    /// id)`), refines
     /// the peaks of the open events, emits the samples and the impacts of the step to `sink`
     /// and applies the switch.
     pub fn step(
         &mut self,
         end: f64,
         sink: &mut impl Sink,
-        external: &mut impl FnMut(f64, f64, &Dense) -> Option<(f64, usize)>,
+        external: &mut impl FnMut(
+            &System,
+            &[Option<Engagement>],
+            f64,
+            f64,
+            &Dense,
+        ) -> Option<(f64, usize)>,
     ) -> Result<Switch, EngineError> {
         let t = self.t;
         // The located onsets of the events opened since the last step: their first contact
@@ -351,7 +358,7 @@ impl<'a> Stepper<'a> {
             }
         }
         let mut ext = None;
-        if let Some((te, id)) = external(t, t_end, cur) {
+        if let Some((te, id)) = external(sys, &self.modes, t, t_end, cur) {
             if event.is_none_or(|(ti, _)| te < ti) {
                 event = None;
                 ext = Some((te, id));

@@ -7,6 +7,36 @@ use clutchpack_model::{
     ToothKinematics,
 };
 
+/// What a friction interface does between two stick-slip events (MODEL.md section 5).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Face {
+    /// No clamp force: an oil gap (Couette drag).
+    Open,
+    /// Clamped and slipping; the sign (+1 or -1) of its slip `omega_upper - omega_lower`.
+    Slip(f64),
+    /// Clamped and stuck: the two faces turn as one.
+    Locked,
+}
+
+/// The stack's forces at one instant ([`System::stack_eval`]); interfaces from the piston,
+/// bodies in stack order.
+#[derive(Debug, Clone)]
+pub(crate) struct StackEval {
+    /// `F_p - sum_{b <= m} mu_spline Q_b`, N (the clamp before it is cut at 0).
+    pub raw_clamp: Vec<f64>,
+    /// Clamp force, N (>= 0).
+    pub clamp: Vec<f64>,
+    /// Slip `omega_upper - omega_lower`, rad/s.
+    pub slip: Vec<f64>,
+    /// Torque of the interface on its upper body, N m (the lower body gets the opposite); for
+    /// a locked interface the torque that holds it.
+    pub torque: Vec<f64>,
+    /// Heat rate `-torque * slip`, W (>= 0).
+    pub heat_rate: Vec<f64>,
+    /// Acceleration of each stack body, rad/s^2.
+    pub alpha: Vec<f64>,
+}
+
 /// What a coupling's spline ties its body to.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Carrier {
@@ -36,6 +66,8 @@ pub(crate) struct System<'a> {
     pub ids: Vec<usize>,
     /// Number of friction discs of the pack.
     nd: usize,
+    /// What each friction interface does between stick-slip events (with a stack).
+    pub faces: Vec<Face>,
     /// Open-gap damping `c = pi eta (Ro^4 - Ri^4) / (2 h)` of every interface, N m s/rad (0
     /// without a stack or its oil gap; MODEL.md section 5).
     c_gap: f64,
@@ -54,12 +86,14 @@ impl<'a> System<'a> {
             .stack
             .as_ref()
             .map_or(0.0, |s| -s.open_gap_torque_n_m(1.0));
+        let faces = vec![Face::Open; pack.stack.as_ref().map_or(0, |_| 2 * pack.discs.len())];
         let sys = System {
             pack,
             off,
             ids,
             nd: pack.discs.len(),
             c_gap,
+            faces,
         };
         debug_assert!(
             !sys.is_whole() || sys.ids == (0..sys.nd + pack.plates.len()).collect::<Vec<_>>()
@@ -153,14 +187,15 @@ impl<'a> System<'a> {
         self.disc(slot).law.engagement_depth_m(&self.kin(slot, y))
     }
 
-    /// `dy = f(t, y)` with the slots' contact modes `modes`.
-    pub fn rhs(&self, t: f64, y: &[f64], modes: &[Option<Engagement>], dy: &mut [f64]) {
+    /// The carriers' motion at `t` for state `y` and contact modes `modes`: the shaft's speed
+    /// and acceleration, the drum's (0 without a drum), rad/s and rad/s^2. The carriers feel
+    /// only their couplings' spline reactions (eq 4; the drum's load and drag), never the
+    /// stack, which acts between discs and plates.
+    pub fn carriers(&self, t: f64, y: &[f64], modes: &[Option<Engagement>]) -> [f64; 4] {
         let (omega_s, alpha_prescribed) = match &self.pack.shaft {
             Shaft::Prescribed(p) => (p.speed(t), p.acceleration(t)),
             Shaft::Inertial { .. } => (y[1], 0.0),
         };
-        // The carriers first: an inertial shaft and a drum need their couplings' reactions.
-        let mut alpha_s = alpha_prescribed;
         let inertial = matches!(self.pack.shaft, Shaft::Inertial { .. });
         let (mut shaft_torque, mut drum_torque) = (0.0, 0.0);
         if inertial || self.pack.drum.is_some() {
@@ -176,113 +211,268 @@ impl<'a> System<'a> {
                 }
             }
         }
-        if let Shaft::Inertial {
-            inertia_kg_m2,
-            damping_n_m_s_rad,
-            ..
-        } = &self.pack.shaft
-        {
-            alpha_s = (self.pack.shaft.drive_torque_n_m(t) + shaft_torque
-                - damping_n_m_s_rad * omega_s)
-                / inertia_kg_m2;
-            dy[0] = omega_s;
-            dy[1] = alpha_s;
-        }
-        let (mut omega_r, mut alpha_r) = (0.0, 0.0);
-        if let Some(drum) = &self.pack.drum {
+        let alpha_s = match &self.pack.shaft {
+            Shaft::Inertial {
+                inertia_kg_m2,
+                damping_n_m_s_rad,
+                ..
+            } => {
+                (self.pack.shaft.drive_torque_n_m(t) + shaft_torque - damping_n_m_s_rad * omega_s)
+                    / inertia_kg_m2
+            }
+            Shaft::Prescribed(_) => alpha_prescribed,
+        };
+        let (omega_r, alpha_r) = match &self.pack.drum {
             // the drum: its load, its drag and the plates' spline reactions (MODEL.md section 5)
-            let r = self.drum_at();
-            omega_r = y[r + 1];
-            alpha_r = (drum.load_torque_n_m + drum_torque - drum.drag_n_m_s_rad * omega_r)
-                / drum.inertia_kg_m2;
-            dy[r] = omega_r;
-            dy[r + 1] = alpha_r;
+            Some(drum) => {
+                let omega_r = y[self.drum_at() + 1];
+                let alpha_r = (drum.load_torque_n_m + drum_torque - drum.drag_n_m_s_rad * omega_r)
+                    / drum.inertia_kg_m2;
+                (omega_r, alpha_r)
+            }
+            None => (0.0, 0.0),
+        };
+        [omega_s, alpha_s, omega_r, alpha_r]
+    }
+
+    /// Speed and acceleration of the carrier of `slot` from [`Self::carriers`].
+    fn carrier_of(&self, slot: usize, c: &[f64; 4]) -> (f64, f64) {
+        match self.carrier(slot) {
+            Carrier::Shaft => (c[0], c[1]),
+            Carrier::Drum => (c[2], c[3]),
+            Carrier::Housing => (0.0, 0.0),
+        }
+    }
+
+    /// `dy = f(t, y)` with the slots' contact modes `modes`.
+    pub fn rhs(&self, t: f64, y: &[f64], modes: &[Option<Engagement>], dy: &mut [f64]) {
+        let c = self.carriers(t, y, modes);
+        if matches!(self.pack.shaft, Shaft::Inertial { .. }) {
+            dy[0] = c[0];
+            dy[1] = c[1];
+        }
+        if self.pack.drum.is_some() {
+            dy[self.drum_at()] = c[2];
+            dy[self.drum_at() + 1] = c[3];
+        }
+        if self.pack.stack.is_some() {
+            // every body is a stack body: its acceleration comes from the stack's balance
+            let ev = self.stack_eval(t, y, modes, &c);
+            for slot in 0..self.ids.len() {
+                let k = self.off + 2 * slot;
+                let alpha_c = self.carrier_of(slot, &c).1;
+                dy[k] = y[k + 1];
+                dy[k + 1] = alpha_c - ev.alpha[self.position(slot)];
+            }
+            let h = self.heat_at();
+            dy[h..h + self.interfaces()].copy_from_slice(&ev.heat_rate);
+            return;
         }
         for slot in 0..self.ids.len() {
-            let d = self.disc(slot);
             let k = self.off + 2 * slot;
-            let f = self.load(slot, y, &modes[slot]);
-            let (omega_c, alpha_c) = match self.carrier(slot) {
-                Carrier::Shaft => (omega_s, alpha_s),
-                Carrier::Drum => (omega_r, alpha_r),
-                Carrier::Housing => (0.0, 0.0),
-            };
-            let omega_b = omega_c - y[k + 1];
-            let stack = self.stack_torque_n_m(slot, y, omega_s, omega_r);
-            // Hu et al. eq (5), with the open gaps' drag on a whole pack
-            let alpha_b = (d.spline.disc_torque_n_m(f) - d.drag_n_m_s_rad * omega_b + stack)
-                / d.inertia_kg_m2;
+            let (omega_c, alpha_c) = self.carrier_of(slot, &c);
+            let alpha_b = self.free_torque_n_m(slot, y, &modes[slot], omega_c)
+                / self.disc(slot).inertia_kg_m2;
             dy[k] = y[k + 1];
             dy[k + 1] = alpha_c - alpha_b;
         }
-        let h = self.heat_at();
-        for m in 0..self.interfaces() {
-            // heat rate of an open gap: c slip^2 (>= 0)
-            let slip = self.stack_speed(m + 1, y, omega_s, omega_r)
-                - self.stack_speed(m, y, omega_s, omega_r);
-            dy[h + m] = self.c_gap * slip * slip;
-        }
     }
 
-    /// Speed (rad/s) of the body at stack position `b` (whole pack: slot = coupling index),
-    /// with the shaft at `omega_s` and the drum at `omega_r` (rad/s).
-    fn stack_speed(&self, b: usize, y: &[f64], omega_s: f64, omega_r: f64) -> f64 {
-        let slot = StackBody::at(b).body_index(self.nd);
-        let omega_c = match self.carrier(slot) {
-            Carrier::Shaft => omega_s,
-            Carrier::Drum => omega_r,
-            Carrier::Housing => 0.0,
-        };
-        omega_c - y[self.off + 2 * slot + 1]
+    /// The torque on the body in `slot` from its teeth and its oil drag (Hu et al. eq 5), N m,
+    /// with its carrier at `omega_c` (rad/s).
+    fn free_torque_n_m(
+        &self,
+        slot: usize,
+        y: &[f64],
+        mode: &Option<Engagement>,
+        omega_c: f64,
+    ) -> f64 {
+        let d = self.disc(slot);
+        let omega_b = omega_c - y[self.off + 2 * slot + 1];
+        d.spline.disc_torque_n_m(self.load(slot, y, mode)) - d.drag_n_m_s_rad * omega_b
     }
 
-    /// Torque of the open stack's gaps on the body in `slot`, N m: the Couette drag `-c slip`
-    /// of each interface it shares with a neighbour (MODEL.md section 5).
-    fn stack_torque_n_m(&self, slot: usize, y: &[f64], omega_s: f64, omega_r: f64) -> f64 {
-        if self.interfaces() == 0 {
-            return 0.0;
-        }
+    /// Stack position of the body in `slot` (whole pack: slot = coupling index).
+    fn position(&self, slot: usize) -> usize {
         let id = self.ids[slot];
-        let b = if id < self.nd {
+        if id < self.nd {
             StackBody::Disc(id)
         } else {
             StackBody::Plate(id - self.nd)
         }
-        .position();
-        let me = self.stack_speed(b, y, omega_s, omega_r);
-        let mut torque = 0.0;
-        if b > 0 {
-            torque -= self.c_gap * (me - self.stack_speed(b - 1, y, omega_s, omega_r));
-        }
-        if b < 2 * self.nd {
-            torque -= self.c_gap * (me - self.stack_speed(b + 1, y, omega_s, omega_r));
-        }
-        torque
+        .position()
     }
 
-    /// The open interfaces' states at `t` for state `y` (empty without a stack).
-    pub fn interface_samples(&self, t: f64, y: &[f64]) -> Vec<InterfaceSample> {
+    /// The stack at `t` for state `y` (MODEL.md section 5), with the faces in
+    /// [`Self::faces`]: clamp forces, slips, each interface's torque on its upper body, the
+    /// heat rates and every stack body's acceleration. An open interface drags with the
+    /// Couette law; a slipping one with `mu(|v|) F R_eff` against its slip direction; the
+    /// bodies joined by locked interfaces move as one (one acceleration, from their summed
+    /// free torques), and each locked interface carries the torque that holds it,
+    /// `X_m = sum over the group's bodies below it of (T_b - J_b alpha)`.
+    pub fn stack_eval(
+        &self,
+        t: f64,
+        y: &[f64],
+        modes: &[Option<Engagement>],
+        c: &[f64; 4],
+    ) -> StackEval {
+        let stack = self.pack.stack.as_ref().expect("a stack");
+        let n_b = 2 * self.nd + 1;
+        let n_if = n_b - 1;
+        let r_eff = stack.effective_radius_m();
+        let mut ev = StackEval {
+            raw_clamp: vec![0.0; n_if],
+            clamp: vec![0.0; n_if],
+            slip: vec![0.0; n_if],
+            torque: vec![0.0; n_if],
+            heat_rate: vec![0.0; n_if],
+            alpha: vec![0.0; n_b],
+        };
+        let mut omega = vec![0.0; n_b];
+        let mut free = vec![0.0; n_b];
+        let mut inertia = vec![0.0; n_b];
+        let mut f_p = stack.piston.force_n(t);
+        for b in 0..n_b {
+            let slot = StackBody::at(b).body_index(self.nd);
+            let (omega_c, _) = self.carrier_of(slot, c);
+            omega[b] = omega_c - y[self.off + 2 * slot + 1];
+            free[b] = self.free_torque_n_m(slot, y, &modes[slot], omega_c);
+            inertia[b] = self.disc(slot).inertia_kg_m2;
+            if b < n_if {
+                // MODEL.md section 5: each body holds back mu_spline n |F| of the clamp
+                let d = self.disc(slot);
+                let q = d.spline.teeth as f64 * self.load(slot, y, &modes[slot]).abs();
+                f_p -= stack.spline_friction * q;
+                ev.raw_clamp[b] = f_p;
+                ev.clamp[b] = f_p.max(0.0);
+            }
+        }
+        for m in 0..n_if {
+            let slip = omega[m + 1] - omega[m];
+            ev.slip[m] = slip;
+            let torque = match self.faces[m] {
+                Face::Open => -self.c_gap * slip,
+                Face::Slip(dir) => -dir * stack.friction.mu(slip * r_eff) * ev.clamp[m] * r_eff,
+                Face::Locked => 0.0,
+            };
+            ev.torque[m] = torque;
+            ev.heat_rate[m] = -torque * slip;
+            free[m + 1] += torque;
+            free[m] -= torque;
+        }
+        // locked groups: runs of bodies joined by locked interfaces
+        let mut b0 = 0;
+        while b0 < n_b {
+            let mut b1 = b0;
+            while b1 < n_if && self.faces[b1] == Face::Locked {
+                b1 += 1;
+            }
+            let (sum_t, sum_j): (f64, f64) = (b0..=b1)
+                .map(|b| (free[b], inertia[b]))
+                .fold((0.0, 0.0), |(a, j), (tb, jb)| (a + tb, j + jb));
+            let alpha = sum_t / sum_j;
+            let mut hold = 0.0;
+            for b in b0..=b1 {
+                ev.alpha[b] = alpha;
+                if b < b1 {
+                    hold += free[b] - inertia[b] * alpha;
+                    ev.torque[b] = hold;
+                }
+            }
+            b0 = b1 + 1;
+        }
+        ev
+    }
+
+    /// The interfaces' states at `t` for state `y` (empty without a stack).
+    pub fn interface_samples(
+        &self,
+        t: f64,
+        y: &[f64],
+        modes: &[Option<Engagement>],
+    ) -> Vec<InterfaceSample> {
         let Some(stack) = &self.pack.stack else {
             return Vec::new();
         };
-        let omega_s = self.shaft(t, y).1;
-        let omega_r = self.pack.drum.map_or(0.0, |_| y[self.drum_at() + 1]);
+        let c = self.carriers(t, y, modes);
+        let ev = self.stack_eval(t, y, modes, &c);
         let r_eff = stack.effective_radius_m();
         (0..self.interfaces())
-            .map(|m| {
-                let slip = self.stack_speed(m + 1, y, omega_s, omega_r)
-                    - self.stack_speed(m, y, omega_s, omega_r);
-                InterfaceSample {
-                    slip_rad_s: slip,
-                    slip_m_s: slip * r_eff,
-                    mu: 0.0,
-                    clamp_n: 0.0,
-                    torque_n_m: -self.c_gap * slip,
-                    locked: false,
-                    dissipated_j: y[self.heat_at() + m],
-                }
+            .map(|m| InterfaceSample {
+                slip_rad_s: ev.slip[m],
+                slip_m_s: ev.slip[m] * r_eff,
+                mu: match self.faces[m] {
+                    Face::Open => 0.0,
+                    _ => stack.friction.mu(ev.slip[m] * r_eff),
+                },
+                clamp_n: ev.clamp[m],
+                torque_n_m: ev.torque[m],
+                locked: self.faces[m] == Face::Locked,
+                dissipated_j: y[self.heat_at() + m],
             })
             .collect()
+    }
+
+    /// Whether interface `m` must change its mode at the state `ev` (a stick-slip event):
+    /// an open one clamps, a slipping one's slip reaches zero (against its direction) or its
+    /// clamp vanishes, a locked one needs more torque than `mu(0) F R_eff` or loses its clamp.
+    pub fn face_switches(&self, m: usize, ev: &StackEval) -> bool {
+        let stack = self.pack.stack.as_ref().expect("a stack");
+        match self.faces[m] {
+            Face::Open => ev.raw_clamp[m] > 0.0,
+            Face::Slip(dir) => dir * ev.slip[m] <= 0.0 || ev.raw_clamp[m] <= 0.0,
+            Face::Locked => {
+                ev.raw_clamp[m] <= 0.0
+                    || ev.torque[m].abs()
+                        > stack.friction.static_mu() * ev.clamp[m] * stack.effective_radius_m()
+            }
+        }
+    }
+
+    /// The mode interface `m` takes at `(t, y)` when its event fires (or at t = 0): open
+    /// without clamp; else locked if the torque that holds it stays within `mu(0) F R_eff`
+    /// and its slip is zero (or has just reached zero), else slipping in the direction its
+    /// slip goes (the direction the unbalanced torque drives it, when it starts from zero).
+    /// A lock sets the slip exactly to zero, moving the bodies above it (with those locked to
+    /// them) to the speed below.
+    pub fn settle_face(&mut self, m: usize, t: f64, y: &mut [f64], modes: &[Option<Engagement>]) {
+        let stack = self.pack.stack.as_ref().expect("a stack");
+        let c = self.carriers(t, y, modes);
+        let ev = self.stack_eval(t, y, modes, &c);
+        if ev.raw_clamp[m] <= 0.0 {
+            self.faces[m] = Face::Open;
+            return;
+        }
+        let slip = ev.slip[m];
+        let reached_zero = match self.faces[m] {
+            Face::Slip(dir) => dir * slip <= 0.0,
+            Face::Locked => true,
+            Face::Open => slip == 0.0,
+        };
+        if !reached_zero {
+            self.faces[m] = Face::Slip(slip.signum());
+            return;
+        }
+        let was = self.faces[m];
+        self.faces[m] = Face::Locked;
+        let held = self.stack_eval(t, y, modes, &c);
+        let bound = stack.friction.static_mu() * held.clamp[m] * stack.effective_radius_m();
+        if held.torque[m].abs() <= bound && was != Face::Locked {
+            // lock: the upper bodies (and those locked above them) take the lower's speed
+            let mut b = m + 1;
+            loop {
+                let slot = StackBody::at(b).body_index(self.nd);
+                y[self.off + 2 * slot + 1] += slip;
+                if b >= 2 * self.nd || self.faces[b] != Face::Locked {
+                    break;
+                }
+                b += 1;
+            }
+        } else if held.torque[m].abs() > bound {
+            // the lock cannot hold: the upper body slips against the torque it would need
+            self.faces[m] = Face::Slip(-held.torque[m].signum());
+        }
     }
 
     /// The state at t = 0.

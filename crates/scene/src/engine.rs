@@ -57,9 +57,9 @@ impl Scene {
             (Some(_), _) => "asked by --engine",
             (None, Some(_)) => "chosen by the scene (simulation.engine)",
             (None, None) if self.pack.non_torsional_parts().is_empty() => {
-                "the default for a torsional pack (concentric bodies, an open stack if any)"
+                "the default for a torsional pack (concentric bodies: discs, plates, drum, stack)"
             }
-            (None, None) => "the only engine for per-tooth effects or a clamping stack",
+            (None, None) => "the only engine for per-tooth effects",
         }
     }
 
@@ -69,11 +69,6 @@ impl Scene {
         let per_tooth = format!(
             "the reference engine (chosen by {why}) runs concentric discs with identical \
              teeth only (one rotational degree of freedom per disc): use the multibody engine"
-        );
-        let clamped = format!(
-            "the reference engine (chosen by {why}) runs open stacks only (every interface an \
-             oil gap); a piston that clamps needs stick and slip of the faces: use the \
-             multibody engine"
         );
         match part {
             NonTorsional::RadialFloat(i) => {
@@ -91,18 +86,6 @@ impl Scene {
                 Problem::new(disc(i, "tooth_spacing_errors_m"), Some(v), per_tooth)
             }
             NonTorsional::PlatePerTooth(j) => Problem::new(format!("plates[{j}]"), None, per_tooth),
-            NonTorsional::ClampedStack => {
-                let p = self
-                    .pack
-                    .stack
-                    .as_ref()
-                    .map_or(0.0, |s| s.piston.pressure.max_pressure_pa());
-                Problem::new(
-                    "stack.pressure",
-                    Some(format!("{} Pa at most", fmt_num(p))),
-                    clamped,
-                )
-            }
         }
     }
 }
