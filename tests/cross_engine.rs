@@ -268,3 +268,108 @@ mod staggered {
         assert_agree(Scheme::Shared, 512.0);
     }
 }
+
+/// Issue 21: `pack-6-engagement` (6 discs rattling, 7 plates on a drum, the piston ramping at
+/// 50-80 ms) in both engines (the multibody engine at its defaults): every interface's first
+/// lock within 0.5 % and its heat within 1 % (measured 2.0e-4 and 1.2e-3; 1e5 Hz samples
+/// place a lock to 10 us). Then the discs' impacts one by one, peak within 0.5 % or 2 N and
+/// onset within 2 us, over the first 25 ms with the multibody engine's longest step at
+/// 2.5e-7 s (measured: 69 impacts, worst onset 1.4 us). Not met: "every impact before the lock"
+/// (85.8 ms). In the open clutch the plates ride on a free drum, barely touching its teeth
+/// (2-30 N), and the multibody engine's first-order gap drag leaves them off by 4-10 us from
+/// 14 ms even at 1e-7 s while the reference is converged (1e-12 and 1e-13 agree to 3e-8 s);
+/// through the gaps this reaches the discs after about 30 ms. At its default step the
+/// multibody engine's discs differ from the first impacts on (2 us, 0.3 %).
+#[test]
+fn engagement_pack_6_locks_and_heats_alike() {
+    let s = scene(
+        "scenes/pack-6-engagement.toml",
+        &[
+            "simulation.duration_s=0.12",
+            "simulation.record_rate_hz=1e5",
+        ],
+    );
+    let duration = s.simulation.duration_s;
+    let oracle = Settings {
+        tolerance: 1e-12,
+        max_step_s: s.simulation.max_step_s,
+        record_rate_hz: s.simulation.record_rate_hz,
+    };
+    let mut reference = Collector::default();
+    ReferenceEngine::new(s.pack.clone(), oracle)
+        .run(duration, &mut reference)
+        .unwrap();
+    let options = MultibodyOptions::with_settings(
+        s.simulation.record_rate_hz,
+        s.simulation.max_step_s,
+        false,
+    );
+    let mut multibody = Collector::default();
+    MultibodyEngine::new(s.pack.clone(), options)
+        .unwrap()
+        .run(duration, &mut multibody)
+        .unwrap();
+    let first_lock = |c: &Collector, m: usize| {
+        c.interfaces
+            .iter()
+            .find(|(_, f)| f[m].locked)
+            .map(|(t, _)| *t)
+            .expect("every face locks")
+    };
+    let heat = |c: &Collector, m: usize| c.interfaces.last().unwrap().1[m].dissipated_j;
+    let (mut worst_lock, mut worst_heat) = (0.0f64, 0.0f64);
+    for m in 0..2 * s.pack.discs.len() {
+        let (lr, lm) = (first_lock(&reference, m), first_lock(&multibody, m));
+        let (hr, hm) = (heat(&reference, m), heat(&multibody, m));
+        worst_lock = worst_lock.max((lr - lm).abs() / lr);
+        worst_heat = worst_heat.max((hr - hm).abs() / hr);
+        assert!(
+            (lr - lm).abs() <= 5e-3 * lr,
+            "interface {m}: lock {lr} vs {lm}"
+        );
+        assert!(
+            (hr - hm).abs() <= 1e-2 * hr,
+            "interface {m}: heat {hr} vs {hm}"
+        );
+    }
+    println!("pack-6-engagement: locks within {worst_lock:.2e}, heat within {worst_heat:.2e}");
+
+    // the discs' impacts over the first 25 ms
+    let s = scene(
+        "scenes/pack-6-engagement.toml",
+        &["simulation.duration_s=0.025"],
+    );
+    let nd = s.pack.discs.len();
+    let oracle = Settings {
+        tolerance: 1e-12,
+        ..Settings::default()
+    };
+    let discs = |v: Vec<ImpactEvent>| v.into_iter().filter(|e| e.disc < nd).collect::<Vec<_>>();
+    let r = discs(impacts(
+        &mut ReferenceEngine::new(s.pack.clone(), oracle),
+        0.025,
+    ));
+    let options = MultibodyOptions::with_settings(1e4, 2.5e-7, false);
+    let m = discs(impacts(
+        &mut MultibodyEngine::new(s.pack.clone(), options).unwrap(),
+        0.025,
+    ));
+    assert!(r.len() >= 5 * nd, "{}", r.len());
+    assert_eq!(r.len(), m.len(), "disc impacts");
+    let (mut worst_rel, mut worst_dt) = (0.0f64, 0.0f64);
+    for (a, b) in r.iter().zip(&m) {
+        assert_eq!((a.disc, a.flank), (b.disc, b.flank), "{a:?} vs {b:?}");
+        assert!(
+            (a.peak_n - b.peak_n).abs() <= (0.005 * a.peak_n.abs()).max(2.0),
+            "{a:?} vs {b:?}"
+        );
+        assert!((a.t_on_s - b.t_on_s).abs() <= 2e-6, "{a:?} vs {b:?}");
+        worst_rel = worst_rel.max((a.peak_n - b.peak_n).abs() / a.peak_n.abs());
+        worst_dt = worst_dt.max((a.t_on_s - b.t_on_s).abs());
+    }
+    println!(
+        "pack-6-engagement, first 25 ms: {} disc impacts, worst peak {worst_rel:.2e}, worst \
+         onset {worst_dt:.2e} s",
+        r.len()
+    );
+}
