@@ -108,8 +108,14 @@ impl SplineGeometry {
     /// Penetration and closing speed for a relative angle `phi_rad = theta_s - theta_d` and
     /// relative speed `dphi_rad_s = omega_s - omega_d` (MODEL.md section 1).
     pub fn kinematics(&self, phi_rad: f64, dphi_rad_s: f64) -> ToothKinematics {
+        self.kinematics_at(phi_rad, dphi_rad_s, self.base_radius_m())
+    }
+
+    /// [`Self::kinematics`] with the base radius `rb_m` (m) already known: an engine that
+    /// evaluates it millions of times keeps [`Self::base_radius_m`] instead of a cosine per
+    /// call.
+    pub fn kinematics_at(&self, phi_rad: f64, dphi_rad_s: f64, rb: f64) -> ToothKinematics {
         let flank = Flank::of(phi_rad);
-        let rb = self.base_radius_m();
         ToothKinematics {
             flank,
             delta_m: (phi_rad.abs() - self.half_play_rad()) * rb,

@@ -123,7 +123,7 @@ use clutchpack_model::{
     Engagement, Engine, EngineError, ImpactEvent, Observer, PackModel, RunStats, Shaft,
 };
 use stepper::{Sink, Stepper, Switch};
-use system::System;
+use system::{Face, System};
 
 /// Integration and output settings of the reference engine.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -362,6 +362,14 @@ fn face_event(
     d: &dopri::Dense,
     buf: &mut Vec<f64>,
 ) -> Option<(f64, usize)> {
+    // An open pack stays open while the piston does not push: skip the probe then (the
+    // clamp of an interface is at most the piston force)
+    let piston = &sys.pack.stack.as_ref().expect("a stack").piston;
+    if sys.faces.iter().all(|f| *f == Face::Open)
+        && (0..=4).all(|q| piston.force_n(t0 + (t1 - t0) * q as f64 / 4.0) <= 0.0)
+    {
+        return None;
+    }
     buf.resize(sys.dim(), 0.0);
     let eval = |t: f64, buf: &mut Vec<f64>| {
         d.eval(t, buf);

@@ -122,6 +122,8 @@ pub(crate) struct Stepper<'a> {
     /// Number of the next output sample (at `k / rate`).
     pub next_sample: u64,
     buf: Vec<f64>,
+    /// The state at a step's three inner quarter points (for the event probes).
+    quarters: Vec<f64>,
     y_new: Vec<f64>,
     dy: Vec<f64>,
     pub stats: RunStats,
@@ -149,6 +151,7 @@ impl<'a> Stepper<'a> {
             rate: settings.record_rate_hz,
             next_sample: 0,
             buf: vec![0.0; n],
+            quarters: Vec::new(),
             y_new: vec![0.0; n],
             dy: vec![0.0; n],
             stats: RunStats::default(),
@@ -312,6 +315,13 @@ impl<'a> Stepper<'a> {
         // Earliest mode switch inside the step (probes at quarter points catch grazing
         // contacts that enter and leave within a step).
         let mut event: Option<(f64, usize)> = None;
+        // the state at the quarter points, evaluated once for every slot
+        let n = buf.len();
+        let quarters = &mut self.quarters;
+        quarters.resize(3 * n, 0.0);
+        for q in 1..=3 {
+            cur.eval(t + h * q as f64 / 4.0, &mut quarters[(q - 1) * n..q * n]);
+        }
         for i in 0..sys.ids.len() {
             let engaged = self.modes[i].is_some();
             let triggered = |yy: &[f64]| {
@@ -325,17 +335,12 @@ impl<'a> Stepper<'a> {
             let mut ta = t;
             let mut found = None;
             for q in 1..=4 {
-                let tq = if q == 4 {
-                    t_end
+                let (tq, yq) = if q == 4 {
+                    (t_end, &self.solver.y_new[..])
                 } else {
-                    t + h * q as f64 / 4.0
+                    (t + h * q as f64 / 4.0, &quarters[(q - 1) * n..q * n])
                 };
-                if q == 4 {
-                    buf.copy_from_slice(&self.solver.y_new);
-                } else {
-                    cur.eval(tq, buf);
-                }
-                if triggered(buf) {
+                if triggered(yq) {
                     found = Some((ta, tq));
                     break;
                 }

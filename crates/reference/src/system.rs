@@ -68,6 +68,8 @@ pub(crate) struct System<'a> {
     nd: usize,
     /// What each friction interface does between stick-slip events (with a stack).
     pub faces: Vec<Face>,
+    /// Base radius `Rb` of every coupling (by global index), m.
+    rb: Vec<f64>,
     /// Open-gap damping `c = pi eta (Ro^4 - Ri^4) / (2 h)` of every interface, N m s/rad (0
     /// without a stack or its oil gap; MODEL.md section 5).
     c_gap: f64,
@@ -94,6 +96,12 @@ impl<'a> System<'a> {
             nd: pack.discs.len(),
             c_gap,
             faces,
+            rb: pack
+                .discs
+                .iter()
+                .chain(&pack.plates)
+                .map(|d| d.spline.base_radius_m())
+                .collect(),
         };
         debug_assert!(
             !sys.is_whole() || sys.ids == (0..sys.nd + pack.plates.len()).collect::<Vec<_>>()
@@ -171,7 +179,10 @@ impl<'a> System<'a> {
 
     pub fn kin(&self, slot: usize, y: &[f64]) -> ToothKinematics {
         let k = self.off + 2 * slot;
-        self.disc(slot).spline.kinematics(y[k], y[k + 1])
+        let id = self.ids[slot];
+        self.coupling(id)
+            .spline
+            .kinematics_at(y[k], y[k + 1], self.rb[id])
     }
 
     /// Signed per-tooth load of the disc in `slot`, N, for its mode.
@@ -200,10 +211,13 @@ impl<'a> System<'a> {
         let (mut shaft_torque, mut drum_torque) = (0.0, 0.0);
         if inertial || self.pack.drum.is_some() {
             for slot in 0..self.ids.len() {
+                if modes[slot].is_none() {
+                    continue;
+                }
                 let d = self.disc(slot);
                 let f = self.load(slot, y, &modes[slot]);
                 // Hu et al. eq (4): the spline reaction n F Rb acts back on the carrier
-                let reaction = d.spline.teeth as f64 * f * d.spline.base_radius_m();
+                let reaction = d.spline.teeth as f64 * f * self.rb[self.ids[slot]];
                 match self.carrier(slot) {
                     Carrier::Shaft => shaft_torque += reaction,
                     Carrier::Drum => drum_torque += reaction,
@@ -289,7 +303,14 @@ impl<'a> System<'a> {
     ) -> f64 {
         let d = self.disc(slot);
         let omega_b = omega_c - y[self.off + 2 * slot + 1];
-        d.spline.disc_torque_n_m(self.load(slot, y, mode)) - d.drag_n_m_s_rad * omega_b
+        let teeth = match mode {
+            // eq (5): -n F Rb
+            Some(_) => {
+                -(d.spline.teeth as f64) * self.load(slot, y, mode) * self.rb[self.ids[slot]]
+            }
+            None => 0.0,
+        };
+        teeth - d.drag_n_m_s_rad * omega_b
     }
 
     /// Stack position of the body in `slot` (whole pack: slot = coupling index).
