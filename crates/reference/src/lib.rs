@@ -74,6 +74,36 @@
 //!   accuracy are those of the monolithic scheme; what it saves is the per-step work of the
 //!   discs in free flight.
 //!
+//! ## Whole packs (MODEL.md section 5)
+//! Separator plates are couplings like discs, against their carrier: the housing (angle and
+//! speed 0) or the output drum, whose angle and speed join the state (`J_r omega_r' = T_load
+//! + sum_plates n F Rb - C_r omega_r`). For a plate, `phi = theta_c - theta_p` and `psi =
+//! omega_c - omega_p`. The carriers feel only the spline reactions; the stack acts between
+//! discs and plates, interface `m` between stack bodies `m` and `m + 1` (plate 0, disc 0,
+//! plate 1, ...), with the clamp `F_m = max(0, F_p - sum_{b <= m} mu_spline n |F_b|)`. Each
+//! interface is in one of three modes between events:
+//! - **open** (`F_m = 0`): the Couette drag `-c slip`, `c = pi eta (Ro^4 - Ri^4) / (2 h)`;
+//! - **slipping**: `mu(|v|) F_m R_eff` against the slip's direction, which is fixed between
+//!   events (no regularised sign);
+//! - **locked**: the bodies joined by locked interfaces form a group with one acceleration,
+//!   `sum T_b / sum J_b` over its free torques (teeth, drag, the other interfaces), and each
+//!   locked interface carries the torque that holds it, `X_m = sum_{b in group, b <= m} (T_b
+//!   - J_b alpha)`. The slip of a locked interface stays zero exactly: its bodies'
+//!   accelerations are equal in the right-hand side, and the integrator's linear stages keep
+//!   equal speeds equal.
+//!
+//! Mode switches are events located like the contacts (quarter-point probes on the dense
+//! output, bisection to 1e-13 s, restart): a clamp appears (open -> slipping, or locked if the
+//! slip is zero and the lock holds) or vanishes (-> open); a slip reaches zero (-> locked if
+//! `|X_m| <= mu(0) F_m R_eff`, the slip then set exactly to zero by moving the bodies above to
+//! the speed below; else slipping the other way, against `X_m`); a lock needs more than
+//! `mu(0) F_m R_eff` (-> slipping against `X_m`). Each interface's heat (`-torque * slip`)
+//! is integrated in the state. What is exact: the stick-slip logic and its instants (to the
+//! bisection), the group dynamics, the energy and momentum bookkeeping (checked to 2e-10 and
+//! exactly in the right-hand side); what is integrated: everything else, at the tolerance. A
+//! whole pack runs one step sequence for all its bodies (the multirate schemes are for
+//! friction discs on a shaft): the gaps and faces couple neighbours within every step.
+//!
 //! ## Order and energy
 //! - Order: every scheme takes the same DOPRI5 steps (5th-order solution, 4th-order error
 //!   estimate and dense output) between located events, so each is 5th order in the step
@@ -235,7 +265,7 @@ impl ReferenceEngine {
                 "the housing"
             };
             let stack = if self.pack.stack.is_some() {
-                ", the open stack's oil gaps coupling neighbours"
+                ", the stack's faces (oil gaps, exact stick and slip) coupling neighbours"
             } else {
                 ""
             };

@@ -180,7 +180,7 @@ table! {
 }
 
 table! {
-    /// `[stack]`: the piston, the clamped stack and its friction faces (multibody engine only).
+    /// `[stack]`: the piston, the clamped stack and its friction faces.
     RawStack at "stack" {
         /// inner radius of the friction faces
         face_inner_radius_m: "m", POSITIVE, Dflt::When("required with [stack]");

@@ -73,8 +73,8 @@
 //! film_thickness_m = 75e-6
 //! ```
 //!
-//! A whole pack (MODEL.md section 5; multibody engine only) adds separator plates, an
-//! output drum and the clamped stack:
+//! A whole pack (MODEL.md section 5; both engines) adds separator plates, an output drum and
+//! the clamped stack:
 //!
 //! ```toml
 //! [plate_defaults]              # the same keys as [defaults], for the plates; plates do not
