@@ -1,6 +1,6 @@
 //! `clutchpack bench`: speed figures as ratios and times, printed, never asserted.
 
-use crate::common::{self, RunCollector};
+use crate::common::{self, EngineArg, RunCollector};
 use crate::run::run_recorded;
 use crate::sweep::run_cases_until;
 use anyhow::Result;
@@ -30,6 +30,10 @@ pub struct BenchArgs {
     /// Repetitions of each staggered-pack timing (the median is reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub pack_runs: usize,
+    /// Repetitions of each whole-pack timing (reference and multibody engines in turn on
+    /// `scenes/pack-8-brake.toml` and `pack-6-engagement.toml`); 0 skips that part.
+    #[arg(long, default_value_t = 3)]
+    pub whole_runs: usize,
     /// Only the staggered-pack part (skips the paper case, the sweep and the recording cost).
     #[arg(long)]
     pub pack_only: bool,
@@ -230,12 +234,66 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         }
         let _ = std::fs::remove_dir_all(&dir);
     }
+    whole_packs(a.whole_runs, &stop)?;
+    if stopped() {
+        return Ok(crate::signals::exit_code());
+    }
     staggered_packs(a.pack_runs, &stop)?;
     Ok(if stopped() {
         crate::signals::exit_code()
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// 4. The shipped whole packs (plates, drum, stack), 0.3 s, each engine with the settings
+///    `run` gives it, the two in turn `runs` times (the medians and the median of the pairs'
+///    ratios are reported): the reference engine against the multibody engine.
+fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
+    if runs == 0 {
+        return Ok(());
+    }
+    for file in ["scenes/pack-8-brake.toml", "scenes/pack-6-engagement.toml"] {
+        let path = std::path::Path::new(file);
+        if !path.exists() {
+            out!("whole pack {file}: skipped (run from the repository root)");
+            continue;
+        }
+        let scene = common::load_scene(Some(path), &[])?;
+        let mut times = [Vec::new(), Vec::new()];
+        let mut ratios = Vec::new();
+        for _ in 0..runs {
+            let mut pair = [0.0; 2];
+            for (k, engine) in [EngineArg::Reference, EngineArg::Multibody]
+                .into_iter()
+                .enumerate()
+            {
+                let mut e = common::make_engine(&scene, Some(engine))?;
+                let mut obs =
+                    RunCollector::new(e.disc_names().len(), false).with_stop(Arc::clone(stop));
+                let t0 = Instant::now();
+                e.run(scene.simulation.duration_s, &mut obs)?;
+                if stop.load(Ordering::SeqCst) {
+                    return Ok(());
+                }
+                pair[k] = t0.elapsed().as_secs_f64();
+                times[k].push(pair[k]);
+            }
+            ratios.push(pair[1] / pair[0]);
+        }
+        out!(
+            "whole pack {} ({} discs, {} plates), {} s: reference {:.3} s, multibody {:.3} s \
+             (medians of {runs}, in turn): reference {:.1}x faster",
+            scene.name,
+            scene.pack.discs.len(),
+            scene.pack.plates.len(),
+            scene.simulation.duration_s,
+            median(times[0].clone()),
+            median(times[1].clone()),
+            median(ratios)
+        );
+    }
+    Ok(())
 }
 
 /// One engine configuration of the staggered-pack benchmark.
