@@ -76,9 +76,9 @@
 //!
 //! ## Whole packs (MODEL.md section 5)
 //! Separator plates are couplings like discs, against their carrier: the housing (angle and
-//! speed 0) or the output drum, whose angle and speed join the state (`J_r omega_r' = T_load
-//! + sum_plates n F Rb - C_r omega_r`). For a plate, `phi = theta_c - theta_p` and `psi =
-//! omega_c - omega_p`. The carriers feel only the spline reactions; the stack acts between
+//! speed 0) or the output drum, whose angle and speed join the state:
+//! `J_r omega_r' = T_load + sum_plates n F Rb - C_r omega_r`. For a plate,
+//! `phi = theta_c - theta_p` and `psi = omega_c - omega_p`. The carriers feel only the spline reactions; the stack acts between
 //! discs and plates, interface `m` between stack bodies `m` and `m + 1` (plate 0, disc 0,
 //! plate 1, ...), with the clamp `F_m = max(0, F_p - sum_{b <= m} mu_spline n |F_b|)`. Each
 //! interface is in one of three modes between events:
