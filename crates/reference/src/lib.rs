@@ -87,8 +87,9 @@
 //!   events (no regularised sign);
 //! - **locked**: the bodies joined by locked interfaces form a group with one acceleration,
 //!   `sum T_b / sum J_b` over its free torques (teeth, drag, the other interfaces), and each
-//!   locked interface carries the torque that holds it, `X_m = sum_{b in group, b <= m} (T_b
-//!   - J_b alpha)`. The slip of a locked interface stays zero exactly: its bodies'
+//!   locked interface carries the torque that holds it,
+//!   `X_m = sum_{b in group, b <= m} (T_b - J_b alpha)`. The slip of a locked interface stays
+//!   zero exactly: its bodies'
 //!   accelerations are equal in the right-hand side, and the integrator's linear stages keep
 //!   equal speeds equal.
 //!
