@@ -351,7 +351,7 @@ fn impossible_or_mismatched_scenes_are_refused_with_the_key() {
         (&["--set", "discs[0].inertia_kg_m2=5e-324"], "inertia_kg_m2"),
         (&["--duration", "1e19"], "duration_s"),
         (
-            &["scenes/pack-8-brake.toml", "--engine", "reference"],
+            &["scenes/eccentric-disc.toml", "--engine", "reference"],
             "reference",
         ),
     ];
@@ -364,7 +364,12 @@ fn impossible_or_mismatched_scenes_are_refused_with_the_key() {
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
         assert!(stderr(&o).contains(key), "{args:?}: {}", stderr(&o));
     }
-    let o = run(&["check", "--engine", "reference", "scenes/pack-8-brake.toml"]);
+    let o = run(&[
+        "check",
+        "--engine",
+        "reference",
+        "scenes/eccentric-disc.toml",
+    ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
 
