@@ -85,17 +85,16 @@ struct FatigueJson {
 }
 
 /// The initial relative angles of ensemble member `k` of `count`: every disc at the same
-/// fraction `-1 + (2k + 1) / count` of 90 % of its free play (the half play less the film's
-/// engagement offset), so members are spread evenly and none starts in contact.
+/// fraction of its start free play, by the model's one rule
+/// (`clutchpack_model::ensemble_angle_rad`, which a study's spread ensemble uses too), so
+/// members are spread evenly and none starts in contact.
 pub fn ensemble_member(scene: &Scene, k: usize, count: usize) -> Scene {
     let mut s = scene.clone();
     if count <= 1 {
         return s;
     }
-    let frac = -1.0 + (2 * k + 1) as f64 / count as f64;
     for d in s.pack.discs.iter_mut() {
-        let free = d.spline.free_half_play_rad(d.law.engagement_offset_m());
-        d.initial_rel_angle_rad = frac * 0.9 * free;
+        d.initial_rel_angle_rad = clutchpack_model::ensemble_angle_rad(d, k as u64, count as u64);
     }
     s
 }

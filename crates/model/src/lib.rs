@@ -67,7 +67,8 @@ pub use fatigue::{FatigueParams, Material, MinerRule, ToothForm};
 pub use impact::{detect_impacts, parabolic_peak, ImpactEvent, ImpactTracker};
 pub use law::{ContactState, Engagement, Hertz, LawKind, OilFilm, ToothLaw};
 pub use pack::{
-    annulus_inner_radius_m, annulus_outer_radius_m, DiscModel, NonTorsional, PackModel,
+    annulus_inner_radius_m, annulus_outer_radius_m, ensemble_angle_rad, DiscModel, NonTorsional,
+    PackModel,
 };
 pub use spline::{Flank, SplineGeometry, ToothKinematics};
 pub use stream::{

@@ -57,6 +57,24 @@ impl DiscModel {
             && self.tooth_spacing_errors_m.iter().all(|&e| e == 0.0)
     }
 
+    /// The half free play in which the body may start with no tooth in contact, rad (>= 0):
+    /// the half play `g0` less, along the line of action, the law's engagement offset (the
+    /// film `h_o`, 0 for dry), the largest spacing error's `max|e_k| cos(alpha)` and the
+    /// centre's offset `|e|`, divided by `Rb` (MODEL.md section 5). The one rule: the scene's
+    /// validation refuses `|phi0|` at or beyond it, and ensembles place members inside it
+    /// ([`ensemble_angle_rad`]).
+    pub fn start_free_play_rad(&self) -> f64 {
+        let rb = self.spline.base_radius_m();
+        let worst = self
+            .tooth_spacing_errors_m
+            .iter()
+            .fold(0f64, |m, e| m.max(e.abs()));
+        let offset = self.initial_offset_m[0].hypot(self.initial_offset_m[1]);
+        let reach_m =
+            self.law.engagement_offset_m() + worst * self.spline.pressure_angle_rad.cos() + offset;
+        (self.spline.half_play_rad() - reach_m / rb).max(0.0)
+    }
+
     /// Spacing error of tooth `k` as an angle at the pitch circle, rad (`e_k / R`; 0 when
     /// the disc has no spacing errors).
     pub fn tooth_phase_error_rad(&self, k: usize) -> f64 {
@@ -64,6 +82,15 @@ impl DiscModel {
             .get(k)
             .map_or(0.0, |e| e / self.spline.pitch_radius_m)
     }
+}
+
+/// Where member `k` of an evenly spread ensemble of `count` starts, rad: the fraction
+/// `-1 + (2k + 1) / count` of 90 % of the body's [`DiscModel::start_free_play_rad`], so that
+/// members are spread evenly and none starts in contact (`sweep --ensemble` and a study's
+/// `initial_positions = "spread"` both use it).
+pub fn ensemble_angle_rad(d: &DiscModel, k: u64, count: u64) -> f64 {
+    let frac = -1.0 + (2 * k + 1) as f64 / count as f64;
+    frac * 0.9 * d.start_free_play_rad()
 }
 
 /// A part of a pack that a torsional model (one rotational degree of freedom per friction

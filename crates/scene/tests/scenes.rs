@@ -807,3 +807,35 @@ fn stack_mistakes_are_reported() {
     let e = parse_err(&text, &[]);
     assert!(problem_at(&e, "drum").rule.contains("add [[plates]]"));
 }
+
+/// Issue 22: one free-play rule. Every member of an evenly spread ensemble
+/// (`clutchpack_model::ensemble_angle_rad`, used by `sweep --ensemble` and a study's spread
+/// placement) of the eccentric disc with spacing errors (`scenes/eccentric-disc.toml`, its
+/// offset raised from 30 to 150 um) passes the scene's own start check; the old sweep rule
+/// (the half play less the film only) put its outer members on a tooth, which the validation
+/// refuses. (At the scene's own 30 um the old rule's 10 % margin happened to cover it.)
+#[test]
+fn ensemble_members_start_inside_the_free_play_the_validation_accepts() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/eccentric-disc.toml");
+    let offset: Override = "discs[0].initial_offset_m=[150e-6, 0]".parse().unwrap();
+    let scene = load(&file, std::slice::from_ref(&offset)).unwrap();
+    let d = &scene.pack.discs[0];
+    assert!(d.tooth_spacing_errors_m.iter().any(|e| *e != 0.0));
+    let set = |angle: f64| {
+        let at: Override = format!("discs[0].initial_rel_angle_rad={angle:e}")
+            .parse()
+            .unwrap();
+        load(&file, &[offset.clone(), at])
+    };
+    let count = 16;
+    for k in 0..count {
+        let angle = clutchpack_model::ensemble_angle_rad(d, k, count);
+        set(angle).unwrap_or_else(|e| panic!("member {k} at {angle} rad: {e}"));
+    }
+    // the old rule: 90 % of the half play less the film, at the outer member
+    let old = (-1.0 + (2 * count - 1) as f64 / count as f64)
+        * 0.9
+        * d.spline.free_half_play_rad(d.law.engagement_offset_m());
+    let e = set(old).expect_err("the old rule starts a tooth in contact");
+    assert!(e.to_string().contains("inside the free play"), "{e}");
+}

@@ -333,35 +333,20 @@ impl Study {
         match self.placement {
             Placement::Scene => {}
             Placement::Spread => {
-                let frac = -1.0 + (2 * case.member + 1) as f64 / self.members as f64;
                 for d in scene.pack.discs.iter_mut() {
-                    d.initial_rel_angle_rad = frac * 0.9 * free_play_rad(d);
+                    d.initial_rel_angle_rad =
+                        clutchpack_model::ensemble_angle_rad(d, case.member, self.members);
                 }
             }
             Placement::Random => {
                 let mut rng = Stream::new(self.seed, case.id, STREAM_PLACEMENT);
                 for d in scene.pack.discs.iter_mut() {
-                    d.initial_rel_angle_rad = rng.uniform(-0.9, 0.9) * free_play_rad(d);
+                    d.initial_rel_angle_rad = rng.uniform(-0.9, 0.9) * d.start_free_play_rad();
                 }
             }
         }
         Ok(scene)
     }
-}
-
-/// The half free play (rad) in which a disc may start without a tooth in contact: the half
-/// play less the film's engagement offset, the largest spacing error along the line of action
-/// and the centre's offset (the scene's rule, clutchpack_scene's crate doc).
-pub fn free_play_rad(d: &clutchpack_model::DiscModel) -> f64 {
-    let rb = d.spline.base_radius_m();
-    let emax = d
-        .tooth_spacing_errors_m
-        .iter()
-        .fold(0f64, |m, e| m.max(e.abs()));
-    let off = d.initial_offset_m[0].hypot(d.initial_offset_m[1]);
-    let free = d.spline.half_play_rad()
-        - (d.law.engagement_offset_m() + emax * d.spline.pressure_angle_rad.cos() + off) / rb;
-    free.max(0.0)
 }
 
 /// A number as TOML: integers without a fraction (`154`), else the shortest round-trip form

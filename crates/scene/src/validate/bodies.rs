@@ -479,44 +479,15 @@ impl Body<'_> {
                     ),
                 );
                 inside = false;
-            } else if let (Some((errors, errors_source)), Some((e, offset_source))) =
-                (spacing_errors.as_ref(), offset.as_ref())
-            {
-                // Every tooth must start inside the free play too: a spacing error e_k moves
-                // its gap by e_k cos(alpha) along the line of action, the offset by up to |e|.
-                let worst_error = errors.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-                let along = worst_error * spline.pressure_angle_rad.cos();
-                let offset_len = e[0].hypot(e[1]);
-                let reach_m = half_play_m - offset_m;
-                if inside && phi0.abs() * spline.base_radius_m() + along + offset_len >= reach_m {
-                    let (k, value, source) = if offset_len > 0.0 {
-                        (
-                            &B::initial_offset_m,
-                            format!("[{}, {}]", fmt_num(e[0]), fmt_num(e[1])),
-                            *offset_source,
-                        )
-                    } else {
-                        (
-                            &B::tooth_spacing_errors_m,
-                            format!("[...max |e| = {}]", fmt_num(worst_error)),
-                            *errors_source,
-                        )
-                    };
-                    ck.report(
-                        k.at(item),
-                        Some(value),
-                        format!(
-                            "every tooth must start inside the free play: |phi0| Rb + max|e_k| \
-                             cos(alpha) + |offset| = {:.6e} m must be < g0 Rb - h_o = \
-                             {reach_m:.6e} m{}",
-                            phi0.abs() * spline.base_radius_m() + along + offset_len,
-                            inherited(sec, source, k)
-                        ),
-                    );
-                    inside = false;
-                }
             }
         }
+        // Every tooth must start inside the free play too (checked below, on the built disc,
+        // by the model's one rule: `DiscModel::start_free_play_rad`).
+        let tooth_check = (
+            spacing_errors.as_ref().map(|(_, s)| *s),
+            offset.as_ref().map(|(_, s)| *s),
+            angle.map(|(_, s)| s),
+        );
         let fatigue = self.fatigue();
         if !inside {
             return None;
@@ -553,6 +524,43 @@ impl Body<'_> {
                 [e[0], e[1]]
             },
         };
+        if let (Some(errors_source), Some(offset_source), Some(_)) = tooth_check {
+            let free = disc.start_free_play_rad();
+            let phi0 = disc.initial_rel_angle_rad;
+            if phi0.abs() >= free {
+                let e = disc.initial_offset_m;
+                let offset_len = e[0].hypot(e[1]);
+                let worst = disc
+                    .tooth_spacing_errors_m
+                    .iter()
+                    .fold(0.0f64, |m, x| m.max(x.abs()));
+                let (k, value, source) = if offset_len > 0.0 {
+                    (
+                        &B::initial_offset_m,
+                        format!("[{}, {}]", fmt_num(e[0]), fmt_num(e[1])),
+                        offset_source,
+                    )
+                } else {
+                    (
+                        &B::tooth_spacing_errors_m,
+                        format!("[...max |e| = {}]", fmt_num(worst)),
+                        errors_source,
+                    )
+                };
+                ck.report(
+                    k.at(item),
+                    Some(value),
+                    format!(
+                        "every tooth must start inside the free play: |phi0| = {} rad must be \
+                         < {free:.6e} rad, the half play less (h_o + max|e_k| cos(alpha) + \
+                         |offset|) / Rb{}",
+                        fmt_num(phi0),
+                        inherited(sec, source, k)
+                    ),
+                );
+                return None;
+            }
+        }
         if !resolvable(ck, item, &disc) {
             return None;
         }
