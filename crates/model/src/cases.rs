@@ -6,6 +6,7 @@
 //! Every value here is either from Hu et al. Table 2, from MODEL.md section 4's assumed
 //! values, or from `scenes/bench-8-disc.toml`; each function says which.
 
+use crate::clutch::{FrictionCurve, OpenGap, Piston, PressureProfile, StackModel};
 use crate::drive::{Shaft, SpeedProfile};
 use crate::law::{Hertz, LawKind, OilFilm, ToothLaw};
 use crate::pack::{DiscModel, PackModel};
@@ -218,6 +219,50 @@ pub fn bench_pack(n: usize) -> PackModel {
 /// free play (issue 9).
 pub fn staggered_rel_angle_rad(i: usize, n: usize, g0_rad: f64) -> f64 {
     -0.8 * g0_rad * (2.0 * (i as f64 + 0.5) / n as f64 - 1.0)
+}
+
+/// The open brake of issues 20 and 21: [`staggered_pack`]`(n)` with `n + 1` separator plates
+/// on the fixed housing (`plate-1` ... `plate-(n+1)`: 0.1382 kg m^2, 132 teeth at 0.305 m, 30
+/// deg, 0.5 mm backlash, the discs' dry law, no drag, centred at rest), stacked plate, disc,
+/// plate, ..., plate, and the open stack's Couette drag between neighbours (0.01 Pa s across
+/// 1 mm, faces 0.235-0.290 m; the piston released). The pack of the MuJoCo anchor's
+/// `time_brake.sh N`.
+pub fn staggered_brake(n: usize) -> PackModel {
+    let mut pack = staggered_pack(n);
+    pack.plates = (0..=n)
+        .map(|j| {
+            let mut p = bench_disc(&format!("plate-{}", j + 1));
+            p.inertia_kg_m2 = 0.1382;
+            p.spline = SplineGeometry {
+                teeth: 132,
+                pitch_radius_m: 0.305,
+                pressure_angle_rad: 30f64.to_radians(),
+                backlash_m: 0.5e-3,
+            };
+            p
+        })
+        .collect();
+    pack.stack = Some(StackModel {
+        face_inner_radius_m: 0.235,
+        face_outer_radius_m: 0.290,
+        friction: FrictionCurve::Stribeck {
+            static_mu: 0.10,
+            kinetic_mu: 0.13,
+            stribeck_speed_m_s: 0.5,
+            viscous_slope_s_m: 0.0,
+        },
+        piston: Piston {
+            area_m2: 0.05,
+            pressure: PressureProfile::Constant { pressure_pa: 0.0 },
+            return_spring_n: 2000.0,
+        },
+        open_gap: Some(OpenGap {
+            viscosity_pa_s: 0.01,
+            gap_m: 1e-3,
+        }),
+        spline_friction: 0.0,
+    });
+    pack
 }
 
 /// The staggered pack of issue 9: `n` benchmark discs ([`bench_disc`], `disc-1` ...
