@@ -1,13 +1,12 @@
 //! `clutchpack study`: run, merge, submit and compare studies (clutchpack_study).
 
-use crate::common::{self, BadInput, EngineArg};
+use crate::common::{self, BadInput, EngineArg, RunCollector};
 use crate::signals;
 use anyhow::{Context, Result};
-use clutchpack_analysis::PeakStats;
 use clutchpack_model::{ImpactEvent, Observer};
 use clutchpack_scene::Scene;
 use clutchpack_study::merge::Merged;
-use clutchpack_study::part::{array_syntax, RunResult};
+use clutchpack_study::part::{array_syntax, CaseFatigue, RunResult};
 use clutchpack_study::stats::{welch, Summary};
 use clutchpack_study::{scheduler, CaseOutput, MergeError, Shard, Study};
 use std::path::{Path, PathBuf};
@@ -152,29 +151,20 @@ pub fn load_study(path: &Path) -> Result<Study> {
     clutchpack_study::load(path).map_err(|e| BadInput(e.to_string()).into())
 }
 
-/// Keeps the impact peaks (bounded memory: `PeakStats`); asks the engine to stop when `stop`
-/// is set.
-struct CaseObserver<'a> {
-    peaks: PeakStats,
-    stop: &'a AtomicBool,
-}
-
-impl Observer for CaseObserver<'_> {
-    fn impact(&mut self, e: &ImpactEvent) {
-        self.peaks.push(e.disc, e.peak_n);
-    }
-    fn progress(&mut self, _t_s: f64) -> bool {
-        self.stop.load(Ordering::Relaxed)
-    }
-}
-
-/// Runs one case's scene with the study's engine (else the scene's choice).
+/// Runs one case's scene with the study's engine (else the scene's choice), with the same
+/// collector as `clutchpack run` (`RunCollector`: the peak statistics, the teeth's fatigue as
+/// running sums, both in bounded memory), so a case's figures are `run`'s figures.
 pub fn run_scene(scene: &Scene, engine: Option<EngineArg>, stop: &AtomicBool) -> RunResult {
     let mut e = common::make_engine(scene, engine).map_err(|e| format!("{e:#}"))?;
     let names = e.disc_names();
+    // the collector polls a shared flag: mirror the case's stop flag into one
+    let flag = std::sync::Arc::new(AtomicBool::new(stop.load(Ordering::SeqCst)));
     let mut obs = CaseObserver {
-        peaks: PeakStats::new(),
+        inner: RunCollector::new(names.len(), false)
+            .with_fatigue(scene, false)
+            .with_stop(std::sync::Arc::clone(&flag)),
         stop,
+        flag,
     };
     let stats = e
         .run(scene.simulation.duration_s, &mut obs)
@@ -182,15 +172,49 @@ pub fn run_scene(scene: &Scene, engine: Option<EngineArg>, stop: &AtomicBool) ->
     if stop.load(Ordering::SeqCst) && stats.simulated_s < scene.simulation.duration_s {
         return Ok(None);
     }
+    let fatigue = obs
+        .inner
+        .assess_fatigue(&names, stats.simulated_s)
+        .iter()
+        .map(|f| CaseFatigue {
+            damage_rate_per_h: f.lumped.damage_rate_per_h,
+            life_h: f.lumped.life_h,
+            eq_load_range_n: f.lumped.eq_load_range_n,
+        })
+        .collect();
     Ok(Some(CaseOutput {
-        discs: obs
-            .peaks
-            .stats(&names)
-            .map_err(|e| format!("reading back the impact peaks kept on disk: {e}"))?,
+        discs: obs.inner.disc_stats(&names).map_err(|e| format!("{e:#}"))?,
+        fatigue,
         steps: stats.steps,
         rejected_steps: stats.rejected_steps,
         simulated_s: stats.simulated_s,
     }))
+}
+
+/// `run`'s collector, with the study's stop flag (a plain `AtomicBool` owned by the shard)
+/// copied into the collector's shared one at every progress poll.
+struct CaseObserver<'a> {
+    inner: RunCollector,
+    stop: &'a AtomicBool,
+    flag: std::sync::Arc<AtomicBool>,
+}
+
+impl Observer for CaseObserver<'_> {
+    fn sample(&mut self, s: &clutchpack_model::Sample) {
+        self.inner.sample(s);
+    }
+    fn impact(&mut self, e: &ImpactEvent) {
+        self.inner.impact(e);
+    }
+    fn interfaces(&mut self, t_s: f64, i: &[clutchpack_model::InterfaceSample]) {
+        self.inner.interfaces(t_s, i);
+    }
+    fn progress(&mut self, t_s: f64) -> bool {
+        if self.stop.load(Ordering::Relaxed) {
+            self.flag.store(true, Ordering::Relaxed);
+        }
+        self.inner.progress(t_s)
+    }
 }
 
 /// The engine a study names.

@@ -10,7 +10,7 @@
 //! | `design_point` | INT64 | design point, `case / members` |
 //! | `member` | INT64 | ensemble member, `case % members` |
 //! | one per study column | DOUBLE | each design factor's level, each random key's draw, `initial_fraction`, `drive.phase_deg`: in the key's unit |
-//! | `<disc>.<stat>` | DOUBLE, nullable (`impacts`: INT64) | per disc (scene names, scene order) and kept statistic: `peak_abs_n` (N, the larger of `max_positive_n` and `-max_negative_n`), `max_positive_n` (N, >= 0), `max_negative_n` (N, <= 0), `p99_abs_n` (N), `mean_top10_abs_n` (N), `impacts` (count); null for a failed case |
+//! | `<disc>.<stat>` | DOUBLE, nullable (`impacts`: INT64) | per disc (scene names, scene order) and kept statistic: `peak_abs_n` (N, the larger of `max_positive_n` and `-max_negative_n`), `max_positive_n` (N, >= 0), `max_negative_n` (N, <= 0), `p99_abs_n` (N), `mean_top10_abs_n` (N), `impacts` (count), the teeth's fatigue as `clutchpack run` assesses it: `damage_rate_per_h` (1/h), `life_h` (h; null when unlimited), `eq_load_range_n` (N); null for a failed case |
 //! | `steps` | INT64 | accepted engine steps (0 if failed) |
 //! | `rejected_steps` | INT64 | rejected engine steps |
 //! | `simulated_s` | DOUBLE | simulated time reached, s |
@@ -163,16 +163,27 @@ pub fn collect(dir: &Path) -> Result<Merged, MergeError> {
     })
 }
 
-/// The value of statistic `stat` ([`crate::spec::STATS`]) of one disc.
-pub fn stat_value(d: &DiscStats, stat: &str) -> f64 {
+/// The value of statistic `stat` ([`crate::spec::STATS`]) of disc `disc` in case `r`;
+/// `None` when the case has no such value (a failed case, an unlimited life, a part written
+/// before fatigue was kept).
+pub fn stat_value(r: &CaseRecord, disc: usize, stat: &str) -> Option<f64> {
+    if let Some(f) = r.fatigue.get(disc) {
+        match stat {
+            "damage_rate_per_h" => return Some(f.damage_rate_per_h),
+            "life_h" => return f.life_h,
+            "eq_load_range_n" => return Some(f.eq_load_range_n),
+            _ => {}
+        }
+    }
+    let d: &DiscStats = r.discs.get(disc)?;
     match stat {
-        "peak_abs_n" => d.max_positive_n.max(-d.max_negative_n),
-        "max_positive_n" => d.max_positive_n,
-        "max_negative_n" => d.max_negative_n,
-        "p99_abs_n" => d.p99_abs_n,
-        "mean_top10_abs_n" => d.mean_top10_abs_n,
-        "impacts" => d.impacts as f64,
-        _ => f64::NAN,
+        "peak_abs_n" => Some(d.max_positive_n.max(-d.max_negative_n)),
+        "max_positive_n" => Some(d.max_positive_n),
+        "max_negative_n" => Some(d.max_negative_n),
+        "p99_abs_n" => Some(d.p99_abs_n),
+        "mean_top10_abs_n" => Some(d.mean_top10_abs_n),
+        "impacts" => Some(d.impacts as f64),
+        _ => None,
     }
 }
 
@@ -240,8 +251,7 @@ impl Merged {
                     for st in &self.header.outputs {
                         row.push(match (r.discs.get(i), st.as_str()) {
                             (Some(d), "impacts") => Cell::Int(d.impacts as i64),
-                            (Some(d), s) => Cell::Float(stat_value(d, s)),
-                            (None, _) => Cell::Null,
+                            _ => stat_value(r, i, st).map_or(Cell::Null, Cell::Float),
                         });
                     }
                 }
@@ -296,7 +306,7 @@ impl Merged {
         self.records
             .iter()
             .filter(|r| r.error.is_none() && keep(r))
-            .filter_map(|r| r.discs.get(disc).map(|d| stat_value(d, stat)))
+            .filter_map(|r| stat_value(r, disc, stat))
             .collect()
     }
 
@@ -341,7 +351,7 @@ impl Merged {
                 for st in &self.header.outputs {
                     let v: Vec<f64> = self
                         .ok_records(Some(p))
-                        .filter_map(|r| r.discs.get(i).map(|d| stat_value(d, st)))
+                        .filter_map(|r| stat_value(r, i, st))
                         .collect();
                     let mut line = p.to_string();
                     for x in &first.values[..nf] {
@@ -426,6 +436,7 @@ high = 0.02
                 impacts: 7,
                 ..DiscStats::empty(d.name.clone())
             }],
+            fatigue: Vec::new(),
             steps: 100,
             rejected_steps: 1,
             simulated_s: scene.simulation.duration_s,
@@ -481,7 +492,8 @@ high = 0.02
             head,
             "case,design_point,member,defaults.oil.film_thickness_m,defaults.drag_n_m_s_rad,\
              initial_fraction,disc.peak_abs_n,disc.max_positive_n,disc.max_negative_n,\
-             disc.p99_abs_n,disc.mean_top10_abs_n,disc.impacts,steps,rejected_steps,\
+             disc.p99_abs_n,disc.mean_top10_abs_n,disc.impacts,disc.damage_rate_per_h,\
+             disc.life_h,disc.eq_load_range_n,steps,rejected_steps,\
              simulated_s,error"
         );
         let _ = std::fs::remove_dir_all(one);

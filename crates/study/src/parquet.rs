@@ -146,6 +146,11 @@ mod tests {
                 impacts: 42,
                 ..DiscStats::empty("d1")
             }],
+            fatigue: vec![crate::part::CaseFatigue {
+                damage_rate_per_h: 2e-6,
+                life_h: Some(5e5),
+                eq_load_range_n: 640.0,
+            }],
             steps: 1000,
             rejected_steps: 3,
             simulated_s: 0.3,
@@ -156,6 +161,7 @@ mod tests {
             case: 1,
             member: 1,
             discs: Vec::new(),
+            fatigue: Vec::new(),
             steps: 0,
             rejected_steps: 0,
             simulated_s: 0.0,

@@ -41,11 +41,25 @@ impl Shard {
     }
 }
 
+/// The fatigue of one disc's (coupling's) spline teeth in one case, as `clutchpack run`
+/// computes it (MODEL.md section 7; `clutchpack_analysis::DiscFatigue`, its lumped figures).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CaseFatigue {
+    /// Miner damage per hour of the simulated duty, 1/h (>= 0).
+    pub damage_rate_per_h: f64,
+    /// Life at that duty, h; `None` when the rate is 0 (unlimited).
+    pub life_h: Option<f64>,
+    /// Damage-equivalent load range for one hour of duty at the knee's cycle count, N.
+    pub eq_load_range_n: f64,
+}
+
 /// What an engine gives for one case.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CaseOutput {
     /// Per-disc statistics, discs in scene order.
     pub discs: Vec<DiscStats>,
+    /// Per-disc fatigue, discs in scene order (empty when not assessed).
+    pub fatigue: Vec<CaseFatigue>,
     /// Accepted steps.
     pub steps: u64,
     /// Rejected steps.
@@ -67,6 +81,9 @@ pub struct CaseRecord {
     pub values: Vec<f64>,
     /// Per-disc statistics (empty for a failed case).
     pub discs: Vec<DiscStats>,
+    /// Per-disc fatigue (empty for a failed case, and in parts written before it was kept).
+    #[serde(default)]
+    pub fatigue: Vec<CaseFatigue>,
     /// Accepted engine steps (0 for a failed case).
     pub steps: u64,
     /// Rejected engine steps.
@@ -453,6 +470,7 @@ pub fn run_case(
         Err(msg) => (
             CaseOutput {
                 discs: Vec::new(),
+                fatigue: Vec::new(),
                 steps: 0,
                 rejected_steps: 0,
                 simulated_s: 0.0,
@@ -466,6 +484,7 @@ pub fn run_case(
         member: case.member,
         values: case.values,
         discs: out.discs,
+        fatigue: out.fatigue,
         steps: out.steps,
         rejected_steps: out.rejected_steps,
         simulated_s: out.simulated_s,

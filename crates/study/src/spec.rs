@@ -142,14 +142,19 @@ pub struct Spacing {
 }
 
 /// The per-disc statistics a study can keep (from `clutchpack_analysis::DiscStats`, plus
-/// `peak_abs_n`, the larger of the two peaks' magnitudes, always kept).
-pub const STATS: [&str; 6] = [
+/// `peak_abs_n`, the larger of the two peaks' magnitudes, always kept), and the teeth's
+/// fatigue as `clutchpack run` assesses it: `damage_rate_per_h` (1/h), `life_h` (h, empty
+/// when unlimited), `eq_load_range_n` (N).
+pub const STATS: [&str; 9] = [
     "peak_abs_n",
     "max_positive_n",
     "max_negative_n",
     "p99_abs_n",
     "mean_top10_abs_n",
     "impacts",
+    "damage_rate_per_h",
+    "life_h",
+    "eq_load_range_n",
 ];
 
 /// A validated study.
