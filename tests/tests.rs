@@ -1,6 +1,7 @@
 //! Integration tests of the `clutchpack` binary: the paper's table from a sweep, the CLI
 //! outputs, and bad input. One test binary (as ripgrep does); each test states what it checks.
 
+mod architecture;
 mod cross_engine;
 mod fatigue;
 mod hardening;
