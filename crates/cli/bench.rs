@@ -1,14 +1,14 @@
 //! `clutchpack bench`: speed figures as ratios and times, printed, never asserted.
 
-use crate::common::{self, EngineArg, RunCollector};
-use crate::run::run_recorded;
-use crate::sweep::run_cases_until;
 use anyhow::Result;
 use clutchpack_model::cases::staggered_pack;
-use clutchpack_model::{Engine, PackModel};
-use clutchpack_record::{RecordOptions, Recorder};
-use clutchpack_reference::{ReferenceEngine, Scheme};
+use clutchpack_model::Observer;
+use clutchpack_record::{RecordOptions, Replace};
 use clutchpack_scene::Override;
+use clutchpack_sdk::{
+    load_scene, EngineChoice, PackEngine, RecordingRequest, RunCollector, RunRequest, Scheme,
+    Simulation,
+};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -72,7 +72,7 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     }
 
     // 1. The paper case, 0.3 s simulated, one disc, h_o = 0 (the built-in default scene).
-    let scene = common::load_scene(None, &[])?;
+    let scene = load_scene(None, &[])?;
     let mut times = Vec::new();
     let mut steps = 0;
     let mut impacts = 0;
@@ -80,16 +80,17 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         if stopped() {
             return Ok(crate::signals::exit_code());
         }
-        let mut engine = common::make_engine(&scene, None)?;
-        let mut obs = RunCollector::new(1, false).with_stop(Arc::clone(&stop));
-        let t0 = Instant::now();
-        let s = engine.run(scene.simulation.duration_s, &mut obs)?;
+        let done = Simulation::new(scene.clone(), None)?.run(RunRequest {
+            stop: Some(&*stop),
+            ..RunRequest::default()
+        })?;
+        let s = done.stats()?;
         if stopped() {
             return Ok(crate::signals::exit_code());
         }
-        times.push(t0.elapsed().as_secs_f64());
+        times.push(done.wall_time_s);
         steps = s.steps;
-        impacts = obs.impact_count();
+        impacts = done.collector.impact_count();
     }
     let t = median(times);
     out!(
@@ -106,7 +107,7 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     let scenes = values
         .iter()
         .map(|v| {
-            common::load_scene(
+            load_scene(
                 None,
                 &[Override {
                     key: param.into(),
@@ -114,15 +115,24 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
                 }],
             )
         })
-        .collect::<Result<Vec<_>>>()?;
+        .collect::<clutchpack_sdk::Result<Vec<_>>>()?;
     let mut best = [f64::INFINITY; 2];
     for _ in 0..a.repeats.max(1) {
         for (i, jobs) in [1usize, 2].into_iter().enumerate() {
-            let crate::sweep::CaseRuns {
+            let clutchpack_sdk::CaseRuns {
                 wall_s: wall,
                 unfinished,
                 ..
-            } = run_cases_until(&scenes, &values, param, 4, jobs, None, None, &stop)?;
+            } = clutchpack_sdk::run_cases(
+                &scenes,
+                &values,
+                param,
+                4,
+                jobs,
+                None,
+                &stop,
+                &|_, _| {},
+            )?;
             if unfinished > 0 || stopped() {
                 return Ok(crate::signals::exit_code());
             }
@@ -170,7 +180,7 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
                 })
                 .into_iter()
                 .collect();
-            let scene = common::load_scene(path.as_deref(), &sets)?;
+            let scene = load_scene(path.as_deref(), &sets)?;
             let (mut plain, mut recorded, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
             let (mut engine_cpu, mut recorder_cpu) = (Vec::new(), Vec::new());
             let mut plain_cpu = Vec::new();
@@ -182,25 +192,20 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
                 }
                 let mut pair = [0.0; 2];
                 for record in [false, true] {
-                    let mut engine = common::make_engine(&scene, None)?;
-                    let collector = RunCollector::new(engine.disc_names().len(), false);
                     let out = dir.join(format!("run-{k}.mcap"));
-                    let recorder = if record {
-                        let info = common::run_info(&scene, engine.name(), path.as_deref());
-                        Some(Recorder::create(&out, &info, &RecordOptions::default())?)
-                    } else {
-                        None
-                    };
-                    let t0 = Instant::now();
-                    let done = run_recorded(
-                        engine.as_mut(),
-                        scene.simulation.duration_s,
-                        collector,
-                        recorder,
-                        Arc::clone(&stop),
-                    );
-                    let wall = t0.elapsed().as_secs_f64();
-                    done.result?;
+                    let recording = record.then(|| RecordingRequest {
+                        path: out.clone(),
+                        replace: Replace::Existing,
+                        options: RecordOptions::default(),
+                        scene_path: path.clone(),
+                    });
+                    let done = Simulation::new(scene.clone(), None)?.run(RunRequest {
+                        recording,
+                        stop: Some(&*stop),
+                        ..RunRequest::default()
+                    })?;
+                    let wall = done.wall_time_s;
+                    done.stats()?;
                     if let Some(r) = done.recording {
                         r?;
                     }
@@ -259,24 +264,21 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
             out!("whole pack {file}: skipped (run from the repository root)");
             continue;
         }
-        let scene = common::load_scene(Some(path), &[])?;
+        let scene = load_scene(Some(path), &[])?;
         let mut times = [Vec::new(), Vec::new()];
         let mut ratios = Vec::new();
         for _ in 0..runs {
             let mut pair = [0.0; 2];
-            for (k, engine) in [EngineArg::Reference, EngineArg::Multibody]
-                .into_iter()
-                .enumerate()
-            {
-                let mut e = common::make_engine(&scene, Some(engine))?;
-                let mut obs =
-                    RunCollector::new(e.disc_names().len(), false).with_stop(Arc::clone(stop));
-                let t0 = Instant::now();
-                e.run(scene.simulation.duration_s, &mut obs)?;
+            for (k, engine) in EngineChoice::ALL.into_iter().enumerate() {
+                let done = Simulation::new(scene.clone(), Some(engine))?.run(RunRequest {
+                    stop: Some(&**stop),
+                    ..RunRequest::default()
+                })?;
+                done.stats()?;
                 if stop.load(Ordering::SeqCst) {
                     return Ok(());
                 }
-                pair[k] = t0.elapsed().as_secs_f64();
+                pair[k] = done.wall_time_s;
                 times[k].push(pair[k]);
             }
             ratios.push(pair[1] / pair[0]);
@@ -297,23 +299,15 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
 }
 
 /// One engine configuration of the staggered-pack benchmark.
-struct PackEngine {
+struct Timed {
     label: &'static str,
     /// Largest pack it is timed on.
     max_discs: usize,
-    make: fn(PackModel) -> Result<Box<dyn Engine>>,
+    engine: PackEngine,
 }
 
 /// Simulated time of each staggered-pack run, s (issue 9's table).
 const PACK_DURATION_S: f64 = 0.1;
-
-fn reference_engine(pack: PackModel, scheme: Scheme, parallel: bool) -> Box<dyn Engine> {
-    Box::new(
-        ReferenceEngine::new(pack, clutchpack_reference::Settings::default())
-            .with_scheme(scheme)
-            .with_parallel(parallel),
-    )
-}
 
 /// 4. The cost of a pack whose discs strike out of step (`cases::staggered_pack`, the pack
 ///    of `scenes/staggered-*-disc.toml`), per disc, as the pack grows: N = 1, 4, 16 and 64
@@ -324,29 +318,35 @@ fn staggered_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         return Ok(());
     }
     let engines = [
-        PackEngine {
+        Timed {
             label: "reference, multirate (the default)",
             max_discs: 64,
-            make: |p| Ok(reference_engine(p, Scheme::Multirate, true)),
+            engine: PackEngine::Reference {
+                scheme: Scheme::Multirate,
+                parallel: true,
+            },
         },
-        PackEngine {
+        Timed {
             label: "reference, multirate, 1 thread",
             max_discs: 64,
-            make: |p| Ok(reference_engine(p, Scheme::Multirate, false)),
+            engine: PackEngine::Reference {
+                scheme: Scheme::Multirate,
+                parallel: false,
+            },
         },
-        PackEngine {
+        Timed {
             label: "reference, monolithic (before issue 9)",
             max_discs: 64,
-            make: |p| Ok(reference_engine(p, Scheme::Monolithic, false)),
+            engine: PackEngine::Reference {
+                scheme: Scheme::Monolithic,
+                parallel: false,
+            },
         },
-        PackEngine {
+        Timed {
             label: "multibody (default stepping)",
             max_discs: 16,
-            make: |p| {
-                let options = clutchpack_sim::MultibodyOptions::default();
-                Ok(Box::new(clutchpack_sim::MultibodyEngine::from_pack(
-                    p, 10_000.0, options,
-                )?))
+            engine: PackEngine::Multibody {
+                record_rate_hz: 10_000.0,
             },
         },
     ];
@@ -367,8 +367,11 @@ fn staggered_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         for _ in 0..runs {
             for (j, &n) in sizes.iter().enumerate() {
                 for _ in 0..(e.max_discs / n).clamp(1, 16) {
-                    let mut engine = (e.make)(staggered_pack(n))?;
-                    let mut obs = RunCollector::new(n, false).with_stop(Arc::clone(stop));
+                    let mut engine = e.engine.build(staggered_pack(n))?;
+                    let mut obs = Stoppable {
+                        inner: RunCollector::new(n, false),
+                        stop,
+                    };
                     let t0 = Instant::now();
                     let s = engine.run(PACK_DURATION_S, &mut obs)?;
                     if stop.load(Ordering::SeqCst) {
@@ -376,7 +379,7 @@ fn staggered_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
                         return Ok(());
                     }
                     per_disc[j].push(t0.elapsed().as_secs_f64() / n as f64);
-                    counts[j] = (s.steps, obs.impact_count());
+                    counts[j] = (s.steps, obs.inner.impact_count());
                 }
             }
         }
@@ -410,4 +413,23 @@ fn staggered_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The collector of a run, stopped by the bench's stop flag (a pack built in code has no
+/// scene, so its engine is driven here rather than through [`Simulation::run`]).
+struct Stoppable<'a> {
+    inner: RunCollector,
+    stop: &'a AtomicBool,
+}
+
+impl Observer for Stoppable<'_> {
+    fn sample(&mut self, s: &clutchpack_model::Sample) {
+        self.inner.sample(s);
+    }
+    fn impact(&mut self, e: &clutchpack_model::ImpactEvent) {
+        self.inner.impact(e);
+    }
+    fn progress(&mut self, _t_s: f64) -> bool {
+        self.stop.load(Ordering::SeqCst)
+    }
 }

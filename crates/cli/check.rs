@@ -1,8 +1,9 @@
 //! `clutchpack check`: validates scene files (and, with `--engine`, that the engine can run
 //! them) without running anything; `--keys` prints the reference of every scene key.
 
-use crate::common::{BadInput, EngineArg};
+use crate::common::{self, BadInput};
 use anyhow::Result;
+use clutchpack_scene::EngineChoice;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -14,8 +15,8 @@ pub struct CheckArgs {
     pub scenes: Vec<PathBuf>,
     /// Also check that this engine can run each scene (else the engine `run` would choose:
     /// the scene's `simulation.engine`, else the one that fits the pack).
-    #[arg(long, value_enum)]
-    pub engine: Option<EngineArg>,
+    #[arg(long, value_parser = common::engine_parser())]
+    pub engine: Option<EngineChoice>,
     /// Print the reference of every scene key and exit.
     #[arg(long)]
     pub keys: bool,
@@ -37,7 +38,7 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
     for p in &a.scenes {
         let origin = p.display().to_string();
         let checked = clutchpack_scene::load(p, &[]).and_then(|s| {
-            let engine = s.engine(a.engine.map(EngineArg::choice), &origin)?;
+            let engine = s.engine(a.engine, &origin)?;
             Ok((s, engine))
         });
         match checked {

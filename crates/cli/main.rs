@@ -112,8 +112,7 @@ fn main() -> ExitCode {
         Ok(_) if STDOUT_FAILED.load(std::sync::atomic::Ordering::SeqCst) => ExitCode::from(1),
         Ok(code) => code,
         Err(e) => {
-            let bad_input = e.chain().any(|c| c.is::<common::BadInput>())
-                || e.chain().any(|c| c.is::<clutchpack_scene::SceneError>());
+            let bad_input = common::is_bad_input(&e);
             eprintln!("error: {}", error_text(&e));
             if bad_input {
                 ExitCode::from(2)

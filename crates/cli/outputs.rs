@@ -218,6 +218,12 @@ pub fn write_with(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Resul
     }
 }
 
+/// Writes `value` as pretty JSON to `path`, whole or not at all.
+pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
+    let text = serde_json::to_string_pretty(value)?;
+    write_text(path, &(text + "\n"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

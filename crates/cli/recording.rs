@@ -444,53 +444,17 @@ pub struct PlotArgs {
     pub spectrum: bool,
 }
 
-/// The teeth's fatigue of a recorded run, from its samples and impacts with the tooth form
-/// and material of the recorded scene (with its overrides); without fatigue figures when the
-/// scene cannot be read back (a warning says so).
-pub fn recorded_fatigue(
-    reader: &RecordingReader,
-) -> (
-    Vec<String>,
-    Vec<clutchpack_analysis::fatigue::DiscHistories>,
-    Vec<clutchpack_analysis::DiscFatigue>,
-    f64,
-) {
-    let names = reader.disc_names();
-    let samples = reader.samples();
-    let impacts = reader.impacts();
-    let duration = reader
-        .summary()
-        .map(|s| s.t_end_s)
-        .or(reader.info().end_s)
-        .unwrap_or(0.0);
-    let scene = reader.run_info().and_then(|info| {
-        let sets: Vec<clutchpack_scene::Override> = info
-            .overrides
-            .iter()
-            .filter_map(|o| o.parse().ok())
-            .collect();
-        match clutchpack_scene::parse(&info.scene_text, &info.scene_file, Path::new("."), &sets) {
-            Ok(s) => Some(s),
-            Err(e) => {
-                eprintln!(
-                    "warning: the recorded scene does not read back ({e}); no damage figures"
-                );
-                None
-            }
-        }
-    });
-    let params = scene
-        .as_ref()
-        .map(crate::common::fatigue_params)
-        .unwrap_or_default();
-    let collector = clutchpack_analysis::FatigueCollector::replay(&samples, &impacts);
-    let histories = collector.clone().finish(names.len());
-    let fatigue = crate::common::assess_histories(&histories, &params, &names, duration);
-    (names, histories, fatigue, duration)
-}
-
 fn plot_spectrum(reader: &RecordingReader, a: &PlotArgs) -> Result<ExitCode> {
-    let (names, histories, fatigue, duration) = recorded_fatigue(reader);
+    let clutchpack_sdk::RecordedFatigue {
+        names,
+        histories,
+        fatigue,
+        duration_s: duration,
+        warning,
+    } = clutchpack_sdk::RecordedFatigue::of(reader);
+    if let Some(w) = warning {
+        eprintln!("warning: {w}");
+    }
     reread_ok(reader)?;
     let spectra: Vec<(String, Vec<(f64, f64)>)> = names
         .iter()
@@ -533,7 +497,7 @@ pub fn plot(a: PlotArgs) -> Result<ExitCode> {
         .into_iter()
         .map(|h| (h.name, h.t_s.into_iter().zip(h.load_n).collect()))
         .unzip();
-    crate::common::merge_peaks(&mut histories, &reader.impacts());
+    clutchpack_sdk::merge_peaks(&mut histories, &reader.impacts());
     reread_ok(&reader)?;
     let series: Vec<(String, Vec<(f64, f64)>)> = names.into_iter().zip(histories).collect();
     let scene = reader

@@ -1,18 +1,14 @@
 //! `clutchpack run`.
 
-use crate::common::{self, EngineArg, RunCollector, RunSummary};
+use crate::common;
 use crate::outputs::Output;
 use anyhow::{Context, Result};
 use clutchpack_analysis::{stats_table, TableFormat};
-use clutchpack_model::{DiscSample, ImpactEvent, InterfaceSample, Observer, Sample};
-use clutchpack_record::Replace;
-use clutchpack_record::{RecordOptions, Recorder, ThreadedRecorder};
+use clutchpack_record::{RecordOptions, Replace};
 use clutchpack_scene::Override;
+use clutchpack_sdk::{EngineChoice, RecordingRequest, RunRequest, Simulation};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
-use std::time::Instant;
 
 /// Arguments of `clutchpack run`.
 #[derive(clap::Args, Debug)]
@@ -22,9 +18,11 @@ use std::time::Instant;
 pub struct RunArgs {
     /// Scene file (TOML). Without it, the paper's case `scenes/hu-table2.toml` (built in).
     pub scene: Option<PathBuf>,
-    /// Engine; default: the scene's `simulation.engine`, else `reference`.
-    #[arg(long, value_enum)]
-    pub engine: Option<EngineArg>,
+    /// Engine: `reference` (the reduced torsional engine, fast) or `multibody` (rapier3d,
+    /// per tooth); default: the scene's `simulation.engine`, else `reference` for a torsional
+    /// pack and `multibody` for one with per-tooth effects.
+    #[arg(long, value_parser = common::engine_parser())]
+    pub engine: Option<EngineChoice>,
     /// Override a scene key: `--set KEY=VALUE` with KEY the dotted path as in the file
     /// (`defaults.oil.film_thickness_m=25e-6`, `discs[1].inertia_kg_m2=0.2`). Repeatable.
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -99,7 +97,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             value: r.to_string(),
         });
     }
-    let scene = common::load_scene(a.scene.as_deref(), &sets)?;
+    let scene = clutchpack_sdk::load_scene(a.scene.as_deref(), &sets)?;
     // Every output checked before any work (crate::outputs); the recording's folder is made.
     let record_path = (!a.no_record).then(|| {
         a.out.clone().unwrap_or_else(|| {
@@ -130,73 +128,69 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         crate::outputs::create_folder("--out", p)?;
     }
     crate::outputs::check_outputs(&outs, &inputs)?;
-    let (mut engine, engine_line) = common::choose_engine(&scene, a.engine)?;
-    let names = engine.disc_names();
-    let duration = scene.simulation.duration_s;
-    let mut collector = RunCollector::new(names.len(), a.plot.is_some())
-        .with_interfaces(
-            common::friction_interfaces(&scene)
-                .into_iter()
-                .map(|f| f.name()),
-        )
-        .with_fatigue(&scene, a.fatigue_json.is_some());
-    if let Some(path) = &a.impacts_csv {
-        collector = collector.with_impacts_csv(path, &names)?;
-    }
-    let pb = common::time_progress(duration, &scene.name);
-    collector.progress = Some(pb.clone());
-    let recorder = if let Some(path) = record_path {
+    let mut sim = Simulation::new(scene, a.engine)?;
+    let scene = sim.scene().clone();
+    let recording = record_path.map(|path| RecordingRequest {
         // an explicit --out replaces an existing file (documented); a default name never does
-        let replace = if a.out.is_some() {
+        replace: if a.out.is_some() {
             Replace::Existing
         } else {
             Replace::Never
-        };
-        let info = common::run_info(&scene, engine.name(), a.scene.as_deref());
-        let opts = RecordOptions {
+        },
+        options: RecordOptions {
             deterministic: a.deterministic,
             per_tooth: a.per_tooth || scene.simulation.record_per_tooth,
             contact_samples: !a.no_contact_samples && scene.simulation.record_contact_samples,
             ..RecordOptions::default()
-        };
-        Some(
-            Recorder::create_output(&path, replace, &info, &opts)
-                .with_context(|| format!("creating the recording {}", path.display()))?,
-        )
-    } else {
-        None
-    };
-    let t0 = Instant::now();
-    let done = run_recorded(engine.as_mut(), duration, collector, recorder, interrupted);
-    let wall = t0.elapsed().as_secs_f64();
+        },
+        scene_path: a.scene.clone(),
+        path,
+    });
+    let pb = common::time_progress(scene.simulation.duration_s, &scene.name);
+    let mut progress = |t: f64| common::show_time(&pb, t);
+    let done = sim
+        .run(RunRequest {
+            keep_history: a.plot.is_some(),
+            keep_cycles: a.fatigue_json.is_some(),
+            impacts_csv: a.impacts_csv.clone(),
+            recording,
+            stop: Some(&*interrupted),
+            progress: Some(&mut progress),
+        })
+        .with_context(|| format!("starting the run of {}", scene.name))?;
     pb.finish_and_clear();
-    let (result, mut obs) = (done.result, done.collector);
+    for w in &done.warnings {
+        eprintln!("warning: {w}");
+    }
     // A recording that could not be finished is reported after the other outputs are written.
-    let recording_error = match done.recording {
+    let recording_error = match &done.recording {
         Some(Ok(path)) => {
             eprintln!("recording: {}", path.display());
             None
         }
-        Some(Err(e)) => Some(e),
+        Some(Err(e)) => Some(anyhow::anyhow!("finishing the recording: {e}")),
         None => None,
     };
 
     // Write what we have even when the run failed, then report the failure.
-    obs.finish_impacts_csv()?;
-    let stats = obs.disc_stats(&names)?;
+    if let Some(Err(e)) = &done.impacts_csv {
+        return Err(anyhow::anyhow!("{e}"));
+    }
+    let names = &done.body_names;
+    let stats = done.body_stats()?;
     if let Some(path) = &a.plot {
         let series: Vec<(String, Vec<(f64, f64)>)> = names
             .iter()
             .cloned()
-            .zip(obs.histories_with_peaks())
+            .zip(done.collector.histories_with_peaks())
             .collect();
-        let title = format!("{}: per-tooth load ({} engine)", scene.name, engine.name());
+        let title = format!("{}: per-tooth load ({} engine)", scene.name, done.engine);
         crate::outputs::write_with(path, |tmp| {
             clutchpack_analysis::plot_load_history(tmp, &title, &series)
                 .with_context(|| format!("plotting {}", path.display()))
         })?;
     }
-    let run_stats = match result {
+    let run_stats = match done.stats() {
         Ok(s) if s.stopped_early => {
             if crate::signals::received().is_none() && recording_error.is_some() {
                 // the recorder failed (a full disk): the run stopped for that, not a signal
@@ -212,45 +206,38 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                     s.simulated_s
                 );
             }
-            s
+            s.clone()
         }
-        Ok(s) => s,
+        Ok(s) => s.clone(),
         Err(e) => {
             if let Some(r) = recording_error {
                 eprintln!("error: {r:#}");
             }
-            return Err(anyhow::Error::new(e).context(format!(
-                "{} engine on {} ({} impacts kept before the failure)",
-                engine.name(),
-                scene.name,
-                obs.impact_count()
-            )));
+            return Err(e.into());
         }
     };
-    let mut summary = RunSummary::new(&scene, engine.name(), &run_stats, wall, stats.clone());
-    summary.interfaces = obs.interfaces.clone();
-    summary.fatigue = obs.assess_fatigue(&names, run_stats.simulated_s);
+    let summary = done.summary()?;
     if let Some(path) = &a.fatigue_json {
-        let histories = obs.fatigue.clone().finish(names.len());
+        let histories = done.collector.fatigue.clone().finish(names.len());
         let cycles: Vec<_> = names
             .iter()
             .zip(&histories)
             .map(|(n, h)| clutchpack_analysis::disc_cycles(n, h, run_stats.simulated_s))
             .collect();
-        common::write_json(path, &cycles)?;
+        crate::outputs::write_json(path, &cycles)?;
     }
     if let Some(path) = &a.summary_json {
-        common::write_json(path, &summary)?;
+        crate::outputs::write_json(path, &summary)?;
     }
     out!(
         "{}: {:.3} s simulated with the {} engine in {:.3} s wall ({} steps)",
         scene.name,
         run_stats.simulated_s,
         summary.engine,
-        wall,
+        done.wall_time_s,
         run_stats.steps
     );
-    out!("{engine_line}");
+    out!("{}", sim.engine_line());
     out!("per-tooth impact loads (negative: the shaft leads; positive: the disc leads)");
     out!("{}", stats_table(&stats, TableFormat::Text).trim_end());
     if let Some(worst) = stats.iter().max_by(|x, y| {
@@ -276,11 +263,11 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             clutchpack_analysis::fatigue_table(&summary.fatigue, TableFormat::Text).trim_end()
         );
     }
-    if !obs.interfaces.is_empty() {
+    if !summary.interfaces.is_empty() {
         out!("friction interfaces (from the piston side)");
         out!(
             "{}",
-            clutchpack_analysis::interface_table(&obs.interfaces, TableFormat::Text).trim_end()
+            clutchpack_analysis::interface_table(&summary.interfaces, TableFormat::Text).trim_end()
         );
     }
     if let Some(e) = recording_error {
@@ -304,133 +291,4 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         return Ok(crate::signals::exit_code());
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// What [`run_recorded`] gives back.
-pub(crate) struct RecordedRun {
-    /// The engine's result.
-    pub result: Result<clutchpack_model::RunStats, clutchpack_model::EngineError>,
-    /// The impacts (and histories) collected on the engine's thread.
-    pub collector: RunCollector,
-    /// The finished recording's path, or why it could not be finished (`None`: no recorder).
-    pub recording: Option<Result<PathBuf>>,
-    /// CPU time of the engine's thread during the run, s.
-    pub engine_cpu_s: f64,
-    /// CPU time of the recording thread, s (0 without a recorder).
-    pub recorder_cpu_s: f64,
-}
-
-/// Runs `engine` for `duration_s` with `collector` on the engine's thread and `recorder` (if
-/// any) on a recording thread, then finishes the recording: with the engine's statistics
-/// when it ran, and in any case with everything recorded before a failure or a stop. Stops
-/// early and cleanly when `interrupted` is set.
-pub(crate) fn run_recorded(
-    engine: &mut (dyn clutchpack_model::Engine + Send),
-    duration_s: f64,
-    collector: RunCollector,
-    recorder: Option<Recorder>,
-    interrupted: Arc<AtomicBool>,
-) -> RecordedRun {
-    let mut obs = RunObserver {
-        collector,
-        recorder: recorder.map(ThreadedRecorder::start),
-        interrupted,
-    };
-    let cpu = cpu_time::ThreadTime::try_now().ok();
-    let result = engine.run(duration_s, &mut obs);
-    let engine_cpu_s = cpu
-        .and_then(|c| c.try_elapsed().ok())
-        .map_or(0.0, |d| d.as_secs_f64());
-    let RunObserver {
-        collector,
-        recorder,
-        ..
-    } = obs;
-    // Close the recording first: it holds everything before a failure or an interruption.
-    let mut recorder_cpu_s = 0.0;
-    let recording = match recorder {
-        Some(rec) => {
-            let (mut rec, cpu_s) = rec.join();
-            recorder_cpu_s = cpu_s;
-            // the file is finished even if the peaks kept on disk cannot be read back
-            let mut summary = rec.summary().unwrap_or_else(|e| {
-                eprintln!("warning: {e}; the recording's /summary has no impact statistics");
-                clutchpack_record::RunSummary {
-                    t_end_s: result.as_ref().map_or(0.0, |s| s.simulated_s),
-                    discs: Vec::new(),
-                    fatigue: Vec::new(),
-                }
-            });
-            if let Ok(s) = &result {
-                rec.set_run_stats(s);
-                // the teeth's fatigue over the duty that ran, beside the peak statistics
-                let names: Vec<String> = summary.discs.iter().map(|d| d.name.clone()).collect();
-                let fatigue = collector.assess_fatigue(&names, s.simulated_s);
-                summary.fatigue = fatigue
-                    .iter()
-                    .map(|f| Some(clutchpack_record::FatigueSummary::from(f)))
-                    .collect();
-            }
-            Some(rec.finish(Some(summary)).context("finishing the recording"))
-        }
-        None => None,
-    };
-    RecordedRun {
-        result,
-        collector,
-        recording,
-        engine_cpu_s,
-        recorder_cpu_s,
-    }
-}
-
-/// Feeds the collector and the recorder; stops the run on Ctrl-C or when recording failed.
-struct RunObserver {
-    collector: RunCollector,
-    recorder: Option<ThreadedRecorder>,
-    interrupted: Arc<AtomicBool>,
-}
-
-impl Observer for RunObserver {
-    fn sample(&mut self, s: &Sample) {
-        self.collector.sample(s);
-        if let Some(r) = &mut self.recorder {
-            r.push_sample(s);
-        }
-    }
-    fn impact(&mut self, e: &ImpactEvent) {
-        self.collector.impact(e);
-        if let Some(r) = &mut self.recorder {
-            r.push_impact(e);
-        }
-    }
-    fn interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
-        self.collector.interfaces(t_s, interfaces);
-        if let Some(r) = &mut self.recorder {
-            r.push_interfaces(t_s, interfaces);
-        }
-    }
-    fn contact_sample(&mut self, disc: usize, t_s: f64, state: &DiscSample) {
-        self.collector.contact_sample(disc, t_s, state);
-        if let Some(r) = &mut self.recorder {
-            r.push_contact_sample(disc, t_s, state);
-        }
-    }
-    fn wants_contact_samples(&self) -> bool {
-        self.collector.wants_contact_samples()
-            || self
-                .recorder
-                .as_ref()
-                .is_some_and(ThreadedRecorder::wants_contact_samples)
-    }
-    fn progress(&mut self, t_s: f64) -> bool {
-        let mut stop = self.collector.progress(t_s);
-        if let Some(r) = &mut self.recorder {
-            // hand over what is pending, so a slow engine's samples reach the file (and its
-            // wall-clock flush) without waiting for a full batch
-            r.send();
-            stop |= r.failed();
-        }
-        stop || self.interrupted.load(Ordering::SeqCst)
-    }
 }

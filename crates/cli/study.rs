@@ -1,17 +1,15 @@
 //! `clutchpack study`: run, merge, submit and compare studies (clutchpack_study).
 
-use crate::common::{self, BadInput, EngineArg, RunCollector};
+use crate::common::BadInput;
 use crate::signals;
 use anyhow::{Context, Result};
-use clutchpack_model::{ImpactEvent, Observer};
-use clutchpack_scene::Scene;
 use clutchpack_study::merge::Merged;
-use clutchpack_study::part::{array_syntax, CaseFatigue, RunResult};
+use clutchpack_study::part::array_syntax;
 use clutchpack_study::stats::{welch, Summary};
-use clutchpack_study::{scheduler, CaseOutput, MergeError, Shard, Study};
+use clutchpack_study::{scheduler, MergeError, Shard, Study};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 /// Arguments of `clutchpack study`.
@@ -151,81 +149,6 @@ pub fn load_study(path: &Path) -> Result<Study> {
     clutchpack_study::load(path).map_err(|e| BadInput(e.to_string()).into())
 }
 
-/// Runs one case's scene with the study's engine (else the scene's choice), with the same
-/// collector as `clutchpack run` (`RunCollector`: the peak statistics, the teeth's fatigue as
-/// running sums, both in bounded memory), so a case's figures are `run`'s figures.
-pub fn run_scene(scene: &Scene, engine: Option<EngineArg>, stop: &AtomicBool) -> RunResult {
-    let mut e = common::make_engine(scene, engine).map_err(|e| format!("{e:#}"))?;
-    let names = e.disc_names();
-    // the collector polls a shared flag: mirror the case's stop flag into one
-    let flag = std::sync::Arc::new(AtomicBool::new(stop.load(Ordering::SeqCst)));
-    let mut obs = CaseObserver {
-        inner: RunCollector::new(names.len(), false)
-            .with_fatigue(scene, false)
-            .with_stop(std::sync::Arc::clone(&flag)),
-        stop,
-        flag,
-    };
-    let stats = e
-        .run(scene.simulation.duration_s, &mut obs)
-        .map_err(|e| e.to_string())?;
-    if stop.load(Ordering::SeqCst) && stats.simulated_s < scene.simulation.duration_s {
-        return Ok(None);
-    }
-    let fatigue = obs
-        .inner
-        .assess_fatigue(&names, stats.simulated_s)
-        .iter()
-        .map(|f| CaseFatigue {
-            damage_rate_per_h: f.lumped.damage_rate_per_h,
-            life_h: f.lumped.life_h,
-            eq_load_range_n: f.lumped.eq_load_range_n,
-        })
-        .collect();
-    Ok(Some(CaseOutput {
-        discs: obs.inner.disc_stats(&names).map_err(|e| format!("{e:#}"))?,
-        fatigue,
-        steps: stats.steps,
-        rejected_steps: stats.rejected_steps,
-        simulated_s: stats.simulated_s,
-    }))
-}
-
-/// `run`'s collector, with the study's stop flag (a plain `AtomicBool` owned by the shard)
-/// copied into the collector's shared one at every progress poll.
-struct CaseObserver<'a> {
-    inner: RunCollector,
-    stop: &'a AtomicBool,
-    flag: std::sync::Arc<AtomicBool>,
-}
-
-impl Observer for CaseObserver<'_> {
-    fn sample(&mut self, s: &clutchpack_model::Sample) {
-        self.inner.sample(s);
-    }
-    fn impact(&mut self, e: &ImpactEvent) {
-        self.inner.impact(e);
-    }
-    fn interfaces(&mut self, t_s: f64, i: &[clutchpack_model::InterfaceSample]) {
-        self.inner.interfaces(t_s, i);
-    }
-    fn progress(&mut self, t_s: f64) -> bool {
-        if self.stop.load(Ordering::Relaxed) {
-            self.flag.store(true, Ordering::Relaxed);
-        }
-        self.inner.progress(t_s)
-    }
-}
-
-/// The engine a study names.
-pub fn engine_of(study: &Study) -> Option<EngineArg> {
-    match study.engine.as_deref() {
-        Some("reference") => Some(EngineArg::Reference),
-        Some("multibody") => Some(EngineArg::Multibody),
-        _ => None,
-    }
-}
-
 /// Threads: `--jobs`, else SLURM_CPUS_PER_TASK (a task may see every core of its node), else
 /// the number of cores.
 fn threads(jobs: Option<usize>) -> Result<usize> {
@@ -301,7 +224,7 @@ fn run(a: RunArgs) -> Result<ExitCode> {
     let shard = shard_of(a.shard.as_deref(), a.shards)?;
     let jobs = threads(a.jobs)?;
     let stop = signals::flag();
-    let engine = engine_of(&study);
+    let engine = study.engine;
     let label = format!("{} shard {}/{}", study.name, shard.index, shard.count);
     eprintln!(
         "{label}: {} of {} cases on {jobs} threads, part in {}",
@@ -328,7 +251,7 @@ fn run(a: RunArgs) -> Result<ExitCode> {
         jobs,
         &stop,
         Duration::from_secs(5),
-        &|scene, stop| run_scene(scene, engine, stop),
+        &|scene, stop| clutchpack_sdk::run_case(scene, engine, stop),
         &progress,
     )
     .map_err(|e| match e {

@@ -1,19 +1,16 @@
 //! `clutchpack sweep`.
 
-use crate::common::{self, BadInput, EngineArg, RunCollector};
+use crate::common::{self, BadInput};
 use anyhow::{Context, Result};
 use clutchpack_analysis::{
-    ensemble_fatigue, fatigue_spread_table, sweep_fits, sweep_rows, sweep_table, DiscFatigue,
-    DiscFatigueSpread, DiscStats, PolyFit, SweepCase, SweepRow, TableFormat,
+    ensemble_fatigue, fatigue_spread_table, sweep_fits, sweep_rows, sweep_table, DiscFatigueSpread,
+    PolyFit, SweepCase, SweepRow, TableFormat,
 };
-use clutchpack_model::{ImpactEvent, InterfaceSample, Observer, Sample};
 use clutchpack_scene::{Override, Scene};
-use rayon::prelude::*;
+use clutchpack_sdk::{CaseRuns, EngineChoice, MemberFatigue, Simulation, MAX_BATCH_CASES};
 use serde::Serialize;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
 
 /// Arguments of `clutchpack sweep`.
 #[derive(clap::Args, Debug)]
@@ -38,9 +35,10 @@ pub struct SweepArgs {
     /// and [`MAX_JOBS`].
     #[arg(long, value_name = "J")]
     pub jobs: Option<usize>,
-    /// Engine; default: the scene's, else `reference`.
-    #[arg(long, value_enum)]
-    pub engine: Option<EngineArg>,
+    /// Engine (`reference` or `multibody`); default: the scene's, else the reference engine
+    /// for a torsional pack.
+    #[arg(long, value_parser = common::engine_parser())]
+    pub engine: Option<EngineChoice>,
     /// Further overrides applied to every case (`KEY=VALUE`, repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub sets: Vec<Override>,
@@ -84,24 +82,9 @@ struct FatigueJson {
     discs: Vec<DiscFatigueSpread>,
 }
 
-/// The initial relative angles of ensemble member `k` of `count`: every disc at the same
-/// fraction of its start free play, by the model's one rule
-/// (`clutchpack_model::ensemble_angle_rad`, which a study's spread ensemble uses too), so
-/// members are spread evenly and none starts in contact.
-pub fn ensemble_member(scene: &Scene, k: usize, count: usize) -> Scene {
-    let mut s = scene.clone();
-    if count <= 1 {
-        return s;
-    }
-    for d in s.pack.discs.iter_mut() {
-        d.initial_rel_angle_rad = clutchpack_model::ensemble_angle_rad(d, k as u64, count as u64);
-    }
-    s
-}
-
 /// The most cases (values x members) one sweep runs: every case's statistics are held in
 /// memory until the table is printed.
-pub const MAX_SWEEP_CASES: usize = 1_000_000;
+pub const MAX_SWEEP_CASES: usize = MAX_BATCH_CASES;
 
 pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
     if a.ensemble == 0 || a.ensemble > MAX_SWEEP_CASES {
@@ -162,12 +145,12 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             key: a.param.clone(),
             value: format!("{v:e}"),
         });
-        let scene = common::load_scene(Some(&a.scene), &sets)
+        let scene = clutchpack_sdk::load_scene(Some(&a.scene), &sets)
             .with_context(|| format!("case {} = {v}", a.param))?;
         scenes.push(scene);
     }
-    let engine_name = common::make_engine(&scenes[0], a.engine)?
-        .name()
+    let engine_name = Simulation::new(scenes[0].clone(), a.engine)?
+        .engine_name()
         .to_string();
     let show = indicatif::ProgressBar::new(0);
     show.set_style(
@@ -182,16 +165,20 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         fatigue,
         wall_s: wall,
         unfinished,
-    } = run_cases_until(
+    } = clutchpack_sdk::run_cases(
         &scenes,
         &a.values,
         &a.param,
         a.ensemble,
         jobs,
         a.engine,
-        Some(show),
         &stop,
+        &|done, total| {
+            show.set_length(total as u64);
+            show.set_position(done as u64);
+        },
     )?;
+    show.finish_and_clear();
     let n_cases = a.values.len() * a.ensemble;
     if unfinished > 0 {
         eprintln!(
@@ -295,7 +282,7 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
                 })
                 .collect(),
         };
-        common::write_json(path, &summary)?;
+        crate::outputs::write_json(path, &summary)?;
     }
     if unfinished > 0 {
         // 128 + signal, as a shell reports a command stopped by that signal
@@ -306,33 +293,6 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
 
 /// The most threads `sweep --jobs` starts (more only cost memory and start-up time).
 pub const MAX_JOBS: usize = 256;
-
-/// A case's observer that also stops the engine when `stop` is set (a signal).
-struct Stoppable<'a> {
-    inner: &'a mut RunCollector,
-    stop: &'a AtomicBool,
-}
-
-impl Observer for Stoppable<'_> {
-    fn sample(&mut self, s: &Sample) {
-        self.inner.sample(s);
-    }
-    fn impact(&mut self, e: &ImpactEvent) {
-        self.inner.impact(e);
-    }
-    fn interfaces(&mut self, t_s: f64, i: &[InterfaceSample]) {
-        self.inner.interfaces(t_s, i);
-    }
-    fn contact_sample(&mut self, disc: usize, t_s: f64, state: &clutchpack_model::DiscSample) {
-        self.inner.contact_sample(disc, t_s, state);
-    }
-    fn wants_contact_samples(&self) -> bool {
-        self.inner.wants_contact_samples()
-    }
-    fn progress(&mut self, t_s: f64) -> bool {
-        self.inner.progress(t_s) || self.stop.load(Ordering::SeqCst)
-    }
-}
 
 fn poly_text(p: &PolyFit) -> String {
     p.coefficients
@@ -345,122 +305,4 @@ fn poly_text(p: &PolyFit) -> String {
         })
         .collect::<Vec<_>>()
         .join(" ")
-}
-
-/// Runs every (value, ensemble member) case on a pool of `jobs` threads; returns one
-/// [`SweepCase`] per value and the wall time in s. `progress`, if given, counts cases.
-#[allow(dead_code)] // for callers without a stop flag
-pub fn run_cases(
-    scenes: &[Scene],
-    values: &[f64],
-    param: &str,
-    ensemble: usize,
-    jobs: usize,
-    engine: Option<EngineArg>,
-    progress: Option<indicatif::ProgressBar>,
-) -> Result<(Vec<SweepCase>, f64)> {
-    let never = AtomicBool::new(false);
-    let r = run_cases_until(
-        scenes, values, param, ensemble, jobs, engine, progress, &never,
-    )?;
-    Ok((r.cases, r.wall_s))
-}
-
-/// Fatigue of each member of each value: `[value][member][disc]`.
-pub type MemberFatigue = Vec<Vec<Vec<DiscFatigue>>>;
-
-/// What [`run_cases_until`] ran.
-pub struct CaseRuns {
-    /// One [`SweepCase`] per value, with the members that finished.
-    pub cases: Vec<SweepCase>,
-    /// The teeth's fatigue of every finished member, `[value][member][disc]`.
-    pub fatigue: MemberFatigue,
-    /// Wall time in s.
-    pub wall_s: f64,
-    /// Members stopped or never started because `stop` was set.
-    pub unfinished: usize,
-}
-
-/// [`run_cases`] that stops when `stop` is set: cases not started are skipped and running
-/// ones stop at their engine's next progress call; neither is in the result, and
-/// [`CaseRuns::unfinished`] counts them.
-#[allow(clippy::too_many_arguments)]
-pub fn run_cases_until(
-    scenes: &[Scene],
-    values: &[f64],
-    param: &str,
-    ensemble: usize,
-    jobs: usize,
-    engine: Option<EngineArg>,
-    progress: Option<indicatif::ProgressBar>,
-    stop: &AtomicBool,
-) -> Result<CaseRuns> {
-    let tasks: Vec<(usize, usize)> = (0..scenes.len())
-        .flat_map(|c| (0..ensemble).map(move |k| (c, k)))
-        .collect();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs)
-        .build()
-        .context("starting the worker threads")?;
-    let pb = progress.unwrap_or_else(indicatif::ProgressBar::hidden);
-    pb.set_length(tasks.len() as u64);
-    let t0 = Instant::now();
-    type Member = (Vec<DiscStats>, Vec<DiscFatigue>);
-    let results: Vec<Result<Option<Member>>> = pool.install(|| {
-        tasks
-            .par_iter()
-            .map(|&(c, k)| {
-                if stop.load(Ordering::SeqCst) {
-                    return Ok(None);
-                }
-                let member = ensemble_member(&scenes[c], k, ensemble);
-                let mut engine = common::make_engine(&member, engine)?;
-                let names = engine.disc_names();
-                let mut obs = RunCollector::new(names.len(), false).with_fatigue(&member, false);
-                let run = engine
-                    .run(
-                        member.simulation.duration_s,
-                        &mut Stoppable {
-                            inner: &mut obs,
-                            stop,
-                        },
-                    )
-                    .with_context(|| format!("case {param} = {}, member {k}", values[c]))?;
-                if run.stopped_early {
-                    return Ok(None);
-                }
-                pb.inc(1);
-                Ok(Some((
-                    obs.disc_stats(&names)?,
-                    obs.assess_fatigue(&names, run.simulated_s),
-                )))
-            })
-            .collect()
-    });
-    pb.finish_and_clear();
-    let wall = t0.elapsed().as_secs_f64();
-    let mut cases: Vec<SweepCase> = values
-        .iter()
-        .map(|&value| SweepCase {
-            value,
-            members: Vec::new(),
-        })
-        .collect();
-    let mut unfinished = 0;
-    let mut fatigue: MemberFatigue = vec![Vec::new(); values.len()];
-    for (&(c, _), r) in tasks.iter().zip(results) {
-        match r? {
-            Some((stats, f)) => {
-                cases[c].members.push(stats);
-                fatigue[c].push(f);
-            }
-            None => unfinished += 1,
-        }
-    }
-    Ok(CaseRuns {
-        cases,
-        fatigue,
-        wall_s: wall,
-        unfinished,
-    })
 }

@@ -11,12 +11,38 @@ use crate::{EngineChoice, Problem, Scene, SceneError};
 use clutchpack_model::NonTorsional;
 
 impl EngineChoice {
+    /// Every engine, in the order their names are listed in messages.
+    pub const ALL: [EngineChoice; 2] = [EngineChoice::Reference, EngineChoice::Multibody];
+
+    /// The engine named `name` (as in scenes, study files and on the command line).
+    pub fn from_name(name: &str) -> Option<EngineChoice> {
+        EngineChoice::ALL.into_iter().find(|e| e.name() == name)
+    }
+
+    /// Every engine's name, in [`EngineChoice::ALL`]'s order.
+    pub fn names() -> [&'static str; 2] {
+        EngineChoice::ALL.map(EngineChoice::name)
+    }
+
     /// The engine's name as written in scenes and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             EngineChoice::Reference => "reference",
             EngineChoice::Multibody => "multibody",
         }
+    }
+}
+
+impl std::str::FromStr for EngineChoice {
+    type Err = String;
+    /// [`EngineChoice::from_name`], with a message listing the names.
+    fn from_str(s: &str) -> Result<EngineChoice, String> {
+        EngineChoice::from_name(s).ok_or_else(|| {
+            format!(
+                "{s:?} is not an engine: expected one of {}",
+                EngineChoice::names().join(", ")
+            )
+        })
     }
 }
 

@@ -168,8 +168,8 @@ pub struct Study {
     pub scene_path: PathBuf,
     /// Its text.
     pub scene_text: String,
-    /// `"reference"` or `"multibody"`, if the study names one.
-    pub engine: Option<String>,
+    /// The engine the study names (`study.engine`), if it names one.
+    pub engine: Option<EngineChoice>,
     /// Seed of every random draw.
     pub seed: u64,
     /// Ensemble members per design point.
@@ -616,12 +616,8 @@ pub fn parse(text: &str, file: &str, dir: &Path) -> Result<Study, SpecError> {
         );
     }
     let engine = ck
-        .choice(
-            "study.engine",
-            st.get("engine"),
-            &["reference", "multibody"],
-        )
-        .map(|i| ["reference", "multibody"][i].to_string());
+        .choice("study.engine", st.get("engine"), &EngineChoice::names())
+        .map(|i| EngineChoice::ALL[i]);
     let seed = match st.get("seed") {
         None => 0,
         Some(Value::Integer(i)) if *i >= 0 => *i as u64,
@@ -1038,11 +1034,7 @@ pub fn parse(text: &str, file: &str, dir: &Path) -> Result<Study, SpecError> {
     // ... and the study's engine must be able to run each of them (`clutchpack check
     // --engine`'s rule): a study of spacing errors on the reference engine would only fail
     // every case.
-    let engine = match study.engine.as_deref() {
-        Some("reference") => Some(EngineChoice::Reference),
-        Some("multibody") => Some(EngineChoice::Multibody),
-        _ => None,
-    };
+    let engine = study.engine;
     let origin = study.scene_path.display().to_string();
     for (k, (p, value, case)) in probes.into_iter().enumerate() {
         let checked = study.scene(&case).and_then(|scene| {

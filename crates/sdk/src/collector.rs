@@ -1,0 +1,240 @@
+//! What a run keeps for its outputs: peak statistics, interfaces, fatigue sums, the impacts
+//! CSV, and (when asked) the load histories.
+
+use crate::{Error, Result};
+use clutchpack_analysis::{DiscFatigue, DiscStats, FatigueCollector, InterfaceStats, PeakStats};
+use clutchpack_model::{
+    FatigueParams, ImpactEvent, InterfaceSample, Observer, Sample, SplineGeometry,
+};
+use clutchpack_scene::Scene;
+use std::path::Path;
+
+/// Keeps what a run's outputs need, in memory that does not grow with the run unless an
+/// output asks for every value: the impact peaks' statistics ([`PeakStats`]), the teeth's
+/// fatigue as running sums ([`FatigueCollector::summing`]), what each friction interface did
+/// (when named with [`RunCollector::with_interfaces`]), the impacts CSV written as the
+/// impacts come ([`RunCollector::with_impacts_csv`]). Kept whole only when asked: the load
+/// histories and impacts for `--plot` (`keep_history`) and every counted cycle for
+/// `--fatigue-json` ([`RunCollector::with_fatigue`]).
+pub struct RunCollector {
+    /// Every impact, only when `keep_history` (the plot merges their peaks in).
+    pub impacts: Vec<ImpactEvent>,
+    /// The statistics of every impact's peak.
+    pub peaks: PeakStats,
+    pub interfaces: Vec<InterfaceStats>,
+    /// Per disc: (t s, load N) samples, only when `keep_history`.
+    pub history: Vec<Vec<(f64, f64)>>,
+    pub keep_history: bool,
+    /// The load histories' cycles for the teeth's fatigue (MODEL.md section 7).
+    pub fatigue: FatigueCollector,
+    /// Spline and fatigue parameters of each coupling (engine order), set by
+    /// [`RunCollector::with_fatigue`]; empty: no fatigue in the recording's summary.
+    pub fatigue_params: Vec<(SplineGeometry, FatigueParams)>,
+    /// The impacts CSV being written, if asked.
+    csv: Option<ImpactsCsv>,
+}
+
+impl RunCollector {
+    pub fn new(discs: usize, keep_history: bool) -> RunCollector {
+        RunCollector {
+            impacts: Vec::new(),
+            peaks: PeakStats::new(),
+            interfaces: Vec::new(),
+            history: vec![Vec::new(); discs],
+            keep_history,
+            fatigue: FatigueCollector::new(),
+            fatigue_params: Vec::new(),
+            csv: None,
+        }
+    }
+
+    /// Also assesses the teeth's fatigue with the scene's parameters ([`crate::fatigue_params`]),
+    /// summing the damage as the cycles are counted; `keep_cycles` also keeps every cycle
+    /// (for `--fatigue-json`'s spectra; memory grows with the run).
+    pub fn with_fatigue(mut self, scene: &Scene, keep_cycles: bool) -> RunCollector {
+        self.fatigue_params = crate::fatigue::fatigue_params(scene);
+        let curves = self
+            .fatigue_params
+            .iter()
+            .map(|(g, p)| {
+                (
+                    clutchpack_model::fatigue::stress_per_newton(g, &p.form),
+                    p.material,
+                )
+            })
+            .collect();
+        self.fatigue = FatigueCollector::summing(curves, keep_cycles);
+        self
+    }
+
+    /// Also writes every impact to the CSV file `path` as it comes (a temporary sibling,
+    /// renamed into place by [`Self::finish_impacts_csv`]); `names` are the disc names in
+    /// engine order.
+    pub fn with_impacts_csv(mut self, path: &Path, names: &[String]) -> Result<RunCollector> {
+        self.csv = Some(ImpactsCsv::create(path, names)?);
+        Ok(self)
+    }
+
+    /// Completes the impacts CSV (if one is written) with the impacts so far and renames it
+    /// into place.
+    pub fn finish_impacts_csv(&mut self) -> Result<()> {
+        match self.csv.take() {
+            Some(c) => c.finish(),
+            None => Ok(()),
+        }
+    }
+
+    /// Impacts so far.
+    pub fn impact_count(&self) -> usize {
+        self.peaks.impacts()
+    }
+
+    /// The per-disc statistics of the impacts so far, named `names`.
+    pub fn disc_stats(&self, names: &[String]) -> Result<Vec<DiscStats>> {
+        self.peaks.stats(names).map_err(Error::io(
+            "the impact peaks kept in a temporary file (reading them back)",
+        ))
+    }
+
+    /// The fatigue of every coupling (named `names`) over `duration_s` of simulated duty,
+    /// from the histories collected so far.
+    pub fn assess_fatigue(&self, names: &[String], duration_s: f64) -> Vec<DiscFatigue> {
+        crate::fatigue::assess_fatigue(
+            self.fatigue.clone(),
+            &self.fatigue_params,
+            names,
+            duration_s,
+        )
+    }
+
+    /// Also keeps the figures of the stack's friction interfaces, named in stack order.
+    pub fn with_interfaces(mut self, names: impl IntoIterator<Item = String>) -> RunCollector {
+        self.interfaces = names.into_iter().map(InterfaceStats::new).collect();
+        self
+    }
+
+    /// Load histories with each impact's onset, peak and separation merged in (see
+    /// [`merge_peaks`]); only with `keep_history`.
+    pub fn histories_with_peaks(&self) -> Vec<Vec<(f64, f64)>> {
+        let mut h = self.history.clone();
+        merge_peaks(&mut h, &self.impacts);
+        h
+    }
+}
+
+/// The impacts CSV of a run, written row by row to a temporary sibling of its path.
+struct ImpactsCsv {
+    pending: clutchpack_record::PendingFile,
+    out: std::io::BufWriter<std::fs::File>,
+    names: Vec<String>,
+    /// the first write error (reported by `finish`)
+    error: Option<std::io::Error>,
+}
+
+impl ImpactsCsv {
+    fn create(path: &Path, names: &[String]) -> Result<ImpactsCsv> {
+        let (pending, file) =
+            clutchpack_record::PendingFile::create(path, clutchpack_record::Replace::Existing)
+                .map_err(Error::io(path))?;
+        let mut c = ImpactsCsv {
+            pending,
+            out: std::io::BufWriter::new(file),
+            names: names.to_vec(),
+            error: None,
+        };
+        c.write(|w| writeln!(w, "disc,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n"));
+        Ok(c)
+    }
+
+    fn write(&mut self, f: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>) {
+        if self.error.is_none() {
+            if let Err(e) = f(&mut self.out) {
+                self.error = Some(e);
+            }
+        }
+    }
+
+    fn row(&mut self, e: &ImpactEvent) {
+        let name = self
+            .names
+            .get(e.disc)
+            .cloned()
+            .unwrap_or_else(|| format!("disc {}", e.disc));
+        self.write(|w| {
+            writeln!(
+                w,
+                "{},{:.9},{:.9},{:.9},{},{:.6},{:.4}",
+                clutchpack_analysis::csv_field(&name),
+                e.t_on_s,
+                e.t_peak_s,
+                e.t_off_s,
+                e.flank.label(),
+                e.v_on_m_s,
+                e.peak_n
+            )
+        });
+    }
+
+    fn finish(mut self) -> Result<()> {
+        use std::io::Write as _;
+        let path = self.pending.target().to_path_buf();
+        let flushed = match self.error.take() {
+            Some(e) => Err(e),
+            None => self
+                .out
+                .flush()
+                .and_then(|()| self.out.get_ref().sync_all()),
+        };
+        match flushed {
+            Ok(()) => {
+                drop(self.out);
+                self.pending.commit().map_err(Error::io(path))?;
+                Ok(())
+            }
+            Err(e) => {
+                self.pending.discard();
+                Err(Error::Io { path, source: e })
+            }
+        }
+    }
+}
+
+/// Merges each impact's onset (0 N), located peak and separation (0 N) into the sampled load
+/// histories `(t s, load N)` of its disc, in time order, so that plotted spikes reach the
+/// located peaks whatever the sample rate.
+pub fn merge_peaks(histories: &mut [Vec<(f64, f64)>], impacts: &[ImpactEvent]) {
+    for e in impacts {
+        if let Some(v) = histories.get_mut(e.disc) {
+            v.extend([(e.t_on_s, 0.0), (e.t_peak_s, e.peak_n), (e.t_off_s, 0.0)]);
+        }
+    }
+    for v in histories.iter_mut() {
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+}
+
+impl Observer for RunCollector {
+    fn sample(&mut self, s: &Sample) {
+        self.fatigue.sample(s);
+        if self.keep_history {
+            for (i, d) in s.discs.iter().enumerate() {
+                self.history[i].push((s.t_s, d.load_n));
+            }
+        }
+    }
+    fn impact(&mut self, e: &ImpactEvent) {
+        if self.keep_history {
+            self.impacts.push(*e);
+        }
+        self.peaks.push(e.disc, e.peak_n);
+        if let Some(c) = &mut self.csv {
+            c.row(e);
+        }
+        self.fatigue.impact(e);
+    }
+    fn interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
+        for (st, f) in self.interfaces.iter_mut().zip(interfaces) {
+            st.update(t_s, f);
+        }
+    }
+}

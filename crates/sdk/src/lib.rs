@@ -1,0 +1,42 @@
+//! # clutchpack_sdk: clutchpack as a library
+//!
+//! The one place that turns a validated scene into results: the command-line front end
+//! (`clutchpack run`, `sweep`, `study`, `bench`), the FMU and the Python package are thin
+//! callers of it. It owns the choice of engine, what a run keeps (the impacts' statistics,
+//! the friction interfaces, the teeth's fatigue, the impacts CSV, the recording), the
+//! summary of a run, ensembles and batches of runs, and the fatigue of a recording. It
+//! prints nothing and never exits: problems are an [`Error`], bad input told from a failed
+//! run by [`Error::is_bad_input`].
+//!
+//! ```no_run
+//! use clutchpack_sdk::{load_scene, RunRequest, Simulation};
+//! let scene = load_scene(None, &[])?; // the paper's case, built in
+//! let mut sim = Simulation::new(scene, None)?;
+//! let outcome = sim.run(RunRequest::default())?;
+//! let summary = outcome.summary()?;
+//! println!("{}: largest + load {:.1} N", summary.scene, summary.discs[0].max_positive_n);
+//! # Ok::<(), clutchpack_sdk::Error>(())
+//! ```
+
+mod batch;
+mod collector;
+mod error;
+mod fatigue;
+mod run;
+mod scene;
+mod simulation;
+mod summary;
+
+pub use batch::{ensemble_member, run_case, run_cases, CaseRuns, MemberFatigue, MAX_BATCH_CASES};
+pub use collector::{merge_peaks, RunCollector};
+pub use error::{Error, Result};
+pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
+pub use run::{RecordingRequest, RunOutcome, RunRequest};
+pub use scene::{load_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TEXT};
+pub use simulation::{PackEngine, Simulation};
+pub use summary::{friction_interfaces, run_info, RunSummary};
+
+/// The reference engine's integration schemes (for [`PackEngine::Reference`]).
+pub use clutchpack_reference::Scheme;
+/// Which engine runs a scene.
+pub use clutchpack_scene::EngineChoice;

@@ -1,0 +1,316 @@
+//! One run of a scene: the engine on the caller's thread feeding the collector, the
+//! recording (if asked) on its own thread, both finished whatever stops the run.
+
+use crate::collector::RunCollector;
+use crate::summary::{friction_interfaces, run_info, RunSummary};
+use crate::{Error, Result, Simulation};
+use clutchpack_analysis::{DiscFatigue, DiscStats};
+use clutchpack_model::{
+    DiscSample, Engine, EngineError, ImpactEvent, InterfaceSample, Observer, RunStats, Sample,
+};
+use clutchpack_record::{RecordError, RecordOptions, Recorder, Replace, ThreadedRecorder};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// Where and how a run is recorded (MCAP).
+#[derive(Debug, Clone)]
+pub struct RecordingRequest {
+    /// The recording's path; written as a `.partial` sibling and renamed when complete.
+    pub path: PathBuf,
+    /// Whether an existing file at `path` is replaced.
+    pub replace: Replace,
+    /// What is recorded (per-tooth loads, contact samples, determinism).
+    pub options: RecordOptions,
+    /// The scene file the run was loaded from (its name goes into the recording).
+    pub scene_path: Option<PathBuf>,
+}
+
+/// What a run keeps and writes besides its statistics (the peak statistics, the interfaces'
+/// figures and the teeth's fatigue as running sums are always kept, in bounded memory).
+#[derive(Default)]
+pub struct RunRequest<'a> {
+    /// Keep every sample's per-tooth load and every impact (for a plot); memory grows with
+    /// the run.
+    pub keep_history: bool,
+    /// Keep every counted load cycle (for the cycle spectra of `--fatigue-json`); memory
+    /// grows with the run.
+    pub keep_cycles: bool,
+    /// Write one CSV row per impact to this file as the impacts close.
+    pub impacts_csv: Option<PathBuf>,
+    /// Record the run.
+    pub recording: Option<RecordingRequest>,
+    /// Stops the run cleanly (at the engine's next progress poll, within milliseconds) once
+    /// set; the outcome then holds the run up to there.
+    pub stop: Option<&'a AtomicBool>,
+    /// Called at the engine's progress polls with the simulated time reached, s.
+    pub progress: Option<&'a mut dyn FnMut(f64)>,
+}
+
+/// What a run gave: the engine's result and everything kept, complete up to where the run
+/// ended (its end, a stop or a failure).
+pub struct RunOutcome {
+    /// The scene's name.
+    pub scene: String,
+    /// The engine that ran.
+    pub engine: &'static str,
+    /// The engine's statistics, or why it failed (the other fields hold what came before).
+    pub result: std::result::Result<RunStats, EngineError>,
+    /// Wall-clock time of the run, s.
+    pub wall_time_s: f64,
+    /// CPU time of the engine's thread during the run, s.
+    pub engine_cpu_s: f64,
+    /// CPU time of the recording thread, s (0 without a recording).
+    pub recorder_cpu_s: f64,
+    /// The bodies' names, in the engines' order (discs, then plates).
+    pub body_names: Vec<String>,
+    /// What was kept.
+    pub collector: RunCollector,
+    /// The impacts CSV: written, or why not (`None`: not asked).
+    pub impacts_csv: Option<Result<PathBuf>>,
+    /// The finished recording's path, or why it could not be finished (`None`: not asked).
+    pub recording: Option<std::result::Result<PathBuf, RecordError>>,
+    /// What went wrong without stopping the run (to be shown to the user).
+    pub warnings: Vec<String>,
+}
+
+impl RunOutcome {
+    /// The engine's statistics; an engine failure as [`Error::Engine`], naming the scene, the
+    /// engine and the impacts kept before it.
+    pub fn stats(&self) -> Result<&RunStats> {
+        self.result.as_ref().map_err(|e| Error::Engine {
+            context: format!(
+                "{} engine on {} ({} impacts kept before the failure)",
+                self.engine,
+                self.scene,
+                self.collector.impact_count()
+            ),
+            source: e.clone(),
+        })
+    }
+
+    /// Whether the run stopped before its duration (a stop flag, or a failed recording).
+    pub fn stopped_early(&self) -> bool {
+        self.result.as_ref().is_ok_and(|s| s.stopped_early)
+    }
+
+    /// The per-body statistics of the impacts.
+    pub fn body_stats(&self) -> Result<Vec<DiscStats>> {
+        self.collector.disc_stats(&self.body_names)
+    }
+
+    /// The teeth's fatigue over the simulated time that ran.
+    pub fn fatigue(&self) -> Vec<DiscFatigue> {
+        let t = self.result.as_ref().map_or(0.0, |s| s.simulated_s);
+        self.collector.assess_fatigue(&self.body_names, t)
+    }
+
+    /// The run's summary (what `--summary-json` writes): statistics, interfaces, fatigue.
+    /// An error when the engine failed.
+    pub fn summary(&self) -> Result<RunSummary> {
+        let stats = self.stats()?;
+        let mut s = RunSummary {
+            scene: self.scene.clone(),
+            engine: self.engine.to_string(),
+            duration_s: stats.simulated_s,
+            wall_time_s: self.wall_time_s,
+            steps: stats.steps,
+            rejected_steps: stats.rejected_steps,
+            discs: self.body_stats()?,
+            interfaces: Vec::new(),
+            fatigue: Vec::new(),
+        };
+        s.interfaces = self.collector.interfaces.clone();
+        s.fatigue = self.fatigue();
+        Ok(s)
+    }
+}
+
+impl Simulation {
+    /// Runs the scene for its `simulation.duration_s` as `request` asks. Outputs that cannot
+    /// be created (the impacts CSV, the recording) are errors before any work; after that,
+    /// whatever ends the run, the outcome holds it and every output is complete up to there.
+    pub fn run(&mut self, request: RunRequest<'_>) -> Result<RunOutcome> {
+        let names = self.body_names();
+        let scene = self.scene();
+        let mut collector = RunCollector::new(names.len(), request.keep_history)
+            .with_interfaces(friction_interfaces(scene).into_iter().map(|f| f.name()))
+            .with_fatigue(scene, request.keep_cycles);
+        if let Some(path) = &request.impacts_csv {
+            collector = collector.with_impacts_csv(path, &names)?;
+        }
+        let recorder = match &request.recording {
+            Some(r) => {
+                let info = run_info(scene, self.engine_name(), r.scene_path.as_deref());
+                Some(Recorder::create_output(
+                    &r.path, r.replace, &info, &r.options,
+                )?)
+            }
+            None => None,
+        };
+        let duration = scene.simulation.duration_s;
+        let scene_name = scene.name.clone();
+        let engine_name = self.engine_name();
+        let t0 = Instant::now();
+        let done = run_recorded(
+            self.engine_mut(),
+            duration,
+            collector,
+            recorder,
+            request.stop,
+            request.progress,
+        );
+        let wall_time_s = t0.elapsed().as_secs_f64();
+        let mut collector = done.collector;
+        let impacts_csv = request
+            .impacts_csv
+            .map(|p| collector.finish_impacts_csv().map(|()| p));
+        Ok(RunOutcome {
+            scene: scene_name,
+            engine: engine_name,
+            result: done.result,
+            wall_time_s,
+            engine_cpu_s: done.engine_cpu_s,
+            recorder_cpu_s: done.recorder_cpu_s,
+            body_names: names,
+            collector,
+            impacts_csv,
+            recording: done.recording,
+            warnings: done.warnings,
+        })
+    }
+}
+
+/// What [`run_recorded`] gives back.
+struct RecordedRun {
+    result: std::result::Result<RunStats, EngineError>,
+    collector: RunCollector,
+    recording: Option<std::result::Result<PathBuf, RecordError>>,
+    engine_cpu_s: f64,
+    recorder_cpu_s: f64,
+    warnings: Vec<String>,
+}
+
+/// Runs `engine` for `duration_s` with `collector` on the engine's thread and `recorder` (if
+/// any) on a recording thread, then finishes the recording: with the engine's statistics and
+/// the teeth's fatigue when it ran, and in any case with everything recorded before a
+/// failure or a stop.
+fn run_recorded<'a>(
+    engine: &mut (dyn Engine + Send),
+    duration_s: f64,
+    collector: RunCollector,
+    recorder: Option<Recorder>,
+    stop: Option<&'a AtomicBool>,
+    progress: Option<&'a mut dyn FnMut(f64)>,
+) -> RecordedRun {
+    let mut obs = RunObserver {
+        collector,
+        recorder: recorder.map(ThreadedRecorder::start),
+        stop,
+        progress,
+    };
+    let cpu = cpu_time::ThreadTime::try_now().ok();
+    let result = engine.run(duration_s, &mut obs);
+    let engine_cpu_s = cpu
+        .and_then(|c| c.try_elapsed().ok())
+        .map_or(0.0, |d| d.as_secs_f64());
+    let RunObserver {
+        collector,
+        recorder,
+        ..
+    } = obs;
+    // Close the recording first: it holds everything before a failure or a stop.
+    let mut recorder_cpu_s = 0.0;
+    let mut warnings = Vec::new();
+    let recording = recorder.map(|rec| {
+        let (mut rec, cpu_s) = rec.join();
+        recorder_cpu_s = cpu_s;
+        // the file is finished even if the peaks kept on disk cannot be read back: its
+        // summary then has no impact statistics
+        let mut summary = rec.summary().unwrap_or_else(|e| {
+            warnings.push(format!(
+                "{e}; the recording's /summary has no impact statistics"
+            ));
+            clutchpack_record::RunSummary {
+                t_end_s: result.as_ref().map_or(0.0, |s| s.simulated_s),
+                discs: Vec::new(),
+                fatigue: Vec::new(),
+            }
+        });
+        if let Ok(s) = &result {
+            rec.set_run_stats(s);
+            // the teeth's fatigue over the duty that ran, beside the peak statistics
+            let names: Vec<String> = summary.discs.iter().map(|d| d.name.clone()).collect();
+            summary.fatigue = collector
+                .assess_fatigue(&names, s.simulated_s)
+                .iter()
+                .map(|f| Some(clutchpack_record::FatigueSummary::from(f)))
+                .collect();
+        }
+        rec.finish(Some(summary))
+    });
+    RecordedRun {
+        result,
+        collector,
+        recording,
+        engine_cpu_s,
+        recorder_cpu_s,
+        warnings,
+    }
+}
+
+/// Feeds the collector and the recorder; stops the run when the stop flag is set or the
+/// recording failed.
+struct RunObserver<'a> {
+    collector: RunCollector,
+    recorder: Option<ThreadedRecorder>,
+    stop: Option<&'a AtomicBool>,
+    progress: Option<&'a mut dyn FnMut(f64)>,
+}
+
+impl Observer for RunObserver<'_> {
+    fn sample(&mut self, s: &Sample) {
+        self.collector.sample(s);
+        if let Some(r) = &mut self.recorder {
+            r.push_sample(s);
+        }
+    }
+    fn impact(&mut self, e: &ImpactEvent) {
+        self.collector.impact(e);
+        if let Some(r) = &mut self.recorder {
+            r.push_impact(e);
+        }
+    }
+    fn interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
+        self.collector.interfaces(t_s, interfaces);
+        if let Some(r) = &mut self.recorder {
+            r.push_interfaces(t_s, interfaces);
+        }
+    }
+    fn contact_sample(&mut self, disc: usize, t_s: f64, state: &DiscSample) {
+        self.collector.contact_sample(disc, t_s, state);
+        if let Some(r) = &mut self.recorder {
+            r.push_contact_sample(disc, t_s, state);
+        }
+    }
+    fn wants_contact_samples(&self) -> bool {
+        self.collector.wants_contact_samples()
+            || self
+                .recorder
+                .as_ref()
+                .is_some_and(ThreadedRecorder::wants_contact_samples)
+    }
+    fn progress(&mut self, t_s: f64) -> bool {
+        if let Some(p) = &mut self.progress {
+            p(t_s);
+        }
+        let mut stop = false;
+        if let Some(r) = &mut self.recorder {
+            // hand over what is pending, so a slow engine's samples reach the file (and its
+            // wall-clock flush) without waiting for a full batch
+            r.send();
+            stop |= r.failed();
+        }
+        stop || self.stop.is_some_and(|s| s.load(Ordering::SeqCst))
+    }
+}
