@@ -99,3 +99,154 @@ fn architecture_names_every_file_crate_and_long_file() {
         );
     }
 }
+
+/// The module (file) that `path` names from `file`'s module: `crate::a::b` and `super::b`
+/// resolved to a source file of the same crate (`a/b.rs`, `a/b/mod.rs`, `a.rs`, `a/mod.rs`),
+/// or `None` (another crate, or a crate root: roots declare their modules, which is not a
+/// cycle).
+fn module_file(src: &Path, file: &Path, path: &[&str]) -> Option<PathBuf> {
+    let (mut dir, rest) = match path.first() {
+        Some(&"crate") => (src.to_path_buf(), &path[1..]),
+        Some(&"super") => {
+            // the parent module's folder: a file `x/y.rs` is module y inside x's folder
+            let here = file.parent()?.to_path_buf();
+            let is_mod = file.file_name().is_some_and(|f| f == "mod.rs");
+            (
+                if is_mod {
+                    here.parent()?.to_path_buf()
+                } else {
+                    here
+                },
+                &path[1..],
+            )
+        }
+        _ => return None,
+    };
+    let mut found = None;
+    for seg in rest {
+        let as_file = dir.join(format!("{seg}.rs"));
+        let as_dir = dir.join(seg).join("mod.rs");
+        if as_file.is_file() {
+            found = Some(as_file);
+        } else if as_dir.is_file() {
+            found = Some(as_dir);
+        } else {
+            break;
+        }
+        dir = dir.join(seg);
+    }
+    found
+}
+
+/// The paths a file names through `crate::` or `super::`, each as its segments, from `use`
+/// trees (`use crate::{a, b::c}`) and paths in code (`crate::a::f()`); comments skipped.
+fn named_paths(text: &str) -> Vec<Vec<String>> {
+    let code: String = text
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let mut out = Vec::new();
+    for root in ["crate::", "super::"] {
+        let mut rest = code.as_str();
+        while let Some(i) = rest.find(root) {
+            // not `$crate::` (macros) nor part of a longer identifier
+            let before = rest[..i].chars().last();
+            let after = &rest[i + root.len()..];
+            rest = after;
+            if before.is_some_and(|c| c == '$' || c.is_alphanumeric() || c == '_') {
+                continue;
+            }
+            let head = root.trim_end_matches("::").to_string();
+            if let Some(group) = after.strip_prefix('{') {
+                // `use crate::{a, b::c, d::{e, f}}`: the first segment of each item
+                let end = group.find('}').unwrap_or(group.len());
+                for item in group[..end].split(',') {
+                    let first = item.trim().split("::").next().unwrap_or("").trim();
+                    if !first.is_empty() {
+                        out.push(vec![head.clone(), first.to_string()]);
+                    }
+                }
+                continue;
+            }
+            let segs: Vec<String> = after
+                .split("::")
+                .map_while(|s| {
+                    let id: String = s
+                        .chars()
+                        .take_while(|c| c.is_alphanumeric() || *c == '_')
+                        .collect();
+                    (!id.is_empty() && id.len() == s.len())
+                        .then_some(id.clone())
+                        .or({
+                            // the last segment ends the path (`a::f(`, `a::{`)
+                            None
+                        })
+                })
+                .collect();
+            let last: String = after
+                .split("::")
+                .nth(segs.len())
+                .map(|s| {
+                    s.chars()
+                        .take_while(|c| c.is_alphanumeric() || *c == '_')
+                        .collect()
+                })
+                .unwrap_or_default();
+            let mut p = vec![head.clone()];
+            p.extend(segs);
+            if !last.is_empty() {
+                p.push(last);
+            }
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// Issue 22: no two files of a crate import each other (`cli/common.rs` and `outputs.rs`,
+/// `scene/src/keys.rs` and `schema.rs`, `sim/src/engine/state.rs` with `events.rs` and
+/// `energy.rs` did); a crate root (`lib.rs`, `main.rs`) and a folder's `mod.rs` declare their
+/// modules and are left out.
+#[test]
+fn no_two_files_import_each_other() {
+    let mut edges = std::collections::BTreeSet::new();
+    for c in std::fs::read_dir(root().join("crates")).unwrap() {
+        let c = c.unwrap().path();
+        let src = if c.join("src").is_dir() {
+            c.join("src")
+        } else {
+            c.clone()
+        };
+        let mut files = Vec::new();
+        rust_files(&src, &mut files);
+        for f in &files {
+            let text = std::fs::read_to_string(f).unwrap();
+            for p in named_paths(&text) {
+                let segs: Vec<&str> = p.iter().map(String::as_str).collect();
+                if let Some(to) = module_file(&src, f, &segs) {
+                    let root_like = |x: &Path| {
+                        x.file_name()
+                            .is_some_and(|n| n == "lib.rs" || n == "main.rs" || n == "mod.rs")
+                    };
+                    if &to != f && !root_like(&to) && !root_like(f) {
+                        edges.insert((f.clone(), to));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        edges.len() > 40,
+        "the scan found too few imports: {edges:?}"
+    );
+    let pairs: Vec<String> = edges
+        .iter()
+        .filter(|(a, b)| a < b && edges.contains(&(b.clone(), a.clone())))
+        .map(|(a, b)| {
+            let rel = |p: &Path| p.strip_prefix(root()).unwrap().display().to_string();
+            format!("{} <-> {}", rel(a), rel(b))
+        })
+        .collect();
+    assert!(pairs.is_empty(), "files that import each other: {pairs:?}");
+}

@@ -152,6 +152,7 @@
 
 #![warn(missing_docs)]
 
+mod catalog;
 mod csv;
 mod engine;
 mod error;
@@ -161,9 +162,9 @@ mod raw;
 mod schema;
 mod validate;
 
+pub use catalog::{keys_doc, keys_markdown};
 pub use error::{Problem, SceneError};
 pub use overrides::{Override, OverrideError};
-pub use schema::{keys_doc, keys_markdown};
 
 use std::path::Path;
 use toml::{Table, Value};
@@ -354,7 +355,7 @@ fn deserialize_raw(doc: Table, problems: &mut Vec<Problem>) -> Option<keys::RawS
         let parent = key.rfind('.').map_or("", |i| &key[..i]);
         let rule = format!(
             "unknown key ({})",
-            schema::expected_text(&schema::normalize(parent))
+            catalog::expected_text(&catalog::normalize(parent))
         );
         problems.push(Problem::new(key, None, rule));
     }
@@ -438,7 +439,7 @@ mod tests {
     #[test]
     fn every_schema_key_is_read_by_the_raw_structs() {
         let mut doc = Table::new();
-        for path in schema::all_paths() {
+        for path in catalog::all_paths() {
             insert(&mut doc, path);
         }
         let mut problems = Vec::new();

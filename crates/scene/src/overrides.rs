@@ -7,8 +7,8 @@
 //! `{ teeth = 3 }`); if it is not valid TOML it is taken as a string, so `--set
 //! drive.kind=sine` needs no quotes. The key must exist in the scene schema.
 
+use crate::catalog;
 use crate::error::Problem;
-use crate::schema;
 use std::fmt;
 use std::str::FromStr;
 use toml::{Table, Value};
@@ -151,24 +151,24 @@ fn unknown_key_rule(norm: &str) -> String {
             Some(i) => &parent[..i],
             None => "",
         };
-        if schema::is_known(parent) {
+        if catalog::is_known(parent) {
             break;
         }
     }
-    if schema::is_leaf(parent) {
+    if catalog::is_leaf(parent) {
         format!("unknown key given with --set ({parent} holds a value, not keys)")
-    } else if schema::is_array(parent) && !norm[parent.len()..].starts_with("[]") {
+    } else if catalog::is_array(parent) && !norm[parent.len()..].starts_with("[]") {
         format!(
             "unknown key given with --set ({parent} is an array of tables: pick an item by \
              index, e.g. {parent}[0].{})",
-            schema::children(&format!("{parent}[]"))
+            catalog::children(&format!("{parent}[]"))
                 .first()
                 .unwrap_or(&"")
         )
     } else {
         format!(
             "unknown key given with --set ({})",
-            schema::expected_text(parent)
+            catalog::expected_text(parent)
         )
     }
 }
@@ -192,8 +192,8 @@ pub(crate) fn apply(
             }
         };
         let key = path_text(&segs);
-        let norm = schema::normalize(&key);
-        if !schema::is_known(&norm) {
+        let norm = catalog::normalize(&key);
+        if !catalog::is_known(&norm) {
             problems.push(Problem::new(key, None, unknown_key_rule(&norm)));
             continue;
         }

@@ -11,8 +11,8 @@
 //! of tables that has the wrong type, so that deserialization itself cannot fail and the rest
 //! of the file is still checked.
 
+use crate::catalog;
 use crate::error::Problem;
-use crate::schema;
 use toml::{Table, Value};
 
 /// Reports and removes each known table (`[simulation]`) or array of tables (`[[discs]]`)
@@ -40,13 +40,13 @@ fn check_table(
         } else {
             format!("{path}.{key}")
         };
-        let norm = schema::normalize(&child);
-        if schema::is_leaf(&norm) || !schema::is_known(&norm) {
+        let norm = catalog::normalize(&child);
+        if catalog::is_leaf(&norm) || !catalog::is_known(&norm) {
             continue;
         }
         let section = norm.replace("[]", "");
         match value {
-            Value::Array(items) if schema::is_array(&norm) => {
+            Value::Array(items) if catalog::is_array(&norm) => {
                 for (i, item) in items.iter_mut().enumerate() {
                     let item_path = format!("{child}[{i}]");
                     if let Value::Table(t) = item {
@@ -59,9 +59,11 @@ fn check_table(
                     }
                 }
             }
-            Value::Table(t) if !schema::is_array(&norm) => check_table(t, &child, problems, voided),
+            Value::Table(t) if !catalog::is_array(&norm) => {
+                check_table(t, &child, problems, voided)
+            }
             _ => {
-                let rule = if schema::is_array(&norm) {
+                let rule = if catalog::is_array(&norm) {
                     format!("must be an array of tables: write [[{section}]] entries")
                 } else {
                     format!("must be a table: write [{section}]")

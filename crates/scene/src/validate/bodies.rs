@@ -10,11 +10,12 @@
 //! the free play.
 
 use super::{Checker, Field};
+use crate::catalog::body_keys;
 use crate::keys::{
     RawBody as B, RawContact as C, RawMaterial as M, RawOil as O, RawSpline as Sp,
     RawToothForm as F,
 };
-use crate::schema::{body_keys, fmt_num, show, Key, Kind, RawTable};
+use crate::schema::{fmt_num, show, Key, Kind, RawTable};
 use clutchpack_model::{
     DiscModel, FatigueParams, Hertz, LawKind, Material, MinerRule, OilFilm, SplineGeometry,
     ToothForm, ToothLaw,
@@ -212,7 +213,7 @@ pub(super) fn bodies(
             None,
             format!(
                 "unknown key ({}; a name belongs to each [[{}]] entry)",
-                crate::schema::expected_text(sec.defaults),
+                crate::catalog::expected_text(sec.defaults),
                 sec.items
             ),
         );

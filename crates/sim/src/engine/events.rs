@@ -1,10 +1,9 @@
 //! Impact events of each coupling: onset, peak (with the parabola through the samples around
 //! it) and separation, with the model's definitions ([`clutchpack_model::ImpactTracker`]).
 
-use super::state::Run;
 use crate::hook::CouplingForces;
-use crate::stepping::contact_duration_s;
-use clutchpack_model::{parabolic_peak, ImpactTracker, Observer};
+
+use clutchpack_model::{parabolic_peak, ImpactTracker};
 
 /// Per-coupling event bookkeeping.
 #[derive(Debug, Clone, Default)]
@@ -115,31 +114,5 @@ impl EventTrack {
         }
         self.before_last = self.last;
         self.last = Some((t, load));
-    }
-}
-
-impl Run<'_> {
-    /// Feeds the impact trackers with the state at `t` and sends the impacts that closed and
-    /// the contact samples due ([`EventTrack::contact_sample_due`]).
-    pub(super) fn track_events(&mut self, steps_per_contact: f64, observer: &mut dyn Observer) {
-        for i in 0..self.tracks.len() {
-            let law = &self.bodies[i].law;
-            let f = &self.forces[i];
-            let m = self.m_eff[i];
-            let step = |v| contact_duration_s(law, f.kin.flank, v, m) / steps_per_contact;
-            let track = &mut self.tracks[i];
-            let was_open = track.tracker.is_open();
-            let closed = track.update(self.t, f, step);
-            if let Some(e) = &closed {
-                observer.impact(e);
-            }
-            if self.contact_samples && track.contact_sample_due(self.t, was_open, steps_per_contact)
-            {
-                // the state that closed the event is sent at its separation (see
-                // `contact_sample_due`)
-                let t = closed.map_or(self.t, |e| e.t_off_s);
-                observer.contact_sample(i, t, &self.disc_sample(i, false));
-            }
-        }
     }
 }

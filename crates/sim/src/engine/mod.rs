@@ -6,6 +6,7 @@
 //! (the energy audit), `control` (the step controller and the landing on contact onsets);
 //! this module validates the pack and runs the loop.
 
+mod accounting;
 mod control;
 mod energy;
 mod events;
