@@ -69,8 +69,8 @@ impl Lcg {
 }
 
 pub use fatigue::{
-    assess, disc_cycles, ensemble_fatigue, fatigue_spread_table, fatigue_table, DiscCycles,
-    DiscFatigue, DiscFatigueSpread, FatigueCollector,
+    assess, disc_cycles, ensemble_fatigue, DiscCycles, DiscFatigue, DiscFatigueSpread,
+    FatigueCollector,
 };
 pub use fit::{polyfit, FitError, PolyFit};
 pub use interfaces::InterfaceStats;
@@ -80,4 +80,7 @@ pub use plot::{
 };
 pub use stats::{disc_stats, percentile, DiscStats, PeakStats};
 pub use sweep::{sweep_fits, sweep_rows, Spread, SweepCase, SweepRow};
-pub use table::{csv_field, interface_table, stats_table, sweep_table, TableFormat};
+pub use table::{
+    csv_field, fatigue_spread_table, fatigue_table, interface_table, stats_table, sweep_table,
+    TableFormat,
+};

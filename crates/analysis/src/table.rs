@@ -5,6 +5,7 @@
 //! round numbers to about four significant digits for reading; CSV keeps every digit
 //! (Rust's shortest round-trip form) for machines.
 
+use crate::fatigue::{format_life_h, DiscFatigue, DiscFatigueSpread};
 use crate::interfaces::InterfaceStats;
 use crate::stats::DiscStats;
 use crate::sweep::{Spread, SweepRow};
@@ -331,6 +332,180 @@ pub(crate) fn fmt_short(v: f64) -> String {
         mantissa
     };
     format!("{mantissa}{exp}")
+}
+
+fn fmt_mpa(pa: f64) -> String {
+    format!("{:.1}", pa * 1e-6)
+}
+
+fn fmt_opt(x: Option<f64>) -> String {
+    x.map_or_else(String::new, |v| format!("{v:?}"))
+}
+
+/// The fatigue of one run, one row per disc.
+///
+/// Columns (text and markdown): `disc`, `impacts`, `cycles`, `max sigma_F [MPa]` (root
+/// stress of the largest peak), `max p [MPa]` (flank pressure), `damage [1/h]`, `life [h]`
+/// (at this duty; `unlimited` without damage), `S_eq [N]` (damage-equivalent load range for
+/// one hour at `N_D`), `sigma_eq [MPa]` (its stress amplitude), and where the engine resolved
+/// teeth `worst tooth` (index) and `worst life [h]`. CSV: the same with unit suffixes and
+/// every digit (`life_h` empty when unlimited).
+pub fn fatigue_table(discs: &[DiscFatigue], format: TableFormat) -> String {
+    let teeth = discs.iter().any(|d| d.teeth.is_some());
+    if format == TableFormat::Csv {
+        let mut out = String::from(
+            "disc,impacts,cycles,max_root_stress_pa,max_flank_pressure_pa,damage_rate_per_h,life_h,eq_load_range_n,eq_stress_amplitude_pa,worst_tooth,worst_tooth_life_h\n",
+        );
+        for d in discs {
+            let a = &d.lumped;
+            let (wt, wl) = d
+                .teeth
+                .as_ref()
+                .map_or((String::new(), String::new()), |t| {
+                    (t.worst_tooth.to_string(), fmt_opt(t.worst.life_h))
+                });
+            out.push_str(&format!(
+                "{},{},{:?},{:?},{:?},{:?},{},{:?},{:?},{wt},{wl}\n",
+                csv_field(&d.name),
+                d.impacts,
+                a.cycles,
+                d.max_root_stress_pa,
+                d.max_flank_pressure_pa,
+                a.damage_rate_per_h,
+                fmt_opt(a.life_h),
+                a.eq_load_range_n,
+                a.eq_stress_amplitude_pa
+            ));
+        }
+        return out;
+    }
+    let mut cols = vec![
+        col("disc", false),
+        col("impacts", true),
+        col("cycles", true),
+        col("max sigma_F [MPa]", true),
+        col("max p [MPa]", true),
+        col("damage [1/h]", true),
+        col("life [h]", true),
+        col("S_eq [N]", true),
+        col("sigma_eq [MPa]", true),
+    ];
+    if teeth {
+        cols.push(col("worst tooth", true));
+        cols.push(col("worst life [h]", true));
+    }
+    let rows: Vec<Vec<String>> = discs
+        .iter()
+        .map(|d| {
+            let a = &d.lumped;
+            let mut r = vec![
+                d.name.clone(),
+                d.impacts.to_string(),
+                fmt_num(a.cycles),
+                fmt_mpa(d.max_root_stress_pa),
+                fmt_mpa(d.max_flank_pressure_pa),
+                fmt_num(a.damage_rate_per_h),
+                format_life_h(a.life_h),
+                fmt_num(a.eq_load_range_n),
+                fmt_mpa(a.eq_stress_amplitude_pa),
+            ];
+            if teeth {
+                match &d.teeth {
+                    Some(t) => {
+                        r.push(t.worst_tooth.to_string());
+                        r.push(format_life_h(t.worst.life_h));
+                    }
+                    None => r.extend(["-".to_string(), "-".to_string()]),
+                }
+            }
+            r
+        })
+        .collect();
+    render(format, &cols, &rows)
+}
+
+/// The fatigue of ensembles: one row per (parameter value, disc); `param` names the first
+/// column (`None`: no parameter column, one ensemble).
+///
+/// Columns (text and markdown): `param` (when given), `disc`, `members`, `damage [1/h]` (mean ± std of
+/// the members' damage rates), `damage range [1/h]` (min .. max), `life [h]` (at the mean
+/// rate), `life range [h]` (at the largest .. the smallest rate), `S_eq [N]` (mean ± std).
+/// CSV: `damage_rate_{mean,std,min,max}_per_h`, `life_at_mean_rate_h`, `life_min_h`,
+/// `life_max_h`, `eq_load_range_{mean,std}_n` (lives empty when unlimited).
+pub fn fatigue_spread_table(
+    param: Option<&str>,
+    rows: &[(f64, Vec<DiscFatigueSpread>)],
+    format: TableFormat,
+) -> String {
+    if format == TableFormat::Csv {
+        let mut out = String::new();
+        if let Some(p) = param {
+            out.push_str(&csv_field(p));
+            out.push(',');
+        }
+        out.push_str("disc,members,damage_rate_mean_per_h,damage_rate_std_per_h,damage_rate_min_per_h,damage_rate_max_per_h,life_at_mean_rate_h,life_min_h,life_max_h,eq_load_range_mean_n,eq_load_range_std_n\n");
+        for (v, discs) in rows {
+            for d in discs {
+                let r = &d.damage_rate_per_h;
+                if param.is_some() {
+                    out.push_str(&format!("{v:?},"));
+                }
+                out.push_str(&format!(
+                    "{},{},{:?},{:?},{:?},{:?},{},{},{},{:?},{:?}\n",
+                    csv_field(&d.name),
+                    r.n,
+                    r.mean,
+                    r.std,
+                    r.min,
+                    r.max,
+                    fmt_opt(d.life_at_mean_rate_h),
+                    fmt_opt(d.life_min_h),
+                    fmt_opt(d.life_max_h),
+                    d.eq_load_range_n.mean,
+                    d.eq_load_range_n.std
+                ));
+            }
+        }
+        return out;
+    }
+    let mut cols = Vec::new();
+    if let Some(p) = param {
+        cols.push(col(p, true));
+    }
+    cols.extend([
+        col("disc", false),
+        col("members", true),
+        col("damage [1/h]", true),
+        col("damage range [1/h]", true),
+        col("life [h]", true),
+        col("life range [h]", true),
+        col("S_eq [N]", true),
+    ]);
+    let mut cells = Vec::new();
+    for (v, discs) in rows {
+        for d in discs {
+            let r = &d.damage_rate_per_h;
+            let mut row = Vec::new();
+            if param.is_some() {
+                row.push(fmt_num(*v));
+            }
+            row.extend([
+                d.name.clone(),
+                r.n.to_string(),
+                mean_std(r),
+                format!("{} .. {}", fmt_num(r.min), fmt_num(r.max)),
+                format_life_h(d.life_at_mean_rate_h),
+                format!(
+                    "{} .. {}",
+                    format_life_h(d.life_min_h),
+                    format_life_h(d.life_max_h)
+                ),
+                mean_std(&d.eq_load_range_n),
+            ]);
+            cells.push(row);
+        }
+    }
+    render(format, &cols, &cells)
 }
 
 #[cfg(test)]
