@@ -13,7 +13,7 @@
 //! checked with 512 steps per contact (0.14 us off).
 
 use clutchpack_model::{Collector, Engine, ImpactEvent};
-use clutchpack_reference::{ReferenceEngine, Scheme, Settings};
+use clutchpack_reference::{ReferenceEngine, ReferenceOptions, Scheme};
 use clutchpack_scene::Override;
 use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Stepping};
 use std::path::Path;
@@ -55,7 +55,7 @@ fn assert_engines_agree_within(
 ) {
     let s = scene(file, sets);
     let duration = s.simulation.duration_s;
-    let oracle = Settings {
+    let oracle = ReferenceOptions {
         tolerance: 1e-12,
         max_step_s: s.simulation.max_step_s,
         record_rate_hz: s.simulation.record_rate_hz,
@@ -181,9 +181,9 @@ fn open_brake_pack_8_with_plates() {
 fn staggered_brake_8_with_plates() {
     let pack = clutchpack_model::cases::staggered_brake(8);
     let duration = 0.025;
-    let oracle = Settings {
+    let oracle = ReferenceOptions {
         tolerance: 1e-12,
-        ..Settings::default()
+        ..ReferenceOptions::default()
     };
     let r = impacts(&mut ReferenceEngine::new(pack.clone(), oracle), duration);
     let options = MultibodyOptions::with_settings(1e4, 2.5e-7, false);
@@ -223,15 +223,15 @@ mod staggered {
     use super::impacts;
     use clutchpack_model::cases::staggered_pack;
     use clutchpack_model::ImpactEvent;
-    use clutchpack_reference::{ReferenceEngine, Settings};
+    use clutchpack_reference::{ReferenceEngine, ReferenceOptions};
     use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping};
 
     const DURATION_S: f64 = 0.05;
 
     fn oracle() -> Vec<ImpactEvent> {
-        let settings = Settings {
+        let settings = ReferenceOptions {
             tolerance: 1e-12,
-            ..Settings::default()
+            ..ReferenceOptions::default()
         };
         impacts(
             &mut ReferenceEngine::new(staggered_pack(8), settings)
@@ -328,7 +328,7 @@ fn engagement_pack_6_locks_and_heats_alike() {
         ],
     );
     let duration = s.simulation.duration_s;
-    let oracle = Settings {
+    let oracle = ReferenceOptions {
         tolerance: 1e-12,
         max_step_s: s.simulation.max_step_s,
         record_rate_hz: s.simulation.record_rate_hz,
@@ -378,9 +378,9 @@ fn engagement_pack_6_locks_and_heats_alike() {
         &["simulation.duration_s=0.025"],
     );
     let nd = s.pack.discs.len();
-    let oracle = Settings {
+    let oracle = ReferenceOptions {
         tolerance: 1e-12,
-        ..Settings::default()
+        ..ReferenceOptions::default()
     };
     let discs = |v: Vec<ImpactEvent>| v.into_iter().filter(|e| e.disc < nd).collect::<Vec<_>>();
     let r = discs(impacts(

@@ -258,24 +258,9 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
 
+    /// The paper's law (Table 2), one definition for every test ([`crate::cases::paper_law`]).
     fn law(kind: LawKind, h_o: f64) -> ToothLaw {
-        ToothLaw {
-            kind,
-            hertz: Hertz {
-                modulus_pa: 210e9,
-                curvature_radius_m: 1.75e-3,
-                loss_coefficient_s_m: 0.8,
-            },
-            oil: OilFilm {
-                thickness_m: h_o,
-                viscosity_pa_s: 289.1,
-                leakage_coefficient: 0.421,
-                width_m: 3e-3,
-                length_m: 3e-3,
-                v_floor_m_s: 0.01,
-                h_min_m: 1e-6,
-            },
-        }
+        crate::cases::paper_law(kind, h_o)
     }
 
     fn kin(delta: f64, v: f64) -> ToothKinematics {

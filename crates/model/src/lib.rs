@@ -48,6 +48,9 @@
 #![warn(missing_docs)]
 
 pub mod cases;
+/// Consistency checks of an engine's output stream for the engines' tests (feature
+/// `test-support`; not part of the product's interface).
+#[cfg(any(test, feature = "test-support"))]
 pub mod checks;
 pub mod clutch;
 pub mod drive;

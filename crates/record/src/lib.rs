@@ -115,6 +115,9 @@ mod view3d;
 // Test fixture for this crate's tests, benches and examples (integration tests are other
 // crates, so it stays `pub`); not part of the API.
 #[doc(hidden)]
+/// Synthetic runs for tests and examples (feature `test-support`; not part of the product's
+/// interface).
+#[cfg(any(test, feature = "test-support"))]
 pub mod synthetic;
 mod threaded;
 pub mod topics;

@@ -4,7 +4,7 @@
 
 use clutchpack_model::cases::paper_pack;
 use clutchpack_model::*;
-use clutchpack_reference::{ReferenceEngine, Settings};
+use clutchpack_reference::{ReferenceEngine, ReferenceOptions};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 fn bench(c: &mut Criterion) {
@@ -15,9 +15,9 @@ fn bench(c: &mut Criterion) {
             b.iter(|| {
                 let mut e = ReferenceEngine::new(
                     paper_pack(h_o),
-                    Settings {
+                    ReferenceOptions {
                         record_rate_hz: 20_000.0,
-                        ..Settings::default()
+                        ..ReferenceOptions::default()
                     },
                 );
                 let mut obs = Collector::default();

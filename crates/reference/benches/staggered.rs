@@ -8,7 +8,7 @@
 
 use clutchpack_model::cases::staggered_pack;
 use clutchpack_model::*;
-use clutchpack_reference::{ReferenceEngine, Scheme, Settings};
+use clutchpack_reference::{ReferenceEngine, ReferenceOptions, Scheme};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 
 /// Discards everything (the engine's cost alone).
@@ -22,7 +22,7 @@ impl Observer for Discard {
 }
 
 fn run(n: usize, scheme: Scheme, parallel: bool) -> usize {
-    let mut e = ReferenceEngine::new(staggered_pack(n), Settings::default())
+    let mut e = ReferenceEngine::new(staggered_pack(n), ReferenceOptions::default())
         .with_scheme(scheme)
         .with_parallel(parallel);
     let mut obs = Discard(0);

@@ -5,7 +5,7 @@
 use crate::dopri::Dense;
 use crate::stepper::{Sink, Stepper, Switch};
 use crate::system::{disc_sample, System};
-use crate::Settings;
+use crate::ReferenceOptions;
 use clutchpack_model::{
     DiscModel, DiscSample, Engagement, EngineError, ImpactEvent, Observer, PackModel, RunStats,
     Sample,
@@ -144,7 +144,7 @@ impl Sink for PackSink<'_, '_> {
 
 pub(crate) fn run(
     pack: &PackModel,
-    settings: &Settings,
+    settings: &ReferenceOptions,
     duration_s: f64,
     obs: &mut dyn Observer,
 ) -> Result<RunStats, EngineError> {

@@ -4,7 +4,7 @@
 
 use crate::stepper::{Sink, Stepper};
 use crate::system::System;
-use crate::{no_external, Settings};
+use crate::{no_external, ReferenceOptions};
 use clutchpack_model::{
     DiscSample, Engagement, EngineError, ImpactEvent, Observer, PackModel, RunStats, Sample,
 };
@@ -100,7 +100,7 @@ const MAX_BUFFERED_SAMPLES: f64 = 4e3;
 
 pub(crate) fn run(
     pack: &PackModel,
-    settings: &Settings,
+    settings: &ReferenceOptions,
     parallel: bool,
     duration_s: f64,
     obs: &mut dyn Observer,

@@ -9,7 +9,7 @@
 //! resolved by the error control.
 //!
 //! It is the oracle for the multibody engine and the fast engine for sweeps. It is built from
-//! the model ([`PackModel`] and [`Settings`]), never from a scene file.
+//! the model ([`PackModel`] and [`ReferenceOptions`]), never from a scene file.
 //!
 //! # Theory
 //! ## Equations
@@ -29,7 +29,7 @@
 //! Integrating the relative quantities keeps the error control on the backlash scale
 //! (nanometres at the pitch circle) instead of on the growing absolute angles: the absolute
 //! tolerance is `tol g0_i` for `phi_i` (`g0_i` the half play, rad), `tol` for speeds (rad/s)
-//! and for the shaft angle (rad), with the relative tolerance `tol` ([`Settings::tolerance`]).
+//! and for the shaft angle (rad), with the relative tolerance `tol` ([`ReferenceOptions::tolerance`]).
 //!
 //! ## Events
 //! `F_i` is only evaluated inside a contact event, which starts when `s_i` crosses zero
@@ -108,7 +108,7 @@
 //! ## Order and energy
 //! - Order: every scheme takes the same DOPRI5 steps (5th-order solution, 4th-order error
 //!   estimate and dense output) between located events, so each is 5th order in the step
-//!   and its error is set by [`Settings::tolerance`], not by the scheme. The multirate schemes
+//!   and its error is set by [`ReferenceOptions::tolerance`], not by the scheme. The multirate schemes
 //!   add no splitting error: on a prescribed shaft the discs exchange nothing (the split is
 //!   exact), and on an inertial shaft the free discs follow the exact solution of their
 //!   equation while every coupling that carries a load is integrated together with the
@@ -156,9 +156,10 @@ use clutchpack_model::{
 use stepper::{Sink, Stepper, Switch};
 use system::{Face, System};
 
-/// Integration and output settings of the reference engine.
+/// The reference engine's options (as `MultibodyOptions` are the multibody engine's): the
+/// integration tolerance, the largest step and the sample rate of its output.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Settings {
+pub struct ReferenceOptions {
     /// Relative error tolerance (dimensionless). Absolute tolerances derive from it: `tol *
     /// g0` rad for relative angles, `tol * 1 rad/s` for speeds, `tol * 1 rad` for the shaft angle.
     pub tolerance: f64,
@@ -168,9 +169,9 @@ pub struct Settings {
     pub record_rate_hz: f64,
 }
 
-impl Default for Settings {
+impl Default for ReferenceOptions {
     fn default() -> Self {
-        Settings {
+        ReferenceOptions {
             tolerance: 1e-9,
             max_step_s: 1e-4,
             record_rate_hz: 10_000.0,
@@ -194,7 +195,7 @@ pub enum Scheme {
 #[derive(Debug, Clone)]
 pub struct ReferenceEngine {
     pack: PackModel,
-    settings: Settings,
+    settings: ReferenceOptions,
     scheme: Scheme,
     parallel: bool,
 }
@@ -204,7 +205,7 @@ const PARALLEL_MIN_DISCS: usize = 2;
 
 impl ReferenceEngine {
     /// An engine for `pack` with `settings`, the [`Scheme::Multirate`] scheme, parallel.
-    pub fn new(pack: PackModel, settings: Settings) -> ReferenceEngine {
+    pub fn new(pack: PackModel, settings: ReferenceOptions) -> ReferenceEngine {
         ReferenceEngine {
             pack,
             settings,
@@ -336,7 +337,7 @@ pub(crate) fn no_external(
 /// every plate, the drum and the stack's faces with their stick-slip events).
 fn run_monolithic(
     pack: &PackModel,
-    settings: &Settings,
+    settings: &ReferenceOptions,
     duration_s: f64,
     obs: &mut dyn Observer,
 ) -> Result<RunStats, EngineError> {

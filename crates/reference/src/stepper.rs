@@ -4,7 +4,7 @@
 
 use crate::dopri::{next_step, Dense, Dopri5};
 use crate::system::System;
-use crate::Settings;
+use crate::ReferenceOptions;
 use clutchpack_model::{DiscModel, Engagement, EngineError, ImpactEvent, ImpactTracker, RunStats};
 use clutchpack_model::{STALL_SPAN_S, STALL_STEPS as STALL_BLOCK};
 
@@ -133,7 +133,7 @@ pub(crate) struct Stepper<'a> {
 
 impl<'a> Stepper<'a> {
     /// Starts `sys` at t = 0 from its initial state; a disc may start inside a contact event.
-    pub fn new(sys: System<'a>, settings: &Settings) -> Stepper<'a> {
+    pub fn new(sys: System<'a>, settings: &ReferenceOptions) -> Stepper<'a> {
         let n = sys.dim();
         let tol = settings.tolerance;
         let y = sys.initial_state();

@@ -6,13 +6,15 @@
 use clutchpack_model::cases::{paper_pack, staggered_pack};
 use clutchpack_model::checks::{check_contact_samples, OrderedCollector};
 use clutchpack_model::*;
-use clutchpack_reference::{ReferenceEngine, Scheme, Settings};
+use clutchpack_reference::{ReferenceEngine, ReferenceOptions, Scheme};
 
-/// Largest relative shortfall of the densest contact sample below the located peak.
-const PEAK_TOLERANCE: f64 = 0.02;
+/// Largest relative shortfall of the densest contact sample below the located peak: the
+/// measured worst (1.27e-3, the paper case at 50 um; 7.2e-4 on the staggered pack) with a
+/// margin of about 1.6.
+const PEAK_TOLERANCE: f64 = 2e-3;
 
 fn run(pack: PackModel, scheme: Scheme, duration: f64) -> Collector {
-    let mut e = ReferenceEngine::new(pack, Settings::default()).with_scheme(scheme);
+    let mut e = ReferenceEngine::new(pack, ReferenceOptions::default()).with_scheme(scheme);
     let mut o = OrderedCollector::default();
     e.run(duration, &mut o).unwrap();
     assert!(
@@ -32,9 +34,9 @@ fn check(label: &str, c: &Collector, nd: usize) -> (f64, f64) {
 }
 
 /// The paper case (one disc, prescribed shaft) at the three film thicknesses of MODEL.md
-/// section 4, both schemes: every impact's located peak is matched within 2 % by its contact
-/// samples (measured: worst 0.13 % below the peak, about 32 points per contact: every second
-/// DOPRI5 step and the steps around the peak).
+/// section 4, both schemes: every impact's located peak is matched within [`PEAK_TOLERANCE`] by
+/// its contact samples (measured: worst 0.127 % below the peak, about 32 points per contact:
+/// every second DOPRI5 step and the steps around the peak).
 #[test]
 fn paper_case_contact_samples_reach_the_located_peaks() {
     for h_o in [0.0, 25e-6, 50e-6] {
@@ -102,7 +104,8 @@ fn contact_samples_only_when_asked() {
     let pack = staggered_pack(4);
     for scheme in [Scheme::Multirate, Scheme::Monolithic] {
         let asked = run(pack.clone(), scheme, 0.05);
-        let mut e = ReferenceEngine::new(pack.clone(), Settings::default()).with_scheme(scheme);
+        let mut e =
+            ReferenceEngine::new(pack.clone(), ReferenceOptions::default()).with_scheme(scheme);
         let mut plain = NotAsking::default();
         e.run(0.05, &mut plain).unwrap();
         assert!(!asked.contacts.is_empty(), "{scheme:?}");

@@ -15,13 +15,13 @@
 
 use clutchpack_model::cases::{bench_drive, staggered_pack};
 use clutchpack_model::*;
-use clutchpack_reference::{ReferenceEngine, Scheme, Settings};
+use clutchpack_reference::{ReferenceEngine, ReferenceOptions, Scheme};
 use std::path::Path;
 
-fn settings(tolerance: f64) -> Settings {
-    Settings {
+fn settings(tolerance: f64) -> ReferenceOptions {
+    ReferenceOptions {
         tolerance,
-        ..Settings::default()
+        ..ReferenceOptions::default()
     }
 }
 
@@ -133,7 +133,7 @@ fn staggered_8_disc_pack_matches_the_monolithic_oracle() {
         "staggered-8",
         &c,
         8,
-        Settings::default().record_rate_hz,
+        ReferenceOptions::default().record_rate_hz,
         0.05,
     );
 }
@@ -182,7 +182,7 @@ fn inertial_shaft_pack_matches_the_monolithic_oracle() {
         "inertial-2",
         &c,
         2,
-        Settings::default().record_rate_hz,
+        ReferenceOptions::default().record_rate_hz,
         0.05,
     );
 }

@@ -6,12 +6,12 @@ use clutchpack_model::cases::{
     PAPER_FIRST_IMPACTS_25UM,
 };
 use clutchpack_model::*;
-use clutchpack_reference::{ReferenceEngine, Settings};
+use clutchpack_reference::{ReferenceEngine, ReferenceOptions};
 
 fn run(pack: PackModel, duration: f64, tol: f64, rate: f64) -> Collector {
     let mut e = ReferenceEngine::new(
         pack,
-        Settings {
+        ReferenceOptions {
             tolerance: tol,
             max_step_s: 1e-4,
             record_rate_hz: rate,
@@ -174,7 +174,7 @@ fn per_tooth_effects_are_refused() {
     for set in cases {
         let mut pack = paper_pack(25e-6);
         set(&mut pack.discs[0]);
-        let mut e = ReferenceEngine::new(pack, Settings::default());
+        let mut e = ReferenceEngine::new(pack, ReferenceOptions::default());
         let err = e.run(1e-3, &mut Collector::default()).unwrap_err();
         assert!(
             matches!(&err, EngineError::Unsupported(m) if m.contains("disc disc")),
@@ -201,7 +201,7 @@ fn per_tooth_effects_are_refused() {
         spline_friction: 0.1,
     });
     let mut c = Collector::default();
-    ReferenceEngine::new(pack, Settings::default())
+    ReferenceEngine::new(pack, ReferenceOptions::default())
         .run(2e-3, &mut c)
         .unwrap();
     assert!(c
@@ -214,7 +214,7 @@ fn per_tooth_effects_are_refused() {
     // all-zero spacing errors are no errors
     let mut pack = paper_pack(25e-6);
     pack.discs[0].tooth_spacing_errors_m = vec![0.0; 154];
-    ReferenceEngine::new(pack, Settings::default())
+    ReferenceEngine::new(pack, ReferenceOptions::default())
         .run(1e-3, &mut Collector::default())
         .unwrap();
 }

@@ -3,7 +3,7 @@
 
 use clutchpack_model::cases::paper_disc;
 use clutchpack_model::*;
-use clutchpack_reference::{ReferenceEngine, Settings};
+use clutchpack_reference::{ReferenceEngine, ReferenceOptions};
 
 /// An undriven inertial shaft at 100 rad/s, 2 dry lossless discs without drag, 3 plates on
 /// the housing, open gaps between them: the gaps' heat is the only loss.
@@ -64,9 +64,9 @@ fn mechanical_energy(pack: &PackModel, s: &Sample) -> f64 {
 #[test]
 fn open_gaps_heat_is_the_mechanical_energy_lost() {
     let pack = open_brake();
-    let settings = Settings {
+    let settings = ReferenceOptions {
         tolerance: 1e-10,
-        ..Settings::default()
+        ..ReferenceOptions::default()
     };
     let mut c = Collector::default();
     ReferenceEngine::new(pack.clone(), settings)
@@ -146,10 +146,10 @@ fn engagement() -> PackModel {
 fn engagement_locks_at_the_closed_form_time_with_the_closed_form_heat() {
     let pack = engagement();
     let stack = pack.stack.clone().unwrap();
-    let settings = Settings {
+    let settings = ReferenceOptions {
         tolerance: 1e-10,
         record_rate_hz: 1e5,
-        ..Settings::default()
+        ..ReferenceOptions::default()
     };
     let mut c = Collector::default();
     ReferenceEngine::new(pack.clone(), settings)
@@ -215,9 +215,9 @@ fn clamped_faces_heat_is_the_mechanical_energy_lost() {
             viscous_slope_s_m: 0.0,
         };
     }
-    let settings = Settings {
+    let settings = ReferenceOptions {
         tolerance: 1e-10,
-        ..Settings::default()
+        ..ReferenceOptions::default()
     };
     let mut c = Collector::default();
     ReferenceEngine::new(pack.clone(), settings)

@@ -25,7 +25,7 @@ impl Simulation {
             EngineChoice::Reference => {
                 let engine = ReferenceEngine::new(
                     scene.pack.clone(),
-                    clutchpack_reference::Settings {
+                    clutchpack_reference::ReferenceOptions {
                         tolerance: sim.tolerance,
                         max_step_s: sim.max_step_s,
                         record_rate_hz: sim.record_rate_hz,
@@ -106,15 +106,14 @@ impl PackEngine {
     pub fn build(self, pack: PackModel) -> Result<Box<dyn Engine + Send>> {
         Ok(match self {
             PackEngine::Reference { scheme, parallel } => Box::new(
-                ReferenceEngine::new(pack, clutchpack_reference::Settings::default())
+                ReferenceEngine::new(pack, clutchpack_reference::ReferenceOptions::default())
                     .with_scheme(scheme)
                     .with_parallel(parallel),
             ),
             PackEngine::Multibody { record_rate_hz } => Box::new(
-                clutchpack_sim::MultibodyEngine::from_pack(
+                clutchpack_sim::MultibodyEngine::new(
                     pack,
-                    record_rate_hz,
-                    clutchpack_sim::MultibodyOptions::default(),
+                    clutchpack_sim::MultibodyOptions::default().with_record_rate(record_rate_hz),
                 )
                 .map_err(|e| Error::BadInput(e.to_string()))?,
             ),

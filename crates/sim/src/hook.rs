@@ -345,7 +345,7 @@ pub(crate) const FLANKS: [Flank; 2] = [Flank::ShaftLeads, Flank::DiscLeads];
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clutchpack_model::{Hertz, LawKind, OilFilm};
+    use clutchpack_model::LawKind;
 
     fn paper_spline() -> SplineGeometry {
         SplineGeometry {
@@ -356,24 +356,9 @@ mod tests {
         }
     }
 
+    /// The paper's law (Table 2), from the model's named cases.
     fn law(kind: LawKind, h_o: f64) -> ToothLaw {
-        ToothLaw {
-            kind,
-            hertz: Hertz {
-                modulus_pa: 210e9,
-                curvature_radius_m: 1.75e-3,
-                loss_coefficient_s_m: 0.8,
-            },
-            oil: OilFilm {
-                thickness_m: h_o,
-                viscosity_pa_s: 289.1,
-                leakage_coefficient: 0.421,
-                width_m: 3e-3,
-                length_m: 3e-3,
-                v_floor_m_s: 0.01,
-                h_min_m: 1e-6,
-            },
-        }
+        clutchpack_model::cases::paper_law(kind, h_o)
     }
 
     /// MODEL.md 5: with a concentric disc and no spacing errors the per-tooth hook is the

@@ -190,6 +190,14 @@ impl Default for MultibodyOptions {
 }
 
 impl MultibodyOptions {
+    /// These options with samples at `record_rate_hz` (Hz).
+    pub fn with_record_rate(self, record_rate_hz: f64) -> MultibodyOptions {
+        MultibodyOptions {
+            record_rate_hz,
+            ..self
+        }
+    }
+
     /// The default options with a run's settings (what a scene's `[simulation]` gives):
     /// samples at `record_rate_hz` (Hz), adaptive steps of at most `max_step_s` (s), every
     /// tooth's load in the samples if `record_tooth_loads`.

@@ -9,8 +9,10 @@ use clutchpack_model::checks::{check_contact_samples, OrderedCollector};
 use clutchpack_model::*;
 use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping};
 
-/// Largest relative shortfall of the densest contact sample below the located peak.
-const PEAK_TOLERANCE: f64 = 0.02;
+/// Largest relative shortfall of the densest contact sample below the located peak: the
+/// measured worst (2.94e-3, the paper case without film, multirate) with a margin of about
+/// 1.5.
+const PEAK_TOLERANCE: f64 = 4.5e-3;
 
 fn run(pack: PackModel, scheme: Scheme, duration: f64) -> Collector {
     let opts = MultibodyOptions {
@@ -18,7 +20,7 @@ fn run(pack: PackModel, scheme: Scheme, duration: f64) -> Collector {
         scheme,
         ..Default::default()
     };
-    let mut e = MultibodyEngine::from_pack(pack, 1e4, opts).expect("engine");
+    let mut e = MultibodyEngine::new(pack, opts.with_record_rate(1e4)).expect("engine");
     let mut o = OrderedCollector::default();
     e.run(duration, &mut o).unwrap();
     assert!(
@@ -38,8 +40,8 @@ fn check(label: &str, c: &Collector, nd: usize) -> (f64, f64) {
 }
 
 /// The paper case (one disc, prescribed shaft) at the three film thicknesses of MODEL.md
-/// section 4, both schemes: every impact's located peak is matched within 2 % by its contact
-/// samples (measured: worst 0.29 % below the peak, about 35 points per contact).
+/// section 4, both schemes: every impact's located peak is matched within [`PEAK_TOLERANCE`] by
+/// its contact samples (measured: worst 0.29 % below the peak, about 35 points per contact).
 #[test]
 fn paper_case_contact_samples_reach_the_located_peaks() {
     for h_o in [0.0, 25e-6, 50e-6] {

@@ -72,7 +72,7 @@ fn run(
     opts: MultibodyOptions,
     duration: f64,
 ) -> (Collector, MultibodyEngine) {
-    let mut e = MultibodyEngine::from_pack(pack.clone(), rate_hz, opts).expect("engine");
+    let mut e = MultibodyEngine::new(pack.clone(), opts.with_record_rate(rate_hz)).expect("engine");
     let mut c = Collector::default();
     let stats = e.run(duration, &mut c).expect("run");
     assert!(!stats.stopped_early);
@@ -388,7 +388,7 @@ fn observer_stops_the_run() {
         }
     }
     let pack = paper_pack(LawKind::Paper, 0.0, 0.8, 0.01);
-    let mut e = MultibodyEngine::from_pack(pack, 1e4, fixed(1e-6)).unwrap();
+    let mut e = MultibodyEngine::new(pack, fixed(1e-6).with_record_rate(1e4)).unwrap();
     let mut obs = StopAt(5e-3, 0);
     let stats = e.run(1.0, &mut obs).unwrap();
     assert!(stats.stopped_early);
@@ -405,7 +405,7 @@ fn observer_stops_the_run() {
 fn impossible_state_is_reported_as_diverged() {
     let mut pack = paper_pack(LawKind::Dry, 0.0, 0.8, 0.0);
     pack.discs[0].initial_rel_angle_rad = 1.2 * std::f64::consts::PI / 154.0;
-    let mut e = MultibodyEngine::from_pack(pack, 1e4, adaptive()).unwrap();
+    let mut e = MultibodyEngine::new(pack, adaptive().with_record_rate(1e4)).unwrap();
     let err = e.run(1e-3, &mut Collector::default()).unwrap_err();
     assert!(matches!(err, EngineError::Diverged { .. }), "{err}");
 }
@@ -414,7 +414,7 @@ fn impossible_state_is_reported_as_diverged() {
 #[test]
 fn squeeze_law_is_refused() {
     let pack = paper_pack(LawKind::Squeeze, 25e-6, 0.8, 0.01);
-    let err = MultibodyEngine::from_pack(pack, 1e4, adaptive()).unwrap_err();
+    let err = MultibodyEngine::new(pack, adaptive().with_record_rate(1e4)).unwrap_err();
     assert!(matches!(err, EngineError::Unsupported(_)), "{err}");
 }
 

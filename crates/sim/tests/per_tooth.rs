@@ -124,7 +124,7 @@ fn run_observed(pack: &PackModel, rate_hz: f64, duration: f64) -> FirstContacts 
         record_tooth_loads: true,
         ..Default::default()
     };
-    let mut e = MultibodyEngine::from_pack(pack.clone(), rate_hz, opts).expect("engine");
+    let mut e = MultibodyEngine::new(pack.clone(), opts.with_record_rate(rate_hz)).expect("engine");
     let mut o = FirstContacts::default();
     e.run(duration, &mut o).expect("run");
     o
@@ -341,7 +341,7 @@ fn floating_disc_chatters_radially_in_the_rattle() {
             record_tooth_loads: true,
             ..Default::default()
         };
-        let mut e = MultibodyEngine::from_pack(pack.clone(), 2e4, opts).expect("engine");
+        let mut e = MultibodyEngine::new(pack.clone(), opts.with_record_rate(2e4)).expect("engine");
         let mut c = Collector::default();
         e.run(duration, &mut c).expect("run");
         c

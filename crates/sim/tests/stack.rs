@@ -81,8 +81,11 @@ fn stack(friction: FrictionCurve, pressure: PressureProfile) -> StackModel {
 }
 
 fn run(pack: &PackModel, duration: f64) -> Collector {
-    let mut e =
-        MultibodyEngine::from_pack(pack.clone(), 2e3, MultibodyOptions::default()).expect("engine");
+    let mut e = MultibodyEngine::new(
+        pack.clone(),
+        MultibodyOptions::default().with_record_rate(2e3),
+    )
+    .expect("engine");
     let mut c = Collector::default();
     e.run(duration, &mut c).expect("run");
     c
@@ -261,7 +264,7 @@ fn open_gaps_drag_with_the_couette_law() {
     for b in p.discs.iter_mut().chain(p.plates.iter_mut()) {
         b.law.hertz.loss_coefficient_s_m = 5.0;
     }
-    let mut e = MultibodyEngine::from_pack(p, 2e3, MultibodyOptions::default()).unwrap();
+    let mut e = MultibodyEngine::new(p, MultibodyOptions::default().with_record_rate(2e3)).unwrap();
     let mut c = Collector::default();
     e.run(0.1, &mut c).unwrap();
     let last = c.samples.last().unwrap();
@@ -295,7 +298,8 @@ fn spline_friction_lowers_the_clamp_along_the_stack() {
     );
     st.spline_friction = 0.1;
     let p = pack(2, 200.0, None, st);
-    let mut e = MultibodyEngine::from_pack(p.clone(), 2e3, MultibodyOptions::default()).unwrap();
+    let mut e =
+        MultibodyEngine::new(p.clone(), MultibodyOptions::default().with_record_rate(2e3)).unwrap();
     let mut c = Collector::default();
     e.run(0.05, &mut c).unwrap();
     let s = c.samples.last().unwrap();
@@ -379,7 +383,7 @@ fn work_of_the_drive_equals_friction_loss_plus_energy_change() {
     for b in p.discs.iter_mut().chain(p.plates.iter_mut()) {
         b.law.hertz.loss_coefficient_s_m = 0.0;
     }
-    let mut e = MultibodyEngine::from_pack(p, 2e3, MultibodyOptions::default()).unwrap();
+    let mut e = MultibodyEngine::new(p, MultibodyOptions::default().with_record_rate(2e3)).unwrap();
     let mut c = Collector::default();
     e.run(0.05, &mut c).unwrap();
     let a = e.energy();

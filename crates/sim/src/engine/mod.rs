@@ -164,22 +164,6 @@ impl MultibodyEngine {
         })
     }
 
-    /// Builds the engine for a pack model, emitting samples at `record_rate_hz` (Hz): the
-    /// options with that rate ([`MultibodyEngine::new`]).
-    pub fn from_pack(
-        pack: PackModel,
-        record_rate_hz: f64,
-        options: MultibodyOptions,
-    ) -> Result<MultibodyEngine, EngineError> {
-        MultibodyEngine::new(
-            pack,
-            MultibodyOptions {
-                record_rate_hz,
-                ..options
-            },
-        )
-    }
-
     /// Whether runs use the multirate scheme (crate docs, "Theory").
     pub fn is_multirate(&self) -> bool {
         self.multirate_refused.is_none()

@@ -424,7 +424,6 @@ impl<'a> Run<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clutchpack_model::{Hertz, LawKind, OilFilm, SplineGeometry, ToothLaw};
 
     /// The graded sub-step: the floor at an onset, a quarter of the contact's age after it,
     /// the controller's step once that is longer, a quarter of the predicted time to
@@ -469,29 +468,9 @@ mod tests {
     /// 2.2e-6 at `r h = 0.1`).
     #[test]
     fn sub_step_is_fourth_order_and_audits_the_drag() {
-        let spline = SplineGeometry {
-            teeth: 154,
-            pitch_radius_m: 0.231,
-            pressure_angle_rad: 20f64.to_radians(),
-            backlash_m: 0.75e-3,
-        };
-        let law = ToothLaw {
-            kind: LawKind::Dry,
-            hertz: Hertz {
-                modulus_pa: 210e9,
-                curvature_radius_m: 5e-3,
-                loss_coefficient_s_m: 0.5,
-            },
-            oil: OilFilm {
-                thickness_m: 0.0,
-                viscosity_pa_s: 0.0,
-                leakage_coefficient: 0.421,
-                width_m: 3e-3,
-                length_m: 3e-3,
-                v_floor_m_s: 0.01,
-                h_min_m: 1e-6,
-            },
-        };
+        // the bench disc's spline and dry law (`scenes/bench-8-disc.toml`)
+        let disc = clutchpack_model::cases::bench_disc("d");
+        let (spline, law) = (disc.spline, disc.law);
         let coupling = Coupling::new(spline, law, false, &[]);
         let profile = SpeedProfile::sine(0.0, 0.0, 1.0);
         let (j, c2, w0) = (0.2, 20.0, 1e-3);
