@@ -1,5 +1,5 @@
 //! What a run reports from its state as it goes: the impact events and contact samples of
-//! each coupling (with [`EventTrack`]) and the energy audit (with [`Powers`]). The run's
+//! each coupling (with its `EventBook`) and the energy audit (with its `EnergyBook`). The run's
 //! state (`state.rs`) holds the trackers and the audit; the bookkeeping types know nothing of
 //! the run.
 
@@ -12,24 +12,18 @@ use clutchpack_model::Observer;
 
 impl Run<'_> {
     /// Feeds the impact trackers with the state at `t` and sends the impacts that closed and
-    /// the contact samples due ([`EventTrack::contact_sample_due`]).
+    /// the contact samples due.
     pub(super) fn track_events(&mut self, steps_per_contact: f64, observer: &mut dyn Observer) {
-        for i in 0..self.tracks.len() {
+        for i in 0..self.couplings.len() {
             let law = &self.bodies[i].law;
             let f = &self.forces[i];
             let m = self.m_eff[i];
             let step = |v| contact_duration_s(law, f.kin.flank, v, m) / steps_per_contact;
-            let track = &mut self.tracks[i];
-            let was_open = track.tracker.is_open();
-            let closed = track.update(self.t, f, step);
-            if let Some(e) = &closed {
+            let tracked = self.events.update(i, self.t, f, steps_per_contact, step);
+            if let Some(e) = &tracked.closed {
                 observer.impact(e);
             }
-            if self.contact_samples && track.contact_sample_due(self.t, was_open, steps_per_contact)
-            {
-                // the state that closed the event is sent at its separation (see
-                // `contact_sample_due`)
-                let t = closed.map_or(self.t, |e| e.t_off_s);
+            if let Some(t) = tracked.contact_sample_at {
                 observer.contact_sample(i, t, &self.disc_sample(i, false));
             }
         }
@@ -98,17 +92,7 @@ impl Run<'_> {
             drag: drag + shaft_damping + drum_drag,
             load,
         };
-        if let Some(b) = self.powers_before {
-            let h = now.t - b.t;
-            self.energy.drive_work_j += match self.shaft {
-                ShaftDrive::Prescribed(_) => {
-                    0.5 * (b.spline_torque + now.spline_torque) * (now.theta_s - b.theta_s)
-                }
-                ShaftDrive::Inertial { .. } => 0.5 * (b.drive + now.drive) * h,
-            };
-            self.energy.drag_work_j += 0.5 * (b.drag + now.drag) * h;
-            self.energy.load_work_j += 0.5 * (b.load + now.load) * h;
-        }
-        self.powers_before = Some(now);
+        let prescribed = matches!(self.shaft, ShaftDrive::Prescribed(_));
+        self.energy.add_powers(now, prescribed);
     }
 }

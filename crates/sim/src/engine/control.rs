@@ -63,8 +63,8 @@ impl Run<'_> {
                 m_eff_kg: self.m_eff[i],
                 // 1 % over the bound: rounding must not make it optimistic.
                 rel_accel_bound: 1.01 * (a_carrier + a_disc),
-                event_step_s: self.tracks[i].event_step_s,
-                event_age_s: self.tracks[i].event_t_on_s.map(|t_on| self.t - t_on),
+                event_step_s: self.events.event_step_s(i),
+                event_age_s: self.events.event_age_s(i, self.t),
             };
             let (dt, c) = coupling_step(&view, a);
             if dt < want {

@@ -45,3 +45,56 @@ pub(super) struct Powers {
     /// Power of the drum's load torque, W.
     pub(super) load: f64,
 }
+
+/// The energy audit of a run as it goes, the one place that writes it: the work of the
+/// drive, the drag, the load (trapezoidal over the evaluations, [`EnergyBook::add_powers`]),
+/// of the stack and of the multirate sub-steps, and the energies at the start and the end.
+#[derive(Debug, Clone, Default)]
+pub(super) struct EnergyBook {
+    audit: EnergyAudit,
+    /// Powers at the last evaluation.
+    before: Option<Powers>,
+}
+
+impl EnergyBook {
+    /// Adds the work since the last evaluation, from its powers and `now`'s (trapezoidal
+    /// rule); for a prescribed shaft (`prescribed`) the drive's work is the teeth's torque
+    /// times the shaft's turn.
+    pub(super) fn add_powers(&mut self, now: Powers, prescribed: bool) {
+        if let Some(b) = self.before {
+            let h = now.t - b.t;
+            self.audit.drive_work_j += if prescribed {
+                0.5 * (b.spline_torque + now.spline_torque) * (now.theta_s - b.theta_s)
+            } else {
+                0.5 * (b.drive + now.drive) * h
+            };
+            self.audit.drag_work_j += 0.5 * (b.drag + now.drag) * h;
+            self.audit.load_work_j += 0.5 * (b.load + now.load) * h;
+        }
+        self.before = Some(now);
+    }
+
+    /// Adds the stack's work over a step, J.
+    pub(super) fn add_stack_work(&mut self, work_j: f64) {
+        self.audit.stack_work_j += work_j;
+    }
+
+    /// Adds a multirate sub-step's work of the drive and of the drag, J.
+    pub(super) fn add_sub_step(&mut self, drive_j: f64, drag_j: f64) {
+        self.audit.drive_work_j += drive_j;
+        self.audit.drag_work_j += drag_j;
+    }
+
+    /// The energies at t = 0: the teeth's potential and the kinetic energy, J.
+    pub(super) fn start(&mut self, contact_potential_j: f64, kinetic_j: f64) {
+        self.audit.initial_contact_potential_j = contact_potential_j;
+        self.audit.initial_kinetic_j = kinetic_j;
+    }
+
+    /// The audit, with the energies at the end of the run, J.
+    pub(super) fn finish(&mut self, contact_potential_j: f64, kinetic_j: f64) -> EnergyAudit {
+        self.audit.contact_potential_j = contact_potential_j;
+        self.audit.kinetic_j = kinetic_j;
+        self.audit
+    }
+}

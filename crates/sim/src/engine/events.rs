@@ -3,23 +3,23 @@
 
 use crate::hook::CouplingForces;
 
-use clutchpack_model::{parabolic_peak, ImpactTracker};
+use clutchpack_model::{parabolic_peak, ImpactEvent, ImpactTracker};
 
 /// Per-coupling event bookkeeping.
 #[derive(Debug, Clone, Default)]
-pub(super) struct EventTrack {
-    pub(super) tracker: ImpactTracker,
+struct EventTrack {
+    tracker: ImpactTracker,
     /// (t, depth, v_n) at the previous evaluation.
-    pub(super) prev: Option<(f64, f64, f64)>,
+    prev: Option<(f64, f64, f64)>,
     /// The last two (t, load) of the open event, for the parabolic peak.
-    pub(super) last: Option<(f64, f64)>,
-    pub(super) before_last: Option<(f64, f64)>,
+    last: Option<(f64, f64)>,
+    before_last: Option<(f64, f64)>,
     /// The step of the open event (adaptive stepping).
-    pub(super) event_step_s: Option<f64>,
+    event_step_s: Option<f64>,
     /// The onset of the open event, s.
-    pub(super) event_t_on_s: Option<f64>,
+    event_t_on_s: Option<f64>,
     /// Time of the last contact sample sent, s.
-    pub(super) last_contact_sample_s: f64,
+    last_contact_sample_s: f64,
 }
 
 /// Contact samples per contact aimed at ([`EventTrack::contact_sample_due`]): with 32 points
@@ -30,7 +30,7 @@ pub(crate) const CONTACT_SAMPLES_PER_CONTACT: f64 = 32.0;
 
 impl EventTrack {
     /// Feeds the coupling's state at `t`; returns an event that closed.
-    pub(super) fn update(
+    fn update(
         &mut self,
         t: f64,
         f: &CouplingForces,
@@ -79,12 +79,7 @@ impl EventTrack {
     /// the time since its onset: about 32 points over an impact, and a sustained contact's
     /// points thin out geometrically (32 more per e-fold of its age; the regular samples
     /// carry it at the record rate).
-    pub(super) fn contact_sample_due(
-        &mut self,
-        t: f64,
-        was_open: bool,
-        steps_per_contact: f64,
-    ) -> bool {
+    fn contact_sample_due(&mut self, t: f64, was_open: bool, steps_per_contact: f64) -> bool {
         let due = match (was_open, self.tracker.is_open()) {
             (false, false) => false,
             (false, true) | (true, false) => true,
@@ -102,7 +97,7 @@ impl EventTrack {
 
     /// Observes a load sample and, when the previous sample was a local maximum of `|F|`, the
     /// vertex of the parabola through the three samples around it (the peak between steps).
-    pub(super) fn push(&mut self, t: f64, load: f64) {
+    fn push(&mut self, t: f64, load: f64) {
         self.tracker.observe(t, load);
         if let (Some((t0, f0)), Some((t1, f1))) = (self.before_last, self.last) {
             if f1 != 0.0 && t0 < t1 && t1 < t {
@@ -114,5 +109,82 @@ impl EventTrack {
         }
         self.before_last = self.last;
         self.last = Some((t, load));
+    }
+}
+
+/// What one update of a coupling's tracker gave.
+pub(super) struct Tracked {
+    /// The impact that closed, if one did.
+    pub(super) closed: Option<ImpactEvent>,
+    /// When a contact sample is due, the time to send it at (the separation for the state
+    /// that closed an impact); `None` also when the observer takes no contact samples.
+    pub(super) contact_sample_at: Option<f64>,
+}
+
+/// The impact events of every coupling of a run, the one place that writes them: each
+/// coupling's tracker and its contact-sample schedule.
+#[derive(Debug, Clone)]
+pub(super) struct EventBook {
+    tracks: Vec<EventTrack>,
+    /// Whether the observer takes contact samples (`Observer::wants_contact_samples`).
+    contact_samples: bool,
+}
+
+impl EventBook {
+    /// The trackers of `couplings` couplings, numbered as the engine's output.
+    pub(super) fn new(couplings: usize) -> EventBook {
+        EventBook {
+            tracks: (0..couplings)
+                .map(|i| EventTrack {
+                    tracker: ImpactTracker::new(i),
+                    ..Default::default()
+                })
+                .collect(),
+            contact_samples: false,
+        }
+    }
+
+    /// Whether contact samples are scheduled (the observer's wish).
+    pub(super) fn take_contact_samples(&mut self, yes: bool) {
+        self.contact_samples = yes;
+    }
+
+    /// The step of coupling `i`'s open event, s.
+    pub(super) fn event_step_s(&self, i: usize) -> Option<f64> {
+        self.tracks[i].event_step_s
+    }
+
+    /// The age at `t` of coupling `i`'s open event, s.
+    pub(super) fn event_age_s(&self, i: usize, t: f64) -> Option<f64> {
+        self.tracks[i].event_t_on_s.map(|t_on| t - t_on)
+    }
+
+    /// Feeds coupling `i`'s state at `t` (`contact_step` gives the step of a new event from
+    /// its closing speed, [`EventTrack::update`]); says whether an impact closed and whether a
+    /// contact sample is due ([`EventTrack::contact_sample_due`]).
+    pub(super) fn update(
+        &mut self,
+        i: usize,
+        t: f64,
+        f: &CouplingForces,
+        steps_per_contact: f64,
+        contact_step: impl FnOnce(f64) -> f64,
+    ) -> Tracked {
+        let track = &mut self.tracks[i];
+        let was_open = track.tracker.is_open();
+        let closed = track.update(t, f, contact_step);
+        let due = self.contact_samples && track.contact_sample_due(t, was_open, steps_per_contact);
+        Tracked {
+            closed,
+            contact_sample_at: due.then(|| closed.map_or(t, |e| e.t_off_s)),
+        }
+    }
+
+    /// Closes the events still open at the end of the run, `t`.
+    pub(super) fn finish(&mut self, t: f64) -> Vec<ImpactEvent> {
+        self.tracks
+            .iter_mut()
+            .filter_map(|k| k.tracker.finish(t))
+            .collect()
     }
 }

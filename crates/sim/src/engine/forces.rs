@@ -432,7 +432,7 @@ impl Run<'_> {
             for m in 0..s.interfaces() {
                 let slip = w(s.body[m + 1]) - w(s.body[m]);
                 let work = s.impulse[m] * slip;
-                self.energy.stack_work_j += work;
+                self.energy.add_stack_work(work);
                 s.dissipated_j[m] -= work;
             }
         }

@@ -253,7 +253,8 @@ impl MultibodyEngine {
     ) -> Result<RunStats, EngineError> {
         let opts = &self.options;
         let mut run = Run::new(&self.pack, opts, &self.per_tooth)?;
-        run.contact_samples = observer.wants_contact_samples();
+        run.events
+            .take_contact_samples(observer.wants_contact_samples());
         let period = 1.0 / opts.record_rate_hz;
         let rec_time = |j: u64| j as f64 * period;
         let mut rec_index: u64 = 0;
@@ -279,8 +280,8 @@ impl MultibodyEngine {
             run.evaluate(t_last_good)?;
             t_last_good = run.t;
             if steps == 0 {
-                run.energy.initial_contact_potential_j = run.potential_j;
-                run.energy.initial_kinetic_j = run.kinetic_energy();
+                let kinetic_j = run.kinetic_energy();
+                run.energy.start(run.potential_j, kinetic_j);
             }
             run.track_events(steps_per_contact, observer);
             if rec_time(rec_index) <= run.t + half_step {
@@ -366,14 +367,11 @@ impl MultibodyEngine {
             run.advance(t_next);
             steps += 1;
         }
-        for track in run.tracks.iter_mut() {
-            if let Some(e) = track.tracker.finish(run.t) {
-                observer.impact(&e);
-            }
+        for e in run.events.finish(run.t) {
+            observer.impact(&e);
         }
-        run.energy.contact_potential_j = run.potential_j;
-        run.energy.kinetic_j = run.kinetic_energy();
-        self.energy = run.energy;
+        let kinetic_j = run.kinetic_energy();
+        self.energy = run.energy.finish(run.potential_j, kinetic_j);
         Ok(RunStats {
             simulated_s: run.t,
             steps,
@@ -395,7 +393,8 @@ impl MultibodyEngine {
     ) -> Result<RunStats, EngineError> {
         let opts = &self.options;
         let mut run = Run::new(&self.pack, opts, &self.per_tooth)?;
-        run.contact_samples = observer.wants_contact_samples();
+        run.events
+            .take_contact_samples(observer.wants_contact_samples());
         let period = 1.0 / opts.record_rate_hz;
         let rec_time = |j: u64| j as f64 * period;
         let mut rec_index: u64 = 0;
@@ -406,8 +405,8 @@ impl MultibodyEngine {
         let mut stopped = false;
         // The state at t = 0, as the shared step reads it.
         run.evaluate(0.0)?;
-        run.energy.initial_contact_potential_j = run.potential_j;
-        run.energy.initial_kinetic_j = run.kinetic_energy();
+        let kinetic_j = run.kinetic_energy();
+        run.energy.start(run.potential_j, kinetic_j);
         run.track_events(a.steps_per_contact, observer);
         loop {
             if rec_time(rec_index) <= run.t {
@@ -438,14 +437,11 @@ impl MultibodyEngine {
             }
             steps += 1;
         }
-        for track in run.tracks.iter_mut() {
-            if let Some(e) = track.tracker.finish(run.t) {
-                observer.impact(&e);
-            }
+        for e in run.events.finish(run.t) {
+            observer.impact(&e);
         }
-        run.energy.contact_potential_j = run.potential_j;
-        run.energy.kinetic_j = run.kinetic_energy();
-        self.energy = run.energy;
+        let kinetic_j = run.kinetic_energy();
+        self.energy = run.energy.finish(run.potential_j, kinetic_j);
         self.substeps = counts.substeps;
         Ok(RunStats {
             simulated_s: run.t,

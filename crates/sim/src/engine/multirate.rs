@@ -192,7 +192,7 @@ impl<'a> Run<'a> {
     /// each disc's tooth impulse. Impact events that closed go to `closed` (in the order they
     /// closed within each coupling), the contact samples `(coupling, t s, state)` of the
     /// sub-steps to `contacts` (in time order within each coupling; see
-    /// `EventTrack::contact_sample_due`).
+    /// `EventBook::update`).
     pub(super) fn multirate_step(
         &mut self,
         t1: f64,
@@ -303,11 +303,11 @@ impl<'a> Run<'a> {
                 // 1 % over the bound: rounding must not make it optimistic.
                 rel_accel_bound: 1.01
                     * (self.shaft_accel_bound + d.drag_n_m_s_rad * wd.abs() * inv_j),
-                event_step_s: self.tracks[i].event_step_s,
-                event_age_s: self.tracks[i].event_t_on_s.map(|t_on| t - t_on),
+                event_step_s: self.events.event_step_s(i),
+                event_age_s: self.events.event_age_s(i, t),
             };
             let (want, _) = coupling_step(&view, a);
-            let want = graded_step(want, &f, self.tracks[i].event_t_on_s.map(|t_on| t - t_on));
+            let want = graded_step(want, &f, self.events.event_age_s(i, t));
             if want.is_nan() || want < a.min_step_s {
                 return Err(EngineError::Diverged {
                     t_s: t,
@@ -373,8 +373,7 @@ impl<'a> Run<'a> {
             shaft = step.shaft;
             counts.substeps += 1;
             counts.evals += step.evals + 1;
-            self.energy.drive_work_j += step.drive_j;
-            self.energy.drag_work_j += step.drag_j;
+            self.energy.add_sub_step(step.drive_j, step.drag_j);
             if !(phi.abs() <= limit && dphi.is_finite()) {
                 return Err(EngineError::Diverged {
                     t_s: t,
@@ -400,19 +399,16 @@ impl<'a> Run<'a> {
             self.rel[i] = rel_state;
             let steps_per_contact = a.steps_per_contact;
             let step_of = |v| contact_duration_s(&d.law, f.kin.flank, v, m_eff) / steps_per_contact;
-            let was_open = self.tracks[i].tracker.is_open();
-            let ended = self.tracks[i].update(t, &f, step_of);
-            if let Some(e) = ended {
+            let tracked = self.events.update(i, t, &f, steps_per_contact, step_of);
+            if let Some(e) = tracked.closed {
                 closed.push(e);
             }
-            if self.contact_samples
-                && self.tracks[i].contact_sample_due(t, was_open, steps_per_contact)
-            {
+            if let Some(at) = tracked.contact_sample_at {
+                // the closing state is sent at the separation
                 let omega_d = shaft.speed - dphi;
                 contacts.push((
                     i,
-                    // the closing state at the separation (`contact_sample_due`)
-                    ended.map_or(t, |e| e.t_off_s),
+                    at,
                     disc_sample(&f, &rel_state, shaft.angle, omega_d, Vec::new()),
                 ));
             }

@@ -2,8 +2,8 @@
 //! body's loads and kicks, the couplings and their memories, the clock; and what is read from
 //! it (relative states, carriers, samples).
 
-use super::energy::{EnergyAudit, Powers};
-use super::events::EventTrack;
+use super::energy::EnergyBook;
+use super::events::EventBook;
 use crate::hook::{Coupling, CouplingForces, RelativeState};
 use crate::integrate::{Kick, Load, LoadHistory, Motion};
 use crate::options::MultibodyOptions;
@@ -11,8 +11,8 @@ use crate::stack::Stack;
 use crate::stepping::profile_acceleration_bound;
 use crate::world::{angle_about_z, Carrier, World};
 use clutchpack_model::{
-    DiscModel, DiscSample, DrumModel, EngineError, ImpactTracker, PackModel, Sample, Shaft,
-    ShaftExcitation, SpeedProfile,
+    DiscModel, DiscSample, DrumModel, EngineError, PackModel, Sample, Shaft, ShaftExcitation,
+    SpeedProfile,
 };
 use rapier3d_f64::prelude::{RigidBody, Vector};
 
@@ -85,6 +85,15 @@ pub(super) struct DrumRun {
 ///
 /// Couplings are numbered as the engine's output: the friction discs (carrier: the shaft),
 /// then the separator plates (carrier: the drum, or the housing).
+///
+/// Who writes what: the models and the couplings are set here and only read after; the
+/// impact events and the energy audit are books written through their own methods
+/// (`events.rs`, `energy.rs`); the teeth's kicks and the loads only by the shared step
+/// (`forces.rs`); the clock and the kinematic state (`t`, the shaft's angle and speed, the
+/// bodies' speeds, the relative states and the forces, the teeth's potential, the world's
+/// poses) by the two schemes that advance it, the shared step (`forces.rs`) and the
+/// multirate step (`multirate.rs`); the stack and the drum by the shared step and their own
+/// methods (`stack.rs`).
 pub(super) struct Run<'a> {
     pub(super) pack: &'a PackModel,
     /// The coupled bodies' models: the discs, then the plates.
@@ -98,14 +107,11 @@ pub(super) struct Run<'a> {
     pub(super) couplings: Vec<Coupling>,
     /// Effective mass per tooth of each coupling, kg (reduced with an inertial carrier).
     pub(super) m_eff: Vec<f64>,
-    pub(super) tracks: Vec<EventTrack>,
-    /// Whether the observer takes contact samples (`Observer::wants_contact_samples`).
-    pub(super) contact_samples: bool,
+    /// The impact events (written through its methods only, `events.rs`).
+    pub(super) events: EventBook,
     /// The hook's results at `t` (filled by [`Run::evaluate`]).
     pub(super) rel: Vec<RelativeState>,
     pub(super) forces: Vec<CouplingForces>,
-    /// Powers at the last evaluation.
-    pub(super) powers_before: Option<Powers>,
     /// The loads of each coupled body and of an inertial shaft (the drum keeps its own).
     pub(super) loads: Vec<BodyLoads>,
     pub(super) shaft_loads: BodyLoads,
@@ -130,7 +136,8 @@ pub(super) struct Run<'a> {
     pub(super) omega_s: f64,
     /// Elastic energy in the teeth at `t`, J.
     pub(super) potential_j: f64,
-    pub(super) energy: EnergyAudit,
+    /// The energy audit (written through its methods only, `energy.rs`).
+    pub(super) energy: EnergyBook,
 }
 
 impl<'a> Run<'a> {
@@ -152,12 +159,6 @@ impl<'a> Run<'a> {
             })
             .collect();
         let nd = couplings.len();
-        let tracks = (0..nd)
-            .map(|i| EventTrack {
-                tracker: ImpactTracker::new(i),
-                ..Default::default()
-            })
-            .collect();
         let (shaft, shaft_accel_bound) = match &pack.shaft {
             Shaft::Prescribed(p) => (ShaftDrive::Prescribed(p), profile_acceleration_bound(p)),
             Shaft::Inertial {
@@ -217,11 +218,9 @@ impl<'a> Run<'a> {
             stack,
             couplings,
             m_eff,
-            tracks,
-            contact_samples: false,
+            events: EventBook::new(nd),
             rel: Vec::with_capacity(nd),
             forces: Vec::with_capacity(nd),
-            powers_before: None,
             loads: vec![BodyLoads::default(); nd],
             shaft_loads: BodyLoads::default(),
             prev_motion: vec![None; nd],
@@ -235,7 +234,7 @@ impl<'a> Run<'a> {
             theta_s: 0.0,
             omega_s: pack.shaft.initial_speed_rad_s(),
             potential_j: 0.0,
-            energy: EnergyAudit::default(),
+            energy: EnergyBook::default(),
         })
     }
 
