@@ -20,28 +20,10 @@ use std::process::ExitCode;
 
 /// Opens a recording; a damaged one is bad input unless `salvage`.
 pub fn open_recording(path: &Path, salvage: bool) -> Result<RecordingReader> {
-    let reader = clutchpack_record::open(path).map_err(|e| BadInput(e.to_string()))?;
-    if let Some(d) = reader.damage() {
-        if salvage && reader.info().messages == 0 {
-            // nothing to work on: not a success
-            return Err(BadInput(format!(
-                "{}: {d}; --salvage recovered no message",
-                path.display()
-            ))
-            .into());
-        }
-        if salvage {
-            eprintln!(
-                "warning: {}: {d}; using the recovered messages",
-                path.display()
-            );
-        } else {
-            return Err(BadInput(format!(
-                "{}: {d} (pass --salvage to use the recovered messages)",
-                path.display()
-            ))
-            .into());
-        }
+    let (reader, warning) =
+        clutchpack_sdk::open_recording(path, salvage).map_err(|e| BadInput(e.to_string()))?;
+    if let Some(w) = warning {
+        eprintln!("warning: {w}");
     }
     Ok(reader)
 }

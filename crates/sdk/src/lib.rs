@@ -6,7 +6,8 @@
 //! the friction interfaces, the teeth's fatigue, the impacts CSV, the recording), the
 //! summary of a run, ensembles and batches of runs, and the fatigue of a recording. It
 //! prints nothing and never exits: problems are an [`Error`], bad input told from a failed
-//! run by [`Error::is_bad_input`].
+//! run by [`Error::is_bad_input`]. Reading a recording back: [`open_recording`] (the policy
+//! for damaged files) and [`RecordedFatigue`].
 //!
 //! ```no_run
 //! use clutchpack_sdk::{load_scene, RunRequest, Simulation};
@@ -22,6 +23,7 @@ mod batch;
 mod collector;
 mod error;
 mod fatigue;
+mod recording;
 mod run;
 mod scene;
 mod simulation;
@@ -31,6 +33,7 @@ pub use batch::{ensemble_member, run_case, run_cases, CaseRuns, MemberFatigue, M
 pub use collector::{merge_peaks, RunCollector};
 pub use error::{Error, Result};
 pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
+pub use recording::open_recording;
 pub use run::{RecordingRequest, RunOutcome, RunRequest};
 pub use scene::{load_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TEXT};
 pub use simulation::{PackEngine, Simulation};
