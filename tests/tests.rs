@@ -5,6 +5,7 @@ mod architecture;
 mod cross_engine;
 mod fatigue;
 mod hardening;
+mod python_package;
 mod reliability;
 mod slurm;
 mod study;

@@ -1,0 +1,247 @@
+"""clutchpack: wet multi-disc clutch and brake pack simulator.
+
+How hard the spline teeth of each friction disc and separator plate hit their carrier when
+the shaft's speed fluctuates, how the oil film softens the impacts, which body suffers most,
+and whether the pack survives. The same library the ``clutchpack`` command line calls: a run
+from Python is a run of the CLI, number for number.
+
+Units are SI everywhere (degrees only under keys ending ``_deg``). Per-tooth loads are in N,
+negative when the shaft (or carrier) leads, positive when the disc leads.
+
+    >>> import clutchpack
+    >>> r = clutchpack.run("scenes/hu-table2.toml")
+    >>> r.summary["discs"][0]["max_positive_n"]      # N
+    >>> r.impacts.head()                               # a pandas DataFrame
+
+Bad input raises ``ValueError`` naming the key and the rule, as ``clutchpack check`` prints
+it. An engine runs with the GIL released; Ctrl-C stops it within a fraction of a second,
+its outputs (the recording) complete, and raises ``KeyboardInterrupt``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Union
+
+import numpy as np
+import pandas as pd
+
+from . import _clutchpack
+from ._clutchpack import Scene
+
+__version__: str = _clutchpack.__version__
+
+__all__ = ["Scene", "Result", "load_scene", "run", "sweep", "read", "IMPACT_COLUMNS"]
+
+#: The columns of ``Result.impacts``, as in ``clutchpack run --impacts-csv``: body name,
+#: onset, peak and separation times (s), flank (``drive`` or ``coast``... as the CSV), the
+#: closing speed at onset (m/s) and the signed peak per-tooth load (N).
+IMPACT_COLUMNS = ["disc", "t_on_s", "t_peak_s", "t_off_s", "flank", "v_on_m_s", "peak_n"]
+
+PathLike = Union[str, "os.PathLike[str]"]
+SceneLike = Union[Scene, PathLike, Mapping[str, Any], None]
+
+
+def _sets(set: Optional[Mapping[str, Any]]) -> List[tuple]:
+    """``{"defaults.oil.film_thickness_m": 25e-6}`` -> ``[("defaults...", "2.5e-05")]``,
+    values written as the command line's ``--set KEY=VALUE`` takes them."""
+    out = []
+    for k, v in (set or {}).items():
+        if isinstance(v, bool):
+            text = "true" if v else "false"
+        elif isinstance(v, (list, tuple, dict)):
+            text = json.dumps(v)
+        elif isinstance(v, float):
+            text = repr(v)
+        else:
+            text = str(v)
+        out.append((str(k), text))
+    return out
+
+
+def load_scene(
+    scene: SceneLike = None, set: Optional[Mapping[str, Any]] = None, name: Optional[str] = None
+) -> Scene:
+    """A validated scene: a file path, a dict of the TOML file's tables, or ``None`` for the
+    paper's case (built in); ``set`` overrides keys (dotted paths as in the file, e.g.
+    ``{"discs[1].inertia_kg_m2": 0.2}``). Every problem raises ``ValueError`` at once, with
+    its key, as ``clutchpack check`` prints it."""
+    sets = _sets(set)
+    if isinstance(scene, Scene):
+        return scene.with_sets(sets) if sets else scene
+    if scene is None:
+        return _clutchpack.load_scene(sets=sets)
+    if isinstance(scene, Mapping):
+        return _clutchpack.scene_from_json(json.dumps(scene), name or "<dict>", sets)
+    return _clutchpack.load_scene(path=os.fspath(scene), sets=sets)
+
+
+def _impacts(raw: Any) -> pd.DataFrame:
+    return pd.DataFrame(
+        {
+            "disc": raw.impact_disc,
+            "t_on_s": np.asarray(raw.impact_t_on_s, dtype=float),
+            "t_peak_s": np.asarray(raw.impact_t_peak_s, dtype=float),
+            "t_off_s": np.asarray(raw.impact_t_off_s, dtype=float),
+            "flank": raw.impact_flank,
+            "v_on_m_s": np.asarray(raw.impact_v_on_m_s, dtype=float),
+            "peak_n": np.asarray(raw.impact_peak_n, dtype=float),
+        },
+        columns=IMPACT_COLUMNS,
+    )
+
+
+@dataclass
+class Result:
+    """A run (``run``) or a recording read back (``read``).
+
+    - ``summary``: dict, what ``clutchpack run --summary-json`` writes (scene, engine,
+      ``duration_s`` in s, ``steps``, per-body ``discs`` statistics in N, ``interfaces``,
+      ``fatigue``); for a recording, its stored summary.
+    - ``impacts``: DataFrame with ``IMPACT_COLUMNS``, one row per impact in time of closing.
+    - ``samples``: DataFrame of the per-tooth load history (N) at the record rate, column
+      ``t_s`` (s) and one column per body (a run); for a recording, per body, its load series
+      (``loads``).
+    - ``interfaces``: list of dicts, the stack's friction interfaces (clamp N, torque N m,
+      lock time s, heat J); empty without a stack.
+    - ``fatigue``: DataFrame, one row per body: damage rate (1/h), life (h), damage-equivalent
+      load range (N).
+    - ``recording``: the recording's path, if recorded; ``scene_text``: the scene as run.
+    """
+
+    summary: Dict[str, Any]
+    impacts: pd.DataFrame
+    samples: pd.DataFrame
+    recording: Optional[str] = None
+    engine_line: str = ""
+    scene_text: Optional[str] = None
+    overrides: List[str] = field(default_factory=list)
+    loads: Dict[str, pd.DataFrame] = field(default_factory=dict)
+    warnings: List[str] = field(default_factory=list)
+
+    @property
+    def interfaces(self) -> List[Dict[str, Any]]:
+        return list(self.summary.get("interfaces", []))
+
+    @property
+    def fatigue(self) -> pd.DataFrame:
+        rows = []
+        for body, f in zip(self.summary.get("discs", []), self.summary.get("fatigue", [])):
+            if not f:
+                continue
+            rows.append(
+                {
+                    "disc": body["name"],
+                    "damage_rate_per_h": f["damage_rate_per_h"],
+                    "life_h": np.nan if f["life_h"] is None else f["life_h"],
+                    "eq_load_range_n": f["eq_load_range_n"],
+                }
+            )
+        return pd.DataFrame(rows, columns=["disc", "damage_rate_per_h", "life_h", "eq_load_range_n"])
+
+    def stats(self) -> pd.DataFrame:
+        """The per-body statistics of ``summary["discs"]`` as a DataFrame (loads in N)."""
+        return pd.DataFrame(self.summary.get("discs", []))
+
+
+def run(
+    scene: SceneLike = None,
+    engine: Optional[str] = None,
+    duration: Optional[float] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    record: Optional[PathLike] = None,
+    impacts_csv: Optional[PathLike] = None,
+    keep_samples: bool = True,
+    deterministic: bool = False,
+) -> Result:
+    """Runs a scene (a path, a dict, a ``Scene`` or ``None`` for the paper's case) as
+    ``clutchpack run`` does. ``engine``: ``"reference"`` or ``"multibody"`` (default: the
+    scene's choice); ``duration``: simulated time in s; ``set``: key overrides; ``record``:
+    write the MCAP recording there; ``impacts_csv``: also write the impacts CSV."""
+    s = dict(set or {})
+    if duration is not None:
+        s["simulation.duration_s"] = float(duration)
+    sc = load_scene(scene, s)
+    raw = _clutchpack.run(
+        sc,
+        engine=engine,
+        record=None if record is None else os.fspath(record),
+        impacts_csv=None if impacts_csv is None else os.fspath(impacts_csv),
+        keep_samples=keep_samples,
+        deterministic=deterministic,
+    )
+    samples = pd.DataFrame({"t_s": np.asarray(raw.sample_t_s, dtype=float)})
+    for name, loads in raw.sample_load_n:
+        samples[name] = np.asarray(loads, dtype=float)
+    return Result(
+        summary=json.loads(raw.summary_json),
+        impacts=_impacts(raw),
+        samples=samples,
+        recording=None if raw.recording is None else os.fspath(raw.recording),
+        engine_line=raw.engine_line,
+        scene_text=sc.text,
+        overrides=list(sc.overrides),
+        warnings=list(raw.warnings),
+    )
+
+
+def read(path: PathLike, salvage: bool = False) -> Result:
+    """A recording as a ``Result``: its summary, impacts and each body's load series
+    (``loads[name]``: DataFrame ``t_s``, ``load_n``), and the scene it was run from. A
+    damaged file (cut by a kill) raises ``ValueError`` unless ``salvage``: then what could be
+    read, with the damage in ``warnings``."""
+    raw = _clutchpack.read(os.fspath(path), salvage=salvage)
+    loads = {
+        name: pd.DataFrame({"t_s": np.asarray(t, dtype=float), "load_n": np.asarray(v, dtype=float)})
+        for name, t, v in raw.loads
+    }
+    return Result(
+        summary=json.loads(raw.summary_json),
+        impacts=_impacts(raw),
+        samples=pd.DataFrame(),
+        recording=os.fspath(path),
+        scene_text=raw.scene_text,
+        overrides=list(raw.overrides),
+        loads=loads,
+        warnings=[] if raw.warning is None else [raw.warning],
+    )
+
+
+@dataclass
+class Sweep:
+    """A sweep: ``rows`` (DataFrame: ``value``, ``disc``, and for each statistic its ensemble
+    ``mean``, ``std``, ``min``, ``max``; loads in N) and ``summary`` (what
+    ``clutchpack sweep --summary-json`` writes, but the fits)."""
+
+    summary: Dict[str, Any]
+    rows: pd.DataFrame
+
+
+def sweep(
+    scene: SceneLike,
+    param: str,
+    values: Sequence[float],
+    ensemble: int = 1,
+    jobs: Optional[int] = None,
+    engine: Optional[str] = None,
+    set: Optional[Mapping[str, Any]] = None,
+) -> Sweep:
+    """Runs ``scene`` once per value of the key ``param`` (as ``clutchpack sweep``), each value
+    as an ensemble of ``ensemble`` members spread across the free play, on ``jobs`` threads."""
+    if int(ensemble) < 1:
+        raise ValueError(f"ensemble = {ensemble}: expected an integer >= 1")
+    sc = load_scene(scene, set)
+    text = _clutchpack.sweep(
+        sc, param, [float(v) for v in values], ensemble=int(ensemble), jobs=jobs, engine=engine
+    )
+    summary = json.loads(text)
+    flat = []
+    for r in summary["rows"]:
+        row = {"value": r["value"], "disc": r["disc"]}
+        for stat in ("max_positive", "max_negative", "p99_abs", "impacts"):
+            for k, v in r[stat].items():
+                row[f"{stat}_{k}"] = v
+        flat.append(row)
+    return Sweep(summary=summary, rows=pd.DataFrame(flat))

@@ -1,0 +1,82 @@
+"""Type stubs of the native module (crates/python/src/lib.rs). Units: SI."""
+
+from os import PathLike
+from typing import List, Optional, Sequence, Tuple, Union
+
+_Path = Union[str, PathLike[str]]
+
+__version__: str
+
+class Scene:
+    """A validated scene."""
+    @property
+    def name(self) -> str: ...
+    @property
+    def text(self) -> str: ...
+    @property
+    def overrides(self) -> List[str]: ...
+    @property
+    def duration_s(self) -> float:
+        """Simulated duration, s."""
+    @property
+    def bodies(self) -> List[str]:
+        """Friction discs, then separator plates."""
+    @property
+    def path(self) -> Optional[str]: ...
+    def engine_line(self, engine: Optional[str] = None) -> str: ...
+    def with_sets(self, sets: Sequence[Tuple[str, str]]) -> "Scene": ...
+
+class RawRun:
+    summary_json: str
+    engine_line: str
+    impact_disc: List[str]
+    impact_t_on_s: List[float]
+    impact_t_peak_s: List[float]
+    impact_t_off_s: List[float]
+    impact_flank: List[str]
+    impact_v_on_m_s: List[float]
+    impact_peak_n: List[float]
+    sample_t_s: List[float]
+    sample_load_n: List[Tuple[str, List[float]]]
+    recording: Optional[str]
+    stopped_early: bool
+    warnings: List[str]
+
+class RawRecording:
+    summary_json: str
+    scene_text: Optional[str]
+    overrides: List[str]
+    impact_disc: List[str]
+    impact_t_on_s: List[float]
+    impact_t_peak_s: List[float]
+    impact_t_off_s: List[float]
+    impact_flank: List[str]
+    impact_v_on_m_s: List[float]
+    impact_peak_n: List[float]
+    loads: List[Tuple[str, List[float], List[float]]]
+    warning: Optional[str]
+
+def load_scene(
+    path: Optional[_Path] = None,
+    text: Optional[str] = None,
+    name: Optional[str] = None,
+    sets: Sequence[Tuple[str, str]] = ...,
+) -> Scene: ...
+def scene_from_json(json: str, name: str, sets: Sequence[Tuple[str, str]] = ...) -> Scene: ...
+def run(
+    scene: Scene,
+    engine: Optional[str] = None,
+    record: Optional[_Path] = None,
+    impacts_csv: Optional[_Path] = None,
+    keep_samples: bool = True,
+    deterministic: bool = False,
+) -> RawRun: ...
+def sweep(
+    scene: Scene,
+    param: str,
+    values: Sequence[float],
+    ensemble: int = 1,
+    jobs: Optional[int] = None,
+    engine: Optional[str] = None,
+) -> str: ...
+def read(path: _Path, salvage: bool = False) -> RawRecording: ...

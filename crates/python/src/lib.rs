@@ -1,0 +1,529 @@
+//! `clutchpack._clutchpack`: the native half of the `clutchpack` Python package, a thin layer
+//! over `clutchpack_sdk` (the same library the command line calls, so a run from Python is a
+//! run of the CLI). It hands Python plain values (JSON text for the summaries, lists for
+//! columns); the Python half (`python/clutchpack/__init__.py`) makes them DataFrames and numpy
+//! arrays.
+//!
+//! Errors: bad input (a scene, a key, an engine that cannot run the pack, a damaged recording
+//! not salvaged) raises `ValueError` with the message the CLI prints; a failed run or a file
+//! that cannot be written raises `RuntimeError`. An engine runs with the GIL released; Ctrl-C
+//! (SIGINT) stops it within about 50 ms of wall time, its outputs complete (the recording
+//! finished), and then raises `KeyboardInterrupt`.
+
+use clutchpack_scene::{EngineChoice, Override};
+use clutchpack_sdk::{Error, RecordingRequest, RunRequest, Simulation};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// How often a running engine looks for Ctrl-C (Python's signal handlers), wall time.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// An sdk error as the Python exception a user expects: `ValueError` for bad input.
+fn py_err(e: Error) -> PyErr {
+    if e.is_bad_input() {
+        PyValueError::new_err(e.to_string())
+    } else {
+        PyRuntimeError::new_err(e.to_string())
+    }
+}
+
+/// A validated scene: a file, a TOML text or a dict, with its overrides.
+#[pyclass(name = "Scene", module = "clutchpack", frozen)]
+struct Scene {
+    inner: clutchpack_scene::Scene,
+    /// The scene file, if it came from one.
+    path: Option<PathBuf>,
+    /// The folder relative paths in the scene resolve against.
+    base_dir: PathBuf,
+    /// The overrides applied (`KEY=VALUE`), in order.
+    sets: Vec<Override>,
+}
+
+#[pymethods]
+impl Scene {
+    /// The scene's name (its file as named when loaded).
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name.clone()
+    }
+    /// The scene's TOML text (before the overrides).
+    #[getter]
+    fn text(&self) -> String {
+        self.inner.source_text.clone()
+    }
+    /// The overrides applied, as `KEY=VALUE`.
+    #[getter]
+    fn overrides(&self) -> Vec<String> {
+        self.inner.overrides.clone()
+    }
+    /// Simulated duration, s.
+    #[getter]
+    fn duration_s(&self) -> f64 {
+        self.inner.simulation.duration_s
+    }
+    /// The bodies whose teeth are loaded: the friction discs, then the separator plates.
+    #[getter]
+    fn bodies(&self) -> Vec<String> {
+        let p = &self.inner.pack;
+        p.discs
+            .iter()
+            .chain(&p.plates)
+            .map(|d| d.name.clone())
+            .collect()
+    }
+    /// The scene file, if the scene came from one.
+    #[getter]
+    fn path(&self) -> Option<PathBuf> {
+        self.path.clone()
+    }
+    /// The engine `run` would choose and why (`engine: ...`, as `clutchpack run` prints).
+    fn engine_line(&self, engine: Option<&str>) -> PyResult<String> {
+        let sim = Simulation::new(self.inner.clone(), engine_choice(engine)?).map_err(py_err)?;
+        Ok(sim.engine_line().to_string())
+    }
+    /// This scene reloaded with more overrides `sets` (`(key, value)` pairs, after its own).
+    fn with_sets(&self, sets: Vec<(String, String)>) -> PyResult<Scene> {
+        let mut all = self.sets.clone();
+        all.extend(overrides(sets));
+        let inner = clutchpack_scene::parse(
+            &self.inner.source_text,
+            &self.inner.name,
+            &self.base_dir,
+            &all,
+        )
+        .map_err(|e| py_err(e.into()))?;
+        Ok(Scene {
+            inner,
+            path: self.path.clone(),
+            base_dir: self.base_dir.clone(),
+            sets: all,
+        })
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Scene({:?}, {} bodies, {} s)",
+            self.inner.name,
+            self.bodies().len(),
+            self.inner.simulation.duration_s
+        )
+    }
+}
+
+/// `engine` as the sdk's choice (`None`: the scene's); an unknown name is a `ValueError`.
+fn engine_choice(engine: Option<&str>) -> PyResult<Option<EngineChoice>> {
+    engine
+        .map(|e| e.parse::<EngineChoice>().map_err(PyValueError::new_err))
+        .transpose()
+}
+
+/// `(key, value)` pairs as overrides.
+fn overrides(sets: Vec<(String, String)>) -> Vec<Override> {
+    sets.into_iter()
+        .map(|(key, value)| Override { key, value })
+        .collect()
+}
+
+/// Loads and validates a scene from a file (`path`), a TOML text (`text`, named `name` in
+/// messages) or neither (the paper's case, built in), with the overrides `sets`.
+#[pyfunction]
+#[pyo3(signature = (path=None, text=None, name=None, sets=Vec::new()))]
+fn load_scene(
+    path: Option<PathBuf>,
+    text: Option<String>,
+    name: Option<String>,
+    sets: Vec<(String, String)>,
+) -> PyResult<Scene> {
+    let sets = overrides(sets);
+    let here = std::env::current_dir().unwrap_or_else(|_| PathBuf::from("."));
+    let (inner, base_dir) = match (&path, text) {
+        (Some(_), Some(_)) => {
+            return Err(PyValueError::new_err(
+                "give a scene as a path or as a text, not both",
+            ))
+        }
+        (None, Some(t)) => {
+            let name = name.unwrap_or_else(|| "<scene text>".into());
+            let s =
+                clutchpack_scene::parse(&t, &name, &here, &sets).map_err(|e| py_err(e.into()))?;
+            (s, here)
+        }
+        (p, None) => {
+            let s = clutchpack_sdk::load_scene(p.as_deref(), &sets).map_err(py_err)?;
+            let dir = p
+                .as_deref()
+                .and_then(Path::parent)
+                .map_or(here, Path::to_path_buf);
+            (s, dir)
+        }
+    };
+    Ok(Scene {
+        inner,
+        path,
+        base_dir,
+        sets,
+    })
+}
+
+/// A scene from the JSON text of a Python dict (the TOML file's tables as nested dicts),
+/// named `name` in messages.
+#[pyfunction]
+#[pyo3(signature = (json, name, sets=Vec::new()))]
+fn scene_from_json(json: &str, name: &str, sets: Vec<(String, String)>) -> PyResult<Scene> {
+    let value: toml::Value = serde_json::from_str(json)
+        .map_err(|e| PyValueError::new_err(format!("{name}: not a scene: {e}")))?;
+    let text = toml::to_string(&value)
+        .map_err(|e| PyValueError::new_err(format!("{name}: not a scene: {e}")))?;
+    load_scene(None, Some(text), Some(name.to_string()), sets)
+}
+
+/// What one run gave, for the Python half.
+#[pyclass(name = "RawRun", module = "clutchpack", frozen, get_all)]
+struct RawRun {
+    /// `--summary-json`'s content (JSON text).
+    summary_json: String,
+    /// The engine line (`engine: ... , why`).
+    engine_line: String,
+    /// The impacts: disc name, onset, peak, separation times (s), flank, closing speed at
+    /// onset (m/s), signed peak (N) per row, as columns.
+    impact_disc: Vec<String>,
+    impact_t_on_s: Vec<f64>,
+    impact_t_peak_s: Vec<f64>,
+    impact_t_off_s: Vec<f64>,
+    impact_flank: Vec<String>,
+    impact_v_on_m_s: Vec<f64>,
+    impact_peak_n: Vec<f64>,
+    /// Sample times, s, and each body's per-tooth load at them, N (empty unless kept).
+    sample_t_s: Vec<f64>,
+    sample_load_n: Vec<(String, Vec<f64>)>,
+    /// The recording's path, if recorded.
+    recording: Option<PathBuf>,
+    /// Whether the run stopped before its duration.
+    stopped_early: bool,
+    /// Warnings to show (a recording's summary without statistics, ...).
+    warnings: Vec<String>,
+}
+
+/// Runs `scene` (engine: `engine`, else the scene's choice), optionally recording to
+/// `record` and writing `impacts_csv`; keeps the load history when `keep_samples`. The GIL
+/// is released while the engine runs; Ctrl-C stops it with its outputs complete and raises
+/// `KeyboardInterrupt`.
+#[pyfunction]
+#[pyo3(signature = (scene, engine=None, record=None, impacts_csv=None, keep_samples=true, deterministic=false))]
+fn run(
+    py: Python<'_>,
+    scene: &Scene,
+    engine: Option<&str>,
+    record: Option<PathBuf>,
+    impacts_csv: Option<PathBuf>,
+    keep_samples: bool,
+    deterministic: bool,
+) -> PyResult<RawRun> {
+    let mut sim = Simulation::new(scene.inner.clone(), engine_choice(engine)?).map_err(py_err)?;
+    let recording = record.map(|path| RecordingRequest {
+        path,
+        replace: clutchpack_record::Replace::Existing,
+        options: clutchpack_record::RecordOptions {
+            deterministic,
+            per_tooth: scene.inner.simulation.record_per_tooth,
+            contact_samples: scene.inner.simulation.record_contact_samples,
+            ..clutchpack_record::RecordOptions::default()
+        },
+        scene_path: scene.path.clone(),
+    });
+    let stop = AtomicBool::new(false);
+    let mut interrupt: Option<PyErr> = None;
+    let outcome = py.detach(|| {
+        let mut last = Instant::now();
+        let mut progress = |_t: f64| {
+            if last.elapsed() >= SIGNAL_POLL {
+                last = Instant::now();
+                if let Err(e) = Python::attach(|py| py.check_signals()) {
+                    interrupt = Some(e);
+                    stop.store(true, Ordering::SeqCst);
+                }
+            }
+        };
+        sim.run(RunRequest {
+            keep_history: true,
+            keep_cycles: false,
+            impacts_csv,
+            recording,
+            stop: Some(&stop),
+            progress: Some(&mut progress),
+        })
+    });
+    let outcome = outcome.map_err(py_err)?;
+    if let Some(Err(e)) = &outcome.impacts_csv {
+        return Err(PyRuntimeError::new_err(e.to_string()));
+    }
+    let recording = match &outcome.recording {
+        Some(Ok(p)) => Some(p.clone()),
+        Some(Err(e)) => return Err(PyRuntimeError::new_err(format!("the recording: {e}"))),
+        None => None,
+    };
+    if let Some(e) = interrupt {
+        // the outputs are complete up to the stop; the user asked to stop
+        return Err(e);
+    }
+    let summary = outcome.summary().map_err(py_err)?;
+    let names = &outcome.body_names;
+    let impacts = &outcome.collector.impacts;
+    let name_of = |i: usize| names.get(i).cloned().unwrap_or_else(|| format!("disc {i}"));
+    let (sample_t_s, sample_load_n) = if keep_samples {
+        let h = &outcome.collector.history;
+        let t = h
+            .first()
+            .map(|v| v.iter().map(|p| p.0).collect())
+            .unwrap_or_default();
+        let loads = names
+            .iter()
+            .zip(h)
+            .map(|(n, v)| (n.clone(), v.iter().map(|p| p.1).collect()))
+            .collect();
+        (t, loads)
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    Ok(RawRun {
+        summary_json: serde_json::to_string(&summary)
+            .map_err(|e| PyRuntimeError::new_err(e.to_string()))?,
+        engine_line: sim.engine_line().to_string(),
+        impact_disc: impacts.iter().map(|e| name_of(e.disc)).collect(),
+        impact_t_on_s: impacts.iter().map(|e| e.t_on_s).collect(),
+        impact_t_peak_s: impacts.iter().map(|e| e.t_peak_s).collect(),
+        impact_t_off_s: impacts.iter().map(|e| e.t_off_s).collect(),
+        impact_flank: impacts
+            .iter()
+            .map(|e| e.flank.label().to_string())
+            .collect(),
+        impact_v_on_m_s: impacts.iter().map(|e| e.v_on_m_s).collect(),
+        impact_peak_n: impacts.iter().map(|e| e.peak_n).collect(),
+        sample_t_s,
+        sample_load_n,
+        recording,
+        stopped_early: outcome.stopped_early(),
+        warnings: outcome.warnings.clone(),
+    })
+}
+
+/// Runs `f` on a worker thread with the GIL released, polling Ctrl-C on this (the main)
+/// thread; on Ctrl-C sets `stop` (which `f` must honour), waits for `f` to return, and
+/// raises `KeyboardInterrupt`.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    stop: &AtomicBool,
+    f: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    let mut interrupt = None;
+    let out = py.detach(|| {
+        std::thread::scope(|s| {
+            let worker = s.spawn(f);
+            while !worker.is_finished() {
+                std::thread::sleep(Duration::from_millis(10));
+                if interrupt.is_none() {
+                    if let Err(e) = Python::attach(|py| py.check_signals()) {
+                        interrupt = Some(e);
+                        stop.store(true, Ordering::SeqCst);
+                    }
+                }
+            }
+            worker.join()
+        })
+    });
+    let out = out.map_err(|_| PyRuntimeError::new_err("a worker thread panicked"))?;
+    match interrupt {
+        Some(e) => Err(e),
+        None => Ok(out),
+    }
+}
+
+/// A sweep of `param` over `values` on `scene` (reloaded with `param=value` and `sets` for
+/// each value), each value as an ensemble of `ensemble` members, on `jobs` threads: the
+/// sweep table's rows and the members' fatigue, as `clutchpack sweep --summary-json` gives
+/// them (JSON text).
+#[pyfunction]
+#[pyo3(signature = (scene, param, values, ensemble=1, jobs=None, engine=None))]
+fn sweep(
+    py: Python<'_>,
+    scene: &Scene,
+    param: &str,
+    values: Vec<f64>,
+    ensemble: usize,
+    jobs: Option<usize>,
+    engine: Option<&str>,
+) -> PyResult<String> {
+    if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "values {values:?}: expected one or more finite numbers"
+        )));
+    }
+    let engine = engine_choice(engine)?;
+    let mut scenes = Vec::new();
+    for v in &values {
+        let mut sets = scene.sets.clone();
+        sets.push(Override {
+            key: param.to_string(),
+            value: format!("{v:e}"),
+        });
+        let s = clutchpack_scene::parse(
+            &scene.inner.source_text,
+            &scene.inner.name,
+            &scene.base_dir,
+            &sets,
+        )
+        .map_err(|e| py_err(e.into()))?;
+        scenes.push(s);
+    }
+    let jobs = jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .clamp(1, 256);
+    let engine_name = Simulation::new(scenes[0].clone(), engine)
+        .map_err(py_err)?
+        .engine_name();
+    let stop = AtomicBool::new(false);
+    let runs = interruptible(py, &stop, || {
+        clutchpack_sdk::run_cases(
+            &scenes,
+            &values,
+            param,
+            ensemble,
+            jobs,
+            engine,
+            &stop,
+            &|_, _| {},
+        )
+    })?
+    .map_err(py_err)?;
+    let rows = clutchpack_analysis::sweep_rows(&runs.cases);
+    let fatigue: Vec<serde_json::Value> = runs
+        .cases
+        .iter()
+        .zip(&scenes)
+        .zip(&runs.fatigue)
+        .map(|((c, s), members)| {
+            let d_crit: Vec<f64> = s
+                .fatigue
+                .iter()
+                .map(|f| f.material.critical_damage)
+                .collect();
+            serde_json::json!({
+                "value": c.value,
+                "discs": clutchpack_analysis::ensemble_fatigue(members, &d_crit),
+            })
+        })
+        .collect();
+    let out = serde_json::json!({
+        "scene": scenes[0].name,
+        "engine": engine_name,
+        "param": param,
+        "values": values,
+        "ensemble": ensemble,
+        "jobs": jobs,
+        "wall_time_s": runs.wall_s,
+        "rows": rows,
+        "fatigue": fatigue,
+    });
+    Ok(out.to_string())
+}
+
+/// What a recording holds, for the Python half.
+#[pyclass(name = "RawRecording", module = "clutchpack", frozen, get_all)]
+struct RawRecording {
+    /// The summary (JSON text): scene, engine, duration, per-body statistics and fatigue.
+    summary_json: String,
+    /// The scene's TOML text and overrides, as run.
+    scene_text: Option<String>,
+    overrides: Vec<String>,
+    /// Impacts as columns (as [`RawRun`]).
+    impact_disc: Vec<String>,
+    impact_t_on_s: Vec<f64>,
+    impact_t_peak_s: Vec<f64>,
+    impact_t_off_s: Vec<f64>,
+    impact_flank: Vec<String>,
+    impact_v_on_m_s: Vec<f64>,
+    impact_peak_n: Vec<f64>,
+    /// Each body's load history: (name, times s, per-tooth load N).
+    loads: Vec<(String, Vec<f64>, Vec<f64>)>,
+    /// Why the file was salvaged, if it was damaged.
+    warning: Option<String>,
+}
+
+/// Reads the recording at `path`; a damaged one only with `salvage` (what could be read).
+#[pyfunction]
+#[pyo3(signature = (path, salvage=false))]
+fn read(py: Python<'_>, path: PathBuf, salvage: bool) -> PyResult<RawRecording> {
+    py.detach(|| read_recording(&path, salvage)).map_err(py_err)
+}
+
+fn read_recording(path: &Path, salvage: bool) -> Result<RawRecording, Error> {
+    let (reader, warning) = clutchpack_sdk::open_recording(path, salvage)?;
+    let names = reader.disc_names();
+    let impacts = reader.impacts();
+    let summary = reader.summary_or_recomputed();
+    let info = reader.run_info();
+    let fatigue: Vec<serde_json::Value> = summary
+        .fatigue
+        .iter()
+        .map(|f| match f {
+            Some(f) => serde_json::json!({
+                "damage_rate_per_h": f.damage_rate_per_h,
+                "life_h": f.life_h,
+                "eq_load_range_n": f.eq_load_range_n,
+                "max_root_stress_pa": f.max_root_stress_pa,
+            }),
+            None => serde_json::Value::Null,
+        })
+        .collect();
+    let summary_json = serde_json::json!({
+        "scene": info.as_ref().map(|i| i.scene_name.clone()),
+        "engine": info.as_ref().map(|i| i.engine.clone()),
+        "duration_s": summary.t_end_s,
+        "discs": summary.discs,
+        "fatigue": fatigue,
+    })
+    .to_string();
+    let name_of = |i: usize| names.get(i).cloned().unwrap_or_else(|| format!("disc {i}"));
+    let loads = reader
+        .load_histories()
+        .into_iter()
+        .map(|h| (h.name, h.t_s, h.load_n))
+        .collect();
+    if let Some(e) = reader.reread_error() {
+        return Err(Error::BadInput(e.to_string()));
+    }
+    Ok(RawRecording {
+        summary_json,
+        scene_text: info.as_ref().map(|i| i.scene_text.clone()),
+        overrides: info.map(|i| i.overrides).unwrap_or_default(),
+        impact_disc: impacts.iter().map(|e| name_of(e.disc)).collect(),
+        impact_t_on_s: impacts.iter().map(|e| e.t_on_s).collect(),
+        impact_t_peak_s: impacts.iter().map(|e| e.t_peak_s).collect(),
+        impact_t_off_s: impacts.iter().map(|e| e.t_off_s).collect(),
+        impact_flank: impacts
+            .iter()
+            .map(|e| e.flank.label().to_string())
+            .collect(),
+        impact_v_on_m_s: impacts.iter().map(|e| e.v_on_m_s).collect(),
+        impact_peak_n: impacts.iter().map(|e| e.peak_n).collect(),
+        loads,
+        warning,
+    })
+}
+
+/// The native module.
+#[pymodule]
+fn _clutchpack(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Scene>()?;
+    m.add_class::<RawRun>()?;
+    m.add_class::<RawRecording>()?;
+    m.add_function(wrap_pyfunction!(load_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(scene_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

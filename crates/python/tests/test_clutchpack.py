@@ -1,0 +1,178 @@
+"""Tests of the clutchpack wheel against the command line (issue 24's "must show").
+
+Run by tests/python_package.rs in a fresh virtual environment with the wheel installed;
+CLUTCHPACK_BIN names the CLI binary of the same checkout, the working folder is the
+repository root.
+"""
+
+import glob
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import clutchpack
+
+BIN = os.environ["CLUTCHPACK_BIN"]
+ROOT = os.getcwd()
+
+
+def cli(*args, check=True):
+    p = subprocess.run([BIN, *args], capture_output=True, text=True)
+    if check:
+        assert p.returncode == 0, p.stderr
+    return p
+
+
+def without_wall(summary):
+    s = dict(summary)
+    s.pop("wall_time_s", None)
+    return s
+
+
+@pytest.mark.parametrize(
+    "scene,engine",
+    [("scenes/hu-table2.toml", None), ("scenes/pack-6-engagement.toml", "reference")],
+)
+def test_run_equals_the_cli(tmp_path, scene, engine):
+    """`.summary` is `--summary-json` number for number (but the wall time), `.impacts` is
+    `--impacts-csv` row for row (to the CSV's printed digits)."""
+    js, csv = tmp_path / "s.json", tmp_path / "i.csv"
+    extra = ["--engine", engine] if engine else []
+    cli("run", scene, "--no-record", "--summary-json", str(js), "--impacts-csv", str(csv), *extra)
+    r = clutchpack.run(scene, engine=engine)
+    assert without_wall(r.summary) == without_wall(json.loads(js.read_text()))
+    want = pd.read_csv(csv)
+    got = r.impacts
+    assert list(got.columns) == list(want.columns)
+    assert len(got) == len(want) > 10
+    assert (got["disc"] == want["disc"]).all()
+    assert (got["flank"] == want["flank"]).all()
+    # the CSV prints times to 1e-9 s, speeds to 1e-6 m/s, loads to 1e-4 N
+    for col, digits in [("t_on_s", 9), ("t_peak_s", 9), ("t_off_s", 9), ("v_on_m_s", 6), ("peak_n", 4)]:
+        err = np.abs(got[col].to_numpy() - want[col].to_numpy()).max()
+        assert err <= 0.5001 * 10.0**-digits, (col, err)
+
+
+def test_read_gives_what_the_run_gave(tmp_path):
+    rec = tmp_path / "r.mcap"
+    r = clutchpack.run("scenes/pack-4-rattle.toml", duration=0.2, record=rec)
+    assert r.recording == str(rec) and rec.exists()
+    back = clutchpack.read(rec)
+    # the same impacts (the recording stores them by time of closing per window; the run's
+    # collector in the order the engine sent them)
+    def by_time(df):
+        return df.sort_values(["t_off_s", "disc"]).reset_index(drop=True)
+
+    pd.testing.assert_frame_equal(by_time(back.impacts), by_time(r.impacts), check_exact=True)
+    assert back.summary["discs"] == r.summary["discs"]
+    assert back.summary["duration_s"] == r.summary["duration_s"]
+    for f_run, f_rec in zip(r.summary["fatigue"], back.summary["fatigue"]):
+        for k in ("damage_rate_per_h", "eq_load_range_n"):
+            assert f_rec[k] == f_run[k], k
+    assert back.scene_text == clutchpack.load_scene("scenes/pack-4-rattle.toml").text
+    assert set(back.loads) == set(clutchpack.load_scene("scenes/pack-4-rattle.toml").bodies)
+
+
+def test_a_killed_recording_is_refused_then_salvaged(tmp_path):
+    out = tmp_path / "k.mcap"
+    p = subprocess.Popen(
+        [BIN, "run", "scenes/pack-4-rattle.toml", "--duration", "30", "--out", str(out)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    time.sleep(2.5)
+    assert p.poll() is None, "the run ended before the kill: make it longer"
+    p.kill()  # SIGKILL: no chance to finish the file
+    p.wait()
+    partial = glob.glob(str(tmp_path / "k.partial-*.mcap"))
+    assert len(partial) == 1, os.listdir(tmp_path)
+    with pytest.raises(ValueError, match="salvage"):
+        clutchpack.read(partial[0])
+    got = clutchpack.read(partial[0], salvage=True)
+    assert got.warnings and "recovered" in got.warnings[0]
+    assert len(got.impacts) > 50
+    # the summary is recomputed from the recovered impacts
+    assert sum(d["impacts"] for d in got.summary["discs"]) == len(got.impacts)
+
+
+def test_bad_input_raises_value_error_naming_the_key():
+    with pytest.raises(ValueError, match=r"defaults\.inertia_kg_m2 = -0\.1: must be > 0"):
+        clutchpack.run("scenes/hu-table2.toml", set={"defaults.inertia_kg_m2": -0.1})
+    with pytest.raises(ValueError, match="simulation.duration_sec"):
+        clutchpack.load_scene("scenes/hu-table2.toml", set={"simulation.duration_sec": 1})
+    with pytest.raises(ValueError, match="engine"):
+        clutchpack.run("scenes/hu-table2.toml", engine="fastest")
+    with pytest.raises(ValueError, match="initial_offset_m"):
+        clutchpack.run("scenes/eccentric-disc.toml", engine="reference")
+    with pytest.raises(ValueError, match="nope.toml"):
+        clutchpack.load_scene("nope.toml")
+
+
+def test_a_scene_from_a_dict_runs_as_its_file():
+    tomllib = pytest.importorskip("tomllib")
+    with open("scenes/hu-table2.toml", "rb") as f:
+        d = tomllib.load(f)
+    a = clutchpack.run(d)
+    b = clutchpack.run("scenes/hu-table2.toml")
+    assert a.summary["discs"] == b.summary["discs"]
+    assert a.summary["steps"] == b.summary["steps"]
+
+
+def test_sigint_stops_a_long_run_within_a_second(tmp_path):
+    """Ctrl-C (SIGINT to the Python process) during a 60 s run: KeyboardInterrupt within a
+    second, the recording complete (it reads without salvage)."""
+    rec = tmp_path / "long.mcap"
+    code = (
+        "import clutchpack\n"
+        f"clutchpack.run('scenes/pack-4-rattle.toml', duration=60, record={str(rec)!r})\n"
+    )
+    p = subprocess.Popen([sys.executable, "-c", code], stderr=subprocess.PIPE, text=True)
+    time.sleep(3.0)
+    assert p.poll() is None, "the run ended before the signal"
+    t0 = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=30)
+    took = time.monotonic() - t0
+    assert took < 1.0, f"stopped {took:.2f} s after SIGINT"
+    assert p.returncode != 0 and "KeyboardInterrupt" in err, err
+    back = clutchpack.read(rec)
+    assert 0.0 < back.summary["duration_s"] < 60.0
+    assert len(back.impacts) > 0
+
+
+def test_fig3_example_is_the_cli_sweep(tmp_path):
+    """examples/python/fig3.py reproduces `clutchpack sweep`'s ensemble means, number for
+    number."""
+    out = tmp_path / "fig3.json"
+    p = subprocess.run(
+        [sys.executable, "examples/python/fig3.py", "--ensemble", "8", "--json", str(out)],
+        capture_output=True,
+        text=True,
+    )
+    assert p.returncode == 0, p.stderr
+    assert "max + mean" in p.stdout
+    js = tmp_path / "cli.json"
+    cli(
+        "sweep", "scenes/hu-table2.toml", "--param", "defaults.oil.film_thickness_m",
+        "--values", "0,25e-6,50e-6,75e-6,100e-6", "--ensemble", "8", "--summary-json", str(js),
+    )
+    want = json.loads(js.read_text())
+    got = json.loads(out.read_text())
+    assert got["rows"] == want["rows"]
+    assert got["fatigue"] == want["fatigue"]
+
+
+def test_pack_compare_example_runs():
+    p = subprocess.run(
+        [sys.executable, "examples/python/pack_compare.py"], capture_output=True, text=True
+    )
+    assert p.returncode == 0, p.stderr
+    assert "hardest hit as shipped: disc-" in p.stdout
