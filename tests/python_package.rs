@@ -11,6 +11,9 @@ use std::process::Command;
 #[test]
 fn python_package_passes_its_tests() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // the tests' environment (maturin among its packages) made once, by the same call as
+    // every other test that needs it: two setup.sh at once would both rebuild it
+    let _ = super::python_reader();
     let o = Command::new("bash")
         .arg(root.join("tests/python/build_wheel.sh"))
         .output()

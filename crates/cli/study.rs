@@ -224,7 +224,6 @@ fn run(a: RunArgs) -> Result<ExitCode> {
     let shard = shard_of(a.shard.as_deref(), a.shards)?;
     let jobs = threads(a.jobs)?;
     let stop = signals::flag();
-    let engine = study.engine;
     let label = format!("{} shard {}/{}", study.name, shard.index, shard.count);
     eprintln!(
         "{label}: {} of {} cases on {jobs} threads, part in {}",
@@ -244,20 +243,7 @@ fn run(a: RunArgs) -> Result<ExitCode> {
             );
         }
     };
-    let outcome = clutchpack_study::run_shard(
-        &study,
-        &a.out,
-        shard,
-        jobs,
-        &stop,
-        Duration::from_secs(5),
-        &|scene, stop| clutchpack_sdk::run_case(scene, engine, stop),
-        &progress,
-    )
-    .map_err(|e| match e {
-        clutchpack_study::part::PartError::OtherStudy { .. } => BadInput(e.to_string()).into(),
-        e => anyhow::Error::from(e),
-    })?;
+    let outcome = clutchpack_sdk::run_study_shard(&study, &a.out, shard, jobs, &stop, &progress)?;
     if let Some((to, reason)) = &outcome.set_aside {
         eprintln!(
             "warning: {label}: the part was damaged ({reason}); moved to {} and its cases ran again",
@@ -299,20 +285,13 @@ fn run(a: RunArgs) -> Result<ExitCode> {
 pub const EXIT_MISSING: u8 = 3;
 
 fn merge(a: MergeArgs) -> Result<ExitCode> {
-    if !a.dir.is_dir() {
-        return Err(BadInput(format!(
-            "{}: not a folder (expected the --out folder of `study run` or `study submit`)",
-            a.dir.display()
-        ))
-        .into());
-    }
-    let m = match clutchpack_study::collect(&a.dir) {
-        Ok(m) => m,
-        Err(MergeError::Missing {
+    let done = match clutchpack_sdk::merge_study(&a.dir, &a.plot_format) {
+        Ok(d) => d,
+        Err(clutchpack_sdk::Error::StudyIncomplete(MergeError::Missing {
             count,
             missing,
             set_aside,
-        }) => {
+        })) => {
             for (to, reason) in &set_aside {
                 eprintln!(
                     "warning: a damaged part ({reason}) was moved to {}; its shard runs again",
@@ -329,52 +308,25 @@ fn merge(a: MergeArgs) -> Result<ExitCode> {
             out!("--array={}", array_syntax(&missing));
             return Ok(ExitCode::from(EXIT_MISSING));
         }
-        Err(e @ MergeError::Mixed { .. }) => return Err(BadInput(e.to_string()).into()),
         Err(e) => return Err(e.into()),
     };
-    let write = |name: &str, text: &str| -> Result<()> {
-        let p = a.dir.join(name);
-        clutchpack_study::part::write_atomic(&p, text.as_bytes())
-            .with_context(|| format!("writing {}", p.display()))
-    };
-    write("results.csv", &m.csv())?;
-    write("summary.csv", &m.summary_csv())?;
-    let pq = a.dir.join("results.parquet");
-    let tmp = a.dir.join("results.parquet.tmp");
-    let written = clutchpack_study::parquet::write_results(&tmp, &m)
-        .map_err(anyhow::Error::from)
-        .and_then(|()| {
-            std::fs::rename(&tmp, &pq).with_context(|| format!("writing {}", pq.display()))
-        });
-    if written.is_err() {
-        // a full disk: leave no temporary file behind
-        let _ = std::fs::remove_file(&tmp);
-    }
-    written?;
+    let m = &done.merged;
     let failed = m.records.iter().filter(|r| r.error.is_some()).count();
-    let plot = a.dir.join(format!("main-effects.{}", a.plot_format));
-    let plotted = if failed < m.records.len() {
-        clutchpack_study::plot::plot_main_effects(&plot, &m)?;
-        true
-    } else {
-        false
-    };
     out!(
         "{}: {} cases ({} failed) merged from {} into results.parquet, results.csv, summary.csv{}",
         m.header.name,
         m.records.len(),
         failed,
         a.dir.display(),
-        if plotted {
-            format!(
+        match &done.plot {
+            Some(plot) => format!(
                 ", {}",
                 plot.file_name().unwrap_or_default().to_string_lossy()
-            )
-        } else {
-            String::new()
+            ),
+            None => String::new(),
         }
     );
-    print_effects(&m);
+    print_effects(m);
     Ok(ExitCode::SUCCESS)
 }
 

@@ -3,8 +3,8 @@
 use crate::common::{self, BadInput};
 use anyhow::{Context, Result};
 use clutchpack_analysis::{
-    ensemble_fatigue, fatigue_spread_table, sweep_fits, sweep_rows, sweep_table, DiscFatigueSpread,
-    PolyFit, SweepCase, SweepRow, TableFormat,
+    fatigue_spread_table, sweep_fits, sweep_rows, sweep_table, DiscFatigueSpread, PolyFit,
+    SweepCase, SweepRow, TableFormat,
 };
 use clutchpack_scene::{Override, Scene};
 use clutchpack_sdk::{CaseRuns, EngineChoice, MemberFatigue, Simulation, MAX_BATCH_CASES};
@@ -236,16 +236,7 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
     let fatigue: Vec<(f64, Vec<DiscFatigueSpread>)> = cases
         .iter()
         .map(|c| c.value)
-        .zip(kept_scenes)
-        .zip(&fatigue)
-        .map(|((v, scene), members)| {
-            let d_crit: Vec<f64> = scene
-                .fatigue
-                .iter()
-                .map(|f| f.material.critical_damage)
-                .collect();
-            (v, ensemble_fatigue(members, &d_crit))
-        })
+        .zip(clutchpack_sdk::ensemble_fatigue(&kept_scenes, &fatigue))
         .collect();
     out!("fatigue of the spline teeth against {} (damage rate per hour: ensemble mean, std, min..max; life at the mean rate, and at the largest..smallest rate)", a.param);
     out!(

@@ -179,6 +179,39 @@ fn scene_from_json(json: &str, name: &str, sets: Vec<(String, String)>) -> PyRes
     load_scene(None, Some(text), Some(name.to_string()), sets)
 }
 
+/// Impacts as columns: body name, onset, peak and separation times (s), flank, closing speed
+/// at onset (m/s), signed peak per-tooth load (N), one entry per impact.
+#[pyclass(name = "ImpactColumns", module = "clutchpack", frozen, get_all)]
+#[derive(Clone)]
+struct ImpactColumns {
+    disc: Vec<String>,
+    t_on_s: Vec<f64>,
+    t_peak_s: Vec<f64>,
+    t_off_s: Vec<f64>,
+    flank: Vec<String>,
+    v_on_m_s: Vec<f64>,
+    peak_n: Vec<f64>,
+}
+
+impl ImpactColumns {
+    /// `impacts`, their bodies named by `names` (engine order).
+    fn of(impacts: &[clutchpack_model::ImpactEvent], names: &[String]) -> ImpactColumns {
+        let name_of = |i: usize| names.get(i).cloned().unwrap_or_else(|| format!("disc {i}"));
+        ImpactColumns {
+            disc: impacts.iter().map(|e| name_of(e.disc)).collect(),
+            t_on_s: impacts.iter().map(|e| e.t_on_s).collect(),
+            t_peak_s: impacts.iter().map(|e| e.t_peak_s).collect(),
+            t_off_s: impacts.iter().map(|e| e.t_off_s).collect(),
+            flank: impacts
+                .iter()
+                .map(|e| e.flank.label().to_string())
+                .collect(),
+            v_on_m_s: impacts.iter().map(|e| e.v_on_m_s).collect(),
+            peak_n: impacts.iter().map(|e| e.peak_n).collect(),
+        }
+    }
+}
+
 /// What one run gave, for the Python half.
 #[pyclass(name = "RawRun", module = "clutchpack", frozen, get_all)]
 struct RawRun {
@@ -186,15 +219,8 @@ struct RawRun {
     summary_json: String,
     /// The engine line (`engine: ... , why`).
     engine_line: String,
-    /// The impacts: disc name, onset, peak, separation times (s), flank, closing speed at
-    /// onset (m/s), signed peak (N) per row, as columns.
-    impact_disc: Vec<String>,
-    impact_t_on_s: Vec<f64>,
-    impact_t_peak_s: Vec<f64>,
-    impact_t_off_s: Vec<f64>,
-    impact_flank: Vec<String>,
-    impact_v_on_m_s: Vec<f64>,
-    impact_peak_n: Vec<f64>,
+    /// The impacts, as columns.
+    impacts: ImpactColumns,
     /// Sample times, s, and each body's per-tooth load at them, N (empty unless kept).
     sample_t_s: Vec<f64>,
     sample_load_n: Vec<(String, Vec<f64>)>,
@@ -271,7 +297,6 @@ fn run(
     let summary = outcome.summary().map_err(py_err)?;
     let names = &outcome.body_names;
     let impacts = &outcome.collector.impacts;
-    let name_of = |i: usize| names.get(i).cloned().unwrap_or_else(|| format!("disc {i}"));
     let (sample_t_s, sample_load_n) = if keep_samples {
         let h = &outcome.collector.history;
         let t = h
@@ -291,16 +316,7 @@ fn run(
         summary_json: serde_json::to_string(&summary)
             .map_err(|e| PyRuntimeError::new_err(e.to_string()))?,
         engine_line: sim.engine_line().to_string(),
-        impact_disc: impacts.iter().map(|e| name_of(e.disc)).collect(),
-        impact_t_on_s: impacts.iter().map(|e| e.t_on_s).collect(),
-        impact_t_peak_s: impacts.iter().map(|e| e.t_peak_s).collect(),
-        impact_t_off_s: impacts.iter().map(|e| e.t_off_s).collect(),
-        impact_flank: impacts
-            .iter()
-            .map(|e| e.flank.label().to_string())
-            .collect(),
-        impact_v_on_m_s: impacts.iter().map(|e| e.v_on_m_s).collect(),
-        impact_peak_n: impacts.iter().map(|e| e.peak_n).collect(),
+        impacts: ImpactColumns::of(impacts, names),
         sample_t_s,
         sample_load_n,
         recording,
@@ -437,14 +453,8 @@ struct RawRecording {
     /// The scene's TOML text and overrides, as run.
     scene_text: Option<String>,
     overrides: Vec<String>,
-    /// Impacts as columns (as [`RawRun`]).
-    impact_disc: Vec<String>,
-    impact_t_on_s: Vec<f64>,
-    impact_t_peak_s: Vec<f64>,
-    impact_t_off_s: Vec<f64>,
-    impact_flank: Vec<String>,
-    impact_v_on_m_s: Vec<f64>,
-    impact_peak_n: Vec<f64>,
+    /// The impacts, as columns.
+    impacts: ImpactColumns,
     /// Each body's load history: (name, times s, per-tooth load N).
     loads: Vec<(String, Vec<f64>, Vec<f64>)>,
     /// Why the file was salvaged, if it was damaged.
@@ -485,7 +495,6 @@ fn read_recording(path: &Path, salvage: bool) -> Result<RawRecording, Error> {
         "fatigue": fatigue,
     })
     .to_string();
-    let name_of = |i: usize| names.get(i).cloned().unwrap_or_else(|| format!("disc {i}"));
     let loads = reader
         .load_histories()
         .into_iter()
@@ -498,25 +507,68 @@ fn read_recording(path: &Path, salvage: bool) -> Result<RawRecording, Error> {
         summary_json,
         scene_text: info.as_ref().map(|i| i.scene_text.clone()),
         overrides: info.map(|i| i.overrides).unwrap_or_default(),
-        impact_disc: impacts.iter().map(|e| name_of(e.disc)).collect(),
-        impact_t_on_s: impacts.iter().map(|e| e.t_on_s).collect(),
-        impact_t_peak_s: impacts.iter().map(|e| e.t_peak_s).collect(),
-        impact_t_off_s: impacts.iter().map(|e| e.t_off_s).collect(),
-        impact_flank: impacts
-            .iter()
-            .map(|e| e.flank.label().to_string())
-            .collect(),
-        impact_v_on_m_s: impacts.iter().map(|e| e.v_on_m_s).collect(),
-        impact_peak_n: impacts.iter().map(|e| e.peak_n).collect(),
+        impacts: ImpactColumns::of(&impacts, &names),
         loads,
         warning,
     })
+}
+
+/// Runs shard `shard` of `shards` of the study file `study` (all of it by default) into the
+/// folder `out` on `jobs` threads: the cases its part lacks, as `clutchpack study run`.
+/// Returns (part file, cases, skipped, ran, failed, complete). Ctrl-C stops it between
+/// cases, the part complete up to there, and raises `KeyboardInterrupt`.
+#[pyfunction]
+#[pyo3(signature = (study, out, jobs=None, shard=0, shards=1))]
+fn study_run(
+    py: Python<'_>,
+    study: PathBuf,
+    out: PathBuf,
+    jobs: Option<usize>,
+    shard: u64,
+    shards: u64,
+) -> PyResult<(PathBuf, usize, usize, usize, usize, bool)> {
+    let s = clutchpack_study::load(&study).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    if shards == 0 || shard >= shards {
+        return Err(PyValueError::new_err(format!(
+            "shard {shard} of {shards}: the index must be in 0..{shards} (shards >= 1)"
+        )));
+    }
+    let jobs = jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .clamp(1, 256);
+    let shard = clutchpack_study::Shard {
+        index: shard,
+        count: shards,
+    };
+    let stop = AtomicBool::new(false);
+    let o = interruptible(py, &stop, || {
+        clutchpack_sdk::run_study_shard(&s, &out, shard, jobs, &stop, &|_, _| {})
+    })?
+    .map_err(py_err)?;
+    Ok((o.path, o.cases, o.skipped, o.ran, o.failed, o.complete))
+}
+
+/// Merges the study parts in `dir` into `results.csv`, `summary.csv`, `results.parquet` and
+/// the main-effects figure (`plot_format`: `png` or `svg`), as `clutchpack study merge`;
+/// returns the path of `results.csv`. Missing shards raise `RuntimeError` naming them.
+#[pyfunction]
+#[pyo3(signature = (dir, plot_format="png"))]
+fn study_merge(py: Python<'_>, dir: PathBuf, plot_format: &str) -> PyResult<PathBuf> {
+    if !["png", "svg"].contains(&plot_format) {
+        return Err(PyValueError::new_err(format!(
+            "plot_format {plot_format:?}: expected png or svg"
+        )));
+    }
+    py.detach(|| clutchpack_sdk::merge_study(&dir, plot_format))
+        .map_err(py_err)?;
+    Ok(dir.join("results.csv"))
 }
 
 /// The native module.
 #[pymodule]
 fn _clutchpack(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
+    m.add_class::<ImpactColumns>()?;
     m.add_class::<RawRun>()?;
     m.add_class::<RawRecording>()?;
     m.add_function(wrap_pyfunction!(load_scene, m)?)?;
@@ -524,6 +576,8 @@ fn _clutchpack(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(study_run, m)?)?;
+    m.add_function(wrap_pyfunction!(study_merge, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

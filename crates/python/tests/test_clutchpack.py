@@ -176,3 +176,40 @@ def test_pack_compare_example_runs():
     )
     assert p.returncode == 0, p.stderr
     assert "hardest hit as shipped: disc-" in p.stdout
+
+
+STUDY = """
+[study]
+name = "py-study"
+scene = "{scene}"
+[ensemble]
+members = 2
+[set]
+"simulation.duration_s" = 0.05
+[[factor]]
+key = "defaults.oil.film_thickness_m"
+values = [0.0, 50e-6]
+"""
+
+
+def test_a_study_from_python_is_the_cli_study(tmp_path):
+    """clutchpack.study.run and merge give the table `clutchpack study run` and `study
+    merge` give, fatigue columns included."""
+    f = tmp_path / "s.toml"
+    f.write_text(STUDY.format(scene=os.path.join(ROOT, "scenes", "hu-table2.toml")))
+    import clutchpack.study
+
+    r = clutchpack.study.run(f, tmp_path / "py", jobs=2)
+    assert (r.cases, r.ran, r.failed, r.complete) == (4, 4, 0, True)
+    again = clutchpack.study.run(f, tmp_path / "py", jobs=2)
+    assert (again.skipped, again.ran) == (4, 0)
+    got = clutchpack.study.merge(tmp_path / "py")
+    cli("study", "run", str(f), "--out", str(tmp_path / "cli"), "--jobs", "2")
+    cli("study", "merge", str(tmp_path / "cli"))
+    want = pd.read_csv(tmp_path / "cli" / "results.csv")
+    pd.testing.assert_frame_equal(got, want)
+    assert "disc.damage_rate_per_h" in got.columns and len(got) == 4
+    with pytest.raises(ValueError, match="study.name"):
+        bad = tmp_path / "bad.toml"
+        bad.write_text(STUDY.replace('name = "py-study"', 'name = "a b"').format(scene="x.toml"))
+        clutchpack.study.run(bad, tmp_path / "bad")

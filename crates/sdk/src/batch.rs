@@ -1,7 +1,7 @@
 //! Many runs: ensembles of a scene, the cases of a sweep on a pool of threads, a study's case.
 
 use crate::{Error, Result, RunRequest, Simulation};
-use clutchpack_analysis::{DiscFatigue, DiscStats, SweepCase};
+use clutchpack_analysis::{DiscFatigue, DiscFatigueSpread, DiscStats, SweepCase};
 use clutchpack_scene::{EngineChoice, Scene};
 use clutchpack_study::part::{CaseFatigue, RunResult};
 use clutchpack_study::CaseOutput;
@@ -131,6 +131,24 @@ pub fn run_cases(
         wall_s,
         unfinished,
     })
+}
+
+/// The fatigue of each scene's ensemble (`fatigue[scene][member][body]`, as [`run_cases`]
+/// gives it): per body the damage rate over the members (mean, spread) and the life at them,
+/// with each scene's critical damage.
+pub fn ensemble_fatigue(scenes: &[&Scene], fatigue: &MemberFatigue) -> Vec<Vec<DiscFatigueSpread>> {
+    scenes
+        .iter()
+        .zip(fatigue)
+        .map(|(scene, members)| {
+            let d_crit: Vec<f64> = scene
+                .fatigue
+                .iter()
+                .map(|f| f.material.critical_damage)
+                .collect();
+            clutchpack_analysis::ensemble_fatigue(members, &d_crit)
+        })
+        .collect()
 }
 
 /// One case of a study: `scene` on `engine` (else the scene's choice), kept as `run` keeps

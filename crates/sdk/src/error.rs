@@ -37,6 +37,12 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+    /// A study's part or table could not be read or written.
+    #[error("{0}")]
+    Study(String),
+    /// A study's merge found shards missing or unfinished (which ones: the merge's error).
+    #[error(transparent)]
+    StudyIncomplete(clutchpack_study::MergeError),
     /// The worker threads of a batch could not be started.
     #[error("starting the worker threads: {0}")]
     Threads(String),

@@ -27,9 +27,13 @@ mod recording;
 mod run;
 mod scene;
 mod simulation;
+mod study;
 mod summary;
 
-pub use batch::{ensemble_member, run_case, run_cases, CaseRuns, MemberFatigue, MAX_BATCH_CASES};
+pub use batch::{
+    ensemble_fatigue, ensemble_member, run_case, run_cases, CaseRuns, MemberFatigue,
+    MAX_BATCH_CASES,
+};
 pub use collector::{merge_peaks, RunCollector};
 pub use error::{Error, Result};
 pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
@@ -37,6 +41,7 @@ pub use recording::open_recording;
 pub use run::{RecordingRequest, RunOutcome, RunRequest};
 pub use scene::{load_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TEXT};
 pub use simulation::{PackEngine, Simulation};
+pub use study::{merge_study, run_study_shard, MergedStudy, PART_FLUSH};
 pub use summary::{friction_interfaces, run_info, RunSummary};
 
 /// The reference engine's integration schemes (for [`PackEngine::Reference`]).

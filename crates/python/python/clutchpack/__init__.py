@@ -28,12 +28,12 @@ from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Union
 import numpy as np
 import pandas as pd
 
-from . import _clutchpack
+from . import _clutchpack, study
 from ._clutchpack import Scene
 
 __version__: str = _clutchpack.__version__
 
-__all__ = ["Scene", "Result", "load_scene", "run", "sweep", "read", "IMPACT_COLUMNS"]
+__all__ = ["Scene", "Result", "Sweep", "load_scene", "run", "sweep", "read", "study", "IMPACT_COLUMNS"]
 
 #: The columns of ``Result.impacts``, as in ``clutchpack run --impacts-csv``: body name,
 #: onset, peak and separation times (s), flank (``drive`` or ``coast``... as the CSV), the
@@ -79,18 +79,12 @@ def load_scene(
 
 
 def _impacts(raw: Any) -> pd.DataFrame:
-    return pd.DataFrame(
-        {
-            "disc": raw.impact_disc,
-            "t_on_s": np.asarray(raw.impact_t_on_s, dtype=float),
-            "t_peak_s": np.asarray(raw.impact_t_peak_s, dtype=float),
-            "t_off_s": np.asarray(raw.impact_t_off_s, dtype=float),
-            "flank": raw.impact_flank,
-            "v_on_m_s": np.asarray(raw.impact_v_on_m_s, dtype=float),
-            "peak_n": np.asarray(raw.impact_peak_n, dtype=float),
-        },
-        columns=IMPACT_COLUMNS,
-    )
+    cols = raw.impacts
+    data: Dict[str, Any] = {}
+    for c in IMPACT_COLUMNS:
+        v = getattr(cols, c)
+        data[c] = v if c in ("disc", "flank") else np.asarray(v, dtype=float)
+    return pd.DataFrame(data, columns=IMPACT_COLUMNS)
 
 
 @dataclass

@@ -26,16 +26,21 @@ class Scene:
     def engine_line(self, engine: Optional[str] = None) -> str: ...
     def with_sets(self, sets: Sequence[Tuple[str, str]]) -> "Scene": ...
 
+class ImpactColumns:
+    """One entry per impact: body, onset/peak/separation times (s), flank, closing speed at
+    onset (m/s), signed peak per-tooth load (N)."""
+    disc: List[str]
+    t_on_s: List[float]
+    t_peak_s: List[float]
+    t_off_s: List[float]
+    flank: List[str]
+    v_on_m_s: List[float]
+    peak_n: List[float]
+
 class RawRun:
     summary_json: str
     engine_line: str
-    impact_disc: List[str]
-    impact_t_on_s: List[float]
-    impact_t_peak_s: List[float]
-    impact_t_off_s: List[float]
-    impact_flank: List[str]
-    impact_v_on_m_s: List[float]
-    impact_peak_n: List[float]
+    impacts: ImpactColumns
     sample_t_s: List[float]
     sample_load_n: List[Tuple[str, List[float]]]
     recording: Optional[str]
@@ -46,13 +51,7 @@ class RawRecording:
     summary_json: str
     scene_text: Optional[str]
     overrides: List[str]
-    impact_disc: List[str]
-    impact_t_on_s: List[float]
-    impact_t_peak_s: List[float]
-    impact_t_off_s: List[float]
-    impact_flank: List[str]
-    impact_v_on_m_s: List[float]
-    impact_peak_n: List[float]
+    impacts: ImpactColumns
     loads: List[Tuple[str, List[float], List[float]]]
     warning: Optional[str]
 
@@ -80,3 +79,7 @@ def sweep(
     engine: Optional[str] = None,
 ) -> str: ...
 def read(path: _Path, salvage: bool = False) -> RawRecording: ...
+def study_run(
+    study: _Path, out: _Path, jobs: Optional[int] = None, shard: int = 0, shards: int = 1
+) -> Tuple[str, int, int, int, int, bool]: ...
+def study_merge(dir: _Path, plot_format: str = "png") -> str: ...
