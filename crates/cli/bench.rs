@@ -2,7 +2,7 @@
 
 use anyhow::Result;
 use clutchpack_model::cases::staggered_pack;
-use clutchpack_model::Observer;
+use clutchpack_model::{Observer, PackModel};
 use clutchpack_record::{RecordOptions, Replace};
 use clutchpack_scene::Override;
 use clutchpack_sdk::{
@@ -34,7 +34,12 @@ pub struct BenchArgs {
     /// `scenes/pack-8-brake.toml` and `pack-6-engagement.toml`); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub whole_runs: usize,
-    /// Only the staggered-pack part (skips the paper case, the sweep and the recording cost).
+    /// Repetitions of each brake-pack timing (N discs and N + 1 plates, open gaps: the MuJoCo
+    /// anchor's pack; the median is reported); 0 skips that part.
+    #[arg(long, default_value_t = 3)]
+    pub brake_runs: usize,
+    /// Only the staggered-pack and brake-pack parts (skips the paper case, the sweep, the
+    /// recording cost and the shipped whole packs).
     #[arg(long)]
     pub pack_only: bool,
 }
@@ -64,6 +69,9 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     };
     if a.pack_only {
         staggered_packs(a.pack_runs, &stop)?;
+        if !stop.load(Ordering::SeqCst) {
+            brake_packs(a.brake_runs, &stop)?;
+        }
         return Ok(if stopped() {
             crate::signals::exit_code()
         } else {
@@ -244,6 +252,10 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         return Ok(crate::signals::exit_code());
     }
     staggered_packs(a.pack_runs, &stop)?;
+    if stopped() {
+        return Ok(crate::signals::exit_code());
+    }
+    brake_packs(a.brake_runs, &stop)?;
     Ok(if stopped() {
         crate::signals::exit_code()
     } else {
@@ -353,9 +365,59 @@ fn staggered_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     out!(
         "staggered packs (cases::staggered_pack: N discs across +-0.8 of the free play, {PACK_DURATION_S} s; {runs} rounds over the sizes); growth = wall per disc / wall per disc at N = 1"
     );
-    for e in &engines {
-        let sizes: Vec<usize> = [1usize, 4, 16, 64]
-            .into_iter()
+    pack_growth(staggered_pack, &[1, 4, 16, 64], &engines, runs, stop)
+}
+
+/// 5. The real pack of issue 20: N staggered discs and N + 1 separator plates on the housing
+///    with the open gaps' drag (`cases::staggered_brake`, the MuJoCo anchor's
+///    `time_brake.sh N` pack), per disc, as the pack grows: N = 1, 4, 8 and 16 for 0.1 s,
+///    each engine with its default scheme.
+fn brake_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
+    if runs == 0 {
+        return Ok(());
+    }
+    let engines = [
+        Timed {
+            label: "reference (the default for the pack)",
+            max_discs: 16,
+            engine: PackEngine::Reference {
+                scheme: Scheme::default(),
+                parallel: true,
+            },
+        },
+        Timed {
+            label: "multibody (default scheme)",
+            max_discs: 16,
+            engine: PackEngine::Multibody {
+                record_rate_hz: 10_000.0,
+            },
+        },
+    ];
+    out!(
+        "brake packs (cases::staggered_brake: N discs across +-0.8 of the free play and N + 1 plates on the housing, open gaps, {PACK_DURATION_S} s; {runs} rounds over the sizes); growth = wall per disc / wall per disc at N = 1"
+    );
+    pack_growth(
+        clutchpack_model::cases::staggered_brake,
+        &[1, 4, 8, 16],
+        &engines,
+        runs,
+        stop,
+    )
+}
+
+/// Times each of `engines` on the packs `build(n)` for the `sizes` up to its `max_discs`, in
+/// `runs` rounds, and prints the wall time per disc and its growth from the first size.
+fn pack_growth(
+    build: fn(usize) -> PackModel,
+    sizes: &[usize],
+    engines: &[Timed],
+    runs: usize,
+    stop: &Arc<AtomicBool>,
+) -> Result<()> {
+    for e in engines {
+        let sizes: Vec<usize> = sizes
+            .iter()
+            .copied()
             .filter(|&n| n <= e.max_discs)
             .collect();
         // Round robin over the sizes, so that a change of the machine's load between the
@@ -367,9 +429,11 @@ fn staggered_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         for _ in 0..runs {
             for (j, &n) in sizes.iter().enumerate() {
                 for _ in 0..(e.max_discs / n).clamp(1, 16) {
-                    let mut engine = e.engine.build(staggered_pack(n))?;
+                    let pack = build(n);
+                    let bodies = pack.discs.len() + pack.plates.len();
+                    let mut engine = e.engine.build(pack)?;
                     let mut obs = Stoppable {
-                        inner: RunCollector::new(n, false),
+                        inner: RunCollector::new(bodies, false),
                         stop,
                     };
                     let t0 = Instant::now();

@@ -84,8 +84,10 @@ enum Command {
     /// Plot a recording's per-disc load histories (PNG or SVG); holds every sample of every
     /// disc in memory (what it draws).
     Plot(recording::PlotArgs),
-    /// Measure speed: the paper case per run, and the speed-up of a 16-case sweep on 2
-    /// threads over 1 (prints ratios; timing is never a test).
+    /// Measure speed: the paper case per run, the speed-up of a 16-case sweep on 2 threads
+    /// over 1, the recording's cost, the shipped whole packs on both engines, and the cost
+    /// per disc as staggered packs and brake packs (discs and plates) grow (prints times and
+    /// ratios; timing is never a test).
     Bench(bench::BenchArgs),
     /// Studies: many cases of a scene (design factors, random draws, ensembles), sharded over
     /// threads and Slurm or Kubernetes job arrays, merged into Parquet and CSV tables.

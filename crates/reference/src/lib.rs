@@ -239,7 +239,9 @@ impl ReferenceEngine {
 
     /// Whether the pack has separator plates, a drum or a stack: it then runs monolithic (one
     /// step sequence for every body; the open gaps couple neighbours).
-    fn is_whole(&self) -> bool {
+    /// Whether the pack is a whole pack (plates, a drum or a stack), which this engine runs
+    /// monolithic whatever the scheme asked.
+    pub fn is_whole(&self) -> bool {
         !self.pack.plates.is_empty() || self.pack.drum.is_some() || self.pack.stack.is_some()
     }
 

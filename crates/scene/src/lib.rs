@@ -182,6 +182,21 @@ pub enum EngineChoice {
     Multibody,
 }
 
+/// How an engine steps a pack's bodies (key `simulation.scheme`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SchemeChoice {
+    /// Multirate where the engine can (each coupling sub-steps its own contacts), one shared
+    /// step otherwise; the engine says which ran and why.
+    #[default]
+    Auto,
+    /// One step sequence for every body: the multibody engine's shared step, the reference
+    /// engine's monolithic scheme (the oracle).
+    Shared,
+    /// The multirate scheme, or bad input for a pack the engine cannot run so.
+    Multirate,
+}
+
 /// Run settings of a scene (`[simulation]`). The rules and defaults of the keys are those of
 /// [`keys_doc`] (`clutchpack check --keys`), defined once in the scene crate.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -190,6 +205,8 @@ pub struct Simulation {
     pub duration_s: f64,
     /// Engine asked for by the scene, if any. Key `simulation.engine`.
     pub engine: Option<EngineChoice>,
+    /// How the engine steps the bodies. Key `simulation.scheme`.
+    pub scheme: SchemeChoice,
     /// Rate at which samples are emitted, Hz (> 0). Key `simulation.record_rate_hz`.
     pub record_rate_hz: f64,
     /// Relative error tolerance of the adaptive integrators (dimensionless). Key

@@ -3,7 +3,7 @@
 use crate::{Error, Result};
 use clutchpack_model::{Engine, PackModel};
 use clutchpack_reference::{ReferenceEngine, Scheme};
-use clutchpack_scene::{EngineChoice, Scene};
+use clutchpack_scene::{EngineChoice, Scene, SchemeChoice};
 
 /// A validated scene and the engine that runs it. The engine is the one asked for, else the
 /// scene's `simulation.engine`, else the reference engine for a torsional pack and the
@@ -23,6 +23,10 @@ impl Simulation {
         let sim = &scene.simulation;
         let (engine, line): (Box<dyn Engine + Send>, String) = match choice {
             EngineChoice::Reference => {
+                let scheme = match sim.scheme {
+                    SchemeChoice::Shared => Scheme::Monolithic,
+                    SchemeChoice::Auto | SchemeChoice::Multirate => Scheme::Multirate,
+                };
                 let engine = ReferenceEngine::new(
                     scene.pack.clone(),
                     clutchpack_reference::ReferenceOptions {
@@ -30,20 +34,34 @@ impl Simulation {
                         max_step_s: sim.max_step_s,
                         record_rate_hz: sim.record_rate_hz,
                     },
-                );
+                )
+                .with_scheme(scheme);
+                if sim.scheme == SchemeChoice::Multirate && engine.is_whole() {
+                    return Err(Error::BadInput(format!(
+                        "{}: simulation.scheme = \"multirate\": the reference engine runs a \
+                         whole pack (plates, a drum or a stack) in one step sequence; use \
+                         \"auto\" or \"shared\"",
+                        scene.name
+                    )));
+                }
                 let line = format!("engine: reference ({}), {why}", engine.describe());
                 (Box::new(engine), line)
             }
             EngineChoice::Multibody => {
-                let engine = clutchpack_sim::MultibodyEngine::new(
-                    scene.pack.clone(),
-                    clutchpack_sim::MultibodyOptions::with_settings(
+                let options = clutchpack_sim::MultibodyOptions {
+                    scheme: match sim.scheme {
+                        SchemeChoice::Auto => clutchpack_sim::Scheme::Auto,
+                        SchemeChoice::Shared => clutchpack_sim::Scheme::Shared,
+                        SchemeChoice::Multirate => clutchpack_sim::Scheme::Multirate,
+                    },
+                    ..clutchpack_sim::MultibodyOptions::with_settings(
                         sim.record_rate_hz,
                         sim.max_step_s,
                         sim.record_per_tooth,
-                    ),
-                )
-                .map_err(|e| Error::BadInput(format!("{}: {e}", scene.name)))?;
+                    )
+                };
+                let engine = clutchpack_sim::MultibodyEngine::new(scene.pack.clone(), options)
+                    .map_err(|e| Error::BadInput(format!("{}: {e}", scene.name)))?;
                 let line = format!("engine: multibody ({}), {why}", engine.scheme_explanation());
                 (Box::new(engine), line)
             }

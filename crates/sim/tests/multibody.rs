@@ -477,6 +477,7 @@ fn engine_follows_the_scene() {
         simulation: Simulation {
             duration_s: 5e-3,
             engine: None,
+            scheme: Default::default(),
             record_rate_hz: 4e3,
             tolerance: 1e-9,
             max_step_s: 2e-5,

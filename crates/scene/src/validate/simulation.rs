@@ -4,7 +4,7 @@
 use super::Checker;
 use crate::keys::{RawSimulation as S, MAX_SAMPLES};
 use crate::schema::{fmt_bound, fmt_num, Key, RawTable};
-use crate::{EngineChoice, Simulation};
+use crate::{EngineChoice, SchemeChoice, Simulation};
 
 /// `[simulation]`.
 pub(super) fn simulation(ck: &mut Checker, raw: Option<&S>) -> Option<Simulation> {
@@ -24,6 +24,18 @@ pub(super) fn simulation(ck: &mut Checker, raw: Option<&S>) -> Option<Simulation
             &[EngineChoice::Reference, EngineChoice::Multibody],
         )
         .optional();
+    let scheme = ck
+        .choice(
+            &S::scheme.rel(),
+            r.scheme.as_ref(),
+            &S::scheme,
+            &[
+                SchemeChoice::Auto,
+                SchemeChoice::Shared,
+                SchemeChoice::Multirate,
+            ],
+        )
+        .or(SchemeChoice::Auto);
     let rate = num(ck, &S::record_rate_hz).or(S::record_rate_hz.default_num());
     let tolerance = num(ck, &S::tolerance).or(S::tolerance.default_num());
     let max_step = num(ck, &S::max_step_s).or(S::max_step_s.default_num());
@@ -60,6 +72,7 @@ pub(super) fn simulation(ck: &mut Checker, raw: Option<&S>) -> Option<Simulation
     Some(Simulation {
         duration_s: duration?,
         engine: engine?,
+        scheme: scheme?,
         record_rate_hz: rate?,
         tolerance: tolerance?,
         max_step_s: max_step?,
