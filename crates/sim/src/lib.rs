@@ -142,6 +142,22 @@
 //!   (1 000 world steps), 13 % in the tooth law, 7 % in allocation and the kernel, 2 % in the
 //!   impact trackers.
 //!
+//! **Where a whole pack's time goes today** (issue 20; the 16-disc brake pack, 16 staggered
+//! discs and 17 plates on the housing with the open gaps' drag, which runs the shared step;
+//! `perf record --call-graph dwarf` of `clutchpack run` on the MuJoCo anchor's
+//! `brake_N16.toml`, 20 ms, release build): 52 % in rapier's world step (the 34 bodies'
+//! joint constraints rebuilt and solved at every shared step: 84 590 steps per 0.1 s, 84 per
+//! impact), 14 % in the hook's evaluation, 13 % in the step controller, 12.5 % in the stack's
+//! solve, 5 % in `powf` (`s^1.5`, contact durations), 7 % in copies. Every one of these is
+//! paid per shared step, so the cure is fewer world steps (the multirate scheme), not a
+//! faster step. Before the kinematics kept `Rb` (`hook.rs`), a cosine per tooth-law call was
+//! 16 % of the run on its own: keeping it made the 16-disc brake 12 % faster (1.80 -> 1.56 s
+//! for 50 ms, whole process, median of 5 in turn), with byte-identical results. Per 0.1 s
+//! simulated, same minute, whole processes (median of 5, in turn): MuJoCo 4 0.248 s (N = 8)
+//! and 0.436 s (N = 16) against this engine's 1.28 s and 3.46 s (before the `Rb` change); the
+//! reference engine runs the same packs in 0.100 s and 0.231 s. `clutchpack bench` prints the
+//! per-disc growth (N = 1, 4, 8, 16: 1.00, 2.05, 2.87, 4.18x).
+//!
 //! # Conventions
 //! Those of [`clutchpack_model`]: SI units, the shaft axis is `+z`, `phi = theta_s - theta_d`,
 //! per-tooth loads negative when the shaft leads.
