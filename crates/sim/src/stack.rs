@@ -306,6 +306,14 @@ impl<'a> Stack<'a> {
         None
     }
 
+    /// Records a step of length `h` (s) of an open stack taken outside [`Self::solve`] (the
+    /// multirate scheme integrates the gaps' drag with each body's sub-steps and fills
+    /// [`Self::impulse`] and [`Self::dissipated_j`]): nothing is locked.
+    pub fn record_open_step(&mut self, h: f64) {
+        self.h = h;
+        self.locked.iter_mut().for_each(|l| *l = false);
+    }
+
     /// The torque of the stack on coupling body `i` over the step being taken, N m.
     pub fn torque_on(&self, i: usize) -> f64 {
         self.body

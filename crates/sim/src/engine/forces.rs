@@ -169,8 +169,16 @@ impl Run<'_> {
             self.rel.push(rel);
             self.forces.push(f);
         }
+        self.update_stack();
+        self.audit_energy();
+        self.compute_loads();
+        Ok(())
+    }
+
+    /// The stack's clamp forces and slips at `t` from the teeth's normal loads
+    /// `n |F| = |torque| / Rb` and the bodies' speeds (no-op without a stack).
+    pub(super) fn update_stack(&mut self) {
         if let Some(stack) = self.stack.as_mut() {
-            // The teeth's normal load n |F| = |torque| / Rb of each coupling.
             let normal: Vec<f64> = self
                 .forces
                 .iter()
@@ -179,9 +187,6 @@ impl Run<'_> {
                 .collect();
             stack.update(self.t, &normal, &self.omega_d);
         }
-        self.audit_energy();
-        self.compute_loads();
-        Ok(())
     }
 
     /// The physical loads at `t` on every body (the drag, the teeth and their reactions, the

@@ -182,11 +182,18 @@ impl MultibodyEngine {
                     Scheme::Multirate => "asked for",
                     _ => "automatic",
                 };
+                let bodies = if self.pack.plates.is_empty() {
+                    "a prescribed shaft and concentric friction discs only, so the discs are \
+                     independent within a world step"
+                } else {
+                    "a prescribed shaft, plates on the housing and an open stack, so the \
+                     bodies are independent within a world step but for the gaps' drag, held \
+                     over it"
+                };
                 format!(
-                    "multirate scheme ({how}: a prescribed shaft and concentric friction discs \
-                     only, so the discs are independent within a world step): the rapier world \
-                     steps at up to {} s, each disc's spline coupling sub-steps its own \
-                     contacts ({} steps per contact, classical Runge-Kutta)",
+                    "multirate scheme ({how}: {bodies}): the rapier world steps at up to {} s, \
+                     each body's spline coupling sub-steps its own contacts ({} steps per \
+                     contact, classical Runge-Kutta)",
                     a.max_step_s, a.steps_per_contact
                 )
             }
@@ -411,6 +418,9 @@ impl MultibodyEngine {
         loop {
             if rec_time(rec_index) <= run.t {
                 observer.sample(&run.sample(opts.record_tooth_loads));
+                if let Some(s) = &run.stack {
+                    observer.interfaces(run.t, &s.samples());
+                }
                 while rec_time(rec_index) <= run.t {
                     rec_index += 1;
                 }
@@ -424,6 +434,7 @@ impl MultibodyEngine {
             let t1 = world_step_end(run.t, a.max_step_s, rec_time(rec_index), duration_s);
             run.read_relative_states();
             run.multirate_step(t1, &a, &mut counts, &mut closed, &mut contacts)?;
+            run.update_stack();
             // Events in the order they closed across the couplings.
             closed.sort_by(|x, y| x.t_off_s.total_cmp(&y.t_off_s));
             for e in closed.drain(..) {
