@@ -64,10 +64,10 @@ fn piston_can_clamp(stack: &clutchpack_model::StackModel) -> bool {
 }
 
 /// The open gaps' drag on one body over a world step, `sum_nb c (w_nb - w)` (Couette, MODEL.md
-/// section 5): the neighbours' speeds held at the step's start, the body's own speed taken
-/// along its sub-steps (the damping `c` per gap on its own speed is exact within the step;
-/// only the neighbours' change within the step is lagged, a coupling with a time constant
-/// `J / c` of seconds against a world step of 0.1 ms).
+/// section 5): the neighbours' speeds held at their predicted mean over the step (see
+/// `Run::multirate_step`), the body's own speed taken along its sub-steps (the damping `c`
+/// per gap on its own speed is exact within the step; the neighbours' are a coupling with a
+/// time constant `J / c` of seconds against a world step of 0.1 ms).
 #[derive(Debug, Clone, Copy, Default)]
 struct GapDrag {
     /// `c sum_nb w_nb`, N m.
@@ -301,8 +301,7 @@ impl<'a> Run<'a> {
         let n_discs = self.pack.discs.len();
         let mut gaps = self.gap_drags(&self.omega_d);
         if self.stack.is_some() {
-            // ... the plates at their mean speed over the step predicted from their
-            // acceleration at t (teeth, gaps, drag), second order where it is smooth
+            // the plates' predicted mean speeds, for the discs
             let w: Vec<f64> = (0..self.couplings.len())
                 .map(|j| {
                     let w = self.omega_d[j];
