@@ -178,6 +178,24 @@ fn open_brake_pack_8_with_plates() {
 /// (230 impacts in the reference's, not the same count in the multibody engine's).
 #[test]
 fn staggered_brake_8_with_plates() {
+    // the shared step (issue 20 made the multirate scheme the default for this pack:
+    // `staggered_brake_8_multirate`)
+    let options = MultibodyOptions {
+        scheme: clutchpack_sim::Scheme::Shared,
+        ..MultibodyOptions::with_settings(1e4, 2.5e-7, false)
+    };
+    brake_8_agrees(
+        "staggered brake 8, shared step",
+        options,
+        (0.005, 2.0),
+        2e-6,
+    );
+}
+
+/// The open 8-disc brake of the MuJoCo anchor over its first 25 ms in the reference engine at
+/// tolerance 1e-12 and in the multibody engine with `options`: the same impacts on the same
+/// flanks, every peak within `peak.0` relative or `peak.1` N, every onset within `dt_s`.
+fn brake_8_agrees(label: &str, options: MultibodyOptions, peak: (f64, f64), dt_s: f64) {
     let pack = clutchpack_model::cases::staggered_brake(8);
     let duration = 0.025;
     let oracle = ReferenceOptions {
@@ -185,29 +203,34 @@ fn staggered_brake_8_with_plates() {
         ..ReferenceOptions::default()
     };
     let r = impacts(&mut ReferenceEngine::new(pack.clone(), oracle), duration);
-    // the shared step (issue 20 made the multirate scheme the default for this pack:
-    // `staggered_brake_8_multirate`)
-    let options = MultibodyOptions {
-        scheme: clutchpack_sim::Scheme::Shared,
-        ..MultibodyOptions::with_settings(1e4, 2.5e-7, false)
-    };
-    let m = impacts(&mut MultibodyEngine::new(pack, options).unwrap(), duration);
+    let multirate = options.scheme != clutchpack_sim::Scheme::Shared;
+    let mut engine = MultibodyEngine::new(pack, options).unwrap();
+    assert_eq!(
+        engine.is_multirate(),
+        multirate,
+        "{}",
+        engine.scheme_explanation()
+    );
+    let m = impacts(&mut engine, duration);
     assert!(r.len() >= 5 * 17, "{}", r.len());
     assert!(r.iter().any(|e| e.disc >= 8), "the plates strike");
-    assert_eq!(r.len(), m.len(), "impact counts");
+    assert_eq!(r.len(), m.len(), "{label}: impact counts");
     let (mut worst_rel, mut worst_dt) = (0.0f64, 0.0f64);
     for (a, b) in r.iter().zip(&m) {
         assert_eq!((a.disc, a.flank), (b.disc, b.flank), "{a:?} vs {b:?}");
         assert!(
-            (a.peak_n - b.peak_n).abs() <= (0.005 * a.peak_n.abs()).max(2.0),
-            "{a:?} vs {b:?}"
+            (a.peak_n - b.peak_n).abs() <= (peak.0 * a.peak_n.abs()).max(peak.1),
+            "{label}: {a:?} vs {b:?}"
         );
-        assert!((a.t_on_s - b.t_on_s).abs() <= 2e-6, "{a:?} vs {b:?}");
+        assert!(
+            (a.t_on_s - b.t_on_s).abs() <= dt_s,
+            "{label}: {a:?} vs {b:?}"
+        );
         worst_rel = worst_rel.max((a.peak_n - b.peak_n).abs() / a.peak_n.abs());
         worst_dt = worst_dt.max((a.t_on_s - b.t_on_s).abs());
     }
     println!(
-        "staggered brake 8: {} impacts, worst peak {worst_rel:.2e}, worst onset {worst_dt:.2e} s",
+        "{label}: {} impacts, worst peak {worst_rel:.2e}, worst onset {worst_dt:.2e} s",
         r.len()
     );
 }
@@ -224,34 +247,9 @@ fn staggered_brake_8_with_plates() {
 /// 8 us off by 35-50 ms, the shared step at a longest step of 2.5e-7 s 15 us by 36 ms).
 #[test]
 fn staggered_brake_8_multirate() {
-    let pack = clutchpack_model::cases::staggered_brake(8);
-    let duration = 0.025;
-    let oracle = ReferenceOptions {
-        tolerance: 1e-12,
-        ..ReferenceOptions::default()
-    };
-    let r = impacts(&mut ReferenceEngine::new(pack.clone(), oracle), duration);
+    // the settings `run` gives it: world steps of at most 0.1 ms
     let options = MultibodyOptions::with_settings(1e4, 1e-4, false);
-    let mut engine = MultibodyEngine::new(pack, options).unwrap();
-    assert!(engine.is_multirate(), "{}", engine.scheme_explanation());
-    let m = impacts(&mut engine, duration);
-    assert!(r.iter().any(|e| e.disc >= 8), "the plates strike");
-    assert_eq!(r.len(), m.len(), "impact counts");
-    let (mut worst_rel, mut worst_dt) = (0.0f64, 0.0f64);
-    for (a, b) in r.iter().zip(&m) {
-        assert_eq!((a.disc, a.flank), (b.disc, b.flank), "{a:?} vs {b:?}");
-        assert!(
-            (a.peak_n - b.peak_n).abs() <= 1e-3 * a.peak_n.abs(),
-            "{a:?} vs {b:?}"
-        );
-        assert!((a.t_on_s - b.t_on_s).abs() <= 1e-6, "{a:?} vs {b:?}");
-        worst_rel = worst_rel.max((a.peak_n - b.peak_n).abs() / a.peak_n.abs());
-        worst_dt = worst_dt.max((a.t_on_s - b.t_on_s).abs());
-    }
-    println!(
-        "staggered brake 8, multirate: {} impacts, worst peak {worst_rel:.2e}, worst onset {worst_dt:.2e} s",
-        r.len()
-    );
+    brake_8_agrees("staggered brake 8, multirate", options, (1e-3, 0.0), 1e-6);
 }
 
 /// Issue 9: the multibody engine's two schemes on the 8-disc staggered pack

@@ -249,16 +249,22 @@ impl<'a> Run<'a> {
         }
     }
 
+    /// The open gaps' Couette coefficient `c` (torque per slip), N m s/rad; 0 without a stack
+    /// or without oil in the gaps.
+    fn gap_coefficient(&self) -> f64 {
+        -self
+            .pack
+            .stack
+            .as_ref()
+            .map_or(0.0, |m| m.open_gap_torque_n_m(1.0))
+    }
+
     /// The open gaps' drag on every coupling body over a world step from `t` ([`GapDrag`];
     /// zero without a stack), with the neighbours' speeds `w` (rad/s, coupling order).
     fn gap_drags(&self, w: &[f64]) -> Vec<GapDrag> {
         let mut g = vec![GapDrag::default(); self.couplings.len()];
         let Some(stack) = &self.stack else { return g };
-        let c = -self
-            .pack
-            .stack
-            .as_ref()
-            .map_or(0.0, |m| m.open_gap_torque_n_m(1.0));
+        let c = self.gap_coefficient();
         for m in 0..stack.interfaces() {
             let (lo, up) = (stack.body[m], stack.body[m + 1]);
             g[lo].held_n_m += c * w[up];
@@ -342,14 +348,10 @@ impl<'a> Run<'a> {
             // of the relative angle.
             means.push((c1.angle - c0.angle - (phi1 - phi0)) / h);
         }
+        let c = self.gap_coefficient();
         if let Some(s) = self.stack.as_mut() {
             // Each interface's share of the gaps' work, from the bodies' mean speeds over the
             // step (the bodies' own audit is exact along their sub-steps).
-            let c = -self
-                .pack
-                .stack
-                .as_ref()
-                .map_or(0.0, |m| m.open_gap_torque_n_m(1.0));
             for m in 0..s.interfaces() {
                 let slip = means[s.body[m + 1]] - means[s.body[m]];
                 s.impulse[m] = -c * slip * h;
