@@ -177,7 +177,6 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         return Err(anyhow::anyhow!("{e}"));
     }
     let names = &done.body_names;
-    let stats = done.body_stats()?;
     if let Some(path) = &a.plot {
         let series: Vec<(String, Vec<(f64, f64)>)> = names
             .iter()
@@ -239,7 +238,8 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     );
     out!("{}", sim.engine_line());
     out!("per-tooth impact loads (negative: the shaft leads; positive: the disc leads)");
-    out!("{}", stats_table(&stats, TableFormat::Text).trim_end());
+    let stats = &summary.discs;
+    out!("{}", stats_table(stats, TableFormat::Text).trim_end());
     if let Some(worst) = stats.iter().max_by(|x, y| {
         x.max_positive_n
             .max(-x.max_negative_n)

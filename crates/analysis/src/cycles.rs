@@ -392,7 +392,7 @@ pub fn exceedance_spectrum(peaks: &[f64], duration_s: f64) -> Vec<(f64, f64)> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use clutchpack_model::Flank;
 
@@ -484,7 +484,9 @@ mod tests {
         }
     }
 
-    fn event(t_on: f64, t_peak: f64, t_off: f64, peak: f64) -> ImpactEvent {
+    /// An impact of disc 0 (closing at 0.1 m/s, the flank from the peak's sign), for the
+    /// cycle and fatigue tests.
+    pub(crate) fn event(t_on: f64, t_peak: f64, t_off: f64, peak: f64) -> ImpactEvent {
         ImpactEvent {
             disc: 0,
             t_on_s: t_on,

@@ -112,6 +112,12 @@ impl Scene {
     }
 }
 
+/// `jobs` threads, else one per core; at least 1, at most 256 (as `clutchpack sweep`).
+fn threads(jobs: Option<usize>) -> usize {
+    jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .clamp(1, 256)
+}
+
 /// `engine` as the sdk's choice (`None`: the scene's); an unknown name is a `ValueError`.
 fn engine_choice(engine: Option<&str>) -> PyResult<Option<EngineChoice>> {
     engine
@@ -377,25 +383,14 @@ fn sweep(
         )));
     }
     let engine = engine_choice(engine)?;
-    let mut scenes = Vec::new();
-    for v in &values {
-        let mut sets = scene.sets.clone();
-        sets.push(Override {
-            key: param.to_string(),
-            value: format!("{v:e}"),
-        });
-        let s = clutchpack_scene::parse(
-            &scene.inner.source_text,
-            &scene.inner.name,
-            &scene.base_dir,
-            &sets,
-        )
-        .map_err(|e| py_err(e.into()))?;
-        scenes.push(s);
-    }
-    let jobs = jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-        .clamp(1, 256);
+    let scenes = values
+        .iter()
+        .map(|v| {
+            let case = scene.with_sets(vec![(param.to_string(), format!("{v:e}"))])?;
+            Ok(case.inner)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    let jobs = threads(jobs);
     let engine_name = Simulation::new(scenes[0].clone(), engine)
         .map_err(py_err)?
         .engine_name();
@@ -533,9 +528,7 @@ fn study_run(
             "shard {shard} of {shards}: the index must be in 0..{shards} (shards >= 1)"
         )));
     }
-    let jobs = jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-        .clamp(1, 256);
+    let jobs = threads(jobs);
     let shard = clutchpack_study::Shard {
         index: shard,
         count: shards,

@@ -109,17 +109,13 @@ impl RunOutcome {
     /// An error when the engine failed.
     pub fn summary(&self) -> Result<RunSummary> {
         let stats = self.stats()?;
-        let mut s = RunSummary {
-            scene: self.scene.clone(),
-            engine: self.engine.to_string(),
-            duration_s: stats.simulated_s,
-            wall_time_s: self.wall_time_s,
-            steps: stats.steps,
-            rejected_steps: stats.rejected_steps,
-            discs: self.body_stats()?,
-            interfaces: Vec::new(),
-            fatigue: Vec::new(),
-        };
+        let mut s = RunSummary::new(
+            &self.scene,
+            self.engine,
+            stats,
+            self.wall_time_s,
+            self.body_stats()?,
+        );
         s.interfaces = self.collector.interfaces.clone();
         s.fatigue = self.fatigue();
         Ok(s)

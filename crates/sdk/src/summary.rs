@@ -34,17 +34,17 @@ pub struct RunSummary {
 }
 
 impl RunSummary {
-    /// The summary of a run of `scene` on `engine` from the engine's `stats`, its wall time
-    /// in s and the bodies' statistics; no interfaces and no fatigue yet.
+    /// The summary of a run of the scene named `scene` on `engine` from the engine's `stats`,
+    /// its wall time in s and the bodies' statistics; no interfaces and no fatigue yet.
     pub fn new(
-        scene: &Scene,
+        scene: &str,
         engine: &str,
         stats: &RunStats,
         wall_time_s: f64,
         discs: Vec<DiscStats>,
     ) -> RunSummary {
         RunSummary {
-            scene: scene.name.clone(),
+            scene: scene.to_string(),
             engine: engine.to_string(),
             duration_s: stats.simulated_s,
             wall_time_s,

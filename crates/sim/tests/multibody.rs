@@ -263,9 +263,7 @@ fn drive_work_equals_the_change_of_energy() {
         let (c, e) = run(&pack, 1e4, opts, 50e-3);
         assert!(c.impacts.len() >= 10, "a rattle: {}", c.impacts.len());
         let a = e.energy();
-        let de = a.kinetic_j + a.contact_potential_j
-            - a.initial_kinetic_j
-            - a.initial_contact_potential_j;
+        let de = a.energy_change_j();
         let w = a.drive_work_j + a.drag_work_j;
         let gross: f64 = c.impacts.len() as f64;
         println!(

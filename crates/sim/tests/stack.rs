@@ -396,9 +396,7 @@ fn work_of_the_drive_equals_friction_loss_plus_energy_change() {
         "{heat} J vs {}",
         a.stack_work_j
     );
-    let de =
-        a.kinetic_j + a.contact_potential_j - a.initial_kinetic_j - a.initial_contact_potential_j;
-    let w = a.drive_work_j + a.drag_work_j + a.stack_work_j + a.load_work_j;
+    let (de, w) = (a.energy_change_j(), a.work_j());
     println!(
         "drive {:.4} J, faces {:.4} J, dE {de:.6} J, balance {:.3e} of the drive's work",
         a.drive_work_j,
@@ -446,9 +444,7 @@ fn multirate_open_brake_audits_its_energy() {
     let a = e.energy();
     let (_, last) = c.interfaces.last().unwrap();
     let heat: f64 = last.iter().map(|f| f.dissipated_j).sum();
-    let de =
-        a.kinetic_j + a.contact_potential_j - a.initial_kinetic_j - a.initial_contact_potential_j;
-    let w = a.drive_work_j + a.drag_work_j + a.stack_work_j + a.load_work_j;
+    let (de, w) = (a.energy_change_j(), a.work_j());
     println!(
         "drive {:.6} J, gaps {:.6} J, heat {heat:.6} J, dE {de:.6} J, balance {:.3e} of the drive's work, heat vs gaps {:.3e}",
         a.drive_work_j,

@@ -313,28 +313,13 @@ pub fn disc_cycles(name: &str, h: &DiscHistories, duration_s: f64) -> DiscCycles
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cycles::tests::event;
     use crate::cycles::{impact_history, rainflow, turning_points};
     use approx::assert_relative_eq;
-    use clutchpack_model::{DiscSample, Flank};
+    use clutchpack_model::DiscSample;
 
     fn paper() -> SplineGeometry {
         clutchpack_model::cases::paper_spline()
-    }
-
-    fn event(t_on: f64, t_peak: f64, t_off: f64, peak: f64) -> ImpactEvent {
-        ImpactEvent {
-            disc: 0,
-            t_on_s: t_on,
-            t_peak_s: t_peak,
-            t_off_s: t_off,
-            flank: if peak > 0.0 {
-                Flank::DiscLeads
-            } else {
-                Flank::ShaftLeads
-            },
-            v_on_m_s: 0.1,
-            peak_n: peak,
-        }
     }
 
     fn sample(t: f64, load: f64, teeth: Vec<f64>) -> Sample {

@@ -31,14 +31,10 @@ impl Figure for Compare<'_> {
             0.1,
         );
         let (x0, x1) = (-0.5, nd as f64 - 0.5);
-        let mut chart = ChartBuilder::on(&chart_area)
-            .margin(12)
-            .x_label_area_size(56)
-            .y_label_area_size(90)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(msg)?;
-        style_mesh(
-            &mut chart,
+        let mut chart = framed_chart(
+            &chart_area,
+            x0..x1,
+            y0..y1,
             Some("disc"),
             "max peak per-tooth load [N]",
             false,

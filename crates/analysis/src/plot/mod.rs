@@ -383,6 +383,27 @@ fn draw_legend<DB: DrawingBackend>(
 }
 
 /// The common axis styling: tick labels without trailing zeros, light grid.
+/// The chart of a one-panel figure on `area`, in the frame every such figure shares (margin,
+/// label areas, mesh styled by [`style_mesh`]): x over `x` and y over `y`, axis captions
+/// `x_desc` and `y_desc`, x labels only when `x_labels`.
+fn framed_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+    x_desc: Option<&str>,
+    y_desc: &str,
+    x_labels: bool,
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
+    let mut chart = ChartBuilder::on(area)
+        .margin(12)
+        .x_label_area_size(56)
+        .y_label_area_size(90)
+        .build_cartesian_2d(x, y)
+        .map_err(msg)?;
+    style_mesh(&mut chart, x_desc, y_desc, x_labels)?;
+    Ok(chart)
+}
+
 fn style_mesh<DB: DrawingBackend>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     x_desc: Option<&str>,

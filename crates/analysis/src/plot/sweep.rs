@@ -80,14 +80,10 @@ impl Figure for Sweep<'_> {
             .chain([0.0]);
         let (y0, y1) = padded_range(ys, 0.06);
 
-        let mut chart = ChartBuilder::on(&chart_area)
-            .margin(12)
-            .x_label_area_size(56)
-            .y_label_area_size(90)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(msg)?;
-        style_mesh(
-            &mut chart,
+        let mut chart = framed_chart(
+            &chart_area,
+            x0..x1,
+            y0..y1,
             Some(self.param),
             "peak per-tooth load [N]",
             true,

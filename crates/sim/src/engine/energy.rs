@@ -31,6 +31,21 @@ pub struct EnergyAudit {
     pub contact_potential_j: f64,
 }
 
+impl EnergyAudit {
+    /// The change of the kinetic and elastic energy since t = 0, J.
+    pub fn energy_change_j(&self) -> f64 {
+        self.kinetic_j + self.contact_potential_j
+            - self.initial_kinetic_j
+            - self.initial_contact_potential_j
+    }
+
+    /// The work of everything outside the bodies and the teeth since t = 0 (drive, drag,
+    /// stack, load), J: equal to [`Self::energy_change_j`] up to the integration error.
+    pub fn work_j(&self) -> f64 {
+        self.drive_work_j + self.drag_work_j + self.stack_work_j + self.load_work_j
+    }
+}
+
 /// Powers at one evaluation, for the trapezoidal energy audit.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Powers {

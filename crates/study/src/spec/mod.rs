@@ -9,29 +9,13 @@ use crate::rng::Stream;
 use crate::tolerance::{self, PitchDistribution};
 use clutchpack_scene::{EngineChoice, Override, Scene, SceneError};
 use sha2::{Digest, Sha256};
-use std::fmt;
 use std::path::{Path, PathBuf};
 use toml::{Table, Value};
 
-/// One problem of a study file: the key path, the value as written (if any) and the rule.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Problem {
-    /// Key path in the study file (`factor[1].log`), or `line L column C` for a syntax error.
-    pub key: String,
-    /// The offending value in TOML syntax, `None` when missing or unknown.
-    pub value: Option<String>,
-    /// The rule broken.
-    pub rule: String,
-}
-
-impl fmt::Display for Problem {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match &self.value {
-            Some(v) => write!(f, "{} = {}: {}", self.key, v, self.rule),
-            None => write!(f, "{}: {}", self.key, self.rule),
-        }
-    }
-}
+/// One problem of a study file: the key path (`factor[1].log`, or `line L column C` for a
+/// syntax error), the value as written (if any) and the rule; the scene crate's type, so that
+/// a study's problems read as a scene's do.
+pub use clutchpack_scene::Problem;
 
 /// Why a study file cannot be used.
 #[derive(Debug, thiserror::Error)]
