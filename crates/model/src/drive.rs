@@ -129,6 +129,17 @@ pub enum SpeedProfile {
     },
     /// Tabulated speed in rad/s, linear between rows.
     Table(Table),
+    /// A speed held from `t0_s` on (a co-simulation input between two communication points,
+    /// `crate::session`): `omega = speed`, `theta = angle0 + speed (t - t0)`. Valid for
+    /// `t >= t0_s` only (engines never ask earlier).
+    Held {
+        /// Start of the hold, s.
+        t0_s: f64,
+        /// Shaft angle at `t0_s`, rad.
+        angle0_rad: f64,
+        /// The held speed, rad/s.
+        speed_rad_s: f64,
+    },
 }
 
 impl SpeedProfile {
@@ -158,6 +169,7 @@ impl SpeedProfile {
                         .sum::<f64>()
             }
             SpeedProfile::Table(tab) => tab.value(t),
+            SpeedProfile::Held { speed_rad_s, .. } => *speed_rad_s,
         }
     }
 
@@ -179,6 +191,11 @@ impl SpeedProfile {
                         .sum::<f64>()
             }
             SpeedProfile::Table(tab) => tab.integral_from_zero(t),
+            SpeedProfile::Held {
+                t0_s,
+                angle0_rad,
+                speed_rad_s,
+            } => angle0_rad + speed_rad_s * (t - t0_s),
         }
     }
 
@@ -193,6 +210,7 @@ impl SpeedProfile {
                 })
                 .sum(),
             SpeedProfile::Table(tab) => tab.slope(t),
+            SpeedProfile::Held { .. } => 0.0,
         }
     }
 }
@@ -207,6 +225,14 @@ pub enum ShaftExcitation {
     Torque {
         /// The torque history, N m.
         table: Table,
+        /// Shaft speed at t = 0, rad/s.
+        initial_speed_rad_s: f64,
+    },
+    /// A drive torque held constant (a co-simulation input between two communication points,
+    /// `crate::session`), N m.
+    Held {
+        /// The torque, N m (positive along the positive rotation).
+        torque_n_m: f64,
         /// Shaft speed at t = 0, rad/s.
         initial_speed_rad_s: f64,
     },
@@ -238,6 +264,10 @@ impl Shaft {
                 ShaftExcitation::Torque {
                     initial_speed_rad_s,
                     ..
+                }
+                | ShaftExcitation::Held {
+                    initial_speed_rad_s,
+                    ..
                 } => *initial_speed_rad_s,
             },
         }
@@ -255,6 +285,7 @@ impl Shaft {
                 // Hu et al. eq (4): J1 * 2 pi f A cos(2 pi f t)
                 ShaftExcitation::Profile(p) => inertia_kg_m2 * p.acceleration(t),
                 ShaftExcitation::Torque { table, .. } => table.value(t),
+                ShaftExcitation::Held { torque_n_m, .. } => *torque_n_m,
             },
         }
     }

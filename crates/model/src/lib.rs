@@ -59,6 +59,7 @@ pub mod impact;
 pub mod law;
 pub mod pack;
 pub mod spline;
+pub mod session;
 pub mod stream;
 
 pub use clutch::{

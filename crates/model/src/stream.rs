@@ -3,6 +3,7 @@
 
 use crate::clutch::InterfaceSample;
 use crate::impact::ImpactEvent;
+use crate::session::{Driven, Session};
 use serde::{Deserialize, Serialize};
 
 /// State of one disc's coupling at one instant.
@@ -168,11 +169,24 @@ pub trait Engine {
     fn name(&self) -> &'static str;
     /// Names of the discs in output order.
     fn disc_names(&self) -> Vec<String>;
+    /// Starts a steppable run at t = 0 ([`Session`]) whose caller drives the inputs `driven`
+    /// (the others follow the scene's profiles). The session owns a copy of the model: the
+    /// engine stays usable.
+    fn start(&self, driven: Driven) -> Result<Box<dyn Session>, EngineError> {
+        let _ = driven;
+        Err(EngineError::Unsupported(format!(
+            "the {} engine is not steppable yet",
+            self.name()
+        )))
+    }
     /// Runs from t = 0 to `duration_s`, sending samples and impacts to `observer`. On error,
-    /// everything before the failure has already been delivered.
+    /// everything before the failure has already been delivered. Built on [`Engine::start`]:
+    /// one session driven by nothing, advanced to `duration_s` in one call.
     fn run(
         &mut self,
         duration_s: f64,
         observer: &mut dyn Observer,
-    ) -> Result<RunStats, EngineError>;
+    ) -> Result<RunStats, EngineError> {
+        crate::session::run_session(self.start(Driven::NONE)?, duration_s, observer)
+    }
 }

@@ -175,6 +175,7 @@ impl<'a> Run<'a> {
                     ShaftExcitation::Torque { table, .. } => {
                         table.y.iter().fold(0.0, |m: f64, y| m.max(y.abs())) / inertia_kg_m2
                     }
+                    ShaftExcitation::Held { torque_n_m, .. } => torque_n_m.abs() / inertia_kg_m2,
                 },
             ),
         };

@@ -1,0 +1,176 @@
+//! Steppable engines (co-simulation): a [`Session`] advances a pack to one communication point
+//! after another, with inputs that arrive one call at a time, and can be cloned to save and
+//! restore its state (FMI 2.0's `fmi2GetFMUstate`). `Engine::run` is built on it.
+//!
+//! How an input is held between communication points and what happens to a contact open at a
+//! communication point: docs/DECISIONS.md, "Co-simulation".
+
+use crate::clutch::InterfaceSample;
+use crate::stream::{EngineError, Observer, RunStats, Sample};
+
+/// Which of the pack's inputs a session's caller drives (the others follow the scene's
+/// profiles). A session driven by nothing follows the scene exactly as `Engine::run` does,
+/// and its steps never stop at a communication point (so any split of a run into calls gives
+/// the run's results bit for bit). A driven session ends a step at every communication point,
+/// where an input may change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Driven {
+    /// The prescribed shaft's speed (a shaft with `mode = "prescribed"`).
+    pub shaft_speed: bool,
+    /// The drive torque on an inertial shaft (`mode = "inertial"`).
+    pub shaft_torque: bool,
+    /// The load torque on the drum (a pack with a drum).
+    pub drum_load: bool,
+    /// The pressure on the piston (a pack with a stack).
+    pub piston_pressure: bool,
+}
+
+impl Driven {
+    /// Nothing driven: the scene's own inputs.
+    pub const NONE: Driven = Driven {
+        shaft_speed: false,
+        shaft_torque: false,
+        drum_load: false,
+        piston_pressure: false,
+    };
+
+    /// Whether any input is driven.
+    pub fn any(&self) -> bool {
+        self.shaft_speed || self.shaft_torque || self.drum_load || self.piston_pressure
+    }
+}
+
+/// Input values set at a communication point and held (zero-order hold) until the next one.
+/// `None` keeps the value held before (at the start of a session: the scene's profile's value
+/// at t = 0). Only the inputs the session was started to drive ([`Driven`]) may be set.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Inputs {
+    /// Prescribed shaft speed, rad/s (positive: the shaft's positive rotation). The shaft's
+    /// angle stays continuous: it integrates the held speed.
+    pub shaft_speed_rad_s: Option<f64>,
+    /// Drive torque on an inertial shaft, N m (positive along the positive rotation; eq 4's
+    /// `T_drive`).
+    pub shaft_torque_n_m: Option<f64>,
+    /// Load torque on the drum, N m (negative: it brakes a drum turning the positive way).
+    pub drum_load_n_m: Option<f64>,
+    /// Pressure on the piston, Pa (>= 0).
+    pub piston_pressure_pa: Option<f64>,
+}
+
+impl Inputs {
+    /// The driven inputs that `self` sets and `driven` does not allow, by name.
+    pub fn undriven(&self, driven: &Driven) -> Vec<&'static str> {
+        let mut out = Vec::new();
+        if self.shaft_speed_rad_s.is_some() && !driven.shaft_speed {
+            out.push("shaft speed");
+        }
+        if self.shaft_torque_n_m.is_some() && !driven.shaft_torque {
+            out.push("shaft torque");
+        }
+        if self.drum_load_n_m.is_some() && !driven.drum_load {
+            out.push("drum load");
+        }
+        if self.piston_pressure_pa.is_some() && !driven.piston_pressure {
+            out.push("piston pressure");
+        }
+        out
+    }
+
+    /// The first value that is not finite (or a negative pressure), as `(name, value)`.
+    pub fn invalid(&self) -> Option<(&'static str, f64)> {
+        let all = [
+            ("shaft speed", self.shaft_speed_rad_s),
+            ("shaft torque", self.shaft_torque_n_m),
+            ("drum load", self.drum_load_n_m),
+            ("piston pressure", self.piston_pressure_pa),
+        ];
+        for (name, v) in all {
+            if let Some(v) = v {
+                if !v.is_finite() || (name == "piston pressure" && v < 0.0) {
+                    return Some((name, v));
+                }
+            }
+        }
+        None
+    }
+}
+
+/// The pack's state at a session's current time: what an FMU outputs at a communication point.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Snapshot {
+    /// The shaft and every body (the discs, then the plates), as the engines' samples: per
+    /// body the speed (rad/s), the per-tooth load (N, signed as eq 6) and the spline torque
+    /// on the body (N m, `-n F Rb`, eq 5).
+    pub sample: Sample,
+    /// The stack's friction interfaces (empty without a stack).
+    pub interfaces: Vec<InterfaceSample>,
+    /// Drum angle (rad) and speed (rad/s); `None` for plates on the housing or no plates.
+    pub drum: Option<(f64, f64)>,
+}
+
+impl Snapshot {
+    /// Torque of the pack on the shaft, N m (positive along the shaft's positive rotation):
+    /// the discs' spline reactions `sum n F Rb` (eq 4), the first `n_discs` bodies.
+    pub fn shaft_torque_n_m(&self, n_discs: usize) -> f64 {
+        -self.sample.discs[..n_discs.min(self.sample.discs.len())]
+            .iter()
+            .map(|d| d.torque_n_m)
+            .sum::<f64>()
+    }
+
+    /// Torque of the plates on their carrier (the drum or the housing), N m (positive along
+    /// the positive rotation): the plates' spline reactions, the bodies after the discs.
+    pub fn carrier_torque_n_m(&self, n_discs: usize) -> f64 {
+        -self
+            .sample
+            .discs
+            .iter()
+            .skip(n_discs)
+            .map(|d| d.torque_n_m)
+            .sum::<f64>()
+    }
+}
+
+/// How a call to [`Session::advance_to`] ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Advance {
+    /// The session reached the asked time.
+    Reached,
+    /// The observer asked to stop ([`Observer::progress`]); the session stands at an earlier
+    /// time, everything up to it delivered.
+    Stopped,
+}
+
+/// A run in progress that owns everything it needs (no borrow of the engine or the model).
+pub trait Session: Send {
+    /// The time the session stands at, s (the last communication point reached).
+    fn time_s(&self) -> f64;
+    /// Sets inputs from [`Session::time_s`] on, held until changed. Fails (nothing changed)
+    /// on an input the session does not drive or a value that is not finite.
+    fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError>;
+    /// Advances to `t_s` (>= [`Session::time_s`]), sending the samples, contact samples and
+    /// impacts closed up to `t_s` to `observer`. On error, everything before the failure has
+    /// been delivered and the session must not be advanced again.
+    fn advance_to(&mut self, t_s: f64, observer: &mut dyn Observer)
+        -> Result<Advance, EngineError>;
+    /// The pack's state at [`Session::time_s`].
+    fn snapshot(&self) -> Snapshot;
+    /// Ends the run at [`Session::time_s`]: the contact events still open are closed and
+    /// sent; returns the run's statistics. The session is spent afterwards.
+    fn finish(&mut self, observer: &mut dyn Observer) -> RunStats;
+    /// A copy of the whole state (FMI state save/restore): advancing the copy gives exactly
+    /// what advancing the original would.
+    fn boxed_clone(&self) -> Box<dyn Session>;
+}
+
+/// Runs a session started at t = 0 to `duration_s` and finishes it: what `Engine::run` does.
+pub fn run_session(
+    mut session: Box<dyn Session>,
+    duration_s: f64,
+    observer: &mut dyn Observer,
+) -> Result<RunStats, EngineError> {
+    let advance = session.advance_to(duration_s, observer)?;
+    let mut stats = session.finish(observer);
+    stats.stopped_early = advance == Advance::Stopped;
+    Ok(stats)
+}
