@@ -136,6 +136,13 @@ impl PeakStats {
         PeakStats::default()
     }
 
+    /// The largest `|peak|` of disc `disc` so far, N (0 before its first impact).
+    pub fn max_abs_n(&self, disc: usize) -> f64 {
+        self.discs
+            .get(disc)
+            .map_or(0.0, |d| d.max_positive_n.max(-d.max_negative_n))
+    }
+
     /// Impacts counted so far.
     pub fn impacts(&self) -> usize {
         self.discs.iter().map(|d| d.impacts).sum()
@@ -157,6 +164,27 @@ impl PeakStats {
                 self.in_memory_only = true;
             }
         }
+    }
+
+    /// An independent copy (a steppable run's saved state): the values spilled to the
+    /// temporary file are copied to a new one. Errors only when the file cannot be copied.
+    pub fn try_clone(&self) -> std::io::Result<PeakStats> {
+        use std::io::{Seek, SeekFrom};
+        let file = match self.file.as_ref() {
+            Some(mut f) => {
+                f.seek(SeekFrom::Start(0))?;
+                let mut copy = tempfile::tempfile()?;
+                std::io::copy(&mut f, &mut copy)?;
+                Some(copy)
+            }
+            None => None,
+        };
+        Ok(PeakStats {
+            discs: self.discs.clone(),
+            held: self.held.clone(),
+            file,
+            in_memory_only: self.in_memory_only,
+        })
     }
 
     /// Whether some values went to the temporary file.

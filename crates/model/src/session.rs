@@ -5,7 +5,9 @@
 //! How an input is held between communication points and what happens to a contact open at a
 //! communication point: docs/DECISIONS.md, "Co-simulation".
 
-use crate::clutch::InterfaceSample;
+use crate::clutch::{InterfaceSample, PressureProfile};
+use crate::drive::{Shaft, ShaftExcitation, SpeedProfile};
+use crate::pack::PackModel;
 use crate::stream::{EngineError, Observer, RunStats, Sample};
 
 /// Which of the pack's inputs a session's caller drives (the others follow the scene's
@@ -37,6 +39,35 @@ impl Driven {
     /// Whether any input is driven.
     pub fn any(&self) -> bool {
         self.shaft_speed || self.shaft_torque || self.drum_load || self.piston_pressure
+    }
+
+    /// Whether `pack` has every input driven: a prescribed shaft for its speed, an inertial
+    /// shaft for its torque, a drum for its load, a stack for the pressure. The error says
+    /// which is missing.
+    pub fn check(&self, pack: &PackModel) -> Result<(), EngineError> {
+        let inertial = matches!(pack.shaft, Shaft::Inertial { .. });
+        let missing = [
+            (self.shaft_speed && inertial, "the shaft speed needs a prescribed shaft (shaft.mode = \"prescribed\"); an inertial shaft takes a drive torque"),
+            (self.shaft_torque && !inertial, "the shaft torque needs an inertial shaft (shaft.mode = \"inertial\"); a prescribed shaft takes a speed"),
+            (self.drum_load && pack.drum.is_none(), "the drum load needs a pack with a drum"),
+            (self.piston_pressure && pack.stack.is_none(), "the piston pressure needs a pack with a stack"),
+        ];
+        match missing.iter().find(|(m, _)| *m) {
+            Some((_, why)) => Err(EngineError::Unsupported(why.to_string())),
+            None => Ok(()),
+        }
+    }
+
+    /// The scene's inputs that a session can drive for `pack`: the shaft's speed or torque,
+    /// the drum's load, the piston's pressure (what an FMU of the pack takes).
+    pub fn all_for(pack: &PackModel) -> Driven {
+        let inertial = matches!(pack.shaft, Shaft::Inertial { .. });
+        Driven {
+            shaft_speed: !inertial,
+            shaft_torque: inertial,
+            drum_load: pack.drum.is_some(),
+            piston_pressure: pack.stack.is_some(),
+        }
     }
 }
 
@@ -93,6 +124,45 @@ impl Inputs {
         }
         None
     }
+}
+
+/// `pack` with `inputs` held from `t_s` on (zero-order hold; `crate::session`), and the jump
+/// of the prescribed shaft's speed at `t_s` (rad/s, new minus old; 0 when it is not set): the
+/// speed becomes `SpeedProfile::Held` from the shaft's angle at `t_s` (so the angle stays
+/// continuous), the drive torque `ShaftExcitation::Held`, the pressure a constant, the drum's
+/// load its new value. Inputs the pack does not have are ignored (checked by
+/// [`Driven::check`] when the session starts).
+pub fn hold_inputs(pack: &PackModel, t_s: f64, inputs: &Inputs) -> (PackModel, f64) {
+    let mut out = pack.clone();
+    let mut jump = 0.0;
+    match &mut out.shaft {
+        Shaft::Prescribed(p) => {
+            if let Some(v) = inputs.shaft_speed_rad_s {
+                jump = v - p.speed(t_s);
+                *p = SpeedProfile::Held {
+                    t0_s: t_s,
+                    angle0_rad: p.angle(t_s),
+                    speed_rad_s: v,
+                };
+            }
+        }
+        Shaft::Inertial { excitation, .. } => {
+            if let Some(torque) = inputs.shaft_torque_n_m {
+                let initial_speed_rad_s = pack.shaft.initial_speed_rad_s();
+                *excitation = ShaftExcitation::Held {
+                    torque_n_m: torque,
+                    initial_speed_rad_s,
+                };
+            }
+        }
+    }
+    if let (Some(d), Some(load)) = (out.drum.as_mut(), inputs.drum_load_n_m) {
+        d.load_torque_n_m = load;
+    }
+    if let (Some(s), Some(p)) = (out.stack.as_mut(), inputs.piston_pressure_pa) {
+        s.piston.pressure = PressureProfile::Constant { pressure_pa: p };
+    }
+    (out, jump)
 }
 
 /// The pack's state at a session's current time: what an FMU outputs at a communication point.
@@ -153,6 +223,11 @@ pub trait Session: Send {
     /// been delivered and the session must not be advanced again.
     fn advance_to(&mut self, t_s: f64, observer: &mut dyn Observer)
         -> Result<Advance, EngineError>;
+    /// Declares the time the session will not be advanced beyond (FMI's stop time, `run`'s
+    /// duration), s: steps land on it rather than pass it, as a run's last step does. Without
+    /// it a session driven by nothing steps past its communication points as far as its
+    /// steps go.
+    fn set_stop_time(&mut self, t_s: f64);
     /// The pack's state at [`Session::time_s`].
     fn snapshot(&self) -> Snapshot;
     /// Ends the run at [`Session::time_s`]: the contact events still open are closed and
@@ -169,6 +244,7 @@ pub fn run_session(
     duration_s: f64,
     observer: &mut dyn Observer,
 ) -> Result<RunStats, EngineError> {
+    session.set_stop_time(duration_s);
     let advance = session.advance_to(duration_s, observer)?;
     let mut stats = session.finish(observer);
     stats.stopped_early = advance == Advance::Stopped;

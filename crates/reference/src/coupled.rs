@@ -3,17 +3,20 @@
 //! the integrated state at their located re-engagement (crate docs, Theory).
 
 use crate::dopri::Dense;
+use crate::session::{Clock, Queue};
 use crate::stepper::{Sink, Stepper, Switch};
 use crate::system::{disc_sample, System};
 use crate::ReferenceOptions;
+use clutchpack_model::session::{Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::{
     DiscModel, DiscSample, Engagement, EngineError, ImpactEvent, Observer, PackModel, RunStats,
     Sample,
 };
+use std::sync::Arc;
 
 /// A disc in free flight since `t0` (s): eq (5) with `F = 0`, `J2 omega' = -C2 omega`.
 #[derive(Debug, Clone, Copy)]
-struct Free {
+pub(crate) struct Free {
     t0: f64,
     /// Disc angle at `t0`, rad.
     theta0: f64,
@@ -100,112 +103,199 @@ fn probe(
 }
 
 /// Builds whole-pack samples from the integrated state and the free discs' closed forms.
-struct PackSink<'o, 'f> {
-    obs: &'o mut dyn Observer,
+struct PackSink<'q, 'f> {
+    queue: &'q mut Queue,
     free: &'f [Option<Free>],
-    sample: &'f mut Sample,
+}
+
+/// The sample at `t` (s) of the pack whose integrated slots are in `sys` (state `y`, modes
+/// `modes`) and whose other discs are free (`free`).
+fn pack_sample(
+    t: f64,
+    sys: &System,
+    y: &[f64],
+    modes: &[Option<Engagement>],
+    free: &[Option<Free>],
+) -> Sample {
+    let (theta_s, omega_s) = sys.shaft(t, y);
+    let mut sample = Sample {
+        t_s: t,
+        shaft_angle_rad: theta_s,
+        shaft_speed_rad_s: omega_s,
+        discs: vec![DiscSample::default(); free.len()],
+    };
+    for (slot, &id) in sys.ids.iter().enumerate() {
+        sample.discs[id] = sys.disc_sample(t, slot, y, &modes[slot]);
+    }
+    for (id, f) in free.iter().enumerate() {
+        if let Some(f) = f {
+            let (th, om) = f.at(t);
+            sample.discs[id] = disc_sample(
+                &sys.pack.discs[id],
+                theta_s,
+                omega_s,
+                theta_s - th,
+                omega_s - om,
+                &None,
+            );
+        }
+    }
+    sample
 }
 
 impl Sink for PackSink<'_, '_> {
     fn sample(&mut self, _k: u64, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]) {
-        let (theta_s, omega_s) = sys.shaft(t, y);
-        self.sample.t_s = t;
-        self.sample.shaft_angle_rad = theta_s;
-        self.sample.shaft_speed_rad_s = omega_s;
-        for (slot, &id) in sys.ids.iter().enumerate() {
-            self.sample.discs[id] = sys.disc_sample(t, slot, y, &modes[slot]);
-        }
-        for (id, f) in self.free.iter().enumerate() {
-            if let Some(f) = f {
-                let (th, om) = f.at(t);
-                self.sample.discs[id] = disc_sample(
-                    &sys.pack.discs[id],
-                    theta_s,
-                    omega_s,
-                    theta_s - th,
-                    omega_s - om,
-                    &None,
-                );
-            }
-        }
-        self.obs.sample(self.sample);
+        self.queue.sample(pack_sample(t, sys, y, modes, self.free));
     }
     fn impact(&mut self, e: ImpactEvent) {
-        self.obs.impact(&e);
+        self.queue.impact(e);
     }
     fn contact(&mut self, slot: usize, t: f64, sys: &System, y: &[f64], mode: &Option<Engagement>) {
-        if !self.obs.wants_contact_samples() {
-            return;
+        if self.queue.wants_contacts {
+            let d = sys.disc_sample(t, slot, y, mode);
+            self.queue.contact(sys.ids[slot], t, d);
         }
-        let d = sys.disc_sample(t, slot, y, mode);
-        self.obs.contact_sample(sys.ids[slot], t, &d);
     }
 }
 
-pub(crate) fn run(
-    pack: &PackModel,
-    settings: &ReferenceOptions,
-    duration_s: f64,
-    obs: &mut dyn Observer,
-) -> Result<RunStats, EngineError> {
-    let nd = pack.discs.len();
-    // Start from the whole pack and let every disc out of contact leave the integration.
-    let mut st = Stepper::new(System::new(pack, (0..nd).collect()), settings);
-    let mut free: Vec<Option<Free>> = vec![None; nd];
-    let mut slot = 0;
-    while slot < st.sys.ids.len() {
-        if st.modes[slot].is_none() {
-            release(&mut st, slot, &mut free);
-        } else {
-            slot += 1;
-        }
-    }
-    st.restart();
-    let mut sample = Sample {
-        discs: vec![DiscSample::default(); nd],
-        ..Sample::default()
-    };
-    let mut stopped = false;
-    while st.t < duration_s {
-        let switch = {
-            let mut sink = PackSink {
-                obs: &mut *obs,
-                free: &free,
-                sample: &mut sample,
-            };
-            let free = &free;
-            st.step(duration_s, &mut sink, &mut |_, _, t0, t1, d| {
-                probe(pack, free, t0, t1, d)
-            })?
-        };
-        match switch {
-            Switch::Separated(slot) => {
+/// The multirate scheme on an inertial shaft as a session.
+#[derive(Clone)]
+pub(crate) struct CoupledSession {
+    st: Stepper,
+    free: Vec<Option<Free>>,
+    clock: Clock,
+    queue: Queue,
+    /// The integration and the free discs as they were before the last step's change of the
+    /// integrated discs, when that step passed the session's time (the snapshot needs them).
+    before: Option<Box<(Stepper, Vec<Option<Free>>)>>,
+}
+
+impl CoupledSession {
+    pub fn new(pack: Arc<PackModel>, settings: &ReferenceOptions, driven: Driven) -> Self {
+        let nd = pack.discs.len();
+        // Start from the whole pack and let every disc out of contact leave the integration.
+        let mut st = Stepper::new(System::new(pack, (0..nd).collect()), settings);
+        let mut free: Vec<Option<Free>> = vec![None; nd];
+        let mut slot = 0;
+        while slot < st.sys.ids.len() {
+            if st.modes[slot].is_none() {
                 release(&mut st, slot, &mut free);
-                st.restart();
+            } else {
+                slot += 1;
             }
-            Switch::External(id) => {
-                let f = free[id].take().expect("a free disc engaged");
-                let (th, om) = f.at(st.t);
-                let (phi, psi) = (st.y[0] - th, st.y[1] - om);
-                st.insert(id, phi, psi);
-                st.restart();
-            }
-            Switch::None | Switch::Engaged(_) => {}
         }
-        if st.stats.steps.is_multiple_of(256) && obs.progress(st.t) {
-            stopped = true;
-            break;
+        st.restart();
+        CoupledSession {
+            st,
+            free,
+            clock: Clock::new(driven),
+            queue: Queue::default(),
+            before: None,
         }
     }
-    st.finish(&mut PackSink {
-        obs,
-        free: &free,
-        sample: &mut sample,
-    });
-    let mut stats = st.stats.clone();
-    stats.simulated_s = st.t;
-    stats.stopped_early = stopped;
-    Ok(stats)
+}
+
+impl Session for CoupledSession {
+    fn time_s(&self) -> f64 {
+        self.clock.t
+    }
+
+    fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
+        // an inertial shaft: its drive torque, no jump of a speed
+        let (pack, _) = self.clock.hold(&self.st.sys.pack, inputs)?;
+        self.st.sys.pack = Arc::new(pack);
+        self.st.restart();
+        Ok(())
+    }
+
+    fn set_stop_time(&mut self, t_s: f64) {
+        self.clock.stop = t_s;
+    }
+
+    fn advance_to(&mut self, t: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
+        self.clock.check_advance(t)?;
+        self.queue.wants_contacts = obs.wants_contact_samples();
+        let end = self.clock.step_end(t);
+        let mut advance = Advance::Reached;
+        while self.st.t < t {
+            let step = {
+                let mut sink = PackSink {
+                    queue: &mut self.queue,
+                    free: &self.free,
+                };
+                let (free, pack) = (&self.free, self.st.sys.pack.clone());
+                self.st.step(end, &mut sink, &mut |_, _, t0, t1, d| {
+                    probe(&pack, free, t0, t1, d)
+                })
+            };
+            let switch = match step {
+                Ok(s) => s,
+                Err(e) => {
+                    self.clock.failed = true;
+                    self.queue.flush(self.st.t, obs);
+                    return Err(e);
+                }
+            };
+            let regroups = matches!(switch, Switch::Separated(_) | Switch::External(_));
+            self.before =
+                (regroups && self.st.t > t).then(|| Box::new((self.st.clone(), self.free.clone())));
+            match switch {
+                Switch::Separated(slot) => {
+                    release(&mut self.st, slot, &mut self.free);
+                    self.st.restart();
+                }
+                Switch::External(id) => {
+                    let f = self.free[id].take().expect("a free disc engaged");
+                    let (th, om) = f.at(self.st.t);
+                    let (phi, psi) = (self.st.y[0] - th, self.st.y[1] - om);
+                    self.st.insert(id, phi, psi);
+                    self.st.restart();
+                }
+                Switch::None | Switch::Engaged(_) => {}
+            }
+            if self.st.stats.steps.is_multiple_of(256) && obs.progress(self.st.t) {
+                advance = Advance::Stopped;
+                break;
+            }
+        }
+        self.clock.t = if advance == Advance::Stopped {
+            self.st.t.min(t)
+        } else {
+            t
+        };
+        self.queue.flush(self.clock.t, obs);
+        Ok(advance)
+    }
+
+    fn snapshot(&self) -> Snapshot {
+        let t = self.clock.t;
+        let (st, free) = match &self.before {
+            Some(b) if t < self.st.t => (&b.0, &b.1),
+            _ => (&self.st, &self.free),
+        };
+        let mut y = Vec::new();
+        let modes = st.state_at(t, &mut y);
+        Snapshot {
+            sample: pack_sample(t, &st.sys, &y, modes, free),
+            interfaces: Vec::new(),
+            drum: None,
+        }
+    }
+
+    fn finish(&mut self, obs: &mut dyn Observer) -> RunStats {
+        self.st.finish(&mut PackSink {
+            queue: &mut self.queue,
+            free: &self.free,
+        });
+        self.queue.flush(f64::INFINITY, obs);
+        let mut stats = self.st.stats.clone();
+        stats.simulated_s = self.clock.t;
+        stats
+    }
+
+    fn boxed_clone(&self) -> Box<dyn Session> {
+        Box::new(self.clone())
+    }
 }
 
 /// Moves the disc in `slot` (out of contact) from the integration to free flight.

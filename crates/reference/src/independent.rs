@@ -2,18 +2,21 @@
 //! steps and events, advanced window by window (in parallel when asked) and merged into one
 //! time-ordered stream of samples and impacts (crate docs, Theory).
 
+use crate::session::{shift_disc_speeds, Clock};
 use crate::stepper::{Sink, Stepper};
 use crate::system::System;
 use crate::{no_external, ReferenceOptions};
+use clutchpack_model::session::{Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::{
     DiscSample, Engagement, EngineError, ImpactEvent, Observer, PackModel, RunStats, Sample,
 };
 use rayon::prelude::*;
 use std::collections::VecDeque;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// One disc's output not yet merged.
-#[derive(Default)]
+#[derive(Default, Clone)]
 struct Buffer {
     /// `(sample number, the disc's sample)` in order.
     samples: VecDeque<(u64, DiscSample)>,
@@ -57,23 +60,21 @@ fn send_contacts(runs: &mut [DiscRun], t: f64, obs: &mut dyn Observer) {
 }
 
 /// One disc's integration and its unmerged output.
-struct DiscRun<'a> {
-    stepper: Stepper<'a>,
+#[derive(Clone)]
+struct DiscRun {
+    stepper: Stepper,
     out: Buffer,
     error: Option<EngineError>,
 }
 
-impl DiscRun<'_> {
-    /// Integrates until the disc's time reaches `t_w` (s) or the end of the run, or until
-    /// the wall clock passes `deadline` (so that a stop request is seen even when the
+impl DiscRun {
+    /// Integrates until the disc's time reaches `t_w` (s), its steps ending at `end` (s), or
+    /// until the wall clock passes `deadline` (so that a stop request is seen even when the
     /// steps become very small).
-    fn advance(&mut self, t_w: f64, duration_s: f64, deadline: Instant) {
+    fn advance(&mut self, t_w: f64, end: f64, deadline: Instant) {
         let mut n: u32 = 0;
-        while self.error.is_none() && self.stepper.t < t_w && self.stepper.t < duration_s {
-            if let Err(e) = self
-                .stepper
-                .step(duration_s, &mut self.out, &mut no_external)
-            {
+        while self.error.is_none() && self.stepper.t < t_w {
+            if let Err(e) = self.stepper.step(end, &mut self.out, &mut no_external) {
                 self.error = Some(e);
             }
             n = n.wrapping_add(1);
@@ -98,54 +99,78 @@ const WINDOW_WALL_CUT_S: f64 = 0.25;
 /// which a 300 s run met and a 3 s run did not.
 const MAX_BUFFERED_SAMPLES: f64 = 4e3;
 
-pub(crate) fn run(
-    pack: &PackModel,
-    settings: &ReferenceOptions,
+/// The multirate scheme on a prescribed shaft as a session: the discs' integrations and the
+/// merge's state between calls.
+#[derive(Clone)]
+pub(crate) struct IndependentSession {
+    runs: Vec<DiscRun>,
+    pack: Arc<PackModel>,
     parallel: bool,
-    duration_s: f64,
-    obs: &mut dyn Observer,
-) -> Result<RunStats, EngineError> {
-    let nd = pack.discs.len();
-    let wants_contacts = obs.wants_contact_samples();
-    let mut runs: Vec<DiscRun> = (0..nd)
-        .map(|i| DiscRun {
-            stepper: Stepper::new(System::new(pack, vec![i]), settings),
-            out: Buffer {
-                wants_contacts,
-                ..Buffer::default()
+    clock: Clock,
+    rate: f64,
+    /// Window length in simulated time, s, and its upper bound.
+    window: f64,
+    cap: f64,
+    /// Time every disc has reached and whose output has been merged, s.
+    t_w: f64,
+    /// Number of the next merged sample.
+    next_k: u64,
+    /// Impacts closed but not yet sent, in the order of their end.
+    pending: Vec<ImpactEvent>,
+    sample: Sample,
+}
+
+impl IndependentSession {
+    pub fn new(
+        pack: Arc<PackModel>,
+        settings: &ReferenceOptions,
+        parallel: bool,
+        driven: Driven,
+    ) -> Self {
+        let nd = pack.discs.len();
+        let runs = (0..nd)
+            .map(|i| DiscRun {
+                stepper: Stepper::new(System::new(pack.clone(), vec![i]), settings),
+                out: Buffer::default(),
+                error: None,
+            })
+            .collect();
+        let rate = settings.record_rate_hz;
+        let cap = (MAX_BUFFERED_SAMPLES / (rate * nd as f64)).max(2.0 / rate);
+        IndependentSession {
+            runs,
+            pack,
+            parallel,
+            clock: Clock::new(driven),
+            rate,
+            window: (1e-3f64).min(cap),
+            cap,
+            t_w: 0.0,
+            next_k: 0,
+            pending: Vec::new(),
+            sample: Sample {
+                discs: vec![DiscSample::default(); nd],
+                ..Sample::default()
             },
-            error: None,
-        })
-        .collect();
-    let shaft = match &pack.shaft {
-        clutchpack_model::Shaft::Prescribed(p) => p,
-        clutchpack_model::Shaft::Inertial { .. } => unreachable!("a prescribed shaft"),
-    };
-    let rate = settings.record_rate_hz;
-    let cap = (MAX_BUFFERED_SAMPLES / (rate * nd as f64)).max(2.0 / rate);
-    let mut window = (1e-3f64).min(cap);
-    let mut t_w = 0.0;
-    let mut next_k: u64 = 0;
-    let mut pending: Vec<ImpactEvent> = Vec::new();
-    let mut sample = Sample {
-        discs: vec![DiscSample::default(); nd],
-        ..Sample::default()
-    };
-    let mut stopped = false;
-    let mut failure: Option<EngineError> = None;
-    while t_w < duration_s {
-        let target = (t_w + window).min(duration_s);
+        }
+    }
+
+    /// Runs the discs through one window ending at most at `target` (s), their steps ending
+    /// at `end`, and sends what the window completed; returns the error of the earliest disc
+    /// that failed.
+    fn window(&mut self, target: f64, end: f64, obs: &mut dyn Observer) -> Result<(), EngineError> {
+        let runs = &mut self.runs;
         let wall = Instant::now();
         let deadline = wall + std::time::Duration::from_secs_f64(WINDOW_WALL_CUT_S);
-        if parallel {
+        if self.parallel {
             runs.par_iter_mut()
-                .for_each(|r| r.advance(target, duration_s, deadline));
+                .for_each(|r| r.advance(target, end, deadline));
         } else {
             runs.iter_mut()
-                .for_each(|r| r.advance(target, duration_s, deadline));
+                .for_each(|r| r.advance(target, end, deadline));
         }
         // a window cut short by the deadline ends where the slowest disc got to
-        t_w = runs
+        self.t_w = runs
             .iter()
             .filter(|r| r.error.is_none())
             .map(|r| r.stepper.t.min(target))
@@ -158,30 +183,45 @@ pub(crate) fn run(
             .map(|r| r.out.samples.len() + r.out.contacts.len())
             .sum::<usize>() as f64;
         if wall > WINDOW_WALL_MAX_S || buffered > MAX_BUFFERED_SAMPLES {
-            window *= 0.5;
+            self.window *= 0.5;
         } else if wall < WINDOW_WALL_MIN_S && 2.0 * buffered <= MAX_BUFFERED_SAMPLES {
-            window = (2.0 * window).min(cap);
+            self.window = (2.0 * self.window).min(self.cap);
         }
         // Deliver everything up to `limit`: the window's end, or the last good time of the
         // earliest disc that failed.
-        let mut limit = t_w;
-        for r in &runs {
+        let mut limit = self.t_w;
+        let mut failure = None;
+        for r in runs.iter() {
             if let (Some(e), true) = (&r.error, r.stepper.t <= limit) {
                 limit = r.stepper.t;
                 failure = Some(e.clone());
             }
         }
-        for r in runs.iter_mut() {
-            pending.append(&mut r.out.impacts);
+        self.merge(limit, obs);
+        match failure {
+            Some(e) => Err(e),
+            None => Ok(()),
         }
+    }
+
+    /// Sends the samples, contact samples and impacts up to `limit` (s) in time order.
+    fn merge(&mut self, limit: f64, obs: &mut dyn Observer) {
+        let runs = &mut self.runs;
+        for r in runs.iter_mut() {
+            self.pending.append(&mut r.out.impacts);
+        }
+        let pending = &mut self.pending;
         pending.sort_by(|a, b| a.t_off_s.total_cmp(&b.t_off_s).then(a.disc.cmp(&b.disc)));
         let mut next_impact = 0;
         loop {
-            let ts = next_k as f64 / rate;
+            let ts = self.next_k as f64 / self.rate;
             // a disc that failed before its first step has no sample at t = 0
-            let ready = runs
-                .iter()
-                .all(|r| r.out.samples.front().is_some_and(|&(k, _)| k == next_k));
+            let ready = runs.iter().all(|r| {
+                r.out
+                    .samples
+                    .front()
+                    .is_some_and(|&(k, _)| k == self.next_k)
+            });
             if ts > limit || !ready {
                 break;
             }
@@ -190,51 +230,123 @@ pub(crate) fn run(
                 next_impact += 1;
             }
             // each disc's contact samples up to this sample first: one time order per disc
-            send_contacts(&mut runs, ts, obs);
+            send_contacts(runs, ts, obs);
+            let sample = &mut self.sample;
             sample.t_s = ts;
-            sample.shaft_angle_rad = shaft.angle(ts);
-            sample.shaft_speed_rad_s = shaft.speed(ts);
+            // the shaft of the first disc's system: the pack with the inputs held so far
+            let shaft = &runs[0].stepper.sys;
+            (sample.shaft_angle_rad, sample.shaft_speed_rad_s) = shaft.shaft(ts, &[]);
             for (r, d) in runs.iter_mut().zip(sample.discs.iter_mut()) {
                 if let Some((_, s)) = r.out.samples.pop_front() {
                     *d = s;
                 }
             }
-            obs.sample(&sample);
-            next_k += 1;
+            obs.sample(sample);
+            self.next_k += 1;
         }
         // the contact samples before the next sample (which the next window sends)
-        send_contacts(&mut runs, limit.min(next_k as f64 / rate).next_down(), obs);
+        send_contacts(
+            runs,
+            limit.min(self.next_k as f64 / self.rate).next_down(),
+            obs,
+        );
         while next_impact < pending.len() && pending[next_impact].t_off_s <= limit {
             obs.impact(&pending[next_impact]);
             next_impact += 1;
         }
         pending.drain(..next_impact);
-        if let Some(e) = failure {
-            return Err(e);
+    }
+}
+
+impl Session for IndependentSession {
+    fn time_s(&self) -> f64 {
+        self.clock.t
+    }
+
+    fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
+        let (pack, jump) = self.clock.hold(&self.pack, inputs)?;
+        self.pack = Arc::new(pack);
+        for r in self.runs.iter_mut() {
+            r.stepper.sys.pack = self.pack.clone();
+            shift_disc_speeds(&mut r.stepper, jump);
+            r.stepper.restart();
         }
-        if obs.progress(t_w) {
-            stopped = true;
-            break;
+        Ok(())
+    }
+
+    fn set_stop_time(&mut self, t_s: f64) {
+        self.clock.stop = t_s;
+    }
+
+    fn advance_to(&mut self, t: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
+        self.clock.check_advance(t)?;
+        let wants_contacts = obs.wants_contact_samples();
+        for r in self.runs.iter_mut() {
+            r.out.wants_contacts = wants_contacts;
+        }
+        let end = self.clock.step_end(t);
+        while self.t_w < t {
+            let target = (self.t_w + self.window).min(t);
+            if let Err(e) = self.window(target, end, obs) {
+                self.clock.failed = true;
+                return Err(e);
+            }
+            if obs.progress(self.t_w) {
+                self.clock.t = self.t_w;
+                return Ok(Advance::Stopped);
+            }
+        }
+        self.clock.t = t;
+        Ok(Advance::Reached)
+    }
+
+    fn snapshot(&self) -> Snapshot {
+        let t = self.clock.t;
+        let mut y = Vec::new();
+        let mut sample = Sample {
+            t_s: t,
+            discs: Vec::with_capacity(self.runs.len()),
+            ..Sample::default()
+        };
+        for r in &self.runs {
+            let modes = r.stepper.state_at(t, &mut y);
+            sample
+                .discs
+                .push(r.stepper.sys.disc_sample(t, 0, &y, &modes[0]));
+        }
+        if let Some(r) = self.runs.first() {
+            (sample.shaft_angle_rad, sample.shaft_speed_rad_s) = r.stepper.sys.shaft(t, &[]);
+        }
+        Snapshot {
+            sample,
+            interfaces: Vec::new(),
+            drum: None,
         }
     }
-    // Impacts closed beyond the last window's end (a stop), then the events still open.
-    for e in &pending {
-        obs.impact(e);
-    }
-    send_contacts(&mut runs, f64::INFINITY, obs);
-    let mut stats = RunStats::default();
-    for r in runs.iter_mut() {
-        let mut rest = Buffer::default();
-        r.stepper.finish(&mut rest);
-        for e in &rest.impacts {
-            obs.impact(e);
+
+    fn finish(&mut self, obs: &mut dyn Observer) -> RunStats {
+        // Impacts closed beyond the last window's end (a stop), then the events still open.
+        for e in self.pending.drain(..) {
+            obs.impact(&e);
         }
-        let s = &r.stepper.stats;
-        stats.steps += s.steps;
-        stats.rejected_steps += s.rejected_steps;
-        stats.rhs_evals += s.rhs_evals;
+        send_contacts(&mut self.runs, f64::INFINITY, obs);
+        let mut stats = RunStats::default();
+        for r in self.runs.iter_mut() {
+            let mut rest = Buffer::default();
+            r.stepper.finish(&mut rest);
+            for e in &rest.impacts {
+                obs.impact(e);
+            }
+            let s = &r.stepper.stats;
+            stats.steps += s.steps;
+            stats.rejected_steps += s.rejected_steps;
+            stats.rhs_evals += s.rhs_evals;
+        }
+        stats.simulated_s = self.clock.t;
+        stats
     }
-    stats.simulated_s = if stopped { t_w } else { duration_s.min(t_w) };
-    stats.stopped_early = stopped;
-    Ok(stats)
+
+    fn boxed_clone(&self) -> Box<dyn Session> {
+        Box::new(self.clone())
+    }
 }

@@ -147,13 +147,14 @@
 mod coupled;
 mod dopri;
 mod independent;
+mod session;
 mod stepper;
 mod system;
 
-use clutchpack_model::{
-    Engagement, Engine, EngineError, ImpactEvent, Observer, PackModel, RunStats, Shaft,
-};
-use stepper::{Sink, Stepper, Switch};
+use clutchpack_model::session::{Driven, Session};
+use clutchpack_model::{Engagement, Engine, EngineError, PackModel, Shaft};
+use session::MonolithicSession;
+use std::sync::Arc;
 use system::{Face, System};
 
 /// The reference engine's options (as `MultibodyOptions` are the multibody engine's): the
@@ -300,30 +301,6 @@ impl ReferenceEngine {
     }
 }
 
-/// Sends a whole-pack stepper's output to an observer.
-struct ObserverSink<'o> {
-    obs: &'o mut dyn Observer,
-}
-
-impl Sink for ObserverSink<'_> {
-    fn sample(&mut self, _k: u64, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]) {
-        self.obs.sample(&sys.sample(t, y, modes));
-        if sys.interfaces() > 0 {
-            self.obs.interfaces(t, &sys.interface_samples(t, y, modes));
-        }
-    }
-    fn impact(&mut self, e: ImpactEvent) {
-        self.obs.impact(&e);
-    }
-    fn contact(&mut self, slot: usize, t: f64, sys: &System, y: &[f64], mode: &Option<Engagement>) {
-        if !self.obs.wants_contact_samples() {
-            return;
-        }
-        let d = sys.disc_sample(t, slot, y, mode);
-        self.obs.contact_sample(sys.ids[slot], t, &d);
-    }
-}
-
 /// No events outside the system.
 pub(crate) fn no_external(
     _sys: &System,
@@ -335,60 +312,11 @@ pub(crate) fn no_external(
     None
 }
 
-/// The monolithic scheme: one stepper for the shaft and every disc (and, on a whole pack,
-/// every plate, the drum and the stack's faces with their stick-slip events).
-fn run_monolithic(
-    pack: &PackModel,
-    settings: &ReferenceOptions,
-    duration_s: f64,
-    obs: &mut dyn Observer,
-) -> Result<RunStats, EngineError> {
-    let nd = pack.discs.len() + pack.plates.len();
-    let mut st = Stepper::new(System::new(pack, (0..nd).collect()), settings);
-    if pack.stack.is_some() {
-        // the faces' modes at t = 0, from the piston on
-        for m in 0..st.sys.faces.len() {
-            let (t, modes) = (st.t, st.modes.clone());
-            st.sys.settle_face(m, t, &mut st.y, &modes);
-        }
-        st.restart();
-    }
-    let mut sink = ObserverSink { obs };
-    // A step costs O(N): poll the observer about every 1024 disc-steps (a stop acts within
-    // a few ms of wall time whatever the pack).
-    let poll = (1024 / nd.max(1)).max(1) as u64;
-    let mut stopped = false;
-    let mut buf = vec![0.0; st.sys.dim()];
-    while st.t < duration_s {
-        let switch = if pack.stack.is_some() {
-            st.step(duration_s, &mut sink, &mut |sys, modes, t0, t1, d| {
-                face_event(sys, modes, t0, t1, d, &mut buf)
-            })?
-        } else {
-            st.step(duration_s, &mut sink, &mut no_external)?
-        };
-        if let Switch::External(m) = switch {
-            let (t, modes) = (st.t, st.modes.clone());
-            st.sys.settle_face(m, t, &mut st.y, &modes);
-            st.restart();
-        }
-        if st.stats.steps.is_multiple_of(poll) && sink.obs.progress(st.t) {
-            stopped = true;
-            break;
-        }
-    }
-    st.finish(&mut sink);
-    let mut stats = st.stats.clone();
-    stats.simulated_s = st.t;
-    stats.stopped_early = stopped;
-    Ok(stats)
-}
-
 /// The earliest stick-slip event of the stack's faces inside the step `[t0, t1]` (dense output
 /// `d`), as `(time, interface)`: each face's switching condition
 /// ([`System::face_switches`]) probed at the step's quarter points, the first crossing
 /// bisected to 1e-13 s (as the contact events are).
-fn face_event(
+pub(crate) fn face_event(
     sys: &System,
     modes: &[Option<Engagement>],
     t0: f64,
@@ -460,22 +388,23 @@ impl Engine for ReferenceEngine {
             .collect()
     }
 
-    fn run(&mut self, duration_s: f64, obs: &mut dyn Observer) -> Result<RunStats, EngineError> {
+    fn start(&self, driven: Driven) -> Result<Box<dyn Session>, EngineError> {
         for d in self.pack.discs.iter().chain(&self.pack.plates) {
             stepper::check_disc(d)?;
         }
-        let (pack, settings) = (&self.pack, &self.settings);
-        match (self.scheme, &pack.shaft) {
+        driven.check(&self.pack)?;
+        let (pack, settings) = (Arc::new(self.pack.clone()), &self.settings);
+        Ok(match (self.scheme, &self.pack.shaft) {
             (Scheme::Multirate, _) if pack.discs.is_empty() || self.is_whole() => {
-                run_monolithic(pack, settings, duration_s, obs)
+                Box::new(MonolithicSession::new(pack, settings, driven))
             }
-            (Scheme::Monolithic, _) => run_monolithic(pack, settings, duration_s, obs),
-            (Scheme::Multirate, Shaft::Prescribed(_)) => {
-                independent::run(pack, settings, self.runs_parallel(), duration_s, obs)
-            }
+            (Scheme::Monolithic, _) => Box::new(MonolithicSession::new(pack, settings, driven)),
+            (Scheme::Multirate, Shaft::Prescribed(_)) => Box::new(
+                independent::IndependentSession::new(pack, settings, self.runs_parallel(), driven),
+            ),
             (Scheme::Multirate, Shaft::Inertial { .. }) => {
-                coupled::run(pack, settings, duration_s, obs)
+                Box::new(coupled::CoupledSession::new(pack, settings, driven))
             }
-        }
+        })
     }
 }

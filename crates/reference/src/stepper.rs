@@ -35,6 +35,7 @@ pub(crate) enum Switch {
 }
 
 /// Per-slot bookkeeping of contact events.
+#[derive(Clone)]
 pub(crate) struct DiscTrack {
     pub tracker: ImpactTracker,
     /// |load| at the end of the last accepted step, N.
@@ -101,14 +102,18 @@ pub(crate) fn check_disc(d: &DiscModel) -> Result<(), EngineError> {
 }
 
 /// The adaptive integration of one system.
-pub(crate) struct Stepper<'a> {
-    pub sys: System<'a>,
+#[derive(Clone)]
+pub(crate) struct Stepper {
+    pub sys: System,
     /// Time reached, s.
     pub t: f64,
     /// State at `t`.
     pub y: Vec<f64>,
     /// Contact mode of each slot.
     pub modes: Vec<Option<Engagement>>,
+    /// The modes along the last accepted step (they differ from `modes` after a step that
+    /// ended on a switch), for [`Stepper::state_at`].
+    step_modes: Vec<Option<Engagement>>,
     tracks: Vec<DiscTrack>,
     solver: Dopri5,
     /// Dense output of the step before the last accepted one, and of the last.
@@ -131,15 +136,16 @@ pub(crate) struct Stepper<'a> {
     block_t0: f64,
 }
 
-impl<'a> Stepper<'a> {
+impl Stepper {
     /// Starts `sys` at t = 0 from its initial state; a disc may start inside a contact event.
-    pub fn new(sys: System<'a>, settings: &ReferenceOptions) -> Stepper<'a> {
+    pub fn new(sys: System, settings: &ReferenceOptions) -> Stepper {
         let n = sys.dim();
         let tol = settings.tolerance;
         let y = sys.initial_state();
         let mut s = Stepper {
             t: 0.0,
             modes: vec![None; sys.ids.len()],
+            step_modes: Vec::new(),
             tracks: sys.ids.iter().map(|&id| DiscTrack::new(id)).collect(),
             atol: vec![tol; n],
             solver: Dopri5::new(n),
@@ -236,6 +242,20 @@ impl<'a> Stepper<'a> {
         self.dy.resize(n, 0.0);
     }
 
+    /// The state at `t` (s) into `out` and the contact modes it has there: the current state
+    /// for `t >= self.t`, else the dense output of the last two steps (`t` must not lie
+    /// before them; a session's time lies in the last step).
+    pub fn state_at(&self, t: f64, out: &mut Vec<f64>) -> &[Option<Engagement>] {
+        out.resize(self.y.len(), 0.0);
+        if t >= self.t || self.cur.h <= 0.0 {
+            out.copy_from_slice(&self.y);
+            &self.modes
+        } else {
+            eval2(&self.prev, &self.cur, t, out);
+            &self.step_modes
+        }
+    }
+
     /// Closes the open contact events at the end of a run (or a stop) at `self.t`.
     pub fn finish(&mut self, sink: &mut impl Sink) {
         for tr in self.tracks.iter_mut() {
@@ -263,6 +283,7 @@ impl<'a> Stepper<'a> {
         ) -> Option<(f64, usize)>,
     ) -> Result<Switch, EngineError> {
         let t = self.t;
+        self.step_modes.clone_from(&self.modes);
         // The located onsets of the events opened since the last step: their first contact
         // samples (after the grid samples up to `t`, sent by the last step).
         for (i, tr) in self.tracks.iter_mut().enumerate() {

@@ -6,6 +6,7 @@ use clutchpack_model::{
     DiscModel, DiscSample, Engagement, InterfaceSample, PackModel, Sample, Shaft, StackBody,
     ToothKinematics,
 };
+use std::sync::Arc;
 
 /// What a friction interface does between two stick-slip events (MODEL.md section 5).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -58,8 +59,11 @@ enum Carrier {
 /// `off = 0` and the shaft comes from its profile. A whole pack (plates, a drum or a stack:
 /// every coupling in its slot, in order) continues with the drum's angle (rad) and speed
 /// (rad/s) when there is a drum, then the heat (J) each open interface has dissipated.
-pub(crate) struct System<'a> {
-    pub pack: &'a PackModel,
+#[derive(Clone)]
+pub(crate) struct System {
+    /// The model, shared by the steppers of one run (a session replaces it when an input
+    /// changes, `session.rs`).
+    pub pack: Arc<PackModel>,
     /// Index of the first disc state: 0 for a prescribed shaft, 2 for an inertial one.
     pub off: usize,
     /// Global coupling index of each slot.
@@ -75,10 +79,10 @@ pub(crate) struct System<'a> {
     c_gap: f64,
 }
 
-impl<'a> System<'a> {
+impl System {
     /// The shaft and the couplings `ids` of `pack`. A pack with plates, a drum or a stack
     /// needs every coupling in order (`ids = 0..N + P`).
-    pub fn new(pack: &'a PackModel, ids: Vec<usize>) -> System<'a> {
+    pub fn new(pack: Arc<PackModel>, ids: Vec<usize>) -> System {
         let off = if matches!(pack.shaft, Shaft::Inertial { .. }) {
             2
         } else {
@@ -89,22 +93,24 @@ impl<'a> System<'a> {
             .as_ref()
             .map_or(0.0, |s| -s.open_gap_torque_n_m(1.0));
         let faces = vec![Face::Open; pack.stack.as_ref().map_or(0, |_| 2 * pack.discs.len())];
+        let rb = pack
+            .discs
+            .iter()
+            .chain(&pack.plates)
+            .map(|d| d.spline.base_radius_m())
+            .collect();
+        let nd = pack.discs.len();
         let sys = System {
             pack,
             off,
             ids,
-            nd: pack.discs.len(),
+            nd,
             c_gap,
             faces,
-            rb: pack
-                .discs
-                .iter()
-                .chain(&pack.plates)
-                .map(|d| d.spline.base_radius_m())
-                .collect(),
+            rb,
         };
         debug_assert!(
-            !sys.is_whole() || sys.ids == (0..sys.nd + pack.plates.len()).collect::<Vec<_>>()
+            !sys.is_whole() || sys.ids == (0..sys.nd + sys.pack.plates.len()).collect::<Vec<_>>()
         );
         sys
     }
@@ -117,6 +123,13 @@ impl<'a> System<'a> {
     /// Index of the drum's angle in the state (its speed follows).
     fn drum_at(&self) -> usize {
         self.off + 2 * self.ids.len()
+    }
+
+    /// The drum's angle (rad) and speed (rad/s) in state `y`; `None` without a drum.
+    pub fn drum_state(&self, y: &[f64]) -> Option<(f64, f64)> {
+        self.pack
+            .drum
+            .map(|_| (y[self.drum_at()], y[self.drum_at() + 1]))
     }
 
     /// Index of the first interface's heat in the state.
@@ -138,7 +151,7 @@ impl<'a> System<'a> {
     }
 
     /// The coupling with global index `id`: disc `id`, or plate `id - N`.
-    fn coupling(&self, id: usize) -> &'a DiscModel {
+    fn coupling(&self, id: usize) -> &DiscModel {
         if id < self.nd {
             &self.pack.discs[id]
         } else {
@@ -146,7 +159,7 @@ impl<'a> System<'a> {
         }
     }
 
-    pub fn disc(&self, slot: usize) -> &'a DiscModel {
+    pub fn disc(&self, slot: usize) -> &DiscModel {
         self.coupling(self.ids[slot])
     }
 
@@ -636,7 +649,7 @@ mod tests {
     #[test]
     fn whole_pack_rhs_conserves_momentum_and_power() {
         let pack = free_pack();
-        let sys = System::new(&pack, (0..5).collect());
+        let sys = System::new(std::sync::Arc::new(pack.clone()), (0..5).collect());
         assert_eq!(sys.dim(), 2 + 2 * 5 + 2 + 4);
         let g0 = pack.discs[0].spline.half_play_rad();
         for (k, contact) in [

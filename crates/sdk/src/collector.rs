@@ -48,6 +48,29 @@ impl RunCollector {
         }
     }
 
+    /// An independent copy of everything kept (a steppable run's saved state); an error with
+    /// an impacts CSV (a file being written cannot be rewound) or when the peaks spilled to a
+    /// temporary file cannot be copied.
+    pub fn try_clone(&self) -> Result<RunCollector> {
+        if self.csv.is_some() {
+            return Err(Error::BadInput(
+                "a run that writes an impacts CSV cannot save its state".into(),
+            ));
+        }
+        Ok(RunCollector {
+            impacts: self.impacts.clone(),
+            peaks: self.peaks.try_clone().map_err(Error::io(
+                "the impact peaks kept in a temporary file (copying them)",
+            ))?,
+            interfaces: self.interfaces.clone(),
+            history: self.history.clone(),
+            keep_history: self.keep_history,
+            fatigue: self.fatigue.clone(),
+            fatigue_params: self.fatigue_params.clone(),
+            csv: None,
+        })
+    }
+
     /// Also assesses the teeth's fatigue with the scene's parameters ([`crate::fatigue_params`]),
     /// summing the damage as the cycles are counted; `keep_cycles` also keeps every cycle
     /// (for `--fatigue-json`'s spectra; memory grows with the run).

@@ -26,6 +26,7 @@ mod fatigue;
 mod recording;
 mod run;
 mod scene;
+mod session;
 mod simulation;
 mod study;
 mod summary;
@@ -34,12 +35,15 @@ pub use batch::{
     ensemble_fatigue, ensemble_member, run_case, run_cases, CaseRuns, MemberFatigue,
     MAX_BATCH_CASES,
 };
+/// The steppable engines' inputs and outputs (co-simulation).
+pub use clutchpack_model::session::{Advance, Driven, Inputs, Snapshot};
 pub use collector::{merge_peaks, RunCollector};
 pub use error::{Error, Result};
 pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
 pub use recording::open_recording;
 pub use run::{RecordingRequest, RunOutcome, RunRequest};
 pub use scene::{load_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TEXT};
+pub use session::{Session, SessionRequest, SessionState};
 pub use simulation::{PackEngine, Simulation};
 pub use study::{merge_study, run_study_shard, MergedStudy, PART_FLUSH};
 pub use summary::{friction_interfaces, run_info, RunSummary};

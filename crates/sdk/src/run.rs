@@ -199,51 +199,28 @@ fn run_recorded<'a>(
     stop: Option<&'a AtomicBool>,
     progress: Option<&'a mut dyn FnMut(f64)>,
 ) -> RecordedRun {
-    let mut obs = RunObserver {
-        collector,
-        recorder: recorder.map(ThreadedRecorder::start),
-        stop,
-        progress,
-    };
+    let mut collector = collector;
+    let mut recorder = recorder.map(ThreadedRecorder::start);
     let cpu = cpu_time::ThreadTime::try_now().ok();
-    let result = engine.run(duration_s, &mut obs);
+    let result = engine.run(
+        duration_s,
+        &mut RunObserver {
+            collector: &mut collector,
+            recorder: recorder.as_mut(),
+            stop,
+            progress,
+        },
+    );
     let engine_cpu_s = cpu
         .and_then(|c| c.try_elapsed().ok())
         .map_or(0.0, |d| d.as_secs_f64());
-    let RunObserver {
-        collector,
-        recorder,
-        ..
-    } = obs;
     // Close the recording first: it holds everything before a failure or a stop.
     let mut recorder_cpu_s = 0.0;
     let mut warnings = Vec::new();
     let recording = recorder.map(|rec| {
-        let (mut rec, cpu_s) = rec.join();
+        let (recording, cpu_s) = finish_recording(rec, &result, &collector, &mut warnings);
         recorder_cpu_s = cpu_s;
-        // the file is finished even if the peaks kept on disk cannot be read back: its
-        // summary then has no impact statistics
-        let mut summary = rec.summary().unwrap_or_else(|e| {
-            warnings.push(format!(
-                "{e}; the recording's /summary has no impact statistics"
-            ));
-            clutchpack_record::RunSummary {
-                t_end_s: result.as_ref().map_or(0.0, |s| s.simulated_s),
-                discs: Vec::new(),
-                fatigue: Vec::new(),
-            }
-        });
-        if let Ok(s) = &result {
-            rec.set_run_stats(s);
-            // the teeth's fatigue over the duty that ran, beside the peak statistics
-            let names: Vec<String> = summary.discs.iter().map(|d| d.name.clone()).collect();
-            summary.fatigue = collector
-                .assess_fatigue(&names, s.simulated_s)
-                .iter()
-                .map(|f| Some(clutchpack_record::FatigueSummary::from(f)))
-                .collect();
-        }
-        rec.finish(Some(summary))
+        recording
     });
     RecordedRun {
         result,
@@ -255,16 +232,52 @@ fn run_recorded<'a>(
     }
 }
 
-/// Feeds the collector and the recorder; stops the run when the stop flag is set or the
-/// recording failed.
-struct RunObserver<'a> {
-    collector: RunCollector,
-    recorder: Option<ThreadedRecorder>,
-    stop: Option<&'a AtomicBool>,
-    progress: Option<&'a mut dyn FnMut(f64)>,
+/// Finishes a recording after its run ended with `result`: with the engine's statistics and
+/// the teeth's fatigue when it ran (from `collector`), and in any case with everything
+/// recorded before a failure or a stop. Returns the file (or why not) and the recording
+/// thread's CPU time, s; problems that do not lose the file go to `warnings`.
+pub(crate) fn finish_recording(
+    rec: ThreadedRecorder,
+    result: &std::result::Result<RunStats, EngineError>,
+    collector: &RunCollector,
+    warnings: &mut Vec<String>,
+) -> (std::result::Result<PathBuf, RecordError>, f64) {
+    let (mut rec, cpu_s) = rec.join();
+    // the file is finished even if the peaks kept on disk cannot be read back: its
+    // summary then has no impact statistics
+    let mut summary = rec.summary().unwrap_or_else(|e| {
+        warnings.push(format!(
+            "{e}; the recording's /summary has no impact statistics"
+        ));
+        clutchpack_record::RunSummary {
+            t_end_s: result.as_ref().map_or(0.0, |s| s.simulated_s),
+            discs: Vec::new(),
+            fatigue: Vec::new(),
+        }
+    });
+    if let Ok(s) = result {
+        rec.set_run_stats(s);
+        // the teeth's fatigue over the duty that ran, beside the peak statistics
+        let names: Vec<String> = summary.discs.iter().map(|d| d.name.clone()).collect();
+        summary.fatigue = collector
+            .assess_fatigue(&names, s.simulated_s)
+            .iter()
+            .map(|f| Some(clutchpack_record::FatigueSummary::from(f)))
+            .collect();
+    }
+    (rec.finish(Some(summary)), cpu_s)
 }
 
-impl Observer for RunObserver<'_> {
+/// Feeds the collector and the recorder; stops the run when the stop flag is set or the
+/// recording failed.
+pub(crate) struct RunObserver<'c, 'a> {
+    pub collector: &'c mut RunCollector,
+    pub recorder: Option<&'c mut ThreadedRecorder>,
+    pub stop: Option<&'a AtomicBool>,
+    pub progress: Option<&'a mut dyn FnMut(f64)>,
+}
+
+impl Observer for RunObserver<'_, '_> {
     fn sample(&mut self, s: &Sample) {
         self.collector.sample(s);
         if let Some(r) = &mut self.recorder {
@@ -294,7 +307,7 @@ impl Observer for RunObserver<'_> {
             || self
                 .recorder
                 .as_ref()
-                .is_some_and(ThreadedRecorder::wants_contact_samples)
+                .is_some_and(|r| r.wants_contact_samples())
     }
     fn progress(&mut self, t_s: f64) -> bool {
         if let Some(p) = &mut self.progress {

@@ -95,6 +95,11 @@ impl Simulation {
         self.engine.disc_names()
     }
 
+    /// The engine (to start sessions from).
+    pub(crate) fn engine(&self) -> &(dyn Engine + Send) {
+        self.engine.as_ref()
+    }
+
     /// The engine itself (for callers that drive it with their own observer).
     pub fn engine_mut(&mut self) -> &mut (dyn Engine + Send) {
         self.engine.as_mut()

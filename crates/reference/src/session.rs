@@ -1,0 +1,324 @@
+//! Steppable runs (`clutchpack_model::session`): what every scheme's session shares (the
+//! queue that holds output past the session's time, the checks and the holding of inputs) and
+//! the monolithic scheme's session. The multirate schemes' sessions are in `independent.rs`
+//! and `coupled.rs`.
+//!
+//! A session driven by nothing steps exactly as a whole run does (its steps end at the stop
+//! time, never at a communication point), so that a run split into calls is the run, bit for
+//! bit; a step may then pass the session's time, and what it produced beyond waits in the
+//! [`Queue`] for the next call. A driven session ends a step at every communication point,
+//! where an input may change; the integration restarts there (docs/DECISIONS.md,
+//! "Co-simulation").
+
+use crate::stepper::{Sink, Stepper, Switch};
+use crate::system::System;
+use crate::{face_event, no_external, ReferenceOptions};
+use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
+use clutchpack_model::{
+    DiscSample, Engagement, EngineError, ImpactEvent, InterfaceSample, Observer, PackModel,
+    RunStats, Sample,
+};
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+/// One piece of output, in the order the steps produced it.
+#[derive(Debug, Clone)]
+enum Item {
+    Sample(Sample),
+    Interfaces(f64, Vec<InterfaceSample>),
+    Impact(ImpactEvent),
+    Contact(usize, f64, DiscSample),
+}
+
+impl Item {
+    /// The time the item describes, s (an impact's: its end).
+    fn t_s(&self) -> f64 {
+        match self {
+            Item::Sample(s) => s.t_s,
+            Item::Interfaces(t, _) | Item::Contact(_, t, _) => *t,
+            Item::Impact(e) => e.t_off_s,
+        }
+    }
+}
+
+/// Output produced by steps that passed the session's time, kept for the next call.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Queue {
+    items: VecDeque<Item>,
+    /// Whether the observer takes contact samples (asked at every call).
+    pub wants_contacts: bool,
+}
+
+impl Queue {
+    pub fn sample(&mut self, s: Sample) {
+        self.items.push_back(Item::Sample(s));
+    }
+    pub fn interfaces(&mut self, t: f64, i: Vec<InterfaceSample>) {
+        self.items.push_back(Item::Interfaces(t, i));
+    }
+    pub fn impact(&mut self, e: ImpactEvent) {
+        self.items.push_back(Item::Impact(e));
+    }
+    pub fn contact(&mut self, disc: usize, t: f64, d: DiscSample) {
+        if self.wants_contacts {
+            self.items.push_back(Item::Contact(disc, t, d));
+        }
+    }
+
+    /// Sends the items up to `t` (s) inclusive to `obs`, in the order they were produced;
+    /// the first item later than `t` and everything after it wait.
+    pub fn flush(&mut self, t: f64, obs: &mut dyn Observer) {
+        while self.items.front().is_some_and(|i| i.t_s() <= t) {
+            match self.items.pop_front().expect("a front") {
+                Item::Sample(s) => obs.sample(&s),
+                Item::Interfaces(t, i) => obs.interfaces(t, &i),
+                Item::Impact(e) => obs.impact(&e),
+                Item::Contact(d, t, s) => obs.contact_sample(d, t, &s),
+            }
+        }
+    }
+}
+
+/// Sends a whole-pack (or all-disc) stepper's output to a queue.
+struct QueueSink<'q> {
+    queue: &'q mut Queue,
+}
+
+impl Sink for QueueSink<'_> {
+    fn sample(&mut self, _k: u64, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]) {
+        self.queue.sample(sys.sample(t, y, modes));
+        if sys.interfaces() > 0 {
+            self.queue.interfaces(t, sys.interface_samples(t, y, modes));
+        }
+    }
+    fn impact(&mut self, e: ImpactEvent) {
+        self.queue.impact(e);
+    }
+    fn contact(&mut self, slot: usize, t: f64, sys: &System, y: &[f64], mode: &Option<Engagement>) {
+        if self.queue.wants_contacts {
+            let d = sys.disc_sample(t, slot, y, mode);
+            self.queue.contact(sys.ids[slot], t, d);
+        }
+    }
+}
+
+/// What every scheme's session keeps besides its integration.
+#[derive(Debug, Clone)]
+pub(crate) struct Clock {
+    /// The session's time (the last communication point reached), s.
+    pub t: f64,
+    /// The stop time (steps land on it), s; infinite when none was set.
+    pub stop: f64,
+    /// The inputs the caller drives.
+    pub driven: Driven,
+    /// Whether the session failed (it must not be advanced again).
+    pub failed: bool,
+}
+
+impl Clock {
+    pub fn new(driven: Driven) -> Clock {
+        Clock {
+            t: 0.0,
+            stop: f64::INFINITY,
+            driven,
+            failed: false,
+        }
+    }
+
+    /// Where the steps of a call to `t` (s) end: at `t` for a driven session, else at the stop
+    /// time (at `t` when the stop time lies before it).
+    pub fn step_end(&self, t: f64) -> f64 {
+        if self.driven.any() {
+            t
+        } else {
+            self.stop.max(t)
+        }
+    }
+
+    /// Checks a call to `t` (s).
+    pub fn check_advance(&self, t: f64) -> Result<(), EngineError> {
+        if self.failed {
+            return Err(EngineError::Unsupported(
+                "the session failed before; start a new one".into(),
+            ));
+        }
+        if !(t.is_finite() && t >= self.t) {
+            return Err(EngineError::Unsupported(format!(
+                "advance to t = {t} s: expected a finite time at or after the session's time \
+                 {} s",
+                self.t
+            )));
+        }
+        Ok(())
+    }
+
+    /// Checks inputs against what the session drives; returns the pack with them held from
+    /// the session's time on and the jump of the prescribed shaft's speed (rad/s).
+    pub fn hold(&self, pack: &PackModel, inputs: &Inputs) -> Result<(PackModel, f64), EngineError> {
+        let undriven = inputs.undriven(&self.driven);
+        if !undriven.is_empty() {
+            return Err(EngineError::Unsupported(format!(
+                "the session does not drive the {} (the scene's profile runs it); start the \
+                 session with it driven",
+                undriven.join(", ")
+            )));
+        }
+        if let Some((name, v)) = inputs.invalid() {
+            return Err(EngineError::Unsupported(format!(
+                "{name} = {v}: expected a finite value (a pressure >= 0)"
+            )));
+        }
+        Ok(hold_inputs(pack, self.t, inputs))
+    }
+}
+
+/// Adds `jump` (rad/s) to the relative speed of every disc slot of `st` against the shaft
+/// (a jump of the prescribed shaft's speed; the plates' carriers do not move with it).
+pub(crate) fn shift_disc_speeds(st: &mut Stepper, jump: f64) {
+    if jump == 0.0 {
+        return;
+    }
+    let nd = st.sys.pack.discs.len();
+    for slot in 0..st.sys.ids.len() {
+        if st.sys.ids[slot] < nd {
+            st.y[st.sys.off + 2 * slot + 1] += jump;
+        }
+    }
+}
+
+/// The monolithic scheme's session: one stepper for the shaft and every coupling (and, on a
+/// whole pack, the drum and the stack's faces with their stick-slip events).
+#[derive(Clone)]
+pub(crate) struct MonolithicSession {
+    st: Stepper,
+    clock: Clock,
+    queue: Queue,
+    /// Observer polls every this many steps.
+    poll: u64,
+    buf: Vec<f64>,
+}
+
+impl MonolithicSession {
+    pub fn new(pack: Arc<PackModel>, settings: &ReferenceOptions, driven: Driven) -> Self {
+        let nd = pack.discs.len() + pack.plates.len();
+        let mut st = Stepper::new(System::new(pack, (0..nd).collect()), settings);
+        settle_faces(&mut st);
+        MonolithicSession {
+            st,
+            clock: Clock::new(driven),
+            queue: Queue::default(),
+            // A step costs O(N): poll the observer about every 1024 disc-steps (a stop acts
+            // within a few ms of wall time whatever the pack).
+            poll: (1024 / nd.max(1)).max(1) as u64,
+            buf: Vec::new(),
+        }
+    }
+}
+
+/// Sets every face of a stack's pack to its mode at the stepper's time (from the piston on)
+/// and restarts the integration; nothing without a stack.
+fn settle_faces(st: &mut Stepper) {
+    if st.sys.pack.stack.is_some() {
+        for m in 0..st.sys.faces.len() {
+            let (t, modes) = (st.t, st.modes.clone());
+            st.sys.settle_face(m, t, &mut st.y, &modes);
+        }
+        st.restart();
+    }
+}
+
+impl Session for MonolithicSession {
+    fn time_s(&self) -> f64 {
+        self.clock.t
+    }
+
+    fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
+        let (pack, jump) = self.clock.hold(&self.st.sys.pack, inputs)?;
+        self.st.sys.pack = Arc::new(pack);
+        shift_disc_speeds(&mut self.st, jump);
+        self.st.restart();
+        if inputs.piston_pressure_pa.is_some() {
+            settle_faces(&mut self.st);
+        }
+        Ok(())
+    }
+
+    fn set_stop_time(&mut self, t_s: f64) {
+        self.clock.stop = t_s;
+    }
+
+    fn advance_to(&mut self, t: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
+        self.clock.check_advance(t)?;
+        self.queue.wants_contacts = obs.wants_contact_samples();
+        let end = self.clock.step_end(t);
+        let stack = self.st.sys.pack.stack.is_some();
+        let mut advance = Advance::Reached;
+        while self.st.t < t {
+            let mut sink = QueueSink {
+                queue: &mut self.queue,
+            };
+            let buf = &mut self.buf;
+            let switch = if stack {
+                self.st.step(end, &mut sink, &mut |sys, modes, t0, t1, d| {
+                    face_event(sys, modes, t0, t1, d, buf)
+                })
+            } else {
+                self.st.step(end, &mut sink, &mut no_external)
+            };
+            let switch = match switch {
+                Ok(s) => s,
+                Err(e) => {
+                    self.clock.failed = true;
+                    self.queue.flush(self.st.t, obs);
+                    return Err(e);
+                }
+            };
+            if let Switch::External(m) = switch {
+                let (ts, modes) = (self.st.t, self.st.modes.clone());
+                self.st.sys.settle_face(m, ts, &mut self.st.y, &modes);
+                self.st.restart();
+            }
+            if self.st.stats.steps.is_multiple_of(self.poll) && obs.progress(self.st.t) {
+                advance = Advance::Stopped;
+                break;
+            }
+        }
+        self.clock.t = if advance == Advance::Stopped {
+            self.st.t.min(t)
+        } else {
+            t
+        };
+        self.queue.flush(self.clock.t, obs);
+        Ok(advance)
+    }
+
+    fn snapshot(&self) -> Snapshot {
+        let t = self.clock.t;
+        let mut y = Vec::new();
+        let modes = self.st.state_at(t, &mut y);
+        let sys = &self.st.sys;
+        Snapshot {
+            sample: sys.sample(t, &y, modes),
+            interfaces: if sys.interfaces() > 0 {
+                sys.interface_samples(t, &y, modes)
+            } else {
+                Vec::new()
+            },
+            drum: sys.drum_state(&y),
+        }
+    }
+
+    fn finish(&mut self, obs: &mut dyn Observer) -> RunStats {
+        self.st.finish(&mut QueueSink {
+            queue: &mut self.queue,
+        });
+        self.queue.flush(f64::INFINITY, obs);
+        let mut stats = self.st.stats.clone();
+        stats.simulated_s = self.clock.t;
+        stats
+    }
+
+    fn boxed_clone(&self) -> Box<dyn Session> {
+        Box::new(self.clone())
+    }
+}

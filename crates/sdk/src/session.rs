@@ -1,0 +1,237 @@
+//! A steppable run of a scene (co-simulation: the FMU, Python's `Simulation`): the engine's
+//! session advanced call by call with inputs held between calls, feeding the same collector
+//! and recording as [`Simulation::run`], finished into the same [`RunOutcome`].
+
+use crate::collector::RunCollector;
+use crate::run::{finish_recording, RecordingRequest, RunObserver, RunOutcome};
+use crate::summary::{friction_interfaces, run_info};
+use crate::{Error, Result, Simulation};
+use clutchpack_model::session::{Advance, Driven, Inputs, Snapshot};
+use clutchpack_model::{EngineError, RunStats};
+use clutchpack_record::{Recorder, ThreadedRecorder};
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+/// How a steppable run starts.
+#[derive(Debug, Clone, Default)]
+pub struct SessionRequest {
+    /// The inputs the caller drives (the others follow the scene's profiles); none: the
+    /// scene's own inputs, and a run split into calls is the run bit for bit.
+    pub driven: Driven,
+    /// The time the run will not be advanced beyond, s (steps land on it); `None`: the
+    /// scene's `simulation.duration_s` is not a limit, the caller decides.
+    pub stop_time_s: Option<f64>,
+    /// Record the run (MCAP), as [`crate::RunRequest::recording`].
+    pub recording: Option<RecordingRequest>,
+    /// Keep every sample's load and every impact (memory grows with the run).
+    pub keep_history: bool,
+}
+
+/// A run in progress: [`Session::advance_to`] one communication point after another, then
+/// [`Session::finish`].
+pub struct Session {
+    scene: String,
+    engine: &'static str,
+    body_names: Vec<String>,
+    n_discs: usize,
+    inner: Box<dyn clutchpack_model::session::Session>,
+    collector: RunCollector,
+    recorder: Option<ThreadedRecorder>,
+    /// Why the engine failed, once it has (the session then only finishes).
+    failure: Option<EngineError>,
+    stopped: bool,
+    started: Instant,
+}
+
+/// A saved state of a [`Session`] ([`Session::save`]), restored by [`Session::restore`] any
+/// number of times.
+pub struct SessionState {
+    inner: Box<dyn clutchpack_model::session::Session>,
+    collector: RunCollector,
+}
+
+impl Simulation {
+    /// Starts a steppable run at t = 0 as `request` asks. Bad input (an input the pack does
+    /// not have, a recording that cannot be created) is an error before any work.
+    pub fn start(&self, request: SessionRequest) -> Result<Session> {
+        let scene = self.scene();
+        let names = self.body_names();
+        let mut inner = self
+            .engine()
+            .start(request.driven)
+            .map_err(|e| Error::BadInput(format!("{}: {e}", scene.name)))?;
+        if let Some(t) = request.stop_time_s {
+            inner.set_stop_time(t);
+        }
+        let collector = RunCollector::new(names.len(), request.keep_history)
+            .with_interfaces(friction_interfaces(scene).into_iter().map(|f| f.name()))
+            .with_fatigue(scene, false);
+        let recorder = match &request.recording {
+            Some(r) => {
+                let info = run_info(scene, self.engine_name(), r.scene_path.as_deref());
+                Some(ThreadedRecorder::start(Recorder::create_output(
+                    &r.path, r.replace, &info, &r.options,
+                )?))
+            }
+            None => None,
+        };
+        Ok(Session {
+            scene: scene.name.clone(),
+            engine: self.engine_name(),
+            body_names: names,
+            n_discs: scene.pack.discs.len(),
+            inner,
+            collector,
+            recorder,
+            failure: None,
+            stopped: false,
+            started: Instant::now(),
+        })
+    }
+}
+
+impl Session {
+    /// The time the run stands at, s.
+    pub fn time_s(&self) -> f64 {
+        self.inner.time_s()
+    }
+
+    /// The bodies' names in output order (the discs, then the plates).
+    pub fn body_names(&self) -> &[String] {
+        &self.body_names
+    }
+
+    /// How many of the bodies are friction discs (the rest are plates).
+    pub fn disc_count(&self) -> usize {
+        self.n_discs
+    }
+
+    /// Sets inputs from [`Session::time_s`] on (held until changed); bad input names the
+    /// input and why.
+    pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<()> {
+        self.inner
+            .set_inputs(inputs)
+            .map_err(|e| Error::BadInput(format!("{}: {e}", self.scene)))
+    }
+
+    /// Advances to `t_s`, feeding the statistics and the recording; `stop` (checked at the
+    /// engine's progress polls) ends the call early. After an engine failure the session only
+    /// finishes (everything before the failure is kept).
+    pub fn advance_to(&mut self, t_s: f64, stop: Option<&AtomicBool>) -> Result<Advance> {
+        if let Some(e) = &self.failure {
+            return Err(self.engine_error(e.clone()));
+        }
+        let mut obs = RunObserver {
+            collector: &mut self.collector,
+            recorder: self.recorder.as_mut(),
+            stop,
+            progress: None,
+        };
+        match self.inner.advance_to(t_s, &mut obs) {
+            Ok(a) => {
+                self.stopped |= a == Advance::Stopped;
+                Ok(a)
+            }
+            Err(EngineError::Unsupported(why)) => {
+                Err(Error::BadInput(format!("{}: {why}", self.scene)))
+            }
+            Err(e) => {
+                self.failure = Some(e.clone());
+                Err(self.engine_error(e))
+            }
+        }
+    }
+
+    fn engine_error(&self, source: EngineError) -> Error {
+        Error::Engine {
+            context: format!("{} engine on {} (co-simulation)", self.engine, self.scene),
+            source,
+        }
+    }
+
+    /// The pack's state at [`Session::time_s`].
+    pub fn snapshot(&self) -> Snapshot {
+        self.inner.snapshot()
+    }
+
+    /// Each body's largest impact load so far, N (the largest `|F|` per tooth of its
+    /// impacts' peaks; 0 before its first impact), in body order.
+    pub fn max_loads_n(&self) -> Vec<f64> {
+        (0..self.body_names.len())
+            .map(|i| self.collector.peaks.max_abs_n(i))
+            .collect()
+    }
+
+    /// Each body's teeth's fatigue damage so far (Miner sum over the duty that ran,
+    /// dimensionless; 1 = the predicted life used up), in body order (MODEL.md section 7).
+    pub fn damage(&self) -> Vec<f64> {
+        self.collector
+            .assess_fatigue(&self.body_names, self.time_s())
+            .iter()
+            .map(|f| f.lumped.damage)
+            .collect()
+    }
+
+    /// Saves the whole state (the engine's and what is kept); a run being recorded cannot
+    /// save (a file cannot be rewound).
+    pub fn save(&self) -> Result<SessionState> {
+        if self.recorder.is_some() {
+            return Err(Error::BadInput(format!(
+                "{}: a recorded run cannot save its state (the recording cannot be rewound); \
+                 run without the recording to roll back",
+                self.scene
+            )));
+        }
+        Ok(SessionState {
+            inner: self.inner.boxed_clone(),
+            collector: self.collector.try_clone()?,
+        })
+    }
+
+    /// Restores a state saved by [`Session::save`] of this session.
+    pub fn restore(&mut self, state: &SessionState) -> Result<()> {
+        self.inner = state.inner.boxed_clone();
+        self.collector = state.collector.try_clone()?;
+        self.failure = None;
+        Ok(())
+    }
+
+    /// Ends the run at [`Session::time_s`]: closes the open contact events, finishes the
+    /// recording, and gives what a whole run gives.
+    pub fn finish(mut self) -> RunOutcome {
+        let result = match self.failure.take() {
+            Some(e) => Err(e),
+            None => {
+                let mut obs = RunObserver {
+                    collector: &mut self.collector,
+                    recorder: self.recorder.as_mut(),
+                    stop: None,
+                    progress: None,
+                };
+                let mut stats: RunStats = self.inner.finish(&mut obs);
+                stats.stopped_early = self.stopped;
+                Ok(stats)
+            }
+        };
+        let mut warnings = Vec::new();
+        let mut recorder_cpu_s = 0.0;
+        let recording = self.recorder.take().map(|rec| {
+            let (r, cpu) = finish_recording(rec, &result, &self.collector, &mut warnings);
+            recorder_cpu_s = cpu;
+            r
+        });
+        RunOutcome {
+            scene: self.scene,
+            engine: self.engine,
+            result,
+            wall_time_s: self.started.elapsed().as_secs_f64(),
+            engine_cpu_s: 0.0,
+            recorder_cpu_s,
+            body_names: self.body_names,
+            collector: self.collector,
+            impacts_csv: None,
+            recording,
+            warnings,
+        }
+    }
+}
