@@ -7,6 +7,7 @@ mod fatigue;
 mod hardening;
 mod python_package;
 mod reliability;
+mod session;
 mod slurm;
 mod study;
 

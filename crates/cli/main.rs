@@ -44,6 +44,7 @@ mod bench;
 mod check;
 mod common;
 mod describe;
+mod fmu;
 mod outputs;
 mod recording;
 mod run;
@@ -94,6 +95,9 @@ enum Command {
     Study(study::StudyArgs),
     /// Validate scene files: exit 0 if all are valid, 2 with every problem listed if not.
     Check(check::CheckArgs),
+    /// Pack a scene into an FMI 2.0 co-simulation FMU (linux64), to put the pack between the
+    /// inertias of a driveline model.
+    Fmu(fmu::FmuArgs),
 }
 
 fn main() -> ExitCode {
@@ -108,6 +112,7 @@ fn main() -> ExitCode {
         Command::Compare(a) => recording::compare(a),
         Command::Export(a) => recording::export(a),
         Command::Plot(a) => recording::plot(a),
+        Command::Fmu(a) => fmu::fmu(a),
     };
     match result {
         // a command that could not write its results to stdout did not succeed

@@ -154,6 +154,11 @@ impl Session {
         self.inner.snapshot()
     }
 
+    /// Impacts closed so far.
+    pub fn impact_count(&self) -> usize {
+        self.collector.impact_count()
+    }
+
     /// Each body's largest impact load so far, N (the largest `|F|` per tooth of its
     /// impacts' peaks; 0 before its first impact), in body order.
     pub fn max_loads_n(&self) -> Vec<f64> {

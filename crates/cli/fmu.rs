@@ -1,0 +1,62 @@
+//! `clutchpack fmu`: packs a scene into an FMI 2.0 co-simulation FMU (README, "Co-simulation
+//! (FMI 2.0)").
+
+use crate::common::{self, BadInput};
+use anyhow::{Context, Result};
+use clutchpack_scene::{EngineChoice, Override};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Arguments of `clutchpack fmu`.
+#[derive(clap::Args, Debug)]
+pub struct FmuArgs {
+    /// The scene to pack.
+    pub scene: PathBuf,
+    /// The FMU to write (replaced if it exists).
+    #[arg(long, short)]
+    pub out: PathBuf,
+    /// The engine the FMU runs by default (its `engine` parameter; else the scene's choice).
+    #[arg(long, value_parser = common::engine_parser())]
+    pub engine: Option<EngineChoice>,
+    /// Override a scene key, `KEY=VALUE` (TOML value), repeatable.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<Override>,
+}
+
+/// The FMU's binary: `libclutchpack_fmu.so`, built by cargo beside this executable (the
+/// `clutchpack_fmu` crate is a dependency of the CLI, so one `cargo build` makes both).
+fn library() -> Result<PathBuf> {
+    let exe = std::env::current_exe().context("locating the clutchpack executable")?;
+    let dir = exe.parent().unwrap_or(Path::new("."));
+    let name = "libclutchpack_fmu.so";
+    [dir.join(name), dir.join("deps").join(name)]
+        .into_iter()
+        .find(|p| p.is_file())
+        .ok_or_else(|| {
+            anyhow::anyhow!(
+                "the FMU's binary {name} is not beside {} (nor in its deps/): build the \
+                 workspace with cargo (`cargo build --release`), which builds it with the \
+                 executable",
+                exe.display()
+            )
+        })
+}
+
+pub fn fmu(a: FmuArgs) -> Result<ExitCode> {
+    let scene = clutchpack_scene::load(&a.scene, &a.sets)?;
+    let engine = clutchpack_fmu::check_representable(&scene, a.engine).map_err(|e| match e {
+        clutchpack_fmu::PackageError::Unrepresentable(why) => {
+            anyhow::Error::new(BadInput(format!("{}: {why}", a.scene.display())))
+        }
+        other => other.into(),
+    })?;
+    let lib = library()?;
+    let n = clutchpack_fmu::write_fmu(&scene, engine, &lib, &a.out)?;
+    out!(
+        "{}: FMI 2.0 co-simulation FMU of {} ({} engine, {n} variables)",
+        a.out.display(),
+        scene.name,
+        engine.name()
+    );
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,470 @@
+//! One FMU instance as plain Rust: FMI 2.0's co-simulation state machine (instantiated,
+//! initialisation, stepping, terminated) over `clutchpack_sdk`'s steppable run. The C
+//! functions (`ffi.rs`) only translate pointers and statuses; every rule and every message
+//! is here, testable without a host.
+
+use crate::variables::Variable;
+use crate::variables::{variables, BodyField, Causality, Input, InterfaceField, Kind, Quantity};
+use clutchpack_model::session::{Driven, Inputs, Snapshot};
+use clutchpack_record::{RecordOptions, Replace};
+use clutchpack_scene::{EngineChoice, Scene};
+use clutchpack_sdk::{
+    RecordingRequest, RunOutcome, Session, SessionRequest, SessionState, Simulation,
+};
+use std::path::{Path, PathBuf};
+
+/// Where an instance is in FMI's state machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// After `fmi2Instantiate` (or `fmi2Reset`): parameters and inputs may be set.
+    Instantiated,
+    /// Between `fmi2EnterInitializationMode` and `fmi2ExitInitializationMode`.
+    Initialization,
+    /// Stepping (`fmi2DoStep`).
+    Stepping,
+    /// After `fmi2Terminate`: the final outputs may be read.
+    Terminated,
+    /// An engine failure or a bad call that leaves the run unusable: only reading,
+    /// terminating, resetting and freeing.
+    Failed,
+}
+
+/// A saved FMU state (`fmi2GetFMUstate`).
+pub struct SavedState {
+    session: SessionState,
+    reals: Vec<f64>,
+    snapshot: Snapshot,
+}
+
+/// One FMU instance.
+pub struct Instance {
+    scene: Scene,
+    vars: Vec<Variable>,
+    /// Value of every Real variable by value reference (parameters and inputs as set,
+    /// outputs as last computed).
+    reals: Vec<f64>,
+    strings: Vec<String>,
+    phase: Phase,
+    stop_time_s: Option<f64>,
+    session: Option<Session>,
+    snapshot: Snapshot,
+    /// The finished run (after `fmi2Terminate`).
+    outcome: Option<RunOutcome>,
+    /// Every body's damage at the time it was computed (hosts read every output at every
+    /// step; the assessment covers all bodies at once).
+    damage_cache: std::cell::RefCell<Option<(f64, Vec<f64>)>>,
+}
+
+/// Reads the scene an FMU carries: `resources/scene.json` (the validated scene, written by
+/// `clutchpack fmu`), checking `resources/guid.txt` against the host's GUID.
+pub fn load_resources(resources: &Path, guid: &str) -> Result<Scene, String> {
+    let read = |name: &str| {
+        let p = resources.join(name);
+        std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))
+    };
+    let own = read("guid.txt")?;
+    if own.trim() != guid {
+        return Err(format!(
+            "the GUID {guid:?} from the model description is not this FMU's ({:?}): the \
+             model description and the resources come from different builds",
+            own.trim()
+        ));
+    }
+    let text = read("scene.json")?;
+    serde_json::from_str(&text).map_err(|e| {
+        format!(
+            "{}: not a scene written by clutchpack fmu: {e}",
+            resources.join("scene.json").display()
+        )
+    })
+}
+
+impl Instance {
+    /// An instance of `scene` (engine: the scene's choice, as `clutchpack run` makes it).
+    pub fn new(scene: Scene) -> Result<Instance, String> {
+        let engine = scene.engine(None, &scene.name).map_err(|e| e.to_string())?;
+        let vars = variables(&scene, engine.name());
+        let mut inst = Instance {
+            reals: Vec::new(),
+            strings: Vec::new(),
+            vars,
+            scene,
+            phase: Phase::Instantiated,
+            stop_time_s: None,
+            session: None,
+            snapshot: Snapshot::default(),
+            outcome: None,
+            damage_cache: Default::default(),
+        };
+        inst.reset();
+        Ok(inst)
+    }
+
+    /// Back to the state after instantiation, every variable at its start value.
+    pub fn reset(&mut self) {
+        let count = |k| self.vars.iter().filter(|v| v.kind == k).count();
+        let (nr, ns) = (count(Kind::Real), count(Kind::String));
+        self.reals = vec![0.0; nr];
+        self.strings = vec![String::new(); ns];
+        for v in &self.vars {
+            match v.kind {
+                Kind::Real => self.reals[v.vr as usize] = v.start_real.unwrap_or(0.0),
+                Kind::String => {
+                    self.strings[v.vr as usize] = v.start_string.clone().unwrap_or_default()
+                }
+                Kind::Integer => {}
+            }
+        }
+        if let Some(s) = self.session.take() {
+            // a recording in progress is finished with what it holds
+            let _ = s.finish();
+        }
+        self.phase = Phase::Instantiated;
+        self.stop_time_s = None;
+        self.snapshot = Snapshot::default();
+        self.outcome = None;
+        self.damage_cache.take();
+    }
+
+    /// Where the instance is.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// The variables.
+    pub fn variables(&self) -> &[Variable] {
+        &self.vars
+    }
+
+    fn var(&self, kind: Kind, vr: u32) -> Result<&Variable, String> {
+        self.vars
+            .iter()
+            .find(|v| v.kind == kind && v.vr == vr)
+            .ok_or_else(|| format!("no {kind:?} variable has the value reference {vr}"))
+    }
+
+    /// `fmi2SetupExperiment`: the run starts at t = 0; a stop time, if given, is where the
+    /// steps land rather than pass.
+    pub fn setup_experiment(&mut self, start_s: f64, stop_s: Option<f64>) -> Result<(), String> {
+        if self.phase != Phase::Instantiated {
+            return Err("fmi2SetupExperiment is allowed only after instantiation".into());
+        }
+        if start_s != 0.0 {
+            return Err(format!(
+                "startTime = {start_s} s: a pack's run starts at t = 0 (its initial state is \
+                 the scene's)"
+            ));
+        }
+        if let Some(stop) = stop_s {
+            if !(stop.is_finite() && stop > 0.0) {
+                return Err(format!("stopTime = {stop} s: expected a positive time"));
+            }
+        }
+        self.stop_time_s = stop_s;
+        Ok(())
+    }
+
+    /// `fmi2EnterInitializationMode`.
+    pub fn enter_initialization(&mut self) -> Result<(), String> {
+        if self.phase != Phase::Instantiated {
+            return Err("fmi2EnterInitializationMode is allowed only after instantiation".into());
+        }
+        self.phase = Phase::Initialization;
+        Ok(())
+    }
+
+    /// `fmi2ExitInitializationMode`: starts the run with the parameters and inputs set.
+    pub fn exit_initialization(&mut self) -> Result<(), String> {
+        if self.phase != Phase::Initialization {
+            return Err("fmi2ExitInitializationMode is allowed only in initialization".into());
+        }
+        let engine_name = self.string_of(Quantity::Engine);
+        let engine = EngineChoice::from_name(&engine_name).ok_or_else(|| {
+            format!(
+                "engine = {engine_name:?}: expected one of {}",
+                EngineChoice::names().join(", ")
+            )
+        })?;
+        let limit = self.real_of(Quantity::DurationLimit);
+        if !(limit.is_finite() && limit > 0.0) {
+            return Err(format!(
+                "duration_limit_s = {limit}: expected a positive time in s"
+            ));
+        }
+        let path = self.string_of(Quantity::RecordingPath);
+        let recording = (!path.is_empty()).then(|| RecordingRequest {
+            path: PathBuf::from(&path),
+            replace: Replace::Existing,
+            options: RecordOptions::default(),
+            scene_path: None,
+        });
+        let sim = Simulation::new(self.scene.clone(), Some(engine)).map_err(|e| e.to_string())?;
+        let mut session = sim
+            .start(SessionRequest {
+                driven: Driven::all_for(&self.scene.pack),
+                stop_time_s: self.stop_time_s,
+                recording,
+                keep_history: false,
+            })
+            .map_err(|e| e.to_string())?;
+        session
+            .set_inputs(&self.inputs())
+            .map_err(|e| e.to_string())?;
+        self.snapshot = session.snapshot();
+        self.session = Some(session);
+        self.phase = Phase::Stepping;
+        Ok(())
+    }
+
+    fn real_of(&self, q: Quantity) -> f64 {
+        self.vars
+            .iter()
+            .find(|v| v.quantity == q)
+            .map_or(0.0, |v| self.reals[v.vr as usize])
+    }
+
+    fn string_of(&self, q: Quantity) -> String {
+        self.vars
+            .iter()
+            .find(|v| v.quantity == q)
+            .map_or(String::new(), |v| self.strings[v.vr as usize].clone())
+    }
+
+    /// The inputs as set now.
+    fn inputs(&self) -> Inputs {
+        let mut out = Inputs::default();
+        for v in &self.vars {
+            if let Quantity::Input(i) = v.quantity {
+                let x = Some(self.reals[v.vr as usize]);
+                match i {
+                    Input::ShaftSpeed => out.shaft_speed_rad_s = x,
+                    Input::ShaftTorque => out.shaft_torque_n_m = x,
+                    Input::DrumLoad => out.drum_load_n_m = x,
+                    Input::PistonPressure => out.piston_pressure_pa = x,
+                }
+            }
+        }
+        out
+    }
+
+    /// `fmi2SetReal` of one variable.
+    pub fn set_real(&mut self, vr: u32, value: f64) -> Result<(), String> {
+        let v = self.var(Kind::Real, vr)?;
+        match v.causality {
+            Causality::Output => Err(format!("{} is an output: it cannot be set", v.name)),
+            Causality::Parameter
+                if !matches!(self.phase, Phase::Instantiated | Phase::Initialization) =>
+            {
+                Err(format!(
+                    "{} is a fixed parameter: set it before fmi2ExitInitializationMode",
+                    v.name
+                ))
+            }
+            _ if !value.is_finite() => {
+                Err(format!("{} = {value}: expected a finite value", v.name))
+            }
+            Causality::Input if matches!(self.phase, Phase::Terminated | Phase::Failed) => {
+                Err(format!("{}: the run has ended", v.name))
+            }
+            _ => {
+                self.reals[vr as usize] = value;
+                Ok(())
+            }
+        }
+    }
+
+    /// `fmi2SetString` of one variable.
+    pub fn set_string(&mut self, vr: u32, value: &str) -> Result<(), String> {
+        let v = self.var(Kind::String, vr)?;
+        if !matches!(self.phase, Phase::Instantiated | Phase::Initialization) {
+            return Err(format!(
+                "{} is a fixed parameter: set it before fmi2ExitInitializationMode",
+                v.name
+            ));
+        }
+        self.strings[vr as usize] = value.to_string();
+        Ok(())
+    }
+
+    /// `fmi2GetString` of one variable.
+    pub fn get_string(&self, vr: u32) -> Result<&str, String> {
+        self.var(Kind::String, vr)?;
+        Ok(&self.strings[vr as usize])
+    }
+
+    /// `fmi2GetInteger` of one variable (the impacts so far).
+    pub fn get_integer(&self, vr: u32) -> Result<i32, String> {
+        self.var(Kind::Integer, vr)?;
+        let n = match (&self.session, &self.outcome) {
+            (Some(s), _) => s.impact_count(),
+            (None, Some(o)) => o.collector.impact_count(),
+            _ => 0,
+        };
+        Ok(n.min(i32::MAX as usize) as i32)
+    }
+
+    /// `fmi2GetReal` of one variable.
+    pub fn get_real(&self, vr: u32) -> Result<f64, String> {
+        let v = self.var(Kind::Real, vr)?;
+        if v.causality != Causality::Output {
+            return Ok(self.reals[vr as usize]);
+        }
+        let s = &self.snapshot;
+        let nd = self.scene.pack.discs.len();
+        Ok(match v.quantity {
+            Quantity::ShaftAngle => s.sample.shaft_angle_rad,
+            Quantity::ShaftSpeed => s.sample.shaft_speed_rad_s,
+            Quantity::PackShaftTorque => s.shaft_torque_n_m(nd),
+            Quantity::CarrierTorque => s.carrier_torque_n_m(nd),
+            Quantity::DrumAngle => s.drum.map_or(0.0, |d| d.0),
+            Quantity::DrumSpeed => s.drum.map_or(0.0, |d| d.1),
+            Quantity::Body(i, f) => {
+                let body = s.sample.discs.get(i);
+                match f {
+                    BodyField::Speed => body.map_or(0.0, |b| b.speed_rad_s),
+                    BodyField::Load => body.map_or(0.0, |b| b.load_n),
+                    BodyField::Torque => body.map_or(0.0, |b| b.torque_n_m),
+                    BodyField::MaxLoad => self.max_load(i),
+                    BodyField::Damage => self.damage(i),
+                }
+            }
+            Quantity::Interface(m, f) => {
+                let x = s.interfaces.get(m).copied().unwrap_or_default();
+                match f {
+                    InterfaceField::Torque => x.torque_n_m,
+                    InterfaceField::Slip => x.slip_rad_s,
+                    InterfaceField::Clamp => x.clamp_n,
+                    InterfaceField::Heat => x.dissipated_j,
+                }
+            }
+            _ => self.reals[vr as usize],
+        })
+    }
+
+    fn max_load(&self, i: usize) -> f64 {
+        match (&self.session, &self.outcome) {
+            (Some(s), _) => s.max_loads_n().get(i).copied().unwrap_or(0.0),
+            (None, Some(o)) => o.collector.peaks.max_abs_n(i),
+            _ => 0.0,
+        }
+    }
+
+    fn damage(&self, i: usize) -> f64 {
+        let t = self.time_s();
+        let mut cache = self.damage_cache.borrow_mut();
+        if cache.as_ref().is_none_or(|(tc, _)| *tc != t) {
+            let all = match (&self.session, &self.outcome) {
+                (Some(s), _) => s.damage(),
+                (None, Some(o)) => o.fatigue().iter().map(|f| f.lumped.damage).collect(),
+                _ => Vec::new(),
+            };
+            *cache = Some((t, all));
+        }
+        cache
+            .as_ref()
+            .and_then(|(_, d)| d.get(i).copied())
+            .unwrap_or(0.0)
+    }
+
+    /// `fmi2DoStep`: holds the inputs from `t_s` and advances to `t_s + h_s`.
+    pub fn do_step(&mut self, t_s: f64, h_s: f64) -> Result<(), String> {
+        if self.phase != Phase::Stepping {
+            return Err(format!(
+                "fmi2DoStep in {:?}: allowed only after fmi2ExitInitializationMode",
+                self.phase
+            ));
+        }
+        let inputs = self.inputs();
+        let limit = self.real_of(Quantity::DurationLimit);
+        let session = self.session.as_mut().expect("a session while stepping");
+        let now = session.time_s();
+        if (t_s - now).abs() > 1e-9 * now.max(1e-3) {
+            return Err(format!(
+                "currentCommunicationPoint = {t_s} s, but the FMU stands at {now} s"
+            ));
+        }
+        let end = t_s + h_s;
+        if !(h_s > 0.0 && end.is_finite()) {
+            return Err(format!("communicationStepSize = {h_s} s: expected > 0"));
+        }
+        if end > limit * (1.0 + 1e-12) {
+            return Err(format!(
+                "a step to {end} s passes duration_limit_s = {limit} s (set the parameter to \
+                 run longer)"
+            ));
+        }
+        session.set_inputs(&inputs).map_err(|e| e.to_string())?;
+        match session.advance_to(end.max(now), None) {
+            Ok(_) => {
+                self.snapshot = session.snapshot();
+                Ok(())
+            }
+            Err(e) => {
+                self.phase = Phase::Failed;
+                Err(e.to_string())
+            }
+        }
+    }
+
+    /// The time the run stands at, s (after `fmi2Terminate`: where it ended).
+    pub fn time_s(&self) -> f64 {
+        match (&self.session, &self.outcome) {
+            (Some(s), _) => s.time_s(),
+            (None, Some(o)) => o.result.as_ref().map_or(0.0, |r| r.simulated_s),
+            _ => 0.0,
+        }
+    }
+
+    /// `fmi2Terminate`: finishes the run (its recording too); the final outputs stay
+    /// readable. Warnings of the finish (a recording's summary) come back as text.
+    pub fn terminate(&mut self) -> Result<Vec<String>, String> {
+        let mut warnings = Vec::new();
+        if let Some(s) = self.session.take() {
+            let outcome = s.finish();
+            warnings.extend(outcome.warnings.iter().cloned());
+            if let Some(Err(e)) = &outcome.recording {
+                warnings.push(format!("the recording could not be finished: {e}"));
+            }
+            if let Err(e) = &outcome.result {
+                warnings.push(format!("the run had failed: {e}"));
+            }
+            self.outcome = Some(outcome);
+        }
+        self.phase = Phase::Terminated;
+        Ok(warnings)
+    }
+
+    /// The finished run, after [`Instance::terminate`].
+    pub fn outcome(&self) -> Option<&RunOutcome> {
+        self.outcome.as_ref()
+    }
+
+    /// `fmi2GetFMUstate`.
+    pub fn save(&self) -> Result<SavedState, String> {
+        let s = self
+            .session
+            .as_ref()
+            .filter(|_| self.phase == Phase::Stepping)
+            .ok_or("fmi2GetFMUstate is supported while stepping (after initialization)")?;
+        Ok(SavedState {
+            session: s.save().map_err(|e| e.to_string())?,
+            reals: self.reals.clone(),
+            snapshot: self.snapshot.clone(),
+        })
+    }
+
+    /// `fmi2SetFMUstate`.
+    pub fn restore(&mut self, state: &SavedState) -> Result<(), String> {
+        let s = self
+            .session
+            .as_mut()
+            .filter(|_| matches!(self.phase, Phase::Stepping | Phase::Failed))
+            .ok_or("fmi2SetFMUstate is supported while stepping (after initialization)")?;
+        s.restore(&state.session).map_err(|e| e.to_string())?;
+        self.reals.clone_from(&state.reals);
+        self.snapshot = state.snapshot.clone();
+        self.damage_cache.take();
+        self.phase = Phase::Stepping;
+        Ok(())
+    }
+}

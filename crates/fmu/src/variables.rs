@@ -1,0 +1,412 @@
+//! The FMU's variables for a scene: the one table that both the model description
+//! (`description.rs`) and the binary's `fmi2GetReal`/`fmi2SetReal` (`instance.rs`) read, so
+//! the value references the host sees are the ones the binary serves.
+
+use clutchpack_model::session::Driven;
+use clutchpack_scene::Scene;
+
+/// An FMI 2.0 base type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// `fmi2Real`.
+    Real,
+    /// `fmi2Integer`.
+    Integer,
+    /// `fmi2String`.
+    String,
+}
+
+/// An FMI 2.0 causality.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Causality {
+    /// Set before the run starts (variability "fixed").
+    Parameter,
+    /// Set by the host at each communication point (held between them).
+    Input,
+    /// Computed by the FMU.
+    Output,
+}
+
+/// An input of the pack (`clutchpack_model::session::Inputs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Input {
+    /// The prescribed shaft's speed, rad/s.
+    ShaftSpeed,
+    /// The drive torque on an inertial shaft, N m.
+    ShaftTorque,
+    /// The load torque on the drum, N m.
+    DrumLoad,
+    /// The pressure on the piston, Pa.
+    PistonPressure,
+}
+
+/// A body's output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BodyField {
+    /// Speed, rad/s.
+    Speed,
+    /// Per-tooth load now, N (eq 6's sign).
+    Load,
+    /// Spline torque on the body now, N m (`-n F Rb`, eq 5).
+    Torque,
+    /// Largest `|peak|` of its impacts so far, N.
+    MaxLoad,
+    /// Miner damage of its teeth so far (dimensionless).
+    Damage,
+}
+
+/// A friction interface's output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InterfaceField {
+    /// Torque on the upper body, N m.
+    Torque,
+    /// Slip speed upper minus lower, rad/s.
+    Slip,
+    /// Clamp force, N.
+    Clamp,
+    /// Heat since t = 0, J.
+    Heat,
+}
+
+/// What a variable stands for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quantity {
+    /// Parameter: the engine's name.
+    Engine,
+    /// Parameter: the latest time the FMU may be advanced to, s.
+    DurationLimit,
+    /// Parameter: the MCAP recording's path (empty: none).
+    RecordingPath,
+    /// An input.
+    Input(Input),
+    /// The shaft's angle, rad.
+    ShaftAngle,
+    /// The inertial shaft's speed, rad/s.
+    ShaftSpeed,
+    /// Torque of the pack on the shaft, N m.
+    PackShaftTorque,
+    /// Torque of the plates on the drum or housing, N m.
+    CarrierTorque,
+    /// The drum's angle, rad.
+    DrumAngle,
+    /// The drum's speed, rad/s.
+    DrumSpeed,
+    /// Body `i` (the discs, then the plates).
+    Body(usize, BodyField),
+    /// Friction interface `m`.
+    Interface(usize, InterfaceField),
+    /// Impacts closed so far (Integer).
+    Impacts,
+}
+
+/// One scalar variable of the model description.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Variable {
+    /// Structured name, e.g. `discs[3].load_n` (indices from 1, as Modelica's).
+    pub name: String,
+    /// What it is.
+    pub quantity: Quantity,
+    /// Its base type.
+    pub kind: Kind,
+    /// Parameter, input or output.
+    pub causality: Causality,
+    /// Value reference (numbered per base type from 0).
+    pub vr: u32,
+    /// Unit (a name of the model description's unit definitions), if any.
+    pub unit: Option<&'static str>,
+    /// What it means, with its sign.
+    pub description: String,
+    /// Start value of a Real parameter or input.
+    pub start_real: Option<f64>,
+    /// Start value of a String parameter.
+    pub start_string: Option<String>,
+}
+
+/// The units the variables use, with their SI base-unit exponents `(kg, m, s, rad)`.
+pub const UNITS: [(&str, [i32; 4]); 8] = [
+    ("s", [0, 0, 1, 0]),
+    ("rad", [0, 0, 0, 1]),
+    ("rad/s", [0, 0, -1, 1]),
+    ("N", [1, 1, -2, 0]),
+    ("N.m", [1, 2, -2, 0]),
+    ("Pa", [1, -1, -2, 0]),
+    ("J", [1, 2, -2, 0]),
+    ("1", [0, 0, 0, 0]),
+];
+
+/// The FMU's variables for `scene`, whose run the engine `engine` (`reference` or
+/// `multibody`) makes: parameters, then inputs (what [`Driven::all_for`] gives the pack),
+/// then outputs.
+pub fn variables(scene: &Scene, engine: &str) -> Vec<Variable> {
+    let mut v = Table::default();
+    let pack = &scene.pack;
+    v.string(
+        "engine",
+        Quantity::Engine,
+        "the engine: \"reference\" (one rotational degree of freedom per body) or \
+         \"multibody\" (rapier3d bodies, per-tooth contacts)",
+        engine,
+    );
+    v.param(
+        "duration_limit_s",
+        Quantity::DurationLimit,
+        "s",
+        "the latest time the FMU may be advanced to; a step past it fails (a guard against \
+         a runaway host; the scene's simulation.duration_s by default)",
+        scene.simulation.duration_s,
+    );
+    v.string(
+        "recording_path",
+        Quantity::RecordingPath,
+        "an MCAP file to record the co-simulated run to (empty: no recording); replaced \
+         if it exists",
+        "",
+    );
+    let driven = Driven::all_for(pack);
+    let shaft0 = pack.shaft.initial_speed_rad_s();
+    if driven.shaft_speed {
+        v.input(
+            "shaft.speed_rad_s",
+            Input::ShaftSpeed,
+            "rad/s",
+            "speed of the prescribed shaft (positive: its positive rotation), held until the \
+             next communication point; the shaft's angle integrates it",
+            shaft0,
+        );
+    }
+    if driven.shaft_torque {
+        v.input(
+            "shaft.drive_torque_n_m",
+            Input::ShaftTorque,
+            "N.m",
+            "drive torque on the inertial shaft (eq 4's T_drive, positive along the positive \
+             rotation), held until the next communication point",
+            pack.shaft.drive_torque_n_m(0.0),
+        );
+    }
+    if let Some(d) = &pack.drum {
+        v.input(
+            "drum.load_torque_n_m",
+            Input::DrumLoad,
+            "N.m",
+            "load torque on the drum (negative: it brakes a drum turning the positive way), \
+             held until the next communication point",
+            d.load_torque_n_m,
+        );
+    }
+    if let Some(s) = &pack.stack {
+        v.input(
+            "piston.pressure_pa",
+            Input::PistonPressure,
+            "Pa",
+            "pressure on the piston (>= 0), held until the next communication point",
+            s.piston.pressure.pressure_pa(0.0),
+        );
+    }
+    v.output(
+        "shaft.angle_rad",
+        Quantity::ShaftAngle,
+        "rad",
+        "the shaft's angle",
+    );
+    if driven.shaft_torque {
+        v.output(
+            "shaft.speed_rad_s",
+            Quantity::ShaftSpeed,
+            "rad/s",
+            "the inertial shaft's speed",
+        );
+    }
+    v.output(
+        "pack.shaft_torque_n_m",
+        Quantity::PackShaftTorque,
+        "N.m",
+        "torque of the pack on the shaft now (the discs' spline reactions sum n F Rb, eq 4; \
+         positive along the positive rotation): what a host's shaft inertia feels",
+    );
+    if !pack.plates.is_empty() {
+        let on = if pack.drum.is_some() {
+            "drum"
+        } else {
+            "housing"
+        };
+        v.output(
+            "pack.carrier_torque_n_m",
+            Quantity::CarrierTorque,
+            "N.m",
+            &format!(
+                "torque of the plates on the {on} now (their spline reactions; positive along \
+                 the positive rotation)"
+            ),
+        );
+    }
+    if pack.drum.is_some() {
+        v.output(
+            "drum.angle_rad",
+            Quantity::DrumAngle,
+            "rad",
+            "the drum's angle",
+        );
+        v.output(
+            "drum.speed_rad_s",
+            Quantity::DrumSpeed,
+            "rad/s",
+            "the drum's speed",
+        );
+    }
+    let nd = pack.discs.len();
+    for (i, body) in pack.discs.iter().chain(&pack.plates).enumerate() {
+        let (list, k) = if i < nd {
+            ("discs", i + 1)
+        } else {
+            ("plates", i - nd + 1)
+        };
+        let name = &body.name;
+        let fields = [
+            (BodyField::Speed, "speed_rad_s", Some("rad/s"), "speed now"),
+            (
+                BodyField::Load,
+                "load_n",
+                Some("N"),
+                "per-tooth load now (eq 6; negative when its carrier leads)",
+            ),
+            (
+                BodyField::Torque,
+                "torque_n_m",
+                Some("N.m"),
+                "spline torque on it now (-n F Rb, eq 5)",
+            ),
+            (
+                BodyField::MaxLoad,
+                "max_load_n",
+                Some("N"),
+                "largest per-tooth |load| of its impacts so far",
+            ),
+            (
+                BodyField::Damage,
+                "damage",
+                Some("1"),
+                "Miner damage sum of its teeth so far (1: the predicted life used up; MODEL.md \
+                 section 7)",
+            ),
+        ];
+        for (field, suffix, unit, what) in fields {
+            v.push(Variable {
+                name: format!("{list}[{k}].{suffix}"),
+                quantity: Quantity::Body(i, field),
+                kind: Kind::Real,
+                causality: Causality::Output,
+                vr: 0,
+                unit,
+                description: format!("{name}: {what}"),
+                start_real: None,
+                start_string: None,
+            });
+        }
+    }
+    for (m, f) in clutchpack_sdk::friction_interfaces(scene)
+        .iter()
+        .enumerate()
+    {
+        let what = format!("interface {} ({} | {})", m + 1, f.lower, f.upper);
+        let fields = [
+            (
+                InterfaceField::Torque,
+                "torque_n_m",
+                "N.m",
+                "friction (or open-gap drag) torque on the upper body now",
+            ),
+            (
+                InterfaceField::Slip,
+                "slip_rad_s",
+                "rad/s",
+                "slip speed, upper minus lower body, now",
+            ),
+            (InterfaceField::Clamp, "clamp_n", "N", "clamp force now"),
+            (InterfaceField::Heat, "heat_j", "J", "heat since t = 0"),
+        ];
+        for (field, suffix, unit, text) in fields {
+            v.output(
+                &format!("interfaces[{}].{suffix}", m + 1),
+                Quantity::Interface(m, field),
+                unit,
+                &format!("{what}: {text}"),
+            );
+        }
+    }
+    v.push(Variable {
+        name: "impacts".into(),
+        quantity: Quantity::Impacts,
+        kind: Kind::Integer,
+        causality: Causality::Output,
+        vr: 0,
+        unit: None,
+        description: "impacts (contact events of any body) closed so far".into(),
+        start_real: None,
+        start_string: None,
+    });
+    v.0
+}
+
+/// Builds the list, numbering value references per base type.
+#[derive(Default)]
+struct Table(Vec<Variable>);
+
+impl Table {
+    fn push(&mut self, mut var: Variable) {
+        var.vr = self.0.iter().filter(|x| x.kind == var.kind).count() as u32;
+        self.0.push(var);
+    }
+    fn string(&mut self, name: &str, quantity: Quantity, description: &str, start: &str) {
+        self.push(Variable {
+            name: name.into(),
+            quantity,
+            kind: Kind::String,
+            causality: Causality::Parameter,
+            vr: 0,
+            unit: None,
+            description: description.into(),
+            start_real: None,
+            start_string: Some(start.into()),
+        });
+    }
+    fn param(&mut self, name: &str, q: Quantity, unit: &'static str, what: &str, start: f64) {
+        self.push(Variable {
+            name: name.into(),
+            quantity: q,
+            kind: Kind::Real,
+            causality: Causality::Parameter,
+            vr: 0,
+            unit: Some(unit),
+            description: what.into(),
+            start_real: Some(start),
+            start_string: None,
+        });
+    }
+    fn input(&mut self, name: &str, input: Input, unit: &'static str, what: &str, start: f64) {
+        self.push(Variable {
+            name: name.into(),
+            quantity: Quantity::Input(input),
+            kind: Kind::Real,
+            causality: Causality::Input,
+            vr: 0,
+            unit: Some(unit),
+            description: what.into(),
+            start_real: Some(start),
+            start_string: None,
+        });
+    }
+    fn output(&mut self, name: &str, q: Quantity, unit: &'static str, what: &str) {
+        self.push(Variable {
+            name: name.into(),
+            quantity: q,
+            kind: Kind::Real,
+            causality: Causality::Output,
+            vr: 0,
+            unit: Some(unit),
+            description: what.into(),
+            start_real: None,
+            start_string: None,
+        });
+    }
+}

@@ -1,0 +1,146 @@
+//! Steppable engines (issue 23): a session advanced in 1, 3 and 1,000 calls is the whole run;
+//! a saved state restored gives the same outputs again.
+
+use clutchpack_model::session::{Advance, Driven};
+use clutchpack_model::Collector;
+use clutchpack_scene::{EngineChoice, Override};
+use clutchpack_sdk::{SessionRequest, Simulation};
+use std::path::Path;
+
+fn simulation(file: &str, engine: EngineChoice, duration_s: f64) -> Simulation {
+    let o: Vec<Override> = vec![format!("simulation.duration_s={duration_s}")
+        .parse()
+        .unwrap()];
+    let scene =
+        clutchpack_scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(file), &o).unwrap();
+    Simulation::new(scene, Some(engine)).unwrap()
+}
+
+/// The whole run of `sim`'s engine and the same run as a session advanced in `calls` equal
+/// calls: everything they send, in order.
+fn whole_and_split(sim: &mut Simulation, duration: f64, calls: usize) -> (Collector, Collector) {
+    let mut whole = Collector::default();
+    sim.engine_mut().run(duration, &mut whole).unwrap();
+    let mut split = Collector::default();
+    let mut s = sim.engine_mut().start(Driven::NONE).unwrap();
+    s.set_stop_time(duration);
+    for k in 1..=calls {
+        let t = if k == calls {
+            duration
+        } else {
+            duration * k as f64 / calls as f64
+        };
+        assert_eq!(s.advance_to(t, &mut split).unwrap(), Advance::Reached);
+        assert_eq!(s.time_s(), t);
+        // nothing after the session's time has been sent
+        assert!(split.samples.last().is_none_or(|x| x.t_s <= t));
+        assert!(split.impacts.iter().all(|e| e.t_off_s <= t));
+    }
+    s.finish(&mut split);
+    (whole, split)
+}
+
+/// Identical, not merely close: the session's steps are the run's (they never end at a call).
+fn assert_identical(file: &str, engine: EngineChoice, duration: f64) {
+    let mut sim = simulation(file, engine, duration);
+    for calls in [1, 3, 1000] {
+        let (whole, split) = whole_and_split(&mut sim, duration, calls);
+        assert!(
+            whole.impacts.len() > 3,
+            "{file}: {} impacts",
+            whole.impacts.len()
+        );
+        assert_eq!(
+            whole.impacts, split.impacts,
+            "{file} {engine:?} in {calls} calls"
+        );
+        assert_eq!(
+            whole.samples, split.samples,
+            "{file} {engine:?} in {calls} calls"
+        );
+        assert_eq!(whole.interfaces, split.interfaces, "{file} {engine:?}");
+        assert_eq!(
+            whole.contacts, split.contacts,
+            "{file} {engine:?} in {calls} calls"
+        );
+    }
+}
+
+#[test]
+fn reference_sessions_in_any_number_of_calls_are_the_run() {
+    // monolithic (a whole pack), independent discs (prescribed shafts)
+    for file in [
+        "scenes/hu-table2.toml",
+        "scenes/pack-4-rattle.toml",
+        "scenes/pack-6-engagement.toml",
+        "scenes/staggered-8-disc.toml",
+    ] {
+        assert_identical(file, EngineChoice::Reference, 0.1);
+    }
+}
+
+#[test]
+fn reference_session_on_an_inertial_shaft_is_the_run() {
+    // the coupled scheme (the shaft integrated with the discs in contact)
+    let o: Vec<Override> = [
+        "simulation.duration_s=0.1",
+        "shaft.mode=\"inertial\"",
+        "shaft.inertia_kg_m2=0.5",
+    ]
+    .iter()
+    .map(|s| s.parse().unwrap())
+    .collect();
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/pack-4-rattle.toml");
+    let scene = clutchpack_scene::load(&file, &o).unwrap();
+    let mut sim = Simulation::new(scene, Some(EngineChoice::Reference)).unwrap();
+    for calls in [1, 3, 1000] {
+        let (whole, split) = whole_and_split(&mut sim, 0.1, calls);
+        assert!(whole.impacts.len() > 3);
+        assert_eq!(whole.impacts, split.impacts, "in {calls} calls");
+        assert_eq!(whole.samples, split.samples, "in {calls} calls");
+    }
+}
+
+/// Save at 40 ms, run to 100 ms, restore, run to 100 ms again: the same impacts and snapshot.
+#[test]
+fn a_restored_state_gives_the_same_outputs() {
+    for (file, engine) in [
+        ("scenes/pack-4-rattle.toml", EngineChoice::Reference),
+        ("scenes/pack-6-engagement.toml", EngineChoice::Reference),
+    ] {
+        let sim = simulation(file, engine, 0.1);
+        let driven = Driven::all_for(&sim.scene().pack);
+        let mut s = sim
+            .start(SessionRequest {
+                driven,
+                keep_history: true,
+                ..SessionRequest::default()
+            })
+            .unwrap();
+        let mut t = 0.0;
+        while t < 0.04 - 1e-12 {
+            t += 1e-4;
+            s.advance_to(t, None).unwrap();
+        }
+        let saved = s.save().unwrap();
+        let impacts_at_save = s_impacts(&s);
+        let run_on = |s: &mut clutchpack_sdk::Session| {
+            let mut t = s.time_s();
+            while t < 0.1 - 1e-12 {
+                t += 1e-4;
+                s.advance_to(t, None).unwrap();
+            }
+            (s.snapshot(), s.max_loads_n(), s_impacts(s))
+        };
+        let first = run_on(&mut s);
+        s.restore(&saved).unwrap();
+        assert_eq!(s_impacts(&s), impacts_at_save);
+        let second = run_on(&mut s);
+        assert!(first.2 > impacts_at_save, "{file}: impacts after the save");
+        assert_eq!(first, second, "{file}");
+    }
+}
+
+fn s_impacts(s: &clutchpack_sdk::Session) -> usize {
+    s.impact_count()
+}
