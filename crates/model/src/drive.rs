@@ -24,6 +24,10 @@ pub struct Table {
     pub y: Vec<f64>,
     /// Running integral of `y` from `t_s[0]` to each knot (unit of `y` times s).
     integral: Vec<f64>,
+    /// Each row's value held until the next row (a zero-order hold) instead of linear
+    /// interpolation ([`Table::held`]).
+    #[serde(default)]
+    pub hold: bool,
 }
 
 /// Why a table is not usable.
@@ -64,7 +68,23 @@ impl Table {
         for i in 1..t_s.len() {
             integral[i] = integral[i - 1] + 0.5 * (y[i] + y[i - 1]) * (t_s[i] - t_s[i - 1]);
         }
-        Ok(Table { t_s, y, integral })
+        Ok(Table {
+            t_s,
+            y,
+            integral,
+            hold: false,
+        })
+    }
+
+    /// The same rows, each value held until the next row (a zero-order hold, as a
+    /// co-simulation master gives its inputs): a step function, right-continuous at the rows.
+    pub fn held(mut self) -> Table {
+        self.hold = true;
+        for i in 1..self.t_s.len() {
+            self.integral[i] =
+                self.integral[i - 1] + self.y[i - 1] * (self.t_s[i] - self.t_s[i - 1]);
+        }
+        self
     }
 
     fn segment(&self, t: f64) -> usize {
@@ -73,7 +93,8 @@ impl Table {
         i.saturating_sub(1).min(self.t_s.len() - 2)
     }
 
-    /// Linearly interpolated value at `t` (held beyond the ends).
+    /// Linearly interpolated value at `t` (held beyond the ends; with [`Table::hold`], the
+    /// value of the last row at or before `t`).
     pub fn value(&self, t: f64) -> f64 {
         let n = self.t_s.len();
         if t <= self.t_s[0] {
@@ -83,6 +104,9 @@ impl Table {
             return self.y[n - 1];
         }
         let i = self.segment(t);
+        if self.hold {
+            return self.y[i];
+        }
         let w = (t - self.t_s[i]) / (self.t_s[i + 1] - self.t_s[i]);
         self.y[i] + w * (self.y[i + 1] - self.y[i])
     }
@@ -90,7 +114,7 @@ impl Table {
     /// Slope `dy/dt` at `t` (0 beyond the ends; the right-hand slope at a knot).
     pub fn slope(&self, t: f64) -> f64 {
         let n = self.t_s.len();
-        if t < self.t_s[0] || t >= self.t_s[n - 1] {
+        if self.hold || t < self.t_s[0] || t >= self.t_s[n - 1] {
             return 0.0;
         }
         let i = self.segment(t);
@@ -111,6 +135,9 @@ impl Table {
             return self.integral[n - 1] + (t - self.t_s[n - 1]) * self.y[n - 1];
         }
         let i = self.segment(t);
+        if self.hold {
+            return self.integral[i] + self.y[i] * (t - self.t_s[i]);
+        }
         let v = self.value(t);
         self.integral[i] + 0.5 * (self.y[i] + v) * (t - self.t_s[i])
     }
@@ -293,6 +320,23 @@ impl Shaft {
 
 #[cfg(test)]
 mod tests {
+    use super::Table;
+
+    #[test]
+    fn a_held_table_is_a_step_function_with_its_exact_integral() {
+        let t = Table::new(vec![0.0, 1.0, 3.0], vec![2.0, 5.0, -1.0])
+            .unwrap()
+            .held();
+        assert_eq!(
+            (t.value(0.5), t.value(1.0), t.value(2.9), t.value(9.0)),
+            (2.0, 5.0, 5.0, -1.0)
+        );
+        assert_eq!(t.slope(0.5), 0.0);
+        // 2 * 1 + 5 * 2 + (-1) * 1
+        assert!((t.integral_from_zero(4.0) - 11.0).abs() < 1e-12);
+        assert!((t.integral_from_zero(2.0) - 7.0).abs() < 1e-12);
+    }
+
     use super::*;
     use approx::assert_relative_eq;
 

@@ -6,9 +6,9 @@
 //! communication point: docs/DECISIONS.md, "Co-simulation".
 
 use crate::clutch::{InterfaceSample, PressureProfile};
-use crate::drive::{Shaft, ShaftExcitation, SpeedProfile};
+use crate::drive::{Shaft, ShaftExcitation, SpeedProfile, Table};
 use crate::pack::PackModel;
-use crate::stream::{EngineError, Observer, RunStats, Sample};
+use crate::stream::{Engine, EngineError, Observer, RunStats, Sample};
 
 /// Which of the pack's inputs a session's caller drives (the others follow the scene's
 /// profiles). A session driven by nothing follows the scene exactly as `Engine::run` does,
@@ -52,6 +52,14 @@ impl Driven {
             (self.drum_load && pack.drum.is_none(), "the drum load needs a pack with a drum"),
             (self.piston_pressure && pack.stack.is_none(), "the piston pressure needs a pack with a stack"),
         ];
+        if !self.shaft_speed && matches!(held_table(pack), Some((_, true))) {
+            return Err(EngineError::Unsupported(
+                "a held speed table (drive.interpolation = \"hold\") jumps at its rows: run it \
+                 with Engine::run (clutchpack run), which ends a step at every row, or drive the \
+                 shaft speed"
+                    .into(),
+            ));
+        }
         match missing.iter().find(|(m, _)| *m) {
             Some((_, why)) => Err(EngineError::Unsupported(why.to_string())),
             None => Ok(()),
@@ -238,14 +246,71 @@ pub trait Session: Send {
     fn boxed_clone(&self) -> Box<dyn Session>;
 }
 
-/// Runs a session started at t = 0 to `duration_s` and finishes it: what `Engine::run` does.
-pub fn run_session(
-    mut session: Box<dyn Session>,
+/// A held (zero-order hold) table driving the shaft: its speed (prescribed shaft, `true`) or
+/// its drive torque (inertial shaft, `false`).
+fn held_table(pack: &PackModel) -> Option<(&Table, bool)> {
+    match &pack.shaft {
+        Shaft::Prescribed(SpeedProfile::Table(t)) if t.hold => Some((t, true)),
+        Shaft::Inertial {
+            excitation: ShaftExcitation::Torque { table, .. },
+            ..
+        } if table.hold => Some((table, false)),
+        _ => None,
+    }
+}
+
+/// What `Engine::run` does: a session of `engine` from t = 0 to `duration_s`, finished.
+/// A held table on the shaft (`Table::hold`) runs as a driven session whose communication
+/// points are the table's rows, each row's value set there: the held speed's jumps are where
+/// steps end (an engine integrating relative speeds cannot step across a jump of the
+/// prescribed speed), exactly as a co-simulation master holding the same values drives it.
+/// Anything else runs as one session driven by nothing.
+pub fn run_engine<E: Engine + ?Sized>(
+    engine: &E,
     duration_s: f64,
     observer: &mut dyn Observer,
 ) -> Result<RunStats, EngineError> {
+    let Some((table, speed)) = held_table(engine.model()) else {
+        let mut session = engine.start(Driven::NONE)?;
+        session.set_stop_time(duration_s);
+        let advance = session.advance_to(duration_s, observer)?;
+        let mut stats = session.finish(observer);
+        stats.stopped_early = advance == Advance::Stopped;
+        return Ok(stats);
+    };
+    let table = table.clone();
+    let mut session = engine.start(Driven {
+        shaft_speed: speed,
+        shaft_torque: !speed,
+        ..Driven::NONE
+    })?;
     session.set_stop_time(duration_s);
-    let advance = session.advance_to(duration_s, observer)?;
+    let mut advance = Advance::Reached;
+    while session.time_s() < duration_s {
+        let t = session.time_s();
+        let v = Some(table.value(t));
+        session.set_inputs(&if speed {
+            Inputs {
+                shaft_speed_rad_s: v,
+                ..Inputs::default()
+            }
+        } else {
+            Inputs {
+                shaft_torque_n_m: v,
+                ..Inputs::default()
+            }
+        })?;
+        let next = table
+            .t_s
+            .iter()
+            .copied()
+            .find(|&x| x > t)
+            .map_or(duration_s, |x| x.min(duration_s));
+        advance = session.advance_to(next, observer)?;
+        if advance == Advance::Stopped {
+            break;
+        }
+    }
     let mut stats = session.finish(observer);
     stats.stopped_early = advance == Advance::Stopped;
     Ok(stats)

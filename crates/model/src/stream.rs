@@ -169,6 +169,8 @@ pub trait Engine {
     fn name(&self) -> &'static str;
     /// Names of the discs in output order.
     fn disc_names(&self) -> Vec<String>;
+    /// The model this engine runs.
+    fn model(&self) -> &crate::pack::PackModel;
     /// Starts a steppable run at t = 0 ([`Session`]) whose caller drives the inputs `driven`
     /// (the others follow the scene's profiles). The session owns a copy of the model: the
     /// engine stays usable.
@@ -180,13 +182,13 @@ pub trait Engine {
         )))
     }
     /// Runs from t = 0 to `duration_s`, sending samples and impacts to `observer`. On error,
-    /// everything before the failure has already been delivered. Built on [`Engine::start`]:
-    /// one session driven by nothing, advanced to `duration_s` in one call.
+    /// everything before the failure has already been delivered. Built on [`Engine::start`]
+    /// ([`crate::session::run_engine`]).
     fn run(
         &mut self,
         duration_s: f64,
         observer: &mut dyn Observer,
     ) -> Result<RunStats, EngineError> {
-        crate::session::run_session(self.start(Driven::NONE)?, duration_s, observer)
+        crate::session::run_engine(self, duration_s, observer)
     }
 }

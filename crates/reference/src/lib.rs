@@ -388,6 +388,10 @@ impl Engine for ReferenceEngine {
             .collect()
     }
 
+    fn model(&self) -> &PackModel {
+        &self.pack
+    }
+
     fn start(&self, driven: Driven) -> Result<Box<dyn Session>, EngineError> {
         for d in self.pack.discs.iter().chain(&self.pack.plates) {
             stepper::check_disc(d)?;

@@ -147,6 +147,8 @@ table! {
         phase_deg: "deg", FINITE, Dflt::Num(0.0);
         /// CSV with a header row, relative to the scene file's folder; speed_table: columns time_s, speed_rad_s; torque_table: columns time_s, torque_n_m (needs shaft.mode = "inertial")
         file: "", Kind::Text, Dflt::When("required for speed_table and torque_table");
+        /// speed_table and torque_table: "linear" between rows, or "hold": each row's value held until the next row (a zero-order hold, as a co-simulation master gives its inputs; a held speed table runs with a step ending at every row)
+        interpolation: "", Kind::Choice(&["linear", "hold"]), Dflt::Choice("linear");
     }
     children {
         harmonics: array RawHarmonic,

@@ -370,7 +370,32 @@ fn speed_table_drive_loads_from_csv() {
     };
     assert_eq!(t.t_s, [0.0, 0.1, 0.2]);
     assert_eq!(t.y, [200.0, 210.0, 190.0]);
+    assert!(!t.hold, "linear by default");
     assert_relative_eq!(s.pack.shaft.initial_speed_rad_s(), 200.0);
+
+    // held rows (a co-simulation master's zero-order hold)
+    let held = text.replace(
+        "file = \"speed.csv\"",
+        "file = \"speed.csv\"\ninterpolation = \"hold\"",
+    );
+    let s = parse(&held, "t.toml", csv.parent().unwrap(), &[]).unwrap();
+    let Shaft::Prescribed(SpeedProfile::Table(t)) = &s.pack.shaft else {
+        panic!("expected a speed table, got {:?}", s.pack.shaft)
+    };
+    assert!(t.hold);
+    assert_eq!(t.value(0.15), 210.0);
+    // not a sine's key
+    let e = parse(
+        &PAPER.replace(
+            "frequency_hz = 104.0",
+            "frequency_hz = 104.0\ninterpolation = \"hold\"",
+        ),
+        "t.toml",
+        csv.parent().unwrap(),
+        &[],
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("drive.interpolation"), "{e}");
 
     // a broken table names the file and the line
     std::fs::write(&csv, "time_s,speed_rad_s\n0.0,200.0\n0.0,210.0\n").unwrap();

@@ -45,7 +45,7 @@ impl DriveKind {
                 "phase_deg",
             ],
             DriveKind::Harmonics => &["omega0_rad_s", "harmonics"],
-            DriveKind::SpeedTable | DriveKind::TorqueTable => &["file"],
+            DriveKind::SpeedTable | DriveKind::TorqueTable => &["file", "interpolation"],
         }
     }
 }
@@ -83,7 +83,7 @@ pub(super) fn drive(
     };
 
     // Keys of other kinds are errors: they would be silently ignored otherwise.
-    let given: [(&str, Option<&Value>, bool); 6] = [
+    let given: [(&str, Option<&Value>, bool); 7] = [
         (
             "omega0_rad_s",
             r.omega0_rad_s.as_ref(),
@@ -102,6 +102,11 @@ pub(super) fn drive(
         ("phase_deg", r.phase_deg.as_ref(), r.phase_deg.is_some()),
         ("harmonics", None, r.harmonics.is_some()),
         ("file", r.file.as_ref(), r.file.is_some()),
+        (
+            "interpolation",
+            r.interpolation.as_ref(),
+            r.interpolation.is_some(),
+        ),
     ];
     for (key, value, present) in given {
         if present && !kind.keys().contains(&key) {
@@ -198,8 +203,21 @@ pub(super) fn drive(
                      file's folder)"
                 )),
             );
-            file.and_then(
-                |file| match csv::read_table(&base_dir.join(&file), &file, column) {
+            let hold = ck
+                .choice(
+                    &D::interpolation.rel(),
+                    r.interpolation.as_ref(),
+                    &D::interpolation,
+                    &[false, true],
+                )
+                .or(false);
+            file.zip(hold).and_then(|(file, hold)| {
+                match csv::read_table(&base_dir.join(&file), &file, column) {
+                    Ok(table) if hold => Some(if kind == DriveKind::SpeedTable {
+                        Drive::Profile(SpeedProfile::Table(table.held()))
+                    } else {
+                        Drive::Torque(table.held())
+                    }),
                     Ok(table) if kind == DriveKind::SpeedTable => {
                         Some(Drive::Profile(SpeedProfile::Table(table)))
                     }
@@ -208,8 +226,8 @@ pub(super) fn drive(
                         ck.report(D::file.rel(), r.file.as_ref().map(show), message);
                         None
                     }
-                },
-            )
+                }
+            })
         }
     };
     (Field::Valid(kind), drive)

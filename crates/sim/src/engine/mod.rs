@@ -229,6 +229,10 @@ impl Engine for MultibodyEngine {
         "multibody"
     }
 
+    fn model(&self) -> &PackModel {
+        &self.pack
+    }
+
     fn disc_names(&self) -> Vec<String> {
         self.pack
             .discs
