@@ -4,6 +4,7 @@
 mod architecture;
 mod cross_engine;
 mod fatigue;
+mod fmu;
 mod hardening;
 mod python_package;
 mod reliability;

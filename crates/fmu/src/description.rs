@@ -68,7 +68,7 @@ pub fn model_description(header: &Header, vars: &[Variable]) -> String {
             ("modelIdentifier", MODEL_IDENTIFIER),
             ("needsExecutionTool", "false"),
             ("canHandleVariableCommunicationStepSize", "true"),
-            ("canInterpolateInputs", "false"),
+            ("canInterpolateInputs", "true"),
             ("maxOutputDerivativeOrder", "0"),
             ("canRunAsynchronuously", "false"),
             ("canBeInstantiatedOnlyOncePerProcess", "false"),

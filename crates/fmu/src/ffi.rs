@@ -485,7 +485,7 @@ pub unsafe extern "C" fn fmi2SetInteger(
 ) -> c_int {
     with(c, "fmi2SetInteger", |_| match unsafe { slice(vr, n) } {
         Some([]) => Ok(OK),
-        Some(_) => Err("the only Integer variable (impacts) is an output".into()),
+        Some(_) => Err("the Integer variables (impacts, last_impact.body) are outputs".into()),
         None => Err(NULL_ARRAY.into()),
     })
 }
@@ -635,23 +635,28 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     })
 }
 
-/// `fmi2SetRealInputDerivatives`: the inputs are held, not interpolated.
+/// `fmi2SetRealInputDerivatives`: the slope of the shaft's speed or drive torque (order 1),
+/// a first-order hold over the coming steps.
 ///
 /// # Safety
 /// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
     c: *mut c_void,
-    _vr: *const u32,
-    _n: usize,
-    _order: *const c_int,
-    _value: *const f64,
+    vr: *const u32,
+    n: usize,
+    order: *const c_int,
+    value: *const f64,
 ) -> c_int {
-    with(c, "fmi2SetRealInputDerivatives", |_| {
-        Err(
-            "the inputs are held between communication points (canInterpolateInputs = false)"
-                .into(),
-        )
+    with(c, "fmi2SetRealInputDerivatives", |comp| {
+        let (vr, order, value) = unsafe { (slice(vr, n), slice(order, n), slice(value, n)) };
+        let (Some(vr), Some(order), Some(value)) = (vr, order, value) else {
+            return Err(NULL_ARRAY.into());
+        };
+        for ((r, o), v) in vr.iter().zip(order).zip(value) {
+            comp.instance.set_real_derivative(*r, *o, *v)?;
+        }
+        Ok(OK)
     })
 }
 

@@ -4,7 +4,9 @@
 //! is here, testable without a host.
 
 use crate::variables::Variable;
-use crate::variables::{variables, BodyField, Causality, Input, InterfaceField, Kind, Quantity};
+use crate::variables::{
+    variables, BodyField, Causality, ImpactField, Input, InterfaceField, Kind, Quantity,
+};
 use clutchpack_model::session::{Driven, Inputs, Snapshot};
 use clutchpack_record::{RecordOptions, Replace};
 use clutchpack_scene::{EngineChoice, Scene};
@@ -33,6 +35,7 @@ pub enum Phase {
 pub struct SavedState {
     session: SessionState,
     reals: Vec<f64>,
+    slopes: Vec<[f64; 2]>,
     snapshot: Snapshot,
 }
 
@@ -43,6 +46,10 @@ pub struct Instance {
     /// Value of every Real variable by value reference (parameters and inputs as set,
     /// outputs as last computed).
     reals: Vec<f64>,
+    /// First and second derivatives of each Real input by value reference
+    /// (`fmi2SetRealInputDerivatives`, orders 1 and 2), per s and per s^2; reset to 0
+    /// whenever the input's value is set.
+    slopes: Vec<[f64; 2]>,
     strings: Vec<String>,
     phase: Phase,
     stop_time_s: Option<f64>,
@@ -86,6 +93,7 @@ impl Instance {
         let vars = variables(&scene, engine.name());
         let mut inst = Instance {
             reals: Vec::new(),
+            slopes: Vec::new(),
             strings: Vec::new(),
             vars,
             scene,
@@ -105,6 +113,7 @@ impl Instance {
         let count = |k| self.vars.iter().filter(|v| v.kind == k).count();
         let (nr, ns) = (count(Kind::Real), count(Kind::String));
         self.reals = vec![0.0; nr];
+        self.slopes = vec![[0.0; 2]; nr];
         self.strings = vec![String::new(); ns];
         for v in &self.vars {
             match v.kind {
@@ -236,9 +245,17 @@ impl Instance {
         for v in &self.vars {
             if let Quantity::Input(i) = v.quantity {
                 let x = Some(self.reals[v.vr as usize]);
+                let [slope, curvature] = self.slopes[v.vr as usize];
                 match i {
-                    Input::ShaftSpeed => out.shaft_speed_rad_s = x,
-                    Input::ShaftTorque => out.shaft_torque_n_m = x,
+                    Input::ShaftSpeed => {
+                        out.shaft_speed_rad_s = x;
+                        out.shaft_speed_slope_rad_s2 = Some(slope);
+                        out.shaft_speed_curvature_rad_s3 = Some(curvature);
+                    }
+                    Input::ShaftTorque => {
+                        out.shaft_torque_n_m = x;
+                        out.shaft_torque_slope_n_m_s = Some(slope);
+                    }
                     Input::DrumLoad => out.drum_load_n_m = x,
                     Input::PistonPressure => out.piston_pressure_pa = x,
                 }
@@ -268,9 +285,49 @@ impl Instance {
             }
             _ => {
                 self.reals[vr as usize] = value;
+                self.slopes[vr as usize] = [0.0; 2];
                 Ok(())
             }
         }
+    }
+
+    /// `fmi2SetRealInputDerivatives` of one input: its slope (`order` 1) or, for the shaft's
+    /// speed, also its second derivative (`order` 2) over the coming communication steps,
+    /// until its value is set again (a first- or second-order hold). Only the shaft's speed
+    /// and drive torque take derivatives.
+    pub fn set_real_derivative(&mut self, vr: u32, order: i32, value: f64) -> Result<(), String> {
+        let v = self.var(Kind::Real, vr)?;
+        if !matches!(
+            v.quantity,
+            Quantity::Input(Input::ShaftSpeed | Input::ShaftTorque)
+        ) {
+            return Err(format!(
+                "{}: only the shaft's speed or drive torque take an input derivative",
+                v.name
+            ));
+        }
+        let most = if v.quantity == Quantity::Input(Input::ShaftSpeed) {
+            2
+        } else {
+            1
+        };
+        if !(1..=most).contains(&order) {
+            return Err(format!(
+                "{}: derivative of order {order}: it takes orders 1 to {most}",
+                v.name
+            ));
+        }
+        if !value.is_finite() {
+            return Err(format!(
+                "{}: slope {value}: expected a finite value",
+                v.name
+            ));
+        }
+        if matches!(self.phase, Phase::Terminated | Phase::Failed) {
+            return Err(format!("{}: the run has ended", v.name));
+        }
+        self.slopes[vr as usize][order as usize - 1] = value;
+        Ok(())
     }
 
     /// `fmi2SetString` of one variable.
@@ -292,9 +349,21 @@ impl Instance {
         Ok(&self.strings[vr as usize])
     }
 
-    /// `fmi2GetInteger` of one variable (the impacts so far).
+    /// The impact that closed last.
+    fn last_impact(&self) -> Option<clutchpack_model::ImpactEvent> {
+        match (&self.session, &self.outcome) {
+            (Some(s), _) => s.last_impact(),
+            (None, Some(o)) => o.collector.last_impact,
+            _ => None,
+        }
+    }
+
+    /// `fmi2GetInteger` of one variable (the impacts so far, the last impact's body).
     pub fn get_integer(&self, vr: u32) -> Result<i32, String> {
-        self.var(Kind::Integer, vr)?;
+        let v = self.var(Kind::Integer, vr)?;
+        if v.quantity == Quantity::LastImpact(ImpactField::Body) {
+            return Ok(self.last_impact().map_or(0, |e| e.disc as i32 + 1));
+        }
         let n = match (&self.session, &self.outcome) {
             (Some(s), _) => s.impact_count(),
             (None, Some(o)) => o.collector.impact_count(),
@@ -337,6 +406,13 @@ impl Instance {
                     InterfaceField::Heat => x.dissipated_j,
                 }
             }
+            Quantity::LastImpact(f) => self.last_impact().map_or(0.0, |e| match f {
+                ImpactField::Onset => e.t_on_s,
+                ImpactField::PeakTime => e.t_peak_s,
+                ImpactField::End => e.t_off_s,
+                ImpactField::Peak => e.peak_n,
+                ImpactField::Body => 0.0,
+            }),
             _ => self.reals[vr as usize],
         })
     }
@@ -449,6 +525,7 @@ impl Instance {
         Ok(SavedState {
             session: s.save().map_err(|e| e.to_string())?,
             reals: self.reals.clone(),
+            slopes: self.slopes.clone(),
             snapshot: self.snapshot.clone(),
         })
     }
@@ -462,6 +539,7 @@ impl Instance {
             .ok_or("fmi2SetFMUstate is supported while stepping (after initialization)")?;
         s.restore(&state.session).map_err(|e| e.to_string())?;
         self.reals.clone_from(&state.reals);
+        self.slopes.clone_from(&state.slopes);
         self.snapshot = state.snapshot.clone();
         self.damage_cache.take();
         self.phase = Phase::Stepping;

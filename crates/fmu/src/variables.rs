@@ -97,6 +97,23 @@ pub enum Quantity {
     Interface(usize, InterfaceField),
     /// Impacts closed so far (Integer).
     Impacts,
+    /// The impact that closed last.
+    LastImpact(ImpactField),
+}
+
+/// What the last impact's outputs give.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImpactField {
+    /// The body's number, 1-based in the discs-then-plates order (Integer; 0: none yet).
+    Body,
+    /// Onset, s.
+    Onset,
+    /// Time of the peak, s.
+    PeakTime,
+    /// End, s.
+    End,
+    /// Signed peak per-tooth load, N.
+    Peak,
 }
 
 /// One scalar variable of the model description.
@@ -333,6 +350,38 @@ pub fn variables(scene: &Scene, engine: &str) -> Vec<Variable> {
                 &format!("{what}: {text}"),
             );
         }
+    }
+    v.push(Variable {
+        name: "last_impact.body".into(),
+        quantity: Quantity::LastImpact(ImpactField::Body),
+        kind: Kind::Integer,
+        causality: Causality::Output,
+        vr: 0,
+        unit: None,
+        description: "the body of the impact that closed last: its number in the discs then \
+                      the plates, from 1 (0: none yet; when several close within one step, the \
+                      last; the recording has them all)"
+            .into(),
+        start_real: None,
+        start_string: None,
+    });
+    for (field, suffix, unit, what) in [
+        (ImpactField::Onset, "t_on_s", "s", "onset"),
+        (ImpactField::PeakTime, "t_peak_s", "s", "time of the peak"),
+        (ImpactField::End, "t_off_s", "s", "end"),
+        (
+            ImpactField::Peak,
+            "peak_n",
+            "N",
+            "signed peak per-tooth load (eq 6's sign)",
+        ),
+    ] {
+        v.output(
+            &format!("last_impact.{suffix}"),
+            Quantity::LastImpact(field),
+            unit,
+            &format!("the impact that closed last: its {what} (0: none yet)"),
+        );
     }
     v.push(Variable {
         name: "impacts".into(),

@@ -157,15 +157,21 @@ pub enum SpeedProfile {
     /// Tabulated speed in rad/s, linear between rows.
     Table(Table),
     /// A speed held from `t0_s` on (a co-simulation input between two communication points,
-    /// `crate::session`): `omega = speed`, `theta = angle0 + speed (t - t0)`. Valid for
-    /// `t >= t0_s` only (engines never ask earlier).
+    /// `crate::session`), with an optional slope and curvature (first- or second-order hold):
+    /// `omega = speed + accel tau + jerk tau^2 / 2`, `theta = angle0 + speed tau + accel tau^2
+    /// / 2 + jerk tau^3 / 6`, `tau = t - t0`. Valid for `t >= t0_s` only (engines never ask
+    /// earlier).
     Held {
         /// Start of the hold, s.
         t0_s: f64,
         /// Shaft angle at `t0_s`, rad.
         angle0_rad: f64,
-        /// The held speed, rad/s.
+        /// The speed at `t0_s`, rad/s.
         speed_rad_s: f64,
+        /// The speed's slope at `t0_s`, rad/s^2 (0: a zero-order hold).
+        accel_rad_s2: f64,
+        /// The speed's second derivative over the hold, rad/s^3 (0: at most first order).
+        jerk_rad_s3: f64,
     },
 }
 
@@ -196,7 +202,16 @@ impl SpeedProfile {
                         .sum::<f64>()
             }
             SpeedProfile::Table(tab) => tab.value(t),
-            SpeedProfile::Held { speed_rad_s, .. } => *speed_rad_s,
+            SpeedProfile::Held {
+                t0_s,
+                speed_rad_s,
+                accel_rad_s2,
+                jerk_rad_s3,
+                ..
+            } => {
+                let tau = t - t0_s;
+                speed_rad_s + accel_rad_s2 * tau + 0.5 * jerk_rad_s3 * tau * tau
+            }
         }
     }
 
@@ -222,7 +237,13 @@ impl SpeedProfile {
                 t0_s,
                 angle0_rad,
                 speed_rad_s,
-            } => angle0_rad + speed_rad_s * (t - t0_s),
+                accel_rad_s2,
+                jerk_rad_s3,
+            } => {
+                let tau = t - t0_s;
+                angle0_rad
+                    + tau * (speed_rad_s + tau * (0.5 * accel_rad_s2 + tau * jerk_rad_s3 / 6.0))
+            }
         }
     }
 
@@ -237,7 +258,12 @@ impl SpeedProfile {
                 })
                 .sum(),
             SpeedProfile::Table(tab) => tab.slope(t),
-            SpeedProfile::Held { .. } => 0.0,
+            SpeedProfile::Held {
+                t0_s,
+                accel_rad_s2,
+                jerk_rad_s3,
+                ..
+            } => accel_rad_s2 + jerk_rad_s3 * (t - t0_s),
         }
     }
 }
@@ -255,11 +281,16 @@ pub enum ShaftExcitation {
         /// Shaft speed at t = 0, rad/s.
         initial_speed_rad_s: f64,
     },
-    /// A drive torque held constant (a co-simulation input between two communication points,
-    /// `crate::session`), N m.
+    /// A drive torque held from `t0_s` on (a co-simulation input between two communication
+    /// points, `crate::session`), with an optional slope (first-order hold): `T = torque +
+    /// rate (t - t0)`.
     Held {
-        /// The torque, N m (positive along the positive rotation).
+        /// Start of the hold, s.
+        t0_s: f64,
+        /// The torque at `t0_s`, N m (positive along the positive rotation).
         torque_n_m: f64,
+        /// Its slope over the hold, N m/s (0: a zero-order hold).
+        rate_n_m_s: f64,
         /// Shaft speed at t = 0, rad/s.
         initial_speed_rad_s: f64,
     },
@@ -312,7 +343,12 @@ impl Shaft {
                 // Hu et al. eq (4): J1 * 2 pi f A cos(2 pi f t)
                 ShaftExcitation::Profile(p) => inertia_kg_m2 * p.acceleration(t),
                 ShaftExcitation::Torque { table, .. } => table.value(t),
-                ShaftExcitation::Held { torque_n_m, .. } => *torque_n_m,
+                ShaftExcitation::Held {
+                    t0_s,
+                    torque_n_m,
+                    rate_n_m_s,
+                    ..
+                } => torque_n_m + rate_n_m_s * (t - t0_s),
             },
         }
     }

@@ -94,6 +94,15 @@ pub struct Inputs {
     pub drum_load_n_m: Option<f64>,
     /// Pressure on the piston, Pa (>= 0).
     pub piston_pressure_pa: Option<f64>,
+    /// Slope of the prescribed shaft's speed over the coming interval, rad/s^2 (a first-order
+    /// hold, FMI's input derivative); `None` or with no speed set: 0 from this point on.
+    pub shaft_speed_slope_rad_s2: Option<f64>,
+    /// Second derivative of the prescribed shaft's speed over the coming interval, rad/s^3
+    /// (a second-order hold); as [`Inputs::shaft_speed_slope_rad_s2`].
+    pub shaft_speed_curvature_rad_s3: Option<f64>,
+    /// Slope of the inertial shaft's drive torque over the coming interval, N m/s; as
+    /// [`Inputs::shaft_speed_slope_rad_s2`].
+    pub shaft_torque_slope_n_m_s: Option<f64>,
 }
 
 impl Inputs {
@@ -112,6 +121,14 @@ impl Inputs {
         if self.piston_pressure_pa.is_some() && !driven.piston_pressure {
             out.push("piston pressure");
         }
+        if (self.shaft_speed_slope_rad_s2.is_some() || self.shaft_speed_curvature_rad_s3.is_some())
+            && !driven.shaft_speed
+        {
+            out.push("shaft speed's derivatives");
+        }
+        if self.shaft_torque_slope_n_m_s.is_some() && !driven.shaft_torque {
+            out.push("shaft torque's slope");
+        }
         out
     }
 
@@ -122,6 +139,9 @@ impl Inputs {
             ("shaft torque", self.shaft_torque_n_m),
             ("drum load", self.drum_load_n_m),
             ("piston pressure", self.piston_pressure_pa),
+            ("shaft speed's slope", self.shaft_speed_slope_rad_s2),
+            ("shaft speed's curvature", self.shaft_speed_curvature_rad_s3),
+            ("shaft torque's slope", self.shaft_torque_slope_n_m_s),
         ];
         for (name, v) in all {
             if let Some(v) = v {
@@ -134,7 +154,8 @@ impl Inputs {
     }
 }
 
-/// `pack` with `inputs` held from `t_s` on (zero-order hold; `crate::session`), and the jump
+/// `pack` with `inputs` held from `t_s` on (a zero-order hold, or first-order with a slope;
+/// `crate::session`), and the jump
 /// of the prescribed shaft's speed at `t_s` (rad/s, new minus old; 0 when it is not set): the
 /// speed becomes `SpeedProfile::Held` from the shaft's angle at `t_s` (so the angle stays
 /// continuous), the drive torque `ShaftExcitation::Held`, the pressure a constant, the drum's
@@ -145,20 +166,31 @@ pub fn hold_inputs(pack: &PackModel, t_s: f64, inputs: &Inputs) -> (PackModel, f
     let mut jump = 0.0;
     match &mut out.shaft {
         Shaft::Prescribed(p) => {
-            if let Some(v) = inputs.shaft_speed_rad_s {
+            if inputs.shaft_speed_rad_s.is_some()
+                || inputs.shaft_speed_slope_rad_s2.is_some()
+                || inputs.shaft_speed_curvature_rad_s3.is_some()
+            {
+                let v = inputs.shaft_speed_rad_s.unwrap_or_else(|| p.speed(t_s));
                 jump = v - p.speed(t_s);
                 *p = SpeedProfile::Held {
                     t0_s: t_s,
                     angle0_rad: p.angle(t_s),
                     speed_rad_s: v,
+                    accel_rad_s2: inputs.shaft_speed_slope_rad_s2.unwrap_or(0.0),
+                    jerk_rad_s3: inputs.shaft_speed_curvature_rad_s3.unwrap_or(0.0),
                 };
             }
         }
         Shaft::Inertial { excitation, .. } => {
-            if let Some(torque) = inputs.shaft_torque_n_m {
+            if inputs.shaft_torque_n_m.is_some() || inputs.shaft_torque_slope_n_m_s.is_some() {
+                let torque = inputs
+                    .shaft_torque_n_m
+                    .unwrap_or_else(|| pack.shaft.drive_torque_n_m(t_s));
                 let initial_speed_rad_s = pack.shaft.initial_speed_rad_s();
                 *excitation = ShaftExcitation::Held {
+                    t0_s: t_s,
                     torque_n_m: torque,
+                    rate_n_m_s: inputs.shaft_torque_slope_n_m_s.unwrap_or(0.0),
                     initial_speed_rad_s,
                 };
             }

@@ -32,6 +32,8 @@ pub struct RunCollector {
     pub fatigue_params: Vec<(SplineGeometry, FatigueParams)>,
     /// The impacts CSV being written, if asked.
     csv: Option<ImpactsCsv>,
+    /// The impact that closed last (in the order the engine sent them).
+    pub last_impact: Option<ImpactEvent>,
 }
 
 impl RunCollector {
@@ -45,6 +47,7 @@ impl RunCollector {
             fatigue: FatigueCollector::new(),
             fatigue_params: Vec::new(),
             csv: None,
+            last_impact: None,
         }
     }
 
@@ -68,6 +71,7 @@ impl RunCollector {
             fatigue: self.fatigue.clone(),
             fatigue_params: self.fatigue_params.clone(),
             csv: None,
+            last_impact: self.last_impact,
         })
     }
 
@@ -246,6 +250,7 @@ impl Observer for RunCollector {
         }
     }
     fn impact(&mut self, e: &ImpactEvent) {
+        self.last_impact = Some(*e);
         if self.keep_history {
             self.impacts.push(*e);
         }

@@ -159,6 +159,11 @@ impl Session {
         self.collector.impact_count()
     }
 
+    /// The impact that closed last, if any (the recording and the statistics have them all).
+    pub fn last_impact(&self) -> Option<clutchpack_model::ImpactEvent> {
+        self.collector.last_impact
+    }
+
     /// Each body's largest impact load so far, N (the largest `|F|` per tooth of its
     /// impacts' peaks; 0 before its first impact), in body order.
     pub fn max_loads_n(&self) -> Vec<f64> {

@@ -39,7 +39,7 @@ pub(crate) fn profile_acceleration_bound(p: &SpeedProfile) -> f64 {
             .zip(tab.y.windows(2))
             .map(|(t, y)| ((y[1] - y[0]) / (t[1] - t[0])).abs())
             .fold(0.0, f64::max),
-        SpeedProfile::Held { .. } => 0.0,
+        SpeedProfile::Held { accel_rad_s2, .. } => accel_rad_s2.abs(),
     }
 }
 

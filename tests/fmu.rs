@@ -1,0 +1,165 @@
+//! The FMU from outside (issue 23): FMPy validates every shipped scene's FMU, drives the
+//! paper case's FMU as `clutchpack run` runs the same held input, couples it two ways to a
+//! shaft inertia it integrates itself, and rolls it back (tests/python/fmu_check.py does the
+//! Python side and prints what it measured; the bounds are here).
+
+use serde_json::Value;
+use std::path::Path;
+use std::process::Command;
+
+/// Runs one check of fmu_check.py and returns its JSON.
+fn check(name: &str) -> Value {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let work = super::scratch(&format!("fmu-{name}"));
+    let o = Command::new(super::python_reader())
+        .arg(root.join("tests/python/fmu_check.py"))
+        .args(["--bin", env!("CARGO_BIN_EXE_clutchpack")])
+        .arg("--root")
+        .arg(root)
+        .arg("--work")
+        .arg(&work)
+        .arg(name)
+        .output()
+        .expect("python runs");
+    assert!(
+        o.status.success(),
+        "fmu_check.py {name}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+/// `(body, t_on s, t_peak s, t_off s, peak N)` rows.
+fn impacts(v: &Value) -> Vec<(String, f64, f64, f64, f64)> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            let f = |i: usize| r[i].as_f64().unwrap();
+            (r[0].as_str().unwrap().to_string(), f(1), f(2), f(3), f(4))
+        })
+        .collect()
+}
+
+/// The worst relative peak and absolute onset differences (s) over the first `n` impacts.
+fn worst(
+    a: &[(String, f64, f64, f64, f64)],
+    b: &[(String, f64, f64, f64, f64)],
+    n: usize,
+) -> (f64, f64) {
+    a.iter().zip(b).take(n).fold((0.0, 0.0), |(p, o), (x, y)| {
+        assert_eq!(x.0, y.0);
+        (
+            p.max((x.4 - y.4).abs() / y.4.abs()),
+            o.max((x.1 - y.1).abs()),
+        )
+    })
+}
+
+#[test]
+fn fmpy_validates_every_shipped_scene_that_an_fmu_can_represent() {
+    let v = check("validate");
+    let scenes = v.as_object().unwrap();
+    assert!(scenes.len() >= 8, "{v}");
+    let mut built = 0;
+    for (scene, r) in scenes {
+        let message = r["message"].as_str().unwrap();
+        if r["built"].as_bool().unwrap() {
+            built += 1;
+            assert_eq!(r["problems"], serde_json::json!([]), "{scene}: {message}");
+        } else {
+            // refused as bad input, with the reason
+            assert_eq!(r["exit"], 2, "{scene}: {message}");
+            assert!(
+                message.contains("cannot run it as a co-simulation"),
+                "{scene}: {message}"
+            );
+        }
+    }
+    eprintln!(
+        "{built} of {} shipped scenes built and validated",
+        scenes.len()
+    );
+    assert!(built >= 4, "{v}");
+}
+
+/// FMPy's simulate_fmu with Table 2's sine sampled at every 1e-5 s communication point gives
+/// the impacts of `clutchpack run` on the scene with that held speed: measured 2.1e-7 in
+/// peak and 4.9e-10 s in onset over 50 ms (FMPy's communication points are its own sums of
+/// the step, a few ulps from the table's rows); bound 1e-3 as the issue asks.
+#[test]
+fn fmpy_driving_the_paper_case_gives_the_runs_impacts() {
+    let v = check("paper");
+    let (fmu, run) = (impacts(&v["fmu"]), impacts(&v["run"]));
+    assert!(run.len() >= 20, "{} impacts", run.len());
+    assert_eq!(fmu.len(), run.len());
+    let (peak, onset) = worst(&fmu, &run, run.len());
+    eprintln!(
+        "FMU vs run: {} impacts, peak {peak:.2e}, onset {onset:.2e} s",
+        run.len()
+    );
+    assert!(
+        peak < 1e-3 && onset < 1e-7,
+        "peak {peak:e}, onset {onset:e}"
+    );
+    // the outputs at the end and the recording
+    assert_eq!(v["impacts_output"].as_u64().unwrap() as usize, run.len());
+    let largest = run.iter().map(|r| r.4.abs()).fold(0.0, f64::max);
+    let max_out = v["max_load_output"].as_f64().unwrap();
+    assert!(
+        (max_out - largest).abs() < 1e-3 * largest,
+        "{max_out} vs {largest}"
+    );
+    assert!(v["damage_output"].as_f64().unwrap() > 0.0);
+    assert_eq!(v["replay_exit"], 0, "{}", v["replay"]);
+    // the official MCAP reader reads the co-simulated run's recording whole
+    let rec = super::read_independently(Path::new(v["recording"].as_str().unwrap()), false);
+    assert_eq!(rec["complete"], true, "{rec}");
+    assert_eq!(rec["topics"]["/impacts"]["count"].as_u64().unwrap() as usize, run.len());
+}
+
+/// A Python master couples the paper case's FMU (a prescribed shaft) to a shaft inertia
+/// (J1 = 0.5 kg m^2) it integrates itself, against the same pack with shaft.mode =
+/// "inertial". The rattle is chaotic (MODEL.md section 6): differences grow about threefold
+/// per impact, so the impacts are compared over the first five (about 5 ms). Measured
+/// (peak, onset) of the first five at 2e-5 / 1e-5 / 5e-6 s: speed held 44 / 24 / 12 %;
+/// a first-order hold (the acceleration at the step's start as the slope) 5.0 / 1.3 /
+/// 0.21 %; iterated (each step redone from a saved state as a second-order hold with the
+/// pack's torque at both ends) 2.3 / 0.52 / 0.21 % and 35 / 5.5 / 3.0 us.
+#[test]
+fn a_python_master_couples_the_fmu_to_a_shaft_inertia() {
+    let v = check("coupling");
+    let run = impacts(&v["run"]);
+    let master = |scheme: &str, h: &str| impacts(&v["master"][scheme][h]);
+    let (peak, onset) = worst(&master("iterated", "1e-05"), &run, 5);
+    eprintln!("iterated master at 1e-5 s: first 5 impacts within {peak:.2e} (peak), {onset:.2e} s");
+    // the issue's 1 % (measured 0.52 %)
+    assert!(
+        peak < 1e-2 && onset < 1e-5,
+        "peak {peak:e}, onset {onset:e}"
+    );
+    // the error falls with the step, and the held speed is the worst master
+    let e = |scheme: &str, h: &str| worst(&master(scheme, h), &run, 5).0;
+    assert!(e("iterated", "2e-05") > e("iterated", "1e-05"));
+    assert!(e("iterated", "1e-05") > e("iterated", "5e-06"));
+    assert!(e("hold", "1e-05") > 5.0 * e("slope", "1e-05"));
+    // the last-impact outputs are the recording's impacts
+    for pair in v["polled_vs_recorded"].as_array().unwrap() {
+        assert_eq!(impacts(&pair[0]), impacts(&pair[1]));
+    }
+}
+
+/// Get the FMU's state, advance 10 ms, set the state, advance again: identical outputs.
+#[test]
+fn a_restored_fmu_state_gives_identical_outputs() {
+    let v = check("rollback");
+    assert_eq!(v["first"].as_array().unwrap().len(), 1000);
+    assert_eq!(v["first"], v["second"]);
+    // something happened in those 10 ms (impacts closed)
+    let first = v["first"].as_array().unwrap();
+    assert!(
+        first[999][4].as_i64() > first[0][4].as_i64(),
+        "{}",
+        first[999]
+    );
+}

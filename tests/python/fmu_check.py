@@ -1,0 +1,323 @@
+#!/usr/bin/env python3
+"""The FMU checked from outside with FMPy (issue 23), run by tests/fmu.rs:
+
+    "$py" tests/python/fmu_check.py --bin CLUTCHPACK --root REPO --work DIR CHECK
+
+CHECK is one of:
+- validate: `clutchpack fmu` of every shipped scene, then FMPy's validate_fmu on each FMU
+  built; prints {scene: {"built", "message", "problems"}}.
+- paper: FMPy's simulate_fmu drives the paper case's FMU with the sine of Table 2 sampled at
+  every 1e-5 s communication point, recording to an MCAP; `clutchpack run` runs the same
+  scene with that held speed as a table (drive.interpolation = "hold"). Prints both impact
+  lists and whether `clutchpack replay` read the recording.
+- coupling: a Python master (FMPy's FMU2Slave) couples the paper case's FMU (a prescribed
+  shaft) to a shaft inertia it integrates itself, J1 dw/dt = T_drive + T_pack, at several
+  communication steps; `clutchpack run` runs the same pack with shaft.mode = "inertial".
+  Prints the impact lists of each.
+- rollback: get the FMU's state, advance, set the state, advance again; prints both output
+  histories.
+
+Every result is JSON on stdout; the assertions and their bounds are in tests/fmu.rs.
+"""
+
+import argparse
+import csv
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+
+import fmpy
+import numpy as np
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+from fmpy.validation import validate_fmu
+
+# Table 2's drive (scenes/hu-table2.toml)
+OMEGA0, AMPLITUDE, FREQUENCY = 200.0, 4.378, 104.0
+DURATION = 0.05
+
+
+def speed(t):
+    return OMEGA0 + AMPLITUDE * np.sin(2 * np.pi * FREQUENCY * t)
+
+
+def run(args, *cmd):
+    p = subprocess.run([args.bin, *cmd], capture_output=True, text=True, cwd=args.root)
+    if p.returncode != 0:
+        raise SystemExit(f"clutchpack {' '.join(cmd)}: exit {p.returncode}: {p.stderr}")
+    return p
+
+
+def build(args, scene, out, *extra):
+    return subprocess.run(
+        [args.bin, "fmu", scene, "--out", out, *extra],
+        capture_output=True,
+        text=True,
+        cwd=args.root,
+    )
+
+
+def read_impacts(path, exported):
+    """Impacts as (body, t_on, t_peak, t_off, peak) from a run's --impacts-csv or an
+    export's impacts.csv."""
+    rows = []
+    with open(path) as f:
+        for r in csv.DictReader(f):
+            rows.append(
+                [r["disc"], float(r["t_on_s"]), float(r["t_peak_s"]), float(r["t_off_s"]),
+                 float(r["peak_n"])]
+            )
+    return rows
+
+
+def recorded_impacts(args, mcap, work, name):
+    out = os.path.join(work, name)
+    run(args, "export", mcap, "--csv", out)
+    return read_impacts(os.path.join(out, "impacts.csv"), True)
+
+
+def paper_scene(args, work, name, drive):
+    """The paper case with its [drive] table replaced by `drive` (TOML lines)."""
+    src = open(os.path.join(args.root, "scenes/hu-table2.toml")).read().splitlines()
+    out, skip = [], False
+    for line in src:
+        if line.startswith("["):
+            skip = line.strip() == "[drive]"
+            if skip:
+                out.append("[drive]")
+                out.extend(drive)
+                continue
+        if not skip:
+            out.append(line)
+    path = os.path.join(work, name)
+    with open(path, "w") as f:
+        f.write("\n".join(out) + "\n")
+    return path
+
+
+def check_validate(args):
+    work = args.work
+    result = {}
+    for name in sorted(os.listdir(os.path.join(args.root, "scenes"))):
+        if not name.endswith(".toml"):
+            continue
+        fmu = os.path.join(work, name.replace(".toml", ".fmu"))
+        p = build(args, os.path.join("scenes", name), fmu)
+        entry = {"built": p.returncode == 0, "exit": p.returncode,
+                 "message": (p.stdout + p.stderr).strip()}
+        if p.returncode == 0:
+            entry["problems"] = validate_fmu(fmu)
+        result[name] = entry
+    return result
+
+
+def check_paper(args):
+    work, h = args.work, 1e-5
+    fmu = os.path.join(work, "hu-table2.fmu")
+    p = build(args, "scenes/hu-table2.toml", fmu)
+    if p.returncode != 0:
+        raise SystemExit(p.stderr)
+    t = np.arange(0, DURATION + h / 2, h)
+    u = np.zeros(len(t), dtype=[("time", float), ("shaft.speed_rad_s", float)])
+    u["time"], u["shaft.speed_rad_s"] = t, speed(t)
+    mcap = os.path.join(work, "paper-fmu.mcap")
+    r = fmpy.simulate_fmu(
+        fmu,
+        stop_time=DURATION,
+        output_interval=h,
+        input=u,
+        start_values={"recording_path": mcap},
+        output=["impacts", "discs[1].max_load_n", "discs[1].damage"],
+    )
+    # the same held speed as a scene: one row per communication point
+    table = os.path.join(work, "held.csv")
+    rows = t[t < DURATION - h / 2]
+    with open(table, "w") as f:
+        f.write("time_s,speed_rad_s\n")
+        for ti in rows:
+            f.write(f"{float(ti)!r},{float(speed(ti))!r}\n")
+    scene = paper_scene(args, work, "held.toml",
+                        ['kind = "speed_table"', 'file = "held.csv"', 'interpolation = "hold"'])
+    csv_path = os.path.join(work, "held-run.csv")
+    run(args, "run", scene, "--duration", str(DURATION), "--no-record", "--impacts-csv", csv_path)
+    replay = subprocess.run([args.bin, "replay", mcap], capture_output=True, text=True)
+    return {
+        "fmu": recorded_impacts(args, mcap, work, "paper-export"),
+        "run": read_impacts(csv_path, False),
+        "impacts_output": int(r["impacts"][-1]),
+        "max_load_output": float(r["discs[1].max_load_n"][-1]),
+        "damage_output": float(r["discs[1].damage"][-1]),
+        "replay_exit": replay.returncode,
+        "replay": replay.stdout + replay.stderr,
+        "recording": mcap,
+    }
+
+
+class Slave:
+    """The paper case's FMU through FMPy's FMU2Slave."""
+
+    def __init__(self, fmu, recording=None):
+        self.md = read_model_description(fmu)
+        self.dir = extract(fmu)
+        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+        self.s = FMU2Slave(
+            guid=self.md.guid,
+            unzipDirectory=self.dir,
+            modelIdentifier=self.md.coSimulation.modelIdentifier,
+            instanceName="pack",
+        )
+        self.s.instantiate()
+        self.s.setupExperiment(startTime=0.0)
+        self.s.enterInitializationMode()
+        if recording:
+            self.s.setString([self.vr["recording_path"]], [recording])
+        self.s.exitInitializationMode()
+
+    def get(self, name):
+        return self.s.getReal([self.vr[name]])[0]
+
+    def poll_impact(self, seen, impacts):
+        """Appends the impact that closed in the last step (the FMU's last_impact outputs)
+        when the count rose; returns the count. One disc: at most one closes per step."""
+        count = self.s.getInteger([self.vr["impacts"]])[0]
+        if count > seen:
+            impacts.append(
+                ["disc"] + [self.get(f"last_impact.{x}") for x in ("t_on_s", "t_peak_s",
+                                                                   "t_off_s", "peak_n")]
+            )
+        return count
+
+    def set(self, name, value):
+        self.s.setReal([self.vr[name]], [value])
+
+    def close(self):
+        self.s.terminate()
+        self.s.freeInstance()
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+J1 = 0.5  # kg m^2: the host's shaft, about 3 disc inertias (the coupling is felt)
+
+
+def check_coupling(args):
+    work = args.work
+    fmu = os.path.join(work, "hu-coupling.fmu")
+    p = build(args, "scenes/hu-table2.toml", fmu)
+    if p.returncode != 0:
+        raise SystemExit(p.stderr)
+    scene = paper_scene(
+        args, work, "inertial.toml",
+        ['kind = "sine"', f"omega0_rad_s = {OMEGA0}", f"amplitude_rad_s = {AMPLITUDE}",
+         f"frequency_hz = {FREQUENCY}"],
+    )
+    csv_path = os.path.join(work, "inertial-run.csv")
+    run(args, "run", scene, "--duration", str(DURATION), "--no-record", "--impacts-csv", csv_path,
+        "--set", 'shaft.mode="inertial"', "--set", f"shaft.inertia_kg_m2={J1}")
+    out = {"run": read_impacts(csv_path, False), "master": {}}
+    w = 2 * math.pi * FREQUENCY
+    for scheme in ("hold", "slope", "iterated"):
+        out["master"][scheme] = {}
+        for h in (2e-5, 1e-5, 5e-6):
+            mcap = os.path.join(work, f"coupled-{scheme}-{h:g}.mcap")
+            # the iterated master redoes each step from a saved state; a recorded FMU cannot
+            # roll back, so it runs unrecorded and reports the impacts as an output would
+            s = Slave(fmu, recording=None if scheme == "iterated" else mcap)
+            n = int(round(DURATION / h))
+            omega, torque = OMEGA0, s.get("pack.shaft_torque_n_m")
+            vr = s.vr["shaft.speed_rad_s"]
+            seen, polled = 0, []
+            for k in range(n):
+                t0, t1 = k * h, (k + 1) * h
+                drive = AMPLITUDE * (math.sin(w * t1) - math.sin(w * t0))
+                if scheme == "hold":
+                    s.set("shaft.speed_rad_s", omega)
+                    s.s.doStep(currentCommunicationPoint=t0, communicationStepSize=h)
+                    new_torque = s.get("pack.shaft_torque_n_m")
+                else:
+                    # a first-order hold: the speed's slope over the step is the shaft's
+                    # acceleration at its start (eq 4)
+                    slope = AMPLITUDE * w * math.cos(w * t0) + torque / J1
+                    if scheme == "iterated":
+                        state = s.s.getFMUState()
+                    s.set("shaft.speed_rad_s", omega)
+                    s.s.setRealInputDerivatives([vr], [1], [slope])
+                    s.s.doStep(currentCommunicationPoint=t0, communicationStepSize=h)
+                    new_torque = s.get("pack.shaft_torque_n_m")
+                    if scheme == "iterated":
+                        # the step again from the saved state, as a second-order hold: the
+                        # acceleration's change over the step from the pack's torque at both
+                        # ends (linear between them) and the drive's
+                        s.s.setFMUState(state)
+                        s.s.freeFMUState(state)
+                        curvature = (new_torque - torque) / (h * J1) - AMPLITUDE * w * w * math.sin(
+                            w * t0
+                        )
+                        s.set("shaft.speed_rad_s", omega)
+                        s.s.setRealInputDerivatives([vr, vr], [1, 2], [slope, curvature])
+                        s.s.doStep(currentCommunicationPoint=t0, communicationStepSize=h)
+                        new_torque = s.get("pack.shaft_torque_n_m")
+                # eq (4) over the step: the drive's impulse exactly (T_drive = J1 A w cos(w t),
+                # the inertial scene's drive), the pack's torque by the trapezoid rule
+                omega += drive + 0.5 * h * (torque + new_torque) / J1
+                torque = new_torque
+                seen = s.poll_impact(seen, polled)
+            s.close()
+            if scheme == "iterated":
+                impacts = polled
+            else:
+                impacts = recorded_impacts(args, mcap, work, f"coupled-{scheme}-{h:g}")
+                out.setdefault("polled_vs_recorded", []).append([polled, impacts])
+            out["master"][scheme][f"{h:g}"] = impacts
+    return out
+
+
+def check_rollback(args):
+    work, h = args.work, 1e-5
+    fmu = os.path.join(work, "hu-rollback.fmu")
+    p = build(args, "scenes/hu-table2.toml", fmu)
+    if p.returncode != 0:
+        raise SystemExit(p.stderr)
+    s = Slave(fmu)
+    names = ["discs[1].load_n", "pack.shaft_torque_n_m", "discs[1].speed_rad_s",
+             "discs[1].max_load_n"]
+
+    def advance(k0, k1):
+        rows = []
+        for k in range(k0, k1):
+            s.set("shaft.speed_rad_s", float(speed(k * h)))
+            s.s.doStep(currentCommunicationPoint=k * h, communicationStepSize=h)
+            rows.append([s.get(n) for n in names] + [s.s.getInteger([s.vr["impacts"]])[0]])
+        return rows
+
+    advance(0, 2000)
+    state = s.s.getFMUState()
+    first = advance(2000, 3000)
+    s.s.setFMUState(state)
+    second = advance(2000, 3000)
+    s.s.freeFMUState(state)
+    s.close()
+    return {"first": first, "second": second}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--bin", required=True)
+    ap.add_argument("--root", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("check", choices=["validate", "paper", "coupling", "rollback"])
+    args = ap.parse_args()
+    os.makedirs(args.work, exist_ok=True)
+    result = {
+        "validate": check_validate,
+        "paper": check_paper,
+        "coupling": check_coupling,
+        "rollback": check_rollback,
+    }[args.check](args)
+    json.dump(result, sys.stdout)
+
+
+if __name__ == "__main__":
+    main()
