@@ -115,7 +115,10 @@ fn fmpy_driving_the_paper_case_gives_the_runs_impacts() {
     // the official MCAP reader reads the co-simulated run's recording whole
     let rec = super::read_independently(Path::new(v["recording"].as_str().unwrap()), false);
     assert_eq!(rec["complete"], true, "{rec}");
-    assert_eq!(rec["topics"]["/impacts"]["count"].as_u64().unwrap() as usize, run.len());
+    assert_eq!(
+        rec["topics"]["/impacts"]["count"].as_u64().unwrap() as usize,
+        run.len()
+    );
 }
 
 /// A Python master couples the paper case's FMU (a prescribed shaft) to a shaft inertia

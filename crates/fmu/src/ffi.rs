@@ -6,7 +6,10 @@
 //! # Safety
 //! Every function takes the pointers FMI 2.0 defines, as a host passes them: a component
 //! from `fmi2Instantiate` (not yet freed), arrays of the stated lengths, NUL-terminated
-//! strings. Null components and arrays are refused with `fmi2Error`.
+//! strings. Null components and arrays are refused with `fmi2Error`. (Said once here rather
+//! than under each of the 35 functions.)
+
+#![allow(clippy::missing_safety_doc)]
 
 use crate::instance::{load_resources, Instance, SavedState};
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
@@ -190,9 +193,6 @@ pub extern "C" fn fmi2GetVersion() -> *const c_char {
 
 /// `fmi2Instantiate`: reads the scene from the resources and checks the GUID; null (after
 /// logging why) on any problem.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Instantiate(
     instance_name: *const c_char,
@@ -240,9 +240,6 @@ pub unsafe extern "C" fn fmi2Instantiate(
 }
 
 /// `fmi2FreeInstance`: a run still going is finished first (its recording completed).
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: *mut c_void) {
     if c.is_null() {
@@ -254,9 +251,6 @@ pub unsafe extern "C" fn fmi2FreeInstance(c: *mut c_void) {
 }
 
 /// `fmi2SetDebugLogging`: errors and warnings are always logged; nothing else is.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetDebugLogging(
     c: *mut c_void,
@@ -268,9 +262,6 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
 }
 
 /// `fmi2SetupExperiment`.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetupExperiment(
     c: *mut c_void,
@@ -287,9 +278,6 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
 }
 
 /// `fmi2EnterInitializationMode`.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> c_int {
     with(c, "fmi2EnterInitializationMode", |comp| {
@@ -298,9 +286,6 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> c_int {
 }
 
 /// `fmi2ExitInitializationMode`: starts the run.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> c_int {
     with(c, "fmi2ExitInitializationMode", |comp| {
@@ -309,9 +294,6 @@ pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> c_int {
 }
 
 /// `fmi2Terminate`: finishes the run and its recording.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Terminate(c: *mut c_void) -> c_int {
     with(c, "fmi2Terminate", |comp| {
@@ -324,9 +306,6 @@ pub unsafe extern "C" fn fmi2Terminate(c: *mut c_void) -> c_int {
 }
 
 /// `fmi2Reset`.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Reset(c: *mut c_void) -> c_int {
     with(c, "fmi2Reset", |comp| {
@@ -336,9 +315,6 @@ pub unsafe extern "C" fn fmi2Reset(c: *mut c_void) -> c_int {
 }
 
 /// `fmi2GetReal`.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetReal(
     c: *mut c_void,
@@ -359,9 +335,6 @@ pub unsafe extern "C" fn fmi2GetReal(
 }
 
 /// `fmi2GetInteger`.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetInteger(
     c: *mut c_void,
@@ -382,9 +355,6 @@ pub unsafe extern "C" fn fmi2GetInteger(
 }
 
 /// `fmi2GetBoolean`: the FMU has no Boolean variables.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetBoolean(
     c: *mut c_void,
@@ -396,9 +366,6 @@ pub unsafe extern "C" fn fmi2GetBoolean(
 }
 
 /// `fmi2SetBoolean`: the FMU has no Boolean variables.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetBoolean(
     c: *mut c_void,
@@ -421,9 +388,6 @@ fn no_booleans(vr: *const u32, n: usize) -> Result<c_int, String> {
 }
 
 /// `fmi2GetString`: the strings stay valid until the next call on the instance.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetString(
     c: *mut c_void,
@@ -450,9 +414,6 @@ pub unsafe extern "C" fn fmi2GetString(
 }
 
 /// `fmi2SetReal`.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetReal(
     c: *mut c_void,
@@ -473,9 +434,6 @@ pub unsafe extern "C" fn fmi2SetReal(
 }
 
 /// `fmi2SetInteger`: the one Integer variable is an output.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetInteger(
     c: *mut c_void,
@@ -491,9 +449,6 @@ pub unsafe extern "C" fn fmi2SetInteger(
 }
 
 /// `fmi2SetString`.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetString(
     c: *mut c_void,
@@ -515,9 +470,6 @@ pub unsafe extern "C" fn fmi2SetString(
 }
 
 /// `fmi2GetFMUstate`: a new state, or the one given overwritten.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, state: *mut *mut c_void) -> c_int {
     with(c, "fmi2GetFMUstate", |comp| {
@@ -537,9 +489,6 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, state: *mut *mut c_void
 }
 
 /// `fmi2SetFMUstate`.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, state: *mut c_void) -> c_int {
     with(c, "fmi2SetFMUstate", |comp| {
@@ -553,9 +502,6 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, state: *mut c_void) -> 
 }
 
 /// `fmi2FreeFMUstate`.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeFMUstate(c: *mut c_void, state: *mut *mut c_void) -> c_int {
     with(c, "fmi2FreeFMUstate", |_| {
@@ -572,9 +518,6 @@ const NO_SERIALIZE: &str = "this FMU cannot serialize its state (canSerializeFMU
      a state holds the engine's integration in memory; use fmi2GetFMUstate";
 
 /// `fmi2SerializedFMUstateSize`: not supported.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     c: *mut c_void,
@@ -589,9 +532,6 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
 }
 
 /// `fmi2SerializeFMUstate`: not supported.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SerializeFMUstate(
     c: *mut c_void,
@@ -603,9 +543,6 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
 }
 
 /// `fmi2DeSerializeFMUstate`: not supported.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     c: *mut c_void,
@@ -617,9 +554,6 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
 }
 
 /// `fmi2GetDirectionalDerivative`: not provided.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     c: *mut c_void,
@@ -637,9 +571,6 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
 
 /// `fmi2SetRealInputDerivatives`: the slope of the shaft's speed or drive torque (order 1),
 /// a first-order hold over the coming steps.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
     c: *mut c_void,
@@ -661,9 +592,6 @@ pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
 }
 
 /// `fmi2GetRealOutputDerivatives`: not provided.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
     c: *mut c_void,
@@ -678,9 +606,6 @@ pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
 }
 
 /// `fmi2DoStep`: the inputs set are held from `current` to `current + h`.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2DoStep(
     c: *mut c_void,
@@ -694,9 +619,6 @@ pub unsafe extern "C" fn fmi2DoStep(
 }
 
 /// `fmi2CancelStep`: steps are synchronous; nothing to cancel.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2CancelStep(c: *mut c_void) -> c_int {
     with(c, "fmi2CancelStep", |_| {
@@ -705,18 +627,12 @@ pub unsafe extern "C" fn fmi2CancelStep(c: *mut c_void) -> c_int {
 }
 
 /// `fmi2GetStatus`: steps are synchronous, nothing is pending.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetStatus(c: *mut c_void, _kind: c_int, _value: *mut c_int) -> c_int {
     with(c, "fmi2GetStatus", |_| Ok(DISCARD))
 }
 
 /// `fmi2GetRealStatus`: `fmi2LastSuccessfulTime` gives the time the run stands at.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetRealStatus(c: *mut c_void, kind: c_int, value: *mut f64) -> c_int {
     with(c, "fmi2GetRealStatus", |comp| {
@@ -731,9 +647,6 @@ pub unsafe extern "C" fn fmi2GetRealStatus(c: *mut c_void, kind: c_int, value: *
 }
 
 /// `fmi2GetIntegerStatus`: nothing to report.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetIntegerStatus(
     c: *mut c_void,
@@ -745,9 +658,6 @@ pub unsafe extern "C" fn fmi2GetIntegerStatus(
 
 /// `fmi2GetBooleanStatus`: `fmi2Terminated` is never asked by the FMU (it never ends a
 /// run on its own).
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetBooleanStatus(
     c: *mut c_void,
@@ -758,9 +668,6 @@ pub unsafe extern "C" fn fmi2GetBooleanStatus(
 }
 
 /// `fmi2GetStringStatus`: nothing to report.
-///
-/// # Safety
-/// Module docs.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetStringStatus(
     c: *mut c_void,

@@ -74,10 +74,11 @@ pub use pack::{
     annulus_inner_radius_m, annulus_outer_radius_m, ensemble_angle_rad, DiscModel, NonTorsional,
     PackModel,
 };
+pub use session::Engine;
 pub use spline::{Flank, SplineGeometry, ToothKinematics};
 pub use stream::{
-    Collector, DiscSample, Engine, EngineError, NullObserver, Observer, RunStats, Sample,
-    STALL_SPAN_S, STALL_STEPS,
+    Collector, DiscSample, EngineError, NullObserver, Observer, RunStats, Sample, STALL_SPAN_S,
+    STALL_STEPS,
 };
 
 /// Closed-form peak load of one free, undamped impact (MODEL.md section 4):

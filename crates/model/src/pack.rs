@@ -142,6 +142,12 @@ impl PackModel {
         self.non_torsional_parts().is_empty()
     }
 
+    /// Whether the pack has separator plates, a drum or a stack (a whole pack, MODEL.md
+    /// section 5), beyond friction discs on a shaft.
+    pub fn is_whole(&self) -> bool {
+        !self.plates.is_empty() || self.drum.is_some() || self.stack.is_some()
+    }
+
     /// Every part of the pack that the torsional engine does not run (MODEL.md section 5), in
     /// order: per disc its radial float, offset and spacing errors, then each plate with any of
     /// them. Empty exactly when [`Self::is_torsional`]. The one statement of what the

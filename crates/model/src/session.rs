@@ -8,7 +8,7 @@
 use crate::clutch::{InterfaceSample, PressureProfile};
 use crate::drive::{Shaft, ShaftExcitation, SpeedProfile, Table};
 use crate::pack::PackModel;
-use crate::stream::{Engine, EngineError, Observer, RunStats, Sample};
+use crate::stream::{EngineError, Observer, RunStats, Sample};
 
 /// Which of the pack's inputs a session's caller drives (the others follow the scene's
 /// profiles). A session driven by nothing follows the scene exactly as `Engine::run` does,
@@ -346,4 +346,34 @@ pub fn run_engine<E: Engine + ?Sized>(
     let mut stats = session.finish(observer);
     stats.stopped_early = advance == Advance::Stopped;
     Ok(stats)
+}
+
+/// A simulation engine built from a scene.
+pub trait Engine {
+    /// Short name (`"reference"`, `"multibody"`).
+    fn name(&self) -> &'static str;
+    /// Names of the discs in output order.
+    fn disc_names(&self) -> Vec<String>;
+    /// The model this engine runs.
+    fn model(&self) -> &PackModel;
+    /// Starts a steppable run at t = 0 ([`Session`]) whose caller drives the inputs `driven`
+    /// (the others follow the scene's profiles). The session owns a copy of the model: the
+    /// engine stays usable.
+    fn start(&self, driven: Driven) -> Result<Box<dyn Session>, EngineError> {
+        let _ = driven;
+        Err(EngineError::Unsupported(format!(
+            "the {} engine is not steppable yet",
+            self.name()
+        )))
+    }
+    /// Runs from t = 0 to `duration_s`, sending samples and impacts to `observer`. On error,
+    /// everything before the failure has already been delivered. Built on [`Engine::start`]
+    /// ([`run_engine`]).
+    fn run(
+        &mut self,
+        duration_s: f64,
+        observer: &mut dyn Observer,
+    ) -> Result<RunStats, EngineError> {
+        run_engine(self, duration_s, observer)
+    }
 }

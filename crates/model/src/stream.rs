@@ -1,9 +1,8 @@
-//! The engine interface: what every engine emits (samples, impact events, a run report) and
-//! the [`Engine`] trait that both the reference and the multibody engine implement.
+//! What every engine emits (samples, impact events, a run report) to an [`Observer`]; the
+//! `Engine` trait itself is in `crate::session`.
 
 use crate::clutch::InterfaceSample;
 use crate::impact::ImpactEvent;
-use crate::session::{Driven, Session};
 use serde::{Deserialize, Serialize};
 
 /// State of one disc's coupling at one instant.
@@ -161,34 +160,4 @@ pub enum EngineError {
     /// The engine cannot run this model.
     #[error("this engine cannot run the scene: {0}")]
     Unsupported(String),
-}
-
-/// A simulation engine built from a scene.
-pub trait Engine {
-    /// Short name (`"reference"`, `"multibody"`).
-    fn name(&self) -> &'static str;
-    /// Names of the discs in output order.
-    fn disc_names(&self) -> Vec<String>;
-    /// The model this engine runs.
-    fn model(&self) -> &crate::pack::PackModel;
-    /// Starts a steppable run at t = 0 ([`Session`]) whose caller drives the inputs `driven`
-    /// (the others follow the scene's profiles). The session owns a copy of the model: the
-    /// engine stays usable.
-    fn start(&self, driven: Driven) -> Result<Box<dyn Session>, EngineError> {
-        let _ = driven;
-        Err(EngineError::Unsupported(format!(
-            "the {} engine is not steppable yet",
-            self.name()
-        )))
-    }
-    /// Runs from t = 0 to `duration_s`, sending samples and impacts to `observer`. On error,
-    /// everything before the failure has already been delivered. Built on [`Engine::start`]
-    /// ([`crate::session::run_engine`]).
-    fn run(
-        &mut self,
-        duration_s: f64,
-        observer: &mut dyn Observer,
-    ) -> Result<RunStats, EngineError> {
-        crate::session::run_engine(self, duration_s, observer)
-    }
 }

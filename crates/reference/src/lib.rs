@@ -243,7 +243,7 @@ impl ReferenceEngine {
     /// Whether the pack is a whole pack (plates, a drum or a stack), which this engine runs
     /// monolithic whatever the scheme asked.
     pub fn is_whole(&self) -> bool {
-        !self.pack.plates.is_empty() || self.pack.drum.is_some() || self.pack.stack.is_some()
+        self.pack.is_whole()
     }
 
     /// Whether the discs run in parallel: the multirate scheme on a prescribed shaft with

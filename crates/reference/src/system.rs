@@ -61,8 +61,7 @@ enum Carrier {
 /// (rad/s) when there is a drum, then the heat (J) each open interface has dissipated.
 #[derive(Clone)]
 pub(crate) struct System {
-    /// The model, shared by the steppers of one run (a session replaces it when an input
-    /// changes, `session.rs`).
+    /// The model (shared by a run's steppers; `session.rs` swaps it when an input changes).
     pub pack: Arc<PackModel>,
     /// Index of the first disc state: 0 for a prescribed shaft, 2 for an inertial one.
     pub off: usize,
@@ -93,31 +92,26 @@ impl System {
             .as_ref()
             .map_or(0.0, |s| -s.open_gap_torque_n_m(1.0));
         let faces = vec![Face::Open; pack.stack.as_ref().map_or(0, |_| 2 * pack.discs.len())];
-        let rb = pack
-            .discs
-            .iter()
-            .chain(&pack.plates)
-            .map(|d| d.spline.base_radius_m())
-            .collect();
-        let nd = pack.discs.len();
+        // `pack` moves last: the fields before it read it
         let sys = System {
-            pack,
             off,
             ids,
-            nd,
+            nd: pack.discs.len(),
             c_gap,
             faces,
-            rb,
+            rb: pack
+                .discs
+                .iter()
+                .chain(&pack.plates)
+                .map(|d| d.spline.base_radius_m())
+                .collect(),
+            pack,
         };
         debug_assert!(
-            !sys.is_whole() || sys.ids == (0..sys.nd + sys.pack.plates.len()).collect::<Vec<_>>()
+            !sys.pack.is_whole()
+                || sys.ids == (0..sys.nd + sys.pack.plates.len()).collect::<Vec<_>>()
         );
         sys
-    }
-
-    /// Whether the pack has plates, a drum or a stack (the whole-pack layout).
-    pub fn is_whole(&self) -> bool {
-        !self.pack.plates.is_empty() || self.pack.drum.is_some() || self.pack.stack.is_some()
     }
 
     /// Index of the drum's angle in the state (its speed follows).
@@ -127,9 +121,8 @@ impl System {
 
     /// The drum's angle (rad) and speed (rad/s) in state `y`; `None` without a drum.
     pub fn drum_state(&self, y: &[f64]) -> Option<(f64, f64)> {
-        self.pack
-            .drum
-            .map(|_| (y[self.drum_at()], y[self.drum_at() + 1]))
+        let r = self.drum_at();
+        self.pack.drum.map(|_| (y[r], y[r + 1]))
     }
 
     /// Index of the first interface's heat in the state.
@@ -649,9 +642,9 @@ mod tests {
     #[test]
     fn whole_pack_rhs_conserves_momentum_and_power() {
         let pack = free_pack();
-        let sys = System::new(std::sync::Arc::new(pack.clone()), (0..5).collect());
-        assert_eq!(sys.dim(), 2 + 2 * 5 + 2 + 4);
         let g0 = pack.discs[0].spline.half_play_rad();
+        let sys = System::new(std::sync::Arc::new(pack), (0..5).collect());
+        assert_eq!(sys.dim(), 2 + 2 * 5 + 2 + 4);
         for (k, contact) in [
             [0.3, 1.02, -0.7, -1.01, 0.2],
             [1.01, 0.1, 1.03, -0.5, -1.02],
@@ -685,12 +678,11 @@ mod tests {
             );
             for slot in 0..5 {
                 let (w_c, a_c) = if slot < 2 { (w_s, a_s) } else { (w_r, a_r) };
-                let (psi, j) = (y[2 + 2 * slot + 1], sys.disc(slot).inertia_kg_m2);
-                let (w_b, a_b) = (w_c - psi, a_c - dy[2 + 2 * slot + 1]);
-                momentum += j * a_b;
-                scale += (j * a_b).abs();
-                power += j * w_b * a_b;
                 let d = sys.disc(slot);
+                let (psi, j) = (y[2 + 2 * slot + 1], d.inertia_kg_m2);
+                let (w_b, a_b) = (w_c - psi, a_c - dy[2 + 2 * slot + 1]);
+                (momentum, scale) = (momentum + j * a_b, scale + (j * a_b).abs());
+                power += j * w_b * a_b;
                 teeth += d.spline.teeth as f64
                     * sys.load(slot, &y, &modes[slot])
                     * d.spline.base_radius_m()
@@ -699,9 +691,8 @@ mod tests {
             let heat: f64 = dy[sys.heat_at()..].iter().sum();
             assert!(heat > 0.0);
             assert!(momentum.abs() <= 1e-12 * scale, "{momentum} of {scale}");
-            let p_scale = teeth.abs() + heat;
             assert!(
-                (power - teeth + heat).abs() <= 1e-11 * p_scale,
+                (power - teeth + heat).abs() <= 1e-11 * (teeth.abs() + heat),
                 "{power} {teeth} {heat}"
             );
         }
