@@ -408,7 +408,8 @@ impl Run {
         if !self.exact_drum_load {
             return 0.0;
         }
-        self.drum_load_past() + crate::integrate::ramp_integral(self.t, x, false, |t| self.drum_load(t))
+        self.drum_load_past()
+            + crate::integrate::ramp_integral(self.t, x, false, |t| self.drum_load(t))
     }
 
     /// The kick of the drive torque on an inertial shaft for a step of length `x` from `t`

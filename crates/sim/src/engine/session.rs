@@ -37,8 +37,8 @@
 
 use super::energy::EnergyAudit;
 use super::multirate;
-use super::world_step_end;
 use super::state::{shaft_accel_bound, Run, ShaftDrive};
+use super::world_step_end;
 use super::PROGRESS_BODY_STEPS;
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use clutchpack_model::session::{Advance, Driven, Inputs, Session, Snapshot};
@@ -180,15 +180,41 @@ impl MultibodySession {
         j as f64 / self.options.record_rate_hz
     }
 
+    /// How far apart a communication point and a point of the record grid (or of the fixed
+    /// steps' grid, `interval_s`) may be and still be one point, s: a driven session's
+    /// communication points `k T` and the grid's `j / rate` are the same instants but for
+    /// rounding (9e-3 against 90 / 1e4 = 9.000000000000001e-3), and a step between two such
+    /// would be 1e-18 s long. A billionth of the interval; 0 for a session driven by nothing,
+    /// whose steps are `run`'s.
+    fn slack(&self, interval_s: f64) -> f64 {
+        if self.driven.any() {
+            1e-9 * interval_s
+        } else {
+            0.0
+        }
+    }
+
+    /// The next point of the record grid as a step's target aiming at `end` (s): `end`
+    /// itself when the two are one point ([`Self::slack`]).
+    fn grid_target(&self, end: f64) -> f64 {
+        let grid = self.rec_time(self.rec_index);
+        if (grid - end).abs() <= self.slack(1.0 / self.options.record_rate_hz) {
+            end
+        } else {
+            grid
+        }
+    }
+
     /// Sends the sample (and the stack's interfaces) at `t` if one is due.
     fn sample_if_due(&mut self, observer: &mut dyn Observer) {
         let run = &self.run;
-        if self.rec_time(self.rec_index) <= run.t + self.half_step {
+        let slack = self.slack(1.0 / self.options.record_rate_hz);
+        if self.rec_time(self.rec_index) <= run.t + self.half_step + slack {
             observer.sample(&run.sample(self.options.record_tooth_loads));
             if let Some(s) = &run.stack {
                 observer.interfaces(run.t, &s.samples());
             }
-            while self.rec_time(self.rec_index) <= run.t + self.half_step {
+            while self.rec_time(self.rec_index) <= run.t + self.half_step + slack {
                 self.rec_index += 1;
             }
         }
@@ -220,7 +246,10 @@ impl MultibodySession {
             let t_next = match self.options.stepping {
                 Stepping::Fixed { dt_s } => {
                     let grid = (self.fixed_index + 1) as f64 * dt_s;
-                    if grid <= end {
+                    if (grid - end).abs() <= self.slack(dt_s) {
+                        self.fixed_index += 1;
+                        end
+                    } else if grid <= end {
                         self.fixed_index += 1;
                         grid
                     } else {
@@ -273,7 +302,7 @@ impl MultibodySession {
     /// step, free-flight steps landing on the sampling grid, every step landing on a contact
     /// onset or separation (the stack solved for it).
     fn adaptive_step_end(&mut self, a: &AdaptiveStepping, end: f64) -> Result<f64, EngineError> {
-        let next_sample = self.rec_time(self.rec_index);
+        let next_sample = self.grid_target(end);
         let run = &mut self.run;
         let t = run.t;
         let (want, contact) = run.desired_step(a);
@@ -328,7 +357,7 @@ impl MultibodySession {
         let mut contacts = Vec::new();
         while self.run.t < t_s {
             let end = self.step_end(t_s);
-            let grid = self.rec_time(self.rec_index);
+            let grid = self.grid_target(end);
             let run = &mut self.run;
             let t1 = world_step_end(run.t, a.max_step_s, grid, end);
             run.read_relative_states();
