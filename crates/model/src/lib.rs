@@ -58,8 +58,8 @@ pub mod fatigue;
 pub mod impact;
 pub mod law;
 pub mod pack;
-pub mod session;
 pub mod spline;
+pub mod session;
 pub mod stream;
 
 pub use clutch::{
