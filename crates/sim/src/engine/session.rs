@@ -175,9 +175,10 @@ impl MultibodySession {
         }
     }
 
-    /// Time of record sample `j`, s.
+    /// Time of record sample `j`, s: `j` times the period (as `run` always computed it, not
+    /// `j / rate`, which rounds differently).
     fn rec_time(&self, j: u64) -> f64 {
-        j as f64 / self.options.record_rate_hz
+        j as f64 * (1.0 / self.options.record_rate_hz)
     }
 
     /// How far apart a communication point and a point of the record grid (or of the fixed
