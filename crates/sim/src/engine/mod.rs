@@ -25,13 +25,6 @@ use clutchpack_model::session::{Advance, Driven, Session};
 use clutchpack_model::{Engine, EngineError, LawKind, Observer, PackModel, RunStats};
 use std::sync::Arc;
 
-/// How often the observer's `progress` is polled by the shared step: every this many steps
-/// of one coupled body (a step of `n` discs and plates counts `n`: every 1000 steps of one
-/// disc, every step of a pack of 1000 or more). A body-step costs a few microseconds,
-/// so a stop acts within milliseconds whatever the pack's size; the multirate scheme polls at
-/// every world step.
-pub(super) const PROGRESS_BODY_STEPS: u64 = 1000;
-
 /// The rapier3d-f64 multibody engine (see the crate docs).
 #[derive(Debug, Clone)]
 pub struct MultibodyEngine {
@@ -298,39 +291,5 @@ impl MultibodyEngine {
             multirate,
             driven,
         )
-    }
-}
-
-/// The end of the multirate scheme's next world step from `t` (s): a free-flight step of
-/// `max_step_s`, landing exactly on the next sample time `grid_s` and on the end of the run
-/// `end_s` when they come within it. "Within" allows a millionth of a step of rounding: taking
-/// `t + max_step_s` a rounding error short of the grid would leave a world step of 1e-19 s,
-/// and the impact tracker's parabola through samples that close is meaningless.
-pub(super) fn world_step_end(t: f64, max_step_s: f64, grid_s: f64, end_s: f64) -> f64 {
-    let reach = t + max_step_s * (1.0 + 1e-6);
-    if end_s <= reach && end_s <= grid_s {
-        end_s
-    } else if grid_s <= reach {
-        grid_s
-    } else {
-        t + max_step_s
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::world_step_end;
-
-    /// The world step lands on the sampling grid and the end of the run, never a rounding
-    /// error short of them.
-    #[test]
-    fn world_steps_land_on_the_grid_and_the_end() {
-        // 21 steps of 1e-4 s add up to a hair under 21 * 1e-4
-        let t = (0..21).fold(0.0, |t, _| t + 1e-4);
-        let grid = 22.0 * 1e-4;
-        assert_eq!(world_step_end(t, 1e-4, grid, 1.0), grid);
-        assert_eq!(world_step_end(0.0, 1e-4, 5e-4, 1.0), 1e-4);
-        assert_eq!(world_step_end(0.0, 1e-4, 5e-4, 0.5e-4), 0.5e-4);
-        assert_eq!(world_step_end(0.0, 1e-4, 1e-4, 1e-4), 1e-4);
     }
 }
