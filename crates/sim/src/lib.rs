@@ -28,6 +28,12 @@
 //!   events with the model's definitions ([`clutchpack_model::ImpactTracker`]: onset where the
 //!   engagement depth becomes positive, the peak of `|F|`, separation where the depth falls
 //!   back), an energy audit ([`EnergyAudit`]).
+//! - Is steppable (`Engine::start`, [`MultibodySession`]): a run advances one communication
+//!   point at a time on either scheme, with the shaft's speed or torque, the drum's load and
+//!   the piston's pressure driven by the caller (held between calls), and can be cloned to save
+//!   and restore its state; `Engine::run` is one session advanced once, and a session driven
+//!   by nothing gives `run`'s outputs bit for bit however its run is split into calls
+//!   (`engine/session.rs`).
 //! - Fixed steps (the check mode) or contact-aware adaptive steps ([`AdaptiveStepping`]), on
 //!   one of two schemes ([`Scheme`], chosen automatically, see "Theory"): the multirate
 //!   scheme, where the world steps at free-flight length and each disc's coupling sub-steps
@@ -184,7 +190,7 @@ mod stack;
 mod stepping;
 mod world;
 
-pub use engine::{EnergyAudit, MultibodyEngine};
+pub use engine::{EnergyAudit, MultibodyEngine, MultibodySession};
 pub use options::{
     AdaptiveStepping, BodyShapes, DiscMount, MultibodyOptions, Scheme, Stepping, ToothResolution,
 };

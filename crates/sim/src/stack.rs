@@ -34,15 +34,17 @@
 // m + 1); iterator chains would obscure them.
 #![allow(clippy::needless_range_loop)]
 
-use clutchpack_model::{InterfaceSample, StackBody, StackModel};
+use clutchpack_model::{InterfaceSample, PressureProfile, StackBody, StackModel};
 
 /// Most Gauss-Seidel sweeps per step (the fallback of the active-set solve).
 const MAX_SWEEPS: usize = 5000;
 
 /// The stack's state during a run.
 #[derive(Debug, Clone)]
-pub(crate) struct Stack<'a> {
-    model: &'a StackModel,
+pub(crate) struct Stack {
+    /// The stack's model (a copy: a session changes its piston's pressure, see
+    /// [`Stack::set_pressure`]).
+    model: StackModel,
     /// The engine's coupling index of each stack body (`2N + 1`): plate `j` (stack body
     /// `2j`) is coupling `N + j`, disc `i` (stack body `2i + 1`) is coupling `i`.
     pub body: Vec<usize>,
@@ -68,17 +70,17 @@ pub(crate) struct Stack<'a> {
     pub torque: Vec<f64>,
 }
 
-impl<'a> Stack<'a> {
+impl Stack {
     /// The stack of `n_discs` discs and `n_discs + 1` plates (couplings `0..n_discs` are the
     /// discs, then the plates).
-    pub fn new(model: &'a StackModel, n_discs: usize) -> Stack<'a> {
+    pub fn new(model: &StackModel, n_discs: usize) -> Stack {
         let body = (0..2 * n_discs + 1)
             .map(|b| StackBody::at(b).body_index(n_discs))
             .collect();
         let n_if = 2 * n_discs;
         let n_bodies = 2 * n_discs + 1;
         Stack {
-            model,
+            model: model.clone(),
             body,
             r_eff: model.effective_radius_m(),
             c_gap: -model.open_gap_torque_n_m(1.0),
@@ -90,6 +92,12 @@ impl<'a> Stack<'a> {
             locked: vec![false; n_if],
             torque: vec![0.0; n_bodies],
         }
+    }
+
+    /// Replaces the piston's pressure history (a driven pressure, held from the session's time
+    /// on); the clamp forces follow at the next [`Self::update`].
+    pub fn set_pressure(&mut self, pressure: PressureProfile) {
+        self.model.piston.pressure = pressure;
     }
 
     /// The length of the step the impulses were last solved for, s (0 before the first).

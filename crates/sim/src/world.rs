@@ -49,6 +49,45 @@ pub(crate) struct World {
     owed: Vec<Vector>,
 }
 
+/// A copy of the world, exact: every part of rapier's state is cloned (the bodies with their
+/// poses, speeds and applied forces, the joints with their warm-start impulses, the island
+/// manager, the broad and narrow phases, the CCD solver), but the physics and collision
+/// pipelines, which are not `Clone`. Those hold only workspace buffers, rebuilt at every step
+/// (rapier's docs: "contains only temporary working memory"; a new pipeline also invalidates
+/// the joint set's memo of its last selection, `joint_selection_primed`), so fresh ones step
+/// the copy exactly as the original's step the original (checked bit for bit by
+/// `tests/session.rs`, "a clone advances as the original").
+impl Clone for World {
+    fn clone(&self) -> World {
+        let p = &self.physics;
+        World {
+            physics: PhysicsWorld {
+                gravity: p.gravity,
+                integration_parameters: p.integration_parameters,
+                physics_pipeline: rapier3d_f64::pipeline::PhysicsPipeline::new(),
+                collision_pipeline: rapier3d_f64::pipeline::CollisionPipeline::new(),
+                islands: p.islands.clone(),
+                broad_phase: p.broad_phase.clone(),
+                narrow_phase: p.narrow_phase.clone(),
+                bodies: p.bodies.clone(),
+                colliders: p.colliders.clone(),
+                impulse_joints: p.impulse_joints.clone(),
+                multibody_joints: p.multibody_joints.clone(),
+                soft_bodies: p.soft_bodies.clone(),
+                ccd_solver: p.ccd_solver.clone(),
+            },
+            shaft: self.shaft,
+            shaft_dynamic: self.shaft_dynamic,
+            housing: self.housing,
+            drum: self.drum,
+            discs: self.discs.clone(),
+            carriers: self.carriers.clone(),
+            disc_axial_m: self.disc_axial_m.clone(),
+            owed: self.owed.clone(),
+        }
+    }
+}
+
 /// Owed turns are applied to the rapier pose once they exceed this, rad. Setting a pose makes
 /// rapier recompute the body's world mass properties (measured: a tenth of the step's cost
 /// with 8 discs), while the owed turn, kept exactly, costs nothing to add when reading.

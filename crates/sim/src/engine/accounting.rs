@@ -10,7 +10,7 @@ use crate::stepping::contact_duration_s;
 use crate::world::Carrier;
 use clutchpack_model::Observer;
 
-impl Run<'_> {
+impl Run {
     /// Feeds the impact trackers with the state at `t` and sends the impacts that closed and
     /// the contact samples due.
     pub(super) fn track_events(&mut self, steps_per_contact: f64, observer: &mut dyn Observer) {
@@ -30,7 +30,7 @@ impl Run<'_> {
     }
 }
 
-impl Run<'_> {
+impl Run {
     /// Kinetic energy of the discs, the plates (and of an inertial shaft and the drum) at
     /// `t`, J: `sum J w^2 / 2` with the synchronised speeds, plus `m v^2 / 2` of the bodies'
     /// centres (rapier's speed over the last step: zero for a concentric body, whose joint
@@ -61,7 +61,7 @@ impl Run<'_> {
         let (drive, shaft_damping) = match self.shaft {
             ShaftDrive::Prescribed(_) => (0.0, 0.0),
             ShaftDrive::Inertial { c1, .. } => (
-                self.pack.shaft.drive_torque_n_m(self.t) * self.omega_s,
+                self.drive_torque(self.t) * self.omega_s,
                 -c1 * self.omega_s * self.omega_s,
             ),
         };

@@ -6,7 +6,7 @@ use crate::options::AdaptiveStepping;
 use crate::stepping::{coupling_step, CouplingView};
 use crate::world::Carrier;
 
-impl Run<'_> {
+impl Run {
     /// The step the adaptive controller wants at `t`, s, and whether it is a contact step.
     pub(super) fn desired_step(&self, a: &AdaptiveStepping) -> (f64, bool) {
         let a_shaft = match self.shaft {
@@ -117,9 +117,9 @@ impl Run<'_> {
             ShaftDrive::Inertial { .. } => 0.0,
         };
         let w_s = bodies[self.world.shaft].angvel().z;
-        let shaft_turn = |x: f64| match self.shaft {
+        let shaft_turn = |x: f64| match &self.shaft {
             ShaftDrive::Prescribed(p) => p.angle(self.t + x) - theta_s0,
-            ShaftDrive::Inertial { j1, .. } => {
+            &ShaftDrive::Inertial { j1, .. } => {
                 let teeth: f64 = (0..self.couplings.len())
                     .filter(|&i| self.world.carriers[i] == Carrier::Shaft)
                     .map(|i| self.teeth_impulse(i, x))
@@ -137,7 +137,8 @@ impl Run<'_> {
                     .map(|i| self.teeth_impulse(i, x))
                     .sum();
                 x * (bodies[hd].angvel().z
-                    + (d.loads.kick.impulse_component(5, x) - teeth) / d.model.inertia_kg_m2)
+                    + (d.loads.kick.impulse_component(5, x) + self.drum_load_impulse(x) - teeth)
+                        / d.model.inertia_kg_m2)
             }
             _ => 0.0,
         };

@@ -8,7 +8,7 @@ use crate::world::{angle_about_z, Carrier};
 use clutchpack_model::EngineError;
 use rapier3d_f64::prelude::{RigidBody, Rotation, Vector};
 
-impl Run<'_> {
+impl Run {
     /// The hook at `t`: every coupling's relative state and tooth loads, then the stack's
     /// clamp forces. Fails if the state is not finite or the teeth passed through each other
     /// (|phi| beyond half a pitch).
@@ -17,12 +17,12 @@ impl Run<'_> {
         let shaft = &bodies[self.world.shaft];
         // First estimates of the speeds at t: rapier's mean speeds plus the extrapolated
         // accelerations over the last step.
-        self.omega_s = match self.shaft {
+        self.omega_s = match &self.shaft {
             ShaftDrive::Prescribed(p) => p.speed(self.t),
             ShaftDrive::Inertial { j1, .. } => {
                 self.shaft_loads
                     .full_history
-                    .synchronised(self.t, shaft.angvel().z, 5, 1.0 / j1)
+                    .synchronised(self.t, shaft.angvel().z, 5, 1.0 / *j1)
             }
         };
         if let (Some(d), Some(h)) = (self.drum.as_mut(), self.world.drum) {
@@ -69,6 +69,7 @@ impl Run<'_> {
                 }
             }
         }
+        let load_past = self.drum_load_past();
         if let ShaftDrive::Inertial { j1, .. } = self.shaft {
             if self.shaft_loads.history.len() > 0 {
                 self.omega_s = shaft.angvel().z
@@ -81,7 +82,8 @@ impl Run<'_> {
         if let (Some(d), Some(h)) = (self.drum.as_mut(), self.world.drum) {
             if d.loads.history.len() > 0 {
                 d.omega = bodies[h].angvel().z
-                    + (d.loads.history.synchronised(self.t, 0.0, 5, 1.0) - teeth_past_drum)
+                    + (d.loads.history.synchronised(self.t, 0.0, 5, 1.0) + load_past
+                        - teeth_past_drum)
                         / d.model.inertia_kg_m2;
             }
         }
@@ -175,6 +177,35 @@ impl Run<'_> {
         Ok(())
     }
 
+    /// Re-evaluates the state at `t` after a session's driven input changed there
+    /// (`session.rs`): the relative motion of every coupling on the shaft by the shaft's speed
+    /// jump `shaft_jump` (rad/s; the bodies' speeds are continuous, so `dphi` and the offset's
+    /// rate in the shaft's turning frame jump), the tooth loads at it (the contact memories
+    /// keep their events), the clamp forces; on the shared step (not `multirate`, whose
+    /// sub-steps do their own audit and read no kicks) also the energy audit's powers (a
+    /// zero-length interval, no work) and the loads and kicks of the next step. The past half
+    /// of the teeth's kick keeps the motion before the jump, as the step that ended at `t` had.
+    pub(super) fn input_changed(&mut self, shaft_jump: f64, multirate: bool) {
+        self.potential_j = 0.0;
+        for i in 0..self.couplings.len() {
+            if self.world.carriers[i] == Carrier::Shaft && shaft_jump != 0.0 {
+                let rel = &mut self.rel[i];
+                rel.dphi += shaft_jump;
+                // rate = dv - omega_s z x d in the shaft's frame
+                rel.offset_rate[0] += shaft_jump * rel.offset[1];
+                rel.offset_rate[1] -= shaft_jump * rel.offset[0];
+            }
+            let f = self.couplings[i].evaluate(&self.rel[i]);
+            self.potential_j += f.potential_j;
+            self.forces[i] = f;
+        }
+        self.update_stack();
+        if !multirate {
+            self.audit_energy();
+            self.compute_loads();
+        }
+    }
+
     /// The stack's clamp forces and slips at `t` from the teeth's normal loads
     /// `n |F| = |torque| / Rb` and the bodies' speeds (no-op without a stack).
     pub(super) fn update_stack(&mut self) {
@@ -182,7 +213,7 @@ impl Run<'_> {
             let normal: Vec<f64> = self
                 .forces
                 .iter()
-                .zip(&self.bodies)
+                .zip(self.bodies.iter())
                 .map(|(f, d)| f.moment[2].abs() / d.spline.base_radius_m())
                 .collect();
             stack.update(self.t, &normal, &self.omega_d);
@@ -201,7 +232,7 @@ impl Run<'_> {
         let mut drum_torque_full = Vector::ZERO;
         let mut disc_accel = vec![0.0; self.forces.len()];
         for (i, f) in self.forces.iter().enumerate() {
-            let d = self.bodies[i];
+            let d = &self.bodies[i];
             let carrier = self.world.carriers[i];
             let qs = *bodies[self.carrier_body(i)].rotation();
             // Hu et al. eq (5): drag -C2 omega_d.
@@ -248,15 +279,16 @@ impl Run<'_> {
             }
             self.loads[i].kick = self.loads[i].history.kick(self.t, &self.loads[i].load);
         }
-        let shaft_accel = match self.shaft {
+        let drive_now = self.drive_torque(self.t);
+        let shaft_accel = match &self.shaft {
             ShaftDrive::Prescribed(p) => p.acceleration(self.t),
-            ShaftDrive::Inertial { j1, c1 } => {
+            &ShaftDrive::Inertial { j1, c1 } => {
                 // Hu et al. eq (4): the drive torque, the spline reactions, damping -C1 omega.
                 // The drive is a known function of time: its kick is integrated exactly
                 // (`drive_impulse`), not extrapolated.
                 let damping = -c1 * self.omega_s;
                 shaft_torque.z += damping;
-                shaft_torque_full.z += damping + self.pack.shaft.drive_torque_n_m(self.t);
+                shaft_torque_full.z += damping + drive_now;
                 let l = |t: Vector| [shaft_force.x, shaft_force.y, shaft_force.z, t.x, t.y, t.z];
                 self.shaft_loads.load = l(shaft_torque);
                 self.shaft_loads.full = l(shaft_torque_full);
@@ -271,7 +303,12 @@ impl Run<'_> {
             Some(dr) => {
                 // The drum: its load torque, its drag, the plates' spline reactions.
                 let own = dr.model.load_torque_n_m - dr.model.drag_n_m_s_rad * dr.omega;
-                drum_torque.z += own;
+                // A driven load is integrated exactly (`drum_load_impulse`), not extrapolated.
+                drum_torque.z += if self.exact_drum_load {
+                    -dr.model.drag_n_m_s_rad * dr.omega
+                } else {
+                    own
+                };
                 drum_torque_full.z += own;
                 let l = |t: Vector| [drum_force.x, drum_force.y, drum_force.z, t.x, t.y, t.z];
                 dr.loads.load = l(drum_torque);
@@ -332,7 +369,47 @@ impl Run<'_> {
         if h <= 0.0 || matches!(self.shaft, ShaftDrive::Prescribed(_)) {
             return 0.0;
         }
-        crate::integrate::ramp_integral(t0, h, true, |t| self.pack.shaft.drive_torque_n_m(t))
+        crate::integrate::ramp_integral(t0, h, true, |t| self.drive_torque(t))
+    }
+
+    /// The drive torque on an inertial shaft at `t`, N m: the pack's excitation, or before a
+    /// driven torque's last change (`drive_switch`) the value held until then.
+    pub(super) fn drive_torque(&self, t: f64) -> f64 {
+        match self.drive_switch {
+            Some((t_switch, before)) if t < t_switch => before,
+            _ => self.pack.shaft.drive_torque_n_m(t),
+        }
+    }
+
+    /// A driven drum load at `t`, N m: the drum's, or before its last change (`load_switch`)
+    /// the value held until then.
+    fn drum_load(&self, t: f64) -> f64 {
+        match (self.load_switch, &self.drum) {
+            (Some((t_switch, before)), _) if t < t_switch => before,
+            (_, Some(d)) => d.model.load_torque_n_m,
+            (_, None) => 0.0,
+        }
+    }
+
+    /// A driven drum load integrated against the rising ramp of the last step, N m s (0 when
+    /// the load is not driven: it is then in the drum's polynomial kick).
+    pub(super) fn drum_load_past(&self) -> f64 {
+        match self.t_prev {
+            Some(t0) if self.exact_drum_load && self.t > t0 => {
+                crate::integrate::ramp_integral(t0, self.t - t0, true, |t| self.drum_load(t))
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The kick of a driven drum load for a step of length `x` from `t` (both halves, N m s; 0
+    /// when the load is not driven).
+    pub(super) fn drum_load_impulse(&self, x: f64) -> f64 {
+        if !self.exact_drum_load {
+            return 0.0;
+        }
+        self.drum_load_past()
+            + crate::integrate::ramp_integral(self.t, x, false, |t| self.drum_load(t))
     }
 
     /// The kick of the drive torque on an inertial shaft for a step of length `x` from `t`
@@ -342,9 +419,7 @@ impl Run<'_> {
             return 0.0;
         }
         self.drive_past()
-            + crate::integrate::ramp_integral(self.t, x, false, |t| {
-                self.pack.shaft.drive_torque_n_m(t)
-            })
+            + crate::integrate::ramp_integral(self.t, x, false, |t| self.drive_torque(t))
     }
 
     /// Resets and applies every body's forces for the step from `t` to `t_next`: each body's
@@ -359,6 +434,7 @@ impl Run<'_> {
             .map(|i| self.stack_torque(i))
             .collect();
         let drive = self.drive_impulse(h);
+        let drum_load = self.drum_load_impulse(h);
         let bodies = &mut self.world.physics.bodies;
         let apply = |body: &mut RigidBody, l: Load| {
             body.reset_forces(false);
@@ -383,7 +459,7 @@ impl Run<'_> {
             self.prev_motion[i] = Some((self.t, m.phi, m.dphi, m.ddphi));
         }
         let shaft = &mut bodies[self.world.shaft];
-        match self.shaft {
+        match &self.shaft {
             ShaftDrive::Prescribed(p) => {
                 self.theta_next = p.angle(t_next);
                 shaft.set_next_kinematic_rotation(Rotation::from_rotation_z(self.theta_next));
@@ -400,7 +476,7 @@ impl Run<'_> {
         }
         if let (Some(d), Some(hd)) = (self.drum.as_mut(), self.world.drum) {
             let mut load = d.loads.kick.applied(h);
-            load[5] += teeth_on_drum;
+            load[5] += teeth_on_drum + drum_load / h;
             apply(&mut bodies[hd], load);
             d.loads.history.push(self.t, d.loads.load);
             d.loads.full_history.push(self.t, d.loads.full);

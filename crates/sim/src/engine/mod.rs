@@ -3,8 +3,9 @@
 //!
 //! One module per job: `state` (the world and every body's state), `forces` (the hook at
 //! `t`, the loads and kicks, the step handed to rapier), `events` (impact events), `energy`
-//! (the energy audit), `control` (the step controller and the landing on contact onsets);
-//! this module validates the pack and runs the loop.
+//! (the energy audit), `control` (the step controller and the landing on contact onsets),
+//! `session` (the resumable loops of both schemes: a run as a steppable session); this module
+//! validates the pack and starts sessions.
 
 mod accounting;
 mod control;
@@ -12,26 +13,23 @@ mod energy;
 mod events;
 mod forces;
 mod multirate;
+mod session;
 mod state;
 
 pub use energy::EnergyAudit;
+pub use session::MultibodySession;
 
-use crate::options::{AdaptiveStepping, MultibodyOptions, Scheme, Stepping, ToothResolution};
+use crate::options::{MultibodyOptions, Scheme, Stepping, ToothResolution};
 use crate::world::World;
+use clutchpack_model::session::{Advance, Driven, Session};
 use clutchpack_model::{Engine, EngineError, LawKind, Observer, PackModel, RunStats};
-use state::Run;
-
-/// How often the observer's `progress` is polled by the shared step: every this many steps
-/// of one coupled body (a step of `n` discs and plates counts `n`: every 1000 steps of one
-/// disc, every step of a pack of 1000 or more). A body-step costs a few microseconds,
-/// so a stop acts within milliseconds whatever the pack's size; the multirate scheme polls at
-/// every world step.
-const PROGRESS_BODY_STEPS: u64 = 1000;
+use std::sync::Arc;
 
 /// The rapier3d-f64 multibody engine (see the crate docs).
 #[derive(Debug, Clone)]
 pub struct MultibodyEngine {
-    pack: PackModel,
+    /// The pack, shared with the sessions (each copies it when an input changes).
+    pack: Arc<PackModel>,
     options: MultibodyOptions,
     /// Why the multirate scheme does not run this pack (`None`: it does).
     multirate_refused: Option<&'static str>,
@@ -155,7 +153,7 @@ impl MultibodyEngine {
             return bad(format!("the multirate scheme cannot run this pack: {why}"));
         }
         Ok(MultibodyEngine {
-            pack,
+            pack: Arc::new(pack),
             multirate_refused,
             substeps: 0,
             options,
@@ -242,262 +240,60 @@ impl Engine for MultibodyEngine {
             .collect()
     }
 
+    fn start(&self, driven: Driven) -> Result<Box<dyn Session>, EngineError> {
+        Ok(Box::new(self.session(driven)?))
+    }
+
+    /// One session driven by nothing, its end declared ([`MultibodySession::set_end`]),
+    /// advanced to `duration_s` in one call and finished; kept as an override to keep
+    /// [`MultibodyEngine::energy`] and [`MultibodyEngine::coupling_substeps`] up to date.
     fn run(
         &mut self,
         duration_s: f64,
         observer: &mut dyn Observer,
     ) -> Result<RunStats, EngineError> {
-        match (self.multirate_refused, self.options.stepping) {
-            (None, Stepping::Adaptive(a)) => self.run_multirate(duration_s, observer, a),
-            _ => self.run_shared(duration_s, observer),
-        }
+        let mut session = self.session(Driven::NONE)?;
+        session.set_end(duration_s);
+        let advance = session.advance_to(duration_s, observer)?;
+        let mut stats = session.finish(observer);
+        stats.stopped_early = advance == Advance::Stopped;
+        self.energy = session.energy();
+        self.substeps = session.coupling_substeps();
+        Ok(stats)
     }
 }
 
 impl MultibodyEngine {
-    /// The shared step: every body advances with one contact-aware step (the shortest any
-    /// coupling needs), the teeth's kick integrated along it (`integrate.rs`).
-    fn run_shared(
-        &mut self,
-        duration_s: f64,
-        observer: &mut dyn Observer,
-    ) -> Result<RunStats, EngineError> {
-        let opts = &self.options;
-        let mut run = Run::new(&self.pack, opts, &self.per_tooth)?;
-        run.events
-            .take_contact_samples(observer.wants_contact_samples());
-        let period = 1.0 / opts.record_rate_hz;
-        let rec_time = |j: u64| j as f64 * period;
-        let mut rec_index: u64 = 0;
-        // Half of the current step: samples are taken at the step nearest to the grid when
-        // the step does not land on it (fixed steps, adaptive contact steps).
-        let mut half_step = match opts.stepping {
-            Stepping::Fixed { dt_s } => 0.5 * dt_s,
-            Stepping::Adaptive(_) => 0.0,
+    /// Starts a steppable run at t = 0 whose caller drives `driven` (as [`Engine::start`],
+    /// with the concrete type: [`MultibodySession::set_end`], the energy audit). Fails with
+    /// [`EngineError::Unsupported`] for an input the pack does not have (a shaft speed on an
+    /// inertial shaft, a shaft torque on a prescribed one, a drum load without a drum, a
+    /// piston pressure without a stack) and for a driven pressure on the multirate scheme
+    /// asked for explicitly (a pressure over the return spring would clamp the stack, which
+    /// couples the bodies within a world step; the automatic choice runs the shared step
+    /// then).
+    pub fn session(&self, driven: Driven) -> Result<MultibodySession, EngineError> {
+        if let Some(why) = session::refused_inputs(&self.pack, &driven) {
+            return Err(EngineError::Unsupported(why));
+        }
+        let multirate = match (self.multirate_refused, self.options.stepping) {
+            (None, Stepping::Adaptive(a)) if !driven.piston_pressure => Some(a),
+            (None, _) if self.options.scheme == Scheme::Multirate => {
+                return Err(EngineError::Unsupported(
+                    "the multirate scheme cannot take a driven piston pressure (a pressure \
+                     over the return spring clamps the stack, which couples the bodies within \
+                     a world step): use the automatic or the shared scheme"
+                        .into(),
+                ))
+            }
+            _ => None,
         };
-        let steps_per_contact = match opts.stepping {
-            Stepping::Adaptive(a) => a.steps_per_contact,
-            Stepping::Fixed { .. } => AdaptiveStepping::default().steps_per_contact,
-        };
-        let mut steps: u64 = 0;
-        let mut stopped = false;
-        let mut t_last_good = 0.0;
-        // simulated time at the start of the stall check's current block, s
-        let mut stall_t0 = 0.0;
-        // A step costs about the same per body: poll the stop every PROGRESS_BODY_STEPS
-        // body-steps.
-        let progress_every = (PROGRESS_BODY_STEPS / (run.couplings.len() as u64).max(1)).max(1);
-        loop {
-            run.evaluate(t_last_good)?;
-            t_last_good = run.t;
-            if steps == 0 {
-                let kinetic_j = run.kinetic_energy();
-                run.energy.start(run.potential_j, kinetic_j);
-            }
-            run.track_events(steps_per_contact, observer);
-            if rec_time(rec_index) <= run.t + half_step {
-                observer.sample(&run.sample(opts.record_tooth_loads));
-                if let Some(s) = &run.stack {
-                    observer.interfaces(run.t, &s.samples());
-                }
-                while rec_time(rec_index) <= run.t + half_step {
-                    rec_index += 1;
-                }
-            }
-            if steps > 0 && steps.is_multiple_of(progress_every) && observer.progress(run.t) {
-                stopped = true;
-            }
-            if steps > 0
-                && steps.is_multiple_of(clutchpack_model::STALL_STEPS)
-                && matches!(opts.stepping, Stepping::Adaptive(_))
-            {
-                // adaptive steps far below any real pack's: stop rather than run for days
-                let span = run.t - stall_t0;
-                if span < clutchpack_model::STALL_SPAN_S {
-                    return Err(EngineError::Diverged {
-                        t_s: run.t,
-                        reason: format!(
-                            "{} steps advanced only {span:.3e} s: a coupling is stiffer, or the \
-                             drive faster, than the engine can integrate (check the contact, oil \
-                             and drive values)",
-                            clutchpack_model::STALL_STEPS
-                        ),
-                    });
-                }
-                stall_t0 = run.t;
-            }
-            if stopped || run.t >= duration_s {
-                break;
-            }
-            let t = run.t;
-            let t_next = match opts.stepping {
-                Stepping::Fixed { dt_s } => ((steps + 1) as f64 * dt_s).min(duration_s),
-                Stepping::Adaptive(a) => {
-                    let (want, contact) = run.desired_step(&a);
-                    if want.is_nan() || want < a.min_step_s {
-                        return Err(EngineError::Diverged {
-                            t_s: t,
-                            reason: format!("the step size collapsed to {want:.3e} s"),
-                        });
-                    }
-                    // Free-flight steps land on the sampling grid; contact steps keep their
-                    // length (a varying step spoils the symplectic step's energy).
-                    half_step = if contact { 0.5 * want } else { 0.0 };
-                    let target = if contact {
-                        duration_s
-                    } else {
-                        rec_time(rec_index).min(duration_s)
-                    };
-                    let rem = target - t;
-                    let h = if want >= rem {
-                        rem
-                    } else if want > 0.5 * rem {
-                        0.5 * rem
-                    } else {
-                        want
-                    };
-                    // The stack's torques for this step enter the landing's prediction.
-                    run.solve_stack(h);
-                    // Never step over an onset or a separation: land on it.
-                    match run.landing(h, 1e-3 * h.min(want)) {
-                        Some(x) => {
-                            half_step = 0.5 * x;
-                            t + x
-                        }
-                        None if h == rem => target,
-                        None => t + h,
-                    }
-                }
-            };
-            // (Re)solve the stack for the step actually taken.
-            let h = t_next - t;
-            if run.stack.as_ref().is_some_and(|s| s.step_s() != h) {
-                run.solve_stack(h);
-            }
-            run.apply_forces(t_next);
-            run.advance(t_next);
-            steps += 1;
-        }
-        for e in run.events.finish(run.t) {
-            observer.impact(&e);
-        }
-        let kinetic_j = run.kinetic_energy();
-        self.energy = run.energy.finish(run.potential_j, kinetic_j);
-        Ok(RunStats {
-            simulated_s: run.t,
-            steps,
-            rejected_steps: 0,
-            rhs_evals: steps + 1,
-            stopped_early: stopped,
-        })
-    }
-}
-
-impl MultibodyEngine {
-    /// The multirate scheme (`multirate.rs`): the world steps at free-flight length, landing
-    /// on the sampling grid, and every coupling sub-steps its own contacts within it.
-    fn run_multirate(
-        &mut self,
-        duration_s: f64,
-        observer: &mut dyn Observer,
-        a: AdaptiveStepping,
-    ) -> Result<RunStats, EngineError> {
-        let opts = &self.options;
-        let mut run = Run::new(&self.pack, opts, &self.per_tooth)?;
-        run.events
-            .take_contact_samples(observer.wants_contact_samples());
-        let period = 1.0 / opts.record_rate_hz;
-        let rec_time = |j: u64| j as f64 * period;
-        let mut rec_index: u64 = 0;
-        let mut counts = multirate::Counts::default();
-        let mut closed = Vec::new();
-        let mut contacts = Vec::new();
-        let mut steps: u64 = 0;
-        let mut stopped = false;
-        // The state at t = 0, as the shared step reads it.
-        run.evaluate(0.0)?;
-        let kinetic_j = run.kinetic_energy();
-        run.energy.start(run.potential_j, kinetic_j);
-        run.track_events(a.steps_per_contact, observer);
-        loop {
-            if rec_time(rec_index) <= run.t {
-                observer.sample(&run.sample(opts.record_tooth_loads));
-                if let Some(s) = &run.stack {
-                    observer.interfaces(run.t, &s.samples());
-                }
-                while rec_time(rec_index) <= run.t {
-                    rec_index += 1;
-                }
-            }
-            if observer.progress(run.t) {
-                stopped = true;
-            }
-            if stopped || run.t >= duration_s {
-                break;
-            }
-            let t1 = world_step_end(run.t, a.max_step_s, rec_time(rec_index), duration_s);
-            run.read_relative_states();
-            run.multirate_step(t1, &a, &mut counts, &mut closed, &mut contacts)?;
-            run.update_stack();
-            // Events in the order they closed across the couplings.
-            closed.sort_by(|x, y| x.t_off_s.total_cmp(&y.t_off_s));
-            for e in closed.drain(..) {
-                observer.impact(&e);
-            }
-            // The sub-steps' contact samples, all in (t, t1], before the sample at t1; a
-            // stable sort keeps each coupling's order and interleaves the couplings in time.
-            contacts.sort_by(|x, y| x.1.total_cmp(&y.1));
-            for (i, t, s) in contacts.drain(..) {
-                observer.contact_sample(i, t, &s);
-            }
-            steps += 1;
-        }
-        for e in run.events.finish(run.t) {
-            observer.impact(&e);
-        }
-        let kinetic_j = run.kinetic_energy();
-        self.energy = run.energy.finish(run.potential_j, kinetic_j);
-        self.substeps = counts.substeps;
-        Ok(RunStats {
-            simulated_s: run.t,
-            steps,
-            rejected_steps: 0,
-            rhs_evals: counts.evals,
-            stopped_early: stopped,
-        })
-    }
-}
-
-/// The end of the multirate scheme's next world step from `t` (s): a free-flight step of
-/// `max_step_s`, landing exactly on the next sample time `grid_s` and on the end of the run
-/// `end_s` when they come within it. "Within" allows a millionth of a step of rounding: taking
-/// `t + max_step_s` a rounding error short of the grid would leave a world step of 1e-19 s,
-/// and the impact tracker's parabola through samples that close is meaningless.
-fn world_step_end(t: f64, max_step_s: f64, grid_s: f64, end_s: f64) -> f64 {
-    let reach = t + max_step_s * (1.0 + 1e-6);
-    if end_s <= reach && end_s <= grid_s {
-        end_s
-    } else if grid_s <= reach {
-        grid_s
-    } else {
-        t + max_step_s
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::world_step_end;
-
-    /// The world step lands on the sampling grid and the end of the run, never a rounding
-    /// error short of them.
-    #[test]
-    fn world_steps_land_on_the_grid_and_the_end() {
-        // 21 steps of 1e-4 s add up to a hair under 21 * 1e-4
-        let t = (0..21).fold(0.0, |t, _| t + 1e-4);
-        let grid = 22.0 * 1e-4;
-        assert_eq!(world_step_end(t, 1e-4, grid, 1.0), grid);
-        assert_eq!(world_step_end(0.0, 1e-4, 5e-4, 1.0), 1e-4);
-        assert_eq!(world_step_end(0.0, 1e-4, 5e-4, 0.5e-4), 0.5e-4);
-        assert_eq!(world_step_end(0.0, 1e-4, 1e-4, 1e-4), 1e-4);
+        MultibodySession::new(
+            Arc::clone(&self.pack),
+            &self.options,
+            &self.per_tooth,
+            multirate,
+            driven,
+        )
     }
 }

@@ -235,12 +235,12 @@ pub(super) struct Counts {
     pub(super) evals: u64,
 }
 
-impl<'a> Run<'a> {
+impl Run {
     /// The speed profile of coupling `i`'s carrier: the prescribed shaft's (the multirate
     /// scheme runs only on one), `None` for the housing (at rest).
-    fn profile(&self, i: usize) -> Option<&'a SpeedProfile> {
-        match (self.world.carriers[i], self.shaft) {
-            (Carrier::Shaft, ShaftDrive::Prescribed(p)) => Some(p),
+    fn profile(&self, i: usize) -> Option<std::sync::Arc<SpeedProfile>> {
+        match (self.world.carriers[i], &self.shaft) {
+            (Carrier::Shaft, ShaftDrive::Prescribed(p)) => Some(std::sync::Arc::clone(p)),
             (Carrier::Shaft, ShaftDrive::Inertial { .. }) => {
                 unreachable!("the multirate scheme needs a prescribed shaft")
             }
@@ -291,7 +291,7 @@ impl<'a> Run<'a> {
     ) -> Result<(), EngineError> {
         let t0 = self.t;
         let h = t1 - t0;
-        let ShaftDrive::Prescribed(shaft_profile) = self.shaft else {
+        let ShaftDrive::Prescribed(shaft_profile) = &self.shaft else {
             unreachable!("the multirate scheme needs a prescribed shaft")
         };
         let theta_s1 = shaft_profile.angle(t1);
@@ -314,7 +314,7 @@ impl<'a> Run<'a> {
                     if j < n_discs {
                         return w;
                     }
-                    let d = self.bodies[j];
+                    let d = &self.bodies[j];
                     let torque = self.forces[j].moment[2] + gaps[j].held_n_m
                         - (gaps[j].damping + d.drag_n_m_s_rad) * w;
                     w + 0.5 * h * torque / d.inertia_kg_m2
@@ -341,7 +341,7 @@ impl<'a> Run<'a> {
             self.integrate_coupling(i, t1, a, gaps[i], counts, closed, contacts)?;
             let (phi1, dphi1) = (self.rel[i].phi, self.rel[i].dphi);
             let p = self.profile(i);
-            let (c0, c1) = (ShaftAt::of(p, t0), ShaftAt::of(p, t1));
+            let (c0, c1) = (ShaftAt::of(p.as_deref(), t0), ShaftAt::of(p.as_deref(), t1));
             self.omega_d[i] = c1.speed - dphi1;
             self.potential_j += self.forces[i].potential_j;
             // The body's mean speed over the step: it turns with its carrier less the change
@@ -417,8 +417,10 @@ impl<'a> Run<'a> {
         closed: &mut Vec<ImpactEvent>,
         contacts: &mut Vec<(usize, f64, DiscSample)>,
     ) -> Result<(), EngineError> {
-        let d = self.bodies[i];
-        let profile = self.profile(i);
+        let bodies = std::sync::Arc::clone(&self.bodies);
+        let d = &bodies[i];
+        let profile_arc = self.profile(i);
+        let profile = profile_arc.as_deref();
         let inv_j = self.world.physics.bodies[self.world.discs[i]]
             .mass_properties()
             .local_mprops

@@ -15,6 +15,7 @@ use clutchpack_model::{
     SpeedProfile,
 };
 use rapier3d_f64::prelude::{RigidBody, Vector};
+use std::sync::Arc;
 
 /// Reads the relative state of a disc in the shaft's frame. `omega_s` and `omega_d` are the
 /// speeds about the axis at the time of the poses; `owed` is the disc's turn about the axis not
@@ -41,10 +42,11 @@ pub(super) fn relative_state(
 }
 
 /// The shaft as the run loop drives it.
-#[derive(Debug, Clone, Copy)]
-pub(super) enum ShaftDrive<'a> {
-    /// Follows a speed profile exactly (eq 3).
-    Prescribed(&'a SpeedProfile),
+#[derive(Debug, Clone)]
+pub(super) enum ShaftDrive {
+    /// Follows a speed profile exactly (eq 3); shared (`Arc`) so that a loop can hold it while
+    /// it writes the run's state.
+    Prescribed(Arc<SpeedProfile>),
     /// A body (eq 4): inertia `J1`, damping `C1`.
     Inertial { j1: f64, c1: f64 },
 }
@@ -94,16 +96,22 @@ pub(super) struct DrumRun {
 /// poses) by the two schemes that advance it, the shared step (`forces.rs`) and the
 /// multirate step (`multirate.rs`); the stack and the drum by the shared step and their own
 /// methods (`stack.rs`).
-pub(super) struct Run<'a> {
-    pub(super) pack: &'a PackModel,
+///
+/// A run owns everything it reads (the model behind an `Arc`, shared with the engine and the
+/// clones of a session until an input changes it), so that a session can hold it and clone it.
+#[derive(Clone)]
+pub(super) struct Run {
+    /// The pack with the inputs in force from `t` on (a session's `set_inputs` writes the
+    /// driven ones, `session.rs`).
+    pub(super) pack: Arc<PackModel>,
     /// The coupled bodies' models: the discs, then the plates.
-    pub(super) bodies: Vec<&'a DiscModel>,
+    pub(super) bodies: Arc<[DiscModel]>,
     pub(super) world: World,
-    pub(super) shaft: ShaftDrive<'a>,
+    pub(super) shaft: ShaftDrive,
     /// Bound of the drive's shaft acceleration, rad/s^2.
     pub(super) shaft_accel_bound: f64,
     pub(super) drum: Option<DrumRun>,
-    pub(super) stack: Option<Stack<'a>>,
+    pub(super) stack: Option<Stack>,
     pub(super) couplings: Vec<Coupling>,
     /// Effective mass per tooth of each coupling, kg (reduced with an inertial carrier).
     pub(super) m_eff: Vec<f64>,
@@ -138,16 +146,46 @@ pub(super) struct Run<'a> {
     pub(super) potential_j: f64,
     /// The energy audit (written through its methods only, `energy.rs`).
     pub(super) energy: EnergyBook,
+    /// A driven drive torque on an inertial shaft changed at this time, s, from this value,
+    /// N m: the torque before it, for the past half of the kick of the step that ends there
+    /// (`forces.rs`). `None`: the pack's excitation holds for all `t`.
+    pub(super) drive_switch: Option<(f64, f64)>,
+    /// Whether the drum's load torque is a driven input, integrated exactly as a held value
+    /// (its kick `L_before h1 / 2 + L h0 / 2`) rather than through the polynomial kick of the
+    /// drum's other loads (byte-identical runs need the latter for the scene's constant load).
+    pub(super) exact_drum_load: bool,
+    /// A driven drum load changed at this time, s, from this value, N m (as `drive_switch`).
+    pub(super) load_switch: Option<(f64, f64)>,
 }
 
-impl<'a> Run<'a> {
+/// Bound of the shaft's acceleration from its drive alone, rad/s^2: the profile's for a
+/// prescribed shaft or an inertial one driven by a profile (eq 4), the largest drive torque
+/// over `J1` for a torque drive.
+pub(super) fn shaft_accel_bound(shaft: &Shaft) -> f64 {
+    match shaft {
+        Shaft::Prescribed(p) => profile_acceleration_bound(p),
+        Shaft::Inertial {
+            inertia_kg_m2,
+            excitation,
+            ..
+        } => match excitation {
+            ShaftExcitation::Profile(p) => profile_acceleration_bound(p),
+            ShaftExcitation::Torque { table, .. } => {
+                table.y.iter().fold(0.0, |m: f64, y| m.max(y.abs())) / inertia_kg_m2
+            }
+            ShaftExcitation::Held { torque_n_m, .. } => torque_n_m.abs() / inertia_kg_m2,
+        },
+    }
+}
+
+impl Run {
     pub(super) fn new(
-        pack: &'a PackModel,
+        pack: Arc<PackModel>,
         opts: &MultibodyOptions,
         per_tooth: &[bool],
-    ) -> Result<Run<'a>, EngineError> {
-        let world = World::build(pack, &opts.shapes, opts.mount)?;
-        let bodies: Vec<&DiscModel> = pack.discs.iter().chain(&pack.plates).collect();
+    ) -> Result<Run, EngineError> {
+        let world = World::build(&pack, &opts.shapes, opts.mount)?;
+        let bodies: Arc<[DiscModel]> = pack.discs.iter().chain(&pack.plates).cloned().collect();
         let couplings: Vec<Coupling> = bodies
             .iter()
             .zip(per_tooth)
@@ -159,33 +197,25 @@ impl<'a> Run<'a> {
             })
             .collect();
         let nd = couplings.len();
-        let (shaft, shaft_accel_bound) = match &pack.shaft {
-            Shaft::Prescribed(p) => (ShaftDrive::Prescribed(p), profile_acceleration_bound(p)),
+        let shaft = match &pack.shaft {
+            Shaft::Prescribed(p) => ShaftDrive::Prescribed(Arc::new(p.clone())),
             Shaft::Inertial {
                 inertia_kg_m2,
                 damping_n_m_s_rad,
-                excitation,
-            } => (
-                ShaftDrive::Inertial {
-                    j1: *inertia_kg_m2,
-                    c1: *damping_n_m_s_rad,
-                },
-                match excitation {
-                    ShaftExcitation::Profile(p) => profile_acceleration_bound(p),
-                    ShaftExcitation::Torque { table, .. } => {
-                        table.y.iter().fold(0.0, |m: f64, y| m.max(y.abs())) / inertia_kg_m2
-                    }
-                    ShaftExcitation::Held { torque_n_m, .. } => torque_n_m.abs() / inertia_kg_m2,
-                },
-            ),
+                ..
+            } => ShaftDrive::Inertial {
+                j1: *inertia_kg_m2,
+                c1: *damping_n_m_s_rad,
+            },
         };
+        let shaft_accel_bound = shaft_accel_bound(&pack.shaft);
         let m_eff = bodies
             .iter()
             .zip(&world.carriers)
             .map(|(d, carrier)| {
                 let md = d.spline.effective_mass_kg(d.inertia_kg_m2);
-                let carrier_inertia = match (carrier, shaft) {
-                    (Carrier::Shaft, ShaftDrive::Inertial { j1, .. }) => Some(j1),
+                let carrier_inertia = match (carrier, &shaft) {
+                    (Carrier::Shaft, ShaftDrive::Inertial { j1, .. }) => Some(*j1),
                     (Carrier::Drum, _) => pack.drum.map(|dr| dr.inertia_kg_m2),
                     _ => None,
                 };
@@ -210,7 +240,6 @@ impl<'a> Run<'a> {
             .as_ref()
             .map(|st| Stack::new(st, pack.discs.len()));
         Ok(Run {
-            pack,
             bodies,
             world,
             shaft,
@@ -236,6 +265,10 @@ impl<'a> Run<'a> {
             omega_s: pack.shaft.initial_speed_rad_s(),
             potential_j: 0.0,
             energy: EnergyBook::default(),
+            drive_switch: None,
+            exact_drum_load: false,
+            load_switch: None,
+            pack,
         })
     }
 
