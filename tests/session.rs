@@ -22,6 +22,7 @@ fn whole_and_split(sim: &mut Simulation, duration: f64, calls: usize) -> (Collec
     let mut whole = Collector::default();
     sim.engine_mut().run(duration, &mut whole).unwrap();
     let mut split = Collector::default();
+    let reference = sim.engine_name() == "reference";
     let mut s = sim.engine_mut().start(Driven::NONE).unwrap();
     s.set_stop_time(duration);
     for k in 1..=calls {
@@ -31,10 +32,17 @@ fn whole_and_split(sim: &mut Simulation, duration: f64, calls: usize) -> (Collec
             duration * k as f64 / calls as f64
         };
         assert_eq!(s.advance_to(t, &mut split).unwrap(), Advance::Reached);
-        assert_eq!(s.time_s(), t);
+        // the reference engine stands at t (its dense output); the multibody engine's world
+        // step may end past it (module docs of crates/sim/src/engine/session.rs)
+        let now = s.time_s();
+        if reference {
+            assert_eq!(now, t);
+        } else {
+            assert!(now >= t, "{now} < {t}");
+        }
         // nothing after the session's time has been sent
-        assert!(split.samples.last().is_none_or(|x| x.t_s <= t));
-        assert!(split.impacts.iter().all(|e| e.t_off_s <= t));
+        assert!(split.samples.last().is_none_or(|x| x.t_s <= now));
+        assert!(split.impacts.iter().all(|e| e.t_off_s <= now));
     }
     s.finish(&mut split);
     (whole, split)
@@ -80,6 +88,21 @@ fn reference_sessions_in_any_number_of_calls_are_the_run() {
 }
 
 #[test]
+fn multibody_sessions_in_any_number_of_calls_are_the_run() {
+    // the multirate scheme (prescribed shafts, the open brake) and the shared step (the
+    // engaging clutch's clamped stack)
+    for file in [
+        "scenes/hu-table2.toml",
+        "scenes/pack-4-rattle.toml",
+        "scenes/pack-6-engagement.toml",
+        "scenes/staggered-8-disc.toml",
+        "scenes/pack-8-brake.toml",
+    ] {
+        assert_identical(file, EngineChoice::Multibody, 0.05);
+    }
+}
+
+#[test]
 fn reference_session_on_an_inertial_shaft_is_the_run() {
     // the coupled scheme (the shaft integrated with the discs in contact)
     let o: Vec<Override> = [
@@ -107,6 +130,8 @@ fn a_restored_state_gives_the_same_outputs() {
     for (file, engine) in [
         ("scenes/pack-4-rattle.toml", EngineChoice::Reference),
         ("scenes/pack-6-engagement.toml", EngineChoice::Reference),
+        ("scenes/pack-4-rattle.toml", EngineChoice::Multibody),
+        ("scenes/pack-6-engagement.toml", EngineChoice::Multibody),
     ] {
         let sim = simulation(file, engine, 0.1);
         let driven = Driven::all_for(&sim.scene().pack);

@@ -43,7 +43,7 @@ impl Driven {
 
     /// Whether `pack` has every input driven: a prescribed shaft for its speed, an inertial
     /// shaft for its torque, a drum for its load, a stack for the pressure. The error says
-    /// which is missing.
+    /// what is missing (all of it).
     pub fn check(&self, pack: &PackModel) -> Result<(), EngineError> {
         let inertial = matches!(pack.shaft, Shaft::Inertial { .. });
         let missing = [
@@ -60,9 +60,15 @@ impl Driven {
                     .into(),
             ));
         }
-        match missing.iter().find(|(m, _)| *m) {
-            Some((_, why)) => Err(EngineError::Unsupported(why.to_string())),
-            None => Ok(()),
+        let why: Vec<&str> = missing
+            .iter()
+            .filter(|(m, _)| *m)
+            .map(|(_, w)| *w)
+            .collect();
+        if why.is_empty() {
+            Ok(())
+        } else {
+            Err(EngineError::Unsupported(why.join("; ")))
         }
     }
 
@@ -253,7 +259,10 @@ pub enum Advance {
 
 /// A run in progress that owns everything it needs (no borrow of the engine or the model).
 pub trait Session: Send {
-    /// The time the session stands at, s (the last communication point reached).
+    /// The time the session's state stands at, s: the last communication point reached; a
+    /// session driven by nothing on the multibody engine may stand up to one world step past
+    /// it (its steps never end at a call), the reference engine exactly at it (its dense
+    /// output).
     fn time_s(&self) -> f64;
     /// Sets inputs from [`Session::time_s`] on, held until changed. Fails (nothing changed)
     /// on an input the session does not drive or a value that is not finite.
@@ -268,7 +277,7 @@ pub trait Session: Send {
     /// it a session driven by nothing steps past its communication points as far as its
     /// steps go.
     fn set_stop_time(&mut self, t_s: f64);
-    /// The pack's state at [`Session::time_s`].
+    /// The pack's state at [`Session::time_s`] (`sample.t_s`).
     fn snapshot(&self) -> Snapshot;
     /// Ends the run at [`Session::time_s`]: the contact events still open are closed and
     /// sent; returns the run's statistics. The session is spent afterwards.
@@ -280,7 +289,7 @@ pub trait Session: Send {
 
 /// A held (zero-order hold) table driving the shaft: its speed (prescribed shaft, `true`) or
 /// its drive torque (inertial shaft, `false`).
-fn held_table(pack: &PackModel) -> Option<(&Table, bool)> {
+pub fn held_table(pack: &PackModel) -> Option<(&Table, bool)> {
     match &pack.shaft {
         Shaft::Prescribed(SpeedProfile::Table(t)) if t.hold => Some((t, true)),
         Shaft::Inertial {
@@ -359,13 +368,7 @@ pub trait Engine {
     /// Starts a steppable run at t = 0 ([`Session`]) whose caller drives the inputs `driven`
     /// (the others follow the scene's profiles). The session owns a copy of the model: the
     /// engine stays usable.
-    fn start(&self, driven: Driven) -> Result<Box<dyn Session>, EngineError> {
-        let _ = driven;
-        Err(EngineError::Unsupported(format!(
-            "the {} engine is not steppable yet",
-            self.name()
-        )))
-    }
+    fn start(&self, driven: Driven) -> Result<Box<dyn Session>, EngineError>;
     /// Runs from t = 0 to `duration_s`, sending samples and impacts to `observer`. On error,
     /// everything before the failure has already been delivered. Built on [`Engine::start`]
     /// ([`run_engine`]).

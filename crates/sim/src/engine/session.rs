@@ -395,26 +395,35 @@ impl MultibodySession {
         let run = &mut self.run;
         let t = run.t;
         let mut shaft_jump = 0.0;
-        if let Some(w) = inputs.shaft_speed_rad_s {
+        if inputs.shaft_speed_rad_s.is_some()
+            || inputs.shaft_speed_slope_rad_s2.is_some()
+            || inputs.shaft_speed_curvature_rad_s3.is_some()
+        {
+            let w = inputs.shaft_speed_rad_s.unwrap_or(run.omega_s);
             let held = SpeedProfile::Held {
                 t0_s: t,
                 angle0_rad: run.theta_s,
                 speed_rad_s: w,
+                accel_rad_s2: inputs.shaft_speed_slope_rad_s2.unwrap_or(0.0),
+                jerk_rad_s3: inputs.shaft_speed_curvature_rad_s3.unwrap_or(0.0),
             };
             Arc::make_mut(&mut run.pack).shaft = Shaft::Prescribed(held.clone());
             run.shaft = ShaftDrive::Prescribed(Arc::new(held));
             shaft_jump = w - run.omega_s;
             run.omega_s = w;
         }
-        if let Some(torque) = inputs.shaft_torque_n_m {
+        if inputs.shaft_torque_n_m.is_some() || inputs.shaft_torque_slope_n_m_s.is_some() {
             let before = run.drive_torque(t);
+            let torque = inputs.shaft_torque_n_m.unwrap_or(before);
             if run.drive_switch.is_none_or(|(ts, _)| ts != t) {
                 run.drive_switch = Some((t, before));
             }
             if let Shaft::Inertial { excitation, .. } = &mut Arc::make_mut(&mut run.pack).shaft {
                 let initial_speed_rad_s = excitation_initial_speed(excitation);
                 *excitation = ShaftExcitation::Held {
+                    t0_s: t,
                     torque_n_m: torque,
+                    rate_n_m_s: inputs.shaft_torque_slope_n_m_s.unwrap_or(0.0),
                     initial_speed_rad_s,
                 };
             }
@@ -470,11 +479,15 @@ fn hold_driven_inputs(pack: &mut clutchpack_model::PackModel, driven: &Driven) {
                 t0_s: 0.0,
                 angle0_rad: 0.0,
                 speed_rad_s: p.speed(0.0),
+                accel_rad_s2: 0.0,
+                jerk_rad_s3: 0.0,
             };
         }
         Shaft::Inertial { excitation, .. } if driven.shaft_torque => {
             *excitation = ShaftExcitation::Held {
+                t0_s: 0.0,
                 torque_n_m: t0_torque,
+                rate_n_m_s: 0.0,
                 initial_speed_rad_s: excitation_initial_speed(excitation),
             };
         }
@@ -487,31 +500,13 @@ fn hold_driven_inputs(pack: &mut clutchpack_model::PackModel, driven: &Driven) {
     }
 }
 
-/// Why `pack` cannot take the inputs `driven` (`None`: it can).
-pub(super) fn refused_inputs(
-    pack: &clutchpack_model::PackModel,
-    driven: &Driven,
-) -> Option<String> {
-    let prescribed = matches!(pack.shaft, Shaft::Prescribed(_));
-    let mut why = Vec::new();
-    if driven.shaft_speed && !prescribed {
-        why.push("a driven shaft speed needs a prescribed shaft (this one is inertial: drive its torque)");
-    }
-    if driven.shaft_torque && prescribed {
-        why.push("a driven shaft torque needs an inertial shaft (this one is prescribed: drive its speed)");
-    }
-    if driven.drum_load && pack.drum.is_none() {
-        why.push("a driven drum load needs a drum (this pack has none)");
-    }
-    if driven.piston_pressure && pack.stack.is_none() {
-        why.push("a driven piston pressure needs a stack (this pack has none)");
-    }
-    (!why.is_empty()).then(|| why.join("; "))
-}
-
 impl Session for MultibodySession {
     fn time_s(&self) -> f64 {
         self.run.t
+    }
+
+    fn set_stop_time(&mut self, t_s: f64) {
+        self.set_end(t_s);
     }
 
     fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
