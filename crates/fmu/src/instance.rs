@@ -7,13 +7,14 @@ use crate::variables::Variable;
 use crate::variables::{
     variables, BodyField, Causality, ImpactField, Input, InterfaceField, Kind, Quantity,
 };
-use clutchpack_model::session::{Driven, Inputs, Snapshot};
+use clutchpack_model::session::{Advance, Driven, Inputs, Snapshot};
 use clutchpack_record::{RecordOptions, Replace};
 use clutchpack_scene::{EngineChoice, Scene};
 use clutchpack_sdk::{
     RecordingRequest, RunOutcome, Session, SessionRequest, SessionState, Simulation,
 };
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 
 /// Where an instance is in FMI's state machine.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -42,6 +43,8 @@ pub struct SavedState {
 /// One FMU instance.
 pub struct Instance {
     scene: Scene,
+    /// The inputs the caller drives.
+    driven: Driven,
     vars: Vec<Variable>,
     /// Value of every Real variable by value reference (parameters and inputs as set,
     /// outputs as last computed).
@@ -87,11 +90,21 @@ pub fn load_resources(resources: &Path, guid: &str) -> Result<Scene, String> {
 }
 
 impl Instance {
-    /// An instance of `scene` (engine: the scene's choice, as `clutchpack run` makes it).
+    /// An instance of `scene` (engine: the scene's choice, as `clutchpack run` makes it)
+    /// driving every input the pack has, as an FMU does.
     pub fn new(scene: Scene) -> Result<Instance, String> {
+        let driven = Driven::all_for(&scene.pack);
+        Instance::driving(scene, driven)
+    }
+
+    /// An instance of `scene` whose caller drives only `driven` (the other inputs follow the
+    /// scene's profiles; Python's `Simulation`). Driving nothing, the run is the scene's run
+    /// split into calls.
+    pub fn driving(scene: Scene, driven: Driven) -> Result<Instance, String> {
         let engine = scene.engine(None, &scene.name).map_err(|e| e.to_string())?;
-        let vars = variables(&scene, engine.name());
+        let vars = variables(&scene, engine.name(), driven);
         let mut inst = Instance {
+            driven,
             reals: Vec::new(),
             slopes: Vec::new(),
             strings: Vec::new(),
@@ -210,15 +223,17 @@ impl Instance {
         let sim = Simulation::new(self.scene.clone(), Some(engine)).map_err(|e| e.to_string())?;
         let mut session = sim
             .start(SessionRequest {
-                driven: Driven::all_for(&self.scene.pack),
+                driven: self.driven,
                 stop_time_s: self.stop_time_s,
                 recording,
                 keep_history: false,
             })
             .map_err(|e| e.to_string())?;
-        session
-            .set_inputs(&self.inputs())
-            .map_err(|e| e.to_string())?;
+        if self.driven.any() {
+            session
+                .set_inputs(&self.inputs())
+                .map_err(|e| e.to_string())?;
+        }
         self.snapshot = session.snapshot();
         self.session = Some(session);
         self.phase = Phase::Stepping;
@@ -450,7 +465,6 @@ impl Instance {
                 self.phase
             ));
         }
-        let inputs = self.inputs();
         let limit = self.real_of(Quantity::DurationLimit);
         let session = self.session.as_mut().expect("a session while stepping");
         let now = session.time_s();
@@ -469,12 +483,31 @@ impl Instance {
                  run longer)"
             ));
         }
-        session.set_inputs(&inputs).map_err(|e| e.to_string())?;
-        match session.advance_to(end.max(now), None) {
-            Ok(_) => {
+        self.advance_to(end.max(now), None).map(|_| ())
+    }
+
+    /// Holds the inputs set from the run's time and advances to `t_end` (s); `stop` (checked
+    /// at the engine's progress polls) ends it early: `Ok(false)`, the run standing at an
+    /// earlier time. The steps of [`Instance::do_step`] without its checks of the host's
+    /// communication point and the duration limit (Python's `Simulation`).
+    pub fn advance_to(&mut self, t_end: f64, stop: Option<&AtomicBool>) -> Result<bool, String> {
+        if self.phase != Phase::Stepping {
+            return Err(format!(
+                "advancing in {:?}: allowed only after initialization",
+                self.phase
+            ));
+        }
+        let inputs = self.inputs();
+        let session = self.session.as_mut().expect("a session while stepping");
+        if self.driven.any() {
+            session.set_inputs(&inputs).map_err(|e| e.to_string())?;
+        }
+        match session.advance_to(t_end, stop) {
+            Ok(a) => {
                 self.snapshot = session.snapshot();
-                Ok(())
+                Ok(a == Advance::Reached)
             }
+            Err(e) if e.is_bad_input() => Err(e.to_string()),
             Err(e) => {
                 self.phase = Phase::Failed;
                 Err(e.to_string())

@@ -21,6 +21,7 @@
 #![warn(missing_docs)]
 
 pub mod description;
+#[cfg(feature = "ffi")]
 pub mod ffi;
 pub mod instance;
 pub mod package;

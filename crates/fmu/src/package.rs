@@ -90,7 +90,7 @@ pub fn write_fmu(
     let scene = &scene;
     let scene_json = serde_json::to_string_pretty(scene).expect("a scene serialises");
     let guid = guid(&scene_json);
-    let vars = variables(scene, engine.name());
+    let vars = variables(scene, engine.name(), Driven::all_for(&scene.pack));
     let xml = model_description(
         &Header {
             model_name: &scene.name,

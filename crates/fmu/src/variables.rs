@@ -152,9 +152,9 @@ pub const UNITS: [(&str, [i32; 4]); 8] = [
 ];
 
 /// The FMU's variables for `scene`, whose run the engine `engine` (`reference` or
-/// `multibody`) makes: parameters, then inputs (what [`Driven::all_for`] gives the pack),
-/// then outputs.
-pub fn variables(scene: &Scene, engine: &str) -> Vec<Variable> {
+/// `multibody`) makes with the inputs `driven` (an FMU drives what [`Driven::all_for`] gives
+/// the pack): parameters, then inputs, then outputs.
+pub fn variables(scene: &Scene, engine: &str, driven: Driven) -> Vec<Variable> {
     let mut v = Table::default();
     let pack = &scene.pack;
     v.string(
@@ -179,7 +179,6 @@ pub fn variables(scene: &Scene, engine: &str) -> Vec<Variable> {
          if it exists",
         "",
     );
-    let driven = Driven::all_for(pack);
     let shaft0 = pack.shaft.initial_speed_rad_s();
     if driven.shaft_speed {
         v.input(
@@ -201,7 +200,7 @@ pub fn variables(scene: &Scene, engine: &str) -> Vec<Variable> {
             pack.shaft.drive_torque_n_m(0.0),
         );
     }
-    if let Some(d) = &pack.drum {
+    if let Some(d) = pack.drum.as_ref().filter(|_| driven.drum_load) {
         v.input(
             "drum.load_torque_n_m",
             Input::DrumLoad,
@@ -211,7 +210,7 @@ pub fn variables(scene: &Scene, engine: &str) -> Vec<Variable> {
             d.load_torque_n_m,
         );
     }
-    if let Some(s) = &pack.stack {
+    if let Some(s) = pack.stack.as_ref().filter(|_| driven.piston_pressure) {
         v.input(
             "piston.pressure_pa",
             Input::PistonPressure,
@@ -226,7 +225,7 @@ pub fn variables(scene: &Scene, engine: &str) -> Vec<Variable> {
         "rad",
         "the shaft's angle",
     );
-    if driven.shaft_torque {
+    if matches!(pack.shaft, clutchpack_model::Shaft::Inertial { .. }) {
         v.output(
             "shaft.speed_rad_s",
             Quantity::ShaftSpeed,

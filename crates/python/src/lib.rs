@@ -10,6 +10,8 @@
 //! (SIGINT) stops it within about 50 ms of wall time, its outputs complete (the recording
 //! finished), and then raises `KeyboardInterrupt`.
 
+mod stepper;
+
 use clutchpack_scene::{EngineChoice, Override};
 use clutchpack_sdk::{Error, RecordingRequest, RunRequest, Simulation};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -564,6 +566,8 @@ fn _clutchpack(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ImpactColumns>()?;
     m.add_class::<RawRun>()?;
     m.add_class::<RawRecording>()?;
+    m.add_class::<stepper::Stepper>()?;
+    m.add_class::<stepper::StepperState>()?;
     m.add_function(wrap_pyfunction!(load_scene, m)?)?;
     m.add_function(wrap_pyfunction!(scene_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;

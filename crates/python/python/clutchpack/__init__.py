@@ -33,7 +33,10 @@ from ._clutchpack import Scene
 
 __version__: str = _clutchpack.__version__
 
-__all__ = ["Scene", "Result", "Sweep", "load_scene", "run", "sweep", "read", "study", "IMPACT_COLUMNS"]
+__all__ = [
+    "Scene", "Result", "Sweep", "Simulation", "load_scene", "run", "sweep", "read", "study",
+    "IMPACT_COLUMNS",
+]
 
 #: The columns of ``Result.impacts``, as in ``clutchpack run --impacts-csv``: body name,
 #: onset, peak and separation times (s), flank (``drive`` or ``coast``... as the CSV), the
@@ -239,3 +242,84 @@ def sweep(
                 row[f"{stat}_{k}"] = v
         flat.append(row)
     return Sweep(summary=summary, rows=pd.DataFrame(flat))
+
+
+class Simulation:
+    """A run advanced call by call, for controllers and co-simulation written in Python: the
+    FMU of ``clutchpack fmu`` as a Python object, with the same inputs, outputs and names.
+
+        >>> sim = clutchpack.Simulation("scenes/pack-6-engagement.toml", drive=["piston_pressure"])
+        >>> for k in range(1, 301):
+        ...     sim.advance_to(k * 1e-3, **{"piston.pressure_pa": controller(sim.outputs)})
+        >>> summary = sim.finish()
+
+    ``drive`` names the inputs the caller sets (``"shaft_speed"``, ``"shaft_torque"``,
+    ``"drum_load"``, ``"piston_pressure"``); the others follow the scene's profiles. Driving
+    nothing, the run is the scene's run split into calls, impact for impact. An input set in
+    ``advance_to`` is held from the current time until it is set again (docs/DECISIONS.md
+    "Co-simulation"); ``slopes`` gives an input's slope (per s) for a first-order hold.
+    Outputs (``outputs``, a dict): ``pack.shaft_torque_n_m`` (the pack's torque on the shaft,
+    N m), per body ``discs[i].load_n`` (N), ``speed_rad_s``, ``torque_n_m``, ``max_load_n``,
+    ``damage``, per interface ``interfaces[m].torque_n_m`` ..., ``impacts`` and the last
+    impact (``last_impact.*``), as the FMU's (indices from 1). ``advance_to`` releases the GIL;
+    Ctrl-C stops it (the run stands at an earlier time, everything before kept) and raises
+    ``KeyboardInterrupt``.
+    """
+
+    def __init__(
+        self,
+        scene: SceneLike = None,
+        engine: Optional[str] = None,
+        drive: Iterable[str] = (),
+        set: Optional[Mapping[str, Any]] = None,
+        record: Optional[PathLike] = None,
+        stop_time: Optional[float] = None,
+    ) -> None:
+        sc = load_scene(scene, set)
+        self.scene: Scene = sc
+        self._s = _clutchpack.Stepper(
+            sc, engine, list(drive), os.fspath(record) if record is not None else None, stop_time
+        )
+        #: Every variable: name -> (causality, unit, description).
+        self.variables: Dict[str, tuple] = {
+            name: (c, unit, doc) for name, c, unit, doc in self._s.variables()
+        }
+        #: The inputs the caller sets, by name (e.g. ``"shaft.speed_rad_s"``).
+        self.inputs: List[str] = [n for n, v in self.variables.items() if v[0] == "input"]
+
+    @property
+    def time(self) -> float:
+        """The time the run stands at, s."""
+        return self._s.time
+
+    @property
+    def outputs(self) -> Dict[str, float]:
+        """Every output now, by name (SI units; ``variables`` gives each unit)."""
+        return dict(self._s.outputs())
+
+    def advance_to(
+        self, t: float, slopes: Optional[Mapping[str, float]] = None, **inputs: float
+    ) -> "Simulation":
+        """Sets ``inputs`` (by their names, e.g. ``**{"shaft.speed_rad_s": 201.0}``), held from
+        now on, and advances to ``t`` (s). Unknown inputs raise ``ValueError`` naming the
+        inputs this simulation has."""
+        alone = [k for k in (slopes or {}) if k not in inputs]
+        if alone:
+            raise ValueError(f"slopes[{alone[0]!r}]: set the input's value with its slope")
+        for name, value in inputs.items():
+            self._s.set_input(name, float(value), (slopes or {}).get(name))
+        self._s.advance_to(float(t))
+        return self
+
+    def save(self) -> Any:
+        """The whole state, to ``restore`` later (not while recording)."""
+        return self._s.save()
+
+    def restore(self, state: Any) -> None:
+        """Back to a state from ``save``: advancing again gives the same outputs."""
+        self._s.restore(state)
+
+    def finish(self) -> Dict[str, Any]:
+        """Ends the run (the recording finished) and returns its summary, as
+        ``clutchpack run --summary-json`` (per-body statistics and fatigue)."""
+        return json.loads(self._s.finish())

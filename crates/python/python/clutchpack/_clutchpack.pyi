@@ -83,3 +83,31 @@ def study_run(
     study: _Path, out: _Path, jobs: Optional[int] = None, shard: int = 0, shards: int = 1
 ) -> Tuple[str, int, int, int, int, bool]: ...
 def study_merge(dir: _Path, plot_format: str = "png") -> str: ...
+
+class StepperState:
+    """A saved state of a Stepper."""
+
+class Stepper:
+    """A run advanced call by call (``clutchpack.Simulation`` wraps it)."""
+    def __init__(
+        self,
+        scene: Scene,
+        engine: Optional[str] = None,
+        drive: Sequence[str] = ...,
+        record: Optional[str] = None,
+        stop_time: Optional[float] = None,
+    ) -> None: ...
+    @property
+    def time(self) -> float:
+        """The run's time, s."""
+    def variables(self) -> List[Tuple[str, str, str, str]]:
+        """(name, causality, unit, description) of every variable."""
+    def set_input(
+        self, name: str, value: float, slope: Optional[float] = None, curvature: Optional[float] = None
+    ) -> None: ...
+    def advance_to(self, t: float) -> None: ...
+    def outputs(self) -> List[Tuple[str, float]]: ...
+    def save(self) -> StepperState: ...
+    def restore(self, state: StepperState) -> None: ...
+    def finish(self) -> str:
+        """The run's summary (JSON text)."""
