@@ -112,6 +112,30 @@ pub struct Inputs {
 }
 
 impl Inputs {
+    /// The scene's values at `t_s` of the inputs `driven` (the others `None`): what a driven
+    /// session holds from its start until its caller sets them.
+    pub fn of_scene(pack: &PackModel, driven: &Driven, t_s: f64) -> Inputs {
+        let speed = match &pack.shaft {
+            Shaft::Prescribed(p) => Some(p.speed(t_s)),
+            Shaft::Inertial { .. } => None,
+        };
+        Inputs {
+            shaft_speed_rad_s: speed.filter(|_| driven.shaft_speed),
+            shaft_torque_n_m: Some(pack.shaft.drive_torque_n_m(t_s))
+                .filter(|_| driven.shaft_torque),
+            drum_load_n_m: pack
+                .drum
+                .map(|d| d.load_torque_n_m)
+                .filter(|_| driven.drum_load),
+            piston_pressure_pa: pack
+                .stack
+                .as_ref()
+                .map(|s| s.piston.pressure.pressure_pa(t_s))
+                .filter(|_| driven.piston_pressure),
+            ..Inputs::default()
+        }
+    }
+
     /// The driven inputs that `self` sets and `driven` does not allow, by name.
     pub fn undriven(&self, driven: &Driven) -> Vec<&'static str> {
         let mut out = Vec::new();

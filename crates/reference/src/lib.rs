@@ -151,7 +151,7 @@ mod session;
 mod stepper;
 mod system;
 
-use clutchpack_model::session::{Driven, Session};
+use clutchpack_model::session::{Driven, Inputs, Session};
 use clutchpack_model::{Engagement, Engine, EngineError, PackModel, Shaft};
 use session::MonolithicSession;
 use std::sync::Arc;
@@ -398,7 +398,7 @@ impl Engine for ReferenceEngine {
         }
         driven.check(&self.pack)?;
         let (pack, settings) = (Arc::new(self.pack.clone()), &self.settings);
-        Ok(match (self.scheme, &self.pack.shaft) {
+        let mut session: Box<dyn Session> = match (self.scheme, &self.pack.shaft) {
             (Scheme::Multirate, _) if pack.discs.is_empty() || self.is_whole() => {
                 Box::new(MonolithicSession::new(pack, settings, driven))
             }
@@ -409,6 +409,11 @@ impl Engine for ReferenceEngine {
             (Scheme::Multirate, Shaft::Inertial { .. }) => {
                 Box::new(coupled::CoupledSession::new(pack, settings, driven))
             }
-        })
+        };
+        if driven.any() {
+            // the driven inputs held at the scene's values until the caller sets them
+            session.set_inputs(&Inputs::of_scene(&self.pack, &driven, 0.0))?;
+        }
+        Ok(session)
     }
 }
