@@ -296,6 +296,23 @@ pub enum ShaftExcitation {
     },
 }
 
+impl ShaftExcitation {
+    /// The shaft's speed at t = 0 this drive starts it at, rad/s.
+    pub fn initial_speed_rad_s(&self) -> f64 {
+        match self {
+            ShaftExcitation::Profile(p) => p.speed(0.0),
+            ShaftExcitation::Torque {
+                initial_speed_rad_s,
+                ..
+            }
+            | ShaftExcitation::Held {
+                initial_speed_rad_s,
+                ..
+            } => *initial_speed_rad_s,
+        }
+    }
+}
+
 /// The shaft model (MODEL.md section 3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Shaft {
@@ -317,17 +334,7 @@ impl Shaft {
     pub fn initial_speed_rad_s(&self) -> f64 {
         match self {
             Shaft::Prescribed(p) => p.speed(0.0),
-            Shaft::Inertial { excitation, .. } => match excitation {
-                ShaftExcitation::Profile(p) => p.speed(0.0),
-                ShaftExcitation::Torque {
-                    initial_speed_rad_s,
-                    ..
-                }
-                | ShaftExcitation::Held {
-                    initial_speed_rad_s,
-                    ..
-                } => *initial_speed_rad_s,
-            },
+            Shaft::Inertial { excitation, .. } => excitation.initial_speed_rad_s(),
         }
     }
 

@@ -151,10 +151,7 @@ impl Sink for PackSink<'_, '_> {
         self.queue.impact(e);
     }
     fn contact(&mut self, slot: usize, t: f64, sys: &System, y: &[f64], mode: &Option<Engagement>) {
-        if self.queue.wants_contacts {
-            let d = sys.disc_sample(t, slot, y, mode);
-            self.queue.contact(sys.ids[slot], t, d);
-        }
+        self.queue.contact(slot, t, sys, y, mode);
     }
 }
 
@@ -258,12 +255,8 @@ impl Session for CoupledSession {
                 break;
             }
         }
-        self.clock.t = if advance == Advance::Stopped {
-            self.st.t.min(t)
-        } else {
-            t
-        };
-        self.queue.flush(self.clock.t, obs);
+        let now = self.clock.end_call(advance, self.st.t, t);
+        self.queue.flush(now, obs);
         Ok(advance)
     }
 

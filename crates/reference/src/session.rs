@@ -59,9 +59,19 @@ impl Queue {
     pub fn impact(&mut self, e: ImpactEvent) {
         self.items.push_back(Item::Impact(e));
     }
-    pub fn contact(&mut self, disc: usize, t: f64, d: DiscSample) {
+    /// The contact sample of the coupling in `slot` of `sys` at `t` (state `y`), if the
+    /// observer takes them.
+    pub fn contact(
+        &mut self,
+        slot: usize,
+        t: f64,
+        sys: &System,
+        y: &[f64],
+        mode: &Option<Engagement>,
+    ) {
         if self.wants_contacts {
-            self.items.push_back(Item::Contact(disc, t, d));
+            let d = sys.disc_sample(t, slot, y, mode);
+            self.items.push_back(Item::Contact(sys.ids[slot], t, d));
         }
     }
 
@@ -95,10 +105,7 @@ impl Sink for QueueSink<'_> {
         self.queue.impact(e);
     }
     fn contact(&mut self, slot: usize, t: f64, sys: &System, y: &[f64], mode: &Option<Engagement>) {
-        if self.queue.wants_contacts {
-            let d = sys.disc_sample(t, slot, y, mode);
-            self.queue.contact(sys.ids[slot], t, d);
-        }
+        self.queue.contact(slot, t, sys, y, mode);
     }
 }
 
@@ -123,6 +130,17 @@ impl Clock {
             driven,
             failed: false,
         }
+    }
+
+    /// Ends a call to `t` (s) that ended with `advance`, the stepper at `stepper_t` (s): the
+    /// session's time, `t` or (stopped) where the stepper got to.
+    pub fn end_call(&mut self, advance: Advance, stepper_t: f64, t: f64) -> f64 {
+        self.t = if advance == Advance::Stopped {
+            stepper_t.min(t)
+        } else {
+            t
+        };
+        self.t
     }
 
     /// Where the steps of a call to `t` (s) end: at `t` for a driven session, else at the stop
@@ -283,12 +301,8 @@ impl Session for MonolithicSession {
                 break;
             }
         }
-        self.clock.t = if advance == Advance::Stopped {
-            self.st.t.min(t)
-        } else {
-            t
-        };
-        self.queue.flush(self.clock.t, obs);
+        let now = self.clock.end_call(advance, self.st.t, t);
+        self.queue.flush(now, obs);
         Ok(advance)
     }
 

@@ -39,7 +39,7 @@ use super::energy::EnergyAudit;
 use super::multirate;
 use super::state::{shaft_accel_bound, Run, ShaftDrive};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
-use clutchpack_model::session::{Advance, Driven, Inputs, Session, Snapshot};
+use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::{
     EngineError, Observer, PressureProfile, RunStats, Shaft, ShaftExcitation, SpeedProfile,
 };
@@ -110,7 +110,8 @@ impl MultibodySession {
     ) -> Result<MultibodySession, EngineError> {
         let mut pack = pack;
         if driven.any() {
-            hold_driven_inputs(Arc::make_mut(&mut pack), &driven);
+            // the driven inputs held at the scene's values until the caller sets them
+            pack = Arc::new(hold_inputs(&pack, 0.0, &Inputs::of_scene(&pack, &driven, 0.0)).0);
         }
         let mut run = Run::new(pack, options, per_tooth)?;
         run.exact_drum_load = driven.drum_load;
@@ -419,7 +420,7 @@ impl MultibodySession {
                 run.drive_switch = Some((t, before));
             }
             if let Shaft::Inertial { excitation, .. } = &mut Arc::make_mut(&mut run.pack).shaft {
-                let initial_speed_rad_s = excitation_initial_speed(excitation);
+                let initial_speed_rad_s = excitation.initial_speed_rad_s();
                 *excitation = ShaftExcitation::Held {
                     t0_s: t,
                     torque_n_m: torque,
@@ -451,52 +452,6 @@ impl MultibodySession {
         }
         run.shaft_accel_bound = shaft_accel_bound(&run.pack.shaft);
         run.input_changed(shaft_jump, multirate);
-    }
-}
-
-/// The initial speed of an inertial shaft's excitation, rad/s.
-fn excitation_initial_speed(e: &ShaftExcitation) -> f64 {
-    match e {
-        ShaftExcitation::Profile(p) => p.speed(0.0),
-        ShaftExcitation::Torque {
-            initial_speed_rad_s,
-            ..
-        }
-        | ShaftExcitation::Held {
-            initial_speed_rad_s,
-            ..
-        } => *initial_speed_rad_s,
-    }
-}
-
-/// Replaces the driven inputs of `pack` by their scene values at t = 0, held: what a driven
-/// session follows until its caller sets them.
-fn hold_driven_inputs(pack: &mut clutchpack_model::PackModel, driven: &Driven) {
-    let t0_torque = pack.shaft.drive_torque_n_m(0.0);
-    match &mut pack.shaft {
-        Shaft::Prescribed(p) if driven.shaft_speed => {
-            *p = SpeedProfile::Held {
-                t0_s: 0.0,
-                angle0_rad: 0.0,
-                speed_rad_s: p.speed(0.0),
-                accel_rad_s2: 0.0,
-                jerk_rad_s3: 0.0,
-            };
-        }
-        Shaft::Inertial { excitation, .. } if driven.shaft_torque => {
-            *excitation = ShaftExcitation::Held {
-                t0_s: 0.0,
-                torque_n_m: t0_torque,
-                rate_n_m_s: 0.0,
-                initial_speed_rad_s: excitation_initial_speed(excitation),
-            };
-        }
-        _ => {}
-    }
-    if let Some(st) = pack.stack.as_mut().filter(|_| driven.piston_pressure) {
-        st.piston.pressure = PressureProfile::Constant {
-            pressure_pa: st.piston.pressure.pressure_pa(0.0),
-        };
     }
 }
 
