@@ -292,9 +292,10 @@ impl Stepper {
                 tr.last_contact_t = t;
             }
         }
-        let (err, h) = loop {
-            let h = self.h.min(self.max_step).min(end - t);
-            self.h = h;
+        let (err, h, free) = loop {
+            // the step the controller wants, and the one taken (cut short by `end`)
+            let free = self.h.min(self.max_step);
+            let h = free.min(end - t);
             if h < 1e-15 * t.max(1.0) && end - t > 1e-15 * t.max(1.0) {
                 return Err(EngineError::Diverged {
                     t_s: t,
@@ -323,12 +324,16 @@ impl Stepper {
                 self.h = next_step(h, err);
                 continue;
             }
-            break (err, h);
+            break (err, h, free);
         };
         // Accepted: build the dense output of [t, t + h].
         std::mem::swap(&mut self.prev, &mut self.cur);
         self.solver.dense_into(t, &self.y, h, &mut self.cur);
-        let t_end = t + h;
+        // A step cut short by `end` lands on it exactly (`t + (end - t)` may round an ulp
+        // short, which would leave a step of 1e-18 s), and does not shrink the steps after it
+        // (a driven session's calls end every step at a communication point).
+        let cut = h < free;
+        let t_end = if cut { end } else { t + h };
         let sys = &self.sys;
         let cur = &self.cur;
         let buf = &mut self.buf;
@@ -490,7 +495,11 @@ impl Stepper {
             Switch::External(_) => {}
             _ => self.restart(),
         }
-        self.h = next_step(h, err);
+        self.h = if cut {
+            next_step(h, err).max(free)
+        } else {
+            next_step(h, err)
+        };
         self.stats.simulated_s = self.t;
         if self.stats.steps.is_multiple_of(STALL_BLOCK) {
             if self.t - self.block_t0 < STALL_SPAN_S {

@@ -251,3 +251,77 @@ fn clamped_faces_heat_is_the_mechanical_energy_lost() {
     assert!(heat > 100.0);
     assert!((lost - heat).abs() <= 1e-9 * heat, "{lost} vs {heat}");
 }
+
+/// Break-loose (issue 21's closed form): the engaged pack of [`engagement`] with a braking
+/// preload of 20 N m on the drum from the start (it locks at about 0.11 s), and from 0.2 s a
+/// load rising slowly (4,000 N m/s, held at every 1e-4 s communication point of a driven
+/// session: steps of 0.4 N m) until the faces slip. The locked group (the two plates and the
+/// disc) passes the load to the shaft; each face holds half of it, so the faces break loose
+/// together when the load reaches `mu(0) F R_eff` summed over the two faces (497.07 N m).
+/// Measured: 497.2 N m, the first 0.4 N m step past it (2.7e-4); bound 1e-3 as the issue asks.
+///
+/// Quasi-static only if the teeth stay in contact: with the shipped tooth damping (0.5 s/m)
+/// the drum and the disc rattle in their backlash under the load, and an impact's torque
+/// slips the faces first (measured: at 128 N m). So the teeth here are heavily damped (50
+/// s/m: the contacts settle), and the preload keeps the drum's teeth on the plates' through
+/// the lock (a load put on a drum coasting in its backlash makes the teeth strike).
+#[test]
+fn a_locked_pack_breaks_loose_at_the_faces_static_torque() {
+    use clutchpack_model::session::{Driven, Inputs};
+    let mut pack = engagement();
+    for b in pack.discs.iter_mut().chain(pack.plates.iter_mut()) {
+        b.law.hertz.loss_coefficient_s_m = 50.0;
+    }
+    let stack = pack.stack.clone().unwrap();
+    let engine = ReferenceEngine::new(
+        pack,
+        ReferenceOptions {
+            tolerance: 1e-10,
+            ..ReferenceOptions::default()
+        },
+    );
+    let mut s = engine
+        .start(Driven {
+            drum_load: true,
+            ..Driven::NONE
+        })
+        .unwrap();
+    let mut c = Collector::default();
+    // the preload from the start, then the ramp
+    let (h, preload, t_ramp, rate) = (1e-4, -20.0, 0.2, -4000.0);
+    let expected = 2.0 * stack.friction.static_mu() * 9500.0 * stack.effective_radius_m();
+    let mut broke = None;
+    let mut k = 0;
+    while broke.is_none() && k < 20_000 {
+        let t = k as f64 * h;
+        let load = preload + rate * (t - t_ramp).max(0.0);
+        s.set_inputs(&Inputs {
+            drum_load_n_m: Some(load),
+            ..Inputs::default()
+        })
+        .unwrap();
+        s.advance_to((k + 1) as f64 * h, &mut c).unwrap();
+        let faces = s.snapshot().interfaces;
+        if (t - t_ramp).abs() < 0.5 * h {
+            assert!(
+                faces.iter().all(|f| f.locked),
+                "locked when the ramp starts"
+            );
+        }
+        if t > t_ramp && faces.iter().any(|f| !f.locked) {
+            broke = Some((t, -load, faces));
+        }
+        k += 1;
+    }
+    let (t, load, faces) = broke.expect("the faces break loose");
+    // the load held over the step in which they slipped
+    println!(
+        "break-loose at t = {t} s under {load} N m (closed form {expected} N m): faces {:?}",
+        faces.iter().map(|f| f.locked).collect::<Vec<_>>()
+    );
+    assert!(faces.iter().all(|f| !f.locked), "both faces together");
+    assert!(
+        (load - expected).abs() <= 1e-3 * expected,
+        "{load} N m vs {expected} N m"
+    );
+}
