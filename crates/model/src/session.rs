@@ -303,8 +303,10 @@ pub trait Session: Send {
     fn set_stop_time(&mut self, t_s: f64);
     /// The pack's state at [`Session::time_s`] (`sample.t_s`).
     fn snapshot(&self) -> Snapshot;
-    /// Ends the run at [`Session::time_s`]: the contact events still open are closed and
-    /// sent; returns the run's statistics. The session is spent afterwards.
+    /// Ends the run: the contact events still open are closed (at the engine's last step,
+    /// which a session driven by nothing and without a stop time may have taken past
+    /// [`Session::time_s`]) and sent; returns the run's statistics. The session is spent
+    /// afterwards.
     fn finish(&mut self, observer: &mut dyn Observer) -> RunStats;
     /// A copy of the whole state (FMI state save/restore): advancing the copy gives exactly
     /// what advancing the original would.
