@@ -178,6 +178,18 @@ def test_pack_compare_example_runs():
     assert "hardest hit as shipped: disc-" in p.stdout
 
 
+def test_cosim_engagement_example_runs():
+    """A controller sets the piston pressure every millisecond: the drum reaches the
+    shaft's speed in both engagements, and the two differ (the controller acts)."""
+    p = subprocess.run(
+        [sys.executable, "examples/python/cosim_engagement.py"], capture_output=True, text=True
+    )
+    assert p.returncode == 0, p.stderr
+    lines = [l for l in p.stdout.splitlines() if "drum at the shaft's speed from" in l]
+    assert len(lines) == 2 and "never" not in p.stdout, p.stdout
+    assert lines[0].split(":", 1)[1] != lines[1].split(":", 1)[1], p.stdout
+
+
 STUDY = """
 [study]
 name = "py-study"
