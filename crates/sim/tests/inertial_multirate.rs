@@ -82,8 +82,8 @@ fn options(scheme: Scheme, steps_per_contact: f64, max_step_s: f64) -> Multibody
 /// The 8-disc staggered pack on an inertial shaft (eq 4), multirate at the default settings,
 /// against the shared step at a tight setting (1024 steps per contact, world steps of at most
 /// 25 us): every disc's impacts one by one, each peak within 0.1 % and each onset within
-/// 1 us, over the first 15 ms (43 impacts). Measured 4.6e-5 and 4.9e-9 s; the shared step at
-/// its default settings is 1.1e-3 and 1.2e-7 s off the same reference.
+/// 1 us, over the first 15 ms (43 impacts). Measured 4.3e-5 and 4.6e-9 s; the shared step at
+/// its default settings is 1.1e-3 and 1.2e-7 s off a tighter reference (2048, 10 us).
 ///
 /// Why not 50 ms: this rattle is chaotic (no drag, stiff dry teeth). The shared step at 1024
 /// and at 2048 steps per contact (10 us) agree to 2.6e-6 and 0.3 ns over 15 ms, 4.4e-4 and
