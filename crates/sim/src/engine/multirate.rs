@@ -1020,8 +1020,10 @@ impl Run {
             self.potential_j += self.forces[i].potential_j;
             means.push((end.angle - start.angle - (self.rel[i].phi - phi0)) / h);
         }
-        // The world's step, as on a prescribed shaft (`multirate_step`), the shaft's impulse
-        // handed to its body as the discs' are to theirs.
+        // The world's step, as on a prescribed shaft (`multirate_step`); the shaft's body
+        // gets its mean speed set for the step instead of a torque: rapier's inverse inertia
+        // of the shaft reads 0 until its first step computes the body's mass properties, and
+        // the torque from it, infinite, left every body at rest from then on (measured).
         let shaft_mean = (end.angle - start.angle) / h;
         let bodies = &mut self.world.physics.bodies;
         for (i, &mean) in means.iter().enumerate() {
