@@ -519,9 +519,9 @@ fn engine_for(
 }
 
 /// The scheme is chosen automatically and explained (issue 9): the multirate scheme on a
-/// prescribed shaft with concentric friction discs, the shared step with the reason on an
-/// inertial shaft, on fixed steps and when asked for; asking for the multirate scheme where it
-/// cannot run is refused with the reason.
+/// prescribed or an inertial shaft with concentric friction discs, the shared step with the
+/// reason on an inertial shaft with plates on a drum, on fixed steps and when asked for;
+/// asking for the multirate scheme where it cannot run is refused with the reason.
 #[test]
 fn scheme_is_chosen_and_explained() {
     use clutchpack_model::cases::staggered_pack;
@@ -551,6 +551,21 @@ fn scheme_is_chosen_and_explained() {
         excitation: ShaftExcitation::Profile(SpeedProfile::sine(100.0, 4.378, 104.0)),
     };
     let (multirate, why) = explain(inertial.clone(), adaptive());
+    assert!(multirate, "{why}");
+    assert!(
+        why.starts_with("multirate scheme (automatic: an inertial shaft"),
+        "{why}"
+    );
+    // an inertial shaft with plates on a drum still runs the shared step
+    let mut with_drum = inertial;
+    with_drum.plates = vec![clutchpack_model::cases::bench_disc("plate")];
+    with_drum.drum = Some(clutchpack_model::DrumModel {
+        inertia_kg_m2: 0.3,
+        load_torque_n_m: 0.0,
+        drag_n_m_s_rad: 0.0,
+        initial_speed_rad_s: 0.0,
+    });
+    let (multirate, why) = explain(with_drum.clone(), adaptive());
     assert!(!multirate, "{why}");
     assert!(
         why.starts_with("shared step (automatic: an inertial shaft"),
@@ -560,7 +575,7 @@ fn scheme_is_chosen_and_explained() {
         scheme: Scheme::Multirate,
         ..adaptive()
     };
-    match MultibodyEngine::new(inertial, asked) {
+    match MultibodyEngine::new(with_drum, asked) {
         Err(EngineError::Unsupported(m)) => assert!(m.contains("an inertial shaft"), "{m}"),
         other => panic!("{other:?}"),
     }

@@ -98,7 +98,8 @@ fn cases_to_split() -> Vec<(&'static str, PackModel, Scheme, bool)> {
             Scheme::Shared,
             false,
         ),
-        ("inertial shaft, shared", inertial(), Scheme::Auto, false),
+        ("inertial shaft, multirate", inertial(), Scheme::Auto, true),
+        ("inertial shaft, shared", inertial(), Scheme::Shared, false),
         ("engaging clutch, shared", engaging(), Scheme::Auto, false),
     ]
 }

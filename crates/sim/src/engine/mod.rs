@@ -169,8 +169,10 @@ impl MultibodyEngine {
 
     /// Which time-stepping scheme runs this pack and why, in one line of words for `run` to
     /// print, e.g. `multirate scheme (automatic: a prescribed shaft and concentric friction
-    /// discs only, so the discs are independent within a world step): ...` or `shared step
-    /// (automatic: an inertial shaft (eq 4) couples ...): ...`.
+    /// discs only, so the discs are independent within a world step): ...`, `multirate scheme
+    /// (automatic: an inertial shaft and concentric friction discs only: within a world step
+    /// the shaft is integrated with the discs that may touch it ...): ...` or `shared step
+    /// (automatic: a drum couples ...): ...`.
     pub fn scheme_explanation(&self) -> String {
         let shared = "every body advances with one contact-aware step, the shortest any \
                       coupling needs";
@@ -180,7 +182,13 @@ impl MultibodyEngine {
                     Scheme::Multirate => "asked for",
                     _ => "automatic",
                 };
-                let bodies = if self.pack.plates.is_empty() {
+                let bodies = if matches!(self.pack.shaft, clutchpack_model::Shaft::Inertial { .. })
+                {
+                    "an inertial shaft and concentric friction discs only: within a world step \
+                     the shaft is integrated with the discs that may touch it (in contact, or \
+                     near it) as one system, which conserves the angular momentum exactly, and \
+                     the others fly free against the shaft's motion so found"
+                } else if self.pack.plates.is_empty() {
                     "a prescribed shaft and concentric friction discs only, so the discs are \
                      independent within a world step"
                 } else {

@@ -26,8 +26,13 @@ pub(super) fn unsupported(
     if !matches!(options.stepping, Stepping::Adaptive(_)) {
         return Some("fixed steps (the check mode) step the whole world at dt");
     }
-    if !matches!(pack.shaft, Shaft::Prescribed(_)) {
-        return Some("an inertial shaft (eq 4) couples every disc through its speed within a step");
+    if !matches!(pack.shaft, Shaft::Prescribed(_))
+        && (pack.drum.is_some() || pack.stack.is_some() || !pack.plates.is_empty())
+    {
+        return Some(
+            "an inertial shaft (eq 4) runs multirate with friction discs only (no plates, \
+             drum or stack)",
+        );
     }
     if pack.drum.is_some() {
         return Some("a drum couples its plates within a step through its inertia");
@@ -139,8 +144,8 @@ struct SubStep {
 /// and 0.1 ms, 1e-11 rad, enough to move the onsets of a chaotic rattle by microseconds
 /// within 40 ms).
 struct Relative<'a> {
-    /// The carrier's speed profile: the shaft's, or `None` for the housing (at rest).
-    profile: Option<&'a SpeedProfile>,
+    /// The carrier's motion over the world step.
+    path: Path<'a>,
     coupling: &'a Coupling,
     /// The disc's inverse inertia about the axis, from its rapier mass properties, 1/(kg m^2).
     inv_j: f64,
@@ -154,9 +159,9 @@ impl Relative<'_> {
     /// One classical Runge-Kutta step of length `h` from `(phi, dphi)` at `t`, with the work
     /// of the drive and the drag integrated by the same stages (the augmented system).
     fn rk4(&self, t: f64, shaft: ShaftAt, phi: f64, dphi: f64, h: f64) -> SubStep {
-        let p = self.profile;
+        let p = self.path;
         let (tm, te) = (t + 0.5 * h, t + h);
-        let (mid, end) = (ShaftAt::of(p, tm), ShaftAt::of(p, te));
+        let (mid, end) = (p.at(tm), p.at(te));
         let gap = self.gap;
         let (w0, wm, we) = (shaft.speed, mid.speed, end.speed);
         // The shaft's turn from t, exact.
@@ -226,6 +231,68 @@ impl ShaftAt {
     }
 }
 
+/// The inertial shaft at a sub-step's end: time, s, unwrapped angle, rad, speed, rad/s (the
+/// nodes of [`Path::Nodes`]).
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    t: f64,
+    angle: f64,
+    speed: f64,
+}
+
+/// A carrier's motion over a world step as a coupling's sub-steps see it: a prescribed
+/// shaft's profile, the housing at rest, or an inertial shaft's motion already integrated
+/// over the step ([`Run::integrate_shaft`]) given by its nodes: exact at them, the cubic
+/// Hermite interpolant of angle and speed between them (used by couplings in free flight,
+/// whose motion does not depend on the shaft's: only their depth, for the landing, does).
+#[derive(Debug, Clone, Copy)]
+enum Path<'a> {
+    Profile(&'a SpeedProfile),
+    Housing,
+    Nodes(&'a [Node]),
+}
+
+impl Path<'_> {
+    /// The carrier at `t`.
+    fn at(self, t: f64) -> ShaftAt {
+        match self {
+            Path::Profile(p) => ShaftAt::of(Some(p), t),
+            Path::Housing => ShaftAt::of(None, t),
+            Path::Nodes(n) => {
+                let k = n.partition_point(|x| x.t < t);
+                if k < n.len() && n[k].t == t {
+                    return ShaftAt {
+                        speed: n[k].speed,
+                        angle: n[k].angle,
+                    };
+                }
+                let k = k.clamp(1, n.len() - 1);
+                let (a, b) = (n[k - 1], n[k]);
+                let h = b.t - a.t;
+                let s = (t - a.t) / h;
+                let (s2, s3) = (s * s, s * s * s);
+                let (h00, h10, h01, h11) = (
+                    2.0 * s3 - 3.0 * s2 + 1.0,
+                    s3 - 2.0 * s2 + s,
+                    -2.0 * s3 + 3.0 * s2,
+                    s3 - s2,
+                );
+                // the derivative of the cubic, per unit time
+                let (d00, d10, d01, d11) = (
+                    6.0 * (s2 - s),
+                    3.0 * s2 - 4.0 * s + 1.0,
+                    6.0 * (s - s2),
+                    3.0 * s2 - 2.0 * s,
+                );
+                ShaftAt {
+                    angle: h00 * a.angle + h10 * h * a.speed + h01 * b.angle + h11 * h * b.speed,
+                    speed: (d00 * a.angle + d01 * b.angle) / h + d10 * a.speed + d11 * b.speed,
+                }
+            }
+        }
+    }
+}
+
 /// What the multirate loop counts in a run.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct Counts {
@@ -233,6 +300,9 @@ pub(super) struct Counts {
     pub(super) substeps: u64,
     /// Tooth-law evaluations (stages, landings, the evaluation at each sub-step's end).
     pub(super) evals: u64,
+    /// Inertial shaft: couplings that touched within a world step they were predicted to
+    /// fly through (integrated against the shaft's motion without their own reaction on it).
+    pub(super) missed: u64,
 }
 
 impl Run {
@@ -289,6 +359,9 @@ impl Run {
         closed: &mut Vec<ImpactEvent>,
         contacts: &mut Vec<(usize, f64, DiscSample)>,
     ) -> Result<(), EngineError> {
+        if let ShaftDrive::Inertial { c1, .. } = self.shaft {
+            return self.multirate_step_inertial(t1, a, c1, counts, closed, contacts);
+        }
         let t0 = self.t;
         let h = t1 - t0;
         let ShaftDrive::Prescribed(shaft_profile) = &self.shaft else {
@@ -338,10 +411,14 @@ impl Run {
                 gaps = self.gap_drags(&w);
             }
             let phi0 = self.rel[i].phi;
-            self.integrate_coupling(i, t1, a, gaps[i], counts, closed, contacts)?;
-            let (phi1, dphi1) = (self.rel[i].phi, self.rel[i].dphi);
             let p = self.profile(i);
-            let (c0, c1) = (ShaftAt::of(p.as_deref(), t0), ShaftAt::of(p.as_deref(), t1));
+            let (path, bound) = match p.as_deref() {
+                Some(p) => (Path::Profile(p), self.shaft_accel_bound),
+                None => (Path::Housing, 0.0),
+            };
+            self.integrate_coupling(i, t1, a, gaps[i], path, bound, counts, closed, contacts)?;
+            let (phi1, dphi1) = (self.rel[i].phi, self.rel[i].dphi);
+            let (c0, c1) = (path.at(t0), path.at(t1));
             self.omega_d[i] = c1.speed - dphi1;
             self.potential_j += self.forces[i].potential_j;
             // The body's mean speed over the step: it turns with its carrier less the change
@@ -413,14 +490,14 @@ impl Run {
         t1: f64,
         a: &AdaptiveStepping,
         gap: GapDrag,
+        path: Path<'_>,
+        carrier_accel_bound: f64,
         counts: &mut Counts,
         closed: &mut Vec<ImpactEvent>,
         contacts: &mut Vec<(usize, f64, DiscSample)>,
     ) -> Result<(), EngineError> {
         let bodies = std::sync::Arc::clone(&self.bodies);
         let d = &bodies[i];
-        let profile_arc = self.profile(i);
-        let profile = profile_arc.as_deref();
         let inv_j = self.world.physics.bodies[self.world.discs[i]]
             .mass_properties()
             .local_mprops
@@ -428,11 +505,15 @@ impl Run {
             .z;
         let (g0, rb) = (d.spline.half_play_rad(), d.spline.base_radius_m());
         let offset = d.law.engagement_offset_m();
-        let limit = std::f64::consts::PI / d.spline.teeth as f64;
         let m_eff = self.m_eff[i];
+        // On an inertial shaft the teeth's work is internal (the drive's is the shaft's,
+        // integrated with it) and a coupling integrated here is in free flight (the others
+        // go with the shaft, `integrate_shaft`): one that touches all the same is counted.
+        let inertial = matches!(path, Path::Nodes(_));
+        let mut missed = false;
         let mut t = self.t;
         let (mut phi, mut dphi) = (self.rel[i].phi, self.rel[i].dphi);
-        let mut shaft = ShaftAt::of(profile, t);
+        let mut shaft = path.at(t);
         while t < t1 {
             let f = self.forces[i];
             let wd = shaft.speed - dphi;
@@ -446,12 +527,9 @@ impl Run {
                 m_eff_kg: m_eff,
                 // 1 % over the bound: rounding must not make it optimistic.
                 rel_accel_bound: 1.01
-                    * (if profile.is_some() {
-                        self.shaft_accel_bound
-                    } else {
-                        0.0
-                    } + ((d.drag_n_m_s_rad + gap.damping) * wd.abs() + gap.held_n_m.abs())
-                        * inv_j),
+                    * (carrier_accel_bound
+                        + ((d.drag_n_m_s_rad + gap.damping) * wd.abs() + gap.held_n_m.abs())
+                            * inv_j),
                 event_step_s: self.events.event_step_s(i),
                 event_age_s: self.events.event_age_s(i, t),
             };
@@ -472,7 +550,7 @@ impl Run {
                 want
             };
             let rel = Relative {
-                profile,
+                path,
                 coupling: &self.couplings[i],
                 inv_j,
                 c2: d.drag_n_m_s_rad,
@@ -523,47 +601,454 @@ impl Run {
             shaft = step.shaft;
             counts.substeps += 1;
             counts.evals += step.evals + 1;
-            self.energy.add_sub_step(step.drive_j, step.drag_j);
+            self.energy
+                .add_sub_step(if inertial { 0.0 } else { step.drive_j }, step.drag_j);
             self.energy.add_stack_work(step.gap_j);
-            if !(phi.abs() <= limit && dphi.is_finite()) {
-                return Err(EngineError::Diverged {
-                    t_s: t,
-                    reason: format!(
-                        "disc {i}: relative angle {phi:.6e} rad, speed {dphi:.6e} rad/s (half a tooth \
-                         pitch is {limit:.6e} rad)"
-                    ),
-                });
-            }
-            let rel_state = RelativeState {
-                phi,
-                dphi,
-                ..Default::default()
-            };
-            let f = self.couplings[i].evaluate(&rel_state);
-            if !(f.load_n.is_finite() && f.moment[2].is_finite()) {
-                return Err(EngineError::Diverged {
-                    t_s: t,
-                    reason: format!("disc {i}: tooth load {:.6e} N", f.load_n),
-                });
-            }
-            self.forces[i] = f;
-            self.rel[i] = rel_state;
-            let steps_per_contact = a.steps_per_contact;
-            let step_of = |v| contact_duration_s(&d.law, f.kin.flank, v, m_eff) / steps_per_contact;
-            let tracked = self.events.update(i, t, &f, steps_per_contact, step_of);
-            if let Some(e) = tracked.closed {
-                closed.push(e);
-            }
-            if let Some(at) = tracked.contact_sample_at {
-                // the closing state is sent at the separation
-                let omega_d = shaft.speed - dphi;
-                contacts.push((
-                    i,
-                    at,
-                    disc_sample(&f, &rel_state, shaft.angle, omega_d, Vec::new()),
-                ));
+            let f = self.end_sub_step(i, t, phi, dphi, shaft, a, closed, contacts)?;
+            if inertial && f.depth_m > 0.0 && !missed {
+                missed = true;
+                counts.missed += 1;
             }
         }
+        Ok(())
+    }
+
+    /// Ends a sub-step of coupling `i` at `t` in the relative state `(phi, dphi)` with its
+    /// carrier at `shaft`: checks the state, evaluates the teeth there (advancing their
+    /// contact memory) into `forces[i]` and `rel[i]`, and feeds the events and the contact
+    /// samples.
+    #[allow(clippy::too_many_arguments)]
+    fn end_sub_step(
+        &mut self,
+        i: usize,
+        t: f64,
+        phi: f64,
+        dphi: f64,
+        shaft: ShaftAt,
+        a: &AdaptiveStepping,
+        closed: &mut Vec<ImpactEvent>,
+        contacts: &mut Vec<(usize, f64, DiscSample)>,
+    ) -> Result<CouplingForces, EngineError> {
+        let d = &self.bodies[i];
+        let limit = std::f64::consts::PI / d.spline.teeth as f64;
+        if !(phi.abs() <= limit && dphi.is_finite()) {
+            return Err(EngineError::Diverged {
+                t_s: t,
+                reason: format!(
+                    "disc {i}: relative angle {phi:.6e} rad, speed {dphi:.6e} rad/s (half a tooth \
+                     pitch is {limit:.6e} rad)"
+                ),
+            });
+        }
+        let rel_state = RelativeState {
+            phi,
+            dphi,
+            ..Default::default()
+        };
+        let f = self.couplings[i].evaluate(&rel_state);
+        if !(f.load_n.is_finite() && f.moment[2].is_finite()) {
+            return Err(EngineError::Diverged {
+                t_s: t,
+                reason: format!("disc {i}: tooth load {:.6e} N", f.load_n),
+            });
+        }
+        self.forces[i] = f;
+        self.rel[i] = rel_state;
+        let steps_per_contact = a.steps_per_contact;
+        let m_eff = self.m_eff[i];
+        let step_of = |v| contact_duration_s(&d.law, f.kin.flank, v, m_eff) / steps_per_contact;
+        let tracked = self.events.update(i, t, &f, steps_per_contact, step_of);
+        if let Some(e) = tracked.closed {
+            closed.push(e);
+        }
+        if let Some(at) = tracked.contact_sample_at {
+            // the closing state is sent at the separation
+            let omega_d = shaft.speed - dphi;
+            contacts.push((
+                i,
+                at,
+                disc_sample(&f, &rel_state, shaft.angle, omega_d, Vec::new()),
+            ));
+        }
+        Ok(f)
+    }
+}
+
+/// An inertial shaft's sub-steps are at most the world step over this (dimensionless): the
+/// shaft's own motion under its drive (eq 4) is integrated by the classical method, whose
+/// error per step in the angle grows as the fifth power of the step (see
+/// [`Run::integrate_shaft`]).
+const SHAFT_SUB_STEPS: f64 = 4.0;
+
+/// One classical Runge-Kutta step of an inertial shaft and the couplings that go with it
+/// ([`Run::integrate_shaft`]).
+#[derive(Debug, Clone)]
+struct ShaftStep {
+    /// The shaft's turn over the step, rad, and its speed at the end, rad/s.
+    turn: f64,
+    speed: f64,
+    /// Each coupling's relative angle and speed at the end.
+    phi: Vec<f64>,
+    dphi: Vec<f64>,
+    /// Work of the drive torque on the shaft, J.
+    drive_j: f64,
+    /// Work of the shaft's damping and the discs' drag, J (<= 0).
+    drag_j: f64,
+}
+
+impl Run {
+    /// The bound of an inertial shaft's acceleration at speed `w` with the teeth's torques
+    /// `reaction` (sum of magnitudes, N m) on it, rad/s^2: the drive's bound, the damping,
+    /// the reactions (as the shared step's controller, `control.rs`).
+    fn inertial_accel_bound(&self, c1: f64, inv_j1: f64, w: f64, reaction: f64) -> f64 {
+        self.shaft_accel_bound + (c1 * w.abs() + reaction) * inv_j1
+    }
+
+    /// The inverse of the inertial shaft's inertia `1 / J1`, 1/(kg m^2): the model's, not
+    /// rapier's, which is 0 until its first step computes the body's mass properties.
+    fn inv_j1(&self) -> f64 {
+        match self.shaft {
+            ShaftDrive::Inertial { j1, .. } => 1.0 / j1,
+            ShaftDrive::Prescribed(_) => 0.0,
+        }
+    }
+
+    /// The inverse of a rapier body's inertia about the axis, 1/(kg m^2).
+    fn inv_inertia_z(&self, h: rapier3d_f64::prelude::RigidBodyHandle) -> f64 {
+        self.world.physics.bodies[h]
+            .mass_properties()
+            .local_mprops
+            .inv_principal_inertia
+            .z
+    }
+
+    /// One classical Runge-Kutta step of length `h` from `t` of the inertial shaft (speed
+    /// `w0`) and the couplings `cluster` (relative states `phi`, `dphi`), integrated as one
+    /// system: the shaft `J1 w' = T_drive(t) - C1 w - sum T_k` (Hu et al. eq 4), each disc
+    /// `J w_d' = T_k - C2 w_d` (eq 5), `T_k` the teeth's torque on disc `k` at
+    /// `phi_k = theta_s - theta_d`. As in [`Relative::rk4`] the bodies' own motions are
+    /// integrated, not the relative ones. The teeth's torques cancel in the total angular
+    /// momentum at every stage, so the step conserves it exactly (a linear invariant) but
+    /// for the drive and the damping.
+    #[allow(clippy::too_many_arguments)]
+    fn shaft_rk4(
+        &self,
+        cluster: &[usize],
+        inv_j: &[f64],
+        inv_j1: f64,
+        c1: f64,
+        t: f64,
+        w0: f64,
+        phi: &[f64],
+        dphi: &[f64],
+        h: f64,
+    ) -> ShaftStep {
+        let n = cluster.len();
+        let hh = h * h;
+        let u0: Vec<f64> = (0..n).map(|k| w0 - dphi[k]).collect();
+        // The accelerations at a stage at `ts`: the shaft turned by `s` at speed `w`, disc k
+        // by `th[k]` at `u[k]`; the discs' into `acc`, returns the shaft's and the drive.
+        let stage = |ts: f64, s: f64, w: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
+            let mut teeth = 0.0;
+            for k in 0..n {
+                let i = cluster[k];
+                let torque = self.couplings[i].probe_torque(phi[k] + s - th[k], w - u[k]);
+                teeth += torque;
+                acc[k] = (torque - self.bodies[i].drag_n_m_s_rad * u[k]) * inv_j[k];
+            }
+            let drive = self.drive_torque(ts);
+            ((drive - c1 * w - teeth) * inv_j1, drive)
+        };
+        let (mut k1, mut k2, mut k3, mut k4) =
+            (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let zero = vec![0.0; n];
+        let (a1, d1) = stage(t, 0.0, w0, &zero, &u0, &mut k1);
+        let w2 = w0 + 0.5 * h * a1;
+        let th2: Vec<f64> = u0.iter().map(|u| 0.5 * h * u).collect();
+        let u2: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k1[k]).collect();
+        let (a2, d2) = stage(t + 0.5 * h, 0.5 * h * w0, w2, &th2, &u2, &mut k2);
+        let w3 = w0 + 0.5 * h * a2;
+        let th3: Vec<f64> = (0..n)
+            .map(|k| 0.5 * h * u0[k] + 0.25 * hh * k1[k])
+            .collect();
+        let u3: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k2[k]).collect();
+        let (a3, d3) = stage(
+            t + 0.5 * h,
+            0.5 * h * w0 + 0.25 * hh * a1,
+            w3,
+            &th3,
+            &u3,
+            &mut k3,
+        );
+        let w4 = w0 + h * a3;
+        let th4: Vec<f64> = (0..n).map(|k| h * u0[k] + 0.5 * hh * k2[k]).collect();
+        let u4: Vec<f64> = (0..n).map(|k| u0[k] + h * k3[k]).collect();
+        let (a4, d4) = stage(t + h, h * w0 + 0.5 * hh * a2, w4, &th4, &u4, &mut k4);
+        let h6 = h / 6.0;
+        let turn = h * w0 + h * h6 * (a1 + a2 + a3);
+        let speed = w0 + h6 * (a1 + 2.0 * (a2 + a3) + a4);
+        let sq = |a: f64, b: f64, c: f64, d: f64| a * a + 2.0 * (b * b + c * c) + d * d;
+        let mut drag_j = -c1 * h6 * sq(w0, w2, w3, w4);
+        let mut phi1 = Vec::with_capacity(n);
+        let mut dphi1 = Vec::with_capacity(n);
+        for k in 0..n {
+            let th = h * u0[k] + h * h6 * (k1[k] + k2[k] + k3[k]);
+            let u1 = u0[k] + h6 * (k1[k] + 2.0 * (k2[k] + k3[k]) + k4[k]);
+            phi1.push(phi[k] + turn - th);
+            dphi1.push(speed - u1);
+            drag_j -= self.bodies[cluster[k]].drag_n_m_s_rad * h6 * sq(u0[k], u2[k], u3[k], u4[k]);
+        }
+        ShaftStep {
+            turn,
+            speed,
+            phi: phi1,
+            dphi: dphi1,
+            drive_j: h6 * (d1 * w0 + 2.0 * (d2 * w2 + d3 * w3) + d4 * w4),
+            drag_j,
+        }
+    }
+
+    /// Integrates an inertial shaft from `t` to `t1` together with the couplings `cluster`
+    /// (those that may touch within the world step; the others fly free and load nothing),
+    /// with sub-steps of the shortest any of them wants (the prescribed shaft's controller
+    /// and grading, applied to each), at most the world step over [`SHAFT_SUB_STEPS`], landed
+    /// on every onset and separation. Leaves the couplings' states at `t1` in `rel` and
+    /// `forces`, adds the drive's, the damping's and the drag's work to the audit, feeds the
+    /// events, and returns the shaft's nodes (the motion the free couplings follow).
+    #[allow(clippy::too_many_arguments)]
+    fn integrate_shaft(
+        &mut self,
+        t1: f64,
+        a: &AdaptiveStepping,
+        c1: f64,
+        cluster: &[usize],
+        counts: &mut Counts,
+        closed: &mut Vec<ImpactEvent>,
+        contacts: &mut Vec<(usize, f64, DiscSample)>,
+    ) -> Result<Vec<Node>, EngineError> {
+        let n = cluster.len();
+        let inv_j1 = self.inv_j1();
+        let inv_j: Vec<f64> = cluster
+            .iter()
+            .map(|&i| self.inv_inertia_z(self.world.discs[i]))
+            .collect();
+        let mut t = self.t;
+        let (mut angle, mut w) = (self.theta_s, self.omega_s);
+        let mut phi: Vec<f64> = cluster.iter().map(|&i| self.rel[i].phi).collect();
+        let mut dphi: Vec<f64> = cluster.iter().map(|&i| self.rel[i].dphi).collect();
+        let mut nodes = vec![Node { t, angle, speed: w }];
+        let cap = a.max_step_s / SHAFT_SUB_STEPS;
+        while t < t1 {
+            let reaction: f64 = cluster
+                .iter()
+                .map(|&i| self.forces[i].moment[2].abs())
+                .sum();
+            let a_shaft = self.inertial_accel_bound(c1, inv_j1, w, reaction);
+            let mut want = cap;
+            for (k, &i) in cluster.iter().enumerate() {
+                let d = &self.bodies[i];
+                let f = self.forces[i];
+                let wd = w - dphi[k];
+                let view = CouplingView {
+                    forces: &f,
+                    law: &d.law,
+                    phi: phi[k],
+                    dphi: dphi[k],
+                    g0: d.spline.half_play_rad(),
+                    rb: d.spline.base_radius_m(),
+                    m_eff_kg: self.m_eff[i],
+                    rel_accel_bound: 1.01 * (a_shaft + d.drag_n_m_s_rad * wd.abs() * inv_j[k]),
+                    event_step_s: self.events.event_step_s(i),
+                    event_age_s: self.events.event_age_s(i, t),
+                };
+                let (wk, _) = coupling_step(&view, a);
+                want = want.min(graded_step(wk, &f, self.events.event_age_s(i, t)));
+            }
+            if want.is_nan() || want < a.min_step_s {
+                return Err(EngineError::Diverged {
+                    t_s: t,
+                    reason: format!("inertial shaft: the sub-step collapsed to {want:.3e} s"),
+                });
+            }
+            let rem = t1 - t;
+            let mut h = if want >= rem {
+                rem
+            } else if want > 0.5 * rem {
+                0.5 * rem
+            } else {
+                want
+            };
+            let rk4 = |x: f64| self.shaft_rk4(cluster, &inv_j, inv_j1, c1, t, w, &phi, &dphi, x);
+            let mut step = rk4(h);
+            // Never step over an onset or a separation of any coupling: land on the first.
+            let tiny = 1e-3 * h.min(want);
+            let mut first: Option<f64> = None;
+            for (k, &i) in cluster.iter().enumerate() {
+                let d = &self.bodies[i];
+                let f = &self.forces[i];
+                let (g0, rb) = (d.spline.half_play_rad(), d.spline.base_radius_m());
+                let offset = d.law.engagement_offset_m();
+                let engaged = f.depth_m > 0.0;
+                for flank in FLANKS {
+                    if engaged && flank != f.kin.flank {
+                        continue;
+                    }
+                    let sigma = flank.phi_sign();
+                    let depth = |p: f64| (sigma * p - g0) * rb + offset;
+                    let (d0, d1) = (depth(phi[k]), depth(step.phi[k]));
+                    let crosses = if engaged {
+                        d0 > 0.0 && d1 <= 0.0
+                    } else {
+                        d0 <= 0.0 && d1 > 0.0
+                    };
+                    if !crosses {
+                        continue;
+                    }
+                    let evals = std::cell::Cell::new(0);
+                    let x = bracketed_root(
+                        |x| {
+                            evals.set(evals.get() + 4 * n as u64);
+                            depth(rk4(x).phi[k])
+                        },
+                        0.0,
+                        d0,
+                        h,
+                        d1,
+                        1e-16,
+                    );
+                    counts.evals += evals.get();
+                    if x > tiny && x < h && first.is_none_or(|b| x < b) {
+                        first = Some(x);
+                    }
+                }
+            }
+            if let Some(x) = first {
+                h = x;
+                step = rk4(x);
+                counts.evals += 4 * n as u64;
+            }
+            t = if h == rem { t1 } else { t + h };
+            angle += step.turn;
+            w = step.speed;
+            phi.clone_from(&step.phi);
+            dphi.clone_from(&step.dphi);
+            counts.substeps += 1;
+            counts.evals += 5 * n as u64;
+            self.energy.add_sub_step(step.drive_j, step.drag_j);
+            nodes.push(Node { t, angle, speed: w });
+            let at = ShaftAt { speed: w, angle };
+            for (k, &i) in cluster.iter().enumerate() {
+                self.end_sub_step(i, t, phi[k], dphi[k], at, a, closed, contacts)?;
+            }
+        }
+        Ok(nodes)
+    }
+
+    /// [`Run::multirate_step`] on an inertial shaft (friction discs only): the couplings that
+    /// may touch within the world step (in contact at `t`, or closer to it than the prescribed
+    /// scheme's controller lets a coupling fly within the step, with the shaft's acceleration
+    /// bounded by the drive, the damping and the reactions at `t`) are integrated with the
+    /// shaft as one system ([`Run::integrate_shaft`]); every other coupling then flies free
+    /// against the shaft's motion so found ([`Path::Nodes`]), as against a prescribed shaft.
+    fn multirate_step_inertial(
+        &mut self,
+        t1: f64,
+        a: &AdaptiveStepping,
+        c1: f64,
+        counts: &mut Counts,
+        closed: &mut Vec<ImpactEvent>,
+        contacts: &mut Vec<(usize, f64, DiscSample)>,
+    ) -> Result<(), EngineError> {
+        let t0 = self.t;
+        let h = t1 - t0;
+        let n = self.couplings.len();
+        let inv_j1 = self.inv_j1();
+        let reaction: f64 = self.forces.iter().map(|f| f.moment[2].abs()).sum();
+        let a_shaft = self.inertial_accel_bound(c1, inv_j1, self.omega_s, reaction);
+        let mut cluster = Vec::new();
+        for i in 0..n {
+            let f = self.forces[i];
+            if f.depth_m > 0.0 {
+                cluster.push(i);
+                continue;
+            }
+            let d = &self.bodies[i];
+            let inv_j = self.inv_inertia_z(self.world.discs[i]);
+            let wd = self.omega_s - self.rel[i].dphi;
+            let view = CouplingView {
+                forces: &f,
+                law: &d.law,
+                phi: self.rel[i].phi,
+                dphi: self.rel[i].dphi,
+                g0: d.spline.half_play_rad(),
+                rb: d.spline.base_radius_m(),
+                m_eff_kg: self.m_eff[i],
+                rel_accel_bound: 1.01 * (a_shaft + d.drag_n_m_s_rad * wd.abs() * inv_j),
+                event_step_s: self.events.event_step_s(i),
+                event_age_s: self.events.event_age_s(i, t0),
+            };
+            if coupling_step(&view, a).0 < h {
+                cluster.push(i);
+            }
+        }
+        let phi0: Vec<f64> = self.rel.iter().map(|r| r.phi).collect();
+        let nodes = self.integrate_shaft(t1, a, c1, &cluster, counts, closed, contacts)?;
+        let path = Path::Nodes(&nodes);
+        let mut in_cluster = cluster.iter().peekable();
+        for i in 0..n {
+            if in_cluster.peek() == Some(&&i) {
+                in_cluster.next();
+                continue;
+            }
+            self.integrate_coupling(
+                i,
+                t1,
+                a,
+                GapDrag::default(),
+                path,
+                a_shaft,
+                counts,
+                closed,
+                contacts,
+            )?;
+        }
+        let (start, end) = (nodes[0], nodes[nodes.len() - 1]);
+        let mut means = Vec::with_capacity(n);
+        self.potential_j = 0.0;
+        for (i, &phi0) in phi0.iter().enumerate() {
+            self.omega_d[i] = end.speed - self.rel[i].dphi;
+            self.potential_j += self.forces[i].potential_j;
+            means.push((end.angle - start.angle - (self.rel[i].phi - phi0)) / h);
+        }
+        // The world's step, as on a prescribed shaft (`multirate_step`); the shaft's body
+        // gets its mean speed set for the step instead of a torque: rapier's inverse inertia
+        // of the shaft reads 0 until its first step computes the body's mass properties, and
+        // the torque from it, infinite, left every body at rest from then on (measured).
+        let shaft_mean = (end.angle - start.angle) / h;
+        let bodies = &mut self.world.physics.bodies;
+        for (i, &mean) in means.iter().enumerate() {
+            let body = &mut bodies[self.world.discs[i]];
+            let inv_j = body.mass_properties().local_mprops.inv_principal_inertia.z;
+            let torque = (mean - body.angvel().z) / (h * inv_j);
+            body.reset_forces(false);
+            body.reset_torques(false);
+            body.add_torque(Vector::new(0.0, 0.0, torque), false);
+        }
+        let shaft = &mut bodies[self.world.shaft];
+        shaft.reset_forces(false);
+        shaft.reset_torques(false);
+        shaft.set_angvel(Vector::new(0.0, 0.0, shaft_mean), false);
+        self.world.step(h);
+        let bodies = &mut self.world.physics.bodies;
+        for i in 0..n {
+            let body = &mut bodies[self.world.discs[i]];
+            body.set_angvel(Vector::new(0.0, 0.0, self.omega_d[i]), false);
+        }
+        bodies[self.world.shaft].set_angvel(Vector::new(0.0, 0.0, end.speed), false);
+        self.t_prev = Some(t0);
+        self.t = t1;
+        self.theta_s = end.angle;
+        self.omega_s = end.speed;
         Ok(())
     }
 }
@@ -622,7 +1107,7 @@ mod tests {
         let profile = SpeedProfile::sine(0.0, 0.0, 1.0);
         let (j, c2, w0) = (0.2, 20.0, 1e-3);
         let rel = Relative {
-            profile: Some(&profile),
+            path: Path::Profile(&profile),
             coupling: &coupling,
             inv_j: 1.0 / j,
             c2,

@@ -160,6 +160,14 @@ impl MultibodySession {
         self.counts.substeps
     }
 
+    /// Couplings on an inertial shaft that touched within a world step the multirate scheme
+    /// predicted them to fly through, so far (each integrated for the rest of that step
+    /// against the shaft's motion without its reaction on it; crate docs, "Multirate on an
+    /// inertial shaft"). 0 on the shared step and on a prescribed shaft.
+    pub fn missed_contacts(&self) -> u64 {
+        self.counts.missed
+    }
+
     /// Whether the session runs the multirate scheme.
     pub fn is_multirate(&self) -> bool {
         matches!(self.scheme, Loop::Multirate(_))
