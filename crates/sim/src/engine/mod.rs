@@ -12,9 +12,11 @@ mod control;
 mod energy;
 mod events;
 mod forces;
+mod inertial;
 mod multirate;
 mod session;
 mod state;
+mod substep;
 
 pub use energy::EnergyAudit;
 pub use session::MultibodySession;
