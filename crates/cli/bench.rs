@@ -38,7 +38,11 @@ pub struct BenchArgs {
     /// anchor's pack; the median is reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub brake_runs: usize,
-    /// Only the staggered-pack and brake-pack parts (skips the paper case, the sweep, the
+    /// Repetitions of each inertial-shaft pack timing (N staggered discs on a shaft of 2 kg
+    /// m^2 driven by a torque; the median is reported); 0 skips that part.
+    #[arg(long, default_value_t = 3)]
+    pub inertial_runs: usize,
+    /// Only the staggered-pack, brake-pack and inertial-pack parts (skips the paper case, the sweep, the
     /// recording cost and the shipped whole packs).
     #[arg(long)]
     pub pack_only: bool,
@@ -71,6 +75,9 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         staggered_packs(a.pack_runs, &stop)?;
         if !stop.load(Ordering::SeqCst) {
             brake_packs(a.brake_runs, &stop)?;
+        }
+        if !stop.load(Ordering::SeqCst) {
+            inertial_packs(a.inertial_runs, &stop)?;
         }
         return Ok(if stopped() {
             crate::signals::exit_code()
@@ -256,6 +263,10 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         return Ok(crate::signals::exit_code());
     }
     brake_packs(a.brake_runs, &stop)?;
+    if stopped() {
+        return Ok(crate::signals::exit_code());
+    }
+    inertial_packs(a.inertial_runs, &stop)?;
     Ok(if stopped() {
         crate::signals::exit_code()
     } else {
@@ -398,6 +409,42 @@ fn brake_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     );
     pack_growth(
         clutchpack_model::cases::staggered_brake,
+        &[1, 4, 8, 16],
+        &engines,
+        runs,
+        stop,
+    )
+}
+
+/// 6. Issue 20's inertial-shaft pack: N staggered discs on a shaft of 2 kg m^2 driven by a
+///    torque (eq 4; `cases::staggered_inertial`), per disc, as the pack grows: N = 1, 4, 8 and
+///    16 for 0.1 s, each engine with its default scheme (both multirate since issue 20).
+fn inertial_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
+    if runs == 0 {
+        return Ok(());
+    }
+    let engines = [
+        Timed {
+            label: "reference (multirate, coupled shaft)",
+            max_discs: 16,
+            engine: PackEngine::Reference {
+                scheme: Scheme::default(),
+                parallel: true,
+            },
+        },
+        Timed {
+            label: "multibody (default scheme)",
+            max_discs: 16,
+            engine: PackEngine::Multibody {
+                record_rate_hz: 10_000.0,
+            },
+        },
+    ];
+    out!(
+        "inertial-shaft packs (cases::staggered_inertial: N discs across +-0.8 of the free play on a shaft of 2 kg m^2 driven by a torque, {PACK_DURATION_S} s; {runs} rounds over the sizes); growth = wall per disc / wall per disc at N = 1"
+    );
+    pack_growth(
+        clutchpack_model::cases::staggered_inertial,
         &[1, 4, 8, 16],
         &engines,
         runs,

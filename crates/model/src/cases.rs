@@ -284,6 +284,19 @@ pub fn staggered_pack(n: usize) -> PackModel {
     )
 }
 
+/// [`staggered_pack`] on an inertial shaft (eq 4): `J1 = 2 kg m^2`, undamped, driven by the
+/// torque `J1 d(omega)/dt` of [`bench_drive`] and starting at its speed (issue 20's
+/// inertial-shaft pack).
+pub fn staggered_inertial(n: usize) -> PackModel {
+    let mut pack = staggered_pack(n);
+    pack.shaft = Shaft::Inertial {
+        inertia_kg_m2: 2.0,
+        damping_n_m_s_rad: 0.0,
+        excitation: crate::drive::ShaftExcitation::Profile(bench_drive()),
+    };
+    pack
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
