@@ -387,23 +387,7 @@ fn brake_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     if runs == 0 {
         return Ok(());
     }
-    let engines = [
-        Timed {
-            label: "reference (the default for the pack)",
-            max_discs: 16,
-            engine: PackEngine::Reference {
-                scheme: Scheme::default(),
-                parallel: true,
-            },
-        },
-        Timed {
-            label: "multibody (default scheme)",
-            max_discs: 16,
-            engine: PackEngine::Multibody {
-                record_rate_hz: 10_000.0,
-            },
-        },
-    ];
+    let engines = default_engines("reference (the default for the pack)");
     out!(
         "brake packs (cases::staggered_brake: N discs across +-0.8 of the free play and N + 1 plates on the housing, open gaps, {PACK_DURATION_S} s; {runs} rounds over the sizes); growth = wall per disc / wall per disc at N = 1"
     );
@@ -416,16 +400,12 @@ fn brake_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     )
 }
 
-/// 6. Issue 20's inertial-shaft pack: N staggered discs on a shaft of 2 kg m^2 driven by a
-///    torque (eq 4; `cases::staggered_inertial`), per disc, as the pack grows: N = 1, 4, 8 and
-///    16 for 0.1 s, each engine with its default scheme (both multirate since issue 20).
-fn inertial_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
-    if runs == 0 {
-        return Ok(());
-    }
-    let engines = [
+/// Both engines with their default schemes, up to 16 discs (the brake and inertial packs);
+/// `reference` labels the reference engine's line.
+fn default_engines(reference: &'static str) -> [Timed; 2] {
+    [
         Timed {
-            label: "reference (multirate, coupled shaft)",
+            label: reference,
             max_discs: 16,
             engine: PackEngine::Reference {
                 scheme: Scheme::default(),
@@ -439,7 +419,17 @@ fn inertial_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
                 record_rate_hz: 10_000.0,
             },
         },
-    ];
+    ]
+}
+
+/// 6. Issue 20's inertial-shaft pack: N staggered discs on a shaft of 2 kg m^2 driven by a
+///    torque (eq 4; `cases::staggered_inertial`), per disc, as the pack grows: N = 1, 4, 8 and
+///    16 for 0.1 s, each engine with its default scheme (both multirate since issue 20).
+fn inertial_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
+    if runs == 0 {
+        return Ok(());
+    }
+    let engines = default_engines("reference (multirate, coupled shaft)");
     out!(
         "inertial-shaft packs (cases::staggered_inertial: N discs across +-0.8 of the free play on a shaft of 2 kg m^2 driven by a torque, {PACK_DURATION_S} s; {runs} rounds over the sizes); growth = wall per disc / wall per disc at N = 1"
     );

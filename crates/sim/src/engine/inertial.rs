@@ -5,7 +5,7 @@
 
 use super::multirate::Counts;
 use super::state::{Run, ShaftDrive};
-use super::substep::{graded_step, GapDrag, Node, Path, ShaftAt};
+use super::substep::{graded_step, split_remainder, GapDrag, Node, Path, ShaftAt};
 use crate::hook::FLANKS;
 use crate::options::AdaptiveStepping;
 use crate::stepping::{bracketed_root, coupling_step, CouplingView};
@@ -209,13 +209,7 @@ impl Run {
                 });
             }
             let rem = t1 - t;
-            let mut h = if want >= rem {
-                rem
-            } else if want > 0.5 * rem {
-                0.5 * rem
-            } else {
-                want
-            };
+            let mut h = split_remainder(want, rem);
             let rk4 = |x: f64| self.shaft_rk4(cluster, &inv_j, inv_j1, c1, t, w, &phi, &dphi, x);
             let mut step = rk4(h);
             // Never step over an onset or a separation of any coupling: land on the first.

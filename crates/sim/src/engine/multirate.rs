@@ -4,7 +4,7 @@
 //! rapier body, which carries the disc's state from one world step to the next.
 
 use super::state::{disc_sample, relative_state, Run, ShaftDrive};
-use super::substep::{graded_step, GapDrag, Path, Relative, ShaftAt};
+use super::substep::{graded_step, split_remainder, GapDrag, Path, Relative, ShaftAt};
 use crate::hook::{CouplingForces, RelativeState, FLANKS};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use crate::stepping::{bracketed_root, contact_duration_s, coupling_step, CouplingView};
@@ -318,13 +318,7 @@ impl Run {
                 });
             }
             let rem = t1 - t;
-            let mut h = if want >= rem {
-                rem
-            } else if want > 0.5 * rem {
-                0.5 * rem
-            } else {
-                want
-            };
+            let mut h = split_remainder(want, rem);
             let rel = Relative {
                 path,
                 coupling: &self.couplings[i],

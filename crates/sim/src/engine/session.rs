@@ -38,6 +38,7 @@
 use super::energy::EnergyAudit;
 use super::multirate;
 use super::state::{shaft_accel_bound, Run, ShaftDrive};
+use super::substep::split_remainder;
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::{
@@ -332,13 +333,7 @@ impl MultibodySession {
         self.half_step = if contact { 0.5 * want } else { 0.0 };
         let target = if contact { end } else { next_sample.min(end) };
         let rem = target - t;
-        let h = if want >= rem {
-            rem
-        } else if want > 0.5 * rem {
-            0.5 * rem
-        } else {
-            want
-        };
+        let h = split_remainder(want, rem);
         // The stack's torques for this step enter the landing's prediction.
         run.solve_stack(h);
         // Never step over an onset or a separation: land on it.

@@ -54,6 +54,19 @@ pub(super) fn graded_step(want: f64, f: &CouplingForces, age_s: Option<f64>) -> 
     h
 }
 
+/// The next (sub-)step, s, towards an end `rem` s away when the controller wants `want` s:
+/// the rest if `want` covers it, half of it if `want` covers more than half (two even steps
+/// rather than a long one and a sliver), else `want`.
+pub(super) fn split_remainder(want: f64, rem: f64) -> f64 {
+    if want >= rem {
+        rem
+    } else if want > 0.5 * rem {
+        0.5 * rem
+    } else {
+        want
+    }
+}
+
 /// One sub-step's outcome: the relative state at its end and the work done along it.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct SubStep {
