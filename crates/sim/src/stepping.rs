@@ -129,6 +129,18 @@ pub(crate) fn coupling_step(c: &CouplingView<'_>, a: &AdaptiveStepping) -> (f64,
     (dt, contact)
 }
 
+/// Whether a coupling's engagement depth going from `d0` to `d1` (m) over a step crosses the
+/// contact's boundary: a separation for a coupling `engaged` at the step's start (depth falls
+/// to 0 or below), an onset otherwise (depth rises above 0). The one rule the step controller
+/// and both multirate schemes land their steps on.
+pub(crate) fn crosses_contact(engaged: bool, d0: f64, d1: f64) -> bool {
+    if engaged {
+        d0 > 0.0 && d1 <= 0.0
+    } else {
+        d0 <= 0.0 && d1 > 0.0
+    }
+}
+
 /// The root of `f` in `[a, b]` given `fa = f(a)`, `fb = f(b)` of opposite signs (or zero),
 /// by the Illinois variant of regula falsi, to `|f| <= tol` or a bracket of relative width
 /// 1e-15. Returns the end of the final bracket on the side of `b`'s sign, so that `f` has

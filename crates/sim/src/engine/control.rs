@@ -183,11 +183,7 @@ impl Run {
                 let depth = |x: f64| (sigma * phi(x) - g0) * rb + offset;
                 let d0 = (sigma * phi0 - g0) * rb + offset;
                 let d1 = (sigma * phi_h - g0) * rb + offset;
-                let crosses = if engaged {
-                    d0 > 0.0 && d1 <= 0.0
-                } else {
-                    d0 <= 0.0 && d1 > 0.0
-                };
+                let crosses = crate::stepping::crosses_contact(engaged, d0, d1);
                 if !crosses {
                     continue;
                 }

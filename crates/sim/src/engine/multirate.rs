@@ -338,11 +338,7 @@ impl Run {
                 let sigma = flank.phi_sign();
                 let depth = |p: f64| (sigma * p - g0) * rb + offset;
                 let (d0, d1) = (depth(phi), depth(step.phi));
-                let crosses = if engaged {
-                    d0 > 0.0 && d1 <= 0.0
-                } else {
-                    d0 <= 0.0 && d1 > 0.0
-                };
+                let crosses = crate::stepping::crosses_contact(engaged, d0, d1);
                 if !crosses {
                     continue;
                 }
