@@ -146,7 +146,9 @@
 
 mod coupled;
 mod dopri;
+mod gaps;
 mod independent;
+mod open;
 mod session;
 mod stepper;
 mod system;
@@ -252,9 +254,20 @@ impl ReferenceEngine {
         self.scheme == Scheme::Multirate
             && !self.is_whole()
             && matches!(self.pack.shaft, Shaft::Prescribed(_))
-            && self.parallel
+            && self.spreads_bodies()
+    }
+
+    /// Whether independent bodies may be spread over threads: allowed, at least two discs
+    /// and more than one rayon thread.
+    fn spreads_bodies(&self) -> bool {
+        self.parallel
             && self.pack.discs.len() >= PARALLEL_MIN_DISCS
             && rayon::current_num_threads() > 1
+    }
+
+    /// Whether a run takes the open-pack multirate scheme (crate docs, "Whole packs").
+    fn runs_open(&self) -> bool {
+        self.scheme == Scheme::Multirate && open::runs_open(&self.pack, &Driven::NONE)
     }
 
     /// One line saying which scheme runs and why, e.g. `"multirate: prescribed shaft, no
@@ -262,6 +275,19 @@ impl ReferenceEngine {
     pub fn describe(&self) -> String {
         let nd = self.pack.discs.len();
         let discs = if nd == 1 { "disc" } else { "discs" };
+        if self.runs_open() {
+            let threads = if self.spreads_bodies() {
+                format!(" on {} threads", rayon::current_num_threads())
+            } else {
+                String::new()
+            };
+            return format!(
+                "multirate: an open pack (the piston never clamps), so {nd} {discs} on the \
+                 prescribed shaft and {} plates on the housing each take their own steps{threads}, \
+                 the open gaps' drag between them relaxed window by window to the tolerance",
+                self.pack.plates.len()
+            );
+        }
         if self.is_whole() {
             let np = self.pack.plates.len();
             let carrier = if self.pack.drum.is_some() {
@@ -399,6 +425,9 @@ impl Engine for ReferenceEngine {
         driven.check(&self.pack)?;
         let (pack, settings) = (Arc::new(self.pack.clone()), &self.settings);
         let mut session: Box<dyn Session> = match (self.scheme, &self.pack.shaft) {
+            (Scheme::Multirate, _) if open::runs_open(&pack, &driven) => Box::new(
+                open::OpenSession::new(pack, settings, self.spreads_bodies(), driven),
+            ),
             (Scheme::Multirate, _) if pack.discs.is_empty() || self.is_whole() => {
                 Box::new(MonolithicSession::new(pack, settings, driven))
             }

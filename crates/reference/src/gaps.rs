@@ -1,0 +1,157 @@
+//! The open stack's oil gaps as an input of one body (the open-pack multirate scheme,
+//! `open.rs`, crate docs "Whole packs"): the Couette drag of the gaps below and above a body,
+//! from its neighbours' speeds over the current window, held at the window's start or taken
+//! from the dense output of the neighbour's last pass through the window.
+
+use crate::dopri::{eval_component, Dense};
+use std::sync::Arc;
+
+/// One accepted step of a body's relative speed `psi` (rad/s): the step `[t0, t0 + h]` of the
+/// dense output (s), the time the step ended at (s; before `t0 + h` when an event cut it) and
+/// the interpolant's coefficients.
+#[derive(Debug, Clone, Copy)]
+struct Segment {
+    t0: f64,
+    h: f64,
+    t_end: f64,
+    c: [f64; 5],
+}
+
+/// A body's relative speed `psi = omega_carrier - omega_body` (rad/s) through one window: the
+/// dense output of its accepted steps, in order.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Track {
+    segments: Vec<Segment>,
+}
+
+impl Track {
+    /// Forgets the last window.
+    pub fn clear(&mut self) {
+        self.segments.clear();
+    }
+
+    /// Appends the step just accepted: the dense output `d` of state component `i` (the
+    /// body's `psi`), the step having ended at `t_end` (s).
+    pub fn push(&mut self, d: &Dense, i: usize, t_end: f64) {
+        let (t0, h, c) = d.component(i);
+        self.segments.push(Segment { t0, h, t_end, c });
+    }
+
+    /// `psi` at `t` (s), rad/s: the step that ends at or after `t` (the last one past the end).
+    fn psi(&self, t: f64) -> f64 {
+        let n = self.segments.len();
+        let j = self.segments.partition_point(|s| s.t_end < t).min(n - 1);
+        let s = &self.segments[j];
+        eval_component(s.t0, s.h, &s.c, t)
+    }
+
+    /// The times (s) at which two tracks are compared: every step's end and middle.
+    fn probe_times(&self) -> impl Iterator<Item = f64> + '_ {
+        let mut start = self.segments.first().map_or(0.0, |s| s.t0);
+        self.segments.iter().flat_map(move |s| {
+            let mid = 0.5 * (start + s.t_end);
+            start = s.t_end;
+            [mid, s.t_end]
+        })
+    }
+}
+
+/// A neighbour's speed over a window, as a body's gap sees it.
+#[derive(Debug, Clone)]
+pub(crate) enum Neighbour {
+    /// Its speed at the window's start (rad/s), held (the first pass's prediction).
+    Held(f64),
+    /// Its last pass through the window; `on_shaft` when its carrier is the shaft (a friction
+    /// disc), else the housing (a plate, carrier at rest).
+    Track { psi: Arc<Track>, on_shaft: bool },
+}
+
+impl Neighbour {
+    /// Its speed at `t` (s), rad/s, the shaft turning at `omega_shaft` (rad/s).
+    pub fn omega(&self, t: f64, omega_shaft: f64) -> f64 {
+        match self {
+            Neighbour::Held(w) => *w,
+            Neighbour::Track { psi, on_shaft } => {
+                (if *on_shaft { omega_shaft } else { 0.0 }) - psi.psi(t)
+            }
+        }
+    }
+
+    /// The largest difference (rad/s) between this speed and the neighbour's new pass `new`
+    /// (`psi`, carried as `on_shaft` says) over the window, probed at every step's end and
+    /// middle of the new pass; `shaft(t)` is the shaft's speed (rad/s).
+    pub fn max_change(&self, new: &Track, on_shaft: bool, shaft: impl Fn(f64) -> f64) -> f64 {
+        new.probe_times()
+            .map(|t| {
+                let w_s = shaft(t);
+                let w_new = (if on_shaft { w_s } else { 0.0 }) - new.psi(t);
+                (self.omega(t, w_s) - w_new).abs()
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The gaps on both sides of one body: the Couette coefficient and its neighbours below
+/// (towards the piston) and above, `None` at an end of the stack.
+#[derive(Debug, Clone)]
+pub(crate) struct Gaps {
+    /// `c = pi eta (Ro^4 - Ri^4) / (2 h)` of one gap, N m s/rad (MODEL.md section 5).
+    pub c: f64,
+    pub below: Option<Neighbour>,
+    pub above: Option<Neighbour>,
+}
+
+impl Gaps {
+    /// The drag of the gap below and of the gap above on the body turning at `omega_b`
+    /// (rad/s) at `t` (s), N m each: `-c (omega_b - omega_neighbour)` (MODEL.md section 5).
+    pub fn torques_n_m(&self, t: f64, omega_b: f64, omega_shaft: f64) -> [f64; 2] {
+        let drag = |n: &Option<Neighbour>| {
+            n.as_ref()
+                .map_or(0.0, |n| -self.c * (omega_b - n.omega(t, omega_shaft)))
+        };
+        [drag(&self.below), drag(&self.above)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dopri::Dopri5;
+
+    /// A track built from DOPRI5 steps of `psi' = cos t` returns `sin t` between and at its
+    /// steps' ends, and a held neighbour's change against it is the largest difference.
+    #[test]
+    fn track_interpolates_its_steps() {
+        let mut solver = Dopri5::new(1);
+        let f = |t: f64, _y: &[f64], dy: &mut [f64]| dy[0] = t.cos();
+        let (mut t, mut y) = (0.0, vec![0.0]);
+        let mut dy = vec![1.0];
+        f(0.0, &y, &mut dy);
+        solver.set_start_derivative(&dy);
+        let mut track = Track::default();
+        let mut d = Dense::default();
+        for _ in 0..10 {
+            let h = 0.1;
+            let mut ff = f;
+            let err = solver.try_step(&mut ff, t, &y, h, &[1e-12], 1e-12);
+            assert!(err.is_finite());
+            solver.dense_into(t, &y, h, &mut d);
+            y.copy_from_slice(&solver.y_new);
+            t += h;
+            solver.accept();
+            track.push(&d, 0, t);
+        }
+        for k in 0..=100 {
+            let tk = k as f64 * 0.01;
+            assert!((track.psi(tk) - tk.sin()).abs() < 1e-7, "{tk}");
+        }
+        // on the housing: omega = -psi; held at 0, the change is max |sin t| on [0, 1]
+        let change = Neighbour::Held(0.0).max_change(&track, false, |_| 0.0);
+        assert!((change - 1f64.sin()).abs() < 1e-7, "{change}");
+        let same = Neighbour::Track {
+            psi: Arc::new(track.clone()),
+            on_shaft: true,
+        };
+        assert_eq!(same.max_change(&track, true, |t| 3.0 * t), 0.0);
+    }
+}
