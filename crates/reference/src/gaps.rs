@@ -30,6 +30,11 @@ impl Track {
         self.segments.clear();
     }
 
+    /// Number of steps in the window.
+    pub fn len(&self) -> usize {
+        self.segments.len()
+    }
+
     /// Appends the step just accepted: the dense output `d` of state component `i` (the
     /// body's `psi`), the step having ended at `t_end` (s).
     pub fn push(&mut self, d: &Dense, i: usize, t_end: f64) {
@@ -59,8 +64,9 @@ impl Track {
 /// A neighbour's speed over a window, as a body's gap sees it.
 #[derive(Debug, Clone)]
 pub(crate) enum Neighbour {
-    /// Its speed at the window's start (rad/s), held (the first pass's prediction).
-    Held(f64),
+    /// The first pass's prediction: its speed `omega` (rad/s) at the window's start `t0` (s)
+    /// moving on with the acceleration `alpha` (rad/s^2) it had there.
+    Predicted { t0: f64, omega: f64, alpha: f64 },
     /// Its last pass through the window; `on_shaft` when its carrier is the shaft (a friction
     /// disc), else the housing (a plate, carrier at rest).
     Track { psi: Arc<Track>, on_shaft: bool },
@@ -70,10 +76,18 @@ impl Neighbour {
     /// Its speed at `t` (s), rad/s, the shaft turning at `omega_shaft` (rad/s).
     pub fn omega(&self, t: f64, omega_shaft: f64) -> f64 {
         match self {
-            Neighbour::Held(w) => *w,
+            Neighbour::Predicted { t0, omega, alpha } => omega + alpha * (t - t0),
             Neighbour::Track { psi, on_shaft } => {
                 (if *on_shaft { omega_shaft } else { 0.0 }) - psi.psi(t)
             }
+        }
+    }
+
+    /// A prediction's speed at its start, rad/s (0 for a track).
+    pub fn omega_at_start(&self) -> f64 {
+        match self {
+            Neighbour::Predicted { omega, .. } => *omega,
+            Neighbour::Track { .. } => 0.0,
         }
     }
 
@@ -146,7 +160,12 @@ mod tests {
             assert!((track.psi(tk) - tk.sin()).abs() < 1e-7, "{tk}");
         }
         // on the housing: omega = -psi; held at 0, the change is max |sin t| on [0, 1]
-        let change = Neighbour::Held(0.0).max_change(&track, false, |_| 0.0);
+        let held = Neighbour::Predicted {
+            t0: 0.0,
+            omega: 0.0,
+            alpha: 0.0,
+        };
+        let change = held.max_change(&track, false, |_| 0.0);
         assert!((change - 1f64.sin()).abs() < 1e-7, "{change}");
         let same = Neighbour::Track {
             psi: Arc::new(track.clone()),

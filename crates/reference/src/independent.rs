@@ -201,7 +201,7 @@ impl IndependentSession {
                 failure = Some(e.clone());
             }
         }
-        self.merger.merge(runs, limit, obs, &|_, _| None);
+        self.merger.merge(runs, limit, true, obs, &|_, _| None);
         match failure {
             Some(e) => Err(e),
             None => Ok(()),
@@ -319,11 +319,14 @@ impl Merger {
     }
 
     /// Sends the samples (each followed by the interfaces `interfaces` makes of it), contact
-    /// samples and impacts of `runs` up to `limit` (s) in time order.
+    /// samples and impacts of `runs` up to `limit` (s) in time order; the contact samples
+    /// after the last sample only when `limit_is_window_end` (so that the contact samples of
+    /// the bodies interleave alike whatever calls a session took: by sample and by window).
     pub fn merge(
         &mut self,
         runs: &mut [DiscRun],
         limit: f64,
+        limit_is_window_end: bool,
         obs: &mut dyn Observer,
         interfaces: InterfacesOf,
     ) {
@@ -372,12 +375,15 @@ impl Merger {
             }
             self.next_k += 1;
         }
-        // the contact samples before the next sample (which the next window sends)
-        send_contacts(
-            runs,
-            limit.min(self.next_k as f64 / self.rate).next_down(),
-            obs,
-        );
+        // the contact samples before the next sample (which the next window sends), when the
+        // bodies' output is complete up to `limit`
+        if limit_is_window_end {
+            send_contacts(
+                runs,
+                limit.min(self.next_k as f64 / self.rate).next_down(),
+                obs,
+            );
+        }
         while next_impact < pending.len() && pending[next_impact].t_off_s <= limit {
             obs.impact(&pending[next_impact]);
             next_impact += 1;

@@ -5,7 +5,7 @@
 //! relaxation over the two colours of the stack) until its effect on any body's speed is below
 //! the integrator's tolerance.
 
-use crate::gaps::Neighbour;
+use crate::gaps::{Gaps, Neighbour};
 use crate::independent::{DiscRun, Merger};
 use crate::session::{shift_disc_speeds, Clock};
 use crate::system::System;
@@ -41,6 +41,15 @@ pub(crate) fn runs_open(pack: &PackModel, driven: &Driven) -> bool {
         && !driven.piston_pressure
 }
 
+/// `saved` restarted with `gaps` (a body's state at a window's start, its gaps seeing new
+/// inputs).
+fn restarted(saved: &DiscRun, gaps: Gaps) -> DiscRun {
+    let mut r = saved.clone();
+    r.stepper.sys.gaps = Some(gaps);
+    r.stepper.restart();
+    r
+}
+
 /// Advances `r` until its time reaches `t` (s), its steps ending at `end` (s), recording its
 /// steps' relative speed in its track.
 fn advance(r: &mut DiscRun, t: f64, end: f64) {
@@ -72,8 +81,6 @@ pub(crate) struct OpenSession {
     /// Time every body has reached (the end of the last window), s.
     t_w: f64,
     merger: Merger,
-    /// Sweeps beyond the first of all windows so far.
-    extra_sweeps: u64,
     /// Couette coefficient of one gap, N m s/rad, and the faces' `R_eff`, m.
     c_gap: f64,
     r_eff: f64,
@@ -82,10 +89,10 @@ pub(crate) struct OpenSession {
     last: Option<Arc<LastWindow>>,
 }
 
-/// What a window's last sweep started from.
+/// Where the last window started from: every body's state (its last pass's inputs are in
+/// its gaps) and the window's end, s.
 struct LastWindow {
     saved: Vec<DiscRun>,
-    seen: Vec<Neighbour>,
     t1: f64,
 }
 
@@ -119,7 +126,6 @@ impl OpenSession {
             tol: settings.tolerance,
             t_w: 0.0,
             merger: Merger::new(settings.record_rate_hz, n),
-            extra_sweeps: 0,
             c_gap,
             r_eff,
             last: None,
@@ -145,22 +151,34 @@ impl OpenSession {
         b < self.pack.discs.len()
     }
 
-    /// Speed of body `b` at its stepper's time, rad/s.
-    fn speed_now(&self, b: usize) -> f64 {
+    /// The first pass's prediction of body `b`'s speed through the window starting at its
+    /// stepper's time: in free flight its speed there moving on with its acceleration there
+    /// (a plate pushed by its gaps' drag), in contact its speed held.
+    fn predicted(&self, b: usize) -> Neighbour {
         let st = &self.runs[b].stepper;
-        let w_c = if self.on_shaft(b) {
-            st.sys.shaft(st.t, &[]).1
+        let (t, k) = (st.t, st.sys.off + 1);
+        let mut dy = vec![0.0; st.y.len()];
+        st.sys.rhs(t, &st.y, &st.modes, &mut dy);
+        let (w_c, a_c) = if self.on_shaft(b) {
+            let c = st.sys.carriers(t, &st.y, &st.modes);
+            (c[0], c[1])
         } else {
-            0.0
+            (0.0, 0.0)
         };
-        w_c - st.y[st.sys.off + 1]
+        let free = st.modes[0].is_none();
+        Neighbour::Predicted {
+            t0: t,
+            omega: w_c - st.y[k],
+            alpha: if free { a_c - dy[k] } else { 0.0 },
+        }
     }
 
     /// Runs the bodies `group` from the window's start to `t1` (s) against the neighbours'
     /// speeds `seen` (by body), each from its saved state at the window's start.
     fn pass(&mut self, group: &[usize], seen: &[Neighbour], saved: &[DiscRun], t1: f64) {
         for &b in group {
-            self.runs[b] = self.restarted(b, &saved[b], seen);
+            let gaps = self.gaps_seeing(b, seen);
+            self.runs[b] = restarted(&saved[b], gaps);
         }
         let run = |r: &mut DiscRun| {
             r.track.clear();
@@ -173,33 +191,32 @@ impl OpenSession {
             .filter(|(b, _)| group.contains(b))
             .map(|(_, r)| r)
             .collect();
-        if self.parallel {
+        if self.parallel && members.len() > 1 {
             members.par_iter_mut().for_each(|r| run(r));
         } else {
             members.iter_mut().for_each(|r| run(r));
         }
     }
 
-    /// Body `b` from its state `saved` at a window's start, its gaps seeing the neighbours'
-    /// speeds `seen` (by body).
-    fn restarted(&self, b: usize, saved: &DiscRun, seen: &[Neighbour]) -> DiscRun {
+    /// The gaps of body `b` seeing its neighbours' speeds `seen` (by body).
+    fn gaps_seeing(&self, b: usize, seen: &[Neighbour]) -> Gaps {
         let [lo, hi] = self.neighbours(b);
-        let mut r = saved.clone();
-        let gaps = r.stepper.sys.gaps.as_mut().expect("an open body");
-        gaps.below = lo.map(|q| seen[q].clone());
-        gaps.above = hi.map(|q| seen[q].clone());
-        r.stepper.restart();
-        r
+        Gaps {
+            c: self.c_gap,
+            below: lo.map(|q| seen[q].clone()),
+            above: hi.map(|q| seen[q].clone()),
+        }
     }
 
     /// The state of body `b` at `t` (s) into `y` and its contact modes there, `t` at or before
     /// its time and inside the last window: from its last steps, or (further back) from a
-    /// rerun of the window's last sweep, which takes the same steps.
+    /// rerun of the window's last pass, which takes the same steps.
     fn state_at(&self, b: usize, t: f64, y: &mut Vec<f64>) -> Vec<Option<Engagement>> {
         let st = &self.runs[b].stepper;
         match (&self.last, st.remembers(t)) {
             (Some(last), false) => {
-                let mut r = self.restarted(b, &last.saved[b], &last.seen);
+                let gaps = st.sys.gaps.clone().expect("an open body");
+                let mut r = restarted(&last.saved[b], gaps);
                 r.out.wants_contacts = false;
                 advance(&mut r, t, last.t1);
                 r.stepper.state_at(t, y).to_vec()
@@ -218,49 +235,65 @@ impl OpenSession {
         }
     }
 
-    /// One window `[t_w, t1]`: the discs against their plates' speeds held at `t_w`, the
-    /// plates against the discs' pass, then as long as the plates' pass moved any disc's
-    /// speed by more than the tolerance (the bound `c W sum |d omega_plate| / J_disc`), the
-    /// discs again against the plates' last pass and the plates again.
+    /// How much the neighbours' latest passes `seen` differ from what body `b`'s last pass
+    /// saw, relative to what the tolerance allows it: the bound `c W sum max |d omega| / J` on
+    /// the change of its speed (rad/s) over the error its steps in the window may make
+    /// (`tol (1 + |omega|)` each). At most 1: its pass stands.
+    fn unsettled(&self, b: usize, seen: &[Neighbour], width: f64) -> f64 {
+        let r = &self.runs[b];
+        let gaps = r.stepper.sys.gaps.as_ref().expect("an open body");
+        let shaft = |t: f64| r.stepper.sys.shaft(t, &[]).1;
+        let mut moved = 0.0;
+        for (q, used) in self
+            .neighbours(b)
+            .into_iter()
+            .zip([&gaps.below, &gaps.above])
+        {
+            if let (Some(q), Some(used)) = (q, used) {
+                if let Neighbour::Track { psi, on_shaft } = &seen[q] {
+                    if !matches!(used, Neighbour::Track { psi: p, .. } if Arc::ptr_eq(p, psi)) {
+                        moved += used.max_change(psi, *on_shaft, shaft);
+                    }
+                }
+            }
+        }
+        let j = r.stepper.sys.disc(0).inertia_kg_m2;
+        let allowed = self.tol * (1.0 + self.predicted(b).omega_at_start().abs());
+        self.c_gap * width * moved / j / (allowed * r.track.len().max(1) as f64)
+    }
+
+    /// One window `[t_w, t1]` (Gauss-Seidel waveform relaxation over the stack's two colours):
+    /// the discs against their plates' predicted speeds, the plates against the discs' passes;
+    /// then each disc whose plates moved more than the tolerance allows
+    /// ([`Self::unsettled`]) again against the plates' last passes, and its plates again,
+    /// until every pass stands.
     fn window(&mut self, t1: f64) -> Result<(), EngineError> {
         let n = self.runs.len();
         let saved = self.runs.clone();
-        let mut seen: Vec<Neighbour> = (0..n).map(|b| Neighbour::Held(self.speed_now(b))).collect();
-        let (first, second) = (self.first.clone(), self.second.clone());
+        let mut seen: Vec<Neighbour> = (0..n).map(|b| self.predicted(b)).collect();
+        let first = self.first.clone();
         let width = t1 - self.t_w;
-        let c = self.c_gap;
+        let (mut redo_first, mut redo_second) = (first.clone(), self.second.clone());
         let mut sweeps = 0;
-        let mut used: Vec<Neighbour>;
         loop {
-            self.pass(&first, &seen, &saved, t1);
-            self.tracks(&first, &mut seen);
-            used = second.iter().map(|&b| seen[b].clone()).collect();
-            self.pass(&second, &seen, &saved, t1);
-            self.tracks(&second, &mut seen);
+            self.pass(&redo_first, &seen, &saved, t1);
+            self.tracks(&redo_first, &mut seen);
+            self.pass(&redo_second, &seen, &saved, t1);
+            self.tracks(&redo_second, &mut seen);
             if let Some(e) = self.runs.iter().find_map(|r| r.error.clone()) {
                 return Err(e);
             }
-            // how far the second colour's new pass moves the first colour's speeds
-            let mut change = vec![0.0; n];
-            let shaft = |t: f64| self.runs[0].stepper.sys.shaft(t, &[]).1;
-            for (&b, old) in second.iter().zip(&used) {
-                change[b] = old.max_change(&self.runs[b].track, self.on_shaft(b), shaft);
-            }
+            sweeps += 1;
             let worst = first
                 .iter()
-                .map(|&b| {
-                    let j = self.runs[b].stepper.sys.disc(0).inertia_kg_m2;
-                    let moved: f64 = self
-                        .neighbours(b)
-                        .iter()
-                        .flatten()
-                        .map(|&q| change[q])
-                        .sum();
-                    c * width * moved / j
-                })
-                .fold(0.0, f64::max);
-            sweeps += 1;
-            if worst <= self.tol {
+                .map(|&b| (b, self.unsettled(b, &seen, width)))
+                .fold((0, 0.0), |a, x| if x.1 > a.1 { x } else { a });
+            redo_first = first
+                .iter()
+                .copied()
+                .filter(|&b| self.unsettled(b, &seen, width) > 1.0)
+                .collect();
+            if redo_first.is_empty() {
                 break;
             }
             if sweeps >= MAX_SWEEPS {
@@ -268,29 +301,36 @@ impl OpenSession {
                     t_s: self.t_w,
                     reason: format!(
                         "the open gaps' drag did not converge in {MAX_SWEEPS} sweeps of the \
-                         window [{}, {t1}] s (last change {worst:.2e} rad/s)",
-                        self.t_w
+                         window [{}, {t1}] s (body {} still {:.2e} times the tolerance)",
+                        self.t_w, worst.0, worst.1
                     ),
                 });
             }
+            redo_second = self
+                .second
+                .iter()
+                .copied()
+                .filter(|&q| {
+                    self.neighbours(q)
+                        .iter()
+                        .flatten()
+                        .any(|b| redo_first.contains(b))
+                })
+                .collect();
         }
-        self.extra_sweeps += sweeps as u64 - 1;
         self.t_w = t1;
-        // what each body saw in the last sweep: the first colour the second's speeds before
-        // its new pass, the second colour the first's tracks
-        for (&b, u) in second.iter().zip(used) {
-            seen[b] = u;
-        }
-        self.last = Some(Arc::new(LastWindow { saved, seen, t1 }));
+        self.last = Some(Arc::new(LastWindow { saved, t1 }));
         Ok(())
     }
 
     /// Sends the output up to `limit` (s): the bodies' samples, each followed by the gaps'.
     fn merge(&mut self, limit: f64, obs: &mut dyn Observer) {
         let (at, c, r_eff) = (&self.at, self.c_gap, self.r_eff);
-        self.merger.merge(&mut self.runs, limit, obs, &|s, w| {
-            Some(gap_samples(at, c, r_eff, s, w))
-        });
+        let whole = limit >= self.t_w;
+        self.merger
+            .merge(&mut self.runs, limit, whole, obs, &|s, w| {
+                Some(gap_samples(at, c, r_eff, s, w))
+            });
     }
 }
 
@@ -398,14 +438,6 @@ impl Session for OpenSession {
     }
 
     fn finish(&mut self, obs: &mut dyn Observer) -> RunStats {
-        if std::env::var_os("CP_DEBUG").is_some() {
-            let steps: Vec<u64> = self.runs.iter().map(|r| r.stepper.stats.steps).collect();
-            eprintln!(
-                "extra sweeps {} windows {:.0} steps {steps:?}",
-                self.extra_sweeps,
-                self.t_w / WINDOW_S
-            );
-        }
         let mut stats = self.merger.finish(&mut self.runs, obs);
         stats.simulated_s = self.clock.t;
         stats
