@@ -4,6 +4,7 @@
 //! from the dense output of the neighbour's last pass through the window.
 
 use crate::dopri::{eval_component, Dense};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 /// One accepted step of a body's relative speed `psi` (rad/s): the step `[t0, t0 + h]` of the
@@ -42,66 +43,111 @@ impl Track {
         self.segments.push(Segment { t0, h, t_end, c });
     }
 
-    /// `psi` at `t` (s), rad/s: the step that ends at or after `t` (the last one past the end).
-    fn psi(&self, t: f64) -> f64 {
+    /// `psi` at `t` (s), rad/s: the step that ends at or after `t` (the last one past the
+    /// end). `hint` is where the last lookup found its step (the integrator asks for times
+    /// close together): checked first, then its successor, then a binary search.
+    fn psi(&self, t: f64, hint: &AtomicUsize) -> f64 {
         let n = self.segments.len();
-        let j = self.segments.partition_point(|s| s.t_end < t).min(n - 1);
+        let covers = |j: usize| {
+            j < n && self.segments[j].t_end >= t && (j == 0 || self.segments[j - 1].t_end < t)
+        };
+        let h = hint.load(Ordering::Relaxed);
+        let j = if covers(h) {
+            h
+        } else if covers(h + 1) {
+            h + 1
+        } else {
+            self.segments.partition_point(|s| s.t_end < t).min(n - 1)
+        };
+        hint.store(j, Ordering::Relaxed);
         let s = &self.segments[j];
         eval_component(s.t0, s.h, &s.c, t)
     }
 
-    /// The times (s) at which two tracks are compared: every step's end and middle.
-    fn probe_times(&self) -> impl Iterator<Item = f64> + '_ {
-        let mut start = self.segments.first().map_or(0.0, |s| s.t0);
-        self.segments.iter().flat_map(move |s| {
-            let mid = 0.5 * (start + s.t_end);
-            start = s.t_end;
-            [mid, s.t_end]
-        })
+    /// `integral |f(t)| dt` over the window (f in rad/s; rad) by Simpson's rule on every step.
+    fn integral_abs(&self, f: impl Fn(f64) -> f64) -> f64 {
+        let Some(first) = self.segments.first() else {
+            return 0.0;
+        };
+        let (mut a, mut fa) = (first.t0, f(first.t0).abs());
+        let mut sum = 0.0;
+        for s in &self.segments {
+            let fm = f(0.5 * (a + s.t_end)).abs();
+            let fb = f(s.t_end).abs();
+            sum += (s.t_end - a) / 6.0 * (fa + 4.0 * fm + fb);
+            (a, fa) = (s.t_end, fb);
+        }
+        sum
     }
 }
 
 /// A neighbour's speed over a window, as a body's gap sees it.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub(crate) enum Neighbour {
     /// The first pass's prediction: its speed `omega` (rad/s) at the window's start `t0` (s)
     /// moving on with the acceleration `alpha` (rad/s^2) it had there.
     Predicted { t0: f64, omega: f64, alpha: f64 },
     /// Its last pass through the window; `on_shaft` when its carrier is the shaft (a friction
     /// disc), else the housing (a plate, carrier at rest).
-    Track { psi: Arc<Track>, on_shaft: bool },
+    /// `hint`: where the last lookup in `psi` found its step.
+    Track {
+        psi: Arc<Track>,
+        on_shaft: bool,
+        hint: AtomicUsize,
+    },
+}
+
+impl Clone for Neighbour {
+    fn clone(&self) -> Self {
+        match self {
+            Neighbour::Predicted { t0, omega, alpha } => Neighbour::Predicted {
+                t0: *t0,
+                omega: *omega,
+                alpha: *alpha,
+            },
+            Neighbour::Track { psi, on_shaft, .. } => Neighbour::track(psi.clone(), *on_shaft),
+        }
+    }
 }
 
 impl Neighbour {
-    /// Its speed at `t` (s), rad/s, the shaft turning at `omega_shaft` (rad/s).
-    pub fn omega(&self, t: f64, omega_shaft: f64) -> f64 {
+    /// The neighbour of the track `psi` (its relative speed), carried by the shaft when
+    /// `on_shaft`, else by the housing.
+    pub fn track(psi: Arc<Track>, on_shaft: bool) -> Neighbour {
+        Neighbour::Track {
+            psi,
+            on_shaft,
+            hint: AtomicUsize::new(0),
+        }
+    }
+
+    /// Its speed at `t` (s), rad/s, the shaft turning at `omega_shaft()` (rad/s; asked only
+    /// for a neighbour on the shaft).
+    pub fn omega(&self, t: f64, omega_shaft: impl Fn() -> f64) -> f64 {
         match self {
             Neighbour::Predicted { t0, omega, alpha } => omega + alpha * (t - t0),
-            Neighbour::Track { psi, on_shaft } => {
-                (if *on_shaft { omega_shaft } else { 0.0 }) - psi.psi(t)
+            Neighbour::Track {
+                psi,
+                on_shaft,
+                hint,
+            } => (if *on_shaft { omega_shaft() } else { 0.0 }) - psi.psi(t, hint),
+        }
+    }
+
+    /// `integral |omega - omega_new| dt` (rad) over the window between this speed and the
+    /// neighbour's new pass `new` (its `psi`), by Simpson's rule on the new pass's steps. Both
+    /// have the same carrier, so the shaft's speed cancels.
+    pub fn change(&self, new: &Track) -> f64 {
+        let hint = AtomicUsize::new(0);
+        match self {
+            Neighbour::Predicted { .. } => {
+                // a prediction is only made of a plate (on the housing: omega = -psi)
+                new.integral_abs(|t| self.omega(t, || 0.0) + new.psi(t, &hint))
+            }
+            Neighbour::Track { psi, hint: h, .. } => {
+                new.integral_abs(|t| psi.psi(t, h) - new.psi(t, &hint))
             }
         }
-    }
-
-    /// A prediction's speed at its start, rad/s (0 for a track).
-    pub fn omega_at_start(&self) -> f64 {
-        match self {
-            Neighbour::Predicted { omega, .. } => *omega,
-            Neighbour::Track { .. } => 0.0,
-        }
-    }
-
-    /// The largest difference (rad/s) between this speed and the neighbour's new pass `new`
-    /// (`psi`, carried as `on_shaft` says) over the window, probed at every step's end and
-    /// middle of the new pass; `shaft(t)` is the shaft's speed (rad/s).
-    pub fn max_change(&self, new: &Track, on_shaft: bool, shaft: impl Fn(f64) -> f64) -> f64 {
-        new.probe_times()
-            .map(|t| {
-                let w_s = shaft(t);
-                let w_new = (if on_shaft { w_s } else { 0.0 }) - new.psi(t);
-                (self.omega(t, w_s) - w_new).abs()
-            })
-            .fold(0.0, f64::max)
     }
 }
 
@@ -118,10 +164,10 @@ pub(crate) struct Gaps {
 impl Gaps {
     /// The drag of the gap below and of the gap above on the body turning at `omega_b`
     /// (rad/s) at `t` (s), N m each: `-c (omega_b - omega_neighbour)` (MODEL.md section 5).
-    pub fn torques_n_m(&self, t: f64, omega_b: f64, omega_shaft: f64) -> [f64; 2] {
+    pub fn torques_n_m(&self, t: f64, omega_b: f64, omega_shaft: impl Fn() -> f64) -> [f64; 2] {
         let drag = |n: &Option<Neighbour>| {
             n.as_ref()
-                .map_or(0.0, |n| -self.c * (omega_b - n.omega(t, omega_shaft)))
+                .map_or(0.0, |n| -self.c * (omega_b - n.omega(t, &omega_shaft)))
         };
         [drag(&self.below), drag(&self.above)]
     }
@@ -155,22 +201,22 @@ mod tests {
             solver.accept();
             track.push(&d, 0, t);
         }
-        for k in 0..=100 {
+        let hint = AtomicUsize::new(0);
+        for k in (0..=100).chain((0..=100).rev()) {
             let tk = k as f64 * 0.01;
-            assert!((track.psi(tk) - tk.sin()).abs() < 1e-7, "{tk}");
+            assert!((track.psi(tk, &hint) - tk.sin()).abs() < 1e-7, "{tk}");
         }
-        // on the housing: omega = -psi; held at 0, the change is max |sin t| on [0, 1]
+        // on the housing: omega = -psi; held at 0, the change is the integral of |sin t| on
+        // [0, 1], 1 - cos 1
         let held = Neighbour::Predicted {
             t0: 0.0,
             omega: 0.0,
             alpha: 0.0,
         };
-        let change = held.max_change(&track, false, |_| 0.0);
-        assert!((change - 1f64.sin()).abs() < 1e-7, "{change}");
-        let same = Neighbour::Track {
-            psi: Arc::new(track.clone()),
-            on_shaft: true,
-        };
-        assert_eq!(same.max_change(&track, true, |t| 3.0 * t), 0.0);
+        let change = held.change(&track);
+        assert!((change - (1.0 - 1f64.cos())).abs() < 1e-7, "{change}");
+        let same = Neighbour::track(Arc::new(track.clone()), true);
+        assert_eq!(same.change(&track), 0.0);
+        assert_eq!(same.omega(0.5, || 3.0), 3.0 - track.psi(0.5, &hint));
     }
 }

@@ -151,26 +151,48 @@ impl OpenSession {
         b < self.pack.discs.len()
     }
 
-    /// The first pass's prediction of body `b`'s speed through the window starting at its
-    /// stepper's time: in free flight its speed there moving on with its acceleration there
-    /// (a plate pushed by its gaps' drag), in contact its speed held.
-    fn predicted(&self, b: usize) -> Neighbour {
+    /// Speed of body `b` at its stepper's time, rad/s.
+    fn speed(&self, b: usize) -> f64 {
+        let st = &self.runs[b].stepper;
+        let w_c = if self.on_shaft(b) {
+            st.sys.shaft(st.t, &[]).1
+        } else {
+            0.0
+        };
+        w_c - st.y[st.sys.off + 1]
+    }
+
+    /// Body `b` at its stepper's time: its speed (rad/s), its acceleration (rad/s^2) and
+    /// whether it flies free (no tooth in contact).
+    fn motion(&self, b: usize) -> (f64, f64, bool) {
         let st = &self.runs[b].stepper;
         let (t, k) = (st.t, st.sys.off + 1);
         let mut dy = vec![0.0; st.y.len()];
         st.sys.rhs(t, &st.y, &st.modes, &mut dy);
-        let (w_c, a_c) = if self.on_shaft(b) {
-            let c = st.sys.carriers(t, &st.y, &st.modes);
-            (c[0], c[1])
+        let a_c = if self.on_shaft(b) {
+            st.sys.carriers(t, &st.y, &st.modes)[1]
         } else {
-            (0.0, 0.0)
+            0.0
         };
-        let free = st.modes[0].is_none();
-        Neighbour::Predicted {
-            t0: t,
-            omega: w_c - st.y[k],
-            alpha: if free { a_c - dy[k] } else { 0.0 },
-        }
+        (self.speed(b), a_c - dy[k], st.modes[0].is_none())
+    }
+
+    /// The first pass's predictions of the bodies' speeds through the window starting at the
+    /// steppers' time: a body in free flight (a plate pushed by its gaps' drag) moving on with
+    /// its acceleration; a body in contact at its speed, held. (Adding the jerk its gaps give
+    /// it as its neighbours accelerate changed no window's outcome on pack-8-brake: its
+    /// plates' errors come from their own contacts.)
+    fn predictions(&self) -> Vec<Neighbour> {
+        (0..self.runs.len())
+            .map(|b| {
+                let (omega, alpha, free) = self.motion(b);
+                Neighbour::Predicted {
+                    t0: self.runs[b].stepper.t,
+                    omega,
+                    alpha: if free { alpha } else { 0.0 },
+                }
+            })
+            .collect()
     }
 
     /// Runs the bodies `group` from the window's start to `t1` (s) against the neighbours'
@@ -228,10 +250,7 @@ impl OpenSession {
     /// The bodies' tracks of their last pass as neighbours' inputs.
     fn tracks(&self, group: &[usize], seen: &mut [Neighbour]) {
         for &b in group {
-            seen[b] = Neighbour::Track {
-                psi: Arc::new(self.runs[b].track.clone()),
-                on_shaft: self.on_shaft(b),
-            };
+            seen[b] = Neighbour::track(Arc::new(self.runs[b].track.clone()), self.on_shaft(b));
         }
     }
 
@@ -239,10 +258,9 @@ impl OpenSession {
     /// saw, relative to what the tolerance allows it: the bound `c W sum max |d omega| / J` on
     /// the change of its speed (rad/s) over the error its steps in the window may make
     /// (`tol (1 + |omega|)` each). At most 1: its pass stands.
-    fn unsettled(&self, b: usize, seen: &[Neighbour], width: f64) -> f64 {
+    fn unsettled(&self, b: usize, seen: &[Neighbour]) -> f64 {
         let r = &self.runs[b];
         let gaps = r.stepper.sys.gaps.as_ref().expect("an open body");
-        let shaft = |t: f64| r.stepper.sys.shaft(t, &[]).1;
         let mut moved = 0.0;
         for (q, used) in self
             .neighbours(b)
@@ -250,16 +268,16 @@ impl OpenSession {
             .zip([&gaps.below, &gaps.above])
         {
             if let (Some(q), Some(used)) = (q, used) {
-                if let Neighbour::Track { psi, on_shaft } = &seen[q] {
+                if let Neighbour::Track { psi, .. } = &seen[q] {
                     if !matches!(used, Neighbour::Track { psi: p, .. } if Arc::ptr_eq(p, psi)) {
-                        moved += used.max_change(psi, *on_shaft, shaft);
+                        moved += used.change(psi);
                     }
                 }
             }
         }
         let j = r.stepper.sys.disc(0).inertia_kg_m2;
-        let allowed = self.tol * (1.0 + self.predicted(b).omega_at_start().abs());
-        self.c_gap * width * moved / j / (allowed * r.track.len().max(1) as f64)
+        let allowed = self.tol * (1.0 + self.speed(b).abs());
+        self.c_gap * moved / j / (allowed * r.track.len().max(1) as f64)
     }
 
     /// One window `[t_w, t1]` (Gauss-Seidel waveform relaxation over the stack's two colours):
@@ -268,11 +286,9 @@ impl OpenSession {
     /// ([`Self::unsettled`]) again against the plates' last passes, and its plates again,
     /// until every pass stands.
     fn window(&mut self, t1: f64) -> Result<(), EngineError> {
-        let n = self.runs.len();
         let saved = self.runs.clone();
-        let mut seen: Vec<Neighbour> = (0..n).map(|b| self.predicted(b)).collect();
+        let mut seen: Vec<Neighbour> = self.predictions();
         let first = self.first.clone();
-        let width = t1 - self.t_w;
         let (mut redo_first, mut redo_second) = (first.clone(), self.second.clone());
         let mut sweeps = 0;
         loop {
@@ -286,12 +302,12 @@ impl OpenSession {
             sweeps += 1;
             let worst = first
                 .iter()
-                .map(|&b| (b, self.unsettled(b, &seen, width)))
+                .map(|&b| (b, self.unsettled(b, &seen)))
                 .fold((0, 0.0), |a, x| if x.1 > a.1 { x } else { a });
             redo_first = first
                 .iter()
                 .copied()
-                .filter(|&b| self.unsettled(b, &seen, width) > 1.0)
+                .filter(|&b| self.unsettled(b, &seen) > 1.0)
                 .collect();
             if redo_first.is_empty() {
                 break;

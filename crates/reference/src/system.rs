@@ -300,6 +300,28 @@ impl System {
 
     /// `dy = f(t, y)` with the slots' contact modes `modes`.
     pub fn rhs(&self, t: f64, y: &[f64], modes: &[Option<Engagement>], dy: &mut [f64]) {
+        if let Some(gaps) = &self.gaps {
+            // one body of an open pack on a prescribed shaft: its teeth, its drag and its gaps
+            // (MODEL.md section 5); the shaft's acceleration only for a disc
+            let Shaft::Prescribed(p) = &self.pack.shaft else {
+                unreachable!("an open pack's shaft is prescribed")
+            };
+            let k = self.off;
+            let omega_s = p.speed(t);
+            let (omega_c, alpha_c) = match self.carrier(0) {
+                Carrier::Shaft => (omega_s, p.acceleration(t)),
+                _ => (0.0, 0.0),
+            };
+            let omega_b = omega_c - y[k + 1];
+            let [below, above] = gaps.torques_n_m(t, omega_b, || omega_s);
+            let free = self.free_torque_n_m(0, y, &modes[0], omega_c) + below + above;
+            dy[k] = y[k + 1];
+            dy[k + 1] = alpha_c - free / self.disc(0).inertia_kg_m2;
+            let h = self.heat_at();
+            dy[h] = below * omega_b;
+            dy[h + 1] = above * omega_b;
+            return;
+        }
         let c = self.carriers(t, y, modes);
         if matches!(self.pack.shaft, Shaft::Inertial { .. }) {
             dy[0] = c[0];
@@ -308,20 +330,6 @@ impl System {
         if self.pack.drum.is_some() {
             dy[self.drum_at()] = c[2];
             dy[self.drum_at() + 1] = c[3];
-        }
-        if let Some(gaps) = &self.gaps {
-            // one body of an open pack: its teeth, its drag and its gaps (MODEL.md section 5)
-            let k = self.off;
-            let (omega_c, alpha_c) = self.carrier_of(0, &c);
-            let omega_b = omega_c - y[k + 1];
-            let [below, above] = gaps.torques_n_m(t, omega_b, c[0]);
-            let free = self.free_torque_n_m(0, y, &modes[0], omega_c) + below + above;
-            dy[k] = y[k + 1];
-            dy[k + 1] = alpha_c - free / self.disc(0).inertia_kg_m2;
-            let h = self.heat_at();
-            dy[h] = below * omega_b;
-            dy[h + 1] = above * omega_b;
-            return;
         }
         if self.pack.stack.is_some() {
             // every body is a stack body: its acceleration comes from the stack's balance
