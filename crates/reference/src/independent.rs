@@ -215,13 +215,7 @@ impl Session for IndependentSession {
     }
 
     fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
-        let (pack, jump) = self.clock.hold(&self.pack, inputs)?;
-        self.pack = Arc::new(pack);
-        for r in self.runs.iter_mut() {
-            r.stepper.sys.pack = self.pack.clone();
-            shift_disc_speeds(&mut r.stepper, jump);
-            r.stepper.restart();
-        }
+        self.pack = hold_in_runs(&self.clock, &self.pack, &mut self.runs, inputs)?;
         Ok(())
     }
 
@@ -231,10 +225,7 @@ impl Session for IndependentSession {
 
     fn advance_to(&mut self, t: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
         self.clock.check_advance(t)?;
-        let wants_contacts = obs.wants_contact_samples();
-        for r in self.runs.iter_mut() {
-            r.out.wants_contacts = wants_contacts;
-        }
+        want_contacts(&mut self.runs, obs);
         let end = self.clock.step_end(t);
         while self.t_w < t {
             let target = (self.t_w + self.window).min(t);
@@ -412,5 +403,32 @@ impl Merger {
             stats.rhs_evals += s.rhs_evals;
         }
         stats
+    }
+}
+
+/// Holds `inputs` from the session's time (`clock`) in every run of `runs` on `pack`: the
+/// pack with them, the discs' relative speeds shifted by a jump of the shaft's speed, the
+/// integrations restarted; returns the new pack.
+pub(crate) fn hold_in_runs(
+    clock: &Clock,
+    pack: &PackModel,
+    runs: &mut [DiscRun],
+    inputs: &Inputs,
+) -> Result<Arc<PackModel>, EngineError> {
+    let (pack, jump) = clock.hold(pack, inputs)?;
+    let pack = Arc::new(pack);
+    for r in runs.iter_mut() {
+        r.stepper.sys.pack = pack.clone();
+        shift_disc_speeds(&mut r.stepper, jump);
+        r.stepper.restart();
+    }
+    Ok(pack)
+}
+
+/// Tells every run whether `obs` takes contact samples (asked at every call).
+pub(crate) fn want_contacts(runs: &mut [DiscRun], obs: &dyn Observer) {
+    let wants = obs.wants_contact_samples();
+    for r in runs.iter_mut() {
+        r.out.wants_contacts = wants;
     }
 }

@@ -6,8 +6,8 @@
 //! the integrator's tolerance.
 
 use crate::gaps::{Gaps, Neighbour};
-use crate::independent::{DiscRun, Merger};
-use crate::session::{shift_disc_speeds, Clock};
+use crate::independent::{hold_in_runs, want_contacts, DiscRun, Merger};
+use crate::session::Clock;
 use crate::system::System;
 use crate::{no_external, ReferenceOptions};
 use clutchpack_model::session::{Advance, Driven, Inputs, Session, Snapshot};
@@ -384,13 +384,7 @@ impl Session for OpenSession {
     }
 
     fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
-        let (pack, jump) = self.clock.hold(&self.pack, inputs)?;
-        self.pack = Arc::new(pack);
-        for r in self.runs.iter_mut() {
-            r.stepper.sys.pack = self.pack.clone();
-            shift_disc_speeds(&mut r.stepper, jump);
-            r.stepper.restart();
-        }
+        self.pack = hold_in_runs(&self.clock, &self.pack, &mut self.runs, inputs)?;
         Ok(())
     }
 
@@ -400,10 +394,7 @@ impl Session for OpenSession {
 
     fn advance_to(&mut self, t: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
         self.clock.check_advance(t)?;
-        let wants_contacts = obs.wants_contact_samples();
-        for r in self.runs.iter_mut() {
-            r.out.wants_contacts = wants_contacts;
-        }
+        want_contacts(&mut self.runs, obs);
         let end = self.clock.step_end(t);
         while self.t_w < t {
             // windows on a fixed grid (a run split into calls takes the same steps); a driven
