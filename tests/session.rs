@@ -76,12 +76,14 @@ fn assert_identical(file: &str, engine: EngineChoice, duration: f64) {
 
 #[test]
 fn reference_sessions_in_any_number_of_calls_are_the_run() {
-    // monolithic (a whole pack), independent discs (prescribed shafts)
+    // monolithic (a whole pack), independent discs (prescribed shafts), the open pack's
+    // windows (a call inside a window: the state there from a rerun of its last pass)
     for file in [
         "scenes/hu-table2.toml",
         "scenes/pack-4-rattle.toml",
         "scenes/pack-6-engagement.toml",
         "scenes/staggered-8-disc.toml",
+        "scenes/pack-8-brake.toml",
     ] {
         assert_identical(file, EngineChoice::Reference, 0.1);
     }
@@ -238,4 +240,41 @@ fn a_driven_shaft_is_the_run_of_the_same_held_table() {
         table.impacts.len(),
         whole.impacts.len()
     );
+}
+
+/// The open pack's relaxation windows (1 ms) hold many calls: a snapshot at a call inside a
+/// window is the state the run passes through there (found by rerunning the window's last
+/// pass), identical to the whole run's sample at that instant.
+#[test]
+fn reference_snapshots_inside_an_open_packs_window_are_the_run() {
+    let mut sim = simulation("scenes/pack-8-brake.toml", EngineChoice::Reference, 0.02);
+    let mut whole = Collector::default();
+    sim.engine_mut().run(0.02, &mut whole).unwrap();
+    let mut s = sim.engine_mut().start(Driven::NONE).unwrap();
+    s.set_stop_time(0.02);
+    let mut split = Collector::default();
+    for k in 1..=200u32 {
+        let t = k as f64 / 1e4;
+        s.advance_to(t, &mut split).unwrap();
+        let snap = s.snapshot();
+        let w = &whole.samples[k as usize];
+        assert_eq!(w.t_s, t);
+        // the same dense output at the same instant (a sample on a step's end is the dense
+        // output's value there, the snapshot the step's end state: an ulp apart)
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(1e-3);
+        for (a, b) in w.discs.iter().zip(&snap.sample.discs) {
+            assert!(
+                close(a.rel_angle_rad, b.rel_angle_rad)
+                    && close(a.speed_rad_s, b.speed_rad_s)
+                    && (a.load_n - b.load_n).abs() <= 1e-9 * a.load_n.abs().max(1.0),
+                "at {t} s: {a:?} vs {b:?}"
+            );
+        }
+        let gaps = &whole.interfaces[k as usize];
+        assert_eq!(gaps.0, t);
+        assert_eq!(gaps.1.len(), snap.interfaces.len());
+        for (a, b) in gaps.1.iter().zip(&snap.interfaces) {
+            assert!(close(a.dissipated_j, b.dissipated_j), "at {t} s");
+        }
+    }
 }

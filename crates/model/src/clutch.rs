@@ -173,6 +173,18 @@ impl Piston {
     pub fn force_n(&self, t_s: f64) -> f64 {
         (self.pressure.pressure_pa(t_s) * self.area_m2 - self.return_spring_n).max(0.0)
     }
+
+    /// Whether the piston can ever push on the stack: its largest pressure times its area
+    /// exceeds the return spring. When not, every interface stays an open oil gap for the
+    /// whole run (the engines' multirate schemes for open packs rely on it).
+    pub fn can_clamp(&self) -> bool {
+        let max_pa = match &self.pressure {
+            PressureProfile::Constant { pressure_pa }
+            | PressureProfile::Ramp { pressure_pa, .. } => *pressure_pa,
+            PressureProfile::Table(t) => t.y.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        };
+        max_pa * self.area_m2 > self.return_spring_n
+    }
 }
 
 /// The oil gaps of an open pack (no clamp force).
@@ -406,6 +418,14 @@ mod tests {
         assert_eq!(p.force_n(0.012), 0.0); // 1e5 Pa * 0.01 m^2 = 1000 N < 2000 N
         assert_relative_eq!(p.force_n(0.02), 5e5 * 0.01 - 2000.0, max_relative = 1e-12);
         assert_relative_eq!(p.force_n(1.0), 1e4 - 2000.0, max_relative = 1e-12);
+        // it can clamp: 1e6 Pa * 0.01 m^2 = 1e4 N > 2000 N; not against a spring of 1e4 N
+        assert!(p.can_clamp());
+        let held_off = Piston {
+            return_spring_n: 1e4,
+            ..p.clone()
+        };
+        assert!(!held_off.can_clamp());
+        assert_eq!(held_off.force_n(1.0), 0.0);
     }
 
     /// Spline friction holds back mu_spline Q_b at each body from the piston on: the clamp

@@ -94,17 +94,38 @@ impl Dense {
     /// Interpolated state at `t` (within the step) into `out` (its first `out.len()`
     /// components).
     pub fn eval(&self, t: f64, out: &mut [f64]) {
-        let th = if self.h > 0.0 {
-            ((t - self.t0) / self.h).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let th1 = 1.0 - th;
+        let th = fraction(self.t0, self.h, t);
         for i in 0..out.len() {
-            out[i] = self.r1[i]
-                + th * (self.r2[i] + th1 * (self.r3[i] + th * (self.r4[i] + th1 * self.r5[i])));
+            let c = [self.r1[i], self.r2[i], self.r3[i], self.r4[i], self.r5[i]];
+            out[i] = interpolate(&c, th);
         }
     }
+
+    /// The interpolant of component `i` alone: `(t0, h, coefficients)` for [`eval_component`].
+    pub fn component(&self, i: usize) -> (f64, f64, [f64; 5]) {
+        let c = [self.r1[i], self.r2[i], self.r3[i], self.r4[i], self.r5[i]];
+        (self.t0, self.h, c)
+    }
+}
+
+/// The value at `t` of one component's interpolant `(t0, h, c)` from [`Dense::component`].
+pub fn eval_component(t0: f64, h: f64, c: &[f64; 5], t: f64) -> f64 {
+    interpolate(c, fraction(t0, h, t))
+}
+
+/// The fraction `(t - t0) / h` of a step `[t0, t0 + h]` at `t`, clamped to [0, 1].
+fn fraction(t0: f64, h: f64, t: f64) -> f64 {
+    if h > 0.0 {
+        ((t - t0) / h).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+/// The dense output's polynomial (Hairer's form for DOPRI5) at the step's fraction `th`.
+fn interpolate(c: &[f64; 5], th: f64) -> f64 {
+    let th1 = 1.0 - th;
+    c[0] + th * (c[1] + th1 * (c[2] + th * (c[3] + th1 * c[4])))
 }
 
 /// Workspace and stages of the integrator for a system of dimension `n`.

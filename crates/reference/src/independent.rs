@@ -2,13 +2,15 @@
 //! steps and events, advanced window by window (in parallel when asked) and merged into one
 //! time-ordered stream of samples and impacts (crate docs, Theory).
 
+use crate::gaps::Track;
 use crate::session::{shift_disc_speeds, Clock};
 use crate::stepper::{Sink, Stepper};
 use crate::system::System;
 use crate::{no_external, ReferenceOptions};
 use clutchpack_model::session::{Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::{
-    DiscSample, Engagement, EngineError, ImpactEvent, Observer, PackModel, RunStats, Sample,
+    DiscSample, Engagement, EngineError, ImpactEvent, InterfaceSample, Observer, PackModel,
+    RunStats, Sample,
 };
 use rayon::prelude::*;
 use std::collections::VecDeque;
@@ -17,21 +19,26 @@ use std::time::Instant;
 
 /// One disc's output not yet merged.
 #[derive(Default, Clone)]
-struct Buffer {
-    /// `(sample number, the disc's sample)` in order.
-    samples: VecDeque<(u64, DiscSample)>,
+pub(crate) struct Buffer {
+    /// `(sample number, the disc's sample, the work of its gaps below and above in J (0
+    /// without gaps))` in order.
+    samples: VecDeque<(u64, DiscSample, [f64; 2])>,
     /// Impacts in the order they closed.
     impacts: Vec<ImpactEvent>,
     /// `(t s, the disc's state)` of its contact samples, in order.
     contacts: VecDeque<(f64, DiscSample)>,
     /// Whether the observer takes contact samples (else none are kept).
-    wants_contacts: bool,
+    pub wants_contacts: bool,
 }
 
 impl Sink for Buffer {
     fn sample(&mut self, k: u64, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]) {
+        let work = match sys.gaps {
+            Some(_) => sys.gap_work_j(y),
+            None => [0.0; 2],
+        };
         self.samples
-            .push_back((k, sys.disc_sample(t, 0, y, &modes[0])));
+            .push_back((k, sys.disc_sample(t, 0, y, &modes[0]), work));
     }
     fn impact(&mut self, e: ImpactEvent) {
         self.impacts.push(e);
@@ -59,15 +66,27 @@ fn send_contacts(runs: &mut [DiscRun], t: f64, obs: &mut dyn Observer) {
     }
 }
 
-/// One disc's integration and its unmerged output.
+/// One body's integration and its unmerged output.
 #[derive(Clone)]
-struct DiscRun {
-    stepper: Stepper,
-    out: Buffer,
-    error: Option<EngineError>,
+pub(crate) struct DiscRun {
+    pub stepper: Stepper,
+    pub out: Buffer,
+    pub error: Option<EngineError>,
+    /// Its relative speed through the current window (the open-pack scheme; empty else).
+    pub track: Track,
 }
 
 impl DiscRun {
+    /// A run of `sys` from t = 0.
+    pub fn new(sys: System, settings: &ReferenceOptions) -> DiscRun {
+        DiscRun {
+            stepper: Stepper::new(sys, settings),
+            out: Buffer::default(),
+            error: None,
+            track: Track::default(),
+        }
+    }
+
     /// Integrates until the disc's time reaches `t_w` (s), its steps ending at `end` (s), or
     /// until the wall clock passes `deadline` (so that a stop request is seen even when the
     /// steps become very small).
@@ -107,17 +126,12 @@ pub(crate) struct IndependentSession {
     pack: Arc<PackModel>,
     parallel: bool,
     clock: Clock,
-    rate: f64,
     /// Window length in simulated time, s, and its upper bound.
     window: f64,
     cap: f64,
     /// Time every disc has reached and whose output has been merged, s.
     t_w: f64,
-    /// Number of the next merged sample.
-    next_k: u64,
-    /// Impacts closed but not yet sent, in the order of their end.
-    pending: Vec<ImpactEvent>,
-    sample: Sample,
+    merger: Merger,
 }
 
 impl IndependentSession {
@@ -129,11 +143,7 @@ impl IndependentSession {
     ) -> Self {
         let nd = pack.discs.len();
         let runs = (0..nd)
-            .map(|i| DiscRun {
-                stepper: Stepper::new(System::new(pack.clone(), vec![i]), settings),
-                out: Buffer::default(),
-                error: None,
-            })
+            .map(|i| DiscRun::new(System::new(pack.clone(), vec![i]), settings))
             .collect();
         let rate = settings.record_rate_hz;
         let cap = (MAX_BUFFERED_SAMPLES / (rate * nd as f64)).max(2.0 / rate);
@@ -142,16 +152,10 @@ impl IndependentSession {
             pack,
             parallel,
             clock: Clock::new(driven),
-            rate,
             window: (1e-3f64).min(cap),
             cap,
             t_w: 0.0,
-            next_k: 0,
-            pending: Vec::new(),
-            sample: Sample {
-                discs: vec![DiscSample::default(); nd],
-                ..Sample::default()
-            },
+            merger: Merger::new(rate, nd),
         }
     }
 
@@ -197,64 +201,11 @@ impl IndependentSession {
                 failure = Some(e.clone());
             }
         }
-        self.merge(limit, obs);
+        self.merger.merge(runs, limit, true, obs, &|_, _| None);
         match failure {
             Some(e) => Err(e),
             None => Ok(()),
         }
-    }
-
-    /// Sends the samples, contact samples and impacts up to `limit` (s) in time order.
-    fn merge(&mut self, limit: f64, obs: &mut dyn Observer) {
-        let runs = &mut self.runs;
-        for r in runs.iter_mut() {
-            self.pending.append(&mut r.out.impacts);
-        }
-        let pending = &mut self.pending;
-        pending.sort_by(|a, b| a.t_off_s.total_cmp(&b.t_off_s).then(a.disc.cmp(&b.disc)));
-        let mut next_impact = 0;
-        loop {
-            let ts = self.next_k as f64 / self.rate;
-            // a disc that failed before its first step has no sample at t = 0
-            let ready = runs.iter().all(|r| {
-                r.out
-                    .samples
-                    .front()
-                    .is_some_and(|&(k, _)| k == self.next_k)
-            });
-            if ts > limit || !ready {
-                break;
-            }
-            while next_impact < pending.len() && pending[next_impact].t_off_s < ts {
-                obs.impact(&pending[next_impact]);
-                next_impact += 1;
-            }
-            // each disc's contact samples up to this sample first: one time order per disc
-            send_contacts(runs, ts, obs);
-            let sample = &mut self.sample;
-            sample.t_s = ts;
-            // the shaft of the first disc's system: the pack with the inputs held so far
-            let shaft = &runs[0].stepper.sys;
-            (sample.shaft_angle_rad, sample.shaft_speed_rad_s) = shaft.shaft(ts, &[]);
-            for (r, d) in runs.iter_mut().zip(sample.discs.iter_mut()) {
-                if let Some((_, s)) = r.out.samples.pop_front() {
-                    *d = s;
-                }
-            }
-            obs.sample(sample);
-            self.next_k += 1;
-        }
-        // the contact samples before the next sample (which the next window sends)
-        send_contacts(
-            runs,
-            limit.min(self.next_k as f64 / self.rate).next_down(),
-            obs,
-        );
-        while next_impact < pending.len() && pending[next_impact].t_off_s <= limit {
-            obs.impact(&pending[next_impact]);
-            next_impact += 1;
-        }
-        pending.drain(..next_impact);
     }
 }
 
@@ -264,13 +215,7 @@ impl Session for IndependentSession {
     }
 
     fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
-        let (pack, jump) = self.clock.hold(&self.pack, inputs)?;
-        self.pack = Arc::new(pack);
-        for r in self.runs.iter_mut() {
-            r.stepper.sys.pack = self.pack.clone();
-            shift_disc_speeds(&mut r.stepper, jump);
-            r.stepper.restart();
-        }
+        self.pack = hold_in_runs(&self.clock, &self.pack, &mut self.runs, inputs)?;
         Ok(())
     }
 
@@ -280,10 +225,7 @@ impl Session for IndependentSession {
 
     fn advance_to(&mut self, t: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
         self.clock.check_advance(t)?;
-        let wants_contacts = obs.wants_contact_samples();
-        for r in self.runs.iter_mut() {
-            r.out.wants_contacts = wants_contacts;
-        }
+        want_contacts(&mut self.runs, obs);
         let end = self.clock.step_end(t);
         while self.t_w < t {
             let target = (self.t_w + self.window).min(t);
@@ -325,13 +267,131 @@ impl Session for IndependentSession {
     }
 
     fn finish(&mut self, obs: &mut dyn Observer) -> RunStats {
-        // Impacts closed beyond the last window's end (a stop), then the events still open.
+        let mut stats = self.merger.finish(&mut self.runs, obs);
+        stats.simulated_s = self.clock.t;
+        stats
+    }
+
+    fn boxed_clone(&self) -> Box<dyn Session> {
+        Box::new(self.clone())
+    }
+}
+
+/// The interface samples (if any) of a merged sample from its bodies' samples and their gaps'
+/// work (J, below and above, in the bodies' order).
+pub(crate) type InterfacesOf<'a> = &'a dyn Fn(&Sample, &[[f64; 2]]) -> Option<Vec<InterfaceSample>>;
+
+/// The merge of the bodies' separately integrated output into one time-ordered stream.
+#[derive(Clone)]
+pub(crate) struct Merger {
+    rate: f64,
+    /// Number of the next merged sample.
+    next_k: u64,
+    /// Impacts closed but not yet sent, in the order of their end.
+    pending: Vec<ImpactEvent>,
+    sample: Sample,
+    /// Each body's gap work at the sample being merged, J.
+    works: Vec<[f64; 2]>,
+}
+
+impl Merger {
+    /// A merge of `n` bodies sampled at `rate` Hz.
+    pub fn new(rate: f64, n: usize) -> Merger {
+        Merger {
+            rate,
+            next_k: 0,
+            pending: Vec::new(),
+            sample: Sample {
+                discs: vec![DiscSample::default(); n],
+                ..Sample::default()
+            },
+            works: vec![[0.0; 2]; n],
+        }
+    }
+
+    /// Sends the samples (each followed by the interfaces `interfaces` makes of it), contact
+    /// samples and impacts of `runs` up to `limit` (s) in time order; the contact samples
+    /// after the last sample only when `limit_is_window_end` (so that the contact samples of
+    /// the bodies interleave alike whatever calls a session took: by sample and by window).
+    pub fn merge(
+        &mut self,
+        runs: &mut [DiscRun],
+        limit: f64,
+        limit_is_window_end: bool,
+        obs: &mut dyn Observer,
+        interfaces: InterfacesOf,
+    ) {
+        for r in runs.iter_mut() {
+            self.pending.append(&mut r.out.impacts);
+        }
+        let pending = &mut self.pending;
+        pending.sort_by(|a, b| a.t_off_s.total_cmp(&b.t_off_s).then(a.disc.cmp(&b.disc)));
+        let mut next_impact = 0;
+        loop {
+            let ts = self.next_k as f64 / self.rate;
+            // a disc that failed before its first step has no sample at t = 0
+            let ready = runs.iter().all(|r| {
+                r.out
+                    .samples
+                    .front()
+                    .is_some_and(|&(k, _, _)| k == self.next_k)
+            });
+            if ts > limit || !ready {
+                break;
+            }
+            while next_impact < pending.len() && pending[next_impact].t_off_s < ts {
+                obs.impact(&pending[next_impact]);
+                next_impact += 1;
+            }
+            // each disc's contact samples up to this sample first: one time order per disc
+            send_contacts(runs, ts, obs);
+            let sample = &mut self.sample;
+            sample.t_s = ts;
+            // the shaft of the first disc's system: the pack with the inputs held so far
+            let shaft = &runs[0].stepper.sys;
+            (sample.shaft_angle_rad, sample.shaft_speed_rad_s) = shaft.shaft(ts, &[]);
+            for ((r, d), w) in runs
+                .iter_mut()
+                .zip(sample.discs.iter_mut())
+                .zip(self.works.iter_mut())
+            {
+                if let Some((_, s, work)) = r.out.samples.pop_front() {
+                    *d = s;
+                    *w = work;
+                }
+            }
+            obs.sample(sample);
+            if let Some(ifs) = interfaces(sample, &self.works) {
+                obs.interfaces(ts, &ifs);
+            }
+            self.next_k += 1;
+        }
+        // the contact samples before the next sample (which the next window sends), when the
+        // bodies' output is complete up to `limit`
+        if limit_is_window_end {
+            send_contacts(
+                runs,
+                limit.min(self.next_k as f64 / self.rate).next_down(),
+                obs,
+            );
+        }
+        while next_impact < pending.len() && pending[next_impact].t_off_s <= limit {
+            obs.impact(&pending[next_impact]);
+            next_impact += 1;
+        }
+        pending.drain(..next_impact);
+    }
+
+    /// Sends what is left at the end of a run: the impacts closed beyond the last merge (a
+    /// stop), the contact samples, then the events still open; returns the bodies' summed
+    /// step counts.
+    pub fn finish(&mut self, runs: &mut [DiscRun], obs: &mut dyn Observer) -> RunStats {
         for e in self.pending.drain(..) {
             obs.impact(&e);
         }
-        send_contacts(&mut self.runs, f64::INFINITY, obs);
+        send_contacts(runs, f64::INFINITY, obs);
         let mut stats = RunStats::default();
-        for r in self.runs.iter_mut() {
+        for r in runs.iter_mut() {
             let mut rest = Buffer::default();
             r.stepper.finish(&mut rest);
             for e in &rest.impacts {
@@ -342,11 +402,33 @@ impl Session for IndependentSession {
             stats.rejected_steps += s.rejected_steps;
             stats.rhs_evals += s.rhs_evals;
         }
-        stats.simulated_s = self.clock.t;
         stats
     }
+}
 
-    fn boxed_clone(&self) -> Box<dyn Session> {
-        Box::new(self.clone())
+/// Holds `inputs` from the session's time (`clock`) in every run of `runs` on `pack`: the
+/// pack with them, the discs' relative speeds shifted by a jump of the shaft's speed, the
+/// integrations restarted; returns the new pack.
+pub(crate) fn hold_in_runs(
+    clock: &Clock,
+    pack: &PackModel,
+    runs: &mut [DiscRun],
+    inputs: &Inputs,
+) -> Result<Arc<PackModel>, EngineError> {
+    let (pack, jump) = clock.hold(pack, inputs)?;
+    let pack = Arc::new(pack);
+    for r in runs.iter_mut() {
+        r.stepper.sys.pack = pack.clone();
+        shift_disc_speeds(&mut r.stepper, jump);
+        r.stepper.restart();
+    }
+    Ok(pack)
+}
+
+/// Tells every run whether `obs` takes contact samples (asked at every call).
+pub(crate) fn want_contacts(runs: &mut [DiscRun], obs: &dyn Observer) {
+    let wants = obs.wants_contact_samples();
+    for r in runs.iter_mut() {
+        r.out.wants_contacts = wants;
     }
 }

@@ -256,6 +256,17 @@ impl Stepper {
         }
     }
 
+    /// Whether [`Self::state_at`] knows the state at `t` (s): `t` at or after the stepper's
+    /// time or inside its last two steps.
+    pub fn remembers(&self, t: f64) -> bool {
+        let start = if self.prev.h > 0.0 {
+            self.prev.t0
+        } else {
+            self.cur.t0
+        };
+        t >= self.t || self.cur.h <= 0.0 || t >= start
+    }
+
     /// Closes the open contact events at the end of a run (or a stop) at `self.t`.
     pub fn finish(&mut self, sink: &mut impl Sink) {
         for tr in self.tracks.iter_mut() {

@@ -2,6 +2,7 @@
 //! state layout the integrator advances; for a whole pack also the separator plates on the
 //! housing or the drum, the drum (MODEL.md section 5) and the open stack's oil gaps.
 
+use crate::gaps::Gaps;
 use clutchpack_model::{
     DiscModel, DiscSample, Engagement, InterfaceSample, PackModel, Sample, Shaft, StackBody,
     ToothKinematics,
@@ -58,7 +59,9 @@ enum Carrier {
 /// (the shaft for a disc, the drum or the housing for a plate); for a prescribed shaft
 /// `off = 0` and the shaft comes from its profile. A whole pack (plates, a drum or a stack:
 /// every coupling in its slot, in order) continues with the drum's angle (rad) and speed
-/// (rad/s) when there is a drum, then the heat (J) each open interface has dissipated.
+/// (rad/s) when there is a drum, then the heat (J) each open interface has dissipated. A body
+/// of an open pack run on its own (the open-pack multirate scheme, [`System::open_body`])
+/// continues instead with the work (J) the gap below and the gap above have done on it.
 #[derive(Clone)]
 pub(crate) struct System {
     /// The model (shared by a run's steppers; `session.rs` swaps it when an input changes).
@@ -76,12 +79,25 @@ pub(crate) struct System {
     /// Open-gap damping `c = pi eta (Ro^4 - Ri^4) / (2 h)` of every interface, N m s/rad (0
     /// without a stack or its oil gap; MODEL.md section 5).
     c_gap: f64,
+    /// The open gaps on both sides of the one body of an open-pack multirate run
+    /// ([`System::open_body`]); `None` otherwise.
+    pub gaps: Option<Gaps>,
 }
 
 impl System {
     /// The shaft and the couplings `ids` of `pack`. A pack with plates, a drum or a stack
     /// needs every coupling in order (`ids = 0..N + P`).
     pub fn new(pack: Arc<PackModel>, ids: Vec<usize>) -> System {
+        let sys = System::build(pack, ids);
+        debug_assert!(
+            !sys.pack.is_whole()
+                || sys.ids == (0..sys.nd + sys.pack.plates.len()).collect::<Vec<_>>()
+        );
+        sys
+    }
+
+    /// The system of the couplings `ids`, unchecked.
+    fn build(pack: Arc<PackModel>, ids: Vec<usize>) -> System {
         let off = if matches!(pack.shaft, Shaft::Inertial { .. }) {
             2
         } else {
@@ -93,12 +109,13 @@ impl System {
             .map_or(0.0, |s| -s.open_gap_torque_n_m(1.0));
         let faces = vec![Face::Open; pack.stack.as_ref().map_or(0, |_| 2 * pack.discs.len())];
         // `pack` moves last: the fields before it read it
-        let sys = System {
+        System {
             off,
             ids,
             nd: pack.discs.len(),
             c_gap,
             faces,
+            gaps: None,
             rb: pack
                 .discs
                 .iter()
@@ -106,12 +123,28 @@ impl System {
                 .map(|d| d.spline.base_radius_m())
                 .collect(),
             pack,
-        };
-        debug_assert!(
-            !sys.pack.is_whole()
-                || sys.ids == (0..sys.nd + sys.pack.plates.len()).collect::<Vec<_>>()
-        );
+        }
+    }
+
+    /// The body `id` of an open pack (plates on the housing, a prescribed shaft, a stack whose
+    /// piston never clamps) alone: its spline coupling, its drag and the open gaps to its
+    /// neighbours, whose speeds the caller sets in [`Self::gaps`] window by window.
+    pub fn open_body(pack: Arc<PackModel>, id: usize) -> System {
+        let mut sys = System::build(pack, vec![id]);
+        sys.faces.clear();
+        sys.gaps = Some(Gaps {
+            c: sys.c_gap,
+            below: None,
+            above: None,
+        });
         sys
+    }
+
+    /// The work (J) the gap below and the gap above have done on the body of an
+    /// [`Self::open_body`] system in state `y`.
+    pub fn gap_work_j(&self, y: &[f64]) -> [f64; 2] {
+        let h = self.heat_at();
+        [y[h], y[h + 1]]
     }
 
     /// Index of the drum's angle in the state (its speed follows).
@@ -130,9 +163,10 @@ impl System {
         self.drum_at() + if self.pack.drum.is_some() { 2 } else { 0 }
     }
 
-    /// Number of friction interfaces (`2N` with a stack).
+    /// Number of friction interfaces in the state (`2N` for a whole pack with a stack; none
+    /// for one body of an open pack, which carries its gaps' work instead).
     pub fn interfaces(&self) -> usize {
-        if self.pack.stack.is_some() {
+        if self.pack.stack.is_some() && self.gaps.is_none() {
             2 * self.nd
         } else {
             0
@@ -140,7 +174,7 @@ impl System {
     }
 
     pub fn dim(&self) -> usize {
-        self.heat_at() + self.interfaces()
+        self.heat_at() + self.interfaces() + if self.gaps.is_some() { 2 } else { 0 }
     }
 
     /// The coupling with global index `id`: disc `id`, or plate `id - N`.
@@ -266,6 +300,28 @@ impl System {
 
     /// `dy = f(t, y)` with the slots' contact modes `modes`.
     pub fn rhs(&self, t: f64, y: &[f64], modes: &[Option<Engagement>], dy: &mut [f64]) {
+        if let Some(gaps) = &self.gaps {
+            // one body of an open pack on a prescribed shaft: its teeth, its drag and its gaps
+            // (MODEL.md section 5); the shaft's acceleration only for a disc
+            let Shaft::Prescribed(p) = &self.pack.shaft else {
+                unreachable!("an open pack's shaft is prescribed")
+            };
+            let k = self.off;
+            let omega_s = p.speed(t);
+            let (omega_c, alpha_c) = match self.carrier(0) {
+                Carrier::Shaft => (omega_s, p.acceleration(t)),
+                _ => (0.0, 0.0),
+            };
+            let omega_b = omega_c - y[k + 1];
+            let [below, above] = gaps.torques_n_m(t, omega_b, || omega_s);
+            let free = self.free_torque_n_m(0, y, &modes[0], omega_c) + below + above;
+            dy[k] = y[k + 1];
+            dy[k + 1] = alpha_c - free / self.disc(0).inertia_kg_m2;
+            let h = self.heat_at();
+            dy[h] = below * omega_b;
+            dy[h + 1] = above * omega_b;
+            return;
+        }
         let c = self.carriers(t, y, modes);
         if matches!(self.pack.shaft, Shaft::Inertial { .. }) {
             dy[0] = c[0];

@@ -39,7 +39,7 @@ pub(super) fn unsupported(
         return Some("a drum couples its plates within a step through its inertia");
     }
     if let Some(stack) = &pack.stack {
-        if piston_can_clamp(stack) {
+        if stack.piston.can_clamp() {
             return Some(
                 "a clamped stack (the piston's force exceeds its return spring) couples the \
                  bodies within a step through the faces' friction",
@@ -55,18 +55,6 @@ pub(super) fn unsupported(
         );
     }
     None
-}
-
-/// Whether the piston's force can ever exceed its return spring (a clamped stack), from the
-/// largest pressure of its profile.
-fn piston_can_clamp(stack: &clutchpack_model::StackModel) -> bool {
-    use clutchpack_model::PressureProfile as P;
-    let p = &stack.piston;
-    let max_pa = match &p.pressure {
-        P::Constant { pressure_pa } | P::Ramp { pressure_pa, .. } => *pressure_pa,
-        P::Table(t) => t.y.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-    };
-    max_pa * p.area_m2 > p.return_spring_n
 }
 
 /// What the multirate loop counts in a run.
