@@ -152,6 +152,11 @@ fn tooth_load(
 }
 
 impl Coupling {
+    /// The base radius `Rb`, m (kept: a cosine per call is dear in the inner loops).
+    pub fn base_radius_m(&self) -> f64 {
+        self.rb
+    }
+
     /// A coupling; `per_tooth` resolves every tooth, with spacing errors `phase_errors_rad`
     /// (one per tooth, or empty for none).
     pub fn new(

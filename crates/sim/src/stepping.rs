@@ -106,8 +106,6 @@ pub(crate) fn coupling_step(c: &CouplingView<'_>, a: &AdaptiveStepping) -> (f64,
         // Worst-case gap to this flank's engagement and closing speed.
         let gap = -((sigma * c.phi - c.g0) * c.rb + offset) - f.gap_margin_m;
         let v = sigma * c.dphi * c.rb + f.speed_margin_m_s;
-        let v_hit = (v.max(0.0).powi(2) + 2.0 * a_lin * gap.max(0.0)).sqrt();
-        let dt_contact = contact_duration_s(c.law, flank, v_hit, c.m_eff_kg) / n;
         // Largest tau with v tau + a tau^2 / 2 <= fraction * gap.
         let g = a.approach_fraction * gap.max(0.0);
         let den = v + (v * v + 2.0 * a_lin * g).sqrt();
@@ -116,6 +114,13 @@ pub(crate) fn coupling_step(c: &CouplingView<'_>, a: &AdaptiveStepping) -> (f64,
         } else {
             f64::INFINITY
         };
+        if tau >= dt {
+            // neither branch below can shorten the step (a contact step would need
+            // `dt_contact >= tau >= dt`): skip the contact's duration (two powers)
+            continue;
+        }
+        let v_hit = (v.max(0.0).powi(2) + 2.0 * a_lin * gap.max(0.0)).sqrt();
+        let dt_contact = contact_duration_s(c.law, flank, v_hit, c.m_eff_kg) / n;
         if tau <= dt_contact {
             if dt_contact < dt {
                 dt = dt_contact;

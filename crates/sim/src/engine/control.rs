@@ -59,7 +59,7 @@ impl Run {
                 phi: self.rel[i].phi,
                 dphi: self.rel[i].dphi,
                 g0: d.spline.half_play_rad(),
-                rb: d.spline.base_radius_m(),
+                rb: self.couplings[i].base_radius_m(),
                 m_eff_kg: self.m_eff[i],
                 // 1 % over the bound: rounding must not make it optimistic.
                 rel_accel_bound: 1.01 * (a_carrier + a_disc),
@@ -165,7 +165,7 @@ impl Run {
             let j = d.inertia_kg_m2;
             let stack = self.stack_torque(i);
             let g0 = d.spline.half_play_rad();
-            let rb = d.spline.base_radius_m();
+            let rb = self.couplings[i].base_radius_m();
             let offset = d.law.engagement_offset_m();
             let phi0 = self.rel[i].phi;
             let turn_d = |x: f64| {

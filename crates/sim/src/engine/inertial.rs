@@ -86,7 +86,13 @@ impl Run {
         let u0: Vec<f64> = (0..n).map(|k| w0 - dphi[k]).collect();
         // The accelerations at a stage at `ts`: the shaft turned by `s` at speed `w`, disc k
         // by `th[k]` at `u[k]`; the discs' into `acc`, returns the shaft's and the drive.
-        let stage = |ts: f64, s: f64, w: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
+        // the drive at the step's start, middle (stages 2 and 3) and end
+        let drives = [
+            self.drive_torque(t),
+            self.drive_torque(t + 0.5 * h),
+            self.drive_torque(t + h),
+        ];
+        let stage = |drive: f64, s: f64, w: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
             let mut teeth = 0.0;
             for k in 0..n {
                 let i = cluster[k];
@@ -94,24 +100,23 @@ impl Run {
                 teeth += torque;
                 acc[k] = (torque - self.bodies[i].drag_n_m_s_rad * u[k]) * inv_j[k];
             }
-            let drive = self.drive_torque(ts);
             ((drive - c1 * w - teeth) * inv_j1, drive)
         };
         let (mut k1, mut k2, mut k3, mut k4) =
             (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let zero = vec![0.0; n];
-        let (a1, d1) = stage(t, 0.0, w0, &zero, &u0, &mut k1);
+        let (a1, d1) = stage(drives[0], 0.0, w0, &zero, &u0, &mut k1);
         let w2 = w0 + 0.5 * h * a1;
         let th2: Vec<f64> = u0.iter().map(|u| 0.5 * h * u).collect();
         let u2: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k1[k]).collect();
-        let (a2, d2) = stage(t + 0.5 * h, 0.5 * h * w0, w2, &th2, &u2, &mut k2);
+        let (a2, d2) = stage(drives[1], 0.5 * h * w0, w2, &th2, &u2, &mut k2);
         let w3 = w0 + 0.5 * h * a2;
         let th3: Vec<f64> = (0..n)
             .map(|k| 0.5 * h * u0[k] + 0.25 * hh * k1[k])
             .collect();
         let u3: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k2[k]).collect();
         let (a3, d3) = stage(
-            t + 0.5 * h,
+            drives[1],
             0.5 * h * w0 + 0.25 * hh * a1,
             w3,
             &th3,
@@ -121,7 +126,7 @@ impl Run {
         let w4 = w0 + h * a3;
         let th4: Vec<f64> = (0..n).map(|k| h * u0[k] + 0.5 * hh * k2[k]).collect();
         let u4: Vec<f64> = (0..n).map(|k| u0[k] + h * k3[k]).collect();
-        let (a4, d4) = stage(t + h, h * w0 + 0.5 * hh * a2, w4, &th4, &u4, &mut k4);
+        let (a4, d4) = stage(drives[2], h * w0 + 0.5 * hh * a2, w4, &th4, &u4, &mut k4);
         let h6 = h / 6.0;
         let turn = h * w0 + h * h6 * (a1 + a2 + a3);
         let speed = w0 + h6 * (a1 + 2.0 * (a2 + a3) + a4);
@@ -193,7 +198,7 @@ impl Run {
                     phi: phi[k],
                     dphi: dphi[k],
                     g0: d.spline.half_play_rad(),
-                    rb: d.spline.base_radius_m(),
+                    rb: self.couplings[i].base_radius_m(),
                     m_eff_kg: self.m_eff[i],
                     rel_accel_bound: 1.01 * (a_shaft + d.drag_n_m_s_rad * wd.abs() * inv_j[k]),
                     event_step_s: self.events.event_step_s(i),
@@ -218,7 +223,7 @@ impl Run {
             for (k, &i) in cluster.iter().enumerate() {
                 let d = &self.bodies[i];
                 let f = &self.forces[i];
-                let (g0, rb) = (d.spline.half_play_rad(), d.spline.base_radius_m());
+                let (g0, rb) = (d.spline.half_play_rad(), self.couplings[i].base_radius_m());
                 let offset = d.law.engagement_offset_m();
                 let engaged = f.depth_m > 0.0;
                 for flank in FLANKS {
@@ -309,7 +314,7 @@ impl Run {
                 phi: self.rel[i].phi,
                 dphi: self.rel[i].dphi,
                 g0: d.spline.half_play_rad(),
-                rb: d.spline.base_radius_m(),
+                rb: self.couplings[i].base_radius_m(),
                 m_eff_kg: self.m_eff[i],
                 rel_accel_bound: 1.01 * (a_shaft + d.drag_n_m_s_rad * wd.abs() * inv_j),
                 event_step_s: self.events.event_step_s(i),

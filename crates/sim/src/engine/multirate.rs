@@ -267,7 +267,7 @@ impl Run {
             .local_mprops
             .inv_principal_inertia
             .z;
-        let (g0, rb) = (d.spline.half_play_rad(), d.spline.base_radius_m());
+        let (g0, rb) = (d.spline.half_play_rad(), self.couplings[i].base_radius_m());
         let offset = d.law.engagement_offset_m();
         let m_eff = self.m_eff[i];
         // On an inertial shaft the teeth's work is internal (the drive's is the shaft's,
