@@ -296,9 +296,13 @@ impl Session for MonolithicSession {
                 self.st.sys.settle_face(m, ts, &mut self.st.y, &modes);
                 self.st.restart();
             }
-            if self.st.stats.steps.is_multiple_of(self.poll) && obs.progress(self.st.t) {
-                advance = Advance::Stopped;
-                break;
+            if self.st.stats.steps.is_multiple_of(self.poll) {
+                // what the steps completed so far: the queue stays short on a long call
+                self.queue.flush(self.st.t.min(t), obs);
+                if obs.progress(self.st.t) {
+                    advance = Advance::Stopped;
+                    break;
+                }
             }
         }
         let now = self.clock.end_call(advance, self.st.t, t);
