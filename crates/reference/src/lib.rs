@@ -119,8 +119,9 @@
 //! colours. The discs run first against their plates' predicted speeds (in free flight the
 //! speed at the window's start moving on with its acceleration there, in contact held), then
 //! the plates against the discs' dense output. A disc whose plates' passes differ from what it
-//! saw by more than the tolerance allows (the bound `c integral |d omega| dt / J` on the change
-//! of its speed, against `tol (1 + |omega|)` per step it took in the window) runs again from
+//! saw by more than the tolerance allows (`c integral |d omega| dt / J`, the change of its
+//! speed in free flight, against `tol (1 + |omega|)` per step it took in the window: a
+//! relative tolerance on its speed, chosen by measurement) runs again from
 //! the window's start against them, and its plates after it, until every pass stands (at
 //! most 12 sweeps, else the run fails with the reason). What is exact: each body's equation
 //! and events, as in the monolithic scheme; the coupling is converged to the tolerance, not

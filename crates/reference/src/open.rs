@@ -255,9 +255,9 @@ impl OpenSession {
     }
 
     /// How much the neighbours' latest passes `seen` differ from what body `b`'s last pass
-    /// saw, relative to what the tolerance allows it: the bound `c W sum max |d omega| / J` on
-    /// the change of its speed (rad/s) over the error its steps in the window may make
-    /// (`tol (1 + |omega|)` each). At most 1: its pass stands.
+    /// saw, against what it is allowed: `c sum integral |d omega| dt / J` (rad/s; the change
+    /// of its speed in free flight) over `tol (1 + |omega|)` (a relative tolerance on its
+    /// speed) per step it took in the window. At most 1: its pass stands.
     fn unsettled(&self, b: usize, seen: &[Neighbour]) -> f64 {
         let r = &self.runs[b];
         let gaps = r.stepper.sys.gaps.as_ref().expect("an open body");
