@@ -306,16 +306,21 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
             }
             ratios.push(pair[1] / pair[0]);
         }
+        let ratio = median(ratios);
+        let verdict = if ratio >= 1.0 {
+            format!("reference {ratio:.1}x faster")
+        } else {
+            format!("multibody {:.1}x faster", 1.0 / ratio)
+        };
         out!(
             "whole pack {} ({} discs, {} plates), {} s: reference {:.3} s, multibody {:.3} s \
-             (medians of {runs}, in turn): reference {:.1}x faster",
+             (medians of {runs}, in turn): {verdict}",
             scene.name,
             scene.pack.discs.len(),
             scene.pack.plates.len(),
             scene.simulation.duration_s,
             median(times[0].clone()),
             median(times[1].clone()),
-            median(ratios)
         );
     }
     Ok(())
