@@ -162,8 +162,9 @@
 //!   scheme costs the sum of the discs' own steps: `O(N)`, spread over threads. The coupled
 //!   scheme costs the shaft's steps, each as dear as the discs in contact at that moment. The
 //!   open pack's scheme costs the bodies' own steps, about 1.7 times for the reruns: linear in
-//!   the pack (per disc 8.0 ms at 16 discs and 17 plates, 8.8 ms at 1, against 232.8 ms for
-//!   the 16-disc pack monolithic, growth 1.51x; `clutchpack bench --pack-only`).
+//!   the pack (`clutchpack bench --pack-only`, 0.1 s: per disc 6.3 ms at one disc and two
+//!   plates, 5.3 ms at 16 and 17, growth 0.84x; the 16-disc pack on one step sequence 232.8
+//!   ms, growth 1.51x).
 //!
 //! # Why not an ODE crate
 //! We looked at `ode_solvers` (DOPRI5/DOP853, dense output through `solout`, no event

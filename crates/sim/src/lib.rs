@@ -211,13 +211,16 @@
 //!   step at 1024 and 2048 steps per contact are 4.4e-4 apart by 20 ms and differ in their
 //!   impacts by 50 ms, so no comparison holds over 50 ms.
 //! - *Cost* (`examples/inertial.rs`: the staggered pack on J1 = 2 kg m^2, 0.1 s simulated,
-//!   release, best of 5 runs): per-disc wall time 11.5, 7.7, 9.7 and 12.4 ms at N = 1, 4, 8
-//!   and 16 discs (1.00, 0.67, 0.84, 1.08x one disc's), against the shared step's 31, 39, 54
-//!   and 72 ms (1.00, 1.25, 1.72, 2.30x): 2.7x faster at one disc, 5.8x at 16. It is not
-//!   linear all the way: a disc pushed along by the shaft's drive rides its flank for long
-//!   stretches, so the cluster holds about 60 % of the discs at a time (9.8 of 16 per world
-//!   step on average) and the sub-steps of each follow the tightest contact in it (tooth-law
-//!   evaluations per disc: 61 000 at one disc, 281 000 at 16).
+//!   release, best of 5 runs): per-disc wall time 8.9, 6.1, 7.0 and 8.3 ms at N = 1, 4, 8
+//!   and 16 discs (1.00, 0.68, 0.79, 0.93x one disc's), against the shared step's 31, 39, 54
+//!   and 72 ms (1.00, 1.25, 1.72, 2.30x): 3.5x faster at one disc, 8.7x at 16. A disc pushed
+//!   along by the shaft's drive rides its flank for long stretches, so the cluster holds
+//!   about 60 % of the discs at a time (9.8 of 16 per world step on average) and the
+//!   sub-steps of each follow the tightest contact in it (tooth-law evaluations per disc:
+//!   61 000 at one disc, 281 000 at 16). Before the step controller skipped the contact
+//!   duration of a flank it cannot reach within the step (two powers each) and the cluster
+//!   used the couplings' kept base radius instead of a cosine, 16 discs cost 12.4 ms per disc
+//!   (1.08x; perf: 20 % `pow`, 12 % `cos`).
 //!
 //! **Where a whole pack's time goes today** (issue 20; the 16-disc brake pack, 16 staggered
 //! discs and 17 plates on the housing with the open gaps' drag, which runs the shared step;
