@@ -201,6 +201,19 @@ fn parallel_and_serial_multirate_runs_are_identical() {
     .0;
     assert_eq!(a.impacts, b.impacts);
     assert_eq!(a.samples, b.samples);
+    // the open pack's scheme: its windows' relaxation, the gaps' heat too
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/pack-8-brake.toml");
+    let pack = clutchpack_scene::load(&path, &[]).unwrap().pack;
+    let a = run(ReferenceEngine::new(pack.clone(), settings(1e-9)), 0.01).0;
+    let b = run(
+        ReferenceEngine::new(pack, settings(1e-9)).with_parallel(false),
+        0.01,
+    )
+    .0;
+    assert!(a.impacts.len() > 20, "{} impacts", a.impacts.len());
+    assert_eq!(a.impacts, b.impacts);
+    assert_eq!(a.samples, b.samples);
+    assert_eq!(a.interfaces, b.interfaces);
 }
 
 /// A stop request (the observer's `progress` returning true) ends a multirate run cleanly
@@ -219,19 +232,25 @@ fn a_stop_request_ends_a_multirate_run_with_complete_samples() {
             t >= self.1
         }
     }
-    let mut obs = StopAt(Collector::default(), 0.01);
-    let stats = ReferenceEngine::new(staggered_pack(8), settings(1e-9))
-        .run(1.0, &mut obs)
-        .unwrap();
-    assert!(stats.stopped_early);
-    assert!(
-        stats.simulated_s >= 0.01 && stats.simulated_s < 1.0,
-        "{}",
-        stats.simulated_s
-    );
-    let last = obs.0.samples.last().unwrap();
-    assert!(last.t_s <= stats.simulated_s + 1e-12);
-    assert!(obs.0.samples.iter().all(|s| s.discs.len() == 8));
+    // independent discs; the open pack's bodies (17)
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/pack-8-brake.toml");
+    let brake = clutchpack_scene::load(&path, &[]).unwrap().pack;
+    for (pack, bodies) in [(staggered_pack(8), 8), (brake, 17)] {
+        let mut obs = StopAt(Collector::default(), 0.01);
+        let stats = ReferenceEngine::new(pack, settings(1e-9))
+            .run(1.0, &mut obs)
+            .unwrap();
+        assert!(stats.stopped_early);
+        assert!(
+            stats.simulated_s >= 0.01 && stats.simulated_s < 0.02,
+            "{}",
+            stats.simulated_s
+        );
+        let last = obs.0.samples.last().unwrap();
+        assert!(last.t_s <= stats.simulated_s + 1e-12);
+        assert!(last.t_s >= 0.01 - 1e-12, "{}", last.t_s);
+        assert!(obs.0.samples.iter().all(|s| s.discs.len() == bodies));
+    }
 }
 
 /// `scenes/staggered-8-disc.toml` and `staggered-16-disc.toml` are the model's
