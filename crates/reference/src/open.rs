@@ -2,8 +2,8 @@
 //! a prescribed shaft and separator plates on the housing, the piston never clamping. Each
 //! body is its own ODE with its own steps and events; the only coupling, the open gaps'
 //! Couette drag between stack neighbours, is relaxed window by window (Gauss-Seidel waveform
-//! relaxation over the two colours of the stack) until its effect on any body's speed is below
-//! the integrator's tolerance.
+//! relaxation over the two colours of the stack) until what it still changes in any body's
+//! speed is within the allowance the crate docs state.
 
 use crate::gaps::{Gaps, Neighbour};
 use crate::independent::{hold_in_runs, want_contacts, DiscRun, Merger};
@@ -25,7 +25,8 @@ use std::sync::Arc;
 /// ones cut more steps at their ends (each body's last step in a window ends on it).
 const WINDOW_S: f64 = 1e-3;
 
-/// Most sweeps a window may take before the run fails (the measured packs need 1 or 2).
+/// Most sweeps a window may take before the run fails (each sweep shrinks the coupling's
+/// error about 2e3-fold, so a window that needs this many is not an open pack's).
 const MAX_SWEEPS: u32 = 12;
 
 /// Whether the open-pack multirate scheme can run `pack` driven by `driven`: a whole pack on
@@ -84,8 +85,8 @@ pub(crate) struct OpenSession {
     /// Couette coefficient of one gap, N m s/rad, and the faces' `R_eff`, m.
     c_gap: f64,
     r_eff: f64,
-    /// The last window: its start, every body's state there and the neighbours' speeds of
-    /// its last sweep (to find the state at a time inside it, [`Self::state_at`]).
+    /// The last window: every body's state at its start (to find the state at a time inside
+    /// it, [`Self::state_at`]).
     last: Option<Arc<LastWindow>>,
 }
 
@@ -300,14 +301,18 @@ impl OpenSession {
                 return Err(e);
             }
             sweeps += 1;
-            let worst = first
+            let unsettled: Vec<(usize, f64)> = first
                 .iter()
                 .map(|&b| (b, self.unsettled(b, &seen)))
-                .fold((0, 0.0), |a, x| if x.1 > a.1 { x } else { a });
-            redo_first = first
+                .collect();
+            let worst = unsettled
                 .iter()
                 .copied()
-                .filter(|&b| self.unsettled(b, &seen) > 1.0)
+                .fold((0, 0.0), |a, x| if x.1 > a.1 { x } else { a });
+            redo_first = unsettled
+                .iter()
+                .filter(|x| x.1 > 1.0)
+                .map(|x| x.0)
                 .collect();
             if redo_first.is_empty() {
                 break;
