@@ -1,7 +1,8 @@
 //! The open stack's oil gaps as an input of one body (the open-pack multirate scheme,
 //! `open.rs`, crate docs "Whole packs"): the Couette drag of the gaps below and above a body,
-//! from its neighbours' speeds over the current window, held at the window's start or taken
-//! from the dense output of the neighbour's last pass through the window.
+//! from its neighbours' speeds over the current window, predicted from the window's start
+//! (speed and acceleration there) or taken from the dense output of the neighbour's last pass
+//! through the window.
 
 use crate::dopri::{eval_component, Dense};
 use std::sync::atomic::{AtomicUsize, Ordering};
