@@ -250,13 +250,9 @@ impl Session for CoupledSession {
                 }
                 Switch::None | Switch::Engaged(_) => {}
             }
-            if self.st.stats.steps.is_multiple_of(256) {
-                // what the steps completed so far: the queue stays short on a long call
-                self.queue.flush(self.st.t.min(t), obs);
-                if obs.progress(self.st.t) {
-                    advance = Advance::Stopped;
-                    break;
-                }
+            if self.st.stats.steps.is_multiple_of(256) && self.queue.poll(self.st.t, t, obs) {
+                advance = Advance::Stopped;
+                break;
             }
         }
         let now = self.clock.end_call(advance, self.st.t, t);

@@ -75,6 +75,14 @@ impl Queue {
         }
     }
 
+    /// A poll during a call to `t` (s), the steps at `t_steps` (s): sends what the steps
+    /// completed (so that the queue stays short on a long call), then asks the observer
+    /// whether to stop (`Observer::progress`).
+    pub fn poll(&mut self, t_steps: f64, t: f64, obs: &mut dyn Observer) -> bool {
+        self.flush(t_steps.min(t), obs);
+        obs.progress(t_steps)
+    }
+
     /// Sends the items up to `t` (s) inclusive to `obs`, in the order they were produced;
     /// the first item later than `t` and everything after it wait.
     pub fn flush(&mut self, t: f64, obs: &mut dyn Observer) {
@@ -296,13 +304,9 @@ impl Session for MonolithicSession {
                 self.st.sys.settle_face(m, ts, &mut self.st.y, &modes);
                 self.st.restart();
             }
-            if self.st.stats.steps.is_multiple_of(self.poll) {
-                // what the steps completed so far: the queue stays short on a long call
-                self.queue.flush(self.st.t.min(t), obs);
-                if obs.progress(self.st.t) {
-                    advance = Advance::Stopped;
-                    break;
-                }
+            if self.st.stats.steps.is_multiple_of(self.poll) && self.queue.poll(self.st.t, t, obs) {
+                advance = Advance::Stopped;
+                break;
             }
         }
         let now = self.clock.end_call(advance, self.st.t, t);

@@ -7,6 +7,33 @@ use crate::stepping::{coupling_step, CouplingView};
 use crate::world::Carrier;
 
 impl Run {
+    /// What the step controller ([`coupling_step`]) reads of coupling `i` at `t` (s): its
+    /// evaluated `forces`, its relative angle and speed `rel` (rad, rad/s), and the bound
+    /// of `|d dphi / dt|` in free flight `accel_bound` (rad/s^2), taken 1 % over (rounding
+    /// must not make it optimistic).
+    pub(super) fn coupling_view<'a>(
+        &'a self,
+        i: usize,
+        forces: &'a crate::hook::CouplingForces,
+        rel: (f64, f64),
+        accel_bound: f64,
+        t: f64,
+    ) -> CouplingView<'a> {
+        let d = &self.bodies[i];
+        CouplingView {
+            forces,
+            law: &d.law,
+            phi: rel.0,
+            dphi: rel.1,
+            g0: d.spline.half_play_rad(),
+            rb: self.couplings[i].base_radius_m(),
+            m_eff_kg: self.m_eff[i],
+            rel_accel_bound: 1.01 * accel_bound,
+            event_step_s: self.events.event_step_s(i),
+            event_age_s: self.events.event_age_s(i, t),
+        }
+    }
+
     /// The step the adaptive controller wants at `t`, s, and whether it is a contact step.
     pub(super) fn desired_step(&self, a: &AdaptiveStepping) -> (f64, bool) {
         let a_shaft = match self.shaft {
@@ -53,19 +80,14 @@ impl Run {
                 Carrier::Drum => a_drum,
                 Carrier::Housing => 0.0,
             };
-            let view = CouplingView {
-                forces: &self.forces[i],
-                law: &d.law,
-                phi: self.rel[i].phi,
-                dphi: self.rel[i].dphi,
-                g0: d.spline.half_play_rad(),
-                rb: self.couplings[i].base_radius_m(),
-                m_eff_kg: self.m_eff[i],
-                // 1 % over the bound: rounding must not make it optimistic.
-                rel_accel_bound: 1.01 * (a_carrier + a_disc),
-                event_step_s: self.events.event_step_s(i),
-                event_age_s: self.events.event_age_s(i, self.t),
-            };
+            let rel = self.rel[i];
+            let view = self.coupling_view(
+                i,
+                &self.forces[i],
+                (rel.phi, rel.dphi),
+                a_carrier + a_disc,
+                self.t,
+            );
             let (dt, c) = coupling_step(&view, a);
             if dt < want {
                 want = dt;

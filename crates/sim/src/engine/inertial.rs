@@ -5,10 +5,12 @@
 
 use super::multirate::Counts;
 use super::state::{Run, ShaftDrive};
-use super::substep::{graded_step, split_remainder, GapDrag, Node, Path, ShaftAt};
+use super::substep::{
+    checked_sub_step, graded_step, split_remainder, GapDrag, Node, Path, ShaftAt,
+};
 use crate::hook::FLANKS;
 use crate::options::AdaptiveStepping;
-use crate::stepping::{bracketed_root, coupling_step, CouplingView};
+use crate::stepping::{bracketed_root, coupling_step};
 use clutchpack_model::{DiscSample, EngineError, ImpactEvent};
 use rapier3d_f64::prelude::Vector;
 
@@ -192,27 +194,12 @@ impl Run {
                 let d = &self.bodies[i];
                 let f = self.forces[i];
                 let wd = w - dphi[k];
-                let view = CouplingView {
-                    forces: &f,
-                    law: &d.law,
-                    phi: phi[k],
-                    dphi: dphi[k],
-                    g0: d.spline.half_play_rad(),
-                    rb: self.couplings[i].base_radius_m(),
-                    m_eff_kg: self.m_eff[i],
-                    rel_accel_bound: 1.01 * (a_shaft + d.drag_n_m_s_rad * wd.abs() * inv_j[k]),
-                    event_step_s: self.events.event_step_s(i),
-                    event_age_s: self.events.event_age_s(i, t),
-                };
+                let bound = a_shaft + d.drag_n_m_s_rad * wd.abs() * inv_j[k];
+                let view = self.coupling_view(i, &f, (phi[k], dphi[k]), bound, t);
                 let (wk, _) = coupling_step(&view, a);
                 want = want.min(graded_step(wk, &f, self.events.event_age_s(i, t)));
             }
-            if want.is_nan() || want < a.min_step_s {
-                return Err(EngineError::Diverged {
-                    t_s: t,
-                    reason: format!("inertial shaft: the sub-step collapsed to {want:.3e} s"),
-                });
-            }
+            let want = checked_sub_step(want, a, t, || "inertial shaft".into())?;
             let rem = t1 - t;
             let mut h = split_remainder(want, rem);
             let rk4 = |x: f64| self.shaft_rk4(cluster, &inv_j, inv_j1, c1, t, w, &phi, &dphi, x);
@@ -308,18 +295,9 @@ impl Run {
             let d = &self.bodies[i];
             let inv_j = self.inv_inertia_z(self.world.discs[i]);
             let wd = self.omega_s - self.rel[i].dphi;
-            let view = CouplingView {
-                forces: &f,
-                law: &d.law,
-                phi: self.rel[i].phi,
-                dphi: self.rel[i].dphi,
-                g0: d.spline.half_play_rad(),
-                rb: self.couplings[i].base_radius_m(),
-                m_eff_kg: self.m_eff[i],
-                rel_accel_bound: 1.01 * (a_shaft + d.drag_n_m_s_rad * wd.abs() * inv_j),
-                event_step_s: self.events.event_step_s(i),
-                event_age_s: self.events.event_age_s(i, t0),
-            };
+            let bound = a_shaft + d.drag_n_m_s_rad * wd.abs() * inv_j;
+            let rel = self.rel[i];
+            let view = self.coupling_view(i, &f, (rel.phi, rel.dphi), bound, t0);
             if coupling_step(&view, a).0 < h {
                 cluster.push(i);
             }

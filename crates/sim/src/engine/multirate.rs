@@ -4,10 +4,12 @@
 //! rapier body, which carries the disc's state from one world step to the next.
 
 use super::state::{disc_sample, relative_state, Run, ShaftDrive};
-use super::substep::{graded_step, split_remainder, GapDrag, Path, Relative, ShaftAt};
+use super::substep::{
+    checked_sub_step, graded_step, split_remainder, GapDrag, Path, Relative, ShaftAt,
+};
 use crate::hook::{CouplingForces, RelativeState, FLANKS};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
-use crate::stepping::{bracketed_root, contact_duration_s, coupling_step, CouplingView};
+use crate::stepping::{bracketed_root, contact_duration_s, coupling_step};
 use crate::world::Carrier;
 use clutchpack_model::{DiscSample, EngineError, ImpactEvent, PackModel, Shaft, SpeedProfile};
 use rapier3d_f64::prelude::{Rotation, Vector};
@@ -269,7 +271,6 @@ impl Run {
             .z;
         let (g0, rb) = (d.spline.half_play_rad(), self.couplings[i].base_radius_m());
         let offset = d.law.engagement_offset_m();
-        let m_eff = self.m_eff[i];
         // On an inertial shaft the teeth's work is internal (the drive's is the shaft's,
         // integrated with it) and a coupling integrated here is in free flight (the others
         // go with the shaft, `integrate_shaft`): one that touches all the same is counted.
@@ -281,30 +282,12 @@ impl Run {
         while t < t1 {
             let f = self.forces[i];
             let wd = shaft.speed - dphi;
-            let view = CouplingView {
-                forces: &f,
-                law: &d.law,
-                phi,
-                dphi,
-                g0,
-                rb,
-                m_eff_kg: m_eff,
-                // 1 % over the bound: rounding must not make it optimistic.
-                rel_accel_bound: 1.01
-                    * (carrier_accel_bound
-                        + ((d.drag_n_m_s_rad + gap.damping) * wd.abs() + gap.held_n_m.abs())
-                            * inv_j),
-                event_step_s: self.events.event_step_s(i),
-                event_age_s: self.events.event_age_s(i, t),
-            };
+            let bound = carrier_accel_bound
+                + ((d.drag_n_m_s_rad + gap.damping) * wd.abs() + gap.held_n_m.abs()) * inv_j;
+            let view = self.coupling_view(i, &f, (phi, dphi), bound, t);
             let (want, _) = coupling_step(&view, a);
             let want = graded_step(want, &f, self.events.event_age_s(i, t));
-            if want.is_nan() || want < a.min_step_s {
-                return Err(EngineError::Diverged {
-                    t_s: t,
-                    reason: format!("disc {i}: the sub-step collapsed to {want:.3e} s"),
-                });
-            }
+            let want = checked_sub_step(want, a, t, || format!("disc {i}"))?;
             let rem = t1 - t;
             let mut h = split_remainder(want, rem);
             let rel = Relative {

@@ -3,7 +3,8 @@
 //! path, graded towards the tooth law's kinks, with the open gaps' drag held over the step.
 
 use crate::hook::{Coupling, CouplingForces};
-use clutchpack_model::SpeedProfile;
+use crate::options::AdaptiveStepping;
+use clutchpack_model::{EngineError, SpeedProfile};
 
 /// The open gaps' drag on one body over a world step, `sum_nb c (w_nb - w)` (Couette, MODEL.md
 /// section 5): the neighbours' speeds held at their predicted mean over the step (see
@@ -52,6 +53,23 @@ pub(super) fn graded_step(want: f64, f: &CouplingForces, age_s: Option<f64>) -> 
         h = h.min((KINK_GRADE * f.depth_m / -v).max(floor));
     }
     h
+}
+
+/// The sub-step `want` (s) a controller asked for at `t` (s), or the run's failure when it
+/// collapsed below the smallest step (or is not a number); `who()` names what asked.
+pub(super) fn checked_sub_step(
+    want: f64,
+    a: &AdaptiveStepping,
+    t: f64,
+    who: impl FnOnce() -> String,
+) -> Result<f64, EngineError> {
+    if want.is_nan() || want < a.min_step_s {
+        return Err(EngineError::Diverged {
+            t_s: t,
+            reason: format!("{}: the sub-step collapsed to {want:.3e} s", who()),
+        });
+    }
+    Ok(want)
 }
 
 /// The next (sub-)step, s, towards an end `rem` s away when the controller wants `want` s:
