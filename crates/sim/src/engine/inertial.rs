@@ -336,15 +336,8 @@ impl Run {
         // of the shaft reads 0 until its first step computes the body's mass properties, and
         // the torque from it, infinite, left every body at rest from then on (measured).
         let shaft_mean = (end.angle - start.angle) / h;
+        self.drive_to_means(&means, h);
         let bodies = &mut self.world.physics.bodies;
-        for (i, &mean) in means.iter().enumerate() {
-            let body = &mut bodies[self.world.discs[i]];
-            let inv_j = body.mass_properties().local_mprops.inv_principal_inertia.z;
-            let torque = (mean - body.angvel().z) / (h * inv_j);
-            body.reset_forces(false);
-            body.reset_torques(false);
-            body.add_torque(Vector::new(0.0, 0.0, torque), false);
-        }
         let shaft = &mut bodies[self.world.shaft];
         shaft.reset_forces(false);
         shaft.reset_torques(false);

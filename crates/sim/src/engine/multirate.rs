@@ -205,15 +205,8 @@ impl Run {
         // The world's step: each disc's impulse in two halves, `J (mean - w(t))` applied as a
         // torque over the step (rapier's semi-implicit Euler then drifts the disc by
         // exactly `mean h`) and `J (w(t1) - mean)` as the speed set at its end.
+        self.drive_to_means(&means, h);
         let bodies = &mut self.world.physics.bodies;
-        for (i, &mean) in means.iter().enumerate() {
-            let body = &mut bodies[self.world.discs[i]];
-            let inv_j = body.mass_properties().local_mprops.inv_principal_inertia.z;
-            let torque = (mean - body.angvel().z) / (h * inv_j);
-            body.reset_forces(false);
-            body.reset_torques(false);
-            body.add_torque(Vector::new(0.0, 0.0, torque), false);
-        }
         bodies[self.world.shaft].set_next_kinematic_rotation(Rotation::from_rotation_z(theta_s1));
         self.world.step(h);
         let bodies = &mut self.world.physics.bodies;
@@ -226,6 +219,20 @@ impl Run {
         self.theta_s = theta_s1;
         self.omega_s = omega_s1;
         Ok(())
+    }
+
+    /// Sets each coupling body's torque for the world's step of length `h` (s) so that
+    /// rapier's semi-implicit Euler drifts it by exactly `means[i] h`: `J (mean - w(t)) / h`.
+    pub(super) fn drive_to_means(&mut self, means: &[f64], h: f64) {
+        let bodies = &mut self.world.physics.bodies;
+        for (i, &mean) in means.iter().enumerate() {
+            let body = &mut bodies[self.world.discs[i]];
+            let inv_j = body.mass_properties().local_mprops.inv_principal_inertia.z;
+            let torque = (mean - body.angvel().z) / (h * inv_j);
+            body.reset_forces(false);
+            body.reset_torques(false);
+            body.add_torque(Vector::new(0.0, 0.0, torque), false);
+        }
     }
 
     /// Reads every coupling's relative state at `t` from the rapier bodies (the state each
