@@ -30,8 +30,9 @@ pub struct BenchArgs {
     /// Repetitions of each staggered-pack timing (the median is reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub pack_runs: usize,
-    /// Repetitions of each whole-pack timing (reference and multibody engines in turn on
-    /// `scenes/pack-8-brake.toml` and `pack-6-engagement.toml`); 0 skips that part.
+    /// Repetitions of each whole-pack timing (the reference engine, the multibody engine and
+    /// its shared step in turn on `scenes/pack-8-brake.toml` and `pack-6-engagement.toml`); 0
+    /// skips that part.
     #[arg(long, default_value_t = 3)]
     pub whole_runs: usize,
     /// Repetitions of each brake-pack timing (N discs and N + 1 plates, open gaps: the MuJoCo
@@ -275,8 +276,10 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
 }
 
 /// 4. The shipped whole packs (plates, drum, stack), 0.3 s, each engine with the settings
-///    `run` gives it, the two in turn `runs` times (the medians and the median of the pairs'
-///    ratios are reported): the reference engine against the multibody engine.
+///    `run` gives it and the multibody engine's shared step (`simulation.scheme = "shared"`,
+///    issue 20's yardstick), the three in turn `runs` times (the medians and the medians of
+///    the rounds' ratios are reported): the reference engine against the multibody engine,
+///    and the multibody engine against its shared step.
 fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     if runs == 0 {
         return Ok(());
@@ -288,11 +291,18 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
             continue;
         }
         let scene = load_scene(Some(path), &[])?;
-        let mut times = [Vec::new(), Vec::new()];
-        let mut ratios = Vec::new();
+        let mut shared = scene.clone();
+        shared.simulation.scheme = clutchpack_scene::SchemeChoice::Shared;
+        let configs = [
+            (&scene, EngineChoice::Reference),
+            (&scene, EngineChoice::Multibody),
+            (&shared, EngineChoice::Multibody),
+        ];
+        let mut times = [Vec::new(), Vec::new(), Vec::new()];
+        let mut ratios = [Vec::new(), Vec::new()];
         for _ in 0..runs {
-            let mut pair = [0.0; 2];
-            for (k, engine) in EngineChoice::ALL.into_iter().enumerate() {
+            let mut round = [0.0; 3];
+            for (k, (scene, engine)) in configs.into_iter().enumerate() {
                 let done = Simulation::new(scene.clone(), Some(engine))?.run(RunRequest {
                     stop: Some(&**stop),
                     ..RunRequest::default()
@@ -301,26 +311,28 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
                 if stop.load(Ordering::SeqCst) {
                     return Ok(());
                 }
-                pair[k] = done.wall_time_s;
-                times[k].push(pair[k]);
+                round[k] = done.wall_time_s;
+                times[k].push(round[k]);
             }
-            ratios.push(pair[1] / pair[0]);
+            ratios[0].push(round[1] / round[0]);
+            ratios[1].push(round[2] / round[1]);
         }
-        let ratio = median(ratios);
+        let [ratio, over_shared] = ratios.map(median);
         let verdict = if ratio >= 1.0 {
             format!("reference {ratio:.1}x faster")
         } else {
             format!("multibody {:.1}x faster", 1.0 / ratio)
         };
+        let [reference, multibody, shared] = times.map(median);
         out!(
-            "whole pack {} ({} discs, {} plates), {} s: reference {:.3} s, multibody {:.3} s \
-             (medians of {runs}, in turn): {verdict}",
+            "whole pack {} ({} discs, {} plates), {} s: reference {reference:.3} s, multibody \
+             {multibody:.3} s, multibody's shared step {shared:.3} s (medians of {runs}, in \
+             turn): {verdict}; the multibody engine {over_shared:.1}x faster than its shared \
+             step",
             scene.name,
             scene.pack.discs.len(),
             scene.pack.plates.len(),
             scene.simulation.duration_s,
-            median(times[0].clone()),
-            median(times[1].clone()),
         );
     }
     Ok(())

@@ -178,12 +178,33 @@ impl Piston {
     /// exceeds the return spring. When not, every interface stays an open oil gap for the
     /// whole run (the engines' multirate schemes for open packs rely on it).
     pub fn can_clamp(&self) -> bool {
-        let max_pa = match &self.pressure {
-            PressureProfile::Constant { pressure_pa }
-            | PressureProfile::Ramp { pressure_pa, .. } => *pressure_pa,
-            PressureProfile::Table(t) => t.y.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        };
-        max_pa * self.area_m2 > self.return_spring_n
+        self.open_until_s() < f64::INFINITY
+    }
+
+    /// The time before which the piston cannot push on the stack, s: its force
+    /// `max(0, p(t) A - F_rs)` is zero for every `t` before it (the multibody engine's multirate
+    /// scheme runs an open pack until then). `f64::INFINITY` when the pressure never exceeds
+    /// the return spring (see [`Piston::can_clamp`]), `f64::NEG_INFINITY` when it may push
+    /// from the start (a constant pressure over the spring, a table whose first row is).
+    /// Conservative where the exact instant would round: a ramp's start, the row of a table
+    /// after which the pressure first rises over the spring.
+    pub fn open_until_s(&self) -> f64 {
+        let pushes = |p: f64| p * self.area_m2 > self.return_spring_n;
+        match &self.pressure {
+            PressureProfile::Constant { pressure_pa } if pushes(*pressure_pa) => f64::NEG_INFINITY,
+            PressureProfile::Ramp {
+                start_s,
+                pressure_pa,
+                ..
+            } if pushes(*pressure_pa) => *start_s,
+            PressureProfile::Constant { .. } | PressureProfile::Ramp { .. } => f64::INFINITY,
+            PressureProfile::Table(t) => match t.y.iter().position(|&p| pushes(p)) {
+                None => f64::INFINITY,
+                Some(0) => f64::NEG_INFINITY,
+                // below the spring at row k - 1 and linear up to row k
+                Some(k) => t.t_s[k - 1],
+            },
+        }
     }
 }
 
@@ -470,5 +491,56 @@ mod tests {
             (0..2 * n + 1).collect::<Vec<_>>(),
             "every body exactly once"
         );
+    }
+
+    /// The piston pushes on the stack only once `p A` exceeds the return spring: its force is
+    /// zero before `open_until_s` (checked on a fine grid), which is a ramp's start, the row
+    /// of a table before the first one over the spring, never for a pressure below it, and
+    /// from the start for a constant pressure or a first row above it; `can_clamp` agrees.
+    #[test]
+    fn the_piston_is_open_until_it_can_push() {
+        let piston = |pressure| Piston {
+            area_m2: 0.05,
+            pressure,
+            return_spring_n: 2000.0,
+        };
+        let ramp = |p| PressureProfile::Ramp {
+            start_s: 0.05,
+            rise_s: 0.03,
+            pressure_pa: p,
+        };
+        let table = |y: Vec<f64>| {
+            PressureProfile::Table(Table::new(vec![0.0, 0.01, 0.02, 0.03], y).unwrap())
+        };
+        let cases = [
+            (ramp(1.2e6), 0.05),
+            (ramp(4.0e4), f64::INFINITY), // 2000 N exactly: never more
+            (
+                PressureProfile::Constant { pressure_pa: 1e5 },
+                f64::NEG_INFINITY,
+            ),
+            (
+                PressureProfile::Constant { pressure_pa: 1e4 },
+                f64::INFINITY,
+            ),
+            (table(vec![0.0, 3e4, 1e5, 0.0]), 0.01),
+            (table(vec![5e4, 0.0, 0.0, 0.0]), f64::NEG_INFINITY),
+            (table(vec![0.0, 3e4, 3e4, 0.0]), f64::INFINITY),
+        ];
+        for (pressure, expected) in cases {
+            let p = piston(pressure);
+            let open = p.open_until_s();
+            assert_eq!(open, expected, "{p:?}");
+            assert_eq!(p.can_clamp(), open < f64::INFINITY, "{p:?}");
+            let mut pushed = false;
+            for k in 0..=1000 {
+                let t = 1e-4 * k as f64;
+                if t < open {
+                    assert_eq!(p.force_n(t), 0.0, "{p:?} at {t}");
+                }
+                pushed |= p.force_n(t) > 0.0;
+            }
+            assert_eq!(pushed, p.can_clamp(), "{p:?}");
+        }
     }
 }

@@ -579,4 +579,34 @@ fn scheme_is_chosen_and_explained() {
         Err(EngineError::Unsupported(m)) => assert!(m.contains("an inertial shaft"), "{m}"),
         other => panic!("{other:?}"),
     }
+    // the open brake with its plates on a drum instead of the housing: multirate, the drum
+    // integrated with its plates; with a piston that ramps at 50 ms, multirate until then; with
+    // one that pushes from the start, the shared step
+    let mut drum_brake = clutchpack_model::cases::staggered_brake(2);
+    drum_brake.drum = Some(clutchpack_model::DrumModel {
+        inertia_kg_m2: 0.5,
+        load_torque_n_m: 0.0,
+        drag_n_m_s_rad: 50.0,
+        initial_speed_rad_s: 0.0,
+    });
+    let (multirate, why) = explain(drum_brake.clone(), adaptive());
+    assert!(multirate, "{why}");
+    assert!(
+        why.contains("plates on a drum") && !why.contains("until"),
+        "{why}"
+    );
+    let piston = &mut drum_brake.stack.as_mut().unwrap().piston;
+    piston.pressure = clutchpack_model::PressureProfile::Ramp {
+        start_s: 0.05,
+        rise_s: 0.03,
+        pressure_pa: 1e7,
+    };
+    let (multirate, why) = explain(drum_brake.clone(), adaptive());
+    assert!(multirate, "{why}");
+    assert!(why.contains("until t = 0.05 s"), "{why}");
+    let piston = &mut drum_brake.stack.as_mut().unwrap().piston;
+    piston.pressure = clutchpack_model::PressureProfile::Constant { pressure_pa: 1e7 };
+    let (multirate, why) = explain(drum_brake, adaptive());
+    assert!(!multirate, "{why}");
+    assert!(why.contains("from the start"), "{why}");
 }

@@ -89,6 +89,13 @@ impl EnergyBook {
         self.before = Some(now);
     }
 
+    /// Forgets the powers of the last evaluation: the trapezoidal audit starts again at the
+    /// next (the shared step taking over from the multirate scheme, whose sub-steps audited
+    /// the work up to there).
+    pub(super) fn restart_powers(&mut self) {
+        self.before = None;
+    }
+
     /// Adds the stack's work over a step, J.
     pub(super) fn add_stack_work(&mut self, work_j: f64) {
         self.audit.stack_work_j += work_j;
@@ -98,6 +105,11 @@ impl EnergyBook {
     pub(super) fn add_sub_step(&mut self, drive_j: f64, drag_j: f64) {
         self.audit.drive_work_j += drive_j;
         self.audit.drag_work_j += drag_j;
+    }
+
+    /// Adds a multirate sub-step's work of the drum's load, J.
+    pub(super) fn add_load_work(&mut self, load_j: f64) {
+        self.audit.load_work_j += load_j;
     }
 
     /// The energies at t = 0: the teeth's potential and the kinetic energy, J.

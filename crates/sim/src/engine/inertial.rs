@@ -1,7 +1,8 @@
-//! The multirate scheme on an inertial shaft (eq 4; crate docs, "Multirate on an inertial
-//! shaft"): each world step the shaft and the discs that may touch it are integrated together
-//! with classical Runge-Kutta sub-steps, the other discs fly free against the shaft's motion
-//! (`multirate.rs`'s per-coupling integration).
+//! The multirate scheme on an inertial carrier (crate docs, "Multirate on an inertial
+//! shaft"): an inertial shaft (eq 4) with its friction discs, or the output drum with its
+//! separator plates. Each world step the carrier and the bodies that may touch it are
+//! integrated together with classical Runge-Kutta sub-steps, the other bodies fly free against
+//! the carrier's motion (`multirate.rs`'s per-coupling integration).
 
 use super::multirate::Counts;
 use super::state::{Run, ShaftDrive};
@@ -11,46 +12,129 @@ use super::substep::{
 use crate::hook::FLANKS;
 use crate::options::AdaptiveStepping;
 use crate::stepping::{bracketed_root, coupling_step};
+use crate::world::Carrier;
 use clutchpack_model::{DiscSample, EngineError, ImpactEvent};
 use rapier3d_f64::prelude::Vector;
 
-/// An inertial shaft's sub-steps are at most the world step over this (dimensionless): the
-/// shaft's own motion under its drive (eq 4) is integrated by the classical method, whose
+/// An inertial carrier's sub-steps are at most the world step over this (dimensionless): the
+/// carrier's own motion under its drive or load is integrated by the classical method, whose
 /// error per step in the angle grows as the fifth power of the step (see
-/// [`Run::integrate_shaft`]).
+/// [`Run::integrate_carrier`]).
 const SHAFT_SUB_STEPS: f64 = 4.0;
 
-/// One classical Runge-Kutta step of an inertial shaft and the couplings that go with it
-/// ([`Run::integrate_shaft`]).
+/// An inertial carrier of couplings, integrated with the bodies that may touch it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Inertial {
+    /// The inertial shaft (Hu et al. eq 4), carrying the friction discs.
+    Shaft,
+    /// The output drum, carrying the separator plates.
+    Drum,
+}
+
+/// An inertial carrier's own dynamics over a sub-step: `J w' = T_ext(t) - C w - sum T_k`.
+#[derive(Debug, Clone, Copy)]
+struct CarrierDynamics {
+    /// `1 / J`, 1/(kg m^2).
+    inv_j: f64,
+    /// Damping `C`, N m s/rad.
+    damping: f64,
+    /// The external torque (the shaft's drive, the drum's load) at the sub-step's start,
+    /// middle and end, N m.
+    torque: [f64; 3],
+}
+
+/// One classical Runge-Kutta step of an inertial carrier and the couplings that go with it
+/// ([`Run::integrate_carrier`]).
 #[derive(Debug, Clone)]
-struct ShaftStep {
-    /// The shaft's turn over the step, rad, and its speed at the end, rad/s.
+struct CarrierStep {
+    /// The carrier's turn over the step, rad, and its speed at the end, rad/s.
     turn: f64,
     speed: f64,
     /// Each coupling's relative angle and speed at the end.
     phi: Vec<f64>,
     dphi: Vec<f64>,
-    /// Work of the drive torque on the shaft, J.
-    drive_j: f64,
-    /// Work of the shaft's damping and the discs' drag, J (<= 0).
+    /// Work of the external torque on the carrier (the shaft's drive, the drum's load), J.
+    external_j: f64,
+    /// Work of the carrier's damping and the bodies' drag, J (<= 0).
     drag_j: f64,
+    /// Work of the open gaps' drag on the bodies, J.
+    gap_j: f64,
 }
 
 impl Run {
-    /// The bound of an inertial shaft's acceleration at speed `w` with the teeth's torques
-    /// `reaction` (sum of magnitudes, N m) on it, rad/s^2: the drive's bound, the damping,
-    /// the reactions (as the shared step's controller, `control.rs`).
-    fn inertial_accel_bound(&self, c1: f64, inv_j1: f64, w: f64, reaction: f64) -> f64 {
-        self.shaft_accel_bound + (c1 * w.abs() + reaction) * inv_j1
+    /// The bound of inertial carrier `c`'s acceleration at speed `w` with the teeth's torques
+    /// `reaction` (sum of magnitudes, N m) on it, rad/s^2: the drive's bound (the shaft) or the
+    /// load (the drum), the damping, the reactions (as the shared step's controller,
+    /// `control.rs`).
+    fn inertial_accel_bound(&self, c: Inertial, w: f64, reaction: f64) -> f64 {
+        let (inv_j, damping, own) = match (c, &self.drum) {
+            (Inertial::Shaft, _) => {
+                let (inv_j, damping) = self.carrier_inertia(c);
+                (inv_j, damping, self.shaft_accel_bound)
+            }
+            (Inertial::Drum, Some(d)) => {
+                let inv_j = 1.0 / d.model.inertia_kg_m2;
+                (
+                    inv_j,
+                    d.model.drag_n_m_s_rad,
+                    d.model.load_torque_n_m.abs() * inv_j,
+                )
+            }
+            (Inertial::Drum, None) => unreachable!("a drum"),
+        };
+        own + (damping * w.abs() + reaction) * inv_j
     }
 
-    /// The inverse of the inertial shaft's inertia `1 / J1`, 1/(kg m^2): the model's, not
-    /// rapier's, which is 0 until its first step computes the body's mass properties.
-    fn inv_j1(&self) -> f64 {
-        match self.shaft {
-            ShaftDrive::Inertial { j1, .. } => 1.0 / j1,
-            ShaftDrive::Prescribed(_) => 0.0,
+    /// Inertial carrier `c`'s inverse inertia, 1/(kg m^2), and damping, N m s/rad: the
+    /// model's (not rapier's inertia, which is 0 until its first step computes the body's
+    /// mass properties).
+    fn carrier_inertia(&self, c: Inertial) -> (f64, f64) {
+        match (c, &self.shaft, &self.drum) {
+            (Inertial::Shaft, ShaftDrive::Inertial { j1, c1 }, _) => (1.0 / j1, *c1),
+            (Inertial::Drum, _, Some(d)) => (1.0 / d.model.inertia_kg_m2, d.model.drag_n_m_s_rad),
+            _ => unreachable!("{c:?} is not an inertial carrier of this pack"),
         }
+    }
+
+    /// Inertial carrier `c`'s dynamics over a sub-step of length `h` from `t`: its inertia and
+    /// damping ([`Run::carrier_inertia`]) and its external torque (the shaft's drive, eq 4, at
+    /// the step's start, middle and end; the drum's load, held over a world step).
+    fn carrier_dynamics(&self, c: Inertial, t: f64, h: f64) -> CarrierDynamics {
+        let (inv_j, damping) = self.carrier_inertia(c);
+        let torque = match (c, &self.drum) {
+            (Inertial::Shaft, _) => [
+                self.drive_torque(t),
+                self.drive_torque(t + 0.5 * h),
+                self.drive_torque(t + h),
+            ],
+            (Inertial::Drum, Some(d)) => [d.model.load_torque_n_m; 3],
+            (Inertial::Drum, None) => unreachable!("a drum"),
+        };
+        CarrierDynamics {
+            inv_j,
+            damping,
+            torque,
+        }
+    }
+
+    /// Inertial carrier `c`'s unwrapped angle, rad, and speed, rad/s, at `t`.
+    fn carrier_state(&self, c: Inertial) -> (f64, f64) {
+        match (c, &self.drum) {
+            (Inertial::Shaft, _) => (self.theta_s, self.omega_s),
+            (Inertial::Drum, Some(d)) => (d.theta, d.omega),
+            (Inertial::Drum, None) => unreachable!("a drum"),
+        }
+    }
+
+    /// The couplings carried by inertial carrier `c`.
+    fn carried_by(&self, c: Inertial) -> Vec<usize> {
+        let carrier = match c {
+            Inertial::Shaft => Carrier::Shaft,
+            Inertial::Drum => Carrier::Drum,
+        };
+        (0..self.couplings.len())
+            .filter(|&i| self.world.carriers[i] == carrier)
+            .collect()
     }
 
     /// The inverse of a rapier body's inertia about the axis, 1/(kg m^2).
@@ -62,78 +146,70 @@ impl Run {
             .z
     }
 
-    /// One classical Runge-Kutta step of length `h` from `t` of the inertial shaft (speed
-    /// `w0`) and the couplings `cluster` (relative states `phi`, `dphi`), integrated as one
-    /// system: the shaft `J1 w' = T_drive(t) - C1 w - sum T_k` (Hu et al. eq 4), each disc
-    /// `J w_d' = T_k - C2 w_d` (eq 5), `T_k` the teeth's torque on disc `k` at
-    /// `phi_k = theta_s - theta_d`. As in [`Relative::rk4`] the bodies' own motions are
-    /// integrated, not the relative ones. The teeth's torques cancel in the total angular
-    /// momentum at every stage, so the step conserves it exactly (a linear invariant) but
-    /// for the drive and the damping.
+    /// One classical Runge-Kutta step of length `h` from `t` of an inertial carrier (speed
+    /// `w0`, dynamics `dy`) and the couplings `cluster` (relative states `phi`, `dphi`, the
+    /// open gaps' drag `gaps`), integrated as one system: the carrier
+    /// `J w' = T_ext(t) - C w - sum T_k` (the shaft: Hu et al. eq 4; the drum: its load and
+    /// drag), each body `J w_d' = T_k - C2 w_d + g_k(w_d)` (eq 5 and the gaps' drag), `T_k`
+    /// the teeth's torque on body `k` at `phi_k = theta_c - theta_d`. As in
+    /// [`Relative::rk4`](super::substep::Relative::rk4) the bodies' own motions are integrated,
+    /// not the relative ones. The teeth's torques cancel in the total angular momentum at
+    /// every stage, so the step conserves it exactly (a linear invariant) but for the external
+    /// torque, the damping and the gaps.
     #[allow(clippy::too_many_arguments)]
-    fn shaft_rk4(
+    fn carrier_rk4(
         &self,
         cluster: &[usize],
         inv_j: &[f64],
-        inv_j1: f64,
-        c1: f64,
-        t: f64,
+        gaps: &[GapDrag],
+        dy: &CarrierDynamics,
         w0: f64,
         phi: &[f64],
         dphi: &[f64],
         h: f64,
-    ) -> ShaftStep {
+    ) -> CarrierStep {
         let n = cluster.len();
         let hh = h * h;
+        let (inv_j1, c1) = (dy.inv_j, dy.damping);
         let u0: Vec<f64> = (0..n).map(|k| w0 - dphi[k]).collect();
-        // The accelerations at a stage at `ts`: the shaft turned by `s` at speed `w`, disc k
-        // by `th[k]` at `u[k]`; the discs' into `acc`, returns the shaft's and the drive.
-        // the drive at the step's start, middle (stages 2 and 3) and end
-        let drives = [
-            self.drive_torque(t),
-            self.drive_torque(t + 0.5 * h),
-            self.drive_torque(t + h),
-        ];
-        let stage = |drive: f64, s: f64, w: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
+        // The accelerations at a stage: the carrier turned by `s` at speed `w`, body k by
+        // `th[k]` at `u[k]`; the bodies' into `acc`, returns the carrier's.
+        let stage = |ext: f64, s: f64, w: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
             let mut teeth = 0.0;
             for k in 0..n {
                 let i = cluster[k];
                 let torque = self.couplings[i].probe_torque(phi[k] + s - th[k], w - u[k]);
                 teeth += torque;
-                acc[k] = (torque - self.bodies[i].drag_n_m_s_rad * u[k]) * inv_j[k];
+                let g = gaps[k].held_n_m - gaps[k].damping * u[k];
+                acc[k] = (torque - self.bodies[i].drag_n_m_s_rad * u[k] + g) * inv_j[k];
             }
-            ((drive - c1 * w - teeth) * inv_j1, drive)
+            (ext - c1 * w - teeth) * inv_j1
         };
+        let [e1, em, e4] = dy.torque;
         let (mut k1, mut k2, mut k3, mut k4) =
             (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let zero = vec![0.0; n];
-        let (a1, d1) = stage(drives[0], 0.0, w0, &zero, &u0, &mut k1);
+        let a1 = stage(e1, 0.0, w0, &zero, &u0, &mut k1);
         let w2 = w0 + 0.5 * h * a1;
         let th2: Vec<f64> = u0.iter().map(|u| 0.5 * h * u).collect();
         let u2: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k1[k]).collect();
-        let (a2, d2) = stage(drives[1], 0.5 * h * w0, w2, &th2, &u2, &mut k2);
+        let a2 = stage(em, 0.5 * h * w0, w2, &th2, &u2, &mut k2);
         let w3 = w0 + 0.5 * h * a2;
         let th3: Vec<f64> = (0..n)
             .map(|k| 0.5 * h * u0[k] + 0.25 * hh * k1[k])
             .collect();
         let u3: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k2[k]).collect();
-        let (a3, d3) = stage(
-            drives[1],
-            0.5 * h * w0 + 0.25 * hh * a1,
-            w3,
-            &th3,
-            &u3,
-            &mut k3,
-        );
+        let a3 = stage(em, 0.5 * h * w0 + 0.25 * hh * a1, w3, &th3, &u3, &mut k3);
         let w4 = w0 + h * a3;
         let th4: Vec<f64> = (0..n).map(|k| h * u0[k] + 0.5 * hh * k2[k]).collect();
         let u4: Vec<f64> = (0..n).map(|k| u0[k] + h * k3[k]).collect();
-        let (a4, d4) = stage(drives[2], h * w0 + 0.5 * hh * a2, w4, &th4, &u4, &mut k4);
+        let a4 = stage(e4, h * w0 + 0.5 * hh * a2, w4, &th4, &u4, &mut k4);
         let h6 = h / 6.0;
         let turn = h * w0 + h * h6 * (a1 + a2 + a3);
         let speed = w0 + h6 * (a1 + 2.0 * (a2 + a3) + a4);
         let sq = |a: f64, b: f64, c: f64, d: f64| a * a + 2.0 * (b * b + c * c) + d * d;
         let mut drag_j = -c1 * h6 * sq(w0, w2, w3, w4);
+        let mut gap_j = 0.0;
         let mut phi1 = Vec::with_capacity(n);
         let mut dphi1 = Vec::with_capacity(n);
         for k in 0..n {
@@ -142,67 +218,81 @@ impl Run {
             phi1.push(phi[k] + turn - th);
             dphi1.push(speed - u1);
             drag_j -= self.bodies[cluster[k]].drag_n_m_s_rad * h6 * sq(u0[k], u2[k], u3[k], u4[k]);
+            let g = |u: f64| (gaps[k].held_n_m - gaps[k].damping * u) * u;
+            gap_j += h6 * (g(u0[k]) + 2.0 * (g(u2[k]) + g(u3[k])) + g(u4[k]));
         }
-        ShaftStep {
+        CarrierStep {
             turn,
             speed,
             phi: phi1,
             dphi: dphi1,
-            drive_j: h6 * (d1 * w0 + 2.0 * (d2 * w2 + d3 * w3) + d4 * w4),
+            external_j: h6 * (e1 * w0 + 2.0 * (em * w2 + em * w3) + e4 * w4),
             drag_j,
+            gap_j,
         }
     }
 
-    /// Integrates an inertial shaft from `t` to `t1` together with the couplings `cluster`
-    /// (those that may touch within the world step; the others fly free and load nothing),
-    /// with sub-steps of the shortest any of them wants (the prescribed shaft's controller
-    /// and grading, applied to each), at most the world step over [`SHAFT_SUB_STEPS`], landed
-    /// on every onset and separation. Leaves the couplings' states at `t1` in `rel` and
-    /// `forces`, adds the drive's, the damping's and the drag's work to the audit, feeds the
-    /// events, and returns the shaft's nodes (the motion the free couplings follow).
+    /// Integrates inertial carrier `c` from `t` to `t1` together with the couplings `cluster`
+    /// (those that may touch it within the world step; the others fly free and load nothing),
+    /// the open gaps' drag `gaps` on each coupling, with sub-steps of the shortest any of them
+    /// wants (the prescribed shaft's controller and grading, applied to each), at most the
+    /// world step over [`SHAFT_SUB_STEPS`], landed on every onset and separation. Leaves the
+    /// couplings' states at `t1` in `rel` and `forces`, adds the external torque's, the
+    /// damping's, the drag's and the gaps' work to the audit, feeds the events, and returns
+    /// the carrier's nodes (the motion the free couplings follow).
     #[allow(clippy::too_many_arguments)]
-    fn integrate_shaft(
+    fn integrate_carrier(
         &mut self,
+        c: Inertial,
         t1: f64,
         a: &AdaptiveStepping,
-        c1: f64,
         cluster: &[usize],
+        gaps: &[GapDrag],
         counts: &mut Counts,
         closed: &mut Vec<ImpactEvent>,
         contacts: &mut Vec<(usize, f64, DiscSample)>,
     ) -> Result<Vec<Node>, EngineError> {
         let n = cluster.len();
-        let inv_j1 = self.inv_j1();
         let inv_j: Vec<f64> = cluster
             .iter()
             .map(|&i| self.inv_inertia_z(self.world.discs[i]))
             .collect();
+        let gaps: Vec<GapDrag> = cluster.iter().map(|&i| gaps[i]).collect();
         let mut t = self.t;
-        let (mut angle, mut w) = (self.theta_s, self.omega_s);
+        let (mut angle, mut w) = self.carrier_state(c);
         let mut phi: Vec<f64> = cluster.iter().map(|&i| self.rel[i].phi).collect();
         let mut dphi: Vec<f64> = cluster.iter().map(|&i| self.rel[i].dphi).collect();
         let mut nodes = vec![Node { t, angle, speed: w }];
         let cap = a.max_step_s / SHAFT_SUB_STEPS;
+        let who = match c {
+            Inertial::Shaft => "inertial shaft",
+            Inertial::Drum => "drum",
+        };
         while t < t1 {
             let reaction: f64 = cluster
                 .iter()
                 .map(|&i| self.forces[i].moment[2].abs())
                 .sum();
-            let a_shaft = self.inertial_accel_bound(c1, inv_j1, w, reaction);
+            let a_carrier = self.inertial_accel_bound(c, w, reaction);
             let mut want = cap;
             for (k, &i) in cluster.iter().enumerate() {
                 let d = &self.bodies[i];
                 let f = self.forces[i];
                 let wd = w - dphi[k];
-                let bound = a_shaft + d.drag_n_m_s_rad * wd.abs() * inv_j[k];
+                let g = gaps[k];
+                let bound = a_carrier
+                    + ((d.drag_n_m_s_rad + g.damping) * wd.abs() + g.held_n_m.abs()) * inv_j[k];
                 let view = self.coupling_view(i, &f, (phi[k], dphi[k]), bound, t);
                 let (wk, _) = coupling_step(&view, a);
                 want = want.min(graded_step(wk, &f, self.events.event_age_s(i, t)));
             }
-            let want = checked_sub_step(want, a, t, || "inertial shaft".into())?;
+            let want = checked_sub_step(want, a, t, || who.into())?;
             let rem = t1 - t;
             let mut h = split_remainder(want, rem);
-            let rk4 = |x: f64| self.shaft_rk4(cluster, &inv_j, inv_j1, c1, t, w, &phi, &dphi, x);
+            let rk4 = |x: f64| {
+                let dy = self.carrier_dynamics(c, t, x);
+                self.carrier_rk4(cluster, &inv_j, &gaps, &dy, w, &phi, &dphi, x)
+            };
             let mut step = rk4(h);
             // Never step over an onset or a separation of any coupling: land on the first.
             let tiny = 1e-3 * h.min(want);
@@ -254,7 +344,14 @@ impl Run {
             dphi.clone_from(&step.dphi);
             counts.substeps += 1;
             counts.evals += 5 * n as u64;
-            self.energy.add_sub_step(step.drive_j, step.drag_j);
+            match c {
+                Inertial::Shaft => self.energy.add_sub_step(step.external_j, step.drag_j),
+                Inertial::Drum => {
+                    self.energy.add_sub_step(0.0, step.drag_j);
+                    self.energy.add_load_work(step.external_j);
+                }
+            }
+            self.energy.add_stack_work(step.gap_j);
             nodes.push(Node { t, angle, speed: w });
             let at = ShaftAt { speed: w, angle };
             for (k, &i) in cluster.iter().enumerate() {
@@ -264,95 +361,137 @@ impl Run {
         Ok(nodes)
     }
 
-    /// [`Run::multirate_step`] on an inertial shaft (friction discs only): the couplings that
-    /// may touch within the world step (in contact at `t`, or closer to it than the prescribed
-    /// scheme's controller lets a coupling fly within the step, with the shaft's acceleration
-    /// bounded by the drive, the damping and the reactions at `t`) are integrated with the
-    /// shaft as one system ([`Run::integrate_shaft`]); every other coupling then flies free
-    /// against the shaft's motion so found ([`Path::Nodes`]), as against a prescribed shaft.
-    pub(super) fn multirate_step_inertial(
+    /// Advances inertial carrier `c` and the couplings it carries from `t` to `t1`, the open
+    /// gaps' drag `gaps` on each coupling (indexed by coupling): the couplings that may touch
+    /// it within the world step (in contact at `t`, or closer to it than the prescribed
+    /// scheme's controller lets a coupling fly within the step, with the carrier's
+    /// acceleration bounded by its drive or load, its damping and the reactions at `t`) are
+    /// integrated with the carrier as one system ([`Run::integrate_carrier`]); every other
+    /// one then flies free against the carrier's motion so found ([`Path::Nodes`]), as against
+    /// a prescribed shaft. Writes each carried coupling's speed at `t1` into `omega_d` and its
+    /// mean speed over the step into `means`; returns the carrier's nodes at `t` and `t1`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn advance_carrier(
         &mut self,
+        c: Inertial,
         t1: f64,
         a: &AdaptiveStepping,
-        c1: f64,
+        gaps: &[GapDrag],
+        means: &mut [f64],
         counts: &mut Counts,
         closed: &mut Vec<ImpactEvent>,
         contacts: &mut Vec<(usize, f64, DiscSample)>,
-    ) -> Result<(), EngineError> {
+    ) -> Result<(Node, Node), EngineError> {
         let t0 = self.t;
         let h = t1 - t0;
-        let n = self.couplings.len();
-        let inv_j1 = self.inv_j1();
-        let reaction: f64 = self.forces.iter().map(|f| f.moment[2].abs()).sum();
-        let a_shaft = self.inertial_accel_bound(c1, inv_j1, self.omega_s, reaction);
+        let carried = self.carried_by(c);
+        let reaction: f64 = carried
+            .iter()
+            .map(|&i| self.forces[i].moment[2].abs())
+            .sum();
+        let a_carrier = self.inertial_accel_bound(c, self.carrier_state(c).1, reaction);
         let mut cluster = Vec::new();
-        for i in 0..n {
+        let mut free = Vec::new();
+        for &i in &carried {
             let f = self.forces[i];
             if f.depth_m > 0.0 {
                 cluster.push(i);
                 continue;
             }
             let d = &self.bodies[i];
+            let g = gaps[i];
             let inv_j = self.inv_inertia_z(self.world.discs[i]);
-            let wd = self.omega_s - self.rel[i].dphi;
-            let bound = a_shaft + d.drag_n_m_s_rad * wd.abs() * inv_j;
+            let wd = self.carrier_state(c).1 - self.rel[i].dphi;
+            let bound =
+                a_carrier + ((d.drag_n_m_s_rad + g.damping) * wd.abs() + g.held_n_m.abs()) * inv_j;
             let rel = self.rel[i];
             let view = self.coupling_view(i, &f, (rel.phi, rel.dphi), bound, t0);
             if coupling_step(&view, a).0 < h {
                 cluster.push(i);
+            } else {
+                free.push(i);
             }
         }
         let phi0: Vec<f64> = self.rel.iter().map(|r| r.phi).collect();
-        let nodes = self.integrate_shaft(t1, a, c1, &cluster, counts, closed, contacts)?;
+        let nodes = self.integrate_carrier(c, t1, a, &cluster, gaps, counts, closed, contacts)?;
         let path = Path::Nodes(&nodes);
-        let mut in_cluster = cluster.iter().peekable();
-        for i in 0..n {
-            if in_cluster.peek() == Some(&&i) {
-                in_cluster.next();
-                continue;
-            }
-            self.integrate_coupling(
-                i,
-                t1,
-                a,
-                GapDrag::default(),
-                path,
-                a_shaft,
-                counts,
-                closed,
-                contacts,
-            )?;
+        for &i in &free {
+            self.integrate_coupling(i, t1, a, gaps[i], path, a_carrier, counts, closed, contacts)?;
         }
         let (start, end) = (nodes[0], nodes[nodes.len() - 1]);
-        let mut means = Vec::with_capacity(n);
-        self.potential_j = 0.0;
-        for (i, &phi0) in phi0.iter().enumerate() {
+        for &i in &carried {
             self.omega_d[i] = end.speed - self.rel[i].dphi;
-            self.potential_j += self.forces[i].potential_j;
-            means.push((end.angle - start.angle - (self.rel[i].phi - phi0)) / h);
+            means[i] = (end.angle - start.angle - (self.rel[i].phi - phi0[i])) / h;
         }
-        // The world's step, as on a prescribed shaft (`multirate_step`); the shaft's body
-        // gets its mean speed set for the step instead of a torque: rapier's inverse inertia
-        // of the shaft reads 0 until its first step computes the body's mass properties, and
-        // the torque from it, infinite, left every body at rest from then on (measured).
-        let shaft_mean = (end.angle - start.angle) / h;
-        self.drive_to_means(&means, h);
+        match (c, self.drum.as_mut()) {
+            (Inertial::Drum, Some(d)) => (d.theta, d.omega) = (end.angle, end.speed),
+            _ => (self.theta_s, self.omega_s) = (end.angle, end.speed),
+        }
+        Ok((start, end))
+    }
+
+    /// [`Run::multirate_step`] on an inertial shaft (friction discs only): the shaft and its
+    /// discs by [`Run::advance_carrier`], then the world's step.
+    pub(super) fn multirate_step_inertial(
+        &mut self,
+        t1: f64,
+        a: &AdaptiveStepping,
+        counts: &mut Counts,
+        closed: &mut Vec<ImpactEvent>,
+        contacts: &mut Vec<(usize, f64, DiscSample)>,
+    ) -> Result<(), EngineError> {
+        let t0 = self.t;
+        let n = self.couplings.len();
+        let gaps = vec![GapDrag::default(); n];
+        let mut means = vec![0.0; n];
+        let (start, end) = self.advance_carrier(
+            Inertial::Shaft,
+            t1,
+            a,
+            &gaps,
+            &mut means,
+            counts,
+            closed,
+            contacts,
+        )?;
+        self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
+        self.drive_to_means(&means, t1 - t0);
+        self.step_world_multirate(t1, Some((self.world.shaft, start, end)));
+        Ok(())
+    }
+
+    /// The world's step of the multirate schemes from `t` to `t1`, after each coupling body's
+    /// torque was set to drift it by its mean speed ([`Run::drive_to_means`]): an inertial
+    /// carrier's body (`carrier`: its handle and its nodes at `t` and `t1`) gets its mean
+    /// speed set for the step instead of a torque (rapier's inverse inertia of such a body
+    /// reads 0 until its first step computes the body's mass properties, and the torque from
+    /// it, infinite, left every body at rest from then on: measured); then every body's speed
+    /// is set to its speed at `t1`, and the clock advances.
+    pub(super) fn step_world_multirate(
+        &mut self,
+        t1: f64,
+        carrier: Option<(rapier3d_f64::prelude::RigidBodyHandle, Node, Node)>,
+    ) {
+        let t0 = self.t;
+        let h = t1 - t0;
         let bodies = &mut self.world.physics.bodies;
-        let shaft = &mut bodies[self.world.shaft];
-        shaft.reset_forces(false);
-        shaft.reset_torques(false);
-        shaft.set_angvel(Vector::new(0.0, 0.0, shaft_mean), false);
+        if let Some((handle, start, end)) = carrier {
+            let body = &mut bodies[handle];
+            body.reset_forces(false);
+            body.reset_torques(false);
+            let mean = (end.angle - start.angle) / h;
+            body.set_angvel(Vector::new(0.0, 0.0, mean), false);
+        }
         self.world.step(h);
         let bodies = &mut self.world.physics.bodies;
-        for i in 0..n {
+        for i in 0..self.couplings.len() {
             let body = &mut bodies[self.world.discs[i]];
             body.set_angvel(Vector::new(0.0, 0.0, self.omega_d[i]), false);
         }
-        bodies[self.world.shaft].set_angvel(Vector::new(0.0, 0.0, end.speed), false);
+        if let Some((handle, _, end)) = carrier {
+            bodies[handle].set_angvel(Vector::new(0.0, 0.0, end.speed), false);
+        }
         self.t_prev = Some(t0);
         self.t = t1;
-        self.theta_s = end.angle;
-        self.omega_s = end.speed;
-        Ok(())
     }
 }

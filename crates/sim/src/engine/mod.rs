@@ -164,7 +164,8 @@ impl MultibodyEngine {
         })
     }
 
-    /// Whether runs use the multirate scheme (crate docs, "Theory").
+    /// Whether runs use the multirate scheme (crate docs, "Theory"), from the start (a pack
+    /// whose piston starts to push during the run hands over to the shared step then).
     pub fn is_multirate(&self) -> bool {
         self.multirate_refused.is_none()
     }
@@ -193,15 +194,29 @@ impl MultibodyEngine {
                 } else if self.pack.plates.is_empty() {
                     "a prescribed shaft and concentric friction discs only, so the discs are \
                      independent within a world step"
+                } else if self.pack.drum.is_some() {
+                    "a prescribed shaft, plates on a drum and an open stack: within a world \
+                     step the drum is integrated with the plates that may touch it as one \
+                     system, the others fly free against its motion, and the bodies pull on \
+                     each other only through the gaps' drag, held over the step"
                 } else {
                     "a prescribed shaft, plates on the housing and an open stack, so the \
                      bodies are independent within a world step but for the gaps' drag, held \
                      over it"
                 };
+                let until = match &self.pack.stack {
+                    Some(s) if s.piston.can_clamp() => format!(
+                        "; until t = {} s, where the piston may start to clamp the stack: the \
+                         shared step from there (the faces' friction couples the bodies within \
+                         a step)",
+                        s.piston.open_until_s()
+                    ),
+                    _ => String::new(),
+                };
                 format!(
                     "multirate scheme ({how}: {bodies}): the rapier world steps at up to {} s, \
                      each body's spline coupling sub-steps its own contacts ({} steps per \
-                     contact, classical Runge-Kutta)",
+                     contact, classical Runge-Kutta){until}",
                     a.max_step_s, a.steps_per_contact
                 )
             }

@@ -3,6 +3,7 @@
 //! its own contact-aware sub-steps; the tooth impulse of the step is handed to the disc's
 //! rapier body, which carries the disc's state from one world step to the next.
 
+use super::inertial::Inertial;
 use super::state::{disc_sample, relative_state, Run, ShaftDrive};
 use super::substep::{
     checked_sub_step, graded_step, split_remainder, GapDrag, Path, Relative, ShaftAt,
@@ -16,11 +17,15 @@ use rapier3d_f64::prelude::{Rotation, Vector};
 
 /// Why the multirate scheme cannot run this pack with these options (`None`: it can).
 ///
-/// It needs the bodies to be independent within a world step but for weak couplings: each
-/// friction disc coupled by its teeth only to a prescribed shaft and each separator plate only
-/// to the fixed housing (carriers whose motion is known in advance), turning about the axis
-/// only; neighbours in an open stack (the piston never clamps it) pull on each other only
-/// through the oil gaps' Couette drag, which a world step holds (see [`GapDrag`]).
+/// It needs the bodies to be independent within a world step but for weak couplings and their
+/// inertial carriers: each friction disc coupled by its teeth only to a prescribed shaft (or,
+/// without plates, to an inertial one, integrated with the discs that may touch it) and each
+/// separator plate only to the fixed housing or to the drum (integrated with the plates that
+/// may touch it, `inertial.rs`), turning about the axis only; neighbours in an open stack
+/// pull on each other only through the oil gaps' Couette drag, which a world step holds (see
+/// [`GapDrag`]). A stack whose piston may push later (`Piston::open_until_s` > 0) is open
+/// until then: the session runs the multirate scheme up to that time and the shared step
+/// after it.
 pub(super) fn unsupported(
     pack: &PackModel,
     options: &MultibodyOptions,
@@ -37,14 +42,12 @@ pub(super) fn unsupported(
              drum or stack)",
         );
     }
-    if pack.drum.is_some() {
-        return Some("a drum couples its plates within a step through its inertia");
-    }
     if let Some(stack) = &pack.stack {
-        if stack.piston.can_clamp() {
+        // a stack that clamps later runs multirate until the piston may push (`session.rs`)
+        if stack.piston.open_until_s() <= 0.0 {
             return Some(
-                "a clamped stack (the piston's force exceeds its return spring) couples the \
-                 bodies within a step through the faces' friction",
+                "a clamped stack (the piston's force exceeds its return spring from the \
+                 start) couples the bodies within a step through the faces' friction",
             );
         }
     } else if !pack.plates.is_empty() {
@@ -81,7 +84,7 @@ impl Run {
                 unreachable!("the multirate scheme needs a prescribed shaft")
             }
             (Carrier::Housing, _) => None,
-            (Carrier::Drum, _) => unreachable!("the multirate scheme runs no drum"),
+            (Carrier::Drum, _) => unreachable!("the drum's plates go with the drum"),
         }
     }
 
@@ -125,8 +128,8 @@ impl Run {
         closed: &mut Vec<ImpactEvent>,
         contacts: &mut Vec<(usize, f64, DiscSample)>,
     ) -> Result<(), EngineError> {
-        if let ShaftDrive::Inertial { c1, .. } = self.shaft {
-            return self.multirate_step_inertial(t1, a, c1, counts, closed, contacts);
+        if let ShaftDrive::Inertial { .. } = self.shaft {
+            return self.multirate_step_inertial(t1, a, counts, closed, contacts);
         }
         let t0 = self.t;
         let h = t1 - t0;
@@ -161,11 +164,11 @@ impl Run {
                 .collect();
             gaps = self.gap_drags(&w);
         }
-        let mut means = Vec::with_capacity(self.couplings.len());
-        self.potential_j = 0.0;
-        for i in 0..self.couplings.len() {
+        let n = self.couplings.len();
+        let mut means = vec![0.0; n];
+        for i in 0..n {
             if i == n_discs && self.stack.is_some() {
-                let w: Vec<f64> = (0..self.couplings.len())
+                let w: Vec<f64> = (0..n)
                     .map(|j| {
                         if j < n_discs {
                             means[j]
@@ -175,6 +178,9 @@ impl Run {
                     })
                     .collect();
                 gaps = self.gap_drags(&w);
+            }
+            if self.world.carriers[i] == Carrier::Drum {
+                continue; // with the drum, below
             }
             let phi0 = self.rel[i].phi;
             let p = self.profile(i);
@@ -186,11 +192,29 @@ impl Run {
             let (phi1, dphi1) = (self.rel[i].phi, self.rel[i].dphi);
             let (c0, c1) = (path.at(t0), path.at(t1));
             self.omega_d[i] = c1.speed - dphi1;
-            self.potential_j += self.forces[i].potential_j;
             // The body's mean speed over the step: it turns with its carrier less the change
             // of the relative angle.
-            means.push((c1.angle - c0.angle - (phi1 - phi0)) / h);
+            means[i] = (c1.angle - c0.angle - (phi1 - phi0)) / h;
         }
+        // The drum and its plates, as an inertial shaft and its discs, the plates' gaps' drag
+        // from the discs' mean speeds as for plates on the housing.
+        let drum = match self.world.drum {
+            Some(handle) => {
+                let (start, end) = self.advance_carrier(
+                    Inertial::Drum,
+                    t1,
+                    a,
+                    &gaps,
+                    &mut means,
+                    counts,
+                    closed,
+                    contacts,
+                )?;
+                Some((handle, start, end))
+            }
+            None => None,
+        };
+        self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let c = self.gap_coefficient();
         if let Some(s) = self.stack.as_mut() {
             // Each interface's share of the gaps' work, from the bodies' mean speeds over the
@@ -202,20 +226,13 @@ impl Run {
             }
             s.record_open_step(h);
         }
-        // The world's step: each disc's impulse in two halves, `J (mean - w(t))` applied as a
-        // torque over the step (rapier's semi-implicit Euler then drifts the disc by
+        // The world's step: each body's impulse in two halves, `J (mean - w(t))` applied as a
+        // torque over the step (rapier's semi-implicit Euler then drifts the body by
         // exactly `mean h`) and `J (w(t1) - mean)` as the speed set at its end.
         self.drive_to_means(&means, h);
         let bodies = &mut self.world.physics.bodies;
         bodies[self.world.shaft].set_next_kinematic_rotation(Rotation::from_rotation_z(theta_s1));
-        self.world.step(h);
-        let bodies = &mut self.world.physics.bodies;
-        for i in 0..self.couplings.len() {
-            let body = &mut bodies[self.world.discs[i]];
-            body.set_angvel(Vector::new(0.0, 0.0, self.omega_d[i]), false);
-        }
-        self.t_prev = Some(t0);
-        self.t = t1;
+        self.step_world_multirate(t1, drum);
         self.theta_s = theta_s1;
         self.omega_s = omega_s1;
         Ok(())

@@ -88,6 +88,12 @@ pub struct MultibodySession {
     stall_t0: f64,
     /// The multirate scheme's sub-step counts.
     counts: multirate::Counts,
+    /// When the multirate scheme hands over to the shared step, s: the time before which the
+    /// piston cannot push on the stack (`Piston::open_until_s`; `f64::INFINITY`: never).
+    shared_from_s: f64,
+    /// World steps the multirate scheme took before the shared step took over (0: it did
+    /// not run, or still runs).
+    multirate_steps: u64,
     /// Whether the outputs at t = 0 (the trackers' first update, the first sample) are sent.
     started: bool,
     /// Set when a call failed: the session must not be advanced again.
@@ -119,6 +125,11 @@ impl MultibodySession {
         run.evaluate(0.0)?;
         let kinetic_j = run.kinetic_energy();
         run.energy.start(run.potential_j, kinetic_j);
+        let shared_from_s = run
+            .pack
+            .stack
+            .as_ref()
+            .map_or(f64::INFINITY, |s| s.piston.open_until_s());
         Ok(MultibodySession {
             run,
             options: options.clone(),
@@ -135,6 +146,8 @@ impl MultibodySession {
             t_last_good: 0.0,
             stall_t0: 0.0,
             counts: multirate::Counts::default(),
+            shared_from_s,
+            multirate_steps: 0,
             started: false,
             failed: false,
             finished: None,
@@ -169,7 +182,8 @@ impl MultibodySession {
         self.counts.missed
     }
 
-    /// Whether the session runs the multirate scheme.
+    /// Whether the session runs the multirate scheme now (a pack whose piston starts to push
+    /// during the run switches to the shared step then).
     pub fn is_multirate(&self) -> bool {
         matches!(self.scheme, Loop::Multirate(_))
     }
@@ -366,7 +380,14 @@ impl MultibodySession {
         let mut closed = Vec::new();
         let mut contacts = Vec::new();
         while self.run.t < t_s {
-            let end = self.step_end(t_s);
+            if self.run.t >= self.shared_from_s {
+                // the piston may push from now on: the shared step from this state
+                self.scheme = Loop::Shared;
+                self.multirate_steps = self.steps;
+                self.run.restart_shared(self.t_last_good)?;
+                return self.advance_shared(t_s, observer);
+            }
+            let end = self.step_end(t_s).min(self.shared_from_s);
             let grid = self.grid_target(end);
             let run = &mut self.run;
             let t1 = world_step_end(run.t, a.max_step_s, grid, end);
@@ -385,6 +406,7 @@ impl MultibodySession {
                 observer.contact_sample(i, t, &s);
             }
             self.steps += 1;
+            self.t_last_good = self.run.t;
             self.sample_if_due(observer);
             if observer.progress(self.run.t) {
                 return Ok(Advance::Stopped);
@@ -538,8 +560,9 @@ impl Session for MultibodySession {
             simulated_s: run.t,
             steps: self.steps,
             rejected_steps: 0,
+            // the multirate scheme's evaluations, and one per shared step (and at its start)
             rhs_evals: match self.scheme {
-                Loop::Shared => self.steps + 1,
+                Loop::Shared => self.counts.evals + self.steps - self.multirate_steps + 1,
                 Loop::Multirate(_) => self.counts.evals,
             },
             stopped_early: false,
