@@ -103,8 +103,9 @@
 //! [`MultibodyEngine::scheme_explanation`] says which one runs and why.
 //!
 //! **Shared step** (`Scheme::Shared`; the scheme of every pack the multirate one cannot run:
-//! fixed steps, a drum, a clamped stack, plates without a stack, an inertial shaft with
-//! anything but friction discs, per-tooth couplings). All bodies
+//! fixed steps, a stack clamped from the start (and any stack once its piston may push),
+//! plates without a stack, an inertial shaft with anything but friction discs, per-tooth
+//! couplings). All bodies
 //! advance with one contact-aware step, the shortest any coupling needs; the kick above makes
 //! it third order (explicit Stormer-Cowell for equal steps) and, for constant steps within a
 //! contact, symplectic: the energy error oscillates without drift (measured: drive work equals
@@ -113,9 +114,9 @@
 //! the per-disc cost of one disc).
 //!
 //! **Multirate** (`Scheme::Auto` on a prescribed shaft with concentric couplings: friction
-//! discs, and separator plates on the housing with an open stack, whose piston never clamps
-//! it; and on an inertial shaft with concentric friction discs only, see "Multirate on an
-//! inertial shaft" below). Within a world step the bodies are then independent: each one's teeth couple it only
+//! discs, and separator plates on the housing or on a drum with an open stack, see "Multirate
+//! with a drum" below; and on an inertial shaft with concentric friction discs only, see
+//! "Multirate on an inertial shaft" below). Within a world step the bodies are then independent: each one's teeth couple it only
 //! to a carrier whose motion is known in advance (the shaft's profile, the housing at rest),
 //! and neighbours pull on each other only through the open gaps' Couette drag, a coupling of
 //! time constant `J / c` of seconds (2.2 s on the MuJoCo anchor's brake) against a world step
@@ -126,8 +127,8 @@
 //! (the energy audit's stack work) and each gap's share, from the mean slips, is its heat.
 //! Measured on the open 8-disc brake against the reference engine at 1e-12 over 25 ms: worst
 //! onset 0.82 us and peak 3.3e-4 at the default world step (second order in it: 0.13 us at
-//! half). A clamped stack, a drum, an inertial shaft with plates, a drum or a stack, and
-//! per-tooth couplings still run the shared step. So the rapier world steps at free-flight length
+//! half). A clamped stack, an inertial shaft with plates, a drum or a stack, and per-tooth
+//! couplings still run the shared step. So the rapier world steps at free-flight length
 //! (`max_step_s`, landing on the sample times) and each coupling integrates its own relative
 //! motion over the world step with its own sub-steps (`engine/multirate.rs`):
 //! - *The sub-step* is the classical Runge-Kutta method (order 4) on the disc's motion,
@@ -221,6 +222,22 @@
 //!   duration of a flank it cannot reach within the step (two powers each) and the cluster
 //!   used the couplings' kept base radius instead of a cosine, 16 discs cost 12.4 ms per disc
 //!   (1.08x; perf: 20 % `pow`, 12 % `cos`).
+//!
+//! **Multirate with a drum, and the piston's start** (issue 20). The drum is an inertial
+//! carrier as the inertial shaft is: each world step it is integrated with the plates that may
+//! touch it by the same kernel (`engine/inertial.rs`, `Inertial::Drum`: the drum
+//! `J w' = T_load - C w - sum T_k` with its load held over the world step, each plate
+//! `J w_p' = T_k - C2 w_p` plus its gaps' drag, held as for plates on the housing), the
+//! others flying free against its nodes; the same order, momentum and energy behaviour as
+//! above (the load's work integrated by the same stages: the audit closes to 2.8e-11 of the
+//! drive's work over 50 ms of `pack-6-engagement` held open, `tests/stack.rs`). A stack whose
+//! piston may push later is open until then (`Piston::open_until_s`): the session runs the
+//! multirate scheme to that time and the shared step from there, started afresh as at t = 0
+//! (`Run::restart_shared`). Measured on `pack-6-engagement` (0.3 s, the piston ramping from
+//! 50 ms): 0.67 s against 1.05 s on the shared step from the start; its open 50 ms in 0.04 s
+//! against 0.63 s; the discs' 137 impacts over the first 50 ms agree with the reference engine
+//! at 1e-12 within 1.7e-3 of the peak and 0.84 us at world steps of 5e-5 s, where the shared
+//! step's first-order gap drag limited the agreement to 25 ms.
 //!
 //! **Where a whole pack's time goes today** (issue 20; the 16-disc brake pack, 16 staggered
 //! discs and 17 plates on the housing with the open gaps' drag, which runs the shared step;

@@ -175,7 +175,7 @@ impl MultibodyEngine {
     /// discs only, so the discs are independent within a world step): ...`, `multirate scheme
     /// (automatic: an inertial shaft and concentric friction discs only: within a world step
     /// the shaft is integrated with the discs that may touch it ...): ...` or `shared step
-    /// (automatic: a drum couples ...): ...`.
+    /// (automatic: a clamped stack ...): ...`.
     pub fn scheme_explanation(&self) -> String {
         let shared = "every body advances with one contact-aware step, the shortest any \
                       coupling needs";
