@@ -4,10 +4,9 @@
 //! integrated together with classical Runge-Kutta sub-steps, the other bodies fly free against
 //! the carrier's motion (`multirate.rs`'s per-coupling integration).
 
-use super::multirate::Counts;
 use super::state::{Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, split_remainder, GapDrag, Node, Path, ShaftAt,
+    checked_sub_step, graded_step, split_remainder, Counts, GapDrag, Node, Path, ShaftAt,
 };
 use crate::hook::FLANKS;
 use crate::options::AdaptiveStepping;

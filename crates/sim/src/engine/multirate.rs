@@ -6,7 +6,7 @@
 use super::inertial::Inertial;
 use super::state::{disc_sample, relative_state, Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, split_remainder, GapDrag, Path, Relative, ShaftAt,
+    checked_sub_step, graded_step, split_remainder, Counts, GapDrag, Path, Relative, ShaftAt,
 };
 use crate::hook::{CouplingForces, RelativeState, FLANKS};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
@@ -60,18 +60,6 @@ pub(super) fn unsupported(
         );
     }
     None
-}
-
-/// What the multirate loop counts in a run.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct Counts {
-    /// Sub-steps taken by all couplings together.
-    pub(super) substeps: u64,
-    /// Tooth-law evaluations (stages, landings, the evaluation at each sub-step's end).
-    pub(super) evals: u64,
-    /// Inertial shaft: couplings that touched within a world step they were predicted to
-    /// fly through (integrated against the shaft's motion without their own reaction on it).
-    pub(super) missed: u64,
 }
 
 impl Run {
@@ -295,9 +283,10 @@ impl Run {
             .z;
         let (g0, rb) = (d.spline.half_play_rad(), self.couplings[i].base_radius_m());
         let offset = d.law.engagement_offset_m();
-        // On an inertial shaft the teeth's work is internal (the drive's is the shaft's,
-        // integrated with it) and a coupling integrated here is in free flight (the others
-        // go with the shaft, `integrate_shaft`): one that touches all the same is counted.
+        // On an inertial carrier (shaft, drum) the teeth's work is internal (the drive's or the
+        // load's is the carrier's, integrated with it) and a coupling integrated here is in
+        // free flight (the others go with the carrier, `integrate_carrier`): one that touches
+        // all the same is counted.
         let inertial = matches!(path, Path::Nodes(_));
         let mut missed = false;
         let mut t = self.t;

@@ -36,9 +36,8 @@
 //! for bit (`tests/session.rs`).
 
 use super::energy::EnergyAudit;
-use super::multirate;
 use super::state::{shaft_accel_bound, Run, ShaftDrive};
-use super::substep::split_remainder;
+use super::substep::{split_remainder, Counts};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::{
@@ -87,7 +86,7 @@ pub struct MultibodySession {
     /// Simulated time at the start of the stall check's current block, s.
     stall_t0: f64,
     /// The multirate scheme's sub-step counts.
-    counts: multirate::Counts,
+    counts: Counts,
     /// When the multirate scheme hands over to the shared step, s: the time before which the
     /// piston cannot push on the stack (`Piston::open_until_s`; `f64::INFINITY`: never).
     shared_from_s: f64,
@@ -145,7 +144,7 @@ impl MultibodySession {
             },
             t_last_good: 0.0,
             stall_t0: 0.0,
-            counts: multirate::Counts::default(),
+            counts: Counts::default(),
             shared_from_s,
             multirate_steps: 0,
             started: false,
@@ -174,10 +173,11 @@ impl MultibodySession {
         self.counts.substeps
     }
 
-    /// Couplings on an inertial shaft that touched within a world step the multirate scheme
-    /// predicted them to fly through, so far (each integrated for the rest of that step
-    /// against the shaft's motion without its reaction on it; crate docs, "Multirate on an
-    /// inertial shaft"). 0 on the shared step and on a prescribed shaft.
+    /// Couplings on an inertial carrier (an inertial shaft, the drum) that touched within a
+    /// world step the multirate scheme predicted them to fly through, so far (each integrated
+    /// for the rest of that step against the carrier's motion without its reaction on it;
+    /// crate docs, "Multirate on an inertial shaft"). 0 on the shared step and for couplings
+    /// on a prescribed shaft or the housing.
     pub fn missed_contacts(&self) -> u64 {
         self.counts.missed
     }

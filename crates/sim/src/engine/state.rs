@@ -94,8 +94,9 @@ pub(super) struct DrumRun {
 /// (`forces.rs`); the clock and the kinematic state (`t`, the shaft's angle and speed, the
 /// bodies' speeds, the relative states and the forces, the teeth's potential, the world's
 /// poses) by the two schemes that advance it, the shared step (`forces.rs`) and the
-/// multirate step (`multirate.rs`); the stack and the drum by the shared step and their own
-/// methods (`stack.rs`).
+/// multirate step (`multirate.rs`, `inertial.rs`); the stack and the drum by the shared step
+/// and their own methods (`stack.rs`), and by the multirate step (the open gaps' heat, the
+/// drum's angle and speed).
 ///
 /// A run owns everything it reads (the model behind an `Arc`, shared with the engine and the
 /// clones of a session until an input changes it), so that a session can hold it and clone it.

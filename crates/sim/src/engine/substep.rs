@@ -1,6 +1,7 @@
 //! One coupling's sub-steps inside a world step (the multirate schemes, `multirate.rs` and
 //! `inertial.rs`): the classical Runge-Kutta step of its relative motion against its carrier's
-//! path, graded towards the tooth law's kinks, with the open gaps' drag held over the step.
+//! path, graded towards the tooth law's kinks, with the open gaps' drag held over the step;
+//! and what the multirate schemes count.
 
 use crate::hook::{Coupling, CouplingForces};
 use crate::options::AdaptiveStepping;
@@ -17,6 +18,19 @@ pub(super) struct GapDrag {
     pub(super) held_n_m: f64,
     /// `c` times the number of neighbours, N m s/rad.
     pub(super) damping: f64,
+}
+
+/// What the multirate loop counts in a run.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Counts {
+    /// Sub-steps taken by all couplings together.
+    pub(super) substeps: u64,
+    /// Tooth-law evaluations (stages, landings, the evaluation at each sub-step's end).
+    pub(super) evals: u64,
+    /// Inertial carriers (shaft, drum): couplings that touched within a world step they were
+    /// predicted to fly through (integrated against the carrier's motion without their own
+    /// reaction on it).
+    pub(super) missed: u64,
 }
 
 /// Sub-steps near a kink of the `s^1.5` law are at most this fraction of the time from the
@@ -200,21 +214,22 @@ impl ShaftAt {
     }
 }
 
-/// The inertial shaft at a sub-step's end: time, s, unwrapped angle, rad, speed, rad/s (the
-/// nodes of [`Path::Nodes`]).
+/// An inertial carrier (shaft, drum) at a sub-step's end: time, s, unwrapped angle, rad,
+/// speed, rad/s (the nodes of [`Path::Nodes`]).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Node {
-    /// Time, s; the shaft's angle, rad, and speed, rad/s, there.
+    /// Time, s; the carrier's angle, rad, and speed, rad/s, there.
     pub(super) t: f64,
     pub(super) angle: f64,
     pub(super) speed: f64,
 }
 
 /// A carrier's motion over a world step as a coupling's sub-steps see it: a prescribed
-/// shaft's profile, the housing at rest, or an inertial shaft's motion already integrated
-/// over the step ([`Run::integrate_shaft`]) given by its nodes: exact at them, the cubic
-/// Hermite interpolant of angle and speed between them (used by couplings in free flight,
-/// whose motion does not depend on the shaft's: only their depth, for the landing, does).
+/// shaft's profile, the housing at rest, or an inertial carrier's (shaft, drum) motion
+/// integrated over the step ([`Run::integrate_carrier`]) given by its nodes: exact at them,
+/// the cubic Hermite interpolant of angle and speed between them (used by couplings in free
+/// flight, whose motion does not depend on the carrier's: only their depth, for the landing,
+/// does).
 #[derive(Debug, Clone, Copy)]
 pub(super) enum Path<'a> {
     Profile(&'a SpeedProfile),
