@@ -479,3 +479,58 @@ fn engagement_pack_6_locks_and_heats_alike() {
         r.len()
     );
 }
+
+/// Issue 20: an open clutch on an inertial shaft with its plates on a drum, both inertial
+/// carriers in the multibody engine's multirate scheme (`pack-6-engagement` with the shaft
+/// made inertial, J1 = 2 kg m^2 driven by `J1 d(profile)/dt`, the piston not yet pushing),
+/// against the reference engine at 1e-12 (monolithic): every disc's impacts one by one over
+/// the first 15 ms, peak within 0.1 % and onset within 1 us (issue 20's limits; measured: 36
+/// impacts, 3.7e-4 and 0.17 us). Not longer, and not the plates: this pack is chaotic beyond
+/// what either engine resolves (the reference at 1e-10 and 1e-12 part at about 25 ms, at
+/// 1e-12 and 1e-13 at about 30 ms), and the plates' light impacts on the drum (2-30 N at
+/// 0.02-0.07 m/s) turn the multibody engine's held gap drag (first order in the world step:
+/// the discs' speed held at its mean over a step in which they strike) into onsets 2 us off
+/// from 9 ms; the shared step's discs part from the reference at 4 ms.
+#[test]
+fn inertial_shaft_with_a_drum_multirate() {
+    let s = scene(
+        "scenes/pack-6-engagement.toml",
+        &[
+            "shaft.mode=inertial",
+            "shaft.inertia_kg_m2=2",
+            "simulation.duration_s=0.015",
+        ],
+    );
+    let nd = s.pack.discs.len();
+    let oracle = ReferenceOptions {
+        tolerance: 1e-12,
+        ..ReferenceOptions::default()
+    };
+    let discs = |v: Vec<ImpactEvent>| v.into_iter().filter(|e| e.disc < nd).collect::<Vec<_>>();
+    let r = discs(impacts(
+        &mut ReferenceEngine::new(s.pack.clone(), oracle),
+        0.015,
+    ));
+    let options = MultibodyOptions::with_settings(1e4, s.simulation.max_step_s, false);
+    let mut e = MultibodyEngine::new(s.pack.clone(), options).unwrap();
+    assert!(e.is_multirate(), "{}", e.scheme_explanation());
+    let m = discs(impacts(&mut e, 0.015));
+    assert!(r.len() >= 5 * nd, "{}", r.len());
+    assert_eq!(r.len(), m.len(), "disc impacts");
+    let (mut worst_rel, mut worst_dt) = (0.0f64, 0.0f64);
+    for (a, b) in r.iter().zip(&m) {
+        assert_eq!((a.disc, a.flank), (b.disc, b.flank), "{a:?} vs {b:?}");
+        assert!(
+            (a.peak_n - b.peak_n).abs() <= 1e-3 * a.peak_n.abs(),
+            "{a:?} vs {b:?}"
+        );
+        assert!((a.t_on_s - b.t_on_s).abs() <= 1e-6, "{a:?} vs {b:?}");
+        worst_rel = worst_rel.max((a.peak_n - b.peak_n).abs() / a.peak_n.abs());
+        worst_dt = worst_dt.max((a.t_on_s - b.t_on_s).abs());
+    }
+    println!(
+        "inertial shaft and drum, first 15 ms: {} disc impacts, worst peak {worst_rel:.2e}, \
+         worst onset {worst_dt:.2e} s",
+        r.len()
+    );
+}

@@ -520,7 +520,7 @@ fn engine_for(
 
 /// The scheme is chosen automatically and explained (issue 9): the multirate scheme on a
 /// prescribed or an inertial shaft with concentric friction discs, the shared step with the
-/// reason on an inertial shaft with plates on a drum, on fixed steps and when asked for;
+/// reason on plates without a stack, on fixed steps and when asked for;
 /// asking for the multirate scheme where it cannot run is refused with the reason.
 #[test]
 fn scheme_is_chosen_and_explained() {
@@ -556,8 +556,8 @@ fn scheme_is_chosen_and_explained() {
         why.starts_with("multirate scheme (automatic: an inertial shaft"),
         "{why}"
     );
-    // an inertial shaft with plates on a drum still runs the shared step
-    let mut with_drum = inertial;
+    // plates without a stack run the shared step (and are refused when multirate is asked)
+    let mut with_drum = inertial.clone();
     with_drum.plates = vec![clutchpack_model::cases::bench_disc("plate")];
     with_drum.drum = Some(clutchpack_model::DrumModel {
         inertia_kg_m2: 0.3,
@@ -568,7 +568,7 @@ fn scheme_is_chosen_and_explained() {
     let (multirate, why) = explain(with_drum.clone(), adaptive());
     assert!(!multirate, "{why}");
     assert!(
-        why.starts_with("shared step (automatic: an inertial shaft"),
+        why.starts_with("shared step (automatic: separator plates without a stack"),
         "{why}"
     );
     let asked = MultibodyOptions {
@@ -576,9 +576,26 @@ fn scheme_is_chosen_and_explained() {
         ..adaptive()
     };
     match MultibodyEngine::new(with_drum, asked) {
-        Err(EngineError::Unsupported(m)) => assert!(m.contains("an inertial shaft"), "{m}"),
+        Err(EngineError::Unsupported(m)) => assert!(m.contains("without a stack"), "{m}"),
         other => panic!("{other:?}"),
     }
+    // an open brake on an inertial shaft with its plates on a drum: multirate, both inertial
+    // carriers integrated with the bodies that may touch them
+    let mut inertial_brake = clutchpack_model::cases::staggered_brake(2);
+    inertial_brake.shaft = inertial.shaft.clone();
+    inertial_brake.drum = Some(clutchpack_model::DrumModel {
+        inertia_kg_m2: 0.5,
+        load_torque_n_m: 0.0,
+        drag_n_m_s_rad: 50.0,
+        initial_speed_rad_s: 0.0,
+    });
+    let (multirate, why) = explain(inertial_brake, adaptive());
+    assert!(multirate, "{why}");
+    assert!(
+        why.starts_with("multirate scheme (automatic: an inertial shaft")
+            && why.contains("plates on a drum"),
+        "{why}"
+    );
     // the open brake with its plates on a drum instead of the housing: multirate, the drum
     // integrated with its plates; with a piston that ramps at 50 ms, multirate until then; with
     // one that pushes from the start, the shared step

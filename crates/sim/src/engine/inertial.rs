@@ -429,39 +429,9 @@ impl Run {
         Ok((start, end))
     }
 
-    /// [`Run::multirate_step`] on an inertial shaft (friction discs only): the shaft and its
-    /// discs by [`Run::advance_carrier`], then the world's step.
-    pub(super) fn multirate_step_inertial(
-        &mut self,
-        t1: f64,
-        a: &AdaptiveStepping,
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
-    ) -> Result<(), EngineError> {
-        let t0 = self.t;
-        let n = self.couplings.len();
-        let gaps = vec![GapDrag::default(); n];
-        let mut means = vec![0.0; n];
-        let (start, end) = self.advance_carrier(
-            Inertial::Shaft,
-            t1,
-            a,
-            &gaps,
-            &mut means,
-            counts,
-            closed,
-            contacts,
-        )?;
-        self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
-        self.drive_to_means(&means, t1 - t0);
-        self.step_world_multirate(t1, Some((self.world.shaft, start, end)));
-        Ok(())
-    }
-
     /// The world's step of the multirate schemes from `t` to `t1`, after each coupling body's
-    /// torque was set to drift it by its mean speed ([`Run::drive_to_means`]): an inertial
-    /// carrier's body (`carrier`: its handle and its nodes at `t` and `t1`) gets its mean
+    /// torque was set to drift it by its mean speed ([`Run::drive_to_means`]): each inertial
+    /// carrier's body (`carriers`: its handle and its nodes at `t` and `t1`) gets its mean
     /// speed set for the step instead of a torque (rapier's inverse inertia of such a body
     /// reads 0 until its first step computes the body's mass properties, and the torque from
     /// it, infinite, left every body at rest from then on: measured); then every body's speed
@@ -469,12 +439,12 @@ impl Run {
     pub(super) fn step_world_multirate(
         &mut self,
         t1: f64,
-        carrier: Option<(rapier3d_f64::prelude::RigidBodyHandle, Node, Node)>,
+        carriers: &[(rapier3d_f64::prelude::RigidBodyHandle, Node, Node)],
     ) {
         let t0 = self.t;
         let h = t1 - t0;
         let bodies = &mut self.world.physics.bodies;
-        if let Some((handle, start, end)) = carrier {
+        for &(handle, start, end) in carriers {
             let body = &mut bodies[handle];
             body.reset_forces(false);
             body.reset_torques(false);
@@ -487,7 +457,7 @@ impl Run {
             let body = &mut bodies[self.world.discs[i]];
             body.set_angvel(Vector::new(0.0, 0.0, self.omega_d[i]), false);
         }
-        if let Some((handle, _, end)) = carrier {
+        for &(handle, _, end) in carriers {
             bodies[handle].set_angvel(Vector::new(0.0, 0.0, end.speed), false);
         }
         self.t_prev = Some(t0);

@@ -185,25 +185,36 @@ impl MultibodyEngine {
                     Scheme::Multirate => "asked for",
                     _ => "automatic",
                 };
-                let bodies = if matches!(self.pack.shaft, clutchpack_model::Shaft::Inertial { .. })
-                {
-                    "an inertial shaft and concentric friction discs only: within a world step \
-                     the shaft is integrated with the discs that may touch it (in contact, or \
-                     near it) as one system, which conserves the angular momentum exactly, and \
-                     the others fly free against the shaft's motion so found"
-                } else if self.pack.plates.is_empty() {
-                    "a prescribed shaft and concentric friction discs only, so the discs are \
-                     independent within a world step"
-                } else if self.pack.drum.is_some() {
-                    "a prescribed shaft, plates on a drum and an open stack: within a world \
-                     step the drum is integrated with the plates that may touch it as one \
-                     system, the others fly free against its motion, and the bodies pull on \
-                     each other only through the gaps' drag, held over the step"
+                let inertial = matches!(self.pack.shaft, clutchpack_model::Shaft::Inertial { .. });
+                let shaft = if inertial {
+                    "an inertial shaft (within a world step the shaft is integrated with the \
+                     discs that may touch it, in contact or near it, as one system, which \
+                     conserves the angular momentum exactly, and the others fly free against \
+                     the shaft's motion so found)"
                 } else {
-                    "a prescribed shaft, plates on the housing and an open stack, so the \
-                     bodies are independent within a world step but for the gaps' drag, held \
-                     over it"
+                    "a prescribed shaft"
                 };
+                let plates = if self.pack.plates.is_empty() {
+                    if inertial {
+                        " and concentric friction discs only".to_string()
+                    } else {
+                        " and concentric friction discs only, so the discs are independent \
+                         within a world step"
+                            .to_string()
+                    }
+                } else {
+                    let carrier = if self.pack.drum.is_some() {
+                        "on a drum (integrated with the plates that may touch it as one \
+                         system, the others flying free against its motion)"
+                    } else {
+                        "on the housing"
+                    };
+                    format!(
+                        ", plates {carrier} and an open stack, so the bodies pull on each other \
+                         within a world step only through the gaps' drag, held over it"
+                    )
+                };
+                let bodies = format!("{shaft}{plates}");
                 let until = match &self.pack.stack {
                     Some(s) if s.piston.can_clamp() => format!(
                         "; until t = {} s, where the piston may start to clamp the stack: the \

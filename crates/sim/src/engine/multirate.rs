@@ -12,16 +12,16 @@ use crate::hook::{CouplingForces, RelativeState, FLANKS};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use crate::stepping::{bracketed_root, contact_duration_s, coupling_step};
 use crate::world::Carrier;
-use clutchpack_model::{DiscSample, EngineError, ImpactEvent, PackModel, Shaft, SpeedProfile};
+use clutchpack_model::{DiscSample, EngineError, ImpactEvent, PackModel, SpeedProfile};
 use rapier3d_f64::prelude::{Rotation, Vector};
 
 /// Why the multirate scheme cannot run this pack with these options (`None`: it can).
 ///
 /// It needs the bodies to be independent within a world step but for weak couplings and their
-/// inertial carriers: each friction disc coupled by its teeth only to a prescribed shaft (or,
-/// without plates, to an inertial one, integrated with the discs that may touch it) and each
-/// separator plate only to the fixed housing or to the drum (integrated with the plates that
-/// may touch it, `inertial.rs`), turning about the axis only; neighbours in an open stack
+/// inertial carriers: each friction disc coupled by its teeth only to the shaft (prescribed,
+/// or inertial and integrated with the discs that may touch it) and each separator plate only
+/// to the fixed housing or to the drum (integrated with the plates that may touch it,
+/// `inertial.rs`), turning about the axis only; neighbours in an open stack
 /// pull on each other only through the oil gaps' Couette drag, which a world step holds (see
 /// [`GapDrag`]). A stack whose piston may push later (`Piston::open_until_s` > 0) is open
 /// until then: the session runs the multirate scheme up to that time and the shared step
@@ -33,14 +33,6 @@ pub(super) fn unsupported(
 ) -> Option<&'static str> {
     if !matches!(options.stepping, Stepping::Adaptive(_)) {
         return Some("fixed steps (the check mode) step the whole world at dt");
-    }
-    if !matches!(pack.shaft, Shaft::Prescribed(_))
-        && (pack.drum.is_some() || pack.stack.is_some() || !pack.plates.is_empty())
-    {
-        return Some(
-            "an inertial shaft (eq 4) runs multirate with friction discs only (no plates, \
-             drum or stack)",
-        );
     }
     if let Some(stack) = &pack.stack {
         // a stack that clamps later runs multirate until the piston may push (`session.rs`)
@@ -69,7 +61,7 @@ impl Run {
         match (self.world.carriers[i], &self.shaft) {
             (Carrier::Shaft, ShaftDrive::Prescribed(p)) => Some(std::sync::Arc::clone(p)),
             (Carrier::Shaft, ShaftDrive::Inertial { .. }) => {
-                unreachable!("the multirate scheme needs a prescribed shaft")
+                unreachable!("the inertial shaft's discs go with the shaft")
             }
             (Carrier::Housing, _) => None,
             (Carrier::Drum, _) => unreachable!("the drum's plates go with the drum"),
@@ -102,12 +94,13 @@ impl Run {
         g
     }
 
-    /// Advances the run from `t` to `t1` by the multirate scheme: every coupling sub-steps its
-    /// relative motion over `[t, t1]`, then the rapier world takes one step of `t1 - t` with
-    /// each disc's tooth impulse. Impact events that closed go to `closed` (in the order they
-    /// closed within each coupling), the contact samples `(coupling, t s, state)` of the
-    /// sub-steps to `contacts` (in time order within each coupling; see
-    /// `EventBook::update`).
+    /// Advances the run from `t` to `t1` by the multirate scheme: the friction discs (each on
+    /// its own against a prescribed shaft, or with an inertial shaft, [`Run::advance_carrier`]),
+    /// then the plates (each on its own against the housing, or with the drum), then the rapier
+    /// world takes one step of `t1 - t` with each body's impulse. Impact events that closed go
+    /// to `closed` (in the order they closed within each coupling), the contact samples
+    /// `(coupling, t s, state)` of the sub-steps to `contacts` (in time order within each
+    /// coupling; see `EventBook::update`).
     pub(super) fn multirate_step(
         &mut self,
         t1: f64,
@@ -116,16 +109,8 @@ impl Run {
         closed: &mut Vec<ImpactEvent>,
         contacts: &mut Vec<(usize, f64, DiscSample)>,
     ) -> Result<(), EngineError> {
-        if let ShaftDrive::Inertial { .. } = self.shaft {
-            return self.multirate_step_inertial(t1, a, counts, closed, contacts);
-        }
         let t0 = self.t;
         let h = t1 - t0;
-        let ShaftDrive::Prescribed(shaft_profile) = &self.shaft else {
-            unreachable!("the multirate scheme needs a prescribed shaft")
-        };
-        let theta_s1 = shaft_profile.angle(t1);
-        let omega_s1 = shaft_profile.speed(t1);
         // The open gaps' drag: the discs first, with their neighbours (plates, which turn
         // slowly) at their mean speed over the step predicted from their acceleration at t
         // (teeth, gaps, drag; second order where it is smooth); then the plates, with their
@@ -135,10 +120,11 @@ impl Run {
         // over 25 ms: worst onset 0.43 us at the default world step of 0.1 ms, 0.13 us at
         // 0.05 ms (1.65 us and 1.06 us with every neighbour held at its speed at t).
         let n_discs = self.pack.discs.len();
+        let n = self.couplings.len();
         let mut gaps = self.gap_drags(&self.omega_d);
         if self.stack.is_some() {
             // the plates' predicted mean speeds, for the discs
-            let w: Vec<f64> = (0..self.couplings.len())
+            let w: Vec<f64> = (0..n)
                 .map(|j| {
                     let w = self.omega_d[j];
                     if j < n_discs {
@@ -152,56 +138,63 @@ impl Run {
                 .collect();
             gaps = self.gap_drags(&w);
         }
-        let n = self.couplings.len();
         let mut means = vec![0.0; n];
-        for i in 0..n {
-            if i == n_discs && self.stack.is_some() {
-                let w: Vec<f64> = (0..n)
-                    .map(|j| {
-                        if j < n_discs {
-                            means[j]
-                        } else {
-                            self.omega_d[j]
-                        }
-                    })
-                    .collect();
-                gaps = self.gap_drags(&w);
+        // the inertial carriers' bodies and their states at t and t1, for the world's step
+        let mut carriers = Vec::new();
+        let prescribed = match &self.shaft {
+            ShaftDrive::Prescribed(p) => Some(std::sync::Arc::clone(p)),
+            ShaftDrive::Inertial { .. } => None,
+        };
+        if prescribed.is_some() {
+            for (i, &gap) in gaps.iter().enumerate().take(n_discs) {
+                self.advance_alone(i, t1, a, gap, &mut means, counts, closed, contacts)?;
             }
-            if self.world.carriers[i] == Carrier::Drum {
-                continue; // with the drum, below
+        } else {
+            let (start, end) = self.advance_carrier(
+                Inertial::Shaft,
+                t1,
+                a,
+                &gaps,
+                &mut means,
+                counts,
+                closed,
+                contacts,
+            )?;
+            carriers.push((self.world.shaft, start, end));
+        }
+        if self.stack.is_some() {
+            // the discs' mean speeds over the step, for the plates
+            let w: Vec<f64> = (0..n)
+                .map(|j| {
+                    if j < n_discs {
+                        means[j]
+                    } else {
+                        self.omega_d[j]
+                    }
+                })
+                .collect();
+            gaps = self.gap_drags(&w);
+        }
+        for (i, &gap) in gaps.iter().enumerate().skip(n_discs) {
+            if self.world.carriers[i] == Carrier::Housing {
+                self.advance_alone(i, t1, a, gap, &mut means, counts, closed, contacts)?;
             }
-            let phi0 = self.rel[i].phi;
-            let p = self.profile(i);
-            let (path, bound) = match p.as_deref() {
-                Some(p) => (Path::Profile(p), self.shaft_accel_bound),
-                None => (Path::Housing, 0.0),
-            };
-            self.integrate_coupling(i, t1, a, gaps[i], path, bound, counts, closed, contacts)?;
-            let (phi1, dphi1) = (self.rel[i].phi, self.rel[i].dphi);
-            let (c0, c1) = (path.at(t0), path.at(t1));
-            self.omega_d[i] = c1.speed - dphi1;
-            // The body's mean speed over the step: it turns with its carrier less the change
-            // of the relative angle.
-            means[i] = (c1.angle - c0.angle - (phi1 - phi0)) / h;
         }
         // The drum and its plates, as an inertial shaft and its discs, the plates' gaps' drag
         // from the discs' mean speeds as for plates on the housing.
-        let drum = match self.world.drum {
-            Some(handle) => {
-                let (start, end) = self.advance_carrier(
-                    Inertial::Drum,
-                    t1,
-                    a,
-                    &gaps,
-                    &mut means,
-                    counts,
-                    closed,
-                    contacts,
-                )?;
-                Some((handle, start, end))
-            }
-            None => None,
-        };
+        if let Some(handle) = self.world.drum {
+            let (start, end) = self.advance_carrier(
+                Inertial::Drum,
+                t1,
+                a,
+                &gaps,
+                &mut means,
+                counts,
+                closed,
+                contacts,
+            )?;
+            carriers.push((handle, start, end));
+        }
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let c = self.gap_coefficient();
         if let Some(s) = self.stack.as_mut() {
@@ -218,11 +211,49 @@ impl Run {
         // torque over the step (rapier's semi-implicit Euler then drifts the body by
         // exactly `mean h`) and `J (w(t1) - mean)` as the speed set at its end.
         self.drive_to_means(&means, h);
-        let bodies = &mut self.world.physics.bodies;
-        bodies[self.world.shaft].set_next_kinematic_rotation(Rotation::from_rotation_z(theta_s1));
-        self.step_world_multirate(t1, drum);
-        self.theta_s = theta_s1;
-        self.omega_s = omega_s1;
+        if let Some(p) = &prescribed {
+            let bodies = &mut self.world.physics.bodies;
+            bodies[self.world.shaft]
+                .set_next_kinematic_rotation(Rotation::from_rotation_z(p.angle(t1)));
+        }
+        self.step_world_multirate(t1, &carriers);
+        if let Some(p) = &prescribed {
+            self.theta_s = p.angle(t1);
+            self.omega_s = p.speed(t1);
+        }
+        Ok(())
+    }
+
+    /// Advances coupling `i` alone from `t` to `t1` against its carrier's known motion (a
+    /// prescribed shaft's profile, the housing at rest) with the open gaps' drag `gap`
+    /// ([`Run::integrate_coupling`]); writes its speed at `t1` into `omega_d` and its mean
+    /// speed over the step into `means[i]`.
+    #[allow(clippy::too_many_arguments)]
+    fn advance_alone(
+        &mut self,
+        i: usize,
+        t1: f64,
+        a: &AdaptiveStepping,
+        gap: GapDrag,
+        means: &mut [f64],
+        counts: &mut Counts,
+        closed: &mut Vec<ImpactEvent>,
+        contacts: &mut Vec<(usize, f64, DiscSample)>,
+    ) -> Result<(), EngineError> {
+        let (t0, h) = (self.t, t1 - self.t);
+        let phi0 = self.rel[i].phi;
+        let p = self.profile(i);
+        let (path, bound) = match p.as_deref() {
+            Some(p) => (Path::Profile(p), self.shaft_accel_bound),
+            None => (Path::Housing, 0.0),
+        };
+        self.integrate_coupling(i, t1, a, gap, path, bound, counts, closed, contacts)?;
+        let (phi1, dphi1) = (self.rel[i].phi, self.rel[i].dphi);
+        let (c0, c1) = (path.at(t0), path.at(t1));
+        self.omega_d[i] = c1.speed - dphi1;
+        // The body's mean speed over the step: it turns with its carrier less the change of
+        // the relative angle.
+        means[i] = (c1.angle - c0.angle - (phi1 - phi0)) / h;
         Ok(())
     }
 
