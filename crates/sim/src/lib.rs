@@ -120,13 +120,19 @@
 //! and neighbours pull on each other only through the open gaps' Couette drag, a coupling of
 //! time constant `J / c` of seconds (2.2 s on the MuJoCo anchor's brake) against a world step
 //! of 0.1 ms. Each body's sub-steps take that drag with its own speed exact and its
-//! neighbours' held: the discs' neighbours (plates) at their mean speed predicted from their
-//! acceleration at the step's start, the plates' neighbours (discs) at the discs' mean speeds
-//! over the step, integrated first; the drag's work is integrated by the sub-steps' stages
-//! (the energy audit's stack work) and each gap's share, from the mean slips, is its heat.
-//! Measured on the open 8-disc brake against the reference engine at 1e-12 over 25 ms: worst
-//! onset 0.82 us and peak 3.3e-4 at the default world step (second order in it: 0.13 us at
-//! half). A clamped stack and per-tooth couplings still run the shared step. So the rapier world steps at free-flight length
+//! neighbours' as a known function of time: the discs' neighbours (plates) held at their mean
+//! speed predicted from their acceleration at the step's start; the plates' neighbours (discs,
+//! integrated first) affine in time with the discs' mean speed and first moment of speed over
+//! the step, accumulated along the discs' sub-steps by cubic Hermite quadrature
+//! (`TurnMoment`): a disc's speed jumps at its impacts within the step, and its speed held at
+//! its mean gives the plate the right impulse but the wrong turn, first order in the step
+//! (measured on `pack-6-engagement`'s open 50 ms: the plates' light impacts on the drum parted
+//! from the reference from 15 ms, 24 us off; with the moment they agree over 30 ms within
+//! 0.28 us). The drag's work is integrated by the sub-steps' stages (the energy audit's stack
+//! work) and each gap's share, from the mean slips, is its heat. Measured on the open 8-disc
+//! brake against the reference engine at 1e-12 over 25 ms: worst onset 0.46 us and peak
+//! 3.3e-4 at the default world step. A clamped stack and per-tooth couplings still run the
+//! shared step. So the rapier world steps at free-flight length
 //! (`max_step_s`, landing on the sample times) and each coupling integrates its own relative
 //! motion over the world step with its own sub-steps (`engine/multirate.rs`):
 //! - *The sub-step* is the classical Runge-Kutta method (order 4) on the disc's motion,
@@ -233,9 +239,10 @@
 //! multirate scheme to that time and the shared step from there, started afresh as at t = 0
 //! (`Run::restart_shared`). Measured on `pack-6-engagement` (0.3 s, the piston ramping from
 //! 50 ms): 0.67 s against 1.05 s on the shared step from the start; its open 50 ms in 0.04 s
-//! against 0.63 s; the discs' 137 impacts over the first 50 ms agree with the reference engine
-//! at 1e-12 within 1.7e-3 of the peak and 0.84 us at world steps of 5e-5 s, where the shared
-//! step's first-order gap drag limited the agreement to 25 ms. On an inertial shaft both
+//! against 0.63 s; against the reference engine at 1e-12 at world steps of 5e-5 s the discs'
+//! 137 impacts over the first 50 ms agree within 1.0e-3 of the peak and 0.52 us, the plates'
+//! 47 over the first 30 ms within 2.3e-3 and 0.28 us, where the shared step's first-order gap
+//! drag limited the discs' agreement to 25 ms. On an inertial shaft both
 //! carriers run so, each with its bodies, the discs first (the shaft's cluster), then the
 //! plates (the drum's), coupled only through the gaps' drag as on a prescribed shaft: the
 //! energy audit closes to 3.6e-11 of the drive's work over 50 ms, and the discs' 36 impacts

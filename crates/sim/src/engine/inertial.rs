@@ -162,6 +162,7 @@ impl Run {
         inv_j: &[f64],
         gaps: &[GapDrag],
         dy: &CarrierDynamics,
+        t: f64,
         w0: f64,
         phi: &[f64],
         dphi: &[f64],
@@ -173,36 +174,45 @@ impl Run {
         let u0: Vec<f64> = (0..n).map(|k| w0 - dphi[k]).collect();
         // The accelerations at a stage: the carrier turned by `s` at speed `w`, body k by
         // `th[k]` at `u[k]`; the bodies' into `acc`, returns the carrier's.
-        let stage = |ext: f64, s: f64, w: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
-            let mut teeth = 0.0;
-            for k in 0..n {
-                let i = cluster[k];
-                let torque = self.couplings[i].probe_torque(phi[k] + s - th[k], w - u[k]);
-                teeth += torque;
-                let g = gaps[k].held_n_m - gaps[k].damping * u[k];
-                acc[k] = (torque - self.bodies[i].drag_n_m_s_rad * u[k] + g) * inv_j[k];
-            }
-            (ext - c1 * w - teeth) * inv_j1
-        };
+        let (tm, te) = (t + 0.5 * h, t + h);
+        let stage =
+            |(ts, ext): (f64, f64), s: f64, w: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
+                let mut teeth = 0.0;
+                for k in 0..n {
+                    let i = cluster[k];
+                    let torque = self.couplings[i].probe_torque(phi[k] + s - th[k], w - u[k]);
+                    teeth += torque;
+                    let g = gaps[k].torque(ts, u[k]);
+                    acc[k] = (torque - self.bodies[i].drag_n_m_s_rad * u[k] + g) * inv_j[k];
+                }
+                (ext - c1 * w - teeth) * inv_j1
+            };
         let [e1, em, e4] = dy.torque;
         let (mut k1, mut k2, mut k3, mut k4) =
             (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let zero = vec![0.0; n];
-        let a1 = stage(e1, 0.0, w0, &zero, &u0, &mut k1);
+        let a1 = stage((t, e1), 0.0, w0, &zero, &u0, &mut k1);
         let w2 = w0 + 0.5 * h * a1;
         let th2: Vec<f64> = u0.iter().map(|u| 0.5 * h * u).collect();
         let u2: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k1[k]).collect();
-        let a2 = stage(em, 0.5 * h * w0, w2, &th2, &u2, &mut k2);
+        let a2 = stage((tm, em), 0.5 * h * w0, w2, &th2, &u2, &mut k2);
         let w3 = w0 + 0.5 * h * a2;
         let th3: Vec<f64> = (0..n)
             .map(|k| 0.5 * h * u0[k] + 0.25 * hh * k1[k])
             .collect();
         let u3: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k2[k]).collect();
-        let a3 = stage(em, 0.5 * h * w0 + 0.25 * hh * a1, w3, &th3, &u3, &mut k3);
+        let a3 = stage(
+            (tm, em),
+            0.5 * h * w0 + 0.25 * hh * a1,
+            w3,
+            &th3,
+            &u3,
+            &mut k3,
+        );
         let w4 = w0 + h * a3;
         let th4: Vec<f64> = (0..n).map(|k| h * u0[k] + 0.5 * hh * k2[k]).collect();
         let u4: Vec<f64> = (0..n).map(|k| u0[k] + h * k3[k]).collect();
-        let a4 = stage(e4, h * w0 + 0.5 * hh * a2, w4, &th4, &u4, &mut k4);
+        let a4 = stage((te, e4), h * w0 + 0.5 * hh * a2, w4, &th4, &u4, &mut k4);
         let h6 = h / 6.0;
         let turn = h * w0 + h * h6 * (a1 + a2 + a3);
         let speed = w0 + h6 * (a1 + 2.0 * (a2 + a3) + a4);
@@ -217,8 +227,8 @@ impl Run {
             phi1.push(phi[k] + turn - th);
             dphi1.push(speed - u1);
             drag_j -= self.bodies[cluster[k]].drag_n_m_s_rad * h6 * sq(u0[k], u2[k], u3[k], u4[k]);
-            let g = |u: f64| (gaps[k].held_n_m - gaps[k].damping * u) * u;
-            gap_j += h6 * (g(u0[k]) + 2.0 * (g(u2[k]) + g(u3[k])) + g(u4[k]));
+            let g = |ts: f64, u: f64| gaps[k].torque(ts, u) * u;
+            gap_j += h6 * (g(t, u0[k]) + 2.0 * (g(tm, u2[k]) + g(tm, u3[k])) + g(te, u4[k]));
         }
         CarrierStep {
             turn,
@@ -280,7 +290,7 @@ impl Run {
                 let wd = w - dphi[k];
                 let g = gaps[k];
                 let bound = a_carrier
-                    + ((d.drag_n_m_s_rad + g.damping) * wd.abs() + g.held_n_m.abs()) * inv_j[k];
+                    + ((d.drag_n_m_s_rad + g.damping) * wd.abs() + g.bound_n_m()) * inv_j[k];
                 let view = self.coupling_view(i, &f, (phi[k], dphi[k]), bound, t);
                 let (wk, _) = coupling_step(&view, a);
                 want = want.min(graded_step(wk, &f, self.events.event_age_s(i, t)));
@@ -290,7 +300,7 @@ impl Run {
             let mut h = split_remainder(want, rem);
             let rk4 = |x: f64| {
                 let dy = self.carrier_dynamics(c, t, x);
-                self.carrier_rk4(cluster, &inv_j, &gaps, &dy, w, &phi, &dphi, x)
+                self.carrier_rk4(cluster, &inv_j, &gaps, &dy, t, w, &phi, &dphi, x)
             };
             let mut step = rk4(h);
             // Never step over an onset or a separation of any coupling: land on the first.
@@ -402,7 +412,7 @@ impl Run {
             let inv_j = self.inv_inertia_z(self.world.discs[i]);
             let wd = self.carrier_state(c).1 - self.rel[i].dphi;
             let bound =
-                a_carrier + ((d.drag_n_m_s_rad + g.damping) * wd.abs() + g.held_n_m.abs()) * inv_j;
+                a_carrier + ((d.drag_n_m_s_rad + g.damping) * wd.abs() + g.bound_n_m()) * inv_j;
             let rel = self.rel[i];
             let view = self.coupling_view(i, &f, (rel.phi, rel.dphi), bound, t0);
             if coupling_step(&view, a).0 < h {

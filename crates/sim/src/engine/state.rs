@@ -135,6 +135,9 @@ pub(super) struct Run {
     pub(super) teeth_motion: Vec<Motion>,
     /// Body speeds at `t` (synchronised with the poses), rad/s.
     pub(super) omega_d: Vec<f64>,
+    /// Multirate scheme: each body's first moment of speed over the world step being taken
+    /// (its neighbours' gap drag reads its slope).
+    pub(super) moments: Vec<super::substep::TurnMoment>,
     /// Time of the evaluation before the last step.
     pub(super) t_prev: Option<f64>,
     /// Prescribed shaft: its angle at the end of the step being taken.
@@ -259,6 +262,7 @@ impl Run {
             teeth_cache: vec![std::cell::Cell::new((f64::NAN, 0.0)); nd],
             teeth_motion: vec![Motion::default(); nd],
             omega_d: Vec::with_capacity(nd),
+            moments: vec![Default::default(); nd],
             t_prev: None,
             theta_next: 0.0,
             t: 0.0,

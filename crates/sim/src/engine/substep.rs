@@ -8,16 +8,86 @@ use crate::options::AdaptiveStepping;
 use clutchpack_model::{EngineError, SpeedProfile};
 
 /// The open gaps' drag on one body over a world step, `sum_nb c (w_nb - w)` (Couette, MODEL.md
-/// section 5): the neighbours' speeds held at their predicted mean over the step (see
-/// `Run::multirate_step`), the body's own speed taken along its sub-steps (the damping `c`
-/// per gap on its own speed is exact within the step; the neighbours' are a coupling with a
-/// time constant `J / c` of seconds against a world step of 0.1 ms).
+/// section 5): the neighbours' speeds taken as an affine function of time over the step with
+/// their mean and their first moment about its middle (predicted, or integrated before; see
+/// `Run::multirate_step`), the body's own speed along its sub-steps (the damping `c` per gap
+/// on its own speed is exact within the step; the neighbours' are a coupling with a time
+/// constant `J / c` of seconds against a world step of 0.1 ms).
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct GapDrag {
-    /// `c sum_nb w_nb`, N m.
+    /// `c sum_nb w_nb` at the step's middle (the mean over the step), N m.
     pub(super) held_n_m: f64,
+    /// Its rate over the step, N m/s: `c sum_nb` of the neighbours' speeds' slopes (the
+    /// affine function with their first moment).
+    pub(super) slope_n_m_s: f64,
+    /// The world step's middle, s, and half its length, s.
+    pub(super) t_mid_s: f64,
+    pub(super) half_step_s: f64,
     /// `c` times the number of neighbours, N m s/rad.
     pub(super) damping: f64,
+}
+
+impl GapDrag {
+    /// The drag on the body at `t` (s) turning at `u` (rad/s), N m.
+    pub(super) fn torque(&self, t: f64, u: f64) -> f64 {
+        self.held_n_m + self.slope_n_m_s * (t - self.t_mid_s) - self.damping * u
+    }
+
+    /// The largest magnitude of the neighbours' part over the step, N m (for the step
+    /// controller's bound of the body's acceleration).
+    pub(super) fn bound_n_m(&self) -> f64 {
+        self.held_n_m.abs() + self.slope_n_m_s.abs() * self.half_step_s
+    }
+}
+
+/// A body's first moment of speed about a world step's middle, accumulated along its sub-steps
+/// (`Run::end_sub_step`): `integral (s - t_mid) w ds` from the body's turns at the sub-steps'
+/// ends by cubic Hermite quadrature (exact for a cubic angle between them), for the slope of
+/// its speed that its neighbours' gap drag takes ([`GapDrag`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct TurnMoment {
+    /// The world step's start, s.
+    t0: f64,
+    /// The body's angle at the start, rad.
+    theta0: f64,
+    /// The last sub-step's end: time, s, angle from `theta0`, rad, speed, rad/s.
+    t: f64,
+    turn: f64,
+    speed: f64,
+    /// `integral (theta - theta0) ds` so far, rad s.
+    integral: f64,
+}
+
+impl TurnMoment {
+    /// Starts a world step at `t0` with the body at angle `theta0` (rad) and speed `w0`.
+    pub(super) fn start(t0: f64, theta0: f64, w0: f64) -> TurnMoment {
+        TurnMoment {
+            t0,
+            theta0,
+            t: t0,
+            turn: 0.0,
+            speed: w0,
+            integral: 0.0,
+        }
+    }
+
+    /// A sub-step's end at `t` with the body at angle `theta` (rad) and speed `w` (rad/s).
+    pub(super) fn add(&mut self, t: f64, theta: f64, w: f64) {
+        let (d, turn) = (t - self.t, theta - self.theta0);
+        self.integral += 0.5 * d * (self.turn + turn) + d * d / 12.0 * (self.speed - w);
+        (self.t, self.turn, self.speed) = (t, turn, w);
+    }
+
+    /// The slope of the affine speed with the body's mean speed `(turn at t) / h` and its first
+    /// moment over the step so far (to `t`, length `h`), rad/s^2: `12 m1 / h^3` with
+    /// `m1 = integral (s - t_mid) w ds = h turn / 2 - integral turn ds`.
+    pub(super) fn slope(&self) -> f64 {
+        let h = self.t - self.t0;
+        if h <= 0.0 {
+            return 0.0;
+        }
+        12.0 * (0.5 * h * self.turn - self.integral) / (h * h * h)
+    }
 }
 
 /// What the multirate loop counts in a run.
@@ -152,20 +222,20 @@ impl Relative<'_> {
         let u0 = w0 - dphi;
         // (omega_d', teeth torque) at a stage: the shaft turned by `s` at speed `ws`, the
         // disc turned by `th` at speed `u`.
-        let f = |s: f64, ws: f64, th: f64, u: f64| {
+        let f = |ts: f64, s: f64, ws: f64, th: f64, u: f64| {
             let torque = self.coupling.probe_torque(phi + s - th, ws - u);
             // Hu et al. eq (5): J omega_d' = T - C2 omega_d, plus the open gaps' drag
-            let g = gap.held_n_m - gap.damping * u;
+            let g = gap.torque(ts, u);
             ((torque - self.c2 * u + g) * self.inv_j, torque)
         };
         let hh = h * h;
-        let (k1, t1) = f(0.0, w0, 0.0, u0);
+        let (k1, t1) = f(t, 0.0, w0, 0.0, u0);
         let u2 = u0 + 0.5 * h * k1;
-        let (k2, t2) = f(sm, wm, 0.5 * h * u0, u2);
+        let (k2, t2) = f(tm, sm, wm, 0.5 * h * u0, u2);
         let u3 = u0 + 0.5 * h * k2;
-        let (k3, t3) = f(sm, wm, 0.5 * h * u0 + 0.25 * hh * k1, u3);
+        let (k3, t3) = f(tm, sm, wm, 0.5 * h * u0 + 0.25 * hh * k1, u3);
         let u4 = u0 + h * k3;
-        let (k4, t4) = f(se, we, h * u0 + 0.5 * hh * k2, u4);
+        let (k4, t4) = f(te, se, we, h * u0 + 0.5 * hh * k2, u4);
         let h6 = h / 6.0;
         // The classical method on the first-order system (angle, speed), written for the
         // angle: the disc turns by h u0 + h^2/6 (k1 + k2 + k3).
@@ -178,11 +248,9 @@ impl Relative<'_> {
             drive_j: h6 * (t1 * w0 + 2.0 * (t2 + t3) * wm + t4 * we),
             drag_j: -self.c2 * h6 * (u0 * u0 + 2.0 * (u2 * u2 + u3 * u3) + u4 * u4),
             gap_j: h6
-                * ((gap.held_n_m - gap.damping * u0) * u0
-                    + 2.0
-                        * ((gap.held_n_m - gap.damping * u2) * u2
-                            + (gap.held_n_m - gap.damping * u3) * u3)
-                    + (gap.held_n_m - gap.damping * u4) * u4),
+                * (gap.torque(t, u0) * u0
+                    + 2.0 * (gap.torque(tm, u2) * u2 + gap.torque(tm, u3) * u3)
+                    + gap.torque(te, u4) * u4),
             evals: 4,
         }
     }
@@ -314,6 +382,40 @@ mod tests {
         assert_eq!(graded_step(want, &falling, Some(1e-5)), 0.25 * 2e-7);
         assert_eq!(graded_step(want, &forces(1e-12, -0.5), Some(1e-5)), 1e-8);
         assert_eq!(graded_step(want, &forces(-1e-7, -0.5), Some(0.0)), want);
+    }
+
+    /// The first moment of speed over a world step from the body's angle and speed at uneven
+    /// sub-step ends is exact for a cubic angle (Hermite quadrature): `theta = a s + b s^2 +
+    /// c s^3` from `t0` = 0.3 s over 1e-4 s in five uneven sub-steps gives the slope
+    /// `12 m1 / h^3` of the exact moment to rounding; a body turning at constant speed has
+    /// slope 0, and the affine speed so found has the body's mean and moment.
+    #[test]
+    fn turn_moment_is_exact_for_a_cubic_angle() {
+        let (a, b, c) = (200.0, 3.0e3, -4.0e7);
+        let (t0, h) = (0.3, 1e-4);
+        let theta = |s: f64| 50.0 + a * s + b * s * s + c * s * s * s;
+        let speed = |s: f64| a + 2.0 * b * s + 3.0 * c * s * s;
+        let mut m = TurnMoment::start(t0, theta(0.0), speed(0.0));
+        let mut flat = TurnMoment::start(t0, 1.0, a);
+        for f in [0.1, 0.15, 0.5, 0.9, 1.0] {
+            m.add(t0 + f * h, theta(f * h), speed(f * h));
+            flat.add(t0 + f * h, 1.0 + a * f * h, a);
+        }
+        // m1 = integral_0^h (s - h/2) w(s) ds for w = a + 2 b s + 3 c s^2
+        let m1 = 2.0 * b * h.powi(3) / 12.0 + 3.0 * c * h.powi(4) / 12.0;
+        let exact = 12.0 * m1 / h.powi(3);
+        assert!((m.slope() - exact).abs() < 1e-6 * exact.abs(), "{} vs {exact}", m.slope());
+        assert!(flat.slope().abs() < 1e-3, "{}", flat.slope());
+        let g = GapDrag {
+            held_n_m: 2.0,
+            slope_n_m_s: 10.0,
+            t_mid_s: t0 + 0.5 * h,
+            half_step_s: 0.5 * h,
+            damping: 0.5,
+        };
+        assert_eq!(g.torque(t0 + 0.5 * h, 4.0), 0.0);
+        assert!((g.torque(t0 + h, 0.0) - (2.0 + 10.0 * 0.5 * h)).abs() < 1e-15);
+        assert!((g.bound_n_m() - (2.0 + 10.0 * 0.5 * h)).abs() < 1e-15);
     }
 
     /// A disc in free flight inside the backlash of a shaft at rest, slowed by its drag:
