@@ -404,7 +404,11 @@ mod tests {
         // m1 = integral_0^h (s - h/2) w(s) ds for w = a + 2 b s + 3 c s^2
         let m1 = 2.0 * b * h.powi(3) / 12.0 + 3.0 * c * h.powi(4) / 12.0;
         let exact = 12.0 * m1 / h.powi(3);
-        assert!((m.slope() - exact).abs() < 1e-6 * exact.abs(), "{} vs {exact}", m.slope());
+        assert!(
+            (m.slope() - exact).abs() < 1e-6 * exact.abs(),
+            "{} vs {exact}",
+            m.slope()
+        );
         assert!(flat.slope().abs() < 1e-3, "{}", flat.slope());
         let g = GapDrag {
             held_n_m: 2.0,
