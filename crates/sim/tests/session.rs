@@ -564,3 +564,29 @@ fn a_sine_drive_sampled_and_held_drives_the_pack() {
     assert!(worst_angle < 1.05 * bound, "{worst_angle} against {bound}");
     assert!(c.impacts.len().abs_diff(whole.impacts.len()) <= 4);
 }
+
+/// The hand-over (issue 20): the engaging clutch's piston ramps from 2 ms, so its session runs
+/// the multirate scheme until then and the shared step from there: multirate after a call to
+/// 1.9 ms, shared after one to 2.1 ms, a sample at 2 ms itself (a world step lands on the
+/// hand-over, which is on the 1e4 Hz grid), and every interface open up to it.
+#[test]
+fn the_multirate_scheme_hands_over_where_the_piston_may_push() {
+    let e = engine(engaging(), Scheme::Auto);
+    assert!(e.scheme_explanation().contains("until t = 0.002 s"));
+    let mut s = e.session(Driven::NONE).expect("session");
+    let mut c = Collector::default();
+    s.advance_to(0.0019, &mut c).expect("advance");
+    assert!(s.is_multirate());
+    s.advance_to(0.0021, &mut c).expect("advance");
+    assert!(!s.is_multirate());
+    assert!(
+        c.samples.iter().any(|x| x.t_s == 0.002),
+        "a sample at the hand-over"
+    );
+    let open_before = c
+        .interfaces
+        .iter()
+        .filter(|(t, _)| *t <= 0.002)
+        .all(|(_, f)| f.iter().all(|x| x.clamp_n == 0.0));
+    assert!(open_before);
+}
