@@ -30,6 +30,16 @@ pub(super) enum Inertial {
     Drum,
 }
 
+impl Inertial {
+    /// The carrier of the couplings this one carries.
+    pub(super) fn carrier(self) -> Carrier {
+        match self {
+            Inertial::Shaft => Carrier::Shaft,
+            Inertial::Drum => Carrier::Drum,
+        }
+    }
+}
+
 /// An inertial carrier's own dynamics over a sub-step: `J w' = T_ext(t) - C w - sum T_k`.
 #[derive(Debug, Clone, Copy)]
 struct CarrierDynamics {
@@ -127,13 +137,17 @@ impl Run {
 
     /// The couplings carried by inertial carrier `c`.
     fn carried_by(&self, c: Inertial) -> Vec<usize> {
-        let carrier = match c {
-            Inertial::Shaft => Carrier::Shaft,
-            Inertial::Drum => Carrier::Drum,
-        };
         (0..self.couplings.len())
-            .filter(|&i| self.world.carriers[i] == carrier)
+            .filter(|&i| self.world.carriers[i] == c.carrier())
             .collect()
+    }
+
+    /// Inertial carrier `c`'s rapier body.
+    pub(super) fn carrier_body_of(&self, c: Inertial) -> rapier3d_f64::prelude::RigidBodyHandle {
+        match c {
+            Inertial::Shaft => self.world.shaft,
+            Inertial::Drum => self.world.drum.expect("a drum"),
+        }
     }
 
     /// The inverse of a rapier body's inertia about the axis, 1/(kg m^2).

@@ -6,7 +6,7 @@
 use super::inertial::Inertial;
 use super::state::{disc_sample, relative_state, Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, split_remainder, Counts, GapDrag, Path, Relative, ShaftAt,
+    checked_sub_step, graded_step, split_remainder, Counts, GapDrag, Node, Path, Relative, ShaftAt,
     TurnMoment,
 };
 use crate::hook::{CouplingForces, RelativeState, FLANKS};
@@ -14,7 +14,7 @@ use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use crate::stepping::{bracketed_root, contact_duration_s, coupling_step};
 use crate::world::Carrier;
 use clutchpack_model::{DiscSample, EngineError, ImpactEvent, PackModel, SpeedProfile};
-use rapier3d_f64::prelude::{Rotation, Vector};
+use rapier3d_f64::prelude::{RigidBodyHandle, Rotation, Vector};
 
 /// Why the multirate scheme cannot run this pack with these options (`None`: it can).
 ///
@@ -160,23 +160,21 @@ impl Run {
             ShaftDrive::Prescribed(p) => Some(std::sync::Arc::clone(p)),
             ShaftDrive::Inertial { .. } => None,
         };
-        if prescribed.is_some() {
-            for (i, &gap) in gaps.iter().enumerate().take(n_discs) {
-                self.advance_alone(i, t1, a, gap, &mut means, counts, closed, contacts)?;
-            }
-        } else {
-            let (start, end) = self.advance_carrier(
-                Inertial::Shaft,
-                t1,
-                a,
-                &gaps,
-                &mut means,
-                counts,
-                closed,
-                contacts,
-            )?;
-            carriers.push((self.world.shaft, start, end));
-        }
+        // the discs, with an inertial shaft as their carrier or each alone
+        let shaft = prescribed.is_none().then_some(Inertial::Shaft);
+        let (discs, plates) = (0..n_discs, n_discs..n);
+        self.advance_group(
+            discs,
+            shaft,
+            t1,
+            a,
+            &gaps,
+            &mut means,
+            &mut carriers,
+            counts,
+            closed,
+            contacts,
+        )?;
         if self.stack.is_some() {
             // the discs' speeds over the step, for the plates: the affine function with their
             // mean and their first moment, from their sub-steps
@@ -200,26 +198,21 @@ impl Run {
                 .collect();
             gaps = self.gap_drags(&w, &slope, h);
         }
-        for (i, &gap) in gaps.iter().enumerate().skip(n_discs) {
-            if self.world.carriers[i] == Carrier::Housing {
-                self.advance_alone(i, t1, a, gap, &mut means, counts, closed, contacts)?;
-            }
-        }
-        // The drum and its plates, as an inertial shaft and its discs, the plates' gaps' drag
-        // from the discs' mean speeds as for plates on the housing.
-        if let Some(handle) = self.world.drum {
-            let (start, end) = self.advance_carrier(
-                Inertial::Drum,
-                t1,
-                a,
-                &gaps,
-                &mut means,
-                counts,
-                closed,
-                contacts,
-            )?;
-            carriers.push((handle, start, end));
-        }
+        // the plates: each alone on the housing, then the drum with its own (as an inertial
+        // shaft with its discs), their gaps' drag from the discs' speeds as on the housing
+        let drum = self.world.drum.map(|_| Inertial::Drum);
+        self.advance_group(
+            plates,
+            drum,
+            t1,
+            a,
+            &gaps,
+            &mut means,
+            &mut carriers,
+            counts,
+            closed,
+            contacts,
+        )?;
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let c = self.gap_coefficient();
         if let Some(s) = self.stack.as_mut() {
@@ -236,15 +229,49 @@ impl Run {
         // torque over the step (rapier's semi-implicit Euler then drifts the body by
         // exactly `mean h`) and `J (w(t1) - mean)` as the speed set at its end.
         self.drive_to_means(&means, h);
-        if let Some(p) = &prescribed {
+        let shaft_at = prescribed.map(|p| (p.angle(t1), p.speed(t1)));
+        if let Some((angle, _)) = shaft_at {
             let bodies = &mut self.world.physics.bodies;
-            bodies[self.world.shaft]
-                .set_next_kinematic_rotation(Rotation::from_rotation_z(p.angle(t1)));
+            bodies[self.world.shaft].set_next_kinematic_rotation(Rotation::from_rotation_z(angle));
         }
         self.step_world_multirate(t1, &carriers);
-        if let Some(p) = &prescribed {
-            self.theta_s = p.angle(t1);
-            self.omega_s = p.speed(t1);
+        if let Some((angle, speed)) = shaft_at {
+            (self.theta_s, self.omega_s) = (angle, speed);
+        }
+        Ok(())
+    }
+
+    /// Advances the couplings `group` (the discs, or the plates) from `t` to `t1`, the open
+    /// gaps' drag `gaps` on each: those carried by the inertial carrier `inertial` together
+    /// with it ([`Run::advance_carrier`], its body and nodes then pushed onto `carriers` for
+    /// the world's step), every other one alone against its carrier's known motion
+    /// ([`Run::advance_alone`]) first. Writes each one's speed at `t1` into `omega_d` and its
+    /// mean speed over the step into `means`.
+    #[allow(clippy::too_many_arguments)]
+    fn advance_group(
+        &mut self,
+        group: std::ops::Range<usize>,
+        inertial: Option<Inertial>,
+        t1: f64,
+        a: &AdaptiveStepping,
+        gaps: &[GapDrag],
+        means: &mut [f64],
+        carriers: &mut Vec<(RigidBodyHandle, Node, Node)>,
+        counts: &mut Counts,
+        closed: &mut Vec<ImpactEvent>,
+        contacts: &mut Vec<(usize, f64, DiscSample)>,
+    ) -> Result<(), EngineError> {
+        let carrier = inertial.map(Inertial::carrier);
+        for i in group {
+            if Some(self.world.carriers[i]) != carrier {
+                self.advance_alone(i, t1, a, gaps[i], means, counts, closed, contacts)?;
+            }
+        }
+        if let Some(c) = inertial {
+            let handle = self.carrier_body_of(c);
+            let (start, end) =
+                self.advance_carrier(c, t1, a, gaps, means, counts, closed, contacts)?;
+            carriers.push((handle, start, end));
         }
         Ok(())
     }
