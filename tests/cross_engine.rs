@@ -38,6 +38,45 @@ fn impacts(engine: &mut dyn Engine, duration: f64) -> Vec<ImpactEvent> {
     v
 }
 
+/// The reference's impacts `r` and the multibody engine's `m` agree one by one: as many, on
+/// the same bodies and flanks, every peak within `peak.0` relative or `peak.1` N (the larger)
+/// and every onset within `dt_s`; prints the count and the worst differences under `label`.
+fn agree_one_by_one(
+    label: &str,
+    r: &[ImpactEvent],
+    m: &[ImpactEvent],
+    peak: (f64, f64),
+    dt_s: f64,
+) {
+    assert_eq!(r.len(), m.len(), "{label}: impact counts");
+    let (mut worst_rel, mut worst_dt) = (0.0f64, 0.0f64);
+    for (a, b) in r.iter().zip(m) {
+        assert_eq!(
+            (a.disc, a.flank),
+            (b.disc, b.flank),
+            "{label}: {a:?} vs {b:?}"
+        );
+        assert!(
+            (a.peak_n - b.peak_n).abs() <= (peak.0 * a.peak_n.abs()).max(peak.1),
+            "{label}: peak {} vs {} ({a:?} vs {b:?})",
+            a.peak_n,
+            b.peak_n
+        );
+        assert!(
+            (a.t_on_s - b.t_on_s).abs() <= dt_s,
+            "{label}: onset {} vs {} ({a:?} vs {b:?})",
+            a.t_on_s,
+            b.t_on_s
+        );
+        worst_rel = worst_rel.max((a.peak_n - b.peak_n).abs() / a.peak_n.abs());
+        worst_dt = worst_dt.max((a.t_on_s - b.t_on_s).abs());
+    }
+    println!(
+        "{label}: {} impacts, worst peak {worst_rel:.2e}, worst onset {worst_dt:.2e} s",
+        r.len()
+    );
+}
+
 /// Runs both engines on `file` with `sets` for 50 ms and compares their impacts;
 /// `steps_per_contact` overrides the multibody engine's adaptive default.
 fn assert_engines_agree(file: &str, sets: &[&str], steps_per_contact: Option<f64>) {
@@ -82,41 +121,12 @@ fn assert_engines_agree_within(
         "{file} {sets:?}: {}",
         reference.len()
     );
-    assert_eq!(
-        reference.len(),
-        multibody.len(),
-        "{file} {sets:?}: impact counts differ"
-    );
-    let mut worst_rel: f64 = 0.0;
-    let mut worst_dt: f64 = 0.0;
-    for (r, m) in reference.iter().zip(&multibody) {
-        assert_eq!(
-            (r.disc, r.flank),
-            (m.disc, m.flank),
-            "{file} {sets:?}: {r:?} vs {m:?}"
-        );
-        let tol = (0.005 * r.peak_n.abs()).max(2.0);
-        assert!(
-            (r.peak_n - m.peak_n).abs() <= tol,
-            "{file} {sets:?}: peak {} vs {} ({r:?} vs {m:?})",
-            r.peak_n,
-            m.peak_n
-        );
-        assert!(
-            (r.t_on_s - m.t_on_s).abs() <= onset_s,
-            "{file} {sets:?}: disc {} onset {} vs {}",
-            r.disc,
-            r.t_on_s,
-            m.t_on_s
-        );
-        worst_rel = worst_rel.max((r.peak_n - m.peak_n).abs() / r.peak_n.abs());
-        worst_dt = worst_dt.max((r.t_on_s - m.t_on_s).abs());
-    }
-    println!(
-        "{file} {sets:?}: {} impacts, worst peak difference {:.2e} relative, worst onset {:.2e} s",
-        reference.len(),
-        worst_rel,
-        worst_dt
+    agree_one_by_one(
+        &format!("{file} {sets:?}"),
+        &reference,
+        &multibody,
+        (0.005, 2.0),
+        onset_s,
     );
 }
 
@@ -221,25 +231,7 @@ fn brake_8_agrees(
     let m = impacts(&mut engine, duration);
     assert!(r.len() >= 5 * 17, "{}", r.len());
     assert!(r.iter().any(|e| e.disc >= 8), "the plates strike");
-    assert_eq!(r.len(), m.len(), "{label}: impact counts");
-    let (mut worst_rel, mut worst_dt) = (0.0f64, 0.0f64);
-    for (a, b) in r.iter().zip(&m) {
-        assert_eq!((a.disc, a.flank), (b.disc, b.flank), "{a:?} vs {b:?}");
-        assert!(
-            (a.peak_n - b.peak_n).abs() <= (peak.0 * a.peak_n.abs()).max(peak.1),
-            "{label}: {a:?} vs {b:?}"
-        );
-        assert!(
-            (a.t_on_s - b.t_on_s).abs() <= dt_s,
-            "{label}: {a:?} vs {b:?}"
-        );
-        worst_rel = worst_rel.max((a.peak_n - b.peak_n).abs() / a.peak_n.abs());
-        worst_dt = worst_dt.max((a.t_on_s - b.t_on_s).abs());
-    }
-    println!(
-        "{label}: {} impacts, worst peak {worst_rel:.2e}, worst onset {worst_dt:.2e} s",
-        r.len()
-    );
+    agree_one_by_one(label, &r, &m, peak, dt_s);
 }
 
 /// Issue 20: the multibody engine's multirate scheme on the open 8-disc brake of the MuJoCo
@@ -469,41 +461,21 @@ fn engagement_pack_6_locks_and_heats_alike() {
     };
     let (pr, pm) = (plates(&all_r), plates(&all_m));
     assert!(pr.len() >= 5 * (nd + 1), "{}", pr.len());
-    assert_eq!(pr.len(), pm.len(), "plate impacts");
-    let (mut plate_rel, mut plate_dt) = (0.0f64, 0.0f64);
-    for (a, b) in pr.iter().zip(&pm) {
-        assert_eq!((a.disc, a.flank), (b.disc, b.flank), "{a:?} vs {b:?}");
-        assert!(
-            (a.peak_n - b.peak_n).abs() <= (0.005 * a.peak_n.abs()).max(2.0),
-            "{a:?} vs {b:?}"
-        );
-        assert!((a.t_on_s - b.t_on_s).abs() <= 2e-6, "{a:?} vs {b:?}");
-        plate_rel = plate_rel.max((a.peak_n - b.peak_n).abs() / a.peak_n.abs());
-        plate_dt = plate_dt.max((a.t_on_s - b.t_on_s).abs());
-    }
-    println!(
-        "pack-6-engagement, first 30 ms: {} plate impacts, worst peak {plate_rel:.2e}, worst \
-         onset {plate_dt:.2e} s",
-        pr.len()
+    agree_one_by_one(
+        "pack-6-engagement, plates, first 30 ms",
+        &pr,
+        &pm,
+        (0.005, 2.0),
+        2e-6,
     );
     let (r, m) = (discs(all_r), discs(all_m));
     assert!(r.len() >= 5 * nd, "{}", r.len());
-    assert_eq!(r.len(), m.len(), "disc impacts");
-    let (mut worst_rel, mut worst_dt) = (0.0f64, 0.0f64);
-    for (a, b) in r.iter().zip(&m) {
-        assert_eq!((a.disc, a.flank), (b.disc, b.flank), "{a:?} vs {b:?}");
-        assert!(
-            (a.peak_n - b.peak_n).abs() <= (0.005 * a.peak_n.abs()).max(2.0),
-            "{a:?} vs {b:?}"
-        );
-        assert!((a.t_on_s - b.t_on_s).abs() <= 2e-6, "{a:?} vs {b:?}");
-        worst_rel = worst_rel.max((a.peak_n - b.peak_n).abs() / a.peak_n.abs());
-        worst_dt = worst_dt.max((a.t_on_s - b.t_on_s).abs());
-    }
-    println!(
-        "pack-6-engagement, first 50 ms: {} disc impacts, worst peak {worst_rel:.2e}, worst \
-         onset {worst_dt:.2e} s",
-        r.len()
+    agree_one_by_one(
+        "pack-6-engagement, discs, first 50 ms",
+        &r,
+        &m,
+        (0.005, 2.0),
+        2e-6,
     );
 }
 
@@ -540,21 +512,11 @@ fn inertial_shaft_with_a_drum_multirate() {
         "{}",
         r.len()
     );
-    assert_eq!(r.len(), m.len(), "impacts");
-    let (mut worst_rel, mut worst_dt) = (0.0f64, 0.0f64);
-    for (a, b) in r.iter().zip(&m) {
-        assert_eq!((a.disc, a.flank), (b.disc, b.flank), "{a:?} vs {b:?}");
-        assert!(
-            (a.peak_n - b.peak_n).abs() <= 1e-3 * a.peak_n.abs(),
-            "{a:?} vs {b:?}"
-        );
-        assert!((a.t_on_s - b.t_on_s).abs() <= 1e-6, "{a:?} vs {b:?}");
-        worst_rel = worst_rel.max((a.peak_n - b.peak_n).abs() / a.peak_n.abs());
-        worst_dt = worst_dt.max((a.t_on_s - b.t_on_s).abs());
-    }
-    println!(
-        "inertial shaft and drum, first 15 ms: {} impacts, worst peak {worst_rel:.2e}, worst \
-         onset {worst_dt:.2e} s",
-        r.len()
+    agree_one_by_one(
+        "inertial shaft and drum, first 15 ms",
+        &r,
+        &m,
+        (1e-3, 0.0),
+        1e-6,
     );
 }
