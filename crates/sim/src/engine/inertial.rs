@@ -331,7 +331,8 @@ impl Run {
                         continue;
                     }
                     let sigma = flank.phi_sign();
-                    let depth = |p: f64| (sigma * p - g0) * rb + offset;
+                    let shift = self.couplings[i].deepest_tooth_shift_m(flank);
+                    let depth = |p: f64| (sigma * p - g0) * rb + offset + shift;
                     let (d0, d1) = (depth(phi[k]), depth(step.phi[k]));
                     let crosses = crate::stepping::crosses_contact(engaged, d0, d1);
                     if !crosses {

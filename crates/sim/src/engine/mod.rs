@@ -171,11 +171,11 @@ impl MultibodyEngine {
     }
 
     /// Which time-stepping scheme runs this pack and why, in one line of words for `run` to
-    /// print, e.g. `multirate scheme (automatic: a prescribed shaft and concentric friction
-    /// discs only, so the discs are independent within a world step): ...`, `multirate scheme
-    /// (automatic: an inertial shaft and concentric friction discs only: within a world step
-    /// the shaft is integrated with the discs that may touch it ...): ...` or `shared step
-    /// (automatic: a clamped stack ...): ...`.
+    /// print, e.g. `multirate scheme (automatic: a prescribed shaft and friction discs
+    /// turning about the axis only, so the discs are independent within a world step): ...`,
+    /// `multirate scheme (automatic: an inertial shaft and friction discs turning about the
+    /// axis only: within a world step the shaft is integrated with the discs that may touch
+    /// it ...): ...` or `shared step (automatic: a clamped stack ...): ...`.
     pub fn scheme_explanation(&self) -> String {
         let shared = "every body advances with one contact-aware step, the shortest any \
                       coupling needs";
@@ -196,10 +196,10 @@ impl MultibodyEngine {
                 };
                 let plates = if self.pack.plates.is_empty() {
                     if inertial {
-                        " and concentric friction discs only".to_string()
+                        " and friction discs turning about the axis only".to_string()
                     } else {
-                        " and concentric friction discs only, so the discs are independent \
-                         within a world step"
+                        " and friction discs turning about the axis only, so the discs are \
+                         independent within a world step"
                             .to_string()
                     }
                 } else {

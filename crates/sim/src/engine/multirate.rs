@@ -22,7 +22,10 @@ use rapier3d_f64::prelude::{RigidBodyHandle, Rotation, Vector};
 /// inertial carriers: each friction disc coupled by its teeth only to the shaft (prescribed,
 /// or inertial and integrated with the discs that may touch it) and each separator plate only
 /// to the fixed housing or to the drum (integrated with the plates that may touch it,
-/// `inertial.rs`), turning about the axis only; neighbours in an open stack
+/// `inertial.rs`), turning about the axis only (a per-tooth coupling too, with spacing errors
+/// or held eccentric: its sub-steps land on the deepest tooth's onsets and separations,
+/// [`crate::hook::Coupling::deepest_tooth_shift_m`]; not a disc that floats radially, whose
+/// centre moves within the step); neighbours in an open stack
 /// pull on each other only through the oil gaps' Couette drag, which a world step holds (see
 /// [`GapDrag`]). A stack whose piston may push later (`Piston::open_until_s` > 0) is open
 /// until then: the session runs the multirate scheme up to that time and the shared step
@@ -46,10 +49,15 @@ pub(super) fn unsupported(
     } else if !pack.plates.is_empty() {
         return Some("separator plates without a stack");
     }
-    if per_tooth.iter().any(|&p| p) {
+    let bodies = pack.discs.iter().chain(&pack.plates);
+    if per_tooth
+        .iter()
+        .zip(bodies)
+        .any(|(&p, d)| p && d.radial_float)
+    {
         return Some(
-            "per-tooth couplings (radial float, eccentric discs, spacing errors) move off the \
-             axis or need every tooth's contact memory along the sub-steps",
+            "a disc floats radially: its centre moves off the axis within a world step (two \
+             more degrees of freedom the sub-steps do not integrate)",
         );
     }
     None
@@ -336,6 +344,11 @@ impl Run {
                 disc.angvel().z,
                 self.world.disc_turn_owed_z(i),
             );
+            // No body floats radially here (`unsupported`): each sits at its offset in its
+            // carrier's frame, exactly (its joint holds it there; rapier's pose only to the
+            // joint solver's error).
+            self.rel[i].offset = self.bodies[i].initial_offset_m;
+            self.rel[i].offset_rate = [0.0; 2];
             self.omega_d[i] = disc.angvel().z;
         }
     }
@@ -375,6 +388,9 @@ impl Run {
         let mut t = self.t;
         let (mut phi, mut dphi) = (self.rel[i].phi, self.rel[i].dphi);
         let mut shaft = path.at(t);
+        // whether `forces[i]` holds the hook's evaluation at `(phi, dphi)`: from the first
+        // sub-step's end on (at a world step's start the state was read back from rapier)
+        let mut evaluated_here = false;
         while t < t1 {
             let f = self.forces[i];
             let wd = shaft.speed - dphi;
@@ -386,12 +402,19 @@ impl Run {
             let want = checked_sub_step(want, a, t, || format!("disc {i}"))?;
             let rem = t1 - t;
             let mut h = split_remainder(want, rem);
+            let start_torque_n_m = if evaluated_here {
+                f.moment[2]
+            } else {
+                counts.evals += 1;
+                self.couplings[i].probe_torque(phi, dphi)
+            };
             let rel = Relative {
                 path,
                 coupling: &self.couplings[i],
                 inv_j,
                 c2: d.drag_n_m_s_rad,
                 gap,
+                start_torque_n_m,
             };
             let mut step = rel.rk4(t, shaft, phi, dphi, h);
             // Never step over an onset or a separation: land on it (the `s^1.5` law's kink
@@ -403,7 +426,9 @@ impl Run {
                     continue;
                 }
                 let sigma = flank.phi_sign();
-                let depth = |p: f64| (sigma * p - g0) * rb + offset;
+                // the deepest tooth's (the lumped one's but for per-tooth couplings)
+                let shift = self.couplings[i].deepest_tooth_shift_m(flank);
+                let depth = |p: f64| (sigma * p - g0) * rb + offset + shift;
                 let (d0, d1) = (depth(phi), depth(step.phi));
                 let crosses = crate::stepping::crosses_contact(engaged, d0, d1);
                 if !crosses {
@@ -412,7 +437,7 @@ impl Run {
                 let evals = std::cell::Cell::new(0);
                 let x = bracketed_root(
                     |x| {
-                        evals.set(evals.get() + 4);
+                        evals.set(evals.get() + 3);
                         depth(rel.rk4(t, shaft, phi, dphi, x).phi)
                     },
                     0.0,
@@ -425,7 +450,7 @@ impl Run {
                 if x > tiny && x < h {
                     h = x;
                     step = rel.rk4(t, shaft, phi, dphi, x);
-                    counts.evals += 4;
+                    counts.evals += 3;
                 }
             }
             t = if h == rem { t1 } else { t + h };
@@ -438,6 +463,7 @@ impl Run {
                 .add_sub_step(if inertial { 0.0 } else { step.drive_j }, step.drag_j);
             self.energy.add_stack_work(step.gap_j);
             let f = self.end_sub_step(i, t, phi, dphi, shaft, a, closed, contacts)?;
+            evaluated_here = true;
             if inertial && f.depth_m > 0.0 && !missed {
                 missed = true;
                 counts.missed += 1;
@@ -473,10 +499,11 @@ impl Run {
                 ),
             });
         }
+        // the disc's offset is held (it does not float radially: `unsupported`)
         let rel_state = RelativeState {
             phi,
             dphi,
-            ..Default::default()
+            ..self.rel[i]
         };
         let f = self.couplings[i].evaluate(&rel_state);
         if !(f.load_n.is_finite() && f.moment[2].is_finite()) {

@@ -205,6 +205,9 @@ pub(super) struct Relative<'a> {
     pub(super) c2: f64,
     /// The open gaps' drag on the body.
     pub(super) gap: GapDrag,
+    /// The teeth's torque on the disc at the step's start, N m (the first stage's; the hook's
+    /// evaluation of the last sub-step's end, or a probe at a world step's start).
+    pub(super) start_torque_n_m: f64,
 }
 
 impl Relative<'_> {
@@ -222,14 +225,18 @@ impl Relative<'_> {
         let u0 = w0 - dphi;
         // (omega_d', teeth torque) at a stage: the shaft turned by `s` at speed `ws`, the
         // disc turned by `th` at speed `u`.
+        // Hu et al. eq (5): J omega_d' = T - C2 omega_d, plus the open gaps' drag
+        let accel = |ts: f64, torque: f64, u: f64| {
+            (
+                (torque - self.c2 * u + gap.torque(ts, u)) * self.inv_j,
+                torque,
+            )
+        };
         let f = |ts: f64, s: f64, ws: f64, th: f64, u: f64| {
-            let torque = self.coupling.probe_torque(phi + s - th, ws - u);
-            // Hu et al. eq (5): J omega_d' = T - C2 omega_d, plus the open gaps' drag
-            let g = gap.torque(ts, u);
-            ((torque - self.c2 * u + g) * self.inv_j, torque)
+            accel(ts, self.coupling.probe_torque(phi + s - th, ws - u), u)
         };
         let hh = h * h;
-        let (k1, t1) = f(t, 0.0, w0, 0.0, u0);
+        let (k1, t1) = accel(t, self.start_torque_n_m, u0);
         let u2 = u0 + 0.5 * h * k1;
         let (k2, t2) = f(tm, sm, wm, 0.5 * h * u0, u2);
         let u3 = u0 + 0.5 * h * k2;
@@ -251,7 +258,7 @@ impl Relative<'_> {
                 * (gap.torque(t, u0) * u0
                     + 2.0 * (gap.torque(tm, u2) * u2 + gap.torque(tm, u3) * u3)
                     + gap.torque(te, u4) * u4),
-            evals: 4,
+            evals: 3,
         }
     }
 }
@@ -443,7 +450,10 @@ mod tests {
             inv_j: 1.0 / j,
             c2,
             gap: GapDrag::default(),
+            // free flight within the backlash all along: no tooth touches
+            start_torque_n_m: 0.0,
         };
+        assert_eq!(coupling.probe_torque(0.0, -w0), 0.0);
         let r = c2 / j;
         let duration = 0.05;
         let run = |n: usize| {
