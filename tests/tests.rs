@@ -692,9 +692,12 @@ fn sigkill_leaves_a_file_readable_up_to_the_last_flush() {
 /// but for micro-slips: its faces are clamped right at their static capacity (DECISIONS,
 /// "Whole packs in the reference engine"), and at the drive's peaks (every 9.6 ms) a face may
 /// slip by 1e-5 to 1e-3 rad/s and re-lock within a millisecond. So from 90 ms on every
-/// interface is locked in at least 90 % of the samples and gains less than 2e-3 J of heat
-/// (measured: at most 3 of 101 samples slipping, the run's last among them, and 1.4e-4 J;
-/// over 0.12 s 8 of 301 and 3.7e-4 J). `run` prints the interfaces' table.
+/// interface is locked in at least 75 % of the samples and gains less than 5e-3 J of heat
+/// (measured since the clamped stack runs multirate, issue 20: interface 8 locked in 84 of
+/// 101 samples, 2.2e-3 J, the others in all; the reference engine's exact stick-slip events
+/// on the same run 80 of 101 and 3.8e-3 J on interface 8, 98 of 101 on interface 4; the
+/// shared step's velocity-level friction missed these micro-slips, all 101 locked).
+/// `run` prints the interfaces' table.
 #[test]
 fn stack_recordings_carry_the_friction_interfaces() {
     let d = scratch("interfaces");
@@ -762,7 +765,7 @@ fn stack_recordings_carry_the_friction_interfaces() {
             locked.len()
         );
         assert!(
-            held as f64 >= 0.9 * locked.len() as f64 && gained < 2e-3,
+            held as f64 >= 0.75 * locked.len() as f64 && gained < 5e-3,
             "interface {m}: locked in {held} of {} samples from 90 ms, {gained} J since",
             locked.len()
         );

@@ -39,6 +39,18 @@ use clutchpack_model::{InterfaceSample, PressureProfile, StackBody, StackModel};
 /// Most Gauss-Seidel sweeps per step (the fallback of the active-set solve).
 const MAX_SWEEPS: usize = 5000;
 
+/// A friction face's state between the sub-steps of the clamped stack's multirate
+/// integration (`engine/clamped.rs`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Face {
+    /// Stuck: its two bodies turn as one while the torque that holds them stays within
+    /// `mu(0) F R_eff`.
+    Locked,
+    /// Slipping, with the sign of the slip `omega_upper - omega_lower` (an open face, `F = 0`,
+    /// too: its sign is kept for when it clamps).
+    Slipping(f64),
+}
+
 /// The stack's state during a run.
 #[derive(Debug, Clone)]
 pub(crate) struct Stack {
@@ -118,6 +130,46 @@ impl Stack {
             .clamp_forces_n(self.model.piston.force_n(t_s), &q, &mut self.clamp);
         for m in 0..self.interfaces() {
             self.slip[m] = omega[self.body[m + 1]] - omega[self.body[m]];
+        }
+    }
+
+    /// The clamp forces at `t_s` into `out` (one per interface, N) for the teeth's normal
+    /// loads `tooth_normal_n` in coupling order (N), as [`Self::update`] computes them.
+    pub fn clamp_at(&self, t_s: f64, tooth_normal_n: &[f64], out: &mut [f64]) {
+        let q: Vec<f64> = self.body.iter().map(|&i| tooth_normal_n[i]).collect();
+        self.model
+            .clamp_forces_n(self.model.piston.force_n(t_s), &q, out);
+    }
+
+    /// The friction torque an interface clamped with `clamp_n` (N) passes at the slip
+    /// `slip_rad_s` (rad/s), N m: `mu(|v|) F R_eff` (its magnitude; it opposes the slip).
+    pub fn slip_torque_n_m(&self, clamp_n: f64, slip_rad_s: f64) -> f64 {
+        self.model.friction.mu(slip_rad_s * self.r_eff) * clamp_n * self.r_eff
+    }
+
+    /// The largest torque a locked interface clamped with `clamp_n` (N) holds, N m:
+    /// `mu(0) F R_eff`.
+    pub fn holding_torque_n_m(&self, clamp_n: f64) -> f64 {
+        self.model.friction.static_mu() * clamp_n * self.r_eff
+    }
+
+    /// The open gaps' damping `c`, N m s/rad (0 without oil in the gaps).
+    pub fn gap_damping(&self) -> f64 {
+        self.c_gap
+    }
+
+    /// Records a step of length `h` (s) taken outside [`Self::solve`] by the clamped stack's
+    /// multirate integration: each interface's impulse on its upper body over it (N m s) and
+    /// whether it ended locked; [`Self::dissipated_j`] is kept by the integration.
+    pub fn record_step(&mut self, h: f64, impulse: &[f64], locked: &[bool]) {
+        self.h = h;
+        self.impulse.copy_from_slice(impulse);
+        self.locked.copy_from_slice(locked);
+        self.torque.iter_mut().for_each(|t| *t = 0.0);
+        for m in 0..self.interfaces() {
+            let t = impulse[m] / h;
+            self.torque[m + 1] += t;
+            self.torque[m] -= t;
         }
     }
 

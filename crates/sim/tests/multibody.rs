@@ -519,8 +519,9 @@ fn engine_for(
 }
 
 /// The scheme is chosen automatically and explained (issue 9): the multirate scheme on a
-/// prescribed or an inertial shaft with concentric friction discs, the shared step with the
-/// reason on plates without a stack, on fixed steps and when asked for;
+/// prescribed or an inertial shaft with concentric friction discs, with plates and a stack
+/// (clamping or not: issue 20), the shared step with the reason on plates without a stack,
+/// a stack clamped from the start on an inertial shaft, on fixed steps and when asked for;
 /// asking for the multirate scheme where it cannot run is refused with the reason.
 #[test]
 fn scheme_is_chosen_and_explained() {
@@ -597,8 +598,9 @@ fn scheme_is_chosen_and_explained() {
         "{why}"
     );
     // the open brake with its plates on a drum instead of the housing: multirate, the drum
-    // integrated with its plates; with a piston that ramps at 50 ms, multirate until then; with
-    // one that pushes from the start, the shared step
+    // integrated with its plates; with a piston that ramps at 50 ms, multirate until then and
+    // the clamped stack integrated as one system from then; with one that pushes from the
+    // start, the clamped stack from the start; on an inertial shaft, the shared step
     let mut drum_brake = clutchpack_model::cases::staggered_brake(2);
     drum_brake.drum = Some(clutchpack_model::DrumModel {
         inertia_kg_m2: 0.5,
@@ -620,9 +622,16 @@ fn scheme_is_chosen_and_explained() {
     };
     let (multirate, why) = explain(drum_brake.clone(), adaptive());
     assert!(multirate, "{why}");
-    assert!(why.contains("until t = 0.05 s"), "{why}");
+    assert!(
+        why.contains("from t = 0.05 s") && why.contains("plates and the drum are integrated"),
+        "{why}"
+    );
     let piston = &mut drum_brake.stack.as_mut().unwrap().piston;
     piston.pressure = clutchpack_model::PressureProfile::Constant { pressure_pa: 1e7 };
+    let (multirate, why) = explain(drum_brake.clone(), adaptive());
+    assert!(multirate, "{why}");
+    assert!(why.contains("from t = 0 s"), "{why}");
+    drum_brake.shaft = inertial.shaft.clone();
     let (multirate, why) = explain(drum_brake, adaptive());
     assert!(!multirate, "{why}");
     assert!(why.contains("from the start"), "{why}");

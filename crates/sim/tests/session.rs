@@ -566,19 +566,21 @@ fn a_sine_drive_sampled_and_held_drives_the_pack() {
 }
 
 /// The hand-over (issue 20): the engaging clutch's piston ramps from 2 ms, so its session runs
-/// the multirate scheme until then and the shared step from there: multirate after a call to
-/// 1.9 ms, shared after one to 2.1 ms, a sample at 2 ms itself (a world step lands on the
-/// hand-over, which is on the 1e4 Hz grid), and every interface open up to it.
+/// the open stack's multirate scheme until then and from there the clamped stack integrated as
+/// one system (still the multirate scheme: the rapier world at free-flight steps): a sample
+/// at 2 ms itself (a world step lands on the hand-over, which is on the 1e4 Hz grid), every
+/// interface open up to it and clamped after it. On an inertial shaft the session hands over
+/// to the shared step there instead.
 #[test]
 fn the_multirate_scheme_hands_over_where_the_piston_may_push() {
     let e = engine(engaging(), Scheme::Auto);
-    assert!(e.scheme_explanation().contains("until t = 0.002 s"));
+    assert!(e.scheme_explanation().contains("from t = 0.002 s"));
     let mut s = e.session(Driven::NONE).expect("session");
     let mut c = Collector::default();
     s.advance_to(0.0019, &mut c).expect("advance");
     assert!(s.is_multirate());
-    s.advance_to(0.0021, &mut c).expect("advance");
-    assert!(!s.is_multirate());
+    s.advance_to(0.004, &mut c).expect("advance");
+    assert!(s.is_multirate());
     assert!(
         c.samples.iter().any(|x| x.t_s == 0.002),
         "a sample at the hand-over"
@@ -589,4 +591,19 @@ fn the_multirate_scheme_hands_over_where_the_piston_may_push() {
         .filter(|(t, _)| *t <= 0.002)
         .all(|(_, f)| f.iter().all(|x| x.clamp_n == 0.0));
     assert!(open_before);
+    let (_, last) = c.interfaces.last().expect("interface samples");
+    assert!(last.iter().all(|x| x.clamp_n > 0.0), "{last:?}");
+    let mut inertial = engaging();
+    inertial.shaft = Shaft::Inertial {
+        inertia_kg_m2: 2.0,
+        damping_n_m_s_rad: 0.0,
+        excitation: ShaftExcitation::Profile(cases::bench_drive()),
+    };
+    let e = engine(inertial, Scheme::Auto);
+    assert!(e.scheme_explanation().contains("until t = 0.002 s"));
+    let mut s = e.session(Driven::NONE).expect("session");
+    s.advance_to(0.0019, &mut c).expect("advance");
+    assert!(s.is_multirate());
+    s.advance_to(0.0021, &mut c).expect("advance");
+    assert!(!s.is_multirate());
 }

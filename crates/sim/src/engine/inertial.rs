@@ -151,7 +151,7 @@ impl Run {
     }
 
     /// The inverse of a rapier body's inertia about the axis, 1/(kg m^2).
-    fn inv_inertia_z(&self, h: rapier3d_f64::prelude::RigidBodyHandle) -> f64 {
+    pub(super) fn inv_inertia_z(&self, h: rapier3d_f64::prelude::RigidBodyHandle) -> f64 {
         self.world.physics.bodies[h]
             .mass_properties()
             .local_mprops

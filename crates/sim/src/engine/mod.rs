@@ -8,6 +8,7 @@
 //! validates the pack and starts sessions.
 
 mod accounting;
+mod clamped;
 mod control;
 mod energy;
 mod events;
@@ -216,11 +217,23 @@ impl MultibodyEngine {
                 };
                 let bodies = format!("{shaft}{plates}");
                 let until = match &self.pack.stack {
-                    Some(s) if s.piston.can_clamp() => format!(
+                    Some(s) if s.piston.can_clamp() && inertial => format!(
                         "; until t = {} s, where the piston may start to clamp the stack: the \
-                         shared step from there (the faces' friction couples the bodies within \
-                         a step)",
+                         shared step from there (the faces' friction couples the bodies and the \
+                         shaft within a step)",
                         s.piston.open_until_s()
+                    ),
+                    Some(s) if s.piston.can_clamp() => format!(
+                        "; from t = {} s, where the piston may start to clamp the stack, the \
+                         stack's discs and plates{} are integrated together as one system \
+                         (bodies locked by their faces as one body, the slipping faces' \
+                         friction along the sub-steps, locks landed on)",
+                        s.piston.open_until_s().max(0.0),
+                        if self.pack.drum.is_some() {
+                            " and the drum"
+                        } else {
+                            ""
+                        }
                     ),
                     _ => String::new(),
                 };

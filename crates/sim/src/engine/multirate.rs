@@ -39,11 +39,14 @@ pub(super) fn unsupported(
         return Some("fixed steps (the check mode) step the whole world at dt");
     }
     if let Some(stack) = &pack.stack {
-        // a stack that clamps later runs multirate until the piston may push (`session.rs`)
-        if stack.piston.open_until_s() <= 0.0 {
+        // a stack that clamps runs multirate until the piston may push (`session.rs`), then
+        // integrated as one system on a prescribed shaft (`clamped.rs`)
+        let inertial = matches!(pack.shaft, clutchpack_model::Shaft::Inertial { .. });
+        if inertial && stack.piston.open_until_s() <= 0.0 {
             return Some(
                 "a clamped stack (the piston's force exceeds its return spring from the \
-                 start) couples the bodies within a step through the faces' friction",
+                 start) on an inertial shaft couples the bodies and the shaft within a step \
+                 through the faces' friction",
             );
         }
     } else if !pack.plates.is_empty() {
@@ -236,17 +239,32 @@ impl Run {
         // The world's step: each body's impulse in two halves, `J (mean - w(t))` applied as a
         // torque over the step (rapier's semi-implicit Euler then drifts the body by
         // exactly `mean h`) and `J (w(t1) - mean)` as the speed set at its end.
-        self.drive_to_means(&means, h);
+        self.finish_world_step(&means, t1, prescribed.as_deref(), &carriers);
+        Ok(())
+    }
+
+    /// The world's step of the multirate schemes from `t` to `t1` after the couplings'
+    /// sub-steps: each coupling body driven to its mean speed `means` over the step
+    /// ([`Run::drive_to_means`]), a prescribed shaft to its angle at `t1`, the inertial
+    /// carriers to theirs ([`Run::step_world_multirate`], `carriers`), every body's speed
+    /// then set to its speed at `t1`.
+    pub(super) fn finish_world_step(
+        &mut self,
+        means: &[f64],
+        t1: f64,
+        prescribed: Option<&SpeedProfile>,
+        carriers: &[(RigidBodyHandle, Node, Node)],
+    ) {
+        self.drive_to_means(means, t1 - self.t);
         let shaft_at = prescribed.map(|p| (p.angle(t1), p.speed(t1)));
         if let Some((angle, _)) = shaft_at {
             let bodies = &mut self.world.physics.bodies;
             bodies[self.world.shaft].set_next_kinematic_rotation(Rotation::from_rotation_z(angle));
         }
-        self.step_world_multirate(t1, &carriers);
+        self.step_world_multirate(t1, carriers);
         if let Some((angle, speed)) = shaft_at {
             (self.theta_s, self.omega_s) = (angle, speed);
         }
-        Ok(())
     }
 
     /// Advances the couplings `group` (the discs, or the plates) from `t` to `t1`, the open

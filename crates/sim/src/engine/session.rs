@@ -380,19 +380,29 @@ impl MultibodySession {
         let mut closed = Vec::new();
         let mut contacts = Vec::new();
         while self.run.t < t_s {
-            if self.run.t >= self.shared_from_s {
-                // the piston may push from now on: the shared step from this state
+            // the piston may push from now on: the clamped stack integrated as one system
+            // (`clamped.rs`), or on an inertial shaft the shared step from this state
+            let clamped = self.run.t >= self.shared_from_s;
+            if clamped && !self.run.can_integrate_clamped_stack() {
                 self.scheme = Loop::Shared;
                 self.multirate_steps = self.steps;
                 self.run.restart_shared(self.t_last_good)?;
                 return self.advance_shared(t_s, observer);
             }
-            let end = self.step_end(t_s).min(self.shared_from_s);
+            let end = if clamped {
+                self.step_end(t_s)
+            } else {
+                self.step_end(t_s).min(self.shared_from_s)
+            };
             let grid = self.grid_target(end);
             let run = &mut self.run;
             let t1 = world_step_end(run.t, a.max_step_s, grid, end);
             run.read_relative_states();
-            run.multirate_step(t1, &a, &mut self.counts, &mut closed, &mut contacts)?;
+            if clamped {
+                run.clamped_step(t1, &a, &mut self.counts, &mut closed, &mut contacts)?;
+            } else {
+                run.multirate_step(t1, &a, &mut self.counts, &mut closed, &mut contacts)?;
+            }
             run.update_stack();
             // Events in the order they closed across the couplings.
             closed.sort_by(|x, y| x.t_off_s.total_cmp(&y.t_off_s));

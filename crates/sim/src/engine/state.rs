@@ -138,6 +138,9 @@ pub(super) struct Run {
     /// Multirate scheme: each body's first moment of speed over the world step being taken
     /// (its neighbours' gap drag reads its slope).
     pub(super) moments: Vec<super::substep::TurnMoment>,
+    /// The clamped stack's faces in its multirate integration (`clamped.rs`; empty until
+    /// its first step).
+    pub(super) faces: Vec<crate::stack::Face>,
     /// Time of the evaluation before the last step.
     pub(super) t_prev: Option<f64>,
     /// Prescribed shaft: its angle at the end of the step being taken.
@@ -263,6 +266,7 @@ impl Run {
             teeth_motion: vec![Motion::default(); nd],
             omega_d: Vec::with_capacity(nd),
             moments: vec![Default::default(); nd],
+            faces: Vec::new(),
             t_prev: None,
             theta_next: 0.0,
             t: 0.0,
