@@ -682,10 +682,10 @@ fn sigkill_leaves_a_file_readable_up_to_the_last_flush() {
 /// interface (plate 1 | disc 1 | plate 2 | ... in stack order), every message of which the
 /// independent reader decodes. The recorded fields hang together: while an interface slips
 /// under clamp, its torque opposes the slip and is `mu F R_eff` (R_eff = slip_m_s /
-/// slip_rad_s, the same on every face): the median error below 1e-3 and the largest below
-/// 5 %, not exactly, since the torque is the one of the last step while the clamp force is
-/// the current one, and the clamp ramps and drops at each spline impact (measured: median
-/// 8.5e-5, 99th percentile 1 %, largest 4.2 %). Each interface's heat `dissipated_j` never
+/// slip_rad_s, the same on every face) within 1e-9: the multirate scheme's clamped stack
+/// reports each face's torque at the sample itself (issue 20; measured 0 over 3857 slipping
+/// samples; the shared step reports the torque of its last step against the current clamp,
+/// which ramps and drops at each spline impact: median 8.5e-5, largest 4.2 %). Each interface's heat `dissipated_j` never
 /// falls, and matches the trapezoidal integral of the sampled power `-torque slip` within 1 %
 /// (two different paths: the engine sums each step's impulse times the step's mean slip;
 /// measured within 0.3 % at 10 kHz). The engagement scene locks at 86 ms and stays locked
@@ -796,8 +796,9 @@ fn stack_recordings_carry_the_friction_interfaces() {
     errors.sort_by(f64::total_cmp);
     let checked = errors.len();
     let (median, worst) = (errors[checked / 2], errors[checked - 1]);
+    println!("torque vs mu F R_eff over {checked} slipping samples: median {median:.2e}, worst {worst:.2e}");
     assert!(
-        median < 1e-3 && worst < 0.05,
+        median < 1e-9 && worst < 1e-9,
         "torque vs mu F R_eff: median {median:e}, worst {worst:e}"
     );
     assert!(checked > 500, "{checked} slipping samples checked");

@@ -245,9 +245,24 @@ impl StackModel {
     /// teeth's normal loads `Q_b = n |F|` of the stack bodies in stack order (N; `2N + 1`
     /// values for `2N` interfaces): `F_m = max(0, F_p - sum_{b <= m} mu_spline Q_b)`.
     pub fn clamp_forces_n(&self, piston_n: f64, tooth_normal_loads_n: &[f64], out: &mut [f64]) {
+        self.clamp_forces_with(
+            piston_n,
+            |b| tooth_normal_loads_n.get(b).copied().unwrap_or(0.0),
+            out,
+        );
+    }
+
+    /// [`Self::clamp_forces_n`] with the normal load `Q_b` (N) of stack body `b` given by
+    /// `tooth_normal_load_n(b)`, for an engine that keeps the loads in another order.
+    pub fn clamp_forces_with(
+        &self,
+        piston_n: f64,
+        tooth_normal_load_n: impl Fn(usize) -> f64,
+        out: &mut [f64],
+    ) {
         let mut f = piston_n;
         for (m, o) in out.iter_mut().enumerate() {
-            f -= self.spline_friction * tooth_normal_loads_n.get(m).copied().unwrap_or(0.0);
+            f -= self.spline_friction * tooth_normal_load_n(m);
             *o = f.max(0.0);
         }
     }

@@ -52,9 +52,10 @@
 //! ## What it does not do (yet)
 //! - The axial motion of the stack: the clamp forces follow the piston and the teeth's loads
 //!   quasi-statically (`clutchpack_model::clutch`); no axial compliance, no gap closing.
-//! - Friction at the stack is first order in time (velocity-level, the torque constant over a
-//!   step): fine for slip and lock-up, not for the `s^1.5` impact (the teeth keep their
-//!   third-order treatment).
+//! - On the shared step, friction at the stack is first order in time (velocity-level, the
+//!   torque constant over a step): fine for slip and lock-up, not for the `s^1.5` impact (the
+//!   teeth keep their third-order treatment). The multirate scheme's clamped stack is fourth
+//!   order between events (above).
 //! - The radial motion of a floating disc is integrated by the polynomial kick of its forces
 //!   (second to third order), not along the step like the teeth's torque about the axis; its
 //!   radial speed in the law's damping is rapier's mean speed over the last step. Onsets of
@@ -249,10 +250,10 @@
 //! above (the load's work integrated by the same stages: the audit closes to 2.8e-11 of the
 //! drive's work over 50 ms of `pack-6-engagement` held open, `tests/stack.rs`). A stack whose
 //! piston may push later is open until then (`Piston::open_until_s`): the session runs the
-//! multirate scheme to that time and the shared step from there, started afresh as at t = 0
-//! (`Run::restart_shared`). Measured on `pack-6-engagement` (0.3 s, the piston ramping from
-//! 50 ms): 0.67 s against 1.05 s on the shared step from the start; its open 50 ms in 0.04 s
-//! against 0.63 s; against the reference engine at 1e-12 at world steps of 5e-5 s the discs'
+//! open multirate scheme to that time and the clamped stack's from there (below; on an
+//! inertial shaft the shared step, started afresh as at t = 0, `Run::restart_shared`).
+//! Measured on `pack-6-engagement`'s open 50 ms: 0.04 s against 0.63 s; against the reference
+//! engine at 1e-12 at world steps of 5e-5 s the discs'
 //! 137 impacts over the first 50 ms agree within 1.0e-3 of the peak and 0.52 us, the plates'
 //! 47 over the first 30 ms within 2.3e-3 and 0.28 us, where the shared step's first-order gap
 //! drag limited the discs' agreement to 25 ms. On an inertial shaft both
@@ -262,6 +263,31 @@
 //! over the first 15 ms agree with the reference engine at 1e-12 within 3.7e-4 and 0.17 us
 //! (`tests/cross_engine.rs`, which says why not longer: the pack is chaotic beyond what the
 //! reference itself resolves).
+//!
+//! **The clamped stack** (issue 20, `engine/clamped.rs`). Once the piston may push nothing in
+//! the stack is weak: every face couples its two bodies, and the splines' friction makes each
+//! clamp force depend on every tooth load below it. So on a prescribed shaft the stack's
+//! discs and plates and the drum are integrated together as one system by the classical
+//! Runge-Kutta method (order 4 between events), sub-steps of the shortest any coupling wants
+//! (at most a quarter of the world step), landed on every onset and separation; the rapier
+//! world still steps once per world step with each body's impulse. A locked run of bodies is
+//! one body (total torque over total inertia: its members' speeds stay equal to the bit, a
+//! locked face does not creep); a slipping face passes `mu(|v|) F R_eff` against its slip and
+//! an open one the gaps' drag, both evaluated at every stage. A slip reaching zero is landed on
+//! (order kept) and the face locks if its holding torque `mu(0) F R_eff` keeps its sides
+//! together, its sides' speeds set to their momentum-weighted mean (the landing's rounding,
+//! counted as the face's heat); a locked face beyond its holding torque breaks at the end of
+//! the sub-step that finds it (first order in that event's time, as the shared step's
+//! velocity-level friction is in every one). Energy: the drive's, the load's, the drag's and
+//! the faces' work are integrated by the same stages, so the audit closes to the method's
+//! truncation (1.0e-10 of the drive's work over 0.12 s of the engaging clutch with its drum's
+//! load, `tests/stack.rs`). Measured on `pack-6-engagement`: every interface's first lock
+//! within 3.5e-4 and the heat within 4.0e-4 of the shared step at 2.5e-6 s; the micro-slips
+//! of its faces at capacity as the reference engine's exact stick-slip events show them and
+//! the shared step missed (DECISIONS); 0.20 s against the shared step's 1.20 s over 0.3 s,
+//! whole processes in turn (5.8x; 27 900 sub-steps of the 13 bodies in the locked 214 ms at
+//! 4 us each, against 25 100 shared steps at 17.8 us). A clamping stack on an inertial shaft
+//! still hands over to the shared step (the shaft would join the system).
 //!
 //! **Where a whole pack's time goes today** (issue 20; the 16-disc brake pack, 16 staggered
 //! discs and 17 plates on the housing with the open gaps' drag, which runs the shared step;

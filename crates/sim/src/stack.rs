@@ -80,6 +80,10 @@ pub(crate) struct Stack {
     pub dissipated_j: Vec<f64>,
     /// Torque of the stack on each stack body (stack order) over that step, N m.
     pub torque: Vec<f64>,
+    /// Each interface's torque on its upper body at the end of the step, N m, where the
+    /// clamped stack's multirate integration knows it ([`Self::record_step`]; empty on the
+    /// shared step, whose torque is constant over a step): what the samples report.
+    torque_now: Vec<f64>,
 }
 
 impl Stack {
@@ -103,6 +107,7 @@ impl Stack {
             h: 0.0,
             locked: vec![false; n_if],
             torque: vec![0.0; n_bodies],
+            torque_now: Vec::new(),
         }
     }
 
@@ -134,11 +139,11 @@ impl Stack {
     }
 
     /// The clamp forces at `t_s` into `out` (one per interface, N) for the teeth's normal
-    /// loads `tooth_normal_n` in coupling order (N), as [`Self::update`] computes them.
-    pub fn clamp_at(&self, t_s: f64, tooth_normal_n: &[f64], out: &mut [f64]) {
-        let q: Vec<f64> = self.body.iter().map(|&i| tooth_normal_n[i]).collect();
+    /// loads `n |F|` of the stack's bodies, `normal(b)` of stack position `b` (N):
+    /// `StackModel::clamp_forces_with`.
+    pub fn clamp_at(&self, t_s: f64, normal: impl Fn(usize) -> f64, out: &mut [f64]) {
         self.model
-            .clamp_forces_n(self.model.piston.force_n(t_s), &q, out);
+            .clamp_forces_with(self.model.piston.force_n(t_s), normal, out);
     }
 
     /// The friction torque an interface clamped with `clamp_n` (N) passes at the slip
@@ -159,10 +164,14 @@ impl Stack {
     }
 
     /// Records a step of length `h` (s) taken outside [`Self::solve`] by the clamped stack's
-    /// multirate integration: each interface's impulse on its upper body over it (N m s) and
-    /// whether it ended locked; [`Self::dissipated_j`] is kept by the integration.
-    pub fn record_step(&mut self, h: f64, impulse: &[f64], locked: &[bool]) {
+    /// multirate integration: each interface's impulse on its upper body over it (N m s),
+    /// whether it ended locked and its torque on its upper body at the end (N m; friction, the
+    /// gap's drag, or the holding torque of a locked face); [`Self::dissipated_j`] is kept by
+    /// the integration.
+    pub fn record_step(&mut self, h: f64, impulse: &[f64], locked: &[bool], torque_now: &[f64]) {
         self.h = h;
+        self.torque_now.clear();
+        self.torque_now.extend_from_slice(torque_now);
         self.impulse.copy_from_slice(impulse);
         self.locked.copy_from_slice(locked);
         self.torque.iter_mut().for_each(|t| *t = 0.0);
@@ -203,6 +212,7 @@ impl Stack {
             }
         }
         self.h = h;
+        self.torque_now.clear();
         let mut w: Vec<f64> = self.body.iter().map(|&i| w_pred[i]).collect();
         let inv: Vec<f64> = self.body.iter().map(|&i| inv_j[i]).collect();
         let bound: Vec<f64> = (0..n_if)
@@ -371,6 +381,7 @@ impl Stack {
     /// [`Self::impulse`] and [`Self::dissipated_j`]): nothing is locked.
     pub fn record_open_step(&mut self, h: f64) {
         self.h = h;
+        self.torque_now.clear();
         self.locked.iter_mut().for_each(|l| *l = false);
     }
 
@@ -382,7 +393,8 @@ impl Stack {
             .map_or(0.0, |b| self.torque[b])
     }
 
-    /// What each interface does now (its torque is the one of the last step taken).
+    /// What each interface does now (its torque is the one of the last step taken, or the
+    /// one at its end where the clamped stack's integration recorded it).
     pub fn samples(&self) -> Vec<InterfaceSample> {
         (0..self.interfaces())
             .map(|m| {
@@ -396,7 +408,9 @@ impl Stack {
                         0.0
                     },
                     clamp_n: self.clamp[m],
-                    torque_n_m: if self.h > 0.0 {
+                    torque_n_m: if !self.torque_now.is_empty() {
+                        self.torque_now[m]
+                    } else if self.h > 0.0 {
                         self.impulse[m] / self.h
                     } else {
                         0.0

@@ -17,10 +17,9 @@
 
 use super::state::{Run, ShaftDrive};
 use super::substep::{checked_sub_step, graded_step, split_remainder, Counts, Node, ShaftAt};
-use crate::hook::FLANKS;
 use crate::options::AdaptiveStepping;
 use crate::stack::Face;
-use crate::stepping::{bracketed_root, coupling_step, crosses_contact};
+use crate::stepping::{bracketed_root, coupling_step};
 use crate::world::Carrier;
 use clutchpack_model::{DiscSample, EngineError, ImpactEvent, SpeedProfile};
 use std::sync::Arc;
@@ -58,53 +57,69 @@ struct Stage {
     face: Vec<f64>,
     /// Each interface's clamp force, N.
     clamp: Vec<f64>,
+    /// Each stack position's torque, N m (scratch).
+    torque: Vec<f64>,
+}
+
+impl Stage {
+    /// A stage's buffers for `n` coupling bodies.
+    fn new(n: usize) -> Stage {
+        let n_if = n - 1;
+        Stage {
+            acc: vec![0.0; n],
+            acc_drum: 0.0,
+            teeth: vec![0.0; n],
+            face: vec![0.0; n_if],
+            clamp: vec![0.0; n_if],
+            torque: vec![0.0; n],
+        }
+    }
 }
 
 impl Run {
     /// The accelerations of the stack's bodies and the drum at `ts` with the teeth's torques
-    /// `teeth` (coupling order, N m), the bodies' speeds `u` (rad/s) and the drum's `w_drum`,
-    /// the faces `faces`: each body's teeth, drag and the slipping or open faces' torques;
-    /// locked runs of bodies share one acceleration (their total torque over their total
-    /// inertia), and the torque each locked face passes is what keeps its two sides together.
+    /// `st.teeth` (coupling order, N m), the bodies' speeds `u` (rad/s) and the drum's
+    /// `w_drum`, the faces `faces`, into `st`: each body's teeth, drag and the slipping or
+    /// open faces' torques; locked runs of bodies share one acceleration (their total torque
+    /// over their total inertia), and the torque each locked face passes is what keeps its two
+    /// sides together.
     fn stack_stage(
         &self,
         sys: &System,
         faces: &[Face],
         ts: f64,
-        teeth: Vec<f64>,
         u: &[f64],
         w_drum: f64,
-    ) -> Stage {
+        st: &mut Stage,
+    ) {
         let stack = self.stack.as_ref().expect("a stack");
         let n_if = faces.len();
-        let normal: Vec<f64> = teeth
-            .iter()
-            .enumerate()
-            .map(|(i, t)| t.abs() / self.couplings[i].base_radius_m())
-            .collect();
-        let mut clamp = vec![0.0; n_if];
-        stack.clamp_at(ts, &normal, &mut clamp);
+        stack.clamp_at(
+            ts,
+            |b| {
+                let i = sys.body[b];
+                st.teeth[i].abs() / self.couplings[i].base_radius_m()
+            },
+            &mut st.clamp,
+        );
         let c_gap = stack.gap_damping();
-        let mut face = vec![0.0; n_if];
-        let mut torque: Vec<f64> = sys
-            .body
-            .iter()
-            .map(|&i| teeth[i] - sys.c2[i] * u[i])
-            .collect();
+        for (b, &i) in sys.body.iter().enumerate() {
+            st.torque[b] = st.teeth[i] - sys.c2[i] * u[i];
+        }
         for m in 0..n_if {
+            st.face[m] = 0.0;
             let Face::Slipping(dir) = faces[m] else {
                 continue;
             };
             let v = u[sys.body[m + 1]] - u[sys.body[m]];
-            face[m] = if clamp[m] > 0.0 {
-                -dir * stack.slip_torque_n_m(clamp[m], v)
+            st.face[m] = if st.clamp[m] > 0.0 {
+                -dir * stack.slip_torque_n_m(st.clamp[m], v)
             } else {
                 -c_gap * v
             };
-            torque[m + 1] += face[m];
-            torque[m] -= face[m];
+            st.torque[m + 1] += st.face[m];
+            st.torque[m] -= st.face[m];
         }
-        let mut acc = vec![0.0; u.len()];
         let mut lo = 0;
         while lo < sys.body.len() {
             let mut hi = lo;
@@ -113,38 +128,31 @@ impl Run {
             }
             // stack positions lo..=hi turn as one
             let (t_sum, j_sum) = (lo..=hi).fold((0.0, 0.0), |(t, j), b| {
-                (t + torque[b], j + sys.j[sys.body[b]])
+                (t + st.torque[b], j + sys.j[sys.body[b]])
             });
             let alpha = t_sum / j_sum;
             let (mut t_run, mut j_run) = (0.0, 0.0);
             for b in lo..=hi {
-                acc[sys.body[b]] = alpha;
-                t_run += torque[b];
+                st.acc[sys.body[b]] = alpha;
+                t_run += st.torque[b];
                 j_run += sys.j[sys.body[b]];
                 if b < hi {
                     // the face above b holds the part lo..=b on the group's acceleration
-                    face[b] = t_run - j_run * alpha;
+                    st.face[b] = t_run - j_run * alpha;
                 }
             }
             lo = hi + 1;
         }
-        let acc_drum = match sys.drum {
+        st.acc_drum = match sys.drum {
             Some((inv_j, damping, load)) => {
                 let on_drum: f64 = (0..u.len())
                     .filter(|&i| sys.carriers[i] == Carrier::Drum)
-                    .map(|i| teeth[i])
+                    .map(|i| st.teeth[i])
                     .sum();
                 (load - damping * w_drum - on_drum) * inv_j
             }
             None => 0.0,
         };
-        Stage {
-            acc,
-            acc_drum,
-            teeth,
-            face,
-            clamp,
-        }
     }
 
     /// Whether the clamped stack's integration can run this pack: a stack on a prescribed
@@ -208,19 +216,27 @@ impl Run {
         let mut impulse = vec![0.0; n_if];
         let mut evaluated_here = false;
         let cap = a.max_step_s / STACK_SUB_STEPS;
+        let mut s0 = Stage::new(n);
+        let bufs = std::cell::RefCell::new(RkBuffers::new(n));
+        // the relative angles and the speeds at the end of a full sub-step
+        let (mut phi_h, mut u_h) = (vec![0.0; n], vec![0.0; n]);
         while t < t1 {
             // the teeth's torques at t: the last sub-step's evaluation, else probes
-            let teeth0: Vec<f64> = if evaluated_here {
-                self.forces.iter().map(|f| f.moment[2]).collect()
-            } else {
+            for i in 0..n {
+                s0.teeth[i] = if evaluated_here {
+                    self.forces[i].moment[2]
+                } else {
+                    self.couplings[i].probe_torque(phi[i], self.rel[i].dphi)
+                };
+            }
+            if !evaluated_here {
                 counts.evals += n as u64;
-                (0..n)
-                    .map(|i| self.couplings[i].probe_torque(phi[i], self.rel[i].dphi))
-                    .collect()
-            };
-            let s0 = self.stack_stage(&sys, &self.faces, t, teeth0, &u, w_drum);
-            // the step each coupling wants, its body's acceleration bounded by its locked
-            // group's torques and its carrier's
+            }
+            self.stack_stage(&sys, &self.faces, t, &u, w_drum, &mut s0);
+            // the step each coupling wants, with its relative acceleration bounded by its
+            // carrier's bound and twice its body's acceleration at t (plus 1 rad/s^2): the
+            // bound only sizes the free-flight sub-steps (how soon a gap may close); every
+            // onset within a sub-step is landed on all the same
             let mut want = cap;
             let drum_bound = sys.drum.map_or(0.0, |(inv_j, damping, load)| {
                 let on: f64 = (0..n)
@@ -245,9 +261,18 @@ impl Run {
             let rem = t1 - t;
             let mut h = split_remainder(want, rem);
             let faces = self.faces.clone();
-            let rk4 = |x: f64| self.stack_rk4(&sys, &faces, &s0, t, shaft, &phi, &u, w_drum, x);
-            let mut step = rk4(h);
+            let rk4 = |x: f64| {
+                let b = &mut bufs.borrow_mut();
+                self.stack_rk4(&sys, &faces, &s0, t, shaft, &phi, &u, w_drum, x, b);
+            };
+            rk4(h);
             counts.evals += 3 * n as u64;
+            {
+                let b = bufs.borrow();
+                phi_h.copy_from_slice(&b.out.phi);
+                u_h.copy_from_slice(&b.out.u);
+            }
+            let searched = std::cell::Cell::new(false);
             // land on the first onset or separation of any coupling, or the first slip
             // reaching zero
             let tiny = 1e-3 * h.min(want);
@@ -259,33 +284,13 @@ impl Run {
                 }
             };
             for i in 0..n {
-                let d = &self.bodies[i];
-                let f = &self.forces[i];
-                let (g0, rb) = (d.spline.half_play_rad(), self.couplings[i].base_radius_m());
-                let offset = d.law.engagement_offset_m();
-                let engaged = f.depth_m > 0.0;
-                for flank in FLANKS {
-                    if engaged && flank != f.kin.flank {
-                        continue;
-                    }
-                    let sigma = flank.phi_sign();
-                    let shift = self.couplings[i].deepest_tooth_shift_m(flank);
-                    let depth = |p: f64| (sigma * p - g0) * rb + offset + shift;
-                    let (d0, d1) = (depth(phi[i]), depth(step.phi[i]));
-                    if !crosses_contact(engaged, d0, d1) {
-                        continue;
-                    }
-                    let x = bracketed_root(
-                        |x| {
-                            evals.set(evals.get() + 3 * n as u64);
-                            depth(rk4(x).phi[i])
-                        },
-                        0.0,
-                        d0,
-                        h,
-                        d1,
-                        1e-16,
-                    );
+                let crossing = self.depth_crossing(i, phi[i], phi_h[i], h, |x| {
+                    evals.set(evals.get() + 3 * n as u64);
+                    searched.set(true);
+                    rk4(x);
+                    bufs.borrow().out.phi[i]
+                });
+                if let Some(x) = crossing {
                     consider(x, None);
                 }
             }
@@ -297,13 +302,15 @@ impl Run {
                     continue;
                 }
                 let (lo, up) = (sys.body[m], sys.body[m + 1]);
-                let g = |s: &StackStep| dir * (s.u[up] - s.u[lo]);
-                let (g0, g1) = (dir * (u[up] - u[lo]), g(&step));
+                let g = |u: &[f64]| dir * (u[up] - u[lo]);
+                let (g0, g1) = (g(&u), g(&u_h));
                 if g0 > 0.0 && g1 <= 0.0 {
                     let x = bracketed_root(
                         |x| {
                             evals.set(evals.get() + 3 * n as u64);
-                            g(&rk4(x))
+                            searched.set(true);
+                            rk4(x);
+                            g(&bufs.borrow().out.u)
                         },
                         0.0,
                         g0,
@@ -318,10 +325,16 @@ impl Run {
             let mut locks = None;
             if let Some((x, face)) = first {
                 h = x;
-                step = rk4(x);
+                rk4(x);
                 counts.evals += 3 * n as u64;
                 locks = face;
+            } else if searched.get() {
+                // the searches left another step in the buffers
+                rk4(h);
+                counts.evals += 3 * n as u64;
             }
+            let b = bufs.borrow();
+            let step = &b.out;
             t = if h == rem { t1 } else { t + h };
             for (x, dx) in turn.iter_mut().zip(&step.turn) {
                 *x += dx;
@@ -342,6 +355,7 @@ impl Run {
             for m in 0..n_if {
                 stack.dissipated_j[m] -= step.face_j[m];
             }
+            drop(b);
             if let Some(m) = locks {
                 self.lock_face(&sys, m, &mut u);
             }
@@ -361,7 +375,7 @@ impl Run {
                 self.end_sub_step(i, t, phi[i], dphi, at, a, closed, contacts)?;
             }
             evaluated_here = true;
-            self.break_faces(&sys, t, &u, w_drum);
+            self.break_faces(&sys, t, &u, w_drum, &mut s0);
         }
         // the bodies' and the drum's states at t1, their mean speeds over the step
         let means: Vec<f64> = turn.iter().map(|x| x / h_world).collect();
@@ -383,10 +397,11 @@ impl Run {
         }
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let locked: Vec<bool> = self.faces.iter().map(|f| *f == Face::Locked).collect();
+        // `s0` holds the stage at t1 with the faces as they end (`break_faces`)
         self.stack
             .as_mut()
             .expect("a stack")
-            .record_step(h_world, &impulse, &locked);
+            .record_step(h_world, &impulse, &locked, &s0.face);
         self.finish_world_step(&means, t1, Some(&profile), &carriers);
         Ok(())
     }
@@ -422,11 +437,13 @@ impl Run {
 
     /// Breaks every locked face whose torque exceeds its holding torque at `t` (the state
     /// just evaluated: the teeth's torques in `forces`), the worst first, each then slipping
-    /// the way that torque pushes its upper side (module docs).
-    fn break_faces(&mut self, sys: &System, t: f64, u: &[f64], w_drum: f64) {
+    /// the way that torque pushes its upper side (module docs); `s` is a stage's buffers.
+    fn break_faces(&mut self, sys: &System, t: f64, u: &[f64], w_drum: f64, s: &mut Stage) {
         loop {
-            let teeth: Vec<f64> = self.forces.iter().map(|f| f.moment[2]).collect();
-            let s = self.stack_stage(sys, &self.faces, t, teeth, u, w_drum);
+            for (x, f) in s.teeth.iter_mut().zip(&self.forces) {
+                *x = f.moment[2];
+            }
+            self.stack_stage(sys, &self.faces, t, u, w_drum, s);
             let stack = self.stack.as_ref().expect("a stack");
             let mut worst: Option<(f64, usize)> = None;
             for m in 0..self.faces.len() {
@@ -469,24 +486,57 @@ struct StackStep {
     load_j: f64,
 }
 
+/// The buffers of [`Run::stack_rk4`], reused along the sub-steps (a step allocating its
+/// stages was a fifth of the clamped stack's time, perf).
+struct RkBuffers {
+    k: [Stage; 3],
+    th: Vec<f64>,
+    u: [Vec<f64>; 3],
+    out: StackStep,
+}
+
+impl RkBuffers {
+    fn new(n: usize) -> RkBuffers {
+        let v = || vec![0.0; n];
+        RkBuffers {
+            k: [Stage::new(n), Stage::new(n), Stage::new(n)],
+            th: v(),
+            u: [v(), v(), v()],
+            out: StackStep {
+                turn: v(),
+                u: v(),
+                phi: v(),
+                drum_turn: 0.0,
+                w_drum: 0.0,
+                impulse: vec![0.0; n - 1],
+                face_j: vec![0.0; n - 1],
+                drive_j: 0.0,
+                drag_j: 0.0,
+                load_j: 0.0,
+            },
+        }
+    }
+}
+
 impl Run {
     /// One classical Runge-Kutta step of length `h` from `t` of the clamped stack and the drum
     /// (the faces `faces` held), from the bodies' speeds `u0`, relative angles `phi`, the
-    /// drum's speed `w0_drum`, the first stage `s0` already evaluated; the works integrated
-    /// by the same stages.
+    /// drum's speed `w0_drum`, the first stage `k1` already evaluated, into `b.out`; the works
+    /// integrated by the same stages.
     #[allow(clippy::too_many_arguments)]
     fn stack_rk4(
         &self,
         sys: &System,
         faces: &[Face],
-        s0: &Stage,
+        k1: &Stage,
         t: f64,
         shaft: ShaftAt,
         phi: &[f64],
         u0: &[f64],
         w0_drum: f64,
         h: f64,
-    ) -> StackStep {
+        b: &mut RkBuffers,
+    ) {
         let n = u0.len();
         let hh = h * h;
         let (tm, te) = (t + 0.5 * h, t + h);
@@ -494,102 +544,91 @@ impl Run {
             ShaftAt::of(Some(&sys.profile), tm),
             ShaftAt::of(Some(&sys.profile), te),
         );
-        // the carriers' turns from t and speeds at a stage: the shaft's exact
-        let stage = |ts: f64, at: ShaftAt, d_turn: f64, wd: f64, th: &[f64], u: &[f64]| {
-            let teeth = (0..n)
-                .map(|i| {
+        // a stage: the teeth probed with the carriers turned from t (the shaft's exact, the
+        // drum by `d_turn` at `wd`) and the bodies by `th` at `u`
+        let stage =
+            |ts: f64, at: ShaftAt, d_turn: f64, wd: f64, th: &[f64], u: &[f64], st: &mut Stage| {
+                for i in 0..n {
                     let (turn, speed) = match sys.carriers[i] {
                         Carrier::Shaft => (at.angle - shaft.angle, at.speed),
                         Carrier::Drum => (d_turn, wd),
                         Carrier::Housing => (0.0, 0.0),
                     };
-                    self.couplings[i].probe_torque(phi[i] + turn - th[i], speed - u[i])
-                })
-                .collect();
-            self.stack_stage(sys, faces, ts, teeth, u, wd)
-        };
-        let k1 = s0;
-        let th2: Vec<f64> = u0.iter().map(|u| 0.5 * h * u).collect();
-        let u2: Vec<f64> = (0..n).map(|i| u0[i] + 0.5 * h * k1.acc[i]).collect();
+                    st.teeth[i] =
+                        self.couplings[i].probe_torque(phi[i] + turn - th[i], speed - u[i]);
+                }
+                self.stack_stage(sys, faces, ts, u, wd, st);
+            };
+        let RkBuffers { k, th, u, out } = b;
+        let [k2, k3, k4] = k;
+        let [u2, u3, u4] = u;
+        for i in 0..n {
+            th[i] = 0.5 * h * u0[i];
+            u2[i] = u0[i] + 0.5 * h * k1.acc[i];
+        }
         let (dt2, wd2) = (0.5 * h * w0_drum, w0_drum + 0.5 * h * k1.acc_drum);
-        let k2 = stage(tm, mid, dt2, wd2, &th2, &u2);
-        let th3: Vec<f64> = (0..n)
-            .map(|i| 0.5 * h * u0[i] + 0.25 * hh * k1.acc[i])
-            .collect();
-        let u3: Vec<f64> = (0..n).map(|i| u0[i] + 0.5 * h * k2.acc[i]).collect();
+        stage(tm, mid, dt2, wd2, th, u2, k2);
+        for i in 0..n {
+            th[i] = 0.5 * h * u0[i] + 0.25 * hh * k1.acc[i];
+            u3[i] = u0[i] + 0.5 * h * k2.acc[i];
+        }
         let (dt3, wd3) = (
             0.5 * h * w0_drum + 0.25 * hh * k1.acc_drum,
             w0_drum + 0.5 * h * k2.acc_drum,
         );
-        let k3 = stage(tm, mid, dt3, wd3, &th3, &u3);
-        let th4: Vec<f64> = (0..n).map(|i| h * u0[i] + 0.5 * hh * k2.acc[i]).collect();
-        let u4: Vec<f64> = (0..n).map(|i| u0[i] + h * k3.acc[i]).collect();
+        stage(tm, mid, dt3, wd3, th, u3, k3);
+        for i in 0..n {
+            th[i] = h * u0[i] + 0.5 * hh * k2.acc[i];
+            u4[i] = u0[i] + h * k3.acc[i];
+        }
         let (dt4, wd4) = (
             h * w0_drum + 0.5 * hh * k2.acc_drum,
             w0_drum + h * k3.acc_drum,
         );
-        let k4 = stage(te, end, dt4, wd4, &th4, &u4);
+        stage(te, end, dt4, wd4, th, u4, k4);
         let h6 = h / 6.0;
         let quad = |a: f64, b: f64, c: f64, d: f64| h6 * (a + 2.0 * (b + c) + d);
-        let mut turn = Vec::with_capacity(n);
-        let mut u1 = Vec::with_capacity(n);
-        let mut phi1 = Vec::with_capacity(n);
-        let drum_turn = h * w0_drum + h * h6 * (k1.acc_drum + k2.acc_drum + k3.acc_drum);
-        let w_drum = quad(k1.acc_drum, k2.acc_drum, k3.acc_drum, k4.acc_drum) + w0_drum;
-        let (mut drive_j, mut drag_j) = (0.0, 0.0);
+        out.drum_turn = h * w0_drum + h * h6 * (k1.acc_drum + k2.acc_drum + k3.acc_drum);
+        out.w_drum = quad(k1.acc_drum, k2.acc_drum, k3.acc_drum, k4.acc_drum) + w0_drum;
+        (out.drive_j, out.drag_j, out.load_j) = (0.0, 0.0, 0.0);
         for i in 0..n {
-            let th = h * u0[i] + h * h6 * (k1.acc[i] + k2.acc[i] + k3.acc[i]);
-            turn.push(th);
-            u1.push(u0[i] + quad(k1.acc[i], k2.acc[i], k3.acc[i], k4.acc[i]));
+            let turn = h * u0[i] + h * h6 * (k1.acc[i] + k2.acc[i] + k3.acc[i]);
+            out.turn[i] = turn;
+            out.u[i] = u0[i] + quad(k1.acc[i], k2.acc[i], k3.acc[i], k4.acc[i]);
             let carrier_turn = match sys.carriers[i] {
                 Carrier::Shaft => end.angle - shaft.angle,
-                Carrier::Drum => drum_turn,
+                Carrier::Drum => out.drum_turn,
                 Carrier::Housing => 0.0,
             };
-            phi1.push(phi[i] + carrier_turn - th);
+            out.phi[i] = phi[i] + carrier_turn - turn;
             if sys.carriers[i] == Carrier::Shaft {
-                drive_j += quad(
+                out.drive_j += quad(
                     k1.teeth[i] * shaft.speed,
                     k2.teeth[i] * mid.speed,
                     k3.teeth[i] * mid.speed,
                     k4.teeth[i] * end.speed,
                 );
             }
-            let c2 = sys.c2[i];
-            drag_j -= c2 * quad(u0[i] * u0[i], u2[i] * u2[i], u3[i] * u3[i], u4[i] * u4[i]);
+            let sq = |x: f64| x * x;
+            out.drag_j -= sys.c2[i] * quad(sq(u0[i]), sq(u2[i]), sq(u3[i]), sq(u4[i]));
         }
-        let mut load_j = 0.0;
         if let Some((_, damping, load)) = sys.drum {
-            drag_j -= damping * quad(w0_drum * w0_drum, wd2 * wd2, wd3 * wd3, wd4 * wd4);
-            load_j = load * quad(w0_drum, wd2, wd3, wd4);
+            out.drag_j -= damping * quad(w0_drum * w0_drum, wd2 * wd2, wd3 * wd3, wd4 * wd4);
+            out.load_j = load * quad(w0_drum, wd2, wd3, wd4);
         }
-        let n_if = faces.len();
-        let mut impulse = vec![0.0; n_if];
-        let mut face_j = vec![0.0; n_if];
-        for m in 0..n_if {
-            impulse[m] = quad(k1.face[m], k2.face[m], k3.face[m], k4.face[m]);
+        for m in 0..faces.len() {
+            out.impulse[m] = quad(k1.face[m], k2.face[m], k3.face[m], k4.face[m]);
+            out.face_j[m] = 0.0;
             if faces[m] != Face::Locked {
                 let (lo, up) = (sys.body[m], sys.body[m + 1]);
                 let v = |u: &[f64]| u[up] - u[lo];
-                face_j[m] = quad(
+                out.face_j[m] = quad(
                     k1.face[m] * v(u0),
-                    k2.face[m] * v(&u2),
-                    k3.face[m] * v(&u3),
-                    k4.face[m] * v(&u4),
+                    k2.face[m] * v(u2),
+                    k3.face[m] * v(u3),
+                    k4.face[m] * v(u4),
                 );
             }
-        }
-        StackStep {
-            turn,
-            u: u1,
-            phi: phi1,
-            drum_turn,
-            w_drum,
-            impulse,
-            face_j,
-            drive_j,
-            drag_j,
-            load_j,
         }
     }
 }

@@ -8,9 +8,8 @@ use super::state::{Run, ShaftDrive};
 use super::substep::{
     checked_sub_step, graded_step, split_remainder, Counts, GapDrag, Node, Path, ShaftAt,
 };
-use crate::hook::FLANKS;
 use crate::options::AdaptiveStepping;
-use crate::stepping::{bracketed_root, coupling_step};
+use crate::stepping::coupling_step;
 use crate::world::Carrier;
 use clutchpack_model::{DiscSample, EngineError, ImpactEvent};
 use rapier3d_f64::prelude::Vector;
@@ -321,37 +320,14 @@ impl Run {
             let tiny = 1e-3 * h.min(want);
             let mut first: Option<f64> = None;
             for (k, &i) in cluster.iter().enumerate() {
-                let d = &self.bodies[i];
-                let f = &self.forces[i];
-                let (g0, rb) = (d.spline.half_play_rad(), self.couplings[i].base_radius_m());
-                let offset = d.law.engagement_offset_m();
-                let engaged = f.depth_m > 0.0;
-                for flank in FLANKS {
-                    if engaged && flank != f.kin.flank {
-                        continue;
-                    }
-                    let sigma = flank.phi_sign();
-                    let shift = self.couplings[i].deepest_tooth_shift_m(flank);
-                    let depth = |p: f64| (sigma * p - g0) * rb + offset + shift;
-                    let (d0, d1) = (depth(phi[k]), depth(step.phi[k]));
-                    let crosses = crate::stepping::crosses_contact(engaged, d0, d1);
-                    if !crosses {
-                        continue;
-                    }
-                    let evals = std::cell::Cell::new(0);
-                    let x = bracketed_root(
-                        |x| {
-                            evals.set(evals.get() + 4 * n as u64);
-                            depth(rk4(x).phi[k])
-                        },
-                        0.0,
-                        d0,
-                        h,
-                        d1,
-                        1e-16,
-                    );
-                    counts.evals += evals.get();
-                    if x > tiny && x < h && first.is_none_or(|b| x < b) {
+                let evals = std::cell::Cell::new(0);
+                let crossing = self.depth_crossing(i, phi[k], step.phi[k], h, |x| {
+                    evals.set(evals.get() + 4 * n as u64);
+                    rk4(x).phi[k]
+                });
+                counts.evals += evals.get();
+                if let Some(x) = crossing.filter(|&x| x > tiny && x < h) {
+                    if first.is_none_or(|b| x < b) {
                         first = Some(x);
                     }
                 }

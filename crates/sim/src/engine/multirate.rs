@@ -395,8 +395,6 @@ impl Run {
             .local_mprops
             .inv_principal_inertia
             .z;
-        let (g0, rb) = (d.spline.half_play_rad(), self.couplings[i].base_radius_m());
-        let offset = d.law.engagement_offset_m();
         // On an inertial carrier (shaft, drum) the teeth's work is internal (the drive's or the
         // load's is the carrier's, integrated with it) and a coupling integrated here is in
         // free flight (the others go with the carrier, `integrate_carrier`): one that touches
@@ -437,39 +435,17 @@ impl Run {
             let mut step = rel.rk4(t, shaft, phi, dphi, h);
             // Never step over an onset or a separation: land on it (the `s^1.5` law's kink
             // then falls on a sub-step boundary and the step keeps its order).
-            let engaged = f.depth_m > 0.0;
             let tiny = 1e-3 * h.min(want);
-            for flank in FLANKS {
-                if engaged && flank != f.kin.flank {
-                    continue;
-                }
-                let sigma = flank.phi_sign();
-                // the deepest tooth's (the lumped one's but for per-tooth couplings)
-                let shift = self.couplings[i].deepest_tooth_shift_m(flank);
-                let depth = |p: f64| (sigma * p - g0) * rb + offset + shift;
-                let (d0, d1) = (depth(phi), depth(step.phi));
-                let crosses = crate::stepping::crosses_contact(engaged, d0, d1);
-                if !crosses {
-                    continue;
-                }
-                let evals = std::cell::Cell::new(0);
-                let x = bracketed_root(
-                    |x| {
-                        evals.set(evals.get() + 3);
-                        depth(rel.rk4(t, shaft, phi, dphi, x).phi)
-                    },
-                    0.0,
-                    d0,
-                    h,
-                    d1,
-                    1e-16,
-                );
-                counts.evals += evals.get();
-                if x > tiny && x < h {
-                    h = x;
-                    step = rel.rk4(t, shaft, phi, dphi, x);
-                    counts.evals += 3;
-                }
+            let evals = std::cell::Cell::new(0);
+            let crossing = self.depth_crossing(i, phi, step.phi, h, |x| {
+                evals.set(evals.get() + 3);
+                rel.rk4(t, shaft, phi, dphi, x).phi
+            });
+            counts.evals += evals.get();
+            if let Some(x) = crossing.filter(|&x| x > tiny && x < h) {
+                h = x;
+                step = rel.rk4(t, shaft, phi, dphi, x);
+                counts.evals += 3;
             }
             t = if h == rem { t1 } else { t + h };
             phi = step.phi;
@@ -488,6 +464,43 @@ impl Run {
             }
         }
         Ok(())
+    }
+
+    /// Where within a sub-step of length `h` coupling `i`'s deepest tooth's engagement depth
+    /// crosses zero (an onset when the coupling is not engaged, its separation when it is),
+    /// from the relative angle `phi0` at the sub-step's start to `phi1` at its end, located on
+    /// the sub-step's own path `phi_at(x)` (the relative angle after `x` s) by the Illinois
+    /// root to 1e-16 m; `None` if it does not cross. The depth is the lumped one shifted by
+    /// the deepest tooth's spacing error and offset (`Coupling::deepest_tooth_shift_m`).
+    pub(super) fn depth_crossing(
+        &self,
+        i: usize,
+        phi0: f64,
+        phi1: f64,
+        h: f64,
+        phi_at: impl Fn(f64) -> f64,
+    ) -> Option<f64> {
+        let d = &self.bodies[i];
+        let f = &self.forces[i];
+        let (g0, rb) = (d.spline.half_play_rad(), self.couplings[i].base_radius_m());
+        let offset = d.law.engagement_offset_m();
+        let engaged = f.depth_m > 0.0;
+        let mut first: Option<f64> = None;
+        for flank in FLANKS {
+            if engaged && flank != f.kin.flank {
+                continue;
+            }
+            let sigma = flank.phi_sign();
+            let shift = self.couplings[i].deepest_tooth_shift_m(flank);
+            let depth = |p: f64| (sigma * p - g0) * rb + offset + shift;
+            let (d0, d1) = (depth(phi0), depth(phi1));
+            if !crate::stepping::crosses_contact(engaged, d0, d1) {
+                continue;
+            }
+            let x = bracketed_root(|x| depth(phi_at(x)), 0.0, d0, h, d1, 1e-16);
+            first = Some(first.map_or(x, |b| b.min(x)));
+        }
+        first
     }
 
     /// Ends a sub-step of coupling `i` at `t` in the relative state `(phi, dphi)` with its
