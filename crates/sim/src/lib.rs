@@ -104,8 +104,8 @@
 //! [`MultibodyEngine::scheme_explanation`] says which one runs and why.
 //!
 //! **Shared step** (`Scheme::Shared`; the scheme of every pack the multirate one cannot run:
-//! fixed steps, a stack clamped from the start (and any stack once its piston may push),
-//! plates without a stack, a disc floating radially). All bodies
+//! fixed steps, a stack that clamps on an inertial shaft (from the piston's start), a disc
+//! floating radially). All bodies
 //! advance with one contact-aware step, the shortest any coupling needs; the kick above makes
 //! it third order (explicit Stormer-Cowell for equal steps) and, for constant steps within a
 //! contact, symplectic: the energy error oscillates without drift (measured: drive work equals
@@ -114,7 +114,8 @@
 //! the per-disc cost of one disc).
 //!
 //! **Multirate** (`Scheme::Auto` on a prescribed shaft with couplings turning about the axis
-//! only (concentric, or per-tooth with spacing errors or held eccentric, below): friction
+//! only (concentric, or per-tooth with spacing errors or held eccentric, below; plates without
+//! a stack too, each alone against its carrier): friction
 //! discs, and separator plates on the housing or on a drum with an open stack, see "Multirate
 //! with a drum" below; and the same on an inertial shaft, see "Multirate on an inertial shaft"
 //! below). Within a world step the bodies are then independent: each one's teeth couple it only

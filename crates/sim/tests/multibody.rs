@@ -520,8 +520,8 @@ fn engine_for(
 
 /// The scheme is chosen automatically and explained (issue 9): the multirate scheme on a
 /// prescribed or an inertial shaft with concentric friction discs, with plates and a stack
-/// (clamping or not: issue 20), the shared step with the reason on plates without a stack,
-/// a stack clamped from the start on an inertial shaft, on fixed steps and when asked for;
+/// (clamping or not: issue 20) or without a stack, the shared step with the reason on a
+/// stack clamped from the start on an inertial shaft, on fixed steps and when asked for;
 /// asking for the multirate scheme where it cannot run is refused with the reason.
 #[test]
 fn scheme_is_chosen_and_explained() {
@@ -557,7 +557,7 @@ fn scheme_is_chosen_and_explained() {
         why.starts_with("multirate scheme (automatic: an inertial shaft"),
         "{why}"
     );
-    // plates without a stack run the shared step (and are refused when multirate is asked)
+    // plates without a stack run multirate too (issue 20), each alone against its carrier
     let mut with_drum = inertial.clone();
     with_drum.plates = vec![clutchpack_model::cases::bench_disc("plate")];
     with_drum.drum = Some(clutchpack_model::DrumModel {
@@ -567,17 +567,18 @@ fn scheme_is_chosen_and_explained() {
         initial_speed_rad_s: 0.0,
     });
     let (multirate, why) = explain(with_drum.clone(), adaptive());
-    assert!(!multirate, "{why}");
+    assert!(multirate, "{why}");
     assert!(
-        why.starts_with("shared step (automatic: separator plates without a stack"),
+        why.contains("plates on a drum") && why.contains("no stack"),
         "{why}"
     );
+    // asking for the multirate scheme where it cannot run is refused with the reason
     let asked = MultibodyOptions {
         scheme: Scheme::Multirate,
-        ..adaptive()
+        ..fixed(1e-6)
     };
     match MultibodyEngine::new(with_drum, asked) {
-        Err(EngineError::Unsupported(m)) => assert!(m.contains("without a stack"), "{m}"),
+        Err(EngineError::Unsupported(m)) => assert!(m.contains("fixed steps"), "{m}"),
         other => panic!("{other:?}"),
     }
     // an open brake on an inertial shaft with its plates on a drum: multirate, both inertial

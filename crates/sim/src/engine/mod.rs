@@ -210,10 +210,17 @@ impl MultibodyEngine {
                     } else {
                         "on the housing"
                     };
-                    format!(
-                        ", plates {carrier} and an open stack, so the bodies pull on each other \
-                         within a world step only through the gaps' drag, held over it"
-                    )
+                    if self.pack.stack.is_some() {
+                        format!(
+                            ", plates {carrier} and an open stack, so the bodies pull on each \
+                             other within a world step only through the gaps' drag, held over it"
+                        )
+                    } else {
+                        format!(
+                            ", plates {carrier} and no stack, so the bodies do not pull on each \
+                             other"
+                        )
+                    }
                 };
                 let bodies = format!("{shaft}{plates}");
                 let until = match &self.pack.stack {

@@ -49,8 +49,6 @@ pub(super) fn unsupported(
                  through the faces' friction",
             );
         }
-    } else if !pack.plates.is_empty() {
-        return Some("separator plates without a stack");
     }
     let bodies = pack.discs.iter().chain(&pack.plates);
     if per_tooth
