@@ -1,20 +1,23 @@
 //! The clamped stack in the multirate scheme (crate docs, "The clamped stack"): from the time
-//! the piston may push (`Piston::open_until_s`) every disc and plate of the stack and the drum
-//! are integrated together as one system with classical Runge-Kutta sub-steps, the bodies
-//! locked to each other by their faces as one body, the slipping faces' friction a torque
-//! along the sub-steps, then the rapier world takes one step with each body's impulse.
+//! the piston may push (`Piston::open_until_s`) every disc and plate of the stack, the drum
+//! and an inertial shaft (its drive, Hu et al. eq 4, at every stage) are integrated together
+//! as one system with classical Runge-Kutta sub-steps, the bodies locked to each other by
+//! their faces as one body, the slipping faces' friction a torque along the sub-steps, then
+//! the rapier world takes one step with each body's impulse.
 //!
-//! Within a world step the faces are events: a slipping face whose slip reaches zero is landed
-//! on and locks if its holding torque `mu(0) F R_eff` can keep its two sides together (else it
-//! slips the other way); a locked face whose torque exceeds its holding torque breaks at the
-//! end of the sub-step that found it (as the shared step's velocity-level friction finds it at
-//! the end of its step) and slips the way that torque pushes. The clamp forces follow the
-//! teeth's loads at every stage (the splines' friction, `StackModel::clamp_forces_n`).
+//! Within a world step the faces are events: a slipping face whose slip reaches zero is
+//! landed on and locks if its holding torque `mu(0) F R_eff` can keep its two sides together
+//! (else it slips the other way); a locked face whose torque exceeds its holding torque breaks
+//! at the end of the sub-step that found it (as the shared step's velocity-level friction
+//! finds it at the end of its step) and slips the way that torque pushes. The clamp forces
+//! follow the teeth's loads at every stage (the splines' friction,
+//! `StackModel::clamp_forces_with`).
 
 // Index loops over the bodies (coupling order) and the interfaces (interface m joins stack
 // positions m and m + 1) mirror the equations; iterator chains would obscure them.
 #![allow(clippy::needless_range_loop)]
 
+use super::inertial::Inertial;
 use super::state::{Run, ShaftDrive};
 use super::substep::{checked_sub_step, graded_step, split_remainder, Counts, Node, ShaftAt};
 use crate::options::AdaptiveStepping;
@@ -36,20 +39,23 @@ struct System {
     /// Each coupling's inertia about the axis, kg m^2 (rapier's), and drag `C2`, N m s/rad.
     j: Vec<f64>,
     c2: Vec<f64>,
-    /// The prescribed shaft's profile.
-    profile: Arc<SpeedProfile>,
-    /// The drum's inverse inertia, 1/(kg m^2), damping, N m s/rad, and load, N m (held over
-    /// the world step; zeros without a drum).
-    drum: Option<(f64, f64, f64)>,
+    /// The prescribed shaft's profile (`None`: the shaft is inertial).
+    profile: Option<Arc<SpeedProfile>>,
+    /// The inertial carriers, [the shaft (Hu et al. eq 4), the drum]: inverse inertia,
+    /// 1/(kg m^2), and damping, N m s/rad (`None`: prescribed, or no drum).
+    inertial: [Option<(f64, f64)>; 2],
+    /// The drum's load, N m (held over the world step).
+    drum_load: f64,
     /// Each coupling's carrier.
     carriers: Vec<Carrier>,
 }
 
 /// What the system does at one stage.
 struct Stage {
-    /// Each coupling body's acceleration, rad/s^2, and the drum's.
+    /// Each coupling body's acceleration, rad/s^2, and the inertial carriers' ([shaft, drum];
+    /// 0 where not inertial).
     acc: Vec<f64>,
-    acc_drum: f64,
+    acc_carrier: [f64; 2],
     /// The teeth's torque on each coupling body, N m.
     teeth: Vec<f64>,
     /// Each interface's torque on its upper body, N m: friction or the gap's drag of a
@@ -67,7 +73,7 @@ impl Stage {
         let n_if = n - 1;
         Stage {
             acc: vec![0.0; n],
-            acc_drum: 0.0,
+            acc_carrier: [0.0; 2],
             teeth: vec![0.0; n],
             face: vec![0.0; n_if],
             clamp: vec![0.0; n_if],
@@ -76,10 +82,19 @@ impl Stage {
     }
 }
 
+/// The index of an inertial carrier in [shaft, drum], `None` for the housing.
+fn spin(c: Carrier) -> Option<usize> {
+    match c {
+        Carrier::Shaft => Some(0),
+        Carrier::Drum => Some(1),
+        Carrier::Housing => None,
+    }
+}
+
 impl Run {
     /// The accelerations of the stack's bodies and the drum at `ts` with the teeth's torques
     /// `st.teeth` (coupling order, N m), the bodies' speeds `u` (rad/s) and the drum's
-    /// `w_drum`, the faces `faces`, into `st`: each body's teeth, drag and the slipping or
+    /// inertial carriers' `w` ([shaft, drum], rad/s), the faces `faces`, into `st`: each body's teeth, drag and the slipping or
     /// open faces' torques; locked runs of bodies share one acceleration (their total torque
     /// over their total inertia), and the torque each locked face passes is what keeps its two
     /// sides together.
@@ -89,7 +104,7 @@ impl Run {
         faces: &[Face],
         ts: f64,
         u: &[f64],
-        w_drum: f64,
+        w: [f64; 2],
         st: &mut Stage,
     ) {
         let stack = self.stack.as_ref().expect("a stack");
@@ -143,22 +158,24 @@ impl Run {
             }
             lo = hi + 1;
         }
-        st.acc_drum = match sys.drum {
-            Some((inv_j, damping, load)) => {
-                let on_drum: f64 = (0..u.len())
-                    .filter(|&i| sys.carriers[i] == Carrier::Drum)
-                    .map(|i| st.teeth[i])
-                    .sum();
-                (load - damping * w_drum - on_drum) * inv_j
-            }
-            None => 0.0,
-        };
-    }
-
-    /// Whether the clamped stack's integration can run this pack: a stack on a prescribed
-    /// shaft (an inertial shaft with a stack that clamps hands over to the shared step).
-    pub(super) fn can_integrate_clamped_stack(&self) -> bool {
-        self.stack.is_some() && matches!(self.shaft, ShaftDrive::Prescribed(_))
+        for k in 0..2 {
+            st.acc_carrier[k] = match sys.inertial[k] {
+                Some((inv_j, damping)) => {
+                    // the drive (eq 4) or the load, the damping, the teeth's reactions
+                    let external = if k == 0 {
+                        self.drive_torque(ts)
+                    } else {
+                        sys.drum_load
+                    };
+                    let on: f64 = (0..u.len())
+                        .filter(|&i| spin(sys.carriers[i]) == Some(k))
+                        .map(|i| st.teeth[i])
+                        .sum();
+                    (external - damping * w[k] - on) * inv_j
+                }
+                None => 0.0,
+            };
+        }
     }
 
     /// Advances the whole clamped stack (every disc and plate, and the drum) from `t` to `t1`
@@ -171,10 +188,10 @@ impl Run {
         closed: &mut Vec<ImpactEvent>,
         contacts: &mut Vec<(usize, f64, DiscSample)>,
     ) -> Result<(), EngineError> {
-        let ShaftDrive::Prescribed(profile) = &self.shaft else {
-            unreachable!("the clamped stack's integration runs on a prescribed shaft");
+        let profile = match &self.shaft {
+            ShaftDrive::Prescribed(p) => Some(Arc::clone(p)),
+            ShaftDrive::Inertial { .. } => None,
         };
-        let profile = Arc::clone(profile);
         let n = self.couplings.len();
         let stack = self.stack.as_ref().expect("a stack");
         let n_if = stack.interfaces();
@@ -190,14 +207,16 @@ impl Run {
                 .map(|i| 1.0 / self.inv_inertia_z(self.world.discs[i]))
                 .collect(),
             c2: self.bodies.iter().map(|d| d.drag_n_m_s_rad).collect(),
-            profile: Arc::clone(&profile),
-            drum: self.drum.as_ref().map(|d| {
-                (
-                    1.0 / d.model.inertia_kg_m2,
-                    d.model.drag_n_m_s_rad,
-                    d.model.load_torque_n_m,
-                )
-            }),
+            profile: profile.clone(),
+            inertial: [
+                profile
+                    .is_none()
+                    .then(|| self.carrier_inertia(Inertial::Shaft)),
+                self.drum
+                    .as_ref()
+                    .map(|_| self.carrier_inertia(Inertial::Drum)),
+            ],
+            drum_load: self.drum.as_ref().map_or(0.0, |d| d.model.load_torque_n_m),
             carriers: self.world.carriers.clone(),
         };
         let t0 = self.t;
@@ -207,12 +226,14 @@ impl Run {
         let mut phi = phi0.clone();
         let mut u: Vec<f64> = self.omega_d.clone();
         let mut turn = vec![0.0; n];
-        let (drum_angle0, drum_w0) = self
+        // the inertial carriers' angles and speeds, [shaft, drum]
+        let drum0 = self
             .drum
             .as_ref()
             .map_or((0.0, 0.0), |d| (d.theta, d.omega));
-        let (mut drum_angle, mut w_drum) = (drum_angle0, drum_w0);
-        let mut shaft = ShaftAt::of(Some(&profile), t);
+        let (angle0, w0) = ([self.theta_s, drum0.0], [self.omega_s, drum0.1]);
+        let (mut angle, mut w) = (angle0, w0);
+        let mut shaft = ShaftAt::of(profile.as_deref(), t);
         let mut impulse = vec![0.0; n_if];
         let mut evaluated_here = false;
         let cap = a.max_step_s / STACK_SUB_STEPS;
@@ -232,25 +253,30 @@ impl Run {
             if !evaluated_here {
                 counts.evals += n as u64;
             }
-            self.stack_stage(&sys, &self.faces, t, &u, w_drum, &mut s0);
+            self.stack_stage(&sys, &self.faces, t, &u, w, &mut s0);
             // the step each coupling wants, with its relative acceleration bounded by its
             // carrier's bound and twice its body's acceleration at t (plus 1 rad/s^2): the
             // bound only sizes the free-flight sub-steps (how soon a gap may close); every
             // onset within a sub-step is landed on all the same
             let mut want = cap;
-            let drum_bound = sys.drum.map_or(0.0, |(inv_j, damping, load)| {
-                let on: f64 = (0..n)
-                    .filter(|&i| sys.carriers[i] == Carrier::Drum)
+            let reaction = |k: usize| -> f64 {
+                (0..n)
+                    .filter(|&i| spin(sys.carriers[i]) == Some(k))
                     .map(|i| s0.teeth[i].abs())
-                    .sum();
-                (load.abs() + damping * w_drum.abs() + on) * inv_j
-            });
+                    .sum()
+            };
+            let carrier_bound = [
+                match sys.inertial[0] {
+                    Some(_) => self.inertial_accel_bound(Inertial::Shaft, w[0], reaction(0)),
+                    None => self.shaft_accel_bound,
+                },
+                match sys.inertial[1] {
+                    Some(_) => self.inertial_accel_bound(Inertial::Drum, w[1], reaction(1)),
+                    None => 0.0,
+                },
+            ];
             for i in 0..n {
-                let carrier = match sys.carriers[i] {
-                    Carrier::Shaft => self.shaft_accel_bound,
-                    Carrier::Drum => drum_bound,
-                    Carrier::Housing => 0.0,
-                };
+                let carrier = spin(sys.carriers[i]).map_or(0.0, |k| carrier_bound[k]);
                 let bound = carrier + 2.0 * s0.acc[i].abs() + 1.0;
                 let f = self.forces[i];
                 let view = self.coupling_view(i, &f, (phi[i], self.rel[i].dphi), bound, t);
@@ -263,7 +289,7 @@ impl Run {
             let faces = self.faces.clone();
             let rk4 = |x: f64| {
                 let b = &mut bufs.borrow_mut();
-                self.stack_rk4(&sys, &faces, &s0, t, shaft, &phi, &u, w_drum, x, b);
+                self.stack_rk4(&sys, &faces, &s0, t, shaft, &phi, &u, w, x, b);
             };
             rk4(h);
             counts.evals += 3 * n as u64;
@@ -341,9 +367,11 @@ impl Run {
             }
             phi.clone_from(&step.phi);
             u.clone_from(&step.u);
-            drum_angle += step.drum_turn;
-            w_drum = step.w_drum;
-            shaft = ShaftAt::of(Some(&profile), t);
+            for k in 0..2 {
+                angle[k] += step.carrier_turn[k];
+            }
+            w = step.w_carrier;
+            shaft = ShaftAt::of(profile.as_deref(), t);
             for m in 0..n_if {
                 impulse[m] += step.impulse[m];
             }
@@ -360,40 +388,41 @@ impl Run {
                 self.lock_face(&sys, m, &mut u);
             }
             for i in 0..n {
-                let at = match sys.carriers[i] {
-                    Carrier::Shaft => shaft,
-                    Carrier::Drum => ShaftAt {
-                        speed: w_drum,
-                        angle: drum_angle,
-                    },
-                    Carrier::Housing => ShaftAt {
+                let at = match (sys.carriers[i], &profile) {
+                    (Carrier::Shaft, Some(_)) => shaft,
+                    (Carrier::Housing, _) => ShaftAt {
                         speed: 0.0,
                         angle: 0.0,
                     },
+                    (c, _) => {
+                        let k = spin(c).expect("an inertial carrier");
+                        ShaftAt {
+                            speed: w[k],
+                            angle: angle[k],
+                        }
+                    }
                 };
                 let dphi = at.speed - u[i];
                 self.end_sub_step(i, t, phi[i], dphi, at, a, closed, contacts)?;
             }
             evaluated_here = true;
-            self.break_faces(&sys, t, &u, w_drum, &mut s0);
+            self.break_faces(&sys, t, &u, w, &mut s0);
         }
         // the bodies' and the drum's states at t1, their mean speeds over the step
         let means: Vec<f64> = turn.iter().map(|x| x / h_world).collect();
         self.omega_d.clone_from(&u);
         let mut carriers = Vec::new();
-        if let (Some(d), Some(handle)) = (self.drum.as_mut(), self.world.drum) {
-            (d.theta, d.omega) = (drum_angle, w_drum);
-            let start = Node {
-                t: t0,
-                angle: drum_angle0,
-                speed: drum_w0,
-            };
-            let end = Node {
-                t: t1,
-                angle: drum_angle,
-                speed: w_drum,
-            };
-            carriers.push((handle, start, end));
+        for (k, c) in [Inertial::Shaft, Inertial::Drum].into_iter().enumerate() {
+            if sys.inertial[k].is_none() {
+                continue;
+            }
+            let node = |t, angle, speed| Node { t, angle, speed };
+            let (start, end) = (node(t0, angle0[k], w0[k]), node(t1, angle[k], w[k]));
+            carriers.push((self.carrier_body_of(c), start, end));
+            match (c, self.drum.as_mut()) {
+                (Inertial::Drum, Some(d)) => (d.theta, d.omega) = (angle[k], w[k]),
+                _ => (self.theta_s, self.omega_s) = (angle[k], w[k]),
+            }
         }
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let locked: Vec<bool> = self.faces.iter().map(|f| *f == Face::Locked).collect();
@@ -402,7 +431,7 @@ impl Run {
             .as_mut()
             .expect("a stack")
             .record_step(h_world, &impulse, &locked, &s0.face);
-        self.finish_world_step(&means, t1, Some(&profile), &carriers);
+        self.finish_world_step(&means, t1, profile.as_deref(), &carriers);
         Ok(())
     }
 
@@ -438,12 +467,12 @@ impl Run {
     /// Breaks every locked face whose torque exceeds its holding torque at `t` (the state
     /// just evaluated: the teeth's torques in `forces`), the worst first, each then slipping
     /// the way that torque pushes its upper side (module docs); `s` is a stage's buffers.
-    fn break_faces(&mut self, sys: &System, t: f64, u: &[f64], w_drum: f64, s: &mut Stage) {
+    fn break_faces(&mut self, sys: &System, t: f64, u: &[f64], w: [f64; 2], s: &mut Stage) {
         loop {
             for (x, f) in s.teeth.iter_mut().zip(&self.forces) {
                 *x = f.moment[2];
             }
-            self.stack_stage(sys, &self.faces, t, u, w_drum, s);
+            self.stack_stage(sys, &self.faces, t, u, w, s);
             let stack = self.stack.as_ref().expect("a stack");
             let mut worst: Option<(f64, usize)> = None;
             for m in 0..self.faces.len() {
@@ -472,15 +501,15 @@ struct StackStep {
     turn: Vec<f64>,
     u: Vec<f64>,
     phi: Vec<f64>,
-    /// The drum's turn, rad, and speed at the end, rad/s.
-    drum_turn: f64,
-    w_drum: f64,
+    /// The inertial carriers' turns, rad, and speeds at the end, rad/s ([shaft, drum]).
+    carrier_turn: [f64; 2],
+    w_carrier: [f64; 2],
     /// Each interface's impulse on its upper body, N m s, and the work of its torque on the
     /// slip (friction, the gap's drag; 0 locked), J (<= 0).
     impulse: Vec<f64>,
     face_j: Vec<f64>,
-    /// Work of the shaft on the discs' teeth, of the drag (bodies and drum) and of the drum's
-    /// load, J.
+    /// Work of the drive (a prescribed shaft's on the discs' teeth, an inertial shaft's drive
+    /// torque, eq 4), of the drag (bodies, the carriers' damping) and of the drum's load, J.
     drive_j: f64,
     drag_j: f64,
     load_j: f64,
@@ -506,8 +535,8 @@ impl RkBuffers {
                 turn: v(),
                 u: v(),
                 phi: v(),
-                drum_turn: 0.0,
-                w_drum: 0.0,
+                carrier_turn: [0.0; 2],
+                w_carrier: [0.0; 2],
                 impulse: vec![0.0; n - 1],
                 face_j: vec![0.0; n - 1],
                 drive_j: 0.0,
@@ -519,10 +548,11 @@ impl RkBuffers {
 }
 
 impl Run {
-    /// One classical Runge-Kutta step of length `h` from `t` of the clamped stack and the drum
-    /// (the faces `faces` held), from the bodies' speeds `u0`, relative angles `phi`, the
-    /// drum's speed `w0_drum`, the first stage `k1` already evaluated, into `b.out`; the works
-    /// integrated by the same stages.
+    /// One classical Runge-Kutta step of length `h` from `t` of the clamped stack and the
+    /// inertial carriers (the faces `faces` held), from the bodies' speeds `u0`, relative
+    /// angles `phi`, the carriers' speeds `w0` ([shaft, drum]), a prescribed shaft at `shaft`,
+    /// the first stage `k1` already evaluated, into `b.out`; the works integrated by the same
+    /// stages.
     #[allow(clippy::too_many_arguments)]
     fn stack_rk4(
         &self,
@@ -533,7 +563,7 @@ impl Run {
         shaft: ShaftAt,
         phi: &[f64],
         u0: &[f64],
-        w0_drum: f64,
+        w0: [f64; 2],
         h: f64,
         b: &mut RkBuffers,
     ) {
@@ -541,67 +571,87 @@ impl Run {
         let hh = h * h;
         let (tm, te) = (t + 0.5 * h, t + h);
         let (mid, end) = (
-            ShaftAt::of(Some(&sys.profile), tm),
-            ShaftAt::of(Some(&sys.profile), te),
+            ShaftAt::of(sys.profile.as_deref(), tm),
+            ShaftAt::of(sys.profile.as_deref(), te),
         );
-        // a stage: the teeth probed with the carriers turned from t (the shaft's exact, the
-        // drum by `d_turn` at `wd`) and the bodies by `th` at `u`
-        let stage =
-            |ts: f64, at: ShaftAt, d_turn: f64, wd: f64, th: &[f64], u: &[f64], st: &mut Stage| {
-                for i in 0..n {
-                    let (turn, speed) = match sys.carriers[i] {
-                        Carrier::Shaft => (at.angle - shaft.angle, at.speed),
-                        Carrier::Drum => (d_turn, wd),
-                        Carrier::Housing => (0.0, 0.0),
-                    };
-                    st.teeth[i] =
-                        self.couplings[i].probe_torque(phi[i] + turn - th[i], speed - u[i]);
-                }
-                self.stack_stage(sys, faces, ts, u, wd, st);
-            };
+        // a stage: the teeth probed with the carriers turned from t (a prescribed shaft's
+        // exact, the inertial ones by `c_turn` at `w`) and the bodies by `th` at `u`
+        let stage = |ts: f64,
+                     at: ShaftAt,
+                     c_turn: [f64; 2],
+                     w: [f64; 2],
+                     th: &[f64],
+                     u: &[f64],
+                     st: &mut Stage| {
+            for i in 0..n {
+                let (turn, speed) = match (sys.carriers[i], &sys.profile) {
+                    (Carrier::Shaft, Some(_)) => (at.angle - shaft.angle, at.speed),
+                    (Carrier::Housing, _) => (0.0, 0.0),
+                    (c, _) => {
+                        let k = spin(c).expect("an inertial carrier");
+                        (c_turn[k], w[k])
+                    }
+                };
+                st.teeth[i] = self.couplings[i].probe_torque(phi[i] + turn - th[i], speed - u[i]);
+            }
+            self.stack_stage(sys, faces, ts, u, w, st);
+        };
         let RkBuffers { k, th, u, out } = b;
         let [k2, k3, k4] = k;
         let [u2, u3, u4] = u;
+        let map2 = |f: &dyn Fn(usize) -> f64| [f(0), f(1)];
         for i in 0..n {
             th[i] = 0.5 * h * u0[i];
             u2[i] = u0[i] + 0.5 * h * k1.acc[i];
         }
-        let (dt2, wd2) = (0.5 * h * w0_drum, w0_drum + 0.5 * h * k1.acc_drum);
-        stage(tm, mid, dt2, wd2, th, u2, k2);
+        let (ct2, w2) = (
+            map2(&|k| 0.5 * h * w0[k]),
+            map2(&|k| w0[k] + 0.5 * h * k1.acc_carrier[k]),
+        );
+        stage(tm, mid, ct2, w2, th, u2, k2);
         for i in 0..n {
             th[i] = 0.5 * h * u0[i] + 0.25 * hh * k1.acc[i];
             u3[i] = u0[i] + 0.5 * h * k2.acc[i];
         }
-        let (dt3, wd3) = (
-            0.5 * h * w0_drum + 0.25 * hh * k1.acc_drum,
-            w0_drum + 0.5 * h * k2.acc_drum,
+        let (ct3, w3) = (
+            map2(&|k| 0.5 * h * w0[k] + 0.25 * hh * k1.acc_carrier[k]),
+            map2(&|k| w0[k] + 0.5 * h * k2.acc_carrier[k]),
         );
-        stage(tm, mid, dt3, wd3, th, u3, k3);
+        stage(tm, mid, ct3, w3, th, u3, k3);
         for i in 0..n {
             th[i] = h * u0[i] + 0.5 * hh * k2.acc[i];
             u4[i] = u0[i] + h * k3.acc[i];
         }
-        let (dt4, wd4) = (
-            h * w0_drum + 0.5 * hh * k2.acc_drum,
-            w0_drum + h * k3.acc_drum,
+        let (ct4, w4) = (
+            map2(&|k| h * w0[k] + 0.5 * hh * k2.acc_carrier[k]),
+            map2(&|k| w0[k] + h * k3.acc_carrier[k]),
         );
-        stage(te, end, dt4, wd4, th, u4, k4);
+        stage(te, end, ct4, w4, th, u4, k4);
         let h6 = h / 6.0;
         let quad = |a: f64, b: f64, c: f64, d: f64| h6 * (a + 2.0 * (b + c) + d);
-        out.drum_turn = h * w0_drum + h * h6 * (k1.acc_drum + k2.acc_drum + k3.acc_drum);
-        out.w_drum = quad(k1.acc_drum, k2.acc_drum, k3.acc_drum, k4.acc_drum) + w0_drum;
+        for k in 0..2 {
+            let a = [
+                k1.acc_carrier[k],
+                k2.acc_carrier[k],
+                k3.acc_carrier[k],
+                k4.acc_carrier[k],
+            ];
+            out.carrier_turn[k] = h * w0[k] + h * h6 * (a[0] + a[1] + a[2]);
+            out.w_carrier[k] = w0[k] + quad(a[0], a[1], a[2], a[3]);
+        }
         (out.drive_j, out.drag_j, out.load_j) = (0.0, 0.0, 0.0);
+        let sq = |x: f64| x * x;
         for i in 0..n {
             let turn = h * u0[i] + h * h6 * (k1.acc[i] + k2.acc[i] + k3.acc[i]);
             out.turn[i] = turn;
             out.u[i] = u0[i] + quad(k1.acc[i], k2.acc[i], k3.acc[i], k4.acc[i]);
-            let carrier_turn = match sys.carriers[i] {
-                Carrier::Shaft => end.angle - shaft.angle,
-                Carrier::Drum => out.drum_turn,
-                Carrier::Housing => 0.0,
+            let carrier_turn = match (sys.carriers[i], &sys.profile) {
+                (Carrier::Shaft, Some(_)) => end.angle - shaft.angle,
+                (Carrier::Housing, _) => 0.0,
+                (c, _) => out.carrier_turn[spin(c).expect("an inertial carrier")],
             };
             out.phi[i] = phi[i] + carrier_turn - turn;
-            if sys.carriers[i] == Carrier::Shaft {
+            if sys.carriers[i] == Carrier::Shaft && sys.profile.is_some() {
                 out.drive_j += quad(
                     k1.teeth[i] * shaft.speed,
                     k2.teeth[i] * mid.speed,
@@ -609,12 +659,25 @@ impl Run {
                     k4.teeth[i] * end.speed,
                 );
             }
-            let sq = |x: f64| x * x;
             out.drag_j -= sys.c2[i] * quad(sq(u0[i]), sq(u2[i]), sq(u3[i]), sq(u4[i]));
         }
-        if let Some((_, damping, load)) = sys.drum {
-            out.drag_j -= damping * quad(w0_drum * w0_drum, wd2 * wd2, wd3 * wd3, wd4 * wd4);
-            out.load_j = load * quad(w0_drum, wd2, wd3, wd4);
+        for k in 0..2 {
+            let Some((_, damping)) = sys.inertial[k] else {
+                continue;
+            };
+            let (a, b, c, d) = (w0[k], w2[k], w3[k], w4[k]);
+            out.drag_j -= damping * quad(sq(a), sq(b), sq(c), sq(d));
+            if k == 0 {
+                // the drive's work on an inertial shaft (eq 4)
+                let (e1, em, e4) = (
+                    self.drive_torque(t),
+                    self.drive_torque(tm),
+                    self.drive_torque(te),
+                );
+                out.drive_j += quad(e1 * a, em * b, em * c, e4 * d);
+            } else {
+                out.load_j = sys.drum_load * quad(a, b, c, d);
+            }
         }
         for m in 0..faces.len() {
             out.impulse[m] = quad(k1.face[m], k2.face[m], k3.face[m], k4.face[m]);

@@ -89,13 +89,6 @@ impl EnergyBook {
         self.before = Some(now);
     }
 
-    /// Forgets the powers of the last evaluation: the trapezoidal audit starts again at the
-    /// next (the shared step taking over from the multirate scheme, whose sub-steps audited
-    /// the work up to there).
-    pub(super) fn restart_powers(&mut self) {
-        self.before = None;
-    }
-
     /// Adds the stack's work over a step, J.
     pub(super) fn add_stack_work(&mut self, work_j: f64) {
         self.audit.stack_work_j += work_j;

@@ -177,26 +177,6 @@ impl Run {
         Ok(())
     }
 
-    /// Hands the run from the multirate scheme to the shared step at `t` (`session.rs`: the
-    /// piston may push from now on). The multirate scheme keeps none of the shared step's
-    /// memory, so it starts as at t = 0: no loads of earlier evaluations (their kicks begin
-    /// at first order), no past half of the teeth's kick, the bodies' speeds those the
-    /// multirate step set (exact at `t`); the energy audit's powers restart here (the sub-steps
-    /// audited the work before). Then the state at `t` is evaluated as the shared step's
-    /// first (fails as [`Run::evaluate`], reporting `t_last_good`).
-    pub(super) fn restart_shared(&mut self, t_last_good: f64) -> Result<(), EngineError> {
-        for l in self.loads.iter_mut().chain([&mut self.shaft_loads]) {
-            *l = Default::default();
-        }
-        if let Some(d) = self.drum.as_mut() {
-            d.loads = Default::default();
-        }
-        self.prev_motion.fill(None);
-        self.t_prev = None;
-        self.energy.restart_powers();
-        self.evaluate(t_last_good)
-    }
-
     /// Re-evaluates the state at `t` after a session's driven input changed there
     /// (`session.rs`): the relative motion of every coupling on the shaft by the shaft's speed
     /// jump `shaft_jump` (rad/s; the bodies' speeds are continuous, so `dphi` and the offset's

@@ -74,7 +74,7 @@ impl Run {
     /// `reaction` (sum of magnitudes, N m) on it, rad/s^2: the drive's bound (the shaft) or the
     /// load (the drum), the damping, the reactions (as the shared step's controller,
     /// `control.rs`).
-    fn inertial_accel_bound(&self, c: Inertial, w: f64, reaction: f64) -> f64 {
+    pub(super) fn inertial_accel_bound(&self, c: Inertial, w: f64, reaction: f64) -> f64 {
         let (inv_j, damping, own) = match (c, &self.drum) {
             (Inertial::Shaft, _) => {
                 let (inv_j, damping) = self.carrier_inertia(c);
@@ -96,7 +96,7 @@ impl Run {
     /// Inertial carrier `c`'s inverse inertia, 1/(kg m^2), and damping, N m s/rad: the
     /// model's (not rapier's inertia, which is 0 until its first step computes the body's
     /// mass properties).
-    fn carrier_inertia(&self, c: Inertial) -> (f64, f64) {
+    pub(super) fn carrier_inertia(&self, c: Inertial) -> (f64, f64) {
         match (c, &self.shaft, &self.drum) {
             (Inertial::Shaft, ShaftDrive::Inertial { j1, c1 }, _) => (1.0 / j1, *c1),
             (Inertial::Drum, _, Some(d)) => (1.0 / d.model.inertia_kg_m2, d.model.drag_n_m_s_rad),

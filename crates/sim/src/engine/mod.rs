@@ -165,8 +165,8 @@ impl MultibodyEngine {
         })
     }
 
-    /// Whether runs use the multirate scheme (crate docs, "Theory"), from the start (a pack
-    /// whose piston starts to push during the run hands over to the shared step then).
+    /// Whether runs use the multirate scheme (crate docs, "Theory"); a pack whose piston
+    /// starts to push integrates its clamped stack as one system from then (`clamped.rs`).
     pub fn is_multirate(&self) -> bool {
         self.multirate_refused.is_none()
     }
@@ -224,18 +224,13 @@ impl MultibodyEngine {
                 };
                 let bodies = format!("{shaft}{plates}");
                 let until = match &self.pack.stack {
-                    Some(s) if s.piston.can_clamp() && inertial => format!(
-                        "; until t = {} s, where the piston may start to clamp the stack: the \
-                         shared step from there (the faces' friction couples the bodies and the \
-                         shaft within a step)",
-                        s.piston.open_until_s()
-                    ),
                     Some(s) if s.piston.can_clamp() => format!(
                         "; from t = {} s, where the piston may start to clamp the stack, the \
-                         stack's discs and plates{} are integrated together as one system \
+                         stack's discs and plates{}{} are integrated together as one system \
                          (bodies locked by their faces as one body, the slipping faces' \
                          friction along the sub-steps, locks landed on)",
                         s.piston.open_until_s().max(0.0),
+                        if inertial { ", the shaft" } else { "" },
                         if self.pack.drum.is_some() {
                             " and the drum"
                         } else {

@@ -27,9 +27,9 @@ use rapier3d_f64::prelude::{RigidBodyHandle, Rotation, Vector};
 /// [`crate::hook::Coupling::deepest_tooth_shift_m`]; not a disc that floats radially, whose
 /// centre moves within the step); neighbours in an open stack
 /// pull on each other only through the oil gaps' Couette drag, which a world step holds (see
-/// [`GapDrag`]). A stack whose piston may push later (`Piston::open_until_s` > 0) is open
-/// until then: the session runs the multirate scheme up to that time and the shared step
-/// after it.
+/// [`GapDrag`]). A stack whose piston may push (from `Piston::open_until_s`) is open until
+/// then: from that time the session integrates the clamped stack, the inertial carriers with
+/// it, as one system (`clamped.rs`).
 pub(super) fn unsupported(
     pack: &PackModel,
     options: &MultibodyOptions,
@@ -37,18 +37,6 @@ pub(super) fn unsupported(
 ) -> Option<&'static str> {
     if !matches!(options.stepping, Stepping::Adaptive(_)) {
         return Some("fixed steps (the check mode) step the whole world at dt");
-    }
-    if let Some(stack) = &pack.stack {
-        // a stack that clamps runs multirate until the piston may push (`session.rs`), then
-        // integrated as one system on a prescribed shaft (`clamped.rs`)
-        let inertial = matches!(pack.shaft, clutchpack_model::Shaft::Inertial { .. });
-        if inertial && stack.piston.open_until_s() <= 0.0 {
-            return Some(
-                "a clamped stack (the piston's force exceeds its return spring from the \
-                 start) on an inertial shaft couples the bodies and the shaft within a step \
-                 through the faces' friction",
-            );
-        }
     }
     let bodies = pack.discs.iter().chain(&pack.plates);
     if per_tooth

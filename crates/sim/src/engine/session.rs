@@ -87,12 +87,10 @@ pub struct MultibodySession {
     stall_t0: f64,
     /// The multirate scheme's sub-step counts.
     counts: Counts,
-    /// When the multirate scheme hands over to the shared step, s: the time before which the
-    /// piston cannot push on the stack (`Piston::open_until_s`; `f64::INFINITY`: never).
-    shared_from_s: f64,
-    /// World steps the multirate scheme took before the shared step took over (0: it did
-    /// not run, or still runs).
-    multirate_steps: u64,
+    /// When the multirate scheme goes on with the clamped stack integrated as one system, s:
+    /// the time before which the piston cannot push on the stack (`Piston::open_until_s`;
+    /// `f64::INFINITY`: never).
+    clamped_from_s: f64,
     /// Whether the outputs at t = 0 (the trackers' first update, the first sample) are sent.
     started: bool,
     /// Set when a call failed: the session must not be advanced again.
@@ -124,7 +122,7 @@ impl MultibodySession {
         run.evaluate(0.0)?;
         let kinetic_j = run.kinetic_energy();
         run.energy.start(run.potential_j, kinetic_j);
-        let shared_from_s = run
+        let clamped_from_s = run
             .pack
             .stack
             .as_ref()
@@ -145,8 +143,7 @@ impl MultibodySession {
             t_last_good: 0.0,
             stall_t0: 0.0,
             counts: Counts::default(),
-            shared_from_s,
-            multirate_steps: 0,
+            clamped_from_s,
             started: false,
             failed: false,
             finished: None,
@@ -182,8 +179,8 @@ impl MultibodySession {
         self.counts.missed
     }
 
-    /// Whether the session runs the multirate scheme now (a pack whose piston starts to push
-    /// during the run switches to the shared step then).
+    /// Whether the session runs the multirate scheme (with its clamped stack integrated as
+    /// one system once the piston may push).
     pub fn is_multirate(&self) -> bool {
         matches!(self.scheme, Loop::Multirate(_))
     }
@@ -381,18 +378,12 @@ impl MultibodySession {
         let mut contacts = Vec::new();
         while self.run.t < t_s {
             // the piston may push from now on: the clamped stack integrated as one system
-            // (`clamped.rs`), or on an inertial shaft the shared step from this state
-            let clamped = self.run.t >= self.shared_from_s;
-            if clamped && !self.run.can_integrate_clamped_stack() {
-                self.scheme = Loop::Shared;
-                self.multirate_steps = self.steps;
-                self.run.restart_shared(self.t_last_good)?;
-                return self.advance_shared(t_s, observer);
-            }
+            // (`clamped.rs`)
+            let clamped = self.run.t >= self.clamped_from_s;
             let end = if clamped {
                 self.step_end(t_s)
             } else {
-                self.step_end(t_s).min(self.shared_from_s)
+                self.step_end(t_s).min(self.clamped_from_s)
             };
             let grid = self.grid_target(end);
             let run = &mut self.run;
@@ -572,7 +563,7 @@ impl Session for MultibodySession {
             rejected_steps: 0,
             // the multirate scheme's evaluations, and one per shared step (and at its start)
             rhs_evals: match self.scheme {
-                Loop::Shared => self.counts.evals + self.steps - self.multirate_steps + 1,
+                Loop::Shared => self.steps + 1,
                 Loop::Multirate(_) => self.counts.evals,
             },
             stopped_early: false,
