@@ -440,10 +440,9 @@ fn worst_speed(a: &Collector, b: &Collector) -> f64 {
 /// is integrated exactly (its kick split at the communication point) where the scene's goes
 /// through the same exact ramps (the drive) or the drum's polynomial kick (its load): in one
 /// call both give the scene's run (measured: the same impacts and speeds, bit for bit; the
-/// bound allows rounding). The clutch runs the shared step from the start: the multirate
-/// scheme, which holds the load exactly in either case, hands over to it at 2 ms, and from that
-/// restart the two kicks differ by rounding (measured 6e-12 rad/s at 16 ms), which the
-/// engagement's chaos (below) turns into one impact more by 20 ms.
+/// bound allows rounding). Both run the multirate scheme, which holds the load exactly in
+/// either case (the clutch's clamped stack too, since issue 20; when the shared step took
+/// over at the piston's start its two kicks differed by rounding).
 /// At 20 communication points the steps land on each: on the shaft, impacts within
 /// 6.5e-11 s and 7.9e-7 of the peak (measured); the clutch's engagement is chaotic (a load 1e-12
 /// off moves its bodies' speeds by 0.3 rad/s and its impact count from 191 to 167 within 20
@@ -488,7 +487,7 @@ fn held_torques_at_the_scene_values_are_the_scene_run() {
                 drum_load_n_m: Some(-200.0),
                 ..Default::default()
             },
-            Scheme::Shared,
+            Scheme::Auto,
             false,
         ),
     ];
