@@ -254,6 +254,23 @@ impl Run {
                 counts.evals += n as u64;
             }
             self.stack_stage(&sys, &self.faces, t, &u, w, &mut s0);
+            // an open face takes the sign of its slip (for when it clamps), as does a clamped
+            // one found slipping against its sign (a slip's zero is landed on, so only by
+            // rounding): its friction must oppose the slip
+            let mut turned = false;
+            for m in 0..n_if {
+                let Face::Slipping(dir) = self.faces[m] else {
+                    continue;
+                };
+                let v = u[sys.body[m + 1]] - u[sys.body[m]];
+                if v != 0.0 && v.signum() != dir && (s0.clamp[m] <= 0.0 || dir * v < 0.0) {
+                    self.faces[m] = Face::Slipping(v.signum());
+                    turned |= s0.clamp[m] > 0.0;
+                }
+            }
+            if turned {
+                self.stack_stage(&sys, &self.faces, t, &u, w, &mut s0);
+            }
             // the step each coupling wants, with its relative acceleration bounded by its
             // carrier's bound and twice its body's acceleration at t (plus 1 rad/s^2): the
             // bound only sizes the free-flight sub-steps (how soon a gap may close); every
