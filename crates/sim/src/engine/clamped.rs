@@ -178,8 +178,9 @@ impl Run {
         }
     }
 
-    /// Advances the whole clamped stack (every disc and plate, and the drum) from `t` to `t1`
-    /// as one system (module docs), then the rapier world one step with each body's impulse.
+    /// Advances the whole clamped stack (every disc and plate, the drum, an inertial shaft)
+    /// from `t` to `t1` as one system (module docs), then the rapier world one step with each
+    /// body's impulse.
     pub(super) fn clamped_step(
         &mut self,
         t1: f64,
@@ -254,22 +255,28 @@ impl Run {
                 counts.evals += n as u64;
             }
             self.stack_stage(&sys, &self.faces, t, &u, w, &mut s0);
-            // an open face takes the sign of its slip (for when it clamps), as does a clamped
-            // one found slipping against its sign (a slip's zero is landed on, so only by
-            // rounding): its friction must oppose the slip
+            // An open face takes the sign of its slip (for when it clamps). A clamped one found
+            // slipping against its sign crossed zero unlanded (closer to a sub-step's start
+            // than the landing looks): it locks now if it holds (its friction must never push
+            // the slip along).
             let mut turned = false;
             for m in 0..n_if {
                 let Face::Slipping(dir) = self.faces[m] else {
                     continue;
                 };
                 let v = u[sys.body[m + 1]] - u[sys.body[m]];
-                if v != 0.0 && v.signum() != dir && (s0.clamp[m] <= 0.0 || dir * v < 0.0) {
+                if v == 0.0 || v.signum() == dir {
+                    continue;
+                }
+                if s0.clamp[m] > 0.0 {
+                    self.lock_face(&sys, m, &mut u);
+                    turned = true;
+                } else {
                     self.faces[m] = Face::Slipping(v.signum());
-                    turned |= s0.clamp[m] > 0.0;
                 }
             }
             if turned {
-                self.stack_stage(&sys, &self.faces, t, &u, w, &mut s0);
+                self.break_faces(&sys, t, &u, w, &mut s0);
             }
             // the step each coupling wants, with its relative acceleration bounded by its
             // carrier's bound and twice its body's acceleration at t (plus 1 rad/s^2): the
