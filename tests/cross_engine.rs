@@ -12,6 +12,7 @@
 //! (and the reference at its own default tolerance 1e-9 is 2.3 us off), so the pack is
 //! checked with 512 steps per contact (0.14 us off).
 
+use clutchpack_model::checks::{first_lock_s, heat_j};
 use clutchpack_model::{Collector, Engine, ImpactEvent};
 use clutchpack_reference::{ReferenceEngine, ReferenceOptions, Scheme};
 use clutchpack_scene::Override;
@@ -411,18 +412,11 @@ fn engagement_pack_6_locks_and_heats_alike() {
         .unwrap()
         .run(duration, &mut multibody)
         .unwrap();
-    let first_lock = |c: &Collector, m: usize| {
-        c.interfaces
-            .iter()
-            .find(|(_, f)| f[m].locked)
-            .map(|(t, _)| *t)
-            .expect("every face locks")
-    };
-    let heat = |c: &Collector, m: usize| c.interfaces.last().unwrap().1[m].dissipated_j;
+    let first_lock = |c: &Collector, m: usize| first_lock_s(c, m).expect("every face locks");
     let (mut worst_lock, mut worst_heat) = (0.0f64, 0.0f64);
     for m in 0..2 * s.pack.discs.len() {
         let (lr, lm) = (first_lock(&reference, m), first_lock(&multibody, m));
-        let (hr, hm) = (heat(&reference, m), heat(&multibody, m));
+        let (hr, hm) = (heat_j(&reference, m), heat_j(&multibody, m));
         worst_lock = worst_lock.max((lr - lm).abs() / lr);
         worst_heat = worst_heat.max((hr - hm).abs() / hr);
         assert!(

@@ -1,7 +1,8 @@
 //! Consistency checks of an engine's output stream that hold for every engine and scheme,
 //! shared by the engines' tests so that each is written once: the time order of each disc's
-//! samples and contact samples ([`OrderedCollector`]) and the agreement of the contact
-//! samples with the located impact peaks ([`check_contact_samples`]).
+//! samples and contact samples ([`OrderedCollector`]), the agreement of the contact samples
+//! with the located impact peaks ([`check_contact_samples`]), and each friction interface's
+//! first lock and heat ([`first_lock_s`], [`heat_j`]).
 
 use crate::clutch::InterfaceSample;
 use crate::impact::ImpactEvent;
@@ -135,6 +136,19 @@ pub fn check_contact_samples(
         worst_shortfall: worst,
         points_per_contact: points as f64 / c.impacts.len() as f64,
     })
+}
+
+/// The time of the first sample in which interface `m` is locked, s (`None`: it never is).
+pub fn first_lock_s(c: &Collector, m: usize) -> Option<f64> {
+    c.interfaces
+        .iter()
+        .find(|(_, f)| f[m].locked)
+        .map(|(t, _)| *t)
+}
+
+/// The heat interface `m` had dissipated by the last sample, J (0 without samples).
+pub fn heat_j(c: &Collector, m: usize) -> f64 {
+    c.interfaces.last().map_or(0.0, |(_, f)| f[m].dissipated_j)
 }
 
 #[cfg(test)]

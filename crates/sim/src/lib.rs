@@ -279,7 +279,7 @@
 //! the sub-step that finds it (first order in that event's time, as the shared step's
 //! velocity-level friction is in every one). Energy: the drive's, the load's, the drag's and
 //! the faces' work are integrated by the same stages, so the audit closes to the method's
-//! truncation (1.0e-10 of the drive's work over 0.12 s of the engaging clutch with its drum's
+//! truncation (1.4e-10 of the drive's work over 0.12 s of the engaging clutch with its drum's
 //! load, `tests/stack.rs`). Measured on `pack-6-engagement`: every interface's first lock
 //! within 3.5e-4 and the heat within 4.0e-4 of the shared step at 2.5e-6 s; the micro-slips
 //! of its faces at capacity as the reference engine's exact stick-slip events show them and
