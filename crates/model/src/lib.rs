@@ -61,6 +61,7 @@ pub mod pack;
 pub mod session;
 pub mod spline;
 pub mod stream;
+pub mod thermal;
 
 pub use clutch::{
     DrumModel, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackBody,
