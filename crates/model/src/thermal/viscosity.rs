@@ -154,8 +154,9 @@ fn walther_z(nu_cst: f64) -> f64 {
 /// Walther's law (ASTM D341): `log10 log10(nu + 0.7) = A - B log10 T`, `nu` in cSt, `T` in K;
 /// the dynamic viscosity is `eta = nu rho` with one density.
 ///
-/// ASTM D341 adds small terms to `nu + 0.7` below 2 cSt (they change `nu` by less than 0.1 %
-/// at 2 cSt and vanish above); the simple form is kept, as MODEL.md section 9 writes it.
+/// ASTM D341 (since 2009) adds terms to `nu + 0.7` for viscosities below 2 cSt; the
+/// two-constant form is kept, as MODEL.md section 9 writes it (issue 35's ATF stays above
+/// 2 cSt up to about 190 deg C).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Walther {
     /// `A` of ASTM D341 (dimensionless).
