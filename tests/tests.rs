@@ -2,6 +2,7 @@
 //! outputs, and bad input. One test binary (as ripgrep does); each test states what it checks.
 
 mod architecture;
+mod cosim_hardening;
 mod cross_engine;
 mod fatigue;
 mod fmu;

@@ -44,6 +44,12 @@ fn library() -> Result<PathBuf> {
 
 pub fn fmu(a: FmuArgs) -> Result<ExitCode> {
     let scene = clutchpack_scene::load(&a.scene, &a.sets)?;
+    // the one output policy (`clutchpack_record::check_outputs`): never the scene itself, a
+    // folder, a device or a FIFO
+    crate::outputs::check_outputs(
+        &[crate::outputs::Output::file("--out", &a.out)],
+        &[a.scene.as_path()],
+    )?;
     let engine = clutchpack_fmu::check_representable(&scene, a.engine).map_err(|e| match e {
         clutchpack_fmu::PackageError::Unrepresentable(why) => {
             anyhow::Error::new(BadInput(format!("{}: {why}", a.scene.display())))

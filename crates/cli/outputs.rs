@@ -1,9 +1,10 @@
 //! Output paths, checked before any work and written whole.
 //!
-//! Every command checks all its output paths before it starts ([`check_outputs`]): the folder
-//! exists (the recording's is created) and takes a new file, the path is not a folder, a FIFO
-//! or a device, no two outputs name the same file and no output names an input (the scene
-//! being run). A problem is bad input (exit 2) naming the flag and the path, found in
+//! Every command checks all its output paths before it starts ([`check_outputs`], the one
+//! policy of every front end: `clutchpack_record::check_outputs`): the folder exists (the
+//! recording's is created) and takes a new file, the path is not a folder, a FIFO or a
+//! device, no two outputs name the same file and no output names an input (the scene being
+//! run). A problem is bad input (exit 2) naming the flag and the path, found in
 //! milliseconds rather than after a long simulation. Every output is then written to a
 //! temporary sibling and renamed into place when complete ([`write_text`], [`write_with`],
 //! `clutchpack_record::Recorder::create_output`), so a reader sees the old file or the
@@ -13,34 +14,9 @@ use crate::common::BadInput;
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 
-/// One output of a command: the flag that named it (for messages) and its path.
-#[derive(Clone, Copy)]
-pub struct Output<'a> {
-    pub flag: &'a str,
-    pub path: &'a Path,
-    /// A figure: its format must follow from its extension (`.png`, `.svg`).
-    pub figure: bool,
-}
-
-impl<'a> Output<'a> {
-    /// A file output (any format).
-    pub fn file(flag: &'a str, path: &'a Path) -> Output<'a> {
-        Output {
-            flag,
-            path,
-            figure: false,
-        }
-    }
-
-    /// A figure output: `.png` or `.svg`.
-    pub fn figure(flag: &'a str, path: &'a Path) -> Output<'a> {
-        Output {
-            flag,
-            path,
-            figure: true,
-        }
-    }
-}
+/// One output of a command: the flag that named it (for messages) and its path; the policy
+/// is `clutchpack_record::check_outputs`, shared with the FMU and Python.
+pub type Output<'a> = clutchpack_record::OutputPath<'a>;
 
 /// Creates the folder of an output (`flag` names it in messages) and its parents; a file in
 /// the way is said as such, not as the OS's "File exists". Bad input (exit 2) on failure.
@@ -75,117 +51,11 @@ fn folder(path: &Path) -> PathBuf {
     }
 }
 
-/// A comparable identity of `path`: its canonical folder joined with its file name (the file
-/// itself need not exist).
-fn identity(path: &Path) -> Option<PathBuf> {
-    let dir = folder(path).canonicalize().ok()?;
-    let name = path.file_name()?;
-    let full = dir.join(name);
-    // an existing file may be a symbolic link to another
-    Some(full.canonicalize().unwrap_or(full))
-}
-
-/// Checks one output path; see the module documentation.
-fn check_one(o: &Output<'_>) -> Result<()> {
-    let (flag, path) = (o.flag, o.path);
-    let bad = |why: String| -> anyhow::Error {
-        BadInput(format!("{flag} {}: {why}", path.display())).into()
-    };
-    if path.as_os_str().is_empty() || path.file_name().is_none() {
-        return Err(bad("names no file".into()));
-    }
-    let name_len = path.file_name().map_or(0, |n| n.len());
-    if name_len > clutchpack_record::NAME_MAX_BYTES {
-        return Err(bad(format!(
-            "the file name has {name_len} bytes; a file name may have at most {}",
-            clutchpack_record::NAME_MAX_BYTES
-        )));
-    }
-    if o.figure {
-        if let Err(clutchpack_analysis::PlotError::UnsupportedFormat { extension, .. }) =
-            clutchpack_analysis::figure_format(path)
-        {
-            return Err(bad(format!(
-                "a figure is written as .png or .svg, chosen by the extension (got {extension:?})"
-            )));
-        }
-    }
-    if let Ok(meta) = std::fs::metadata(path) {
-        if meta.is_dir() {
-            return Err(bad("is a folder; give a file path".into()));
-        }
-        if !meta.is_file() {
-            return Err(bad(
-                "exists and is not a regular file (a FIFO, device or socket); outputs are \
-                 written to a temporary file and renamed into place, so give a regular file path"
-                    .into(),
-            ));
-        }
-    }
-    let dir = folder(path);
-    match std::fs::metadata(&dir) {
-        Ok(m) if m.is_dir() => {}
-        Ok(_) => return Err(bad(format!("{} is not a folder", dir.display()))),
-        Err(_) => return Err(bad(format!("the folder {} does not exist", dir.display()))),
-    }
-    // the real test of writability: create (and remove) a new file in the folder, under the
-    // longest temporary name the output will be written to
-    let probe = clutchpack_record::partial_path(path, usize::MAX);
-    match std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&probe)
-    {
-        Ok(_) => {
-            let _ = std::fs::remove_file(&probe);
-        }
-        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
-        Err(e) => {
-            return Err(bad(format!(
-                "cannot create a file in the folder {}: {e}",
-                dir.display()
-            )))
-        }
-    }
-    Ok(())
-}
-
 /// Checks every output before the command does any work: each path (see the module
 /// documentation), no two outputs the same file, no output the same file as an input.
 /// Errors are bad input (exit 2) naming the flag and the path.
 pub fn check_outputs(outputs: &[Output<'_>], inputs: &[&Path]) -> Result<()> {
-    for o in outputs {
-        check_one(o)?;
-    }
-    let ids: Vec<Option<PathBuf>> = outputs.iter().map(|o| identity(o.path)).collect();
-    for (i, a) in outputs.iter().enumerate() {
-        let Some(ia) = &ids[i] else { continue };
-        for (j, b) in outputs.iter().enumerate().skip(i + 1) {
-            if ids[j].as_ref() == Some(ia) {
-                return Err(BadInput(format!(
-                    "{} {} and {} {} name the same file: each output needs its own path",
-                    a.flag,
-                    a.path.display(),
-                    b.flag,
-                    b.path.display()
-                ))
-                .into());
-            }
-        }
-        for input in inputs {
-            let same = input.canonicalize().ok().as_ref() == Some(ia);
-            if same {
-                return Err(BadInput(format!(
-                    "{} {} is an input of this command ({}): refusing to overwrite it",
-                    a.flag,
-                    a.path.display(),
-                    input.display()
-                ))
-                .into());
-            }
-        }
-    }
-    Ok(())
+    clutchpack_record::check_outputs(outputs, inputs).map_err(|e| BadInput(e.to_string()).into())
 }
 
 /// Writes `text` to `path` whole (temporary sibling, renamed into place).

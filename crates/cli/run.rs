@@ -122,7 +122,11 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     }
     let inputs: Vec<&std::path::Path> = a.scene.as_deref().into_iter().collect();
     // the other outputs first, so that a refused one leaves no recording folder behind
-    let others: Vec<Output> = outs.iter().filter(|o| o.flag != "--out").cloned().collect();
+    let others: Vec<Output> = outs
+        .iter()
+        .filter(|o| o.label != "--out")
+        .cloned()
+        .collect();
     crate::outputs::check_outputs(&others, &inputs)?;
     if let Some(p) = record_path.as_deref() {
         crate::outputs::create_folder("--out", p)?;

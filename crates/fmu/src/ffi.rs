@@ -6,15 +6,41 @@
 //! # Safety
 //! Every function takes the pointers FMI 2.0 defines, as a host passes them: a component
 //! from `fmi2Instantiate` (not yet freed), arrays of the stated lengths, NUL-terminated
-//! strings. Null components and arrays are refused with `fmi2Error`. (Said once here rather
-//! than under each of the 35 functions.)
+//! strings. Null components and arrays are refused with `fmi2Error`, and so are components
+//! and states that are not live (freed already, or never made here: a registry of live
+//! addresses), so that a host's double free answers an error rather than crashing. (Said
+//! once here rather than under each of the 35 functions.)
 
 #![allow(clippy::missing_safety_doc)]
 
 use crate::instance::{load_resources, Instance, SavedState};
+use std::collections::BTreeSet;
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
+use std::sync::{Mutex, MutexGuard};
+
+/// The live components (from `fmi2Instantiate`, not yet freed) and the live states (from
+/// `fmi2GetFMUstate`, not yet freed), by address: a pointer the host passes is used only if
+/// it is live, so that a double free, a freed component or a freed state answers
+/// `fmi2Error` (or nothing, for `fmi2FreeInstance`) instead of crashing the host.
+struct Registry {
+    components: BTreeSet<usize>,
+    states: BTreeSet<usize>,
+}
+
+static LIVE: Mutex<Registry> = Mutex::new(Registry {
+    components: BTreeSet::new(),
+    states: BTreeSet::new(),
+});
+
+fn live() -> MutexGuard<'static, Registry> {
+    // the registry is two sets of addresses: a panic elsewhere cannot leave them half-made
+    LIVE.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+const NOT_A_STATE: &str = "not a live state of this FMU (freed already, or never made by \
+     fmi2GetFMUstate)";
 
 /// `fmi2Status`.
 const OK: c_int = 0;
@@ -97,10 +123,11 @@ fn with(
     what: &str,
     f: impl FnOnce(&mut Component) -> Result<c_int, String>,
 ) -> c_int {
-    if c.is_null() {
+    if c.is_null() || !live().components.contains(&(c as usize)) {
+        // null, freed, or never one of ours: nothing to log to
         return ERROR;
     }
-    // SAFETY: a component from fmi2Instantiate (module docs).
+    // SAFETY: a live component from fmi2Instantiate (the registry says so).
     let comp = unsafe { &mut *(c as *mut Component) };
     match catch_unwind(AssertUnwindSafe(|| f(comp))) {
         Ok(Ok(status)) => status,
@@ -223,17 +250,27 @@ pub unsafe extern "C" fn fmi2Instantiate(
         let guid = unsafe { text(guid) }.ok_or("fmuGUID is null or not UTF-8")?;
         let uri =
             unsafe { text(resource_location) }.ok_or("fmuResourceLocation is null or not UTF-8")?;
-        let scene = load_resources(&resource_folder(uri)?, guid)?;
-        Instance::new(scene)
+        let resources = resource_folder(uri)?;
+        let scene = load_resources(&resources, guid)?;
+        // no recording may be written over the FMU's own files
+        let inputs = ["scene.json", "scene.toml", "guid.txt"]
+            .iter()
+            .map(|f| resources.join(f))
+            .collect();
+        Ok(Instance::new(scene)?.reading(inputs))
     }));
     match made {
-        Ok(Ok(instance)) => Box::into_raw(Box::new(Component {
-            instance,
-            name: cname,
-            logger,
-            environment: env,
-            strings: Vec::new(),
-        })) as *mut c_void,
+        Ok(Ok(instance)) => {
+            let c = Box::into_raw(Box::new(Component {
+                instance,
+                name: cname,
+                logger,
+                environment: env,
+                strings: Vec::new(),
+            })) as *mut c_void;
+            live().components.insert(c as usize);
+            c
+        }
         Ok(Err(why)) => fail(format!("fmi2Instantiate: {why}")),
         Err(_) => fail("fmi2Instantiate: internal error (a bug in clutchpack)".into()),
     }
@@ -242,10 +279,11 @@ pub unsafe extern "C" fn fmi2Instantiate(
 /// `fmi2FreeInstance`: a run still going is finished first (its recording completed).
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: *mut c_void) {
-    if c.is_null() {
+    if c.is_null() || !live().components.remove(&(c as usize)) {
+        // null, freed already, or never one of ours: nothing to free
         return;
     }
-    // SAFETY: a component from fmi2Instantiate, freed once (module docs)
+    // SAFETY: a live component from fmi2Instantiate, now out of the registry: freed once
     let mut comp = unsafe { Box::from_raw(c as *mut Component) };
     let _ = catch_unwind(AssertUnwindSafe(|| comp.instance.reset()));
 }
@@ -476,12 +514,18 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, state: *mut *mut c_void
         if state.is_null() {
             return Err("a null state pointer".into());
         }
-        let saved = comp.instance.save()?;
         // SAFETY: a state pointer from the host (null or from fmi2GetFMUstate)
         let old = unsafe { *state };
+        if !old.is_null() && !live().states.contains(&(old as usize)) {
+            return Err(format!("the state to overwrite is {NOT_A_STATE}"));
+        }
+        let saved = comp.instance.save()?;
         if old.is_null() {
-            unsafe { *state = Box::into_raw(Box::new(saved)) as *mut c_void };
+            let new = Box::into_raw(Box::new(saved)) as *mut c_void;
+            live().states.insert(new as usize);
+            unsafe { *state = new };
         } else {
+            // SAFETY: a live state (the registry says so)
             unsafe { *(old as *mut SavedState) = saved };
         }
         Ok(OK)
@@ -495,7 +539,10 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, state: *mut c_void) -> 
         if state.is_null() {
             return Err("a null state".into());
         }
-        // SAFETY: a state from fmi2GetFMUstate
+        if !live().states.contains(&(state as usize)) {
+            return Err(format!("the state is {NOT_A_STATE}"));
+        }
+        // SAFETY: a live state from fmi2GetFMUstate (the registry says so)
         let saved = unsafe { &*(state as *const SavedState) };
         comp.instance.restore(saved).map(|()| OK)
     })
@@ -505,11 +552,16 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, state: *mut c_void) -> 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeFMUstate(c: *mut c_void, state: *mut *mut c_void) -> c_int {
     with(c, "fmi2FreeFMUstate", |_| {
-        if !state.is_null() && !unsafe { *state }.is_null() {
-            // SAFETY: a state from fmi2GetFMUstate, freed once
-            drop(unsafe { Box::from_raw(*state as *mut SavedState) });
-            unsafe { *state = std::ptr::null_mut() };
+        if state.is_null() || unsafe { *state }.is_null() {
+            return Ok(OK);
         }
+        let p = unsafe { *state };
+        if !live().states.remove(&(p as usize)) {
+            return Err(format!("the state is {NOT_A_STATE}"));
+        }
+        // SAFETY: a live state from fmi2GetFMUstate, now out of the registry: freed once
+        drop(unsafe { Box::from_raw(p as *mut SavedState) });
+        unsafe { *state = std::ptr::null_mut() };
         Ok(OK)
     })
 }

@@ -14,7 +14,11 @@ use clutchpack_sdk::{
     RecordingRequest, RunOutcome, Session, SessionRequest, SessionState, Simulation,
 };
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+/// Numbers every run an instance starts (`fmi2ExitInitializationMode`), process-wide: a saved
+/// state names the run it belongs to, and restores only into it.
+static RUNS: AtomicU64 = AtomicU64::new(1);
 
 /// Where an instance is in FMI's state machine.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -32,8 +36,13 @@ pub enum Phase {
     Failed,
 }
 
-/// A saved FMU state (`fmi2GetFMUstate`).
+/// A saved FMU state (`fmi2GetFMUstate`): it belongs to the run that saved it (one instance,
+/// between its `fmi2ExitInitializationMode` and its next reset) and restores only into it.
 pub struct SavedState {
+    /// The run that saved it ([`RUNS`]).
+    run: u64,
+    /// The scene of that run, for messages.
+    scene: String,
     session: SessionState,
     reals: Vec<f64>,
     slopes: Vec<[f64; 2]>,
@@ -63,6 +72,45 @@ pub struct Instance {
     /// Every body's damage at the time it was computed (hosts read every output at every
     /// step; the assessment covers all bodies at once).
     damage_cache: std::cell::RefCell<Option<(f64, Vec<f64>)>>,
+    /// The run started by the last `fmi2ExitInitializationMode` ([`RUNS`]; 0 before).
+    run: u64,
+    /// The files the run reads (the FMU's resources, Python's scene file): no output may
+    /// name one.
+    inputs: Vec<PathBuf>,
+}
+
+/// The bound of the scene key an input stands for: lowest and highest value, and the key.
+fn input_bound(i: Input) -> (f64, f64, &'static str) {
+    use clutchpack_scene::{MAX_PRESSURE_PA, MAX_SPEED_RAD_S, MAX_TORQUE_N_M};
+    match i {
+        Input::ShaftSpeed => (-MAX_SPEED_RAD_S, MAX_SPEED_RAD_S, "drive.omega0_rad_s"),
+        Input::ShaftTorque => (-MAX_TORQUE_N_M, MAX_TORQUE_N_M, "a scene's torques, as drum.load_torque_n_m"),
+        Input::DrumLoad => (-MAX_TORQUE_N_M, MAX_TORQUE_N_M, "drum.load_torque_n_m"),
+        Input::PistonPressure => (0.0, MAX_PRESSURE_PA, "stack.pressure.pressure_pa"),
+    }
+}
+
+/// `Ok` if `value` of the input `name` (its `unit`) lies within the bound of the scene key
+/// it stands for; else why not, in e-notation (never hundreds of digits).
+fn check_input(name: &str, i: Input, unit: &str, value: f64, when: &str) -> Result<(), String> {
+    let (lo, hi, key) = input_bound(i);
+    if (lo..=hi).contains(&value) {
+        return Ok(());
+    }
+    let e = |x: f64| {
+        if x == 0.0 {
+            "0".to_string()
+        } else {
+            format!("{x:e}")
+        }
+    };
+    Err(format!(
+        "{name} = {} {unit}{when}: expected a value in [{}, {}] {unit}, the bound of the \
+         scene key it stands for ({key})",
+        e(value),
+        e(lo),
+        e(hi)
+    ))
 }
 
 /// Reads the scene an FMU carries: `resources/scene.json` (the validated scene, written by
@@ -81,6 +129,15 @@ pub fn load_resources(resources: &Path, guid: &str) -> Result<Scene, String> {
         ));
     }
     let text = read("scene.json")?;
+    // the scene was validated when the FMU was built, and the GUID is a hash of its text:
+    // a scene edited since (a record rate of 1e300 Hz, ...) is refused, never run unchecked
+    if crate::package::guid(&text) != own.trim() {
+        return Err(format!(
+            "{}: changed since the FMU was built (it does not hash to the FMU's GUID); \
+             build the FMU again from the scene file with `clutchpack fmu`, which checks it",
+            resources.join("scene.json").display()
+        ));
+    }
     serde_json::from_str(&text).map_err(|e| {
         format!(
             "{}: not a scene written by clutchpack fmu: {e}",
@@ -116,9 +173,17 @@ impl Instance {
             snapshot: Snapshot::default(),
             outcome: None,
             damage_cache: Default::default(),
+            run: 0,
+            inputs: Vec::new(),
         };
         inst.reset();
         Ok(inst)
+    }
+
+    /// The files the run reads (the FMU's resources, a scene file), which no output may name.
+    pub fn reading(mut self, inputs: Vec<PathBuf>) -> Instance {
+        self.inputs = inputs;
+        self
     }
 
     /// Back to the state after instantiation, every variable at its start value.
@@ -146,6 +211,7 @@ impl Instance {
         self.snapshot = Snapshot::default();
         self.outcome = None;
         self.damage_cache.take();
+        self.run = 0;
     }
 
     /// Where the instance is.
@@ -214,6 +280,18 @@ impl Instance {
             ));
         }
         let path = self.string_of(Quantity::RecordingPath);
+        if !path.is_empty() {
+            // the one output policy of every front end, before any work
+            let inputs: Vec<&Path> = self.inputs.iter().map(PathBuf::as_path).collect();
+            clutchpack_record::check_outputs(
+                &[clutchpack_record::OutputPath::file(
+                    "recording_path",
+                    Path::new(&path),
+                )],
+                &inputs,
+            )
+            .map_err(|e| format!("{e} (leave recording_path empty to run without a recording)"))?;
+        }
         let recording = (!path.is_empty()).then(|| RecordingRequest {
             path: PathBuf::from(&path),
             replace: Replace::Existing,
@@ -237,6 +315,7 @@ impl Instance {
         self.snapshot = session.snapshot();
         self.session = Some(session);
         self.phase = Phase::Stepping;
+        self.run = RUNS.fetch_add(1, Ordering::Relaxed);
         Ok(())
     }
 
@@ -297,6 +376,15 @@ impl Instance {
             }
             Causality::Input if matches!(self.phase, Phase::Terminated | Phase::Failed) => {
                 Err(format!("{}: the run has ended", v.name))
+            }
+            Causality::Input => {
+                let Quantity::Input(i) = v.quantity else {
+                    unreachable!("an input variable stands for an input")
+                };
+                check_input(&v.name, i, v.unit.unwrap_or(""), value, "")?;
+                self.reals[vr as usize] = value;
+                self.slopes[vr as usize] = [0.0; 2];
+                Ok(())
             }
             _ => {
                 self.reals[vr as usize] = value;
@@ -468,6 +556,12 @@ impl Instance {
         let limit = self.real_of(Quantity::DurationLimit);
         let session = self.session.as_mut().expect("a session while stepping");
         let now = session.time_s();
+        if !t_s.is_finite() {
+            return Err(format!(
+                "currentCommunicationPoint = {t_s} s: expected a finite time (the FMU stands \
+                 at {now} s)"
+            ));
+        }
         if (t_s - now).abs() > 1e-9 * now.max(1e-3) {
             return Err(format!(
                 "currentCommunicationPoint = {t_s} s, but the FMU stands at {now} s"
@@ -497,6 +591,7 @@ impl Instance {
                 self.phase
             ));
         }
+        self.check_held_inputs(t_end)?;
         let inputs = self.inputs();
         let session = self.session.as_mut().expect("a session while stepping");
         if self.driven.any() {
@@ -513,6 +608,31 @@ impl Instance {
                 Err(e.to_string())
             }
         }
+    }
+
+    /// Each input held with its slopes (a first- or second-order hold) from the run's time to
+    /// `t_end` (s) stays within its scene key's bound ([`input_bound`]) at `t_end`: a slope
+    /// cannot carry an input where its value could not be set.
+    fn check_held_inputs(&self, t_end: f64) -> Result<(), String> {
+        let dt = t_end - self.time_s();
+        for v in &self.vars {
+            let Quantity::Input(i) = v.quantity else {
+                continue;
+            };
+            let [slope, curvature] = self.slopes[v.vr as usize];
+            if slope == 0.0 && curvature == 0.0 {
+                continue;
+            }
+            let x = self.reals[v.vr as usize] + slope * dt + 0.5 * curvature * dt * dt;
+            check_input(
+                &v.name,
+                i,
+                v.unit.unwrap_or(""),
+                x,
+                &format!(" at {t_end:e} s (held with its derivatives)"),
+            )?;
+        }
+        Ok(())
     }
 
     /// The time the run stands at, s (after `fmi2Terminate`: where it ended).
@@ -556,6 +676,8 @@ impl Instance {
             .filter(|_| self.phase == Phase::Stepping)
             .ok_or("fmi2GetFMUstate is supported while stepping (after initialization)")?;
         Ok(SavedState {
+            run: self.run,
+            scene: self.scene.name.clone(),
             session: s.save().map_err(|e| e.to_string())?,
             reals: self.reals.clone(),
             slopes: self.slopes.clone(),
@@ -563,8 +685,17 @@ impl Instance {
         })
     }
 
-    /// `fmi2SetFMUstate`.
+    /// `fmi2SetFMUstate`: only a state this run saved (never another instance's, another
+    /// scene's, or one from before a reset; a recorded run saves none, so it is never
+    /// rewound).
     pub fn restore(&mut self, state: &SavedState) -> Result<(), String> {
+        if state.run != self.run || self.run == 0 {
+            return Err(format!(
+                "the state was saved by another run (scene {:?}; this instance runs {:?}): a \
+                 state restores only into the instance and run that saved it",
+                state.scene, self.scene.name
+            ));
+        }
         let s = self
             .session
             .as_mut()

@@ -52,8 +52,9 @@ pub fn check_representable(
     Ok(EngineChoice::from_name(sim.engine_name()).expect("an engine's own name"))
 }
 
-/// The GUID of an FMU of `scene_json` (a hash of it and of this crate's version).
-fn guid(scene_json: &str) -> String {
+/// The GUID of an FMU of `scene_json` (a hash of it and of this crate's version): the
+/// binary checks the packed scene against it at `fmi2Instantiate`.
+pub(crate) fn guid(scene_json: &str) -> String {
     let part = |seed: &str| {
         let mut h = std::collections::hash_map::DefaultHasher::new();
         (seed, env!("CARGO_PKG_VERSION"), scene_json).hash(&mut h);

@@ -149,17 +149,28 @@ impl ImpactTracker {
     }
 }
 
+/// The smallest ratio of the two sample spacings of [`parabolic_peak`] (the shorter over the
+/// longer): below it the samples are a rounding error apart (a step landing 1e-19 s from
+/// a communication point or the end), the parabola's slope through them is noise, and its
+/// vertex can lie 1e8 times above every sample.
+pub const MIN_PEAK_SPACING_RATIO: f64 = 1e-6;
+
 /// The peak between samples of a load's magnitude: the vertex `(t, |F|)` of the parabola
 /// through three samples `(t_s, |F| in N)` in time order. `None` unless the middle sample is
-/// the largest of the three, the parabola opens downward and its vertex lies within the
-/// samples' span. Used by [`ImpactTracker`] and by the engines that feed
-/// [`ImpactTracker::observe`] themselves.
+/// the largest of the three, the parabola opens downward, its vertex lies within the
+/// samples' span and the samples are not a rounding error apart ([`MIN_PEAK_SPACING_RATIO`]).
+/// Used by [`ImpactTracker`] and by the engines that feed [`ImpactTracker::observe`]
+/// themselves.
 pub fn parabolic_peak(
     (t0, a0): (f64, f64),
     (t1, a1): (f64, f64),
     (t2, a2): (f64, f64),
 ) -> Option<(f64, f64)> {
     if !(a1 >= a0 && a1 >= a2) {
+        return None;
+    }
+    let (h0, h1) = (t1 - t0, t2 - t1);
+    if h0.min(h1) <= MIN_PEAK_SPACING_RATIO * h0.max(h1) {
         return None;
     }
     // Lagrange parabola through the three points; vertex
@@ -233,6 +244,25 @@ mod tests {
         assert_relative_eq!(ev[1].peak_n, 450.0, max_relative = 1e-5);
         assert!(ev[0].t_on_s >= 50e-6 && ev[0].t_on_s <= 51e-6);
         assert!(ev[1].t_off_s >= 260e-6 && ev[1].t_off_s <= 261e-6);
+    }
+
+    /// Samples a rounding error apart (a step that landed 1e-19 s from a communication point)
+    /// give no parabola: its vertex would lie 1e10 N above loads of 100 N (issue 36's absurd
+    /// FMU peaks). Evenly spaced samples still refine.
+    #[test]
+    fn samples_a_rounding_error_apart_give_no_parabolic_peak() {
+        let t1 = 0.12;
+        let near = t1 - 1e-19_f64.max(t1 * f64::EPSILON);
+        assert_eq!(
+            parabolic_peak((near, 100.0), (t1, 160.0), (t1 + 1e-4, 150.0)),
+            None
+        );
+        assert_eq!(
+            parabolic_peak((t1 - 1e-4, 150.0), (t1, 160.0), (t1 + 1e-14, 100.0)),
+            None
+        );
+        let (tv, av) = parabolic_peak((-1.0, 100.0), (0.0, 160.0), (1.0, 150.0)).unwrap();
+        assert!(av > 160.0 && av < 161.0 && tv > 0.0, "{tv} {av}");
     }
 
     /// An event still open at the end of the history is closed at the last sample.

@@ -54,9 +54,10 @@ impl Driven {
         ];
         if !self.shaft_speed && matches!(held_table(pack), Some((_, true))) {
             return Err(EngineError::Unsupported(
-                "a held speed table (drive.interpolation = \"hold\") jumps at its rows: run it \
-                 with Engine::run (clutchpack run), which ends a step at every row, or drive the \
-                 shaft speed"
+                "a held speed table (drive.interpolation = \"hold\") jumps at its rows, which a \
+                 run in calls does not land on: run the scene whole (`clutchpack run`, Python's \
+                 `clutchpack.run`), which ends a step at every row, or drive the shaft speed \
+                 (Simulation(..., drive=[\"shaft_speed\"]), or the FMU) with the table's values"
                     .into(),
             ));
         }

@@ -114,6 +114,20 @@ impl Scene {
     }
 }
 
+/// The one output policy of every front end (`clutchpack_record::check_outputs`), before any
+/// work: each `(argument, path)` given names a new or regular file in an existing folder, not
+/// a folder, a device or a FIFO, not another output and not the scene file; else
+/// `ValueError` naming the argument.
+fn check_outputs(outputs: &[(&str, Option<&Path>)], scene: &Scene) -> PyResult<()> {
+    let outs: Vec<clutchpack_record::OutputPath> = outputs
+        .iter()
+        .filter_map(|(label, p)| p.map(|p| clutchpack_record::OutputPath::file(label, p)))
+        .collect();
+    let inputs: Vec<&Path> = scene.path.as_deref().into_iter().collect();
+    clutchpack_record::check_outputs(&outs, &inputs)
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
 /// `jobs` threads, else one per core; at least 1, at most 256 (as `clutchpack sweep`).
 fn threads(jobs: Option<usize>) -> usize {
     jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
@@ -255,6 +269,13 @@ fn run(
     keep_samples: bool,
     deterministic: bool,
 ) -> PyResult<RawRun> {
+    check_outputs(
+        &[
+            ("record =", record.as_deref()),
+            ("impacts_csv =", impacts_csv.as_deref()),
+        ],
+        scene,
+    )?;
     let mut sim = Simulation::new(scene.inner.clone(), engine_choice(engine)?).map_err(py_err)?;
     let recording = record.map(|path| RecordingRequest {
         path,

@@ -3,7 +3,7 @@
 //! and their names are the FMU's (`discs[1].load_n`, ...). The Python half wraps it as
 //! `clutchpack.Simulation`.
 
-use crate::{engine_choice, interruptible, py_err, Scene};
+use crate::{check_outputs, engine_choice, interruptible, py_err, Scene};
 use clutchpack_fmu::variables::{Causality, Kind, Quantity};
 use clutchpack_fmu::Instance;
 use clutchpack_model::session::Driven;
@@ -94,7 +94,10 @@ impl Stepper {
         driven
             .check(&scene.inner.pack)
             .map_err(|e| PyValueError::new_err(format!("{}: {e}", scene.inner.name)))?;
-        let mut inst = Instance::driving(scene.inner.clone(), driven).map_err(value_err)?;
+        check_outputs(&[("record =", record.as_deref())], scene)?;
+        let mut inst = Instance::driving(scene.inner.clone(), driven)
+            .map_err(value_err)?
+            .reading(scene.path.iter().cloned().collect());
         let strings: Vec<(Quantity, u32)> = inst
             .variables()
             .iter()

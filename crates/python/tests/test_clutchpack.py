@@ -275,3 +275,98 @@ def test_a_simulation_driven_and_restored():
         sim.advance_to(0.0)
     summary = sim.finish()
     assert summary["discs"][0]["impacts"] == first[-1]["impacts"]
+
+
+def test_outputs_are_checked_before_any_work_by_the_one_policy(tmp_path):
+    """Issue 36: `run(record=, impacts_csv=)` and `Simulation(record=)` keep the output
+    policy of `clutchpack run --out`: the scene itself, a folder, a FIFO and two outputs on
+    one file raise ValueError naming the argument before any work, and leave every path as
+    it was (no `.partial-` file, the scene unchanged, the FIFO still a FIFO)."""
+    scene = tmp_path / "s.toml"
+    scene.write_text(open("scenes/hu-table2.toml").read())
+    before = scene.read_bytes()
+    fifo = tmp_path / "fifo.mcap"
+    os.mkfifo(fifo)
+    folder = tmp_path / "out"
+    folder.mkdir()
+    same = tmp_path / "same.mcap"
+    cases = [
+        (dict(record=scene), "record", "input"),
+        (dict(impacts_csv=scene), "impacts_csv", "input"),
+        (dict(record=folder), "record", "folder"),
+        (dict(record=fifo), "record", "not a regular file"),
+        (dict(record=same, impacts_csv=same), "impacts_csv", "same file"),
+    ]
+    for kwargs, arg, why in cases:
+        with pytest.raises(ValueError, match=why) as e:
+            clutchpack.run(str(scene), **kwargs)
+        assert arg in str(e.value), (kwargs, e.value)
+    for target in (scene, folder, fifo):
+        with pytest.raises(ValueError, match="record"):
+            clutchpack.Simulation(str(scene), record=target)
+    assert scene.read_bytes() == before
+    assert os.path.isdir(folder) and not os.listdir(folder)
+    import stat
+
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)
+    assert not [p for p in os.listdir(tmp_path) if ".partial-" in p], os.listdir(tmp_path)
+
+
+def test_states_belong_to_their_simulation(tmp_path):
+    """Issue 36: a state restores only into the Simulation that saved it; one of another
+    Simulation (of the same scene, or another) raises ValueError, and a recorded Simulation,
+    which saves none, is never rewound."""
+    a = clutchpack.Simulation("scenes/hu-table2.toml")
+    a.advance_to(2e-3)
+    state = a.save()
+    b = clutchpack.Simulation("scenes/hu-table2.toml", record=tmp_path / "b.mcap")
+    b.advance_to(4e-3)
+    with pytest.raises(ValueError, match="another run"):
+        b.restore(state)
+    c = clutchpack.Simulation("scenes/pack-4-rattle.toml")
+    with pytest.raises(ValueError, match="another run"):
+        c.restore(state)
+    with pytest.raises(ValueError, match="recorded run cannot save"):
+        b.save()
+    a.restore(state)  # its own: fine
+    assert a.time == pytest.approx(2e-3)
+    b.finish()
+    r = clutchpack.read(tmp_path / "b.mcap")
+    t = r.impacts["t_on_s"].to_numpy()
+    assert (np.diff(t) >= 0).all() or len(t) < 2
+
+
+def test_inputs_are_checked_against_their_scene_keys_bounds():
+    """Issue 36: a driven input beyond the bound of the scene key it stands for (a shaft
+    speed of 1e9 rad/s, a piston pressure of 1e15 Pa) raises ValueError naming the input and
+    the bound, in e-notation, before any step."""
+    sim = clutchpack.Simulation("scenes/hu-table2.toml", drive=["shaft_speed"])
+    with pytest.raises(ValueError, match=r"shaft.speed_rad_s = 1e9 rad/s.*\[-1e5, 1e5\]"):
+        sim.advance_to(1e-3, **{"shaft.speed_rad_s": 1e9})
+    assert sim.time == 0.0
+    sim = clutchpack.Simulation("scenes/pack-6-engagement.toml", drive=["piston_pressure"])
+    with pytest.raises(ValueError, match=r"piston.pressure_pa = 1e15 Pa.*1e8"):
+        sim.advance_to(1e-3, **{"piston.pressure_pa": 1e15})
+
+
+@pytest.mark.parametrize(
+    "call,exc,words",
+    [
+        (lambda: clutchpack.sweep("scenes/hu-table2.toml", "defaults.oil.film_thickness_m",
+                                  [0.0], jobs=-1), ValueError, "jobs = -1: expected an integer >= 1"),
+        (lambda: clutchpack.sweep("scenes/hu-table2.toml", "defaults.oil.film_thickness_m",
+                                  [0.0], ensemble=1.5), TypeError, "ensemble = 1.5"),
+        (lambda: clutchpack.run(duration=True), TypeError, "duration = True"),
+        (lambda: clutchpack.run(set="abc"), TypeError, "set = 'abc': expected a mapping"),
+        (lambda: clutchpack.study.run("studies/none.toml", "out", shard=-1), ValueError,
+         "shard = -1: expected an integer >= 0"),
+        (lambda: clutchpack.Simulation(stop_time="1"), TypeError, "stop_time = '1'"),
+    ],
+)
+def test_python_arguments_raise_naming_the_argument_and_its_rule(call, exc, words):
+    """Issue 36: the arguments the native half took badly (OverflowError for -1, a bool run
+    as 1 s, 1.5 members run as one, a dict-update message) raise TypeError or ValueError
+    naming the argument and its rule, before any work."""
+    with pytest.raises(exc) as e:
+        call()
+    assert words in str(e.value), e.value

@@ -125,7 +125,10 @@ mod write;
 
 pub use export::{export_csv, export_csv_until};
 pub use info::{sha256_hex, DiscGeometry, FrictionInterface, RunInfo, ShaftGeometry};
-pub use output::{partial_path, write_whole, PendingFile, Replace, NAME_MAX_BYTES};
+pub use output::{
+    check_outputs, partial_path, write_whole, OutputPath, OutputRefused, PendingFile, Replace,
+    NAME_MAX_BYTES,
+};
 pub use read::{
     from_bytes, from_bytes_with, open, open_complete, open_with, AttachmentInfo, Damage,
     DamageKind, DiscSeries, InterfaceSeries, LoadHistory, MessageView, ReadError, ReadOptions,

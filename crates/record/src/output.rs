@@ -205,6 +205,172 @@ impl PendingFile {
     }
 }
 
+/// One output path of a command, as the front end names it: the flag, parameter or argument
+/// (`--out`, `recording_path`, `record`) for messages, and the path.
+#[derive(Debug, Clone, Copy)]
+pub struct OutputPath<'a> {
+    /// How the front end names this output in messages (`--out`, `recording_path`, `record`).
+    pub label: &'a str,
+    /// The path asked for.
+    pub path: &'a Path,
+    /// A figure: its format must follow from its extension (`.png`, `.svg`).
+    pub figure: bool,
+}
+
+impl<'a> OutputPath<'a> {
+    /// A file output (any format).
+    pub fn file(label: &'a str, path: &'a Path) -> OutputPath<'a> {
+        OutputPath {
+            label,
+            path,
+            figure: false,
+        }
+    }
+
+    /// A figure output: `.png` or `.svg`.
+    pub fn figure(label: &'a str, path: &'a Path) -> OutputPath<'a> {
+        OutputPath {
+            label,
+            path,
+            figure: true,
+        }
+    }
+}
+
+/// Why an output path is refused: bad input, found before any work ([`check_outputs`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{label} {}: {why}", path.display())]
+pub struct OutputRefused {
+    /// The front end's name of the output (`--out`, `recording_path`, `record`).
+    pub label: String,
+    /// The path refused.
+    pub path: PathBuf,
+    /// The rule it breaks.
+    pub why: String,
+}
+
+/// The parent folder of `path` (`.` for a bare file name).
+fn folder(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// A comparable identity of `path`: its canonical folder joined with its file name (the file
+/// itself need not exist).
+fn identity(path: &Path) -> Option<PathBuf> {
+    let dir = folder(path).canonicalize().ok()?;
+    let name = path.file_name()?;
+    let full = dir.join(name);
+    // an existing file may be a symbolic link to another
+    Some(full.canonicalize().unwrap_or(full))
+}
+
+/// Checks one output path (see [`check_outputs`]).
+fn check_one(o: &OutputPath<'_>) -> Result<(), OutputRefused> {
+    let path = o.path;
+    let bad = |why: String| OutputRefused {
+        label: o.label.to_string(),
+        path: path.to_path_buf(),
+        why,
+    };
+    if path.as_os_str().is_empty() || path.file_name().is_none() {
+        return Err(bad("names no file".into()));
+    }
+    let name_len = path.file_name().map_or(0, |n| n.len());
+    if name_len > NAME_MAX_BYTES {
+        return Err(bad(format!(
+            "the file name has {name_len} bytes; a file name may have at most {NAME_MAX_BYTES}"
+        )));
+    }
+    if o.figure {
+        if let Err(clutchpack_analysis::PlotError::UnsupportedFormat { extension, .. }) =
+            clutchpack_analysis::figure_format(path)
+        {
+            return Err(bad(format!(
+                "a figure is written as .png or .svg, chosen by the extension (got {extension:?})"
+            )));
+        }
+    }
+    if let Ok(meta) = std::fs::metadata(path) {
+        if meta.is_dir() {
+            return Err(bad("is a folder; give a file path".into()));
+        }
+        if !meta.is_file() {
+            return Err(bad(
+                "exists and is not a regular file (a FIFO, device or socket); outputs are \
+                 written to a temporary file and renamed into place, which would replace it: \
+                 give a regular file path"
+                    .into(),
+            ));
+        }
+    }
+    let dir = folder(path);
+    match std::fs::metadata(&dir) {
+        Ok(m) if m.is_dir() => {}
+        Ok(_) => return Err(bad(format!("{} is not a folder", dir.display()))),
+        Err(_) => return Err(bad(format!("the folder {} does not exist", dir.display()))),
+    }
+    // the real test of writability: create (and remove) a new file in the folder, under the
+    // longest temporary name the output will be written to
+    let probe = partial_path(path, usize::MAX);
+    match OpenOptions::new().write(true).create_new(true).open(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+        }
+        Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {}
+        Err(e) => {
+            return Err(bad(format!(
+                "cannot create a file in the folder {}: {e}",
+                dir.display()
+            )))
+        }
+    }
+    Ok(())
+}
+
+/// The one output policy of every front end (the CLI, the FMU, Python), checked before any
+/// work: each path names a file (not a folder, not a FIFO, device or socket, whose node the
+/// rename into place would replace), in an existing folder that takes a new file, a figure
+/// with a `.png` or `.svg` extension; no two outputs name the same file; no output names an
+/// input (`inputs`: the scene run, a recording read), which it would overwrite.
+pub fn check_outputs(outputs: &[OutputPath<'_>], inputs: &[&Path]) -> Result<(), OutputRefused> {
+    for o in outputs {
+        check_one(o)?;
+    }
+    let ids: Vec<Option<PathBuf>> = outputs.iter().map(|o| identity(o.path)).collect();
+    for (i, a) in outputs.iter().enumerate() {
+        let Some(ia) = &ids[i] else { continue };
+        for (j, b) in outputs.iter().enumerate().skip(i + 1) {
+            if ids[j].as_ref() == Some(ia) {
+                return Err(OutputRefused {
+                    label: a.label.to_string(),
+                    path: a.path.to_path_buf(),
+                    why: format!(
+                        "{} {} names the same file: each output needs its own path",
+                        b.label,
+                        b.path.display()
+                    ),
+                });
+            }
+        }
+        for input in inputs {
+            if input.canonicalize().ok().as_ref() == Some(ia) {
+                return Err(OutputRefused {
+                    label: a.label.to_string(),
+                    path: a.path.to_path_buf(),
+                    why: format!(
+                        "is an input of this run ({}): refusing to overwrite it",
+                        input.display()
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Writes `bytes` to `target` whole: into a temporary sibling, then renamed over `target`
 /// ([`Replace::Existing`]: the caller asked for this path). Nothing is left behind on error.
 pub fn write_whole(target: &Path, bytes: &[u8]) -> io::Result<PathBuf> {

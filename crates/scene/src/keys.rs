@@ -55,8 +55,20 @@ const INERTIA: Kind = Kind::Number(Rule::Bounded {
     floor: MIN_INERTIA_KG_M2,
     ceil: f64::INFINITY,
 });
-/// Largest speed magnitude accepted, rad/s (about 950 000 rpm).
-pub(crate) const MAX_SPEED_RAD_S: f64 = 1e5;
+/// Largest speed magnitude accepted, rad/s (about 950 000 rpm): of a scene's speeds and of a
+/// co-simulation's speed input.
+pub const MAX_SPEED_RAD_S: f64 = 1e5;
+/// Largest piston pressure accepted, Pa (1000 bar: wet clutch pistons work below 3 MPa,
+/// industrial hydraulics below 70 MPa): of a scene's pressures and of a co-simulation's
+/// pressure input.
+pub const MAX_PRESSURE_PA: f64 = 1e8;
+/// Largest torque magnitude accepted, N m (the largest ship drivelines carry about 1e7 N m):
+/// of a scene's load torque and of a co-simulation's torque inputs.
+pub const MAX_TORQUE_N_M: f64 = 1e7;
+/// A piston pressure in Pa: within `[0, MAX_PRESSURE_PA]`.
+const PRESSURE: Kind = Kind::Number(Rule::Closed(0.0, MAX_PRESSURE_PA));
+/// A torque in N m: within +-[`MAX_TORQUE_N_M`].
+const TORQUE: Kind = Kind::Number(Rule::Closed(-MAX_TORQUE_N_M, MAX_TORQUE_N_M));
 /// A speed in rad/s: within +-[`MAX_SPEED_RAD_S`].
 const SPEED: Kind = Kind::Number(Rule::Closed(-MAX_SPEED_RAD_S, MAX_SPEED_RAD_S));
 /// Highest drive frequency accepted, Hz (torsional excitation of a driveline is below 1e4 Hz).
@@ -174,7 +186,7 @@ table! {
         /// drum inertia
         inertia_kg_m2: "kg m^2", INERTIA, Dflt::When("required with [drum]");
         /// load on the drum about the axis (negative brakes it)
-        load_torque_n_m: "N m", FINITE, Dflt::Num(0.0);
+        load_torque_n_m: "N m", TORQUE, Dflt::Num(0.0);
         /// drum drag
         drag_n_m_s_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
         /// starting speed of the drum
@@ -231,14 +243,14 @@ table! {
         /// the piston pressure history
         kind: "", Kind::Choice(&["constant", "ramp", "table"]), Dflt::When("required with [stack]");
         /// the (final) pressure
-        pressure_pa: "Pa", NON_NEGATIVE, Dflt::When("constant and ramp: required");
+        pressure_pa: "Pa", PRESSURE, Dflt::When("constant and ramp: required");
         /// when the rise starts (ramp only)
         start_s: "s", NON_NEGATIVE, Dflt::Num(0.0);
         /// rise time
         rise_s: "s", POSITIVE, Dflt::When("ramp: required");
         /// times, increasing
         times_s: "s", Kind::Numbers, Dflt::When("table: required");
-        /// pressures >= 0, one per times_s
+        /// pressures in [0, 1e8], one per times_s
         values_pa: "Pa", Kind::Numbers, Dflt::When("table: required");
     }
     children {}

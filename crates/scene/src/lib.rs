@@ -164,6 +164,7 @@ mod validate;
 
 pub use catalog::{keys_doc, keys_markdown};
 pub use error::{Problem, SceneError};
+pub use keys::{MAX_PRESSURE_PA, MAX_SPEED_RAD_S, MAX_TORQUE_N_M};
 pub use overrides::{Override, OverrideError};
 
 use std::path::Path;

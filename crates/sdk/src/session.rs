@@ -68,7 +68,8 @@ impl Simulation {
             .with_fatigue(scene, false);
         let recorder = match &request.recording {
             Some(r) => {
-                let info = run_info(scene, self.engine_name(), r.scene_path.as_deref());
+                let mut info = run_info(scene, self.engine_name(), r.scene_path.as_deref());
+                co_simulation_params(&mut info.params, &request);
                 Some(ThreadedRecorder::start(Recorder::create_output(
                     &r.path, r.replace, &info, &r.options,
                 )?))
@@ -88,6 +89,38 @@ impl Simulation {
             started: Instant::now(),
         })
     }
+}
+
+/// What a co-simulated run's recording says of how it was made (`clutchpack.params`): not the
+/// scene's `duration_s` (the caller decides where the run ends: `stop_time_s` if it was
+/// given; the stored statistics say where it ended) and which inputs the caller drove.
+fn co_simulation_params(
+    params: &mut std::collections::BTreeMap<String, String>,
+    request: &SessionRequest,
+) {
+    params.remove("duration_s");
+    params.insert("co_simulation".into(), "true".into());
+    if let Some(t) = request.stop_time_s {
+        params.insert("stop_time_s".into(), t.to_string());
+    }
+    let d = request.driven;
+    let driven: Vec<&str> = [
+        (d.shaft_speed, "shaft_speed"),
+        (d.shaft_torque, "shaft_torque"),
+        (d.drum_load, "drum_load"),
+        (d.piston_pressure, "piston_pressure"),
+    ]
+    .into_iter()
+    .filter_map(|(on, name)| on.then_some(name))
+    .collect();
+    params.insert(
+        "driven_inputs".into(),
+        if driven.is_empty() {
+            "none (the scene's profiles)".into()
+        } else {
+            driven.join(", ")
+        },
+    );
 }
 
 impl Session {
@@ -198,8 +231,16 @@ impl Session {
         })
     }
 
-    /// Restores a state saved by [`Session::save`] of this session.
+    /// Restores a state saved by [`Session::save`] of this session. A recorded run refuses
+    /// every restore: its recording cannot be rewound.
     pub fn restore(&mut self, state: &SessionState) -> Result<()> {
+        if self.recorder.is_some() {
+            return Err(Error::BadInput(format!(
+                "{}: a recorded run cannot be rewound (its recording holds the samples and \
+                 impacts already written); run without the recording to roll back",
+                self.scene
+            )));
+        }
         self.inner = state.inner.boxed_clone();
         self.collector = state.collector.try_clone()?;
         self.failure = None;

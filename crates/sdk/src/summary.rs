@@ -150,7 +150,9 @@ pub fn run_info(
         scene_file: scene_path
             .and_then(|p| p.file_name())
             .map(|f| f.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "hu-table2.toml".to_string()),
+            // a scene without a file (the built-in paper case, an FMU's packed scene, a
+            // Python dict) is named after itself, as `clutchpack run` names the paper case
+            .unwrap_or_else(|| format!("{}.toml", scene.name)),
         scene_text: scene.source_text.clone(),
         overrides: scene.overrides.clone(),
         solver,

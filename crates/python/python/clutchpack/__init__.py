@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from . import _clutchpack, study
+from ._args import _integer, _time
 from ._clutchpack import Scene
 
 __version__: str = _clutchpack.__version__
@@ -50,6 +51,11 @@ SceneLike = Union[Scene, PathLike, Mapping[str, Any], None]
 def _sets(set: Optional[Mapping[str, Any]]) -> List[tuple]:
     """``{"defaults.oil.film_thickness_m": 25e-6}`` -> ``[("defaults...", "2.5e-05")]``,
     values written as the command line's ``--set KEY=VALUE`` takes them."""
+    if set is not None and not isinstance(set, Mapping):
+        raise TypeError(
+            f"set = {set!r:.80}: expected a mapping of scene keys to values, e.g. "
+            '{"defaults.oil.film_thickness_m": 25e-6}'
+        )
     out = []
     for k, v in (set or {}).items():
         if isinstance(v, bool):
@@ -157,9 +163,9 @@ def run(
     ``clutchpack run`` does. ``engine``: ``"reference"`` or ``"multibody"`` (default: the
     scene's choice); ``duration``: simulated time in s; ``set``: key overrides; ``record``:
     write the MCAP recording there; ``impacts_csv``: also write the impacts CSV."""
-    s = dict(set or {})
+    s = dict(_sets(set))
     if duration is not None:
-        s["simulation.duration_s"] = float(duration)
+        s["simulation.duration_s"] = _time("duration", duration)
     sc = load_scene(scene, s)
     raw = _clutchpack.run(
         sc,
@@ -227,11 +233,11 @@ def sweep(
 ) -> Sweep:
     """Runs ``scene`` once per value of the key ``param`` (as ``clutchpack sweep``), each value
     as an ensemble of ``ensemble`` members spread across the free play, on ``jobs`` threads."""
-    if int(ensemble) < 1:
-        raise ValueError(f"ensemble = {ensemble}: expected an integer >= 1")
+    ensemble = _integer("ensemble", ensemble, 1)
+    jobs = None if jobs is None else _integer("jobs", jobs, 1)
     sc = load_scene(scene, set)
     text = _clutchpack.sweep(
-        sc, param, [float(v) for v in values], ensemble=int(ensemble), jobs=jobs, engine=engine
+        sc, param, [float(v) for v in values], ensemble=ensemble, jobs=jobs, engine=engine
     )
     summary = json.loads(text)
     flat = []
@@ -275,6 +281,11 @@ class Simulation:
         record: Optional[PathLike] = None,
         stop_time: Optional[float] = None,
     ) -> None:
+        if stop_time is not None:
+            stop_time = _time("stop_time", stop_time)
+        if isinstance(drive, str):
+            # a single name would be taken letter by letter
+            drive = [drive]
         sc = load_scene(scene, set)
         self.scene: Scene = sc
         self._s = _clutchpack.Stepper(

@@ -15,6 +15,7 @@ from typing import Optional, Union
 import pandas as pd
 
 from . import _clutchpack
+from ._args import _integer
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -41,8 +42,13 @@ def run(
     """Runs shard ``shard`` of ``shards`` of the study file ``study`` into the folder ``out``
     on ``jobs`` threads (default: every core); a rerun runs only the cases its part lacks.
     A bad study file raises ``ValueError`` with every problem at its key."""
+    jobs = None if jobs is None else _integer("jobs", jobs, 1)
+    shards = _integer("shards", shards, 1)
+    shard = _integer("shard", shard, 0)
+    if shard >= shards:
+        raise ValueError(f"shard = {shard}: expected a shard index below shards = {shards}")
     p, cases, skipped, ran, failed, complete = _clutchpack.study_run(
-        os.fspath(study), os.fspath(out), jobs=jobs, shard=int(shard), shards=int(shards)
+        os.fspath(study), os.fspath(out), jobs=jobs, shard=shard, shards=shards
     )
     return ShardRun(os.fspath(p), cases, skipped, ran, failed, complete)
 

@@ -265,7 +265,7 @@ fn pressure(ck: &mut Checker, r: &St) -> Option<PressureProfile> {
             ck,
             (&P::times_s.rel(), pr.times_s.as_ref()),
             (&P::values_pa.rel(), pr.values_pa.as_ref()),
-            Rule::NonNegative,
+            Rule::Closed(0.0, crate::keys::MAX_PRESSURE_PA),
             phint,
         )
         .map(PressureProfile::Table),
