@@ -40,6 +40,9 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
         // it can run the scene (`Simulation::new`, the one home of that decision: an engine
         // that cannot run the pack, a scheme it cannot run it with), with `run`'s message.
         let checked = clutchpack_sdk::load_scene(Some(p), &[]).and_then(|s| {
+            // the engine choice first with the file as the origin of its problems (each at
+            // its key), as before; `Simulation::new` makes the same choice, then builds it
+            s.engine(a.engine, &p.display().to_string())?;
             let (discs, duration_s) = (s.pack.discs.len(), s.simulation.duration_s);
             let sim = clutchpack_sdk::Simulation::new(s, a.engine)?;
             Ok((discs, duration_s, sim.engine_name()))
