@@ -503,3 +503,248 @@ fn bench_stops_on_a_signal_and_fifos_never_block() {
         "stopped before the pack section"
     );
 }
+
+/// Waits for `c`, killing it after 60 s: a hang guard (the bug is a process blocked for
+/// ever), not a speed assertion.
+fn wait_unblocked(mut c: std::process::Child, what: &str) -> Output {
+    let t0 = Instant::now();
+    while c.try_wait().unwrap().is_none() {
+        if t0.elapsed() > Duration::from_secs(60) {
+            let _ = c.kill();
+            panic!("{what}: blocked for 60 s");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    c.wait_with_output().unwrap()
+}
+
+/// Issue 36: `study merge` blocked for ever when its figure `main-effects.png` was a FIFO
+/// (plotters opened it for writing). Its outputs are checked as `run`'s before any work:
+/// exit 2 naming the path and why, nothing written, the FIFO left as it was.
+#[test]
+fn study_merge_refuses_a_fifo_output_before_any_work() {
+    let d = scratch("hard36-merge-fifo");
+    let f = small_study(&d, 0.01, 2);
+    let out = d.join("out");
+    let o = bin()
+        .args(["study", "run", "--jobs", "1", "--out"])
+        .arg(&out)
+        .arg(&f)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let fifo = out.join("main-effects.png");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let c = bin()
+        .args(["study", "merge"])
+        .arg(&out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let o = wait_unblocked(c, "study merge");
+    let err = exit_2(&o, "study merge");
+    assert!(
+        err.contains(&fifo.display().to_string()) && err.contains("not a regular file"),
+        "{err}"
+    );
+    for name in ["results.csv", "summary.csv", "results.parquet"] {
+        assert!(!out.join(name).exists(), "{name} written before the check");
+    }
+    use std::os::unix::fs::FileTypeExt;
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+    // without the FIFO the same merge writes everything, the figure included
+    std::fs::remove_file(&fifo).unwrap();
+    let o = bin().args(["study", "merge"]).arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::metadata(&fifo).unwrap().len() > 0);
+    let leftovers: Vec<_> = tree(&out)
+        .into_iter()
+        .filter(|p| p.to_string_lossy().contains(".partial-"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+/// Issue 36: `check` accepted `simulation.scheme = "multirate"` on packs that scheme cannot
+/// run (a whole pack on the reference engine, a radially floating disc on the multibody
+/// engine) while `run` refused them. `check` now makes `run`'s decision: exit 2, the same
+/// message.
+#[test]
+fn check_refuses_the_multirate_scheme_where_run_does() {
+    let d = scratch("hard36-check-scheme");
+    for (scene, engine) in [
+        ("pack-6-engagement", "reference"),
+        ("eccentric-disc", "multibody"),
+    ] {
+        let text = std::fs::read_to_string(repo(&format!("scenes/{scene}.toml"))).unwrap();
+        let text = text.replacen("[simulation]", "[simulation]\nscheme = \"multirate\"", 1);
+        let f = d.join(format!("{scene}.toml"));
+        std::fs::write(&f, text).unwrap();
+        let what = format!("{scene} on {engine}");
+        let r = bin()
+            .args(["run", "--no-record", "--engine", engine])
+            .arg(&f)
+            .output()
+            .unwrap();
+        let run_err = exit_2(&r, &what);
+        let message = run_err
+            .trim()
+            .strip_prefix("error: ")
+            .unwrap_or_else(|| panic!("{what}: {run_err}"));
+        assert!(message.contains("multirate"), "{what}: {message}");
+        let c = bin()
+            .args(["check", "--engine", engine])
+            .arg(&f)
+            .output()
+            .unwrap();
+        let check_err = exit_2(&c, &what);
+        assert!(check_err.contains(message), "{what}: {check_err}");
+        assert!(!stdout(&c).contains(": ok"), "{what}: {}", stdout(&c));
+    }
+    // the same scenes with the scheme left to the engine pass
+    let c = run(&[
+        "check",
+        "--engine",
+        "multibody",
+        &repo("scenes/eccentric-disc.toml"),
+        &repo("scenes/pack-6-engagement.toml"),
+    ]);
+    assert!(c.status.success(), "{}", stderr(&c));
+}
+
+/// Issue 36: an inertial shaft with J = 1e-6 kg m^2 and a damping of 1e6 N m s/rad (a time
+/// constant J / C of 1e-12 s) passed `check` and ran for 11 to 45 s and up to 500 MB on the
+/// multibody engine before the step collapsed. The bodies' drag rule (J / C >= 1e-6 s)
+/// covers the shaft's damping and the drum's drag: refused by `check` and `run` (exit 2)
+/// naming the key, the bound and the step it would need, before any step; at the bound
+/// both engines run.
+#[test]
+fn a_damping_no_step_can_resolve_is_refused_before_the_run() {
+    let d = scratch("hard36-damping");
+    let shaft = [
+        "shaft.mode=\"inertial\"",
+        "shaft.inertia_kg_m2=1e-6",
+        "shaft.damping_n_m_s_rad=1e6",
+    ];
+    let drum = ["drum.inertia_kg_m2=1e-6", "drum.drag_n_m_s_rad=1e6"];
+    for (scene, sets, key) in [
+        ("hu-table2", &shaft[..], "shaft.damping_n_m_s_rad"),
+        ("pack-8-brake", &shaft[..], "shaft.damping_n_m_s_rad"),
+        ("pack-6-engagement", &drum[..], "drum.drag_n_m_s_rad"),
+    ] {
+        for engine in ["reference", "multibody"] {
+            let what = format!("{scene} on {engine}");
+            let mut args = vec!["run", "--no-record", "--engine", engine];
+            let scene_path = repo(&format!("scenes/{scene}.toml"));
+            args.push(&scene_path);
+            for s in sets {
+                args.extend(["--set", s]);
+            }
+            let o = run(&args);
+            let err = exit_2(&o, &what);
+            assert!(
+                err.contains(&format!("{key} = 1000000"))
+                    && err.contains("drag time constant J / C of at least 1e-6 s")
+                    && err.contains("need steps below 2.0e-12 s"),
+                "{what}: {err}"
+            );
+            assert!(stdout(&o).is_empty(), "{what}: nothing ran");
+        }
+    }
+    // `check` refuses the same scene written out
+    let text = std::fs::read_to_string(repo("scenes/hu-table2.toml")).unwrap();
+    let text = text.replacen(
+        "mode = \"prescribed\"",
+        "mode = \"inertial\"\ninertia_kg_m2 = 1e-6\ndamping_n_m_s_rad = 1e6",
+        1,
+    );
+    let f = d.join("stiff-shaft.toml");
+    std::fs::write(&f, text).unwrap();
+    let o = bin().arg("check").arg(&f).output().unwrap();
+    let err = exit_2(&o, "check");
+    assert!(err.contains("shaft.damping_n_m_s_rad"), "{err}");
+    // at the bound (J / C = 1e-6 s) a short run ends normally on both engines
+    for engine in ["reference", "multibody"] {
+        let o = run(&[
+            "run",
+            "--no-record",
+            "--engine",
+            engine,
+            "--duration",
+            "0.002",
+            &repo("scenes/hu-table2.toml"),
+            "--set",
+            shaft[0],
+            "--set",
+            shaft[1],
+            "--set",
+            "shaft.damping_n_m_s_rad=1",
+        ]);
+        assert!(o.status.success(), "{engine}: {}", stderr(&o));
+    }
+}
+
+/// Issue 36: numbers are echoed in messages in one format (`clutchpack_model::fmt_num`:
+/// e-notation when huge or tiny; `sweep` printed 301-digit decimals for 1e300 and 1e-300),
+/// and a long array is echoed as its first items and its length (a 100 000-number array was
+/// echoed whole: 600 KB).
+#[test]
+fn numbers_and_long_arrays_in_messages_are_short() {
+    let scene = repo("scenes/hu-table2.toml");
+    for (param, value) in [
+        ("defaults.oil.film_thickness_m", "1e300"),
+        ("defaults.inertia_kg_m2", "1e-300"),
+        ("simulation.record_rate_hz", "1e300"),
+    ] {
+        let o = run(&["sweep", &scene, "--param", param, "--values", value]);
+        let err = exit_2(&o, param);
+        assert!(
+            err.contains(&format!("case {param} = {value}")),
+            "{param}: {err}"
+        );
+        assert!(
+            !err.contains("0000000000") && err.len() < 1000,
+            "{param}: {err}"
+        );
+    }
+    let o = run(&["run", "--no-record", "--duration=-1e-300"]);
+    let err = exit_2(&o, "--duration");
+    assert!(
+        err.contains("= -1e-300") && !err.contains("0000000000"),
+        "{err}"
+    );
+
+    let d = scratch("hard36-long-array");
+    let base = std::fs::read_to_string(&scene).unwrap();
+    let long = vec!["1e-6"; 100_000].join(", ");
+    for (key, line) in [
+        ("radial_float", format!("radial_float = [{long}]")),
+        ("spline", format!("spline = [{long}]")),
+    ] {
+        let text = base.replacen("[defaults]\n", &format!("[defaults]\n{line}\n"), 1);
+        let text = if key == "spline" {
+            text.replacen("[defaults.spline]", "[unused_spline]", 1)
+        } else {
+            text
+        };
+        let f = d.join(format!("{key}.toml"));
+        std::fs::write(&f, text).unwrap();
+        let o = bin().arg("check").arg(&f).output().unwrap();
+        let err = exit_2(&o, key);
+        assert!(
+            err.contains(&format!(
+                "defaults.{key} = [1e-6, 1e-6, 1e-6, 1e-6, ... (100000 items)]"
+            )),
+            "{key}: {}",
+            &err[..err.len().min(2000)]
+        );
+        assert!(err.len() < 2000, "{key}: {} bytes of message", err.len());
+    }
+}

@@ -36,18 +36,21 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
     }
     let mut bad = 0;
     for p in &a.scenes {
-        let origin = p.display().to_string();
-        let checked = clutchpack_scene::load(p, &[]).and_then(|s| {
-            let engine = s.engine(a.engine, &origin)?;
-            Ok((s, engine))
+        // The scene's rules, then what `run` decides before any step: the engine and whether
+        // it can run the scene (`Simulation::new`, the one home of that decision: an engine
+        // that cannot run the pack, a scheme it cannot run it with), with `run`'s message.
+        let checked = clutchpack_sdk::load_scene(Some(p), &[]).and_then(|s| {
+            // the engine choice first with the file as the origin of its problems (each at
+            // its key), as before; `Simulation::new` makes the same choice, then builds it
+            s.engine(a.engine, &p.display().to_string())?;
+            let (discs, duration_s) = (s.pack.discs.len(), s.simulation.duration_s);
+            let sim = clutchpack_sdk::Simulation::new(s, a.engine)?;
+            Ok((discs, duration_s, sim.engine_name()))
         });
         match checked {
-            Ok((s, engine)) => out!(
-                "{}: ok ({} discs, {} s, {} engine)",
+            Ok((discs, duration_s, engine)) => out!(
+                "{}: ok ({discs} discs, {duration_s} s, {engine} engine)",
                 p.display(),
-                s.pack.discs.len(),
-                s.simulation.duration_s,
-                engine.name()
             ),
             Err(e) => {
                 eprintln!("{e}");

@@ -88,13 +88,14 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     if let Some(d) = a.duration {
         sets.push(Override {
             key: "simulation.duration_s".into(),
-            value: d.to_string(),
+            // the one number format of messages: the value is echoed if refused
+            value: clutchpack_model::fmt_num(d),
         });
     }
     if let Some(r) = a.record_rate {
         sets.push(Override {
             key: "simulation.record_rate_hz".into(),
-            value: r.to_string(),
+            value: clutchpack_model::fmt_num(r),
         });
     }
     let scene = clutchpack_sdk::load_scene(a.scene.as_deref(), &sets)?;

@@ -1,6 +1,7 @@
 //! `clutchpack study`: run, merge, submit and compare studies (clutchpack_study).
 
 use crate::common::BadInput;
+use crate::outputs::Output;
 use crate::signals;
 use anyhow::{Context, Result};
 use clutchpack_study::merge::Merged;
@@ -284,7 +285,35 @@ fn run(a: RunArgs) -> Result<ExitCode> {
 /// Exit code of `merge` when shards are missing.
 pub const EXIT_MISSING: u8 = 3;
 
+/// The files `study merge` writes in a study's output folder: the results table (CSV and
+/// Parquet), the per-design-point summary and the main-effects figure.
+fn merge_outputs(dir: &Path, plot_format: &str) -> [PathBuf; 4] {
+    [
+        dir.join("results.csv"),
+        dir.join("summary.csv"),
+        dir.join("results.parquet"),
+        dir.join(format!("main-effects.{plot_format}")),
+    ]
+}
+
 fn merge(a: MergeArgs) -> Result<ExitCode> {
+    // Every output checked before any work, as `run`'s (crate::outputs): a FIFO named
+    // main-effects.png blocked the merge for ever (issue 36). A missing folder is the sdk's
+    // to say ("not a folder").
+    if a.dir.is_dir() {
+        let paths = merge_outputs(&a.dir, &a.plot_format);
+        let outs: Vec<Output> = paths
+            .iter()
+            .map(|p| {
+                if p.extension().is_some_and(|e| e == "png" || e == "svg") {
+                    Output::figure("output", p)
+                } else {
+                    Output::file("output", p)
+                }
+            })
+            .collect();
+        crate::outputs::check_outputs(&outs, &[])?;
+    }
     let done = match clutchpack_sdk::merge_study(&a.dir, &a.plot_format) {
         Ok(d) => d,
         Err(clutchpack_sdk::Error::StudyIncomplete(MergeError::Missing {

@@ -146,7 +146,7 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             value: format!("{v:e}"),
         });
         let scene = clutchpack_sdk::load_scene(Some(&a.scene), &sets)
-            .with_context(|| format!("case {} = {v}", a.param))?;
+            .with_context(|| format!("case {} = {}", a.param, clutchpack_model::fmt_num(*v)))?;
         scenes.push(scene);
     }
     let engine_name = Simulation::new(scenes[0].clone(), a.engine)?

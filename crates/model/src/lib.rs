@@ -82,6 +82,18 @@ pub use stream::{
     STALL_STEPS,
 };
 
+/// A number for messages, the one format every front end echoes values in: Rust's shortest
+/// round-trip `{}` for ordinary magnitudes (`|x|` in `[1e-5, 1e9)`, and 0), `{:e}` outside
+/// (`1e300`, not 301 digits; `1e-300`, not 300 zeros; `5e-324`). Both forms read back as the
+/// same `f64`, and both are valid TOML (a value echoed from `--set` can be pasted back).
+pub fn fmt_num(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-5..1e9).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// Closed-form peak load of one free, undamped impact (MODEL.md section 4):
 /// `F_max = k^(2/5) (5/4 m_eff v0^2)^(3/5)` in N, for stiffness `k` (N/m^1.5), effective mass
 /// `m_eff` (kg) and closing speed `v0` (m/s). The rebound speed equals `v0`.
@@ -111,6 +123,28 @@ pub fn free_impact_duration_s(k: f64, m_eff_kg: f64, v0_m_s: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    /// Huge and tiny numbers in e-notation, ordinary ones plain; every form reads back exactly
+    /// (issue 36: 301-digit decimals were echoed for 1e300 and 1e-300).
+    #[test]
+    fn numbers_in_messages_are_short_and_exact() {
+        for (x, want) in [
+            (1e300, "1e300"),
+            (1e-300, "1e-300"),
+            (-1e300, "-1e300"),
+            (0.0, "0"),
+            (0.3, "0.3"),
+            (25e-6, "0.000025"),
+            (1e-6, "1e-6"),
+            (10_000.0, "10000"),
+            (1e9, "1e9"),
+            (5e-324, "5e-324"),
+        ] {
+            let s = super::fmt_num(x);
+            assert_eq!(s, want);
+            assert_eq!(s.parse::<f64>().unwrap(), x);
+        }
+    }
+
     /// The closed-form duration against a direct integration of `m s'' = -k s^1.5` (RK4 with
     /// 1e5 steps over the contact).
     #[test]

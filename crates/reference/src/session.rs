@@ -170,9 +170,10 @@ impl Clock {
         }
         if !(t.is_finite() && t >= self.t) {
             return Err(EngineError::Unsupported(format!(
-                "advance to t = {t} s: expected a finite time at or after the session's time \
+                "advance to t = {} s: expected a finite time at or after the session's time \
                  {} s",
-                self.t
+                clutchpack_model::fmt_num(t),
+                clutchpack_model::fmt_num(self.t)
             )));
         }
         Ok(())
@@ -191,7 +192,8 @@ impl Clock {
         }
         if let Some((name, v)) = inputs.invalid() {
             return Err(EngineError::Unsupported(format!(
-                "{name} = {v}: expected a finite value (a pressure >= 0)"
+                "{name} = {}: expected a finite value (a pressure >= 0)",
+                clutchpack_model::fmt_num(v)
             )));
         }
         Ok(hold_inputs(pack, self.t, inputs))

@@ -53,7 +53,11 @@ fn check_table(
                         check_table(t, &item_path, problems, voided);
                     } else {
                         let rule = format!("must be a table (an [[{section}]] entry)");
-                        problems.push(Problem::new(&item_path, Some(item.to_string()), rule));
+                        problems.push(Problem::new(
+                            &item_path,
+                            Some(crate::schema::show(item)),
+                            rule,
+                        ));
                         *item = Value::Table(Table::new());
                         voided.push(item_path);
                     }
@@ -73,7 +77,7 @@ fn check_table(
         }
     }
     for (key, child, rule) in wrong {
-        let value = table.remove(&key).map(|v| v.to_string());
+        let value = table.remove(&key).map(|v| crate::schema::show(&v));
         problems.push(Problem::new(&child, value, rule));
         voided.push(child);
     }

@@ -171,28 +171,24 @@ pub(crate) fn fmt_bound(x: f64) -> String {
     }
 }
 
-/// A number for messages: Rust's shortest round-trip `{}` for ordinary magnitudes, `{:e}`
-/// for huge or tiny ones (`1e308`, not 309 digits; `5e-324`).
-pub(crate) fn fmt_num(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() || (1e-5..1e9).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
-}
+/// A number for messages: [`clutchpack_model::fmt_num`], the one format of every front end.
+pub(crate) use clutchpack_model::fmt_num;
 
-/// A value as written, in TOML syntax, for messages; huge or tiny floats in `{:e}` form.
+/// Most items of an array echoed in a message; a longer one is shown as its first items and
+/// its length (a 100 000-number array was echoed whole, 600 KB, issue 36).
+pub(crate) const SHOWN_ITEMS: usize = 4;
+
+/// A value as written, in TOML syntax, for messages: huge or tiny floats as [`fmt_num`]
+/// writes them (ordinary ones as TOML writes them, `3.0`), arrays of more than
+/// [`SHOWN_ITEMS`] items as their first items and their length.
 pub(crate) fn show(v: &Value) -> String {
-    fn plain(x: f64) -> bool {
-        x == 0.0 || !x.is_finite() || (1e-5..1e9).contains(&x.abs())
-    }
     match v {
-        Value::Float(x) if !plain(*x) => format!("{x:e}"),
-        Value::Array(items)
-            if items
-                .iter()
-                .any(|i| matches!(i, Value::Float(x) if !plain(*x))) =>
-        {
+        Value::Float(x) if fmt_num(*x).contains('e') => fmt_num(*x),
+        Value::Array(items) if items.len() > SHOWN_ITEMS => {
+            let parts: Vec<String> = items[..SHOWN_ITEMS].iter().map(show).collect();
+            format!("[{}, ... ({} items)]", parts.join(", "), items.len())
+        }
+        Value::Array(items) => {
             let parts: Vec<String> = items.iter().map(show).collect();
             format!("[{}]", parts.join(", "))
         }
@@ -435,6 +431,18 @@ mod tests {
         assert_eq!(show(&Value::Float(1e308)), "1e308");
         assert_eq!(show(&Value::Float(-0.001)), "-0.001");
         assert_eq!(show(&Value::Float(0.0)), "0.0");
+    }
+
+    /// Issue 36: a 100 000-number array was echoed whole in an error (600 KB); it is shown
+    /// as its first items and its length, a short one whole, nested ones summarised too.
+    #[test]
+    fn long_arrays_in_messages_are_summarised() {
+        let long = Value::Array(vec![Value::Float(1e-6); 100_000]);
+        assert_eq!(show(&long), "[1e-6, 1e-6, 1e-6, 1e-6, ... (100000 items)]");
+        let short = Value::Array(vec![Value::Integer(1), Value::Float(2.5)]);
+        assert_eq!(show(&short), "[1, 2.5]");
+        let nested = Value::Array(vec![long.clone()]);
+        assert!(show(&nested).len() < 60, "{}", show(&nested));
     }
 
     #[test]

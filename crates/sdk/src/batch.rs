@@ -93,7 +93,10 @@ pub fn run_cases(
                 })?;
                 let stats = outcome.stats().map_err(|e| match e {
                     Error::Engine { context, source } => Error::Engine {
-                        context: format!("case {param} = {}, member {k}: {context}", values[c]),
+                        context: format!(
+                            "case {param} = {}, member {k}: {context}",
+                            clutchpack_model::fmt_num(values[c])
+                        ),
                         source,
                     },
                     e => e,

@@ -84,8 +84,21 @@ pub fn merge_study(dir: &Path, plot_format: &str) -> Result<MergedStudy> {
     let failed = m.records.iter().filter(|r| r.error.is_some()).count();
     let plot = if failed < m.records.len() {
         let p = dir.join(format!("main-effects.{plot_format}"));
-        clutchpack_study::plot::plot_main_effects(&p, &m)
-            .map_err(|e| Error::Study(e.to_string()))?;
+        // drawn at a temporary sibling (same extension: the format) and renamed into place,
+        // as every other output: never half a figure, never opened at its final path
+        let (pending, file) =
+            clutchpack_record::PendingFile::create(&p, clutchpack_record::Replace::Existing)
+                .map_err(Error::io(&p))?;
+        drop(file);
+        match clutchpack_study::plot::plot_main_effects(pending.tmp_path(), &m) {
+            Ok(()) => {
+                pending.commit().map_err(Error::io(&p))?;
+            }
+            Err(e) => {
+                pending.discard();
+                return Err(Error::Study(e.to_string()));
+            }
+        }
         Some(p)
     } else {
         None

@@ -575,9 +575,39 @@ pub(crate) const PLAUSIBLE_CLOSING_SPEED_M_S: f64 = 10.0;
 /// Shortest tooth impact an engine must resolve, s: about 30 steps of 3e-9 s (the paper's last
 /// 75 us). A shorter one asks for steps near the engines' stall guard (6e-11 s mean).
 pub(crate) const MIN_IMPACT_DURATION_S: f64 = 1e-7;
-/// Shortest drag time constant `J / C`, s: the engines apply the drag explicitly, stable for
-/// steps below `2 J / C`; a clutch body's drag time constant is seconds.
+/// Shortest drag time constant `J / C`, s, of every body with a drag or damping to ground (a
+/// disc or plate's drag, an inertial shaft's damping, the drum's drag): the engines apply it
+/// explicitly, stable for steps below `2 J / C`; a clutch body's drag time constant is seconds.
 pub(crate) const MIN_DRAG_TIME_S: f64 = 1e-6;
+
+/// Whether the engines can integrate a body of inertia `J` (its key path and value) with the
+/// drag or damping `C` to ground (its key path and value): its time constant `J / C` is at
+/// least [`MIN_DRAG_TIME_S`]. Else reports at the drag's key the largest accepted value and
+/// the step the value would need. One rule for the discs, the plates, the shaft and the drum.
+pub(super) fn drag_resolvable(
+    ck: &mut Checker,
+    (inertia_key, inertia): (&str, f64),
+    (drag_key, drag): (&str, f64),
+) -> bool {
+    let tau = inertia / drag;
+    if tau.is_nan() || tau < MIN_DRAG_TIME_S {
+        ck.report(
+            drag_key,
+            Some(fmt_num(drag)),
+            format!(
+                "must be at most {} N m s/rad with {inertia_key} = {} (plausibility bound: a \
+                 drag time constant J / C of at least {} s); this one is {tau:.3e} s and would \
+                 need steps below {:.1e} s",
+                fmt_num(inertia / MIN_DRAG_TIME_S),
+                fmt_num(inertia),
+                fmt_num(MIN_DRAG_TIME_S),
+                2.0 * tau,
+            ),
+        );
+        return false;
+    }
+    true
+}
 
 /// Whether the engines can resolve `disc` in useful time: its hardest tooth impact (Hertz
 /// stiffness `H`, the film only softens it; effective mass `J / (n Rb^2)`, closing at
@@ -609,22 +639,10 @@ fn resolvable(ck: &mut Checker, item: &str, disc: &DiscModel) -> bool {
         );
         ok = false;
     }
-    let tau = disc.inertia_kg_m2 / disc.drag_n_m_s_rad;
-    if tau.is_nan() || tau < MIN_DRAG_TIME_S {
-        ck.report(
-            B::drag_n_m_s_rad.at(item),
-            Some(fmt_num(disc.drag_n_m_s_rad)),
-            format!(
-                "must be at most {} N m s/rad with inertia_kg_m2 = {} (plausibility bound: a \
-                 drag time constant J / C of at least {} s); this one is {tau:.3e} s and would \
-                 need steps below {:.1e} s",
-                fmt_num(disc.inertia_kg_m2 / MIN_DRAG_TIME_S),
-                fmt_num(disc.inertia_kg_m2),
-                fmt_num(MIN_DRAG_TIME_S),
-                2.0 * tau,
-            ),
-        );
-        ok = false;
-    }
+    ok &= drag_resolvable(
+        ck,
+        (&B::inertia_kg_m2.at(item), disc.inertia_kg_m2),
+        (&B::drag_n_m_s_rad.at(item), disc.drag_n_m_s_rad),
+    );
     ok
 }

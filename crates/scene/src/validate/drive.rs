@@ -287,7 +287,17 @@ pub(super) fn shaft(
                 &S::damping_n_m_s_rad,
             )
             .or(S::damping_n_m_s_rad.default_num());
-        (inertia, damping)
+        // the damping to ground is a drag: the same bound on its time constant J / C
+        // (issue 36: J = 1e-6 kg m^2 with C = 1e6 N m s/rad collapsed the step after 26 s)
+        let resolvable = match (inertia, damping) {
+            (Some(j), Some(c)) => super::bodies::drag_resolvable(
+                ck,
+                (&S::inertia_kg_m2.rel(), j),
+                (&S::damping_n_m_s_rad.rel(), c),
+            ),
+            _ => true,
+        };
+        (inertia, damping.filter(|_| resolvable))
     };
 
     let torque_drive = kind == Field::Valid(DriveKind::TorqueTable);

@@ -22,6 +22,16 @@ pub(super) fn drum(ck: &mut Checker, r: &RawDrum) -> Option<DrumModel> {
     let load = or_default(&RawDrum::load_torque_n_m);
     let drag = or_default(&RawDrum::drag_n_m_s_rad);
     let speed = or_default(&RawDrum::initial_speed_rad_s);
+    // the drum's drag: the bodies' bound on the drag time constant J / C
+    if let (Some(j), Some(c)) = (inertia, drag) {
+        if !super::bodies::drag_resolvable(
+            ck,
+            (&RawDrum::inertia_kg_m2.rel(), j),
+            (&RawDrum::drag_n_m_s_rad.rel(), c),
+        ) {
+            return None;
+        }
+    }
     Some(DrumModel {
         inertia_kg_m2: inertia?,
         load_torque_n_m: load?,

@@ -500,7 +500,8 @@ impl Session for MultibodySession {
         }
         if let Some((name, v)) = inputs.invalid() {
             return Err(EngineError::Unsupported(format!(
-                "{name} {v}: must be finite (a pressure >= 0)"
+                "{name} = {}: must be finite (a pressure >= 0)",
+                clutchpack_model::fmt_num(v)
             )));
         }
         if self.finished.is_some() || self.failed {
