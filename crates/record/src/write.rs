@@ -638,7 +638,11 @@ impl Recorder {
             joint_values: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
             max_abs_run: 0.0,
             peaks: clutchpack_analysis::PeakStats::new(),
-            held_impacts: std::collections::BinaryHeap::new(),
+            // reserved whole (pages are touched only as it fills): grown by doubling, the
+            // heap's last copy held the full old and half the new buffer at once, +3.7 MB of
+            // peak memory once a contact held for the run (pack-8-brake's resting plates)
+            // filled it, after 16 s simulated
+            held_impacts: std::collections::BinaryHeap::with_capacity(MAX_HELD_IMPACTS + 1),
             last_free_t_s: vec![f64::NEG_INFINITY; n],
             last_t_s: 0.0,
             messages: 0,

@@ -126,8 +126,8 @@ impl RunCollector {
     /// The fatigue of every coupling (named `names`) over `duration_s` of simulated duty,
     /// from the histories collected so far.
     pub fn assess_fatigue(&self, names: &[String], duration_s: f64) -> Vec<DiscFatigue> {
-        crate::fatigue::assess_fatigue(
-            self.fatigue.clone(),
+        crate::fatigue::assess_histories(
+            &self.fatigue.histories(names.len()),
             &self.fatigue_params,
             names,
             duration_s,

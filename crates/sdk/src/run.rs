@@ -158,6 +158,10 @@ impl Simulation {
         );
         let wall_time_s = t0.elapsed().as_secs_f64();
         let mut collector = done.collector;
+        let mut warnings = done.warnings;
+        if let Some(e) = collector.fatigue.spill_error() {
+            warnings.push(format!("{e}; the fatigue figures miss them"));
+        }
         let impacts_csv = request
             .impacts_csv
             .map(|p| collector.finish_impacts_csv().map(|()| p));
@@ -172,7 +176,7 @@ impl Simulation {
             collector,
             impacts_csv,
             recording: done.recording,
-            warnings: done.warnings,
+            warnings,
         })
     }
 }

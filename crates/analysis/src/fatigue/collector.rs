@@ -3,6 +3,7 @@
 //! their cycles counted as they come and their Miner sums kept ([`DamageSum`]); the
 //! assessment of what it collected is the parent module's.
 
+use super::pending::PendingSamples;
 use super::*;
 
 /// Running Miner sums of one load history's cycles on one S-N curve: what an assessment
@@ -171,8 +172,9 @@ impl ToothTrack {
 
 #[derive(Debug, Clone)]
 struct DiscTrack {
-    /// loaded samples (t s, load N) not yet claimed by a closed impact
-    pending: Vec<(f64, f64)>,
+    /// loaded samples (t s, load N) not yet claimed by a closed impact (bounded in memory,
+    /// the older ones in a temporary file)
+    pending: PendingSamples,
     lumped: HistoryTrack,
     teeth: Vec<ToothTrack>,
 }
@@ -287,7 +289,7 @@ impl FatigueCollector {
             self.discs.extend((first..=i).map(|k| {
                 let sums = curves.get(k).map(|&(c, m)| DamageSum::new(c, m));
                 DiscTrack {
-                    pending: Vec::new(),
+                    pending: PendingSamples::default(),
                     lumped: HistoryTrack::new(keep, sums),
                     teeth: Vec::new(),
                 }
@@ -303,7 +305,7 @@ impl FatigueCollector {
         for (i, d) in s.discs.iter().enumerate() {
             let t = self.disc(i);
             if d.load_n != 0.0 && d.load_n.is_finite() {
-                t.pending.push((s.t_s, d.load_n));
+                t.pending.push(s.t_s, d.load_n);
             }
             if !d.tooth_loads_n.is_empty() {
                 if t.teeth.len() < d.tooth_loads_n.len() {
@@ -327,55 +329,101 @@ impl FatigueCollector {
     /// Takes a closed impact: a pulse, or its samples when they resolve it (the rule of
     /// [`crate::cycles::impact_history`]).
     pub fn impact(&mut self, e: &ImpactEvent) {
-        let t = self.disc(e.disc);
-        let inside: Vec<(f64, f64)> = t
-            .pending
-            .iter()
-            .filter(|s| s.0 > e.t_on_s && s.0 < e.t_off_s)
-            .copied()
-            .collect();
-        let h = &mut t.lumped;
+        let DiscTrack {
+            pending, lumped, ..
+        } = self.disc(e.disc);
+        let h = lumped;
         h.push(0.0);
-        if inside.len() >= SUSTAINED_CONTACT_SAMPLES {
-            let at = inside.partition_point(|s| s.0 <= e.t_peak_s);
-            for s in &inside[..at] {
-                h.push(s.1);
+        // the samples strictly inside the contact, streamed in time order (a sustained
+        // contact's may be millions, partly on disk): the first few wait until there are
+        // enough to count it from its samples, the peak goes in before the first sample
+        // after it
+        let mut first: Vec<(f64, f64)> = Vec::with_capacity(SUSTAINED_CONTACT_SAMPLES);
+        let mut sustained = false;
+        let mut peak_in = false;
+        let mut feed = |h: &mut HistoryTrack, s: (f64, f64)| {
+            if !peak_in && s.0 > e.t_peak_s {
+                h.push(e.peak_n);
+                peak_in = true;
             }
-            h.push(e.peak_n);
-            for s in &inside[at..] {
-                h.push(s.1);
+            h.push(s.1);
+        };
+        pending.claim(e.t_on_s, e.t_off_s, |s| {
+            if sustained {
+                feed(h, s);
+            } else {
+                first.push(s);
+                if first.len() >= SUSTAINED_CONTACT_SAMPLES {
+                    sustained = true;
+                    for s in first.drain(..) {
+                        feed(h, s);
+                    }
+                }
             }
-        } else {
+        });
+        if !(sustained && peak_in) {
             h.push(e.peak_n);
         }
         h.push(0.0);
         h.peak(e.peak_n);
-        t.pending.retain(|s| s.0 > e.t_off_s);
     }
 
     /// The counted histories of every coupling seen, in index order; `couplings` pads the
     /// list for couplings that never hit.
     pub fn finish(self, couplings: usize) -> Vec<DiscHistories> {
-        let mut out: Vec<DiscHistories> = self
-            .discs
-            .into_iter()
-            .map(|mut d| {
-                d.lumped.push(0.0);
-                DiscHistories {
-                    lumped: d.lumped.finish(),
-                    teeth: d.teeth.into_iter().map(ToothTrack::finish).collect(),
-                }
-            })
-            .collect();
-        let (keep, curves) = (self.keep, &self.curves);
-        let first = out.len();
-        out.extend((first..couplings).map(|k| DiscHistories {
-            lumped:
-                HistoryTrack::new(keep, curves.get(k).map(|&(c, m)| DamageSum::new(c, m))).finish(),
-            teeth: Vec::new(),
-        }));
-        out
+        let (keep, curves) = (self.keep, self.curves);
+        let tracks = self.discs.into_iter().map(|d| (d.lumped, d.teeth));
+        finish_tracks(tracks, keep, &curves, couplings)
     }
+
+    /// What [`Self::finish`] gives, leaving the collector as it is (to be fed on): copies
+    /// only the histories' counters, not the loaded samples waiting for their impact (which
+    /// `finish` does not count).
+    pub fn histories(&self, couplings: usize) -> Vec<DiscHistories> {
+        let tracks = self
+            .discs
+            .iter()
+            .map(|d| (d.lumped.clone(), d.teeth.clone()));
+        finish_tracks(tracks, self.keep, &self.curves, couplings)
+    }
+
+    /// Loaded samples held in memory, waiting for the impact that claims them: at most
+    /// [`super::PENDING_IN_MEMORY`] per coupling, however long its contact stays closed (the
+    /// older ones wait in a temporary file).
+    pub fn held_samples(&self) -> usize {
+        self.discs.iter().map(|d| d.pending.held()).sum()
+    }
+
+    /// Why some loaded samples kept in the temporary file could not be read back, if they
+    /// could not: the figures of the contacts that held them then miss them.
+    pub fn spill_error(&self) -> Option<&str> {
+        self.discs.iter().find_map(|d| d.pending.error())
+    }
+}
+
+/// The counted histories of `tracks` (each coupling's lumped history and its teeth's), in
+/// index order, padded with empty histories to `couplings`.
+fn finish_tracks(
+    tracks: impl Iterator<Item = (HistoryTrack, Vec<ToothTrack>)>,
+    keep: bool,
+    curves: &[(f64, Material)],
+    couplings: usize,
+) -> Vec<DiscHistories> {
+    let mut out: Vec<DiscHistories> = tracks
+        .map(|(mut lumped, teeth)| {
+            lumped.push(0.0);
+            DiscHistories {
+                lumped: lumped.finish(),
+                teeth: teeth.into_iter().map(ToothTrack::finish).collect(),
+            }
+        })
+        .collect();
+    let first = out.len();
+    out.extend((first..couplings).map(|k| DiscHistories {
+        lumped: HistoryTrack::new(keep, curves.get(k).map(|&(c, m)| DamageSum::new(c, m))).finish(),
+        teeth: Vec::new(),
+    }));
+    out
 }
 
 impl FatigueCollector {

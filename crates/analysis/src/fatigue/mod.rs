@@ -25,7 +25,9 @@
 //!   elementary the life is `D_crit (S_D / sigma_eq)^k` hours.
 
 mod collector;
+mod pending;
 pub use collector::{DamageSum, DiscHistories, FatigueCollector, HistoryCycles};
+pub use pending::PENDING_IN_MEMORY;
 
 use crate::cycles::{
     count_ranges, exceedance_spectrum, range_histogram, range_mean_matrix, Cycle, Rainflow,
@@ -389,6 +391,72 @@ mod tests {
             count_ranges(&rainflow(&turning_points(&tooth0)))
         );
         assert_eq!(h[0].teeth[0].peaks, crate::cycles::contact_peaks(&tooth0));
+    }
+
+    /// Issue 36, item 4 ("A flat footprint"): a contact that stays closed for long (a plate
+    /// resting on its flank, as pack-8-brake's do from 0.16 s to the end) keeps its loaded
+    /// samples until it separates, since its located peak goes in among them at its time. Past
+    /// [`PENDING_IN_MEMORY`] per coupling they wait in the temporary file: the memory held
+    /// stays bounded, and the contact's cycles are the batch history's
+    /// ([`impact_history`]) bit for bit wherever the peak falls (before the first sample, among
+    /// those on disk, among those in memory, after the last), with samples of the next contact
+    /// already waiting when one closes.
+    #[test]
+    fn long_contacts_count_from_disk_as_from_memory() {
+        let n = 3 * PENDING_IN_MEMORY + 123;
+        let dt = 1e-4;
+        for peak_at in [
+            -0.5,
+            10.0,
+            5_000.0,
+            12_000.5,
+            n as f64 - 1.0,
+            n as f64 - 0.2,
+        ] {
+            let mut c = FatigueCollector::new();
+            let (mut events, mut samples) = (Vec::new(), Vec::new());
+            let mut most_held = 0;
+            let mut t0 = 0.0;
+            let mut open: Option<ImpactEvent> = None;
+            for (k, sign) in [(0, 1.0), (1, -1.0), (2, 1.0)] {
+                // a contact from t0 with n samples inside, the peak at sample index peak_at
+                let e = event(
+                    t0,
+                    t0 + (peak_at + 0.5) * dt,
+                    t0 + (n as f64 + 0.25) * dt,
+                    sign * (900.0 + k as f64),
+                );
+                for j in 0..n {
+                    let ts = t0 + (j as f64 + 0.5) * dt;
+                    let x = j as f64;
+                    let load = sign * (400.0 + 150.0 * (0.37 * x).sin() + 80.0 * (0.011 * x).sin());
+                    samples.push((ts, load));
+                    c.sample(&sample(ts, load, Vec::new()));
+                    most_held = most_held.max(c.held_samples());
+                    // the contact before closes after this one's first samples
+                    if j == 5 {
+                        if let Some(before) = open.take() {
+                            c.impact(&before);
+                        }
+                    }
+                }
+                t0 = e.t_off_s + 0.1 * dt;
+                events.push(e);
+                open = Some(e);
+            }
+            if let Some(last) = open.take() {
+                c.impact(&last);
+            }
+            assert!(
+                most_held <= PENDING_IN_MEMORY,
+                "samples held in memory: {most_held}"
+            );
+            assert!(c.spill_error().is_none());
+            let h = c.finish(1);
+            let batch = rainflow(&turning_points(&impact_history(&events, &samples)));
+            assert_eq!(h[0].lumped.cycles, batch, "peak at sample {peak_at}");
+            assert!(h[0].lumped.cycles.len() > n / 10);
+        }
     }
 
     /// A collector that only sums (bounded memory) gives bit for bit the figures of one that
