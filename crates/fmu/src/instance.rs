@@ -3,6 +3,7 @@
 //! functions (`ffi.rs`) only translate pointers and statuses; every rule and every message
 //! is here, testable without a host.
 
+use crate::bounds::check_input;
 use crate::variables::Variable;
 use crate::variables::{
     variables, BodyField, Causality, ImpactField, Input, InterfaceField, Kind, Quantity,
@@ -77,39 +78,6 @@ pub struct Instance {
     /// The files the run reads (the FMU's resources, Python's scene file): no output may
     /// name one.
     inputs: Vec<PathBuf>,
-}
-
-/// The bound of the scene key an input stands for: lowest and highest value, and the key.
-fn input_bound(i: Input) -> (f64, f64, &'static str) {
-    use clutchpack_scene::{MAX_PRESSURE_PA, MAX_SPEED_RAD_S, MAX_TORQUE_N_M};
-    match i {
-        Input::ShaftSpeed => (-MAX_SPEED_RAD_S, MAX_SPEED_RAD_S, "drive.omega0_rad_s"),
-        Input::ShaftTorque => (
-            -MAX_TORQUE_N_M,
-            MAX_TORQUE_N_M,
-            "a scene's torques, as drum.load_torque_n_m",
-        ),
-        Input::DrumLoad => (-MAX_TORQUE_N_M, MAX_TORQUE_N_M, "drum.load_torque_n_m"),
-        Input::PistonPressure => (0.0, MAX_PRESSURE_PA, "stack.pressure.pressure_pa"),
-    }
-}
-
-/// `Ok` if `value` of the input `name` (its `unit`) lies within the bound of the scene key
-/// it stands for; else why not, numbers as every message writes them
-/// (`clutchpack_model::fmt_num`: never hundreds of digits).
-fn check_input(name: &str, i: Input, unit: &str, value: f64, when: &str) -> Result<(), String> {
-    let (lo, hi, key) = input_bound(i);
-    if (lo..=hi).contains(&value) {
-        return Ok(());
-    }
-    let e = clutchpack_model::fmt_num;
-    Err(format!(
-        "{name} = {} {unit}{when}: expected a value in [{}, {}] {unit}, the bound of the \
-         scene key it stands for ({key})",
-        e(value),
-        e(lo),
-        e(hi)
-    ))
 }
 
 /// Reads the scene an FMU carries: `resources/scene.json` (the validated scene, written by
@@ -610,7 +578,7 @@ impl Instance {
     }
 
     /// Each input held with its slopes (a first- or second-order hold) from the run's time to
-    /// `t_end` (s) stays within its scene key's bound ([`input_bound`]) at `t_end`: a slope
+    /// `t_end` (s) stays within its scene key's bound (`bounds.rs`) at `t_end`: a slope
     /// cannot carry an input where its value could not be set.
     fn check_held_inputs(&self, t_end: f64) -> Result<(), String> {
         let dt = t_end - self.time_s();

@@ -9,6 +9,7 @@
 //!   units and descriptions), the one table both the description and the binary read.
 //! - `description.rs`: modelDescription.xml.
 //! - `package.rs`: the `.fmu` archive (description, binary, the scene as resources).
+//! - `bounds.rs`: the inputs' bounds, those of the scene keys they stand for.
 //! - `instance.rs`: FMI's state machine over `clutchpack_sdk::Session` (the inputs held
 //!   between communication points, docs/DECISIONS.md "Co-simulation").
 //! - `ffi.rs`: the `fmi2*` C functions this crate exports when built as a cdylib (the FMU's
@@ -20,6 +21,7 @@
 
 #![warn(missing_docs)]
 
+mod bounds;
 pub mod description;
 #[cfg(feature = "ffi")]
 pub mod ffi;
