@@ -19,6 +19,14 @@ impl Simulation {
     /// The engine for `scene` (`asked`: an explicit choice, e.g. `--engine`).
     pub fn new(scene: Scene, asked: Option<EngineChoice>) -> Result<Simulation> {
         let choice = scene.engine(asked, &scene.name)?;
+        if scene.thermal.is_some() {
+            return Err(Error::BadInput(format!(
+                "{}: [thermal]: no engine carries temperatures yet (issue 35: the reference \
+                 engine's thermal windows come next); remove the section to run the pack \
+                 isothermal",
+                scene.name
+            )));
+        }
         let why = scene.engine_reason(asked);
         let sim = &scene.simulation;
         let (engine, line): (Box<dyn Engine + Send>, String) = match choice {
