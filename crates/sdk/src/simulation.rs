@@ -19,14 +19,6 @@ impl Simulation {
     /// The engine for `scene` (`asked`: an explicit choice, e.g. `--engine`).
     pub fn new(scene: Scene, asked: Option<EngineChoice>) -> Result<Simulation> {
         let choice = scene.engine(asked, &scene.name)?;
-        if scene.thermal.is_some() {
-            return Err(Error::BadInput(format!(
-                "{}: [thermal]: no engine carries temperatures yet (issue 35: the reference \
-                 engine's thermal windows come next); remove the section to run the pack \
-                 isothermal",
-                scene.name
-            )));
-        }
         let why = scene.engine_reason(asked);
         let sim = &scene.simulation;
         let (engine, line): (Box<dyn Engine + Send>, String) = match choice {
@@ -43,7 +35,8 @@ impl Simulation {
                         record_rate_hz: sim.record_rate_hz,
                     },
                 )
-                .with_scheme(scheme);
+                .with_scheme(scheme)
+                .with_thermal(scene.thermal.clone());
                 if sim.scheme == SchemeChoice::Multirate && engine.is_whole() {
                     return Err(Error::BadInput(format!(
                         "{}: simulation.scheme = \"multirate\": the reference engine runs a \
