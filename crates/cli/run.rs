@@ -275,6 +275,32 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             clutchpack_analysis::interface_table(&summary.interfaces, TableFormat::Text).trim_end()
         );
     }
+    if let Some(th) = &summary.thermal {
+        out!("temperatures (K; [thermal], MODEL.md section 9)");
+        out!("{:<12} {:>10} {:>10}", "body", "final", "max");
+        for b in &th.bodies {
+            out!("{:<12} {:>10.3} {:>10.3}", b.name, b.final_k, b.max_k);
+        }
+        out!(
+            "{:<12} {:>10.3} {:>10.3}",
+            "oil",
+            th.oil_final_k,
+            th.oil_max_k
+        );
+        out!(
+            "heat (J): generated {:.6} (faces {:.6}, gaps {:.6}, teeth {:.6}) = stored {:.6} \
+             (bodies {:.6}, oil {:.6}) + cooler {:.6}; balance error {:.3e}",
+            th.generated_j,
+            th.friction_heat_j,
+            th.gap_heat_j,
+            th.impact_heat_j,
+            th.stored_bodies_j + th.stored_oil_j,
+            th.stored_bodies_j,
+            th.stored_oil_j,
+            th.cooler_j,
+            th.balance_error_j
+        );
+    }
     if let Some(e) = recording_error {
         return Err(e);
     }

@@ -135,6 +135,9 @@ pub struct RunStats {
     pub rhs_evals: u64,
     /// Whether the observer stopped the run early.
     pub stopped_early: bool,
+    /// A thermal run's temperatures and heat balance (`None` for an isothermal run).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<crate::thermal::ThermalReport>,
 }
 
 /// Steps per block of the engines' stall check (see [`STALL_SPAN_S`]).

@@ -134,6 +134,18 @@
 //! Allowing ten times the tolerance halves the time but moved an onset 1.5 us from the oracle's
 //! by 44 ms, so the check stays at the tolerance.
 //!
+//! ## Thermal packs (MODEL.md section 9, `thermal.rs`)
+//! A pack with a thermal model ([`ReferenceEngine::with_thermal`]) runs the monolithic scheme
+//! with the temperatures of every disc, plate and the oil as slow states beside it: operator
+//! splitting on a fixed window. Each accepted step's heat is booked from what the state
+//! integrates (each interface's heat counter, to its two bodies by effusivity while clamped,
+//! to the oil while open; the teeth's work `-n F Rb psi` on the step's dense output, to the
+//! oil); at the first step end past each window the temperatures advance over it (RK4 on the
+//! lumped equations) and the tooth films (eqs 7-8, scaled by `eta(T_oil) / eta(T_ref)`) and the
+//! gaps' viscosity change for the next, with a restart. Steps are never cut at a window, so a
+//! run whose parameters do not change is the isothermal run bit for bit. First order in the
+//! window; the heat balance closes to rounding (docs/DECISIONS.md, "Thermal windows").
+//!
 //! ## Order and energy
 //! - Order: every scheme takes the same DOPRI5 steps (5th-order solution, 4th-order error
 //!   estimate and dense output) between located events, so each is 5th order in the step
@@ -186,8 +198,10 @@ mod open;
 mod session;
 mod stepper;
 mod system;
+mod thermal;
 
 use clutchpack_model::session::{Driven, Inputs, Session};
+use clutchpack_model::thermal::ThermalModel;
 use clutchpack_model::{Engagement, Engine, EngineError, PackModel, Shaft};
 use session::MonolithicSession;
 use std::sync::Arc;
@@ -235,6 +249,7 @@ pub struct ReferenceEngine {
     settings: ReferenceOptions,
     scheme: Scheme,
     parallel: bool,
+    thermal: Option<ThermalModel>,
 }
 
 /// Fewest discs for which the multirate scheme spreads the discs over rayon's threads.
@@ -248,7 +263,16 @@ impl ReferenceEngine {
             settings,
             scheme: Scheme::default(),
             parallel: true,
+            thermal: None,
         }
+    }
+
+    /// The same engine carrying the temperatures of `thermal` (MODEL.md section 9; `None`:
+    /// isothermal). A thermal run takes the monolithic scheme whatever the scheme asked
+    /// (the module `thermal`'s docs: the temperatures advance beside one step sequence).
+    pub fn with_thermal(mut self, thermal: Option<ThermalModel>) -> ReferenceEngine {
+        self.thermal = thermal;
+        self
     }
 
     /// The same engine with the scheme `scheme`.
@@ -299,7 +323,9 @@ impl ReferenceEngine {
 
     /// Whether a run takes the open-pack multirate scheme (crate docs, "Whole packs").
     fn runs_open(&self) -> bool {
-        self.scheme == Scheme::Multirate && open::runs_open(&self.pack, &Driven::NONE)
+        self.scheme == Scheme::Multirate
+            && self.thermal.is_none()
+            && open::runs_open(&self.pack, &Driven::NONE)
     }
 
     /// One line saying which scheme runs and why, e.g. `"multirate: prescribed shaft, no
@@ -307,6 +333,15 @@ impl ReferenceEngine {
     pub fn describe(&self) -> String {
         let nd = self.pack.discs.len();
         let discs = if nd == 1 { "disc" } else { "discs" };
+        if let Some(th) = &self.thermal {
+            return format!(
+                "monolithic: one step sequence for the shaft, {nd} {discs} and {} plates, with \
+                 the temperatures of every body and the oil advanced every {} s beside it \
+                 (a thermal pack runs monolithic)",
+                self.pack.plates.len(),
+                th.step_s
+            );
+        }
         if self.runs_open() {
             let threads = if self.spreads_bodies() {
                 format!(" on {} threads", rayon::current_num_threads())
@@ -456,6 +491,15 @@ impl Engine for ReferenceEngine {
         }
         driven.check(&self.pack)?;
         let (pack, settings) = (Arc::new(self.pack.clone()), &self.settings);
+        if let Some(th) = &self.thermal {
+            let session =
+                MonolithicSession::new(pack, settings, driven).with_thermal(th.clone())?;
+            let mut session: Box<dyn Session> = Box::new(session);
+            if driven.any() {
+                session.set_inputs(&Inputs::of_scene(&self.pack, &driven, 0.0))?;
+            }
+            return Ok(session);
+        }
         let mut session: Box<dyn Session> = match (self.scheme, &self.pack.shaft) {
             (Scheme::Multirate, _) if open::runs_open(&pack, &driven) => Box::new(
                 open::OpenSession::new(pack, settings, self.spreads_bodies(), driven),

@@ -12,6 +12,7 @@
 
 use crate::stepper::{Sink, Stepper, Switch};
 use crate::system::System;
+use crate::thermal::{swap_pack, Thermal};
 use crate::{face_event, no_external, ReferenceOptions};
 use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::{
@@ -224,6 +225,8 @@ pub(crate) struct MonolithicSession {
     /// Observer polls every this many steps.
     poll: u64,
     buf: Vec<f64>,
+    /// The temperatures of a thermal run (`crate::thermal`); `None`: isothermal.
+    thermal: Option<Box<Thermal>>,
 }
 
 impl MonolithicSession {
@@ -239,7 +242,22 @@ impl MonolithicSession {
             // within a few ms of wall time whatever the pack).
             poll: (1024 / nd.max(1)).max(1) as u64,
             buf: Vec::new(),
+            thermal: None,
         }
+    }
+
+    /// The same session carrying the temperatures of `model` (MODEL.md section 9): the pack's
+    /// viscosity-dependent parameters set for t = 0, then updated window by window.
+    pub fn with_thermal(
+        mut self,
+        model: clutchpack_model::thermal::ThermalModel,
+    ) -> Result<Self, EngineError> {
+        let th = Thermal::new(model, &self.st.sys.pack)?;
+        if let Some(pack) = th.initial_pack(&self.st.sys.pack) {
+            swap_pack(&mut self.st, pack);
+        }
+        self.thermal = Some(Box::new(th));
+        Ok(self)
     }
 }
 
@@ -301,10 +319,25 @@ impl Session for MonolithicSession {
                     return Err(e);
                 }
             };
+            // the step's heat, by the faces' modes along it (before its switch applies)
+            if let Some(th) = self.thermal.as_mut() {
+                th.book_step(&self.st);
+            }
             if let Switch::External(m) = switch {
                 let (ts, modes) = (self.st.t, self.st.modes.clone());
                 self.st.sys.settle_face(m, ts, &mut self.st.y, &modes);
                 self.st.restart();
+            }
+            if let Some(th) = self.thermal.as_mut() {
+                match th.close_windows(self.st.t, &self.st.sys.pack) {
+                    Ok(Some(pack)) => swap_pack(&mut self.st, pack),
+                    Ok(None) => {}
+                    Err(e) => {
+                        self.clock.failed = true;
+                        self.queue.flush(self.st.t, obs);
+                        return Err(e);
+                    }
+                }
             }
             if self.st.stats.steps.is_multiple_of(self.poll) && self.queue.poll(self.st.t, t, obs) {
                 advance = Advance::Stopped;
@@ -339,6 +372,7 @@ impl Session for MonolithicSession {
         self.queue.flush(f64::INFINITY, obs);
         let mut stats = self.st.stats.clone();
         stats.simulated_s = self.clock.t;
+        stats.thermal = self.thermal.as_mut().map(|th| th.finish(self.st.t));
         stats
     }
 

@@ -189,6 +189,11 @@ impl Stepper {
         tr.contact_due = false;
     }
 
+    /// The contact modes along the last accepted step (before the switch it ended on).
+    pub fn step_modes(&self) -> &[Option<Engagement>] {
+        &self.step_modes
+    }
+
     /// Restarts the integration at `(t, y)` after a change of mode or of the system.
     pub fn restart(&mut self) {
         self.sys.rhs(self.t, &self.y, &self.modes, &mut self.dy);

@@ -163,6 +163,26 @@ impl System {
         self.drum_at() + if self.pack.drum.is_some() { 2 } else { 0 }
     }
 
+    /// The heat each friction interface has dissipated since t = 0 in state `y`, J (empty
+    /// without a stack).
+    pub fn interface_heat_j<'y>(&self, y: &'y [f64]) -> &'y [f64] {
+        let h = self.heat_at();
+        &y[h..h + self.interfaces()]
+    }
+
+    /// Swaps the model for `pack` (the same bodies and stack; parameters changed, as a thermal
+    /// window changes the oil's viscosities), recomputing what is cached from it.
+    pub fn set_pack(&mut self, pack: Arc<PackModel>) {
+        self.c_gap = pack
+            .stack
+            .as_ref()
+            .map_or(0.0, |s| -s.open_gap_torque_n_m(1.0));
+        if let Some(g) = self.gaps.as_mut() {
+            g.c = self.c_gap;
+        }
+        self.pack = pack;
+    }
+
     /// Number of friction interfaces in the state (`2N` for a whole pack with a stack; none
     /// for one body of an open pack, which carries its gaps' work instead).
     pub fn interfaces(&self) -> usize {

@@ -217,7 +217,8 @@ mod tests {
                 "drum",
                 "stack",
                 "defaults",
-                "plate_defaults"
+                "plate_defaults",
+                "thermal"
             ]
         );
         assert!(children("discs[]").contains(&"name"));

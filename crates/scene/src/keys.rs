@@ -103,6 +103,7 @@ table! {
         stack: table RawStack,
         defaults: table RawBody,
         plate_defaults: table RawBody,
+        thermal: table RawThermal,
     }
 }
 
@@ -383,6 +384,104 @@ table! {
         miner_rule: "", Kind::Choice(&["original", "elementary", "haibach"]), Dflt::Choice(fat::DEFAULT_MINER_RULE.name());
         /// Miner damage sum at failure D_crit
         critical_damage: "", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_CRITICAL_DAMAGE }), Dflt::Num(fat::DEFAULT_CRITICAL_DAMAGE);
+    }
+    children {}
+}
+
+/// Lowest temperature accepted, K (a cold start at -120 deg C is far below any oil's pour
+/// point).
+pub(crate) const MIN_TEMPERATURE_K: f64 = 150.0;
+/// Highest temperature accepted, K (a paper lining chars near 600 K; steel glows at 1000 K).
+pub(crate) const MAX_TEMPERATURE_K: f64 = 1000.0;
+/// A temperature in K, within the plausibility bounds [`MIN_TEMPERATURE_K`], [`MAX_TEMPERATURE_K`].
+const TEMPERATURE: Kind = Kind::Number(Rule::Bounded {
+    floor: MIN_TEMPERATURE_K,
+    ceil: MAX_TEMPERATURE_K,
+});
+/// A thickness of a disc's core or lining or of a plate, m.
+const THICKNESS: Kind = Kind::Number(Rule::Bounded {
+    floor: 1e-5,
+    ceil: 0.1,
+});
+
+table! {
+    /// `[thermal]`: temperatures of every disc, plate and the oil, fed back into the tooth film and the open gaps' drag (MODEL.md section 9; reference engine, monolithic scheme). Temperatures in K.
+    RawThermal at "thermal" {
+        /// temperature of every body and the oil at t = 0
+        initial_temperature_k: "K", TEMPERATURE, Dflt::Required;
+        /// where the tooth films' oil.viscosity_pa_s hold: the film scale is eta(T_oil) / eta(T_ref), exactly 1 there
+        reference_temperature_k: "K", TEMPERATURE, Dflt::Described("default initial_temperature_k (the scene's film viscosities are taken as calibrated where the run starts)");
+        /// thermal window: the temperatures, the film scale and the gaps' viscosity advance once per window (operator splitting, first order in it); the update lands on the first step ending at or after each multiple
+        step_s: "s", Kind::Number(Rule::Bounded { floor: 1e-6, ceil: 10.0 }), Dflt::Num(1e-3);
+        /// the open gaps' viscosity: "absolute" eta(T_oil) of the law, or "scaled": stack.open_gap.viscosity_pa_s times the film scale (for an effective, calibrated gap viscosity)
+        gap_viscosity: "", Kind::Choice(&["absolute", "scaled"]), Dflt::Choice("absolute");
+    }
+    children {
+        oil: table RawThermalOil,
+        convection: table RawConvection,
+        discs: table RawThermalDiscs,
+        plates: table RawThermalPlates,
+    }
+}
+
+table! {
+    /// `[thermal.oil]`: the oil's viscosity law, its volume and the cooler.
+    RawThermalOil at "thermal.oil" {
+        /// viscosity law: "walther" (ASTM D341, two kinematic viscosities), "vogel" (three dynamic viscosities) or "table" (ln eta linear between rows, held beyond them)
+        law: "", Kind::Choice(&["walther", "vogel", "table"]), Dflt::Required;
+        /// increasing temperatures of the law's points: 2 for walther, 3 for vogel, at least 2 for a table
+        temperatures_k: "K", Kind::Numbers, Dflt::Required;
+        /// walther: the kinematic viscosities at temperatures_k, decreasing, > 0.3e-6
+        kinematic_viscosities_m2_s: "m^2/s", Kind::Numbers, Dflt::When("walther: required, an error otherwise");
+        /// vogel and table: the dynamic viscosities at temperatures_k, decreasing
+        viscosities_pa_s: "Pa s", Kind::Numbers, Dflt::When("vogel and table: required, an error for walther");
+        /// walther: density for eta = nu rho; ASSUMED default: an ATF near 80 deg C
+        density_kg_m3: "kg/m^3", Kind::Number(Rule::Bounded { floor: 100.0, ceil: 3000.0 }), Dflt::Num(850.0);
+        /// heat capacity m c_p of the oil volume (sump or cooling flow)
+        heat_capacity_j_k: "J/K", POSITIVE, Dflt::Required;
+        /// the cooler's capacity rate m_dot c_p; 0: no cooler
+        cooler_capacity_rate_w_k: "W/K", NON_NEGATIVE, Dflt::Num(0.0);
+        /// temperature of the oil the cooler returns
+        inlet_temperature_k: "K", TEMPERATURE, Dflt::Described("default thermal.initial_temperature_k");
+        /// thermal conductivity lambda of the oil (laminar_gap convection); ASSUMED default: an ATF
+        conductivity_w_m_k: "W/(m K)", POSITIVE, Dflt::Num(0.13);
+    }
+    children {}
+}
+
+table! {
+    /// `[thermal.convection]`: heat from each body's two faces to the oil, h A (T - T_oil).
+    RawConvection at "thermal.convection" {
+        /// "adiabatic" (none), "given" (h_w_m2_k) or "laminar_gap": h = 7.541 lambda / (2 s), fully developed, both walls heated (VDI Heat Atlas Gb 7)
+        kind: "", Kind::Choice(&["adiabatic", "given", "laminar_gap"]), Dflt::Choice("laminar_gap");
+        /// given: the heat transfer coefficient of every face
+        h_w_m2_k: "W/(m^2 K)", POSITIVE, Dflt::When("given: required, an error otherwise");
+        /// laminar_gap: the oil gap s at each face
+        gap_m: "m", POSITIVE, Dflt::Described("laminar_gap: default stack.open_gap.gap_m, else required; an error otherwise");
+    }
+    children {}
+}
+
+table! {
+    /// `[thermal.discs]`: every friction disc: a steel core between two paper linings on the faces' annulus (stack.face_inner_radius_m to face_outer_radius_m); its faces are the linings'.
+    RawThermalDiscs at "thermal.discs" {
+        /// thickness of the steel core; ASSUMED default
+        core_thickness_m: "m", THICKNESS, Dflt::Num(1.0e-3);
+        /// thickness of each of the two linings; ASSUMED default
+        lining_thickness_m: "m", THICKNESS, Dflt::Num(0.5e-3);
+        /// heat capacity m c of one disc, instead of the geometry's
+        heat_capacity_j_k: "J/K", POSITIVE, Dflt::Described("default: steel core and paper linings (clutchpack_model::thermal::ThermalProperties)");
+    }
+    children {}
+}
+
+table! {
+    /// `[thermal.plates]`: every separator plate: a steel annulus on the faces' annulus.
+    RawThermalPlates at "thermal.plates" {
+        /// thickness of a plate; ASSUMED default: MODEL.md section 9's plate
+        thickness_m: "m", THICKNESS, Dflt::Num(1.8e-3);
+        /// heat capacity m c of one plate, instead of the geometry's
+        heat_capacity_j_k: "J/K", POSITIVE, Dflt::Described("default: steel (clutchpack_model::thermal::ThermalProperties::STEEL)");
     }
     children {}
 }

@@ -146,7 +146,7 @@
 //! [`keys_doc`] (`clutchpack check --keys`) and [`keys_markdown`] (the README's table). Two
 //! stages: the raw structs mirror the file (tables typed, values kept as written; unknown keys
 //! collected with `serde_ignored`), then `validate` (one module per section: simulation,
-//! drive and shaft, bodies, stack and drum) converts them to the typed model, collecting
+//! drive and shaft, bodies, stack and drum, thermal) converts them to the typed model, collecting
 //! every problem. [`Scene::engine`] says which engine runs a scene, refusing a choice that
 //! cannot run it.
 
@@ -244,6 +244,10 @@ pub struct Scene {
     /// couplings (`ImpactEvent::disc`).
     #[serde(default)]
     pub fatigue: Vec<clutchpack_model::FatigueParams>,
+    /// The pack's thermal model (`[thermal]`, MODEL.md section 9); `None` for an isothermal
+    /// scene (every scene without the section), which runs exactly as before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<clutchpack_model::thermal::ThermalModel>,
 }
 
 /// Reads an input text file (a scene, a CSV table, a study file) whole. A path that is not a
@@ -330,6 +334,7 @@ pub fn parse(
             simulation: v.simulation,
             pack: v.pack,
             fatigue: v.fatigue,
+            thermal: v.thermal,
         }),
         _ => {
             debug_assert!(

@@ -46,7 +46,7 @@ pub use scene::{load_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TEXT};
 pub use session::{Session, SessionRequest, SessionState};
 pub use simulation::{PackEngine, Simulation};
 pub use study::{merge_study, run_study_shard, MergedStudy, PART_FLUSH};
-pub use summary::{friction_interfaces, run_info, RunSummary};
+pub use summary::{friction_interfaces, run_info, BodyTemperature, RunSummary, ThermalSummary};
 
 /// The reference engine's integration schemes (for [`PackEngine::Reference`]).
 pub use clutchpack_reference::Scheme;

@@ -35,7 +35,8 @@ impl Simulation {
                         record_rate_hz: sim.record_rate_hz,
                     },
                 )
-                .with_scheme(scheme);
+                .with_scheme(scheme)
+                .with_thermal(scene.thermal.clone());
                 if sim.scheme == SchemeChoice::Multirate && engine.is_whole() {
                     return Err(Error::BadInput(format!(
                         "{}: simulation.scheme = \"multirate\": the reference engine runs a \

@@ -31,6 +31,79 @@ pub struct RunSummary {
     /// hour of this duty, life in hours, damage-equivalent load; per tooth where the engine
     /// resolved teeth.
     pub fatigue: Vec<DiscFatigue>,
+    /// A thermal run's temperatures and heat balance (absent for an isothermal run).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<ThermalSummary>,
+}
+
+/// One body's temperatures in a thermal run, K.
+#[derive(Debug, Clone, Serialize)]
+pub struct BodyTemperature {
+    /// The body's name (a disc or a plate).
+    pub name: String,
+    /// Temperature at the end, K.
+    pub final_k: f64,
+    /// Highest temperature at a thermal window's end, K.
+    pub max_k: f64,
+}
+
+/// A thermal run's temperatures (K) and heat balance (J) (MODEL.md section 9).
+#[derive(Debug, Clone, Serialize)]
+pub struct ThermalSummary {
+    /// Per body (friction discs, then separator plates).
+    pub bodies: Vec<BodyTemperature>,
+    /// The oil's temperature at the end, K.
+    pub oil_final_k: f64,
+    /// The oil's highest temperature at a window's end, K.
+    pub oil_max_k: f64,
+    /// Heat of the slipping faces, J (split between their bodies by effusivity).
+    pub friction_heat_j: f64,
+    /// Heat of the open gaps' drag, J (into the oil).
+    pub gap_heat_j: f64,
+    /// Heat of the tooth impacts, J (into the oil).
+    pub impact_heat_j: f64,
+    /// Heat generated, J: the three above.
+    pub generated_j: f64,
+    /// Heat stored in the bodies, J.
+    pub stored_bodies_j: f64,
+    /// Heat stored in the oil, J.
+    pub stored_oil_j: f64,
+    /// Heat the cooler took, J.
+    pub cooler_j: f64,
+    /// Generated minus (stored + cooler), J: rounding only.
+    pub balance_error_j: f64,
+    /// Thermal windows taken.
+    pub windows: u64,
+}
+
+impl ThermalSummary {
+    /// The summary of `report` with the bodies' `names` (discs, then plates).
+    pub fn new(report: &clutchpack_model::thermal::ThermalReport, names: &[String]) -> Self {
+        ThermalSummary {
+            bodies: report
+                .final_k
+                .iter()
+                .zip(&report.max_k)
+                .enumerate()
+                .map(|(i, (f, m))| BodyTemperature {
+                    name: names.get(i).cloned().unwrap_or_default(),
+                    final_k: *f,
+                    max_k: *m,
+                })
+                .collect(),
+            oil_final_k: report.oil_final_k,
+            oil_max_k: report.oil_max_k,
+            friction_heat_j: report.friction_heat_j,
+            gap_heat_j: report.gap_heat_j,
+            impact_heat_j: report.impact_heat_j,
+            generated_j: report.generated_j(),
+            stored_bodies_j: report.stored_bodies_j,
+            stored_oil_j: report.stored_oil_j,
+            cooler_j: report.cooler_j,
+            balance_error_j: report.generated_j() - report.accounted_j(),
+            windows: report.windows,
+        }
+    }
 }
 
 impl RunSummary {
@@ -43,7 +116,12 @@ impl RunSummary {
         wall_time_s: f64,
         discs: Vec<DiscStats>,
     ) -> RunSummary {
+        let names: Vec<String> = discs.iter().map(|d| d.name.clone()).collect();
         RunSummary {
+            thermal: stats
+                .thermal
+                .as_ref()
+                .map(|r| ThermalSummary::new(r, &names)),
             scene: scene.to_string(),
             engine: engine.to_string(),
             duration_s: stats.simulated_s,
@@ -160,5 +238,45 @@ pub fn run_info(
         shaft: None,
         discs,
         interfaces,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clutchpack_model::thermal::ThermalReport;
+
+    /// A thermal report in the summary: the bodies named in order, the heat generated and the
+    /// balance's error (generated minus stored and cooled, exact here: 0).
+    #[test]
+    fn thermal_summary_names_bodies_and_closes_the_balance() {
+        let report = ThermalReport {
+            final_k: vec![354.0, 360.5],
+            max_k: vec![354.5, 361.0],
+            oil_final_k: 353.5,
+            oil_max_k: 353.6,
+            friction_heat_j: 100.0,
+            gap_heat_j: 20.0,
+            impact_heat_j: 5.0,
+            stored_bodies_j: 90.0,
+            stored_oil_j: 25.0,
+            cooler_j: 10.0,
+            windows: 3,
+            updates: 2,
+        };
+        let s = ThermalSummary::new(&report, &["disc-1".into(), "plate-1".into()]);
+        assert_eq!(s.bodies[1].name, "plate-1");
+        assert_eq!((s.bodies[1].final_k, s.bodies[1].max_k), (360.5, 361.0));
+        assert_eq!(s.generated_j, 125.0);
+        assert_eq!(s.balance_error_j, 0.0);
+        // an isothermal run has none (and `--summary-json` writes no `thermal` key: the field
+        // is skipped when `None`)
+        let mut stats = RunStats::default();
+        assert!(RunSummary::new("x", "reference", &stats, 0.0, Vec::new())
+            .thermal
+            .is_none());
+        stats.thermal = Some(report);
+        let th = RunSummary::new("x", "reference", &stats, 0.0, Vec::new());
+        assert_eq!(th.thermal.map(|t| t.oil_final_k), Some(353.5));
     }
 }

@@ -37,9 +37,11 @@
 //! ([`kelvin_from_deg_c`], [`deg_c_from_kelvin`]).
 
 pub mod friction;
+pub mod pack;
 pub mod viscosity;
 
 pub use friction::{FrictionMap, FrictionMapError};
+pub use pack::{GapViscosity, ThermalBody, ThermalModel, ThermalOil, ThermalReport, ViscosityLaw};
 pub use viscosity::{Viscosity, ViscosityError, ViscosityTable, Vogel, Walther};
 
 use std::f64::consts::PI;

@@ -9,12 +9,13 @@
 //! invalid is not used by the rules between keys (its problem is already reported).
 //!
 //! One module per section of the file: [`simulation`], [`drive`] (with the shaft),
-//! [`bodies`] (discs and plates) and [`stack`] (with the drum).
+//! [`bodies`] (discs and plates), [`stack`] (with the drum) and [`thermal`].
 
 mod bodies;
 mod drive;
 mod simulation;
 mod stack;
+mod thermal;
 
 use crate::error::Problem;
 use crate::keys::RawScene;
@@ -31,6 +32,7 @@ pub(crate) struct Validated {
     pub simulation: Simulation,
     pub pack: PackModel,
     pub fatigue: Vec<clutchpack_model::FatigueParams>,
+    pub thermal: Option<clutchpack_model::thermal::ThermalModel>,
 }
 
 /// The outcome of checking one value where it is written.
@@ -311,6 +313,25 @@ pub(crate) fn validate(
         );
         return None;
     }
+    let thermal = match &raw.thermal {
+        None => Some(None),
+        Some(t) => {
+            // the temperatures advance on one step sequence (docs/DECISIONS.md, "Thermal
+            // windows")
+            if simulation
+                .as_ref()
+                .is_some_and(|s| s.scheme == crate::SchemeChoice::Multirate)
+            {
+                ck.report(
+                    "simulation.scheme",
+                    Some("\"multirate\"".into()),
+                    "a [thermal] scene runs on one step sequence (the reference engine's \
+                     monolithic scheme): use \"auto\" or \"shared\"",
+                );
+            }
+            thermal::thermal(ck, t, raw.stack.as_ref(), n_discs, n_plates).map(Some)
+        }
+    };
     let (discs, disc_fatigue): (Vec<_>, Vec<_>) = discs?.into_iter().unzip();
     let (plates, plate_fatigue): (Vec<_>, Vec<_>) = plates?.into_iter().unzip();
     Some(Validated {
@@ -325,5 +346,6 @@ pub(crate) fn validate(
             drum: drum.map_or(Some(None), |d| d.map(Some))?,
             stack: stack.map_or(Some(None), |s| s.map(Some))?,
         },
+        thermal: thermal?,
     })
 }

@@ -568,6 +568,7 @@ impl Session for MultibodySession {
                 Loop::Multirate(_) => self.counts.evals,
             },
             stopped_early: false,
+            thermal: None,
         };
         self.finished = Some(stats.clone());
         stats
