@@ -103,7 +103,7 @@ fn fmu_inputs_are_checked_against_their_scene_keys_bounds() {
         "pressure_out_of_bounds",
         &[
             "piston.pressure_pa = 1e15 Pa",
-            "1e8",
+            "[0, 100000000]",
             "stack.pressure.pressure_pa",
         ],
     );

@@ -497,7 +497,12 @@ fn bench_stops_on_a_signal_and_fifos_never_block() {
         .success());
     let o = wait(c);
     assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
-    assert!(stderr(&o).contains("interrupted (SIGINT)"));
+    assert!(
+        stderr(&o).contains("interrupted (SIGINT)"),
+        "stderr: {}\nstdout: {}",
+        stderr(&o),
+        super::stdout(&o)
+    );
     assert!(
         !stdout(&o).contains("growth"),
         "stopped before the pack section"
