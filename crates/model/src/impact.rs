@@ -261,8 +261,10 @@ mod tests {
             parabolic_peak((t1 - 1e-4, 150.0), (t1, 160.0), (t1 + 1e-14, 100.0)),
             None
         );
+        // the vertex by hand: t = 5/14, |F| = 160 + 60 t - 35 (t + 1) t = 164.4642857...
         let (tv, av) = parabolic_peak((-1.0, 100.0), (0.0, 160.0), (1.0, 150.0)).unwrap();
-        assert!(av > 160.0 && av < 161.0 && tv > 0.0, "{tv} {av}");
+        assert!((tv - 5.0 / 14.0).abs() < 1e-12, "{tv}");
+        assert!((av - 164.464_285_714_285_7).abs() < 1e-9, "{av}");
     }
 
     /// An event still open at the end of the history is closed at the last sample.
