@@ -8,6 +8,10 @@
 //! replaces only the explicit paths whose `--help` says so, and never a default name, which
 //! is made unique instead ([`Replace::Never`] commits under the first free name
 //! `<stem>-2.<ext>`, `<stem>-3.<ext>`, ..., checked and taken atomically by a hard link).
+//!
+//! Which paths may be outputs at all is one policy for every front end ([`check_outputs`]:
+//! the CLI, the FMU and Python call it before any work), so that no front end writes over a
+//! folder, a device, a FIFO or its own input.
 
 use std::fs::{File, OpenOptions};
 use std::io;
