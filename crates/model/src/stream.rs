@@ -73,6 +73,12 @@ pub trait Observer {
     /// time order together (the calls of different discs may interleave out of time order).
     /// They do not replace the samples: statistics and fatigue use the regular samples only.
     fn contact_sample(&mut self, _disc: usize, _t_s: f64, _state: &DiscSample) {}
+    /// A thermal run's temperatures at time `t_s` (s), at the end of each thermal window
+    /// (MODEL.md section 9): `bodies_k` one per body in the order of
+    /// [`crate::thermal::ThermalReport::final_k`] (the discs in scene order, then the plates),
+    /// K; `oil_k` the oil's, K. In time order with the samples; never called in an
+    /// isothermal run.
+    fn temperatures(&mut self, _t_s: f64, _bodies_k: &[f64], _oil_k: f64) {}
     /// Whether this observer takes [`Observer::contact_sample`]s; engines build and buffer
     /// them only then (asked once, at the start of a run). Default `false`: statistics,
     /// sweeps and benches run without their cost.
@@ -102,6 +108,8 @@ pub struct Collector {
     /// The contact samples `(disc, t s, state)` in the order they came
     /// ([`Observer::contact_sample`]).
     pub contacts: Vec<(usize, f64, DiscSample)>,
+    /// A thermal run's temperatures `(t s, bodies K, oil K)` ([`Observer::temperatures`]).
+    pub temperatures: Vec<(f64, Vec<f64>, f64)>,
 }
 
 impl Observer for Collector {
@@ -116,6 +124,9 @@ impl Observer for Collector {
     }
     fn contact_sample(&mut self, disc: usize, t_s: f64, state: &DiscSample) {
         self.contacts.push((disc, t_s, state.clone()));
+    }
+    fn temperatures(&mut self, t_s: f64, bodies_k: &[f64], oil_k: f64) {
+        self.temperatures.push((t_s, bodies_k.to_vec(), oil_k));
     }
     fn wants_contact_samples(&self) -> bool {
         true

@@ -45,6 +45,9 @@
 //! | `/interfaces/<lower>__<upper>` | `clutchpack.InterfaceState` | each sample, packs with a stack | `t_s, slip_rad_s, slip_m_s, mu, clamp_n, torque_n_m, locked, interface_index, dissipated_j` |
 //! | `/impacts` | `clutchpack.Impact` | each impact, at `t_peak_s` | `disc, disc_index, t_on_s, t_peak_s, t_off_s, flank, v_on_m_s, peak_n` |
 //! | `/discs/<segment>/impacts` | `clutchpack.Impact` | each impact of that disc, at `t_peak_s` | the same messages as `/impacts`: a per-disc series of the exact located peaks |
+//! | `/discs/<segment>/temperature` | `clutchpack.Temperature` | thermal runs: t = 0, then each thermal window's end | `t_s, temperature_k, body_index` |
+//! | `/oil/temperature` | `clutchpack.Temperature` | thermal runs, as above | the oil's `temperature_k`; `body_index` = the number of bodies |
+//! | `/scene/temperatures` | `foxglove.SceneUpdate` | thermal runs: when a body's colour changed (steps of 1/32 of the range) | every body's faces and rims coloured by temperature (blue .. yellow .. red over [`RecordOptions::temperature_color_range_k`]) and a legend naming the range and the oil's temperature |
 //! | `/summary` | `clutchpack.RunSummary` | once, written at the end, logged at t = 0 (so viewers show it on open) | `t_end_s, discs[]{name, index, max_positive_n, max_negative_n, p99_abs_n, impacts, positive_impacts, negative_impacts, mean_top10_abs_n}` |
 //!
 //! `<segment>` is the disc's scene name made topic-safe by [`topic_segment`]. The
@@ -138,7 +141,9 @@ pub use read::{
 pub use serve::{serve, ServeError, ServeOptions};
 pub use summary::{DiscStats, FatigueSummary, RunSummary, MAX_EXTRA_DISCS, TOP_N};
 pub use threaded::ThreadedRecorder;
-pub use write::{default_path, log_time_ns, RecordError, RecordOptions, Recorder};
+pub use write::{
+    auto_chunk_size_bytes, default_path, log_time_ns, RecordError, RecordOptions, Recorder,
+};
 
 /// A disc name made safe for a topic and frame name: every character other than
 /// `A-Z a-z 0-9 _ -` becomes `_` (an empty name becomes `_`). Repeated segments in one

@@ -38,6 +38,8 @@ pub const IMPACT: &str = "clutchpack.Impact";
 pub const RUN_SUMMARY: &str = "clutchpack.RunSummary";
 /// Full schema name of [`LoadSample`] (topics `/discs/<name>/load`).
 pub const LOAD_SAMPLE: &str = "clutchpack.LoadSample";
+/// Full schema name of [`Temperature`] (topics `/discs/<name>/temperature`, `/oil/temperature`).
+pub const TEMPERATURE: &str = "clutchpack.Temperature";
 
 /// The shaft at one sample (topic `/shaft`).
 #[derive(Clone, PartialEq, prost::Message)]
@@ -285,6 +287,22 @@ pub struct LoadSample {
     /// Index of the disc in the scene, from 0.
     #[prost(uint32, tag = "5")]
     pub disc_index: u32,
+}
+
+/// A body's or the oil's temperature in a thermal run, at the end of each thermal window
+/// (topics `/discs/<name>/temperature`, `/oil/temperature`; MODEL.md section 9).
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct Temperature {
+    /// Simulated time in s.
+    #[prost(double, tag = "1")]
+    pub t_s: f64,
+    /// Temperature in K.
+    #[prost(double, tag = "2")]
+    pub temperature_k: f64,
+    /// Index of the body in the scene (the discs, then the plates), from 0; the oil's is the
+    /// number of bodies.
+    #[prost(uint32, tag = "3")]
+    pub body_index: u32,
 }
 
 /// Field type in the schema tables.
@@ -655,6 +673,20 @@ pub(crate) const MESSAGES: &[MessageDef] = &[
             ),
         ],
     },
+    MessageDef {
+        name: "Temperature",
+        doc: "A body's or the oil's temperature in a thermal run, at the end of each thermal window. Topics /discs/<name>/temperature, /oil/temperature.",
+        fields: &[
+            f("t_s", 1, Double, "simulated time, s"),
+            f("temperature_k", 2, Double, "temperature, K"),
+            f(
+                "body_index",
+                3,
+                Uint32,
+                "index of the body in the scene (the discs, then the plates), from 0; the oil's is the number of bodies",
+            ),
+        ],
+    },
 ];
 
 fn json_name(name: &str) -> String {
@@ -934,6 +966,15 @@ mod tests {
             }
             .encode_to_vec(),
         );
+        check(
+            "Temperature",
+            Temperature {
+                t_s: 1.0,
+                temperature_k: 2.0,
+                body_index: 3,
+            }
+            .encode_to_vec(),
+        );
         let ds = DiscSummary {
             name: "a".into(),
             index: 2,
@@ -993,6 +1034,7 @@ mod tests {
             IMPACT,
             RUN_SUMMARY,
             LOAD_SAMPLE,
+            TEMPERATURE,
         ] {
             let short = name.strip_prefix("clutchpack.").unwrap();
             assert!(MESSAGES.iter().any(|m| m.name == short), "{name}");

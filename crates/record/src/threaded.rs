@@ -19,6 +19,8 @@ enum ToRecorder {
     Interfaces(f64, Vec<InterfaceSample>),
     /// `(disc, t s, state)` of a contact sample.
     Contact(usize, f64, DiscSample),
+    /// `(t s, bodies K, oil K)` of a thermal run.
+    Temperatures(f64, Vec<f64>, f64),
 }
 
 /// Items per batch handed to the recording thread. Handing over every sample on its own
@@ -101,6 +103,7 @@ impl ThreadedRecorder {
                         ToRecorder::Impact(e) => rec.impact(e),
                         ToRecorder::Interfaces(t, i) => rec.interfaces(*t, i),
                         ToRecorder::Contact(i, t, d) => rec.contact_sample(*i, *t, d),
+                        ToRecorder::Temperatures(t, b, oil) => rec.temperatures(*t, b, *oil),
                     }
                 }
                 // the wall-clock flush is checked once per batch
@@ -138,6 +141,12 @@ impl ThreadedRecorder {
     /// Hands the friction interfaces' states at `t_s` (s) to the recording thread (batched).
     pub fn push_interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
         self.push(ToRecorder::Interfaces(t_s, interfaces.to_vec()));
+    }
+
+    /// Hands a thermal run's temperatures at `t_s` (s) to the recording thread (batched;
+    /// [`Observer::temperatures`]: the bodies' and the oil's, K).
+    pub fn push_temperatures(&mut self, t_s: f64, bodies_k: &[f64], oil_k: f64) {
+        self.push(ToRecorder::Temperatures(t_s, bodies_k.to_vec(), oil_k));
     }
 
     /// Whether the recorder takes contact samples ([`RecordOptions::contact_samples`]).

@@ -59,6 +59,19 @@ pub fn load(segment: &str) -> String {
     format!("{DISCS_PREFIX}{segment}/load")
 }
 
+/// `/discs/<segment>/temperature`, `clutchpack.Temperature`: a thermal run's body
+/// temperature in K at the end of each thermal window (MODEL.md section 9).
+pub fn temperature(segment: &str) -> String {
+    format!("{DISCS_PREFIX}{segment}/temperature")
+}
+
+/// A thermal run's oil temperature in K, `clutchpack.Temperature`.
+pub const OIL_TEMPERATURE: &str = "/oil/temperature";
+/// A thermal run's temperature colours, `foxglove.SceneUpdate`: every message colours the
+/// faces of every body and carries the legend (the range and the oil's temperature), so that
+/// its latest message restores them all.
+pub const SCENE_TEMPERATURES: &str = "/scene/temperatures";
+
 /// `/discs/<segment>/teeth`, `clutchpack.ToothLoads`.
 pub fn teeth(segment: &str) -> String {
     format!("{DISCS_PREFIX}{segment}/teeth")

@@ -29,12 +29,19 @@
 //! stretches cost nothing. Redrawing every tooth for a lumped load (one colour for all) was
 //! measured at 10 kB per disc and update, 70 % of a recording's bytes and most of its
 //! writing time; the ring says the same in a few hundred bytes.
+//!
+//! A thermal run adds `/scene/temperatures` (the same schema, the same rule: every message
+//! carries every body): `disc/<name>/temperature`, a coat just outside each body's faces
+//! and rims coloured by its temperature (blue .. yellow .. red over the recording's range),
+//! and `temperature/legend`, a text above the pack's end naming the range in K and deg C and
+//! the oil's temperature. Sent when a body's colour level changed (steps of 1/32 of the
+//! range), about 5 kB per body.
 
 use crate::info::{DiscGeometry, RunInfo, ShaftGeometry};
 use foxglove::schemas::{
     line_primitive, packed_element_field, Color, CubePrimitive, CylinderPrimitive, FrameTransform,
     FrameTransforms, LinePrimitive, PackedElementField, Point3, PointCloud, Pose, Quaternion,
-    SceneEntity, SceneUpdate, Timestamp, TriangleListPrimitive, Vector3,
+    SceneEntity, SceneUpdate, TextPrimitive, Timestamp, TriangleListPrimitive, Vector3,
 };
 use parry3d_f64::math::Vector;
 use parry3d_f64::shape::{ConvexPolyhedron, Cuboid};
@@ -452,6 +459,118 @@ pub(crate) fn load_scene(
     }
 }
 
+/// The colour of a temperature level `x = (T - T_lo) / (T_hi - T_lo)`, clamped to 0..=1:
+/// blue at 0, yellow at 0.5, red at 1 (the legend of [`temperature_scene`] names the
+/// range).
+pub fn temperature_color(x: f64) -> Color {
+    let x = if x.is_finite() {
+        x.clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    let (blue, yellow, red) = ([0.1, 0.35, 1.0], [1.0, 0.85, 0.0], [1.0, 0.0, 0.0]);
+    let (a, b, s) = if x < 0.5 {
+        (blue, yellow, x / 0.5)
+    } else {
+        (yellow, red, (x - 0.5) / 0.5)
+    };
+    let mix = |i: usize| a[i] + s * (b[i] - a[i]);
+    Color {
+        r: mix(0),
+        g: mix(1),
+        b: mix(2),
+        a: 1.0,
+    }
+}
+
+/// A coat over an annulus `r0..r1` between `z = -z` and `z = +z`: its two flat faces and
+/// its outer and inner rims, as triangles of [`RING_SEGMENTS`] quads each (no thickness), so
+/// that a body shows its colour from the axis' end and from the side of a stacked pack.
+fn coat(r0: f64, r1: f64, z: f64, color: Color) -> TriangleListPrimitive {
+    let mut m = mesh(Some(color));
+    let n = RING_SEGMENTS;
+    let at = |r: f64, k: u32, z: f64| {
+        let a = 2.0 * PI * f64::from(k % n) / f64::from(n);
+        Point3 {
+            x: r * a.cos(),
+            y: r * a.sin(),
+            z,
+        }
+    };
+    // each quad (p0, p1, q0, q1) as two triangles; faces at z = -z and +z, rims at r1, r0
+    let quads = [
+        ((r0, -z), (r1, -z)),
+        ((r0, z), (r1, z)),
+        ((r1, -z), (r1, z)),
+        ((r0, -z), (r0, z)),
+    ];
+    for ((ra, za), (rb, zb)) in quads {
+        for k in 0..n {
+            let (p0, p1) = (at(ra, k, za), at(rb, k, zb));
+            let (q0, q1) = (at(ra, k + 1, za), at(rb, k + 1, zb));
+            m.points.extend([p0, p1, q0, q0, p1, q1]);
+        }
+    }
+    m
+}
+
+/// The temperature colours of every body and a legend: `disc/<name>/temperature`, the
+/// faces and rims of the body's annulus ([`coat`], just outside the body) coloured by
+/// [`temperature_color`] of `(T - lo) / (hi - lo)`, and `temperature/legend` in the world
+/// frame above the pack's end naming the range and the oil's temperature. `bodies_k`
+/// (K) in the order of `info.discs`; `range_k` `(lo, hi)` in K.
+pub(crate) fn temperature_scene(
+    log_time_ns: u64,
+    info: &RunInfo,
+    frames: &[String],
+    bodies_k: &[f64],
+    oil_k: f64,
+    range_k: (f64, f64),
+) -> SceneUpdate {
+    let (lo, hi) = range_k;
+    let span = (hi - lo).max(f64::MIN_POSITIVE);
+    let mut entities = Vec::with_capacity(bodies_k.len() + 1);
+    let mut top = 0.0_f64;
+    for ((d, frame), &t_k) in info.discs.iter().zip(frames).zip(bodies_k) {
+        let mut e = entity(log_time_ns, frame, &format!("{frame}/temperature"));
+        let (r0, r1) = (
+            d.inner_radius_m.min(d.outer_radius_m),
+            d.outer_radius_m.max(d.inner_radius_m),
+        );
+        top = top.max(r1);
+        let z = 0.5 * d.thickness_m.abs().max(1e-6) * 1.05;
+        // just outside the body (the rims 1 % out), so the coat hides its surfaces
+        let color = temperature_color((t_k - lo) / span);
+        e.triangles.push(coat(0.99 * r0, 1.01 * r1, z, color));
+        entities.push(e);
+    }
+    let s = drawn_shaft(info);
+    let c = |t_k: f64| {
+        let deg_c = clutchpack_model::thermal::deg_c_from_kelvin(t_k);
+        format!("{t_k:.1} K ({deg_c:.1} degC)")
+    };
+    let mut legend = entity(log_time_ns, WORLD_FRAME, "temperature/legend");
+    legend.frame_locked = false;
+    legend.texts.push(TextPrimitive {
+        pose: pose(0.0, 0.0, s.z_max_m + 0.5 * top.max(1e-3), 0.0),
+        billboard: true,
+        font_size: 14.0,
+        scale_invariant: true,
+        color: rgba(1.0, 1.0, 1.0, 1.0),
+        text: format!(
+            "faces by temperature: blue {} .. yellow .. red {}; oil {}",
+            c(lo),
+            c(hi),
+            c(oil_k)
+        ),
+    });
+    entities.push(legend);
+    SceneUpdate {
+        deletions: Vec::new(),
+        entities,
+    }
+}
+
 /// The per-tooth view of the discs `levels` names, `(disc index, level of each drawn tooth)`:
 /// the teeth redrawn as cubes, tooth `k` coloured by its level `max |load_k| / scale`
 /// (0..=1). Other discs' teeth are left as they are.
@@ -685,6 +804,49 @@ mod tests {
             ..info
         };
         assert_eq!(drawn_shaft(&info), given);
+    }
+
+    /// A thermal update colours every body by its temperature over the range (blue at its
+    /// low end, red at its high end and beyond), with a coat just outside the body's faces
+    /// and rims, and carries the legend naming the range and the oil.
+    #[test]
+    fn temperature_colours_coat_every_body_and_name_the_range() {
+        let info = RunInfo {
+            discs: vec![disc(30, 0.0), disc(30, 0.01)],
+            ..Default::default()
+        };
+        let frames = ["disc/a".to_string(), "disc/b".to_string()];
+        let u = temperature_scene(5, &info, &frames, &[313.15, 450.0], 320.0, (313.15, 413.15));
+        assert_eq!(u.entities.len(), 3);
+        for (e, want) in u
+            .entities
+            .iter()
+            .zip([temperature_color(0.0), temperature_color(1.0)])
+        {
+            assert!(e.id.ends_with("/temperature"), "{}", e.id);
+            let m = &e.triangles[0];
+            assert_eq!(m.color, Some(want));
+            // four quads' rings of RING_SEGMENTS quads, two triangles each
+            assert_eq!(m.points.len(), 4 * RING_SEGMENTS as usize * 6);
+            for p in &m.points {
+                let r = p.x.hypot(p.y);
+                assert!(
+                    (0.99 * 0.05 - 1e-12..=1.01 * 0.08 + 1e-12).contains(&r),
+                    "{r}"
+                );
+                assert!(p.z.abs() >= 0.001 - 1e-12, "outside the body: {}", p.z);
+            }
+        }
+        assert_eq!(
+            (temperature_color(0.0).b, temperature_color(1.0).r),
+            (1.0, 1.0)
+        );
+        let legend = &u.entities[2].texts[0].text;
+        assert!(
+            legend.contains("313.1 K (40.0 degC)") && legend.contains("413.1 K (140.0 degC)"),
+            "{legend}"
+        );
+        assert!(legend.contains("oil 320.0 K"), "{legend}");
     }
 
     /// Every disc's load ring lies over its teeth: a closed loop at the middle of the teeth

@@ -29,16 +29,20 @@ pub struct RecordOptions {
     /// Longest wall time between two chunk flushes; a killed run loses at most about this
     /// much. Ignored when `deterministic`. Default 1 s.
     pub flush_interval: Duration,
-    /// Flush the chunk after this many messages at most (deterministic). Default 100 000.
+    /// Flush the chunk after this many messages at most (deterministic). Default 1 000 000
+    /// (the chunk size ends chunks first: about 200 000 messages in pack-8-brake's).
     pub flush_messages: usize,
-    /// Target uncompressed chunk size in bytes: a chunk is ended once it is larger.
-    /// Default 4 MiB. The `mcap` writer keeps every chunk's index entry (with its
-    /// per-channel message-index offsets, about 0.7 kB of heap for our 17 channels) in memory
-    /// until the summary section is written, so the chunk count is the one part of a
-    /// recording run's memory that grows with the run: 1 MiB chunks cost about 3 MB of heap
-    /// (and 6 MB of peak RSS, with the allocator's fragmentation) by the end of a 300 s
-    /// `pack-4-rattle` run, 4 MiB chunks a quarter of that (docs/DECISIONS.md).
-    pub chunk_size_bytes: u64,
+    /// Target uncompressed chunk size in bytes: a chunk is ended once it is larger. `None`
+    /// (the default): [`auto_chunk_size_bytes`] of the run's bodies and friction interfaces,
+    /// 768 KiB each, between 4 and 64 MiB. The `mcap` writer keeps every chunk's index entry
+    /// in memory until the summary section is written (and `finish` clones them all), and an
+    /// entry holds one message-index offset per channel written in the chunk: about 1.2 kB
+    /// of heap for pack-8-brake's 17 bodies and 16 interfaces. So the chunk count is what
+    /// grows with a recorded run, and chunks that grow with the pack keep the index's heap
+    /// per recorded byte the same for every pack: pack-8-brake (35 MB of file per simulated
+    /// second) at 4 MiB chunks grew from 20 MB of peak RSS at 10 s to 73 MB at 600 s; at
+    /// 24 MiB see README, "Memory of long runs" (docs/DECISIONS.md).
+    pub chunk_size_bytes: Option<u64>,
     /// zstd level (1..=19; 0 = zstd's default, 3). Default 1, zstd's fastest: on a 3 s
     /// paper-case run its file was 1.5 % larger than level 3's.
     pub compression_level: u32,
@@ -56,6 +60,10 @@ pub struct RecordOptions {
     /// `|load_n|` in N drawn in full red in `/scene`; `None` uses the largest `|load_n|` seen
     /// so far in the run. Default `None`.
     pub load_color_scale_n: Option<f64>,
+    /// Temperatures `(blue, red)` in K of a thermal run's `/scene/temperatures` colours;
+    /// `None`: from the run's first temperature (the lowest body or oil) to 100 K above it.
+    /// Default `None`.
+    pub temperature_color_range_k: Option<(f64, f64)>,
     /// Write `/discs/<name>/load`: each disc's load at the engine's contact samples
     /// ([`Observer::contact_sample`]) and at the samples with a load (and the first; in
     /// between the load is 0), the series that shows the contact pulses and their peaks.
@@ -70,12 +78,13 @@ impl Default for RecordOptions {
             deterministic: false,
             per_tooth: false,
             flush_interval: Duration::from_secs(1),
-            flush_messages: 100_000,
-            chunk_size_bytes: 4 << 20,
+            flush_messages: 1_000_000,
+            chunk_size_bytes: None,
             compression_level: 1,
             tf_interval_s: 2e-4,
             scene_interval_s: 1e-3,
             load_color_scale_n: None,
+            temperature_color_range_k: None,
             contact_samples: true,
         }
     }
@@ -210,6 +219,14 @@ fn next_tick(t: f64, interval: f64) -> f64 {
     }
 }
 
+/// The chunk size of a recording of `bodies` discs and plates and `interfaces` friction
+/// interfaces, bytes: 768 KiB each, at least 4 MiB and at most 64 MiB
+/// ([`RecordOptions::chunk_size_bytes`]).
+pub fn auto_chunk_size_bytes(bodies: usize, interfaces: usize) -> u64 {
+    let n = (bodies + interfaces) as u64;
+    (n * (768 << 10)).clamp(4 << 20, 64 << 20)
+}
+
 /// A colour level (0..=1) in steps of 1/16: a colour is sent again only when this changes.
 fn quantize(level: f64) -> u8 {
     (level * 16.0).round() as u8
@@ -242,6 +259,21 @@ struct Channels {
     /// `/discs/<segment>/load`: each disc's load at the samples and the contact samples
     /// (empty without [`RecordOptions::contact_samples`])
     load: Vec<u16>,
+}
+
+/// A thermal run's channels and colours, made at its first temperatures (an isothermal
+/// recording has none of them).
+struct ThermalChannels {
+    /// `/discs/<segment>/temperature`, one per body
+    bodies: Vec<u16>,
+    /// `/oil/temperature`
+    oil: u16,
+    /// `/scene/temperatures`
+    scene: u16,
+    /// `(blue, red)` of the colours, K
+    range_k: (f64, f64),
+    /// colour level of each body last sent, in 1/32 (`u8::MAX`: none yet)
+    levels: Vec<u8>,
 }
 
 /// Streams a run into an MCAP file. See the crate documentation for the topics.
@@ -300,6 +332,8 @@ pub struct Recorder {
     last_t_s: f64,
     messages: u64,
     stats: Option<RunStats>,
+    /// a thermal run's channels (from its first temperatures)
+    thermal: Option<ThermalChannels>,
 }
 
 /// Impacts held for ordering at most (about 5 MB): beyond, the earliest is written even if
@@ -392,7 +426,14 @@ impl Recorder {
             // writes of every MCAP message record. Single-threaded zstd output is the same on
             // every machine, which keeps deterministic recordings byte-identical.
             .compression_threads(0)
-            .chunk_size(Some(options.chunk_size_bytes.max(1)))
+            .chunk_size(Some(
+                options
+                    .chunk_size_bytes
+                    .unwrap_or_else(|| {
+                        auto_chunk_size_bytes(info.discs.len(), info.interfaces.len())
+                    })
+                    .max(1),
+            ))
             .library(format!(
                 "clutchpack_record {} (mcap-rs {})",
                 env!("CARGO_PKG_VERSION"),
@@ -647,6 +688,7 @@ impl Recorder {
             last_t_s: 0.0,
             messages: 0,
             stats: None,
+            thermal: None,
         };
         let static_scene = view3d::static_scene(&rec.info, &rec.frames);
         rec.put(rec.ch.scene, 0, &static_scene, "/scene")?;
@@ -1060,6 +1102,118 @@ impl Recorder {
         self.maybe_flush()
     }
 
+    /// Writes a thermal run's temperatures at `t_s` (s): `bodies_k` (K, in the order of the
+    /// run info's discs: the discs, then the plates) on `/discs/<segment>/temperature`,
+    /// `oil_k` (K) on `/oil/temperature`, and, when a body's colour level changed (steps of
+    /// 1/32 of the range), every body's colour and the legend on `/scene/temperatures`. The
+    /// channels are made at the first call.
+    pub fn write_temperatures(
+        &mut self,
+        t_s: f64,
+        bodies_k: &[f64],
+        oil_k: f64,
+    ) -> Result<(), RecordError> {
+        if self.failed {
+            return Err(self.failed_err());
+        }
+        if self.thermal.is_none() {
+            let lo = bodies_k.iter().copied().fold(oil_k, f64::min);
+            let range_k = self
+                .options
+                .temperature_color_range_k
+                .unwrap_or((lo, lo + 100.0));
+            self.thermal = Some(self.thermal_channels(range_k)?);
+        }
+        let Some(th) = self.thermal.as_mut() else {
+            return Ok(());
+        };
+        let lt = log_time_ns(t_s);
+        let (lo, hi) = th.range_k;
+        let span = (hi - lo).max(f64::MIN_POSITIVE);
+        let mut changed = false;
+        let mut puts = Vec::with_capacity(bodies_k.len() + 1);
+        for (i, &t_k) in bodies_k.iter().enumerate() {
+            if let Some(&ch) = th.bodies.get(i) {
+                puts.push((ch, i, t_k));
+            }
+            let q = ((t_k - lo) / span * 32.0).round().clamp(0.0, 32.0) as u8;
+            if let Some(l) = th.levels.get_mut(i) {
+                changed |= *l != q;
+                *l = q;
+            }
+        }
+        puts.push((th.oil, bodies_k.len(), oil_k));
+        let (scene, range_k) = (th.scene, th.range_k);
+        for (ch, i, t_k) in puts {
+            let msg = proto::Temperature {
+                t_s,
+                temperature_k: t_k,
+                body_index: i as u32,
+            };
+            self.put(ch, lt, &msg, "temperature")?;
+        }
+        if changed {
+            let update =
+                view3d::temperature_scene(lt, &self.info, &self.frames, bodies_k, oil_k, range_k);
+            self.put(scene, lt, &update, "/scene/temperatures")?;
+        }
+        self.maybe_flush()
+    }
+
+    /// Makes a thermal run's channels ([`Self::write_temperatures`]).
+    fn thermal_channels(&mut self, range_k: (f64, f64)) -> Result<ThermalChannels, RecordError> {
+        let path = self.path.clone();
+        let err = |what: &str, cause| RecordError::Write {
+            path: path.clone(),
+            what: what.to_string(),
+            cause,
+        };
+        let Some(w) = self.writer.as_mut() else {
+            return Err(self.failed_err());
+        };
+        let none = BTreeMap::new();
+        use foxglove::Encode as _;
+        let scene_schema = foxglove::schemas::SceneUpdate::get_schema()
+            .map(|s| s.data.into_owned())
+            .unwrap_or_default();
+        let s_scene = w
+            .add_schema("foxglove.SceneUpdate", "protobuf", &scene_schema)
+            .map_err(|e| err("schema", e))?;
+        let s_temp = w
+            .add_schema(
+                proto::TEMPERATURE,
+                "protobuf",
+                &proto::file_descriptor_set(),
+            )
+            .map_err(|e| err("schema", e))?;
+        let segments = unique_segments(&self.names);
+        let mut bodies = Vec::with_capacity(segments.len());
+        for (i, (name, seg)) in self.names.iter().zip(&segments).enumerate() {
+            let meta: BTreeMap<String, String> = [
+                ("body".to_string(), name.clone()),
+                ("body_index".to_string(), i.to_string()),
+            ]
+            .into();
+            bodies.push(
+                w.add_channel(s_temp, &topics::temperature(seg), "protobuf", &meta)
+                    .map_err(|e| err("channel", e))?,
+            );
+        }
+        let oil = w
+            .add_channel(s_temp, topics::OIL_TEMPERATURE, "protobuf", &none)
+            .map_err(|e| err("channel", e))?;
+        let scene = w
+            .add_channel(s_scene, topics::SCENE_TEMPERATURES, "protobuf", &none)
+            .map_err(|e| err("channel", e))?;
+        Ok(ThermalChannels {
+            bodies,
+            oil,
+            scene,
+            range_k,
+            levels: vec![u8::MAX; self.names.len()],
+        })
+    }
+
     /// Writes one impact on `/impacts`, logged at its peak time `t_peak_s`.
     pub fn write_impact(&mut self, e: &ImpactEvent) -> Result<(), RecordError> {
         if self.failed {
@@ -1242,6 +1396,13 @@ impl Observer for Recorder {
     fn contact_sample(&mut self, disc: usize, t_s: f64, state: &DiscSample) {
         if !self.failed {
             let r = self.write_contact_sample(disc, t_s, state);
+            self.keep(r);
+        }
+    }
+
+    fn temperatures(&mut self, t_s: f64, bodies_k: &[f64], oil_k: f64) {
+        if !self.failed {
+            let r = self.write_temperatures(t_s, bodies_k, oil_k);
             self.keep(r);
         }
     }

@@ -357,7 +357,7 @@ fn killed_mid_chunk_keeps_the_flushed_chunks() {
     let path = tmp("killed-mid-chunk.mcap");
     let opts = RecordOptions {
         // no chunk ends by itself in this test: only the explicit flush below
-        chunk_size_bytes: 1 << 30,
+        chunk_size_bytes: Some(1 << 30),
         flush_messages: usize::MAX,
         ..options()
     };

@@ -29,6 +29,8 @@ enum Item {
     Interfaces(f64, Vec<InterfaceSample>),
     Impact(ImpactEvent),
     Contact(usize, f64, DiscSample),
+    /// A thermal window's end: the bodies' temperatures, then the oil's, K.
+    Temperatures(f64, Vec<f64>),
 }
 
 impl Item {
@@ -36,7 +38,7 @@ impl Item {
     fn t_s(&self) -> f64 {
         match self {
             Item::Sample(s) => s.t_s,
-            Item::Interfaces(t, _) | Item::Contact(_, t, _) => *t,
+            Item::Interfaces(t, _) | Item::Contact(_, t, _) | Item::Temperatures(t, _) => *t,
             Item::Impact(e) => e.t_off_s,
         }
     }
@@ -59,6 +61,10 @@ impl Queue {
     }
     pub fn impact(&mut self, e: ImpactEvent) {
         self.items.push_back(Item::Impact(e));
+    }
+    /// A thermal run's temperatures at `t` (s): the bodies', then the oil's, K.
+    pub fn temperatures(&mut self, t: f64, k: &[f64]) {
+        self.items.push_back(Item::Temperatures(t, k.to_vec()));
     }
     /// The contact sample of the coupling in `slot` of `sys` at `t` (state `y`), if the
     /// observer takes them.
@@ -93,6 +99,11 @@ impl Queue {
                 Item::Interfaces(t, i) => obs.interfaces(t, &i),
                 Item::Impact(e) => obs.impact(&e),
                 Item::Contact(d, t, s) => obs.contact_sample(d, t, &s),
+                Item::Temperatures(t, k) => {
+                    if let Some((oil, bodies)) = k.split_last() {
+                        obs.temperatures(t, bodies, *oil);
+                    }
+                }
             }
         }
     }
@@ -256,6 +267,8 @@ impl MonolithicSession {
         if let Some(pack) = th.initial_pack(&self.st.sys.pack) {
             swap_pack(&mut self.st, pack);
         }
+        // the temperatures at t = 0, the first point of their series
+        self.queue.temperatures(self.st.t, th.temperatures_k());
         self.thermal = Some(Box::new(th));
         Ok(self)
     }
@@ -329,7 +342,12 @@ impl Session for MonolithicSession {
                 self.st.restart();
             }
             if let Some(th) = self.thermal.as_mut() {
-                match th.close_windows(self.st.t, &self.st.sys.pack) {
+                let windows = th.windows();
+                let closed = th.close_windows(self.st.t, &self.st.sys.pack);
+                if th.windows() != windows {
+                    self.queue.temperatures(self.st.t, th.temperatures_k());
+                }
+                match closed {
                     Ok(Some(pack)) => swap_pack(&mut self.st, pack),
                     Ok(None) => {}
                     Err(e) => {
@@ -369,10 +387,20 @@ impl Session for MonolithicSession {
         self.st.finish(&mut QueueSink {
             queue: &mut self.queue,
         });
+        let t = self.st.t;
+        let thermal = self.thermal.as_mut().map(|th| {
+            // the last (partial) window closes at the run's end
+            let windows = th.windows();
+            let report = th.finish(t);
+            if th.windows() != windows {
+                self.queue.temperatures(t, th.temperatures_k());
+            }
+            report
+        });
         self.queue.flush(f64::INFINITY, obs);
         let mut stats = self.st.stats.clone();
         stats.simulated_s = self.clock.t;
-        stats.thermal = self.thermal.as_mut().map(|th| th.finish(self.st.t));
+        stats.thermal = thermal;
         stats
     }
 

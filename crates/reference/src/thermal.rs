@@ -232,6 +232,16 @@ impl Thermal {
         self.report.impact_heat_j += q;
     }
 
+    /// Thermal windows closed so far.
+    pub fn windows(&self) -> u64 {
+        self.report.windows
+    }
+
+    /// The temperatures now, K: the bodies (discs, then plates), then the oil.
+    pub fn temperatures_k(&self) -> &[f64] {
+        &self.temp
+    }
+
     /// Closes the windows that ended by the stepper's time `t` (s): advances the temperatures
     /// over `[t_w, t]` and returns the pack with the new parameters when they changed.
     /// An error when the oil's temperature has left the viscosity law (Vogel's `eta` is

@@ -300,6 +300,12 @@ impl Observer for RunObserver<'_, '_> {
             r.push_interfaces(t_s, interfaces);
         }
     }
+    fn temperatures(&mut self, t_s: f64, bodies_k: &[f64], oil_k: f64) {
+        self.collector.temperatures(t_s, bodies_k, oil_k);
+        if let Some(r) = &mut self.recorder {
+            r.push_temperatures(t_s, bodies_k, oil_k);
+        }
+    }
     fn contact_sample(&mut self, disc: usize, t_s: f64, state: &DiscSample) {
         self.collector.contact_sample(disc, t_s, state);
         if let Some(r) = &mut self.recorder {

@@ -101,3 +101,69 @@ fn a_stopped_run_and_a_refused_engine() {
     assert!(e.is_bad_input(), "{e}");
     assert!(e.to_string().contains("initial_offset_m"), "{e}");
 }
+
+/// Issue 35: a thermal run's recording carries every body's and the oil's temperature from
+/// t = 0 to the end, window by window, ending at the run's reported final temperatures, and
+/// colours the bodies in 3D; an isothermal recording has none of these topics.
+#[test]
+fn a_thermal_recording_carries_every_temperature() {
+    let dir = std::env::temp_dir().join(format!("clutchpack-sdk-thermal-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let record = |scene: &str, out: &str| {
+        let scene = load_scene(
+            Some(&scene_file(scene)),
+            &["simulation.duration_s=0.05".parse().unwrap()],
+        )
+        .unwrap();
+        let mut sim = Simulation::new(scene, None).unwrap();
+        let path = dir.join(out);
+        let outcome = sim
+            .run(RunRequest {
+                recording: Some(clutchpack_sdk::RecordingRequest {
+                    path: path.clone(),
+                    replace: clutchpack_record::Replace::Existing,
+                    options: Default::default(),
+                    scene_path: None,
+                }),
+                ..Default::default()
+            })
+            .unwrap();
+        let stats = outcome.result.clone().unwrap();
+        outcome.recording.unwrap().unwrap();
+        let rec = clutchpack_record::open_complete(&path).unwrap();
+        (stats, rec)
+    };
+    let (stats, rec) = record("pack-6-thermal.toml", "thermal.mcap");
+    let report = stats.thermal.expect("a thermal report");
+    let temps = rec.temperatures();
+    let bodies = report.final_k.len();
+    assert_eq!(temps.len(), bodies + 1, "every body and the oil");
+    let windows = report.windows as usize;
+    for (i, series) in temps.iter().enumerate() {
+        // t = 0, then one point per window
+        assert_eq!(series.len(), windows + 1, "body {i}");
+        assert_eq!(series[0].t_s, 0.0);
+        assert!(series.windows(2).all(|w| w[0].t_s < w[1].t_s), "body {i}");
+        assert!(
+            (series[windows].t_s - 0.05).abs() < 1e-9,
+            "{}",
+            series[windows].t_s
+        );
+        let last = series[windows].temperature_k;
+        let want = if i < bodies {
+            report.final_k[i]
+        } else {
+            report.oil_final_k
+        };
+        assert_eq!(last, want, "body {i}");
+    }
+    let has = |r: &clutchpack_record::RecordingReader, topic: &str| {
+        r.info().topic(topic).is_some_and(|t| t.messages > 0)
+    };
+    assert!(has(&rec, "/scene/temperatures"));
+    assert!(has(&rec, "/oil/temperature"));
+    let (_, iso) = record("pack-6-engagement.toml", "iso.mcap");
+    assert!(iso.temperatures().is_empty());
+    assert!(!has(&iso, "/scene/temperatures"));
+    std::fs::remove_dir_all(&dir).ok();
+}

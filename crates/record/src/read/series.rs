@@ -216,6 +216,25 @@ impl RecordingReader {
         out
     }
 
+    /// A thermal run's temperatures (`/discs/<name>/temperature` and `/oil/temperature`),
+    /// indexed by body index (the discs, then the plates; the oil last, at the number of
+    /// bodies), each in file order, which is time order; empty for an isothermal recording.
+    pub fn temperatures(&self) -> Vec<Vec<proto::Temperature>> {
+        let mut out: Vec<Vec<proto::Temperature>> = Vec::new();
+        self.for_each_message(|v| {
+            if v.schema_name == proto::TEMPERATURE {
+                if let Ok(m) = proto::Temperature::decode(v.data) {
+                    let i = m.body_index as usize;
+                    if out.len() <= i {
+                        out.resize(i + 1, Vec::new());
+                    }
+                    out[i].push(m);
+                }
+            }
+        });
+        out
+    }
+
     /// Each disc's per-tooth load history (t in s, load in N), in disc-index order: what
     /// `plot` draws, so every sample of every disc is held.
     pub fn load_histories(&self) -> Vec<LoadHistory> {
