@@ -43,6 +43,18 @@ pub struct RunArgs {
     /// leaves the rows up to there.
     #[arg(long, value_name = "FILE")]
     pub impacts_csv: Option<PathBuf>,
+    /// Also give the figures window by window, S seconds each: per window the impacts, the
+    /// largest per-tooth peak and its body, the largest 99th percentile, the worst body's
+    /// tooth damage rate and, in a thermal run, the oil's and the hottest body's temperature
+    /// at its end (a table, and `windows` in `--summary-json`).
+    #[arg(long, value_name = "S")]
+    pub windows: Option<f64>,
+    /// Plot the windows' figures against time (PNG or SVG by extension; an existing FILE is
+    /// replaced): each body's largest peak per tooth and its damage rate (log10; the bodies
+    /// whose largest peak is at least a tenth of the run's) and, in a thermal run, the oil's
+    /// and the hottest body's temperature. Needs `--windows`.
+    #[arg(long, value_name = "FILE", requires = "windows")]
+    pub windows_plot: Option<PathBuf>,
     /// Plot the per-tooth load history of each disc (PNG or SVG by extension; an existing
     /// FILE is replaced). Keeps every sample in memory until the run ends.
     #[arg(long, value_name = "FILE")]
@@ -112,9 +124,10 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         ("--fatigue-json", a.fatigue_json.as_deref()),
         ("--impacts-csv", a.impacts_csv.as_deref()),
         ("--plot", a.plot.as_deref()),
+        ("--windows-plot", a.windows_plot.as_deref()),
     ] {
         if let Some(path) = p {
-            outs.push(if flag == "--plot" {
+            outs.push(if flag == "--plot" || flag == "--windows-plot" {
                 Output::figure(flag, path)
             } else {
                 Output::file(flag, path)
@@ -159,6 +172,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             keep_cycles: a.fatigue_json.is_some(),
             impacts_csv: a.impacts_csv.clone(),
             recording,
+            windows_s: a.windows,
             stop: Some(&*interrupted),
             progress: Some(&mut progress),
         })
@@ -191,6 +205,78 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         let title = format!("{}: per-tooth load ({} engine)", scene.name, done.engine);
         crate::outputs::write_with(path, |tmp| {
             clutchpack_analysis::plot_load_history(tmp, &title, &series)
+                .with_context(|| format!("plotting {}", path.display()))
+        })?;
+    }
+    if let Some(path) = &a.windows_plot {
+        let windows = &done.windows;
+        let mid = |w: &clutchpack_sdk::WindowRow| 0.5 * (w.t0_s + w.t1_s);
+        let series = |name: &str, f: &dyn Fn(&clutchpack_sdk::WindowRow) -> Option<f64>| {
+            let pts = windows
+                .iter()
+                .filter_map(|w| f(w).map(|y| (mid(w), y)))
+                .collect();
+            (name.to_string(), pts)
+        };
+        let bodies = windows.first().map_or(0, |w| w.bodies.len());
+        // the bodies that hit at all: a largest peak of at least a tenth of the run's (a
+        // plate resting on its flank would only crowd the figure)
+        let largest = |i: usize| {
+            windows
+                .iter()
+                .filter_map(|w| w.bodies.get(i))
+                .map(|b| b.peak_abs_n)
+                .fold(0.0, f64::max)
+        };
+        let top = (0..bodies).map(largest).fold(0.0, f64::max);
+        let shown: Vec<usize> = (0..bodies).filter(|&i| largest(i) >= 0.1 * top).collect();
+        let by_body = |f: &dyn Fn(&clutchpack_sdk::BodyWindow) -> f64| {
+            shown
+                .iter()
+                .map(|&i| {
+                    let name = windows[0].bodies[i].name.clone();
+                    let pts = windows
+                        .iter()
+                        .filter_map(|w| w.bodies.get(i).map(|b| (mid(w), f(b))))
+                        .collect();
+                    (name, pts)
+                })
+                .collect::<Vec<_>>()
+        };
+        let mut panels = vec![
+            clutchpack_analysis::Panel {
+                y_label: "largest |peak| per tooth [N]".into(),
+                series: by_body(&|b| b.peak_abs_n),
+            },
+            clutchpack_analysis::Panel {
+                y_label: "log10 damage rate [log10 1/h]".into(),
+                // rates below 1e-12 per hour (a million years) are left out
+                series: by_body(&|b| {
+                    if b.damage_rate_per_h >= 1e-12 {
+                        b.damage_rate_per_h.log10()
+                    } else {
+                        f64::NAN
+                    }
+                }),
+            },
+        ];
+        if windows.iter().any(|w| w.oil_k.is_some()) {
+            panels.push(clutchpack_analysis::Panel {
+                y_label: "temperature [K]".into(),
+                series: vec![
+                    series("oil", &|w| w.oil_k),
+                    series("hottest body", &|w| w.hottest_body_k),
+                ],
+            });
+        }
+        let title = format!(
+            "{}: by window of {} s ({} engine)",
+            scene.name,
+            clutchpack_model::fmt_num(a.windows.unwrap_or(0.0)),
+            done.engine
+        );
+        crate::outputs::write_with(path, |tmp| {
+            clutchpack_analysis::plot_panels(tmp, &title, "window's middle [s]", &panels)
                 .with_context(|| format!("plotting {}", path.display()))
         })?;
     }
@@ -300,6 +386,60 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             th.cooler_j,
             th.balance_error_j
         );
+    }
+    if !summary.windows.is_empty() {
+        out!("by window (the worst body in each; damage rate: lumped teeth, MODEL.md section 7)");
+        out!(
+            "{:>8} {:>8} {:>8} {:>11} {:<12} {:>10} {:>12} {:<12} {:>9} {:>9}",
+            "t0_s",
+            "t1_s",
+            "impacts",
+            "peak_abs_n",
+            "body",
+            "p99_abs_n",
+            "damage_1/h",
+            "body",
+            "oil_k",
+            "hottest_k"
+        );
+        let k = |t: Option<f64>| t.map_or("-".to_string(), |t| format!("{t:.2}"));
+        for w in &summary.windows {
+            out!(
+                "{:>8.3} {:>8.3} {:>8} {:>11.1} {:<12} {:>10.1} {:>12.4e} {:<12} {:>9} {:>9}",
+                w.t0_s,
+                w.t1_s,
+                w.impacts,
+                w.peak_abs_n,
+                w.peak_body,
+                w.p99_abs_n,
+                w.damage_rate_per_h,
+                w.damage_body,
+                k(w.oil_k),
+                k(w.hottest_body_k)
+            );
+        }
+    }
+    if let Some(first) = summary.windows.first() {
+        out!("largest per-tooth |peak| (N) and damage rate (1/h) by body and window end (s)");
+        let mut head = format!("{:<12}", "body");
+        for w in &summary.windows {
+            head.push_str(&format!(" {:>10.3}", w.t1_s));
+        }
+        out!("{head}");
+        for (i, b) in first.bodies.iter().enumerate() {
+            let mut peaks = format!("{:<12}", b.name);
+            let mut rates = format!("{:<12}", "");
+            for w in &summary.windows {
+                let bw = w.bodies.get(i);
+                peaks.push_str(&format!(" {:>10.1}", bw.map_or(0.0, |b| b.peak_abs_n)));
+                rates.push_str(&format!(
+                    " {:>10.3e}",
+                    bw.map_or(0.0, |b| b.damage_rate_per_h)
+                ));
+            }
+            out!("{peaks}");
+            out!("{rates}");
+        }
     }
     if let Some(e) = recording_error {
         return Err(e);

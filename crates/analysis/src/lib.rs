@@ -75,8 +75,8 @@ pub use fatigue::{
 pub use fit::{polyfit, FitError, PolyFit};
 pub use interfaces::InterfaceStats;
 pub use plot::{
-    figure_format, plot_compare, plot_load_history, plot_sweep, register_fonts, FigureFormat,
-    PlotError,
+    figure_format, plot_compare, plot_load_history, plot_panels, plot_sweep, register_fonts,
+    FigureFormat, Panel, PlotError,
 };
 pub use stats::{disc_stats, percentile, DiscStats, PeakStats};
 pub use sweep::{sweep_fits, sweep_rows, Spread, SweepCase, SweepRow};

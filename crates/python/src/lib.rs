@@ -308,6 +308,7 @@ fn run(
             recording,
             stop: Some(&stop),
             progress: Some(&mut progress),
+            windows_s: None,
         })
     });
     let outcome = outcome.map_err(py_err)?;

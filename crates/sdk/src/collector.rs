@@ -34,6 +34,10 @@ pub struct RunCollector {
     csv: Option<ImpactsCsv>,
     /// The impact that closed last (in the order the engine sent them).
     pub last_impact: Option<ImpactEvent>,
+    /// The figures window by window, when asked ([`RunCollector::with_windows`]).
+    windows: Option<crate::windows::Windows>,
+    /// The bodies' names, engine order (for the windows' rows).
+    names: Vec<String>,
 }
 
 impl RunCollector {
@@ -48,6 +52,8 @@ impl RunCollector {
             fatigue_params: Vec::new(),
             csv: None,
             last_impact: None,
+            windows: None,
+            names: Vec::new(),
         }
     }
 
@@ -72,6 +78,8 @@ impl RunCollector {
             fatigue_params: self.fatigue_params.clone(),
             csv: None,
             last_impact: self.last_impact,
+            windows: None,
+            names: self.names.clone(),
         })
     }
 
@@ -80,8 +88,14 @@ impl RunCollector {
     /// (for `--fatigue-json`'s spectra; memory grows with the run).
     pub fn with_fatigue(mut self, scene: &Scene, keep_cycles: bool) -> RunCollector {
         self.fatigue_params = crate::fatigue::fatigue_params(scene);
-        let curves = self
-            .fatigue_params
+        self.fatigue = FatigueCollector::summing(self.curves(), keep_cycles);
+        self
+    }
+
+    /// Each coupling's S-N curve for the collectors: (root stress per newton of tooth load,
+    /// Pa/N; material), from [`Self::with_fatigue`]'s parameters.
+    fn curves(&self) -> Vec<(f64, clutchpack_model::Material)> {
+        self.fatigue_params
             .iter()
             .map(|(g, p)| {
                 (
@@ -89,9 +103,32 @@ impl RunCollector {
                     p.material,
                 )
             })
-            .collect();
-        self.fatigue = FatigueCollector::summing(curves, keep_cycles);
+            .collect()
+    }
+
+    /// Also keeps the figures of every window of `len_s` (s) of the bodies `names` (engine
+    /// order; `crate::windows`); call after [`Self::with_fatigue`], whose curves it uses.
+    pub fn with_windows(mut self, len_s: f64, names: &[String]) -> RunCollector {
+        self.names = names.to_vec();
+        self.windows = Some(crate::windows::Windows::new(
+            len_s,
+            self.fatigue_params.clone(),
+        ));
         self
+    }
+
+    /// Closes the last window at the run's end `t_s` (s) and gives the windows' rows (empty
+    /// when none were asked).
+    pub fn finish_windows(&mut self, t_s: f64) -> Vec<crate::WindowRow> {
+        match self.windows.as_mut() {
+            Some(w) => {
+                if t_s > w.end_s() - w.len_s() {
+                    w.close(t_s, &self.names, &self.fatigue);
+                }
+                std::mem::take(&mut w.rows)
+            }
+            None => Vec::new(),
+        }
     }
 
     /// Also writes every impact to the CSV file `path` as it comes (a temporary sibling,
@@ -242,6 +279,13 @@ pub fn merge_peaks(histories: &mut [Vec<(f64, f64)>], impacts: &[ImpactEvent]) {
 
 impl Observer for RunCollector {
     fn sample(&mut self, s: &Sample) {
+        if let Some(w) = &mut self.windows {
+            // the windows that ended before this sample close on the samples up to their end
+            while s.t_s > w.end_s() {
+                let t1 = w.end_s();
+                w.close(t1, &self.names, &self.fatigue);
+            }
+        }
         self.fatigue.sample(s);
         if self.keep_history {
             for (i, d) in s.discs.iter().enumerate() {
@@ -259,6 +303,14 @@ impl Observer for RunCollector {
             c.row(e);
         }
         self.fatigue.impact(e);
+        if let Some(w) = &mut self.windows {
+            w.impact(e);
+        }
+    }
+    fn temperatures(&mut self, _t_s: f64, bodies_k: &[f64], oil_k: f64) {
+        if let Some(w) = &mut self.windows {
+            w.temperatures(bodies_k, oil_k);
+        }
     }
     fn interfaces(&mut self, t_s: f64, interfaces: &[InterfaceSample]) {
         for (st, f) in self.interfaces.iter_mut().zip(interfaces) {

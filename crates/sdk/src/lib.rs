@@ -30,6 +30,7 @@ mod session;
 mod simulation;
 mod study;
 mod summary;
+mod windows;
 
 pub use batch::{
     ensemble_fatigue, ensemble_member, run_case, run_cases, CaseRuns, MemberFatigue,
@@ -47,6 +48,7 @@ pub use session::{Session, SessionRequest, SessionState};
 pub use simulation::{PackEngine, Simulation};
 pub use study::{merge_study, run_study_shard, MergedStudy, PART_FLUSH};
 pub use summary::{friction_interfaces, run_info, BodyTemperature, RunSummary, ThermalSummary};
+pub use windows::{BodyWindow, WindowRow};
 
 /// The reference engine's integration schemes (for [`PackEngine::Reference`]).
 pub use clutchpack_reference::Scheme;

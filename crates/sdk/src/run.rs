@@ -43,6 +43,9 @@ pub struct RunRequest<'a> {
     /// Stops the run cleanly (at the engine's next progress poll, within milliseconds) once
     /// set; the outcome then holds the run up to there.
     pub stop: Option<&'a AtomicBool>,
+    /// Also the figures window by window, of this length in s (`None`: none;
+    /// [`RunOutcome::windows`]).
+    pub windows_s: Option<f64>,
     /// Called at the engine's progress polls with the simulated time reached, s.
     pub progress: Option<&'a mut dyn FnMut(f64)>,
 }
@@ -70,6 +73,9 @@ pub struct RunOutcome {
     pub impacts_csv: Option<Result<PathBuf>>,
     /// The finished recording's path, or why it could not be finished (`None`: not asked).
     pub recording: Option<std::result::Result<PathBuf, RecordError>>,
+    /// The figures window by window, when [`RunRequest::windows_s`] asked for them (the last
+    /// window ends at the run's end).
+    pub windows: Vec<crate::WindowRow>,
     /// What went wrong without stopping the run (to be shown to the user).
     pub warnings: Vec<String>,
 }
@@ -118,6 +124,7 @@ impl RunOutcome {
         );
         s.interfaces = self.collector.interfaces.clone();
         s.fatigue = self.fatigue();
+        s.windows = self.windows.clone();
         Ok(s)
     }
 }
@@ -127,6 +134,12 @@ impl Simulation {
     /// be created (the impacts CSV, the recording) are errors before any work; after that,
     /// whatever ends the run, the outcome holds it and every output is complete up to there.
     pub fn run(&mut self, request: RunRequest<'_>) -> Result<RunOutcome> {
+        if let Some(len_s) = request.windows_s.filter(|s| !(*s > 0.0 && s.is_finite())) {
+            return Err(Error::BadInput(format!(
+                "windows of {} s (`--windows`, `windows_s`): the window length must be a positive number of seconds",
+                clutchpack_model::fmt_num(len_s)
+            )));
+        }
         let names = self.body_names();
         let scene = self.scene();
         let mut collector = RunCollector::new(names.len(), request.keep_history)
@@ -134,6 +147,9 @@ impl Simulation {
             .with_fatigue(scene, request.keep_cycles);
         if let Some(path) = &request.impacts_csv {
             collector = collector.with_impacts_csv(path, &names)?;
+        }
+        if let Some(len_s) = request.windows_s {
+            collector = collector.with_windows(len_s, &names);
         }
         let recorder = match &request.recording {
             Some(r) => {
@@ -165,6 +181,11 @@ impl Simulation {
         let impacts_csv = request
             .impacts_csv
             .map(|p| collector.finish_impacts_csv().map(|()| p));
+        let t_end = done.result.as_ref().map_or_else(
+            |_| collector.last_impact.map_or(0.0, |e| e.t_off_s),
+            |s| s.simulated_s,
+        );
+        let windows = collector.finish_windows(t_end);
         Ok(RunOutcome {
             scene: scene_name,
             engine: engine_name,
@@ -176,6 +197,7 @@ impl Simulation {
             collector,
             impacts_csv,
             recording: done.recording,
+            windows,
             warnings,
         })
     }

@@ -282,6 +282,7 @@ impl Session {
             collector: self.collector,
             impacts_csv: None,
             recording,
+            windows: Vec::new(),
             warnings,
         }
     }

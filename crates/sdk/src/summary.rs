@@ -34,6 +34,9 @@ pub struct RunSummary {
     /// A thermal run's temperatures and heat balance (absent for an isothermal run).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub thermal: Option<ThermalSummary>,
+    /// The figures window by window (`run --windows S`; absent without).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub windows: Vec<crate::WindowRow>,
 }
 
 /// One body's temperatures in a thermal run, K.
@@ -131,6 +134,7 @@ impl RunSummary {
             discs,
             interfaces: Vec::new(),
             fatigue: Vec::new(),
+            windows: Vec::new(),
         }
     }
 }

@@ -5,6 +5,7 @@
 //! - [`plot_sweep`]: the largest positive and negative peaks against a swept parameter, with
 //!   ensemble min..max error bars and polynomial fit curves (the paper's Fig 3).
 //! - [`plot_compare`]: a grouped bar chart of the peaks of several runs, per disc.
+//! - [`plot_panels`]: stacked panels of named lines against one x axis (a run's windows).
 //!
 //! Text is rendered with plotters' `ab_glyph` renderer from DejaVu Sans bytes embedded in the
 //! binary (the `dejavu` crate), registered on first use by [`register_fonts`]: the figures
@@ -12,9 +13,12 @@
 
 mod compare;
 mod history;
+mod panels;
 mod sweep;
 use compare::*;
 use history::*;
+pub use panels::Panel;
+use panels::Panels;
 use sweep::*;
 
 use crate::fit::PolyFit;
@@ -102,6 +106,28 @@ pub fn plot_load_history(
     let panels = series.len().max(1);
     let size = (1200, 60 + 220 * panels as u32);
     render(path, size, &LoadHistory { title, series })
+}
+
+/// Stacked [`Panel`]s of named lines (with markers) against one x axis labelled `x_label`
+/// (unit included), under `title`; non-finite points are skipped.
+///
+/// The format follows `path`'s extension (`.png` or `.svg`).
+pub fn plot_panels(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    panels: &[Panel],
+) -> Result<(), PlotError> {
+    let size = (1200, 60 + 260 * panels.len().max(1) as u32);
+    render(
+        path,
+        size,
+        &Panels {
+            title,
+            x_label,
+            panels,
+        },
+    )
 }
 
 /// The largest positive and negative peak loads against a swept parameter (the paper's
