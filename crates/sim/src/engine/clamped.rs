@@ -19,12 +19,11 @@
 
 use super::inertial::Inertial;
 use super::state::{Run, ShaftDrive};
-use super::substep::{checked_sub_step, graded_step, split_remainder, Counts, Node, ShaftAt};
-use crate::options::AdaptiveStepping;
+use super::substep::{checked_sub_step, graded_step, split_remainder, Node, ShaftAt, WorldStep};
 use crate::stack::Face;
 use crate::stepping::{bracketed_root, coupling_step};
 use crate::world::Carrier;
-use clutchpack_model::{DiscSample, EngineError, ImpactEvent, SpeedProfile};
+use clutchpack_model::{EngineError, SpeedProfile};
 use std::sync::Arc;
 
 /// Sub-steps of the clamped stack are at most the world step over this (dimensionless), as an
@@ -181,14 +180,8 @@ impl Run {
     /// Advances the whole clamped stack (every disc and plate, the drum, an inertial shaft)
     /// from `t` to `t1` as one system (module docs), then the rapier world one step with each
     /// body's impulse.
-    pub(super) fn clamped_step(
-        &mut self,
-        t1: f64,
-        a: &AdaptiveStepping,
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
-    ) -> Result<(), EngineError> {
+    pub(super) fn clamped_step(&mut self, ws: &mut WorldStep) -> Result<(), EngineError> {
+        let (t1, a) = (ws.t1, ws.a);
         let profile = match &self.shaft {
             ShaftDrive::Prescribed(p) => Some(Arc::clone(p)),
             ShaftDrive::Inertial { .. } => None,
@@ -252,7 +245,7 @@ impl Run {
                 };
             }
             if !evaluated_here {
-                counts.evals += n as u64;
+                ws.counts.evals += n as u64;
             }
             self.stack_stage(&sys, &self.faces, t, &u, w, &mut s0);
             // An open face takes the sign of its slip (for when it clamps). A clamped one found
@@ -311,12 +304,21 @@ impl Run {
             let rem = t1 - t;
             let mut h = split_remainder(want, rem);
             let faces = self.faces.clone();
+            let start = StackStart {
+                faces: &faces,
+                k1: &s0,
+                t,
+                shaft,
+                phi: &phi,
+                u0: &u,
+                w0: w,
+            };
             let rk4 = |x: f64| {
                 let b = &mut bufs.borrow_mut();
-                self.stack_rk4(&sys, &faces, &s0, t, shaft, &phi, &u, w, x, b);
+                self.stack_rk4(&sys, &start, x, b);
             };
             rk4(h);
-            counts.evals += 3 * n as u64;
+            ws.counts.evals += 3 * n as u64;
             {
                 let b = bufs.borrow();
                 phi_h.copy_from_slice(&b.out.phi);
@@ -371,17 +373,17 @@ impl Run {
                     consider(x, Some(m));
                 }
             }
-            counts.evals += evals.get();
+            ws.counts.evals += evals.get();
             let mut locks = None;
             if let Some((x, face)) = first {
                 h = x;
                 rk4(x);
-                counts.evals += 3 * n as u64;
+                ws.counts.evals += 3 * n as u64;
                 locks = face;
             } else if searched.get() {
                 // the searches left another step in the buffers
                 rk4(h);
-                counts.evals += 3 * n as u64;
+                ws.counts.evals += 3 * n as u64;
             }
             let b = bufs.borrow();
             let step = &b.out;
@@ -399,7 +401,7 @@ impl Run {
             for m in 0..n_if {
                 impulse[m] += step.impulse[m];
             }
-            counts.substeps += 1;
+            ws.counts.substeps += 1;
             self.energy.add_sub_step(step.drive_j, step.drag_j);
             self.energy.add_load_work(step.load_j);
             self.energy.add_stack_work(step.face_j.iter().sum());
@@ -427,7 +429,7 @@ impl Run {
                     }
                 };
                 let dphi = at.speed - u[i];
-                self.end_sub_step(i, t, phi[i], dphi, at, a, closed, contacts)?;
+                self.end_sub_step(i, t, phi[i], dphi, at, ws)?;
             }
             evaluated_here = true;
             self.break_faces(&sys, t, &u, w, &mut s0);
@@ -571,26 +573,36 @@ impl RkBuffers {
     }
 }
 
+/// Where a sub-step of the clamped stack starts ([`Run::stack_rk4`]).
+struct StackStart<'a> {
+    /// The faces, held over the sub-step.
+    faces: &'a [Face],
+    /// The first stage, evaluated at the start.
+    k1: &'a Stage,
+    /// The start, s, and a prescribed shaft there.
+    t: f64,
+    shaft: ShaftAt,
+    /// Each coupling's relative angle, rad, and its body's speed, rad/s.
+    phi: &'a [f64],
+    u0: &'a [f64],
+    /// The inertial carriers' speeds, rad/s ([shaft, drum]).
+    w0: [f64; 2],
+}
+
 impl Run {
-    /// One classical Runge-Kutta step of length `h` from `t` of the clamped stack and the
-    /// inertial carriers (the faces `faces` held), from the bodies' speeds `u0`, relative
-    /// angles `phi`, the carriers' speeds `w0` ([shaft, drum]), a prescribed shaft at `shaft`,
-    /// the first stage `k1` already evaluated, into `b.out`; the works integrated by the same
-    /// stages.
-    #[allow(clippy::too_many_arguments)]
-    fn stack_rk4(
-        &self,
-        sys: &System,
-        faces: &[Face],
-        k1: &Stage,
-        t: f64,
-        shaft: ShaftAt,
-        phi: &[f64],
-        u0: &[f64],
-        w0: [f64; 2],
-        h: f64,
-        b: &mut RkBuffers,
-    ) {
+    /// One classical Runge-Kutta step of length `h` of the clamped stack and the inertial
+    /// carriers from `start` (the faces held, the first stage already evaluated), into
+    /// `b.out`; the works integrated by the same stages.
+    fn stack_rk4(&self, sys: &System, start: &StackStart, h: f64, b: &mut RkBuffers) {
+        let StackStart {
+            faces,
+            k1,
+            t,
+            shaft,
+            phi,
+            u0,
+            w0,
+        } = *start;
         let n = u0.len();
         let hh = h * h;
         let (tm, te) = (t + 0.5 * h, t + h);

@@ -6,12 +6,11 @@
 
 use super::state::{Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, split_remainder, Counts, GapDrag, Node, Path, ShaftAt,
+    checked_sub_step, graded_step, split_remainder, GapDrag, Node, Path, ShaftAt, WorldStep,
 };
-use crate::options::AdaptiveStepping;
 use crate::stepping::coupling_step;
 use crate::world::Carrier;
-use clutchpack_model::{DiscSample, EngineError, ImpactEvent};
+use clutchpack_model::EngineError;
 use rapier3d_f64::prelude::Vector;
 
 /// An inertial carrier's sub-steps are at most the world step over this (dimensionless): the
@@ -49,6 +48,22 @@ struct CarrierDynamics {
     /// The external torque (the shaft's drive, the drum's load) at the sub-step's start,
     /// middle and end, N m.
     torque: [f64; 3],
+}
+
+/// An inertial carrier's cluster at a sub-step's start ([`Run::carrier_rk4`]).
+#[derive(Debug, Clone, Copy)]
+struct Cluster<'a> {
+    /// The couplings integrated with the carrier, their bodies' inverse inertias,
+    /// 1/(kg m^2), and the open gaps' drag on each.
+    members: &'a [usize],
+    inv_j: &'a [f64],
+    gaps: &'a [GapDrag],
+    /// The start, s, and the carrier's speed there, rad/s.
+    t: f64,
+    w0: f64,
+    /// Each coupling's relative angle, rad, and speed, rad/s, there.
+    phi: &'a [f64],
+    dphi: &'a [f64],
 }
 
 /// One classical Runge-Kutta step of an inertial carrier and the couplings that go with it
@@ -158,9 +173,9 @@ impl Run {
             .z
     }
 
-    /// One classical Runge-Kutta step of length `h` from `t` of an inertial carrier (speed
-    /// `w0`, dynamics `dy`) and the couplings `cluster` (relative states `phi`, `dphi`, the
-    /// open gaps' drag `gaps`), integrated as one system: the carrier
+    /// One classical Runge-Kutta step of length `h` of an inertial carrier (dynamics `dy`)
+    /// and the couplings of its cluster `cl` from their states at `cl.t`, integrated as one
+    /// system: the carrier
     /// `J w' = T_ext(t) - C w - sum T_k` (the shaft: Hu et al. eq 4; the drum: its load and
     /// drag), each body `J w_d' = T_k - C2 w_d + g_k(w_d)` (eq 5 and the gaps' drag), `T_k`
     /// the teeth's torque on body `k` at `phi_k = theta_c - theta_d`. As in
@@ -168,19 +183,16 @@ impl Run {
     /// not the relative ones. The teeth's torques cancel in the total angular momentum at
     /// every stage, so the step conserves it exactly (a linear invariant) but for the external
     /// torque, the damping and the gaps.
-    #[allow(clippy::too_many_arguments)]
-    fn carrier_rk4(
-        &self,
-        cluster: &[usize],
-        inv_j: &[f64],
-        gaps: &[GapDrag],
-        dy: &CarrierDynamics,
-        t: f64,
-        w0: f64,
-        phi: &[f64],
-        dphi: &[f64],
-        h: f64,
-    ) -> CarrierStep {
+    fn carrier_rk4(&self, cl: &Cluster, dy: &CarrierDynamics, h: f64) -> CarrierStep {
+        let Cluster {
+            members: cluster,
+            inv_j,
+            gaps,
+            t,
+            w0,
+            phi,
+            dphi,
+        } = *cl;
         let n = cluster.len();
         let hh = h * h;
         let (inv_j1, c1) = (dy.inv_j, dy.damping);
@@ -262,18 +274,14 @@ impl Run {
     /// couplings' states at `t1` in `rel` and `forces`, adds the external torque's, the
     /// damping's, the drag's and the gaps' work to the audit, feeds the events, and returns
     /// the carrier's nodes (the motion the free couplings follow).
-    #[allow(clippy::too_many_arguments)]
     fn integrate_carrier(
         &mut self,
         c: Inertial,
-        t1: f64,
-        a: &AdaptiveStepping,
         cluster: &[usize],
         gaps: &[GapDrag],
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<Vec<Node>, EngineError> {
+        let (t1, a) = (ws.t1, ws.a);
         let n = cluster.len();
         let inv_j: Vec<f64> = cluster
             .iter()
@@ -313,7 +321,16 @@ impl Run {
             let mut h = split_remainder(want, rem);
             let rk4 = |x: f64| {
                 let dy = self.carrier_dynamics(c, t, x);
-                self.carrier_rk4(cluster, &inv_j, &gaps, &dy, t, w, &phi, &dphi, x)
+                let start = Cluster {
+                    members: cluster,
+                    inv_j: &inv_j,
+                    gaps: &gaps,
+                    t,
+                    w0: w,
+                    phi: &phi,
+                    dphi: &dphi,
+                };
+                self.carrier_rk4(&start, &dy, x)
             };
             let mut step = rk4(h);
             // Never step over an onset or a separation of any coupling: land on the first.
@@ -325,7 +342,7 @@ impl Run {
                     evals.set(evals.get() + 4 * n as u64);
                     rk4(x).phi[k]
                 });
-                counts.evals += evals.get();
+                ws.counts.evals += evals.get();
                 if let Some(x) = crossing.filter(|&x| x > tiny && x < h) {
                     if first.is_none_or(|b| x < b) {
                         first = Some(x);
@@ -335,15 +352,15 @@ impl Run {
             if let Some(x) = first {
                 h = x;
                 step = rk4(x);
-                counts.evals += 4 * n as u64;
+                ws.counts.evals += 4 * n as u64;
             }
             t = if h == rem { t1 } else { t + h };
             angle += step.turn;
             w = step.speed;
             phi.clone_from(&step.phi);
             dphi.clone_from(&step.dphi);
-            counts.substeps += 1;
-            counts.evals += 5 * n as u64;
+            ws.counts.substeps += 1;
+            ws.counts.evals += 5 * n as u64;
             match c {
                 Inertial::Shaft => self.energy.add_sub_step(step.external_j, step.drag_j),
                 Inertial::Drum => {
@@ -355,7 +372,7 @@ impl Run {
             nodes.push(Node { t, angle, speed: w });
             let at = ShaftAt { speed: w, angle };
             for (k, &i) in cluster.iter().enumerate() {
-                self.end_sub_step(i, t, phi[k], dphi[k], at, a, closed, contacts)?;
+                self.end_sub_step(i, t, phi[k], dphi[k], at, ws)?;
             }
         }
         Ok(nodes)
@@ -370,18 +387,14 @@ impl Run {
     /// one then flies free against the carrier's motion so found ([`Path::Nodes`]), as against
     /// a prescribed shaft. Writes each carried coupling's speed at `t1` into `omega_d` and its
     /// mean speed over the step into `means`; returns the carrier's nodes at `t` and `t1`.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn advance_carrier(
         &mut self,
         c: Inertial,
-        t1: f64,
-        a: &AdaptiveStepping,
         gaps: &[GapDrag],
         means: &mut [f64],
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<(Node, Node), EngineError> {
+        let (t1, a) = (ws.t1, ws.a);
         let t0 = self.t;
         let h = t1 - t0;
         let carried = self.carried_by(c);
@@ -413,10 +426,10 @@ impl Run {
             }
         }
         let phi0: Vec<f64> = self.rel.iter().map(|r| r.phi).collect();
-        let nodes = self.integrate_carrier(c, t1, a, &cluster, gaps, counts, closed, contacts)?;
+        let nodes = self.integrate_carrier(c, &cluster, gaps, ws)?;
         let path = Path::Nodes(&nodes);
         for &i in &free {
-            self.integrate_coupling(i, t1, a, gaps[i], path, a_carrier, counts, closed, contacts)?;
+            self.integrate_coupling(i, gaps[i], path, a_carrier, ws)?;
         }
         let (start, end) = (nodes[0], nodes[nodes.len() - 1]);
         for &i in &carried {

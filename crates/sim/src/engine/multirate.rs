@@ -6,14 +6,14 @@
 use super::inertial::Inertial;
 use super::state::{disc_sample, relative_state, Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, split_remainder, Counts, GapDrag, Node, Path, Relative, ShaftAt,
-    TurnMoment,
+    checked_sub_step, graded_step, split_remainder, GapDrag, Node, Path, Relative, ShaftAt,
+    TurnMoment, WorldStep,
 };
 use crate::hook::{CouplingForces, RelativeState, FLANKS};
-use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
+use crate::options::{MultibodyOptions, Stepping};
 use crate::stepping::{bracketed_root, contact_duration_s, coupling_step};
 use crate::world::Carrier;
-use clutchpack_model::{DiscSample, EngineError, ImpactEvent, PackModel, SpeedProfile};
+use clutchpack_model::{EngineError, PackModel, SpeedProfile};
 use rapier3d_f64::prelude::{RigidBodyHandle, Rotation, Vector};
 
 /// Why the multirate scheme cannot run this pack with these options (`None`: it can).
@@ -105,14 +105,8 @@ impl Run {
     /// to `closed` (in the order they closed within each coupling), the contact samples
     /// `(coupling, t s, state)` of the sub-steps to `contacts` (in time order within each
     /// coupling; see `EventBook::update`).
-    pub(super) fn multirate_step(
-        &mut self,
-        t1: f64,
-        a: &AdaptiveStepping,
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
-    ) -> Result<(), EngineError> {
+    pub(super) fn multirate_step(&mut self, ws: &mut WorldStep) -> Result<(), EngineError> {
+        let t1 = ws.t1;
         let t0 = self.t;
         let h = t1 - t0;
         // The open gaps' drag: the discs first, with their neighbours (plates, which turn
@@ -160,18 +154,7 @@ impl Run {
         // the discs, with an inertial shaft as their carrier or each alone
         let shaft = prescribed.is_none().then_some(Inertial::Shaft);
         let (discs, plates) = (0..n_discs, n_discs..n);
-        self.advance_group(
-            discs,
-            shaft,
-            t1,
-            a,
-            &gaps,
-            &mut means,
-            &mut carriers,
-            counts,
-            closed,
-            contacts,
-        )?;
+        self.advance_group(discs, shaft, &gaps, &mut means, &mut carriers, ws)?;
         if self.stack.is_some() {
             // the discs' speeds over the step, for the plates: the affine function with their
             // mean and their first moment, from their sub-steps
@@ -198,18 +181,7 @@ impl Run {
         // the plates: each alone on the housing, then the drum with its own (as an inertial
         // shaft with its discs), their gaps' drag from the discs' speeds as on the housing
         let drum = self.world.drum.map(|_| Inertial::Drum);
-        self.advance_group(
-            plates,
-            drum,
-            t1,
-            a,
-            &gaps,
-            &mut means,
-            &mut carriers,
-            counts,
-            closed,
-            contacts,
-        )?;
+        self.advance_group(plates, drum, &gaps, &mut means, &mut carriers, ws)?;
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let c = self.gap_coefficient();
         if let Some(s) = self.stack.as_mut() {
@@ -259,30 +231,24 @@ impl Run {
     /// the world's step), every other one alone against its carrier's known motion
     /// ([`Run::advance_alone`]) first. Writes each one's speed at `t1` into `omega_d` and its
     /// mean speed over the step into `means`.
-    #[allow(clippy::too_many_arguments)]
     fn advance_group(
         &mut self,
         group: std::ops::Range<usize>,
         inertial: Option<Inertial>,
-        t1: f64,
-        a: &AdaptiveStepping,
         gaps: &[GapDrag],
         means: &mut [f64],
         carriers: &mut Vec<(RigidBodyHandle, Node, Node)>,
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<(), EngineError> {
         let carrier = inertial.map(Inertial::carrier);
         for i in group {
             if Some(self.world.carriers[i]) != carrier {
-                self.advance_alone(i, t1, a, gaps[i], means, counts, closed, contacts)?;
+                self.advance_alone(i, gaps[i], means, ws)?;
             }
         }
         if let Some(c) = inertial {
             let handle = self.carrier_body_of(c);
-            let (start, end) =
-                self.advance_carrier(c, t1, a, gaps, means, counts, closed, contacts)?;
+            let (start, end) = self.advance_carrier(c, gaps, means, ws)?;
             carriers.push((handle, start, end));
         }
         Ok(())
@@ -292,18 +258,14 @@ impl Run {
     /// prescribed shaft's profile, the housing at rest) with the open gaps' drag `gap`
     /// ([`Run::integrate_coupling`]); writes its speed at `t1` into `omega_d` and its mean
     /// speed over the step into `means[i]`.
-    #[allow(clippy::too_many_arguments)]
     fn advance_alone(
         &mut self,
         i: usize,
-        t1: f64,
-        a: &AdaptiveStepping,
         gap: GapDrag,
         means: &mut [f64],
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<(), EngineError> {
+        let t1 = ws.t1;
         let (t0, h) = (self.t, t1 - self.t);
         let phi0 = self.rel[i].phi;
         let p = self.profile(i);
@@ -311,7 +273,7 @@ impl Run {
             Some(p) => (Path::Profile(p), self.shaft_accel_bound),
             None => (Path::Housing, 0.0),
         };
-        self.integrate_coupling(i, t1, a, gap, path, bound, counts, closed, contacts)?;
+        self.integrate_coupling(i, gap, path, bound, ws)?;
         let (phi1, dphi1) = (self.rel[i].phi, self.rel[i].dphi);
         let (c0, c1) = (path.at(t0), path.at(t1));
         self.omega_d[i] = c1.speed - dphi1;
@@ -361,19 +323,15 @@ impl Run {
     /// `t1`, with the step controller of the shared scheme applied to this coupling alone and
     /// steps landed on every contact onset and separation; leaves the state at `t1` in
     /// `rel[i]` and `forces[i]`, adds the work done to the energy audit and feeds the events.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn integrate_coupling(
         &mut self,
         i: usize,
-        t1: f64,
-        a: &AdaptiveStepping,
         gap: GapDrag,
         path: Path<'_>,
         carrier_accel_bound: f64,
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<(), EngineError> {
+        let (t1, a) = (ws.t1, ws.a);
         let bodies = std::sync::Arc::clone(&self.bodies);
         let d = &bodies[i];
         let inv_j = self.world.physics.bodies[self.world.discs[i]]
@@ -407,7 +365,7 @@ impl Run {
             let start_torque_n_m = if evaluated_here {
                 f.moment[2]
             } else {
-                counts.evals += 1;
+                ws.counts.evals += 1;
                 self.couplings[i].probe_torque(phi, dphi)
             };
             let rel = Relative {
@@ -427,26 +385,26 @@ impl Run {
                 evals.set(evals.get() + 3);
                 rel.rk4(t, shaft, phi, dphi, x).phi
             });
-            counts.evals += evals.get();
+            ws.counts.evals += evals.get();
             if let Some(x) = crossing.filter(|&x| x > tiny && x < h) {
                 h = x;
                 step = rel.rk4(t, shaft, phi, dphi, x);
-                counts.evals += 3;
+                ws.counts.evals += 3;
             }
             t = if h == rem { t1 } else { t + h };
             phi = step.phi;
             dphi = step.dphi;
             shaft = step.shaft;
-            counts.substeps += 1;
-            counts.evals += step.evals + 1;
+            ws.counts.substeps += 1;
+            ws.counts.evals += step.evals + 1;
             self.energy
                 .add_sub_step(if inertial { 0.0 } else { step.drive_j }, step.drag_j);
             self.energy.add_stack_work(step.gap_j);
-            let f = self.end_sub_step(i, t, phi, dphi, shaft, a, closed, contacts)?;
+            let f = self.end_sub_step(i, t, phi, dphi, shaft, ws)?;
             evaluated_here = true;
             if inertial && f.depth_m > 0.0 && !missed {
                 missed = true;
-                counts.missed += 1;
+                ws.counts.missed += 1;
             }
         }
         Ok(())
@@ -493,7 +451,6 @@ impl Run {
     /// carrier at `shaft`: checks the state, evaluates the teeth there (advancing their
     /// contact memory) into `forces[i]` and `rel[i]`, and feeds the events and the contact
     /// samples.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn end_sub_step(
         &mut self,
         i: usize,
@@ -501,9 +458,7 @@ impl Run {
         phi: f64,
         dphi: f64,
         shaft: ShaftAt,
-        a: &AdaptiveStepping,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<CouplingForces, EngineError> {
         let d = &self.bodies[i];
         let limit = std::f64::consts::PI / d.spline.teeth as f64;
@@ -532,17 +487,17 @@ impl Run {
         self.forces[i] = f;
         self.rel[i] = rel_state;
         self.moments[i].add(t, shaft.angle - phi, shaft.speed - dphi);
-        let steps_per_contact = a.steps_per_contact;
+        let steps_per_contact = ws.a.steps_per_contact;
         let m_eff = self.m_eff[i];
         let step_of = |v| contact_duration_s(&d.law, f.kin.flank, v, m_eff) / steps_per_contact;
         let tracked = self.events.update(i, t, &f, steps_per_contact, step_of);
         if let Some(e) = tracked.closed {
-            closed.push(e);
+            ws.closed.push(e);
         }
         if let Some(at) = tracked.contact_sample_at {
             // the closing state is sent at the separation
             let omega_d = shaft.speed - dphi;
-            contacts.push((
+            ws.contacts.push((
                 i,
                 at,
                 disc_sample(&f, &rel_state, shaft.angle, omega_d, Vec::new()),

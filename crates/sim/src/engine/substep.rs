@@ -5,7 +5,25 @@
 
 use crate::hook::{Coupling, CouplingForces};
 use crate::options::AdaptiveStepping;
-use clutchpack_model::{EngineError, SpeedProfile};
+use clutchpack_model::{DiscSample, EngineError, ImpactEvent, SpeedProfile};
+
+/// One world step of the multirate schemes as their sub-steps see it (the context the
+/// schemes pass down instead of long argument lists): where it ends, the step controller's
+/// settings, and where the sub-steps report what they count, the impacts that closed and the
+/// contact samples.
+pub(super) struct WorldStep<'a> {
+    /// The world step's end, s.
+    pub(super) t1: f64,
+    /// The step controller's settings.
+    pub(super) a: &'a AdaptiveStepping,
+    /// What the multirate loop counts in the run.
+    pub(super) counts: &'a mut Counts,
+    /// Impact events that closed (in the order they closed within each coupling).
+    pub(super) closed: &'a mut Vec<ImpactEvent>,
+    /// Contact samples `(coupling, t s, state)` of the sub-steps (in time order within each
+    /// coupling; see `EventBook::update`).
+    pub(super) contacts: &'a mut Vec<(usize, f64, DiscSample)>,
+}
 
 /// The open gaps' drag on one body over a world step, `sum_nb c (w_nb - w)` (Couette, MODEL.md
 /// section 5): the neighbours' speeds taken as an affine function of time over the step with
