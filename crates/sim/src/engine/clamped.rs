@@ -40,21 +40,40 @@ struct System {
     c2: Vec<f64>,
     /// The prescribed shaft's profile (`None`: the shaft is inertial).
     profile: Option<Arc<SpeedProfile>>,
-    /// The inertial carriers, [the shaft (Hu et al. eq 4), the drum]: inverse inertia,
-    /// 1/(kg m^2), and damping, N m s/rad (`None`: prescribed, or no drum).
-    inertial: [Option<(f64, f64)>; 2],
-    /// The drum's load, N m (held over the world step).
-    drum_load: f64,
-    /// Each coupling's carrier.
-    carriers: Vec<Carrier>,
+    /// The inertial carriers integrated with the stack (an inertial shaft, the drum; any
+    /// number, in this order).
+    spins: Vec<Spin>,
+    /// How each coupling's carrier moves.
+    mounts: Vec<Mount>,
+}
+
+/// An inertial carrier integrated with the clamped stack: `J w' = T_ext(t) - C w - sum T_k`
+/// over the couplings it carries (the shaft: Hu et al. eq 4; the drum: its load and drag).
+struct Spin {
+    /// Its role (what its external torque is, where its state lives).
+    role: Inertial,
+    /// `1 / J`, 1/(kg m^2), and the damping `C`, N m s/rad.
+    inv_j: f64,
+    damping: f64,
+}
+
+/// How a coupling's carrier moves within the clamped stack's sub-steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mount {
+    /// The prescribed shaft: its profile, exact.
+    Profile,
+    /// The housing, at rest.
+    Housing,
+    /// Inertial carrier `k` of [`System::spins`], integrated with the stack.
+    Spin(usize),
 }
 
 /// What the system does at one stage.
 struct Stage {
-    /// Each coupling body's acceleration, rad/s^2, and the inertial carriers' ([shaft, drum];
-    /// 0 where not inertial).
+    /// Each coupling body's acceleration, rad/s^2, and the inertial carriers' ([`System::spins`]
+    /// order).
     acc: Vec<f64>,
-    acc_carrier: [f64; 2],
+    acc_carrier: Vec<f64>,
     /// The teeth's torque on each coupling body, N m.
     teeth: Vec<f64>,
     /// Each interface's torque on its upper body, N m: friction or the gap's drag of a
@@ -67,12 +86,12 @@ struct Stage {
 }
 
 impl Stage {
-    /// A stage's buffers for `n` coupling bodies.
-    fn new(n: usize) -> Stage {
+    /// A stage's buffers for `n` coupling bodies and `n_spin` inertial carriers.
+    fn new(n: usize, n_spin: usize) -> Stage {
         let n_if = n - 1;
         Stage {
             acc: vec![0.0; n],
-            acc_carrier: [0.0; 2],
+            acc_carrier: vec![0.0; n_spin],
             teeth: vec![0.0; n],
             face: vec![0.0; n_if],
             clamp: vec![0.0; n_if],
@@ -81,19 +100,11 @@ impl Stage {
     }
 }
 
-/// The index of an inertial carrier in [shaft, drum], `None` for the housing.
-fn spin(c: Carrier) -> Option<usize> {
-    match c {
-        Carrier::Shaft => Some(0),
-        Carrier::Drum => Some(1),
-        Carrier::Housing => None,
-    }
-}
-
 impl Run {
     /// The accelerations of the stack's bodies and the drum at `ts` with the teeth's torques
-    /// `st.teeth` (coupling order, N m), the bodies' speeds `u` (rad/s) and the drum's
-    /// inertial carriers' `w` ([shaft, drum], rad/s), the faces `faces`, into `st`: each body's teeth, drag and the slipping or
+    /// `st.teeth` (coupling order, N m), the bodies' speeds `u` (rad/s) and the inertial
+    /// carriers' `w` ([`System::spins`] order, rad/s), the faces `faces`, into `st`: each
+    /// body's teeth, drag and the slipping or
     /// open faces' torques; locked runs of bodies share one acceleration (their total torque
     /// over their total inertia), and the torque each locked face passes is what keeps its two
     /// sides together.
@@ -103,7 +114,7 @@ impl Run {
         faces: &[Face],
         ts: f64,
         u: &[f64],
-        w: [f64; 2],
+        w: &[f64],
         st: &mut Stage,
     ) {
         let stack = self.stack.as_ref().expect("a stack");
@@ -157,23 +168,14 @@ impl Run {
             }
             lo = hi + 1;
         }
-        for k in 0..2 {
-            st.acc_carrier[k] = match sys.inertial[k] {
-                Some((inv_j, damping)) => {
-                    // the drive (eq 4) or the load, the damping, the teeth's reactions
-                    let external = if k == 0 {
-                        self.drive_torque(ts)
-                    } else {
-                        sys.drum_load
-                    };
-                    let on: f64 = (0..u.len())
-                        .filter(|&i| spin(sys.carriers[i]) == Some(k))
-                        .map(|i| st.teeth[i])
-                        .sum();
-                    (external - damping * w[k] - on) * inv_j
-                }
-                None => 0.0,
-            };
+        for (k, c) in sys.spins.iter().enumerate() {
+            // the drive (eq 4) or the load, the damping, the teeth's reactions
+            let external = self.external_torque(c.role, ts);
+            let on: f64 = (0..u.len())
+                .filter(|&i| sys.mounts[i] == Mount::Spin(k))
+                .map(|i| st.teeth[i])
+                .sum();
+            st.acc_carrier[k] = (external - c.damping * w[k] - on) * c.inv_j;
         }
     }
 
@@ -195,6 +197,33 @@ impl Run {
                 .map(|m| Face::Slipping(stack.slip[m].signum()))
                 .collect();
         }
+        // the inertial carriers: an inertial shaft, then the drum
+        let roles = [
+            profile.is_none().then_some(Inertial::Shaft),
+            self.drum.as_ref().map(|_| Inertial::Drum),
+        ];
+        let spins: Vec<Spin> = roles
+            .into_iter()
+            .flatten()
+            .map(|role| {
+                let (inv_j, damping) = self.carrier_inertia(role);
+                Spin {
+                    role,
+                    inv_j,
+                    damping,
+                }
+            })
+            .collect();
+        let spin_of = |c: Carrier| spins.iter().position(|s| s.role.carrier() == c);
+        let mounts = (0..n)
+            .map(
+                |i| match (self.world.carriers[i], spin_of(self.world.carriers[i])) {
+                    (_, Some(k)) => Mount::Spin(k),
+                    (Carrier::Housing, None) => Mount::Housing,
+                    (_, None) => Mount::Profile,
+                },
+            )
+            .collect();
         let sys = System {
             body: stack.body.clone(),
             j: (0..n)
@@ -202,17 +231,10 @@ impl Run {
                 .collect(),
             c2: self.bodies.iter().map(|d| d.drag_n_m_s_rad).collect(),
             profile: profile.clone(),
-            inertial: [
-                profile
-                    .is_none()
-                    .then(|| self.carrier_inertia(Inertial::Shaft)),
-                self.drum
-                    .as_ref()
-                    .map(|_| self.carrier_inertia(Inertial::Drum)),
-            ],
-            drum_load: self.drum.as_ref().map_or(0.0, |d| d.model.load_torque_n_m),
-            carriers: self.world.carriers.clone(),
+            spins,
+            mounts,
         };
+        let n_spin = sys.spins.len();
         let t0 = self.t;
         let h_world = t1 - t0;
         let mut t = t0;
@@ -220,19 +242,16 @@ impl Run {
         let mut phi = phi0.clone();
         let mut u: Vec<f64> = self.omega_d.clone();
         let mut turn = vec![0.0; n];
-        // the inertial carriers' angles and speeds, [shaft, drum]
-        let drum0 = self
-            .drum
-            .as_ref()
-            .map_or((0.0, 0.0), |d| (d.theta, d.omega));
-        let (angle0, w0) = ([self.theta_s, drum0.0], [self.omega_s, drum0.1]);
-        let (mut angle, mut w) = (angle0, w0);
+        // the inertial carriers' angles and speeds
+        let (angle0, w0): (Vec<f64>, Vec<f64>) =
+            sys.spins.iter().map(|c| self.carrier_state(c.role)).unzip();
+        let (mut angle, mut w) = (angle0.clone(), w0.clone());
         let mut shaft = ShaftAt::of(profile.as_deref(), t);
         let mut impulse = vec![0.0; n_if];
         let mut evaluated_here = false;
         let cap = a.max_step_s / STACK_SUB_STEPS;
-        let mut s0 = Stage::new(n);
-        let bufs = std::cell::RefCell::new(RkBuffers::new(n));
+        let mut s0 = Stage::new(n, n_spin);
+        let bufs = std::cell::RefCell::new(RkBuffers::new(n, n_spin));
         // the relative angles and the speeds at the end of a full sub-step
         let (mut phi_h, mut u_h) = (vec![0.0; n], vec![0.0; n]);
         while t < t1 {
@@ -247,7 +266,7 @@ impl Run {
             if !evaluated_here {
                 ws.counts.evals += n as u64;
             }
-            self.stack_stage(&sys, &self.faces, t, &u, w, &mut s0);
+            self.stack_stage(&sys, &self.faces, t, &u, &w, &mut s0);
             // An open face takes the sign of its slip (for when it clamps). A clamped one found
             // slipping against its sign crossed zero unlanded (closer to a sub-step's start
             // than the landing looks): it locks now if it holds (its friction must never push
@@ -269,7 +288,7 @@ impl Run {
                 }
             }
             if turned {
-                self.break_faces(&sys, t, &u, w, &mut s0);
+                self.break_faces(&sys, t, &u, &w, &mut s0);
             }
             // the step each coupling wants, with its relative acceleration bounded by its
             // carrier's bound and twice its body's acceleration at t (plus 1 rad/s^2): the
@@ -278,22 +297,19 @@ impl Run {
             let mut want = cap;
             let reaction = |k: usize| -> f64 {
                 (0..n)
-                    .filter(|&i| spin(sys.carriers[i]) == Some(k))
+                    .filter(|&i| sys.mounts[i] == Mount::Spin(k))
                     .map(|i| s0.teeth[i].abs())
                     .sum()
             };
-            let carrier_bound = [
-                match sys.inertial[0] {
-                    Some(_) => self.inertial_accel_bound(Inertial::Shaft, w[0], reaction(0)),
-                    None => self.shaft_accel_bound,
-                },
-                match sys.inertial[1] {
-                    Some(_) => self.inertial_accel_bound(Inertial::Drum, w[1], reaction(1)),
-                    None => 0.0,
-                },
-            ];
+            let spin_bound: Vec<f64> = (sys.spins.iter().enumerate())
+                .map(|(k, c)| self.inertial_accel_bound(c.role, w[k], reaction(k)))
+                .collect();
             for i in 0..n {
-                let carrier = spin(sys.carriers[i]).map_or(0.0, |k| carrier_bound[k]);
+                let carrier = match sys.mounts[i] {
+                    Mount::Profile => self.shaft_accel_bound,
+                    Mount::Housing => 0.0,
+                    Mount::Spin(k) => spin_bound[k],
+                };
                 let bound = carrier + 2.0 * s0.acc[i].abs() + 1.0;
                 let f = self.forces[i];
                 let view = self.coupling_view(i, &f, (phi[i], self.rel[i].dphi), bound, t);
@@ -311,7 +327,7 @@ impl Run {
                 shaft,
                 phi: &phi,
                 u0: &u,
-                w0: w,
+                w0: &w,
             };
             let rk4 = |x: f64| {
                 let b = &mut bufs.borrow_mut();
@@ -393,10 +409,10 @@ impl Run {
             }
             phi.clone_from(&step.phi);
             u.clone_from(&step.u);
-            for k in 0..2 {
-                angle[k] += step.carrier_turn[k];
+            for (x, dx) in angle.iter_mut().zip(&step.carrier_turn) {
+                *x += dx;
             }
-            w = step.w_carrier;
+            w.clone_from(&step.w_carrier);
             shaft = ShaftAt::of(profile.as_deref(), t);
             for m in 0..n_if {
                 impulse[m] += step.impulse[m];
@@ -414,41 +430,32 @@ impl Run {
                 self.lock_face(&sys, m, &mut u);
             }
             for i in 0..n {
-                let at = match (sys.carriers[i], &profile) {
-                    (Carrier::Shaft, Some(_)) => shaft,
-                    (Carrier::Housing, _) => ShaftAt {
+                let at = match sys.mounts[i] {
+                    Mount::Profile => shaft,
+                    Mount::Housing => ShaftAt {
                         speed: 0.0,
                         angle: 0.0,
                     },
-                    (c, _) => {
-                        let k = spin(c).expect("an inertial carrier");
-                        ShaftAt {
-                            speed: w[k],
-                            angle: angle[k],
-                        }
-                    }
+                    Mount::Spin(k) => ShaftAt {
+                        speed: w[k],
+                        angle: angle[k],
+                    },
                 };
                 let dphi = at.speed - u[i];
                 self.end_sub_step(i, t, phi[i], dphi, at, ws)?;
             }
             evaluated_here = true;
-            self.break_faces(&sys, t, &u, w, &mut s0);
+            self.break_faces(&sys, t, &u, &w, &mut s0);
         }
         // the bodies' and the drum's states at t1, their mean speeds over the step
         let means: Vec<f64> = turn.iter().map(|x| x / h_world).collect();
         self.omega_d.clone_from(&u);
         let mut carriers = Vec::new();
-        for (k, c) in [Inertial::Shaft, Inertial::Drum].into_iter().enumerate() {
-            if sys.inertial[k].is_none() {
-                continue;
-            }
+        for (k, c) in sys.spins.iter().enumerate() {
             let node = |t, angle, speed| Node { t, angle, speed };
             let (start, end) = (node(t0, angle0[k], w0[k]), node(t1, angle[k], w[k]));
-            carriers.push((self.carrier_body_of(c), start, end));
-            match (c, self.drum.as_mut()) {
-                (Inertial::Drum, Some(d)) => (d.theta, d.omega) = (angle[k], w[k]),
-                _ => (self.theta_s, self.omega_s) = (angle[k], w[k]),
-            }
+            carriers.push((self.carrier_body_of(c.role), start, end));
+            self.set_carrier_state(c.role, angle[k], w[k]);
         }
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let locked: Vec<bool> = self.faces.iter().map(|f| *f == Face::Locked).collect();
@@ -493,7 +500,7 @@ impl Run {
     /// Breaks every locked face whose torque exceeds its holding torque at `t` (the state
     /// just evaluated: the teeth's torques in `forces`), the worst first, each then slipping
     /// the way that torque pushes its upper side (module docs); `s` is a stage's buffers.
-    fn break_faces(&mut self, sys: &System, t: f64, u: &[f64], w: [f64; 2], s: &mut Stage) {
+    fn break_faces(&mut self, sys: &System, t: f64, u: &[f64], w: &[f64], s: &mut Stage) {
         loop {
             for (x, f) in s.teeth.iter_mut().zip(&self.forces) {
                 *x = f.moment[2];
@@ -527,9 +534,10 @@ struct StackStep {
     turn: Vec<f64>,
     u: Vec<f64>,
     phi: Vec<f64>,
-    /// The inertial carriers' turns, rad, and speeds at the end, rad/s ([shaft, drum]).
-    carrier_turn: [f64; 2],
-    w_carrier: [f64; 2],
+    /// The inertial carriers' turns, rad, and speeds at the end, rad/s ([`System::spins`]
+    /// order).
+    carrier_turn: Vec<f64>,
+    w_carrier: Vec<f64>,
     /// Each interface's impulse on its upper body, N m s, and the work of its torque on the
     /// slip (friction, the gap's drag; 0 locked), J (<= 0).
     impulse: Vec<f64>,
@@ -545,24 +553,35 @@ struct StackStep {
 /// stages was a fifth of the clamped stack's time, perf).
 struct RkBuffers {
     k: [Stage; 3],
+    /// The bodies' turns and speeds at the stages 2, 3, 4, and the inertial carriers'.
     th: Vec<f64>,
     u: [Vec<f64>; 3],
+    ct: Vec<f64>,
+    w: [Vec<f64>; 3],
     out: StackStep,
 }
 
 impl RkBuffers {
-    fn new(n: usize) -> RkBuffers {
+    /// The buffers for `n` coupling bodies and `n_spin` inertial carriers.
+    fn new(n: usize, n_spin: usize) -> RkBuffers {
         let v = || vec![0.0; n];
+        let c = || vec![0.0; n_spin];
         RkBuffers {
-            k: [Stage::new(n), Stage::new(n), Stage::new(n)],
+            k: [
+                Stage::new(n, n_spin),
+                Stage::new(n, n_spin),
+                Stage::new(n, n_spin),
+            ],
             th: v(),
             u: [v(), v(), v()],
+            ct: c(),
+            w: [c(), c(), c()],
             out: StackStep {
                 turn: v(),
                 u: v(),
                 phi: v(),
-                carrier_turn: [0.0; 2],
-                w_carrier: [0.0; 2],
+                carrier_turn: c(),
+                w_carrier: c(),
                 impulse: vec![0.0; n - 1],
                 face_j: vec![0.0; n - 1],
                 drive_j: 0.0,
@@ -585,8 +604,8 @@ struct StackStart<'a> {
     /// Each coupling's relative angle, rad, and its body's speed, rad/s.
     phi: &'a [f64],
     u0: &'a [f64],
-    /// The inertial carriers' speeds, rad/s ([shaft, drum]).
-    w0: [f64; 2],
+    /// The inertial carriers' speeds, rad/s ([`System::spins`] order).
+    w0: &'a [f64],
 }
 
 impl Run {
@@ -603,6 +622,7 @@ impl Run {
             u0,
             w0,
         } = *start;
+        let n_spin = w0.len();
         let n = u0.len();
         let hh = h * h;
         let (tm, te) = (t + 0.5 * h, t + h);
@@ -614,58 +634,62 @@ impl Run {
         // exact, the inertial ones by `c_turn` at `w`) and the bodies by `th` at `u`
         let stage = |ts: f64,
                      at: ShaftAt,
-                     c_turn: [f64; 2],
-                     w: [f64; 2],
+                     c_turn: &[f64],
+                     w: &[f64],
                      th: &[f64],
                      u: &[f64],
                      st: &mut Stage| {
             for i in 0..n {
-                let (turn, speed) = match (sys.carriers[i], &sys.profile) {
-                    (Carrier::Shaft, Some(_)) => (at.angle - shaft.angle, at.speed),
-                    (Carrier::Housing, _) => (0.0, 0.0),
-                    (c, _) => {
-                        let k = spin(c).expect("an inertial carrier");
-                        (c_turn[k], w[k])
-                    }
+                let (turn, speed) = match sys.mounts[i] {
+                    Mount::Profile => (at.angle - shaft.angle, at.speed),
+                    Mount::Housing => (0.0, 0.0),
+                    Mount::Spin(k) => (c_turn[k], w[k]),
                 };
                 st.teeth[i] = self.couplings[i].probe_torque(phi[i] + turn - th[i], speed - u[i]);
             }
             self.stack_stage(sys, faces, ts, u, w, st);
         };
-        let RkBuffers { k, th, u, out } = b;
+        let RkBuffers {
+            k,
+            th,
+            u,
+            ct,
+            w,
+            out,
+        } = b;
         let [k2, k3, k4] = k;
         let [u2, u3, u4] = u;
-        let map2 = |f: &dyn Fn(usize) -> f64| [f(0), f(1)];
+        let [w2, w3, w4] = w;
         for i in 0..n {
             th[i] = 0.5 * h * u0[i];
             u2[i] = u0[i] + 0.5 * h * k1.acc[i];
         }
-        let (ct2, w2) = (
-            map2(&|k| 0.5 * h * w0[k]),
-            map2(&|k| w0[k] + 0.5 * h * k1.acc_carrier[k]),
-        );
-        stage(tm, mid, ct2, w2, th, u2, k2);
+        for k in 0..n_spin {
+            ct[k] = 0.5 * h * w0[k];
+            w2[k] = w0[k] + 0.5 * h * k1.acc_carrier[k];
+        }
+        stage(tm, mid, ct, w2, th, u2, k2);
         for i in 0..n {
             th[i] = 0.5 * h * u0[i] + 0.25 * hh * k1.acc[i];
             u3[i] = u0[i] + 0.5 * h * k2.acc[i];
         }
-        let (ct3, w3) = (
-            map2(&|k| 0.5 * h * w0[k] + 0.25 * hh * k1.acc_carrier[k]),
-            map2(&|k| w0[k] + 0.5 * h * k2.acc_carrier[k]),
-        );
-        stage(tm, mid, ct3, w3, th, u3, k3);
+        for k in 0..n_spin {
+            ct[k] = 0.5 * h * w0[k] + 0.25 * hh * k1.acc_carrier[k];
+            w3[k] = w0[k] + 0.5 * h * k2.acc_carrier[k];
+        }
+        stage(tm, mid, ct, w3, th, u3, k3);
         for i in 0..n {
             th[i] = h * u0[i] + 0.5 * hh * k2.acc[i];
             u4[i] = u0[i] + h * k3.acc[i];
         }
-        let (ct4, w4) = (
-            map2(&|k| h * w0[k] + 0.5 * hh * k2.acc_carrier[k]),
-            map2(&|k| w0[k] + h * k3.acc_carrier[k]),
-        );
-        stage(te, end, ct4, w4, th, u4, k4);
+        for k in 0..n_spin {
+            ct[k] = h * w0[k] + 0.5 * hh * k2.acc_carrier[k];
+            w4[k] = w0[k] + h * k3.acc_carrier[k];
+        }
+        stage(te, end, ct, w4, th, u4, k4);
         let h6 = h / 6.0;
         let quad = |a: f64, b: f64, c: f64, d: f64| h6 * (a + 2.0 * (b + c) + d);
-        for k in 0..2 {
+        for k in 0..n_spin {
             let a = [
                 k1.acc_carrier[k],
                 k2.acc_carrier[k],
@@ -681,13 +705,13 @@ impl Run {
             let turn = h * u0[i] + h * h6 * (k1.acc[i] + k2.acc[i] + k3.acc[i]);
             out.turn[i] = turn;
             out.u[i] = u0[i] + quad(k1.acc[i], k2.acc[i], k3.acc[i], k4.acc[i]);
-            let carrier_turn = match (sys.carriers[i], &sys.profile) {
-                (Carrier::Shaft, Some(_)) => end.angle - shaft.angle,
-                (Carrier::Housing, _) => 0.0,
-                (c, _) => out.carrier_turn[spin(c).expect("an inertial carrier")],
+            let carrier_turn = match sys.mounts[i] {
+                Mount::Profile => end.angle - shaft.angle,
+                Mount::Housing => 0.0,
+                Mount::Spin(k) => out.carrier_turn[k],
             };
             out.phi[i] = phi[i] + carrier_turn - turn;
-            if sys.carriers[i] == Carrier::Shaft && sys.profile.is_some() {
+            if sys.mounts[i] == Mount::Profile {
                 out.drive_j += quad(
                     k1.teeth[i] * shaft.speed,
                     k2.teeth[i] * mid.speed,
@@ -697,22 +721,22 @@ impl Run {
             }
             out.drag_j -= sys.c2[i] * quad(sq(u0[i]), sq(u2[i]), sq(u3[i]), sq(u4[i]));
         }
-        for k in 0..2 {
-            let Some((_, damping)) = sys.inertial[k] else {
-                continue;
-            };
+        for (k, spin) in sys.spins.iter().enumerate() {
             let (a, b, c, d) = (w0[k], w2[k], w3[k], w4[k]);
-            out.drag_j -= damping * quad(sq(a), sq(b), sq(c), sq(d));
-            if k == 0 {
-                // the drive's work on an inertial shaft (eq 4)
-                let (e1, em, e4) = (
-                    self.drive_torque(t),
-                    self.drive_torque(tm),
-                    self.drive_torque(te),
-                );
-                out.drive_j += quad(e1 * a, em * b, em * c, e4 * d);
-            } else {
-                out.load_j = sys.drum_load * quad(a, b, c, d);
+            out.drag_j -= spin.damping * quad(sq(a), sq(b), sq(c), sq(d));
+            match spin.role {
+                Inertial::Shaft => {
+                    // the drive's work on an inertial shaft (eq 4)
+                    let (e1, em, e4) = (
+                        self.drive_torque(t),
+                        self.drive_torque(tm),
+                        self.drive_torque(te),
+                    );
+                    out.drive_j += quad(e1 * a, em * b, em * c, e4 * d);
+                }
+                Inertial::Drum => {
+                    out.load_j = self.external_torque(Inertial::Drum, t) * quad(a, b, c, d);
+                }
             }
         }
         for m in 0..faces.len() {

@@ -124,15 +124,7 @@ impl Run {
     /// the step's start, middle and end; the drum's load, held over a world step).
     fn carrier_dynamics(&self, c: Inertial, t: f64, h: f64) -> CarrierDynamics {
         let (inv_j, damping) = self.carrier_inertia(c);
-        let torque = match (c, &self.drum) {
-            (Inertial::Shaft, _) => [
-                self.drive_torque(t),
-                self.drive_torque(t + 0.5 * h),
-                self.drive_torque(t + h),
-            ],
-            (Inertial::Drum, Some(d)) => [d.model.load_torque_n_m; 3],
-            (Inertial::Drum, None) => unreachable!("a drum"),
-        };
+        let torque = [t, t + 0.5 * h, t + h].map(|ts| self.external_torque(c, ts));
         CarrierDynamics {
             inv_j,
             damping,
@@ -140,12 +132,31 @@ impl Run {
         }
     }
 
+    /// The external torque on inertial carrier `c` at `ts` (s), N m: the shaft's drive (Hu et
+    /// al. eq 4), the drum's load (held over a world step).
+    pub(super) fn external_torque(&self, c: Inertial, ts: f64) -> f64 {
+        match (c, &self.drum) {
+            (Inertial::Shaft, _) => self.drive_torque(ts),
+            (Inertial::Drum, Some(d)) => d.model.load_torque_n_m,
+            (Inertial::Drum, None) => unreachable!("a drum"),
+        }
+    }
+
     /// Inertial carrier `c`'s unwrapped angle, rad, and speed, rad/s, at `t`.
-    fn carrier_state(&self, c: Inertial) -> (f64, f64) {
+    pub(super) fn carrier_state(&self, c: Inertial) -> (f64, f64) {
         match (c, &self.drum) {
             (Inertial::Shaft, _) => (self.theta_s, self.omega_s),
             (Inertial::Drum, Some(d)) => (d.theta, d.omega),
             (Inertial::Drum, None) => unreachable!("a drum"),
+        }
+    }
+
+    /// Sets inertial carrier `c`'s unwrapped angle, rad, and speed, rad/s (at a world step's
+    /// end).
+    pub(super) fn set_carrier_state(&mut self, c: Inertial, angle: f64, speed: f64) {
+        match (c, self.drum.as_mut()) {
+            (Inertial::Drum, Some(d)) => (d.theta, d.omega) = (angle, speed),
+            _ => (self.theta_s, self.omega_s) = (angle, speed),
         }
     }
 
@@ -436,10 +447,7 @@ impl Run {
             self.omega_d[i] = end.speed - self.rel[i].dphi;
             means[i] = (end.angle - start.angle - (self.rel[i].phi - phi0[i])) / h;
         }
-        match (c, self.drum.as_mut()) {
-            (Inertial::Drum, Some(d)) => (d.theta, d.omega) = (end.angle, end.speed),
-            _ => (self.theta_s, self.omega_s) = (end.angle, end.speed),
-        }
+        self.set_carrier_state(c, end.angle, end.speed);
         Ok((start, end))
     }
 
