@@ -19,7 +19,9 @@
 
 use super::inertial::Inertial;
 use super::state::{Run, ShaftDrive};
-use super::substep::{checked_sub_step, graded_step, split_remainder, Node, ShaftAt, WorldStep};
+use super::substep::{
+    checked_sub_step, graded_step, split_remainder, Node, Rk4, ShaftAt, WorldStep,
+};
 use crate::stack::Face;
 use crate::stepping::{bracketed_root, coupling_step};
 use crate::world::Carrier;
@@ -552,12 +554,12 @@ struct StackStep {
 /// The buffers of [`Run::stack_rk4`], reused along the sub-steps (a step allocating its
 /// stages was a fifth of the clamped stack's time, perf).
 struct RkBuffers {
+    /// The stages 2, 3 and 4.
     k: [Stage; 3],
-    /// The bodies' turns and speeds at the stages 2, 3, 4, and the inertial carriers'.
-    th: Vec<f64>,
-    u: [Vec<f64>; 3],
-    ct: Vec<f64>,
-    w: [Vec<f64>; 3],
+    /// The step of the bodies (coupling order) and the inertial carriers after them, and
+    /// their speeds at its start.
+    rk: Rk4<Vec<f64>>,
+    x0: Vec<f64>,
     out: StackStep,
 }
 
@@ -572,10 +574,8 @@ impl RkBuffers {
                 Stage::new(n, n_spin),
                 Stage::new(n, n_spin),
             ],
-            th: v(),
-            u: [v(), v(), v()],
-            ct: c(),
-            w: [c(), c(), c()],
+            rk: Rk4::new(n + n_spin),
+            x0: vec![0.0; n + n_spin],
             out: StackStep {
                 turn: v(),
                 u: v(),
@@ -622,23 +622,24 @@ impl Run {
             u0,
             w0,
         } = *start;
-        let n_spin = w0.len();
         let n = u0.len();
-        let hh = h * h;
         let (tm, te) = (t + 0.5 * h, t + h);
         let (mid, end) = (
             ShaftAt::of(sys.profile.as_deref(), tm),
             ShaftAt::of(sys.profile.as_deref(), te),
         );
+        let RkBuffers { k, rk, x0, out } = b;
+        x0[..n].copy_from_slice(u0);
+        x0[n..].copy_from_slice(w0);
+        rk.k[0][..n].copy_from_slice(&k1.acc);
+        rk.k[0][n..].copy_from_slice(&k1.acc_carrier);
         // a stage: the teeth probed with the carriers turned from t (a prescribed shaft's
-        // exact, the inertial ones by `c_turn` at `w`) and the bodies by `th` at `u`
-        let stage = |ts: f64,
-                     at: ShaftAt,
-                     c_turn: &[f64],
-                     w: &[f64],
-                     th: &[f64],
-                     u: &[f64],
-                     st: &mut Stage| {
+        // exact, the inertial ones, after the bodies, by `th[n..]` at `x[n..]`) and the bodies
+        // by `th[..n]` at `x[..n]`
+        rk.step(t, h, x0, |s, ts, th, x, acc| {
+            let st = &mut k[s - 1];
+            let at = if s < 3 { mid } else { end };
+            let ((th, c_turn), (u, w)) = (th.split_at(n), x.split_at(n));
             for i in 0..n {
                 let (turn, speed) = match sys.mounts[i] {
                     Mount::Profile => (at.angle - shaft.angle, at.speed),
@@ -648,63 +649,22 @@ impl Run {
                 st.teeth[i] = self.couplings[i].probe_torque(phi[i] + turn - th[i], speed - u[i]);
             }
             self.stack_stage(sys, faces, ts, u, w, st);
-        };
-        let RkBuffers {
-            k,
-            th,
-            u,
-            ct,
-            w,
-            out,
-        } = b;
+            acc[..n].copy_from_slice(&st.acc);
+            acc[n..].copy_from_slice(&st.acc_carrier);
+        });
         let [k2, k3, k4] = k;
-        let [u2, u3, u4] = u;
-        let [w2, w3, w4] = w;
-        for i in 0..n {
-            th[i] = 0.5 * h * u0[i];
-            u2[i] = u0[i] + 0.5 * h * k1.acc[i];
-        }
-        for k in 0..n_spin {
-            ct[k] = 0.5 * h * w0[k];
-            w2[k] = w0[k] + 0.5 * h * k1.acc_carrier[k];
-        }
-        stage(tm, mid, ct, w2, th, u2, k2);
-        for i in 0..n {
-            th[i] = 0.5 * h * u0[i] + 0.25 * hh * k1.acc[i];
-            u3[i] = u0[i] + 0.5 * h * k2.acc[i];
-        }
-        for k in 0..n_spin {
-            ct[k] = 0.5 * h * w0[k] + 0.25 * hh * k1.acc_carrier[k];
-            w3[k] = w0[k] + 0.5 * h * k2.acc_carrier[k];
-        }
-        stage(tm, mid, ct, w3, th, u3, k3);
-        for i in 0..n {
-            th[i] = h * u0[i] + 0.5 * hh * k2.acc[i];
-            u4[i] = u0[i] + h * k3.acc[i];
-        }
-        for k in 0..n_spin {
-            ct[k] = h * w0[k] + 0.5 * hh * k2.acc_carrier[k];
-            w4[k] = w0[k] + h * k3.acc_carrier[k];
-        }
-        stage(te, end, ct, w4, th, u4, k4);
+        let (u2, u3, u4) = (&rk.u[0][..n], &rk.u[1][..n], &rk.u[2][..n]);
+        let (w2, w3, w4) = (&rk.u[0][n..], &rk.u[1][n..], &rk.u[2][n..]);
         let h6 = h / 6.0;
         let quad = |a: f64, b: f64, c: f64, d: f64| h6 * (a + 2.0 * (b + c) + d);
-        for k in 0..n_spin {
-            let a = [
-                k1.acc_carrier[k],
-                k2.acc_carrier[k],
-                k3.acc_carrier[k],
-                k4.acc_carrier[k],
-            ];
-            out.carrier_turn[k] = h * w0[k] + h * h6 * (a[0] + a[1] + a[2]);
-            out.w_carrier[k] = w0[k] + quad(a[0], a[1], a[2], a[3]);
-        }
+        out.carrier_turn.copy_from_slice(&rk.turn[n..]);
+        out.w_carrier.copy_from_slice(&rk.u1[n..]);
+        out.turn.copy_from_slice(&rk.turn[..n]);
+        out.u.copy_from_slice(&rk.u1[..n]);
         (out.drive_j, out.drag_j, out.load_j) = (0.0, 0.0, 0.0);
         let sq = |x: f64| x * x;
         for i in 0..n {
-            let turn = h * u0[i] + h * h6 * (k1.acc[i] + k2.acc[i] + k3.acc[i]);
-            out.turn[i] = turn;
-            out.u[i] = u0[i] + quad(k1.acc[i], k2.acc[i], k3.acc[i], k4.acc[i]);
+            let turn = out.turn[i];
             let carrier_turn = match sys.mounts[i] {
                 Mount::Profile => end.angle - shaft.angle,
                 Mount::Housing => 0.0,

@@ -6,7 +6,7 @@
 
 use super::state::{Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, split_remainder, GapDrag, Node, Path, ShaftAt, WorldStep,
+    checked_sub_step, graded_step, split_remainder, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep,
 };
 use crate::stepping::coupling_step;
 use crate::world::Carrier;
@@ -64,6 +64,26 @@ struct Cluster<'a> {
     /// Each coupling's relative angle, rad, and speed, rad/s, there.
     phi: &'a [f64],
     dphi: &'a [f64],
+}
+
+/// The buffers of [`Run::carrier_rk4`], reused along a world step's sub-steps (allocating
+/// them per step was a tenth of an inertial-shaft pack's instructions, callgrind): the step of
+/// the cluster's bodies and the carrier after them, their speeds at its start, and zero turns.
+struct CarrierBuffers {
+    rk: Rk4<Vec<f64>>,
+    u0: Vec<f64>,
+    zero: Vec<f64>,
+}
+
+impl CarrierBuffers {
+    /// The buffers for a carrier with `n` couplings.
+    fn new(n: usize) -> CarrierBuffers {
+        CarrierBuffers {
+            rk: Rk4::new(n + 1),
+            u0: vec![0.0; n + 1],
+            zero: vec![0.0; n + 1],
+        }
+    }
 }
 
 /// One classical Runge-Kutta step of an inertial carrier and the couplings that go with it
@@ -194,7 +214,13 @@ impl Run {
     /// not the relative ones. The teeth's torques cancel in the total angular momentum at
     /// every stage, so the step conserves it exactly (a linear invariant) but for the external
     /// torque, the damping and the gaps.
-    fn carrier_rk4(&self, cl: &Cluster, dy: &CarrierDynamics, h: f64) -> CarrierStep {
+    fn carrier_rk4(
+        &self,
+        cl: &Cluster,
+        dy: &CarrierDynamics,
+        h: f64,
+        b: &mut CarrierBuffers,
+    ) -> CarrierStep {
         let Cluster {
             members: cluster,
             inv_j,
@@ -205,63 +231,44 @@ impl Run {
             dphi,
         } = *cl;
         let n = cluster.len();
-        let hh = h * h;
         let (inv_j1, c1) = (dy.inv_j, dy.damping);
-        let u0: Vec<f64> = (0..n).map(|k| w0 - dphi[k]).collect();
-        // The accelerations at a stage: the carrier turned by `s` at speed `w`, body k by
-        // `th[k]` at `u[k]`; the bodies' into `acc`, returns the carrier's.
+        let CarrierBuffers { rk, u0, zero } = b;
+        // the bodies' speeds, then the carrier's
+        for k in 0..n {
+            u0[k] = w0 - dphi[k];
+        }
+        u0[n] = w0;
         let (tm, te) = (t + 0.5 * h, t + h);
-        let stage =
-            |(ts, ext): (f64, f64), s: f64, w: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
-                let mut teeth = 0.0;
-                for k in 0..n {
-                    let i = cluster[k];
-                    let torque = self.couplings[i].probe_torque(phi[k] + s - th[k], w - u[k]);
-                    teeth += torque;
-                    let g = gaps[k].torque(ts, u[k]);
-                    acc[k] = (torque - self.bodies[i].drag_n_m_s_rad * u[k] + g) * inv_j[k];
-                }
-                (ext - c1 * w - teeth) * inv_j1
-            };
         let [e1, em, e4] = dy.torque;
-        let (mut k1, mut k2, mut k3, mut k4) =
-            (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        let zero = vec![0.0; n];
-        let a1 = stage((t, e1), 0.0, w0, &zero, &u0, &mut k1);
-        let w2 = w0 + 0.5 * h * a1;
-        let th2: Vec<f64> = u0.iter().map(|u| 0.5 * h * u).collect();
-        let u2: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k1[k]).collect();
-        let a2 = stage((tm, em), 0.5 * h * w0, w2, &th2, &u2, &mut k2);
-        let w3 = w0 + 0.5 * h * a2;
-        let th3: Vec<f64> = (0..n)
-            .map(|k| 0.5 * h * u0[k] + 0.25 * hh * k1[k])
-            .collect();
-        let u3: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k2[k]).collect();
-        let a3 = stage(
-            (tm, em),
-            0.5 * h * w0 + 0.25 * hh * a1,
-            w3,
-            &th3,
-            &u3,
-            &mut k3,
-        );
-        let w4 = w0 + h * a3;
-        let th4: Vec<f64> = (0..n).map(|k| h * u0[k] + 0.5 * hh * k2[k]).collect();
-        let u4: Vec<f64> = (0..n).map(|k| u0[k] + h * k3[k]).collect();
-        let a4 = stage((te, e4), h * w0 + 0.5 * hh * a2, w4, &th4, &u4, &mut k4);
+        // The accelerations at stage `s` (0 to 3) at `ts`: body k turned by `th[k]` from t
+        // at `u[k]`, the carrier (last) by `th[n]` at `u[n]`.
+        let stage = |s: usize, ts: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
+            let (sc, w) = (th[n], u[n]);
+            let mut teeth = 0.0;
+            for k in 0..n {
+                let i = cluster[k];
+                let torque = self.couplings[i].probe_torque(phi[k] + sc - th[k], w - u[k]);
+                teeth += torque;
+                let g = gaps[k].torque(ts, u[k]);
+                acc[k] = (torque - self.bodies[i].drag_n_m_s_rad * u[k] + g) * inv_j[k];
+            }
+            let ext = [e1, em, em, e4][s];
+            acc[n] = (ext - c1 * w - teeth) * inv_j1;
+        };
+        stage(0, t, zero, u0, &mut rk.k[0]);
+        rk.step(t, h, u0, stage);
+        let [u2, u3, u4] = &rk.u;
+        let (w2, w3, w4) = (u2[n], u3[n], u4[n]);
+        let (turn, speed) = (rk.turn[n], rk.u1[n]);
         let h6 = h / 6.0;
-        let turn = h * w0 + h * h6 * (a1 + a2 + a3);
-        let speed = w0 + h6 * (a1 + 2.0 * (a2 + a3) + a4);
         let sq = |a: f64, b: f64, c: f64, d: f64| a * a + 2.0 * (b * b + c * c) + d * d;
         let mut drag_j = -c1 * h6 * sq(w0, w2, w3, w4);
         let mut gap_j = 0.0;
         let mut phi1 = Vec::with_capacity(n);
         let mut dphi1 = Vec::with_capacity(n);
         for k in 0..n {
-            let th = h * u0[k] + h * h6 * (k1[k] + k2[k] + k3[k]);
-            let u1 = u0[k] + h6 * (k1[k] + 2.0 * (k2[k] + k3[k]) + k4[k]);
-            phi1.push(phi[k] + turn - th);
-            dphi1.push(speed - u1);
+            phi1.push(phi[k] + turn - rk.turn[k]);
+            dphi1.push(speed - rk.u1[k]);
             drag_j -= self.bodies[cluster[k]].drag_n_m_s_rad * h6 * sq(u0[k], u2[k], u3[k], u4[k]);
             let g = |ts: f64, u: f64| gaps[k].torque(ts, u) * u;
             gap_j += h6 * (g(t, u0[k]) + 2.0 * (g(tm, u2[k]) + g(tm, u3[k])) + g(te, u4[k]));
@@ -305,6 +312,7 @@ impl Run {
         let mut dphi: Vec<f64> = cluster.iter().map(|&i| self.rel[i].dphi).collect();
         let mut nodes = vec![Node { t, angle, speed: w }];
         let cap = a.max_step_s / SHAFT_SUB_STEPS;
+        let bufs = std::cell::RefCell::new(CarrierBuffers::new(n));
         let who = match c {
             Inertial::Shaft => "inertial shaft",
             Inertial::Drum => "drum",
@@ -331,6 +339,7 @@ impl Run {
             let rem = t1 - t;
             let mut h = split_remainder(want, rem);
             let rk4 = |x: f64| {
+                let b = &mut bufs.borrow_mut();
                 let dy = self.carrier_dynamics(c, t, x);
                 let start = Cluster {
                     members: cluster,
@@ -341,7 +350,7 @@ impl Run {
                     phi: &phi,
                     dphi: &dphi,
                 };
-                self.carrier_rk4(&start, &dy, x)
+                self.carrier_rk4(&start, &dy, x, b)
             };
             let mut step = rk4(h);
             // Never step over an onset or a separation of any coupling: land on the first.

@@ -187,6 +187,86 @@ pub(super) fn split_remainder(want: f64, rem: f64) -> f64 {
     }
 }
 
+/// The classical Runge-Kutta step of a set of bodies, the one integrator of the multirate
+/// schemes (a coupling alone against its carrier's path, [`Relative::rk4`]; an inertial
+/// carrier with its cluster, `Run::carrier_rk4`; the clamped stack with its inertial
+/// carriers, `Run::stack_rk4`): its stages' accelerations and speeds, kept for the schemes'
+/// energy quadratures, and its result. `V` holds one value per body: `[f64; 1]` for a coupling
+/// alone (no allocation on its hot path), a `Vec<f64>` for a system.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Rk4<V> {
+    /// Each body's acceleration at the four stages, rad/s^2 (`k[0]`, at the step's start, is
+    /// the caller's).
+    pub(super) k: [V; 4],
+    /// Each body's speed at the stages 2, 3 and 4, rad/s.
+    pub(super) u: [V; 3],
+    /// Each body's turn from the start at the stage being evaluated, rad (scratch).
+    th: V,
+    /// Each body's turn over the step, rad, and its speed at the end, rad/s.
+    pub(super) turn: V,
+    pub(super) u1: V,
+}
+
+impl Rk4<Vec<f64>> {
+    /// The buffers for `n` bodies.
+    pub(super) fn new(n: usize) -> Rk4<Vec<f64>> {
+        let v = || vec![0.0; n];
+        Rk4 {
+            k: [v(), v(), v(), v()],
+            u: [v(), v(), v()],
+            th: v(),
+            turn: v(),
+            u1: v(),
+        }
+    }
+}
+
+impl<V: AsRef<[f64]> + AsMut<[f64]>> Rk4<V> {
+    /// One classical Runge-Kutta step (Kutta 1901: nodes 0, 1/2, 1/2, 1, weights 1/6, 1/3,
+    /// 1/3, 1/6) of length `h` from `t` of the bodies' motion `theta' = u`,
+    /// `u' = a(t, theta - theta(t), u)`, from their speeds `u0` and their accelerations at `t`
+    /// in `k[0]`. `stage(s, ts, th, u, acc)` writes into `acc` the bodies' accelerations at
+    /// stage `s` (1, 2, 3: the second to the fourth) at `ts` with the bodies turned by `th`
+    /// (rad) from `t` and turning at `u` (rad/s). Written for the angle, as the method on the
+    /// first-order system (angle, speed) gives it: each body turns by
+    /// `h u0 + h^2/6 (k1 + k2 + k3)` and ends at `u0 + h/6 (k1 + 2 k2 + 2 k3 + k4)`.
+    pub(super) fn step(
+        &mut self,
+        t: f64,
+        h: f64,
+        u0: &[f64],
+        mut stage: impl FnMut(usize, f64, &[f64], &[f64], &mut [f64]),
+    ) {
+        let hh = h * h;
+        let (tm, te) = (t + 0.5 * h, t + h);
+        let Rk4 { k, u, th, turn, u1 } = self;
+        let [k1, k2, k3, k4] = k.each_mut().map(|x| x.as_mut());
+        let [u2, u3, u4] = u.each_mut().map(|x| x.as_mut());
+        let (th, turn, u1) = (th.as_mut(), turn.as_mut(), u1.as_mut());
+        let n = u0.len();
+        for i in 0..n {
+            th[i] = 0.5 * h * u0[i];
+            u2[i] = u0[i] + 0.5 * h * k1[i];
+        }
+        stage(1, tm, th, u2, k2);
+        for i in 0..n {
+            th[i] = 0.5 * h * u0[i] + 0.25 * hh * k1[i];
+            u3[i] = u0[i] + 0.5 * h * k2[i];
+        }
+        stage(2, tm, th, u3, k3);
+        for i in 0..n {
+            th[i] = h * u0[i] + 0.5 * hh * k2[i];
+            u4[i] = u0[i] + h * k3[i];
+        }
+        stage(3, te, th, u4, k4);
+        let h6 = h / 6.0;
+        for i in 0..n {
+            turn[i] = h * u0[i] + h * h6 * (k1[i] + k2[i] + k3[i]);
+            u1[i] = u0[i] + h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+        }
+    }
+}
+
 /// One sub-step's outcome: the relative state at its end and the work done along it.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct SubStep {
@@ -239,33 +319,27 @@ impl Relative<'_> {
         let (w0, wm, we) = (shaft.speed, mid.speed, end.speed);
         // The shaft's turn from t, exact.
         let (sm, se) = (mid.angle - shaft.angle, end.angle - shaft.angle);
-        // The disc's speed at t; `th` below is its turn from t.
+        // The disc's speed at t.
         let u0 = w0 - dphi;
-        // (omega_d', teeth torque) at a stage: the shaft turned by `s` at speed `ws`, the
-        // disc turned by `th` at speed `u`.
+        // omega_d' at a stage with the teeth's torque `torque`, the disc turning at `u`.
         // Hu et al. eq (5): J omega_d' = T - C2 omega_d, plus the open gaps' drag
-        let accel = |ts: f64, torque: f64, u: f64| {
-            (
-                (torque - self.c2 * u + gap.torque(ts, u)) * self.inv_j,
-                torque,
-            )
-        };
-        let f = |ts: f64, s: f64, ws: f64, th: f64, u: f64| {
-            accel(ts, self.coupling.probe_torque(phi + s - th, ws - u), u)
-        };
-        let hh = h * h;
-        let (k1, t1) = accel(t, self.start_torque_n_m, u0);
-        let u2 = u0 + 0.5 * h * k1;
-        let (k2, t2) = f(tm, sm, wm, 0.5 * h * u0, u2);
-        let u3 = u0 + 0.5 * h * k2;
-        let (k3, t3) = f(tm, sm, wm, 0.5 * h * u0 + 0.25 * hh * k1, u3);
-        let u4 = u0 + h * k3;
-        let (k4, t4) = f(te, se, we, h * u0 + 0.5 * hh * k2, u4);
+        let accel =
+            |ts: f64, torque: f64, u: f64| (torque - self.c2 * u + gap.torque(ts, u)) * self.inv_j;
+        // the teeth's torque at the four stages, N m
+        let mut teeth = [self.start_torque_n_m, 0.0, 0.0, 0.0];
+        let mut rk = Rk4::<[f64; 1]>::default();
+        rk.k[0] = [accel(t, teeth[0], u0)];
+        // a stage: the shaft turned from t at its speed there (exact), the disc turned by
+        // `th` at `u`
+        rk.step(t, h, &[u0], |s, ts, th, u, acc| {
+            let (turn, speed) = if s < 3 { (sm, wm) } else { (se, we) };
+            teeth[s] = self.coupling.probe_torque(phi + turn - th[0], speed - u[0]);
+            acc[0] = accel(ts, teeth[s], u[0]);
+        });
+        let [t1, t2, t3, t4] = teeth;
+        let [[u2], [u3], [u4]] = rk.u;
+        let (th, u1) = (rk.turn[0], rk.u1[0]);
         let h6 = h / 6.0;
-        // The classical method on the first-order system (angle, speed), written for the
-        // angle: the disc turns by h u0 + h^2/6 (k1 + k2 + k3).
-        let th = h * u0 + h * h6 * (k1 + k2 + k3);
-        let u1 = u0 + h6 * (k1 + 2.0 * (k2 + k3) + k4);
         SubStep {
             shaft: end,
             phi: phi + se - th,
