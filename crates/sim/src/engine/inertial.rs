@@ -4,10 +4,9 @@
 //! integrated together with classical Runge-Kutta sub-steps, the other bodies fly free against
 //! the carrier's motion (`multirate.rs`'s per-coupling integration).
 
+use super::multirate::SubSteps;
 use super::state::{Run, ShaftDrive};
-use super::substep::{
-    checked_sub_step, graded_step, split_remainder, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep,
-};
+use super::substep::{checked_sub_step, graded_step, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep};
 use crate::stepping::coupling_step;
 use crate::world::Carrier;
 use clutchpack_model::EngineError;
@@ -288,10 +287,11 @@ impl Run {
     /// (those that may touch it within the world step; the others fly free and load nothing),
     /// the open gaps' drag `gaps` on each coupling, with sub-steps of the shortest any of them
     /// wants (the prescribed shaft's controller and grading, applied to each), at most the
-    /// world step over [`SHAFT_SUB_STEPS`], landed on every onset and separation. Leaves the
-    /// couplings' states at `t1` in `rel` and `forces`, adds the external torque's, the
-    /// damping's, the drag's and the gaps' work to the audit, feeds the events, and returns
-    /// the carrier's nodes (the motion the free couplings follow).
+    /// world step over [`SHAFT_SUB_STEPS`], landed on every onset and separation
+    /// ([`Run::land_sub_steps`]). Leaves the couplings' states at `t1` in `rel` and `forces`,
+    /// adds the external torque's, the damping's, the drag's and the gaps' work to the audit,
+    /// feeds the events, and returns the carrier's nodes (the motion the free couplings
+    /// follow).
     fn integrate_carrier(
         &mut self,
         c: Inertial,
@@ -299,103 +299,31 @@ impl Run {
         gaps: &[GapDrag],
         ws: &mut WorldStep,
     ) -> Result<Vec<Node>, EngineError> {
-        let (t1, a) = (ws.t1, ws.a);
         let n = cluster.len();
-        let inv_j: Vec<f64> = cluster
-            .iter()
-            .map(|&i| self.inv_inertia_z(self.world.discs[i]))
-            .collect();
-        let gaps: Vec<GapDrag> = cluster.iter().map(|&i| gaps[i]).collect();
-        let mut t = self.t;
-        let (mut angle, mut w) = self.carrier_state(c);
-        let mut phi: Vec<f64> = cluster.iter().map(|&i| self.rel[i].phi).collect();
-        let mut dphi: Vec<f64> = cluster.iter().map(|&i| self.rel[i].dphi).collect();
-        let mut nodes = vec![Node { t, angle, speed: w }];
-        let cap = a.max_step_s / SHAFT_SUB_STEPS;
-        let bufs = std::cell::RefCell::new(CarrierBuffers::new(n));
-        let who = match c {
-            Inertial::Shaft => "inertial shaft",
-            Inertial::Drum => "drum",
-        };
-        while t < t1 {
-            let reaction: f64 = cluster
+        let (angle, w) = self.carrier_state(c);
+        let mut steps = CarrierSteps {
+            c,
+            cluster,
+            inv_j: cluster
                 .iter()
-                .map(|&i| self.forces[i].moment[2].abs())
-                .sum();
-            let a_carrier = self.inertial_accel_bound(c, w, reaction);
-            let mut want = cap;
-            for (k, &i) in cluster.iter().enumerate() {
-                let d = &self.bodies[i];
-                let f = self.forces[i];
-                let wd = w - dphi[k];
-                let g = gaps[k];
-                let bound = a_carrier
-                    + ((d.drag_n_m_s_rad + g.damping) * wd.abs() + g.bound_n_m()) * inv_j[k];
-                let view = self.coupling_view(i, &f, (phi[k], dphi[k]), bound, t);
-                let (wk, _) = coupling_step(&view, a);
-                want = want.min(graded_step(wk, &f, self.events.event_age_s(i, t)));
-            }
-            let want = checked_sub_step(want, a, t, || who.into())?;
-            let rem = t1 - t;
-            let mut h = split_remainder(want, rem);
-            let rk4 = |x: f64| {
-                let b = &mut bufs.borrow_mut();
-                let dy = self.carrier_dynamics(c, t, x);
-                let start = Cluster {
-                    members: cluster,
-                    inv_j: &inv_j,
-                    gaps: &gaps,
-                    t,
-                    w0: w,
-                    phi: &phi,
-                    dphi: &dphi,
-                };
-                self.carrier_rk4(&start, &dy, x, b)
-            };
-            let mut step = rk4(h);
-            // Never step over an onset or a separation of any coupling: land on the first.
-            let tiny = 1e-3 * h.min(want);
-            let mut first: Option<f64> = None;
-            for (k, &i) in cluster.iter().enumerate() {
-                let evals = std::cell::Cell::new(0);
-                let crossing = self.depth_crossing(i, phi[k], step.phi[k], h, |x| {
-                    evals.set(evals.get() + 4 * n as u64);
-                    rk4(x).phi[k]
-                });
-                ws.counts.evals += evals.get();
-                if let Some(x) = crossing.filter(|&x| x > tiny && x < h) {
-                    if first.is_none_or(|b| x < b) {
-                        first = Some(x);
-                    }
-                }
-            }
-            if let Some(x) = first {
-                h = x;
-                step = rk4(x);
-                ws.counts.evals += 4 * n as u64;
-            }
-            t = if h == rem { t1 } else { t + h };
-            angle += step.turn;
-            w = step.speed;
-            phi.clone_from(&step.phi);
-            dphi.clone_from(&step.dphi);
-            ws.counts.substeps += 1;
-            ws.counts.evals += 5 * n as u64;
-            match c {
-                Inertial::Shaft => self.energy.add_sub_step(step.external_j, step.drag_j),
-                Inertial::Drum => {
-                    self.energy.add_sub_step(0.0, step.drag_j);
-                    self.energy.add_load_work(step.external_j);
-                }
-            }
-            self.energy.add_stack_work(step.gap_j);
-            nodes.push(Node { t, angle, speed: w });
-            let at = ShaftAt { speed: w, angle };
-            for (k, &i) in cluster.iter().enumerate() {
-                self.end_sub_step(i, t, phi[k], dphi[k], at, ws)?;
-            }
-        }
-        Ok(nodes)
+                .map(|&i| self.inv_inertia_z(self.world.discs[i]))
+                .collect(),
+            gaps: cluster.iter().map(|&i| gaps[i]).collect(),
+            t: self.t,
+            angle,
+            w,
+            phi: cluster.iter().map(|&i| self.rel[i].phi).collect(),
+            dphi: cluster.iter().map(|&i| self.rel[i].dphi).collect(),
+            nodes: vec![Node {
+                t: self.t,
+                angle,
+                speed: w,
+            }],
+            cap: ws.a.max_step_s / SHAFT_SUB_STEPS,
+            bufs: std::cell::RefCell::new(CarrierBuffers::new(n)),
+        };
+        self.land_sub_steps(&mut steps, ws)?;
+        Ok(steps.nodes)
     }
 
     /// Advances inertial carrier `c` and the couplings it carries from `t` to `t1`, the open
@@ -493,5 +421,125 @@ impl Run {
         }
         self.t_prev = Some(t0);
         self.t = t1;
+    }
+}
+
+/// An inertial carrier with its cluster as the one landing loop drives it
+/// ([`Run::integrate_carrier`]).
+struct CarrierSteps<'a> {
+    /// The carrier and the couplings integrated with it, their bodies' inverse inertias,
+    /// 1/(kg m^2), and the open gaps' drag on each.
+    c: Inertial,
+    cluster: &'a [usize],
+    inv_j: Vec<f64>,
+    gaps: Vec<GapDrag>,
+    /// The time, s, the carrier's angle, rad, and speed, rad/s, and each coupling's relative
+    /// angle, rad, and speed, rad/s, there.
+    t: f64,
+    angle: f64,
+    w: f64,
+    phi: Vec<f64>,
+    dphi: Vec<f64>,
+    /// The carrier at the sub-steps' ends so far.
+    nodes: Vec<Node>,
+    /// The longest sub-step, s.
+    cap: f64,
+    bufs: std::cell::RefCell<CarrierBuffers>,
+}
+
+impl SubSteps for CarrierSteps<'_> {
+    type Step = CarrierStep;
+
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn members(&self) -> &[usize] {
+        self.cluster
+    }
+
+    fn phi(&self, k: usize) -> f64 {
+        self.phi[k]
+    }
+
+    fn want(&mut self, run: &Run, ws: &mut WorldStep) -> Result<f64, EngineError> {
+        let (a, t, w) = (ws.a, self.t, self.w);
+        let reaction: f64 = self
+            .cluster
+            .iter()
+            .map(|&i| run.forces[i].moment[2].abs())
+            .sum();
+        let a_carrier = run.inertial_accel_bound(self.c, w, reaction);
+        let mut want = self.cap;
+        for (k, &i) in self.cluster.iter().enumerate() {
+            let d = &run.bodies[i];
+            let f = run.forces[i];
+            let wd = w - self.dphi[k];
+            let g = self.gaps[k];
+            let bound = a_carrier
+                + ((d.drag_n_m_s_rad + g.damping) * wd.abs() + g.bound_n_m()) * self.inv_j[k];
+            let view = run.coupling_view(i, &f, (self.phi[k], self.dphi[k]), bound, t);
+            let (wk, _) = coupling_step(&view, a);
+            want = want.min(graded_step(wk, &f, run.events.event_age_s(i, t)));
+        }
+        let who = match self.c {
+            Inertial::Shaft => "inertial shaft",
+            Inertial::Drum => "drum",
+        };
+        checked_sub_step(want, a, t, || who.into())
+    }
+
+    fn rk4(&self, run: &Run, h: f64) -> CarrierStep {
+        let b = &mut self.bufs.borrow_mut();
+        let dy = run.carrier_dynamics(self.c, self.t, h);
+        let start = Cluster {
+            members: self.cluster,
+            inv_j: &self.inv_j,
+            gaps: &self.gaps,
+            t: self.t,
+            w0: self.w,
+            phi: &self.phi,
+            dphi: &self.dphi,
+        };
+        run.carrier_rk4(&start, &dy, h, b)
+    }
+
+    fn phi_end(step: &CarrierStep, k: usize) -> f64 {
+        step.phi[k]
+    }
+
+    fn evals_per_rk4(&self) -> u64 {
+        4 * self.cluster.len() as u64
+    }
+
+    fn accept(
+        &mut self,
+        run: &mut Run,
+        step: CarrierStep,
+        t: f64,
+        ws: &mut WorldStep,
+    ) -> Result<(), EngineError> {
+        self.t = t;
+        self.angle += step.turn;
+        self.w = step.speed;
+        self.phi.clone_from(&step.phi);
+        self.dphi.clone_from(&step.dphi);
+        ws.counts.substeps += 1;
+        ws.counts.evals += 5 * self.cluster.len() as u64;
+        match self.c {
+            Inertial::Shaft => run.energy.add_sub_step(step.external_j, step.drag_j),
+            Inertial::Drum => {
+                run.energy.add_sub_step(0.0, step.drag_j);
+                run.energy.add_load_work(step.external_j);
+            }
+        }
+        run.energy.add_stack_work(step.gap_j);
+        let (angle, w) = (self.angle, self.w);
+        self.nodes.push(Node { t, angle, speed: w });
+        let at = ShaftAt { speed: w, angle };
+        for (k, &i) in self.cluster.iter().enumerate() {
+            run.end_sub_step(i, t, self.phi[k], self.dphi[k], at, ws)?;
+        }
+        Ok(())
     }
 }

@@ -7,7 +7,7 @@ use super::inertial::Inertial;
 use super::state::{disc_sample, relative_state, Run, ShaftDrive};
 use super::substep::{
     checked_sub_step, graded_step, split_remainder, GapDrag, Node, Path, Relative, ShaftAt,
-    TurnMoment, WorldStep,
+    SubStep, TurnMoment, WorldStep,
 };
 use crate::hook::{CouplingForces, RelativeState, FLANKS};
 use crate::options::{MultibodyOptions, Stepping};
@@ -321,8 +321,9 @@ impl Run {
 
     /// Sub-steps coupling `i` from `t` (its state in `rel[i]`, its forces in `forces[i]`) to
     /// `t1`, with the step controller of the shared scheme applied to this coupling alone and
-    /// steps landed on every contact onset and separation; leaves the state at `t1` in
-    /// `rel[i]` and `forces[i]`, adds the work done to the energy audit and feeds the events.
+    /// steps landed on every contact onset and separation ([`Run::land_sub_steps`]); leaves the
+    /// state at `t1` in `rel[i]` and `forces[i]`, adds the work done to the energy audit and
+    /// feeds the events.
     pub(super) fn integrate_coupling(
         &mut self,
         i: usize,
@@ -331,85 +332,70 @@ impl Run {
         carrier_accel_bound: f64,
         ws: &mut WorldStep,
     ) -> Result<(), EngineError> {
-        let (t1, a) = (ws.t1, ws.a);
-        let bodies = std::sync::Arc::clone(&self.bodies);
-        let d = &bodies[i];
-        let inv_j = self.world.physics.bodies[self.world.discs[i]]
-            .mass_properties()
-            .local_mprops
-            .inv_principal_inertia
-            .z;
-        // On an inertial carrier (shaft, drum) the teeth's work is internal (the drive's or the
-        // load's is the carrier's, integrated with it) and a coupling integrated here is in
-        // free flight (the others go with the carrier, `integrate_carrier`): one that touches
-        // all the same is counted.
-        let inertial = matches!(path, Path::Nodes(_));
-        let mut missed = false;
-        let mut t = self.t;
-        let (mut phi, mut dphi) = (self.rel[i].phi, self.rel[i].dphi);
-        let mut shaft = path.at(t);
-        // whether `forces[i]` holds the hook's evaluation at `(phi, dphi)`: from the first
-        // sub-step's end on (at a world step's start the state was read back from rapier)
-        let mut evaluated_here = false;
-        while t < t1 {
-            let f = self.forces[i];
-            let wd = shaft.speed - dphi;
-            let bound = carrier_accel_bound
-                + ((d.drag_n_m_s_rad + gap.damping) * wd.abs() + gap.bound_n_m()) * inv_j;
-            let view = self.coupling_view(i, &f, (phi, dphi), bound, t);
-            let (want, _) = coupling_step(&view, a);
-            let want = graded_step(want, &f, self.events.event_age_s(i, t));
-            let want = checked_sub_step(want, a, t, || format!("disc {i}"))?;
+        let mut alone = Alone {
+            i,
+            gap,
+            path,
+            carrier_accel_bound,
+            inv_j: self.inv_inertia_z(self.world.discs[i]),
+            c2: self.bodies[i].drag_n_m_s_rad,
+            t: self.t,
+            phi: self.rel[i].phi,
+            dphi: self.rel[i].dphi,
+            shaft: path.at(self.t),
+            evaluated_here: false,
+            start_torque_n_m: 0.0,
+            missed: false,
+        };
+        self.land_sub_steps(&mut alone, ws)
+    }
+
+    /// The one landing loop of the multirate schemes: sub-steps `s` from `t` to the world
+    /// step's end, each of the length its controller wants (`SubSteps::want`, split so that
+    /// the last two are even), shortened to land on the first onset or separation of any of
+    /// its couplings within it (located on the sub-step's own path by
+    /// [`Run::depth_crossing`]; the `s^1.5` law's kink then falls on a sub-step boundary and
+    /// the step keeps its order), then accepted (`SubSteps::accept`: its state, the counts,
+    /// the works, the sub-step's end for every coupling).
+    pub(super) fn land_sub_steps<S: SubSteps>(
+        &mut self,
+        s: &mut S,
+        ws: &mut WorldStep,
+    ) -> Result<(), EngineError> {
+        let t1 = ws.t1;
+        while s.t() < t1 {
+            let t = s.t();
+            let want = s.want(self, ws)?;
             let rem = t1 - t;
             let mut h = split_remainder(want, rem);
-            let start_torque_n_m = if evaluated_here {
-                f.moment[2]
-            } else {
-                ws.counts.evals += 1;
-                self.couplings[i].probe_torque(phi, dphi)
-            };
-            let rel = Relative {
-                path,
-                coupling: &self.couplings[i],
-                inv_j,
-                c2: d.drag_n_m_s_rad,
-                gap,
-                start_torque_n_m,
-            };
-            let mut step = rel.rk4(t, shaft, phi, dphi, h);
-            // Never step over an onset or a separation: land on it (the `s^1.5` law's kink
-            // then falls on a sub-step boundary and the step keeps its order).
+            let mut step = s.rk4(self, h);
+            // Never step over an onset or a separation of any coupling: land on the first.
             let tiny = 1e-3 * h.min(want);
-            let evals = std::cell::Cell::new(0);
-            let crossing = self.depth_crossing(i, phi, step.phi, h, |x| {
-                evals.set(evals.get() + 3);
-                rel.rk4(t, shaft, phi, dphi, x).phi
-            });
-            ws.counts.evals += evals.get();
-            if let Some(x) = crossing.filter(|&x| x > tiny && x < h) {
+            let mut first: Option<f64> = None;
+            for k in 0..s.members().len() {
+                let evals = std::cell::Cell::new(0);
+                let (i, phi0) = (s.members()[k], s.phi(k));
+                let crossing = self.depth_crossing(i, phi0, S::phi_end(&step, k), h, |x| {
+                    evals.set(evals.get() + s.evals_per_rk4());
+                    S::phi_end(&s.rk4(self, x), k)
+                });
+                ws.counts.evals += evals.get();
+                if let Some(x) = crossing.filter(|&x| x > tiny && x < h) {
+                    if first.is_none_or(|b| x < b) {
+                        first = Some(x);
+                    }
+                }
+            }
+            if let Some(x) = first {
                 h = x;
-                step = rel.rk4(t, shaft, phi, dphi, x);
-                ws.counts.evals += 3;
+                step = s.rk4(self, x);
+                ws.counts.evals += s.evals_per_rk4();
             }
-            t = if h == rem { t1 } else { t + h };
-            phi = step.phi;
-            dphi = step.dphi;
-            shaft = step.shaft;
-            ws.counts.substeps += 1;
-            ws.counts.evals += step.evals + 1;
-            self.energy
-                .add_sub_step(if inertial { 0.0 } else { step.drive_j }, step.drag_j);
-            self.energy.add_stack_work(step.gap_j);
-            let f = self.end_sub_step(i, t, phi, dphi, shaft, ws)?;
-            evaluated_here = true;
-            if inertial && f.depth_m > 0.0 && !missed {
-                missed = true;
-                ws.counts.missed += 1;
-            }
+            let t = if h == rem { t1 } else { t + h };
+            s.accept(self, step, t, ws)?;
         }
         Ok(())
     }
-
     /// Where within a sub-step of length `h` coupling `i`'s deepest tooth's engagement depth
     /// crosses zero (an onset when the coupling is not engaged, its separation when it is),
     /// from the relative angle `phi0` at the sub-step's start to `phi1` at its end, located on
@@ -504,5 +490,146 @@ impl Run {
             ));
         }
         Ok(f)
+    }
+}
+
+/// A multirate scheme's sub-steps as the one landing loop drives them
+/// ([`Run::land_sub_steps`]): a set of couplings integrated together (with their carrier's
+/// known path, or with their inertial carrier) from their state at `t`.
+pub(super) trait SubSteps {
+    /// One sub-step's outcome.
+    type Step;
+    /// The time the sub-steps have reached, s.
+    fn t(&self) -> f64;
+    /// The couplings integrated together.
+    fn members(&self) -> &[usize];
+    /// Member `k`'s relative angle at `t`, rad.
+    fn phi(&self, k: usize) -> f64;
+    /// The sub-step the controller wants from `t`, s (checked: the run's failure when it
+    /// collapsed); readies the step's start (what the schemes count goes to `ws`).
+    fn want(&mut self, run: &Run, ws: &mut WorldStep) -> Result<f64, EngineError>;
+    /// One classical Runge-Kutta step of length `h` from `t`.
+    fn rk4(&self, run: &Run, h: f64) -> Self::Step;
+    /// Member `k`'s relative angle at the end of `step`, rad.
+    fn phi_end(step: &Self::Step, k: usize) -> f64;
+    /// Tooth-law evaluations of one step.
+    fn evals_per_rk4(&self) -> u64;
+    /// Takes `step`, ending at `t`: the state, the counts, the works, each member's sub-step
+    /// end ([`Run::end_sub_step`]).
+    fn accept(
+        &mut self,
+        run: &mut Run,
+        step: Self::Step,
+        t: f64,
+        ws: &mut WorldStep,
+    ) -> Result<(), EngineError>;
+}
+
+/// One coupling alone against its carrier's known motion (a prescribed shaft's profile, the
+/// housing at rest, an inertial carrier's nodes), [`Relative::rk4`] for its steps.
+struct Alone<'a> {
+    /// The coupling, the open gaps' drag on its body, its carrier's path and the bound of
+    /// the carrier's acceleration, rad/s^2.
+    i: usize,
+    gap: GapDrag,
+    path: Path<'a>,
+    carrier_accel_bound: f64,
+    /// The body's inverse inertia about the axis, 1/(kg m^2) (rapier's), and drag `C2`,
+    /// N m s/rad.
+    inv_j: f64,
+    c2: f64,
+    /// The time, s, the relative state (rad, rad/s) and the carrier there.
+    t: f64,
+    phi: f64,
+    dphi: f64,
+    shaft: ShaftAt,
+    /// Whether `forces[i]` holds the hook's evaluation at `(phi, dphi)`: from the first
+    /// sub-step's end on (at a world step's start the state was read back from rapier).
+    evaluated_here: bool,
+    /// The teeth's torque at the step's start, N m.
+    start_torque_n_m: f64,
+    /// Whether it touched on an inertial carrier (counted once per world step).
+    missed: bool,
+}
+
+impl SubSteps for Alone<'_> {
+    type Step = SubStep;
+
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn members(&self) -> &[usize] {
+        std::slice::from_ref(&self.i)
+    }
+
+    fn phi(&self, _: usize) -> f64 {
+        self.phi
+    }
+
+    fn want(&mut self, run: &Run, ws: &mut WorldStep) -> Result<f64, EngineError> {
+        let (i, a, t, gap) = (self.i, ws.a, self.t, self.gap);
+        let f = run.forces[i];
+        let wd = self.shaft.speed - self.dphi;
+        let bound = self.carrier_accel_bound
+            + ((self.c2 + gap.damping) * wd.abs() + gap.bound_n_m()) * self.inv_j;
+        let view = run.coupling_view(i, &f, (self.phi, self.dphi), bound, t);
+        let (want, _) = coupling_step(&view, a);
+        let want = graded_step(want, &f, run.events.event_age_s(i, t));
+        let want = checked_sub_step(want, a, t, || format!("disc {i}"))?;
+        self.start_torque_n_m = if self.evaluated_here {
+            f.moment[2]
+        } else {
+            ws.counts.evals += 1;
+            run.couplings[i].probe_torque(self.phi, self.dphi)
+        };
+        Ok(want)
+    }
+
+    fn rk4(&self, run: &Run, h: f64) -> SubStep {
+        let rel = Relative {
+            path: self.path,
+            coupling: &run.couplings[self.i],
+            inv_j: self.inv_j,
+            c2: self.c2,
+            gap: self.gap,
+            start_torque_n_m: self.start_torque_n_m,
+        };
+        rel.rk4(self.t, self.shaft, self.phi, self.dphi, h)
+    }
+
+    fn phi_end(step: &SubStep, _: usize) -> f64 {
+        step.phi
+    }
+
+    fn evals_per_rk4(&self) -> u64 {
+        3
+    }
+
+    fn accept(
+        &mut self,
+        run: &mut Run,
+        step: SubStep,
+        t: f64,
+        ws: &mut WorldStep,
+    ) -> Result<(), EngineError> {
+        // On an inertial carrier (shaft, drum) the teeth's work is internal (the drive's or
+        // the load's is the carrier's, integrated with it) and a coupling integrated here is
+        // in free flight (the others go with the carrier, `integrate_carrier`): one that
+        // touches all the same is counted.
+        let inertial = matches!(self.path, Path::Nodes(_));
+        (self.t, self.phi, self.dphi, self.shaft) = (t, step.phi, step.dphi, step.shaft);
+        ws.counts.substeps += 1;
+        ws.counts.evals += step.evals + 1;
+        run.energy
+            .add_sub_step(if inertial { 0.0 } else { step.drive_j }, step.drag_j);
+        run.energy.add_stack_work(step.gap_j);
+        let f = run.end_sub_step(self.i, t, self.phi, self.dphi, self.shaft, ws)?;
+        self.evaluated_here = true;
+        if inertial && f.depth_m > 0.0 && !self.missed {
+            self.missed = true;
+            ws.counts.missed += 1;
+        }
+        Ok(())
     }
 }
