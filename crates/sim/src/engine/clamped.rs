@@ -20,7 +20,7 @@
 use super::inertial::Inertial;
 use super::state::{Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, split_remainder, Node, Rk4, ShaftAt, WorldStep,
+    checked_sub_step, graded_step, rk4_work, split_remainder, Node, Rk4, ShaftAt, WorldStep,
 };
 use crate::stack::Face;
 use crate::stepping::{bracketed_root, coupling_step};
@@ -655,8 +655,7 @@ impl Run {
         let [k2, k3, k4] = k;
         let (u2, u3, u4) = (&rk.u[0][..n], &rk.u[1][..n], &rk.u[2][..n]);
         let (w2, w3, w4) = (&rk.u[0][n..], &rk.u[1][n..], &rk.u[2][n..]);
-        let h6 = h / 6.0;
-        let quad = |a: f64, b: f64, c: f64, d: f64| h6 * (a + 2.0 * (b + c) + d);
+        let quad = |a: f64, b: f64, c: f64, d: f64| rk4_work(h, [a, b, c, d]);
         out.carrier_turn.copy_from_slice(&rk.turn[n..]);
         out.w_carrier.copy_from_slice(&rk.u1[n..]);
         out.turn.copy_from_slice(&rk.turn[..n]);
@@ -684,19 +683,13 @@ impl Run {
         for (k, spin) in sys.spins.iter().enumerate() {
             let (a, b, c, d) = (w0[k], w2[k], w3[k], w4[k]);
             out.drag_j -= spin.damping * quad(sq(a), sq(b), sq(c), sq(d));
+            // the external torque's work: the drive's on an inertial shaft (eq 4), the
+            // drum's load
+            let [e1, em, e4] = [t, tm, te].map(|ts| self.external_torque(spin.role, ts));
+            let work = quad(e1 * a, em * b, em * c, e4 * d);
             match spin.role {
-                Inertial::Shaft => {
-                    // the drive's work on an inertial shaft (eq 4)
-                    let (e1, em, e4) = (
-                        self.drive_torque(t),
-                        self.drive_torque(tm),
-                        self.drive_torque(te),
-                    );
-                    out.drive_j += quad(e1 * a, em * b, em * c, e4 * d);
-                }
-                Inertial::Drum => {
-                    out.load_j = self.external_torque(Inertial::Drum, t) * quad(a, b, c, d);
-                }
+                Inertial::Shaft => out.drive_j += work,
+                Inertial::Drum => out.load_j += work,
             }
         }
         for m in 0..faces.len() {

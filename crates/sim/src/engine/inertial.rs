@@ -6,7 +6,9 @@
 
 use super::multirate::SubSteps;
 use super::state::{Run, ShaftDrive};
-use super::substep::{checked_sub_step, graded_step, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep};
+use super::substep::{
+    checked_sub_step, graded_step, rk4_work, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep,
+};
 use crate::stepping::coupling_step;
 use crate::world::Carrier;
 use clutchpack_model::EngineError;
@@ -259,25 +261,24 @@ impl Run {
         let [u2, u3, u4] = &rk.u;
         let (w2, w3, w4) = (u2[n], u3[n], u4[n]);
         let (turn, speed) = (rk.turn[n], rk.u1[n]);
-        let h6 = h / 6.0;
-        let sq = |a: f64, b: f64, c: f64, d: f64| a * a + 2.0 * (b * b + c * c) + d * d;
-        let mut drag_j = -c1 * h6 * sq(w0, w2, w3, w4);
+        let sq = |a: f64, b: f64, c: f64, d: f64| rk4_work(h, [a * a, b * b, c * c, d * d]);
+        let mut drag_j = -c1 * sq(w0, w2, w3, w4);
         let mut gap_j = 0.0;
         let mut phi1 = Vec::with_capacity(n);
         let mut dphi1 = Vec::with_capacity(n);
         for k in 0..n {
             phi1.push(phi[k] + turn - rk.turn[k]);
             dphi1.push(speed - rk.u1[k]);
-            drag_j -= self.bodies[cluster[k]].drag_n_m_s_rad * h6 * sq(u0[k], u2[k], u3[k], u4[k]);
+            drag_j -= self.bodies[cluster[k]].drag_n_m_s_rad * sq(u0[k], u2[k], u3[k], u4[k]);
             let g = |ts: f64, u: f64| gaps[k].torque(ts, u) * u;
-            gap_j += h6 * (g(t, u0[k]) + 2.0 * (g(tm, u2[k]) + g(tm, u3[k])) + g(te, u4[k]));
+            gap_j += rk4_work(h, [g(t, u0[k]), g(tm, u2[k]), g(tm, u3[k]), g(te, u4[k])]);
         }
         CarrierStep {
             turn,
             speed,
             phi: phi1,
             dphi: dphi1,
-            external_j: h6 * (e1 * w0 + 2.0 * (em * w2 + em * w3) + e4 * w4),
+            external_j: rk4_work(h, [e1 * w0, em * w2, em * w3, e4 * w4]),
             drag_j,
             gap_j,
         }
