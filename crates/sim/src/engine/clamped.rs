@@ -18,10 +18,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::inertial::Inertial;
+use super::multirate::SubSteps;
 use super::state::{Run, ShaftDrive};
-use super::substep::{
-    checked_sub_step, graded_step, rk4_work, split_remainder, Node, Rk4, ShaftAt, WorldStep,
-};
+use super::substep::{checked_sub_step, graded_step, rk4_work, Node, Rk4, ShaftAt, WorldStep};
 use crate::stack::Face;
 use crate::stepping::{bracketed_root, coupling_step};
 use crate::world::Carrier;
@@ -239,233 +238,48 @@ impl Run {
         let n_spin = sys.spins.len();
         let t0 = self.t;
         let h_world = t1 - t0;
-        let mut t = t0;
-        let phi0: Vec<f64> = self.rel.iter().map(|r| r.phi).collect();
-        let mut phi = phi0.clone();
-        let mut u: Vec<f64> = self.omega_d.clone();
-        let mut turn = vec![0.0; n];
         // the inertial carriers' angles and speeds
         let (angle0, w0): (Vec<f64>, Vec<f64>) =
             sys.spins.iter().map(|c| self.carrier_state(c.role)).unzip();
-        let (mut angle, mut w) = (angle0.clone(), w0.clone());
-        let mut shaft = ShaftAt::of(profile.as_deref(), t);
-        let mut impulse = vec![0.0; n_if];
-        let mut evaluated_here = false;
-        let cap = a.max_step_s / STACK_SUB_STEPS;
-        let mut s0 = Stage::new(n, n_spin);
-        let bufs = std::cell::RefCell::new(RkBuffers::new(n, n_spin));
-        // the relative angles and the speeds at the end of a full sub-step
-        let (mut phi_h, mut u_h) = (vec![0.0; n], vec![0.0; n]);
-        while t < t1 {
-            // the teeth's torques at t: the last sub-step's evaluation, else probes
-            for i in 0..n {
-                s0.teeth[i] = if evaluated_here {
-                    self.forces[i].moment[2]
-                } else {
-                    self.couplings[i].probe_torque(phi[i], self.rel[i].dphi)
-                };
-            }
-            if !evaluated_here {
-                ws.counts.evals += n as u64;
-            }
-            self.stack_stage(&sys, &self.faces, t, &u, &w, &mut s0);
-            // An open face takes the sign of its slip (for when it clamps). A clamped one found
-            // slipping against its sign crossed zero unlanded (closer to a sub-step's start
-            // than the landing looks): it locks now if it holds (its friction must never push
-            // the slip along).
-            let mut turned = false;
-            for m in 0..n_if {
-                let Face::Slipping(dir) = self.faces[m] else {
-                    continue;
-                };
-                let v = u[sys.body[m + 1]] - u[sys.body[m]];
-                if v == 0.0 || v.signum() == dir {
-                    continue;
-                }
-                if s0.clamp[m] > 0.0 {
-                    self.lock_face(&sys, m, &mut u);
-                    turned = true;
-                } else {
-                    self.faces[m] = Face::Slipping(v.signum());
-                }
-            }
-            if turned {
-                self.break_faces(&sys, t, &u, &w, &mut s0);
-            }
-            // the step each coupling wants, with its relative acceleration bounded by its
-            // carrier's bound and twice its body's acceleration at t (plus 1 rad/s^2): the
-            // bound only sizes the free-flight sub-steps (how soon a gap may close); every
-            // onset within a sub-step is landed on all the same
-            let mut want = cap;
-            let reaction = |k: usize| -> f64 {
-                (0..n)
-                    .filter(|&i| sys.mounts[i] == Mount::Spin(k))
-                    .map(|i| s0.teeth[i].abs())
-                    .sum()
-            };
-            let spin_bound: Vec<f64> = (sys.spins.iter().enumerate())
-                .map(|(k, c)| self.inertial_accel_bound(c.role, w[k], reaction(k)))
-                .collect();
-            for i in 0..n {
-                let carrier = match sys.mounts[i] {
-                    Mount::Profile => self.shaft_accel_bound,
-                    Mount::Housing => 0.0,
-                    Mount::Spin(k) => spin_bound[k],
-                };
-                let bound = carrier + 2.0 * s0.acc[i].abs() + 1.0;
-                let f = self.forces[i];
-                let view = self.coupling_view(i, &f, (phi[i], self.rel[i].dphi), bound, t);
-                let (w, _) = coupling_step(&view, a);
-                want = want.min(graded_step(w, &f, self.events.event_age_s(i, t)));
-            }
-            let want = checked_sub_step(want, a, t, || "the clamped stack".into())?;
-            let rem = t1 - t;
-            let mut h = split_remainder(want, rem);
-            let faces = self.faces.clone();
-            let start = StackStart {
-                faces: &faces,
-                k1: &s0,
-                t,
-                shaft,
-                phi: &phi,
-                u0: &u,
-                w0: &w,
-            };
-            let rk4 = |x: f64| {
-                let b = &mut bufs.borrow_mut();
-                self.stack_rk4(&sys, &start, x, b);
-            };
-            rk4(h);
-            ws.counts.evals += 3 * n as u64;
-            {
-                let b = bufs.borrow();
-                phi_h.copy_from_slice(&b.out.phi);
-                u_h.copy_from_slice(&b.out.u);
-            }
-            let searched = std::cell::Cell::new(false);
-            // land on the first onset or separation of any coupling, or the first slip
-            // reaching zero
-            let tiny = 1e-3 * h.min(want);
-            let evals = std::cell::Cell::new(0);
-            let mut first: Option<(f64, Option<usize>)> = None;
-            let mut consider = |x: f64, face: Option<usize>| {
-                if x > tiny && x < h && first.is_none_or(|(b, _)| x < b) {
-                    first = Some((x, face));
-                }
-            };
-            for i in 0..n {
-                let crossing = self.depth_crossing(i, phi[i], phi_h[i], h, |x| {
-                    evals.set(evals.get() + 3 * n as u64);
-                    searched.set(true);
-                    rk4(x);
-                    bufs.borrow().out.phi[i]
-                });
-                if let Some(x) = crossing {
-                    consider(x, None);
-                }
-            }
-            for m in 0..n_if {
-                let Face::Slipping(dir) = faces[m] else {
-                    continue;
-                };
-                if s0.clamp[m] <= 0.0 {
-                    continue;
-                }
-                let (lo, up) = (sys.body[m], sys.body[m + 1]);
-                let g = |u: &[f64]| dir * (u[up] - u[lo]);
-                let (g0, g1) = (g(&u), g(&u_h));
-                if g0 > 0.0 && g1 <= 0.0 {
-                    let x = bracketed_root(
-                        |x| {
-                            evals.set(evals.get() + 3 * n as u64);
-                            searched.set(true);
-                            rk4(x);
-                            g(&bufs.borrow().out.u)
-                        },
-                        0.0,
-                        g0,
-                        h,
-                        g1,
-                        0.0,
-                    );
-                    consider(x, Some(m));
-                }
-            }
-            ws.counts.evals += evals.get();
-            let mut locks = None;
-            if let Some((x, face)) = first {
-                h = x;
-                rk4(x);
-                ws.counts.evals += 3 * n as u64;
-                locks = face;
-            } else if searched.get() {
-                // the searches left another step in the buffers
-                rk4(h);
-                ws.counts.evals += 3 * n as u64;
-            }
-            let b = bufs.borrow();
-            let step = &b.out;
-            t = if h == rem { t1 } else { t + h };
-            for (x, dx) in turn.iter_mut().zip(&step.turn) {
-                *x += dx;
-            }
-            phi.clone_from(&step.phi);
-            u.clone_from(&step.u);
-            for (x, dx) in angle.iter_mut().zip(&step.carrier_turn) {
-                *x += dx;
-            }
-            w.clone_from(&step.w_carrier);
-            shaft = ShaftAt::of(profile.as_deref(), t);
-            for m in 0..n_if {
-                impulse[m] += step.impulse[m];
-            }
-            ws.counts.substeps += 1;
-            self.energy.add_sub_step(step.drive_j, step.drag_j);
-            self.energy.add_load_work(step.load_j);
-            self.energy.add_stack_work(step.face_j.iter().sum());
-            let stack = self.stack.as_mut().expect("a stack");
-            for m in 0..n_if {
-                stack.dissipated_j[m] -= step.face_j[m];
-            }
-            drop(b);
-            if let Some(m) = locks {
-                self.lock_face(&sys, m, &mut u);
-            }
-            for i in 0..n {
-                let at = match sys.mounts[i] {
-                    Mount::Profile => shaft,
-                    Mount::Housing => ShaftAt {
-                        speed: 0.0,
-                        angle: 0.0,
-                    },
-                    Mount::Spin(k) => ShaftAt {
-                        speed: w[k],
-                        angle: angle[k],
-                    },
-                };
-                let dphi = at.speed - u[i];
-                self.end_sub_step(i, t, phi[i], dphi, at, ws)?;
-            }
-            evaluated_here = true;
-            self.break_faces(&sys, t, &u, &w, &mut s0);
-        }
+        let mut st = StackSteps {
+            all: (0..n).collect(),
+            t: t0,
+            phi: self.rel.iter().map(|r| r.phi).collect(),
+            u: self.omega_d.clone(),
+            turn: vec![0.0; n],
+            angle: angle0.clone(),
+            w: w0.clone(),
+            shaft: ShaftAt::of(profile.as_deref(), t0),
+            impulse: vec![0.0; n_if],
+            evaluated_here: false,
+            cap: a.max_step_s / STACK_SUB_STEPS,
+            s0: Stage::new(n, n_spin),
+            bufs: std::cell::RefCell::new(RkBuffers::new(n, n_spin)),
+            phi_h: vec![0.0; n],
+            u_h: vec![0.0; n],
+            faces: Vec::new(),
+            sys,
+        };
+        self.land_sub_steps(&mut st, ws)?;
         // the bodies' and the drum's states at t1, their mean speeds over the step
-        let means: Vec<f64> = turn.iter().map(|x| x / h_world).collect();
-        self.omega_d.clone_from(&u);
+        let means: Vec<f64> = st.turn.iter().map(|x| x / h_world).collect();
+        self.omega_d.clone_from(&st.u);
         let mut carriers = Vec::new();
-        for (k, c) in sys.spins.iter().enumerate() {
+        for (k, c) in st.sys.spins.iter().enumerate() {
             let node = |t, angle, speed| Node { t, angle, speed };
-            let (start, end) = (node(t0, angle0[k], w0[k]), node(t1, angle[k], w[k]));
+            let (start, end) = (node(t0, angle0[k], w0[k]), node(t1, st.angle[k], st.w[k]));
             carriers.push((self.carrier_body_of(c.role), start, end));
-            self.set_carrier_state(c.role, angle[k], w[k]);
+            self.set_carrier_state(c.role, st.angle[k], st.w[k]);
         }
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let locked: Vec<bool> = self.faces.iter().map(|f| *f == Face::Locked).collect();
         // `s0` holds the stage at t1 with the faces as they end (`break_faces`)
-        self.stack
-            .as_mut()
-            .expect("a stack")
-            .record_step(h_world, &impulse, &locked, &s0.face);
+        self.stack.as_mut().expect("a stack").record_step(
+            h_world,
+            &st.impulse,
+            &locked,
+            &st.s0.face,
+        );
         self.finish_world_step(&means, t1, profile.as_deref(), &carriers);
         Ok(())
     }
@@ -706,5 +520,256 @@ impl Run {
                 );
             }
         }
+    }
+}
+
+/// The clamped stack's sub-steps as the one landing loop drives them
+/// ([`Run::land_sub_steps`]): every coupling body and the inertial carriers as one system,
+/// the faces' slips reaching zero its own events (landed on, the face then locked).
+struct StackSteps {
+    /// The system, and every coupling (all are integrated together).
+    sys: System,
+    all: Vec<usize>,
+    /// The time, s; each coupling's relative angle, rad, its body's speed, rad/s, and turn
+    /// since the world step's start, rad; the inertial carriers' angles, rad, and speeds,
+    /// rad/s; a prescribed shaft.
+    t: f64,
+    phi: Vec<f64>,
+    u: Vec<f64>,
+    turn: Vec<f64>,
+    angle: Vec<f64>,
+    w: Vec<f64>,
+    shaft: ShaftAt,
+    /// Each interface's impulse on its upper body since the world step's start, N m s.
+    impulse: Vec<f64>,
+    /// Whether `forces` holds the hook's evaluation at the state (from the first sub-step's
+    /// end on).
+    evaluated_here: bool,
+    /// The longest sub-step, s.
+    cap: f64,
+    /// The stage at `t` (the first of the next step).
+    s0: Stage,
+    bufs: std::cell::RefCell<RkBuffers>,
+    /// The relative angles and the body speeds at the end of the full sub-step (kept while the
+    /// searches' trial steps overwrite the buffers).
+    phi_h: Vec<f64>,
+    u_h: Vec<f64>,
+    /// The faces, held over the sub-step.
+    faces: Vec<Face>,
+}
+
+impl SubSteps for StackSteps {
+    type Step = ();
+
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn members(&self) -> &[usize] {
+        &self.all
+    }
+
+    fn phi(&self, k: usize) -> f64 {
+        self.phi[k]
+    }
+
+    fn want(&mut self, run: &mut Run, ws: &mut WorldStep) -> Result<f64, EngineError> {
+        let (a, t, n) = (ws.a, self.t, self.phi.len());
+        let sys = &self.sys;
+        // the teeth's torques at t: the last sub-step's evaluation, else probes
+        for i in 0..n {
+            self.s0.teeth[i] = if self.evaluated_here {
+                run.forces[i].moment[2]
+            } else {
+                run.couplings[i].probe_torque(self.phi[i], run.rel[i].dphi)
+            };
+        }
+        if !self.evaluated_here {
+            ws.counts.evals += n as u64;
+        }
+        run.stack_stage(sys, &run.faces, t, &self.u, &self.w, &mut self.s0);
+        // An open face takes the sign of its slip (for when it clamps). A clamped one found
+        // slipping against its sign crossed zero unlanded (closer to a sub-step's start
+        // than the landing looks): it locks now if it holds (its friction must never push
+        // the slip along).
+        let mut turned = false;
+        for m in 0..run.faces.len() {
+            let Face::Slipping(dir) = run.faces[m] else {
+                continue;
+            };
+            let v = self.u[sys.body[m + 1]] - self.u[sys.body[m]];
+            if v == 0.0 || v.signum() == dir {
+                continue;
+            }
+            if self.s0.clamp[m] > 0.0 {
+                run.lock_face(sys, m, &mut self.u);
+                turned = true;
+            } else {
+                run.faces[m] = Face::Slipping(v.signum());
+            }
+        }
+        if turned {
+            run.break_faces(sys, t, &self.u, &self.w, &mut self.s0);
+        }
+        // the step each coupling wants, with its relative acceleration bounded by its
+        // carrier's bound and twice its body's acceleration at t (plus 1 rad/s^2): the
+        // bound only sizes the free-flight sub-steps (how soon a gap may close); every
+        // onset within a sub-step is landed on all the same
+        let mut want = self.cap;
+        let s0 = &self.s0;
+        let reaction = |k: usize| -> f64 {
+            (0..n)
+                .filter(|&i| sys.mounts[i] == Mount::Spin(k))
+                .map(|i| s0.teeth[i].abs())
+                .sum()
+        };
+        let spin_bound: Vec<f64> = (sys.spins.iter().enumerate())
+            .map(|(k, c)| run.inertial_accel_bound(c.role, self.w[k], reaction(k)))
+            .collect();
+        for i in 0..n {
+            let carrier = match sys.mounts[i] {
+                Mount::Profile => run.shaft_accel_bound,
+                Mount::Housing => 0.0,
+                Mount::Spin(k) => spin_bound[k],
+            };
+            let bound = carrier + 2.0 * s0.acc[i].abs() + 1.0;
+            let f = run.forces[i];
+            let view = run.coupling_view(i, &f, (self.phi[i], run.rel[i].dphi), bound, t);
+            let (w, _) = coupling_step(&view, a);
+            want = want.min(graded_step(w, &f, run.events.event_age_s(i, t)));
+        }
+        let want = checked_sub_step(want, a, t, || "the clamped stack".into())?;
+        self.faces.clone_from(&run.faces);
+        Ok(want)
+    }
+
+    fn rk4(&self, run: &Run, h: f64) {
+        let start = StackStart {
+            faces: &self.faces,
+            k1: &self.s0,
+            t: self.t,
+            shaft: self.shaft,
+            phi: &self.phi,
+            u0: &self.u,
+            w0: &self.w,
+        };
+        run.stack_rk4(&self.sys, &start, h, &mut self.bufs.borrow_mut());
+    }
+
+    fn phi_end(&self, _: &(), k: usize) -> f64 {
+        self.bufs.borrow().out.phi[k]
+    }
+
+    fn keep(&mut self, _: &()) {
+        let b = self.bufs.borrow();
+        self.phi_h.copy_from_slice(&b.out.phi);
+        self.u_h.copy_from_slice(&b.out.u);
+    }
+
+    fn phi_kept(&self, _: &(), k: usize) -> f64 {
+        self.phi_h[k]
+    }
+
+    fn trials_overwrite(&self) -> bool {
+        true
+    }
+
+    /// The first slip of a clamped slipping face reaching zero.
+    fn events(
+        &self,
+        run: &Run,
+        h: f64,
+        consider: &mut dyn FnMut(f64, Option<usize>),
+        trials: &std::cell::Cell<u64>,
+    ) {
+        for m in 0..self.faces.len() {
+            let Face::Slipping(dir) = self.faces[m] else {
+                continue;
+            };
+            if self.s0.clamp[m] <= 0.0 {
+                continue;
+            }
+            let (lo, up) = (self.sys.body[m], self.sys.body[m + 1]);
+            let g = |u: &[f64]| dir * (u[up] - u[lo]);
+            let (g0, g1) = (g(&self.u), g(&self.u_h));
+            if g0 > 0.0 && g1 <= 0.0 {
+                let x = bracketed_root(
+                    |x| {
+                        trials.set(trials.get() + 1);
+                        self.rk4(run, x);
+                        g(&self.bufs.borrow().out.u)
+                    },
+                    0.0,
+                    g0,
+                    h,
+                    g1,
+                    0.0,
+                );
+                consider(x, Some(m));
+            }
+        }
+    }
+
+    fn evals_per_rk4(&self) -> u64 {
+        3 * self.phi.len() as u64
+    }
+
+    fn accept(
+        &mut self,
+        run: &mut Run,
+        _: (),
+        t: f64,
+        event: Option<usize>,
+        ws: &mut WorldStep,
+    ) -> Result<(), EngineError> {
+        let n = self.phi.len();
+        // the sub-step's first full step (before the searches)
+        ws.counts.evals += 3 * n as u64;
+        let b = self.bufs.borrow();
+        let step = &b.out;
+        self.t = t;
+        for (x, dx) in self.turn.iter_mut().zip(&step.turn) {
+            *x += dx;
+        }
+        self.phi.clone_from(&step.phi);
+        self.u.clone_from(&step.u);
+        for (x, dx) in self.angle.iter_mut().zip(&step.carrier_turn) {
+            *x += dx;
+        }
+        self.w.clone_from(&step.w_carrier);
+        self.shaft = ShaftAt::of(self.sys.profile.as_deref(), t);
+        for (x, dx) in self.impulse.iter_mut().zip(&step.impulse) {
+            *x += dx;
+        }
+        ws.counts.substeps += 1;
+        run.energy.add_sub_step(step.drive_j, step.drag_j);
+        run.energy.add_load_work(step.load_j);
+        run.energy.add_stack_work(step.face_j.iter().sum());
+        let stack = run.stack.as_mut().expect("a stack");
+        for (x, dx) in stack.dissipated_j.iter_mut().zip(&step.face_j) {
+            *x -= dx;
+        }
+        drop(b);
+        if let Some(m) = event {
+            run.lock_face(&self.sys, m, &mut self.u);
+        }
+        for i in 0..n {
+            let at = match self.sys.mounts[i] {
+                Mount::Profile => self.shaft,
+                Mount::Housing => ShaftAt {
+                    speed: 0.0,
+                    angle: 0.0,
+                },
+                Mount::Spin(k) => ShaftAt {
+                    speed: self.w[k],
+                    angle: self.angle[k],
+                },
+            };
+            let dphi = at.speed - self.u[i];
+            run.end_sub_step(i, t, self.phi[i], dphi, at, ws)?;
+        }
+        self.evaluated_here = true;
+        run.break_faces(&self.sys, t, &self.u, &self.w, &mut self.s0);
+        Ok(())
     }
 }

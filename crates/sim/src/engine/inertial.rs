@@ -463,7 +463,7 @@ impl SubSteps for CarrierSteps<'_> {
         self.phi[k]
     }
 
-    fn want(&mut self, run: &Run, ws: &mut WorldStep) -> Result<f64, EngineError> {
+    fn want(&mut self, run: &mut Run, ws: &mut WorldStep) -> Result<f64, EngineError> {
         let (a, t, w) = (ws.a, self.t, self.w);
         let reaction: f64 = self
             .cluster
@@ -505,7 +505,7 @@ impl SubSteps for CarrierSteps<'_> {
         run.carrier_rk4(&start, &dy, h, b)
     }
 
-    fn phi_end(step: &CarrierStep, k: usize) -> f64 {
+    fn phi_end(&self, step: &CarrierStep, k: usize) -> f64 {
         step.phi[k]
     }
 
@@ -518,6 +518,7 @@ impl SubSteps for CarrierSteps<'_> {
         run: &mut Run,
         step: CarrierStep,
         t: f64,
+        _: Option<usize>,
         ws: &mut WorldStep,
     ) -> Result<(), EngineError> {
         self.t = t;

@@ -1,7 +1,9 @@
 //! The multirate scheme (crate docs, "Theory"): the rapier world steps at free-flight length
 //! and every spline coupling integrates its own relative motion inside the world's step, with
 //! its own contact-aware sub-steps; the tooth impulse of the step is handed to the disc's
-//! rapier body, which carries the disc's state from one world step to the next.
+//! rapier body, which carries the disc's state from one world step to the next. Also the one
+//! landing loop of every multirate scheme ([`Run::land_sub_steps`] over a [`SubSteps`]: a
+//! coupling alone, an inertial carrier with its cluster, the clamped stack).
 
 use super::inertial::Inertial;
 use super::state::{disc_sample, relative_state, Run, ShaftDrive};
@@ -369,33 +371,47 @@ impl Run {
             let rem = t1 - t;
             let mut h = split_remainder(want, rem);
             let mut step = s.rk4(self, h);
-            // Never step over an onset or a separation of any coupling: land on the first.
+            s.keep(&step);
+            // Never step over an onset or a separation of any coupling, nor over the scheme's
+            // own events: land on the first.
             let tiny = 1e-3 * h.min(want);
-            let mut first: Option<f64> = None;
+            // the trial steps of the searches
+            let trials = std::cell::Cell::new(0);
+            let mut first: Option<(f64, Option<usize>)> = None;
+            let mut consider = |x: f64, event: Option<usize>| {
+                if x > tiny && x < h && first.is_none_or(|(b, _)| x < b) {
+                    first = Some((x, event));
+                }
+            };
             for k in 0..s.members().len() {
-                let evals = std::cell::Cell::new(0);
                 let (i, phi0) = (s.members()[k], s.phi(k));
-                let crossing = self.depth_crossing(i, phi0, S::phi_end(&step, k), h, |x| {
-                    evals.set(evals.get() + s.evals_per_rk4());
-                    S::phi_end(&s.rk4(self, x), k)
+                let crossing = self.depth_crossing(i, phi0, s.phi_kept(&step, k), h, |x| {
+                    trials.set(trials.get() + 1);
+                    s.phi_end(&s.rk4(self, x), k)
                 });
-                ws.counts.evals += evals.get();
-                if let Some(x) = crossing.filter(|&x| x > tiny && x < h) {
-                    if first.is_none_or(|b| x < b) {
-                        first = Some(x);
-                    }
+                if let Some(x) = crossing {
+                    consider(x, None);
                 }
             }
-            if let Some(x) = first {
+            s.events(self, h, &mut consider, &trials);
+            ws.counts.evals += trials.get() * s.evals_per_rk4();
+            let mut event = None;
+            if let Some((x, e)) = first {
                 h = x;
                 step = s.rk4(self, x);
                 ws.counts.evals += s.evals_per_rk4();
+                event = e;
+            } else if trials.get() > 0 && s.trials_overwrite() {
+                // the searches left another step in the scheme's buffers
+                step = s.rk4(self, h);
+                ws.counts.evals += s.evals_per_rk4();
             }
             let t = if h == rem { t1 } else { t + h };
-            s.accept(self, step, t, ws)?;
+            s.accept(self, step, t, event, ws)?;
         }
         Ok(())
     }
+
     /// Where within a sub-step of length `h` coupling `i`'s deepest tooth's engagement depth
     /// crosses zero (an onset when the coupling is not engaged, its separation when it is),
     /// from the relative angle `phi0` at the sub-step's start to `phi1` at its end, located on
@@ -507,20 +523,43 @@ pub(super) trait SubSteps {
     fn phi(&self, k: usize) -> f64;
     /// The sub-step the controller wants from `t`, s (checked: the run's failure when it
     /// collapsed); readies the step's start (what the schemes count goes to `ws`).
-    fn want(&mut self, run: &Run, ws: &mut WorldStep) -> Result<f64, EngineError>;
+    fn want(&mut self, run: &mut Run, ws: &mut WorldStep) -> Result<f64, EngineError>;
     /// One classical Runge-Kutta step of length `h` from `t`.
     fn rk4(&self, run: &Run, h: f64) -> Self::Step;
     /// Member `k`'s relative angle at the end of `step`, rad.
-    fn phi_end(step: &Self::Step, k: usize) -> f64;
+    fn phi_end(&self, step: &Self::Step, k: usize) -> f64;
+    /// Keeps what the searches need of the full step `step` (a scheme whose trial steps
+    /// overwrite its buffers, [`SubSteps::trials_overwrite`]).
+    fn keep(&mut self, _step: &Self::Step) {}
+    /// Member `k`'s relative angle at the end of the full step `step` (kept), rad.
+    fn phi_kept(&self, step: &Self::Step, k: usize) -> f64 {
+        self.phi_end(step, k)
+    }
+    /// Whether a trial step overwrites the step it was given (the full step is then taken
+    /// again after searches that did not land).
+    fn trials_overwrite(&self) -> bool {
+        false
+    }
+    /// The scheme's own events within the step of length `h` (as `consider(x, Some(e))`,
+    /// located on trial steps counted in `trials`): none but the couplings' depth crossings.
+    fn events(
+        &self,
+        _run: &Run,
+        _h: f64,
+        _consider: &mut dyn FnMut(f64, Option<usize>),
+        _trials: &std::cell::Cell<u64>,
+    ) {
+    }
     /// Tooth-law evaluations of one step.
     fn evals_per_rk4(&self) -> u64;
-    /// Takes `step`, ending at `t`: the state, the counts, the works, each member's sub-step
-    /// end ([`Run::end_sub_step`]).
+    /// Takes `step`, ending at `t`, landed on the scheme's own event `event` if any: the
+    /// state, the counts, the works, each member's sub-step end ([`Run::end_sub_step`]).
     fn accept(
         &mut self,
         run: &mut Run,
         step: Self::Step,
         t: f64,
+        event: Option<usize>,
         ws: &mut WorldStep,
     ) -> Result<(), EngineError>;
 }
@@ -567,7 +606,7 @@ impl SubSteps for Alone<'_> {
         self.phi
     }
 
-    fn want(&mut self, run: &Run, ws: &mut WorldStep) -> Result<f64, EngineError> {
+    fn want(&mut self, run: &mut Run, ws: &mut WorldStep) -> Result<f64, EngineError> {
         let (i, a, t, gap) = (self.i, ws.a, self.t, self.gap);
         let f = run.forces[i];
         let wd = self.shaft.speed - self.dphi;
@@ -598,7 +637,7 @@ impl SubSteps for Alone<'_> {
         rel.rk4(self.t, self.shaft, self.phi, self.dphi, h)
     }
 
-    fn phi_end(step: &SubStep, _: usize) -> f64 {
+    fn phi_end(&self, step: &SubStep, _: usize) -> f64 {
         step.phi
     }
 
@@ -611,6 +650,7 @@ impl SubSteps for Alone<'_> {
         run: &mut Run,
         step: SubStep,
         t: f64,
+        _: Option<usize>,
         ws: &mut WorldStep,
     ) -> Result<(), EngineError> {
         // On an inertial carrier (shaft, drum) the teeth's work is internal (the drive's or

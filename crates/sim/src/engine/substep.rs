@@ -1,7 +1,9 @@
-//! One coupling's sub-steps inside a world step (the multirate schemes, `multirate.rs` and
-//! `inertial.rs`): the classical Runge-Kutta step of its relative motion against its carrier's
-//! path, graded towards the tooth law's kinks, with the open gaps' drag held over the step;
-//! and what the multirate schemes count.
+//! The sub-step kernel of the multirate schemes (`multirate.rs`, `inertial.rs`, `clamped.rs`):
+//! the one classical Runge-Kutta step of a set of bodies ([`Rk4`]) and the one quadrature of
+//! the works along it ([`rk4_work`]); a coupling's step against its carrier's path
+//! ([`Relative`]), graded towards the tooth law's kinks, with the open gaps' drag held over
+//! the step; the world-step context the schemes pass down ([`WorldStep`]); and what the
+//! multirate schemes count.
 
 use crate::hook::{Coupling, CouplingForces};
 use crate::options::AdaptiveStepping;
