@@ -18,7 +18,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::inertial::Inertial;
-use super::multirate::SubSteps;
+use super::landing::SubSteps;
 use super::state::{Run, ShaftDrive};
 use super::substep::{checked_sub_step, graded_step, rk4_work, Node, Rk4, ShaftAt, WorldStep};
 use crate::stack::Face;

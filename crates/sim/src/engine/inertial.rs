@@ -4,7 +4,7 @@
 //! integrated together with classical Runge-Kutta sub-steps, the other bodies fly free against
 //! the carrier's motion (`multirate.rs`'s per-coupling integration).
 
-use super::multirate::SubSteps;
+use super::landing::SubSteps;
 use super::state::{Run, ShaftDrive};
 use super::substep::{
     checked_sub_step, graded_step, rk4_work, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep,
