@@ -7,7 +7,7 @@
 use super::landing::SubSteps;
 use super::state::{Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, rk4_work, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep,
+    checked_sub_step, graded_step, rk4_work, Carried, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep,
 };
 use crate::stepping::coupling_step;
 use crate::world::Carrier;
@@ -248,10 +248,16 @@ impl Run {
             let mut teeth = 0.0;
             for k in 0..n {
                 let i = cluster[k];
-                let torque = self.couplings[i].probe_torque(phi[k] + sc - th[k], w - u[k]);
+                let body = Carried {
+                    coupling: &self.couplings[i],
+                    phi: phi[k],
+                    inv_j: inv_j[k],
+                    c2: self.bodies[i].drag_n_m_s_rad,
+                    gap: gaps[k],
+                };
+                let torque;
+                (torque, acc[k]) = body.stage(ts, sc, w, th[k], u[k]);
                 teeth += torque;
-                let g = gaps[k].torque(ts, u[k]);
-                acc[k] = (torque - self.bodies[i].drag_n_m_s_rad * u[k] + g) * inv_j[k];
             }
             let ext = [e1, em, em, e4][s];
             acc[n] = (ext - c1 * w - teeth) * inv_j1;

@@ -296,6 +296,40 @@ pub(super) struct SubStep {
     pub(super) evals: u64,
 }
 
+/// A coupling's body on its carrier at the stages of a sub-step: the one body law of the
+/// steps of a coupling alone ([`Relative::rk4`]) and of an inertial carrier's cluster
+/// (`Run::carrier_rk4`), Hu et al. eq (5) with the open gaps' drag,
+/// `J omega_d' = T(phi, phi') - C2 omega_d + g(omega_d)`. (The clamped stack's bodies sum
+/// their torques over the groups their locked faces make, `clamped.rs`.)
+#[derive(Clone, Copy)]
+pub(super) struct Carried<'a> {
+    /// The coupling (its teeth).
+    pub(super) coupling: &'a Coupling,
+    /// The relative angle at the sub-step's start, rad.
+    pub(super) phi: f64,
+    /// The body's inverse inertia about the axis, 1/(kg m^2), and its drag `C2`, N m s/rad.
+    pub(super) inv_j: f64,
+    pub(super) c2: f64,
+    /// The open gaps' drag on the body.
+    pub(super) gap: GapDrag,
+}
+
+impl Carried<'_> {
+    /// The body's acceleration, rad/s^2, at `ts` (s) turning at `u` (rad/s) with the teeth's
+    /// torque `torque` (N m) on it.
+    pub(super) fn accel(&self, ts: f64, torque: f64, u: f64) -> f64 {
+        (torque - self.c2 * u + self.gap.torque(ts, u)) * self.inv_j
+    }
+
+    /// The teeth's torque on the body, N m, and its acceleration, rad/s^2, at a stage at `ts`:
+    /// the carrier turned by `turn` (rad) from the sub-step's start and turning at `speed`
+    /// (rad/s), the body turned by `th` and turning at `u`.
+    pub(super) fn stage(&self, ts: f64, turn: f64, speed: f64, th: f64, u: f64) -> (f64, f64) {
+        let torque = self.coupling.probe_torque(self.phi + turn - th, speed - u);
+        (torque, self.accel(ts, torque, u))
+    }
+}
+
 /// The relative motion of one coupling on a prescribed shaft, integrated as the disc's own
 /// motion `J omega_d' = T(phi, phi') - C2 omega_d` (Hu et al. eq (5)) with
 /// `phi = theta_s(t) - theta_d`, `phi' = omega_s(t) - omega_d` (eq (3): the shaft's angle and
@@ -333,20 +367,23 @@ impl Relative<'_> {
         let (sm, se) = (mid.angle - shaft.angle, end.angle - shaft.angle);
         // The disc's speed at t.
         let u0 = w0 - dphi;
-        // omega_d' at a stage with the teeth's torque `torque`, the disc turning at `u`.
         // Hu et al. eq (5): J omega_d' = T - C2 omega_d, plus the open gaps' drag
-        let accel =
-            |ts: f64, torque: f64, u: f64| (torque - self.c2 * u + gap.torque(ts, u)) * self.inv_j;
+        let body = Carried {
+            coupling: self.coupling,
+            phi,
+            inv_j: self.inv_j,
+            c2: self.c2,
+            gap,
+        };
         // the teeth's torque at the four stages, N m
         let mut teeth = [self.start_torque_n_m, 0.0, 0.0, 0.0];
         let mut rk = Rk4::<[f64; 1]>::default();
-        rk.k[0] = [accel(t, teeth[0], u0)];
+        rk.k[0] = [body.accel(t, teeth[0], u0)];
         // a stage: the shaft turned from t at its speed there (exact), the disc turned by
         // `th` at `u`
         rk.step(t, h, &[u0], |s, ts, th, u, acc| {
             let (turn, speed) = if s < 3 { (sm, wm) } else { (se, we) };
-            teeth[s] = self.coupling.probe_torque(phi + turn - th[0], speed - u[0]);
-            acc[0] = accel(ts, teeth[s], u[0]);
+            (teeth[s], acc[0]) = body.stage(ts, turn, speed, th[0], u[0]);
         });
         let [t1, t2, t3, t4] = teeth;
         let [[u2], [u3], [u4]] = rk.u;
