@@ -18,13 +18,13 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::inertial::Inertial;
+use super::landing::SubSteps;
 use super::state::{Run, ShaftDrive};
-use super::substep::{checked_sub_step, graded_step, split_remainder, Counts, Node, ShaftAt};
-use crate::options::AdaptiveStepping;
+use super::substep::{checked_sub_step, graded_step, rk4_work, Node, Rk4, ShaftAt, WorldStep};
 use crate::stack::Face;
 use crate::stepping::{bracketed_root, coupling_step};
 use crate::world::Carrier;
-use clutchpack_model::{DiscSample, EngineError, ImpactEvent, SpeedProfile};
+use clutchpack_model::{EngineError, SpeedProfile};
 use std::sync::Arc;
 
 /// Sub-steps of the clamped stack are at most the world step over this (dimensionless), as an
@@ -41,21 +41,40 @@ struct System {
     c2: Vec<f64>,
     /// The prescribed shaft's profile (`None`: the shaft is inertial).
     profile: Option<Arc<SpeedProfile>>,
-    /// The inertial carriers, [the shaft (Hu et al. eq 4), the drum]: inverse inertia,
-    /// 1/(kg m^2), and damping, N m s/rad (`None`: prescribed, or no drum).
-    inertial: [Option<(f64, f64)>; 2],
-    /// The drum's load, N m (held over the world step).
-    drum_load: f64,
-    /// Each coupling's carrier.
-    carriers: Vec<Carrier>,
+    /// The inertial carriers integrated with the stack (an inertial shaft, the drum; any
+    /// number, in this order).
+    spins: Vec<Spin>,
+    /// How each coupling's carrier moves.
+    mounts: Vec<Mount>,
+}
+
+/// An inertial carrier integrated with the clamped stack: `J w' = T_ext(t) - C w - sum T_k`
+/// over the couplings it carries (the shaft: Hu et al. eq 4; the drum: its load and drag).
+struct Spin {
+    /// Its role (what its external torque is, where its state lives).
+    role: Inertial,
+    /// `1 / J`, 1/(kg m^2), and the damping `C`, N m s/rad.
+    inv_j: f64,
+    damping: f64,
+}
+
+/// How a coupling's carrier moves within the clamped stack's sub-steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mount {
+    /// The prescribed shaft: its profile, exact.
+    Profile,
+    /// The housing, at rest.
+    Housing,
+    /// Inertial carrier `k` of [`System::spins`], integrated with the stack.
+    Spin(usize),
 }
 
 /// What the system does at one stage.
 struct Stage {
-    /// Each coupling body's acceleration, rad/s^2, and the inertial carriers' ([shaft, drum];
-    /// 0 where not inertial).
+    /// Each coupling body's acceleration, rad/s^2, and the inertial carriers' ([`System::spins`]
+    /// order).
     acc: Vec<f64>,
-    acc_carrier: [f64; 2],
+    acc_carrier: Vec<f64>,
     /// The teeth's torque on each coupling body, N m.
     teeth: Vec<f64>,
     /// Each interface's torque on its upper body, N m: friction or the gap's drag of a
@@ -68,12 +87,12 @@ struct Stage {
 }
 
 impl Stage {
-    /// A stage's buffers for `n` coupling bodies.
-    fn new(n: usize) -> Stage {
+    /// A stage's buffers for `n` coupling bodies and `n_spin` inertial carriers.
+    fn new(n: usize, n_spin: usize) -> Stage {
         let n_if = n - 1;
         Stage {
             acc: vec![0.0; n],
-            acc_carrier: [0.0; 2],
+            acc_carrier: vec![0.0; n_spin],
             teeth: vec![0.0; n],
             face: vec![0.0; n_if],
             clamp: vec![0.0; n_if],
@@ -82,19 +101,11 @@ impl Stage {
     }
 }
 
-/// The index of an inertial carrier in [shaft, drum], `None` for the housing.
-fn spin(c: Carrier) -> Option<usize> {
-    match c {
-        Carrier::Shaft => Some(0),
-        Carrier::Drum => Some(1),
-        Carrier::Housing => None,
-    }
-}
-
 impl Run {
     /// The accelerations of the stack's bodies and the drum at `ts` with the teeth's torques
-    /// `st.teeth` (coupling order, N m), the bodies' speeds `u` (rad/s) and the drum's
-    /// inertial carriers' `w` ([shaft, drum], rad/s), the faces `faces`, into `st`: each body's teeth, drag and the slipping or
+    /// `st.teeth` (coupling order, N m), the bodies' speeds `u` (rad/s) and the inertial
+    /// carriers' `w` ([`System::spins`] order, rad/s), the faces `faces`, into `st`: each
+    /// body's teeth, drag and the slipping or
     /// open faces' torques; locked runs of bodies share one acceleration (their total torque
     /// over their total inertia), and the torque each locked face passes is what keeps its two
     /// sides together.
@@ -104,7 +115,7 @@ impl Run {
         faces: &[Face],
         ts: f64,
         u: &[f64],
-        w: [f64; 2],
+        w: &[f64],
         st: &mut Stage,
     ) {
         let stack = self.stack.as_ref().expect("a stack");
@@ -158,37 +169,22 @@ impl Run {
             }
             lo = hi + 1;
         }
-        for k in 0..2 {
-            st.acc_carrier[k] = match sys.inertial[k] {
-                Some((inv_j, damping)) => {
-                    // the drive (eq 4) or the load, the damping, the teeth's reactions
-                    let external = if k == 0 {
-                        self.drive_torque(ts)
-                    } else {
-                        sys.drum_load
-                    };
-                    let on: f64 = (0..u.len())
-                        .filter(|&i| spin(sys.carriers[i]) == Some(k))
-                        .map(|i| st.teeth[i])
-                        .sum();
-                    (external - damping * w[k] - on) * inv_j
-                }
-                None => 0.0,
-            };
+        for (k, c) in sys.spins.iter().enumerate() {
+            // the drive (eq 4) or the load, the damping, the teeth's reactions
+            let external = self.external_torque(c.role, ts);
+            let on: f64 = (0..u.len())
+                .filter(|&i| sys.mounts[i] == Mount::Spin(k))
+                .map(|i| st.teeth[i])
+                .sum();
+            st.acc_carrier[k] = (external - c.damping * w[k] - on) * c.inv_j;
         }
     }
 
     /// Advances the whole clamped stack (every disc and plate, the drum, an inertial shaft)
     /// from `t` to `t1` as one system (module docs), then the rapier world one step with each
     /// body's impulse.
-    pub(super) fn clamped_step(
-        &mut self,
-        t1: f64,
-        a: &AdaptiveStepping,
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
-    ) -> Result<(), EngineError> {
+    pub(super) fn clamped_step(&mut self, ws: &mut WorldStep) -> Result<(), EngineError> {
+        let (t1, a) = (ws.t1, ws.a);
         let profile = match &self.shaft {
             ShaftDrive::Prescribed(p) => Some(Arc::clone(p)),
             ShaftDrive::Inertial { .. } => None,
@@ -202,6 +198,33 @@ impl Run {
                 .map(|m| Face::Slipping(stack.slip[m].signum()))
                 .collect();
         }
+        // the inertial carriers: an inertial shaft, then the drum
+        let roles = [
+            profile.is_none().then_some(Inertial::Shaft),
+            self.drum.as_ref().map(|_| Inertial::Drum),
+        ];
+        let spins: Vec<Spin> = roles
+            .into_iter()
+            .flatten()
+            .map(|role| {
+                let (inv_j, damping) = self.carrier_inertia(role);
+                Spin {
+                    role,
+                    inv_j,
+                    damping,
+                }
+            })
+            .collect();
+        let spin_of = |c: Carrier| spins.iter().position(|s| s.role.carrier() == c);
+        let mounts = (0..n)
+            .map(
+                |i| match (self.world.carriers[i], spin_of(self.world.carriers[i])) {
+                    (_, Some(k)) => Mount::Spin(k),
+                    (Carrier::Housing, None) => Mount::Housing,
+                    (_, None) => Mount::Profile,
+                },
+            )
+            .collect();
         let sys = System {
             body: stack.body.clone(),
             j: (0..n)
@@ -209,252 +232,54 @@ impl Run {
                 .collect(),
             c2: self.bodies.iter().map(|d| d.drag_n_m_s_rad).collect(),
             profile: profile.clone(),
-            inertial: [
-                profile
-                    .is_none()
-                    .then(|| self.carrier_inertia(Inertial::Shaft)),
-                self.drum
-                    .as_ref()
-                    .map(|_| self.carrier_inertia(Inertial::Drum)),
-            ],
-            drum_load: self.drum.as_ref().map_or(0.0, |d| d.model.load_torque_n_m),
-            carriers: self.world.carriers.clone(),
+            spins,
+            mounts,
         };
+        let n_spin = sys.spins.len();
         let t0 = self.t;
         let h_world = t1 - t0;
-        let mut t = t0;
-        let phi0: Vec<f64> = self.rel.iter().map(|r| r.phi).collect();
-        let mut phi = phi0.clone();
-        let mut u: Vec<f64> = self.omega_d.clone();
-        let mut turn = vec![0.0; n];
-        // the inertial carriers' angles and speeds, [shaft, drum]
-        let drum0 = self
-            .drum
-            .as_ref()
-            .map_or((0.0, 0.0), |d| (d.theta, d.omega));
-        let (angle0, w0) = ([self.theta_s, drum0.0], [self.omega_s, drum0.1]);
-        let (mut angle, mut w) = (angle0, w0);
-        let mut shaft = ShaftAt::of(profile.as_deref(), t);
-        let mut impulse = vec![0.0; n_if];
-        let mut evaluated_here = false;
-        let cap = a.max_step_s / STACK_SUB_STEPS;
-        let mut s0 = Stage::new(n);
-        let bufs = std::cell::RefCell::new(RkBuffers::new(n));
-        // the relative angles and the speeds at the end of a full sub-step
-        let (mut phi_h, mut u_h) = (vec![0.0; n], vec![0.0; n]);
-        while t < t1 {
-            // the teeth's torques at t: the last sub-step's evaluation, else probes
-            for i in 0..n {
-                s0.teeth[i] = if evaluated_here {
-                    self.forces[i].moment[2]
-                } else {
-                    self.couplings[i].probe_torque(phi[i], self.rel[i].dphi)
-                };
-            }
-            if !evaluated_here {
-                counts.evals += n as u64;
-            }
-            self.stack_stage(&sys, &self.faces, t, &u, w, &mut s0);
-            // An open face takes the sign of its slip (for when it clamps). A clamped one found
-            // slipping against its sign crossed zero unlanded (closer to a sub-step's start
-            // than the landing looks): it locks now if it holds (its friction must never push
-            // the slip along).
-            let mut turned = false;
-            for m in 0..n_if {
-                let Face::Slipping(dir) = self.faces[m] else {
-                    continue;
-                };
-                let v = u[sys.body[m + 1]] - u[sys.body[m]];
-                if v == 0.0 || v.signum() == dir {
-                    continue;
-                }
-                if s0.clamp[m] > 0.0 {
-                    self.lock_face(&sys, m, &mut u);
-                    turned = true;
-                } else {
-                    self.faces[m] = Face::Slipping(v.signum());
-                }
-            }
-            if turned {
-                self.break_faces(&sys, t, &u, w, &mut s0);
-            }
-            // the step each coupling wants, with its relative acceleration bounded by its
-            // carrier's bound and twice its body's acceleration at t (plus 1 rad/s^2): the
-            // bound only sizes the free-flight sub-steps (how soon a gap may close); every
-            // onset within a sub-step is landed on all the same
-            let mut want = cap;
-            let reaction = |k: usize| -> f64 {
-                (0..n)
-                    .filter(|&i| spin(sys.carriers[i]) == Some(k))
-                    .map(|i| s0.teeth[i].abs())
-                    .sum()
-            };
-            let carrier_bound = [
-                match sys.inertial[0] {
-                    Some(_) => self.inertial_accel_bound(Inertial::Shaft, w[0], reaction(0)),
-                    None => self.shaft_accel_bound,
-                },
-                match sys.inertial[1] {
-                    Some(_) => self.inertial_accel_bound(Inertial::Drum, w[1], reaction(1)),
-                    None => 0.0,
-                },
-            ];
-            for i in 0..n {
-                let carrier = spin(sys.carriers[i]).map_or(0.0, |k| carrier_bound[k]);
-                let bound = carrier + 2.0 * s0.acc[i].abs() + 1.0;
-                let f = self.forces[i];
-                let view = self.coupling_view(i, &f, (phi[i], self.rel[i].dphi), bound, t);
-                let (w, _) = coupling_step(&view, a);
-                want = want.min(graded_step(w, &f, self.events.event_age_s(i, t)));
-            }
-            let want = checked_sub_step(want, a, t, || "the clamped stack".into())?;
-            let rem = t1 - t;
-            let mut h = split_remainder(want, rem);
-            let faces = self.faces.clone();
-            let rk4 = |x: f64| {
-                let b = &mut bufs.borrow_mut();
-                self.stack_rk4(&sys, &faces, &s0, t, shaft, &phi, &u, w, x, b);
-            };
-            rk4(h);
-            counts.evals += 3 * n as u64;
-            {
-                let b = bufs.borrow();
-                phi_h.copy_from_slice(&b.out.phi);
-                u_h.copy_from_slice(&b.out.u);
-            }
-            let searched = std::cell::Cell::new(false);
-            // land on the first onset or separation of any coupling, or the first slip
-            // reaching zero
-            let tiny = 1e-3 * h.min(want);
-            let evals = std::cell::Cell::new(0);
-            let mut first: Option<(f64, Option<usize>)> = None;
-            let mut consider = |x: f64, face: Option<usize>| {
-                if x > tiny && x < h && first.is_none_or(|(b, _)| x < b) {
-                    first = Some((x, face));
-                }
-            };
-            for i in 0..n {
-                let crossing = self.depth_crossing(i, phi[i], phi_h[i], h, |x| {
-                    evals.set(evals.get() + 3 * n as u64);
-                    searched.set(true);
-                    rk4(x);
-                    bufs.borrow().out.phi[i]
-                });
-                if let Some(x) = crossing {
-                    consider(x, None);
-                }
-            }
-            for m in 0..n_if {
-                let Face::Slipping(dir) = faces[m] else {
-                    continue;
-                };
-                if s0.clamp[m] <= 0.0 {
-                    continue;
-                }
-                let (lo, up) = (sys.body[m], sys.body[m + 1]);
-                let g = |u: &[f64]| dir * (u[up] - u[lo]);
-                let (g0, g1) = (g(&u), g(&u_h));
-                if g0 > 0.0 && g1 <= 0.0 {
-                    let x = bracketed_root(
-                        |x| {
-                            evals.set(evals.get() + 3 * n as u64);
-                            searched.set(true);
-                            rk4(x);
-                            g(&bufs.borrow().out.u)
-                        },
-                        0.0,
-                        g0,
-                        h,
-                        g1,
-                        0.0,
-                    );
-                    consider(x, Some(m));
-                }
-            }
-            counts.evals += evals.get();
-            let mut locks = None;
-            if let Some((x, face)) = first {
-                h = x;
-                rk4(x);
-                counts.evals += 3 * n as u64;
-                locks = face;
-            } else if searched.get() {
-                // the searches left another step in the buffers
-                rk4(h);
-                counts.evals += 3 * n as u64;
-            }
-            let b = bufs.borrow();
-            let step = &b.out;
-            t = if h == rem { t1 } else { t + h };
-            for (x, dx) in turn.iter_mut().zip(&step.turn) {
-                *x += dx;
-            }
-            phi.clone_from(&step.phi);
-            u.clone_from(&step.u);
-            for k in 0..2 {
-                angle[k] += step.carrier_turn[k];
-            }
-            w = step.w_carrier;
-            shaft = ShaftAt::of(profile.as_deref(), t);
-            for m in 0..n_if {
-                impulse[m] += step.impulse[m];
-            }
-            counts.substeps += 1;
-            self.energy.add_sub_step(step.drive_j, step.drag_j);
-            self.energy.add_load_work(step.load_j);
-            self.energy.add_stack_work(step.face_j.iter().sum());
-            let stack = self.stack.as_mut().expect("a stack");
-            for m in 0..n_if {
-                stack.dissipated_j[m] -= step.face_j[m];
-            }
-            drop(b);
-            if let Some(m) = locks {
-                self.lock_face(&sys, m, &mut u);
-            }
-            for i in 0..n {
-                let at = match (sys.carriers[i], &profile) {
-                    (Carrier::Shaft, Some(_)) => shaft,
-                    (Carrier::Housing, _) => ShaftAt {
-                        speed: 0.0,
-                        angle: 0.0,
-                    },
-                    (c, _) => {
-                        let k = spin(c).expect("an inertial carrier");
-                        ShaftAt {
-                            speed: w[k],
-                            angle: angle[k],
-                        }
-                    }
-                };
-                let dphi = at.speed - u[i];
-                self.end_sub_step(i, t, phi[i], dphi, at, a, closed, contacts)?;
-            }
-            evaluated_here = true;
-            self.break_faces(&sys, t, &u, w, &mut s0);
-        }
+        // the inertial carriers' angles and speeds
+        let (angle0, w0): (Vec<f64>, Vec<f64>) =
+            sys.spins.iter().map(|c| self.carrier_state(c.role)).unzip();
+        let mut st = StackSteps {
+            all: (0..n).collect(),
+            t: t0,
+            phi: self.rel.iter().map(|r| r.phi).collect(),
+            u: self.omega_d.clone(),
+            turn: vec![0.0; n],
+            angle: angle0.clone(),
+            w: w0.clone(),
+            shaft: ShaftAt::of(profile.as_deref(), t0),
+            impulse: vec![0.0; n_if],
+            evaluated_here: false,
+            cap: a.max_step_s / STACK_SUB_STEPS,
+            s0: Stage::new(n, n_spin),
+            bufs: std::cell::RefCell::new(RkBuffers::new(n, n_spin)),
+            phi_h: vec![0.0; n],
+            u_h: vec![0.0; n],
+            faces: Vec::new(),
+            sys,
+        };
+        self.land_sub_steps(&mut st, ws)?;
         // the bodies' and the drum's states at t1, their mean speeds over the step
-        let means: Vec<f64> = turn.iter().map(|x| x / h_world).collect();
-        self.omega_d.clone_from(&u);
+        let means: Vec<f64> = st.turn.iter().map(|x| x / h_world).collect();
+        self.omega_d.clone_from(&st.u);
         let mut carriers = Vec::new();
-        for (k, c) in [Inertial::Shaft, Inertial::Drum].into_iter().enumerate() {
-            if sys.inertial[k].is_none() {
-                continue;
-            }
+        for (k, c) in st.sys.spins.iter().enumerate() {
             let node = |t, angle, speed| Node { t, angle, speed };
-            let (start, end) = (node(t0, angle0[k], w0[k]), node(t1, angle[k], w[k]));
-            carriers.push((self.carrier_body_of(c), start, end));
-            match (c, self.drum.as_mut()) {
-                (Inertial::Drum, Some(d)) => (d.theta, d.omega) = (angle[k], w[k]),
-                _ => (self.theta_s, self.omega_s) = (angle[k], w[k]),
-            }
+            let (start, end) = (node(t0, angle0[k], w0[k]), node(t1, st.angle[k], st.w[k]));
+            carriers.push((self.carrier_body_of(c.role), start, end));
+            self.set_carrier_state(c.role, st.angle[k], st.w[k]);
         }
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let locked: Vec<bool> = self.faces.iter().map(|f| *f == Face::Locked).collect();
         // `s0` holds the stage at t1 with the faces as they end (`break_faces`)
-        self.stack
-            .as_mut()
-            .expect("a stack")
-            .record_step(h_world, &impulse, &locked, &s0.face);
+        self.stack.as_mut().expect("a stack").record_step(
+            h_world,
+            &st.impulse,
+            &locked,
+            &st.s0.face,
+        );
         self.finish_world_step(&means, t1, profile.as_deref(), &carriers);
         Ok(())
     }
@@ -491,7 +316,7 @@ impl Run {
     /// Breaks every locked face whose torque exceeds its holding torque at `t` (the state
     /// just evaluated: the teeth's torques in `forces`), the worst first, each then slipping
     /// the way that torque pushes its upper side (module docs); `s` is a stage's buffers.
-    fn break_faces(&mut self, sys: &System, t: f64, u: &[f64], w: [f64; 2], s: &mut Stage) {
+    fn break_faces(&mut self, sys: &System, t: f64, u: &[f64], w: &[f64], s: &mut Stage) {
         loop {
             for (x, f) in s.teeth.iter_mut().zip(&self.forces) {
                 *x = f.moment[2];
@@ -525,9 +350,10 @@ struct StackStep {
     turn: Vec<f64>,
     u: Vec<f64>,
     phi: Vec<f64>,
-    /// The inertial carriers' turns, rad, and speeds at the end, rad/s ([shaft, drum]).
-    carrier_turn: [f64; 2],
-    w_carrier: [f64; 2],
+    /// The inertial carriers' turns, rad, and speeds at the end, rad/s ([`System::spins`]
+    /// order).
+    carrier_turn: Vec<f64>,
+    w_carrier: Vec<f64>,
     /// Each interface's impulse on its upper body, N m s, and the work of its torque on the
     /// slip (friction, the gap's drag; 0 locked), J (<= 0).
     impulse: Vec<f64>,
@@ -542,25 +368,34 @@ struct StackStep {
 /// The buffers of [`Run::stack_rk4`], reused along the sub-steps (a step allocating its
 /// stages was a fifth of the clamped stack's time, perf).
 struct RkBuffers {
+    /// The stages 2, 3 and 4.
     k: [Stage; 3],
-    th: Vec<f64>,
-    u: [Vec<f64>; 3],
+    /// The step of the bodies (coupling order) and the inertial carriers after them, and
+    /// their speeds at its start.
+    rk: Rk4<Vec<f64>>,
+    x0: Vec<f64>,
     out: StackStep,
 }
 
 impl RkBuffers {
-    fn new(n: usize) -> RkBuffers {
+    /// The buffers for `n` coupling bodies and `n_spin` inertial carriers.
+    fn new(n: usize, n_spin: usize) -> RkBuffers {
         let v = || vec![0.0; n];
+        let c = || vec![0.0; n_spin];
         RkBuffers {
-            k: [Stage::new(n), Stage::new(n), Stage::new(n)],
-            th: v(),
-            u: [v(), v(), v()],
+            k: [
+                Stage::new(n, n_spin),
+                Stage::new(n, n_spin),
+                Stage::new(n, n_spin),
+            ],
+            rk: Rk4::new(n + n_spin),
+            x0: vec![0.0; n + n_spin],
             out: StackStep {
                 turn: v(),
                 u: v(),
                 phi: v(),
-                carrier_turn: [0.0; 2],
-                w_carrier: [0.0; 2],
+                carrier_turn: c(),
+                w_carrier: c(),
                 impulse: vec![0.0; n - 1],
                 face_j: vec![0.0; n - 1],
                 drive_j: 0.0,
@@ -571,111 +406,85 @@ impl RkBuffers {
     }
 }
 
+/// Where a sub-step of the clamped stack starts ([`Run::stack_rk4`]).
+struct StackStart<'a> {
+    /// The faces, held over the sub-step.
+    faces: &'a [Face],
+    /// The first stage, evaluated at the start.
+    k1: &'a Stage,
+    /// The start, s, and a prescribed shaft there.
+    t: f64,
+    shaft: ShaftAt,
+    /// Each coupling's relative angle, rad, and its body's speed, rad/s.
+    phi: &'a [f64],
+    u0: &'a [f64],
+    /// The inertial carriers' speeds, rad/s ([`System::spins`] order).
+    w0: &'a [f64],
+}
+
 impl Run {
-    /// One classical Runge-Kutta step of length `h` from `t` of the clamped stack and the
-    /// inertial carriers (the faces `faces` held), from the bodies' speeds `u0`, relative
-    /// angles `phi`, the carriers' speeds `w0` ([shaft, drum]), a prescribed shaft at `shaft`,
-    /// the first stage `k1` already evaluated, into `b.out`; the works integrated by the same
-    /// stages.
-    #[allow(clippy::too_many_arguments)]
-    fn stack_rk4(
-        &self,
-        sys: &System,
-        faces: &[Face],
-        k1: &Stage,
-        t: f64,
-        shaft: ShaftAt,
-        phi: &[f64],
-        u0: &[f64],
-        w0: [f64; 2],
-        h: f64,
-        b: &mut RkBuffers,
-    ) {
+    /// One classical Runge-Kutta step of length `h` of the clamped stack and the inertial
+    /// carriers from `start` (the faces held, the first stage already evaluated), into
+    /// `b.out`; the works integrated by the same stages.
+    fn stack_rk4(&self, sys: &System, start: &StackStart, h: f64, b: &mut RkBuffers) {
+        let StackStart {
+            faces,
+            k1,
+            t,
+            shaft,
+            phi,
+            u0,
+            w0,
+        } = *start;
         let n = u0.len();
-        let hh = h * h;
         let (tm, te) = (t + 0.5 * h, t + h);
         let (mid, end) = (
             ShaftAt::of(sys.profile.as_deref(), tm),
             ShaftAt::of(sys.profile.as_deref(), te),
         );
+        let RkBuffers { k, rk, x0, out } = b;
+        x0[..n].copy_from_slice(u0);
+        x0[n..].copy_from_slice(w0);
+        rk.k[0][..n].copy_from_slice(&k1.acc);
+        rk.k[0][n..].copy_from_slice(&k1.acc_carrier);
         // a stage: the teeth probed with the carriers turned from t (a prescribed shaft's
-        // exact, the inertial ones by `c_turn` at `w`) and the bodies by `th` at `u`
-        let stage = |ts: f64,
-                     at: ShaftAt,
-                     c_turn: [f64; 2],
-                     w: [f64; 2],
-                     th: &[f64],
-                     u: &[f64],
-                     st: &mut Stage| {
+        // exact, the inertial ones, after the bodies, by `th[n..]` at `x[n..]`) and the bodies
+        // by `th[..n]` at `x[..n]`
+        rk.step(t, h, x0, |s, ts, th, x, acc| {
+            let st = &mut k[s - 1];
+            let at = if s < 3 { mid } else { end };
+            let ((th, c_turn), (u, w)) = (th.split_at(n), x.split_at(n));
             for i in 0..n {
-                let (turn, speed) = match (sys.carriers[i], &sys.profile) {
-                    (Carrier::Shaft, Some(_)) => (at.angle - shaft.angle, at.speed),
-                    (Carrier::Housing, _) => (0.0, 0.0),
-                    (c, _) => {
-                        let k = spin(c).expect("an inertial carrier");
-                        (c_turn[k], w[k])
-                    }
+                let (turn, speed) = match sys.mounts[i] {
+                    Mount::Profile => (at.angle - shaft.angle, at.speed),
+                    Mount::Housing => (0.0, 0.0),
+                    Mount::Spin(k) => (c_turn[k], w[k]),
                 };
                 st.teeth[i] = self.couplings[i].probe_torque(phi[i] + turn - th[i], speed - u[i]);
             }
             self.stack_stage(sys, faces, ts, u, w, st);
-        };
-        let RkBuffers { k, th, u, out } = b;
+            acc[..n].copy_from_slice(&st.acc);
+            acc[n..].copy_from_slice(&st.acc_carrier);
+        });
         let [k2, k3, k4] = k;
-        let [u2, u3, u4] = u;
-        let map2 = |f: &dyn Fn(usize) -> f64| [f(0), f(1)];
-        for i in 0..n {
-            th[i] = 0.5 * h * u0[i];
-            u2[i] = u0[i] + 0.5 * h * k1.acc[i];
-        }
-        let (ct2, w2) = (
-            map2(&|k| 0.5 * h * w0[k]),
-            map2(&|k| w0[k] + 0.5 * h * k1.acc_carrier[k]),
-        );
-        stage(tm, mid, ct2, w2, th, u2, k2);
-        for i in 0..n {
-            th[i] = 0.5 * h * u0[i] + 0.25 * hh * k1.acc[i];
-            u3[i] = u0[i] + 0.5 * h * k2.acc[i];
-        }
-        let (ct3, w3) = (
-            map2(&|k| 0.5 * h * w0[k] + 0.25 * hh * k1.acc_carrier[k]),
-            map2(&|k| w0[k] + 0.5 * h * k2.acc_carrier[k]),
-        );
-        stage(tm, mid, ct3, w3, th, u3, k3);
-        for i in 0..n {
-            th[i] = h * u0[i] + 0.5 * hh * k2.acc[i];
-            u4[i] = u0[i] + h * k3.acc[i];
-        }
-        let (ct4, w4) = (
-            map2(&|k| h * w0[k] + 0.5 * hh * k2.acc_carrier[k]),
-            map2(&|k| w0[k] + h * k3.acc_carrier[k]),
-        );
-        stage(te, end, ct4, w4, th, u4, k4);
-        let h6 = h / 6.0;
-        let quad = |a: f64, b: f64, c: f64, d: f64| h6 * (a + 2.0 * (b + c) + d);
-        for k in 0..2 {
-            let a = [
-                k1.acc_carrier[k],
-                k2.acc_carrier[k],
-                k3.acc_carrier[k],
-                k4.acc_carrier[k],
-            ];
-            out.carrier_turn[k] = h * w0[k] + h * h6 * (a[0] + a[1] + a[2]);
-            out.w_carrier[k] = w0[k] + quad(a[0], a[1], a[2], a[3]);
-        }
+        let (u2, u3, u4) = (&rk.u[0][..n], &rk.u[1][..n], &rk.u[2][..n]);
+        let (w2, w3, w4) = (&rk.u[0][n..], &rk.u[1][n..], &rk.u[2][n..]);
+        let quad = |a: f64, b: f64, c: f64, d: f64| rk4_work(h, [a, b, c, d]);
+        out.carrier_turn.copy_from_slice(&rk.turn[n..]);
+        out.w_carrier.copy_from_slice(&rk.u1[n..]);
+        out.turn.copy_from_slice(&rk.turn[..n]);
+        out.u.copy_from_slice(&rk.u1[..n]);
         (out.drive_j, out.drag_j, out.load_j) = (0.0, 0.0, 0.0);
         let sq = |x: f64| x * x;
         for i in 0..n {
-            let turn = h * u0[i] + h * h6 * (k1.acc[i] + k2.acc[i] + k3.acc[i]);
-            out.turn[i] = turn;
-            out.u[i] = u0[i] + quad(k1.acc[i], k2.acc[i], k3.acc[i], k4.acc[i]);
-            let carrier_turn = match (sys.carriers[i], &sys.profile) {
-                (Carrier::Shaft, Some(_)) => end.angle - shaft.angle,
-                (Carrier::Housing, _) => 0.0,
-                (c, _) => out.carrier_turn[spin(c).expect("an inertial carrier")],
+            let turn = out.turn[i];
+            let carrier_turn = match sys.mounts[i] {
+                Mount::Profile => end.angle - shaft.angle,
+                Mount::Housing => 0.0,
+                Mount::Spin(k) => out.carrier_turn[k],
             };
             out.phi[i] = phi[i] + carrier_turn - turn;
-            if sys.carriers[i] == Carrier::Shaft && sys.profile.is_some() {
+            if sys.mounts[i] == Mount::Profile {
                 out.drive_j += quad(
                     k1.teeth[i] * shaft.speed,
                     k2.teeth[i] * mid.speed,
@@ -685,22 +494,16 @@ impl Run {
             }
             out.drag_j -= sys.c2[i] * quad(sq(u0[i]), sq(u2[i]), sq(u3[i]), sq(u4[i]));
         }
-        for k in 0..2 {
-            let Some((_, damping)) = sys.inertial[k] else {
-                continue;
-            };
+        for (k, spin) in sys.spins.iter().enumerate() {
             let (a, b, c, d) = (w0[k], w2[k], w3[k], w4[k]);
-            out.drag_j -= damping * quad(sq(a), sq(b), sq(c), sq(d));
-            if k == 0 {
-                // the drive's work on an inertial shaft (eq 4)
-                let (e1, em, e4) = (
-                    self.drive_torque(t),
-                    self.drive_torque(tm),
-                    self.drive_torque(te),
-                );
-                out.drive_j += quad(e1 * a, em * b, em * c, e4 * d);
-            } else {
-                out.load_j = sys.drum_load * quad(a, b, c, d);
+            out.drag_j -= spin.damping * quad(sq(a), sq(b), sq(c), sq(d));
+            // the external torque's work: the drive's on an inertial shaft (eq 4), the
+            // drum's load
+            let [e1, em, e4] = [t, tm, te].map(|ts| self.external_torque(spin.role, ts));
+            let work = quad(e1 * a, em * b, em * c, e4 * d);
+            match spin.role {
+                Inertial::Shaft => out.drive_j += work,
+                Inertial::Drum => out.load_j += work,
             }
         }
         for m in 0..faces.len() {
@@ -717,5 +520,256 @@ impl Run {
                 );
             }
         }
+    }
+}
+
+/// The clamped stack's sub-steps as the one landing loop drives them
+/// ([`Run::land_sub_steps`]): every coupling body and the inertial carriers as one system,
+/// the faces' slips reaching zero its own events (landed on, the face then locked).
+struct StackSteps {
+    /// The system, and every coupling (all are integrated together).
+    sys: System,
+    all: Vec<usize>,
+    /// The time, s; each coupling's relative angle, rad, its body's speed, rad/s, and turn
+    /// since the world step's start, rad; the inertial carriers' angles, rad, and speeds,
+    /// rad/s; a prescribed shaft.
+    t: f64,
+    phi: Vec<f64>,
+    u: Vec<f64>,
+    turn: Vec<f64>,
+    angle: Vec<f64>,
+    w: Vec<f64>,
+    shaft: ShaftAt,
+    /// Each interface's impulse on its upper body since the world step's start, N m s.
+    impulse: Vec<f64>,
+    /// Whether `forces` holds the hook's evaluation at the state (from the first sub-step's
+    /// end on).
+    evaluated_here: bool,
+    /// The longest sub-step, s.
+    cap: f64,
+    /// The stage at `t` (the first of the next step).
+    s0: Stage,
+    bufs: std::cell::RefCell<RkBuffers>,
+    /// The relative angles and the body speeds at the end of the full sub-step (kept while the
+    /// searches' trial steps overwrite the buffers).
+    phi_h: Vec<f64>,
+    u_h: Vec<f64>,
+    /// The faces, held over the sub-step.
+    faces: Vec<Face>,
+}
+
+impl SubSteps for StackSteps {
+    type Step = ();
+
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn members(&self) -> &[usize] {
+        &self.all
+    }
+
+    fn phi(&self, k: usize) -> f64 {
+        self.phi[k]
+    }
+
+    fn want(&mut self, run: &mut Run, ws: &mut WorldStep) -> Result<f64, EngineError> {
+        let (a, t, n) = (ws.a, self.t, self.phi.len());
+        let sys = &self.sys;
+        // the teeth's torques at t: the last sub-step's evaluation, else probes
+        for i in 0..n {
+            self.s0.teeth[i] = if self.evaluated_here {
+                run.forces[i].moment[2]
+            } else {
+                run.couplings[i].probe_torque(self.phi[i], run.rel[i].dphi)
+            };
+        }
+        if !self.evaluated_here {
+            ws.counts.evals += n as u64;
+        }
+        run.stack_stage(sys, &run.faces, t, &self.u, &self.w, &mut self.s0);
+        // An open face takes the sign of its slip (for when it clamps). A clamped one found
+        // slipping against its sign crossed zero unlanded (closer to a sub-step's start
+        // than the landing looks): it locks now if it holds (its friction must never push
+        // the slip along).
+        let mut turned = false;
+        for m in 0..run.faces.len() {
+            let Face::Slipping(dir) = run.faces[m] else {
+                continue;
+            };
+            let v = self.u[sys.body[m + 1]] - self.u[sys.body[m]];
+            if v == 0.0 || v.signum() == dir {
+                continue;
+            }
+            if self.s0.clamp[m] > 0.0 {
+                run.lock_face(sys, m, &mut self.u);
+                turned = true;
+            } else {
+                run.faces[m] = Face::Slipping(v.signum());
+            }
+        }
+        if turned {
+            run.break_faces(sys, t, &self.u, &self.w, &mut self.s0);
+        }
+        // the step each coupling wants, with its relative acceleration bounded by its
+        // carrier's bound and twice its body's acceleration at t (plus 1 rad/s^2): the
+        // bound only sizes the free-flight sub-steps (how soon a gap may close); every
+        // onset within a sub-step is landed on all the same
+        let mut want = self.cap;
+        let s0 = &self.s0;
+        let reaction = |k: usize| -> f64 {
+            (0..n)
+                .filter(|&i| sys.mounts[i] == Mount::Spin(k))
+                .map(|i| s0.teeth[i].abs())
+                .sum()
+        };
+        let spin_bound: Vec<f64> = (sys.spins.iter().enumerate())
+            .map(|(k, c)| run.inertial_accel_bound(c.role, self.w[k], reaction(k)))
+            .collect();
+        for i in 0..n {
+            let carrier = match sys.mounts[i] {
+                Mount::Profile => run.shaft_accel_bound,
+                Mount::Housing => 0.0,
+                Mount::Spin(k) => spin_bound[k],
+            };
+            let bound = carrier + 2.0 * s0.acc[i].abs() + 1.0;
+            let f = run.forces[i];
+            let view = run.coupling_view(i, &f, (self.phi[i], run.rel[i].dphi), bound, t);
+            let (w, _) = coupling_step(&view, a);
+            want = want.min(graded_step(w, &f, run.events.event_age_s(i, t)));
+        }
+        let want = checked_sub_step(want, a, t, || "the clamped stack".into())?;
+        self.faces.clone_from(&run.faces);
+        Ok(want)
+    }
+
+    fn rk4(&self, run: &Run, h: f64) {
+        let start = StackStart {
+            faces: &self.faces,
+            k1: &self.s0,
+            t: self.t,
+            shaft: self.shaft,
+            phi: &self.phi,
+            u0: &self.u,
+            w0: &self.w,
+        };
+        run.stack_rk4(&self.sys, &start, h, &mut self.bufs.borrow_mut());
+    }
+
+    fn phi_end(&self, _: &(), k: usize) -> f64 {
+        self.bufs.borrow().out.phi[k]
+    }
+
+    fn keep(&mut self, _: &()) {
+        let b = self.bufs.borrow();
+        self.phi_h.copy_from_slice(&b.out.phi);
+        self.u_h.copy_from_slice(&b.out.u);
+    }
+
+    fn phi_kept(&self, _: &(), k: usize) -> f64 {
+        self.phi_h[k]
+    }
+
+    fn trials_overwrite(&self) -> bool {
+        true
+    }
+
+    /// The first slip of a clamped slipping face reaching zero.
+    fn events(
+        &self,
+        run: &Run,
+        h: f64,
+        consider: &mut dyn FnMut(f64, Option<usize>),
+        trials: &std::cell::Cell<u64>,
+    ) {
+        for m in 0..self.faces.len() {
+            let Face::Slipping(dir) = self.faces[m] else {
+                continue;
+            };
+            if self.s0.clamp[m] <= 0.0 {
+                continue;
+            }
+            let (lo, up) = (self.sys.body[m], self.sys.body[m + 1]);
+            let g = |u: &[f64]| dir * (u[up] - u[lo]);
+            let (g0, g1) = (g(&self.u), g(&self.u_h));
+            if g0 > 0.0 && g1 <= 0.0 {
+                let x = bracketed_root(
+                    |x| {
+                        trials.set(trials.get() + 1);
+                        self.rk4(run, x);
+                        g(&self.bufs.borrow().out.u)
+                    },
+                    0.0,
+                    g0,
+                    h,
+                    g1,
+                    0.0,
+                );
+                consider(x, Some(m));
+            }
+        }
+    }
+
+    fn evals_per_rk4(&self) -> u64 {
+        3 * self.phi.len() as u64
+    }
+
+    fn accept(
+        &mut self,
+        run: &mut Run,
+        _: (),
+        t: f64,
+        event: Option<usize>,
+        ws: &mut WorldStep,
+    ) -> Result<(), EngineError> {
+        let n = self.phi.len();
+        // the sub-step's first full step (before the searches)
+        ws.counts.evals += 3 * n as u64;
+        let b = self.bufs.borrow();
+        let step = &b.out;
+        self.t = t;
+        for (x, dx) in self.turn.iter_mut().zip(&step.turn) {
+            *x += dx;
+        }
+        self.phi.clone_from(&step.phi);
+        self.u.clone_from(&step.u);
+        for (x, dx) in self.angle.iter_mut().zip(&step.carrier_turn) {
+            *x += dx;
+        }
+        self.w.clone_from(&step.w_carrier);
+        self.shaft = ShaftAt::of(self.sys.profile.as_deref(), t);
+        for (x, dx) in self.impulse.iter_mut().zip(&step.impulse) {
+            *x += dx;
+        }
+        ws.counts.substeps += 1;
+        run.energy.add_sub_step(step.drive_j, step.drag_j);
+        run.energy.add_load_work(step.load_j);
+        run.energy.add_stack_work(step.face_j.iter().sum());
+        let stack = run.stack.as_mut().expect("a stack");
+        for (x, dx) in stack.dissipated_j.iter_mut().zip(&step.face_j) {
+            *x -= dx;
+        }
+        drop(b);
+        if let Some(m) = event {
+            run.lock_face(&self.sys, m, &mut self.u);
+        }
+        for i in 0..n {
+            let at = match self.sys.mounts[i] {
+                Mount::Profile => self.shaft,
+                Mount::Housing => ShaftAt {
+                    speed: 0.0,
+                    angle: 0.0,
+                },
+                Mount::Spin(k) => ShaftAt {
+                    speed: self.w[k],
+                    angle: self.angle[k],
+                },
+            };
+            let dphi = at.speed - self.u[i];
+            run.end_sub_step(i, t, self.phi[i], dphi, at, ws)?;
+        }
+        self.evaluated_here = true;
+        run.break_faces(&self.sys, t, &self.u, &self.w, &mut self.s0);
+        Ok(())
     }
 }

@@ -4,14 +4,14 @@
 //! integrated together with classical Runge-Kutta sub-steps, the other bodies fly free against
 //! the carrier's motion (`multirate.rs`'s per-coupling integration).
 
+use super::landing::SubSteps;
 use super::state::{Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, split_remainder, Counts, GapDrag, Node, Path, ShaftAt,
+    checked_sub_step, graded_step, rk4_work, Carried, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep,
 };
-use crate::options::AdaptiveStepping;
 use crate::stepping::coupling_step;
 use crate::world::Carrier;
-use clutchpack_model::{DiscSample, EngineError, ImpactEvent};
+use clutchpack_model::EngineError;
 use rapier3d_f64::prelude::Vector;
 
 /// An inertial carrier's sub-steps are at most the world step over this (dimensionless): the
@@ -49,6 +49,42 @@ struct CarrierDynamics {
     /// The external torque (the shaft's drive, the drum's load) at the sub-step's start,
     /// middle and end, N m.
     torque: [f64; 3],
+}
+
+/// An inertial carrier's cluster at a sub-step's start ([`Run::carrier_rk4`]).
+#[derive(Debug, Clone, Copy)]
+struct Cluster<'a> {
+    /// The couplings integrated with the carrier, their bodies' inverse inertias,
+    /// 1/(kg m^2), and the open gaps' drag on each.
+    members: &'a [usize],
+    inv_j: &'a [f64],
+    gaps: &'a [GapDrag],
+    /// The start, s, and the carrier's speed there, rad/s.
+    t: f64,
+    w0: f64,
+    /// Each coupling's relative angle, rad, and speed, rad/s, there.
+    phi: &'a [f64],
+    dphi: &'a [f64],
+}
+
+/// The buffers of [`Run::carrier_rk4`], reused along a world step's sub-steps (allocating
+/// them per step was a tenth of an inertial-shaft pack's instructions, callgrind): the step of
+/// the cluster's bodies and the carrier after them, their speeds at its start, and zero turns.
+struct CarrierBuffers {
+    rk: Rk4<Vec<f64>>,
+    u0: Vec<f64>,
+    zero: Vec<f64>,
+}
+
+impl CarrierBuffers {
+    /// The buffers for a carrier with `n` couplings.
+    fn new(n: usize) -> CarrierBuffers {
+        CarrierBuffers {
+            rk: Rk4::new(n + 1),
+            u0: vec![0.0; n + 1],
+            zero: vec![0.0; n + 1],
+        }
+    }
 }
 
 /// One classical Runge-Kutta step of an inertial carrier and the couplings that go with it
@@ -109,15 +145,7 @@ impl Run {
     /// the step's start, middle and end; the drum's load, held over a world step).
     fn carrier_dynamics(&self, c: Inertial, t: f64, h: f64) -> CarrierDynamics {
         let (inv_j, damping) = self.carrier_inertia(c);
-        let torque = match (c, &self.drum) {
-            (Inertial::Shaft, _) => [
-                self.drive_torque(t),
-                self.drive_torque(t + 0.5 * h),
-                self.drive_torque(t + h),
-            ],
-            (Inertial::Drum, Some(d)) => [d.model.load_torque_n_m; 3],
-            (Inertial::Drum, None) => unreachable!("a drum"),
-        };
+        let torque = [t, t + 0.5 * h, t + h].map(|ts| self.external_torque(c, ts));
         CarrierDynamics {
             inv_j,
             damping,
@@ -125,12 +153,31 @@ impl Run {
         }
     }
 
+    /// The external torque on inertial carrier `c` at `ts` (s), N m: the shaft's drive (Hu et
+    /// al. eq 4), the drum's load (held over a world step).
+    pub(super) fn external_torque(&self, c: Inertial, ts: f64) -> f64 {
+        match (c, &self.drum) {
+            (Inertial::Shaft, _) => self.drive_torque(ts),
+            (Inertial::Drum, Some(d)) => d.model.load_torque_n_m,
+            (Inertial::Drum, None) => unreachable!("a drum"),
+        }
+    }
+
     /// Inertial carrier `c`'s unwrapped angle, rad, and speed, rad/s, at `t`.
-    fn carrier_state(&self, c: Inertial) -> (f64, f64) {
+    pub(super) fn carrier_state(&self, c: Inertial) -> (f64, f64) {
         match (c, &self.drum) {
             (Inertial::Shaft, _) => (self.theta_s, self.omega_s),
             (Inertial::Drum, Some(d)) => (d.theta, d.omega),
             (Inertial::Drum, None) => unreachable!("a drum"),
+        }
+    }
+
+    /// Sets inertial carrier `c`'s unwrapped angle, rad, and speed, rad/s (at a world step's
+    /// end).
+    pub(super) fn set_carrier_state(&mut self, c: Inertial, angle: f64, speed: f64) {
+        match (c, self.drum.as_mut()) {
+            (Inertial::Drum, Some(d)) => (d.theta, d.omega) = (angle, speed),
+            _ => (self.theta_s, self.omega_s) = (angle, speed),
         }
     }
 
@@ -158,9 +205,9 @@ impl Run {
             .z
     }
 
-    /// One classical Runge-Kutta step of length `h` from `t` of an inertial carrier (speed
-    /// `w0`, dynamics `dy`) and the couplings `cluster` (relative states `phi`, `dphi`, the
-    /// open gaps' drag `gaps`), integrated as one system: the carrier
+    /// One classical Runge-Kutta step of length `h` of an inertial carrier (dynamics `dy`)
+    /// and the couplings of its cluster `cl` from their states at `cl.t`, integrated as one
+    /// system: the carrier
     /// `J w' = T_ext(t) - C w - sum T_k` (the shaft: Hu et al. eq 4; the drum: its load and
     /// drag), each body `J w_d' = T_k - C2 w_d + g_k(w_d)` (eq 5 and the gaps' drag), `T_k`
     /// the teeth's torque on body `k` at `phi_k = theta_c - theta_d`. As in
@@ -168,87 +215,76 @@ impl Run {
     /// not the relative ones. The teeth's torques cancel in the total angular momentum at
     /// every stage, so the step conserves it exactly (a linear invariant) but for the external
     /// torque, the damping and the gaps.
-    #[allow(clippy::too_many_arguments)]
     fn carrier_rk4(
         &self,
-        cluster: &[usize],
-        inv_j: &[f64],
-        gaps: &[GapDrag],
+        cl: &Cluster,
         dy: &CarrierDynamics,
-        t: f64,
-        w0: f64,
-        phi: &[f64],
-        dphi: &[f64],
         h: f64,
+        b: &mut CarrierBuffers,
     ) -> CarrierStep {
+        let Cluster {
+            members: cluster,
+            inv_j,
+            gaps,
+            t,
+            w0,
+            phi,
+            dphi,
+        } = *cl;
         let n = cluster.len();
-        let hh = h * h;
         let (inv_j1, c1) = (dy.inv_j, dy.damping);
-        let u0: Vec<f64> = (0..n).map(|k| w0 - dphi[k]).collect();
-        // The accelerations at a stage: the carrier turned by `s` at speed `w`, body k by
-        // `th[k]` at `u[k]`; the bodies' into `acc`, returns the carrier's.
+        let CarrierBuffers { rk, u0, zero } = b;
+        // the bodies' speeds, then the carrier's
+        for k in 0..n {
+            u0[k] = w0 - dphi[k];
+        }
+        u0[n] = w0;
         let (tm, te) = (t + 0.5 * h, t + h);
-        let stage =
-            |(ts, ext): (f64, f64), s: f64, w: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
-                let mut teeth = 0.0;
-                for k in 0..n {
-                    let i = cluster[k];
-                    let torque = self.couplings[i].probe_torque(phi[k] + s - th[k], w - u[k]);
-                    teeth += torque;
-                    let g = gaps[k].torque(ts, u[k]);
-                    acc[k] = (torque - self.bodies[i].drag_n_m_s_rad * u[k] + g) * inv_j[k];
-                }
-                (ext - c1 * w - teeth) * inv_j1
-            };
         let [e1, em, e4] = dy.torque;
-        let (mut k1, mut k2, mut k3, mut k4) =
-            (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        let zero = vec![0.0; n];
-        let a1 = stage((t, e1), 0.0, w0, &zero, &u0, &mut k1);
-        let w2 = w0 + 0.5 * h * a1;
-        let th2: Vec<f64> = u0.iter().map(|u| 0.5 * h * u).collect();
-        let u2: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k1[k]).collect();
-        let a2 = stage((tm, em), 0.5 * h * w0, w2, &th2, &u2, &mut k2);
-        let w3 = w0 + 0.5 * h * a2;
-        let th3: Vec<f64> = (0..n)
-            .map(|k| 0.5 * h * u0[k] + 0.25 * hh * k1[k])
-            .collect();
-        let u3: Vec<f64> = (0..n).map(|k| u0[k] + 0.5 * h * k2[k]).collect();
-        let a3 = stage(
-            (tm, em),
-            0.5 * h * w0 + 0.25 * hh * a1,
-            w3,
-            &th3,
-            &u3,
-            &mut k3,
-        );
-        let w4 = w0 + h * a3;
-        let th4: Vec<f64> = (0..n).map(|k| h * u0[k] + 0.5 * hh * k2[k]).collect();
-        let u4: Vec<f64> = (0..n).map(|k| u0[k] + h * k3[k]).collect();
-        let a4 = stage((te, e4), h * w0 + 0.5 * hh * a2, w4, &th4, &u4, &mut k4);
-        let h6 = h / 6.0;
-        let turn = h * w0 + h * h6 * (a1 + a2 + a3);
-        let speed = w0 + h6 * (a1 + 2.0 * (a2 + a3) + a4);
-        let sq = |a: f64, b: f64, c: f64, d: f64| a * a + 2.0 * (b * b + c * c) + d * d;
-        let mut drag_j = -c1 * h6 * sq(w0, w2, w3, w4);
+        // The accelerations at stage `s` (0 to 3) at `ts`: body k turned by `th[k]` from t
+        // at `u[k]`, the carrier (last) by `th[n]` at `u[n]`.
+        let stage = |s: usize, ts: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
+            let (sc, w) = (th[n], u[n]);
+            let mut teeth = 0.0;
+            for k in 0..n {
+                let i = cluster[k];
+                let body = Carried {
+                    coupling: &self.couplings[i],
+                    phi: phi[k],
+                    inv_j: inv_j[k],
+                    c2: self.bodies[i].drag_n_m_s_rad,
+                    gap: gaps[k],
+                };
+                let torque;
+                (torque, acc[k]) = body.stage(ts, sc, w, th[k], u[k]);
+                teeth += torque;
+            }
+            let ext = [e1, em, em, e4][s];
+            acc[n] = (ext - c1 * w - teeth) * inv_j1;
+        };
+        stage(0, t, zero, u0, &mut rk.k[0]);
+        rk.step(t, h, u0, stage);
+        let [u2, u3, u4] = &rk.u;
+        let (w2, w3, w4) = (u2[n], u3[n], u4[n]);
+        let (turn, speed) = (rk.turn[n], rk.u1[n]);
+        let sq = |a: f64, b: f64, c: f64, d: f64| rk4_work(h, [a * a, b * b, c * c, d * d]);
+        let mut drag_j = -c1 * sq(w0, w2, w3, w4);
         let mut gap_j = 0.0;
         let mut phi1 = Vec::with_capacity(n);
         let mut dphi1 = Vec::with_capacity(n);
         for k in 0..n {
-            let th = h * u0[k] + h * h6 * (k1[k] + k2[k] + k3[k]);
-            let u1 = u0[k] + h6 * (k1[k] + 2.0 * (k2[k] + k3[k]) + k4[k]);
-            phi1.push(phi[k] + turn - th);
-            dphi1.push(speed - u1);
-            drag_j -= self.bodies[cluster[k]].drag_n_m_s_rad * h6 * sq(u0[k], u2[k], u3[k], u4[k]);
+            phi1.push(phi[k] + turn - rk.turn[k]);
+            dphi1.push(speed - rk.u1[k]);
+            drag_j -= self.bodies[cluster[k]].drag_n_m_s_rad * sq(u0[k], u2[k], u3[k], u4[k]);
             let g = |ts: f64, u: f64| gaps[k].torque(ts, u) * u;
-            gap_j += h6 * (g(t, u0[k]) + 2.0 * (g(tm, u2[k]) + g(tm, u3[k])) + g(te, u4[k]));
+            gap_j += rk4_work(h, [g(t, u0[k]), g(tm, u2[k]), g(tm, u3[k]), g(te, u4[k])]);
         }
         CarrierStep {
             turn,
             speed,
             phi: phi1,
             dphi: dphi1,
-            external_j: h6 * (e1 * w0 + 2.0 * (em * w2 + em * w3) + e4 * w4),
+            external_j: rk4_work(h, [e1 * w0, em * w2, em * w3, e4 * w4]),
             drag_j,
             gap_j,
         }
@@ -258,107 +294,43 @@ impl Run {
     /// (those that may touch it within the world step; the others fly free and load nothing),
     /// the open gaps' drag `gaps` on each coupling, with sub-steps of the shortest any of them
     /// wants (the prescribed shaft's controller and grading, applied to each), at most the
-    /// world step over [`SHAFT_SUB_STEPS`], landed on every onset and separation. Leaves the
-    /// couplings' states at `t1` in `rel` and `forces`, adds the external torque's, the
-    /// damping's, the drag's and the gaps' work to the audit, feeds the events, and returns
-    /// the carrier's nodes (the motion the free couplings follow).
-    #[allow(clippy::too_many_arguments)]
+    /// world step over [`SHAFT_SUB_STEPS`], landed on every onset and separation
+    /// ([`Run::land_sub_steps`]). Leaves the couplings' states at `t1` in `rel` and `forces`,
+    /// adds the external torque's, the damping's, the drag's and the gaps' work to the audit,
+    /// feeds the events, and returns the carrier's nodes (the motion the free couplings
+    /// follow).
     fn integrate_carrier(
         &mut self,
         c: Inertial,
-        t1: f64,
-        a: &AdaptiveStepping,
         cluster: &[usize],
         gaps: &[GapDrag],
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<Vec<Node>, EngineError> {
         let n = cluster.len();
-        let inv_j: Vec<f64> = cluster
-            .iter()
-            .map(|&i| self.inv_inertia_z(self.world.discs[i]))
-            .collect();
-        let gaps: Vec<GapDrag> = cluster.iter().map(|&i| gaps[i]).collect();
-        let mut t = self.t;
-        let (mut angle, mut w) = self.carrier_state(c);
-        let mut phi: Vec<f64> = cluster.iter().map(|&i| self.rel[i].phi).collect();
-        let mut dphi: Vec<f64> = cluster.iter().map(|&i| self.rel[i].dphi).collect();
-        let mut nodes = vec![Node { t, angle, speed: w }];
-        let cap = a.max_step_s / SHAFT_SUB_STEPS;
-        let who = match c {
-            Inertial::Shaft => "inertial shaft",
-            Inertial::Drum => "drum",
-        };
-        while t < t1 {
-            let reaction: f64 = cluster
+        let (angle, w) = self.carrier_state(c);
+        let mut steps = CarrierSteps {
+            c,
+            cluster,
+            inv_j: cluster
                 .iter()
-                .map(|&i| self.forces[i].moment[2].abs())
-                .sum();
-            let a_carrier = self.inertial_accel_bound(c, w, reaction);
-            let mut want = cap;
-            for (k, &i) in cluster.iter().enumerate() {
-                let d = &self.bodies[i];
-                let f = self.forces[i];
-                let wd = w - dphi[k];
-                let g = gaps[k];
-                let bound = a_carrier
-                    + ((d.drag_n_m_s_rad + g.damping) * wd.abs() + g.bound_n_m()) * inv_j[k];
-                let view = self.coupling_view(i, &f, (phi[k], dphi[k]), bound, t);
-                let (wk, _) = coupling_step(&view, a);
-                want = want.min(graded_step(wk, &f, self.events.event_age_s(i, t)));
-            }
-            let want = checked_sub_step(want, a, t, || who.into())?;
-            let rem = t1 - t;
-            let mut h = split_remainder(want, rem);
-            let rk4 = |x: f64| {
-                let dy = self.carrier_dynamics(c, t, x);
-                self.carrier_rk4(cluster, &inv_j, &gaps, &dy, t, w, &phi, &dphi, x)
-            };
-            let mut step = rk4(h);
-            // Never step over an onset or a separation of any coupling: land on the first.
-            let tiny = 1e-3 * h.min(want);
-            let mut first: Option<f64> = None;
-            for (k, &i) in cluster.iter().enumerate() {
-                let evals = std::cell::Cell::new(0);
-                let crossing = self.depth_crossing(i, phi[k], step.phi[k], h, |x| {
-                    evals.set(evals.get() + 4 * n as u64);
-                    rk4(x).phi[k]
-                });
-                counts.evals += evals.get();
-                if let Some(x) = crossing.filter(|&x| x > tiny && x < h) {
-                    if first.is_none_or(|b| x < b) {
-                        first = Some(x);
-                    }
-                }
-            }
-            if let Some(x) = first {
-                h = x;
-                step = rk4(x);
-                counts.evals += 4 * n as u64;
-            }
-            t = if h == rem { t1 } else { t + h };
-            angle += step.turn;
-            w = step.speed;
-            phi.clone_from(&step.phi);
-            dphi.clone_from(&step.dphi);
-            counts.substeps += 1;
-            counts.evals += 5 * n as u64;
-            match c {
-                Inertial::Shaft => self.energy.add_sub_step(step.external_j, step.drag_j),
-                Inertial::Drum => {
-                    self.energy.add_sub_step(0.0, step.drag_j);
-                    self.energy.add_load_work(step.external_j);
-                }
-            }
-            self.energy.add_stack_work(step.gap_j);
-            nodes.push(Node { t, angle, speed: w });
-            let at = ShaftAt { speed: w, angle };
-            for (k, &i) in cluster.iter().enumerate() {
-                self.end_sub_step(i, t, phi[k], dphi[k], at, a, closed, contacts)?;
-            }
-        }
-        Ok(nodes)
+                .map(|&i| self.inv_inertia_z(self.world.discs[i]))
+                .collect(),
+            gaps: cluster.iter().map(|&i| gaps[i]).collect(),
+            t: self.t,
+            angle,
+            w,
+            phi: cluster.iter().map(|&i| self.rel[i].phi).collect(),
+            dphi: cluster.iter().map(|&i| self.rel[i].dphi).collect(),
+            nodes: vec![Node {
+                t: self.t,
+                angle,
+                speed: w,
+            }],
+            cap: ws.a.max_step_s / SHAFT_SUB_STEPS,
+            bufs: std::cell::RefCell::new(CarrierBuffers::new(n)),
+        };
+        self.land_sub_steps(&mut steps, ws)?;
+        Ok(steps.nodes)
     }
 
     /// Advances inertial carrier `c` and the couplings it carries from `t` to `t1`, the open
@@ -370,18 +342,14 @@ impl Run {
     /// one then flies free against the carrier's motion so found ([`Path::Nodes`]), as against
     /// a prescribed shaft. Writes each carried coupling's speed at `t1` into `omega_d` and its
     /// mean speed over the step into `means`; returns the carrier's nodes at `t` and `t1`.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn advance_carrier(
         &mut self,
         c: Inertial,
-        t1: f64,
-        a: &AdaptiveStepping,
         gaps: &[GapDrag],
         means: &mut [f64],
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<(Node, Node), EngineError> {
+        let (t1, a) = (ws.t1, ws.a);
         let t0 = self.t;
         let h = t1 - t0;
         let carried = self.carried_by(c);
@@ -413,20 +381,17 @@ impl Run {
             }
         }
         let phi0: Vec<f64> = self.rel.iter().map(|r| r.phi).collect();
-        let nodes = self.integrate_carrier(c, t1, a, &cluster, gaps, counts, closed, contacts)?;
+        let nodes = self.integrate_carrier(c, &cluster, gaps, ws)?;
         let path = Path::Nodes(&nodes);
         for &i in &free {
-            self.integrate_coupling(i, t1, a, gaps[i], path, a_carrier, counts, closed, contacts)?;
+            self.integrate_coupling(i, gaps[i], path, a_carrier, ws)?;
         }
         let (start, end) = (nodes[0], nodes[nodes.len() - 1]);
         for &i in &carried {
             self.omega_d[i] = end.speed - self.rel[i].dphi;
             means[i] = (end.angle - start.angle - (self.rel[i].phi - phi0[i])) / h;
         }
-        match (c, self.drum.as_mut()) {
-            (Inertial::Drum, Some(d)) => (d.theta, d.omega) = (end.angle, end.speed),
-            _ => (self.theta_s, self.omega_s) = (end.angle, end.speed),
-        }
+        self.set_carrier_state(c, end.angle, end.speed);
         Ok((start, end))
     }
 
@@ -463,5 +428,126 @@ impl Run {
         }
         self.t_prev = Some(t0);
         self.t = t1;
+    }
+}
+
+/// An inertial carrier with its cluster as the one landing loop drives it
+/// ([`Run::integrate_carrier`]).
+struct CarrierSteps<'a> {
+    /// The carrier and the couplings integrated with it, their bodies' inverse inertias,
+    /// 1/(kg m^2), and the open gaps' drag on each.
+    c: Inertial,
+    cluster: &'a [usize],
+    inv_j: Vec<f64>,
+    gaps: Vec<GapDrag>,
+    /// The time, s, the carrier's angle, rad, and speed, rad/s, and each coupling's relative
+    /// angle, rad, and speed, rad/s, there.
+    t: f64,
+    angle: f64,
+    w: f64,
+    phi: Vec<f64>,
+    dphi: Vec<f64>,
+    /// The carrier at the sub-steps' ends so far.
+    nodes: Vec<Node>,
+    /// The longest sub-step, s.
+    cap: f64,
+    bufs: std::cell::RefCell<CarrierBuffers>,
+}
+
+impl SubSteps for CarrierSteps<'_> {
+    type Step = CarrierStep;
+
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn members(&self) -> &[usize] {
+        self.cluster
+    }
+
+    fn phi(&self, k: usize) -> f64 {
+        self.phi[k]
+    }
+
+    fn want(&mut self, run: &mut Run, ws: &mut WorldStep) -> Result<f64, EngineError> {
+        let (a, t, w) = (ws.a, self.t, self.w);
+        let reaction: f64 = self
+            .cluster
+            .iter()
+            .map(|&i| run.forces[i].moment[2].abs())
+            .sum();
+        let a_carrier = run.inertial_accel_bound(self.c, w, reaction);
+        let mut want = self.cap;
+        for (k, &i) in self.cluster.iter().enumerate() {
+            let d = &run.bodies[i];
+            let f = run.forces[i];
+            let wd = w - self.dphi[k];
+            let g = self.gaps[k];
+            let bound = a_carrier
+                + ((d.drag_n_m_s_rad + g.damping) * wd.abs() + g.bound_n_m()) * self.inv_j[k];
+            let view = run.coupling_view(i, &f, (self.phi[k], self.dphi[k]), bound, t);
+            let (wk, _) = coupling_step(&view, a);
+            want = want.min(graded_step(wk, &f, run.events.event_age_s(i, t)));
+        }
+        let who = match self.c {
+            Inertial::Shaft => "inertial shaft",
+            Inertial::Drum => "drum",
+        };
+        checked_sub_step(want, a, t, || who.into())
+    }
+
+    fn rk4(&self, run: &Run, h: f64) -> CarrierStep {
+        let b = &mut self.bufs.borrow_mut();
+        let dy = run.carrier_dynamics(self.c, self.t, h);
+        let start = Cluster {
+            members: self.cluster,
+            inv_j: &self.inv_j,
+            gaps: &self.gaps,
+            t: self.t,
+            w0: self.w,
+            phi: &self.phi,
+            dphi: &self.dphi,
+        };
+        run.carrier_rk4(&start, &dy, h, b)
+    }
+
+    fn phi_end(&self, step: &CarrierStep, k: usize) -> f64 {
+        step.phi[k]
+    }
+
+    fn evals_per_rk4(&self) -> u64 {
+        4 * self.cluster.len() as u64
+    }
+
+    fn accept(
+        &mut self,
+        run: &mut Run,
+        step: CarrierStep,
+        t: f64,
+        _: Option<usize>,
+        ws: &mut WorldStep,
+    ) -> Result<(), EngineError> {
+        self.t = t;
+        self.angle += step.turn;
+        self.w = step.speed;
+        self.phi.clone_from(&step.phi);
+        self.dphi.clone_from(&step.dphi);
+        ws.counts.substeps += 1;
+        ws.counts.evals += 5 * self.cluster.len() as u64;
+        match self.c {
+            Inertial::Shaft => run.energy.add_sub_step(step.external_j, step.drag_j),
+            Inertial::Drum => {
+                run.energy.add_sub_step(0.0, step.drag_j);
+                run.energy.add_load_work(step.external_j);
+            }
+        }
+        run.energy.add_stack_work(step.gap_j);
+        let (angle, w) = (self.angle, self.w);
+        self.nodes.push(Node { t, angle, speed: w });
+        let at = ShaftAt { speed: w, angle };
+        for (k, &i) in self.cluster.iter().enumerate() {
+            run.end_sub_step(i, t, self.phi[k], self.dphi[k], at, ws)?;
+        }
+        Ok(())
     }
 }

@@ -14,6 +14,7 @@ mod energy;
 mod events;
 mod forces;
 mod inertial;
+mod landing;
 mod multirate;
 mod session;
 mod state;

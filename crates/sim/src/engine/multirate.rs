@@ -1,19 +1,21 @@
 //! The multirate scheme (crate docs, "Theory"): the rapier world steps at free-flight length
 //! and every spline coupling integrates its own relative motion inside the world's step, with
 //! its own contact-aware sub-steps; the tooth impulse of the step is handed to the disc's
-//! rapier body, which carries the disc's state from one world step to the next.
+//! rapier body, which carries the disc's state from one world step to the next (a coupling's
+//! sub-steps go through the one landing loop, `landing.rs`, as [`Alone`]).
 
 use super::inertial::Inertial;
+use super::landing::SubSteps;
 use super::state::{disc_sample, relative_state, Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, split_remainder, Counts, GapDrag, Node, Path, Relative, ShaftAt,
-    TurnMoment,
+    checked_sub_step, graded_step, GapDrag, Node, Path, Relative, ShaftAt, SubStep, TurnMoment,
+    WorldStep,
 };
 use crate::hook::{CouplingForces, RelativeState, FLANKS};
-use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
+use crate::options::{MultibodyOptions, Stepping};
 use crate::stepping::{bracketed_root, contact_duration_s, coupling_step};
 use crate::world::Carrier;
-use clutchpack_model::{DiscSample, EngineError, ImpactEvent, PackModel, SpeedProfile};
+use clutchpack_model::{EngineError, PackModel, SpeedProfile};
 use rapier3d_f64::prelude::{RigidBodyHandle, Rotation, Vector};
 
 /// Why the multirate scheme cannot run this pack with these options (`None`: it can).
@@ -105,14 +107,8 @@ impl Run {
     /// to `closed` (in the order they closed within each coupling), the contact samples
     /// `(coupling, t s, state)` of the sub-steps to `contacts` (in time order within each
     /// coupling; see `EventBook::update`).
-    pub(super) fn multirate_step(
-        &mut self,
-        t1: f64,
-        a: &AdaptiveStepping,
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
-    ) -> Result<(), EngineError> {
+    pub(super) fn multirate_step(&mut self, ws: &mut WorldStep) -> Result<(), EngineError> {
+        let t1 = ws.t1;
         let t0 = self.t;
         let h = t1 - t0;
         // The open gaps' drag: the discs first, with their neighbours (plates, which turn
@@ -160,18 +156,7 @@ impl Run {
         // the discs, with an inertial shaft as their carrier or each alone
         let shaft = prescribed.is_none().then_some(Inertial::Shaft);
         let (discs, plates) = (0..n_discs, n_discs..n);
-        self.advance_group(
-            discs,
-            shaft,
-            t1,
-            a,
-            &gaps,
-            &mut means,
-            &mut carriers,
-            counts,
-            closed,
-            contacts,
-        )?;
+        self.advance_group(discs, shaft, &gaps, &mut means, &mut carriers, ws)?;
         if self.stack.is_some() {
             // the discs' speeds over the step, for the plates: the affine function with their
             // mean and their first moment, from their sub-steps
@@ -198,18 +183,7 @@ impl Run {
         // the plates: each alone on the housing, then the drum with its own (as an inertial
         // shaft with its discs), their gaps' drag from the discs' speeds as on the housing
         let drum = self.world.drum.map(|_| Inertial::Drum);
-        self.advance_group(
-            plates,
-            drum,
-            t1,
-            a,
-            &gaps,
-            &mut means,
-            &mut carriers,
-            counts,
-            closed,
-            contacts,
-        )?;
+        self.advance_group(plates, drum, &gaps, &mut means, &mut carriers, ws)?;
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let c = self.gap_coefficient();
         if let Some(s) = self.stack.as_mut() {
@@ -259,30 +233,24 @@ impl Run {
     /// the world's step), every other one alone against its carrier's known motion
     /// ([`Run::advance_alone`]) first. Writes each one's speed at `t1` into `omega_d` and its
     /// mean speed over the step into `means`.
-    #[allow(clippy::too_many_arguments)]
     fn advance_group(
         &mut self,
         group: std::ops::Range<usize>,
         inertial: Option<Inertial>,
-        t1: f64,
-        a: &AdaptiveStepping,
         gaps: &[GapDrag],
         means: &mut [f64],
         carriers: &mut Vec<(RigidBodyHandle, Node, Node)>,
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<(), EngineError> {
         let carrier = inertial.map(Inertial::carrier);
         for i in group {
             if Some(self.world.carriers[i]) != carrier {
-                self.advance_alone(i, t1, a, gaps[i], means, counts, closed, contacts)?;
+                self.advance_alone(i, gaps[i], means, ws)?;
             }
         }
         if let Some(c) = inertial {
             let handle = self.carrier_body_of(c);
-            let (start, end) =
-                self.advance_carrier(c, t1, a, gaps, means, counts, closed, contacts)?;
+            let (start, end) = self.advance_carrier(c, gaps, means, ws)?;
             carriers.push((handle, start, end));
         }
         Ok(())
@@ -292,18 +260,14 @@ impl Run {
     /// prescribed shaft's profile, the housing at rest) with the open gaps' drag `gap`
     /// ([`Run::integrate_coupling`]); writes its speed at `t1` into `omega_d` and its mean
     /// speed over the step into `means[i]`.
-    #[allow(clippy::too_many_arguments)]
     fn advance_alone(
         &mut self,
         i: usize,
-        t1: f64,
-        a: &AdaptiveStepping,
         gap: GapDrag,
         means: &mut [f64],
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<(), EngineError> {
+        let t1 = ws.t1;
         let (t0, h) = (self.t, t1 - self.t);
         let phi0 = self.rel[i].phi;
         let p = self.profile(i);
@@ -311,7 +275,7 @@ impl Run {
             Some(p) => (Path::Profile(p), self.shaft_accel_bound),
             None => (Path::Housing, 0.0),
         };
-        self.integrate_coupling(i, t1, a, gap, path, bound, counts, closed, contacts)?;
+        self.integrate_coupling(i, gap, path, bound, ws)?;
         let (phi1, dphi1) = (self.rel[i].phi, self.rel[i].dphi);
         let (c0, c1) = (path.at(t0), path.at(t1));
         self.omega_d[i] = c1.speed - dphi1;
@@ -359,97 +323,33 @@ impl Run {
 
     /// Sub-steps coupling `i` from `t` (its state in `rel[i]`, its forces in `forces[i]`) to
     /// `t1`, with the step controller of the shared scheme applied to this coupling alone and
-    /// steps landed on every contact onset and separation; leaves the state at `t1` in
-    /// `rel[i]` and `forces[i]`, adds the work done to the energy audit and feeds the events.
-    #[allow(clippy::too_many_arguments)]
+    /// steps landed on every contact onset and separation ([`Run::land_sub_steps`]); leaves the
+    /// state at `t1` in `rel[i]` and `forces[i]`, adds the work done to the energy audit and
+    /// feeds the events.
     pub(super) fn integrate_coupling(
         &mut self,
         i: usize,
-        t1: f64,
-        a: &AdaptiveStepping,
         gap: GapDrag,
         path: Path<'_>,
         carrier_accel_bound: f64,
-        counts: &mut Counts,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<(), EngineError> {
-        let bodies = std::sync::Arc::clone(&self.bodies);
-        let d = &bodies[i];
-        let inv_j = self.world.physics.bodies[self.world.discs[i]]
-            .mass_properties()
-            .local_mprops
-            .inv_principal_inertia
-            .z;
-        // On an inertial carrier (shaft, drum) the teeth's work is internal (the drive's or the
-        // load's is the carrier's, integrated with it) and a coupling integrated here is in
-        // free flight (the others go with the carrier, `integrate_carrier`): one that touches
-        // all the same is counted.
-        let inertial = matches!(path, Path::Nodes(_));
-        let mut missed = false;
-        let mut t = self.t;
-        let (mut phi, mut dphi) = (self.rel[i].phi, self.rel[i].dphi);
-        let mut shaft = path.at(t);
-        // whether `forces[i]` holds the hook's evaluation at `(phi, dphi)`: from the first
-        // sub-step's end on (at a world step's start the state was read back from rapier)
-        let mut evaluated_here = false;
-        while t < t1 {
-            let f = self.forces[i];
-            let wd = shaft.speed - dphi;
-            let bound = carrier_accel_bound
-                + ((d.drag_n_m_s_rad + gap.damping) * wd.abs() + gap.bound_n_m()) * inv_j;
-            let view = self.coupling_view(i, &f, (phi, dphi), bound, t);
-            let (want, _) = coupling_step(&view, a);
-            let want = graded_step(want, &f, self.events.event_age_s(i, t));
-            let want = checked_sub_step(want, a, t, || format!("disc {i}"))?;
-            let rem = t1 - t;
-            let mut h = split_remainder(want, rem);
-            let start_torque_n_m = if evaluated_here {
-                f.moment[2]
-            } else {
-                counts.evals += 1;
-                self.couplings[i].probe_torque(phi, dphi)
-            };
-            let rel = Relative {
-                path,
-                coupling: &self.couplings[i],
-                inv_j,
-                c2: d.drag_n_m_s_rad,
-                gap,
-                start_torque_n_m,
-            };
-            let mut step = rel.rk4(t, shaft, phi, dphi, h);
-            // Never step over an onset or a separation: land on it (the `s^1.5` law's kink
-            // then falls on a sub-step boundary and the step keeps its order).
-            let tiny = 1e-3 * h.min(want);
-            let evals = std::cell::Cell::new(0);
-            let crossing = self.depth_crossing(i, phi, step.phi, h, |x| {
-                evals.set(evals.get() + 3);
-                rel.rk4(t, shaft, phi, dphi, x).phi
-            });
-            counts.evals += evals.get();
-            if let Some(x) = crossing.filter(|&x| x > tiny && x < h) {
-                h = x;
-                step = rel.rk4(t, shaft, phi, dphi, x);
-                counts.evals += 3;
-            }
-            t = if h == rem { t1 } else { t + h };
-            phi = step.phi;
-            dphi = step.dphi;
-            shaft = step.shaft;
-            counts.substeps += 1;
-            counts.evals += step.evals + 1;
-            self.energy
-                .add_sub_step(if inertial { 0.0 } else { step.drive_j }, step.drag_j);
-            self.energy.add_stack_work(step.gap_j);
-            let f = self.end_sub_step(i, t, phi, dphi, shaft, a, closed, contacts)?;
-            evaluated_here = true;
-            if inertial && f.depth_m > 0.0 && !missed {
-                missed = true;
-                counts.missed += 1;
-            }
-        }
-        Ok(())
+        let mut alone = Alone {
+            i,
+            gap,
+            path,
+            carrier_accel_bound,
+            inv_j: self.inv_inertia_z(self.world.discs[i]),
+            c2: self.bodies[i].drag_n_m_s_rad,
+            t: self.t,
+            phi: self.rel[i].phi,
+            dphi: self.rel[i].dphi,
+            shaft: path.at(self.t),
+            evaluated_here: false,
+            start_torque_n_m: 0.0,
+            missed: false,
+        };
+        self.land_sub_steps(&mut alone, ws)
     }
 
     /// Where within a sub-step of length `h` coupling `i`'s deepest tooth's engagement depth
@@ -493,7 +393,6 @@ impl Run {
     /// carrier at `shaft`: checks the state, evaluates the teeth there (advancing their
     /// contact memory) into `forces[i]` and `rel[i]`, and feeds the events and the contact
     /// samples.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn end_sub_step(
         &mut self,
         i: usize,
@@ -501,9 +400,7 @@ impl Run {
         phi: f64,
         dphi: f64,
         shaft: ShaftAt,
-        a: &AdaptiveStepping,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
+        ws: &mut WorldStep,
     ) -> Result<CouplingForces, EngineError> {
         let d = &self.bodies[i];
         let limit = std::f64::consts::PI / d.spline.teeth as f64;
@@ -532,22 +429,132 @@ impl Run {
         self.forces[i] = f;
         self.rel[i] = rel_state;
         self.moments[i].add(t, shaft.angle - phi, shaft.speed - dphi);
-        let steps_per_contact = a.steps_per_contact;
+        let steps_per_contact = ws.a.steps_per_contact;
         let m_eff = self.m_eff[i];
         let step_of = |v| contact_duration_s(&d.law, f.kin.flank, v, m_eff) / steps_per_contact;
         let tracked = self.events.update(i, t, &f, steps_per_contact, step_of);
         if let Some(e) = tracked.closed {
-            closed.push(e);
+            ws.closed.push(e);
         }
         if let Some(at) = tracked.contact_sample_at {
             // the closing state is sent at the separation
             let omega_d = shaft.speed - dphi;
-            contacts.push((
+            ws.contacts.push((
                 i,
                 at,
                 disc_sample(&f, &rel_state, shaft.angle, omega_d, Vec::new()),
             ));
         }
         Ok(f)
+    }
+}
+
+/// One coupling alone against its carrier's known motion (a prescribed shaft's profile, the
+/// housing at rest, an inertial carrier's nodes), [`Relative::rk4`] for its steps.
+struct Alone<'a> {
+    /// The coupling, the open gaps' drag on its body, its carrier's path and the bound of
+    /// the carrier's acceleration, rad/s^2.
+    i: usize,
+    gap: GapDrag,
+    path: Path<'a>,
+    carrier_accel_bound: f64,
+    /// The body's inverse inertia about the axis, 1/(kg m^2) (rapier's), and drag `C2`,
+    /// N m s/rad.
+    inv_j: f64,
+    c2: f64,
+    /// The time, s, the relative state (rad, rad/s) and the carrier there.
+    t: f64,
+    phi: f64,
+    dphi: f64,
+    shaft: ShaftAt,
+    /// Whether `forces[i]` holds the hook's evaluation at `(phi, dphi)`: from the first
+    /// sub-step's end on (at a world step's start the state was read back from rapier).
+    evaluated_here: bool,
+    /// The teeth's torque at the step's start, N m.
+    start_torque_n_m: f64,
+    /// Whether it touched on an inertial carrier (counted once per world step).
+    missed: bool,
+}
+
+impl SubSteps for Alone<'_> {
+    type Step = SubStep;
+
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn members(&self) -> &[usize] {
+        std::slice::from_ref(&self.i)
+    }
+
+    fn phi(&self, _: usize) -> f64 {
+        self.phi
+    }
+
+    fn want(&mut self, run: &mut Run, ws: &mut WorldStep) -> Result<f64, EngineError> {
+        let (i, a, t, gap) = (self.i, ws.a, self.t, self.gap);
+        let f = run.forces[i];
+        let wd = self.shaft.speed - self.dphi;
+        let bound = self.carrier_accel_bound
+            + ((self.c2 + gap.damping) * wd.abs() + gap.bound_n_m()) * self.inv_j;
+        let view = run.coupling_view(i, &f, (self.phi, self.dphi), bound, t);
+        let (want, _) = coupling_step(&view, a);
+        let want = graded_step(want, &f, run.events.event_age_s(i, t));
+        let want = checked_sub_step(want, a, t, || format!("disc {i}"))?;
+        self.start_torque_n_m = if self.evaluated_here {
+            f.moment[2]
+        } else {
+            ws.counts.evals += 1;
+            run.couplings[i].probe_torque(self.phi, self.dphi)
+        };
+        Ok(want)
+    }
+
+    fn rk4(&self, run: &Run, h: f64) -> SubStep {
+        let rel = Relative {
+            path: self.path,
+            coupling: &run.couplings[self.i],
+            inv_j: self.inv_j,
+            c2: self.c2,
+            gap: self.gap,
+            start_torque_n_m: self.start_torque_n_m,
+        };
+        rel.rk4(self.t, self.shaft, self.phi, self.dphi, h)
+    }
+
+    fn phi_end(&self, step: &SubStep, _: usize) -> f64 {
+        step.phi
+    }
+
+    fn evals_per_rk4(&self) -> u64 {
+        3
+    }
+
+    fn accept(
+        &mut self,
+        run: &mut Run,
+        step: SubStep,
+        t: f64,
+        _: Option<usize>,
+        ws: &mut WorldStep,
+    ) -> Result<(), EngineError> {
+        // On an inertial carrier (shaft, drum) the teeth's work is internal (the drive's or
+        // the load's is the carrier's, integrated with it) and a coupling integrated here is
+        // in free flight (the others go with the carrier, `integrate_carrier`): one that
+        // touches all the same is counted.
+        let inertial = matches!(self.path, Path::Nodes(_));
+        (self.t, self.phi, self.dphi, self.shaft) = (t, step.phi, step.dphi, step.shaft);
+        ws.counts.substeps += 1;
+        ws.counts.evals += step.evals + 1;
+        run.energy
+            .add_sub_step(if inertial { 0.0 } else { step.drive_j }, step.drag_j);
+        run.energy.add_stack_work(step.gap_j);
+        let f = run.end_sub_step(self.i, t, self.phi, self.dphi, self.shaft, ws)?;
+        self.evaluated_here = true;
+        if inertial && f.depth_m > 0.0 && !self.missed {
+            self.missed = true;
+            ws.counts.missed += 1;
+        }
+        Ok(())
     }
 }

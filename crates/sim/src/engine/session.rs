@@ -37,7 +37,7 @@
 
 use super::energy::EnergyAudit;
 use super::state::{shaft_accel_bound, Run, ShaftDrive};
-use super::substep::{split_remainder, Counts};
+use super::substep::{split_remainder, Counts, WorldStep};
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::{
@@ -389,10 +389,17 @@ impl MultibodySession {
             let run = &mut self.run;
             let t1 = world_step_end(run.t, a.max_step_s, grid, end);
             run.read_relative_states();
+            let mut ws = WorldStep {
+                t1,
+                a: &a,
+                counts: &mut self.counts,
+                closed: &mut closed,
+                contacts: &mut contacts,
+            };
             if clamped {
-                run.clamped_step(t1, &a, &mut self.counts, &mut closed, &mut contacts)?;
+                run.clamped_step(&mut ws)?;
             } else {
-                run.multirate_step(t1, &a, &mut self.counts, &mut closed, &mut contacts)?;
+                run.multirate_step(&mut ws)?;
             }
             run.update_stack();
             // Events in the order they closed across the couplings.

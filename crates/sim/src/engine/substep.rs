@@ -1,11 +1,31 @@
-//! One coupling's sub-steps inside a world step (the multirate schemes, `multirate.rs` and
-//! `inertial.rs`): the classical Runge-Kutta step of its relative motion against its carrier's
-//! path, graded towards the tooth law's kinks, with the open gaps' drag held over the step;
-//! and what the multirate schemes count.
+//! The sub-step kernel of the multirate schemes (`multirate.rs`, `inertial.rs`, `clamped.rs`):
+//! the one classical Runge-Kutta step of a set of bodies ([`Rk4`]) and the one quadrature of
+//! the works along it ([`rk4_work`]); a coupling's step against its carrier's path
+//! ([`Relative`]), graded towards the tooth law's kinks, with the open gaps' drag held over
+//! the step; the world-step context the schemes pass down ([`WorldStep`]); and what the
+//! multirate schemes count.
 
 use crate::hook::{Coupling, CouplingForces};
 use crate::options::AdaptiveStepping;
-use clutchpack_model::{EngineError, SpeedProfile};
+use clutchpack_model::{DiscSample, EngineError, ImpactEvent, SpeedProfile};
+
+/// One world step of the multirate schemes as their sub-steps see it (the context the
+/// schemes pass down instead of long argument lists): where it ends, the step controller's
+/// settings, and where the sub-steps report what they count, the impacts that closed and the
+/// contact samples.
+pub(super) struct WorldStep<'a> {
+    /// The world step's end, s.
+    pub(super) t1: f64,
+    /// The step controller's settings.
+    pub(super) a: &'a AdaptiveStepping,
+    /// What the multirate loop counts in the run.
+    pub(super) counts: &'a mut Counts,
+    /// Impact events that closed (in the order they closed within each coupling).
+    pub(super) closed: &'a mut Vec<ImpactEvent>,
+    /// Contact samples `(coupling, t s, state)` of the sub-steps (in time order within each
+    /// coupling; see `EventBook::update`).
+    pub(super) contacts: &'a mut Vec<(usize, f64, DiscSample)>,
+}
 
 /// The open gaps' drag on one body over a world step, `sum_nb c (w_nb - w)` (Couette, MODEL.md
 /// section 5): the neighbours' speeds taken as an affine function of time over the step with
@@ -169,6 +189,96 @@ pub(super) fn split_remainder(want: f64, rem: f64) -> f64 {
     }
 }
 
+/// The classical Runge-Kutta step of a set of bodies, the one integrator of the multirate
+/// schemes (a coupling alone against its carrier's path, [`Relative::rk4`]; an inertial
+/// carrier with its cluster, `Run::carrier_rk4`; the clamped stack with its inertial
+/// carriers, `Run::stack_rk4`): its stages' accelerations and speeds, kept for the schemes'
+/// energy quadratures, and its result. `V` holds one value per body: `[f64; 1]` for a coupling
+/// alone (no allocation on its hot path), a `Vec<f64>` for a system.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Rk4<V> {
+    /// Each body's acceleration at the four stages, rad/s^2 (`k[0]`, at the step's start, is
+    /// the caller's).
+    pub(super) k: [V; 4],
+    /// Each body's speed at the stages 2, 3 and 4, rad/s.
+    pub(super) u: [V; 3],
+    /// Each body's turn from the start at the stage being evaluated, rad (scratch).
+    th: V,
+    /// Each body's turn over the step, rad, and its speed at the end, rad/s.
+    pub(super) turn: V,
+    pub(super) u1: V,
+}
+
+impl Rk4<Vec<f64>> {
+    /// The buffers for `n` bodies.
+    pub(super) fn new(n: usize) -> Rk4<Vec<f64>> {
+        let v = || vec![0.0; n];
+        Rk4 {
+            k: [v(), v(), v(), v()],
+            u: [v(), v(), v()],
+            th: v(),
+            turn: v(),
+            u1: v(),
+        }
+    }
+}
+
+impl<V: AsRef<[f64]> + AsMut<[f64]>> Rk4<V> {
+    /// One classical Runge-Kutta step (Kutta 1901: nodes 0, 1/2, 1/2, 1, weights 1/6, 1/3,
+    /// 1/3, 1/6) of length `h` from `t` of the bodies' motion `theta' = u`,
+    /// `u' = a(t, theta - theta(t), u)`, from their speeds `u0` and their accelerations at `t`
+    /// in `k[0]`. `stage(s, ts, th, u, acc)` writes into `acc` the bodies' accelerations at
+    /// stage `s` (1, 2, 3: the second to the fourth) at `ts` with the bodies turned by `th`
+    /// (rad) from `t` and turning at `u` (rad/s). Written for the angle, as the method on the
+    /// first-order system (angle, speed) gives it: each body turns by
+    /// `h u0 + h^2/6 (k1 + k2 + k3)` and ends at `u0 + h/6 (k1 + 2 k2 + 2 k3 + k4)`.
+    pub(super) fn step(
+        &mut self,
+        t: f64,
+        h: f64,
+        u0: &[f64],
+        mut stage: impl FnMut(usize, f64, &[f64], &[f64], &mut [f64]),
+    ) {
+        let hh = h * h;
+        let (tm, te) = (t + 0.5 * h, t + h);
+        let Rk4 { k, u, th, turn, u1 } = self;
+        let [k1, k2, k3, k4] = k.each_mut().map(|x| x.as_mut());
+        let [u2, u3, u4] = u.each_mut().map(|x| x.as_mut());
+        let (th, turn, u1) = (th.as_mut(), turn.as_mut(), u1.as_mut());
+        let n = u0.len();
+        for i in 0..n {
+            th[i] = 0.5 * h * u0[i];
+            u2[i] = u0[i] + 0.5 * h * k1[i];
+        }
+        stage(1, tm, th, u2, k2);
+        for i in 0..n {
+            th[i] = 0.5 * h * u0[i] + 0.25 * hh * k1[i];
+            u3[i] = u0[i] + 0.5 * h * k2[i];
+        }
+        stage(2, tm, th, u3, k3);
+        for i in 0..n {
+            th[i] = h * u0[i] + 0.5 * hh * k2[i];
+            u4[i] = u0[i] + h * k3[i];
+        }
+        stage(3, te, th, u4, k4);
+        let h6 = h / 6.0;
+        for i in 0..n {
+            turn[i] = h * u0[i] + h * h6 * (k1[i] + k2[i] + k3[i]);
+            u1[i] = u0[i] + h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+        }
+    }
+}
+
+/// The work of a power over a classical Runge-Kutta step of length `h` (s) from its values
+/// `p` at the step's four stages (W, or N m for an impulse), J (N m s): the method's own
+/// weights, `h/6 (p1 + 2 p2 + 2 p3 + p4)`, so that the works of the drive, the drag, the
+/// load, the gaps and the faces are integrated by the same stages as the motion (the
+/// augmented system) and the audit closes to the method's order. The one energy quadrature of
+/// the multirate schemes.
+pub(super) fn rk4_work(h: f64, p: [f64; 4]) -> f64 {
+    h / 6.0 * (p[0] + 2.0 * (p[1] + p[2]) + p[3])
+}
+
 /// One sub-step's outcome: the relative state at its end and the work done along it.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct SubStep {
@@ -184,6 +294,40 @@ pub(super) struct SubStep {
     pub(super) gap_j: f64,
     /// Tooth-law evaluations it took.
     pub(super) evals: u64,
+}
+
+/// A coupling's body on its carrier at the stages of a sub-step: the one body law of the
+/// steps of a coupling alone ([`Relative::rk4`]) and of an inertial carrier's cluster
+/// (`Run::carrier_rk4`), Hu et al. eq (5) with the open gaps' drag,
+/// `J omega_d' = T(phi, phi') - C2 omega_d + g(omega_d)`. (The clamped stack's bodies sum
+/// their torques over the groups their locked faces make, `clamped.rs`.)
+#[derive(Clone, Copy)]
+pub(super) struct Carried<'a> {
+    /// The coupling (its teeth).
+    pub(super) coupling: &'a Coupling,
+    /// The relative angle at the sub-step's start, rad.
+    pub(super) phi: f64,
+    /// The body's inverse inertia about the axis, 1/(kg m^2), and its drag `C2`, N m s/rad.
+    pub(super) inv_j: f64,
+    pub(super) c2: f64,
+    /// The open gaps' drag on the body.
+    pub(super) gap: GapDrag,
+}
+
+impl Carried<'_> {
+    /// The body's acceleration, rad/s^2, at `ts` (s) turning at `u` (rad/s) with the teeth's
+    /// torque `torque` (N m) on it.
+    pub(super) fn accel(&self, ts: f64, torque: f64, u: f64) -> f64 {
+        (torque - self.c2 * u + self.gap.torque(ts, u)) * self.inv_j
+    }
+
+    /// The teeth's torque on the body, N m, and its acceleration, rad/s^2, at a stage at `ts`:
+    /// the carrier turned by `turn` (rad) from the sub-step's start and turning at `speed`
+    /// (rad/s), the body turned by `th` and turning at `u`.
+    pub(super) fn stage(&self, ts: f64, turn: f64, speed: f64, th: f64, u: f64) -> (f64, f64) {
+        let torque = self.coupling.probe_torque(self.phi + turn - th, speed - u);
+        (torque, self.accel(ts, torque, u))
+    }
 }
 
 /// The relative motion of one coupling on a prescribed shaft, integrated as the disc's own
@@ -221,43 +365,37 @@ impl Relative<'_> {
         let (w0, wm, we) = (shaft.speed, mid.speed, end.speed);
         // The shaft's turn from t, exact.
         let (sm, se) = (mid.angle - shaft.angle, end.angle - shaft.angle);
-        // The disc's speed at t; `th` below is its turn from t.
+        // The disc's speed at t.
         let u0 = w0 - dphi;
-        // (omega_d', teeth torque) at a stage: the shaft turned by `s` at speed `ws`, the
-        // disc turned by `th` at speed `u`.
         // Hu et al. eq (5): J omega_d' = T - C2 omega_d, plus the open gaps' drag
-        let accel = |ts: f64, torque: f64, u: f64| {
-            (
-                (torque - self.c2 * u + gap.torque(ts, u)) * self.inv_j,
-                torque,
-            )
+        let body = Carried {
+            coupling: self.coupling,
+            phi,
+            inv_j: self.inv_j,
+            c2: self.c2,
+            gap,
         };
-        let f = |ts: f64, s: f64, ws: f64, th: f64, u: f64| {
-            accel(ts, self.coupling.probe_torque(phi + s - th, ws - u), u)
-        };
-        let hh = h * h;
-        let (k1, t1) = accel(t, self.start_torque_n_m, u0);
-        let u2 = u0 + 0.5 * h * k1;
-        let (k2, t2) = f(tm, sm, wm, 0.5 * h * u0, u2);
-        let u3 = u0 + 0.5 * h * k2;
-        let (k3, t3) = f(tm, sm, wm, 0.5 * h * u0 + 0.25 * hh * k1, u3);
-        let u4 = u0 + h * k3;
-        let (k4, t4) = f(te, se, we, h * u0 + 0.5 * hh * k2, u4);
-        let h6 = h / 6.0;
-        // The classical method on the first-order system (angle, speed), written for the
-        // angle: the disc turns by h u0 + h^2/6 (k1 + k2 + k3).
-        let th = h * u0 + h * h6 * (k1 + k2 + k3);
-        let u1 = u0 + h6 * (k1 + 2.0 * (k2 + k3) + k4);
+        // the teeth's torque at the four stages, N m
+        let mut teeth = [self.start_torque_n_m, 0.0, 0.0, 0.0];
+        let mut rk = Rk4::<[f64; 1]>::default();
+        rk.k[0] = [body.accel(t, teeth[0], u0)];
+        // a stage: the shaft turned from t at its speed there (exact), the disc turned by
+        // `th` at `u`
+        rk.step(t, h, &[u0], |s, ts, th, u, acc| {
+            let (turn, speed) = if s < 3 { (sm, wm) } else { (se, we) };
+            (teeth[s], acc[0]) = body.stage(ts, turn, speed, th[0], u[0]);
+        });
+        let [t1, t2, t3, t4] = teeth;
+        let [[u2], [u3], [u4]] = rk.u;
+        let (th, u1) = (rk.turn[0], rk.u1[0]);
+        let g = |ts: f64, u: f64| gap.torque(ts, u) * u;
         SubStep {
             shaft: end,
             phi: phi + se - th,
             dphi: we - u1,
-            drive_j: h6 * (t1 * w0 + 2.0 * (t2 + t3) * wm + t4 * we),
-            drag_j: -self.c2 * h6 * (u0 * u0 + 2.0 * (u2 * u2 + u3 * u3) + u4 * u4),
-            gap_j: h6
-                * (gap.torque(t, u0) * u0
-                    + 2.0 * (gap.torque(tm, u2) * u2 + gap.torque(tm, u3) * u3)
-                    + gap.torque(te, u4) * u4),
+            drive_j: rk4_work(h, [t1 * w0, t2 * wm, t3 * wm, t4 * we]),
+            drag_j: -self.c2 * rk4_work(h, [u0 * u0, u2 * u2, u3 * u3, u4 * u4]),
+            gap_j: rk4_work(h, [g(t, u0), g(tm, u2), g(tm, u3), g(te, u4)]),
             evals: 3,
         }
     }
