@@ -497,11 +497,13 @@ fn coat(r0: f64, r1: f64, z: f64, color: Color) -> TriangleListPrimitive {
             z,
         }
     };
-    // each quad (p0, p1, q0, q1) as two triangles; faces at z = -z and +z, rims at r1, r0
+    // each quad (p0, p1, q0, q1) as two triangles wound so that the normal (p1 - p0) x
+    // (q0 - p0) points out of the body (viewers cull back faces): the face at +z up, the one
+    // at -z down, the outer rim away from the axis, the inner rim towards it
     let quads = [
-        ((r0, -z), (r1, -z)),
         ((r0, z), (r1, z)),
-        ((r1, -z), (r1, z)),
+        ((r1, -z), (r0, -z)),
+        ((r1, z), (r1, -z)),
         ((r0, -z), (r0, z)),
     ];
     for ((ra, za), (rb, zb)) in quads {
@@ -836,6 +838,34 @@ mod tests {
                 );
                 assert!(p.z.abs() >= 0.001 - 1e-12, "outside the body: {}", p.z);
             }
+        }
+        // every triangle faces out of the body (viewers cull back faces): along +-z on a
+        // face, away from the axis on the outer rim, towards it on the inner
+        for t in u.entities[0].triangles[0].points.chunks(3) {
+            let (a, b, c) = (&t[0], &t[1], &t[2]);
+            let (e1, e2) = (
+                [b.x - a.x, b.y - a.y, b.z - a.z],
+                [c.x - a.x, c.y - a.y, c.z - a.z],
+            );
+            let n = [
+                e1[1] * e2[2] - e1[2] * e2[1],
+                e1[2] * e2[0] - e1[0] * e2[2],
+                e1[0] * e2[1] - e1[1] * e2[0],
+            ];
+            let m = [
+                (a.x + b.x + c.x) / 3.0,
+                (a.y + b.y + c.y) / 3.0,
+                (a.z + b.z + c.z) / 3.0,
+            ];
+            let radial = n[0] * m[0] + n[1] * m[1];
+            let out = if a.z == b.z && b.z == c.z {
+                n[2] * m[2]
+            } else if m[0].hypot(m[1]) > 0.065 {
+                radial
+            } else {
+                -radial
+            };
+            assert!(out > 0.0, "a triangle faces into the body at {m:?}");
         }
         assert_eq!(
             (temperature_color(0.0).b, temperature_color(1.0).r),
