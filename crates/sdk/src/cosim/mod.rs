@@ -11,7 +11,8 @@ mod variables;
 
 pub use inputs::{driven_from_names, driven_names, Input};
 pub use variables::{
-    variables, BodyField, Causality, ImpactField, InterfaceField, Kind, Quantity, Variable, UNITS,
+    variables, BodyField, Causality, ImpactField, InterfaceField, Kind, Quantity, Variable,
+    UNCONNECTED, UNITS,
 };
 
 use crate::{RecordingRequest, RunOutcome, Session, SessionRequest, SessionState, Simulation};

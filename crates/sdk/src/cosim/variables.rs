@@ -129,6 +129,12 @@ pub struct Variable {
     pub start_string: Option<String>,
 }
 
+/// What every input's description says of an input its host gives no signal (an FMU drives
+/// every input its pack has; docs/DECISIONS.md "Co-simulation").
+pub const UNCONNECTED: &str = "Give it a signal: unconnected, it holds this start value (the \
+                               scene's value at t = 0) for the whole run, not the scene's \
+                               profile over time";
+
 /// The units the variables use, with their SI base-unit exponents `(kg, m, s, rad)`.
 pub const UNITS: [(&str, [i32; 4]); 8] = [
     ("s", [0, 0, 1, 0]),
@@ -207,11 +213,7 @@ pub fn variables(scene: &Scene, engine: &str, driven: Driven) -> Vec<Variable> {
         if let Some(start) = start {
             v.input(
                 input,
-                &format!(
-                    "{what}, held until the next communication point. Drive it: a host that \
-                     connects no signal to it holds this start value (the scene's value at t = 0) \
-                     for the whole run, not the scene's profile over time"
-                ),
+                &format!("{what}; held until the next communication point. {UNCONNECTED}"),
                 start,
             );
         }
