@@ -202,11 +202,11 @@ fn co_simulated_runs_end_without_absurd_peaks_and_say_what_made_them() {
         let params = &r["params"];
         assert_eq!(params["co_simulation"], "true", "{name}: {r}");
         // an FMU drives every input its pack has (the host set the pressure; the others
-        // held their start values)
+        // held their start values), named by their one public name (issue 33)
         assert!(
-            params["driven_inputs"]
-                .as_str()
-                .is_some_and(|d| d.contains("piston_pressure")),
+            params["driven_inputs"].as_str().is_some_and(|d| {
+                d.contains("piston.pressure_pa") && d.contains("shaft.speed_rad_s")
+            }),
             "{name}: {r}"
         );
         assert!(params.get("duration_s").is_none(), "{name}: {r}");

@@ -27,7 +27,7 @@ def engage(controlled: bool) -> dict:
     sim = clutchpack.Simulation(
         SCENE,
         engine="reference",
-        drive=["piston_pressure"] if controlled else [],
+        drive=["piston.pressure_pa"] if controlled else [],
         stop_time=DURATION,
     )
     pressure, last_speed, synced = 0.0, 0.0, None

@@ -2,7 +2,7 @@
 //! value goes through quick-xml's writer, which escapes it: scene names and descriptions
 //! never become markup.
 
-use crate::variables::{Causality, Kind, Variable, UNITS};
+use clutchpack_sdk::cosim::{Causality, Kind, Variable, UNITS};
 use quick_xml::events::{BytesDecl, BytesEnd, BytesStart, Event};
 use quick_xml::Writer;
 

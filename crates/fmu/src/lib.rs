@@ -5,13 +5,15 @@
 //! slave: the pack between the host's inertias, its tooth and face torques acting back on the
 //! host's driveline.
 //!
-//! - `variables.rs`: the FMU's variables for a scene (parameters, inputs, outputs with SI
-//!   units and descriptions), the one table both the description and the binary read.
-//! - `description.rs`: modelDescription.xml.
+//! The FMU's variables for a scene (parameters, inputs, outputs with SI units and
+//! descriptions, the inputs' bounds) and the inputs held between communication points are the
+//! sdk's co-simulation layer (`clutchpack_sdk::cosim`, which Python's `Simulation` uses too;
+//! docs/DECISIONS.md "Co-simulation"); this crate keeps what is FMI's:
+//!
+//! - `description.rs`: modelDescription.xml from the sdk's variable table.
 //! - `package.rs`: the `.fmu` archive (description, binary, the scene as resources).
-//! - `bounds.rs`: the inputs' bounds, those of the scene keys they stand for.
-//! - `instance.rs`: FMI's state machine over `clutchpack_sdk::Session` (the inputs held
-//!   between communication points, docs/DECISIONS.md "Co-simulation").
+//! - `instance.rs`: FMI's state machine and the host's communication points over
+//!   `clutchpack_sdk::CoSimulation`.
 //! - `ffi.rs`: the `fmi2*` C functions this crate exports when built as a cdylib (the FMU's
 //!   `binaries/linux64/clutchpack_fmu.so`).
 //!
@@ -21,15 +23,14 @@
 
 #![warn(missing_docs)]
 
-mod bounds;
 pub mod description;
 #[cfg(feature = "ffi")]
 pub mod ffi;
 pub mod instance;
 pub mod package;
-pub mod variables;
 
+/// The variable table the model description and the binary read (the sdk's).
+pub use clutchpack_sdk::cosim::{variables, Variable};
 pub use description::MODEL_IDENTIFIER;
 pub use instance::{Instance, Phase};
 pub use package::{check_representable, write_fmu, PackageError, DEFAULT_STEP_S};
-pub use variables::{variables, Variable};

@@ -2,9 +2,9 @@
 //! cdylib) and the scene as resources.
 
 use crate::description::{model_description, Header, MODEL_IDENTIFIER};
-use crate::variables::variables;
 use clutchpack_model::session::Driven;
 use clutchpack_scene::{EngineChoice, Scene};
+use clutchpack_sdk::cosim::variables;
 use clutchpack_sdk::{SessionRequest, Simulation};
 use std::hash::{Hash, Hasher};
 use std::io::Write;

@@ -43,21 +43,22 @@ impl Driven {
 
     /// Whether `pack` has every input driven: a prescribed shaft for its speed, an inertial
     /// shaft for its torque, a drum for its load, a stack for the pressure. The error says
-    /// what is missing (all of it).
+    /// what is missing (all of it), each input by its public name (the FMU's variable,
+    /// `clutchpack_sdk::cosim::Input::name`).
     pub fn check(&self, pack: &PackModel) -> Result<(), EngineError> {
         let inertial = matches!(pack.shaft, Shaft::Inertial { .. });
         let missing = [
-            (self.shaft_speed && inertial, "the shaft speed needs a prescribed shaft (shaft.mode = \"prescribed\"); an inertial shaft takes a drive torque"),
-            (self.shaft_torque && !inertial, "the shaft torque needs an inertial shaft (shaft.mode = \"inertial\"); a prescribed shaft takes a speed"),
-            (self.drum_load && pack.drum.is_none(), "the drum load needs a pack with a drum"),
-            (self.piston_pressure && pack.stack.is_none(), "the piston pressure needs a pack with a stack"),
+            (self.shaft_speed && inertial, "shaft.speed_rad_s (the shaft speed) needs a prescribed shaft (shaft.mode = \"prescribed\"); an inertial shaft takes a drive torque"),
+            (self.shaft_torque && !inertial, "shaft.drive_torque_n_m (the shaft torque) needs an inertial shaft (shaft.mode = \"inertial\"); a prescribed shaft takes a speed"),
+            (self.drum_load && pack.drum.is_none(), "drum.load_torque_n_m (the drum load) needs a pack with a drum"),
+            (self.piston_pressure && pack.stack.is_none(), "piston.pressure_pa (the piston pressure) needs a pack with a stack"),
         ];
         if !self.shaft_speed && matches!(held_table(pack), Some((_, true))) {
             return Err(EngineError::Unsupported(
                 "a held speed table (drive.interpolation = \"hold\") jumps at its rows, which a \
                  run in calls does not land on: run the scene whole (`clutchpack run`, Python's \
                  `clutchpack.run`), which ends a step at every row, or drive the shaft speed \
-                 (Simulation(..., drive=[\"shaft_speed\"]), or the FMU) with the table's values"
+                 (Simulation(..., drive=[\"shaft.speed_rad_s\"]), or the FMU) with the table's values"
                     .into(),
             ));
         }

@@ -271,6 +271,11 @@ def test_a_simulation_driven_and_restored():
         sim.advance_to(0.05, **{"drum.load_torque_n_m": 1.0})
     with pytest.raises(ValueError, match="drum"):
         clutchpack.Simulation("scenes/hu-table2.toml", drive=["drum_load"])
+    # issue 33: one name per input, the FMU's; the older drive names are aliases
+    public = clutchpack.Simulation("scenes/hu-table2.toml", drive=["shaft.speed_rad_s"])
+    assert public.inputs == ["shaft.speed_rad_s"]
+    with pytest.raises(ValueError, match=r'"shaft.speed_rad_s".*"shaft_speed"'):
+        clutchpack.Simulation("scenes/hu-table2.toml", drive=["speed"])
     with pytest.raises(ValueError, match="advance_to"):
         sim.advance_to(0.0)
     summary = sim.finish()

@@ -7,7 +7,9 @@
 //! summary of a run, ensembles and batches of runs, and the fatigue of a recording. It
 //! prints nothing and never exits: problems are an [`Error`], bad input told from a failed
 //! run by [`Error::is_bad_input`]. Reading a recording back: [`open_recording`] (the policy
-//! for damaged files) and [`RecordedFatigue`].
+//! for damaged files) and [`RecordedFatigue`]. Co-simulation (the FMU, Python's
+//! `Simulation`): [`Session`], a run advanced call by call, and [`CoSimulation`], the same
+//! as a table of named variables (parameters, inputs, outputs; module [`cosim`]).
 //!
 //! ```no_run
 //! use clutchpack_sdk::{load_scene, RunRequest, Simulation};
@@ -21,6 +23,7 @@
 
 mod batch;
 mod collector;
+pub mod cosim;
 mod error;
 mod fatigue;
 mod recording;
@@ -39,6 +42,7 @@ pub use batch::{
 /// The steppable engines' inputs and outputs (co-simulation).
 pub use clutchpack_model::session::{Advance, Driven, Inputs, Snapshot};
 pub use collector::{merge_peaks, RunCollector};
+pub use cosim::{CoSimulation, SavedCoSimulation};
 pub use error::{Error, Result};
 pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
 pub use recording::open_recording;

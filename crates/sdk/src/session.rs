@@ -103,16 +103,7 @@ fn co_simulation_params(
     if let Some(t) = request.stop_time_s {
         params.insert("stop_time_s".into(), t.to_string());
     }
-    let d = request.driven;
-    let driven: Vec<&str> = [
-        (d.shaft_speed, "shaft_speed"),
-        (d.shaft_torque, "shaft_torque"),
-        (d.drum_load, "drum_load"),
-        (d.piston_pressure, "piston_pressure"),
-    ]
-    .into_iter()
-    .filter_map(|(on, name)| on.then_some(name))
-    .collect();
+    let driven = crate::cosim::driven_names(&request.driven);
     params.insert(
         "driven_inputs".into(),
         if driven.is_empty() {

@@ -254,13 +254,17 @@ class Simulation:
     """A run advanced call by call, for controllers and co-simulation written in Python: the
     FMU of ``clutchpack fmu`` as a Python object, with the same inputs, outputs and names.
 
-        >>> sim = clutchpack.Simulation("scenes/pack-6-engagement.toml", drive=["piston_pressure"])
+        >>> sim = clutchpack.Simulation("scenes/pack-6-engagement.toml", drive=["piston.pressure_pa"])
         >>> for k in range(1, 301):
         ...     sim.advance_to(k * 1e-3, **{"piston.pressure_pa": controller(sim.outputs)})
         >>> summary = sim.finish()
 
-    ``drive`` names the inputs the caller sets (``"shaft_speed"``, ``"shaft_torque"``,
-    ``"drum_load"``, ``"piston_pressure"``); the others follow the scene's profiles. Driving
+    ``drive`` names the inputs the caller sets, by the FMU's names (``"shaft.speed_rad_s"``,
+    ``"shaft.drive_torque_n_m"``, ``"drum.load_torque_n_m"``, ``"piston.pressure_pa"``; the
+    older ``"shaft_speed"``, ``"shaft_torque"``, ``"drum_load"``, ``"piston_pressure"`` are
+    kept as aliases); the others follow the scene's profiles (unlike an FMU, which drives every
+    input its pack has: an input its host leaves unconnected holds its start value). A driven
+    input holds its start value (the scene's at t = 0) until it is first set. Driving
     nothing, the run is the scene's run split into calls, impact for impact. An input set in
     ``advance_to`` is held from the current time until it is set again (docs/DECISIONS.md
     "Co-simulation"); ``slopes`` gives an input's slope (per s) for a first-order hold.

@@ -88,7 +88,8 @@ class StepperState:
     """A saved state of a Stepper."""
 
 class Stepper:
-    """A run advanced call by call (``clutchpack.Simulation`` wraps it)."""
+    """A run advanced call by call (``clutchpack.Simulation`` wraps it); ``drive``: the inputs'
+    FMU names (``"piston.pressure_pa"``, ...) or their older aliases (``"piston_pressure"``)."""
     def __init__(
         self,
         scene: Scene,

@@ -1,7 +1,10 @@
-//! The FMU's variables for a scene: the one table that both the model description
-//! (`description.rs`) and the binary's `fmi2GetReal`/`fmi2SetReal` (`instance.rs`) read, so
-//! the value references the host sees are the ones the binary serves.
+//! The co-simulation variables of a scene (parameters, inputs, outputs with names, units and
+//! descriptions): the one table that the FMU's model description and its
+//! `fmi2GetReal`/`fmi2SetReal`, and Python's `Simulation`, read (through
+//! [`super::CoSimulation`]), so the value references a host sees are the ones the binary
+//! serves and Python's names are the FMU's.
 
+use super::inputs::Input;
 use clutchpack_model::session::Driven;
 use clutchpack_scene::Scene;
 
@@ -25,19 +28,6 @@ pub enum Causality {
     Input,
     /// Computed by the FMU.
     Output,
-}
-
-/// An input of the pack (`clutchpack_model::session::Inputs`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Input {
-    /// The prescribed shaft's speed, rad/s.
-    ShaftSpeed,
-    /// The drive torque on an inertial shaft, N m.
-    ShaftTorque,
-    /// The load torque on the drum, N m.
-    DrumLoad,
-    /// The pressure on the piston, Pa.
-    PistonPressure,
 }
 
 /// A body's output.
@@ -139,6 +129,12 @@ pub struct Variable {
     pub start_string: Option<String>,
 }
 
+/// What every input's description says of an input its host gives no signal (an FMU drives
+/// every input its pack has; docs/DECISIONS.md "Co-simulation").
+pub const UNCONNECTED: &str = "Give it a signal: unconnected, it holds this start value (the \
+                               scene's value at t = 0) for the whole run, not the scene's \
+                               profile over time";
+
 /// The units the variables use, with their SI base-unit exponents `(kg, m, s, rad)`.
 pub const UNITS: [(&str, [i32; 4]); 8] = [
     ("s", [0, 0, 1, 0]),
@@ -151,7 +147,7 @@ pub const UNITS: [(&str, [i32; 4]); 8] = [
     ("1", [0, 0, 0, 0]),
 ];
 
-/// The FMU's variables for `scene`, whose run the engine `engine` (`reference` or
+/// The co-simulation variables (the FMU's) of `scene`, whose run the engine `engine` (`reference` or
 /// `multibody`) makes with the inputs `driven` (an FMU drives what [`Driven::all_for`] gives
 /// the pack): parameters, then inputs, then outputs.
 pub fn variables(scene: &Scene, engine: &str, driven: Driven) -> Vec<Variable> {
@@ -179,45 +175,48 @@ pub fn variables(scene: &Scene, engine: &str, driven: Driven) -> Vec<Variable> {
          if it exists",
         "",
     );
-    let shaft0 = pack.shaft.initial_speed_rad_s();
-    if driven.shaft_speed {
-        v.input(
-            "shaft.speed_rad_s",
+    // every input a host is given, with what it holds when the host connects nothing to it
+    // (docs/DECISIONS.md "Co-simulation": an FMU drives every input it has)
+    let starts = [
+        (
             Input::ShaftSpeed,
-            "rad/s",
-            "speed of the prescribed shaft (positive: its positive rotation), held until the \
-             next communication point; the shaft's angle integrates it",
-            shaft0,
-        );
-    }
-    if driven.shaft_torque {
-        v.input(
-            "shaft.drive_torque_n_m",
+            driven.shaft_speed.then(|| pack.shaft.initial_speed_rad_s()),
+            "speed of the prescribed shaft (positive: its positive rotation); the shaft's \
+             angle integrates it",
+        ),
+        (
             Input::ShaftTorque,
-            "N.m",
+            driven
+                .shaft_torque
+                .then(|| pack.shaft.drive_torque_n_m(0.0)),
             "drive torque on the inertial shaft (eq 4's T_drive, positive along the positive \
-             rotation), held until the next communication point",
-            pack.shaft.drive_torque_n_m(0.0),
-        );
-    }
-    if let Some(d) = pack.drum.as_ref().filter(|_| driven.drum_load) {
-        v.input(
-            "drum.load_torque_n_m",
+             rotation)",
+        ),
+        (
             Input::DrumLoad,
-            "N.m",
-            "load torque on the drum (negative: it brakes a drum turning the positive way), \
-             held until the next communication point",
-            d.load_torque_n_m,
-        );
-    }
-    if let Some(s) = pack.stack.as_ref().filter(|_| driven.piston_pressure) {
-        v.input(
-            "piston.pressure_pa",
+            pack.drum
+                .as_ref()
+                .filter(|_| driven.drum_load)
+                .map(|d| d.load_torque_n_m),
+            "load torque on the drum (negative: it brakes a drum turning the positive way)",
+        ),
+        (
             Input::PistonPressure,
-            "Pa",
-            "pressure on the piston (>= 0), held until the next communication point",
-            s.piston.pressure.pressure_pa(0.0),
-        );
+            pack.stack
+                .as_ref()
+                .filter(|_| driven.piston_pressure)
+                .map(|s| s.piston.pressure.pressure_pa(0.0)),
+            "pressure on the piston (>= 0)",
+        ),
+    ];
+    for (input, start, what) in starts {
+        if let Some(start) = start {
+            v.input(
+                input,
+                &format!("{what}; held until the next communication point. {UNCONNECTED}"),
+                start,
+            );
+        }
     }
     v.output(
         "shaft.angle_rad",
@@ -320,10 +319,7 @@ pub fn variables(scene: &Scene, engine: &str, driven: Driven) -> Vec<Variable> {
             });
         }
     }
-    for (m, f) in clutchpack_sdk::friction_interfaces(scene)
-        .iter()
-        .enumerate()
-    {
+    for (m, f) in crate::friction_interfaces(scene).iter().enumerate() {
         let what = format!("interface {} ({} | {})", m + 1, f.lower, f.upper);
         let fields = [
             (
@@ -431,14 +427,14 @@ impl Table {
             start_string: None,
         });
     }
-    fn input(&mut self, name: &str, input: Input, unit: &'static str, what: &str, start: f64) {
+    fn input(&mut self, input: Input, what: &str, start: f64) {
         self.push(Variable {
-            name: name.into(),
+            name: input.name().into(),
             quantity: Quantity::Input(input),
             kind: Kind::Real,
             causality: Causality::Input,
             vr: 0,
-            unit: Some(unit),
+            unit: Some(input.unit()),
             description: what.into(),
             start_real: Some(start),
             start_string: None,

@@ -1,0 +1,220 @@
+//! The pack's inputs by their one public name (the FMU's variable names, which Python's
+//! `Simulation` takes too), the older Python names kept as aliases, and the one check of an
+//! input against the bound of the scene key it stands for (`clutchpack_scene::MAX_SPEED_RAD_S`,
+//! `MAX_PRESSURE_PA`, `MAX_TORQUE_N_M`), so that a co-simulation cannot ask what a scene
+//! could not (docs/DECISIONS.md, "Co-simulation hardening").
+
+use clutchpack_model::session::{Driven, Inputs};
+
+/// An input of the pack (`clutchpack_model::session::Inputs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Input {
+    /// The prescribed shaft's speed, rad/s.
+    ShaftSpeed,
+    /// The drive torque on an inertial shaft, N m.
+    ShaftTorque,
+    /// The load torque on the drum, N m.
+    DrumLoad,
+    /// The pressure on the piston, Pa.
+    PistonPressure,
+}
+
+impl Input {
+    /// Every input, in the variable table's order.
+    pub const ALL: [Input; 4] = [
+        Input::ShaftSpeed,
+        Input::ShaftTorque,
+        Input::DrumLoad,
+        Input::PistonPressure,
+    ];
+
+    /// Its one public name: the FMU's variable and Python's `advance_to` keyword.
+    pub fn name(self) -> &'static str {
+        match self {
+            Input::ShaftSpeed => "shaft.speed_rad_s",
+            Input::ShaftTorque => "shaft.drive_torque_n_m",
+            Input::DrumLoad => "drum.load_torque_n_m",
+            Input::PistonPressure => "piston.pressure_pa",
+        }
+    }
+
+    /// The older name Python's `Simulation(drive=[...])` took, kept as an alias so that no
+    /// script breaks.
+    pub fn alias(self) -> &'static str {
+        match self {
+            Input::ShaftSpeed => "shaft_speed",
+            Input::ShaftTorque => "shaft_torque",
+            Input::DrumLoad => "drum_load",
+            Input::PistonPressure => "piston_pressure",
+        }
+    }
+
+    /// The input named `name` (its public name or its alias).
+    pub fn from_name(name: &str) -> Option<Input> {
+        Input::ALL
+            .into_iter()
+            .find(|i| i.name() == name || i.alias() == name)
+    }
+
+    /// Its unit (a name of the model description's unit definitions).
+    pub fn unit(self) -> &'static str {
+        match self {
+            Input::ShaftSpeed => "rad/s",
+            Input::ShaftTorque | Input::DrumLoad => "N.m",
+            Input::PistonPressure => "Pa",
+        }
+    }
+
+    /// The highest order of derivative it takes (`fmi2SetRealInputDerivatives`): 2 for the
+    /// shaft's speed, 1 for the drive torque, 0 (none) for the others.
+    pub fn max_derivative_order(self) -> i32 {
+        match self {
+            Input::ShaftSpeed => 2,
+            Input::ShaftTorque => 1,
+            Input::DrumLoad | Input::PistonPressure => 0,
+        }
+    }
+
+    /// Whether `driven` drives it.
+    pub fn is_driven(self, driven: &Driven) -> bool {
+        *self.flag(&mut driven.clone())
+    }
+
+    /// Marks it driven in `driven`.
+    pub fn drive(self, driven: &mut Driven) {
+        *self.flag(driven) = true;
+    }
+
+    fn flag(self, d: &mut Driven) -> &mut bool {
+        match self {
+            Input::ShaftSpeed => &mut d.shaft_speed,
+            Input::ShaftTorque => &mut d.shaft_torque,
+            Input::DrumLoad => &mut d.drum_load,
+            Input::PistonPressure => &mut d.piston_pressure,
+        }
+    }
+
+    /// Puts `value` with its first and second derivatives (per s, per s^2; those it does
+    /// not take are ignored) into `inputs`: the one mapping from a name to the engines'
+    /// inputs.
+    pub fn put(self, inputs: &mut Inputs, value: f64, [slope, curvature]: [f64; 2]) {
+        match self {
+            Input::ShaftSpeed => {
+                inputs.shaft_speed_rad_s = Some(value);
+                inputs.shaft_speed_slope_rad_s2 = Some(slope);
+                inputs.shaft_speed_curvature_rad_s3 = Some(curvature);
+            }
+            Input::ShaftTorque => {
+                inputs.shaft_torque_n_m = Some(value);
+                inputs.shaft_torque_slope_n_m_s = Some(slope);
+            }
+            Input::DrumLoad => inputs.drum_load_n_m = Some(value),
+            Input::PistonPressure => inputs.piston_pressure_pa = Some(value),
+        }
+    }
+
+    /// The bound of the scene key it stands for: lowest and highest value, and the key.
+    pub fn bound(self) -> (f64, f64, &'static str) {
+        use clutchpack_scene::{MAX_PRESSURE_PA, MAX_SPEED_RAD_S, MAX_TORQUE_N_M};
+        match self {
+            Input::ShaftSpeed => (-MAX_SPEED_RAD_S, MAX_SPEED_RAD_S, "drive.omega0_rad_s"),
+            Input::ShaftTorque => (
+                -MAX_TORQUE_N_M,
+                MAX_TORQUE_N_M,
+                "a scene's torques, as drum.load_torque_n_m",
+            ),
+            Input::DrumLoad => (-MAX_TORQUE_N_M, MAX_TORQUE_N_M, "drum.load_torque_n_m"),
+            Input::PistonPressure => (0.0, MAX_PRESSURE_PA, "stack.pressure.pressure_pa"),
+        }
+    }
+
+    /// `Ok` if `value` lies within the bound of the scene key it stands for; else why not,
+    /// naming the input (`when`: where, e.g. " at 0.1 s"), numbers as every message writes
+    /// them (`clutchpack_model::fmt_num`: never hundreds of digits). The one place an input
+    /// is checked against its bound.
+    pub fn check(self, value: f64, when: &str) -> Result<(), String> {
+        let (lo, hi, key) = self.bound();
+        if (lo..=hi).contains(&value) {
+            return Ok(());
+        }
+        let e = clutchpack_model::fmt_num;
+        let (name, unit) = (self.name(), self.unit());
+        Err(format!(
+            "{name} = {} {unit}{when}: expected a value in [{}, {}] {unit}, the bound of the \
+             scene key it stands for ({key})",
+            e(value),
+            e(lo),
+            e(hi)
+        ))
+    }
+}
+
+/// The public names of the inputs `driven` drives, in the table's order.
+pub fn driven_names(driven: &Driven) -> Vec<&'static str> {
+    Input::ALL
+        .into_iter()
+        .filter(|i| i.is_driven(driven))
+        .map(Input::name)
+        .collect()
+}
+
+/// The inputs named in `names` (public names or aliases) as a [`Driven`]; an unknown name is
+/// an error that lists the names.
+pub fn driven_from_names<S: AsRef<str>>(names: &[S]) -> Result<Driven, String> {
+    let mut driven = Driven::NONE;
+    for n in names {
+        let n = n.as_ref();
+        let i = Input::from_name(n).ok_or_else(|| {
+            let all: Vec<String> = Input::ALL
+                .iter()
+                .map(|i| format!("{:?}", i.name()))
+                .collect();
+            let old: Vec<String> = Input::ALL
+                .iter()
+                .map(|i| format!("{:?}", i.alias()))
+                .collect();
+            format!(
+                "drive = {n:?}: expected any of {} (or the older names {})",
+                all.join(", "),
+                old.join(", ")
+            )
+        })?;
+        i.drive(&mut driven);
+    }
+    Ok(driven)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_input_has_one_name_and_one_alias() {
+        for i in Input::ALL {
+            assert_eq!(Input::from_name(i.name()), Some(i));
+            assert_eq!(Input::from_name(i.alias()), Some(i));
+            let mut d = Driven::NONE;
+            i.drive(&mut d);
+            assert!(i.is_driven(&d));
+            assert_eq!(driven_names(&d), vec![i.name()]);
+        }
+        let d = driven_from_names(&["piston_pressure", "shaft.speed_rad_s"]).unwrap();
+        assert!(d.piston_pressure && d.shaft_speed && !d.drum_load && !d.shaft_torque);
+        let e = driven_from_names(&["pressure"]).unwrap_err();
+        assert!(
+            e.contains("piston.pressure_pa") && e.contains("piston_pressure"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn inputs_are_checked_against_their_keys_bounds() {
+        let e = Input::ShaftSpeed.check(1e9, "").unwrap_err();
+        assert!(
+            e.contains("shaft.speed_rad_s = 1e9 rad/s") && e.contains("100000"),
+            "{e}"
+        );
+        assert!(Input::PistonPressure.check(-1.0, "").is_err());
+        assert!(Input::PistonPressure.check(1e6, "").is_ok());
+    }
+}

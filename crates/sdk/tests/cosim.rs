@@ -1,0 +1,118 @@
+//! Issue 33, part 4: the one co-simulation layer that the FMU and Python's `Simulation` share:
+//! one name per input (older names as aliases), one bound check, and the pitfall of an input
+//! a host leaves unconnected made visible.
+
+use clutchpack_sdk::cosim::{driven_from_names, Causality, Input, Quantity, UNCONNECTED};
+use clutchpack_sdk::{CoSimulation, Driven};
+use std::path::Path;
+
+fn scene(name: &str) -> clutchpack_scene::Scene {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name);
+    clutchpack_scene::load(&file, &[]).unwrap()
+}
+
+/// An FMU's table (every input driven) names each input by its public name, and each input's
+/// description says that an unconnected input holds its start value.
+#[test]
+fn every_input_has_its_public_name_and_says_what_unconnected_means() {
+    let co = CoSimulation::new(scene("pack-6-engagement.toml")).unwrap();
+    let inputs: Vec<_> = co
+        .variables()
+        .iter()
+        .filter(|v| v.causality == Causality::Input)
+        .collect();
+    let names: Vec<&str> = inputs.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "shaft.speed_rad_s",
+            "drum.load_torque_n_m",
+            "piston.pressure_pa"
+        ]
+    );
+    for v in inputs {
+        let Quantity::Input(i) = v.quantity else {
+            panic!("{}: an input", v.name)
+        };
+        assert_eq!((i.name(), v.unit), (v.name.as_str(), Some(i.unit())));
+        assert!(v.description.contains(UNCONNECTED), "{}", v.description);
+    }
+}
+
+/// Python's older drive names are aliases of the public ones: both find the same input, and
+/// an input the run does not have is an error listing the ones it has.
+#[test]
+fn older_names_are_aliases_and_unknown_inputs_list_the_inputs() {
+    let driven = driven_from_names(&["piston_pressure"]).unwrap();
+    assert_eq!(driven, driven_from_names(&["piston.pressure_pa"]).unwrap());
+    let co = CoSimulation::driving(scene("pack-6-engagement.toml"), driven).unwrap();
+    let vr = co.input_named("piston.pressure_pa").unwrap();
+    assert_eq!(co.input_named("piston_pressure").unwrap(), vr);
+    let e = co.input_named("shaft.speed_rad_s").unwrap_err();
+    assert!(e.contains("its inputs: piston.pressure_pa"), "{e}");
+    let e = driven_from_names(&["pressure"]).unwrap_err();
+    assert!(e.contains("\"piston.pressure_pa\""), "{e}");
+    // an input the pack lacks is refused at the start, naming the scene
+    let mut drum = Driven::NONE;
+    Input::DrumLoad.drive(&mut drum);
+    let e = CoSimulation::driving(scene("hu-table2.toml"), drum)
+        .err()
+        .unwrap();
+    assert!(e.contains("hu-table2") && e.contains("drum"), "{e}");
+}
+
+/// One bound check for a value and for a value held with its slope: the error names the input
+/// by its public name and the scene key's bound, and the run does not move.
+#[test]
+fn inputs_are_checked_against_their_scene_keys_bounds_in_one_place() {
+    let mut co = CoSimulation::driving(
+        scene("hu-table2.toml"),
+        driven_from_names(&["shaft_speed"]).unwrap(),
+    )
+    .unwrap();
+    co.start(None).unwrap();
+    let e = co.set_input("shaft_speed", 1e9, [None, None]).unwrap_err();
+    assert!(e.starts_with("shaft.speed_rad_s = 1e9 rad/s"), "{e}");
+    co.set_input("shaft.speed_rad_s", 200.0, [Some(1e9), None])
+        .unwrap();
+    let e = co.advance_to(1e-3, None).unwrap_err();
+    assert!(
+        e.contains("shaft.speed_rad_s") && e.contains("held with its derivatives"),
+        "{e}"
+    );
+    assert_eq!(co.time_s(), 0.0);
+}
+
+/// The pitfall: an FMU drives every input, so a host that sets only the pressure holds the
+/// shaft at its start speed (a constant 200 rad/s on pack-6-engagement), while Python's
+/// `Simulation(drive=["piston.pressure_pa"])` keeps the scene's sine: the shaft's angles part
+/// by the sine's integral (4.378 / (2 pi 104) (1 - cos(2 pi 104 t)), 6.7e-3 rad at a quarter
+/// period).
+#[test]
+fn an_unconnected_fmu_input_holds_its_start_value_while_python_follows_the_scene() {
+    let t = 0.25 / 104.0;
+    let angle = |mut co: CoSimulation| {
+        co.set_string_parameter(Quantity::Engine, "reference")
+            .unwrap();
+        co.start(None).unwrap();
+        co.set_input("piston.pressure_pa", 0.0, [None, None])
+            .unwrap();
+        co.advance_to(t, None).unwrap();
+        let out = co.outputs().unwrap();
+        out.iter().find(|(n, _)| n == "shaft.angle_rad").unwrap().1
+    };
+    let fmu = angle(CoSimulation::new(scene("pack-6-engagement.toml")).unwrap());
+    let python = angle(
+        CoSimulation::driving(
+            scene("pack-6-engagement.toml"),
+            driven_from_names(&["piston.pressure_pa"]).unwrap(),
+        )
+        .unwrap(),
+    );
+    let w = 2.0 * std::f64::consts::PI * 104.0;
+    assert!((fmu - 200.0 * t).abs() < 1e-9, "{fmu}");
+    let sine = 200.0 * t + 4.378 / w * (1.0 - (w * t).cos());
+    assert!((python - sine).abs() < 1e-6, "{python} against {sine}");
+}
