@@ -24,14 +24,17 @@ pub struct FmuArgs {
 }
 
 /// The FMU's binary: `libclutchpack_fmu.so`, built by cargo beside this executable (the
-/// `clutchpack_fmu` crate is a dependency of the CLI, so one `cargo build` makes both).
+/// `clutchpack_fmu` crate is a dependency of the CLI, so one `cargo build` makes both). Of
+/// the copy beside it and the one in `deps/`, the newer: `cargo test` rebuilds only the
+/// `deps/` copy, and taking the other first packed a stale binary after a change.
 fn library() -> Result<PathBuf> {
     let exe = std::env::current_exe().context("locating the clutchpack executable")?;
     let dir = exe.parent().unwrap_or(Path::new("."));
     let name = "libclutchpack_fmu.so";
     [dir.join(name), dir.join("deps").join(name)]
         .into_iter()
-        .find(|p| p.is_file())
+        .filter(|p| p.is_file())
+        .max_by_key(|p| std::fs::metadata(p).and_then(|m| m.modified()).ok())
         .ok_or_else(|| {
             anyhow::anyhow!(
                 "the FMU's binary {name} is not beside {} (nor in its deps/): build the \
