@@ -103,16 +103,21 @@ fn rgba(r: f64, g: f64, b: f64, a: f64) -> Option<Color> {
 /// The colour of a load level `x = |load| / scale`, clamped to 0..=1: grey at 0, yellow at
 /// 0.5, red at 1.
 pub fn load_color(x: f64) -> Color {
+    three_stops(x, [0.6, 0.6, 0.6], [1.0, 0.85, 0.0], [1.0, 0.0, 0.0])
+}
+
+/// The colour at level `x` (clamped to 0..=1; not finite: 1) of a scale running linearly
+/// from `low` at 0 through `mid` at 0.5 to `high` at 1 (RGB in 0..=1, opaque).
+fn three_stops(x: f64, low: [f64; 3], mid: [f64; 3], high: [f64; 3]) -> Color {
     let x = if x.is_finite() {
         x.clamp(0.0, 1.0)
     } else {
         1.0
     };
-    let (grey, yellow, red) = ([0.6, 0.6, 0.6], [1.0, 0.85, 0.0], [1.0, 0.0, 0.0]);
     let (a, b, s) = if x < 0.5 {
-        (grey, yellow, x / 0.5)
+        (low, mid, x / 0.5)
     } else {
-        (yellow, red, (x - 0.5) / 0.5)
+        (mid, high, (x - 0.5) / 0.5)
     };
     let mix = |i: usize| a[i] + s * (b[i] - a[i]);
     Color {
@@ -463,24 +468,7 @@ pub(crate) fn load_scene(
 /// blue at 0, yellow at 0.5, red at 1 (the legend of [`temperature_scene`] names the
 /// range).
 pub fn temperature_color(x: f64) -> Color {
-    let x = if x.is_finite() {
-        x.clamp(0.0, 1.0)
-    } else {
-        1.0
-    };
-    let (blue, yellow, red) = ([0.1, 0.35, 1.0], [1.0, 0.85, 0.0], [1.0, 0.0, 0.0]);
-    let (a, b, s) = if x < 0.5 {
-        (blue, yellow, x / 0.5)
-    } else {
-        (yellow, red, (x - 0.5) / 0.5)
-    };
-    let mix = |i: usize| a[i] + s * (b[i] - a[i]);
-    Color {
-        r: mix(0),
-        g: mix(1),
-        b: mix(2),
-        a: 1.0,
-    }
+    three_stops(x, [0.1, 0.35, 1.0], [1.0, 0.85, 0.0], [1.0, 0.0, 0.0])
 }
 
 /// A coat over an annulus `r0..r1` between `z = -z` and `z = +z`: its two flat faces and

@@ -1,18 +1,22 @@
 //! A run's figures window by window (`clutchpack run --windows S`): how the impact peaks and
 //! the teeth's damage rate move through a long run, e.g. as the oil warms in a thermal run.
 //!
-//! Each window `(t0, t1]` of the requested length (the first from `t = 0`) keeps its own impact peak statistics (the
-//! impacts that closed in it). Its damage is the increase of the run's own (MODEL.md
-//! section 7: the run's rainflow count with its residual as half cycles) over the window, so
-//! the windows' damages add up to the run's exactly; a window holds the cycles that closed in
-//! it (a rainflow count per window would lose the cycles that span windows: 9 % of the
-//! damage with 0.1 s windows on the paper case). A thermal run's oil and hottest body are
+//! Each window `(t0, t1]` of the requested length (the first from `t = 0`) keeps its own
+//! impact peak statistics (the impacts that closed in it). Its damage is the increase of the
+//! run's own (MODEL.md section 7: the run's rainflow count with its residual as half cycles)
+//! over the window, so the windows' damages add up to the run's exactly; a window holds the
+//! cycles that closed in it (a rainflow count per window would lose the cycles that span
+//! windows: 9 % of the damage with 0.1 s windows on the paper case). A run has at most
+//! [`MAX_WINDOWS`]. A thermal run's oil and hottest body are
 //! its last temperatures when the window closes (at the first sample after its end; the
 //! last window at the run's end).
 
 use clutchpack_analysis::{FatigueCollector, PeakStats};
 use clutchpack_model::{FatigueParams, ImpactEvent, SplineGeometry};
 use serde::{Deserialize, Serialize};
+
+/// Most windows a run may ask for (each row holds every body's figures).
+pub const MAX_WINDOWS: f64 = 1e5;
 
 /// One window of a run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -219,4 +219,19 @@ fn windows_tile_the_run_and_add_up_to_it() {
     assert_eq!(oil.len(), 2);
     assert!(oil[0] > 313.15 && oil[1] > oil[0], "{oil:?}");
     assert_eq!(oil[1], th.thermal.unwrap().oil_final_k);
+    // a window length that is not a positive number of seconds, or more than 1e5 windows
+    // (0.3 s / 1e-9 s), is bad input before any work
+    let mut sim = Simulation::new(load_scene(None, &[]).unwrap(), None).unwrap();
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e-9] {
+        let Err(e) = sim.run(RunRequest {
+            windows_s: Some(bad),
+            ..Default::default()
+        }) else {
+            panic!("windows of {bad} s ran");
+        };
+        assert!(
+            e.is_bad_input() && e.to_string().contains("--windows"),
+            "{e}"
+        );
+    }
 }

@@ -201,13 +201,23 @@ impl RecordingReader {
     /// index (empty for a disc without the topic, e.g. a recording made without contact
     /// samples). [`Self::samples`] and [`Self::load_histories`] do not include them.
     pub fn dense_loads(&self) -> Vec<Vec<proto::LoadSample>> {
-        let mut out: Vec<Vec<proto::LoadSample>> = Vec::new();
+        self.by_index(proto::LOAD_SAMPLE, |m: &proto::LoadSample| m.disc_index)
+    }
+
+    /// The messages of schema `schema` (decoded as `M`), grouped by the index `index` gives
+    /// each (a disc's or a body's), each group in file order.
+    fn by_index<M: prost::Message + Default>(
+        &self,
+        schema: &str,
+        index: impl Fn(&M) -> u32,
+    ) -> Vec<Vec<M>> {
+        let mut out: Vec<Vec<M>> = Vec::new();
         self.for_each_message(|v| {
-            if v.schema_name == proto::LOAD_SAMPLE {
-                if let Ok(m) = proto::LoadSample::decode(v.data) {
-                    let i = m.disc_index as usize;
+            if v.schema_name == schema {
+                if let Ok(m) = M::decode(v.data) {
+                    let i = index(&m) as usize;
                     if out.len() <= i {
-                        out.resize(i + 1, Vec::new());
+                        out.resize_with(i + 1, Vec::new);
                     }
                     out[i].push(m);
                 }
@@ -220,19 +230,7 @@ impl RecordingReader {
     /// indexed by body index (the discs, then the plates; the oil last, at the number of
     /// bodies), each in file order, which is time order; empty for an isothermal recording.
     pub fn temperatures(&self) -> Vec<Vec<proto::Temperature>> {
-        let mut out: Vec<Vec<proto::Temperature>> = Vec::new();
-        self.for_each_message(|v| {
-            if v.schema_name == proto::TEMPERATURE {
-                if let Ok(m) = proto::Temperature::decode(v.data) {
-                    let i = m.body_index as usize;
-                    if out.len() <= i {
-                        out.resize(i + 1, Vec::new());
-                    }
-                    out[i].push(m);
-                }
-            }
-        });
-        out
+        self.by_index(proto::TEMPERATURE, |m: &proto::Temperature| m.body_index)
     }
 
     /// Each disc's per-tooth load history (t in s, load in N), in disc-index order: what
