@@ -193,20 +193,12 @@ impl PeakStats {
     }
 
     fn spill(&mut self) -> std::io::Result<()> {
-        use std::io::{Seek, SeekFrom, Write};
-        if self.file.is_none() {
-            self.file = Some(tempfile::tempfile()?);
-        }
         let mut bytes = Vec::with_capacity(self.held.len() * RECORD_BYTES);
         for &(d, v) in &self.held {
             bytes.extend_from_slice(&d.to_le_bytes());
             bytes.extend_from_slice(&v.to_le_bytes());
         }
-        if let Some(mut f) = self.file.as_ref() {
-            // reading (Self::stats) may have moved the offset: always append
-            f.seek(SeekFrom::End(0))?;
-            f.write_all(&bytes)?;
-        }
+        append_to_temp(&mut self.file, &bytes)?;
         self.held.clear();
         Ok(())
     }
@@ -366,6 +358,23 @@ fn percentile_of_top(top: &[f64], n: usize, q: f64) -> f64 {
     } else {
         at(lo) + frac * (at(hi) - at(lo))
     }
+}
+
+/// Appends `bytes` to the unnamed temporary file in `file` (made at the first call; removed
+/// by the system when it is closed): the one spill of what a long run would otherwise hold
+/// in memory ([`PeakStats`], the fatigue collector's pending contact samples). Always at the
+/// end: reading back may have moved the offset.
+pub(crate) fn append_to_temp(
+    file: &mut Option<std::fs::File>,
+    bytes: &[u8],
+) -> std::io::Result<()> {
+    use std::io::{Seek, SeekFrom, Write};
+    let mut f = match file {
+        Some(f) => &*f,
+        None => &*file.insert(tempfile::tempfile()?),
+    };
+    f.seek(SeekFrom::End(0))?;
+    f.write_all(bytes)
 }
 
 #[cfg(test)]

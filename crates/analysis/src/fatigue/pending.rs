@@ -8,7 +8,7 @@
 //! the located peak merged in at its time ([`crate::cycles::impact_history`]), and the peak's
 //! time is known only when the contact closes, so no sample can be counted or dropped before.
 
-use std::io::{BufReader, Read, Seek, SeekFrom, Write};
+use std::io::{BufReader, Read, Seek, SeekFrom};
 
 /// Loaded samples of one coupling held in memory before the older ones go to its temporary
 /// file: 16 bytes each, 64 kB per coupling (a contact of 0.4 s at 10 kHz).
@@ -51,19 +51,12 @@ impl PendingSamples {
     }
 
     fn spill(&mut self) -> std::io::Result<()> {
-        if self.file.is_none() {
-            self.file = Some(tempfile::tempfile()?);
-        }
         let mut bytes = Vec::with_capacity(self.held.len() * RECORD_BYTES);
         for &(t, x) in &self.held {
             bytes.extend_from_slice(&t.to_le_bytes());
             bytes.extend_from_slice(&x.to_le_bytes());
         }
-        if let Some(mut f) = self.file.as_ref() {
-            // reading may have moved the offset: always append
-            f.seek(SeekFrom::End(0))?;
-            f.write_all(&bytes)?;
-        }
+        crate::stats::append_to_temp(&mut self.file, &bytes)?;
         self.held.clear();
         Ok(())
     }
