@@ -57,6 +57,7 @@ pub mod drive;
 pub mod fatigue;
 pub mod impact;
 pub mod law;
+pub mod network;
 pub mod pack;
 pub mod session;
 pub mod spline;
