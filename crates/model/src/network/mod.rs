@@ -136,7 +136,7 @@ impl Network {
     }
 
     /// The network's problems (empty when an engine can run it): unique names; positive
-    /// inertias; couplings naming two different bodies; ideal gears that form no loop (a loop
+    /// inertias; at most one fixed body; couplings naming two different bodies; ideal gears that form no loop (a loop
     /// over-constrains, consistent or not) and do not tie a moving body to a fixed one;
     /// speeds that satisfy the ideal gears at t = 0; every group of connected bodies with
     /// something that moves it (a drive, or a speed at t = 0).
@@ -172,6 +172,13 @@ impl Network {
                     i,
                     "initial_speed_rad_s",
                     "a fixed body does not turn: its speed is 0".into(),
+                ));
+            }
+            if b.fixed && self.bodies[..i].iter().any(|o| o.fixed) {
+                out.push(body(
+                    i,
+                    "fixed",
+                    "a second fixed body: the ground is one body (brakes to it share it)".into(),
                 ));
             }
             if b.drive.as_ref().is_some_and(|d| !d.is_valid()) {

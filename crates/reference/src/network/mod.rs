@@ -1,13 +1,13 @@
 //! The reference engine on a driveline network of lumped parts (MODEL.md section 8): one
 //! rotational degree of freedom per body, ideal gears and locked clutches as constraints (the
-//! rigid groups of [`cluster`]), slipping clutches as torques, every stick, slip, break and
+//! rigid groups of `cluster.rs`), slipping clutches as torques, every stick, slip, break and
 //! release located as an event.
 //!
 //! # Method
 //! The state is every body's angle and speed, plus the energy counters (each clutch's heat,
 //! the drives' and loads' work, the drag's loss) integrated beside them (outside the error
 //! norm). Between events the modes are fixed and the right-hand side is smooth: adaptive
-//! DOPRI5 steps (the [`crate::dopri`] of the pack engine), landing on every instant where a
+//! DOPRI5 steps (the pack engine's `dopri.rs`), landing on every instant where a
 //! signal jumps or bends ([`Network::breakpoints`]). After each step the event functions are
 //! probed at the step's quarter points on the dense output:
 //! - a slipping clutch: `s w_rel` reaching 0 (`s` its direction), and its normal force
