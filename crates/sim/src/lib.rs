@@ -315,6 +315,7 @@
 pub mod engine;
 mod hook;
 mod integrate;
+pub mod network;
 pub mod options;
 mod stack;
 mod stepping;

@@ -10,9 +10,11 @@
 //! conserved: the torque `lambda` on `a` is `-ratio lambda` on `b`).
 
 pub mod clutch;
+pub mod output;
 pub mod signal;
 
 pub use clutch::{ClutchMode, LumpedClutch};
+pub use output::{ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample};
 pub use signal::Signal;
 
 use serde::{Deserialize, Serialize};
