@@ -43,6 +43,10 @@ pub struct BenchArgs {
     /// m^2 driven by a torque; the median is reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub inertial_runs: usize,
+    /// Repetitions of each network timing (`scenes/coupled-clutches.toml` on the reference
+    /// and the multibody engine in turn; the medians are reported); 0 skips that part.
+    #[arg(long, default_value_t = 3)]
+    pub network_runs: usize,
     /// Only the staggered-pack, brake-pack and inertial-pack parts (skips the paper case, the sweep, the
     /// recording cost and the shipped whole packs).
     #[arg(long)]
@@ -259,6 +263,10 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     if stopped() {
         return Ok(crate::signals::exit_code());
     }
+    network_scenes(a.network_runs, &stop)?;
+    if stopped() {
+        return Ok(crate::signals::exit_code());
+    }
     staggered_packs(a.pack_runs, &stop)?;
     if stopped() {
         return Ok(crate::signals::exit_code());
@@ -335,6 +343,78 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
             scene.simulation.duration_s,
         );
     }
+    Ok(())
+}
+
+/// 4b. The shipped network scene (`scenes/coupled-clutches.toml`, MODEL.md section 8) on both
+///    engines with the settings `run` gives them (the reference at the scene's tolerance, the
+///    multibody engine at its fixed step), in turn `runs` times (`--network-runs`; the
+///    medians are reported), and how far apart their lock times and final speeds are.
+fn network_scenes(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
+    if runs == 0 {
+        return Ok(());
+    }
+    let file = "scenes/coupled-clutches.toml";
+    let path = std::path::Path::new(file);
+    if !path.exists() {
+        out!("network {file}: skipped (run from the repository root)");
+        return Ok(());
+    }
+    let scene = load_scene(Some(path), &[])?;
+    let engines = [EngineChoice::Reference, EngineChoice::Multibody];
+    let mut times = [Vec::new(), Vec::new()];
+    let mut last = Vec::new();
+    for _ in 0..runs {
+        last.clear();
+        for (k, engine) in engines.into_iter().enumerate() {
+            let done = clutchpack_sdk::run_network_scene(
+                &scene,
+                Some(engine),
+                clutchpack_sdk::NetworkRequest {
+                    stop: Some(&**stop),
+                    ..Default::default()
+                },
+            )?;
+            if stop.load(Ordering::SeqCst) {
+                return Ok(());
+            }
+            times[k].push(done.summary.wall_time_s);
+            last.push(done.summary);
+        }
+    }
+    let (r, m) = (&last[0], &last[1]);
+    let locks = |s: &clutchpack_sdk::NetworkSummary| -> Vec<f64> {
+        s.couplings
+            .iter()
+            .flat_map(|c| c.lock_times_s.iter().copied())
+            .collect()
+    };
+    let (lr, lm) = (locks(r), locks(m));
+    let apart = if lr.len() == lm.len() {
+        let dt = lr
+            .iter()
+            .zip(&lm)
+            .fold(0.0_f64, |d, (a, b)| d.max((a - b).abs()));
+        let dw = r.bodies.iter().zip(&m.bodies).fold(0.0_f64, |d, (a, b)| {
+            d.max((a.final_speed_rad_s - b.final_speed_rad_s).abs())
+        });
+        format!("lock times within {dt:.1e} s, final speeds within {dw:.1e} rad/s")
+    } else {
+        format!("{} locks against {}", lm.len(), lr.len())
+    };
+    let [reference, multibody] = times.map(median);
+    out!(
+        "network {} ({} bodies, {} couplings), {} s: reference {reference:.4} s ({} steps), \
+         multibody {multibody:.4} s ({} steps of at most {:e} s) (medians of {runs}, in turn); \
+         the engines' {apart}",
+        scene.name,
+        r.bodies.len(),
+        r.couplings.len(),
+        scene.simulation.duration_s,
+        r.steps,
+        m.steps,
+        clutchpack_sdk::multibody_step_s(&scene),
+    );
     Ok(())
 }
 

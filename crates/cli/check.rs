@@ -41,18 +41,14 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
         // that cannot run the pack, a scheme it cannot run it with), with `run`'s message.
         let checked = clutchpack_sdk::load_scene(Some(p), &[]).and_then(|s| {
             if let Some(net) = &s.network {
-                // a network runs on the reference engine (its own rules checked in the load)
-                if a.engine == Some(EngineChoice::Multibody) {
-                    return Err(clutchpack_sdk::Error::BadInput(format!(
-                        "{}: a network scene runs on the reference engine only, for now",
-                        p.display()
-                    )));
-                }
+                // a network runs on either engine (its own rules checked in the load)
+                let engine = s.engine(a.engine, &p.display().to_string())?;
                 return Ok(format!(
-                    "network of {} bodies and {} couplings, {} s, reference engine",
+                    "network of {} bodies and {} couplings, {} s, {} engine",
                     net.bodies.len(),
                     net.couplings.len(),
-                    s.simulation.duration_s
+                    s.simulation.duration_s,
+                    engine.name()
                 ));
             }
             // the engine choice first with the file as the origin of its problems (each at

@@ -16,6 +16,8 @@ use std::sync::atomic::AtomicBool;
 pub struct NetworkArgs<'a> {
     /// The scene file (an input no output may name).
     pub scene_path: Option<&'a Path>,
+    /// `--engine` (else the scene's `simulation.engine`, else the reference engine).
+    pub engine: Option<clutchpack_sdk::EngineChoice>,
     /// `--summary-json`.
     pub summary_json: Option<&'a Path>,
     /// `--plot`.
@@ -47,6 +49,7 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     let mut progress = |t: f64| common::show_time(&pb, t);
     let done = clutchpack_sdk::run_network_scene(
         &scene,
+        a.engine,
         NetworkRequest {
             keep_history: a.plot.is_some(),
             stop: Some(interrupted),
@@ -56,15 +59,16 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     pb.finish_and_clear();
     let s = &done.summary;
     if let Some(path) = a.plot {
-        plot(path, &scene, &done.history)?;
+        plot(path, &scene, s.engine, &done.history)?;
     }
     if let Some(path) = a.summary_json {
         crate::outputs::write_json(path, s)?;
     }
     out!(
-        "{}: {:.3} s simulated with the reference engine (network of {} bodies, {} couplings) in {:.3} s wall ({} steps, {} events)",
+        "{}: {:.3} s simulated with the {} engine (network of {} bodies, {} couplings) in {:.3} s wall ({} steps, {} events)",
         s.scene,
         s.simulated_s,
+        s.engine,
         s.bodies.len(),
         s.couplings.len(),
         s.wall_time_s,
@@ -122,7 +126,12 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
 }
 
 /// The figure: the bodies' speeds and the couplings' torques against time.
-fn plot(path: &Path, scene: &Scene, history: &[clutchpack_sdk::NetworkSample]) -> Result<()> {
+fn plot(
+    path: &Path,
+    scene: &Scene,
+    engine: &str,
+    history: &[clutchpack_sdk::NetworkSample],
+) -> Result<()> {
     let net = scene.network.as_ref().expect("a network scene");
     let series = |name: &str, f: &dyn Fn(&clutchpack_sdk::NetworkSample) -> f64| {
         (
@@ -154,7 +163,7 @@ fn plot(path: &Path, scene: &Scene, history: &[clutchpack_sdk::NetworkSample]) -
         },
     ];
     let title = format!(
-        "{}: speeds and coupling torques (reference engine)",
+        "{}: speeds and coupling torques ({engine} engine)",
         scene.name
     );
     crate::outputs::write_with(path, |tmp| {

@@ -118,13 +118,10 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             ("--fatigue-json", a.fatigue_json.is_some()),
             ("--windows", a.windows.is_some()),
             ("--per-tooth", a.per_tooth),
-            (
-                "--engine multibody",
-                a.engine == Some(EngineChoice::Multibody),
-            ),
         ];
         let args = crate::network::NetworkArgs {
             scene_path: a.scene.as_deref(),
+            engine: a.engine,
             summary_json: a.summary_json.as_deref(),
             plot: a.plot.as_deref(),
             pack_only: pack_only

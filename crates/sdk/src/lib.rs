@@ -40,17 +40,17 @@ pub use batch::{
     ensemble_fatigue, ensemble_member, run_case, run_cases, CaseRuns, MemberFatigue,
     MAX_BATCH_CASES,
 };
+/// A network run's sample (for figures of a network's history).
+pub use clutchpack_model::network::NetworkSample;
 /// The steppable engines' inputs and outputs (co-simulation).
 pub use clutchpack_model::session::{Advance, Driven, Inputs, Snapshot};
-/// A network run's sample (for figures of a network's history).
-pub use clutchpack_reference::network::NetworkSample;
 pub use collector::{merge_peaks, RunCollector};
 pub use cosim::{CoSimulation, SavedCoSimulation};
 pub use error::{Error, Result};
 pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
 pub use network::{
-    run_network_scene, BodySummary, CouplingSummary, EnergySummary, ModeChange, NetworkOutcome,
-    NetworkRequest, NetworkSummary,
+    multibody_step_s, run_network_scene, BodySummary, CouplingSummary, EnergySummary, ModeChange,
+    NetworkOutcome, NetworkRequest, NetworkSummary, MULTIBODY_NETWORK_STEP_S,
 };
 pub use recording::open_recording;
 pub use run::{RecordingRequest, RunOutcome, RunRequest};

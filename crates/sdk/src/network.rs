@@ -1,14 +1,16 @@
-//! A network scene's run (`[[bodies]]`, MODEL.md section 8): the reference engine on the
-//! scene's driveline, its clutches' mode changes and heat, the bodies' speeds and the energy
+//! A network scene's run (`[[bodies]]`, MODEL.md section 8): the reference engine or the
+//! multibody engine on the scene's driveline (the engine asked, else `simulation.engine`, else
+//! the reference), its clutches' mode changes and heat, the bodies' speeds and the energy
 //! balance, as one serializable summary (`run --summary-json`) and, if asked, the sampled
-//! history (for the figure).
+//! history (for the figure). Both engines give the model's output types
+//! ([`clutchpack_model::network::NetworkRun`]), so the summary is built the same way.
 
 use crate::{Error, Result};
-use clutchpack_model::network::{ClutchMode, CouplingKind};
-use clutchpack_reference::network::{
-    run_network, ClutchEvent, NetworkObserver, NetworkOptions, NetworkSample,
+use clutchpack_model::network::{
+    ClutchEvent, ClutchMode, CouplingKind, NetworkObserver, NetworkSample,
 };
-use clutchpack_scene::Scene;
+use clutchpack_reference::network::NetworkOptions;
+use clutchpack_scene::{EngineChoice, Scene};
 use serde::Serialize;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -87,7 +89,7 @@ pub struct EnergySummary {
 pub struct NetworkSummary {
     /// The scene's name.
     pub scene: String,
-    /// The engine (`reference`).
+    /// The engine (`reference` or `multibody`).
     pub engine: &'static str,
     /// Simulated time, s.
     pub simulated_s: f64,
@@ -142,20 +144,33 @@ impl NetworkObserver for Keep<'_, '_> {
     }
 }
 
-/// Runs a network scene on the reference engine. A pack scene is bad input.
-pub fn run_network_scene(scene: &Scene, mut req: NetworkRequest) -> Result<NetworkOutcome> {
+/// The multibody engine's fixed step on a network scene, s: `simulation.max_step_s`, at most
+/// 1e-4 s (the engine is first order: at 1e-4 s CoupledClutches' lock times are within
+/// 2e-5 s and its speeds within 2e-5 of the reference engine's, `crates/sim/tests/network.rs`).
+pub fn multibody_step_s(scene: &Scene) -> f64 {
+    scene.simulation.max_step_s.min(MULTIBODY_NETWORK_STEP_S)
+}
+
+/// The longest fixed step of the multibody engine on a network, s.
+pub const MULTIBODY_NETWORK_STEP_S: f64 = 1e-4;
+
+/// Runs a network scene on the engine `asked` (e.g. `--engine`), else the scene's
+/// `simulation.engine`, else the reference engine: the reference engine at the scene's
+/// tolerance and longest step, the multibody engine at the fixed step
+/// [`multibody_step_s`]. A pack scene is bad input.
+pub fn run_network_scene(
+    scene: &Scene,
+    asked: Option<EngineChoice>,
+    mut req: NetworkRequest,
+) -> Result<NetworkOutcome> {
     let Some(net) = &scene.network else {
         return Err(Error::BadInput(format!(
             "{} is a pack scene, not a network ([[bodies]])",
             scene.name
         )));
     };
+    let engine = scene.engine(asked, &scene.name)?;
     let sim = &scene.simulation;
-    let options = NetworkOptions {
-        tolerance: sim.tolerance,
-        max_step_s: sim.max_step_s,
-        record_rate_hz: sim.record_rate_hz,
-    };
     let mut keep = Keep {
         req: &mut req,
         events: Vec::new(),
@@ -163,11 +178,27 @@ pub fn run_network_scene(scene: &Scene, mut req: NetworkRequest) -> Result<Netwo
         stopped: false,
     };
     let start = std::time::Instant::now();
-    let run =
-        run_network(net, sim.duration_s, &options, &mut keep).map_err(|source| Error::Engine {
-            context: format!("{} (reference engine, network)", scene.name),
-            source,
-        })?;
+    let run = match engine {
+        EngineChoice::Reference => {
+            let options = NetworkOptions {
+                tolerance: sim.tolerance,
+                max_step_s: sim.max_step_s,
+                record_rate_hz: sim.record_rate_hz,
+            };
+            clutchpack_reference::network::run_network(net, sim.duration_s, &options, &mut keep)
+        }
+        EngineChoice::Multibody => {
+            let options = clutchpack_sim::network::NetworkStepOptions {
+                step_s: multibody_step_s(scene),
+                record_rate_hz: sim.record_rate_hz,
+            };
+            clutchpack_sim::network::run_network(net, sim.duration_s, &options, &mut keep)
+        }
+    }
+    .map_err(|source| Error::Engine {
+        context: format!("{} ({} engine, network)", scene.name, engine.name()),
+        source,
+    })?;
     let wall_time_s = start.elapsed().as_secs_f64();
     let last = &run.last;
     let couplings = net
@@ -207,7 +238,7 @@ pub fn run_network_scene(scene: &Scene, mut req: NetworkRequest) -> Result<Netwo
     let e = run.energy;
     let summary = NetworkSummary {
         scene: scene.name.clone(),
-        engine: "reference",
+        engine: engine.name(),
         simulated_s: last.t_s,
         wall_time_s,
         steps: run.steps,

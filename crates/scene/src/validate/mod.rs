@@ -395,15 +395,6 @@ fn network_scene(
             );
         }
     }
-    if let Some(sim) = &simulation {
-        if sim.engine == Some(crate::EngineChoice::Multibody) {
-            ck.report(
-                "simulation.engine",
-                Some("\"multibody\"".into()),
-                "a network runs on the reference engine only, for now",
-            );
-        }
-    }
     let network = network::network(
         ck,
         bodies,
