@@ -499,6 +499,9 @@ pub fn run_network(
             h = h_mid;
             w_force = run.step_torques(t, h, &start);
         }
+        // at least 1e-13 (1 + t) s, so that time moves (a landing nearer than that is on
+        // the step's end to within the events' own precision)
+        h = h.max(1e-13 * (1.0 + t)).min(stop - t);
         let t_force = t + 0.5 * h;
         let t_new = if h == stop - t { stop } else { t + h };
         let h = t_new - t;
