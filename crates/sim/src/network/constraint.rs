@@ -81,7 +81,7 @@ pub(crate) fn solve(rows: &[Row], inv_inertia: &[f64], rhs: &[f64], x: &mut Vec<
             .iter()
             .map(|(i, c)| c * c * inv_inertia[*i])
             .sum();
-        if !(piv > 1e-12 * diag) {
+        if piv.is_nan() || piv <= 1e-12 * diag {
             continue;
         }
         active[k] = true;
