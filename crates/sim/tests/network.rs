@@ -46,9 +46,9 @@ fn reference_run(net: &Network, duration: f64) -> (NetworkRun, Keep) {
     (run, obs)
 }
 
-/// The largest difference of the event times (s) of two runs with the same events, and of
-/// the speeds at the end relative to the largest speed.
-fn compare(a: &(NetworkRun, Keep), b: &(NetworkRun, Keep)) -> (f64, f64) {
+/// The largest difference of the event times (s) of two runs with the same events, of the
+/// speeds at the end relative to the largest speed, and of the angles at the end (rad).
+fn compare(a: &(NetworkRun, Keep), b: &(NetworkRun, Keep)) -> (f64, f64, f64) {
     let ea: Vec<_> = a.1 .0.iter().filter(|e| e.t_s > 0.0).collect();
     let eb: Vec<_> = b.1 .0.iter().filter(|e| e.t_s > 0.0).collect();
     assert_eq!(ea.len(), eb.len(), "{ea:?}\n{eb:?}");
@@ -63,7 +63,13 @@ fn compare(a: &(NetworkRun, Keep), b: &(NetworkRun, Keep)) -> (f64, f64) {
         .iter()
         .zip(wb)
         .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs() / top));
-    (dt, dw)
+    let (pa, pb) = (&a.0.last.angle_rad, &b.0.last.angle_rad);
+    let dp = pa
+        .iter()
+        .zip(pb)
+        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+    println!("  angles at the end within {dp:e} rad");
+    (dt, dw, dp)
 }
 
 /// Modelica's `Rotational.Examples.CoupledClutches` on the multibody engine against the
@@ -131,8 +137,10 @@ fn coupled_clutches_match_modelica_reference_results() {
 /// CoupledClutches on both engines (the reference at tolerance 1e-12), at steps of 1e-4,
 /// 5e-5 and 2.5e-5 s: the same 9 mode changes, and differences that fall as the step's square.
 /// Measured: events within 5.9e-8, 1.5e-8 and 3.7e-9 s, speeds at 1.5 s within 8.1e-8,
-/// 2.0e-8 and 4.9e-9 of the largest (ratios 4.0, 4.1); asserted: both within `10 h^2` (h in
-/// s; 1.2 to 1.7 times what was measured) and each halving dividing both by at least 3.5.
+/// 2.0e-8 and 4.9e-9 of the largest (ratios 4.0, 4.1), the angles within 1.8e-7, 4.6e-8 and
+/// 1.1e-8 rad (the angle is the exact turn of each step's affine speed); asserted: events and
+/// speeds within `10 h^2` (h in s; 1.2 to 1.7 times what was measured), angles within
+/// `25 h^2` rad, and each halving dividing events and speeds by at least 3.5.
 #[test]
 fn coupled_clutches_converge_to_the_reference_engine() {
     let net = cases::coupled_clutches();
@@ -140,8 +148,9 @@ fn coupled_clutches_converge_to_the_reference_engine() {
     let mut last: Option<(f64, f64)> = None;
     for h in [1e-4, 5e-5, 2.5e-5] {
         let m = multibody(&net, 1.5, h);
-        let (dt, dw) = compare(&m, &r);
+        let (dt, dw, dp) = compare(&m, &r);
         println!("step {h:e} s: events within {dt:e} s, speeds within {dw:e}");
+        assert!(dp < 25.0 * h * h, "{dp}");
         assert!(dt < 10.0 * h * h, "{dt}");
         assert!(dw < 10.0 * h * h, "{dw}");
         if let Some((pt, pw)) = last {
@@ -213,7 +222,7 @@ fn geared_dual_clutch_matches_the_reference_engine() {
     };
     for h in [1e-4, 5e-5] {
         let m = multibody(&net, 0.1, h);
-        let (dt, dw) = compare(&m, &r);
+        let (dt, dw, _) = compare(&m, &r);
         let dq = (m.0.heat_j[1] - r.0.heat_j[1]).abs() / r.0.heat_j[1];
         // the output torque after the lock, -r2 lambda on the vehicle
         let out_m = -r2 * m.0.last.torque_n_m[3];
@@ -389,7 +398,7 @@ fn upshift_handover_converges_to_the_reference_engine() {
     let mut last: Option<(f64, f64, f64)> = None;
     for h in [1e-4, 5e-5, 2.5e-5] {
         let m = multibody(&net, 0.3, h);
-        let (dt, dw) = compare(&m, &r);
+        let (dt, dw, _) = compare(&m, &r);
         let dq =
             (m.0.energy.clutch_heat_j - r.0.energy.clutch_heat_j).abs() / r.0.energy.clutch_heat_j;
         println!(
@@ -532,7 +541,7 @@ fn brake_and_parallel_clutches_match_the_reference_engine() {
                 e.t_s, net.couplings[e.coupling].name, e.from, e.to
             );
         }
-        let (dt, dw) = compare(&m, &r);
+        let (dt, dw, _) = compare(&m, &r);
         println!(
             "step {h:e}: events within {dt:e} s, speeds within {dw:e}, residual {:e} J",
             m.0.energy.residual_j()

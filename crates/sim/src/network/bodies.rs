@@ -7,8 +7,9 @@
 //!
 //! With one solver iteration rapier is semi-implicit Euler for these torques (`lib.rs`):
 //! `w += h T / J`, then the pose turns by `2 atan(w h / 2)`; the angle is kept here unwrapped
-//! as `theta += h w` and written back to the pose after each step (the exact turn, as
-//! `World::step` restores it on the pack's bodies).
+//! as `theta += h (w_k + w_{k+1}) / 2`, the exact turn of the speed's affine path under a torque
+//! held over the step (rapier's own `h w_{k+1}` is first order), and written back to the pose
+//! after each step (as `World::step` restores the exact turn on the pack's bodies).
 
 use clutchpack_model::network::Network;
 use parry3d_f64::mass_properties::MassProperties;
@@ -114,6 +115,7 @@ impl NetworkWorld {
             body.reset_torques(false);
             body.add_torque(Vector::new(0.0, 0.0, torque[i]), false);
         }
+        let w0 = self.speeds();
         self.physics.integration_parameters.dt = h;
         self.physics.step();
         let w = self.speeds();
@@ -121,8 +123,10 @@ impl NetworkWorld {
             if self.fixed[i] {
                 continue;
             }
-            // semi-implicit Euler on the angle; the pose gets the exact turn
-            self.angle[i] += h * w[i];
+            // the torque is held over the step, so the speed is affine in time and the turn
+            // is exactly h (w0 + w) / 2 (rapier's semi-implicit Euler turns by h w, first
+            // order); the pose gets it
+            self.angle[i] += 0.5 * h * (w0[i] + w[i]);
             let q = Rotation::from_rotation_z(self.angle[i].rem_euclid(std::f64::consts::TAU));
             self.physics.bodies[*hd].set_rotation(q, false);
         }

@@ -36,10 +36,10 @@
 //!    static limit (a break), are bisected on that trajectory to 1e-13 s and landed on. The
 //!    step's torques are then taken again at the shorter step's midpoint.
 //! 5. **Step**: the torques go to the rapier bodies, and rapier (one solver iteration:
-//!    semi-implicit Euler) steps `w += h T / J`, `theta += h w`; the engine keeps each body's
-//!    angle unwrapped and writes it back to the pose (rapier's linearised quaternion update
-//!    turns by `2 atan(w h / 2)`, `world.rs`), and projects the speeds on the constraints
-//!    against rapier's rounding.
+//!    semi-implicit Euler) steps `w += h T / J`; the engine keeps each body's angle
+//!    unwrapped as `theta += h (w_k + w_{k+1}) / 2` (the exact turn of the affine speed) and
+//!    writes it back to the pose (rapier turns by `2 atan(w h / 2)`, `world.rs`), and projects
+//!    the speeds on the constraints against rapier's rounding.
 //!
 //! # Energy
 //! Every torque's work is counted over a step with the step's mean speed `(w_k + w_{k+1}) / 2`
