@@ -114,7 +114,7 @@ table! {
     RawSimulation at "simulation" {
         /// simulated duration; duration_s x record_rate_hz (the number of samples) is bounded too
         duration_s: "s", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_DURATION_S }), Dflt::Required;
-        /// the engine that runs the scene (else --engine, else the CLI chooses: reference for a torsional pack, multibody otherwise)
+        /// the engine that runs the scene (else --engine, else the CLI chooses: reference for a torsional pack or a network, multibody otherwise)
         engine: "", Kind::Choice(&["reference", "multibody"]), Dflt::Described("optional");
         /// how the engine steps the bodies: auto (multirate where it applies, one shared step otherwise), shared (one step for every body: the multibody shared step, the reference engine's monolithic scheme; the oracle), multirate (an error for a pack the engine cannot run so)
         scheme: "", Kind::Choice(&["auto", "shared", "multirate"]), Dflt::Described("auto");
