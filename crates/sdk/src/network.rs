@@ -39,9 +39,9 @@ pub struct ModeChange {
 pub struct CouplingSummary {
     /// Its name.
     pub name: String,
-    /// `clutch` or `ideal_gear`.
+    /// `clutch`, `ideal_gear` or `gear_mesh`.
     pub kind: &'static str,
-    /// Heat of a clutch over the run, J (0 for a gear).
+    /// Heat of a clutch, or work done on a gear mesh, over the run, J (0 for an ideal gear).
     pub heat_j: f64,
     /// Torque on its body a at the end, N m.
     pub final_torque_n_m: f64,
@@ -76,9 +76,11 @@ pub struct EnergySummary {
     pub drag_loss_j: f64,
     /// Heat of the clutches, J.
     pub clutch_heat_j: f64,
+    /// Work done on the gear meshes (their impact losses), J.
+    pub mesh_work_j: f64,
     /// Kinetic energy at the end less at the start, J.
     pub kinetic_change_j: f64,
-    /// `drive + load - drag - heat - kinetic change`, J (zero to the integrator's tolerance).
+    /// `drive + load - drag - heat - mesh work - kinetic change`, J (zero to the integrator's tolerance).
     pub residual_j: f64,
 }
 
@@ -190,6 +192,7 @@ pub fn run_network_scene(scene: &Scene, mut req: NetworkRequest) -> Result<Netwo
                 kind: match c.kind {
                     CouplingKind::Clutch(_) => "clutch",
                     CouplingKind::IdealGear { .. } => "ideal_gear",
+                    CouplingKind::GearMesh(_) => "gear_mesh",
                 },
                 heat_j: run.heat_j[k],
                 final_torque_n_m: last.torque_n_m[k],
@@ -229,6 +232,7 @@ pub fn run_network_scene(scene: &Scene, mut req: NetworkRequest) -> Result<Netwo
             load_work_j: e.load_work_j,
             drag_loss_j: e.drag_loss_j,
             clutch_heat_j: e.clutch_heat_j,
+            mesh_work_j: e.mesh_work_j,
             kinetic_change_j: e.kinetic_change_j,
             residual_j: e.residual_j(),
         },

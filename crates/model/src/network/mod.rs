@@ -10,9 +10,11 @@
 //! conserved: the torque `lambda` on `a` is `-ratio lambda` on `b`).
 
 pub mod clutch;
+pub mod gear;
 pub mod signal;
 
 pub use clutch::{ClutchMode, LumpedClutch};
+pub use gear::GearMesh;
 pub use signal::Signal;
 
 use serde::{Deserialize, Serialize};
@@ -81,6 +83,8 @@ pub enum CouplingKind {
         /// `w_a / w_b` (nonzero; negative for an external pair turning the other way).
         ratio: f64,
     },
+    /// A gear mesh with backlash and a tooth law (gear rattle; MODEL.md section 8).
+    GearMesh(GearMesh),
 }
 
 /// A coupling between two bodies of a network.
@@ -233,6 +237,11 @@ impl Network {
             match &c.kind {
                 CouplingKind::Clutch(cl) => {
                     for (field, message) in cl.problems() {
+                        out.push(coupling(k, field, message));
+                    }
+                }
+                CouplingKind::GearMesh(g) => {
+                    for (field, message) in g.problems() {
                         out.push(coupling(k, field, message));
                     }
                 }

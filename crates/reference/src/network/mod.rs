@@ -4,7 +4,10 @@
 //! release located as an event.
 //!
 //! # Method
-//! The state is every body's angle and speed, plus the energy counters (each clutch's heat,
+//! The state is every body's angle and speed, each gear mesh's relative displacement along
+//! its line of action (integrated itself, with an absolute tolerance on the backlash's scale,
+//! as the pack engine integrates its relative angles: the bodies' angles grow without bound,
+//! and their error with them), plus the energy counters (each clutch's heat,
 //! the drives' and loads' work, the drag's loss) integrated beside them (outside the error
 //! norm). Between events the modes are fixed and the right-hand side is smooth: adaptive
 //! DOPRI5 steps (the pack engine's `dopri.rs`), landing on every instant where a
@@ -13,7 +16,9 @@
 //! - a slipping clutch: `s w_rel` reaching 0 (`s` its direction), and its normal force
 //!   reaching 0 (free);
 //! - a locked clutch: `peak mu(0) cgeo fn - |tau|` reaching 0 (it breaks), `fn` reaching 0;
-//! - a free clutch: `fn` rising above 0 (it engages).
+//! - a free clutch: `fn` rising above 0 (it engages);
+//! - a gear mesh: the engagement depth of its tooth law reaching 0 from either side (a tooth
+//!   contact's onset, where the law's per-event memory is taken, and its separation).
 //!
 //! A crossing is bisected on the dense output to 1e-13 s relative; the run restarts there
 //! with the modes settled as Modelica's `Clutch` settles them (Otter, Elmqvist and Mattsson
@@ -24,11 +29,12 @@
 //! below 1e-12 rad/s).
 
 pub(crate) mod cluster;
+mod mesh;
 
 use crate::dopri::{next_step, Dense, Dopri5};
 use cluster::Clusters;
-use clutchpack_model::network::{ClutchMode, CouplingKind, LumpedClutch, Network};
-use clutchpack_model::EngineError;
+use clutchpack_model::network::{ClutchMode, CouplingKind, GearMesh, LumpedClutch, Network};
+use clutchpack_model::{Engagement, EngineError, ImpactEvent};
 
 /// Settings of a network run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,7 +67,7 @@ pub struct NetworkSample {
     /// Each body's speed, rad/s.
     pub speed_rad_s: Vec<f64>,
     /// Each coupling's torque on its body `a`, N m (a clutch's `tau`; an ideal gear's
-    /// `lambda`, `-ratio lambda` on `b`).
+    /// `lambda`, `-ratio lambda` on `b`; a gear mesh's `-Rb_a F pairs`).
     pub torque_n_m: Vec<f64>,
     /// Each clutch's mode (`None` for another kind of coupling).
     pub mode: Vec<Option<ClutchMode>>,
@@ -91,16 +97,21 @@ pub struct NetworkEnergy {
     pub drag_loss_j: f64,
     /// Heat of the clutches (>= 0), J.
     pub clutch_heat_j: f64,
+    /// Work done on the gear meshes, J: their teeth's impact losses, plus the elastic energy
+    /// of a contact still closed at the end.
+    pub mesh_work_j: f64,
     /// Kinetic energy at the end less at the start, J.
     pub kinetic_change_j: f64,
 }
 
 impl NetworkEnergy {
-    /// `drive + load - drag - heat - kinetic change`, J: zero to the integrator's tolerance.
+    /// `drive + load - drag - heat - mesh work - kinetic change`, J: zero to the integrator's
+    /// tolerance.
     pub fn residual_j(&self) -> f64 {
         self.drive_work_j + self.load_work_j
             - self.drag_loss_j
             - self.clutch_heat_j
+            - self.mesh_work_j
             - self.kinetic_change_j
     }
 }
@@ -110,7 +121,7 @@ impl NetworkEnergy {
 pub struct NetworkRun {
     /// The state at the end.
     pub last: NetworkSample,
-    /// Each clutch's heat, J (0 for other couplings).
+    /// Each clutch's heat and each gear mesh's work, J (0 for an ideal gear).
     pub heat_j: Vec<f64>,
     /// The energy balance.
     pub energy: NetworkEnergy,
@@ -126,6 +137,9 @@ pub trait NetworkObserver {
     fn sample(&mut self, _sample: &NetworkSample) {}
     /// A clutch changed mode.
     fn clutch_event(&mut self, _event: &ClutchEvent) {}
+    /// A gear mesh's tooth contact closed (its `disc` is the coupling's index; the peak is
+    /// the force per tooth pair, negative when body `a` leads: `x > 0`).
+    fn mesh_impact(&mut self, _impact: &ImpactEvent) {}
     /// Polled after every step with the time reached, s; `false` stops the run there.
     fn progress(&mut self, _t_s: f64) -> bool {
         true
@@ -139,6 +153,8 @@ impl NetworkObserver for () {}
 struct Equations<'n> {
     net: &'n Network,
     modes: Vec<Option<ClutchMode>>,
+    /// Each gear mesh's contact event (its law's memory), `None` in free flight.
+    contacts: Vec<Option<Engagement>>,
     clusters: Clusters,
     // scratch
     torque: Vec<f64>,
@@ -146,13 +162,35 @@ struct Equations<'n> {
     group: Vec<f64>,
     residual: Vec<f64>,
     coupling_torque: Vec<f64>,
+    mesh_force: Vec<f64>,
 }
 
 fn clutch(net: &Network, k: usize) -> Option<&LumpedClutch> {
     match &net.couplings[k].kind {
         CouplingKind::Clutch(c) => Some(c),
-        CouplingKind::IdealGear { .. } => None,
+        _ => None,
     }
+}
+
+fn mesh(net: &Network, k: usize) -> Option<&GearMesh> {
+    match &net.couplings[k].kind {
+        CouplingKind::GearMesh(g) => Some(g),
+        _ => None,
+    }
+}
+
+/// A mesh's tooth kinematics at the state `y = [angles, speeds, ...]`.
+fn mesh_kinematics(
+    net: &Network,
+    k: usize,
+    g: &GearMesh,
+    y: &[f64],
+) -> clutchpack_model::ToothKinematics {
+    let n = net.bodies.len();
+    let c = &net.couplings[k];
+    // x is its own state component; its rate from the speeds
+    let (_, v) = g.displacement((0.0, 0.0), (y[n + c.a], y[n + c.b]));
+    g.kinematics(y[2 * n + k], v)
 }
 
 impl<'n> Equations<'n> {
@@ -162,12 +200,14 @@ impl<'n> Equations<'n> {
         Equations {
             net,
             modes,
+            contacts: vec![None; net.couplings.len()],
             clusters,
             torque: vec![0.0; n],
             acc: vec![0.0; n],
             group: Vec::new(),
             residual: Vec::new(),
             coupling_torque: vec![0.0; net.couplings.len()],
+            mesh_force: vec![0.0; net.couplings.len()],
         }
     }
 
@@ -176,9 +216,12 @@ impl<'n> Equations<'n> {
         self.clusters = Clusters::build(self.net, &rigid(self.net, &self.modes));
     }
 
-    /// Bodies' torques (all but the rigid couplings') and accelerations at `(t, w)`; the
-    /// slipping clutches' torques into `coupling_torque`.
-    fn forces(&mut self, t: f64, w: &[f64]) {
+    /// Bodies' torques (all but the rigid couplings') and accelerations at `(t, y)`; the
+    /// slipping clutches' and the meshes' torques into `coupling_torque` (and each mesh's
+    /// force per pair, N, into `mesh_force`).
+    fn forces(&mut self, t: f64, y: &[f64]) {
+        let n = self.net.bodies.len();
+        let w = &y[n..2 * n];
         for (i, b) in self.net.bodies.iter().enumerate() {
             self.torque[i] = if b.fixed {
                 0.0
@@ -196,6 +239,15 @@ impl<'n> Equations<'n> {
                 self.torque[c.a] += tau;
                 self.torque[c.b] -= tau;
             }
+            if let (Some(g), Some(e)) = (mesh(self.net, k), self.contacts[k]) {
+                // MODEL.md section 8: F signed as x; -Rb_a F on a, -+Rb_b F on b
+                let f = g.force_n(&mesh_kinematics(self.net, k, g, y), &e);
+                let (ta, tb) = g.torques_n_m(f);
+                self.mesh_force[k] = f;
+                self.coupling_torque[k] = ta;
+                self.torque[c.a] += ta;
+                self.torque[c.b] += tb;
+            }
         }
         self.clusters
             .accelerations(&self.torque, &mut self.acc, &mut self.group);
@@ -212,21 +264,32 @@ impl<'n> Equations<'n> {
         );
     }
 
-    /// `dy/dt` of the state `[angles, speeds, counters]`.
+    /// `dy/dt` of the state `[angles, speeds, meshes' x, counters]`.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
         let n = self.net.bodies.len();
         let (theta_dot, rest) = dy.split_at_mut(n);
-        let (w_dot, counters) = rest.split_at_mut(n);
+        let (w_dot, rest) = rest.split_at_mut(n);
+        let m = self.net.couplings.len();
+        let (x_dot, counters) = rest.split_at_mut(m);
         let w = &y[n..2 * n];
         theta_dot.copy_from_slice(w);
-        self.forces(t, w);
+        self.forces(t, y);
         w_dot.copy_from_slice(&self.acc);
+        for (k, c) in self.net.couplings.iter().enumerate() {
+            x_dot[k] = match mesh(self.net, k) {
+                Some(g) => g.displacement((0.0, 0.0), (w[c.a], w[c.b])).1,
+                None => 0.0,
+            };
+        }
         // counters: [heat per coupling, drive work, load work, drag loss]
-        let m = self.net.couplings.len();
         for k in 0..m {
             let c = &self.net.couplings[k];
             counters[k] = if matches!(self.modes[k], Some(ClutchMode::Slipping(_))) {
                 self.coupling_torque[k] * (w[c.b] - w[c.a])
+            } else if let (Some(g), Some(_)) = (mesh(self.net, k), self.contacts[k]) {
+                // power into the mesh: F v pairs (the torques' work on the bodies, negated)
+                let (_, v) = g.displacement((0.0, 0.0), (w[c.a], w[c.b]));
+                self.mesh_force[k] * v * g.pairs
             } else {
                 0.0
             };
@@ -253,10 +316,21 @@ impl<'n> Equations<'n> {
         let w = &y[n..2 * n];
         let any_locked = self.modes.contains(&Some(ClutchMode::Locked));
         if any_locked {
-            self.forces(t, w);
+            self.forces(t, y);
             self.rigid_torques();
         }
         for (k, c) in self.net.couplings.iter().enumerate() {
+            if let Some(g) = mesh(self.net, k) {
+                let depth = g
+                    .law
+                    .engagement_depth_m(&mesh_kinematics(self.net, k, g, y));
+                out[k] = if self.contacts[k].is_some() {
+                    depth
+                } else {
+                    -depth
+                };
+                continue;
+            }
             let Some(cl) = clutch(self.net, k) else {
                 out[k] = 1.0;
                 continue;
@@ -287,6 +361,7 @@ fn rigid(net: &Network, modes: &[Option<ClutchMode>]) -> Vec<bool> {
         .map(|(k, c)| match c.kind {
             CouplingKind::IdealGear { .. } => true,
             CouplingKind::Clutch(_) => modes[k] == Some(ClutchMode::Locked),
+            CouplingKind::GearMesh(_) => false,
         })
         .collect()
 }
@@ -309,13 +384,24 @@ pub fn run_network(
     }
     let n = net.bodies.len();
     let m = net.couplings.len();
-    let dim = 2 * n + m + 3;
+    let dim = 2 * n + 2 * m + 3;
     let tol = options.tolerance;
     let mut atol = vec![tol; dim];
-    atol[2 * n..].iter_mut().for_each(|a| *a = f64::INFINITY);
+    // the meshes' x on their backlash's scale; other slots and the counters out of the norm
+    for k in 0..m {
+        atol[2 * n + k] = mesh(net, k).map_or(f64::INFINITY, |g| tol * g.backlash_m);
+    }
+    atol[2 * n + m..]
+        .iter_mut()
+        .for_each(|a| *a = f64::INFINITY);
     let mut y = vec![0.0; dim];
     for (i, b) in net.bodies.iter().enumerate() {
         y[n + i] = b.initial_speed_rad_s;
+    }
+    for k in 0..m {
+        if let Some(g) = mesh(net, k) {
+            y[2 * n + k] = g.initial_offset_m;
+        }
     }
     let initial_modes: Vec<Option<ClutchMode>> = (0..m)
         .map(|k| clutch(net, k).map(|_| ClutchMode::Free))
@@ -332,6 +418,8 @@ pub fn run_network(
     let kinetic0 = kinetic(&y);
     let mut events = 0u64;
     settle(&mut eq, 0.0, &mut y, &[], obs, &mut events);
+    let mut meshes = mesh::Meshes::new(m, dim);
+    meshes.switch(&mut eq, 0.0, &y, None, obs);
     let breakpoints = net.breakpoints(duration_s);
     let mut next_bp = 0;
     let mut stepper = Dopri5::new(dim);
@@ -426,6 +514,7 @@ pub fn run_network(
                 (t + h_try, land)
             }
         };
+        meshes.observe(&mut eq, &dense, t, t_new);
         // samples up to t_new from the dense output
         while (next_sample as f64) * period <= t_new && (next_sample as f64) * period < duration_s {
             let ts = next_sample as f64 * period;
@@ -445,6 +534,7 @@ pub fn run_network(
             next_bp += 1;
         }
         if at_event {
+            meshes.switch(&mut eq, t, &y, Some(&g1), obs);
             settle(&mut eq, t, &mut y, &g1, obs, &mut events);
             eq.rhs(t, &y, &mut dy);
             stepper.set_start_derivative(&dy);
@@ -457,19 +547,25 @@ pub fn run_network(
             break;
         }
     }
+    meshes.finish(&mut eq, t, obs);
     let last = sample(&mut eq, t, &y);
     obs.sample(&last);
-    let mut heat = y[2 * n..2 * n + m].to_vec();
+    let c0 = 2 * n + m; // the counters
+    let mut heat = y[c0..c0 + m].to_vec();
+    let mut mesh_work = 0.0;
     for (k, h) in heat.iter_mut().enumerate() {
-        if clutch(net, k).is_none() {
+        if mesh(net, k).is_some() {
+            mesh_work += *h;
+        } else if clutch(net, k).is_none() {
             *h = 0.0;
         }
     }
     let energy = NetworkEnergy {
-        drive_work_j: y[2 * n + m],
-        load_work_j: y[2 * n + m + 1],
-        drag_loss_j: y[2 * n + m + 2],
-        clutch_heat_j: heat.iter().sum(),
+        drive_work_j: y[c0 + m],
+        load_work_j: y[c0 + m + 1],
+        drag_loss_j: y[c0 + m + 2],
+        clutch_heat_j: heat.iter().sum::<f64>() - mesh_work,
+        mesh_work_j: mesh_work,
         kinetic_change_j: kinetic(&y) - kinetic0,
     };
     Ok(NetworkRun {
@@ -484,7 +580,7 @@ pub fn run_network(
 /// The state at `t` as a sample (the couplings' torques computed there).
 fn sample(eq: &mut Equations, t: f64, y: &[f64]) -> NetworkSample {
     let n = eq.net.bodies.len();
-    eq.forces(t, &y[n..2 * n]);
+    eq.forces(t, y);
     eq.rigid_torques();
     NetworkSample {
         t_s: t,
@@ -543,7 +639,7 @@ fn settle(
     for _ in 0..=net.couplings.len() {
         eq.set_modes(&modes);
         project_speeds(eq, y);
-        eq.forces(t, &y[n..2 * n]);
+        eq.forces(t, y);
         eq.rigid_torques();
         let mut worst: Option<(usize, f64)> = None;
         for (k, mode) in modes.iter().enumerate() {
