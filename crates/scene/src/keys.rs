@@ -554,12 +554,12 @@ table! {
 }
 
 table! {
-    /// One `[[couplings]]` entry of a network scene: a coupling between bodies a and b (MODEL.md section 8). Signs: a clutch's slip is w_b - w_a and its torque acts +tau on a, -tau on b (Modelica's flanges); an ideal gear ties w_a = ratio w_b.
+    /// One `[[couplings]]` entry of a network scene: a coupling between bodies a and b (MODEL.md section 8). Signs: a clutch's slip is w_b - w_a and its torque acts +tau on a, -tau on b (Modelica's flanges); an ideal gear ties w_a = ratio w_b; a gear mesh's force F, signed as x, acts -Rb_a F on a and -Rb_b F on b (internal: +Rb_b F).
     RawCoupling at "couplings[]" {
         /// the coupling's name, unique
         name: "", Kind::Text, Dflt::Required;
-        /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash
-        kind: "", Kind::Choice(&["clutch", "ideal_gear"]), Dflt::Required;
+        /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash; "gear_mesh": a gear pair with backlash and the tooth law of [couplings.contact] and [couplings.oil] along its line of action (gear rattle)
+        kind: "", Kind::Choice(&["clutch", "ideal_gear", "gear_mesh"]), Dflt::Required;
         /// the name of body a
         a: "", Kind::Text, Dflt::Required;
         /// the name of body b
@@ -578,9 +578,23 @@ table! {
         cgeo_m: "m", NON_NEGATIVE, Dflt::Num(1.0);
         /// clutch: the normal force at force = 1 (Modelica's fn_max)
         max_normal_force_n: "N", NON_NEGATIVE, Dflt::When("clutch: required");
+        /// gear_mesh: base radius of the gear on body a
+        base_radius_a_m: "m", Kind::Number(Rule::Bounded { floor: MIN_PITCH_RADIUS_M, ceil: MAX_PITCH_RADIUS_M }), Dflt::When("gear_mesh: required");
+        /// gear_mesh: base radius of the gear on body b
+        base_radius_b_m: "m", Kind::Number(Rule::Bounded { floor: MIN_PITCH_RADIUS_M, ceil: MAX_PITCH_RADIUS_M }), Dflt::When("gear_mesh: required");
+        /// gear_mesh: an internal mesh (a ring gear: b turns the same way as a); else external
+        internal: "", Kind::Bool, Dflt::Bool(false);
+        /// gear_mesh: backlash along the line of action (the free travel from flank to flank)
+        backlash_m: "m", POSITIVE, Dflt::When("gear_mesh: required");
+        /// gear_mesh: tooth pairs sharing the load (the contact ratio's whole part)
+        pairs: "", Kind::Number(Rule::Closed(1.0, 10.0)), Dflt::Num(1.0);
+        /// gear_mesh: relative displacement x = Rb_a theta_a +- Rb_b theta_b at t = 0 (0: centred in the backlash); |x| + the film must be < backlash_m / 2
+        mesh_offset_m: "m", FINITE, Dflt::Num(0.0);
     }
     children {
         force: table RawForceSignal,
+        contact: table RawContact,
+        oil: table RawOil,
     }
 }
 

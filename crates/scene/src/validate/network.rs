@@ -6,13 +6,14 @@
 
 use super::{Checker, Field};
 use crate::keys::{
-    RawCoupling as C, RawForceSignal as FS, RawNetBody as B, RawRoadLoad as RL,
-    RawTorqueSignal as TS,
+    RawContact as Ct, RawCoupling as C, RawForceSignal as FS, RawNetBody as B, RawOil as O,
+    RawRoadLoad as RL, RawTorqueSignal as TS,
 };
 use crate::schema::{show, Key, RawTable};
 use clutchpack_model::network::{
-    Body, Coupling, CouplingKind, LumpedClutch, Network, NetworkProblem, RoadLoad, Signal,
+    Body, Coupling, CouplingKind, GearMesh, LumpedClutch, Network, NetworkProblem, RoadLoad, Signal,
 };
+use clutchpack_model::{Hertz, LawKind, OilFilm, ToothLaw};
 use std::path::Path;
 use toml::Value;
 
@@ -279,6 +280,7 @@ pub(super) fn network(
     enum Kind {
         Clutch,
         Gear,
+        Mesh,
     }
     for (k, r) in couplings.iter().enumerate() {
         let p = |key: &Key| item(key, k);
@@ -290,7 +292,7 @@ pub(super) fn network(
                 &p(&C::kind),
                 r.value(&C::kind),
                 &C::kind,
-                &[Kind::Clutch, Kind::Gear],
+                &[Kind::Clutch, Kind::Gear, Kind::Mesh],
             )
             .required(ck, &p(&C::kind), "required");
         let body = |ck: &mut Checker, key: &Key| {
@@ -328,34 +330,59 @@ pub(super) fn network(
             &C::cgeo_m,
             &C::max_normal_force_n,
         ];
-        let built = match kind {
-            Kind::Gear => {
-                for key in clutch_keys {
-                    ck.not_allowed(
-                        &p(key),
-                        r.value(key),
-                        "a clutch's key; remove it for an ideal_gear",
-                    );
-                }
-                if r.force.is_some() {
+        let mesh_keys: [&Key; 6] = [
+            &C::base_radius_a_m,
+            &C::base_radius_b_m,
+            &C::internal,
+            &C::backlash_m,
+            &C::pairs,
+            &C::mesh_offset_m,
+        ];
+        let kind_name = show(r.value(&C::kind).expect("the kind was read"));
+        let refuse = |ck: &mut Checker, keys: &[&Key], tables: &[(&str, bool)], whose: &str| {
+            for key in keys {
+                ck.not_allowed(
+                    &p(key),
+                    r.value(key),
+                    &format!("{whose}'s key; remove it for kind = {kind_name}"),
+                );
+            }
+            for (table, present) in tables {
+                if *present {
                     ck.report(
-                        format!("couplings[{k}].force"),
+                        format!("couplings[{k}].{table}"),
                         None,
-                        "a clutch's table; remove it for an ideal_gear",
+                        format!("{whose}'s table; remove it for kind = {kind_name}"),
                     );
                 }
-                ck.num(&p(&C::ratio), r.value(&C::ratio), &C::ratio)
-                    .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
-                    .map(|ratio| CouplingKind::IdealGear { ratio })
+            }
+        };
+        let (force, contact, oil) = (
+            ("force", r.force.is_some()),
+            ("contact", r.contact.is_some()),
+            ("oil", r.oil.is_some()),
+        );
+        match kind {
+            Kind::Gear => {
+                refuse(ck, &clutch_keys, &[force], "a clutch");
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
             }
             Kind::Clutch => {
-                ck.not_allowed(
-                    &p(&C::ratio),
-                    r.value(&C::ratio),
-                    "an ideal gear's key; remove it for a clutch",
-                );
-                clutch(ck, r, k, base_dir).map(CouplingKind::Clutch)
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
             }
+            Kind::Mesh => {
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(ck, &clutch_keys, &[force], "a clutch");
+            }
+        }
+        let built = match kind {
+            Kind::Mesh => gear_mesh(ck, r, k).map(CouplingKind::GearMesh),
+            Kind::Gear => ck
+                .num(&p(&C::ratio), r.value(&C::ratio), &C::ratio)
+                .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
+                .map(|ratio| CouplingKind::IdealGear { ratio }),
+            Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
         };
         match (name, a, b, built) {
             (Some(name), Some(a), Some(b), Some(kind)) => {
@@ -462,4 +489,137 @@ fn clutch(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<LumpedCl
         good = false;
     }
     good.then_some(clutch)
+}
+
+/// A gear mesh's keys and its tooth law (`[couplings.contact]`, `[couplings.oil]`: the keys of
+/// a disc's law, MODEL.md section 2).
+fn gear_mesh(ck: &mut Checker, r: &C, k: usize) -> Option<GearMesh> {
+    let p = |key: &Key| item(key, k);
+    let num = |ck: &mut Checker, key: &Key| ck.num(&p(key), r.value(key), key);
+    let required = |ck: &mut Checker, key: &Key| {
+        num(ck, key).required(ck, &p(key), "required for a gear_mesh")
+    };
+    let ra = required(ck, &C::base_radius_a_m);
+    let rb = required(ck, &C::base_radius_b_m);
+    let backlash = required(ck, &C::backlash_m);
+    let pairs = num(ck, &C::pairs).or(C::pairs.default_num());
+    let offset = num(ck, &C::mesh_offset_m).or(0.0);
+    let internal = ck
+        .boolean(&p(&C::internal), r.value(&C::internal))
+        .or(false);
+    // the law: [couplings.contact] and [couplings.oil] (couplings[k].contact.modulus_pa)
+    let at = format!("couplings[{k}]");
+    let cv = |key: &Key| r.contact.as_ref().and_then(|c| c.value(key));
+    let ov = |key: &Key| r.oil.as_ref().and_then(|o| o.value(key));
+    let law = ck
+        .choice(
+            &Ct::law.at(&at),
+            cv(&Ct::law),
+            &Ct::law,
+            &[LawKind::Paper, LawKind::Dry, LawKind::Squeeze],
+        )
+        .or(LawKind::Paper);
+    let hint = "required for a gear_mesh (in its [couplings.contact])";
+    let modulus = ck
+        .num(
+            &Ct::modulus_pa.at(&at),
+            cv(&Ct::modulus_pa),
+            &Ct::modulus_pa,
+        )
+        .required(ck, &Ct::modulus_pa.at(&at), hint);
+    let curvature = ck
+        .num(
+            &Ct::curvature_radius_m.at(&at),
+            cv(&Ct::curvature_radius_m),
+            &Ct::curvature_radius_m,
+        )
+        .required(ck, &Ct::curvature_radius_m.at(&at), hint);
+    let loss = ck
+        .num(
+            &Ct::loss_coefficient_s_m.at(&at),
+            cv(&Ct::loss_coefficient_s_m),
+            &Ct::loss_coefficient_s_m,
+        )
+        .or(0.0);
+    let film = ck
+        .num(
+            &O::film_thickness_m.at(&at),
+            ov(&O::film_thickness_m),
+            &O::film_thickness_m,
+        )
+        .or(0.0);
+    let needs_oil = matches!((law, film), (Some(l), Some(h)) if l != LawKind::Dry && h > 0.0);
+    let oil_num = |ck: &mut Checker, key: &Key| {
+        let f = ck.num(&key.at(&at), ov(key), key);
+        if needs_oil {
+            f.required(
+                ck,
+                &key.at(&at),
+                "required with a film (film_thickness_m > 0) and a law that is not dry",
+            )
+        } else {
+            f.or(0.0)
+        }
+    };
+    let viscosity = oil_num(ck, &O::viscosity_pa_s);
+    let leakage = oil_num(ck, &O::leakage_coefficient);
+    let width = oil_num(ck, &O::width_m);
+    let length = oil_num(ck, &O::length_m);
+    let v_floor = ck
+        .num(
+            &O::v_floor_m_s.at(&at),
+            ov(&O::v_floor_m_s),
+            &O::v_floor_m_s,
+        )
+        .or(O::v_floor_m_s.default_num());
+    let h_min = ck
+        .num(&O::h_min_m.at(&at), ov(&O::h_min_m), &O::h_min_m)
+        .or(O::h_min_m.default_num());
+    let mesh = GearMesh {
+        base_radius_a_m: ra?,
+        base_radius_b_m: rb?,
+        internal: internal?,
+        backlash_m: backlash?,
+        pairs: pairs?,
+        initial_offset_m: offset?,
+        law: ToothLaw {
+            kind: law?,
+            hertz: Hertz {
+                modulus_pa: modulus?,
+                curvature_radius_m: curvature?,
+                loss_coefficient_s_m: loss?,
+            },
+            oil: OilFilm {
+                thickness_m: film?,
+                viscosity_pa_s: viscosity?,
+                leakage_coefficient: leakage?,
+                width_m: width?,
+                length_m: length?,
+                v_floor_m_s: v_floor?,
+                h_min_m: h_min?,
+            },
+        },
+    };
+    // the film and the start inside the free play, along the line of action
+    let half = 0.5 * mesh.backlash_m;
+    let reach = half - mesh.law.engagement_offset_m();
+    if reach <= 0.0 {
+        ck.report(
+            O::film_thickness_m.at(&at),
+            Some(crate::schema::fmt_num(mesh.law.oil.thickness_m)),
+            format!("must be < backlash_m / 2 = {half:e} m (else both flanks engage at once)"),
+        );
+        return None;
+    }
+    if mesh.initial_offset_m.abs() >= reach {
+        ck.report(
+            p(&C::mesh_offset_m),
+            Some(crate::schema::fmt_num(mesh.initial_offset_m)),
+            format!(
+                "the mesh must start inside its free play: |x| must be < backlash_m / 2 - the film = {reach:e} m"
+            ),
+        );
+        return None;
+    }
+    Some(mesh)
 }
