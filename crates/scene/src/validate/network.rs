@@ -290,7 +290,9 @@ pub(super) fn network(
         let p = |key: &Key| item("couplings", key, k);
         let default_name = format!(
             "{}-{}",
-            r.value(&C::kind).and_then(|v| v.as_str()).unwrap_or("coupling"),
+            r.value(&C::kind)
+                .and_then(|v| v.as_str())
+                .unwrap_or("coupling"),
             k + 1
         );
         let name = ck.text(&p(&C::name), r.value(&C::name)).or(default_name);
