@@ -181,7 +181,11 @@ impl Network {
             if b.fixed && (b.drive.is_some() || b.road_load.is_some()) {
                 out.push(body(
                     i,
-                    if b.drive.is_some() { "drive" } else { "road_load" },
+                    if b.drive.is_some() {
+                        "drive"
+                    } else {
+                        "road_load"
+                    },
                     "a fixed body does not turn: a torque on it does nothing; remove it".into(),
                 ));
             }

@@ -313,11 +313,8 @@ pub(super) fn network(
             )?;
             let found = names.iter().position(|m| m.as_deref() == Some(n.as_str()));
             if found.is_none() {
-                let names: Vec<String> = names
-                    .iter()
-                    .flatten()
-                    .map(|b| format!("\"{b}\""))
-                    .collect();
+                let names: Vec<String> =
+                    names.iter().flatten().map(|b| format!("\"{b}\"")).collect();
                 ck.report(
                     p(key),
                     Some(format!("\"{n}\"")),
