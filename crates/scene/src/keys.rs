@@ -104,6 +104,7 @@ table! {
         defaults: table RawBody,
         plate_defaults: table RawBody,
         thermal: table RawThermal,
+        couplings: array RawCoupling,
     }
 }
 
@@ -192,6 +193,29 @@ table! {
         drag_n_m_s_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
         /// starting speed of the drum
         initial_speed_rad_s: "rad/s", SPEED, Dflt::Num(0.0);
+    }
+    children {}
+}
+
+/// Largest torsional stiffness of a coupling accepted, N m/rad (a solid steel shaft of 100 mm
+/// diameter and 10 mm length is about 8e7 N m/rad).
+pub(crate) const MAX_COUPLING_STIFFNESS_N_M_PER_RAD: f64 = 1e9;
+
+table! {
+    /// A `[[couplings]]` entry: a coupling between two of the pack's rotating bodies besides the splines and the stack (MODEL.md section 8); torque T on b, -T on a.
+    RawCoupling at "" {
+        /// what the coupling is: "spring_damper", a torsional spring with a viscous damper in parallel (a clutch damper, a dual-mass flywheel), T = k (theta_a - theta_b - theta_0) + d (omega_a - omega_b)
+        kind: "", Kind::Choice(&["spring_damper"]), Dflt::Required;
+        /// the body on side a: "shaft" or "drum" (needs [drum]); a prescribed shaft drives b through the coupling
+        a: "", Kind::Text, Dflt::Required;
+        /// the body on side b, not a: "shaft" or "drum"
+        b: "", Kind::Text, Dflt::Required;
+        /// spring_damper: torsional stiffness k
+        stiffness_n_m_per_rad: "N m/rad", Kind::Number(Rule::Closed(0.0, MAX_COUPLING_STIFFNESS_N_M_PER_RAD)), Dflt::Required;
+        /// spring_damper: viscous damping d
+        damping_n_m_s_per_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
+        /// spring_damper: free angle theta_0, the twist theta_a - theta_b at which the spring carries no torque (both bodies start at angle 0, so a non-zero theta_0 starts the spring twisted)
+        free_angle_rad: "rad", FINITE, Dflt::Num(0.0);
     }
     children {}
 }

@@ -9,9 +9,10 @@
 //! invalid is not used by the rules between keys (its problem is already reported).
 //!
 //! One module per section of the file: [`simulation`], [`drive`] (with the shaft),
-//! [`bodies`] (discs and plates), [`stack`] (with the drum) and [`thermal`].
+//! [`bodies`] (discs and plates), [`stack`] (with the drum), [`thermal`] and [`couplings`].
 
 mod bodies;
+mod couplings;
 mod drive;
 mod simulation;
 mod stack;
@@ -290,6 +291,7 @@ pub(crate) fn validate(
     );
     let drum = raw.drum.as_ref().map(|r| stack::drum(ck, r));
     let stack = raw.stack.as_ref().map(|r| stack::stack(ck, r));
+    let couplings = couplings::couplings(ck, raw.couplings.as_deref(), raw.drum.is_some());
     // The stack alternates plates and discs: N discs need N + 1 plates; a drum carries plates.
     let n_discs = raw.discs.as_ref().map_or(0, Vec::len);
     let n_plates = raw.plates.as_ref().map_or(0, Vec::len);
@@ -345,6 +347,7 @@ pub(crate) fn validate(
             plates,
             drum: drum.map_or(Some(None), |d| d.map(Some))?,
             stack: stack.map_or(Some(None), |s| s.map(Some))?,
+            couplings: couplings?,
         },
         thermal: thermal?,
     })
