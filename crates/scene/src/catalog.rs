@@ -218,7 +218,8 @@ mod tests {
                 "stack",
                 "defaults",
                 "plate_defaults",
-                "thermal"
+                "thermal",
+                "couplings"
             ]
         );
         assert!(children("discs[]").contains(&"name"));
