@@ -913,9 +913,7 @@ fn a_spring_damper_joins_the_shaft_and_the_drum() {
 #[test]
 fn bad_couplings_name_their_key_path() {
     let coupling = |body: &str, extra: &str| {
-        format!(
-            "\n[[couplings]]\nkind = \"spring_damper\"\na = \"shaft\"\nb = \"{body}\"\n{extra}"
-        )
+        format!("\n[[couplings]]\nkind = \"spring_damper\"\na = \"shaft\"\nb = \"{body}\"\n{extra}")
     };
     let text = format!(
         "{PAPER}{}{}{}{}",
@@ -926,15 +924,41 @@ fn bad_couplings_name_their_key_path() {
     );
     let e = parse_err(&text, &[]);
     let p = problem_at(&e, "couplings[0].b");
-    assert!(p.rule.contains("unknown body") && p.rule.contains("\"drum\""), "{e}");
-    assert!(problem_at(&e, "couplings[1].b").rule.contains("another body"), "{e}");
-    assert!(problem_at(&e, "couplings[2].b").rule.contains("no [drum]"), "{e}");
-    assert!(problem_at(&e, "couplings[2].stiffness_n_m_per_rad").rule.contains("in [0"), "{e}");
-    assert!(problem_at(&e, "couplings[3].kind").rule.contains("spring_damper"), "{e}");
+    assert!(
+        p.rule.contains("unknown body") && p.rule.contains("\"drum\""),
+        "{e}"
+    );
+    assert!(
+        problem_at(&e, "couplings[1].b")
+            .rule
+            .contains("another body"),
+        "{e}"
+    );
+    assert!(
+        problem_at(&e, "couplings[2].b").rule.contains("no [drum]"),
+        "{e}"
+    );
+    assert!(
+        problem_at(&e, "couplings[2].stiffness_n_m_per_rad")
+            .rule
+            .contains("in [0"),
+        "{e}"
+    );
+    assert!(
+        problem_at(&e, "couplings[3].kind")
+            .rule
+            .contains("spring_damper"),
+        "{e}"
+    );
     // an unknown key inside an entry lists the entry's keys
     let e = parse_err(
         &format!("{PAPER}{}", coupling("shaft", "stiffnes = 1")),
         &[],
     );
-    assert!(problem_at(&e, "couplings[0].stiffnes").rule.contains("stiffness_n_m_per_rad"), "{e}");
+    assert!(
+        problem_at(&e, "couplings[0].stiffnes")
+            .rule
+            .contains("stiffness_n_m_per_rad"),
+        "{e}"
+    );
 }
