@@ -153,7 +153,7 @@ pub enum PackBody {
 /// What a coupling does: one arm per kind (MODEL.md section 8; a lumped clutch and a gear
 /// mesh are the next arms).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum CouplingKind {
+pub enum PackCouplingKind {
     /// A torsional spring-damper ([`SpringDamper`]).
     SpringDamper(SpringDamper),
 }
@@ -168,7 +168,7 @@ pub struct PackCoupling {
     /// Side b (receives the reported torque); not `a`.
     pub b: PackBody,
     /// The law.
-    pub kind: CouplingKind,
+    pub kind: PackCouplingKind,
 }
 
 /// The angle (rad) and speed (rad/s) of a body at one instant.
@@ -180,14 +180,14 @@ impl PackCoupling {
     /// `k (theta_a - theta_b - theta_0) + d (omega_a - omega_b)`.
     pub fn torque_on_b_n_m(&self, a: BodyMotion, b: BodyMotion) -> f64 {
         match &self.kind {
-            CouplingKind::SpringDamper(s) => s.torque_n_m(a.0 - b.0, a.1 - b.1),
+            PackCouplingKind::SpringDamper(s) => s.torque_n_m(a.0 - b.0, a.1 - b.1),
         }
     }
 
     /// The energy the coupling stores at the angles `theta_a`, `theta_b` (rad), J (>= 0).
     pub fn potential_j(&self, theta_a: f64, theta_b: f64) -> f64 {
         match &self.kind {
-            CouplingKind::SpringDamper(s) => s.potential_j(theta_a - theta_b),
+            PackCouplingKind::SpringDamper(s) => s.potential_j(theta_a - theta_b),
         }
     }
 
@@ -195,7 +195,7 @@ impl PackCoupling {
     /// (>= 0).
     pub fn loss_rate_w(&self, omega_a: f64, omega_b: f64) -> f64 {
         match &self.kind {
-            CouplingKind::SpringDamper(s) => s.loss_rate_w(omega_a - omega_b),
+            PackCouplingKind::SpringDamper(s) => s.loss_rate_w(omega_a - omega_b),
         }
     }
 }
@@ -428,7 +428,7 @@ mod tests {
         pack.couplings.push(PackCoupling {
             a: PackBody::Shaft,
             b: PackBody::Drum,
-            kind: CouplingKind::SpringDamper(spring),
+            kind: PackCouplingKind::SpringDamper(spring),
         });
         let l = pack.coupling_loads((0.3, 5.0), (0.1, 4.0));
         // k (0.3 - 0.1 - 0.1) + d (5 - 4) = 10 + 2

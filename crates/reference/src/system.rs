@@ -721,11 +721,13 @@ mod tests {
         pack.couplings = vec![clutchpack_model::PackCoupling {
             a: clutchpack_model::PackBody::Shaft,
             b: clutchpack_model::PackBody::Drum,
-            kind: clutchpack_model::CouplingKind::SpringDamper(clutchpack_model::SpringDamper {
-                stiffness_n_m_per_rad: 800.0,
-                damping_n_m_s_per_rad: 0.7,
-                free_angle_rad: 0.01,
-            }),
+            kind: clutchpack_model::PackCouplingKind::SpringDamper(
+                clutchpack_model::SpringDamper {
+                    stiffness_n_m_per_rad: 800.0,
+                    damping_n_m_s_per_rad: 0.7,
+                    free_angle_rad: 0.01,
+                },
+            ),
         }];
         pack
     }

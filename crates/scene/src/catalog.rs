@@ -219,6 +219,7 @@ mod tests {
                 "defaults",
                 "plate_defaults",
                 "thermal",
+                "bodies",
                 "couplings"
             ]
         );

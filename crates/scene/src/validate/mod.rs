@@ -14,6 +14,7 @@
 mod bodies;
 mod couplings;
 mod drive;
+mod network;
 mod simulation;
 mod stack;
 mod thermal;
@@ -34,6 +35,7 @@ pub(crate) struct Validated {
     pub pack: PackModel,
     pub fatigue: Vec<clutchpack_model::FatigueParams>,
     pub thermal: Option<clutchpack_model::thermal::ThermalModel>,
+    pub network: Option<clutchpack_model::network::Network>,
 }
 
 /// The outcome of checking one value where it is written.
@@ -270,6 +272,9 @@ pub(crate) fn validate(
         .text("description", raw.description.as_ref())
         .or(String::new());
     let simulation = simulation::simulation(ck, raw.simulation.as_ref());
+    if let Some(bodies) = raw.bodies.as_deref() {
+        return network_scene(ck, raw, bodies, base_dir, name, description, simulation);
+    }
     let (kind, drive) = drive::drive(ck, raw.drive.as_ref(), base_dir);
     let shaft = drive::shaft(ck, raw.shaft.as_ref(), kind, drive);
     let mut names = Vec::new();
@@ -350,5 +355,73 @@ pub(crate) fn validate(
             couplings: couplings?,
         },
         thermal: thermal?,
+        network: None,
+    })
+}
+
+/// A network scene (`[[bodies]]`, MODEL.md section 8): the pack's sections are refused (a
+/// resolved pack on a network comes next), the simulation settings that only a pack uses
+/// too; the `pack` is an empty placeholder that nothing runs.
+fn network_scene(
+    ck: &mut Checker,
+    raw: &RawScene,
+    bodies: &[crate::keys::RawNetBody],
+    base_dir: &Path,
+    name: Option<String>,
+    description: Option<String>,
+    simulation: Option<Simulation>,
+) -> Option<Validated> {
+    let pack_sections = [
+        ("shaft", raw.shaft.is_some()),
+        ("drive", raw.drive.is_some()),
+        ("discs", raw.discs.is_some()),
+        ("plates", raw.plates.is_some()),
+        ("drum", raw.drum.is_some()),
+        ("stack", raw.stack.is_some()),
+        ("defaults", raw.defaults.is_some()),
+        ("plate_defaults", raw.plate_defaults.is_some()),
+        ("thermal", raw.thermal.is_some()),
+    ];
+    for (section, present) in pack_sections {
+        if present {
+            ck.report(
+                section,
+                None,
+                "not in a network scene yet: a network ([[bodies]]) runs lumped parts (clutches, ideal gears); resolved packs on a network come next (issue 34)",
+            );
+        }
+    }
+    if let Some(sim) = &simulation {
+        if sim.engine == Some(crate::EngineChoice::Multibody) {
+            ck.report(
+                "simulation.engine",
+                Some("\"multibody\"".into()),
+                "a network runs on the reference engine only, for now",
+            );
+        }
+    }
+    let network = network::network(
+        ck,
+        bodies,
+        raw.couplings.as_deref().unwrap_or(&[]),
+        base_dir,
+    );
+    Some(Validated {
+        name: name?,
+        description: description?,
+        simulation: simulation?,
+        pack: PackModel {
+            shaft: clutchpack_model::Shaft::Prescribed(clutchpack_model::SpeedProfile::sine(
+                0.0, 0.0, 1.0,
+            )),
+            discs: Vec::new(),
+            plates: Vec::new(),
+            drum: None,
+            stack: None,
+            couplings: Vec::new(),
+        },
+        fatigue: Vec::new(),
+        thermal: None,
+        network: Some(network?),
     })
 }

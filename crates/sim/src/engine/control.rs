@@ -130,7 +130,7 @@ impl Run {
             .couplings
             .iter()
             .map(|c| match &c.kind {
-                clutchpack_model::CouplingKind::SpringDamper(s) => {
+                clutchpack_model::PackCouplingKind::SpringDamper(s) => {
                     2.0 * std::f64::consts::PI
                         / s.natural_frequency_rad_s(inertia(c.a), inertia(c.b))
                 }
