@@ -497,7 +497,7 @@ const SIGNAL_KINDS: Kind = Kind::Choice(&["constant", "step", "ramp", "sine", "t
 
 table! {
     /// One `[[bodies]]` entry: a rotational body of a driveline network (MODEL.md section 8). A scene with `[[bodies]]` is a network scene: its bodies and `[[couplings]]` replace `[shaft]`, `[drive]`, `[[discs]]`, `[[plates]]`, `[drum]` and `[stack]` (resolved packs on a network come next).
-    RawNetBody at "bodies[]" {
+    RawNetBody at "" {
         /// the body's name, unique; couplings name their bodies by it
         name: "", Kind::Text, Dflt::Required;
         /// inertia about its axis
@@ -517,7 +517,7 @@ table! {
 
 table! {
     /// `[bodies.drive]`: a driving torque on the body, positive in its sense of rotation.
-    RawTorqueSignal at "bodies[].drive" {
+    RawTorqueSignal at "drive" {
         /// "constant" (value_n_m), "step" (offset_n_m, then + height_n_m from start_s), "ramp" (offset_n_m rising by height_n_m over duration_s from start_s), "sine" (offset_n_m + amplitude_n_m sin(2 pi f (t - start_s) + phase) from start_s), "table" (file)
         kind: "", SIGNAL_KINDS, Dflt::Required;
         /// constant: the torque
@@ -546,7 +546,7 @@ table! {
 
 table! {
     /// `[bodies.road_load]`: a load opposing motion, -sign(w) (a + b |w| + c w^2), zero at rest (a vehicle reduced to a shaft).
-    RawRoadLoad at "bodies[].road_load" {
+    RawRoadLoad at "road_load" {
         /// a: the constant part (rolling resistance)
         constant_n_m: "N m", NON_NEGATIVE, Dflt::Num(0.0);
         /// b: the part proportional to speed
@@ -559,9 +559,9 @@ table! {
 
 table! {
     /// One `[[couplings]]` entry: a coupling between bodies a and b (MODEL.md section 8): in a network scene between two of its [[bodies]]; in a one-pack scene (no [[bodies]]) a spring_damper between its shaft and its drum. Signs: a clutch's slip is w_b - w_a and its torque acts +tau on a, -tau on b (Modelica's flanges); an ideal gear ties w_a = ratio w_b; a gear mesh's force F, signed as x, acts -Rb_a F on a and -Rb_b F on b (internal: +Rb_b F); a spring_damper's torque T = k (theta_a - theta_b - theta_0) + d (w_a - w_b) acts +T on b, -T on a.
-    RawCoupling at "couplings[]" {
-        /// the coupling's name, unique
-        name: "", Kind::Text, Dflt::Required;
+    RawCoupling at "" {
+        /// the coupling's name, unique (tables, summaries and figures name it)
+        name: "", Kind::Text, Dflt::Described("default \"<kind>-<i+1>\" (\"clutch-2\")");
         /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash; "gear_mesh": a gear pair with backlash and the tooth law of [couplings.contact] and [couplings.oil] along its line of action (gear rattle); "spring_damper": a torsional spring with a viscous damper in parallel (a clutch damper, a dual-mass flywheel; one-pack scenes, between "shaft" and "drum")
         kind: "", Kind::Choice(&["clutch", "ideal_gear", "gear_mesh", "spring_damper"]), Dflt::Required;
         /// the name of body a (a one-pack scene: "shaft" or "drum", the drum with [drum]; a prescribed shaft drives b through a spring_damper)
@@ -610,7 +610,7 @@ table! {
 
 table! {
     /// `[couplings.force]`: a clutch's normalized normal force f(t) (the normal force is max_normal_force_n f; engaged while > 0).
-    RawForceSignal at "couplings[].force" {
+    RawForceSignal at "force" {
         /// "constant" (value), "step" (offset, then + height from start_s), "ramp" (offset rising by height over duration_s from start_s), "sine" (offset + amplitude sin(2 pi f (t - start_s) + phase) from start_s), "table" (file)
         kind: "", SIGNAL_KINDS, Dflt::Required;
         /// constant: the force

@@ -32,6 +32,9 @@ pub struct ModeChange {
     pub from: &'static str,
     /// Mode after.
     pub to: &'static str,
+    /// Each coupling's torque step at this instant, N m (after less before, on its body `a`:
+    /// the output torque's step at a lock is its gear's), in the scene's order.
+    pub torque_steps_n_m: Vec<f64>,
 }
 
 /// One coupling's results.
@@ -50,6 +53,10 @@ pub struct CouplingSummary {
     pub final_mode: Option<&'static str>,
     /// The instants a clutch locked, s.
     pub lock_times_s: Vec<f64>,
+    /// The smallest torque on its body a over the samples, N m.
+    pub min_torque_n_m: f64,
+    /// The largest torque on its body a over the samples, N m.
+    pub max_torque_n_m: f64,
     /// Every mode change after t = 0, in time order.
     pub changes: Vec<ModeChange>,
 }
@@ -121,18 +128,36 @@ pub struct NetworkOutcome {
 struct Keep<'a, 'r> {
     req: &'a mut NetworkRequest<'r>,
     events: Vec<ClutchEvent>,
+    /// (t, each coupling's torque step) at each switching instant.
+    steps: Vec<(f64, Vec<f64>)>,
+    /// Per coupling: the smallest and largest torque sampled.
+    range: Vec<(f64, f64)>,
     history: Vec<NetworkSample>,
     stopped: bool,
 }
 
 impl NetworkObserver for Keep<'_, '_> {
     fn sample(&mut self, s: &NetworkSample) {
+        self.range
+            .resize(s.torque_n_m.len(), (f64::INFINITY, f64::NEG_INFINITY));
+        for (r, t) in self.range.iter_mut().zip(&s.torque_n_m) {
+            *r = (r.0.min(*t), r.1.max(*t));
+        }
         if self.req.keep_history {
             self.history.push(s.clone());
         }
     }
     fn clutch_event(&mut self, e: &ClutchEvent) {
         self.events.push(*e);
+    }
+    fn switched(&mut self, before: &NetworkSample, after: &NetworkSample) {
+        let steps = after
+            .torque_n_m
+            .iter()
+            .zip(&before.torque_n_m)
+            .map(|(a, b)| a - b)
+            .collect();
+        self.steps.push((after.t_s, steps));
     }
     fn progress(&mut self, t: f64) -> bool {
         if let Some(p) = self.req.progress.as_mut() {
@@ -161,6 +186,8 @@ pub fn run_network_scene(scene: &Scene, mut req: NetworkRequest) -> Result<Netwo
     let mut keep = Keep {
         req: &mut req,
         events: Vec::new(),
+        steps: Vec::new(),
+        range: Vec::new(),
         history: Vec::new(),
         stopped: false,
     };
@@ -185,6 +212,11 @@ pub fn run_network_scene(scene: &Scene, mut req: NetworkRequest) -> Result<Netwo
                     t_s: e.t_s,
                     from: e.from.label(),
                     to: e.to.label(),
+                    torque_steps_n_m: keep
+                        .steps
+                        .iter()
+                        .find(|(t, _)| *t == e.t_s)
+                        .map_or_else(Vec::new, |(_, s)| s.clone()),
                 })
                 .collect();
             CouplingSummary {
@@ -203,6 +235,8 @@ pub fn run_network_scene(scene: &Scene, mut req: NetworkRequest) -> Result<Netwo
                     .filter(|e| e.coupling == k && e.to == ClutchMode::Locked)
                     .map(|e| e.t_s)
                     .collect(),
+                min_torque_n_m: keep.range.get(k).map_or(0.0, |r| r.0),
+                max_torque_n_m: keep.range.get(k).map_or(0.0, |r| r.1),
                 changes,
             }
         })

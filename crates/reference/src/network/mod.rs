@@ -137,6 +137,10 @@ pub trait NetworkObserver {
     fn sample(&mut self, _sample: &NetworkSample) {}
     /// A clutch changed mode.
     fn clutch_event(&mut self, _event: &ClutchEvent) {}
+    /// The state just before and just after an instant where clutches changed mode (sent
+    /// before their [`Self::clutch_event`]s): the couplings' torques jump there (the output
+    /// torque's step at a lock).
+    fn switched(&mut self, _before: &NetworkSample, _after: &NetworkSample) {}
     /// A gear mesh's tooth contact closed (its `disc` is the coupling's index; the peak is
     /// the force per tooth pair, negative when body `a` leads: `x > 0`).
     fn mesh_impact(&mut self, _impact: &ImpactEvent) {}
@@ -606,6 +610,7 @@ fn settle(
     let net = eq.net;
     let n = net.bodies.len();
     let before = eq.modes.clone();
+    let state_before = sample(eq, t, y);
     let mut modes = before.clone();
     for (k, c) in net.couplings.iter().enumerate() {
         let Some(cl) = clutch(net, k) else { continue };
@@ -662,6 +667,9 @@ fn settle(
     }
     eq.set_modes(&modes);
     *events += 1;
+    if before != modes {
+        obs.switched(&state_before, &sample(eq, t, y));
+    }
     for (k, (b, a)) in before.iter().zip(&modes).enumerate() {
         if let (Some(from), Some(to)) = (b, a) {
             if from != to {

@@ -38,7 +38,7 @@ const OTHER_KEYS: [&Key; 13] = [
 
 /// The path of key `k` of entry `i`: `couplings[2].b`.
 fn item(k: &Key, i: usize) -> String {
-    k.rel().replacen("[]", &format!("[{i}]"), 1)
+    k.at(&format!("couplings[{i}]"))
 }
 
 /// Every `[[couplings]]` entry of a one-pack scene (none: an empty list); `has_drum`: whether
@@ -71,9 +71,10 @@ fn coupling(
     names: &mut Vec<String>,
 ) -> Option<PackCoupling> {
     let path = |k: &Key| item(k, i);
-    let name =
-        ck.text(&path(&C::name), r.value(&C::name))
-            .required(ck, &path(&C::name), "required");
+    // the network's default name, `<kind>-<i+1>`
+    let name = ck
+        .text(&path(&C::name), r.value(&C::name))
+        .or(format!("spring_damper-{}", i + 1));
     if let Some(n) = &name {
         if names.contains(n) {
             ck.report(

@@ -17,9 +17,9 @@ use clutchpack_model::{Hertz, LawKind, OilFilm, ToothLaw};
 use std::path::Path;
 use toml::Value;
 
-/// The path of key `k` of array item `i`: `bodies[2].drive.start_s`.
-fn item(k: &Key, i: usize) -> String {
-    k.rel().replacen("[]", &format!("[{i}]"), 1)
+/// The path of key `k` of item `i` of the array `array`: `bodies[2].drive.start_s`.
+fn item(array: &str, k: &Key, i: usize) -> String {
+    k.at(&format!("{array}[{i}]"))
 }
 
 /// The keys of one signal table (a torque in N m, or a normalized force).
@@ -37,6 +37,8 @@ struct SignalKeys {
     interpolation: Key,
     /// The CSV column of the values.
     column: &'static str,
+    /// The array whose items hold the table: `bodies` or `couplings`.
+    array: &'static str,
 }
 
 const TORQUE_SIGNAL: SignalKeys = SignalKeys {
@@ -52,6 +54,7 @@ const TORQUE_SIGNAL: SignalKeys = SignalKeys {
     file: TS::file,
     interpolation: TS::interpolation,
     column: "torque_n_m",
+    array: "bodies",
 };
 
 const FORCE_SIGNAL: SignalKeys = SignalKeys {
@@ -67,6 +70,7 @@ const FORCE_SIGNAL: SignalKeys = SignalKeys {
     file: FS::file,
     interpolation: FS::interpolation,
     column: "force",
+    array: "couplings",
 };
 
 /// One signal table of item `i`; `get` reads a key's value as written.
@@ -86,7 +90,7 @@ fn signal<'v>(
         Table,
     }
     use K::*;
-    let p = |k: &Key| item(k, i);
+    let p = |k: &Key| item(keys.array, k, i);
     let kind = ck
         .choice(
             &p(&keys.kind),
@@ -207,7 +211,7 @@ pub(super) fn network(
     let mut ok = true;
     let mut net = Network::default();
     for (i, r) in bodies.iter().enumerate() {
-        let p = |k: &Key| item(k, i);
+        let p = |k: &Key| item("bodies", k, i);
         let name = ck.text(&p(&B::name), r.value(&B::name)).required(
             ck,
             &p(&B::name),
@@ -284,10 +288,15 @@ pub(super) fn network(
         Spring,
     }
     for (k, r) in couplings.iter().enumerate() {
-        let p = |key: &Key| item(key, k);
-        let name = ck
-            .text(&p(&C::name), r.value(&C::name))
-            .required(ck, &p(&C::name), "required");
+        let p = |key: &Key| item("couplings", key, k);
+        let default_name = format!(
+            "{}-{}",
+            r.value(&C::kind)
+                .and_then(|v| v.as_str())
+                .unwrap_or("coupling"),
+            k + 1
+        );
+        let name = ck.text(&p(&C::name), r.value(&C::name)).or(default_name);
         let kind = ck
             .choice(
                 &p(&C::kind),
@@ -434,7 +443,7 @@ pub(super) fn network(
 
 /// A clutch's keys and its `force` table.
 fn clutch(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<LumpedClutch> {
-    let p = |key: &Key| item(key, k);
+    let p = |key: &Key| item("couplings", key, k);
     let mu = ck.num(&p(&C::mu), r.value(&C::mu), &C::mu);
     let speeds = ck.numbers(&p(&C::mu_speeds_rad_s), r.value(&C::mu_speeds_rad_s), None);
     let values = ck.numbers(&p(&C::mu_values), r.value(&C::mu_values), None);
@@ -514,7 +523,7 @@ fn clutch(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<LumpedCl
 /// A gear mesh's keys and its tooth law (`[couplings.contact]`, `[couplings.oil]`: the keys of
 /// a disc's law, MODEL.md section 2).
 fn gear_mesh(ck: &mut Checker, r: &C, k: usize) -> Option<GearMesh> {
-    let p = |key: &Key| item(key, k);
+    let p = |key: &Key| item("couplings", key, k);
     let num = |ck: &mut Checker, key: &Key| ck.num(&p(key), r.value(key), key);
     let required = |ck: &mut Checker, key: &Key| {
         num(ck, key).required(ck, &p(key), "required for a gear_mesh")
