@@ -178,6 +178,13 @@ impl Network {
                     "a fixed body does not turn: its speed is 0".into(),
                 ));
             }
+            if b.fixed && (b.drive.is_some() || b.road_load.is_some()) {
+                out.push(body(
+                    i,
+                    if b.drive.is_some() { "drive" } else { "road_load" },
+                    "a fixed body does not turn: a torque on it does nothing; remove it".into(),
+                ));
+            }
             if b.fixed && self.bodies[..i].iter().any(|o| o.fixed) {
                 out.push(body(
                     i,

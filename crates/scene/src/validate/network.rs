@@ -210,6 +210,9 @@ pub(super) fn network(
 ) -> Option<Network> {
     let mut ok = true;
     let mut net = Network::default();
+    // every body's name as written (a coupling is checked against them even when another key
+    // of a body is bad, so that one run lists every problem)
+    let mut names: Vec<Option<String>> = Vec::new();
     for (i, r) in bodies.iter().enumerate() {
         let p = |k: &Key| item("bodies", k, i);
         let name = ck.text(&p(&B::name), r.value(&B::name)).required(
@@ -262,6 +265,7 @@ pub(super) fn network(
             }
             None => Some(None),
         };
+        names.push(name.clone());
         match (name, inertia, fixed, drag, speed, drive, road_load) {
             (Some(name), Some(j), Some(fixed), Some(c), Some(w), Some(drive), Some(road_load)) => {
                 net.bodies.push(Body {
@@ -276,9 +280,6 @@ pub(super) fn network(
             }
             _ => ok = false,
         }
-    }
-    if !ok {
-        return None;
     }
     #[derive(Clone, Copy)]
     enum Kind {
@@ -311,12 +312,12 @@ pub(super) fn network(
                 &p(key),
                 "required: the name of a body in [[bodies]]",
             )?;
-            let found = net.body_index(&n);
+            let found = names.iter().position(|m| m.as_deref() == Some(n.as_str()));
             if found.is_none() {
-                let names: Vec<String> = net
-                    .bodies
+                let names: Vec<String> = names
                     .iter()
-                    .map(|b| format!("\"{}\"", b.name))
+                    .flatten()
+                    .map(|b| format!("\"{b}\""))
                     .collect();
                 ck.report(
                     p(key),
