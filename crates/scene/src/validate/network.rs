@@ -286,6 +286,7 @@ pub(super) fn network(
         Clutch,
         Gear,
         Mesh,
+        Spring,
     }
     for (k, r) in couplings.iter().enumerate() {
         let p = |key: &Key| item("couplings", key, k);
@@ -302,7 +303,7 @@ pub(super) fn network(
                 &p(&C::kind),
                 r.value(&C::kind),
                 &C::kind,
-                &[Kind::Clutch, Kind::Gear, Kind::Mesh],
+                &[Kind::Clutch, Kind::Gear, Kind::Mesh, Kind::Spring],
             )
             .required(ck, &p(&C::kind), "required");
         let body = |ck: &mut Checker, key: &Key| {
@@ -329,6 +330,22 @@ pub(super) fn network(
             ok = false;
             continue;
         };
+        if matches!(kind, Kind::Spring) {
+            // a one-pack scene's coupling so far (validate/couplings.rs)
+            ck.report(
+                p(&C::kind),
+                r.value(&C::kind).map(show),
+                "not in a network scene yet: a spring_damper joins the shaft and the drum of a \
+                 one-pack scene (no [[bodies]])",
+            );
+            ok = false;
+            continue;
+        }
+        let spring_keys: [&Key; 3] = [
+            &C::stiffness_n_m_per_rad,
+            &C::damping_n_m_s_per_rad,
+            &C::free_angle_rad,
+        ];
         let clutch_keys: [&Key; 6] = [
             &C::mu,
             &C::mu_speeds_rad_s,
@@ -370,6 +387,7 @@ pub(super) fn network(
             ("oil", r.oil.is_some()),
         );
         match kind {
+            Kind::Spring => unreachable!("refused above"),
             Kind::Gear => {
                 refuse(ck, &clutch_keys, &[force], "a clutch");
                 refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
@@ -383,6 +401,7 @@ pub(super) fn network(
                 refuse(ck, &clutch_keys, &[force], "a clutch");
             }
         }
+        refuse(ck, &spring_keys, &[], "a spring_damper");
         let built = match kind {
             Kind::Mesh => gear_mesh(ck, r, k).map(CouplingKind::GearMesh),
             Kind::Gear => ck
@@ -390,6 +409,7 @@ pub(super) fn network(
                 .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
                 .map(|ratio| CouplingKind::IdealGear { ratio }),
             Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
+            Kind::Spring => unreachable!("refused above"),
         };
         match (name, a, b, built) {
             (Some(name), Some(a), Some(b), Some(kind)) => {
