@@ -330,17 +330,6 @@ pub(super) fn network(
             ok = false;
             continue;
         };
-        if matches!(kind, Kind::Spring) {
-            // a one-pack scene's coupling so far (validate/couplings.rs)
-            ck.report(
-                p(&C::kind),
-                r.value(&C::kind).map(show),
-                "not in a network scene yet: a spring_damper joins the shaft and the drum of a \
-                 one-pack scene (no [[bodies]])",
-            );
-            ok = false;
-            continue;
-        }
         let spring_keys: [&Key; 3] = [
             &C::stiffness_n_m_per_rad,
             &C::damping_n_m_s_per_rad,
@@ -386,8 +375,15 @@ pub(super) fn network(
             ("contact", r.contact.is_some()),
             ("oil", r.oil.is_some()),
         );
+        if !matches!(kind, Kind::Spring) {
+            refuse(ck, &spring_keys, &[], "a spring_damper");
+        }
         match kind {
-            Kind::Spring => unreachable!("refused above"),
+            Kind::Spring => {
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(ck, &clutch_keys, &[force], "a clutch");
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
+            }
             Kind::Gear => {
                 refuse(ck, &clutch_keys, &[force], "a clutch");
                 refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
@@ -401,7 +397,6 @@ pub(super) fn network(
                 refuse(ck, &clutch_keys, &[force], "a clutch");
             }
         }
-        refuse(ck, &spring_keys, &[], "a spring_damper");
         let built = match kind {
             Kind::Mesh => gear_mesh(ck, r, k).map(CouplingKind::GearMesh),
             Kind::Gear => ck
@@ -409,7 +404,24 @@ pub(super) fn network(
                 .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
                 .map(|ratio| CouplingKind::IdealGear { ratio }),
             Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
-            Kind::Spring => unreachable!("refused above"),
+            Kind::Spring => {
+                let num = |ck: &mut Checker, key: &Key| ck.num(&p(key), r.value(key), key);
+                let k_ = num(ck, &C::stiffness_n_m_per_rad).required(
+                    ck,
+                    &p(&C::stiffness_n_m_per_rad),
+                    "the spring's stiffness, N m/rad",
+                );
+                let d =
+                    num(ck, &C::damping_n_m_s_per_rad).or(C::damping_n_m_s_per_rad.default_num());
+                let theta0 = num(ck, &C::free_angle_rad).or(C::free_angle_rad.default_num());
+                (|| {
+                    Some(CouplingKind::SpringDamper(clutchpack_model::SpringDamper {
+                        stiffness_n_m_per_rad: k_?,
+                        damping_n_m_s_per_rad: d?,
+                        free_angle_rad: theta0?,
+                    }))
+                })()
+            }
         };
         match (name, a, b, built) {
             (Some(name), Some(a), Some(b), Some(kind)) => {
