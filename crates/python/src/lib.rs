@@ -264,6 +264,22 @@ struct RawRun {
 /// `record` and writing `impacts_csv`; keeps the load history when `keep_samples`. The GIL
 /// is released while the engine runs; Ctrl-C stops it with its outputs complete and raises
 /// `KeyboardInterrupt`.
+/// A progress callback for a run with the GIL released: every [`SIGNAL_POLL`] it takes the GIL
+/// to check Python's signals; a pending one (Ctrl-C) is kept in `interrupt` and sets `stop`,
+/// which ends the run with its outputs complete.
+fn signal_poll<'a>(stop: &'a AtomicBool, interrupt: &'a mut Option<PyErr>) -> impl FnMut(f64) + 'a {
+    let mut last = Instant::now();
+    move |_t: f64| {
+        if last.elapsed() >= SIGNAL_POLL {
+            last = Instant::now();
+            if let Err(e) = Python::attach(|py| py.check_signals()) {
+                *interrupt = Some(e);
+                stop.store(true, Ordering::SeqCst);
+            }
+        }
+    }
+}
+
 /// What one network run gave, for the Python half.
 #[pyclass(name = "RawNetworkRun", module = "clutchpack", frozen, get_all)]
 struct RawNetworkRun {
@@ -285,16 +301,7 @@ fn run_network(py: Python<'_>, scene: &Scene) -> PyResult<RawNetworkRun> {
     let stop = AtomicBool::new(false);
     let mut interrupt: Option<PyErr> = None;
     let outcome = py.detach(|| {
-        let mut last = Instant::now();
-        let mut progress = |_t: f64| {
-            if last.elapsed() >= SIGNAL_POLL {
-                last = Instant::now();
-                if let Err(e) = Python::attach(|py| py.check_signals()) {
-                    interrupt = Some(e);
-                    stop.store(true, Ordering::SeqCst);
-                }
-            }
-        };
+        let mut progress = signal_poll(&stop, &mut interrupt);
         clutchpack_sdk::run_network_scene(
             &scene.inner,
             clutchpack_sdk::NetworkRequest {
@@ -363,16 +370,7 @@ fn run(
     let stop = AtomicBool::new(false);
     let mut interrupt: Option<PyErr> = None;
     let outcome = py.detach(|| {
-        let mut last = Instant::now();
-        let mut progress = |_t: f64| {
-            if last.elapsed() >= SIGNAL_POLL {
-                last = Instant::now();
-                if let Err(e) = Python::attach(|py| py.check_signals()) {
-                    interrupt = Some(e);
-                    stop.store(true, Ordering::SeqCst);
-                }
-            }
-        };
+        let mut progress = signal_poll(&stop, &mut interrupt);
         sim.run(RunRequest {
             keep_history: true,
             keep_cycles: false,
