@@ -83,10 +83,12 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     for c in &s.couplings {
         let locks: Vec<String> = c.lock_times_s.iter().map(|t| format!("{t:.6}")).collect();
         out!(
-            "  {:<16} {:<10} heat {:>12.3} J  end: {:<6} {:>10.3} N m  locked at [{}] s",
+            "  {:<16} {:<10} heat {:>12.3} J  torque {:>10.3} to {:>10.3} N m  end: {:<6} {:>10.3} N m  locked at [{}] s",
             c.name,
             c.kind,
             c.heat_j,
+            c.min_torque_n_m,
+            c.max_torque_n_m,
             c.final_mode.unwrap_or("-"),
             c.final_torque_n_m,
             locks.join(", ")
@@ -101,7 +103,24 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     if !changes.is_empty() {
         out!("clutch mode changes:");
         for (name, m) in changes {
-            out!("  {:>12.6} s  {:<16} {} -> {}", m.t_s, name, m.from, m.to);
+            // the largest torque step elsewhere at that instant (a lock's output torque step)
+            let step = m
+                .torque_steps_n_m
+                .iter()
+                .zip(&s.couplings)
+                .filter(|(_, c)| c.name != name)
+                .max_by(|x, y| x.0.abs().total_cmp(&y.0.abs()));
+            let step = match step {
+                Some((d, c)) if d.abs() > 1e-9 => format!("  ({} steps by {d:+.3} N m)", c.name),
+                _ => String::new(),
+            };
+            out!(
+                "  {:>12.6} s  {:<16} {} -> {}{step}",
+                m.t_s,
+                name,
+                m.from,
+                m.to
+            );
         }
     }
     let e = &s.energy;

@@ -198,6 +198,10 @@ table! {
     children {}
 }
 
+/// Largest torsional stiffness of a coupling accepted, N m/rad (a solid steel shaft of 100 mm
+/// diameter and 10 mm length is about 8e7 N m/rad).
+pub(crate) const MAX_COUPLING_STIFFNESS_N_M_PER_RAD: f64 = 1e9;
+
 table! {
     /// `[stack]`: the piston, the clamped stack and its friction faces.
     RawStack at "stack" {
@@ -493,7 +497,7 @@ const SIGNAL_KINDS: Kind = Kind::Choice(&["constant", "step", "ramp", "sine", "t
 
 table! {
     /// One `[[bodies]]` entry: a rotational body of a driveline network (MODEL.md section 8). A scene with `[[bodies]]` is a network scene: its bodies and `[[couplings]]` replace `[shaft]`, `[drive]`, `[[discs]]`, `[[plates]]`, `[drum]` and `[stack]` (resolved packs on a network come next).
-    RawNetBody at "bodies[]" {
+    RawNetBody at "" {
         /// the body's name, unique; couplings name their bodies by it
         name: "", Kind::Text, Dflt::Required;
         /// inertia about its axis
@@ -513,7 +517,7 @@ table! {
 
 table! {
     /// `[bodies.drive]`: a driving torque on the body, positive in its sense of rotation.
-    RawTorqueSignal at "bodies[].drive" {
+    RawTorqueSignal at "drive" {
         /// "constant" (value_n_m), "step" (offset_n_m, then + height_n_m from start_s), "ramp" (offset_n_m rising by height_n_m over duration_s from start_s), "sine" (offset_n_m + amplitude_n_m sin(2 pi f (t - start_s) + phase) from start_s), "table" (file)
         kind: "", SIGNAL_KINDS, Dflt::Required;
         /// constant: the torque
@@ -542,7 +546,7 @@ table! {
 
 table! {
     /// `[bodies.road_load]`: a load opposing motion, -sign(w) (a + b |w| + c w^2), zero at rest (a vehicle reduced to a shaft).
-    RawRoadLoad at "bodies[].road_load" {
+    RawRoadLoad at "road_load" {
         /// a: the constant part (rolling resistance)
         constant_n_m: "N m", NON_NEGATIVE, Dflt::Num(0.0);
         /// b: the part proportional to speed
@@ -554,15 +558,15 @@ table! {
 }
 
 table! {
-    /// One `[[couplings]]` entry of a network scene: a coupling between bodies a and b (MODEL.md section 8). Signs: a clutch's slip is w_b - w_a and its torque acts +tau on a, -tau on b (Modelica's flanges); an ideal gear ties w_a = ratio w_b.
-    RawCoupling at "couplings[]" {
-        /// the coupling's name, unique
-        name: "", Kind::Text, Dflt::Required;
-        /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash
-        kind: "", Kind::Choice(&["clutch", "ideal_gear"]), Dflt::Required;
-        /// the name of body a
+    /// One `[[couplings]]` entry: a coupling between bodies a and b (MODEL.md section 8): in a network scene between two of its [[bodies]]; in a one-pack scene (no [[bodies]]) a spring_damper between its shaft and its drum. Signs: a clutch's slip is w_b - w_a and its torque acts +tau on a, -tau on b (Modelica's flanges); an ideal gear ties w_a = ratio w_b; a gear mesh's force F, signed as x, acts -Rb_a F on a and -Rb_b F on b (internal: +Rb_b F); a spring_damper's torque T = k (theta_a - theta_b - theta_0) + d (w_a - w_b) acts +T on b, -T on a.
+    RawCoupling at "" {
+        /// the coupling's name, unique (tables, summaries and figures name it)
+        name: "", Kind::Text, Dflt::Described("default \"<kind>-<i+1>\" (\"clutch-2\")");
+        /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash; "gear_mesh": a gear pair with backlash and the tooth law of [couplings.contact] and [couplings.oil] along its line of action (gear rattle); "spring_damper": a torsional spring with a viscous damper in parallel (a clutch damper, a dual-mass flywheel; one-pack scenes, between "shaft" and "drum")
+        kind: "", Kind::Choice(&["clutch", "ideal_gear", "gear_mesh", "spring_damper"]), Dflt::Required;
+        /// the name of body a (a one-pack scene: "shaft" or "drum", the drum with [drum]; a prescribed shaft drives b through a spring_damper)
         a: "", Kind::Text, Dflt::Required;
-        /// the name of body b
+        /// the name of body b, not a
         b: "", Kind::Text, Dflt::Required;
         /// ideal_gear: w_a / w_b (negative: b turns the other way)
         ratio: "", FINITE, Dflt::When("ideal_gear: required, an error otherwise");
@@ -578,15 +582,35 @@ table! {
         cgeo_m: "m", NON_NEGATIVE, Dflt::Num(1.0);
         /// clutch: the normal force at force = 1 (Modelica's fn_max)
         max_normal_force_n: "N", NON_NEGATIVE, Dflt::When("clutch: required");
+        /// gear_mesh: base radius of the gear on body a
+        base_radius_a_m: "m", Kind::Number(Rule::Bounded { floor: MIN_PITCH_RADIUS_M, ceil: MAX_PITCH_RADIUS_M }), Dflt::When("gear_mesh: required");
+        /// gear_mesh: base radius of the gear on body b
+        base_radius_b_m: "m", Kind::Number(Rule::Bounded { floor: MIN_PITCH_RADIUS_M, ceil: MAX_PITCH_RADIUS_M }), Dflt::When("gear_mesh: required");
+        /// gear_mesh: an internal mesh (a ring gear: b turns the same way as a); else external
+        internal: "", Kind::Bool, Dflt::Bool(false);
+        /// gear_mesh: backlash along the line of action (the free travel from flank to flank)
+        backlash_m: "m", POSITIVE, Dflt::When("gear_mesh: required");
+        /// gear_mesh: tooth pairs sharing the load (the contact ratio's whole part)
+        pairs: "", Kind::Number(Rule::Closed(1.0, 10.0)), Dflt::Num(1.0);
+        /// gear_mesh: relative displacement x = Rb_a theta_a +- Rb_b theta_b at t = 0 (0: centred in the backlash); |x| + the film must be < backlash_m / 2
+        mesh_offset_m: "m", FINITE, Dflt::Num(0.0);
+        /// spring_damper: torsional stiffness k
+        stiffness_n_m_per_rad: "N m/rad", Kind::Number(Rule::Closed(0.0, MAX_COUPLING_STIFFNESS_N_M_PER_RAD)), Dflt::When("spring_damper: required");
+        /// spring_damper: viscous damping d
+        damping_n_m_s_per_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
+        /// spring_damper: free angle theta_0, the twist theta_a - theta_b at which the spring carries no torque (both bodies start at angle 0, so a non-zero theta_0 starts the spring twisted)
+        free_angle_rad: "rad", FINITE, Dflt::Num(0.0);
     }
     children {
         force: table RawForceSignal,
+        contact: table RawContact,
+        oil: table RawOil,
     }
 }
 
 table! {
     /// `[couplings.force]`: a clutch's normalized normal force f(t) (the normal force is max_normal_force_n f; engaged while > 0).
-    RawForceSignal at "couplings[].force" {
+    RawForceSignal at "force" {
         /// "constant" (value), "step" (offset, then + height from start_s), "ramp" (offset rising by height over duration_s from start_s), "sine" (offset + amplitude sin(2 pi f (t - start_s) + phase) from start_s), "table" (file)
         kind: "", SIGNAL_KINDS, Dflt::Required;
         /// constant: the force

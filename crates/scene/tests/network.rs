@@ -114,3 +114,68 @@ fn bad_networks_are_explained_at_their_keys() {
         "{p:?}"
     );
 }
+
+const MESH: &str = r#"
+[simulation]
+duration_s = 0.01
+
+[[bodies]]
+name = "pinion"
+inertia_kg_m2 = 0.02
+initial_speed_rad_s = 10.0
+
+[[bodies]]
+name = "wheel"
+inertia_kg_m2 = 0.5
+
+[[couplings]]
+name = "mesh"
+kind = "gear_mesh"
+a = "pinion"
+b = "wheel"
+base_radius_a_m = 0.03
+base_radius_b_m = 0.09
+backlash_m = 1e-4
+mesh_offset_m = 2e-5
+[couplings.contact]
+law = "dry"
+modulus_pa = 210e9
+curvature_radius_m = 5e-3
+"#;
+
+/// A gear mesh reaches the model with its law; a start outside the free play, a missing
+/// modulus and a clutch's key on a mesh are each reported at their key.
+#[test]
+fn gear_mesh_keys() {
+    let s = parse(MESH, "scenes/mesh.toml", Path::new("."), &[]).unwrap();
+    let net = s.network.unwrap();
+    let clutchpack_model::network::CouplingKind::GearMesh(g) = &net.couplings[0].kind else {
+        panic!("a mesh")
+    };
+    assert_eq!(
+        (g.base_radius_b_m, g.initial_offset_m, g.internal),
+        (0.09, 2e-5, false)
+    );
+    assert_eq!(g.law.kind, clutchpack_model::LawKind::Dry);
+    let p = problems(&MESH.replace("mesh_offset_m = 2e-5", "mesh_offset_m = 6e-5"));
+    assert!(
+        p.iter()
+            .any(|m| m.contains("couplings[0].mesh_offset_m = 0.00006") && m.contains("free play")),
+        "{p:?}"
+    );
+    let p = problems(
+        &MESH
+            .replace("modulus_pa = 210e9\n", "mu = 0.1\n")
+            .replace("[couplings.contact]", "mu = 0.1\n[couplings.contact]"),
+    );
+    assert!(
+        p.iter()
+            .any(|m| m.contains("couplings[0].contact.modulus_pa") && m.contains("missing")),
+        "{p:?}"
+    );
+    assert!(
+        p.iter()
+            .any(|m| m.contains("couplings[0].mu") && m.contains("remove it")),
+        "{p:?}"
+    );
+}

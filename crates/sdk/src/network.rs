@@ -34,6 +34,9 @@ pub struct ModeChange {
     pub from: &'static str,
     /// Mode after.
     pub to: &'static str,
+    /// Each coupling's torque step at this instant, N m (after less before, on its body `a`:
+    /// the output torque's step at a lock is its gear's), in the scene's order.
+    pub torque_steps_n_m: Vec<f64>,
 }
 
 /// One coupling's results.
@@ -41,9 +44,10 @@ pub struct ModeChange {
 pub struct CouplingSummary {
     /// Its name.
     pub name: String,
-    /// `clutch` or `ideal_gear`.
+    /// `clutch`, `ideal_gear`, `gear_mesh` or `spring_damper`.
     pub kind: &'static str,
-    /// Heat of a clutch over the run, J (0 for a gear).
+    /// Heat of a clutch, work done on a gear mesh, or a damper's loss, over the run, J (0 for
+    /// an ideal gear).
     pub heat_j: f64,
     /// Torque on its body a at the end, N m.
     pub final_torque_n_m: f64,
@@ -52,6 +56,10 @@ pub struct CouplingSummary {
     pub final_mode: Option<&'static str>,
     /// The instants a clutch locked, s.
     pub lock_times_s: Vec<f64>,
+    /// The smallest torque on its body a over the samples, N m.
+    pub min_torque_n_m: f64,
+    /// The largest torque on its body a over the samples, N m.
+    pub max_torque_n_m: f64,
     /// Every mode change after t = 0, in time order.
     pub changes: Vec<ModeChange>,
 }
@@ -78,9 +86,16 @@ pub struct EnergySummary {
     pub drag_loss_j: f64,
     /// Heat of the clutches, J.
     pub clutch_heat_j: f64,
+    /// Work done on the gear meshes (their impact losses), J.
+    pub mesh_work_j: f64,
+    /// Loss to the spring-dampers' dampers, J.
+    pub damper_loss_j: f64,
+    /// The springs' stored energy at the end less at the start, J.
+    pub spring_energy_change_j: f64,
     /// Kinetic energy at the end less at the start, J.
     pub kinetic_change_j: f64,
-    /// `drive + load - drag - heat - kinetic change`, J (zero to the integrator's tolerance).
+    /// `drive + load - drag - heat - mesh work - damper loss - spring energy change - kinetic
+    /// change`, J (zero to the integrator's tolerance).
     pub residual_j: f64,
 }
 
@@ -121,18 +136,36 @@ pub struct NetworkOutcome {
 struct Keep<'a, 'r> {
     req: &'a mut NetworkRequest<'r>,
     events: Vec<ClutchEvent>,
+    /// (t, each coupling's torque step) at each switching instant.
+    steps: Vec<(f64, Vec<f64>)>,
+    /// Per coupling: the smallest and largest torque sampled.
+    range: Vec<(f64, f64)>,
     history: Vec<NetworkSample>,
     stopped: bool,
 }
 
 impl NetworkObserver for Keep<'_, '_> {
     fn sample(&mut self, s: &NetworkSample) {
+        self.range
+            .resize(s.torque_n_m.len(), (f64::INFINITY, f64::NEG_INFINITY));
+        for (r, t) in self.range.iter_mut().zip(&s.torque_n_m) {
+            *r = (r.0.min(*t), r.1.max(*t));
+        }
         if self.req.keep_history {
             self.history.push(s.clone());
         }
     }
     fn clutch_event(&mut self, e: &ClutchEvent) {
         self.events.push(*e);
+    }
+    fn switched(&mut self, before: &NetworkSample, after: &NetworkSample) {
+        let steps = after
+            .torque_n_m
+            .iter()
+            .zip(&before.torque_n_m)
+            .map(|(a, b)| a - b)
+            .collect();
+        self.steps.push((after.t_s, steps));
     }
     fn progress(&mut self, t: f64) -> bool {
         if let Some(p) = self.req.progress.as_mut() {
@@ -149,6 +182,12 @@ impl NetworkObserver for Keep<'_, '_> {
 /// 2e-5 s and its speeds within 2e-5 of the reference engine's, `crates/sim/tests/network.rs`).
 pub fn multibody_step_s(scene: &Scene) -> f64 {
     scene.simulation.max_step_s.min(MULTIBODY_NETWORK_STEP_S)
+}
+
+/// Why the multibody engine cannot run the network `net` (`None`: it can; it runs lumped
+/// clutches and ideal gears), for `check` to say what `run` would.
+pub fn multibody_network_unsupported(net: &clutchpack_model::network::Network) -> Option<String> {
+    clutchpack_sim::network::unsupported(net)
 }
 
 /// The longest fixed step of the multibody engine on a network, s.
@@ -170,10 +209,17 @@ pub fn run_network_scene(
         )));
     };
     let engine = scene.engine(asked, &scene.name)?;
+    if engine == EngineChoice::Multibody {
+        if let Some(why) = clutchpack_sim::network::unsupported(net) {
+            return Err(Error::BadInput(format!("{}: {why}", scene.name)));
+        }
+    }
     let sim = &scene.simulation;
     let mut keep = Keep {
         req: &mut req,
         events: Vec::new(),
+        steps: Vec::new(),
+        range: Vec::new(),
         history: Vec::new(),
         stopped: false,
     };
@@ -214,6 +260,11 @@ pub fn run_network_scene(
                     t_s: e.t_s,
                     from: e.from.label(),
                     to: e.to.label(),
+                    torque_steps_n_m: keep
+                        .steps
+                        .iter()
+                        .find(|(t, _)| *t == e.t_s)
+                        .map_or_else(Vec::new, |(_, s)| s.clone()),
                 })
                 .collect();
             CouplingSummary {
@@ -221,6 +272,8 @@ pub fn run_network_scene(
                 kind: match c.kind {
                     CouplingKind::Clutch(_) => "clutch",
                     CouplingKind::IdealGear { .. } => "ideal_gear",
+                    CouplingKind::GearMesh(_) => "gear_mesh",
+                    CouplingKind::SpringDamper(_) => "spring_damper",
                 },
                 heat_j: run.heat_j[k],
                 final_torque_n_m: last.torque_n_m[k],
@@ -231,6 +284,8 @@ pub fn run_network_scene(
                     .filter(|e| e.coupling == k && e.to == ClutchMode::Locked)
                     .map(|e| e.t_s)
                     .collect(),
+                min_torque_n_m: keep.range.get(k).map_or(0.0, |r| r.0),
+                max_torque_n_m: keep.range.get(k).map_or(0.0, |r| r.1),
                 changes,
             }
         })
@@ -260,6 +315,9 @@ pub fn run_network_scene(
             load_work_j: e.load_work_j,
             drag_loss_j: e.drag_loss_j,
             clutch_heat_j: e.clutch_heat_j,
+            mesh_work_j: e.mesh_work_j,
+            damper_loss_j: e.damper_loss_j,
+            spring_energy_change_j: e.spring_energy_change_j,
             kinetic_change_j: e.kinetic_change_j,
             residual_j: e.residual_j(),
         },

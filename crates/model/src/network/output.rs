@@ -4,6 +4,7 @@
 //! changes, the energy balance, and the observer that receives them in time order.
 
 use super::ClutchMode;
+use crate::ImpactEvent;
 
 /// The network's state at one instant.
 #[derive(Debug, Clone, PartialEq)]
@@ -15,7 +16,8 @@ pub struct NetworkSample {
     /// Each body's speed, rad/s.
     pub speed_rad_s: Vec<f64>,
     /// Each coupling's torque on its body `a`, N m (a clutch's `tau`; an ideal gear's
-    /// `lambda`, `-ratio lambda` on `b`).
+    /// `lambda`, `-ratio lambda` on `b`; a gear mesh's `-Rb_a F pairs`; a spring-damper's
+    /// `-T`).
     pub torque_n_m: Vec<f64>,
     /// Each clutch's mode (`None` for another kind of coupling).
     pub mode: Vec<Option<ClutchMode>>,
@@ -45,16 +47,27 @@ pub struct NetworkEnergy {
     pub drag_loss_j: f64,
     /// Heat of the clutches (>= 0), J.
     pub clutch_heat_j: f64,
+    /// Work done on the gear meshes, J: their teeth's impact losses, plus the elastic energy
+    /// of a contact still closed at the end.
+    pub mesh_work_j: f64,
+    /// Loss to the spring-dampers' dampers (>= 0), J.
+    pub damper_loss_j: f64,
+    /// The spring-dampers' stored energy at the end less at the start, J.
+    pub spring_energy_change_j: f64,
     /// Kinetic energy at the end less at the start, J.
     pub kinetic_change_j: f64,
 }
 
 impl NetworkEnergy {
-    /// `drive + load - drag - heat - kinetic change`, J: zero to the integrator's tolerance.
+    /// `drive + load - drag - heat - mesh work - damper loss - spring energy change - kinetic
+    /// change`, J: zero to the integrator's tolerance.
     pub fn residual_j(&self) -> f64 {
         self.drive_work_j + self.load_work_j
             - self.drag_loss_j
             - self.clutch_heat_j
+            - self.mesh_work_j
+            - self.damper_loss_j
+            - self.spring_energy_change_j
             - self.kinetic_change_j
     }
 }
@@ -64,7 +77,8 @@ impl NetworkEnergy {
 pub struct NetworkRun {
     /// The state at the end.
     pub last: NetworkSample,
-    /// Each clutch's heat, J (0 for other couplings).
+    /// Each clutch's heat, each gear mesh's work and each damper's loss, J (0 for an ideal
+    /// gear).
     pub heat_j: Vec<f64>,
     /// The energy balance.
     pub energy: NetworkEnergy,
@@ -80,6 +94,13 @@ pub trait NetworkObserver {
     fn sample(&mut self, _sample: &NetworkSample) {}
     /// A clutch changed mode.
     fn clutch_event(&mut self, _event: &ClutchEvent) {}
+    /// The state just before and just after an instant where clutches changed mode (sent
+    /// before their [`Self::clutch_event`]s): the couplings' torques jump there (the output
+    /// torque's step at a lock).
+    fn switched(&mut self, _before: &NetworkSample, _after: &NetworkSample) {}
+    /// A gear mesh's tooth contact closed (its `disc` is the coupling's index; the peak is
+    /// the force per tooth pair, negative when body `a` leads: `x > 0`).
+    fn mesh_impact(&mut self, _impact: &ImpactEvent) {}
     /// Polled after every step with the time reached, s; `false` stops the run there.
     fn progress(&mut self, _t_s: f64) -> bool {
         true

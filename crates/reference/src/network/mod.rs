@@ -4,7 +4,11 @@
 //! release located as an event.
 //!
 //! # Method
-//! The state is every body's angle and speed, plus the energy counters (each clutch's heat,
+//! The state is every body's angle and speed, each gear mesh's relative displacement along
+//! its line of action and each spring-damper's twist (integrated themselves, with an absolute
+//! tolerance on the backlash's scale and on the tolerance in rad,
+//! as the pack engine integrates its relative angles: the bodies' angles grow without bound,
+//! and their error with them), plus the energy counters (each clutch's heat,
 //! the drives' and loads' work, the drag's loss) integrated beside them (outside the error
 //! norm). Between events the modes are fixed and the right-hand side is smooth: adaptive
 //! DOPRI5 steps (the pack engine's `dopri.rs`), landing on every instant where a
@@ -13,7 +17,9 @@
 //! - a slipping clutch: `s w_rel` reaching 0 (`s` its direction), and its normal force
 //!   reaching 0 (free);
 //! - a locked clutch: `peak mu(0) cgeo fn - |tau|` reaching 0 (it breaks), `fn` reaching 0;
-//! - a free clutch: `fn` rising above 0 (it engages).
+//! - a free clutch: `fn` rising above 0 (it engages);
+//! - a gear mesh: the engagement depth of its tooth law reaching 0 from either side (a tooth
+//!   contact's onset, where the law's per-event memory is taken, and its separation).
 //!
 //! A crossing is bisected on the dense output to 1e-13 s relative; the run restarts there
 //! with the modes settled as Modelica's `Clutch` settles them (Otter, Elmqvist and Mattsson
@@ -24,15 +30,19 @@
 //! below 1e-12 rad/s).
 
 pub(crate) mod cluster;
+mod mesh;
+mod modes;
+
+use modes::settle;
 
 use crate::dopri::{next_step, Dense, Dopri5};
 use cluster::Clusters;
-use clutchpack_model::network::{ClutchMode, CouplingKind, LumpedClutch, Network};
+use clutchpack_model::network::{ClutchMode, CouplingKind, GearMesh, LumpedClutch, Network};
 // the output types are the model's, shared with the multibody engine
 pub use clutchpack_model::network::{
     ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
 };
-use clutchpack_model::EngineError;
+use clutchpack_model::{Engagement, EngineError};
 
 /// Settings of a network run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,6 +69,8 @@ impl Default for NetworkOptions {
 struct Equations<'n> {
     net: &'n Network,
     modes: Vec<Option<ClutchMode>>,
+    /// Each gear mesh's contact event (its law's memory), `None` in free flight.
+    contacts: Vec<Option<Engagement>>,
     clusters: Clusters,
     // scratch
     torque: Vec<f64>,
@@ -66,13 +78,42 @@ struct Equations<'n> {
     group: Vec<f64>,
     residual: Vec<f64>,
     coupling_torque: Vec<f64>,
+    mesh_force: Vec<f64>,
 }
 
 fn clutch(net: &Network, k: usize) -> Option<&LumpedClutch> {
     match &net.couplings[k].kind {
         CouplingKind::Clutch(c) => Some(c),
-        CouplingKind::IdealGear { .. } => None,
+        _ => None,
     }
+}
+
+fn spring(net: &Network, k: usize) -> Option<&clutchpack_model::SpringDamper> {
+    match &net.couplings[k].kind {
+        CouplingKind::SpringDamper(s) => Some(s),
+        _ => None,
+    }
+}
+
+fn mesh(net: &Network, k: usize) -> Option<&GearMesh> {
+    match &net.couplings[k].kind {
+        CouplingKind::GearMesh(g) => Some(g),
+        _ => None,
+    }
+}
+
+/// A mesh's tooth kinematics at the state `y = [angles, speeds, ...]`.
+fn mesh_kinematics(
+    net: &Network,
+    k: usize,
+    g: &GearMesh,
+    y: &[f64],
+) -> clutchpack_model::ToothKinematics {
+    let n = net.bodies.len();
+    let c = &net.couplings[k];
+    // x is its own state component; its rate from the speeds
+    let (_, v) = g.displacement((0.0, 0.0), (y[n + c.a], y[n + c.b]));
+    g.kinematics(y[2 * n + k], v)
 }
 
 impl<'n> Equations<'n> {
@@ -82,12 +123,14 @@ impl<'n> Equations<'n> {
         Equations {
             net,
             modes,
+            contacts: vec![None; net.couplings.len()],
             clusters,
             torque: vec![0.0; n],
             acc: vec![0.0; n],
             group: Vec::new(),
             residual: Vec::new(),
             coupling_torque: vec![0.0; net.couplings.len()],
+            mesh_force: vec![0.0; net.couplings.len()],
         }
     }
 
@@ -96,9 +139,12 @@ impl<'n> Equations<'n> {
         self.clusters = Clusters::build(self.net, &rigid(self.net, &self.modes));
     }
 
-    /// Bodies' torques (all but the rigid couplings') and accelerations at `(t, w)`; the
-    /// slipping clutches' torques into `coupling_torque`.
-    fn forces(&mut self, t: f64, w: &[f64]) {
+    /// Bodies' torques (all but the rigid couplings') and accelerations at `(t, y)`; the
+    /// slipping clutches' and the meshes' torques into `coupling_torque` (and each mesh's
+    /// force per pair, N, into `mesh_force`).
+    fn forces(&mut self, t: f64, y: &[f64]) {
+        let n = self.net.bodies.len();
+        let w = &y[n..2 * n];
         for (i, b) in self.net.bodies.iter().enumerate() {
             self.torque[i] = if b.fixed {
                 0.0
@@ -116,6 +162,22 @@ impl<'n> Equations<'n> {
                 self.torque[c.a] += tau;
                 self.torque[c.b] -= tau;
             }
+            if let Some(sd) = spring(self.net, k) {
+                // MODEL.md section 8: T on b, -T on a; the twist is its own state
+                let t = sd.torque_n_m(y[2 * n + k], w[c.a] - w[c.b]);
+                self.coupling_torque[k] = -t;
+                self.torque[c.a] -= t;
+                self.torque[c.b] += t;
+            }
+            if let (Some(g), Some(e)) = (mesh(self.net, k), self.contacts[k]) {
+                // MODEL.md section 8: F signed as x; -Rb_a F on a, -+Rb_b F on b
+                let f = g.force_n(&mesh_kinematics(self.net, k, g, y), &e);
+                let (ta, tb) = g.torques_n_m(f);
+                self.mesh_force[k] = f;
+                self.coupling_torque[k] = ta;
+                self.torque[c.a] += ta;
+                self.torque[c.b] += tb;
+            }
         }
         self.clusters
             .accelerations(&self.torque, &mut self.acc, &mut self.group);
@@ -132,21 +194,35 @@ impl<'n> Equations<'n> {
         );
     }
 
-    /// `dy/dt` of the state `[angles, speeds, counters]`.
+    /// `dy/dt` of the state `[angles, speeds, meshes' x, counters]`.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
         let n = self.net.bodies.len();
         let (theta_dot, rest) = dy.split_at_mut(n);
-        let (w_dot, counters) = rest.split_at_mut(n);
+        let (w_dot, rest) = rest.split_at_mut(n);
+        let m = self.net.couplings.len();
+        let (x_dot, counters) = rest.split_at_mut(m);
         let w = &y[n..2 * n];
         theta_dot.copy_from_slice(w);
-        self.forces(t, w);
+        self.forces(t, y);
         w_dot.copy_from_slice(&self.acc);
+        for (k, c) in self.net.couplings.iter().enumerate() {
+            x_dot[k] = match (mesh(self.net, k), spring(self.net, k)) {
+                (Some(g), _) => g.displacement((0.0, 0.0), (w[c.a], w[c.b])).1,
+                (_, Some(_)) => w[c.a] - w[c.b],
+                _ => 0.0,
+            };
+        }
         // counters: [heat per coupling, drive work, load work, drag loss]
-        let m = self.net.couplings.len();
         for k in 0..m {
             let c = &self.net.couplings[k];
             counters[k] = if matches!(self.modes[k], Some(ClutchMode::Slipping(_))) {
                 self.coupling_torque[k] * (w[c.b] - w[c.a])
+            } else if let Some(sd) = spring(self.net, k) {
+                sd.loss_rate_w(w[c.a] - w[c.b])
+            } else if let (Some(g), Some(_)) = (mesh(self.net, k), self.contacts[k]) {
+                // power into the mesh: F v pairs (the torques' work on the bodies, negated)
+                let (_, v) = g.displacement((0.0, 0.0), (w[c.a], w[c.b]));
+                self.mesh_force[k] * v * g.pairs
             } else {
                 0.0
             };
@@ -173,10 +249,21 @@ impl<'n> Equations<'n> {
         let w = &y[n..2 * n];
         let any_locked = self.modes.contains(&Some(ClutchMode::Locked));
         if any_locked {
-            self.forces(t, w);
+            self.forces(t, y);
             self.rigid_torques();
         }
         for (k, c) in self.net.couplings.iter().enumerate() {
+            if let Some(g) = mesh(self.net, k) {
+                let depth = g
+                    .law
+                    .engagement_depth_m(&mesh_kinematics(self.net, k, g, y));
+                out[k] = if self.contacts[k].is_some() {
+                    depth
+                } else {
+                    -depth
+                };
+                continue;
+            }
             let Some(cl) = clutch(self.net, k) else {
                 out[k] = 1.0;
                 continue;
@@ -207,6 +294,7 @@ fn rigid(net: &Network, modes: &[Option<ClutchMode>]) -> Vec<bool> {
         .map(|(k, c)| match c.kind {
             CouplingKind::IdealGear { .. } => true,
             CouplingKind::Clutch(_) => modes[k] == Some(ClutchMode::Locked),
+            CouplingKind::GearMesh(_) | CouplingKind::SpringDamper(_) => false,
         })
         .collect()
 }
@@ -229,13 +317,28 @@ pub fn run_network(
     }
     let n = net.bodies.len();
     let m = net.couplings.len();
-    let dim = 2 * n + m + 3;
+    let dim = 2 * n + 2 * m + 3;
     let tol = options.tolerance;
     let mut atol = vec![tol; dim];
-    atol[2 * n..].iter_mut().for_each(|a| *a = f64::INFINITY);
+    // the meshes' x on their backlash's scale; other slots and the counters out of the norm
+    for k in 0..m {
+        atol[2 * n + k] = match (mesh(net, k), spring(net, k)) {
+            (Some(g), _) => tol * g.backlash_m,
+            (_, Some(_)) => tol,
+            _ => f64::INFINITY,
+        };
+    }
+    atol[2 * n + m..]
+        .iter_mut()
+        .for_each(|a| *a = f64::INFINITY);
     let mut y = vec![0.0; dim];
     for (i, b) in net.bodies.iter().enumerate() {
         y[n + i] = b.initial_speed_rad_s;
+    }
+    for k in 0..m {
+        if let Some(g) = mesh(net, k) {
+            y[2 * n + k] = g.initial_offset_m;
+        }
     }
     let initial_modes: Vec<Option<ClutchMode>> = (0..m)
         .map(|k| clutch(net, k).map(|_| ClutchMode::Free))
@@ -252,6 +355,8 @@ pub fn run_network(
     let kinetic0 = kinetic(&y);
     let mut events = 0u64;
     settle(&mut eq, 0.0, &mut y, &[], obs, &mut events);
+    let mut meshes = mesh::Meshes::new(m, dim);
+    meshes.switch(&mut eq, 0.0, &y, None, obs);
     let breakpoints = net.breakpoints(duration_s);
     let mut next_bp = 0;
     let mut stepper = Dopri5::new(dim);
@@ -346,6 +451,7 @@ pub fn run_network(
                 (t + h_try, land)
             }
         };
+        meshes.observe(&mut eq, &dense, t, t_new);
         // samples up to t_new from the dense output
         while (next_sample as f64) * period <= t_new && (next_sample as f64) * period < duration_s {
             let ts = next_sample as f64 * period;
@@ -365,6 +471,7 @@ pub fn run_network(
             next_bp += 1;
         }
         if at_event {
+            meshes.switch(&mut eq, t, &y, Some(&g1), obs);
             settle(&mut eq, t, &mut y, &g1, obs, &mut events);
             eq.rhs(t, &y, &mut dy);
             stepper.set_start_derivative(&dy);
@@ -377,19 +484,30 @@ pub fn run_network(
             break;
         }
     }
+    meshes.finish(&mut eq, t, obs);
     let last = sample(&mut eq, t, &y);
     obs.sample(&last);
-    let mut heat = y[2 * n..2 * n + m].to_vec();
+    let c0 = 2 * n + m; // the counters
+    let mut heat = y[c0..c0 + m].to_vec();
+    let (mut mesh_work, mut damper_loss, mut spring_change) = (0.0, 0.0, 0.0);
     for (k, h) in heat.iter_mut().enumerate() {
-        if clutch(net, k).is_none() {
+        if mesh(net, k).is_some() {
+            mesh_work += *h;
+        } else if let Some(sd) = spring(net, k) {
+            damper_loss += *h;
+            spring_change += sd.potential_j(y[2 * n + k]) - sd.potential_j(0.0);
+        } else if clutch(net, k).is_none() {
             *h = 0.0;
         }
     }
     let energy = NetworkEnergy {
-        drive_work_j: y[2 * n + m],
-        load_work_j: y[2 * n + m + 1],
-        drag_loss_j: y[2 * n + m + 2],
-        clutch_heat_j: heat.iter().sum(),
+        drive_work_j: y[c0 + m],
+        load_work_j: y[c0 + m + 1],
+        drag_loss_j: y[c0 + m + 2],
+        clutch_heat_j: heat.iter().sum::<f64>() - mesh_work - damper_loss,
+        mesh_work_j: mesh_work,
+        damper_loss_j: damper_loss,
+        spring_energy_change_j: spring_change,
         kinetic_change_j: kinetic(&y) - kinetic0,
     };
     Ok(NetworkRun {
@@ -404,7 +522,7 @@ pub fn run_network(
 /// The state at `t` as a sample (the couplings' torques computed there).
 fn sample(eq: &mut Equations, t: f64, y: &[f64]) -> NetworkSample {
     let n = eq.net.bodies.len();
-    eq.forces(t, &y[n..2 * n]);
+    eq.forces(t, y);
     eq.rigid_torques();
     NetworkSample {
         t_s: t,
@@ -412,112 +530,5 @@ fn sample(eq: &mut Equations, t: f64, y: &[f64]) -> NetworkSample {
         speed_rad_s: y[n..2 * n].to_vec(),
         torque_n_m: eq.coupling_torque.clone(),
         mode: eq.modes.clone(),
-    }
-}
-
-/// Settles the clutches' modes at an event at `t` (MODEL.md section 8; Modelica's `Clutch`):
-/// free while `fn <= 0`; a clutch whose slip crossed zero (`crossed`: its guard `<= 0`), or
-/// that engages at zero slip, is tried locked; a locked clutch whose holding torque exceeds
-/// its static limit slips towards that torque; repeated until every locked clutch holds.
-fn settle(
-    eq: &mut Equations,
-    t: f64,
-    y: &mut [f64],
-    crossed: &[f64],
-    obs: &mut dyn NetworkObserver,
-    events: &mut u64,
-) {
-    let net = eq.net;
-    let n = net.bodies.len();
-    let before = eq.modes.clone();
-    let mut modes = before.clone();
-    for (k, c) in net.couplings.iter().enumerate() {
-        let Some(cl) = clutch(net, k) else { continue };
-        let f = cl.normal_force_n(t);
-        let w_rel = y[n + c.b] - y[n + c.a];
-        let scale = 1e-10 * (1.0 + y[n + c.a].abs() + y[n + c.b].abs());
-        let slip_ended = crossed.get(k).is_some_and(|g| *g <= 0.0);
-        modes[k] = Some(if f <= 0.0 {
-            ClutchMode::Free
-        } else {
-            match modes[k] {
-                Some(ClutchMode::Free) | None => {
-                    if w_rel.abs() > scale {
-                        ClutchMode::Slipping(w_rel.signum() as i8)
-                    } else {
-                        ClutchMode::Locked
-                    }
-                }
-                Some(ClutchMode::Slipping(s)) => {
-                    if slip_ended || f64::from(s) * w_rel <= 0.0 {
-                        ClutchMode::Locked
-                    } else {
-                        ClutchMode::Slipping(s)
-                    }
-                }
-                Some(ClutchMode::Locked) => ClutchMode::Locked,
-            }
-        });
-    }
-    // lock what locks; release the locked clutch that is furthest over its limit, and again
-    for _ in 0..=net.couplings.len() {
-        eq.set_modes(&modes);
-        project_speeds(eq, y);
-        eq.forces(t, &y[n..2 * n]);
-        eq.rigid_torques();
-        let mut worst: Option<(usize, f64)> = None;
-        for (k, mode) in modes.iter().enumerate() {
-            if *mode != Some(ClutchMode::Locked) {
-                continue;
-            }
-            let cl = clutch(net, k).expect("only clutches lock");
-            let over = eq.coupling_torque[k].abs() - cl.max_static_torque_n_m(cl.normal_force_n(t));
-            if over > 0.0 && worst.is_none_or(|(_, o)| over > o) {
-                worst = Some((k, over));
-            }
-        }
-        match worst {
-            Some((k, _)) => {
-                let s = if eq.coupling_torque[k] > 0.0 { 1 } else { -1 };
-                modes[k] = Some(ClutchMode::Slipping(s));
-            }
-            None => break,
-        }
-    }
-    eq.set_modes(&modes);
-    *events += 1;
-    for (k, (b, a)) in before.iter().zip(&modes).enumerate() {
-        if let (Some(from), Some(to)) = (b, a) {
-            if from != to {
-                obs.clutch_event(&ClutchEvent {
-                    t_s: t,
-                    coupling: k,
-                    from: *from,
-                    to: *to,
-                });
-            }
-        }
-    }
-}
-
-/// Sets every rigid group's speeds to its common speed, momentum kept
-/// (`w_group = sum g_i J_i w_i / sum g_i^2 J_i`, `w_i = g_i w_group`; 0 for a fixed group).
-fn project_speeds(eq: &Equations, y: &mut [f64]) {
-    let net = eq.net;
-    let n = net.bodies.len();
-    let cl = &eq.clusters;
-    let mut p = vec![0.0; cl.inertia.len()];
-    for (i, b) in net.bodies.iter().enumerate() {
-        if !b.fixed {
-            p[cl.of[i]] += cl.g[i] * b.inertia_kg_m2 * y[n + i];
-        }
-    }
-    for i in 0..n {
-        let c = cl.of[i];
-        y[n + i] = if cl.fixed[c] {
-            0.0
-        } else {
-            cl.g[i] * p[c] / cl.inertia[c]
-        };
     }
 }

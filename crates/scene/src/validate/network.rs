@@ -6,19 +6,20 @@
 
 use super::{Checker, Field};
 use crate::keys::{
-    RawCoupling as C, RawForceSignal as FS, RawNetBody as B, RawRoadLoad as RL,
-    RawTorqueSignal as TS,
+    RawContact as Ct, RawCoupling as C, RawForceSignal as FS, RawNetBody as B, RawOil as O,
+    RawRoadLoad as RL, RawTorqueSignal as TS,
 };
 use crate::schema::{show, Key, RawTable};
 use clutchpack_model::network::{
-    Body, Coupling, CouplingKind, LumpedClutch, Network, NetworkProblem, RoadLoad, Signal,
+    Body, Coupling, CouplingKind, GearMesh, LumpedClutch, Network, NetworkProblem, RoadLoad, Signal,
 };
+use clutchpack_model::{Hertz, LawKind, OilFilm, ToothLaw};
 use std::path::Path;
 use toml::Value;
 
-/// The path of key `k` of array item `i`: `bodies[2].drive.start_s`.
-fn item(k: &Key, i: usize) -> String {
-    k.rel().replacen("[]", &format!("[{i}]"), 1)
+/// The path of key `k` of item `i` of the array `array`: `bodies[2].drive.start_s`.
+fn item(array: &str, k: &Key, i: usize) -> String {
+    k.at(&format!("{array}[{i}]"))
 }
 
 /// The keys of one signal table (a torque in N m, or a normalized force).
@@ -36,6 +37,8 @@ struct SignalKeys {
     interpolation: Key,
     /// The CSV column of the values.
     column: &'static str,
+    /// The array whose items hold the table: `bodies` or `couplings`.
+    array: &'static str,
 }
 
 const TORQUE_SIGNAL: SignalKeys = SignalKeys {
@@ -51,6 +54,7 @@ const TORQUE_SIGNAL: SignalKeys = SignalKeys {
     file: TS::file,
     interpolation: TS::interpolation,
     column: "torque_n_m",
+    array: "bodies",
 };
 
 const FORCE_SIGNAL: SignalKeys = SignalKeys {
@@ -66,6 +70,7 @@ const FORCE_SIGNAL: SignalKeys = SignalKeys {
     file: FS::file,
     interpolation: FS::interpolation,
     column: "force",
+    array: "couplings",
 };
 
 /// One signal table of item `i`; `get` reads a key's value as written.
@@ -85,7 +90,7 @@ fn signal<'v>(
         Table,
     }
     use K::*;
-    let p = |k: &Key| item(k, i);
+    let p = |k: &Key| item(keys.array, k, i);
     let kind = ck
         .choice(
             &p(&keys.kind),
@@ -205,8 +210,11 @@ pub(super) fn network(
 ) -> Option<Network> {
     let mut ok = true;
     let mut net = Network::default();
+    // every body's name as written (a coupling is checked against them even when another key
+    // of a body is bad, so that one run lists every problem)
+    let mut names: Vec<Option<String>> = Vec::new();
     for (i, r) in bodies.iter().enumerate() {
-        let p = |k: &Key| item(k, i);
+        let p = |k: &Key| item("bodies", k, i);
         let name = ck.text(&p(&B::name), r.value(&B::name)).required(
             ck,
             &p(&B::name),
@@ -257,6 +265,7 @@ pub(super) fn network(
             }
             None => Some(None),
         };
+        names.push(name.clone());
         match (name, inertia, fixed, drag, speed, drive, road_load) {
             (Some(name), Some(j), Some(fixed), Some(c), Some(w), Some(drive), Some(road_load)) => {
                 net.bodies.push(Body {
@@ -272,25 +281,29 @@ pub(super) fn network(
             _ => ok = false,
         }
     }
-    if !ok {
-        return None;
-    }
     #[derive(Clone, Copy)]
     enum Kind {
         Clutch,
         Gear,
+        Mesh,
+        Spring,
     }
     for (k, r) in couplings.iter().enumerate() {
-        let p = |key: &Key| item(key, k);
-        let name = ck
-            .text(&p(&C::name), r.value(&C::name))
-            .required(ck, &p(&C::name), "required");
+        let p = |key: &Key| item("couplings", key, k);
+        let default_name = format!(
+            "{}-{}",
+            r.value(&C::kind)
+                .and_then(|v| v.as_str())
+                .unwrap_or("coupling"),
+            k + 1
+        );
+        let name = ck.text(&p(&C::name), r.value(&C::name)).or(default_name);
         let kind = ck
             .choice(
                 &p(&C::kind),
                 r.value(&C::kind),
                 &C::kind,
-                &[Kind::Clutch, Kind::Gear],
+                &[Kind::Clutch, Kind::Gear, Kind::Mesh, Kind::Spring],
             )
             .required(ck, &p(&C::kind), "required");
         let body = |ck: &mut Checker, key: &Key| {
@@ -299,13 +312,10 @@ pub(super) fn network(
                 &p(key),
                 "required: the name of a body in [[bodies]]",
             )?;
-            let found = net.body_index(&n);
+            let found = names.iter().position(|m| m.as_deref() == Some(n.as_str()));
             if found.is_none() {
-                let names: Vec<String> = net
-                    .bodies
-                    .iter()
-                    .map(|b| format!("\"{}\"", b.name))
-                    .collect();
+                let names: Vec<String> =
+                    names.iter().flatten().map(|b| format!("\"{b}\"")).collect();
                 ck.report(
                     p(key),
                     Some(format!("\"{n}\"")),
@@ -320,6 +330,11 @@ pub(super) fn network(
             ok = false;
             continue;
         };
+        let spring_keys: [&Key; 3] = [
+            &C::stiffness_n_m_per_rad,
+            &C::damping_n_m_s_per_rad,
+            &C::free_angle_rad,
+        ];
         let clutch_keys: [&Key; 6] = [
             &C::mu,
             &C::mu_speeds_rad_s,
@@ -328,33 +343,84 @@ pub(super) fn network(
             &C::cgeo_m,
             &C::max_normal_force_n,
         ];
-        let built = match kind {
-            Kind::Gear => {
-                for key in clutch_keys {
-                    ck.not_allowed(
-                        &p(key),
-                        r.value(key),
-                        "a clutch's key; remove it for an ideal_gear",
-                    );
-                }
-                if r.force.is_some() {
+        let mesh_keys: [&Key; 6] = [
+            &C::base_radius_a_m,
+            &C::base_radius_b_m,
+            &C::internal,
+            &C::backlash_m,
+            &C::pairs,
+            &C::mesh_offset_m,
+        ];
+        let kind_name = show(r.value(&C::kind).expect("the kind was read"));
+        let refuse = |ck: &mut Checker, keys: &[&Key], tables: &[(&str, bool)], whose: &str| {
+            for key in keys {
+                ck.not_allowed(
+                    &p(key),
+                    r.value(key),
+                    &format!("{whose}'s key; remove it for kind = {kind_name}"),
+                );
+            }
+            for (table, present) in tables {
+                if *present {
                     ck.report(
-                        format!("couplings[{k}].force"),
+                        format!("couplings[{k}].{table}"),
                         None,
-                        "a clutch's table; remove it for an ideal_gear",
+                        format!("{whose}'s table; remove it for kind = {kind_name}"),
                     );
                 }
-                ck.num(&p(&C::ratio), r.value(&C::ratio), &C::ratio)
-                    .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
-                    .map(|ratio| CouplingKind::IdealGear { ratio })
+            }
+        };
+        let (force, contact, oil) = (
+            ("force", r.force.is_some()),
+            ("contact", r.contact.is_some()),
+            ("oil", r.oil.is_some()),
+        );
+        if !matches!(kind, Kind::Spring) {
+            refuse(ck, &spring_keys, &[], "a spring_damper");
+        }
+        match kind {
+            Kind::Spring => {
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(ck, &clutch_keys, &[force], "a clutch");
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
+            }
+            Kind::Gear => {
+                refuse(ck, &clutch_keys, &[force], "a clutch");
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
             }
             Kind::Clutch => {
-                ck.not_allowed(
-                    &p(&C::ratio),
-                    r.value(&C::ratio),
-                    "an ideal gear's key; remove it for a clutch",
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
+            }
+            Kind::Mesh => {
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(ck, &clutch_keys, &[force], "a clutch");
+            }
+        }
+        let built = match kind {
+            Kind::Mesh => gear_mesh(ck, r, k).map(CouplingKind::GearMesh),
+            Kind::Gear => ck
+                .num(&p(&C::ratio), r.value(&C::ratio), &C::ratio)
+                .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
+                .map(|ratio| CouplingKind::IdealGear { ratio }),
+            Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
+            Kind::Spring => {
+                let num = |ck: &mut Checker, key: &Key| ck.num(&p(key), r.value(key), key);
+                let k_ = num(ck, &C::stiffness_n_m_per_rad).required(
+                    ck,
+                    &p(&C::stiffness_n_m_per_rad),
+                    "the spring's stiffness, N m/rad",
                 );
-                clutch(ck, r, k, base_dir).map(CouplingKind::Clutch)
+                let d =
+                    num(ck, &C::damping_n_m_s_per_rad).or(C::damping_n_m_s_per_rad.default_num());
+                let theta0 = num(ck, &C::free_angle_rad).or(C::free_angle_rad.default_num());
+                (|| {
+                    Some(CouplingKind::SpringDamper(clutchpack_model::SpringDamper {
+                        stiffness_n_m_per_rad: k_?,
+                        damping_n_m_s_per_rad: d?,
+                        free_angle_rad: theta0?,
+                    }))
+                })()
             }
         };
         match (name, a, b, built) {
@@ -387,7 +453,7 @@ pub(super) fn network(
 
 /// A clutch's keys and its `force` table.
 fn clutch(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<LumpedClutch> {
-    let p = |key: &Key| item(key, k);
+    let p = |key: &Key| item("couplings", key, k);
     let mu = ck.num(&p(&C::mu), r.value(&C::mu), &C::mu);
     let speeds = ck.numbers(&p(&C::mu_speeds_rad_s), r.value(&C::mu_speeds_rad_s), None);
     let values = ck.numbers(&p(&C::mu_values), r.value(&C::mu_values), None);
@@ -462,4 +528,137 @@ fn clutch(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<LumpedCl
         good = false;
     }
     good.then_some(clutch)
+}
+
+/// A gear mesh's keys and its tooth law (`[couplings.contact]`, `[couplings.oil]`: the keys of
+/// a disc's law, MODEL.md section 2).
+fn gear_mesh(ck: &mut Checker, r: &C, k: usize) -> Option<GearMesh> {
+    let p = |key: &Key| item("couplings", key, k);
+    let num = |ck: &mut Checker, key: &Key| ck.num(&p(key), r.value(key), key);
+    let required = |ck: &mut Checker, key: &Key| {
+        num(ck, key).required(ck, &p(key), "required for a gear_mesh")
+    };
+    let ra = required(ck, &C::base_radius_a_m);
+    let rb = required(ck, &C::base_radius_b_m);
+    let backlash = required(ck, &C::backlash_m);
+    let pairs = num(ck, &C::pairs).or(C::pairs.default_num());
+    let offset = num(ck, &C::mesh_offset_m).or(0.0);
+    let internal = ck
+        .boolean(&p(&C::internal), r.value(&C::internal))
+        .or(false);
+    // the law: [couplings.contact] and [couplings.oil] (couplings[k].contact.modulus_pa)
+    let at = format!("couplings[{k}]");
+    let cv = |key: &Key| r.contact.as_ref().and_then(|c| c.value(key));
+    let ov = |key: &Key| r.oil.as_ref().and_then(|o| o.value(key));
+    let law = ck
+        .choice(
+            &Ct::law.at(&at),
+            cv(&Ct::law),
+            &Ct::law,
+            &[LawKind::Paper, LawKind::Dry, LawKind::Squeeze],
+        )
+        .or(LawKind::Paper);
+    let hint = "required for a gear_mesh (in its [couplings.contact])";
+    let modulus = ck
+        .num(
+            &Ct::modulus_pa.at(&at),
+            cv(&Ct::modulus_pa),
+            &Ct::modulus_pa,
+        )
+        .required(ck, &Ct::modulus_pa.at(&at), hint);
+    let curvature = ck
+        .num(
+            &Ct::curvature_radius_m.at(&at),
+            cv(&Ct::curvature_radius_m),
+            &Ct::curvature_radius_m,
+        )
+        .required(ck, &Ct::curvature_radius_m.at(&at), hint);
+    let loss = ck
+        .num(
+            &Ct::loss_coefficient_s_m.at(&at),
+            cv(&Ct::loss_coefficient_s_m),
+            &Ct::loss_coefficient_s_m,
+        )
+        .or(0.0);
+    let film = ck
+        .num(
+            &O::film_thickness_m.at(&at),
+            ov(&O::film_thickness_m),
+            &O::film_thickness_m,
+        )
+        .or(0.0);
+    let needs_oil = matches!((law, film), (Some(l), Some(h)) if l != LawKind::Dry && h > 0.0);
+    let oil_num = |ck: &mut Checker, key: &Key| {
+        let f = ck.num(&key.at(&at), ov(key), key);
+        if needs_oil {
+            f.required(
+                ck,
+                &key.at(&at),
+                "required with a film (film_thickness_m > 0) and a law that is not dry",
+            )
+        } else {
+            f.or(0.0)
+        }
+    };
+    let viscosity = oil_num(ck, &O::viscosity_pa_s);
+    let leakage = oil_num(ck, &O::leakage_coefficient);
+    let width = oil_num(ck, &O::width_m);
+    let length = oil_num(ck, &O::length_m);
+    let v_floor = ck
+        .num(
+            &O::v_floor_m_s.at(&at),
+            ov(&O::v_floor_m_s),
+            &O::v_floor_m_s,
+        )
+        .or(O::v_floor_m_s.default_num());
+    let h_min = ck
+        .num(&O::h_min_m.at(&at), ov(&O::h_min_m), &O::h_min_m)
+        .or(O::h_min_m.default_num());
+    let mesh = GearMesh {
+        base_radius_a_m: ra?,
+        base_radius_b_m: rb?,
+        internal: internal?,
+        backlash_m: backlash?,
+        pairs: pairs?,
+        initial_offset_m: offset?,
+        law: ToothLaw {
+            kind: law?,
+            hertz: Hertz {
+                modulus_pa: modulus?,
+                curvature_radius_m: curvature?,
+                loss_coefficient_s_m: loss?,
+            },
+            oil: OilFilm {
+                thickness_m: film?,
+                viscosity_pa_s: viscosity?,
+                leakage_coefficient: leakage?,
+                width_m: width?,
+                length_m: length?,
+                v_floor_m_s: v_floor?,
+                h_min_m: h_min?,
+            },
+        },
+    };
+    // the film and the start inside the free play, along the line of action
+    let half = 0.5 * mesh.backlash_m;
+    let reach = half - mesh.law.engagement_offset_m();
+    if reach <= 0.0 {
+        ck.report(
+            O::film_thickness_m.at(&at),
+            Some(crate::schema::fmt_num(mesh.law.oil.thickness_m)),
+            format!("must be < backlash_m / 2 = {half:e} m (else both flanks engage at once)"),
+        );
+        return None;
+    }
+    if mesh.initial_offset_m.abs() >= reach {
+        ck.report(
+            p(&C::mesh_offset_m),
+            Some(crate::schema::fmt_num(mesh.initial_offset_m)),
+            format!(
+                "the mesh must start inside its free play: |x| must be < backlash_m / 2 - the film = {reach:e} m"
+            ),
+        );
+        return None;
+    }
+    Some(mesh)
 }

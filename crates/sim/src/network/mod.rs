@@ -81,7 +81,7 @@ impl Default for NetworkStepOptions {
 fn clutch(net: &Network, k: usize) -> Option<&LumpedClutch> {
     match &net.couplings[k].kind {
         CouplingKind::Clutch(c) => Some(c),
-        CouplingKind::IdealGear { .. } => None,
+        _ => None,
     }
 }
 
@@ -124,7 +124,7 @@ impl<'n> Run<'n> {
             let coef_b = match c.kind {
                 CouplingKind::IdealGear { ratio } => -ratio,
                 CouplingKind::Clutch(_) if self.modes[k] == Some(ClutchMode::Locked) => -1.0,
-                CouplingKind::Clutch(_) => continue,
+                _ => continue,
             };
             self.rows.push(Row {
                 coupling: k,
@@ -238,6 +238,7 @@ impl<'n> Run<'n> {
     fn settle(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
         let net = self.net;
         let before = self.modes.clone();
+        let w_before = self.w.clone();
         for (k, c) in net.couplings.iter().enumerate() {
             let Some(cl) = clutch(net, k) else { continue };
             let f = cl.normal_force_n(t);
@@ -304,6 +305,16 @@ impl<'n> Run<'n> {
         }
         if before != self.modes {
             self.events += 1;
+            // the state just before (the old modes at t) and after: the torques' steps
+            let (modes, w) = (self.modes.clone(), self.w.clone());
+            (self.modes, self.w) = (before.clone(), w_before);
+            self.build_rows();
+            self.torques(t);
+            let state_before = self.sample(t);
+            (self.modes, self.w) = (modes, w);
+            self.build_rows();
+            self.torques(t);
+            obs.switched(&state_before, &self.sample(t));
         }
         for (k, (b, a)) in before.iter().zip(&self.modes).enumerate() {
             if let (Some(from), Some(to)) = (b, a) {
@@ -401,6 +412,24 @@ impl<'n> Run<'n> {
     }
 }
 
+/// Why the multibody engine cannot run `net` (`None`: it can): it runs lumped clutches and
+/// ideal gears; a gear mesh with backlash and a spring-damper run on the reference engine for
+/// now, the message names the first such coupling.
+pub fn unsupported(net: &Network) -> Option<String> {
+    net.couplings.iter().find_map(|c| {
+        let kind = match c.kind {
+            CouplingKind::Clutch(_) | CouplingKind::IdealGear { .. } => return None,
+            CouplingKind::GearMesh(_) => "a gear mesh",
+            CouplingKind::SpringDamper(_) => "a spring-damper",
+        };
+        Some(format!(
+            "coupling \"{}\" is {kind}: the multibody engine runs a network's lumped clutches \
+             and ideal gears only, for now (run it with --engine reference)",
+            c.name
+        ))
+    })
+}
+
 /// Runs `net` on the multibody engine for `duration_s` seconds; samples and clutch events go
 /// to `obs` as they happen. A network with problems ([`Network::problems`]), a duration or a
 /// step that is not finite and positive are refused.
@@ -412,6 +441,9 @@ pub fn run_network(
 ) -> Result<NetworkRun, EngineError> {
     if let Some(p) = net.problems().first() {
         return Err(EngineError::Unsupported(format!("{p:?}")));
+    }
+    if let Some(why) = unsupported(net) {
+        return Err(EngineError::Unsupported(why));
     }
     if !(duration_s.is_finite() && duration_s >= 0.0) {
         return Err(EngineError::Unsupported(format!(
