@@ -557,3 +557,32 @@ fn brake_and_parallel_clutches_match_the_reference_engine() {
         last = Some((dt, dw));
     }
 }
+
+/// The shipped DCT upshift (`scenes/dct-upshift.toml`: an engine, two clutches, three ideal
+/// gears, a vehicle with a road load, K2's apply from a table) on both engines. Measured at
+/// 1e-4 and 5e-5 s: the mode changes within 4.5e-12 and 6.4e-13 s, the speeds at 1 s within
+/// 7.8e-13 and 2.0e-13 of the largest (the vehicle's speed dominates the locked end state),
+/// K2's 9.95 kJ within 1.9e-8 and 4.8e-9 (ratio 4.0), the angles within 5.3e-7 and 1.3e-7
+/// rad; asserted: events within 1e-9 s, speeds within 1e-10, K2's heat within `5 h^2`.
+#[test]
+fn dct_upshift_scene_matches_the_reference_engine() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/dct-upshift.toml");
+    let scene = clutchpack_scene::load(&path, &[]).unwrap();
+    let net = scene.network.expect("a network scene");
+    let d = scene.simulation.duration_s;
+    let r = reference_run(&net, d);
+    let k2 = net.couplings.iter().position(|c| c.name == "K2").unwrap();
+    for h in [1e-4, 5e-5] {
+        let m = multibody(&net, d, h);
+        let (dt, dw, _) = compare(&m, &r);
+        let dq = (m.0.heat_j[k2] - r.0.heat_j[k2]).abs() / r.0.heat_j[k2];
+        println!(
+            "step {h:e}: events within {dt:e} s, speeds within {dw:e}, K2's heat within {dq:e}"
+        );
+        assert!(
+            dt < 1e-9 && dw < 1e-10 && dq < 5.0 * h * h,
+            "{dt} {dw} {dq}"
+        );
+    }
+}
