@@ -117,6 +117,13 @@ impl Stack {
         self.model.piston.pressure = pressure;
     }
 
+    /// Replaces the open gaps' oil (a thermal window's new viscosity, MODEL.md section 9):
+    /// their drag coefficient follows from the next step on.
+    pub fn set_open_gap(&mut self, gap: Option<clutchpack_model::OpenGap>) {
+        self.model.open_gap = gap;
+        self.c_gap = -self.model.open_gap_torque_n_m(1.0);
+    }
+
     /// The length of the step the impulses were last solved for, s (0 before the first).
     pub fn step_s(&self) -> f64 {
         self.h
