@@ -6,9 +6,10 @@
 //!
 //! # What this engine books
 //! After every world step (of either scheme): each interface's dissipated work
-//! (`Stack::dissipated_j`, kept by the stack's own integration) grew by its friction's or its
-//! gap's drag's work, which goes by the interface's mode at the step's start (clamped: the
-//! clamp force `> 0`, slipping or locked, to its two bodies by effusivity; open: to the oil);
+//! (`Stack::dissipated_j`, kept by the stack's own integration) grew by its friction's and its
+//! gap's drag's work; the part done while clamped (`Stack::friction_j`: the clamped stack's
+//! sub-step stages with a clamp force `> 0`, the shared step's steps that started clamped,
+//! the locks) goes to its two bodies by effusivity, the rest (open) to the oil;
 //! the teeth's work on the relative motion `-n F Rb psi` (the reference engine's) to the oil,
 //! taken from the energy audit as what the step's external work (drive, drag, the stack's
 //! faces, the load) put in beyond the change of the kinetic energy: the teeth are the only
@@ -27,9 +28,9 @@ use std::sync::Arc;
 #[derive(Debug, Clone)]
 pub(super) struct Thermal {
     windows: ThermalWindows,
-    /// Each interface's dissipated work at the last booking, J, and its mode from there.
+    /// Each interface's dissipated work and its clamped part at the last booking, J.
     counters: Vec<f64>,
-    modes: Vec<FaceMode>,
+    friction: Vec<f64>,
     /// The audit's external work without the stack's (drive, drag, load) and the stack's,
     /// and the kinetic energy, at the last booking, J.
     external_j: f64,
@@ -54,7 +55,7 @@ impl Thermal {
             Thermal {
                 windows,
                 counters: vec![0.0; n_if],
-                modes: vec![FaceMode::Open; n_if],
+                friction: vec![0.0; n_if],
                 external_j: 0.0,
                 stack_j: 0.0,
                 kinetic_j: 0.0,
@@ -70,7 +71,7 @@ impl Thermal {
         self.send(run.t, observer);
     }
 
-    /// The counters and modes at the run's current state.
+    /// The counters at the run's current state.
     fn mark(&mut self, run: &Run) {
         let a = run.energy.so_far();
         self.external_j = a.drive_work_j + a.drag_work_j + a.load_work_j;
@@ -79,13 +80,7 @@ impl Thermal {
         if let Some(s) = &run.stack {
             let n_if = self.counters.len();
             self.counters.copy_from_slice(&s.dissipated_j[..n_if]);
-            for (mode, &f) in self.modes.iter_mut().zip(&s.clamp) {
-                *mode = if f > 0.0 {
-                    FaceMode::Clamped
-                } else {
-                    FaceMode::Open
-                };
-            }
+            self.friction.copy_from_slice(&s.friction_j[..n_if]);
         }
     }
 
@@ -105,8 +100,10 @@ impl Thermal {
     ) -> Result<(), EngineError> {
         if let Some(s) = &run.stack {
             for m in 0..self.counters.len() {
-                let dq = s.dissipated_j[m] - self.counters[m];
-                self.windows.book_face(m, dq, self.modes[m]);
+                let friction = s.friction_j[m] - self.friction[m];
+                let all = s.dissipated_j[m] - self.counters[m];
+                self.windows.book_face(m, friction, FaceMode::Clamped);
+                self.windows.book_face(m, all - friction, FaceMode::Open);
             }
         }
         let a = run.energy.so_far();
