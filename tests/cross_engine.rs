@@ -558,22 +558,13 @@ fn plates_without_a_stack_multirate() {
     );
 }
 
-/// Issue 35: a thermal pack on both engines. pack-6-thermal (pack-6-engagement with
-/// temperatures: the rattle, the piston's ramp, the faces slipping until they lock; 0.3 s,
-/// 300 windows of 1 ms) on each engine at the scene's settings; every body's and the oil's
-/// final temperature rise agrees with the other engine's within `RISE` of the rise, and both
-/// balance their heat to rounding. The faces' heat (39 kJ of 40) dominates and is set by the
-/// engagement's slip, which both engines resolve alike (the locks within 0.5 %, the heat per
-/// face within 1 %: `engagement_pack_6_locks_and_heats_alike`); the rattle before it is
-/// chaotic and the teeth's heat (37 J) differs between the engines by more than the
-/// temperatures show. Measured: see the bound's comment.
-#[test]
-fn thermal_pack_6_heats_alike() {
-    let s = clutchpack_scene::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/pack-6-thermal.toml"),
-        &[],
-    )
-    .unwrap();
+/// Issue 35: a thermal scene run on both engines at its own settings; every body's and the
+/// oil's final temperature rise, relative to the reference engine's, is returned as the worst
+/// (its body named), the per-body rises and the heat of both printed; both balance their heat
+/// to rounding and send the same number of temperature points.
+fn thermal_agreement(file: &str, sets: &[&str]) -> (f64, String) {
+    let o: Vec<Override> = sets.iter().map(|s| s.parse().unwrap()).collect();
+    let s = clutchpack_scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(file), &o).unwrap();
     let sim = &s.simulation;
     let duration = sim.duration_s;
     let mut rc = Collector::default();
@@ -620,7 +611,7 @@ fn thermal_pack_6_heats_alike() {
         let rise = tr - t0;
         let off = (tm - tr).abs() / rise;
         println!(
-            "{name}: reference +{rise:.5} K, multibody +{:.5} K, {off:.2e} of the rise",
+            "{file} {name}: reference +{rise:.5} K, multibody +{:.5} K, {off:.2e} of the rise",
             tm - t0
         );
         if off > worst.0 {
@@ -628,8 +619,8 @@ fn thermal_pack_6_heats_alike() {
         }
     }
     println!(
-        "heat: reference {:.2} J (faces {:.2}, gaps {:.3}, teeth {:.3}), multibody {:.2} J \
-         (faces {:.2}, gaps {:.3}, teeth {:.3}); worst rise {:.2e} ({})",
+        "{file}: heat: reference {:.2} J (faces {:.2}, gaps {:.3}, teeth {:.3}), multibody \
+         {:.2} J (faces {:.2}, gaps {:.3}, teeth {:.3}); worst rise {:.2e} ({})",
         r.generated_j(),
         r.friction_heat_j,
         r.gap_heat_j,
@@ -645,13 +636,35 @@ fn thermal_pack_6_heats_alike() {
     for x in [&r, &m] {
         assert!((x.accounted_j() - x.generated_j()).abs() <= 1e-12 * x.generated_j());
     }
-    assert!(
-        worst.0 <= RISE,
-        "{} off by {:.3e} of its rise",
-        worst.1,
-        worst.0
-    );
+    worst
 }
 
-/// [`thermal_pack_6_heats_alike`]'s bound on the final temperature rises, relative.
-const RISE: f64 = 1e-3;
+/// Issue 35: pack-6-thermal (pack-6-engagement with temperatures: the rattle, the piston's
+/// ramp, the faces slipping until they lock; 0.3 s, 300 windows of 1 ms) on both engines:
+/// every body's and the oil's final temperature rise within 0.1 % (issue 35's bound) of the
+/// reference engine's. The faces' heat (38.4 kJ of 39.7) dominates and is set by the
+/// engagement's slip, which both engines resolve alike (the heat per face within 1 %,
+/// `engagement_pack_6_locks_and_heats_alike`; here the faces' total within 9e-6); the rattle
+/// before it is chaotic, and the teeth's heat (37 J, into the oil) differs by 2.4e-3.
+/// Measured: worst 2.0e-4 of the rise (plate-7, +3.960 K; the oil 7.6e-6 of +0.678 K).
+#[test]
+fn thermal_pack_6_heats_alike() {
+    let (worst, body) = thermal_agreement("scenes/pack-6-thermal.toml", &[]);
+    assert!(worst <= 1e-3, "{body} off by {worst:.3e} of its rise");
+}
+
+/// Issue 35: the duty cycle's first 3 s on both engines (pack-6-duty-cycle: the engagement,
+/// 1.5 s locked driving the drum, the release, the open pack rattling while the drum's load
+/// brakes it, the second engagement's start): the gaps' drag now heats the oil as much as the
+/// faces heat the plates (31 kJ and 39 kJ). Every final temperature rise within 0.1 % of the
+/// reference engine's. Measured: worst 1.05e-4 of the rise (the oil, +9.691 K; the plates
+/// within 1.0e-4, the discs within 9.5e-5); the teeth's heat, 935 J and 930 J, differs by the
+/// chaotic rattle's 0.6 %. Run time: 3.2 s and 3.9 s (release).
+#[test]
+fn thermal_duty_cycle_heats_alike() {
+    let (worst, body) = thermal_agreement(
+        "scenes/pack-6-duty-cycle.toml",
+        &["simulation.duration_s=3"],
+    );
+    assert!(worst <= 1e-3, "{body} off by {worst:.3e} of its rise");
+}
