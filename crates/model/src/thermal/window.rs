@@ -432,7 +432,8 @@ mod tests {
         assert_eq!(r.final_k[2], t0);
         assert!((r.oil_final_k - (t0 + 5.0e-3)).abs() < 1e-12);
         assert!((r.generated_j() - 15.0).abs() < 1e-12);
-        assert!((r.accounted_j() - r.generated_j()).abs() < 1e-12);
+        // the stored heat is C (T - T_0) at 313 K: rounding of 6e-14 K times 100 J/K a body
+        assert!((r.accounted_j() - r.generated_j()).abs() < 1e-10);
     }
 
     /// A window closes at the first time at or after its end; the film scale follows the
