@@ -7,6 +7,7 @@ mod cross_engine;
 mod fatigue;
 mod fmu;
 mod hardening;
+mod network;
 mod python_package;
 mod reliability;
 mod session;

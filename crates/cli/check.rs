@@ -40,18 +40,33 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
         // it can run the scene (`Simulation::new`, the one home of that decision: an engine
         // that cannot run the pack, a scheme it cannot run it with), with `run`'s message.
         let checked = clutchpack_sdk::load_scene(Some(p), &[]).and_then(|s| {
+            if let Some(net) = &s.network {
+                // a network runs on the reference engine (its own rules checked in the load)
+                if a.engine == Some(EngineChoice::Multibody) {
+                    return Err(clutchpack_sdk::Error::BadInput(format!(
+                        "{}: a network scene runs on the reference engine only, for now",
+                        p.display()
+                    )));
+                }
+                return Ok(format!(
+                    "network of {} bodies and {} couplings, {} s, reference engine",
+                    net.bodies.len(),
+                    net.couplings.len(),
+                    s.simulation.duration_s
+                ));
+            }
             // the engine choice first with the file as the origin of its problems (each at
             // its key), as before; `Simulation::new` makes the same choice, then builds it
             s.engine(a.engine, &p.display().to_string())?;
             let (discs, duration_s) = (s.pack.discs.len(), s.simulation.duration_s);
             let sim = clutchpack_sdk::Simulation::new(s, a.engine)?;
-            Ok((discs, duration_s, sim.engine_name()))
+            Ok(format!(
+                "{discs} discs, {duration_s} s, {} engine",
+                sim.engine_name()
+            ))
         });
         match checked {
-            Ok((discs, duration_s, engine)) => out!(
-                "{}: ok ({discs} discs, {duration_s} s, {engine} engine)",
-                p.display(),
-            ),
+            Ok(what) => out!("{}: ok ({what})", p.display()),
             Err(e) => {
                 eprintln!("{e}");
                 bad += 1;

@@ -45,6 +45,7 @@ mod check;
 mod common;
 mod describe;
 mod fmu;
+mod network;
 mod outputs;
 mod recording;
 mod run;

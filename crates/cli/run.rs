@@ -111,6 +111,30 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         });
     }
     let scene = clutchpack_sdk::load_scene(a.scene.as_deref(), &sets)?;
+    if scene.network.is_some() {
+        let pack_only = [
+            ("--out", a.out.is_some()),
+            ("--impacts-csv", a.impacts_csv.is_some()),
+            ("--fatigue-json", a.fatigue_json.is_some()),
+            ("--windows", a.windows.is_some()),
+            ("--per-tooth", a.per_tooth),
+            (
+                "--engine multibody",
+                a.engine == Some(EngineChoice::Multibody),
+            ),
+        ];
+        let args = crate::network::NetworkArgs {
+            scene_path: a.scene.as_deref(),
+            summary_json: a.summary_json.as_deref(),
+            plot: a.plot.as_deref(),
+            pack_only: pack_only
+                .iter()
+                .filter(|(_, on)| *on)
+                .map(|(f, _)| *f)
+                .collect(),
+        };
+        return crate::network::run(&args, scene, &interrupted);
+    }
     // Every output checked before any work (crate::outputs); the recording's folder is made.
     let record_path = (!a.no_record).then(|| {
         a.out.clone().unwrap_or_else(|| {

@@ -297,6 +297,75 @@ pub fn staggered_inertial(n: usize) -> PackModel {
     pack
 }
 
+/// Modelica's `Rotational.Examples.CoupledClutches` (MSL 4.0) as a network (MODEL.md section
+/// 8): four unit inertias in a row (`J1` at 10 rad/s, the others at rest), a torque
+/// `10 sin(2 pi 5 t)` N m on `J1`, and three clutches between them (`mu = 0.5`, `peak = 1.1`,
+/// `cgeo = 1`, `fn_max = 20` N) applied by `cos(2 pi 0.2 t)` (clutch1), a step to 1 at 0.4 s
+/// (clutch2) and one at 0.9 s (clutch3). Its reference results are in
+/// `crates/reference/tests/network.rs`.
+pub fn coupled_clutches() -> crate::network::Network {
+    use crate::network::{Body, Coupling, CouplingKind, LumpedClutch, Network, Signal};
+    let body = |name: &str, w: f64, drive: Option<Signal>| Body {
+        name: name.into(),
+        inertia_kg_m2: 1.0,
+        drag_n_m_s_rad: 0.0,
+        initial_speed_rad_s: w,
+        fixed: false,
+        drive,
+        road_load: None,
+    };
+    let clutch = |name: &str, a: usize, force: Signal| Coupling {
+        name: name.into(),
+        a,
+        b: a + 1,
+        kind: CouplingKind::Clutch(LumpedClutch {
+            mu_table: vec![(0.0, 0.5)],
+            peak: 1.1,
+            cgeo_m: 1.0,
+            fn_max_n: 20.0,
+            force,
+        }),
+    };
+    let step = |start_s: f64| Signal::Step {
+        offset: 0.0,
+        height: 1.0,
+        start_s,
+    };
+    Network {
+        bodies: vec![
+            body(
+                "J1",
+                10.0,
+                Some(Signal::Sine {
+                    offset: 0.0,
+                    amplitude: 10.0,
+                    frequency_hz: 5.0,
+                    phase_rad: 0.0,
+                    start_s: 0.0,
+                }),
+            ),
+            body("J2", 0.0, None),
+            body("J3", 0.0, None),
+            body("J4", 0.0, None),
+        ],
+        couplings: vec![
+            clutch(
+                "clutch1",
+                0,
+                Signal::Sine {
+                    offset: 0.0,
+                    amplitude: 1.0,
+                    frequency_hz: 0.2,
+                    phase_rad: std::f64::consts::FRAC_PI_2,
+                    start_s: 0.0,
+                },
+            ),
+            clutch("clutch2", 1, step(0.4)),
+            clutch("clutch3", 2, step(0.9)),
+        ],
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

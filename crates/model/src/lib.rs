@@ -57,6 +57,7 @@ pub mod drive;
 pub mod fatigue;
 pub mod impact;
 pub mod law;
+pub mod network;
 pub mod pack;
 pub mod session;
 pub mod spline;
@@ -110,7 +111,7 @@ pub fn free_impact_compression_m(k: f64, m_eff_kg: f64, v0_m_s: f64) -> f64 {
 /// `2 \int_0^1 dx / sqrt(1 - x^(5/2))`: the duration of a free Hertz impact in units of
 /// `s_max / v0` (energy conservation `1/2 m s'^2 + 2/5 k s^(5/2) = 1/2 m v0^2` integrated over
 /// the approach and the symmetric restitution).
-pub const HERTZ_DURATION_FACTOR: f64 = 2.943_255;
+pub const HERTZ_DURATION_FACTOR: f64 = 2.943_275_184;
 
 /// Closed-form duration of one free, undamped impact in s (Hertz's impact theory):
 /// `t_c = 2.9433 s_max / v0`, with `s_max` from [`free_impact_compression_m`], for stiffness

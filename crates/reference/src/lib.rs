@@ -194,6 +194,7 @@ mod coupled;
 mod dopri;
 mod gaps;
 mod independent;
+pub mod network;
 mod open;
 mod session;
 mod stepper;

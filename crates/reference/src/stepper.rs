@@ -545,7 +545,7 @@ fn eval2(prev: &Dense, cur: &Dense, t: f64, out: &mut [f64]) {
 
 /// Maximises `|f|` on `[a, b]` by golden-section search (f unimodal in |f|); returns the
 /// argument and the signed value. 60 iterations shrink the bracket by 0.618^60 ~ 3e-13.
-fn golden_peak(mut a: f64, mut b: f64, mut f: impl FnMut(f64) -> f64) -> (f64, f64) {
+pub(crate) fn golden_peak(mut a: f64, mut b: f64, mut f: impl FnMut(f64) -> f64) -> (f64, f64) {
     const R: f64 = 0.618_033_988_749_894_9;
     let mut c = b - R * (b - a);
     let mut d = a + R * (b - a);

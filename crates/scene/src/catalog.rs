@@ -218,7 +218,9 @@ mod tests {
                 "stack",
                 "defaults",
                 "plate_defaults",
-                "thermal"
+                "thermal",
+                "bodies",
+                "couplings"
             ]
         );
         assert!(children("discs[]").contains(&"name"));

@@ -104,6 +104,8 @@ table! {
         defaults: table RawBody,
         plate_defaults: table RawBody,
         thermal: table RawThermal,
+        bodies: array RawNetBody,
+        couplings: array RawCoupling,
     }
 }
 
@@ -482,6 +484,145 @@ table! {
         thickness_m: "m", THICKNESS, Dflt::Num(1.8e-3);
         /// heat capacity m c of one plate, instead of the geometry's
         heat_capacity_j_k: "J/K", POSITIVE, Dflt::Described("default: steel (clutchpack_model::thermal::ThermalProperties::STEEL)");
+    }
+    children {}
+}
+
+/// The signal kinds of a network's drives and clutch forces (`clutchpack_model::network::Signal`).
+const SIGNAL_KINDS: Kind = Kind::Choice(&["constant", "step", "ramp", "sine", "table"]);
+
+table! {
+    /// One `[[bodies]]` entry: a rotational body of a driveline network (MODEL.md section 8). A scene with `[[bodies]]` is a network scene: its bodies and `[[couplings]]` replace `[shaft]`, `[drive]`, `[[discs]]`, `[[plates]]`, `[drum]` and `[stack]` (resolved packs on a network come next).
+    RawNetBody at "" {
+        /// the body's name, unique; couplings name their bodies by it
+        name: "", Kind::Text, Dflt::Required;
+        /// inertia about its axis
+        inertia_kg_m2: "kg m^2", INERTIA, Dflt::When("required, an error for a fixed body");
+        /// viscous drag: the torque -C w
+        drag_n_m_s_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
+        /// speed at t = 0 (the speeds of bodies joined by ideal gears must mesh)
+        initial_speed_rad_s: "rad/s", SPEED, Dflt::Num(0.0);
+        /// a fixed body (the housing): it never turns; a clutch to it is a brake
+        fixed: "", Kind::Bool, Dflt::Bool(false);
+    }
+    children {
+        drive: table RawTorqueSignal,
+        road_load: table RawRoadLoad,
+    }
+}
+
+table! {
+    /// `[bodies.drive]`: a driving torque on the body, positive in its sense of rotation.
+    RawTorqueSignal at "drive" {
+        /// "constant" (value_n_m), "step" (offset_n_m, then + height_n_m from start_s), "ramp" (offset_n_m rising by height_n_m over duration_s from start_s), "sine" (offset_n_m + amplitude_n_m sin(2 pi f (t - start_s) + phase) from start_s), "table" (file)
+        kind: "", SIGNAL_KINDS, Dflt::Required;
+        /// constant: the torque
+        value_n_m: "N m", TORQUE, Dflt::When("constant: required");
+        /// step, ramp, sine: the torque before start_s (sine: the mean)
+        offset_n_m: "N m", TORQUE, Dflt::Num(0.0);
+        /// step, ramp: the change
+        height_n_m: "N m", TORQUE, Dflt::When("step and ramp: required");
+        /// sine: the amplitude
+        amplitude_n_m: "N m", TORQUE, Dflt::When("sine: required");
+        /// sine: the frequency
+        frequency_hz: "Hz", FREQUENCY, Dflt::When("sine: required");
+        /// sine: the phase at start_s
+        phase_deg: "deg", FINITE, Dflt::Num(0.0);
+        /// step, ramp, sine: when it starts
+        start_s: "s", NON_NEGATIVE, Dflt::Num(0.0);
+        /// ramp: its length
+        duration_s: "s", POSITIVE, Dflt::When("ramp: required");
+        /// table: CSV with a header row and columns time_s, torque_n_m, relative to the scene file's folder
+        file: "", Kind::Text, Dflt::When("table: required");
+        /// table: "linear" between rows, or "hold" (each row's value until the next)
+        interpolation: "", Kind::Choice(&["linear", "hold"]), Dflt::Choice("linear");
+    }
+    children {}
+}
+
+table! {
+    /// `[bodies.road_load]`: a load opposing motion, -sign(w) (a + b |w| + c w^2), zero at rest (a vehicle reduced to a shaft).
+    RawRoadLoad at "road_load" {
+        /// a: the constant part (rolling resistance)
+        constant_n_m: "N m", NON_NEGATIVE, Dflt::Num(0.0);
+        /// b: the part proportional to speed
+        linear_n_m_s_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
+        /// c: the part proportional to speed squared (air drag)
+        quadratic_n_m_s2_rad2: "N m s^2/rad^2", NON_NEGATIVE, Dflt::Num(0.0);
+    }
+    children {}
+}
+
+table! {
+    /// One `[[couplings]]` entry of a network scene: a coupling between bodies a and b (MODEL.md section 8). Signs: a clutch's slip is w_b - w_a and its torque acts +tau on a, -tau on b (Modelica's flanges); an ideal gear ties w_a = ratio w_b; a gear mesh's force F, signed as x, acts -Rb_a F on a and -Rb_b F on b (internal: +Rb_b F).
+    RawCoupling at "" {
+        /// the coupling's name, unique (tables, summaries and figures name it)
+        name: "", Kind::Text, Dflt::Described("default \"<kind>-<i+1>\" (\"clutch-2\")");
+        /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash; "gear_mesh": a gear pair with backlash and the tooth law of [couplings.contact] and [couplings.oil] along its line of action (gear rattle)
+        kind: "", Kind::Choice(&["clutch", "ideal_gear", "gear_mesh"]), Dflt::Required;
+        /// the name of body a
+        a: "", Kind::Text, Dflt::Required;
+        /// the name of body b
+        b: "", Kind::Text, Dflt::Required;
+        /// ideal_gear: w_a / w_b (negative: b turns the other way)
+        ratio: "", FINITE, Dflt::When("ideal_gear: required, an error otherwise");
+        /// clutch: the sliding friction coefficient, constant (or mu_speeds_rad_s with mu_values)
+        mu: "", NON_NEGATIVE, Dflt::When("clutch: mu, or mu_speeds_rad_s with mu_values");
+        /// clutch: increasing slip speeds (>= 0) of a friction table, linear between rows and extrapolated from the last two (Modelica's mu_pos)
+        mu_speeds_rad_s: "rad/s", Kind::Numbers, Dflt::When("clutch: with mu_values, instead of mu");
+        /// clutch: the friction coefficients at mu_speeds_rad_s
+        mu_values: "", Kind::Numbers, Dflt::When("clutch: with mu_speeds_rad_s");
+        /// clutch: static over sliding friction at zero slip, >= 1
+        peak: "", Kind::Number(Rule::Closed(1.0, 100.0)), Dflt::Num(1.0);
+        /// clutch: torque per friction force, N (ro + ri) / 2 for N faces under uniform wear (Modelica's cgeo)
+        cgeo_m: "m", NON_NEGATIVE, Dflt::Num(1.0);
+        /// clutch: the normal force at force = 1 (Modelica's fn_max)
+        max_normal_force_n: "N", NON_NEGATIVE, Dflt::When("clutch: required");
+        /// gear_mesh: base radius of the gear on body a
+        base_radius_a_m: "m", Kind::Number(Rule::Bounded { floor: MIN_PITCH_RADIUS_M, ceil: MAX_PITCH_RADIUS_M }), Dflt::When("gear_mesh: required");
+        /// gear_mesh: base radius of the gear on body b
+        base_radius_b_m: "m", Kind::Number(Rule::Bounded { floor: MIN_PITCH_RADIUS_M, ceil: MAX_PITCH_RADIUS_M }), Dflt::When("gear_mesh: required");
+        /// gear_mesh: an internal mesh (a ring gear: b turns the same way as a); else external
+        internal: "", Kind::Bool, Dflt::Bool(false);
+        /// gear_mesh: backlash along the line of action (the free travel from flank to flank)
+        backlash_m: "m", POSITIVE, Dflt::When("gear_mesh: required");
+        /// gear_mesh: tooth pairs sharing the load (the contact ratio's whole part)
+        pairs: "", Kind::Number(Rule::Closed(1.0, 10.0)), Dflt::Num(1.0);
+        /// gear_mesh: relative displacement x = Rb_a theta_a +- Rb_b theta_b at t = 0 (0: centred in the backlash); |x| + the film must be < backlash_m / 2
+        mesh_offset_m: "m", FINITE, Dflt::Num(0.0);
+    }
+    children {
+        force: table RawForceSignal,
+        contact: table RawContact,
+        oil: table RawOil,
+    }
+}
+
+table! {
+    /// `[couplings.force]`: a clutch's normalized normal force f(t) (the normal force is max_normal_force_n f; engaged while > 0).
+    RawForceSignal at "force" {
+        /// "constant" (value), "step" (offset, then + height from start_s), "ramp" (offset rising by height over duration_s from start_s), "sine" (offset + amplitude sin(2 pi f (t - start_s) + phase) from start_s), "table" (file)
+        kind: "", SIGNAL_KINDS, Dflt::Required;
+        /// constant: the force
+        value: "", FINITE, Dflt::When("constant: required");
+        /// step, ramp, sine: the force before start_s (sine: the mean)
+        offset: "", FINITE, Dflt::Num(0.0);
+        /// step, ramp: the change
+        height: "", FINITE, Dflt::When("step and ramp: required");
+        /// sine: the amplitude
+        amplitude: "", FINITE, Dflt::When("sine: required");
+        /// sine: the frequency
+        frequency_hz: "Hz", FREQUENCY, Dflt::When("sine: required");
+        /// sine: the phase at start_s
+        phase_deg: "deg", FINITE, Dflt::Num(0.0);
+        /// step, ramp, sine: when it starts
+        start_s: "s", NON_NEGATIVE, Dflt::Num(0.0);
+        /// ramp: its length
+        duration_s: "s", POSITIVE, Dflt::When("ramp: required");
+        /// table: CSV with a header row and columns time_s, force, relative to the scene file's folder
+        file: "", Kind::Text, Dflt::When("table: required");
+        /// table: "linear" between rows, or "hold" (each row's value until the next)
+        interpolation: "", Kind::Choice(&["linear", "hold"]), Dflt::Choice("linear");
     }
     children {}
 }

@@ -248,6 +248,11 @@ pub struct Scene {
     /// scene (every scene without the section), which runs exactly as before it existed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thermal: Option<clutchpack_model::thermal::ThermalModel>,
+    /// The driveline network of a network scene (`[[bodies]]` and `[[couplings]]`, MODEL.md
+    /// section 8); `None` for a pack scene. A network scene's `pack` is an empty placeholder
+    /// that no pack engine runs (`clutchpack_sdk::Simulation::new` refuses the scene).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub network: Option<clutchpack_model::network::Network>,
 }
 
 /// Reads an input text file (a scene, a CSV table, a study file) whole. A path that is not a
@@ -335,6 +340,7 @@ pub fn parse(
             pack: v.pack,
             fatigue: v.fatigue,
             thermal: v.thermal,
+            network: v.network,
         }),
         _ => {
             debug_assert!(

@@ -26,6 +26,7 @@ mod collector;
 pub mod cosim;
 mod error;
 mod fatigue;
+mod network;
 mod recording;
 mod run;
 mod scene;
@@ -41,10 +42,16 @@ pub use batch::{
 };
 /// The steppable engines' inputs and outputs (co-simulation).
 pub use clutchpack_model::session::{Advance, Driven, Inputs, Snapshot};
+/// A network run's sample (for figures of a network's history).
+pub use clutchpack_reference::network::NetworkSample;
 pub use collector::{merge_peaks, RunCollector};
 pub use cosim::{CoSimulation, SavedCoSimulation};
 pub use error::{Error, Result};
 pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
+pub use network::{
+    run_network_scene, BodySummary, CouplingSummary, EnergySummary, ModeChange, NetworkOutcome,
+    NetworkRequest, NetworkSummary,
+};
 pub use recording::open_recording;
 pub use run::{RecordingRequest, RunOutcome, RunRequest};
 pub use scene::{load_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TEXT};

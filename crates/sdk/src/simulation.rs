@@ -18,6 +18,13 @@ pub struct Simulation {
 impl Simulation {
     /// The engine for `scene` (`asked`: an explicit choice, e.g. `--engine`).
     pub fn new(scene: Scene, asked: Option<EngineChoice>) -> Result<Simulation> {
+        if scene.network.is_some() {
+            return Err(crate::Error::BadInput(format!(
+                "{} is a network scene ([[bodies]]): `clutchpack run` and `check` take it; \
+                 sweeps, studies, recordings, the FMU and Python take pack scenes only, for now",
+                scene.name
+            )));
+        }
         let choice = scene.engine(asked, &scene.name)?;
         let why = scene.engine_reason(asked);
         let sim = &scene.simulation;

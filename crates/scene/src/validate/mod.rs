@@ -13,6 +13,7 @@
 
 mod bodies;
 mod drive;
+mod network;
 mod simulation;
 mod stack;
 mod thermal;
@@ -33,6 +34,7 @@ pub(crate) struct Validated {
     pub pack: PackModel,
     pub fatigue: Vec<clutchpack_model::FatigueParams>,
     pub thermal: Option<clutchpack_model::thermal::ThermalModel>,
+    pub network: Option<clutchpack_model::network::Network>,
 }
 
 /// The outcome of checking one value where it is written.
@@ -269,6 +271,16 @@ pub(crate) fn validate(
         .text("description", raw.description.as_ref())
         .or(String::new());
     let simulation = simulation::simulation(ck, raw.simulation.as_ref());
+    if let Some(bodies) = raw.bodies.as_deref() {
+        return network_scene(ck, raw, bodies, base_dir, name, description, simulation);
+    }
+    if raw.couplings.is_some() {
+        ck.report(
+            "couplings",
+            None,
+            "couplings join the bodies of a network: declare them in [[bodies]]",
+        );
+    }
     let (kind, drive) = drive::drive(ck, raw.drive.as_ref(), base_dir);
     let shaft = drive::shaft(ck, raw.shaft.as_ref(), kind, drive);
     let mut names = Vec::new();
@@ -335,5 +347,72 @@ pub(crate) fn validate(
             stack: stack.map_or(Some(None), |s| s.map(Some))?,
         },
         thermal: thermal?,
+        network: None,
+    })
+}
+
+/// A network scene (`[[bodies]]`, MODEL.md section 8): the pack's sections are refused (a
+/// resolved pack on a network comes next), the simulation settings that only a pack uses
+/// too; the `pack` is an empty placeholder that nothing runs.
+fn network_scene(
+    ck: &mut Checker,
+    raw: &RawScene,
+    bodies: &[crate::keys::RawNetBody],
+    base_dir: &Path,
+    name: Option<String>,
+    description: Option<String>,
+    simulation: Option<Simulation>,
+) -> Option<Validated> {
+    let pack_sections = [
+        ("shaft", raw.shaft.is_some()),
+        ("drive", raw.drive.is_some()),
+        ("discs", raw.discs.is_some()),
+        ("plates", raw.plates.is_some()),
+        ("drum", raw.drum.is_some()),
+        ("stack", raw.stack.is_some()),
+        ("defaults", raw.defaults.is_some()),
+        ("plate_defaults", raw.plate_defaults.is_some()),
+        ("thermal", raw.thermal.is_some()),
+    ];
+    for (section, present) in pack_sections {
+        if present {
+            ck.report(
+                section,
+                None,
+                "not in a network scene yet: a network ([[bodies]]) runs lumped parts (clutches, ideal gears); resolved packs on a network come next (issue 34)",
+            );
+        }
+    }
+    if let Some(sim) = &simulation {
+        if sim.engine == Some(crate::EngineChoice::Multibody) {
+            ck.report(
+                "simulation.engine",
+                Some("\"multibody\"".into()),
+                "a network runs on the reference engine only, for now",
+            );
+        }
+    }
+    let network = network::network(
+        ck,
+        bodies,
+        raw.couplings.as_deref().unwrap_or(&[]),
+        base_dir,
+    );
+    Some(Validated {
+        name: name?,
+        description: description?,
+        simulation: simulation?,
+        pack: PackModel {
+            shaft: clutchpack_model::Shaft::Prescribed(clutchpack_model::SpeedProfile::sine(
+                0.0, 0.0, 1.0,
+            )),
+            discs: Vec::new(),
+            plates: Vec::new(),
+            drum: None,
+            stack: None,
+        },
+        fatigue: Vec::new(),
+        thermal: None,
+        network: Some(network?),
     })
 }

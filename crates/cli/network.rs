@@ -1,0 +1,183 @@
+//! `clutchpack run` of a network scene (`[[bodies]]`, MODEL.md section 8): the clutches' mode
+//! changes and heat, the bodies' final speeds and the energy balance; `--summary-json` and
+//! `--plot` (speeds and coupling torques against time). The pack-only options are refused
+//! before any work (exit 2).
+
+use crate::common::{self, BadInput};
+use crate::outputs::Output;
+use anyhow::{Context, Result};
+use clutchpack_scene::Scene;
+use clutchpack_sdk::NetworkRequest;
+use std::path::Path;
+use std::process::ExitCode;
+use std::sync::atomic::AtomicBool;
+
+/// What `run` passes on for a network scene.
+pub struct NetworkArgs<'a> {
+    /// The scene file (an input no output may name).
+    pub scene_path: Option<&'a Path>,
+    /// `--summary-json`.
+    pub summary_json: Option<&'a Path>,
+    /// `--plot`.
+    pub plot: Option<&'a Path>,
+    /// Each pack-only option given (its flag), refused.
+    pub pack_only: Vec<&'static str>,
+}
+
+/// Runs the network scene `scene` with the options of `a`.
+pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<ExitCode> {
+    if let Some(flag) = a.pack_only.first() {
+        return Err(BadInput(format!(
+            "{flag}: not for a network scene ({} has [[bodies]]); a network run gives its \
+             table, --summary-json and --plot (recordings of networks come next)",
+            scene.name
+        ))
+        .into());
+    }
+    let mut outs = Vec::new();
+    if let Some(p) = a.summary_json {
+        outs.push(Output::file("--summary-json", p));
+    }
+    if let Some(p) = a.plot {
+        outs.push(Output::figure("--plot", p));
+    }
+    let inputs: Vec<&Path> = a.scene_path.into_iter().collect();
+    crate::outputs::check_outputs(&outs, &inputs)?;
+    let pb = common::time_progress(scene.simulation.duration_s, &scene.name);
+    let mut progress = |t: f64| common::show_time(&pb, t);
+    let done = clutchpack_sdk::run_network_scene(
+        &scene,
+        NetworkRequest {
+            keep_history: a.plot.is_some(),
+            stop: Some(interrupted),
+            progress: Some(&mut progress),
+        },
+    )?;
+    pb.finish_and_clear();
+    let s = &done.summary;
+    if let Some(path) = a.plot {
+        plot(path, &scene, &done.history)?;
+    }
+    if let Some(path) = a.summary_json {
+        crate::outputs::write_json(path, s)?;
+    }
+    out!(
+        "{}: {:.3} s simulated with the reference engine (network of {} bodies, {} couplings) in {:.3} s wall ({} steps, {} events)",
+        s.scene,
+        s.simulated_s,
+        s.bodies.len(),
+        s.couplings.len(),
+        s.wall_time_s,
+        s.steps,
+        s.events
+    );
+    out!("bodies (speeds at the end):");
+    for b in &s.bodies {
+        out!("  {:<16} {:>12.6} rad/s", b.name, b.final_speed_rad_s);
+    }
+    out!("couplings:");
+    for c in &s.couplings {
+        let locks: Vec<String> = c.lock_times_s.iter().map(|t| format!("{t:.6}")).collect();
+        out!(
+            "  {:<16} {:<10} heat {:>12.3} J  torque {:>10.3} to {:>10.3} N m  end: {:<6} {:>10.3} N m  locked at [{}] s",
+            c.name,
+            c.kind,
+            c.heat_j,
+            c.min_torque_n_m,
+            c.max_torque_n_m,
+            c.final_mode.unwrap_or("-"),
+            c.final_torque_n_m,
+            locks.join(", ")
+        );
+    }
+    let mut changes: Vec<(&str, &clutchpack_sdk::ModeChange)> = s
+        .couplings
+        .iter()
+        .flat_map(|c| c.changes.iter().map(move |m| (c.name.as_str(), m)))
+        .collect();
+    changes.sort_by(|x, y| x.1.t_s.total_cmp(&y.1.t_s));
+    if !changes.is_empty() {
+        out!("clutch mode changes:");
+        for (name, m) in changes {
+            // the largest torque step elsewhere at that instant (a lock's output torque step)
+            let step = m
+                .torque_steps_n_m
+                .iter()
+                .zip(&s.couplings)
+                .filter(|(_, c)| c.name != name)
+                .max_by(|x, y| x.0.abs().total_cmp(&y.0.abs()));
+            let step = match step {
+                Some((d, c)) if d.abs() > 1e-9 => format!("  ({} steps by {d:+.3} N m)", c.name),
+                _ => String::new(),
+            };
+            out!(
+                "  {:>12.6} s  {:<16} {} -> {}{step}",
+                m.t_s,
+                name,
+                m.from,
+                m.to
+            );
+        }
+    }
+    let e = &s.energy;
+    out!(
+        "energy: drives {:.6} J, loads {:.6} J, drag {:.6} J, clutch heat {:.6} J, kinetic change {:.6} J (balance {:.3e} J)",
+        e.drive_work_j,
+        e.load_work_j,
+        e.drag_loss_j,
+        e.clutch_heat_j,
+        e.kinetic_change_j,
+        e.residual_j
+    );
+    if s.stopped {
+        eprintln!(
+            "interrupted ({}) at t = {:.6} s: the outputs hold the run up to there",
+            crate::signals::received_name(),
+            s.simulated_s
+        );
+        return Ok(crate::signals::exit_code());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The figure: the bodies' speeds and the couplings' torques against time.
+fn plot(path: &Path, scene: &Scene, history: &[clutchpack_sdk::NetworkSample]) -> Result<()> {
+    let net = scene.network.as_ref().expect("a network scene");
+    let series = |name: &str, f: &dyn Fn(&clutchpack_sdk::NetworkSample) -> f64| {
+        (
+            name.to_string(),
+            history.iter().map(|s| (s.t_s, f(s))).collect::<Vec<_>>(),
+        )
+    };
+    let speeds = net
+        .bodies
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| !b.fixed)
+        .map(|(i, b)| series(&b.name, &|s| s.speed_rad_s[i]))
+        .collect();
+    let torques = net
+        .couplings
+        .iter()
+        .enumerate()
+        .map(|(k, c)| series(&c.name, &|s| s.torque_n_m[k]))
+        .collect();
+    let panels = [
+        clutchpack_analysis::Panel {
+            y_label: "speed [rad/s]".into(),
+            series: speeds,
+        },
+        clutchpack_analysis::Panel {
+            y_label: "torque on body a [N m]".into(),
+            series: torques,
+        },
+    ];
+    let title = format!(
+        "{}: speeds and coupling torques (reference engine)",
+        scene.name
+    );
+    crate::outputs::write_with(path, |tmp| {
+        clutchpack_analysis::plot_panels(tmp, &title, "t [s]", &panels)
+            .with_context(|| format!("plotting {}", path.display()))
+    })
+}

@@ -1,0 +1,185 @@
+//! The lumped friction clutch of a driveline network (MODEL.md section 8), with the semantics
+//! of Modelica's `Rotational.Components.Clutch` (MSL 4.0): a normal force
+//! `fn = fn_max f_normalized(t)`, free while `fn <= 0`; slipping with the torque
+//! `mu(w_rel) cgeo fn` against the relative speed; locked while the torque that holds it stays
+//! within `peak mu(0) cgeo fn`. Stick and slip are events the engines locate.
+//!
+//! Sign convention (the network's, as Modelica's flanges): `w_rel = w_b - w_a` (rad/s); the
+//! clutch's torque `tau` (N m) acts as `+tau` on body `a` and `-tau` on body `b`, so a
+//! slipping clutch has `tau = sign(w_rel) mu(|w_rel|) cgeo fn`, which brings the two speeds
+//! together.
+
+use super::signal::Signal;
+use serde::{Deserialize, Serialize};
+
+/// The state of a lumped clutch (Modelica's `mode`: Free 2, Forward 1, Stuck 0, Backward -1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ClutchMode {
+    /// `fn <= 0`: no torque.
+    Free,
+    /// Slipping with `w_rel > 0` (`+1`) or `w_rel < 0` (`-1`).
+    Slipping(i8),
+    /// Locked: `w_rel = 0`, the torque is what holds the two bodies together.
+    Locked,
+}
+
+impl ClutchMode {
+    /// Modelica's integer for the mode (Free 2, Forward 1, Stuck 0, Backward -1), as in
+    /// the MSL reference results' `clutchN.mode` columns.
+    pub fn modelica_code(self) -> i8 {
+        match self {
+            ClutchMode::Free => 2,
+            ClutchMode::Slipping(s) => s,
+            ClutchMode::Locked => 0,
+        }
+    }
+
+    /// A short name for tables: `free`, `slip+`, `slip-`, `locked`.
+    pub fn label(self) -> &'static str {
+        match self {
+            ClutchMode::Free => "free",
+            ClutchMode::Slipping(s) if s > 0 => "slip+",
+            ClutchMode::Slipping(_) => "slip-",
+            ClutchMode::Locked => "locked",
+        }
+    }
+}
+
+/// A lumped friction clutch (or brake, when one side is a fixed body).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LumpedClutch {
+    /// The sliding friction coefficient against the relative speed for `w_rel >= 0`:
+    /// rows `(w_rel rad/s, mu)` with increasing speeds (Modelica's `mu_pos`); linear between
+    /// rows, extrapolated from the last two rows beyond the last (Modelica's `LastTwoPoints`),
+    /// one row means a constant `mu`.
+    pub mu_table: Vec<(f64, f64)>,
+    /// Ratio of the largest static friction to the sliding friction at zero speed (>= 1,
+    /// Modelica's `peak`).
+    pub peak: f64,
+    /// Geometry constant, m: the torque per unit friction force (Modelica's `cgeo`; for `N`
+    /// faces of radii `ri`..`ro` under uniform wear, `N (ro + ri) / 2`).
+    pub cgeo_m: f64,
+    /// Largest normal force, N (Modelica's `fn_max`).
+    pub fn_max_n: f64,
+    /// The normalized normal force `f_normalized(t)` (0..1; engaged while > 0).
+    pub force: Signal,
+}
+
+impl LumpedClutch {
+    /// The sliding friction coefficient at `|w_rel|` (rad/s).
+    pub fn mu(&self, slip_speed_rad_s: f64) -> f64 {
+        let w = slip_speed_rad_s.abs();
+        let rows = &self.mu_table;
+        match rows.len() {
+            0 => 0.0,
+            1 => rows[0].1,
+            n => {
+                // the segment holding w; the first below the table, the last two beyond it
+                let i = rows[1..n - 1].partition_point(|r| r.0 <= w);
+                let (w0, m0) = rows[i];
+                let (w1, m1) = rows[i + 1];
+                m0 + (m1 - m0) * (w - w0) / (w1 - w0)
+            }
+        }
+    }
+
+    /// The normal force at `t`, N (`fn_max f_normalized(t)`; may be <= 0: free).
+    pub fn normal_force_n(&self, t: f64) -> f64 {
+        self.fn_max_n * self.force.value(t)
+    }
+
+    /// The torque of a slipping clutch, N m: `sign(w_rel) mu(|w_rel|) cgeo fn` for the
+    /// direction `direction` (+1 forward, -1 backward; taken from the mode, so that a clutch
+    /// that starts to slip from rest has its torque at once).
+    pub fn slip_torque_n_m(&self, direction: i8, w_rel_rad_s: f64, normal_n: f64) -> f64 {
+        f64::from(direction) * self.mu(w_rel_rad_s) * self.cgeo_m * normal_n.max(0.0)
+    }
+
+    /// The largest torque the locked clutch holds, N m: `peak mu(0) cgeo fn` (0 when free).
+    pub fn max_static_torque_n_m(&self, normal_n: f64) -> f64 {
+        self.peak * self.mu(0.0) * self.cgeo_m * normal_n.max(0.0)
+    }
+
+    /// The problems with the parameters, as `(field, what is wrong)` (empty when good).
+    pub fn problems(&self) -> Vec<(&'static str, String)> {
+        let mut out = Vec::new();
+        if self.mu_table.is_empty() {
+            out.push(("mu", "needs at least one row".to_string()));
+        }
+        for (i, (w, mu)) in self.mu_table.iter().enumerate() {
+            if !w.is_finite() || !mu.is_finite() || *w < 0.0 || *mu < 0.0 {
+                out.push((
+                    "mu",
+                    format!("row {i}: ({w}, {mu}) must be finite and >= 0"),
+                ));
+            }
+            if i > 0 && *w <= self.mu_table[i - 1].0 {
+                out.push(("mu", format!("row {i}: speed {w} does not increase")));
+            }
+        }
+        if !(self.peak.is_finite() && self.peak >= 1.0) {
+            out.push(("peak", format!("{} must be >= 1", self.peak)));
+        }
+        if !(self.cgeo_m.is_finite() && self.cgeo_m >= 0.0) {
+            out.push(("cgeo_m", format!("{} must be >= 0", self.cgeo_m)));
+        }
+        if !(self.fn_max_n.is_finite() && self.fn_max_n >= 0.0) {
+            out.push(("fn_max_n", format!("{} must be >= 0", self.fn_max_n)));
+        }
+        if !self.force.is_valid() {
+            out.push(("force", "has a value that is not finite".to_string()));
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn msl(force: Signal) -> LumpedClutch {
+        // Modelica's Clutch defaults with CoupledClutches' peak and fn_max
+        LumpedClutch {
+            mu_table: vec![(0.0, 0.5)],
+            peak: 1.1,
+            cgeo_m: 1.0,
+            fn_max_n: 20.0,
+            force,
+        }
+    }
+
+    /// The torques of Modelica's clutch: sliding `mu cgeo fn` against the slip, static up to
+    /// `peak` times that; free without force.
+    #[test]
+    fn torques_follow_modelica() {
+        let c = msl(Signal::Constant(0.5));
+        let fn_n = c.normal_force_n(0.0);
+        assert_eq!(fn_n, 10.0);
+        assert_eq!(c.slip_torque_n_m(-1, -3.0, fn_n), -5.0);
+        assert_eq!(c.slip_torque_n_m(1, 3.0, fn_n), 5.0);
+        assert!((c.max_static_torque_n_m(fn_n) - 5.5).abs() < 1e-15);
+        assert_eq!(c.max_static_torque_n_m(-1.0), 0.0);
+        assert!(c.problems().is_empty());
+    }
+
+    /// A table is linear between rows and extrapolated from its last two rows.
+    #[test]
+    fn mu_table_interpolates_and_extrapolates() {
+        let mut c = msl(Signal::Constant(1.0));
+        c.mu_table = vec![(0.0, 0.1), (10.0, 0.2), (20.0, 0.25)];
+        assert!((c.mu(5.0) - 0.15).abs() < 1e-15);
+        assert!((c.mu(-5.0) - 0.15).abs() < 1e-15);
+        assert!((c.mu(15.0) - 0.225).abs() < 1e-15);
+        assert!((c.mu(30.0) - 0.3).abs() < 1e-15);
+        c.mu_table = vec![(0.0, 0.1), (0.0, 0.2)];
+        assert_eq!(c.problems().len(), 1);
+    }
+
+    #[test]
+    fn modes_have_modelica_codes() {
+        assert_eq!(ClutchMode::Free.modelica_code(), 2);
+        assert_eq!(ClutchMode::Slipping(-1).modelica_code(), -1);
+        assert_eq!(ClutchMode::Locked.modelica_code(), 0);
+        assert_eq!(ClutchMode::Slipping(1).label(), "slip+");
+    }
+}

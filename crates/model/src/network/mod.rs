@@ -1,0 +1,421 @@
+//! Drivelines as networks (MODEL.md section 8): named rotational bodies (shafts, drums, an
+//! engine's crank, a vehicle reduced to a shaft) joined by couplings (lumped clutches, ideal
+//! gears; next the resolved packs, gear meshes and spring-dampers), each coupling a term in
+//! both bodies' equations, equal and opposite in its own coordinate.
+//!
+//! Conventions: every body turns about its own axis; angles in rad, speeds in rad/s, torques
+//! in N m, positive in the body's sense of rotation. A coupling between bodies `a` and `b`
+//! has the relative speed `w_rel = w_b - w_a` for a clutch (Modelica's flanges), and an ideal
+//! gear ties `w_a = ratio w_b` (Modelica's `IdealGear`: `phi_a = ratio phi_b`, power
+//! conserved: the torque `lambda` on `a` is `-ratio lambda` on `b`).
+
+pub mod clutch;
+pub mod gear;
+pub mod signal;
+
+pub use clutch::{ClutchMode, LumpedClutch};
+pub use gear::GearMesh;
+pub use signal::Signal;
+
+use serde::{Deserialize, Serialize};
+
+/// A load that opposes motion: `-sign(w) (a + b |w| + c w^2)` (N m), zero at rest (a
+/// vehicle's rolling resistance, losses and air drag reduced to a shaft; at `w = 0` the
+/// constant part does not hold the body: it is not static friction).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RoadLoad {
+    /// `a`, N m (>= 0).
+    pub constant_n_m: f64,
+    /// `b`, N m s/rad (>= 0).
+    pub linear_n_m_s_rad: f64,
+    /// `c`, N m s^2/rad^2 (>= 0).
+    pub quadratic_n_m_s2_rad2: f64,
+}
+
+impl RoadLoad {
+    /// The load's torque on the body at speed `w` (rad/s), N m, signed against `w`.
+    pub fn torque_n_m(&self, w_rad_s: f64) -> f64 {
+        if w_rad_s == 0.0 {
+            return 0.0;
+        }
+        let m = w_rad_s.abs();
+        -w_rad_s.signum()
+            * (self.constant_n_m + self.linear_n_m_s_rad * m + self.quadratic_n_m_s2_rad2 * m * m)
+    }
+}
+
+/// One rotational body of a network.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Body {
+    /// Its name (unique in the network).
+    pub name: String,
+    /// Inertia about its axis, kg m^2 (> 0; ignored for a fixed body).
+    pub inertia_kg_m2: f64,
+    /// Viscous drag, N m s/rad (>= 0): the torque `-C w`.
+    pub drag_n_m_s_rad: f64,
+    /// Speed at t = 0, rad/s.
+    pub initial_speed_rad_s: f64,
+    /// A fixed body (the housing, the ground): it never turns; a clutch to it is a brake.
+    pub fixed: bool,
+    /// The driving torque on it, N m, positive in its sense of rotation (`None`: none).
+    pub drive: Option<Signal>,
+    /// A load opposing its motion (`None`: none).
+    pub road_load: Option<RoadLoad>,
+}
+
+impl Body {
+    /// The external torque on the body at `t` (s) and speed `w` (rad/s), N m: its drive, its
+    /// road load and its drag.
+    pub fn external_torque_n_m(&self, t: f64, w_rad_s: f64) -> f64 {
+        let drive = self.drive.as_ref().map_or(0.0, |s| s.value(t));
+        let load = self.road_load.map_or(0.0, |l| l.torque_n_m(w_rad_s));
+        drive + load - self.drag_n_m_s_rad * w_rad_s
+    }
+}
+
+/// What a coupling is.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum CouplingKind {
+    /// A lumped friction clutch (a brake when one body is fixed).
+    Clutch(LumpedClutch),
+    /// An ideal gear: `w_a = ratio w_b` (rigid, no backlash; one degree of freedom fewer).
+    IdealGear {
+        /// `w_a / w_b` (nonzero; negative for an external pair turning the other way).
+        ratio: f64,
+    },
+    /// A gear mesh with backlash and a tooth law (gear rattle; MODEL.md section 8).
+    GearMesh(GearMesh),
+}
+
+/// A coupling between two bodies of a network.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Coupling {
+    /// Its name (unique in the network).
+    pub name: String,
+    /// Index of body `a` in [`Network::bodies`].
+    pub a: usize,
+    /// Index of body `b`.
+    pub b: usize,
+    /// What it is.
+    pub kind: CouplingKind,
+}
+
+/// A driveline: bodies and the couplings between them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct Network {
+    /// The bodies.
+    pub bodies: Vec<Body>,
+    /// The couplings.
+    pub couplings: Vec<Coupling>,
+}
+
+/// A problem with a network, naming the body or coupling (by index) and what is wrong; the
+/// scene turns it into a key path.
+#[derive(Debug, Clone, PartialEq)]
+pub enum NetworkProblem {
+    /// A body's field.
+    Body {
+        /// Index in `bodies`.
+        index: usize,
+        /// The field (`inertia_kg_m2`, `name`, ...).
+        field: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// A coupling's field.
+    Coupling {
+        /// Index in `couplings`.
+        index: usize,
+        /// The field (`a`, `b`, `ratio`, `mu`, ...).
+        field: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl Network {
+    /// The index of the body named `name`.
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// The network's problems (empty when an engine can run it): unique names; positive
+    /// inertias; at most one fixed body; couplings naming two different bodies; ideal gears that form no loop (a loop
+    /// over-constrains, consistent or not) and do not tie a moving body to a fixed one;
+    /// speeds that satisfy the ideal gears at t = 0; every group of connected bodies with
+    /// something that moves it (a drive, or a speed at t = 0).
+    pub fn problems(&self) -> Vec<NetworkProblem> {
+        let mut out = Vec::new();
+        let body = |index, field, message: String| NetworkProblem::Body {
+            index,
+            field,
+            message,
+        };
+        let coupling = |index, field, message: String| NetworkProblem::Coupling {
+            index,
+            field,
+            message,
+        };
+        if self.bodies.is_empty() {
+            out.push(body(0, "name", "a network needs at least one body".into()));
+        }
+        for (i, b) in self.bodies.iter().enumerate() {
+            if self.bodies[..i].iter().any(|o| o.name == b.name) {
+                out.push(body(i, "name", format!("\"{}\" names two bodies", b.name)));
+            }
+            let good_inertia = b.inertia_kg_m2.is_finite() && b.inertia_kg_m2 > 0.0;
+            if !b.fixed && !good_inertia {
+                out.push(body(
+                    i,
+                    "inertia_kg_m2",
+                    format!("{} must be > 0", b.inertia_kg_m2),
+                ));
+            }
+            if b.fixed && b.initial_speed_rad_s != 0.0 {
+                out.push(body(
+                    i,
+                    "initial_speed_rad_s",
+                    "a fixed body does not turn: its speed is 0".into(),
+                ));
+            }
+            if b.fixed && self.bodies[..i].iter().any(|o| o.fixed) {
+                out.push(body(
+                    i,
+                    "fixed",
+                    "a second fixed body: the ground is one body (brakes to it share it)".into(),
+                ));
+            }
+            if b.drive.as_ref().is_some_and(|d| !d.is_valid()) {
+                out.push(body(i, "drive", "has a value that is not finite".into()));
+            }
+        }
+        let n = self.bodies.len();
+        // union-find with the speed factor of each body against its root: w_i = g_i w_root
+        let mut root: Vec<usize> = (0..n).collect();
+        let mut factor = vec![1.0; n];
+        fn find(root: &mut [usize], factor: &mut [f64], i: usize) -> (usize, f64) {
+            let (mut r, mut g) = (i, 1.0);
+            while root[r] != r {
+                g *= factor[r];
+                r = root[r];
+            }
+            (r, g)
+        }
+        let mut linked: Vec<usize> = (0..n).collect(); // components over every coupling
+        fn top(linked: &mut [usize], mut i: usize) -> usize {
+            while linked[i] != i {
+                i = linked[i];
+            }
+            i
+        }
+        for (k, c) in self.couplings.iter().enumerate() {
+            if self.couplings[..k].iter().any(|o| o.name == c.name) {
+                out.push(coupling(
+                    k,
+                    "name",
+                    format!("\"{}\" names two couplings", c.name),
+                ));
+            }
+            if c.a >= n || c.b >= n {
+                out.push(coupling(
+                    k,
+                    "a",
+                    "names a body that is not in the network".into(),
+                ));
+                continue;
+            }
+            if c.a == c.b {
+                out.push(coupling(
+                    k,
+                    "b",
+                    format!("couples \"{}\" to itself", self.bodies[c.a].name),
+                ));
+                continue;
+            }
+            let (ta, tb) = (top(&mut linked, c.a), top(&mut linked, c.b));
+            linked[ta] = tb;
+            match &c.kind {
+                CouplingKind::Clutch(cl) => {
+                    for (field, message) in cl.problems() {
+                        out.push(coupling(k, field, message));
+                    }
+                }
+                CouplingKind::GearMesh(g) => {
+                    for (field, message) in g.problems() {
+                        out.push(coupling(k, field, message));
+                    }
+                }
+                CouplingKind::IdealGear { ratio } => {
+                    if !(ratio.is_finite() && *ratio != 0.0) {
+                        out.push(coupling(k, "ratio", format!("{ratio} must be nonzero")));
+                        continue;
+                    }
+                    let (ba, bb) = (&self.bodies[c.a], &self.bodies[c.b]);
+                    if ba.fixed != bb.fixed {
+                        out.push(coupling(
+                            k,
+                            "b",
+                            format!(
+                                "an ideal gear from a fixed body would hold \"{}\" still: make it fixed instead",
+                                if ba.fixed { &bb.name } else { &ba.name }
+                            ),
+                        ));
+                        continue;
+                    }
+                    let (ra, ga) = find(&mut root, &mut factor, c.a);
+                    let (rb, gb) = find(&mut root, &mut factor, c.b);
+                    if ra == rb {
+                        out.push(coupling(
+                            k,
+                            "b",
+                            "closes a loop of ideal gears, which over-constrains the bodies (one gear of the loop is redundant, or the ratios contradict)".into(),
+                        ));
+                        continue;
+                    }
+                    // w_a = ratio w_b: w_rb = (ga / (ratio gb)) w_ra... join rb under ra
+                    root[rb] = ra;
+                    factor[rb] = ga / (ratio * gb);
+                    let (wa, wb) = (ba.initial_speed_rad_s, bb.initial_speed_rad_s);
+                    let want = ratio * wb;
+                    if (wa - want).abs() > 1e-9 * (1.0 + wa.abs().max(want.abs())) {
+                        out.push(coupling(
+                            k,
+                            "ratio",
+                            format!(
+                                "the speeds at t = 0 do not mesh: \"{}\" turns at {wa} rad/s but ratio x \"{}\"'s {wb} rad/s is {want}",
+                                ba.name, bb.name
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        // every group of connected bodies has something that moves it
+        for i in 0..n {
+            let t = top(&mut linked, i);
+            if (0..i).any(|j| top(&mut linked, j) == t) {
+                continue; // reported with the group's first body
+            }
+            let group: Vec<usize> = (0..n).filter(|&j| top(&mut linked, j) == t).collect();
+            let moved = group.iter().any(|&j| {
+                let b = &self.bodies[j];
+                b.drive.is_some() || b.initial_speed_rad_s != 0.0
+            });
+            if !moved && group.iter().any(|&j| !self.bodies[j].fixed) {
+                out.push(body(
+                    i,
+                    "drive",
+                    format!(
+                        "nothing moves \"{}\"{}: no body on its path has a drive or a speed at t = 0",
+                        self.bodies[i].name,
+                        if group.len() > 1 {
+                            format!(" and the {} bodies coupled to it", group.len() - 1)
+                        } else {
+                            String::new()
+                        }
+                    ),
+                ));
+            }
+        }
+        out
+    }
+
+    /// Every instant (s, sorted, unique, within `[0, end]`) where a signal of the network jumps
+    /// or bends: the engines land a step on each.
+    pub fn breakpoints(&self, end_s: f64) -> Vec<f64> {
+        let mut out = Vec::new();
+        for b in &self.bodies {
+            if let Some(d) = &b.drive {
+                d.breakpoints(&mut out);
+            }
+        }
+        for c in &self.couplings {
+            if let CouplingKind::Clutch(cl) = &c.kind {
+                cl.force.breakpoints(&mut out);
+            }
+        }
+        out.retain(|t| *t > 0.0 && *t < end_s);
+        out.sort_by(f64::total_cmp);
+        out.dedup();
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn body(name: &str, w: f64) -> Body {
+        Body {
+            name: name.into(),
+            inertia_kg_m2: 1.0,
+            drag_n_m_s_rad: 0.0,
+            initial_speed_rad_s: w,
+            fixed: false,
+            drive: None,
+            road_load: None,
+        }
+    }
+
+    fn gear(name: &str, a: usize, b: usize, ratio: f64) -> Coupling {
+        Coupling {
+            name: name.into(),
+            a,
+            b,
+            kind: CouplingKind::IdealGear { ratio },
+        }
+    }
+
+    /// A road load opposes motion and vanishes at rest.
+    #[test]
+    fn road_load_opposes_motion() {
+        let l = RoadLoad {
+            constant_n_m: 1.0,
+            linear_n_m_s_rad: 0.1,
+            quadratic_n_m_s2_rad2: 0.01,
+        };
+        assert!((l.torque_n_m(10.0) + 3.0).abs() < 1e-15);
+        assert!((l.torque_n_m(-10.0) - 3.0).abs() < 1e-15);
+        assert_eq!(l.torque_n_m(0.0), 0.0);
+    }
+
+    /// A loop of ideal gears, a coupling to itself, an unmeshed start and a body nothing moves
+    /// are each reported at their coupling or body.
+    #[test]
+    fn problems_name_the_part() {
+        let mut net = Network {
+            bodies: vec![
+                body("a", 3.0),
+                body("b", 1.0),
+                body("c", 1.0),
+                body("d", 0.0),
+            ],
+            couplings: vec![gear("g1", 0, 1, 3.0), gear("g2", 1, 2, 1.0)],
+        };
+        let p = net.problems();
+        assert_eq!(p.len(), 1, "{p:?}");
+        assert!(matches!(
+            &p[0],
+            NetworkProblem::Body {
+                index: 3,
+                field: "drive",
+                ..
+            }
+        ));
+        net.bodies[3].initial_speed_rad_s = 1.0;
+        assert!(net.problems().is_empty());
+        net.couplings.push(gear("g3", 2, 0, 1.0 / 3.0));
+        let p = net.problems();
+        assert!(
+            matches!(&p[0], NetworkProblem::Coupling { index: 2, field: "b", message } if message.contains("loop")),
+            "{p:?}"
+        );
+        net.couplings.pop();
+        net.couplings[0].kind = CouplingKind::IdealGear { ratio: 2.0 };
+        let p = net.problems();
+        assert!(
+            matches!(&p[0], NetworkProblem::Coupling { index: 0, field: "ratio", message } if message.contains("do not mesh")),
+            "{p:?}"
+        );
+    }
+}

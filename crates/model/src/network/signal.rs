@@ -1,0 +1,200 @@
+//! Time signals of a driveline network (MODEL.md section 8, "Inputs"): a drive torque, a
+//! clutch's normalized normal force, a schedule. Each is a pure function of time with the
+//! instants where it (or its slope) jumps, which the engines land their steps on.
+
+use crate::drive::Table;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::TAU;
+
+/// A signal `y(t)`; its unit is its owner's (N m for a torque, 1 for a normalized force).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Signal {
+    /// `y = value`.
+    Constant(f64),
+    /// `y = offset` before `start_s`, `offset + height` from `start_s` on (Modelica's
+    /// `Blocks.Sources.Step`).
+    Step {
+        /// Value before the step.
+        offset: f64,
+        /// Jump at `start_s`.
+        height: f64,
+        /// Instant of the jump, s.
+        start_s: f64,
+    },
+    /// `y = offset` before `start_s`, then rising linearly by `height` over `duration_s`, then
+    /// held (Modelica's `Blocks.Sources.Ramp`; a clutch's fill and apply).
+    Ramp {
+        /// Value before the ramp.
+        offset: f64,
+        /// Rise over the ramp (negative: a fall).
+        height: f64,
+        /// Start of the ramp, s.
+        start_s: f64,
+        /// Length of the ramp, s (> 0).
+        duration_s: f64,
+    },
+    /// `y = offset + amplitude sin(2 pi f (t - start_s) + phase)` from `start_s` on, `offset`
+    /// before (Modelica's `Blocks.Sources.Sine`).
+    Sine {
+        /// Mean value.
+        offset: f64,
+        /// Amplitude.
+        amplitude: f64,
+        /// Frequency, Hz (> 0).
+        frequency_hz: f64,
+        /// Phase at `start_s`, rad.
+        phase_rad: f64,
+        /// Start, s.
+        start_s: f64,
+    },
+    /// A table of `(t, y)` rows, linear or held between them, held beyond its ends.
+    Table(Table),
+    /// The sum of several signals (a mean torque with firing-order harmonics).
+    Sum(Vec<Signal>),
+}
+
+impl Signal {
+    /// The value at `t` (s); right-continuous at a jump (a step's value at `start_s` is
+    /// `offset + height`).
+    pub fn value(&self, t: f64) -> f64 {
+        match self {
+            Signal::Constant(v) => *v,
+            Signal::Step {
+                offset,
+                height,
+                start_s,
+            } => {
+                if t >= *start_s {
+                    offset + height
+                } else {
+                    *offset
+                }
+            }
+            Signal::Ramp {
+                offset,
+                height,
+                start_s,
+                duration_s,
+            } => {
+                let x = ((t - start_s) / duration_s).clamp(0.0, 1.0);
+                offset + height * x
+            }
+            Signal::Sine {
+                offset,
+                amplitude,
+                frequency_hz,
+                phase_rad,
+                start_s,
+            } => {
+                if t < *start_s {
+                    *offset
+                } else {
+                    offset + amplitude * (TAU * frequency_hz * (t - start_s) + phase_rad).sin()
+                }
+            }
+            Signal::Table(table) => table.value(t),
+            Signal::Sum(terms) => terms.iter().map(|s| s.value(t)).sum(),
+        }
+    }
+
+    /// The instants (s) where the value or its slope jumps, in any order, with repeats: an
+    /// engine lands a step on each, so that no step straddles a discontinuity.
+    pub fn breakpoints(&self, out: &mut Vec<f64>) {
+        match self {
+            Signal::Constant(_) => {}
+            Signal::Step { start_s, .. } | Signal::Sine { start_s, .. } => out.push(*start_s),
+            Signal::Ramp {
+                start_s,
+                duration_s,
+                ..
+            } => {
+                out.push(*start_s);
+                out.push(start_s + duration_s);
+            }
+            Signal::Table(table) => out.extend_from_slice(&table.t_s),
+            Signal::Sum(terms) => terms.iter().for_each(|s| s.breakpoints(out)),
+        }
+    }
+
+    /// Whether every number in the signal is finite and its lengths positive (the scene
+    /// validation reports the key; this is the model's own guard).
+    pub fn is_valid(&self) -> bool {
+        match self {
+            Signal::Constant(v) => v.is_finite(),
+            Signal::Step {
+                offset,
+                height,
+                start_s,
+            } => [offset, height, start_s].iter().all(|v| v.is_finite()),
+            Signal::Ramp {
+                offset,
+                height,
+                start_s,
+                duration_s,
+            } => {
+                [offset, height, start_s].iter().all(|v| v.is_finite())
+                    && duration_s.is_finite()
+                    && *duration_s > 0.0
+            }
+            Signal::Sine {
+                offset,
+                amplitude,
+                frequency_hz,
+                phase_rad,
+                start_s,
+            } => {
+                [offset, amplitude, phase_rad, start_s]
+                    .iter()
+                    .all(|v| v.is_finite())
+                    && frequency_hz.is_finite()
+                    && *frequency_hz > 0.0
+            }
+            Signal::Table(_) => true,
+            Signal::Sum(terms) => terms.iter().all(Signal::is_valid),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each kind's value at its defining instants, and its breakpoints.
+    #[test]
+    fn values_and_breakpoints() {
+        let step = Signal::Step {
+            offset: 0.0,
+            height: 1.0,
+            start_s: 0.4,
+        };
+        assert_eq!(step.value(0.399_999), 0.0);
+        assert_eq!(step.value(0.4), 1.0);
+        let ramp = Signal::Ramp {
+            offset: 1.0,
+            height: -1.0,
+            start_s: 1.0,
+            duration_s: 0.5,
+        };
+        assert_eq!(ramp.value(0.0), 1.0);
+        assert_eq!(ramp.value(1.25), 0.5);
+        assert_eq!(ramp.value(3.0), 0.0);
+        // Modelica's CoupledClutches: sin2(amplitude = 1, f = 0.2, phase = pi/2) is zero at
+        // t = 1.25 s
+        let sine = Signal::Sine {
+            offset: 0.0,
+            amplitude: 1.0,
+            frequency_hz: 0.2,
+            phase_rad: std::f64::consts::FRAC_PI_2,
+            start_s: 0.0,
+        };
+        assert_eq!(sine.value(0.0), 1.0);
+        assert!(sine.value(1.25).abs() < 1e-15);
+        let sum = Signal::Sum(vec![Signal::Constant(2.0), step.clone(), ramp.clone()]);
+        assert_eq!(sum.value(1.25), 3.5);
+        let mut bp = Vec::new();
+        sum.breakpoints(&mut bp);
+        assert_eq!(bp, vec![0.4, 1.0, 1.5]);
+        assert!(sum.is_valid());
+        assert!(!Signal::Constant(f64::NAN).is_valid());
+    }
+}

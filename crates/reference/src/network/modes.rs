@@ -1,0 +1,117 @@
+//! The clutches' modes at an event of a network run (MODEL.md section 8; Modelica's `Clutch`):
+//! which clutches lock, slip or go free, settled together, and the speeds of a new rigid group
+//! made common with its momentum kept.
+
+use super::{clutch, sample, ClutchEvent, Equations, NetworkObserver};
+use clutchpack_model::network::ClutchMode;
+
+/// Settles the clutches' modes at an event at `t` (MODEL.md section 8; Modelica's `Clutch`):
+/// free while `fn <= 0`; a clutch whose slip crossed zero (`crossed`: its guard `<= 0`), or
+/// that engages at zero slip, is tried locked; a locked clutch whose holding torque exceeds
+/// its static limit slips towards that torque; repeated until every locked clutch holds.
+pub(super) fn settle(
+    eq: &mut Equations,
+    t: f64,
+    y: &mut [f64],
+    crossed: &[f64],
+    obs: &mut dyn NetworkObserver,
+    events: &mut u64,
+) {
+    let net = eq.net;
+    let n = net.bodies.len();
+    let before = eq.modes.clone();
+    let state_before = sample(eq, t, y);
+    let mut modes = before.clone();
+    for (k, c) in net.couplings.iter().enumerate() {
+        let Some(cl) = clutch(net, k) else { continue };
+        let f = cl.normal_force_n(t);
+        let w_rel = y[n + c.b] - y[n + c.a];
+        let scale = 1e-10 * (1.0 + y[n + c.a].abs() + y[n + c.b].abs());
+        let slip_ended = crossed.get(k).is_some_and(|g| *g <= 0.0);
+        modes[k] = Some(if f <= 0.0 {
+            ClutchMode::Free
+        } else {
+            match modes[k] {
+                Some(ClutchMode::Free) | None => {
+                    if w_rel.abs() > scale {
+                        ClutchMode::Slipping(w_rel.signum() as i8)
+                    } else {
+                        ClutchMode::Locked
+                    }
+                }
+                Some(ClutchMode::Slipping(s)) => {
+                    if slip_ended || f64::from(s) * w_rel <= 0.0 {
+                        ClutchMode::Locked
+                    } else {
+                        ClutchMode::Slipping(s)
+                    }
+                }
+                Some(ClutchMode::Locked) => ClutchMode::Locked,
+            }
+        });
+    }
+    // lock what locks; release the locked clutch that is furthest over its limit, and again
+    for _ in 0..=net.couplings.len() {
+        eq.set_modes(&modes);
+        project_speeds(eq, y);
+        eq.forces(t, y);
+        eq.rigid_torques();
+        let mut worst: Option<(usize, f64)> = None;
+        for (k, mode) in modes.iter().enumerate() {
+            if *mode != Some(ClutchMode::Locked) {
+                continue;
+            }
+            let cl = clutch(net, k).expect("only clutches lock");
+            let over = eq.coupling_torque[k].abs() - cl.max_static_torque_n_m(cl.normal_force_n(t));
+            if over > 0.0 && worst.is_none_or(|(_, o)| over > o) {
+                worst = Some((k, over));
+            }
+        }
+        match worst {
+            Some((k, _)) => {
+                let s = if eq.coupling_torque[k] > 0.0 { 1 } else { -1 };
+                modes[k] = Some(ClutchMode::Slipping(s));
+            }
+            None => break,
+        }
+    }
+    eq.set_modes(&modes);
+    *events += 1;
+    if before != modes {
+        obs.switched(&state_before, &sample(eq, t, y));
+    }
+    for (k, (b, a)) in before.iter().zip(&modes).enumerate() {
+        if let (Some(from), Some(to)) = (b, a) {
+            if from != to {
+                obs.clutch_event(&ClutchEvent {
+                    t_s: t,
+                    coupling: k,
+                    from: *from,
+                    to: *to,
+                });
+            }
+        }
+    }
+}
+
+/// Sets every rigid group's speeds to its common speed, momentum kept
+/// (`w_group = sum g_i J_i w_i / sum g_i^2 J_i`, `w_i = g_i w_group`; 0 for a fixed group).
+fn project_speeds(eq: &Equations, y: &mut [f64]) {
+    let net = eq.net;
+    let n = net.bodies.len();
+    let cl = &eq.clusters;
+    let mut p = vec![0.0; cl.inertia.len()];
+    for (i, b) in net.bodies.iter().enumerate() {
+        if !b.fixed {
+            p[cl.of[i]] += cl.g[i] * b.inertia_kg_m2 * y[n + i];
+        }
+    }
+    for i in 0..n {
+        let c = cl.of[i];
+        y[n + i] = if cl.fixed[c] {
+            0.0
+        } else {
+            cl.g[i] * p[c] / cl.inertia[c]
+        };
+    }
+}

@@ -1,0 +1,283 @@
+//! The reference engine on lumped driveline networks (MODEL.md section 8) against Modelica's
+//! published reference results and closed forms.
+
+// The reference values are quoted digit for digit as the reference file prints them.
+#![allow(clippy::excessive_precision)]
+
+use clutchpack_model::cases;
+use clutchpack_model::network::ClutchMode;
+use clutchpack_model::ImpactEvent;
+use clutchpack_reference::network::{
+    run_network, ClutchEvent, NetworkObserver, NetworkOptions, NetworkSample,
+};
+
+#[derive(Default)]
+struct Events(Vec<ClutchEvent>, Vec<NetworkSample>, Vec<ImpactEvent>);
+
+impl NetworkObserver for Events {
+    fn mesh_impact(&mut self, e: &ImpactEvent) {
+        self.2.push(*e);
+    }
+    fn clutch_event(&mut self, e: &ClutchEvent) {
+        self.0.push(*e);
+    }
+    fn sample(&mut self, s: &NetworkSample) {
+        self.1.push(s.clone());
+    }
+}
+
+/// Modelica's `Rotational.Examples.CoupledClutches` against its reference results: the
+/// MAP-LIB reference results of the Modelica Standard Library,
+/// `Modelica/Mechanics/Rotational/Examples/CoupledClutches/CoupledClutches.csv` of
+/// github.com/modelica/MAP-LIB_ReferenceResults (Dymola 2020x, DASSL at tolerance 1e-6,
+/// "Reg test MSL v4.0.0-rc.1"; its event rows give the instants below, its last row the speeds
+/// at 1.5 s: `J1.w`, and the others through `clutchN.w_rel = w_b - w_a`). Every mode change
+/// within 1 ms and every speed at 1.5 s within 1e-3 relative (issue 34's bounds). Measured:
+/// the events within 4.1e-6 s and the speeds within 8.3e-6 relative, which is the reference's
+/// own error (DASSL at 1e-6): this engine at tolerance 1e-9 and 1e-12 agrees with itself to
+/// 1e-13 s and 2e-9 rad/s. Asserted: 2e-5 s and 5e-5 (about 5 times what was measured).
+#[test]
+fn coupled_clutches_match_modelica_reference_results() {
+    let net = cases::coupled_clutches();
+    let mut obs = Events::default();
+    let run = run_network(&net, 1.5, &NetworkOptions::default(), &mut obs).unwrap();
+    use ClutchMode::*;
+    // (t, clutch, mode after) from the reference's mode columns
+    let reference = [
+        (0.4, 1, Slipping(-1)),
+        (0.709_621_463_832_881_3, 1, Locked),
+        (0.791_658_284_320_250_1, 0, Locked),
+        (0.831_108_506_270_335_1, 0, Slipping(-1)),
+        (0.9, 2, Slipping(-1)),
+        (0.906_849_137_544_382_3, 0, Locked),
+        (1.000_295_860_113_868_3, 0, Slipping(-1)),
+        (1.143_969_630_433_705_5, 2, Locked),
+        (1.25, 0, Free),
+    ];
+    let ours: Vec<&ClutchEvent> = obs.0.iter().filter(|e| e.t_s > 0.0).collect();
+    for e in &ours {
+        println!(
+            "{:.9} clutch{} {:?} -> {:?}",
+            e.t_s,
+            e.coupling + 1,
+            e.from,
+            e.to
+        );
+    }
+    assert_eq!(ours.len(), reference.len(), "{ours:?}");
+    let mut worst: f64 = 0.0;
+    for (e, (t, k, mode)) in ours.iter().zip(reference) {
+        assert_eq!((e.coupling, e.to), (k, mode), "at {t} s");
+        worst = worst.max((e.t_s - t).abs());
+    }
+    println!("largest difference of the event times: {worst:e} s");
+    assert!(worst < 2e-5, "{worst}");
+    let j1 = 3.247_034_565_240_657_1;
+    let j2 = j1 - 0.783_826_964_342_972_17;
+    let j3 = j2 + 6.189_601_746_610_612_5e-16;
+    let j4 = j3 + 7.973_578_952_751_563_6e-12;
+    let w = &run.last.speed_rad_s;
+    let mut worst_w: f64 = 0.0;
+    for (ours, theirs) in w.iter().zip([j1, j2, j3, j4]) {
+        worst_w = worst_w.max((ours - theirs).abs() / theirs.abs());
+    }
+    println!("speeds at 1.5 s {w:?}, largest relative difference {worst_w:e}");
+    assert!(worst_w < 5e-5, "{worst_w}");
+    // our own convergence: the same run at a 1000 times tighter tolerance
+    let mut fine = Events::default();
+    let tight = NetworkOptions {
+        tolerance: 1e-12,
+        ..NetworkOptions::default()
+    };
+    let run_fine = run_network(&net, 1.5, &tight, &mut fine).unwrap();
+    let mut self_t: f64 = 0.0;
+    for (a, b) in obs.0.iter().zip(&fine.0) {
+        self_t = self_t.max((a.t_s - b.t_s).abs());
+    }
+    let self_w = (run.last.speed_rad_s[1] - run_fine.last.speed_rad_s[1]).abs();
+    println!(
+        "tolerance 1e-9 against 1e-12: events within {self_t:e} s, J2 within {self_w:e} rad/s"
+    );
+    assert!(self_t < 1e-8 && self_w < 1e-7, "{self_t} {self_w}");
+    let e = run.energy;
+    println!("{e:?} residual {:e}", e.residual_j());
+    assert!(e.residual_j().abs() < 1e-6 * e.drive_work_j.abs().max(e.clutch_heat_j));
+}
+
+/// The inertia phase of a dual-clutch power-on upshift (MODEL.md section 8, closed form): an
+/// engine `J_e` at `w_e = r1 w_out` with a constant torque `T_e`, the off-going clutch open,
+/// the on-coming clutch slipping with a constant torque `T_c > T_e`, the output held by a
+/// vehicle of 1e6 kg m^2. The slip at the start is `dw = w_e (1 - r2 / r1)`; the phase lasts
+/// `t_i = J_e dw / (T_c - T_e)`; the on-coming clutch takes `E_i = T_c dw t_i / 2`; the output
+/// torque is `r2 T_c` during it and steps by `-r2 (T_c - T_e)` at lock. Issue 34's bound is
+/// 0.1 %; measured within 3e-6 (the vehicle's speed moves by 2e-6 relative, which the closed
+/// form holds fixed); asserted 3e-5.
+#[test]
+fn dual_clutch_inertia_phase_matches_closed_form() {
+    use clutchpack_model::network::*;
+    let (j_e, t_e, t_c, r1, r2, w_out) = (0.25, 200.0, 400.0, 3.5, 2.1, 40.0);
+    let body = |name: &str, j: f64, w: f64, drive: Option<Signal>| Body {
+        name: name.into(),
+        inertia_kg_m2: j,
+        drag_n_m_s_rad: 0.0,
+        initial_speed_rad_s: w,
+        fixed: false,
+        drive,
+        road_load: None,
+    };
+    let clutch = |name: &str, b: usize, force: f64| Coupling {
+        name: name.into(),
+        a: 0,
+        b,
+        kind: CouplingKind::Clutch(LumpedClutch {
+            mu_table: vec![(0.0, 0.1)],
+            peak: 1.0,
+            cgeo_m: 0.2,
+            fn_max_n: 20_000.0,
+            force: Signal::Constant(force),
+        }),
+    };
+    let gear = |name: &str, a: usize, ratio: f64| Coupling {
+        name: name.into(),
+        a,
+        b: 3,
+        kind: CouplingKind::IdealGear { ratio },
+    };
+    let net = Network {
+        bodies: vec![
+            body("engine", j_e, r1 * w_out, Some(Signal::Constant(t_e))),
+            body("shaft-1", 0.02, r1 * w_out, None),
+            body("shaft-2", 0.02, r2 * w_out, None),
+            body("vehicle", 1e6, w_out, None),
+        ],
+        couplings: vec![
+            clutch("clutch-1", 1, 0.0),
+            clutch("clutch-2", 2, 1.0),
+            gear("gear-1", 1, r1),
+            gear("gear-2", 2, r2),
+        ],
+    };
+    let mut obs = Events::default();
+    let run = run_network(&net, 0.1, &NetworkOptions::default(), &mut obs).unwrap();
+    let dw = r1 * w_out * (1.0 - r2 / r1);
+    let t_i = j_e * dw / (t_c - t_e);
+    let e_i = t_c * dw * t_i / 2.0;
+    let lock = obs
+        .0
+        .iter()
+        .find(|e| e.coupling == 1 && e.to == ClutchMode::Locked)
+        .expect("the on-coming clutch locks");
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+    println!(
+        "lock at {} s (closed form {t_i}), heat {} J (closed form {e_i})",
+        lock.t_s, run.heat_j[1]
+    );
+    assert!(rel(lock.t_s, t_i) < 3e-5);
+    assert!(rel(run.heat_j[1], e_i) < 3e-5);
+    // the output torque: gear-2 puts -r2 lambda on the vehicle
+    let output = |t: f64| {
+        let s = obs
+            .1
+            .iter()
+            .min_by(|a, b| (a.t_s - t).abs().total_cmp(&(b.t_s - t).abs()))
+            .unwrap();
+        -r2 * s.torque_n_m[3]
+    };
+    let (before, after) = (output(t_i - 2e-3), output(t_i + 2e-3));
+    println!("output torque {before} N m before the lock, {after} N m after");
+    assert!(rel(before, r2 * t_c) < 3e-5);
+    assert!(rel(after - before, -r2 * (t_c - t_e)) < 3e-5);
+    assert!(run.energy.residual_j().abs() < 1e-9 * run.energy.drive_work_j);
+}
+
+/// A free impact across a resolved gear mesh (MODEL.md section 8): a pinion closing its
+/// backlash at `v0` on a wheel at rest, dry Hertz law without loss. The peak force per pair is
+/// section 4's closed form `K^(2/5) (5/4 m_eff v0^2)^(3/5)` with
+/// `m_eff = 1 / (Rb_a^2 / J_a + Rb_b^2 / J_b)`, the contact lasts `2.9433 s_max / v0`, the
+/// rebound speed is `v0` and the mesh does no net work. Measured at the default tolerance
+/// 1e-9: the peak within 3.5e-8 (3.9e-10 at 1e-11: it converges), the duration within 6e-9,
+/// the mesh's net work 3.1e-8 of the kinetic energy, the balance 5e-10 J; asserted 2e-7,
+/// 1e-7, 1e-7 and 5e-9 J.
+#[test]
+fn free_impact_across_a_gear_mesh_matches_closed_form() {
+    use clutchpack_model::law::{Hertz, LawKind, OilFilm, ToothLaw};
+    use clutchpack_model::network::*;
+    let (j_a, j_b, v0) = (0.02, 0.5, 0.3);
+    let g = GearMesh {
+        base_radius_a_m: 0.03,
+        base_radius_b_m: 0.09,
+        internal: false,
+        backlash_m: 1e-4,
+        pairs: 1.0,
+        initial_offset_m: 0.5e-4 - 1e-7,
+        law: ToothLaw {
+            kind: LawKind::Dry,
+            hertz: Hertz {
+                modulus_pa: 210e9,
+                curvature_radius_m: 5e-3,
+                loss_coefficient_s_m: 0.0,
+            },
+            oil: OilFilm {
+                thickness_m: 0.0,
+                viscosity_pa_s: 0.0,
+                leakage_coefficient: 0.421,
+                width_m: 1e-2,
+                length_m: 1e-2,
+                v_floor_m_s: 0.01,
+                h_min_m: 1e-7,
+            },
+        },
+    };
+    let body = |name: &str, j: f64, w: f64| Body {
+        name: name.into(),
+        inertia_kg_m2: j,
+        drag_n_m_s_rad: 0.0,
+        initial_speed_rad_s: w,
+        fixed: false,
+        drive: None,
+        road_load: None,
+    };
+    let net = Network {
+        bodies: vec![body("pinion", j_a, v0 / 0.03), body("wheel", j_b, 0.0)],
+        couplings: vec![Coupling {
+            name: "mesh".into(),
+            a: 0,
+            b: 1,
+            kind: CouplingKind::GearMesh(g.clone()),
+        }],
+    };
+    let mut obs = Events::default();
+    // the rebound crosses the backlash in 0.33 ms: stop before the other flank
+    let run = run_network(&net, 1.2e-3, &NetworkOptions::default(), &mut obs).unwrap();
+    assert_eq!(obs.2.len(), 1, "{:?}", obs.2);
+    let e = obs.2[0];
+    let k = g.law.hertz.coefficient();
+    let m_eff = g.effective_mass_kg(j_a, j_b);
+    let peak = clutchpack_model::free_impact_peak_n(k, m_eff, v0);
+    let duration = clutchpack_model::free_impact_duration_s(k, m_eff, v0);
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+    println!(
+        "peak {} N (closed form {peak}), duration {} s (closed form {duration}), closing at {} m/s",
+        e.peak_n,
+        e.t_off_s - e.t_on_s,
+        e.v_on_m_s
+    );
+    assert!(e.peak_n < 0.0, "the pinion leads: negative");
+    assert!(rel(-e.peak_n, peak) < 2e-7, "{}", rel(-e.peak_n, peak));
+    assert!(
+        rel(e.t_off_s - e.t_on_s, duration) < 1e-7,
+        "{}",
+        rel(e.t_off_s - e.t_on_s, duration)
+    );
+    // the rebound: the line of action's speed reversed
+    let w = &run.last.speed_rad_s;
+    let (_, v) = g.displacement((0.0, 0.0), (w[0], w[1]));
+    assert!(rel(-v, v0) < 1e-7, "rebound {v}");
+    println!(
+        "mesh work {} J of 1 J kinetic, residual {} J",
+        run.energy.mesh_work_j,
+        run.energy.residual_j()
+    );
+    assert!(run.energy.mesh_work_j.abs() < 1e-7 * 0.5 * j_a * (v0 / 0.03f64).powi(2));
+    assert!(run.energy.residual_j().abs() < 5e-9);
+}

@@ -1,0 +1,634 @@
+//! `[[bodies]]` and `[[couplings]]`: a driveline network (MODEL.md section 8). Every value is
+//! checked at its key (`bodies[2].inertia_kg_m2`, `couplings[0].force.start_s`); then the
+//! network's own rules ([`Network::problems`]: names, a coupling naming an unknown body or
+//! the same body twice, a loop of ideal gears, speeds that do not mesh, a body nothing moves)
+//! are reported at the key of the part they concern.
+
+use super::{Checker, Field};
+use crate::keys::{
+    RawContact as Ct, RawCoupling as C, RawForceSignal as FS, RawNetBody as B, RawOil as O,
+    RawRoadLoad as RL, RawTorqueSignal as TS,
+};
+use crate::schema::{show, Key, RawTable};
+use clutchpack_model::network::{
+    Body, Coupling, CouplingKind, GearMesh, LumpedClutch, Network, NetworkProblem, RoadLoad, Signal,
+};
+use clutchpack_model::{Hertz, LawKind, OilFilm, ToothLaw};
+use std::path::Path;
+use toml::Value;
+
+/// The path of key `k` of item `i` of the array `array`: `bodies[2].drive.start_s`.
+fn item(array: &str, k: &Key, i: usize) -> String {
+    k.at(&format!("{array}[{i}]"))
+}
+
+/// The keys of one signal table (a torque in N m, or a normalized force).
+struct SignalKeys {
+    kind: Key,
+    value: Key,
+    offset: Key,
+    height: Key,
+    amplitude: Key,
+    frequency: Key,
+    phase: Key,
+    start: Key,
+    duration: Key,
+    file: Key,
+    interpolation: Key,
+    /// The CSV column of the values.
+    column: &'static str,
+    /// The array whose items hold the table: `bodies` or `couplings`.
+    array: &'static str,
+}
+
+const TORQUE_SIGNAL: SignalKeys = SignalKeys {
+    kind: TS::kind,
+    value: TS::value_n_m,
+    offset: TS::offset_n_m,
+    height: TS::height_n_m,
+    amplitude: TS::amplitude_n_m,
+    frequency: TS::frequency_hz,
+    phase: TS::phase_deg,
+    start: TS::start_s,
+    duration: TS::duration_s,
+    file: TS::file,
+    interpolation: TS::interpolation,
+    column: "torque_n_m",
+    array: "bodies",
+};
+
+const FORCE_SIGNAL: SignalKeys = SignalKeys {
+    kind: FS::kind,
+    value: FS::value,
+    offset: FS::offset,
+    height: FS::height,
+    amplitude: FS::amplitude,
+    frequency: FS::frequency_hz,
+    phase: FS::phase_deg,
+    start: FS::start_s,
+    duration: FS::duration_s,
+    file: FS::file,
+    interpolation: FS::interpolation,
+    column: "force",
+    array: "couplings",
+};
+
+/// One signal table of item `i`; `get` reads a key's value as written.
+fn signal<'v>(
+    ck: &mut Checker,
+    keys: &SignalKeys,
+    i: usize,
+    get: impl Fn(&Key) -> Option<&'v Value>,
+    base_dir: &Path,
+) -> Option<Signal> {
+    #[derive(Clone, Copy, PartialEq)]
+    enum K {
+        Constant,
+        Step,
+        Ramp,
+        Sine,
+        Table,
+    }
+    use K::*;
+    let p = |k: &Key| item(keys.array, k, i);
+    let kind = ck
+        .choice(
+            &p(&keys.kind),
+            get(&keys.kind),
+            &keys.kind,
+            &[Constant, Step, Ramp, Sine, Table],
+        )
+        .required(ck, &p(&keys.kind), "required")?;
+    let uses: &[&Key] = match kind {
+        Constant => &[&keys.value],
+        Step => &[&keys.offset, &keys.height, &keys.start],
+        Ramp => &[&keys.offset, &keys.height, &keys.start, &keys.duration],
+        Sine => &[
+            &keys.offset,
+            &keys.amplitude,
+            &keys.frequency,
+            &keys.phase,
+            &keys.start,
+        ],
+        Table => &[&keys.file, &keys.interpolation],
+    };
+    let kind_name = show(get(&keys.kind).expect("the kind was read"));
+    for k in [
+        &keys.value,
+        &keys.offset,
+        &keys.height,
+        &keys.amplitude,
+        &keys.frequency,
+        &keys.phase,
+        &keys.start,
+        &keys.duration,
+        &keys.file,
+        &keys.interpolation,
+    ] {
+        if !uses.iter().any(|u| u.name == k.name) {
+            ck.not_allowed(
+                &p(k),
+                get(k),
+                &format!("not used by kind = {kind_name}; remove it"),
+            );
+        }
+    }
+    let num = |ck: &mut Checker, k: &Key| ck.num(&p(k), get(k), k);
+    let required = |ck: &mut Checker, k: &Key| {
+        num(ck, k).required(ck, &p(k), &format!("required for kind = {kind_name}"))
+    };
+    let signal = match kind {
+        Constant => Signal::Constant(required(ck, &keys.value)?),
+        Step | Ramp | Sine => {
+            let offset = num(ck, &keys.offset).or(0.0);
+            let start_s = num(ck, &keys.start).or(0.0);
+            match kind {
+                Step => {
+                    let height = required(ck, &keys.height);
+                    Signal::Step {
+                        offset: offset?,
+                        height: height?,
+                        start_s: start_s?,
+                    }
+                }
+                Ramp => {
+                    let height = required(ck, &keys.height);
+                    let duration_s = required(ck, &keys.duration);
+                    Signal::Ramp {
+                        offset: offset?,
+                        height: height?,
+                        start_s: start_s?,
+                        duration_s: duration_s?,
+                    }
+                }
+                _ => {
+                    let amplitude = required(ck, &keys.amplitude);
+                    let frequency_hz = required(ck, &keys.frequency);
+                    let phase = num(ck, &keys.phase).or(0.0);
+                    Signal::Sine {
+                        offset: offset?,
+                        amplitude: amplitude?,
+                        frequency_hz: frequency_hz?,
+                        phase_rad: phase?.to_radians(),
+                        start_s: start_s?,
+                    }
+                }
+            }
+        }
+        Table => {
+            let file = ck.text(&p(&keys.file), get(&keys.file)).required(
+                ck,
+                &p(&keys.file),
+                "required for kind = \"table\"",
+            )?;
+            let hold = ck
+                .choice(
+                    &p(&keys.interpolation),
+                    get(&keys.interpolation),
+                    &keys.interpolation,
+                    &[false, true],
+                )
+                .or(false)?;
+            match crate::csv::read_table(&base_dir.join(&file), &file, keys.column) {
+                Ok(t) => Signal::Table(if hold { t.held() } else { t }),
+                Err(e) => {
+                    ck.report(p(&keys.file), Some(format!("\"{file}\"")), e);
+                    return None;
+                }
+            }
+        }
+    };
+    Some(signal)
+}
+
+/// The network of a scene with `[[bodies]]`.
+pub(super) fn network(
+    ck: &mut Checker,
+    bodies: &[B],
+    couplings: &[C],
+    base_dir: &Path,
+) -> Option<Network> {
+    let mut ok = true;
+    let mut net = Network::default();
+    for (i, r) in bodies.iter().enumerate() {
+        let p = |k: &Key| item("bodies", k, i);
+        let name = ck.text(&p(&B::name), r.value(&B::name)).required(
+            ck,
+            &p(&B::name),
+            "required: couplings name their bodies by it",
+        );
+        let fixed = ck.boolean(&p(&B::fixed), r.value(&B::fixed)).or(false);
+        let inertia = ck.num(
+            &p(&B::inertia_kg_m2),
+            r.value(&B::inertia_kg_m2),
+            &B::inertia_kg_m2,
+        );
+        let inertia = match (fixed, inertia) {
+            (Some(true), f) => {
+                if !matches!(f, Field::Absent) {
+                    ck.report(
+                        p(&B::inertia_kg_m2),
+                        r.value(&B::inertia_kg_m2).map(show),
+                        "a fixed body has no inertia; remove it",
+                    );
+                }
+                Some(0.0)
+            }
+            (_, f) => f.required(ck, &p(&B::inertia_kg_m2), "required for a body that turns"),
+        };
+        let or_default =
+            |ck: &mut Checker, k: &Key| ck.num(&p(k), r.value(k), k).or(k.default_num());
+        let drag = or_default(ck, &B::drag_n_m_s_rad);
+        let speed = or_default(ck, &B::initial_speed_rad_s);
+        let drive = match &r.drive {
+            Some(d) => signal(ck, &TORQUE_SIGNAL, i, |k| d.value(k), base_dir).map(Some),
+            None => Some(None),
+        };
+        let road_load = match &r.road_load {
+            Some(l) => {
+                let mut n = |k: &Key| ck.num(&p(k), l.value(k), k).or(k.default_num());
+                let (a, b, c) = (
+                    n(&RL::constant_n_m),
+                    n(&RL::linear_n_m_s_rad),
+                    n(&RL::quadratic_n_m_s2_rad2),
+                );
+                (|| {
+                    Some(Some(RoadLoad {
+                        constant_n_m: a?,
+                        linear_n_m_s_rad: b?,
+                        quadratic_n_m_s2_rad2: c?,
+                    }))
+                })()
+            }
+            None => Some(None),
+        };
+        match (name, inertia, fixed, drag, speed, drive, road_load) {
+            (Some(name), Some(j), Some(fixed), Some(c), Some(w), Some(drive), Some(road_load)) => {
+                net.bodies.push(Body {
+                    name,
+                    inertia_kg_m2: j,
+                    drag_n_m_s_rad: c,
+                    initial_speed_rad_s: w,
+                    fixed,
+                    drive,
+                    road_load,
+                })
+            }
+            _ => ok = false,
+        }
+    }
+    if !ok {
+        return None;
+    }
+    #[derive(Clone, Copy)]
+    enum Kind {
+        Clutch,
+        Gear,
+        Mesh,
+    }
+    for (k, r) in couplings.iter().enumerate() {
+        let p = |key: &Key| item("couplings", key, k);
+        let default_name = format!(
+            "{}-{}",
+            r.value(&C::kind)
+                .and_then(|v| v.as_str())
+                .unwrap_or("coupling"),
+            k + 1
+        );
+        let name = ck.text(&p(&C::name), r.value(&C::name)).or(default_name);
+        let kind = ck
+            .choice(
+                &p(&C::kind),
+                r.value(&C::kind),
+                &C::kind,
+                &[Kind::Clutch, Kind::Gear, Kind::Mesh],
+            )
+            .required(ck, &p(&C::kind), "required");
+        let body = |ck: &mut Checker, key: &Key| {
+            let n = ck.text(&p(key), r.value(key)).required(
+                ck,
+                &p(key),
+                "required: the name of a body in [[bodies]]",
+            )?;
+            let found = net.body_index(&n);
+            if found.is_none() {
+                let names: Vec<String> = net
+                    .bodies
+                    .iter()
+                    .map(|b| format!("\"{}\"", b.name))
+                    .collect();
+                ck.report(
+                    p(key),
+                    Some(format!("\"{n}\"")),
+                    format!("names no body; the bodies are {}", names.join(", ")),
+                );
+            }
+            found
+        };
+        let a = body(ck, &C::a);
+        let b = body(ck, &C::b);
+        let Some(kind) = kind else {
+            ok = false;
+            continue;
+        };
+        let clutch_keys: [&Key; 6] = [
+            &C::mu,
+            &C::mu_speeds_rad_s,
+            &C::mu_values,
+            &C::peak,
+            &C::cgeo_m,
+            &C::max_normal_force_n,
+        ];
+        let mesh_keys: [&Key; 6] = [
+            &C::base_radius_a_m,
+            &C::base_radius_b_m,
+            &C::internal,
+            &C::backlash_m,
+            &C::pairs,
+            &C::mesh_offset_m,
+        ];
+        let kind_name = show(r.value(&C::kind).expect("the kind was read"));
+        let refuse = |ck: &mut Checker, keys: &[&Key], tables: &[(&str, bool)], whose: &str| {
+            for key in keys {
+                ck.not_allowed(
+                    &p(key),
+                    r.value(key),
+                    &format!("{whose}'s key; remove it for kind = {kind_name}"),
+                );
+            }
+            for (table, present) in tables {
+                if *present {
+                    ck.report(
+                        format!("couplings[{k}].{table}"),
+                        None,
+                        format!("{whose}'s table; remove it for kind = {kind_name}"),
+                    );
+                }
+            }
+        };
+        let (force, contact, oil) = (
+            ("force", r.force.is_some()),
+            ("contact", r.contact.is_some()),
+            ("oil", r.oil.is_some()),
+        );
+        match kind {
+            Kind::Gear => {
+                refuse(ck, &clutch_keys, &[force], "a clutch");
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
+            }
+            Kind::Clutch => {
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
+            }
+            Kind::Mesh => {
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(ck, &clutch_keys, &[force], "a clutch");
+            }
+        }
+        let built = match kind {
+            Kind::Mesh => gear_mesh(ck, r, k).map(CouplingKind::GearMesh),
+            Kind::Gear => ck
+                .num(&p(&C::ratio), r.value(&C::ratio), &C::ratio)
+                .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
+                .map(|ratio| CouplingKind::IdealGear { ratio }),
+            Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
+        };
+        match (name, a, b, built) {
+            (Some(name), Some(a), Some(b), Some(kind)) => {
+                net.couplings.push(Coupling { name, a, b, kind })
+            }
+            _ => ok = false,
+        }
+    }
+    if !ok {
+        return None;
+    }
+    let problems = net.problems();
+    for pr in &problems {
+        match pr {
+            NetworkProblem::Body {
+                index,
+                field,
+                message,
+            } => ck.report(format!("bodies[{index}].{field}"), None, message.clone()),
+            NetworkProblem::Coupling {
+                index,
+                field,
+                message,
+            } => ck.report(format!("couplings[{index}].{field}"), None, message.clone()),
+        }
+    }
+    problems.is_empty().then_some(net)
+}
+
+/// A clutch's keys and its `force` table.
+fn clutch(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<LumpedClutch> {
+    let p = |key: &Key| item("couplings", key, k);
+    let mu = ck.num(&p(&C::mu), r.value(&C::mu), &C::mu);
+    let speeds = ck.numbers(&p(&C::mu_speeds_rad_s), r.value(&C::mu_speeds_rad_s), None);
+    let values = ck.numbers(&p(&C::mu_values), r.value(&C::mu_values), None);
+    let table = match (mu, speeds, values) {
+        (Field::Valid(mu), Field::Absent, Field::Absent) => Some(vec![(0.0, mu)]),
+        (Field::Absent, Field::Valid(w), Field::Valid(m)) => {
+            if w.len() != m.len() || w.is_empty() {
+                ck.report(
+                    p(&C::mu_values),
+                    None,
+                    format!(
+                        "must have one value per entry of mu_speeds_rad_s ({}), has {}",
+                        w.len(),
+                        m.len()
+                    ),
+                );
+                None
+            } else {
+                Some(w.into_iter().zip(m).collect())
+            }
+        }
+        (Field::Invalid, ..) | (_, Field::Invalid, _) | (.., Field::Invalid) => None,
+        _ => {
+            ck.report(
+                p(&C::mu),
+                None,
+                "a clutch needs mu, or mu_speeds_rad_s with mu_values (not both)",
+            );
+            None
+        }
+    };
+    let peak = ck
+        .num(&p(&C::peak), r.value(&C::peak), &C::peak)
+        .or(C::peak.default_num());
+    let cgeo = ck
+        .num(&p(&C::cgeo_m), r.value(&C::cgeo_m), &C::cgeo_m)
+        .or(C::cgeo_m.default_num());
+    let fn_max = ck
+        .num(
+            &p(&C::max_normal_force_n),
+            r.value(&C::max_normal_force_n),
+            &C::max_normal_force_n,
+        )
+        .required(ck, &p(&C::max_normal_force_n), "required for a clutch");
+    let force = match &r.force {
+        Some(f) => signal(ck, &FORCE_SIGNAL, k, |key| f.value(key), base_dir),
+        None => {
+            ck.report(
+                format!("couplings[{k}].force"),
+                None,
+                "missing (a clutch's normalized normal force: a [couplings.force] table)",
+            );
+            None
+        }
+    };
+    let clutch = LumpedClutch {
+        mu_table: table?,
+        peak: peak?,
+        cgeo_m: cgeo?,
+        fn_max_n: fn_max?,
+        force: force?,
+    };
+    let mut good = true;
+    for (field, message) in clutch.problems() {
+        let key = match field {
+            "mu" if r.value(&C::mu).is_none() => p(&C::mu_speeds_rad_s),
+            "fn_max_n" => p(&C::max_normal_force_n),
+            "force" => format!("couplings[{k}].force"),
+            other => format!("couplings[{k}].{other}"),
+        };
+        ck.report(key, None, message);
+        good = false;
+    }
+    good.then_some(clutch)
+}
+
+/// A gear mesh's keys and its tooth law (`[couplings.contact]`, `[couplings.oil]`: the keys of
+/// a disc's law, MODEL.md section 2).
+fn gear_mesh(ck: &mut Checker, r: &C, k: usize) -> Option<GearMesh> {
+    let p = |key: &Key| item("couplings", key, k);
+    let num = |ck: &mut Checker, key: &Key| ck.num(&p(key), r.value(key), key);
+    let required = |ck: &mut Checker, key: &Key| {
+        num(ck, key).required(ck, &p(key), "required for a gear_mesh")
+    };
+    let ra = required(ck, &C::base_radius_a_m);
+    let rb = required(ck, &C::base_radius_b_m);
+    let backlash = required(ck, &C::backlash_m);
+    let pairs = num(ck, &C::pairs).or(C::pairs.default_num());
+    let offset = num(ck, &C::mesh_offset_m).or(0.0);
+    let internal = ck
+        .boolean(&p(&C::internal), r.value(&C::internal))
+        .or(false);
+    // the law: [couplings.contact] and [couplings.oil] (couplings[k].contact.modulus_pa)
+    let at = format!("couplings[{k}]");
+    let cv = |key: &Key| r.contact.as_ref().and_then(|c| c.value(key));
+    let ov = |key: &Key| r.oil.as_ref().and_then(|o| o.value(key));
+    let law = ck
+        .choice(
+            &Ct::law.at(&at),
+            cv(&Ct::law),
+            &Ct::law,
+            &[LawKind::Paper, LawKind::Dry, LawKind::Squeeze],
+        )
+        .or(LawKind::Paper);
+    let hint = "required for a gear_mesh (in its [couplings.contact])";
+    let modulus = ck
+        .num(
+            &Ct::modulus_pa.at(&at),
+            cv(&Ct::modulus_pa),
+            &Ct::modulus_pa,
+        )
+        .required(ck, &Ct::modulus_pa.at(&at), hint);
+    let curvature = ck
+        .num(
+            &Ct::curvature_radius_m.at(&at),
+            cv(&Ct::curvature_radius_m),
+            &Ct::curvature_radius_m,
+        )
+        .required(ck, &Ct::curvature_radius_m.at(&at), hint);
+    let loss = ck
+        .num(
+            &Ct::loss_coefficient_s_m.at(&at),
+            cv(&Ct::loss_coefficient_s_m),
+            &Ct::loss_coefficient_s_m,
+        )
+        .or(0.0);
+    let film = ck
+        .num(
+            &O::film_thickness_m.at(&at),
+            ov(&O::film_thickness_m),
+            &O::film_thickness_m,
+        )
+        .or(0.0);
+    let needs_oil = matches!((law, film), (Some(l), Some(h)) if l != LawKind::Dry && h > 0.0);
+    let oil_num = |ck: &mut Checker, key: &Key| {
+        let f = ck.num(&key.at(&at), ov(key), key);
+        if needs_oil {
+            f.required(
+                ck,
+                &key.at(&at),
+                "required with a film (film_thickness_m > 0) and a law that is not dry",
+            )
+        } else {
+            f.or(0.0)
+        }
+    };
+    let viscosity = oil_num(ck, &O::viscosity_pa_s);
+    let leakage = oil_num(ck, &O::leakage_coefficient);
+    let width = oil_num(ck, &O::width_m);
+    let length = oil_num(ck, &O::length_m);
+    let v_floor = ck
+        .num(
+            &O::v_floor_m_s.at(&at),
+            ov(&O::v_floor_m_s),
+            &O::v_floor_m_s,
+        )
+        .or(O::v_floor_m_s.default_num());
+    let h_min = ck
+        .num(&O::h_min_m.at(&at), ov(&O::h_min_m), &O::h_min_m)
+        .or(O::h_min_m.default_num());
+    let mesh = GearMesh {
+        base_radius_a_m: ra?,
+        base_radius_b_m: rb?,
+        internal: internal?,
+        backlash_m: backlash?,
+        pairs: pairs?,
+        initial_offset_m: offset?,
+        law: ToothLaw {
+            kind: law?,
+            hertz: Hertz {
+                modulus_pa: modulus?,
+                curvature_radius_m: curvature?,
+                loss_coefficient_s_m: loss?,
+            },
+            oil: OilFilm {
+                thickness_m: film?,
+                viscosity_pa_s: viscosity?,
+                leakage_coefficient: leakage?,
+                width_m: width?,
+                length_m: length?,
+                v_floor_m_s: v_floor?,
+                h_min_m: h_min?,
+            },
+        },
+    };
+    // the film and the start inside the free play, along the line of action
+    let half = 0.5 * mesh.backlash_m;
+    let reach = half - mesh.law.engagement_offset_m();
+    if reach <= 0.0 {
+        ck.report(
+            O::film_thickness_m.at(&at),
+            Some(crate::schema::fmt_num(mesh.law.oil.thickness_m)),
+            format!("must be < backlash_m / 2 = {half:e} m (else both flanks engage at once)"),
+        );
+        return None;
+    }
+    if mesh.initial_offset_m.abs() >= reach {
+        ck.report(
+            p(&C::mesh_offset_m),
+            Some(crate::schema::fmt_num(mesh.initial_offset_m)),
+            format!(
+                "the mesh must start inside its free play: |x| must be < backlash_m / 2 - the film = {reach:e} m"
+            ),
+        );
+        return None;
+    }
+    Some(mesh)
+}

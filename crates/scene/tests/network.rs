@@ -1,0 +1,181 @@
+//! Network scenes (`[[bodies]]` and `[[couplings]]`, MODEL.md section 8): the shipped example
+//! reaches the model as the case built in code, and a bad network is explained at its key.
+
+use clutchpack_scene::{load, parse, SceneError};
+use std::path::Path;
+
+fn root() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+}
+
+/// `scenes/coupled-clutches.toml` is exactly `cases::coupled_clutches()` (Modelica's
+/// CoupledClutches), degrees turned into radians.
+#[test]
+fn coupled_clutches_scene_is_the_case() {
+    let scene = load(&root().join("scenes/coupled-clutches.toml"), &[]).unwrap();
+    assert_eq!(
+        scene.network.as_ref(),
+        Some(&clutchpack_model::cases::coupled_clutches())
+    );
+    assert_eq!(scene.simulation.duration_s, 1.5);
+    assert!(scene.pack.discs.is_empty());
+}
+
+const TWO: &str = r#"
+[simulation]
+duration_s = 1.0
+
+[[bodies]]
+name = "engine"
+inertia_kg_m2 = 0.2
+initial_speed_rad_s = 100.0
+[bodies.drive]
+kind = "constant"
+value_n_m = 50.0
+
+[[bodies]]
+name = "vehicle"
+inertia_kg_m2 = 10.0
+[bodies.road_load]
+quadratic_n_m_s2_rad2 = 0.01
+
+[[couplings]]
+name = "launch"
+kind = "clutch"
+a = "engine"
+b = "vehicle"
+mu = 0.1
+max_normal_force_n = 5000.0
+cgeo_m = 0.2
+[couplings.force]
+kind = "ramp"
+height = 1.0
+start_s = 0.1
+duration_s = 0.2
+"#;
+
+fn problems(text: &str) -> Vec<String> {
+    match parse(text, "scenes/net.toml", Path::new("."), &[]) {
+        Ok(_) => panic!("should be refused"),
+        Err(SceneError::Invalid { problems, .. }) => {
+            problems.iter().map(|p| p.to_string()).collect()
+        }
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// A coupling naming an unknown body, a loop of ideal gears, a body nothing moves, a key of
+/// another kind and a pack's section are each reported at their key, all at once.
+#[test]
+fn bad_networks_are_explained_at_their_keys() {
+    let ok = parse(TWO, "scenes/net.toml", Path::new("."), &[]).unwrap();
+    assert_eq!(ok.network.unwrap().couplings.len(), 1);
+    let bad = TWO.replace("b = \"vehicle\"", "b = \"vehicel\"");
+    let p = problems(&bad);
+    assert_eq!(p.len(), 1, "{p:?}");
+    assert!(
+        p[0].contains("couplings[0].b = \"vehicel\"") && p[0].contains("\"engine\", \"vehicle\""),
+        "{p:?}"
+    );
+    let looped = format!(
+        "{TWO}\n[[couplings]]\nname = \"g1\"\nkind = \"ideal_gear\"\na = \"engine\"\nb = \"vehicle\"\nratio = 10.0\nmu = 0.1\n"
+    );
+    let p = problems(&looped);
+    assert!(
+        p.iter()
+            .any(|m| m.contains("couplings[1].mu") && m.contains("remove it")),
+        "{p:?}"
+    );
+    let looped = looped.replace("ratio = 10.0\nmu = 0.1\n", "ratio = 10.0\n")
+        + "\n[[couplings]]\nname = \"g2\"\nkind = \"ideal_gear\"\na = \"engine\"\nb = \"vehicle\"\nratio = 10.0\n";
+    let p = problems(&looped.replace("initial_speed_rad_s = 100.0", "initial_speed_rad_s = 0.0"));
+    assert!(
+        p.iter()
+            .any(|m| m.contains("couplings[2].b") && m.contains("loop of ideal gears")),
+        "{p:?}"
+    );
+    let idle = TWO
+        .replace(
+            "[bodies.drive]\nkind = \"constant\"\nvalue_n_m = 50.0\n",
+            "",
+        )
+        .replace("initial_speed_rad_s = 100.0", "");
+    let p = problems(&idle);
+    assert!(
+        p.iter()
+            .any(|m| m.contains("bodies[0].drive") && m.contains("nothing moves")),
+        "{p:?}"
+    );
+    let with_pack = format!("{TWO}\n[drum]\ninertia_kg_m2 = 1.0\n");
+    let p = problems(&with_pack);
+    assert!(
+        p.iter()
+            .any(|m| m.starts_with("drum") && m.contains("network")),
+        "{p:?}"
+    );
+}
+
+const MESH: &str = r#"
+[simulation]
+duration_s = 0.01
+
+[[bodies]]
+name = "pinion"
+inertia_kg_m2 = 0.02
+initial_speed_rad_s = 10.0
+
+[[bodies]]
+name = "wheel"
+inertia_kg_m2 = 0.5
+
+[[couplings]]
+name = "mesh"
+kind = "gear_mesh"
+a = "pinion"
+b = "wheel"
+base_radius_a_m = 0.03
+base_radius_b_m = 0.09
+backlash_m = 1e-4
+mesh_offset_m = 2e-5
+[couplings.contact]
+law = "dry"
+modulus_pa = 210e9
+curvature_radius_m = 5e-3
+"#;
+
+/// A gear mesh reaches the model with its law; a start outside the free play, a missing
+/// modulus and a clutch's key on a mesh are each reported at their key.
+#[test]
+fn gear_mesh_keys() {
+    let s = parse(MESH, "scenes/mesh.toml", Path::new("."), &[]).unwrap();
+    let net = s.network.unwrap();
+    let clutchpack_model::network::CouplingKind::GearMesh(g) = &net.couplings[0].kind else {
+        panic!("a mesh")
+    };
+    assert_eq!(
+        (g.base_radius_b_m, g.initial_offset_m, g.internal),
+        (0.09, 2e-5, false)
+    );
+    assert_eq!(g.law.kind, clutchpack_model::LawKind::Dry);
+    let p = problems(&MESH.replace("mesh_offset_m = 2e-5", "mesh_offset_m = 6e-5"));
+    assert!(
+        p.iter()
+            .any(|m| m.contains("couplings[0].mesh_offset_m = 0.00006") && m.contains("free play")),
+        "{p:?}"
+    );
+    let p = problems(
+        &MESH
+            .replace("modulus_pa = 210e9\n", "mu = 0.1\n")
+            .replace("[couplings.contact]", "mu = 0.1\n[couplings.contact]"),
+    );
+    assert!(
+        p.iter()
+            .any(|m| m.contains("couplings[0].contact.modulus_pa") && m.contains("missing")),
+        "{p:?}"
+    );
+    assert!(
+        p.iter()
+            .any(|m| m.contains("couplings[0].mu") && m.contains("remove it")),
+        "{p:?}"
+    );
+}

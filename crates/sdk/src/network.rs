@@ -1,0 +1,278 @@
+//! A network scene's run (`[[bodies]]`, MODEL.md section 8): the reference engine on the
+//! scene's driveline, its clutches' mode changes and heat, the bodies' speeds and the energy
+//! balance, as one serializable summary (`run --summary-json`) and, if asked, the sampled
+//! history (for the figure).
+
+use crate::{Error, Result};
+use clutchpack_model::network::{ClutchMode, CouplingKind};
+use clutchpack_reference::network::{
+    run_network, ClutchEvent, NetworkObserver, NetworkOptions, NetworkSample,
+};
+use clutchpack_scene::Scene;
+use serde::Serialize;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// What a network run keeps beside its summary.
+#[derive(Default)]
+pub struct NetworkRequest<'a> {
+    /// Keep every sample (the figure's data; memory grows with the run).
+    pub keep_history: bool,
+    /// Set to stop the run (a signal); the outcome then holds what ran.
+    pub stop: Option<&'a AtomicBool>,
+    /// Called with the simulated time reached, s.
+    pub progress: Option<&'a mut dyn FnMut(f64)>,
+}
+
+/// One mode change of a clutch.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModeChange {
+    /// Time, s.
+    pub t_s: f64,
+    /// Mode before: `free`, `slip+`, `slip-` or `locked`.
+    pub from: &'static str,
+    /// Mode after.
+    pub to: &'static str,
+    /// Each coupling's torque step at this instant, N m (after less before, on its body `a`:
+    /// the output torque's step at a lock is its gear's), in the scene's order.
+    pub torque_steps_n_m: Vec<f64>,
+}
+
+/// One coupling's results.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CouplingSummary {
+    /// Its name.
+    pub name: String,
+    /// `clutch`, `ideal_gear` or `gear_mesh`.
+    pub kind: &'static str,
+    /// Heat of a clutch, or work done on a gear mesh, over the run, J (0 for an ideal gear).
+    pub heat_j: f64,
+    /// Torque on its body a at the end, N m.
+    pub final_torque_n_m: f64,
+    /// A clutch's mode at the end (absent for a gear).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub final_mode: Option<&'static str>,
+    /// The instants a clutch locked, s.
+    pub lock_times_s: Vec<f64>,
+    /// The smallest torque on its body a over the samples, N m.
+    pub min_torque_n_m: f64,
+    /// The largest torque on its body a over the samples, N m.
+    pub max_torque_n_m: f64,
+    /// Every mode change after t = 0, in time order.
+    pub changes: Vec<ModeChange>,
+}
+
+/// One body's results.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BodySummary {
+    /// Its name.
+    pub name: String,
+    /// Speed at the end, rad/s.
+    pub final_speed_rad_s: f64,
+    /// Angle at the end, rad.
+    pub final_angle_rad: f64,
+}
+
+/// Where the energy went, J (MODEL.md section 8, "Energy").
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct EnergySummary {
+    /// Work of the drives, J.
+    pub drive_work_j: f64,
+    /// Work of the road loads (<= 0), J.
+    pub load_work_j: f64,
+    /// Loss to the bodies' drag, J.
+    pub drag_loss_j: f64,
+    /// Heat of the clutches, J.
+    pub clutch_heat_j: f64,
+    /// Work done on the gear meshes (their impact losses), J.
+    pub mesh_work_j: f64,
+    /// Kinetic energy at the end less at the start, J.
+    pub kinetic_change_j: f64,
+    /// `drive + load - drag - heat - mesh work - kinetic change`, J (zero to the integrator's tolerance).
+    pub residual_j: f64,
+}
+
+/// A network run's summary (`run --summary-json` of a network scene).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NetworkSummary {
+    /// The scene's name.
+    pub scene: String,
+    /// The engine (`reference`).
+    pub engine: &'static str,
+    /// Simulated time, s.
+    pub simulated_s: f64,
+    /// Wall time of the run, s.
+    pub wall_time_s: f64,
+    /// Accepted steps.
+    pub steps: u64,
+    /// Events located (mode changes and the signals' breakpoints).
+    pub events: u64,
+    /// Whether the run was stopped before its end (a signal).
+    pub stopped: bool,
+    /// Per body, in the scene's order.
+    pub bodies: Vec<BodySummary>,
+    /// Per coupling, in the scene's order.
+    pub couplings: Vec<CouplingSummary>,
+    /// The energy balance.
+    pub energy: EnergySummary,
+}
+
+/// A network run's outcome.
+#[derive(Debug, Clone)]
+pub struct NetworkOutcome {
+    /// The summary.
+    pub summary: NetworkSummary,
+    /// Every sample, if asked ([`NetworkRequest::keep_history`]).
+    pub history: Vec<NetworkSample>,
+}
+
+struct Keep<'a, 'r> {
+    req: &'a mut NetworkRequest<'r>,
+    events: Vec<ClutchEvent>,
+    /// (t, each coupling's torque step) at each switching instant.
+    steps: Vec<(f64, Vec<f64>)>,
+    /// Per coupling: the smallest and largest torque sampled.
+    range: Vec<(f64, f64)>,
+    history: Vec<NetworkSample>,
+    stopped: bool,
+}
+
+impl NetworkObserver for Keep<'_, '_> {
+    fn sample(&mut self, s: &NetworkSample) {
+        self.range
+            .resize(s.torque_n_m.len(), (f64::INFINITY, f64::NEG_INFINITY));
+        for (r, t) in self.range.iter_mut().zip(&s.torque_n_m) {
+            *r = (r.0.min(*t), r.1.max(*t));
+        }
+        if self.req.keep_history {
+            self.history.push(s.clone());
+        }
+    }
+    fn clutch_event(&mut self, e: &ClutchEvent) {
+        self.events.push(*e);
+    }
+    fn switched(&mut self, before: &NetworkSample, after: &NetworkSample) {
+        let steps = after
+            .torque_n_m
+            .iter()
+            .zip(&before.torque_n_m)
+            .map(|(a, b)| a - b)
+            .collect();
+        self.steps.push((after.t_s, steps));
+    }
+    fn progress(&mut self, t: f64) -> bool {
+        if let Some(p) = self.req.progress.as_mut() {
+            p(t);
+        }
+        let stop = self.req.stop.is_some_and(|s| s.load(Ordering::Relaxed));
+        self.stopped |= stop;
+        !stop
+    }
+}
+
+/// Runs a network scene on the reference engine. A pack scene is bad input.
+pub fn run_network_scene(scene: &Scene, mut req: NetworkRequest) -> Result<NetworkOutcome> {
+    let Some(net) = &scene.network else {
+        return Err(Error::BadInput(format!(
+            "{} is a pack scene, not a network ([[bodies]])",
+            scene.name
+        )));
+    };
+    let sim = &scene.simulation;
+    let options = NetworkOptions {
+        tolerance: sim.tolerance,
+        max_step_s: sim.max_step_s,
+        record_rate_hz: sim.record_rate_hz,
+    };
+    let mut keep = Keep {
+        req: &mut req,
+        events: Vec::new(),
+        steps: Vec::new(),
+        range: Vec::new(),
+        history: Vec::new(),
+        stopped: false,
+    };
+    let start = std::time::Instant::now();
+    let run =
+        run_network(net, sim.duration_s, &options, &mut keep).map_err(|source| Error::Engine {
+            context: format!("{} (reference engine, network)", scene.name),
+            source,
+        })?;
+    let wall_time_s = start.elapsed().as_secs_f64();
+    let last = &run.last;
+    let couplings = net
+        .couplings
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let changes: Vec<ModeChange> = keep
+                .events
+                .iter()
+                .filter(|e| e.coupling == k && e.t_s > 0.0)
+                .map(|e| ModeChange {
+                    t_s: e.t_s,
+                    from: e.from.label(),
+                    to: e.to.label(),
+                    torque_steps_n_m: keep
+                        .steps
+                        .iter()
+                        .find(|(t, _)| *t == e.t_s)
+                        .map_or_else(Vec::new, |(_, s)| s.clone()),
+                })
+                .collect();
+            CouplingSummary {
+                name: c.name.clone(),
+                kind: match c.kind {
+                    CouplingKind::Clutch(_) => "clutch",
+                    CouplingKind::IdealGear { .. } => "ideal_gear",
+                    CouplingKind::GearMesh(_) => "gear_mesh",
+                },
+                heat_j: run.heat_j[k],
+                final_torque_n_m: last.torque_n_m[k],
+                final_mode: last.mode[k].map(ClutchMode::label),
+                lock_times_s: keep
+                    .events
+                    .iter()
+                    .filter(|e| e.coupling == k && e.to == ClutchMode::Locked)
+                    .map(|e| e.t_s)
+                    .collect(),
+                min_torque_n_m: keep.range.get(k).map_or(0.0, |r| r.0),
+                max_torque_n_m: keep.range.get(k).map_or(0.0, |r| r.1),
+                changes,
+            }
+        })
+        .collect();
+    let e = run.energy;
+    let summary = NetworkSummary {
+        scene: scene.name.clone(),
+        engine: "reference",
+        simulated_s: last.t_s,
+        wall_time_s,
+        steps: run.steps,
+        events: run.events,
+        stopped: keep.stopped,
+        bodies: net
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(i, b)| BodySummary {
+                name: b.name.clone(),
+                final_speed_rad_s: last.speed_rad_s[i],
+                final_angle_rad: last.angle_rad[i],
+            })
+            .collect(),
+        couplings,
+        energy: EnergySummary {
+            drive_work_j: e.drive_work_j,
+            load_work_j: e.load_work_j,
+            drag_loss_j: e.drag_loss_j,
+            clutch_heat_j: e.clutch_heat_j,
+            mesh_work_j: e.mesh_work_j,
+            kinetic_change_j: e.kinetic_change_j,
+            residual_j: e.residual_j(),
+        },
+    };
+    Ok(NetworkOutcome {
+        summary,
+        history: keep.history,
+    })
+}
