@@ -485,6 +485,7 @@ fn engine_follows_the_scene() {
         pack: paper_pack(LawKind::Paper, 25e-6, 0.8, 0.01),
         fatigue: vec![],
         thermal: None,
+        network: None,
     };
     let mut e = engine_for(&scene).unwrap();
     assert_eq!(e.name(), "multibody");
