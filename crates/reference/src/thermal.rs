@@ -8,8 +8,8 @@
 //! `System::rhs`) grew by the work of its friction or drag torque, which goes by the
 //! interface's mode during the step (read before the step's switch applies) to its two bodies
 //! (slipping or locked) or to the oil (open); the tooth forces' work on the relative motion,
-//! `-n F Rb psi` (Boole's rule on the step's dense output, exact to the 5th degree), to the
-//! oil. When a window's end brings new parameters, the pack is swapped and the integration
+//! `-n F Rb psi` (integrated in the state beside the faces' counters, outside the step's
+//! error norm: `System::teeth_work`), to the oil. When a window's end brings new parameters, the pack is swapped and the integration
 //! restarts from the same state (the steps are not cut at the windows: a run whose parameters
 //! never change takes the isothermal run's steps bit for bit).
 
@@ -23,9 +23,9 @@ use std::sync::Arc;
 #[derive(Clone)]
 pub(crate) struct Thermal {
     windows: ThermalWindows,
-    /// The interface heat counters at the last step's end, J.
+    /// The interface heat counters and the teeth's work at the last step's end, J.
     counters: Vec<f64>,
-    buf: Vec<f64>,
+    teeth: f64,
 }
 
 impl Thermal {
@@ -35,8 +35,8 @@ impl Thermal {
         let windows = ThermalWindows::new(model, pack)?;
         Ok(Thermal {
             counters: vec![0.0; windows.interfaces()],
+            teeth: 0.0,
             windows,
-            buf: Vec::new(),
         })
     }
 
@@ -60,39 +60,10 @@ impl Thermal {
             };
             self.windows.book_face(m, dq, mode);
         }
-        // the teeth: -n F Rb psi over the step (Boole's rule, 5 points of the dense output)
-        let modes = st.step_modes();
-        if modes.iter().all(Option::is_none) || st.cur.h <= 0.0 {
-            return;
-        }
-        // the step ran from the start of its dense output to the stepper's time (an event
-        // ends it before the interpolant's end)
-        let (t0, h) = (st.cur.t0, st.t - st.cur.t0);
-        if h <= 0.0 {
-            return;
-        }
-        const W: [f64; 5] = [7.0, 32.0, 12.0, 32.0, 7.0];
-        let mut q = 0.0;
-        self.buf.resize(st.y.len(), 0.0);
-        for (i, w) in W.iter().enumerate() {
-            let t = if i == 4 {
-                st.t
-            } else {
-                t0 + h * i as f64 / 4.0
-            };
-            st.cur.eval(t, &mut self.buf);
-            for (slot, mode) in modes.iter().enumerate() {
-                if mode.is_none() {
-                    continue;
-                }
-                let d = st.sys.disc(slot);
-                let f = st.sys.load(slot, &self.buf, mode);
-                let psi = self.buf[st.sys.off + 2 * slot + 1];
-                let rb = d.spline.base_radius_m();
-                q -= w * d.spline.teeth as f64 * f * rb * psi;
-            }
-        }
-        self.windows.book_teeth(q * h / 90.0);
+        // the teeth: -n F Rb psi over the step, integrated in the state
+        let q = st.sys.teeth_work_j(&st.y);
+        self.windows.book_teeth(q - self.teeth);
+        self.teeth = q;
     }
 
     /// Thermal windows closed so far.
