@@ -1,16 +1,19 @@
 //! Named test cases with known answers, built in code (independent of the scene parser), so
 //! that every engine's tests, benches and the CLI's benchmark run the same definitions: the
 //! paper case (MODEL.md section 4), the closed-form free impact, the benchmark disc of
-//! `scenes/bench-8-disc.toml` and the staggered N-disc pack of issue 9.
+//! `scenes/bench-8-disc.toml`, the staggered N-disc pack of issue 9 and the two inertias
+//! joined by a spring-damper (MODEL.md section 8).
 //!
 //! Every value here is either from Hu et al. Table 2, from MODEL.md section 4's assumed
 //! values, or from `scenes/bench-8-disc.toml`; each function says which.
 
-use crate::clutch::{FrictionCurve, OpenGap, Piston, PressureProfile, StackModel};
-use crate::drive::{Shaft, SpeedProfile};
+use crate::clutch::{DrumModel, FrictionCurve, OpenGap, Piston, PressureProfile, StackModel};
+use crate::drive::{Shaft, ShaftExcitation, SpeedProfile};
 use crate::law::{Hertz, LawKind, OilFilm, ToothLaw};
 use crate::pack::{DiscModel, PackModel};
+use crate::pack::{PackBody, PackCoupling, PackCouplingKind};
 use crate::spline::{Flank, SplineGeometry};
+use crate::spring::SpringDamper;
 
 /// Mean shaft speed of the paper case, rad/s (MODEL.md section 4, assumed).
 pub const PAPER_OMEGA0_RAD_S: f64 = 200.0;
@@ -294,6 +297,58 @@ pub fn staggered_inertial(n: usize) -> PackModel {
         damping_n_m_s_rad: 0.0,
         excitation: crate::drive::ShaftExcitation::Profile(bench_drive()),
     };
+    pack
+}
+
+/// Inertia of the shaft of [`spring_pair`], kg m^2.
+pub const SPRING_PAIR_SHAFT_KG_M2: f64 = 0.5;
+/// Inertia of the drum of [`spring_pair`], kg m^2.
+pub const SPRING_PAIR_DRUM_KG_M2: f64 = 0.3;
+
+/// Two inertias joined by a torsional spring-damper (MODEL.md section 8), released from a
+/// twist: an inertial shaft of [`SPRING_PAIR_SHAFT_KG_M2`] (or, with `prescribed`, a shaft
+/// held at its speed) and a drum of [`SPRING_PAIR_DRUM_KG_M2`], both at 100 rad/s, no drive,
+/// load or drag; `spring` from the shaft (a) to the drum (b), its free angle the twist
+/// (both start at angle 0). The splines are there only because a pack has them: one disc on
+/// the shaft and one plate on the drum, 4 teeth with a half play of 0.3 rad, no drag, at
+/// rest relative to their carriers, so that they never touch while the twist stays within
+/// 0.3 rad (the closed forms hold: `SpringDamper::natural_frequency_rad_s` and
+/// `SpringDamper::damping_ratio` of the two inertias, the shaft's infinite when prescribed).
+pub fn spring_pair(spring: SpringDamper, prescribed: bool) -> PackModel {
+    let omega0 = 100.0;
+    let free = |name: &str, inertia: f64| {
+        let mut d = paper_disc(0.0);
+        d.name = name.into();
+        d.spline.teeth = 4;
+        // half play g0 = d / (2 R) = 0.3 rad, within half a pitch (pi / 4)
+        d.spline.backlash_m = 2.0 * d.spline.pitch_radius_m * 0.3;
+        d.inertia_kg_m2 = inertia;
+        d.drag_n_m_s_rad = 0.0;
+        d
+    };
+    let profile = SpeedProfile::sine(omega0, 0.0, 1.0);
+    let shaft = if prescribed {
+        Shaft::Prescribed(profile)
+    } else {
+        Shaft::Inertial {
+            inertia_kg_m2: SPRING_PAIR_SHAFT_KG_M2,
+            damping_n_m_s_rad: 0.0,
+            excitation: ShaftExcitation::Profile(profile),
+        }
+    };
+    let mut pack = PackModel::new(shaft, vec![free("disc", 0.156)]);
+    pack.plates = vec![free("plate", 0.138)];
+    pack.drum = Some(DrumModel {
+        inertia_kg_m2: SPRING_PAIR_DRUM_KG_M2,
+        load_torque_n_m: 0.0,
+        drag_n_m_s_rad: 0.0,
+        initial_speed_rad_s: omega0,
+    });
+    pack.couplings = vec![PackCoupling {
+        a: PackBody::Shaft,
+        b: PackBody::Drum,
+        kind: PackCouplingKind::SpringDamper(spring),
+    }];
     pack
 }
 

@@ -1,8 +1,9 @@
 //! Consistency checks of an engine's output stream that hold for every engine and scheme,
 //! shared by the engines' tests so that each is written once: the time order of each disc's
 //! samples and contact samples ([`OrderedCollector`]), the agreement of the contact samples
-//! with the located impact peaks ([`check_contact_samples`]), and each friction interface's
-//! first lock and heat ([`first_lock_s`], [`heat_j`]).
+//! with the located impact peaks ([`check_contact_samples`]), each friction interface's
+//! first lock and heat ([`first_lock_s`], [`heat_j`]), and the period and decrement of a
+//! free oscillation ([`free_oscillation`], the spring-damper's closed-form tests).
 
 use crate::clutch::InterfaceSample;
 use crate::impact::ImpactEvent;
@@ -216,5 +217,52 @@ mod tests {
         o.contact_sample(0, 0.9, &DiscSample::default());
         assert_eq!(o.out_of_order.len(), 1);
         assert_eq!(o.collector.contacts.len(), 3);
+    }
+}
+
+/// The period and decay of a free oscillation about 0 (a spring-damper's twist less its free
+/// angle), sampled as `(t_s, x)` in time order: the mean period, s (between the first and the
+/// last upward zero crossing, each interpolated linearly between its two samples) and the
+/// mean logarithmic decrement (dimensionless: `ln(x_i / x_{i+1})` over successive maxima,
+/// each the vertex of the parabola through the largest sample and its two neighbours);
+/// `None` with fewer than two crossings or maxima.
+pub fn free_oscillation(samples: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let mut ups = Vec::new();
+    let mut peaks = Vec::new();
+    for w in samples.windows(3) {
+        let [(t0, x0), (t1, x1), (_, x2)] = [w[0], w[1], w[2]];
+        if x0 < 0.0 && x1 >= 0.0 {
+            ups.push(t0 + (t1 - t0) * (-x0) / (x1 - x0));
+        }
+        if x1 > 0.0 && x1 > x0 && x1 >= x2 {
+            // vertex of the parabola through three equally spaced samples
+            let (a, b) = (0.5 * (x0 + x2) - x1, 0.5 * (x2 - x0));
+            peaks.push(x1 - b * b / (4.0 * a));
+        }
+    }
+    if ups.len() < 2 || peaks.len() < 2 {
+        return None;
+    }
+    let period = (ups[ups.len() - 1] - ups[0]) / (ups.len() - 1) as f64;
+    let decrement = (peaks[0] / peaks[peaks.len() - 1]).ln() / (peaks.len() - 1) as f64;
+    Some((period, decrement))
+}
+
+#[cfg(test)]
+mod oscillation_tests {
+    /// A sampled damped cosine gives back its period and decrement.
+    #[test]
+    fn free_oscillation_of_a_damped_cosine() {
+        let (wd, delta) = (2.0 * std::f64::consts::PI * 5.0, 0.1);
+        let sigma = delta * wd / (2.0 * std::f64::consts::PI);
+        let x: Vec<(f64, f64)> = (0..20_000)
+            .map(|k| {
+                let t = k as f64 * 1e-4;
+                (t, (-sigma * t).exp() * (wd * t).cos())
+            })
+            .collect();
+        let (p, d) = super::free_oscillation(&x).unwrap();
+        assert!((p - 0.2).abs() < 1e-6, "{p}");
+        assert!((d - delta).abs() < 1e-4, "{d}");
     }
 }

@@ -28,9 +28,11 @@
 //! | --- | --- | --- | --- | --- |
 //! | spline coupling ([`SplineGeometry`], [`DiscSample`]) | the carrier: shaft for a friction disc, housing or drum for a plate | the disc or plate | `phi = theta_a - theta_b = -rel` (the paper's eq 6 sign, kept so every load matches Hu et al.) | `spline_torque_n_m` on b `= -n F Rb`; per-tooth load `F` **positive when b leads** (`rel > g0`), negative when a leads |
 //! | friction interface `m` ([`InterfaceSample`]) | stack body `m` (piston side, [`StackBody::at`]) | stack body `m + 1` | `slip_rad_s = omega_b - omega_a = rel'` | `torque_n_m` on b (opposes `slip` while it slips) |
+//! | spring-damper ([`SpringDamper`], [`PackCoupling`]) | its `a` (the shaft in a one-pack scene) | its `b` (the drum) | `dtheta = theta_a - theta_b = -rel` (MODEL.md section 8's sign) | torque on b `k (dtheta - theta_0) + d dtheta'` |
 //!
-//! So the only exception to "b minus a" is the spline's `phi`, which keeps the paper's sign;
-//! its torque still follows the rule (reported on b). Heat is never negative:
+//! So the only exceptions to "b minus a" are the spline's `phi`, which keeps the paper's sign,
+//! and the spring-damper's twist, which keeps MODEL.md section 8's;
+//! their torques still follow the rule (reported on b). Heat is never negative:
 //! `-torque_n_m * slip_rad_s >= 0` for a friction interface, and the coupling's film and
 //! impact damping dissipate `>= 0` on either flank.
 //!
@@ -61,6 +63,7 @@ pub mod network;
 pub mod pack;
 pub mod session;
 pub mod spline;
+pub mod spring;
 pub mod stream;
 pub mod thermal;
 
@@ -73,11 +76,12 @@ pub use fatigue::{FatigueParams, Material, MinerRule, ToothForm};
 pub use impact::{detect_impacts, parabolic_peak, ImpactEvent, ImpactTracker};
 pub use law::{ContactState, Engagement, Hertz, LawKind, OilFilm, ToothLaw};
 pub use pack::{
-    annulus_inner_radius_m, annulus_outer_radius_m, ensemble_angle_rad, DiscModel, NonTorsional,
-    PackModel,
+    annulus_inner_radius_m, annulus_outer_radius_m, ensemble_angle_rad, BodyMotion, CouplingLoads,
+    DiscModel, NonTorsional, PackBody, PackCoupling, PackCouplingKind, PackModel,
 };
 pub use session::Engine;
 pub use spline::{Flank, SplineGeometry, ToothKinematics};
+pub use spring::SpringDamper;
 pub use stream::{
     Collector, DiscSample, EngineError, NullObserver, Observer, RunStats, Sample, STALL_SPAN_S,
     STALL_STEPS,

@@ -4,6 +4,7 @@ use crate::clutch::{DrumModel, StackModel};
 use crate::drive::Shaft;
 use crate::law::ToothLaw;
 use crate::spline::SplineGeometry;
+use crate::spring::SpringDamper;
 use serde::{Deserialize, Serialize};
 
 /// One friction disc on the shaft spline (Hu et al. eq 5).
@@ -130,6 +131,87 @@ pub struct PackModel {
     /// (default): no friction between them.
     #[serde(default)]
     pub stack: Option<StackModel>,
+    /// Couplings between two of the pack's rotating bodies beyond the splines and the stack
+    /// (MODEL.md section 8: a torsional spring-damper between the shaft and the drum), in
+    /// scene order. Default none (and then not serialised, so that a pack without couplings
+    /// writes what it wrote before they existed).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub couplings: Vec<PackCoupling>,
+}
+
+/// A body of one pack that a [`PackCoupling`] can join: the bodies with a rotation of their
+/// own besides the discs and plates. A driveline network names its bodies instead; here the
+/// pack has these two.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum PackBody {
+    /// The shaft (prescribed or inertial, [`Shaft`]).
+    Shaft,
+    /// The output drum ([`PackModel::drum`]).
+    Drum,
+}
+
+/// What a coupling does: one arm per kind (MODEL.md section 8; a lumped clutch and a gear
+/// mesh are the next arms).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum PackCouplingKind {
+    /// A torsional spring-damper ([`SpringDamper`]).
+    SpringDamper(SpringDamper),
+}
+
+/// A coupling between two bodies a and b of a pack (MODEL.md section 8): a term in both
+/// bodies' equations, equal and opposite, in the crate's two-sided convention (the torque
+/// reported is the one on b).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PackCoupling {
+    /// Side a (receives the opposite of the reported torque).
+    pub a: PackBody,
+    /// Side b (receives the reported torque); not `a`.
+    pub b: PackBody,
+    /// The law.
+    pub kind: PackCouplingKind,
+}
+
+/// The angle (rad) and speed (rad/s) of a body at one instant.
+pub type BodyMotion = (f64, f64);
+
+impl PackCoupling {
+    /// The torque on b, N m, with a at `(theta_a, omega_a)` and b at `(theta_b, omega_b)`
+    /// (rad, rad/s); a receives the opposite. Spring-damper: MODEL.md section 8,
+    /// `k (theta_a - theta_b - theta_0) + d (omega_a - omega_b)`.
+    pub fn torque_on_b_n_m(&self, a: BodyMotion, b: BodyMotion) -> f64 {
+        match &self.kind {
+            PackCouplingKind::SpringDamper(s) => s.torque_n_m(a.0 - b.0, a.1 - b.1),
+        }
+    }
+
+    /// The energy the coupling stores at the angles `theta_a`, `theta_b` (rad), J (>= 0).
+    pub fn potential_j(&self, theta_a: f64, theta_b: f64) -> f64 {
+        match &self.kind {
+            PackCouplingKind::SpringDamper(s) => s.potential_j(theta_a - theta_b),
+        }
+    }
+
+    /// The power the coupling turns into heat at the speeds `omega_a`, `omega_b` (rad/s), W
+    /// (>= 0).
+    pub fn loss_rate_w(&self, omega_a: f64, omega_b: f64) -> f64 {
+        match &self.kind {
+            PackCouplingKind::SpringDamper(s) => s.loss_rate_w(omega_a - omega_b),
+        }
+    }
+}
+
+/// The couplings' effect on the pack's shaft and drum at one instant
+/// ([`PackModel::coupling_loads`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct CouplingLoads {
+    /// Sum of the couplings' torques on the shaft, N m (positive along the positive rotation).
+    pub shaft_n_m: f64,
+    /// Sum of the couplings' torques on the drum, N m (positive along the positive rotation).
+    pub drum_n_m: f64,
+    /// Energy stored in the couplings, J (>= 0).
+    pub potential_j: f64,
+    /// Power the couplings turn into heat, W (>= 0).
+    pub loss_rate_w: f64,
 }
 
 impl PackModel {
@@ -142,10 +224,13 @@ impl PackModel {
         self.non_torsional_parts().is_empty()
     }
 
-    /// Whether the pack has separator plates, a drum or a stack (a whole pack, MODEL.md
-    /// section 5), beyond friction discs on a shaft.
+    /// Whether the pack has separator plates, a drum, a stack or couplings (a whole pack,
+    /// MODEL.md sections 5 and 8), beyond friction discs on a shaft.
     pub fn is_whole(&self) -> bool {
-        !self.plates.is_empty() || self.drum.is_some() || self.stack.is_some()
+        !self.plates.is_empty()
+            || self.drum.is_some()
+            || self.stack.is_some()
+            || !self.couplings.is_empty()
     }
 
     /// Every part of the pack that the torsional engine does not run (MODEL.md section 5), in
@@ -173,7 +258,7 @@ impl PackModel {
         out
     }
 
-    /// A pack of a shaft and friction discs only (no plates, drum or stack).
+    /// A pack of a shaft and friction discs only (no plates, drum, stack or couplings).
     pub fn new(shaft: Shaft, discs: Vec<DiscModel>) -> PackModel {
         PackModel {
             shaft,
@@ -181,7 +266,33 @@ impl PackModel {
             plates: Vec::new(),
             drum: None,
             stack: None,
+            couplings: Vec::new(),
         }
+    }
+
+    /// What the [`Self::couplings`] do with the shaft at `shaft` and the drum at `drum`
+    /// (angle in rad, speed in rad/s; the drum's ignored without couplings on it): the
+    /// torques on each, the energy stored, the power lost. The one evaluation both engines
+    /// use (MODEL.md section 8: each coupling's torque `T` on its b, `-T` on its a).
+    pub fn coupling_loads(&self, shaft: BodyMotion, drum: BodyMotion) -> CouplingLoads {
+        let mut out = CouplingLoads::default();
+        let motion = |body: PackBody| match body {
+            PackBody::Shaft => shaft,
+            PackBody::Drum => drum,
+        };
+        for c in &self.couplings {
+            let (a, b) = (motion(c.a), motion(c.b));
+            let t = c.torque_on_b_n_m(a, b);
+            for (body, torque) in [(c.a, -t), (c.b, t)] {
+                match body {
+                    PackBody::Shaft => out.shaft_n_m += torque,
+                    PackBody::Drum => out.drum_n_m += torque,
+                }
+            }
+            out.potential_j += c.potential_j(a.0, b.0);
+            out.loss_rate_w += c.loss_rate_w(a.1, b.1);
+        }
+        out
     }
 }
 
@@ -281,6 +392,7 @@ mod tests {
             plates: Vec::new(),
             drum: None,
             stack: None,
+            couplings: Vec::new(),
         };
         assert!(pack.is_torsional());
         pack.discs[0].tooth_spacing_errors_m = vec![0.0; 4];
@@ -296,5 +408,39 @@ mod tests {
         let mut d = disc();
         d.initial_offset_m = [0.0, -1e-6];
         assert!(!d.is_concentric());
+    }
+
+    /// A spring-damper from the shaft (a) to the drum (b): equal and opposite torques, `T`
+    /// on the drum; its potential and loss; with a and b swapped, the same pair of torques
+    /// for the opposite twist convention.
+    #[test]
+    fn coupling_loads_are_equal_and_opposite() {
+        let spring = SpringDamper {
+            stiffness_n_m_per_rad: 100.0,
+            damping_n_m_s_per_rad: 2.0,
+            free_angle_rad: 0.1,
+        };
+        let mut pack = PackModel::new(Shaft::Prescribed(SpeedProfile::sine(1.0, 0.0, 1.0)), vec![]);
+        assert_eq!(
+            pack.coupling_loads((1.0, 2.0), (0.0, 0.0)),
+            CouplingLoads::default()
+        );
+        pack.couplings.push(PackCoupling {
+            a: PackBody::Shaft,
+            b: PackBody::Drum,
+            kind: PackCouplingKind::SpringDamper(spring),
+        });
+        let l = pack.coupling_loads((0.3, 5.0), (0.1, 4.0));
+        // k (0.3 - 0.1 - 0.1) + d (5 - 4) = 10 + 2
+        assert!((l.drum_n_m - 12.0).abs() < 1e-12);
+        assert_eq!(l.shaft_n_m, -l.drum_n_m);
+        assert!((l.potential_j - 0.5).abs() < 1e-12);
+        assert!((l.loss_rate_w - 2.0).abs() < 1e-12);
+        pack.couplings[0].a = PackBody::Drum;
+        pack.couplings[0].b = PackBody::Shaft;
+        let l = pack.coupling_loads((0.3, 5.0), (0.1, 4.0));
+        // k (0.1 - 0.3 - 0.1) + d (4 - 5) = -30 - 2 on the shaft
+        assert!((l.shaft_n_m + 32.0).abs() < 1e-12);
+        assert_eq!(l.drum_n_m, -l.shaft_n_m);
     }
 }

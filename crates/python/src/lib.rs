@@ -76,6 +76,12 @@ impl Scene {
             .map(|d| d.name.clone())
             .collect()
     }
+    /// Whether the scene is a driveline network (`[[bodies]]`; run it with `run` as any
+    /// scene: it gives speeds and coupling torques, not tooth loads).
+    #[getter]
+    fn is_network(&self) -> bool {
+        self.inner.network.is_some()
+    }
     /// The scene file, if the scene came from one.
     #[getter]
     fn path(&self) -> Option<PathBuf> {
@@ -258,6 +264,79 @@ struct RawRun {
 /// `record` and writing `impacts_csv`; keeps the load history when `keep_samples`. The GIL
 /// is released while the engine runs; Ctrl-C stops it with its outputs complete and raises
 /// `KeyboardInterrupt`.
+/// A progress callback for a run with the GIL released: every [`SIGNAL_POLL`] it takes the GIL
+/// to check Python's signals; a pending one (Ctrl-C) is kept in `interrupt` and sets `stop`,
+/// which ends the run with its outputs complete.
+fn signal_poll<'a>(stop: &'a AtomicBool, interrupt: &'a mut Option<PyErr>) -> impl FnMut(f64) + 'a {
+    let mut last = Instant::now();
+    move |_t: f64| {
+        if last.elapsed() >= SIGNAL_POLL {
+            last = Instant::now();
+            if let Err(e) = Python::attach(|py| py.check_signals()) {
+                *interrupt = Some(e);
+                stop.store(true, Ordering::SeqCst);
+            }
+        }
+    }
+}
+
+/// What one network run gave, for the Python half.
+#[pyclass(name = "RawNetworkRun", module = "clutchpack", frozen, get_all)]
+struct RawNetworkRun {
+    /// `--summary-json`'s content for a network (JSON text).
+    summary_json: String,
+    /// Sample times, s.
+    sample_t_s: Vec<f64>,
+    /// Each body's speed at them, rad/s, by name.
+    speed_rad_s: Vec<(String, Vec<f64>)>,
+    /// Each coupling's torque on its body a at them, N m, by name.
+    torque_n_m: Vec<(String, Vec<f64>)>,
+}
+
+/// Runs a network scene (`[[bodies]]`) on the reference engine, as `clutchpack run` does: the
+/// summary and the sampled speeds and torques. The GIL is released while it runs; Ctrl-C
+/// stops it and raises `KeyboardInterrupt`.
+#[pyfunction]
+fn run_network(py: Python<'_>, scene: &Scene) -> PyResult<RawNetworkRun> {
+    let stop = AtomicBool::new(false);
+    let mut interrupt: Option<PyErr> = None;
+    let outcome = py.detach(|| {
+        let mut progress = signal_poll(&stop, &mut interrupt);
+        clutchpack_sdk::run_network_scene(
+            &scene.inner,
+            clutchpack_sdk::NetworkRequest {
+                keep_history: true,
+                stop: Some(&stop),
+                progress: Some(&mut progress),
+            },
+        )
+    });
+    let outcome = outcome.map_err(py_err)?;
+    if let Some(e) = interrupt {
+        return Err(e);
+    }
+    let h = &outcome.history;
+    let s = &outcome.summary;
+    let column = |f: &dyn Fn(&clutchpack_sdk::NetworkSample) -> f64| h.iter().map(f).collect();
+    Ok(RawNetworkRun {
+        summary_json: serde_json::to_string(s)
+            .map_err(|e| PyRuntimeError::new_err(e.to_string()))?,
+        sample_t_s: h.iter().map(|x| x.t_s).collect(),
+        speed_rad_s: s
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (b.name.clone(), column(&|x| x.speed_rad_s[i])))
+            .collect(),
+        torque_n_m: s
+            .couplings
+            .iter()
+            .enumerate()
+            .map(|(k, c)| (c.name.clone(), column(&|x| x.torque_n_m[k])))
+            .collect(),
+    })
+}
+
 #[pyfunction]
 #[pyo3(signature = (scene, engine=None, record=None, impacts_csv=None, keep_samples=true, deterministic=false))]
 fn run(
@@ -291,16 +370,7 @@ fn run(
     let stop = AtomicBool::new(false);
     let mut interrupt: Option<PyErr> = None;
     let outcome = py.detach(|| {
-        let mut last = Instant::now();
-        let mut progress = |_t: f64| {
-            if last.elapsed() >= SIGNAL_POLL {
-                last = Instant::now();
-                if let Err(e) = Python::attach(|py| py.check_signals()) {
-                    interrupt = Some(e);
-                    stop.store(true, Ordering::SeqCst);
-                }
-            }
-        };
+        let mut progress = signal_poll(&stop, &mut interrupt);
         sim.run(RunRequest {
             keep_history: true,
             keep_cycles: false,
@@ -587,12 +657,14 @@ fn _clutchpack(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
     m.add_class::<ImpactColumns>()?;
     m.add_class::<RawRun>()?;
+    m.add_class::<RawNetworkRun>()?;
     m.add_class::<RawRecording>()?;
     m.add_class::<stepper::Stepper>()?;
     m.add_class::<stepper::StepperState>()?;
     m.add_function(wrap_pyfunction!(load_scene, m)?)?;
     m.add_function(wrap_pyfunction!(scene_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(run_network, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(study_run, m)?)?;

@@ -61,6 +61,22 @@ def test_run_equals_the_cli(tmp_path, scene, engine):
         assert err <= 0.5001 * 10.0**-digits, (col, err)
 
 
+def test_a_network_scene_runs_as_the_cli_runs_it(tmp_path):
+    """A driveline network (issue 34): `run` gives `--summary-json`'s content but the wall
+    time, and the speeds and torques as columns (Modelica's CoupledClutches: clutch 2 locks
+    at 0.7096 s, the reference results' instant within 2e-5 s)."""
+    js = tmp_path / "cc.json"
+    cli("run", "scenes/coupled-clutches.toml", "--summary-json", str(js))
+    r = clutchpack.run("scenes/coupled-clutches.toml")
+    assert without_wall(r.summary) == without_wall(json.loads(js.read_text()))
+    assert abs(r.summary["couplings"][1]["lock_times_s"][0] - 0.7096214638) < 2e-5
+    assert len(r.samples) == 1501  # 0 to 1.5 s every ms
+    assert r.samples["J1.speed_rad_s"].iloc[0] == 10.0
+    assert "clutch3.torque_n_m" in r.samples.columns
+    with pytest.raises(ValueError, match="not for a network scene"):
+        clutchpack.run("scenes/coupled-clutches.toml", record=tmp_path / "x.mcap")
+
+
 def test_read_gives_what_the_run_gave(tmp_path):
     rec = tmp_path / "r.mcap"
     r = clutchpack.run("scenes/pack-4-rattle.toml", duration=0.2, record=rec)

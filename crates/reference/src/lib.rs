@@ -368,9 +368,14 @@ impl ReferenceEngine {
             } else {
                 ""
             };
+            let couplings = match self.pack.couplings.len() {
+                0 => String::new(),
+                1 => ", a spring-damper joining the shaft and the drum".to_string(),
+                n => format!(", {n} spring-dampers joining the shaft and the drum"),
+            };
             return format!(
                 "monolithic: one step sequence for the shaft, {nd} {discs} and {np} plates on \
-                 {carrier}{stack} (a whole pack runs monolithic)"
+                 {carrier}{stack}{couplings} (a whole pack runs monolithic)"
             );
         }
         match (self.scheme, &self.pack.shaft) {

@@ -283,8 +283,9 @@ impl System {
 
     /// The carriers' motion at `t` for state `y` and contact modes `modes`: the shaft's speed
     /// and acceleration, the drum's (0 without a drum), rad/s and rad/s^2. The carriers feel
-    /// only their couplings' spline reactions (eq 4; the drum's load and drag), never the
-    /// stack, which acts between discs and plates.
+    /// their couplings' spline reactions (eq 4; the drum's load and drag) and the pack's
+    /// couplings between them (a spring-damper, MODEL.md section 8), never the stack, which
+    /// acts between discs and plates.
     pub fn carriers(&self, t: f64, y: &[f64], modes: &[Option<Engagement>]) -> [f64; 4] {
         let (omega_s, alpha_prescribed) = match &self.pack.shaft {
             Shaft::Prescribed(p) => (p.speed(t), p.acceleration(t)),
@@ -307,6 +308,14 @@ impl System {
                     Carrier::Housing => {}
                 }
             }
+        }
+        if !self.pack.couplings.is_empty() {
+            // MODEL.md section 8: the couplings between the shaft and the drum (a spring-damper:
+            // T = k (theta_a - theta_b - theta_0) + d (omega_a - omega_b) on b, -T on a)
+            let drum = self.drum_state(y).unwrap_or((0.0, 0.0));
+            let loads = self.pack.coupling_loads(self.shaft(t, y), drum);
+            shaft_torque += loads.shaft_n_m;
+            drum_torque += loads.drum_n_m;
         }
         let alpha_s = match &self.pack.shaft {
             Shaft::Inertial {
@@ -749,13 +758,27 @@ mod tests {
             }),
             spline_friction: 0.1,
         });
+        // MODEL.md section 8: a spring-damper from the shaft to the drum
+        pack.couplings = vec![clutchpack_model::PackCoupling {
+            a: clutchpack_model::PackBody::Shaft,
+            b: clutchpack_model::PackBody::Drum,
+            kind: clutchpack_model::PackCouplingKind::SpringDamper(
+                clutchpack_model::SpringDamper {
+                    stiffness_n_m_per_rad: 800.0,
+                    damping_n_m_s_per_rad: 0.7,
+                    free_angle_rad: 0.01,
+                },
+            ),
+        }];
         pack
     }
 
     /// At states with some couplings in contact and every gap slipping, the right-hand side
-    /// conserves angular momentum exactly (`sum J alpha = 0`: every spline reaction and gap
-    /// torque is paired) and power (`sum J omega alpha = sum n F Rb psi - sum heat rates`:
-    /// the teeth's power is what their potential gives up, the gaps' is the heat they make).
+    /// conserves angular momentum exactly (`sum J alpha = 0`: every spline reaction, gap
+    /// torque and the spring-damper's torque is paired) and power (`sum J omega alpha = sum n
+    /// F Rb psi - sum heat rates - dV/dt - d dw^2`: the teeth's power is what their potential
+    /// gives up, the gaps' is the heat they make, the spring-damper's what its spring stores
+    /// and its damper loses, MODEL.md section 8).
     #[test]
     fn whole_pack_rhs_conserves_momentum_and_power() {
         let pack = free_pack();
@@ -775,6 +798,7 @@ mod tests {
                 y[2 + 2 * slot] = contact[slot] * g0;
                 y[2 + 2 * slot + 1] = 3.0 - 1.7 * slot as f64 + k as f64;
             }
+            y[sys.drum_at()] = 0.03 - 0.05 * k as f64;
             y[sys.drum_at() + 1] = -4.0;
             let modes: Vec<Option<Engagement>> = (0..5)
                 .map(|slot| {
@@ -807,10 +831,20 @@ mod tests {
             }
             let heat: f64 = dy[sys.heat_at()..].iter().sum();
             assert!(heat > 0.0);
+            // the spring-damper: its potential's rate and its damper's loss
+            let c = &sys.pack.couplings[0];
+            let (t_s, t_r) = (y[0], y[r]);
+            let spring = c.torque_on_b_n_m((t_s, w_s), (t_r, w_r));
+            assert!(spring.abs() > 1.0, "{spring}");
+            let loss = c.loss_rate_w(w_s, w_r);
+            // dV/dt = k (dtheta - theta_0) dw = T dw - d dw^2
+            let v_rate = spring * (w_s - w_r) - loss;
+            let heat = heat + loss;
             assert!(momentum.abs() <= 1e-12 * scale, "{momentum} of {scale}");
             assert!(
-                (power - teeth + heat).abs() <= 1e-11 * (teeth.abs() + heat),
-                "{power} {teeth} {heat}"
+                (power - teeth + heat + v_rate).abs()
+                    <= 1e-11 * (teeth.abs() + heat + v_rate.abs()),
+                "{power} {teeth} {heat} {v_rate}"
             );
         }
     }

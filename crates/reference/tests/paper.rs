@@ -147,6 +147,7 @@ fn inertial_shaft_conserves_angular_momentum() {
         plates: Vec::new(),
         drum: None,
         stack: None,
+        couplings: Vec::new(),
     };
     let c = run(pack, 0.02, 1e-10, 10_000.0);
     assert!(c.impacts.len() >= 3, "{}", c.impacts.len());

@@ -198,6 +198,10 @@ table! {
     children {}
 }
 
+/// Largest torsional stiffness of a coupling accepted, N m/rad (a solid steel shaft of 100 mm
+/// diameter and 10 mm length is about 8e7 N m/rad).
+pub(crate) const MAX_COUPLING_STIFFNESS_N_M_PER_RAD: f64 = 1e9;
+
 table! {
     /// `[stack]`: the piston, the clamped stack and its friction faces.
     RawStack at "stack" {
@@ -554,15 +558,15 @@ table! {
 }
 
 table! {
-    /// One `[[couplings]]` entry of a network scene: a coupling between bodies a and b (MODEL.md section 8). Signs: a clutch's slip is w_b - w_a and its torque acts +tau on a, -tau on b (Modelica's flanges); an ideal gear ties w_a = ratio w_b; a gear mesh's force F, signed as x, acts -Rb_a F on a and -Rb_b F on b (internal: +Rb_b F).
+    /// One `[[couplings]]` entry: a coupling between bodies a and b (MODEL.md section 8): in a network scene between two of its [[bodies]]; in a one-pack scene (no [[bodies]]) a spring_damper between its shaft and its drum. Signs: a clutch's slip is w_b - w_a and its torque acts +tau on a, -tau on b (Modelica's flanges); an ideal gear ties w_a = ratio w_b; a gear mesh's force F, signed as x, acts -Rb_a F on a and -Rb_b F on b (internal: +Rb_b F); a spring_damper's torque T = k (theta_a - theta_b - theta_0) + d (w_a - w_b) acts +T on b, -T on a.
     RawCoupling at "" {
         /// the coupling's name, unique (tables, summaries and figures name it)
         name: "", Kind::Text, Dflt::Described("default \"<kind>-<i+1>\" (\"clutch-2\")");
-        /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash; "gear_mesh": a gear pair with backlash and the tooth law of [couplings.contact] and [couplings.oil] along its line of action (gear rattle)
-        kind: "", Kind::Choice(&["clutch", "ideal_gear", "gear_mesh"]), Dflt::Required;
-        /// the name of body a
+        /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash; "gear_mesh": a gear pair with backlash and the tooth law of [couplings.contact] and [couplings.oil] along its line of action (gear rattle); "spring_damper": a torsional spring with a viscous damper in parallel (a clutch damper, a dual-mass flywheel; one-pack scenes, between "shaft" and "drum")
+        kind: "", Kind::Choice(&["clutch", "ideal_gear", "gear_mesh", "spring_damper"]), Dflt::Required;
+        /// the name of body a (a one-pack scene: "shaft" or "drum", the drum with [drum]; a prescribed shaft drives b through a spring_damper)
         a: "", Kind::Text, Dflt::Required;
-        /// the name of body b
+        /// the name of body b, not a
         b: "", Kind::Text, Dflt::Required;
         /// ideal_gear: w_a / w_b (negative: b turns the other way)
         ratio: "", FINITE, Dflt::When("ideal_gear: required, an error otherwise");
@@ -590,6 +594,12 @@ table! {
         pairs: "", Kind::Number(Rule::Closed(1.0, 10.0)), Dflt::Num(1.0);
         /// gear_mesh: relative displacement x = Rb_a theta_a +- Rb_b theta_b at t = 0 (0: centred in the backlash); |x| + the film must be < backlash_m / 2
         mesh_offset_m: "m", FINITE, Dflt::Num(0.0);
+        /// spring_damper: torsional stiffness k
+        stiffness_n_m_per_rad: "N m/rad", Kind::Number(Rule::Closed(0.0, MAX_COUPLING_STIFFNESS_N_M_PER_RAD)), Dflt::When("spring_damper: required");
+        /// spring_damper: viscous damping d
+        damping_n_m_s_per_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
+        /// spring_damper: free angle theta_0, the twist theta_a - theta_b at which the spring carries no torque (both bodies start at angle 0, so a non-zero theta_0 starts the spring twisted)
+        free_angle_rad: "rad", FINITE, Dflt::Num(0.0);
     }
     children {
         force: table RawForceSignal,

@@ -864,3 +864,115 @@ fn ensemble_members_start_inside_the_free_play_the_validation_accepts() {
     let e = set(old).expect_err("the old rule starts a tooth in contact");
     assert!(e.to_string().contains("inside the free play"), "{e}");
 }
+
+/// `[[couplings]]` (MODEL.md section 8): a spring-damper from the shaft to the drum reaches
+/// the model with its defaults; a prescribed shaft may drive the drum through it.
+#[test]
+fn a_spring_damper_joins_the_shaft_and_the_drum() {
+    use clutchpack_model::{PackBody, PackCouplingKind, SpringDamper};
+    let s = load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/pack-4-damper.toml"),
+        &[],
+    )
+    .unwrap();
+    assert_eq!(s.pack.couplings.len(), 1);
+    let c = s.pack.couplings[0];
+    assert_eq!((c.a, c.b), (PackBody::Shaft, PackBody::Drum));
+    assert_eq!(
+        c.kind,
+        PackCouplingKind::SpringDamper(SpringDamper {
+            stiffness_n_m_per_rad: 5000.0,
+            damping_n_m_s_per_rad: 5.0,
+            free_angle_rad: 0.0,
+        })
+    );
+    let text = format!(
+        "{PAPER}\n[drum]\ninertia_kg_m2 = 0.5\n[[plates]]\ninertia_kg_m2 = 0.1\n[plates.spline]\n\
+         teeth = 100\npitch_radius_m = 0.3\npressure_angle_deg = 30.0\nbacklash_m = 0.5e-3\n\
+         [plates.contact]\nmodulus_pa = 210e9\ncurvature_radius_m = 1.75e-3\n\
+         [[couplings]]\nname = \"spring\"\nkind = \"spring_damper\"\na = \"drum\"\nb = \"shaft\"\n\
+         stiffness_n_m_per_rad = 100\n"
+    );
+    let s = parse_ok(&text, &[]);
+    assert!(matches!(s.pack.shaft, Shaft::Prescribed(_)));
+    let c = s.pack.couplings[0];
+    assert_eq!((c.a, c.b), (PackBody::Drum, PackBody::Shaft));
+    assert_eq!(
+        c.kind,
+        PackCouplingKind::SpringDamper(SpringDamper {
+            stiffness_n_m_per_rad: 100.0,
+            damping_n_m_s_per_rad: 0.0,
+            free_angle_rad: 0.0,
+        })
+    );
+}
+
+/// Bad couplings of a one-pack scene: an unknown body, a body coupled to itself, the drum
+/// without a `[drum]`, a negative stiffness, a network's kind (whose keys are then not
+/// checked), a network's key, a name used twice; each at its key path, all at once.
+#[test]
+fn bad_couplings_name_their_key_path() {
+    let coupling = |name: &str, body: &str, extra: &str| {
+        format!(
+            "\n[[couplings]]\nname = \"{name}\"\nkind = \"spring_damper\"\na = \"shaft\"\n\
+             b = \"{body}\"\n{extra}"
+        )
+    };
+    let text = format!(
+        "{PAPER}{}{}{}{}{}",
+        coupling("c0", "gearbox", "stiffness_n_m_per_rad = 1e3"),
+        coupling("c1", "shaft", "stiffness_n_m_per_rad = 1e3"),
+        coupling("c2", "drum", "stiffness_n_m_per_rad = -1"),
+        coupling("c3", "drum", "kind = \"clutch\"").replace("kind = \"spring_damper\"\n", ""),
+        coupling("c0", "gearbox", "stiffness_n_m_per_rad = 1\nratio = 2"),
+    );
+    let e = parse_err(&text, &[]);
+    let p = problem_at(&e, "couplings[0].b");
+    assert!(
+        p.rule.contains("unknown body") && p.rule.contains("\"drum\""),
+        "{e}"
+    );
+    assert!(
+        problem_at(&e, "couplings[1].b")
+            .rule
+            .contains("another body"),
+        "{e}"
+    );
+    assert!(
+        problem_at(&e, "couplings[2].b").rule.contains("no [drum]"),
+        "{e}"
+    );
+    assert!(
+        problem_at(&e, "couplings[2].stiffness_n_m_per_rad")
+            .rule
+            .contains("in [0"),
+        "{e}"
+    );
+    assert!(
+        problem_at(&e, "couplings[3].kind")
+            .rule
+            .contains("only \"spring_damper\""),
+        "{e}"
+    );
+    assert!(
+        problem_at(&e, "couplings[4].name").rule.contains("unique"),
+        "{e}"
+    );
+    assert!(
+        problem_at(&e, "couplings[4].ratio")
+            .rule
+            .contains("remove it"),
+        "{e}"
+    );
+    // an unknown key inside an entry lists the entry's keys
+    let e = parse_err(
+        &format!("{PAPER}{}", coupling("c", "shaft", "stiffnes = 1")),
+        &[],
+    );
+    assert!(
+        problem_at(&e, "couplings[0].stiffnes")
+            .rule
+            .contains("stiffness_n_m_per_rad"),
+        "{e}"
+    );
+}

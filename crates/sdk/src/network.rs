@@ -42,9 +42,10 @@ pub struct ModeChange {
 pub struct CouplingSummary {
     /// Its name.
     pub name: String,
-    /// `clutch`, `ideal_gear` or `gear_mesh`.
+    /// `clutch`, `ideal_gear`, `gear_mesh` or `spring_damper`.
     pub kind: &'static str,
-    /// Heat of a clutch, or work done on a gear mesh, over the run, J (0 for an ideal gear).
+    /// Heat of a clutch, work done on a gear mesh, or a damper's loss, over the run, J (0 for
+    /// an ideal gear).
     pub heat_j: f64,
     /// Torque on its body a at the end, N m.
     pub final_torque_n_m: f64,
@@ -85,9 +86,14 @@ pub struct EnergySummary {
     pub clutch_heat_j: f64,
     /// Work done on the gear meshes (their impact losses), J.
     pub mesh_work_j: f64,
+    /// Loss to the spring-dampers' dampers, J.
+    pub damper_loss_j: f64,
+    /// The springs' stored energy at the end less at the start, J.
+    pub spring_energy_change_j: f64,
     /// Kinetic energy at the end less at the start, J.
     pub kinetic_change_j: f64,
-    /// `drive + load - drag - heat - mesh work - kinetic change`, J (zero to the integrator's tolerance).
+    /// `drive + load - drag - heat - mesh work - damper loss - spring energy change - kinetic
+    /// change`, J (zero to the integrator's tolerance).
     pub residual_j: f64,
 }
 
@@ -225,6 +231,7 @@ pub fn run_network_scene(scene: &Scene, mut req: NetworkRequest) -> Result<Netwo
                     CouplingKind::Clutch(_) => "clutch",
                     CouplingKind::IdealGear { .. } => "ideal_gear",
                     CouplingKind::GearMesh(_) => "gear_mesh",
+                    CouplingKind::SpringDamper(_) => "spring_damper",
                 },
                 heat_j: run.heat_j[k],
                 final_torque_n_m: last.torque_n_m[k],
@@ -267,6 +274,8 @@ pub fn run_network_scene(scene: &Scene, mut req: NetworkRequest) -> Result<Netwo
             drag_loss_j: e.drag_loss_j,
             clutch_heat_j: e.clutch_heat_j,
             mesh_work_j: e.mesh_work_j,
+            damper_loss_j: e.damper_loss_j,
+            spring_energy_change_j: e.spring_energy_change_j,
             kinetic_change_j: e.kinetic_change_j,
             residual_j: e.residual_j(),
         },

@@ -115,6 +115,7 @@ fn free_impact_matches_the_closed_form() {
                 plates: Vec::new(),
                 drum: None,
                 stack: None,
+                couplings: Vec::new(),
             };
             let (c, _) = run(&pack, 1e5, opts.clone(), 400e-6);
             assert_eq!(c.impacts.len(), 1, "{label} v0={v0}: {:?}", c.impacts);
@@ -331,6 +332,7 @@ fn inertial_shaft_conserves_angular_momentum() {
         plates: Vec::new(),
         drum: None,
         stack: None,
+        couplings: Vec::new(),
     };
     for opts in [fixed(1e-6), adaptive()] {
         let (c, _) = run(&pack, 1e4, opts, 20e-3);

@@ -31,6 +31,7 @@ fn steady_pack(disc: DiscModel) -> PackModel {
         plates: Vec::new(),
         drum: None,
         stack: None,
+        couplings: Vec::new(),
     }
 }
 
@@ -334,6 +335,7 @@ fn floating_disc_chatters_radially_in_the_rattle() {
         plates: Vec::new(),
         drum: None,
         stack: None,
+        couplings: Vec::new(),
     };
     let run = |stepping: Stepping, duration: f64| {
         let opts = MultibodyOptions {

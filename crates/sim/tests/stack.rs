@@ -63,6 +63,7 @@ fn pack(n: usize, omega: f64, drum: Option<DrumModel>, stack: StackModel) -> Pac
             .collect(),
         drum,
         stack: Some(stack),
+        couplings: Vec::new(),
     }
 }
 

@@ -85,6 +85,9 @@ pub enum CouplingKind {
     },
     /// A gear mesh with backlash and a tooth law (gear rattle; MODEL.md section 8).
     GearMesh(GearMesh),
+    /// A torsional spring-damper (a damper spring, a dual-mass flywheel; MODEL.md section 8):
+    /// `T = k (theta_a - theta_b - theta_0) + d (w_a - w_b)` on `b`, `-T` on `a`.
+    SpringDamper(crate::spring::SpringDamper),
 }
 
 /// A coupling between two bodies of a network.
@@ -178,6 +181,17 @@ impl Network {
                     "a fixed body does not turn: its speed is 0".into(),
                 ));
             }
+            if b.fixed && (b.drive.is_some() || b.road_load.is_some()) {
+                out.push(body(
+                    i,
+                    if b.drive.is_some() {
+                        "drive"
+                    } else {
+                        "road_load"
+                    },
+                    "a fixed body does not turn: a torque on it does nothing; remove it".into(),
+                ));
+            }
             if b.fixed && self.bodies[..i].iter().any(|o| o.fixed) {
                 out.push(body(
                     i,
@@ -243,6 +257,21 @@ impl Network {
                 CouplingKind::GearMesh(g) => {
                     for (field, message) in g.problems() {
                         out.push(coupling(k, field, message));
+                    }
+                }
+                CouplingKind::SpringDamper(sd) => {
+                    let (kk, d) = (sd.stiffness_n_m_per_rad, sd.damping_n_m_s_per_rad);
+                    let good = kk.is_finite()
+                        && kk >= 0.0
+                        && d.is_finite()
+                        && d >= 0.0
+                        && sd.free_angle_rad.is_finite();
+                    if !good {
+                        out.push(coupling(
+                            k,
+                            "stiffness_n_m_per_rad",
+                            "stiffness and damping must be finite and >= 0".into(),
+                        ));
                     }
                 }
                 CouplingKind::IdealGear { ratio } => {

@@ -167,6 +167,8 @@ def run(
     if duration is not None:
         s["simulation.duration_s"] = _time("duration", duration)
     sc = load_scene(scene, s)
+    if sc.is_network:
+        return _run_network(sc, engine, record, impacts_csv)
     raw = _clutchpack.run(
         sc,
         engine=engine,
@@ -187,6 +189,34 @@ def run(
         scene_text=sc.text,
         overrides=list(sc.overrides),
         warnings=list(raw.warnings),
+    )
+
+
+def _run_network(sc: Scene, engine: Optional[str], record: Any, impacts_csv: Any) -> Result:
+    """A network scene's run (``[[bodies]]``): the summary (``couplings`` with each clutch's
+    mode changes, lock times and heat; ``bodies``; ``energy``) and ``samples`` with ``t_s``,
+    ``<body>.speed_rad_s`` and ``<coupling>.torque_n_m`` columns. Recordings, impact CSVs and
+    the multibody engine are for pack scenes, for now."""
+    for what, given in (("record", record), ("impacts_csv", impacts_csv)):
+        if given is not None:
+            raise ValueError(f"{what}: not for a network scene ({sc.name} has [[bodies]])")
+    if engine not in (None, "reference"):
+        raise ValueError(f"engine = {engine!r}: a network runs on the reference engine, for now")
+    raw = _clutchpack.run_network(sc)
+    samples = pd.DataFrame({"t_s": np.asarray(raw.sample_t_s, dtype=float)})
+    for name, values in raw.speed_rad_s:
+        samples[f"{name}.speed_rad_s"] = np.asarray(values, dtype=float)
+    for name, values in raw.torque_n_m:
+        samples[f"{name}.torque_n_m"] = np.asarray(values, dtype=float)
+    return Result(
+        summary=json.loads(raw.summary_json),
+        impacts=pd.DataFrame(columns=IMPACT_COLUMNS),
+        samples=samples,
+        recording=None,
+        engine_line="engine: reference (a driveline network)",
+        scene_text=sc.text,
+        overrides=list(sc.overrides),
+        warnings=[],
     )
 
 

@@ -22,6 +22,9 @@ class Scene:
     def bodies(self) -> List[str]:
         """Friction discs, then separator plates."""
     @property
+    def is_network(self) -> bool:
+        """Whether the scene is a driveline network ([[bodies]])."""
+    @property
     def path(self) -> Optional[str]: ...
     def engine_line(self, engine: Optional[str] = None) -> str: ...
     def with_sets(self, sets: Sequence[Tuple[str, str]]) -> "Scene": ...
@@ -47,6 +50,12 @@ class RawRun:
     stopped_early: bool
     warnings: List[str]
 
+class RawNetworkRun:
+    summary_json: str
+    sample_t_s: List[float]
+    speed_rad_s: List[Tuple[str, List[float]]]
+    torque_n_m: List[Tuple[str, List[float]]]
+
 class RawRecording:
     summary_json: str
     scene_text: Optional[str]
@@ -70,6 +79,7 @@ def run(
     keep_samples: bool = True,
     deterministic: bool = False,
 ) -> RawRun: ...
+def run_network(scene: Scene) -> RawNetworkRun: ...
 def sweep(
     scene: Scene,
     param: str,

@@ -5,7 +5,8 @@
 //!
 //! # Method
 //! The state is every body's angle and speed, each gear mesh's relative displacement along
-//! its line of action (integrated itself, with an absolute tolerance on the backlash's scale,
+//! its line of action and each spring-damper's twist (integrated themselves, with an absolute
+//! tolerance on the backlash's scale and on the tolerance in rad,
 //! as the pack engine integrates its relative angles: the bodies' angles grow without bound,
 //! and their error with them), plus the energy counters (each clutch's heat,
 //! the drives' and loads' work, the drag's loss) integrated beside them (outside the error
@@ -70,7 +71,8 @@ pub struct NetworkSample {
     /// Each body's speed, rad/s.
     pub speed_rad_s: Vec<f64>,
     /// Each coupling's torque on its body `a`, N m (a clutch's `tau`; an ideal gear's
-    /// `lambda`, `-ratio lambda` on `b`; a gear mesh's `-Rb_a F pairs`).
+    /// `lambda`, `-ratio lambda` on `b`; a gear mesh's `-Rb_a F pairs`; a spring-damper's
+    /// `-T`).
     pub torque_n_m: Vec<f64>,
     /// Each clutch's mode (`None` for another kind of coupling).
     pub mode: Vec<Option<ClutchMode>>,
@@ -103,18 +105,24 @@ pub struct NetworkEnergy {
     /// Work done on the gear meshes, J: their teeth's impact losses, plus the elastic energy
     /// of a contact still closed at the end.
     pub mesh_work_j: f64,
+    /// Loss to the spring-dampers' dampers (>= 0), J.
+    pub damper_loss_j: f64,
+    /// The spring-dampers' stored energy at the end less at the start, J.
+    pub spring_energy_change_j: f64,
     /// Kinetic energy at the end less at the start, J.
     pub kinetic_change_j: f64,
 }
 
 impl NetworkEnergy {
-    /// `drive + load - drag - heat - mesh work - kinetic change`, J: zero to the integrator's
-    /// tolerance.
+    /// `drive + load - drag - heat - mesh work - damper loss - spring energy change - kinetic
+    /// change`, J: zero to the integrator's tolerance.
     pub fn residual_j(&self) -> f64 {
         self.drive_work_j + self.load_work_j
             - self.drag_loss_j
             - self.clutch_heat_j
             - self.mesh_work_j
+            - self.damper_loss_j
+            - self.spring_energy_change_j
             - self.kinetic_change_j
     }
 }
@@ -124,7 +132,8 @@ impl NetworkEnergy {
 pub struct NetworkRun {
     /// The state at the end.
     pub last: NetworkSample,
-    /// Each clutch's heat and each gear mesh's work, J (0 for an ideal gear).
+    /// Each clutch's heat, each gear mesh's work and each damper's loss, J (0 for an ideal
+    /// gear).
     pub heat_j: Vec<f64>,
     /// The energy balance.
     pub energy: NetworkEnergy,
@@ -175,6 +184,13 @@ struct Equations<'n> {
 fn clutch(net: &Network, k: usize) -> Option<&LumpedClutch> {
     match &net.couplings[k].kind {
         CouplingKind::Clutch(c) => Some(c),
+        _ => None,
+    }
+}
+
+fn spring(net: &Network, k: usize) -> Option<&clutchpack_model::SpringDamper> {
+    match &net.couplings[k].kind {
+        CouplingKind::SpringDamper(s) => Some(s),
         _ => None,
     }
 }
@@ -246,6 +262,13 @@ impl<'n> Equations<'n> {
                 self.torque[c.a] += tau;
                 self.torque[c.b] -= tau;
             }
+            if let Some(sd) = spring(self.net, k) {
+                // MODEL.md section 8: T on b, -T on a; the twist is its own state
+                let t = sd.torque_n_m(y[2 * n + k], w[c.a] - w[c.b]);
+                self.coupling_torque[k] = -t;
+                self.torque[c.a] -= t;
+                self.torque[c.b] += t;
+            }
             if let (Some(g), Some(e)) = (mesh(self.net, k), self.contacts[k]) {
                 // MODEL.md section 8: F signed as x; -Rb_a F on a, -+Rb_b F on b
                 let f = g.force_n(&mesh_kinematics(self.net, k, g, y), &e);
@@ -283,9 +306,10 @@ impl<'n> Equations<'n> {
         self.forces(t, y);
         w_dot.copy_from_slice(&self.acc);
         for (k, c) in self.net.couplings.iter().enumerate() {
-            x_dot[k] = match mesh(self.net, k) {
-                Some(g) => g.displacement((0.0, 0.0), (w[c.a], w[c.b])).1,
-                None => 0.0,
+            x_dot[k] = match (mesh(self.net, k), spring(self.net, k)) {
+                (Some(g), _) => g.displacement((0.0, 0.0), (w[c.a], w[c.b])).1,
+                (_, Some(_)) => w[c.a] - w[c.b],
+                _ => 0.0,
             };
         }
         // counters: [heat per coupling, drive work, load work, drag loss]
@@ -293,6 +317,8 @@ impl<'n> Equations<'n> {
             let c = &self.net.couplings[k];
             counters[k] = if matches!(self.modes[k], Some(ClutchMode::Slipping(_))) {
                 self.coupling_torque[k] * (w[c.b] - w[c.a])
+            } else if let Some(sd) = spring(self.net, k) {
+                sd.loss_rate_w(w[c.a] - w[c.b])
             } else if let (Some(g), Some(_)) = (mesh(self.net, k), self.contacts[k]) {
                 // power into the mesh: F v pairs (the torques' work on the bodies, negated)
                 let (_, v) = g.displacement((0.0, 0.0), (w[c.a], w[c.b]));
@@ -368,7 +394,7 @@ fn rigid(net: &Network, modes: &[Option<ClutchMode>]) -> Vec<bool> {
         .map(|(k, c)| match c.kind {
             CouplingKind::IdealGear { .. } => true,
             CouplingKind::Clutch(_) => modes[k] == Some(ClutchMode::Locked),
-            CouplingKind::GearMesh(_) => false,
+            CouplingKind::GearMesh(_) | CouplingKind::SpringDamper(_) => false,
         })
         .collect()
 }
@@ -396,7 +422,11 @@ pub fn run_network(
     let mut atol = vec![tol; dim];
     // the meshes' x on their backlash's scale; other slots and the counters out of the norm
     for k in 0..m {
-        atol[2 * n + k] = mesh(net, k).map_or(f64::INFINITY, |g| tol * g.backlash_m);
+        atol[2 * n + k] = match (mesh(net, k), spring(net, k)) {
+            (Some(g), _) => tol * g.backlash_m,
+            (_, Some(_)) => tol,
+            _ => f64::INFINITY,
+        };
     }
     atol[2 * n + m..]
         .iter_mut()
@@ -559,10 +589,13 @@ pub fn run_network(
     obs.sample(&last);
     let c0 = 2 * n + m; // the counters
     let mut heat = y[c0..c0 + m].to_vec();
-    let mut mesh_work = 0.0;
+    let (mut mesh_work, mut damper_loss, mut spring_change) = (0.0, 0.0, 0.0);
     for (k, h) in heat.iter_mut().enumerate() {
         if mesh(net, k).is_some() {
             mesh_work += *h;
+        } else if let Some(sd) = spring(net, k) {
+            damper_loss += *h;
+            spring_change += sd.potential_j(y[2 * n + k]) - sd.potential_j(0.0);
         } else if clutch(net, k).is_none() {
             *h = 0.0;
         }
@@ -571,8 +604,10 @@ pub fn run_network(
         drive_work_j: y[c0 + m],
         load_work_j: y[c0 + m + 1],
         drag_loss_j: y[c0 + m + 2],
-        clutch_heat_j: heat.iter().sum::<f64>() - mesh_work,
+        clutch_heat_j: heat.iter().sum::<f64>() - mesh_work - damper_loss,
         mesh_work_j: mesh_work,
+        damper_loss_j: damper_loss,
+        spring_energy_change_j: spring_change,
         kinetic_change_j: kinetic(&y) - kinetic0,
     };
     Ok(NetworkRun {

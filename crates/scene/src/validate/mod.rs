@@ -9,9 +9,10 @@
 //! invalid is not used by the rules between keys (its problem is already reported).
 //!
 //! One module per section of the file: [`simulation`], [`drive`] (with the shaft),
-//! [`bodies`] (discs and plates), [`stack`] (with the drum) and [`thermal`].
+//! [`bodies`] (discs and plates), [`stack`] (with the drum), [`thermal`] and [`couplings`].
 
 mod bodies;
+mod couplings;
 mod drive;
 mod network;
 mod simulation;
@@ -274,13 +275,6 @@ pub(crate) fn validate(
     if let Some(bodies) = raw.bodies.as_deref() {
         return network_scene(ck, raw, bodies, base_dir, name, description, simulation);
     }
-    if raw.couplings.is_some() {
-        ck.report(
-            "couplings",
-            None,
-            "couplings join the bodies of a network: declare them in [[bodies]]",
-        );
-    }
     let (kind, drive) = drive::drive(ck, raw.drive.as_ref(), base_dir);
     let shaft = drive::shaft(ck, raw.shaft.as_ref(), kind, drive);
     let mut names = Vec::new();
@@ -302,6 +296,7 @@ pub(crate) fn validate(
     );
     let drum = raw.drum.as_ref().map(|r| stack::drum(ck, r));
     let stack = raw.stack.as_ref().map(|r| stack::stack(ck, r));
+    let couplings = couplings::couplings(ck, raw.couplings.as_deref(), raw.drum.is_some());
     // The stack alternates plates and discs: N discs need N + 1 plates; a drum carries plates.
     let n_discs = raw.discs.as_ref().map_or(0, Vec::len);
     let n_plates = raw.plates.as_ref().map_or(0, Vec::len);
@@ -345,6 +340,7 @@ pub(crate) fn validate(
             plates,
             drum: drum.map_or(Some(None), |d| d.map(Some))?,
             stack: stack.map_or(Some(None), |s| s.map(Some))?,
+            couplings: couplings?,
         },
         thermal: thermal?,
         network: None,
@@ -410,6 +406,7 @@ fn network_scene(
             plates: Vec::new(),
             drum: None,
             stack: None,
+            couplings: Vec::new(),
         },
         fatigue: Vec::new(),
         thermal: None,

@@ -210,6 +210,9 @@ pub(super) fn network(
 ) -> Option<Network> {
     let mut ok = true;
     let mut net = Network::default();
+    // every body's name as written (a coupling is checked against them even when another key
+    // of a body is bad, so that one run lists every problem)
+    let mut names: Vec<Option<String>> = Vec::new();
     for (i, r) in bodies.iter().enumerate() {
         let p = |k: &Key| item("bodies", k, i);
         let name = ck.text(&p(&B::name), r.value(&B::name)).required(
@@ -262,6 +265,7 @@ pub(super) fn network(
             }
             None => Some(None),
         };
+        names.push(name.clone());
         match (name, inertia, fixed, drag, speed, drive, road_load) {
             (Some(name), Some(j), Some(fixed), Some(c), Some(w), Some(drive), Some(road_load)) => {
                 net.bodies.push(Body {
@@ -277,14 +281,12 @@ pub(super) fn network(
             _ => ok = false,
         }
     }
-    if !ok {
-        return None;
-    }
     #[derive(Clone, Copy)]
     enum Kind {
         Clutch,
         Gear,
         Mesh,
+        Spring,
     }
     for (k, r) in couplings.iter().enumerate() {
         let p = |key: &Key| item("couplings", key, k);
@@ -301,7 +303,7 @@ pub(super) fn network(
                 &p(&C::kind),
                 r.value(&C::kind),
                 &C::kind,
-                &[Kind::Clutch, Kind::Gear, Kind::Mesh],
+                &[Kind::Clutch, Kind::Gear, Kind::Mesh, Kind::Spring],
             )
             .required(ck, &p(&C::kind), "required");
         let body = |ck: &mut Checker, key: &Key| {
@@ -310,13 +312,10 @@ pub(super) fn network(
                 &p(key),
                 "required: the name of a body in [[bodies]]",
             )?;
-            let found = net.body_index(&n);
+            let found = names.iter().position(|m| m.as_deref() == Some(n.as_str()));
             if found.is_none() {
-                let names: Vec<String> = net
-                    .bodies
-                    .iter()
-                    .map(|b| format!("\"{}\"", b.name))
-                    .collect();
+                let names: Vec<String> =
+                    names.iter().flatten().map(|b| format!("\"{b}\"")).collect();
                 ck.report(
                     p(key),
                     Some(format!("\"{n}\"")),
@@ -331,6 +330,11 @@ pub(super) fn network(
             ok = false;
             continue;
         };
+        let spring_keys: [&Key; 3] = [
+            &C::stiffness_n_m_per_rad,
+            &C::damping_n_m_s_per_rad,
+            &C::free_angle_rad,
+        ];
         let clutch_keys: [&Key; 6] = [
             &C::mu,
             &C::mu_speeds_rad_s,
@@ -371,7 +375,15 @@ pub(super) fn network(
             ("contact", r.contact.is_some()),
             ("oil", r.oil.is_some()),
         );
+        if !matches!(kind, Kind::Spring) {
+            refuse(ck, &spring_keys, &[], "a spring_damper");
+        }
         match kind {
+            Kind::Spring => {
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(ck, &clutch_keys, &[force], "a clutch");
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
+            }
             Kind::Gear => {
                 refuse(ck, &clutch_keys, &[force], "a clutch");
                 refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
@@ -392,6 +404,24 @@ pub(super) fn network(
                 .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
                 .map(|ratio| CouplingKind::IdealGear { ratio }),
             Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
+            Kind::Spring => {
+                let num = |ck: &mut Checker, key: &Key| ck.num(&p(key), r.value(key), key);
+                let k_ = num(ck, &C::stiffness_n_m_per_rad).required(
+                    ck,
+                    &p(&C::stiffness_n_m_per_rad),
+                    "the spring's stiffness, N m/rad",
+                );
+                let d =
+                    num(ck, &C::damping_n_m_s_per_rad).or(C::damping_n_m_s_per_rad.default_num());
+                let theta0 = num(ck, &C::free_angle_rad).or(C::free_angle_rad.default_num());
+                (|| {
+                    Some(CouplingKind::SpringDamper(clutchpack_model::SpringDamper {
+                        stiffness_n_m_per_rad: k_?,
+                        damping_n_m_s_per_rad: d?,
+                        free_angle_rad: theta0?,
+                    }))
+                })()
+            }
         };
         match (name, a, b, built) {
             (Some(name), Some(a), Some(b), Some(kind)) => {

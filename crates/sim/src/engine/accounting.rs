@@ -78,7 +78,7 @@ impl Run {
             ),
             None => (0.0, 0.0),
         };
-        let now = Powers {
+        let mut now = Powers {
             t: self.t,
             theta_s: self.theta_s,
             spline_torque: self
@@ -91,7 +91,17 @@ impl Run {
             drive,
             drag: drag + shaft_damping + drum_drag,
             load,
+            coupling_loss: 0.0,
+            coupling_potential_j: 0.0,
         };
+        if !self.pack.couplings.is_empty() {
+            // MODEL.md section 8: a prescribed shaft also works on the couplings (it exerts
+            // the opposite of their torque on it); they store and lose energy
+            let c = self.coupling_loads();
+            now.spline_torque -= c.shaft_n_m;
+            now.coupling_loss = -c.loss_rate_w;
+            now.coupling_potential_j = c.potential_j;
+        }
         let prescribed = matches!(self.shaft, ShaftDrive::Prescribed(_));
         self.energy.add_powers(now, prescribed);
     }

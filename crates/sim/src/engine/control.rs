@@ -66,6 +66,19 @@ impl Run {
             None => 0.0,
         };
         let mut want = a.max_step_s;
+        let (mut a_shaft, mut a_drum) = (a_shaft, a_drum);
+        if !self.pack.couplings.is_empty() {
+            // the couplings' torques jolt the shaft and the drum too; and their free
+            // oscillation is resolved like a contact (MODEL.md section 8)
+            let c = self.coupling_loads();
+            if let ShaftDrive::Inertial { j1, .. } = self.shaft {
+                a_shaft += c.shaft_n_m.abs() / j1;
+            }
+            if let Some(d) = &self.drum {
+                a_drum += c.drum_n_m.abs() / d.model.inertia_kg_m2;
+            }
+            want = want.min(self.coupling_period_s() / a.steps_per_contact);
+        }
         let mut contact = false;
         for (i, d) in self.bodies.iter().enumerate() {
             let stack = self.stack.as_ref().map_or(0.0, |s| {
@@ -95,6 +108,34 @@ impl Run {
             }
         }
         (want, contact)
+    }
+
+    /// The shortest undamped period of the pack's couplings between the shaft and the drum,
+    /// s: `2 pi / omega_n`, `omega_n = sqrt(k (1/J_a + 1/J_b))` with a prescribed shaft as an
+    /// infinite inertia (MODEL.md section 8); infinite without couplings.
+    pub(super) fn coupling_period_s(&self) -> f64 {
+        let j_shaft = match self.shaft {
+            ShaftDrive::Inertial { j1, .. } => j1,
+            ShaftDrive::Prescribed(_) => f64::INFINITY,
+        };
+        let j_drum = self
+            .drum
+            .as_ref()
+            .map_or(f64::INFINITY, |d| d.model.inertia_kg_m2);
+        let inertia = |b| match b {
+            clutchpack_model::PackBody::Shaft => j_shaft,
+            clutchpack_model::PackBody::Drum => j_drum,
+        };
+        self.pack
+            .couplings
+            .iter()
+            .map(|c| match &c.kind {
+                clutchpack_model::PackCouplingKind::SpringDamper(s) => {
+                    2.0 * std::f64::consts::PI
+                        / s.natural_frequency_rad_s(inertia(c.a), inertia(c.b))
+                }
+            })
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Solves the stack's impulses for a step of length `h` from `t` (no-op without a stack):

@@ -2,9 +2,9 @@
 //! and contact energies, for conservation checks.
 
 /// Energy bookkeeping of a run (J), for conservation checks: with no drag and `p = 0`,
-/// `drive_work_j + drag_work_j + stack_work_j + load_work_j = (kinetic_j +
-/// contact_potential_j) - (initial_kinetic_j + initial_contact_potential_j)` up to the
-/// integrator's error.
+/// `drive_work_j + drag_work_j + stack_work_j + load_work_j + coupling_work_j = (kinetic_j +
+/// contact_potential_j + coupling_potential_j) - (initial_kinetic_j +
+/// initial_contact_potential_j + initial_coupling_potential_j)` up to the integrator's error.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct EnergyAudit {
     /// Work done by the drive since t = 0: for a prescribed shaft the work of the shaft on the
@@ -29,20 +29,33 @@ pub struct EnergyAudit {
     pub initial_contact_potential_j: f64,
     /// Energy stored in the teeth at the end of the run.
     pub contact_potential_j: f64,
+    /// Work of the dampers of the pack's couplings between the shaft and the drum (MODEL.md
+    /// section 8), `-sum d (omega_a - omega_b)^2` integrated by the trapezoidal rule per
+    /// step (<= 0; 0 without couplings).
+    pub coupling_work_j: f64,
+    /// Energy stored in the couplings' springs at t = 0, `sum k (dtheta - theta_0)^2 / 2`.
+    pub initial_coupling_potential_j: f64,
+    /// Energy stored in the couplings' springs at the end of the run.
+    pub coupling_potential_j: f64,
 }
 
 impl EnergyAudit {
     /// The change of the kinetic and elastic energy since t = 0, J.
     pub fn energy_change_j(&self) -> f64 {
-        self.kinetic_j + self.contact_potential_j
+        self.kinetic_j + self.contact_potential_j + self.coupling_potential_j
             - self.initial_kinetic_j
             - self.initial_contact_potential_j
+            - self.initial_coupling_potential_j
     }
 
     /// The work of everything outside the bodies and the teeth since t = 0 (drive, drag,
     /// stack, load), J: equal to [`Self::energy_change_j`] up to the integration error.
     pub fn work_j(&self) -> f64 {
-        self.drive_work_j + self.drag_work_j + self.stack_work_j + self.load_work_j
+        self.drive_work_j
+            + self.drag_work_j
+            + self.stack_work_j
+            + self.load_work_j
+            + self.coupling_work_j
     }
 }
 
@@ -59,6 +72,10 @@ pub(super) struct Powers {
     pub(super) drag: f64,
     /// Power of the drum's load torque, W.
     pub(super) load: f64,
+    /// Power of the couplings' dampers, W (<= 0).
+    pub(super) coupling_loss: f64,
+    /// Energy stored in the couplings' springs, J.
+    pub(super) coupling_potential_j: f64,
 }
 
 /// The energy audit of a run as it goes, the one place that writes it: the work of the
@@ -85,7 +102,11 @@ impl EnergyBook {
             };
             self.audit.drag_work_j += 0.5 * (b.drag + now.drag) * h;
             self.audit.load_work_j += 0.5 * (b.load + now.load) * h;
+            self.audit.coupling_work_j += 0.5 * (b.coupling_loss + now.coupling_loss) * h;
+        } else {
+            self.audit.initial_coupling_potential_j = now.coupling_potential_j;
         }
+        self.audit.coupling_potential_j = now.coupling_potential_j;
         self.before = Some(now);
     }
 

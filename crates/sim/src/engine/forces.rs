@@ -280,6 +280,9 @@ impl Run {
             self.loads[i].kick = self.loads[i].history.kick(self.t, &self.loads[i].load);
         }
         let drive_now = self.drive_torque(self.t);
+        // MODEL.md section 8: the couplings between the shaft and the drum (a spring-damper),
+        // smooth in time: through the polynomial kick, as the drag
+        let joined = (!self.pack.couplings.is_empty()).then(|| self.coupling_loads());
         let shaft_accel = match &self.shaft {
             ShaftDrive::Prescribed(p) => p.acceleration(self.t),
             &ShaftDrive::Inertial { j1, c1 } => {
@@ -289,6 +292,10 @@ impl Run {
                 let damping = -c1 * self.omega_s;
                 shaft_torque.z += damping;
                 shaft_torque_full.z += damping + drive_now;
+                if let Some(c) = joined {
+                    shaft_torque.z += c.shaft_n_m;
+                    shaft_torque_full.z += c.shaft_n_m;
+                }
                 let l = |t: Vector| [shaft_force.x, shaft_force.y, shaft_force.z, t.x, t.y, t.z];
                 self.shaft_loads.load = l(shaft_torque);
                 self.shaft_loads.full = l(shaft_torque_full);
@@ -310,6 +317,10 @@ impl Run {
                     own
                 };
                 drum_torque_full.z += own;
+                if let Some(c) = joined {
+                    drum_torque.z += c.drum_n_m;
+                    drum_torque_full.z += c.drum_n_m;
+                }
                 let l = |t: Vector| [drum_force.x, drum_force.y, drum_force.z, t.x, t.y, t.z];
                 dr.loads.load = l(drum_torque);
                 dr.loads.full = l(drum_torque_full);
@@ -343,6 +354,17 @@ impl Run {
                 jerk_step,
             };
         }
+    }
+
+    /// What the pack's couplings between the shaft and the drum (MODEL.md section 8) do at
+    /// `t`: their torques on both, the energy they store and the power they lose (the
+    /// shaft's and the drum's angles and speeds at `t`).
+    pub(super) fn coupling_loads(&self) -> clutchpack_model::CouplingLoads {
+        let drum = self
+            .drum
+            .as_ref()
+            .map_or((0.0, 0.0), |d| (d.theta, d.omega));
+        self.pack.coupling_loads((self.theta_s, self.omega_s), drum)
     }
 
     /// The impulse of the teeth of coupling `i` on its body about the axis over a step of

@@ -40,6 +40,12 @@ pub(super) fn unsupported(
     if !matches!(options.stepping, Stepping::Adaptive(_)) {
         return Some("fixed steps (the check mode) step the whole world at dt");
     }
+    if !pack.couplings.is_empty() {
+        return Some(
+            "a spring-damper joins the shaft and the drum (MODEL.md section 8), which the \
+             multirate scheme integrates apart within a world step",
+        );
+    }
     let bodies = pack.discs.iter().chain(&pack.plates);
     if per_tooth
         .iter()

@@ -12,11 +12,12 @@
 //! the locks) goes to its two bodies by effusivity, the rest (open) to the oil;
 //! the teeth's work on the relative motion `-n F Rb psi` (the reference engine's) to the oil,
 //! taken from the energy audit as what the step's external work (drive, drag, the stack's
-//! faces, the load) put in beyond the change of the kinetic energy: the teeth are the only
-//! other torques on the bodies, so that difference is their work, exact up to the
-//! integration error of the audit (measured on lossless teeth, `p = 0`: 1e-9 to 1e-6 of the
-//! drive's work, `tests/stack.rs`). A step whose window closes with new parameters swaps them
-//! into the couplings' tooth laws (a paper-law contact keeps the stiffness it took at its
+//! faces, the load, a coupling's damper) put in beyond the change of the kinetic energy and
+//! of a coupling's spring: the teeth are the only other torques on the bodies, so that
+//! difference is their work, exact up to the integration error of the audit (with lossless
+//! teeth, `p = 0`, on the duty cycle: 2.8e-6 J off the elastic energy left in them,
+//! `tests/thermal.rs`). A step whose window closes with new parameters swaps them
+//! into the spline couplings' tooth laws (a paper-law contact keeps the stiffness it took at its
 //! onset, eqs 8-9; the new film reaches it at its next contact) and the stack's open gaps.
 
 use super::state::Run;
@@ -31,11 +32,13 @@ pub(super) struct Thermal {
     /// Each interface's dissipated work and its clamped part at the last booking, J.
     counters: Vec<f64>,
     friction: Vec<f64>,
-    /// The audit's external work without the stack's (drive, drag, load) and the stack's,
-    /// and the kinetic energy, at the last booking, J.
+    /// The audit's external work without the stack's (drive, drag, load, the couplings'
+    /// dampers) and the stack's, the kinetic energy and the couplings' springs' energy, at
+    /// the last booking, J.
     external_j: f64,
     stack_j: f64,
     kinetic_j: f64,
+    spring_j: f64,
 }
 
 impl Thermal {
@@ -59,6 +62,7 @@ impl Thermal {
                 external_j: 0.0,
                 stack_j: 0.0,
                 kinetic_j: 0.0,
+                spring_j: 0.0,
             },
             pack,
         ))
@@ -74,8 +78,9 @@ impl Thermal {
     /// The counters at the run's current state.
     fn mark(&mut self, run: &Run) {
         let a = run.energy.so_far();
-        self.external_j = a.drive_work_j + a.drag_work_j + a.load_work_j;
+        self.external_j = external_work_j(a);
         self.stack_j = a.stack_work_j;
+        self.spring_j = a.coupling_potential_j;
         self.kinetic_j = run.kinetic_energy();
         if let Some(s) = &run.stack {
             let n_if = self.counters.len();
@@ -107,12 +112,13 @@ impl Thermal {
             }
         }
         let a = run.energy.so_far();
-        let external = a.drive_work_j + a.drag_work_j + a.load_work_j;
         let kinetic = run.kinetic_energy();
         // the teeth's work on the relative motion: what the external work put in beyond the
-        // kinetic energy's change (their torques are the only others on the bodies)
-        let teeth = (external - self.external_j) + (a.stack_work_j - self.stack_j)
-            - (kinetic - self.kinetic_j);
+        // kinetic energy's and the springs' energy's change (the teeth's torques are the only
+        // others on the bodies)
+        let teeth = (external_work_j(a) - self.external_j) + (a.stack_work_j - self.stack_j)
+            - (kinetic - self.kinetic_j)
+            - (a.coupling_potential_j - self.spring_j);
         self.windows.book_teeth(teeth);
         self.mark(run);
         let windows = self.windows.windows();
@@ -135,6 +141,13 @@ impl Thermal {
         }
         report
     }
+}
+
+/// The audit's work of everything on the bodies but the stack and the teeth, J: the drive,
+/// the drag, the load, and the dampers of the pack's couplings (MODEL.md section 8; a damper
+/// between the shaft and the drum is not part of the pack's thermal model).
+fn external_work_j(a: &super::EnergyAudit) -> f64 {
+    a.drive_work_j + a.drag_work_j + a.load_work_j + a.coupling_work_j
 }
 
 impl Run {
