@@ -1,5 +1,6 @@
-//! Steppable engines (issue 23): a session advanced in 1, 3 and 1,000 calls is the whole run;
-//! a saved state restored gives the same outputs again.
+//! Steppable engines (issue 23): a session advanced in 1, 3 and 1,000 calls is the whole run
+//! (a thermal run's temperatures too, issue 35); a saved state restored gives the same outputs
+//! again.
 
 use clutchpack_model::session::{Advance, Driven};
 use clutchpack_model::{Collector, Engine};
@@ -67,6 +68,11 @@ fn assert_identical(file: &str, engine: EngineChoice, duration: f64) {
             "{file} {engine:?} in {calls} calls"
         );
         assert_eq!(whole.interfaces, split.interfaces, "{file} {engine:?}");
+        // a thermal run's temperatures at t = 0, each window's end and the run's end
+        assert_eq!(
+            whole.temperatures, split.temperatures,
+            "{file} {engine:?} in {calls} calls"
+        );
         assert_eq!(
             whole.contacts, split.contacts,
             "{file} {engine:?} in {calls} calls"
@@ -84,6 +90,7 @@ fn reference_sessions_in_any_number_of_calls_are_the_run() {
         "scenes/pack-6-engagement.toml",
         "scenes/staggered-8-disc.toml",
         "scenes/pack-8-brake.toml",
+        "scenes/pack-6-thermal.toml",
     ] {
         assert_identical(file, EngineChoice::Reference, 0.1);
     }
@@ -99,6 +106,7 @@ fn multibody_sessions_in_any_number_of_calls_are_the_run() {
         "scenes/pack-6-engagement.toml",
         "scenes/staggered-8-disc.toml",
         "scenes/pack-8-brake.toml",
+        "scenes/pack-6-thermal.toml",
     ] {
         assert_identical(file, EngineChoice::Multibody, 0.05);
     }

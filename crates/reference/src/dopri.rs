@@ -137,6 +137,10 @@ pub struct Dopri5 {
     /// Candidate state at the end of the step.
     pub y_new: Vec<f64>,
     err: Vec<f64>,
+    /// How many leading components the error norm takes (`None`: all): counters after them
+    /// (a thermal run's teeth work) are integrated without steering the step, and the norm
+    /// of the others is exactly what it is without them.
+    pub norm_len: Option<usize>,
 }
 
 impl Dopri5 {
@@ -148,6 +152,7 @@ impl Dopri5 {
             ytmp: v(),
             y_new: v(),
             err: v(),
+            norm_len: None,
         }
     }
 
@@ -209,14 +214,17 @@ impl Dopri5 {
         }
         f(t + h, yn, k7);
         let mut sum = 0.0;
-        for i in 0..n {
+        // the components in the norm: the first `norm_len` (counters after them are integrated
+        // but do not steer the step)
+        let m = self.norm_len.map_or(n, |m| m.min(n));
+        for i in 0..m {
             self.err[i] =
                 h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
             let sc = atol[i] + rtol * y[i].abs().max(yn[i].abs());
             let r = self.err[i] / sc;
             sum += r * r;
         }
-        (sum / n as f64).sqrt()
+        (sum / m as f64).sqrt()
     }
 
     /// Builds the dense output of the step just tried from `(t, y)` with size `h`.

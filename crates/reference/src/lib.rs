@@ -139,8 +139,8 @@
 //! with the temperatures of every disc, plate and the oil as slow states beside it: operator
 //! splitting on a fixed window. Each accepted step's heat is booked from what the state
 //! integrates (each interface's heat counter, to its two bodies by effusivity while clamped,
-//! to the oil while open; the teeth's work `-n F Rb psi` on the step's dense output, to the
-//! oil); at the first step end past each window the temperatures advance over it (RK4 on the
+//! to the oil while open; the teeth's work `-n F Rb psi`, its own counter outside the error
+//! norm, to the oil); at the first step end past each window the temperatures advance over it (RK4 on the
 //! lumped equations) and the tooth films (eqs 7-8, scaled by `eta(T_oil) / eta(T_ref)`) and the
 //! gaps' viscosity change for the next, with a restart. Steps are never cut at a window, so a
 //! run whose parameters do not change is the isothermal run bit for bit. First order in the

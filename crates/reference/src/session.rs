@@ -264,6 +264,8 @@ impl MonolithicSession {
         model: clutchpack_model::thermal::ThermalModel,
     ) -> Result<Self, EngineError> {
         let th = Thermal::new(model, &self.st.sys.pack)?;
+        // the teeth's work integrated in the state, beside the faces' heat counters
+        self.st.carry_teeth_work();
         if let Some(pack) = th.initial_pack(&self.st.sys.pack) {
             swap_pack(&mut self.st, pack);
         }

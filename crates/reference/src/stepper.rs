@@ -189,9 +189,22 @@ impl Stepper {
         tr.contact_due = false;
     }
 
-    /// The contact modes along the last accepted step (before the switch it ended on).
-    pub fn step_modes(&self) -> &[Option<Engagement>] {
-        &self.step_modes
+    /// Extends the state by the teeth's work on the relative motion (J, from 0 now;
+    /// [`System::teeth_work`]), outside the step's error norm, and restarts the integration.
+    pub fn carry_teeth_work(&mut self) {
+        if self.sys.teeth_work {
+            return;
+        }
+        let n = self.sys.dim();
+        self.sys.teeth_work = true;
+        self.y.push(0.0);
+        for v in [&mut self.atol, &mut self.buf, &mut self.y_new, &mut self.dy] {
+            v.resize(n + 1, 0.0);
+        }
+        self.atol[n] = self.tol;
+        self.solver.resize(n + 1);
+        self.solver.norm_len = Some(n);
+        self.restart();
     }
 
     /// Restarts the integration at `(t, y)` after a change of mode or of the system.

@@ -37,6 +37,9 @@ pub(crate) struct StackEval {
     pub heat_rate: Vec<f64>,
     /// Acceleration of each stack body, rad/s^2.
     pub alpha: Vec<f64>,
+    /// Power of the teeth's forces dissipated on the relative motions, `sum -n F Rb psi`, W
+    /// (its integral is the teeth's work, [`System::teeth_work`]).
+    pub teeth_power: f64,
 }
 
 /// What a coupling's spline ties its body to.
@@ -82,6 +85,12 @@ pub(crate) struct System {
     /// The open gaps on both sides of the one body of an open-pack multirate run
     /// ([`System::open_body`]); `None` otherwise.
     pub gaps: Option<Gaps>,
+    /// Whether the state carries the teeth's work on the relative motion, `-n F Rb psi`
+    /// integrated over the run (J), after everything else (a thermal run's heat of the
+    /// teeth, MODEL.md section 9; outside the step's error norm, [`Dopri5::norm_len`]).
+    ///
+    /// [`Dopri5::norm_len`]: crate::dopri::Dopri5::norm_len
+    pub teeth_work: bool,
 }
 
 impl System {
@@ -116,6 +125,7 @@ impl System {
             c_gap,
             faces,
             gaps: None,
+            teeth_work: false,
             rb: pack
                 .discs
                 .iter()
@@ -194,7 +204,20 @@ impl System {
     }
 
     pub fn dim(&self) -> usize {
-        self.heat_at() + self.interfaces() + if self.gaps.is_some() { 2 } else { 0 }
+        self.heat_at()
+            + self.interfaces()
+            + if self.gaps.is_some() { 2 } else { 0 }
+            + usize::from(self.teeth_work)
+    }
+
+    /// The teeth's work on the relative motion since t = 0 in state `y`, `-n F Rb psi`
+    /// integrated (J; [`Self::teeth_work`], else 0).
+    pub fn teeth_work_j(&self, y: &[f64]) -> f64 {
+        if self.teeth_work {
+            y[self.dim() - 1]
+        } else {
+            0.0
+        }
     }
 
     /// The coupling with global index `id`: disc `id`, or plate `id - N`.
@@ -371,6 +394,9 @@ impl System {
             }
             let h = self.heat_at();
             dy[h..h + self.interfaces()].copy_from_slice(&ev.heat_rate);
+            if self.teeth_work {
+                dy[self.dim() - 1] = ev.teeth_power;
+            }
             return;
         }
         for slot in 0..self.ids.len() {
@@ -392,6 +418,17 @@ impl System {
         mode: &Option<Engagement>,
         omega_c: f64,
     ) -> f64 {
+        self.free_and_teeth_n_m(slot, y, mode, omega_c).0
+    }
+
+    /// [`Self::free_torque_n_m`] and its teeth's part `-n F Rb` (eq 5), N m.
+    fn free_and_teeth_n_m(
+        &self,
+        slot: usize,
+        y: &[f64],
+        mode: &Option<Engagement>,
+        omega_c: f64,
+    ) -> (f64, f64) {
         let d = self.disc(slot);
         let omega_b = omega_c - y[self.off + 2 * slot + 1];
         let teeth = match mode {
@@ -401,7 +438,7 @@ impl System {
             }
             None => 0.0,
         };
-        teeth - d.drag_n_m_s_rad * omega_b
+        (teeth - d.drag_n_m_s_rad * omega_b, teeth)
     }
 
     /// Stack position of the body in `slot` (whole pack: slot = coupling index).
@@ -440,6 +477,7 @@ impl System {
             torque: vec![0.0; n_if],
             heat_rate: vec![0.0; n_if],
             alpha: vec![0.0; n_b],
+            teeth_power: 0.0,
         };
         let mut omega = vec![0.0; n_b];
         let mut free = vec![0.0; n_b];
@@ -449,7 +487,10 @@ impl System {
             let slot = StackBody::at(b).body_index(self.nd);
             let (omega_c, _) = self.carrier_of(slot, c);
             omega[b] = omega_c - y[self.off + 2 * slot + 1];
-            free[b] = self.free_torque_n_m(slot, y, &modes[slot], omega_c);
+            let (f, teeth) = self.free_and_teeth_n_m(slot, y, &modes[slot], omega_c);
+            free[b] = f;
+            // the teeth's torque on the body times psi = omega_c - omega_b: -n F Rb psi
+            ev.teeth_power += teeth * y[self.off + 2 * slot + 1];
             inertia[b] = self.disc(slot).inertia_kg_m2;
             if b < n_if {
                 // MODEL.md section 5: each body holds back mu_spline n |F| of the clamp

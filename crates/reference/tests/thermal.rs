@@ -53,7 +53,7 @@ fn rel(a: f64, b: f64) -> f64 {
 /// to the bodies only, the teeth's to the oil): each body rises by its share of its faces'
 /// heat (effusivity split per face, steel 0.953 against the paper lining) over its m c, the
 /// heat per face read from the run's interface table; the heat generated is the heat stored
-/// (no cooler). Measured: worst body 2.4e-13 relative, balance 1.4e-14 (38.8 kJ of face heat,
+/// (no cooler). Measured: worst body 4.6e-13 relative, balance 1.2e-14 (38.8 kJ of face heat,
 /// 38 J of teeth; plate-1 +5.95 K, disc-1 +0.70 K); bounds 1e-9, issue 35's, 4000 times the
 /// rounding of 300 windows measured.
 #[test]

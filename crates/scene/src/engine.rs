@@ -61,28 +61,8 @@ impl Scene {
             (Some(e), _) => (e, format!("--engine {}", e.name())),
             (None, Some(e)) => (e, format!("simulation.engine = \"{}\"", e.name())),
             (None, None) if parts.is_empty() => return Ok(EngineChoice::Reference),
-            // a thermal scene runs on the reference engine, which carries its temperatures
-            (None, None) if self.thermal.is_some() => {
-                (EngineChoice::Reference, "[thermal]".to_string())
-            }
             (None, None) => return Ok(EngineChoice::Multibody),
         };
-        if choice == EngineChoice::Multibody && self.thermal.is_some() {
-            return Err(SceneError::Invalid {
-                origin: origin.to_string(),
-                problems: vec![Problem::new(
-                    "thermal",
-                    None,
-                    format!(
-                        "the multibody engine (chosen by {why}) does not carry temperatures yet: \
-                         it would need the faces' heat booked per step by mode, the teeth's \
-                         dissipated work, and its tooth films' and open gaps' viscosities \
-                         swapped at the thermal windows (issue 35); run the scene with the \
-                         reference engine (--engine reference)"
-                    ),
-                )],
-            });
-        }
         if choice == EngineChoice::Multibody || parts.is_empty() {
             return Ok(choice);
         }
@@ -102,9 +82,6 @@ impl Scene {
         match (asked, self.simulation.engine) {
             (Some(_), _) => "asked by --engine",
             (None, Some(_)) => "chosen by the scene (simulation.engine)",
-            (None, None) if self.thermal.is_some() => {
-                "the engine that carries temperatures ([thermal])"
-            }
             (None, None) if self.pack.non_torsional_parts().is_empty() => {
                 "the default for a torsional pack (concentric bodies: discs, plates, drum, stack)"
             }

@@ -411,7 +411,7 @@ const THICKNESS: Kind = Kind::Number(Rule::Bounded {
 });
 
 table! {
-    /// `[thermal]`: temperatures of every disc, plate and the oil, fed back into the tooth film and the open gaps' drag (MODEL.md section 9; reference engine, monolithic scheme). Temperatures in K.
+    /// `[thermal]`: temperatures of every disc, plate and the oil, fed back into the tooth film and the open gaps' drag (MODEL.md section 9; both engines: the reference engine's monolithic scheme, either scheme of the multibody engine). Temperatures in K.
     RawThermal at "thermal" {
         /// temperature of every body and the oil at t = 0
         initial_temperature_k: "K", TEMPERATURE, Dflt::Required;

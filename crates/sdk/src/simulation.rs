@@ -69,7 +69,8 @@ impl Simulation {
                     )
                 };
                 let engine = clutchpack_sim::MultibodyEngine::new(scene.pack.clone(), options)
-                    .map_err(|e| Error::BadInput(format!("{}: {e}", scene.name)))?;
+                    .map_err(|e| Error::BadInput(format!("{}: {e}", scene.name)))?
+                    .with_thermal(scene.thermal.clone());
                 let line = format!("engine: multibody ({}), {why}", engine.scheme_explanation());
                 (Box::new(engine), line)
             }

@@ -306,6 +306,19 @@
 //! reference engine runs the same packs in 0.100 s and 0.231 s. `clutchpack bench` prints the
 //! per-disc growth (N = 1, 4, 8, 16: 1.00, 2.05, 2.87, 4.18x).
 //!
+//! ## Thermal packs (MODEL.md section 9, `engine/thermal.rs`)
+//! A pack with a thermal model ([`MultibodyEngine::with_thermal`]) carries the temperatures of
+//! every disc, plate and the oil on the model's windows
+//! ([`clutchpack_model::thermal::ThermalWindows`], the reference engine's too), in either
+//! scheme. After each world step its heat is booked: each face's dissipated work (kept by the
+//! stack's integration) by its mode at the step's start, to its two bodies by effusivity
+//! while clamped, to the oil while open; the teeth's work on the relative motion, to the oil,
+//! from the energy audit (the step's external work beyond the kinetic energy's change). At
+//! the first world step end past each window the temperatures advance and new tooth films
+//! and gap viscosities go into the couplings' laws and the stack. World steps are never cut
+//! at a window. First order in the window; the heat balance closes to rounding
+//! (docs/DECISIONS.md, "Thermal windows").
+//!
 //! # Conventions
 //! Those of [`clutchpack_model`]: SI units, the shaft axis is `+z`, `phi = theta_s - theta_d`,
 //! per-tooth loads negative when the shaft leads.

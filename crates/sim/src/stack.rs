@@ -78,6 +78,11 @@ pub(crate) struct Stack {
     /// w_lower)` over the steps, with the bodies' mean speeds of each step (kept by the
     /// engine, which knows them after the step).
     pub dissipated_j: Vec<f64>,
+    /// The part of [`Self::dissipated_j`] each interface dissipated while clamped (clamp
+    /// force `> 0`: friction, and the kinetic energy a lock takes), J (>= 0); the rest is its
+    /// open gap's drag. What a thermal run books to the faces' bodies (friction) or to the
+    /// oil (drag), kept where each integration knows the clamp force.
+    pub friction_j: Vec<f64>,
     /// Torque of the stack on each stack body (stack order) over that step, N m.
     pub torque: Vec<f64>,
     /// Each interface's torque on its upper body at the end of the step, N m, where the
@@ -104,6 +109,7 @@ impl Stack {
             slip: vec![0.0; n_if],
             impulse: vec![0.0; n_if],
             dissipated_j: vec![0.0; n_if],
+            friction_j: vec![0.0; n_if],
             h: 0.0,
             locked: vec![false; n_if],
             torque: vec![0.0; n_bodies],
@@ -115,6 +121,13 @@ impl Stack {
     /// on); the clamp forces follow at the next [`Self::update`].
     pub fn set_pressure(&mut self, pressure: PressureProfile) {
         self.model.piston.pressure = pressure;
+    }
+
+    /// Replaces the open gaps' oil (a thermal window's new viscosity, MODEL.md section 9):
+    /// their drag coefficient follows from the next step on.
+    pub fn set_open_gap(&mut self, gap: Option<clutchpack_model::OpenGap>) {
+        self.model.open_gap = gap;
+        self.c_gap = -self.model.open_gap_torque_n_m(1.0);
     }
 
     /// The length of the step the impulses were last solved for, s (0 before the first).

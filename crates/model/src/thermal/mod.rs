@@ -1,6 +1,7 @@
 //! Thermal packs (MODEL.md section 9, issue 35): the laws of a lumped temperature per friction
-//! disc, per separator plate and for the oil, as pure functions and small validated types. No
-//! state and no engine: the engines hold the temperatures and call these.
+//! disc, per separator plate and for the oil, as pure functions and small validated types, and
+//! the engine-independent windows that advance them ([`ThermalWindows`]); the engines book
+//! their steps' heat into it.
 //!
 //! # Theory
 //! **Lumped bodies.** A plate or disc is one temperature `T` with heat capacity `C = m c`
@@ -32,6 +33,10 @@
 //! Vogel, a table) and the friction coefficient against slip speed and temperature
 //! ([`friction`]).
 //!
+//! **The windows** ([`window`]): the temperatures as a run's slow states, advanced beside the
+//! mechanics on fixed windows (operator splitting), with the heat each engine books per step;
+//! engine-independent, so both engines run one implementation.
+//!
 //! # Units
 //! SI throughout; temperatures in kelvin. Degrees Celsius only where a name says so
 //! ([`kelvin_from_deg_c`], [`deg_c_from_kelvin`]).
@@ -39,10 +44,12 @@
 pub mod friction;
 pub mod pack;
 pub mod viscosity;
+pub mod window;
 
 pub use friction::{FrictionMap, FrictionMapError};
 pub use pack::{GapViscosity, ThermalBody, ThermalModel, ThermalOil, ThermalReport, ViscosityLaw};
 pub use viscosity::{Viscosity, ViscosityError, ViscosityTable, Vogel, Walther};
+pub use window::{FaceMode, ThermalWindows};
 
 use std::f64::consts::PI;
 

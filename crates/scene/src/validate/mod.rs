@@ -322,22 +322,10 @@ pub(crate) fn validate(
     }
     let thermal = match &raw.thermal {
         None => Some(None),
-        Some(t) => {
-            // the temperatures advance on one step sequence (docs/DECISIONS.md, "Thermal
-            // windows")
-            if simulation
-                .as_ref()
-                .is_some_and(|s| s.scheme == crate::SchemeChoice::Multirate)
-            {
-                ck.report(
-                    "simulation.scheme",
-                    Some("\"multirate\"".into()),
-                    "a [thermal] scene runs on one step sequence (the reference engine's \
-                     monolithic scheme): use \"auto\" or \"shared\"",
-                );
-            }
-            thermal::thermal(ck, t, raw.stack.as_ref(), n_discs, n_plates).map(Some)
-        }
+        // either engine carries the temperatures; the reference engine runs a thermal pack
+        // (which has a stack) on its monolithic scheme, as every whole pack (the sdk refuses
+        // "multirate" for it), the multibody engine on either of its schemes
+        Some(t) => thermal::thermal(ck, t, raw.stack.as_ref(), n_discs, n_plates).map(Some),
     };
     let (discs, disc_fatigue): (Vec<_>, Vec<_>) = discs?.into_iter().unzip();
     let (plates, plate_fatigue): (Vec<_>, Vec<_>) = plates?.into_iter().unzip();

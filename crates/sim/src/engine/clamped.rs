@@ -310,7 +310,9 @@ impl Run {
         }
         let lost = e0 - 0.5 * j * w * w;
         self.energy.add_stack_work(-lost);
-        self.stack.as_mut().expect("a stack").dissipated_j[m] += lost;
+        let stack = self.stack.as_mut().expect("a stack");
+        stack.dissipated_j[m] += lost;
+        stack.friction_j[m] += lost;
     }
 
     /// Breaks every locked face whose torque exceeds its holding torque at `t` (the state
@@ -358,6 +360,8 @@ struct StackStep {
     /// slip (friction, the gap's drag; 0 locked), J (<= 0).
     impulse: Vec<f64>,
     face_j: Vec<f64>,
+    /// The part of `face_j` done while clamped (the stages with a clamp force `> 0`), J.
+    friction_j: Vec<f64>,
     /// Work of the drive (a prescribed shaft's on the discs' teeth, an inertial shaft's drive
     /// torque, eq 4), of the drag (bodies, the carriers' damping) and of the drum's load, J.
     drive_j: f64,
@@ -398,6 +402,7 @@ impl RkBuffers {
                 w_carrier: c(),
                 impulse: vec![0.0; n - 1],
                 face_j: vec![0.0; n - 1],
+                friction_j: vec![0.0; n - 1],
                 drive_j: 0.0,
                 drag_j: 0.0,
                 load_j: 0.0,
@@ -509,6 +514,7 @@ impl Run {
         for m in 0..faces.len() {
             out.impulse[m] = quad(k1.face[m], k2.face[m], k3.face[m], k4.face[m]);
             out.face_j[m] = 0.0;
+            out.friction_j[m] = 0.0;
             if faces[m] != Face::Locked {
                 let (lo, up) = (sys.body[m], sys.body[m + 1]);
                 let v = |u: &[f64]| u[up] - u[lo];
@@ -518,6 +524,15 @@ impl Run {
                     k3.face[m] * v(u3),
                     k4.face[m] * v(u4),
                 );
+                // the friction's part: the stages where the face is clamped
+                let fr = |s: &Stage, u: &[f64]| {
+                    if s.clamp[m] > 0.0 {
+                        s.face[m] * v(u)
+                    } else {
+                        0.0
+                    }
+                };
+                out.friction_j[m] = quad(fr(k1, u0), fr(k2, u2), fr(k3, u3), fr(k4, u4));
             }
         }
     }
@@ -747,6 +762,9 @@ impl SubSteps for StackSteps {
         run.energy.add_stack_work(step.face_j.iter().sum());
         let stack = run.stack.as_mut().expect("a stack");
         for (x, dx) in stack.dissipated_j.iter_mut().zip(&step.face_j) {
+            *x -= dx;
+        }
+        for (x, dx) in stack.friction_j.iter_mut().zip(&step.friction_j) {
             *x -= dx;
         }
         drop(b);

@@ -126,6 +126,12 @@ impl EnergyBook {
         self.audit.load_work_j += load_j;
     }
 
+    /// The audit so far: the works up to the last evaluation or sub-step, J (the energies at
+    /// the end are set by [`Self::finish`]).
+    pub(super) fn so_far(&self) -> &EnergyAudit {
+        &self.audit
+    }
+
     /// The energies at t = 0: the teeth's potential and the kinetic energy, J.
     pub(super) fn start(&mut self, contact_potential_j: f64, kinetic_j: f64) {
         self.audit.initial_contact_potential_j = contact_potential_j;

@@ -537,6 +537,10 @@ impl Run {
                 let work = s.impulse[m] * slip;
                 self.energy.add_stack_work(work);
                 s.dissipated_j[m] -= work;
+                // the step's impulse was solved with the clamp at its start
+                if s.clamp[m] > 0.0 {
+                    s.friction_j[m] -= work;
+                }
             }
         }
     }

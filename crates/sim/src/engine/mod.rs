@@ -19,6 +19,7 @@ mod multirate;
 mod session;
 mod state;
 mod substep;
+mod thermal;
 
 pub use energy::EnergyAudit;
 pub use session::MultibodySession;
@@ -26,6 +27,7 @@ pub use session::MultibodySession;
 use crate::options::{MultibodyOptions, Scheme, Stepping, ToothResolution};
 use crate::world::World;
 use clutchpack_model::session::{Advance, Driven, Session};
+use clutchpack_model::thermal::ThermalModel;
 use clutchpack_model::{Engine, EngineError, LawKind, Observer, PackModel, RunStats};
 use std::sync::Arc;
 
@@ -41,6 +43,8 @@ pub struct MultibodyEngine {
     substeps: u64,
     energy: EnergyAudit,
     per_tooth: Vec<bool>,
+    /// The thermal model whose temperatures runs carry (`None`: isothermal).
+    thermal: Option<ThermalModel>,
 }
 
 impl MultibodyEngine {
@@ -163,7 +167,17 @@ impl MultibodyEngine {
             options,
             energy: EnergyAudit::default(),
             per_tooth,
+            thermal: None,
         })
+    }
+
+    /// The same engine carrying the temperatures of `thermal` (MODEL.md section 9; `None`:
+    /// isothermal): the heat of every world step booked by the faces' modes and the teeth's
+    /// work, the temperatures advanced and the tooth films' and open gaps' viscosities swapped
+    /// at the end of each thermal window (`thermal.rs`; docs/DECISIONS.md, "Thermal windows").
+    pub fn with_thermal(mut self, thermal: Option<ThermalModel>) -> MultibodyEngine {
+        self.thermal = thermal;
+        self
     }
 
     /// Whether runs use the multirate scheme (crate docs, "Theory"); a pack whose piston
@@ -348,6 +362,7 @@ impl MultibodyEngine {
             &self.per_tooth,
             multirate,
             driven,
+            self.thermal.clone(),
         )
     }
 }

@@ -38,8 +38,10 @@
 use super::energy::EnergyAudit;
 use super::state::{shaft_accel_bound, Run, ShaftDrive};
 use super::substep::{split_remainder, Counts, WorldStep};
+use super::thermal::Thermal;
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
+use clutchpack_model::thermal::ThermalModel;
 use clutchpack_model::{
     EngineError, Observer, PressureProfile, RunStats, Shaft, ShaftExcitation, SpeedProfile,
 };
@@ -99,24 +101,36 @@ pub struct MultibodySession {
     finished: Option<RunStats>,
     /// The energy audit (complete once finished).
     energy: EnergyAudit,
+    /// The temperatures of a thermal run (`thermal.rs`); `None`: isothermal.
+    thermal: Option<Box<Thermal>>,
 }
 
 impl MultibodySession {
     /// A session at t = 0 on `pack` (the state at t = 0 evaluated), running the shared step
     /// or the multirate scheme (`multirate`), its caller driving `driven` (checked by the
-    /// engine).
+    /// engine), carrying the temperatures of `thermal` (`None`: isothermal).
     pub(super) fn new(
         pack: Arc<clutchpack_model::PackModel>,
         options: &MultibodyOptions,
         per_tooth: &[bool],
         multirate: Option<AdaptiveStepping>,
         driven: Driven,
+        thermal: Option<ThermalModel>,
     ) -> Result<MultibodySession, EngineError> {
         let mut pack = pack;
         if driven.any() {
             // the driven inputs held at the scene's values until the caller sets them
             pack = Arc::new(hold_inputs(&pack, 0.0, &Inputs::of_scene(&pack, &driven, 0.0)).0);
         }
+        // a thermal run starts with the parameters of its temperatures at t = 0
+        let thermal = match thermal {
+            Some(model) => {
+                let (th, p) = Thermal::new(model, pack)?;
+                pack = p;
+                Some(Box::new(th))
+            }
+            None => None,
+        };
         let mut run = Run::new(pack, options, per_tooth)?;
         run.exact_drum_load = driven.drum_load;
         run.evaluate(0.0)?;
@@ -148,6 +162,7 @@ impl MultibodySession {
             failed: false,
             finished: None,
             energy: EnergyAudit::default(),
+            thermal,
         })
     }
 
@@ -264,6 +279,9 @@ impl MultibodySession {
             (PROGRESS_BODY_STEPS / (self.run.couplings.len() as u64).max(1)).max(1);
         if !self.started {
             self.started = true;
+            if let Some(th) = self.thermal.as_mut() {
+                th.start(&self.run, observer);
+            }
             self.run.track_events(steps_per_contact, observer);
             self.sample_if_due(observer);
         }
@@ -298,6 +316,9 @@ impl MultibodySession {
             self.t_last_good = run.t;
             run.track_events(steps_per_contact, observer);
             self.sample_if_due(observer);
+            if let Some(th) = self.thermal.as_mut() {
+                th.after_step(&mut self.run, observer)?;
+            }
             let steps = self.steps;
             let stopped = steps.is_multiple_of(progress_every) && observer.progress(self.run.t);
             if steps.is_multiple_of(clutchpack_model::STALL_STEPS)
@@ -368,6 +389,9 @@ impl MultibodySession {
     ) -> Result<Advance, EngineError> {
         if !self.started {
             self.started = true;
+            if let Some(th) = self.thermal.as_mut() {
+                th.start(&self.run, observer);
+            }
             self.run.track_events(a.steps_per_contact, observer);
             self.sample_if_due(observer);
             if observer.progress(self.run.t) {
@@ -416,6 +440,9 @@ impl MultibodySession {
             self.steps += 1;
             self.t_last_good = self.run.t;
             self.sample_if_due(observer);
+            if let Some(th) = self.thermal.as_mut() {
+                th.after_step(&mut self.run, observer)?;
+            }
             if observer.progress(self.run.t) {
                 return Ok(Advance::Stopped);
             }
@@ -565,6 +592,8 @@ impl Session for MultibodySession {
         }
         let kinetic_j = run.kinetic_energy();
         self.energy = run.energy.finish(run.potential_j, kinetic_j);
+        // the last (partial) window closes at the run's end
+        let thermal = self.thermal.as_mut().map(|th| th.finish(run.t, observer));
         let stats = RunStats {
             simulated_s: run.t,
             steps: self.steps,
@@ -575,7 +604,7 @@ impl Session for MultibodySession {
                 Loop::Multirate(_) => self.counts.evals,
             },
             stopped_early: false,
-            thermal: None,
+            thermal,
         };
         self.finished = Some(stats.clone());
         stats
