@@ -61,27 +61,30 @@ fn fmpy_validates_every_shipped_scene_that_an_fmu_can_represent() {
     let v = check("validate");
     let scenes = v.as_object().unwrap();
     assert!(scenes.len() >= 8, "{v}");
-    let mut built = 0;
+    let (mut built, mut networks) = (0, 0);
     for (scene, r) in scenes {
         let message = r["message"].as_str().unwrap();
         if r["built"].as_bool().unwrap() {
             built += 1;
             assert_eq!(r["problems"], serde_json::json!([]), "{scene}: {message}");
         } else {
-            // refused as bad input, with the reason
+            // refused as bad input, with the reason: a network scene has no FMU yet (issue 34)
             assert_eq!(r["exit"], 2, "{scene}: {message}");
             assert!(
-                message.contains("cannot run it as a co-simulation"),
+                message.contains("cannot run it as a co-simulation")
+                    || message.contains("is a network scene"),
                 "{scene}: {message}"
             );
+            networks += usize::from(message.contains("is a network scene"));
         }
     }
     eprintln!(
-        "{built} of {} shipped scenes built and validated",
+        "{built} of {} shipped scenes built and validated ({networks} network scenes refused)",
         scenes.len()
     );
-    // both engines are steppable: every shipped scene has an FMU
-    assert_eq!(built, scenes.len(), "{v}");
+    // both engines are steppable: every shipped pack scene has an FMU
+    assert_eq!(built + networks, scenes.len(), "{v}");
+    assert!(networks >= 2 && built >= 8, "{v}");
     // a scene the engine asked for cannot run is refused before any file is written, with
     // the reason (the reference engine has one degree of freedom per body)
     let out = super::scratch("fmu-refused").join("eccentric.fmu");
