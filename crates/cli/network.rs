@@ -94,6 +94,14 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
             locks.join(", ")
         );
     }
+    for c in s.couplings.iter().filter(|c| c.kind == "gear_mesh") {
+        out!(
+            "  {:<16} gear mesh: {} tooth impacts, largest peak {:.3} N per tooth pair",
+            c.name,
+            c.impacts,
+            c.largest_peak_n
+        );
+    }
     let mut changes: Vec<(&str, &clutchpack_sdk::ModeChange)> = s
         .couplings
         .iter()

@@ -56,6 +56,11 @@ pub struct CouplingSummary {
     pub final_mode: Option<&'static str>,
     /// The instants a clutch locked, s.
     pub lock_times_s: Vec<f64>,
+    /// A gear mesh's tooth impacts (closed contacts) over the run (0 for other kinds).
+    pub impacts: u64,
+    /// A gear mesh's largest impact peak per tooth pair, N, signed as the impacts' (negative
+    /// when body a leads); 0 without impacts.
+    pub largest_peak_n: f64,
     /// The smallest torque on its body a over the samples, N m.
     pub min_torque_n_m: f64,
     /// The largest torque on its body a over the samples, N m.
@@ -140,6 +145,8 @@ struct Keep<'a, 'r> {
     steps: Vec<(f64, Vec<f64>)>,
     /// Per coupling: the smallest and largest torque sampled.
     range: Vec<(f64, f64)>,
+    /// Per coupling: (impacts, largest peak) of a gear mesh.
+    meshes: std::collections::HashMap<usize, (u64, f64)>,
     history: Vec<NetworkSample>,
     stopped: bool,
 }
@@ -157,6 +164,13 @@ impl NetworkObserver for Keep<'_, '_> {
     }
     fn clutch_event(&mut self, e: &ClutchEvent) {
         self.events.push(*e);
+    }
+    fn mesh_impact(&mut self, e: &clutchpack_model::ImpactEvent) {
+        let m = self.meshes.entry(e.disc).or_insert((0, 0.0));
+        m.0 += 1;
+        if e.peak_n.abs() > m.1.abs() {
+            m.1 = e.peak_n;
+        }
     }
     fn switched(&mut self, before: &NetworkSample, after: &NetworkSample) {
         let steps = after
@@ -220,6 +234,7 @@ pub fn run_network_scene(
         events: Vec::new(),
         steps: Vec::new(),
         range: Vec::new(),
+        meshes: Default::default(),
         history: Vec::new(),
         stopped: false,
     };
@@ -284,6 +299,8 @@ pub fn run_network_scene(
                     .filter(|e| e.coupling == k && e.to == ClutchMode::Locked)
                     .map(|e| e.t_s)
                     .collect(),
+                impacts: keep.meshes.get(&k).map_or(0, |m| m.0),
+                largest_peak_n: keep.meshes.get(&k).map_or(0.0, |m| m.1),
                 min_torque_n_m: keep.range.get(k).map_or(0.0, |r| r.0),
                 max_torque_n_m: keep.range.get(k).map_or(0.0, |r| r.1),
                 changes,
