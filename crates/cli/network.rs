@@ -131,7 +131,7 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
             );
         }
     }
-    let e = &s.energy;
+    let (e, residual_j) = (&s.energy.terms, s.energy.residual_j);
     out!(
         "energy: drives {:.6} J, loads {:.6} J, drag {:.6} J, clutch heat {:.6} J, kinetic change {:.6} J (balance {:.3e} J)",
         e.drive_work_j,
@@ -139,7 +139,7 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
         e.drag_loss_j,
         e.clutch_heat_j,
         e.kinetic_change_j,
-        e.residual_j
+        residual_j
     );
     if s.stopped {
         eprintln!(

@@ -80,25 +80,14 @@ pub struct BodySummary {
     pub final_angle_rad: f64,
 }
 
-/// Where the energy went, J (MODEL.md section 8, "Energy").
+/// Where the energy went, J (MODEL.md section 8, "Energy"): the engine's own balance
+/// ([`clutchpack_model::network::NetworkEnergy`], its fields flattened into the JSON) and its
+/// residual.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct EnergySummary {
-    /// Work of the drives, J.
-    pub drive_work_j: f64,
-    /// Work of the road loads (<= 0), J.
-    pub load_work_j: f64,
-    /// Loss to the bodies' drag, J.
-    pub drag_loss_j: f64,
-    /// Heat of the clutches, J.
-    pub clutch_heat_j: f64,
-    /// Work done on the gear meshes (their impact losses), J.
-    pub mesh_work_j: f64,
-    /// Loss to the spring-dampers' dampers, J.
-    pub damper_loss_j: f64,
-    /// The springs' stored energy at the end less at the start, J.
-    pub spring_energy_change_j: f64,
-    /// Kinetic energy at the end less at the start, J.
-    pub kinetic_change_j: f64,
+    /// The balance's terms, J.
+    #[serde(flatten)]
+    pub terms: clutchpack_model::network::NetworkEnergy,
     /// `drive + load - drag - heat - mesh work - damper loss - spring energy change - kinetic
     /// change`, J (zero to the integrator's tolerance).
     pub residual_j: f64,
@@ -328,14 +317,7 @@ pub fn run_network_scene(
             .collect(),
         couplings,
         energy: EnergySummary {
-            drive_work_j: e.drive_work_j,
-            load_work_j: e.load_work_j,
-            drag_loss_j: e.drag_loss_j,
-            clutch_heat_j: e.clutch_heat_j,
-            mesh_work_j: e.mesh_work_j,
-            damper_loss_j: e.damper_loss_j,
-            spring_energy_change_j: e.spring_energy_change_j,
-            kinetic_change_j: e.kinetic_change_j,
+            terms: e,
             residual_j: e.residual_j(),
         },
     };

@@ -351,6 +351,20 @@ impl Network {
         out
     }
 
+    /// What every engine checks before it runs the network for `duration_s` seconds: no
+    /// [`Self::problems`], and a finite, non-negative duration.
+    pub fn check_run(&self, duration_s: f64) -> Result<(), crate::EngineError> {
+        if let Some(p) = self.problems().first() {
+            return Err(crate::EngineError::Unsupported(format!("{p:?}")));
+        }
+        if !(duration_s.is_finite() && duration_s >= 0.0) {
+            return Err(crate::EngineError::Unsupported(format!(
+                "duration {duration_s} s must be finite and >= 0"
+            )));
+        }
+        Ok(())
+    }
+
     /// Every instant (s, sorted, unique, within `[0, end]`) where a signal of the network jumps
     /// or bends: the engines land a step on each.
     pub fn breakpoints(&self, end_s: f64) -> Vec<f64> {

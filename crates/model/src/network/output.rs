@@ -37,7 +37,7 @@ pub struct ClutchEvent {
 }
 
 /// Where the energy went over a run, J (MODEL.md section 8, "Energy").
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct NetworkEnergy {
     /// Work of the drives, J.
     pub drive_work_j: f64,

@@ -307,14 +307,7 @@ pub fn run_network(
     options: &NetworkOptions,
     obs: &mut dyn NetworkObserver,
 ) -> Result<NetworkRun, EngineError> {
-    if let Some(p) = net.problems().first() {
-        return Err(EngineError::Unsupported(format!("{p:?}")));
-    }
-    if !(duration_s.is_finite() && duration_s >= 0.0) {
-        return Err(EngineError::Unsupported(format!(
-            "duration {duration_s} s must be finite and >= 0"
-        )));
-    }
+    net.check_run(duration_s)?;
     let n = net.bodies.len();
     let m = net.couplings.len();
     let dim = 2 * n + 2 * m + 3;

@@ -439,16 +439,9 @@ pub fn run_network(
     options: &NetworkStepOptions,
     obs: &mut dyn NetworkObserver,
 ) -> Result<NetworkRun, EngineError> {
-    if let Some(p) = net.problems().first() {
-        return Err(EngineError::Unsupported(format!("{p:?}")));
-    }
+    net.check_run(duration_s)?;
     if let Some(why) = unsupported(net) {
         return Err(EngineError::Unsupported(why));
-    }
-    if !(duration_s.is_finite() && duration_s >= 0.0) {
-        return Err(EngineError::Unsupported(format!(
-            "duration {duration_s} s must be finite and >= 0"
-        )));
     }
     let h_max = options.step_s;
     if !(h_max.is_finite() && h_max > 0.0) {
