@@ -14,9 +14,9 @@
 
 use clutchpack_model::checks::{first_lock_s, heat_j};
 use clutchpack_model::{Collector, Engine, ImpactEvent};
+use clutchpack_multibody::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Stepping};
 use clutchpack_reference::{ReferenceEngine, ReferenceOptions, Scheme};
 use clutchpack_scene::Override;
-use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Stepping};
 use std::path::Path;
 
 fn scene(file: &str, sets: &[&str]) -> clutchpack_scene::Scene {
@@ -192,7 +192,7 @@ fn staggered_brake_8_with_plates() {
     // the shared step (issue 20 made the multirate scheme the default for this pack:
     // `staggered_brake_8_multirate`)
     let options = MultibodyOptions {
-        scheme: clutchpack_sim::Scheme::Shared,
+        scheme: clutchpack_multibody::Scheme::Shared,
         ..MultibodyOptions::with_settings(1e4, 2.5e-7, false)
     };
     brake_8_agrees(
@@ -221,7 +221,7 @@ fn brake_8_agrees(
         ..ReferenceOptions::default()
     };
     let r = impacts(&mut ReferenceEngine::new(pack.clone(), oracle), duration);
-    let multirate = options.scheme != clutchpack_sim::Scheme::Shared;
+    let multirate = options.scheme != clutchpack_multibody::Scheme::Shared;
     let mut engine = MultibodyEngine::new(pack, options).unwrap();
     assert_eq!(
         engine.is_multirate(),
@@ -284,8 +284,10 @@ mod staggered {
     use super::impacts;
     use clutchpack_model::cases::staggered_pack;
     use clutchpack_model::ImpactEvent;
+    use clutchpack_multibody::{
+        AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping,
+    };
     use clutchpack_reference::{ReferenceEngine, ReferenceOptions};
-    use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping};
 
     const DURATION_S: f64 = 0.05;
 

@@ -17,7 +17,7 @@ fn simulation(file: &str, engine: EngineChoice, duration_s: f64) -> Simulation {
     Simulation::new(scene, Some(engine)).unwrap()
 }
 
-/// The whole run of `sim`'s engine and the same run as a session advanced in `calls` equal
+/// The whole run of the multibody engine and the same run as a session advanced in `calls` equal
 /// calls: everything they send, in order.
 fn whole_and_split(sim: &mut Simulation, duration: f64, calls: usize) -> (Collector, Collector) {
     let mut whole = Collector::default();
@@ -34,7 +34,7 @@ fn whole_and_split(sim: &mut Simulation, duration: f64, calls: usize) -> (Collec
         };
         assert_eq!(s.advance_to(t, &mut split).unwrap(), Advance::Reached);
         // the reference engine stands at t (its dense output); the multibody engine's world
-        // step may end past it (module docs of crates/sim/src/engine/session.rs)
+        // step may end past it (module docs of crates/multibody/src/engine/session.rs)
         let now = s.time_s();
         if reference {
             assert_eq!(now, t);

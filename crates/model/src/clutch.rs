@@ -31,7 +31,7 @@
 //!
 //! **Stick-slip.** Engines must not regularise `sign(slip)` (a regularisation speed small
 //! enough to hold a lock makes the equations stiff): the multibody engine solves the friction
-//! impulses at velocity level each step (see `clutchpack_sim`), which holds a locked interface
+//! impulses at velocity level each step (see `clutchpack_multibody`), which holds a locked interface
 //! exactly while the torque it needs stays below `mu(0) F R_eff` and lets it slip with
 //! `mu(v) F R_eff` otherwise.
 //!

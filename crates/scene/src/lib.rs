@@ -179,7 +179,7 @@ use serde::{Deserialize, Serialize};
 pub enum EngineChoice {
     /// The reduced torsional engine (`clutchpack_reference`).
     Reference,
-    /// The rapier3d multibody engine (`clutchpack_sim`).
+    /// The rapier3d multibody engine (`clutchpack_multibody`).
     Multibody,
 }
 

@@ -182,7 +182,7 @@ impl NetworkObserver for Keep<'_, '_> {
 
 /// The multibody engine's fixed step on a network scene, s: `simulation.max_step_s`, at most
 /// 1e-4 s (the engine is first order: at 1e-4 s CoupledClutches' lock times are within
-/// 2e-5 s and its speeds within 2e-5 of the reference engine's, `crates/sim/tests/network.rs`).
+/// 2e-5 s and its speeds within 2e-5 of the reference engine's, `crates/multibody/tests/network.rs`).
 pub fn multibody_step_s(scene: &Scene) -> f64 {
     scene.simulation.max_step_s.min(MULTIBODY_NETWORK_STEP_S)
 }
@@ -190,7 +190,7 @@ pub fn multibody_step_s(scene: &Scene) -> f64 {
 /// Why the multibody engine cannot run the network `net` (`None`: it can; it runs lumped
 /// clutches and ideal gears), for `check` to say what `run` would.
 pub fn multibody_network_unsupported(net: &clutchpack_model::network::Network) -> Option<String> {
-    clutchpack_sim::network::unsupported(net)
+    clutchpack_multibody::network::unsupported(net)
 }
 
 /// The longest fixed step of the multibody engine on a network, s.
@@ -213,7 +213,7 @@ pub fn run_network_scene(
     };
     let engine = scene.engine(asked, &scene.name)?;
     if engine == EngineChoice::Multibody {
-        if let Some(why) = clutchpack_sim::network::unsupported(net) {
+        if let Some(why) = clutchpack_multibody::network::unsupported(net) {
             return Err(Error::BadInput(format!("{}: {why}", scene.name)));
         }
     }
@@ -238,11 +238,11 @@ pub fn run_network_scene(
             clutchpack_reference::network::run_network(net, sim.duration_s, &options, &mut keep)
         }
         EngineChoice::Multibody => {
-            let options = clutchpack_sim::network::NetworkStepOptions {
+            let options = clutchpack_multibody::network::NetworkStepOptions {
                 step_s: multibody_step_s(scene),
                 record_rate_hz: sim.record_rate_hz,
             };
-            clutchpack_sim::network::run_network(net, sim.duration_s, &options, &mut keep)
+            clutchpack_multibody::network::run_network(net, sim.duration_s, &options, &mut keep)
         }
     }
     .map_err(|source| Error::Engine {

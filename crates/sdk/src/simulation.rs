@@ -56,21 +56,22 @@ impl Simulation {
                 (Box::new(engine), line)
             }
             EngineChoice::Multibody => {
-                let options = clutchpack_sim::MultibodyOptions {
+                let options = clutchpack_multibody::MultibodyOptions {
                     scheme: match sim.scheme {
-                        SchemeChoice::Auto => clutchpack_sim::Scheme::Auto,
-                        SchemeChoice::Shared => clutchpack_sim::Scheme::Shared,
-                        SchemeChoice::Multirate => clutchpack_sim::Scheme::Multirate,
+                        SchemeChoice::Auto => clutchpack_multibody::Scheme::Auto,
+                        SchemeChoice::Shared => clutchpack_multibody::Scheme::Shared,
+                        SchemeChoice::Multirate => clutchpack_multibody::Scheme::Multirate,
                     },
-                    ..clutchpack_sim::MultibodyOptions::with_settings(
+                    ..clutchpack_multibody::MultibodyOptions::with_settings(
                         sim.record_rate_hz,
                         sim.max_step_s,
                         sim.record_per_tooth,
                     )
                 };
-                let engine = clutchpack_sim::MultibodyEngine::new(scene.pack.clone(), options)
-                    .map_err(|e| Error::BadInput(format!("{}: {e}", scene.name)))?
-                    .with_thermal(scene.thermal.clone());
+                let engine =
+                    clutchpack_multibody::MultibodyEngine::new(scene.pack.clone(), options)
+                        .map_err(|e| Error::BadInput(format!("{}: {e}", scene.name)))?
+                        .with_thermal(scene.thermal.clone());
                 let line = format!("engine: multibody ({}), {why}", engine.scheme_explanation());
                 (Box::new(engine), line)
             }
@@ -143,9 +144,10 @@ impl PackEngine {
                     .with_parallel(parallel),
             ),
             PackEngine::Multibody { record_rate_hz } => Box::new(
-                clutchpack_sim::MultibodyEngine::new(
+                clutchpack_multibody::MultibodyEngine::new(
                     pack,
-                    clutchpack_sim::MultibodyOptions::default().with_record_rate(record_rate_hz),
+                    clutchpack_multibody::MultibodyOptions::default()
+                        .with_record_rate(record_rate_hz),
                 )
                 .map_err(|e| Error::BadInput(e.to_string()))?,
             ),

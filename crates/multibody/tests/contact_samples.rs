@@ -7,7 +7,7 @@
 use clutchpack_model::cases::{paper_pack, staggered_pack};
 use clutchpack_model::checks::{check_contact_samples, OrderedCollector};
 use clutchpack_model::*;
-use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping};
+use clutchpack_multibody::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping};
 
 /// Largest relative shortfall of the densest contact sample below the located peak: the
 /// measured worst (2.94e-3, the paper case without film, multirate) with a margin of about

@@ -8,7 +8,7 @@
 
 use clutchpack_model::cases::staggered_brake;
 use clutchpack_model::{Collector, Engine};
-use clutchpack_sim::{MultibodyEngine, MultibodyOptions};
+use clutchpack_multibody::{MultibodyEngine, MultibodyOptions};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 
 /// Simulated time of one iteration, s.

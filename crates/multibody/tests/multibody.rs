@@ -1,15 +1,15 @@
 //! Physics checks of the multibody engine through rapier (MODEL.md sections 1-5; issue 3
-//! "Must show"). Run in release: `cargo test -p clutchpack_sim --release`.
+//! "Must show"). Run in release: `cargo test -p clutchpack_multibody --release`.
 
 use clutchpack_model::{
     cases, free_impact_peak_n, Collector, DiscModel, Engine, EngineError, Flank, ImpactEvent,
     LawKind, Observer, PackModel, Shaft, ShaftExcitation, SpeedProfile, Table, ToothLaw,
 };
-use clutchpack_scene::{Scene, Simulation};
-use clutchpack_sim::{
+use clutchpack_multibody::{
     AdaptiveStepping, DiscMount, MultibodyEngine, MultibodyOptions, Scheme, Stepping,
     ToothResolution,
 };
+use clutchpack_scene::{Scene, Simulation};
 
 /// The paper's tooth law (`cases::paper_law`) with the impact loss `p` (s/m) in place of
 /// MODEL.md's 0.8.
@@ -514,7 +514,7 @@ fn engine_for(
     let sim = &scene.simulation;
     MultibodyEngine::new(
         scene.pack.clone(),
-        clutchpack_sim::MultibodyOptions::with_settings(
+        clutchpack_multibody::MultibodyOptions::with_settings(
             sim.record_rate_hz,
             sim.max_step_s,
             sim.record_per_tooth,

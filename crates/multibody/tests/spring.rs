@@ -7,7 +7,7 @@
 use clutchpack_model::cases::{spring_pair, SPRING_PAIR_DRUM_KG_M2, SPRING_PAIR_SHAFT_KG_M2};
 use clutchpack_model::checks::free_oscillation;
 use clutchpack_model::{Collector, Engine, Sample, SpringDamper};
-use clutchpack_sim::{MultibodyEngine, MultibodyOptions};
+use clutchpack_multibody::{MultibodyEngine, MultibodyOptions};
 
 const SPRING: SpringDamper = SpringDamper {
     stiffness_n_m_per_rad: 2000.0,

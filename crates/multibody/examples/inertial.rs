@@ -3,7 +3,7 @@
 //! timing the multirate scheme on an inertial shaft against the shared step (issue 20):
 //!
 //! ```text
-//! cargo build --release -p clutchpack_sim --example inertial
+//! cargo build --release -p clutchpack_multibody --example inertial
 //! target/release/examples/inertial 16                 # 16 discs, 0.1 s, default scheme
 //! target/release/examples/inertial 8 shared 0.05 5    # 8 discs, shared step, 50 ms, 5 runs
 //! ```
@@ -15,7 +15,7 @@
 
 use clutchpack_model::cases::{bench_drive, staggered_pack};
 use clutchpack_model::{Collector, Engine, Shaft, ShaftExcitation};
-use clutchpack_sim::{MultibodyEngine, MultibodyOptions, Scheme};
+use clutchpack_multibody::{MultibodyEngine, MultibodyOptions, Scheme};
 use std::time::Instant;
 
 fn main() {

@@ -1,12 +1,12 @@
 //! Per-tooth effects through rapier (MODEL.md section 5): a disc floating radially on its
 //! spline, tooth spacing errors, an eccentric disc. Run in release:
-//! `cargo test -p clutchpack_sim --release --test per_tooth`.
+//! `cargo test -p clutchpack_multibody --release --test per_tooth`.
 
 use clutchpack_model::{
     cases, Collector, DiscModel, Engine, LawKind, OilFilm, PackModel, Shaft, SpeedProfile,
     SplineGeometry, ToothLaw,
 };
-use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping};
+use clutchpack_multibody::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping};
 
 fn spline() -> SplineGeometry {
     cases::paper_spline()

@@ -17,8 +17,10 @@
 //! (multirate on this prescribed-shaft pack), the fixed ones the shared step.
 
 use clutchpack_model::{Collector, Engine};
+use clutchpack_multibody::{
+    AdaptiveStepping, DiscMount, MultibodyEngine, MultibodyOptions, Stepping,
+};
 use clutchpack_scene::Scene;
-use clutchpack_sim::{AdaptiveStepping, DiscMount, MultibodyEngine, MultibodyOptions, Stepping};
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::path::Path;
 use std::time::Instant;

@@ -1,13 +1,13 @@
 //! The multirate scheme on an inertial shaft (issue 20): the staggered pack on an inertial
 //! shaft driven by eq (4) against the shared step at a tight setting, impact by impact, and
 //! the total angular momentum of an undriven, undamped pack. Run in release:
-//! `cargo test -p clutchpack_sim --release --test inertial_multirate -- --nocapture`.
+//! `cargo test -p clutchpack_multibody --release --test inertial_multirate -- --nocapture`.
 
 use clutchpack_model::session::{Driven, Session};
 use clutchpack_model::{
     cases, Collector, Engine, ImpactEvent, PackModel, Shaft, ShaftExcitation, Table,
 };
-use clutchpack_sim::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping};
+use clutchpack_multibody::{AdaptiveStepping, MultibodyEngine, MultibodyOptions, Scheme, Stepping};
 
 /// The staggered pack of `n` discs on an inertial shaft, `J1 = 2 kg m^2`, driven by the
 /// benchmark's sine as the torque `J1 d(profile)/dt` (eq 4), undamped.

@@ -1,13 +1,13 @@
 //! The multibody engine as a steppable session (issue 23): a run split into calls is the run,
 //! a cloned session advances as the original, a driven input follows the caller. Run in
-//! release: `cargo test -p clutchpack_sim --release --test session`.
+//! release: `cargo test -p clutchpack_multibody --release --test session`.
 
 use clutchpack_model::session::{Advance, Driven, Inputs, Session};
 use clutchpack_model::{
     cases, Collector, DrumModel, Engine, EngineError, FrictionCurve, ImpactEvent, PackModel,
     Piston, PressureProfile, Shaft, ShaftExcitation, SpeedProfile, StackModel,
 };
-use clutchpack_sim::{MultibodyEngine, MultibodyOptions, Scheme};
+use clutchpack_multibody::{MultibodyEngine, MultibodyOptions, Scheme};
 
 /// Simulated time of every comparison, s.
 const DURATION_S: f64 = 0.02;

@@ -4,8 +4,8 @@
 
 use clutchpack_model::thermal::ThermalReport;
 use clutchpack_model::{Collector, Engine};
+use clutchpack_multibody::{EnergyAudit, MultibodyEngine, MultibodyOptions};
 use clutchpack_scene::{Override, Scene};
-use clutchpack_sim::{EnergyAudit, MultibodyEngine, MultibodyOptions};
 use std::path::Path;
 
 /// A shipped scene with `sets` applied, `None` when the crate is built outside the repository.

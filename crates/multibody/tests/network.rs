@@ -11,8 +11,8 @@
 
 use clutchpack_model::cases;
 use clutchpack_model::network::*;
+use clutchpack_multibody::network::{run_network, NetworkStepOptions};
 use clutchpack_reference::network as reference;
-use clutchpack_sim::network::{run_network, NetworkStepOptions};
 
 #[derive(Default)]
 struct Keep(Vec<ClutchEvent>, Vec<NetworkSample>);

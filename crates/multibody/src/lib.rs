@@ -1,4 +1,4 @@
-//! # clutchpack_sim
+//! # clutchpack_multibody
 //!
 //! The multibody engine: a clutch pack as rigid bodies in a rapier3d-f64 world, the spline
 //! teeth as our own force law applied tooth by tooth, and a contact-aware step.
@@ -175,7 +175,7 @@
 //!   of the drive's work over a 50 ms rattle (7.7e-7 on the shared step).
 //! - *Cost.* One rapier step per world step for the whole pack, plus each disc's sub-steps,
 //!   which only a disc in contact takes (about 215 per impact): linear in the number of discs.
-//!   Measured on the staggered pack (0.1 s, `cargo bench -p clutchpack_sim --bench staggered`):
+//!   Measured on the staggered pack (0.1 s, `cargo bench -p clutchpack_multibody --bench staggered`):
 //!   per-disc wall time 0.65-0.7x one disc's at 4, 8 and 16 discs. `perf` on 16 discs
 //!   (`examples/staggered.rs`): 36 % in the shaft profile's sin/cos (two evaluations per
 //!   sub-step), 22 % in the sub-steps' arithmetic and the step controller, 18 % in rapier

@@ -2,7 +2,7 @@
 //! whole process, for timing it side by side with other engines and for profiling:
 //!
 //! ```text
-//! cargo build --release -p clutchpack_sim --example staggered
+//! cargo build --release -p clutchpack_multibody --example staggered
 //! time target/release/examples/staggered 16            # 16 discs, 0.1 s, default scheme
 //! target/release/examples/staggered 8 shared 0.05 20   # 8 discs, shared step, 50 ms, 20 runs
 //! ```
@@ -13,7 +13,7 @@
 
 use clutchpack_model::cases::staggered_pack;
 use clutchpack_model::{Collector, Engine};
-use clutchpack_sim::{MultibodyEngine, MultibodyOptions, Scheme};
+use clutchpack_multibody::{MultibodyEngine, MultibodyOptions, Scheme};
 use std::time::Instant;
 
 fn main() {

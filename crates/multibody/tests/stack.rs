@@ -1,6 +1,6 @@
 //! The stack and its friction through rapier (MODEL.md section 5, issue 3 "Engagement"):
 //! separator plates on the housing (a brake) or an output drum (a clutch), the piston's clamp,
-//! face friction and lock-up. Run in release: `cargo test -p clutchpack_sim --release --test
+//! face friction and lock-up. Run in release: `cargo test -p clutchpack_multibody --release --test
 //! stack`.
 
 use clutchpack_model::checks::{first_lock_s, heat_j};
@@ -9,7 +9,7 @@ use clutchpack_model::{
     Hertz, LawKind, OilFilm, PackModel, Piston, PressureProfile, Shaft, SpeedProfile, StackModel,
     ToothLaw,
 };
-use clutchpack_sim::{MultibodyEngine, MultibodyOptions};
+use clutchpack_multibody::{MultibodyEngine, MultibodyOptions};
 
 fn body(name: &str, inertia: f64, drag: f64) -> DiscModel {
     DiscModel {
@@ -431,7 +431,7 @@ fn engine_for(
     let sim = &scene.simulation;
     MultibodyEngine::new(
         scene.pack.clone(),
-        clutchpack_sim::MultibodyOptions::with_settings(
+        clutchpack_multibody::MultibodyOptions::with_settings(
             sim.record_rate_hz,
             sim.max_step_s,
             sim.record_per_tooth,
@@ -565,7 +565,7 @@ fn engagement_with_the_multirate_start_locks_and_heats_as_the_shared_step() {
 
 /// [`engagement_with_the_multirate_start_locks_and_heats_as_the_shared_step`] on one shaft.
 fn engagement_locks_and_heats_as_the_shared_step(what: &str, scene: &clutchpack_scene::Scene) {
-    let run_with = |scheme: clutchpack_sim::Scheme, max_step_s: f64| {
+    let run_with = |scheme: clutchpack_multibody::Scheme, max_step_s: f64| {
         let options = MultibodyOptions {
             scheme,
             ..MultibodyOptions::with_settings(1e5, max_step_s, false)
@@ -575,9 +575,12 @@ fn engagement_locks_and_heats_as_the_shared_step(what: &str, scene: &clutchpack_
         e.run(0.12, &mut c).unwrap();
         (e.is_multirate(), c)
     };
-    let (multirate, auto) = run_with(clutchpack_sim::Scheme::Auto, scene.simulation.max_step_s);
+    let (multirate, auto) = run_with(
+        clutchpack_multibody::Scheme::Auto,
+        scene.simulation.max_step_s,
+    );
     assert!(multirate);
-    let (_, oracle) = run_with(clutchpack_sim::Scheme::Shared, 2.5e-6);
+    let (_, oracle) = run_with(clutchpack_multibody::Scheme::Shared, 2.5e-6);
     let first_lock = |c: &Collector, m: usize| first_lock_s(c, m).expect("every face locks");
     let (mut worst_lock, mut worst_heat) = (0.0f64, 0.0f64);
     for m in 0..2 * scene.pack.discs.len() {

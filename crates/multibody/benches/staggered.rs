@@ -7,12 +7,12 @@
 //! Before criterion's timings the bench prints, for N = 1, 4, 8 and 16 and both schemes
 //! (multirate, the default here, and the shared step), the median wall time of a few runs, the
 //! per-disc cost relative to one disc, world steps, coupling sub-steps and impacts.
-//! `cargo bench -p clutchpack_sim --bench staggered -- summary-only` prints the table alone
+//! `cargo bench -p clutchpack_multibody --bench staggered -- summary-only` prints the table alone
 //! (no criterion group matches that filter).
 
 use clutchpack_model::cases::staggered_pack;
 use clutchpack_model::{Collector, Engine};
-use clutchpack_sim::{MultibodyEngine, MultibodyOptions, Scheme};
+use clutchpack_multibody::{MultibodyEngine, MultibodyOptions, Scheme};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use std::time::Instant;
 
