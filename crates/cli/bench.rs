@@ -1,10 +1,10 @@
 //! `clutchpack bench`: speed figures as ratios and times, printed, never asserted.
 
 use anyhow::Result;
-use clutchpack_model::cases::staggered_pack;
-use clutchpack_model::{Observer, PackModel};
-use clutchpack_record::{RecordOptions, Replace};
-use clutchpack_scene::Override;
+use clutchpack_sdk::model::cases::staggered_pack;
+use clutchpack_sdk::model::{Observer, PackModel};
+use clutchpack_sdk::record::{RecordOptions, Replace};
+use clutchpack_sdk::scene::Override;
 use clutchpack_sdk::{
     load_scene, EngineChoice, PackEngine, RecordingRequest, RunCollector, RunRequest, Scheme,
     Simulation,
@@ -300,7 +300,7 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         }
         let scene = load_scene(Some(path), &[])?;
         let mut shared = scene.clone();
-        shared.simulation.scheme = clutchpack_scene::SchemeChoice::Shared;
+        shared.simulation.scheme = clutchpack_sdk::scene::SchemeChoice::Shared;
         let configs = [
             (&scene, EngineChoice::Reference),
             (&scene, EngineChoice::Multibody),
@@ -489,7 +489,7 @@ fn brake_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         "brake packs (cases::staggered_brake: N discs across +-0.8 of the free play and N + 1 plates on the housing, open gaps, {PACK_DURATION_S} s; {runs} rounds over the sizes); growth = wall per disc / wall per disc at N = 1"
     );
     pack_growth(
-        clutchpack_model::cases::staggered_brake,
+        clutchpack_sdk::model::cases::staggered_brake,
         &[1, 4, 8, 16],
         &engines,
         runs,
@@ -531,7 +531,7 @@ fn inertial_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         "inertial-shaft packs (cases::staggered_inertial: N discs across +-0.8 of the free play on a shaft of 2 kg m^2 driven by a torque, {PACK_DURATION_S} s; {runs} rounds over the sizes); growth = wall per disc / wall per disc at N = 1"
     );
     pack_growth(
-        clutchpack_model::cases::staggered_inertial,
+        clutchpack_sdk::model::cases::staggered_inertial,
         &[1, 4, 8, 16],
         &engines,
         runs,
@@ -621,10 +621,10 @@ struct Stoppable<'a> {
 }
 
 impl Observer for Stoppable<'_> {
-    fn sample(&mut self, s: &clutchpack_model::Sample) {
+    fn sample(&mut self, s: &clutchpack_sdk::model::Sample) {
         self.inner.sample(s);
     }
-    fn impact(&mut self, e: &clutchpack_model::ImpactEvent) {
+    fn impact(&mut self, e: &clutchpack_sdk::model::ImpactEvent) {
         self.inner.impact(e);
     }
     fn progress(&mut self, _t_s: f64) -> bool {
