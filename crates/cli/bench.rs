@@ -43,8 +43,9 @@ pub struct BenchArgs {
     /// m^2 driven by a torque; the median is reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub inertial_runs: usize,
-    /// Repetitions of each network timing (`scenes/coupled-clutches.toml` on the reference
-    /// and the multibody engine in turn; the medians are reported); 0 skips that part.
+    /// Repetitions of each network timing (`scenes/coupled-clutches.toml` and
+    /// `scenes/dct-upshift.toml` on the reference and the multibody engine in turn; the
+    /// medians are reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub network_runs: usize,
     /// Only the staggered-pack, brake-pack and inertial-pack parts (skips the paper case, the sweep, the
@@ -346,15 +347,26 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     Ok(())
 }
 
-/// 4b. The shipped network scene (`scenes/coupled-clutches.toml`, MODEL.md section 8) on both
-///    engines with the settings `run` gives them (the reference at the scene's tolerance, the
-///    multibody engine at its fixed step), in turn `runs` times (`--network-runs`; the
-///    medians are reported), and how far apart their lock times and final speeds are.
+/// 4b. The shipped network scenes (`scenes/coupled-clutches.toml`, `scenes/dct-upshift.toml`,
+///    MODEL.md section 8) on both engines with the settings `run` gives them (the reference
+///    at the scene's tolerance, the multibody engine at its fixed step), in turn `runs` times
+///    (`--network-runs`; the medians are reported), and how far apart their lock times and
+///    final speeds are.
 fn network_scenes(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     if runs == 0 {
         return Ok(());
     }
-    let file = "scenes/coupled-clutches.toml";
+    for file in ["scenes/coupled-clutches.toml", "scenes/dct-upshift.toml"] {
+        if stop.load(Ordering::SeqCst) {
+            return Ok(());
+        }
+        network_scene(file, runs, stop)?;
+    }
+    Ok(())
+}
+
+/// One network scene of [`network_scenes`].
+fn network_scene(file: &str, runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     let path = std::path::Path::new(file);
     if !path.exists() {
         out!("network {file}: skipped (run from the repository root)");
