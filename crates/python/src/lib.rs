@@ -174,8 +174,8 @@ fn load_scene(
         }
         (None, Some(t)) => {
             let name = name.unwrap_or_else(|| "<scene text>".into());
-            let s =
-                clutchpack_sdk::scene::parse(&t, &name, &here, &sets).map_err(|e| py_err(e.into()))?;
+            let s = clutchpack_sdk::scene::parse(&t, &name, &here, &sets)
+                .map_err(|e| py_err(e.into()))?;
             (s, here)
         }
         (p, None) => {
@@ -618,7 +618,8 @@ fn study_run(
     shard: u64,
     shards: u64,
 ) -> PyResult<(PathBuf, usize, usize, usize, usize, bool)> {
-    let s = clutchpack_sdk::study::load(&study).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let s =
+        clutchpack_sdk::study::load(&study).map_err(|e| PyValueError::new_err(e.to_string()))?;
     if shards == 0 || shard >= shards {
         return Err(PyValueError::new_err(format!(
             "shard {shard} of {shards}: the index must be in 0..{shards} (shards >= 1)"
