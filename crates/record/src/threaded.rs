@@ -31,6 +31,15 @@ enum ToRecorder {
 /// hands over what it has at each progress call (every 1024 steps) anyway.
 const BATCH: usize = 256;
 
+/// Bytes of samples per batch at most (about): a batch is handed over at [`BATCH`] items or
+/// this many bytes of their buffers, whichever comes first. A recorder that falls behind (a
+/// starved machine) leaves up to [`QUEUED_BATCHES`] + 3 batches in flight, and their buffers
+/// are kept for reuse: 256 samples of pack-8-brake's 17 bodies were about 870 kB a batch, so
+/// a run `nice`d under a load of 7 peaked at 36 MB recorded against 29 MB unloaded. With 256
+/// KiB a batch, at most about 3 MB are in flight whatever the pack; a 1-disc pack's batch
+/// (about 50 kB) is still [`BATCH`] items, so its hand-overs stay as rare.
+const BATCH_BYTES: usize = 256 << 10;
+
 /// Full batches that may wait for the recording thread. When the engine outruns the
 /// recorder (a long pack run: the recorder is the slower of the two), the queue fills and
 /// holds this many batches for the rest of the run: 64 batches of a 4-disc pack's samples
@@ -49,11 +58,28 @@ pub struct ThreadedRecorder {
     batch: Vec<ToRecorder>,
     /// items of `batch` in use; those beyond are spare buffers
     len: usize,
+    /// the bytes of the items in use (about: [`item_bytes`])
+    bytes: usize,
     failed: Arc<AtomicBool>,
     /// the recorder's `Observer::wants_contact_samples`
     wants_contacts: bool,
     /// gives back the recorder and the thread's CPU time in s
     handle: std::thread::JoinHandle<(Recorder, f64)>,
+}
+
+/// The bytes an item holds (its own size and its buffers', about), for [`BATCH_BYTES`].
+fn item_bytes(m: &ToRecorder) -> usize {
+    let disc = |d: &DiscSample| {
+        std::mem::size_of::<DiscSample>() + d.tooth_loads_n.len() * std::mem::size_of::<f64>()
+    };
+    std::mem::size_of::<ToRecorder>()
+        + match m {
+            ToRecorder::Sample(s) => s.discs.iter().map(disc).sum(),
+            ToRecorder::Contact(_, _, d) => disc(d),
+            ToRecorder::Interfaces(_, i) => i.len() * std::mem::size_of::<InterfaceSample>(),
+            ToRecorder::Temperatures(_, b, _) => b.len() * std::mem::size_of::<f64>(),
+            ToRecorder::Impact(_) => 0,
+        }
 }
 
 /// Copies `src` into `dst` field by field, reusing `dst`'s buffers (a derived `clone_from`
@@ -127,6 +153,7 @@ impl ThreadedRecorder {
             back,
             batch: Vec::with_capacity(BATCH),
             len: 0,
+            bytes: 0,
             failed,
             wants_contacts,
             handle,
@@ -211,7 +238,10 @@ impl ThreadedRecorder {
     }
 
     fn send_if_full(&mut self) {
-        if self.len >= BATCH {
+        if let Some(m) = self.len.checked_sub(1).and_then(|i| self.batch.get(i)) {
+            self.bytes += item_bytes(m);
+        }
+        if self.len >= BATCH || self.bytes >= BATCH_BYTES {
             self.send();
         }
     }
@@ -229,6 +259,7 @@ impl ThreadedRecorder {
             .unwrap_or_else(|_| Vec::with_capacity(BATCH));
         let full = std::mem::replace(&mut self.batch, next);
         self.len = 0;
+        self.bytes = 0;
         // A closed channel means the thread ended; join() reports why.
         let _ = self.tx.send(full);
     }
