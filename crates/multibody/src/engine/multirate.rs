@@ -222,7 +222,10 @@ impl Run {
         carriers: &[(RigidBodyHandle, Node, Node)],
     ) {
         self.drive_to_means(means, t1 - self.t);
-        let shaft_at = prescribed.map(|p| (p.angle(t1), p.speed(t1)));
+        let shaft_at = prescribed.map(|p| {
+            let (speed, angle) = p.speed_and_angle(t1);
+            (angle, speed)
+        });
         if let Some((angle, _)) = shaft_at {
             let bodies = &mut self.world.physics.bodies;
             bodies[self.world.shaft].set_next_kinematic_rotation(Rotation::from_rotation_z(angle));

@@ -415,10 +415,10 @@ impl ShaftAt {
     /// The carrier at `t`: the shaft's profile, or the housing at rest (`None`).
     pub(super) fn of(p: Option<&SpeedProfile>, t: f64) -> ShaftAt {
         match p {
-            Some(p) => ShaftAt {
-                speed: p.speed(t),
-                angle: p.angle(t),
-            },
+            Some(p) => {
+                let (speed, angle) = p.speed_and_angle(t);
+                ShaftAt { speed, angle }
+            }
             None => ShaftAt {
                 speed: 0.0,
                 angle: 0.0,
