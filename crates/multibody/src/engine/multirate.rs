@@ -372,7 +372,10 @@ impl Run {
     ) -> Option<f64> {
         let d = &self.bodies[i];
         let f = &self.forces[i];
-        let (g0, rb) = (d.spline.half_play_rad(), self.couplings[i].base_radius_m());
+        let (g0, rb) = (
+            self.couplings[i].half_play_rad(),
+            self.couplings[i].base_radius_m(),
+        );
         let offset = d.law.engagement_offset_m();
         let engaged = f.depth_m > 0.0;
         let mut first: Option<f64> = None;
