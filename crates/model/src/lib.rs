@@ -71,7 +71,7 @@ pub use clutch::{
     DrumModel, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackBody,
     StackModel,
 };
-pub use drive::{Harmonic, Shaft, ShaftExcitation, SpeedProfile, Table, TableError};
+pub use drive::{Harmonic, LocalProfile, Shaft, ShaftExcitation, SpeedProfile, Table, TableError};
 pub use fatigue::{FatigueParams, Material, MinerRule, ToothForm};
 pub use impact::{detect_impacts, parabolic_peak, ImpactEvent, ImpactTracker};
 pub use law::{ContactState, Engagement, Hertz, LawKind, OilFilm, ToothLaw};

@@ -128,8 +128,22 @@ pub(crate) struct Coupling {
     /// cosine per call was the engine's largest single cost on the 16-disc brake pack (16 %
     /// of the run, perf).
     rb: f64,
+    /// The half play `g0 = d / (2 R)`, rad, kept as `rb` (a division per call of the
+    /// kinematics, four and more per multirate sub-step).
+    g0: f64,
     /// The sine and cosine of the pressure angle (per-tooth lines of action).
     sin_cos_alpha: (f64, f64),
+}
+
+/// The lumped tooth's kinematics at `(phi, dphi)` with the half play `g0` (rad) and the base
+/// radius `rb` (m): [`SplineGeometry::kinematics_at`] to the bit, with both kept.
+fn kinematics(g0: f64, rb: f64, phi_rad: f64, dphi_rad_s: f64) -> ToothKinematics {
+    let flank = Flank::of(phi_rad);
+    ToothKinematics {
+        flank,
+        delta_m: (phi_rad.abs() - g0) * rb,
+        v_n_m_s: flank.phi_sign() * dphi_rad_s * rb,
+    }
 }
 
 /// Advances one tooth's contact memory to `kin` and returns its signed load (N) and engagement
@@ -174,6 +188,16 @@ impl Coupling {
         self.rb
     }
 
+    /// The half play `g0`, rad ([`SplineGeometry::half_play_rad`], kept).
+    pub fn half_play_rad(&self) -> f64 {
+        self.g0
+    }
+
+    /// The lumped tooth's kinematics at `(phi, dphi)` ([`kinematics`]).
+    fn kinematics(&self, phi_rad: f64, dphi_rad_s: f64) -> ToothKinematics {
+        kinematics(self.g0, self.rb, phi_rad, dphi_rad_s)
+    }
+
     /// A coupling; `per_tooth` resolves every tooth, with spacing errors `phase_errors_rad`
     /// (one per tooth, or empty for none).
     pub fn new(
@@ -203,6 +227,7 @@ impl Coupling {
         };
         Coupling {
             rb: spline.base_radius_m(),
+            g0: spline.half_play_rad(),
             sin_cos_alpha: spline.pressure_angle_rad.sin_cos(),
             spline,
             law,
@@ -245,7 +270,7 @@ impl Coupling {
             law.load_n(kin, &e)
         };
         if self.teeth.is_empty() {
-            let kin = self.spline.kinematics_at(phi, dphi, self.rb);
+            let kin = self.kinematics(phi, dphi);
             return self.disc_torque_n_m(load(&self.lumped, &kin));
         }
         let r = self.spline.pitch_radius_m;
@@ -255,9 +280,7 @@ impl Coupling {
         }
         let mut moment = 0.0;
         for tooth in &self.teeth {
-            let k0 = self
-                .spline
-                .kinematics_at(phi + tooth.phase_error_rad, dphi, self.rb);
+            let k0 = self.kinematics(phi + tooth.phase_error_rad, dphi);
             let u = tooth.line_of_action(k0.flank.phi_sign(), self.sin_cos_alpha);
             let k = ToothKinematics {
                 flank: k0.flank,
@@ -278,7 +301,7 @@ impl Coupling {
     /// zero, and so are the sums over them: the probes skip the loop (measured on
     /// `eccentric-disc.toml`: the probes were 40 % of the run, most of them in free flight).
     fn none_can_touch(&self, phi: f64, offset_m: f64) -> bool {
-        let reach = (phi.abs() + self.max_phase_error_rad - self.spline.half_play_rad()) * self.rb
+        let reach = (phi.abs() + self.max_phase_error_rad - self.g0) * self.rb
             + offset_m
             + self.law.engagement_offset_m();
         reach < -PROBE_MARGIN_M
@@ -314,7 +337,7 @@ impl Coupling {
 
     /// Evaluates the tooth law for the relative state `rel`, advancing the contact memories.
     pub fn evaluate(&mut self, rel: &RelativeState) -> CouplingForces {
-        let kin = self.spline.kinematics_at(rel.phi, rel.dphi, self.rb);
+        let kin = self.kinematics(rel.phi, rel.dphi);
         if self.teeth.is_empty() {
             self.evaluate_lumped(kin)
         } else {
@@ -348,6 +371,7 @@ impl Coupling {
 
     /// Every tooth at its own contact point, along its own line of action (MODEL.md 5).
     fn evaluate_per_tooth(&mut self, kin: ToothKinematics, rel: &RelativeState) -> CouplingForces {
+        let (g0, rb) = (self.g0, self.rb);
         let r = self.spline.pitch_radius_m;
         let [ex, ey] = rel.offset;
         let [ex_dot, ey_dot] = rel.offset_rate;
@@ -359,9 +383,7 @@ impl Coupling {
         let mut stiffness = 0.0;
         let mut potential = 0.0;
         for tooth in &mut self.teeth {
-            let k0 = self
-                .spline
-                .kinematics_at(rel.phi + tooth.phase_error_rad, rel.dphi, self.rb);
+            let k0 = kinematics(g0, rb, rel.phi + tooth.phase_error_rad, rel.dphi);
             let u = tooth.line_of_action(k0.flank.phi_sign(), self.sin_cos_alpha);
             let k = ToothKinematics {
                 flank: k0.flank,

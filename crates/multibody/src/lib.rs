@@ -98,7 +98,9 @@
 //!   a pose makes rapier recompute the body's world mass properties).
 //!
 //! The prescribed shaft is a position-based kinematic body set to the profile's exact angle at
-//! every step; its speed in the law is the profile's exact speed.
+//! every step; its speed in the law is the profile's exact speed. (Within a world step of the
+//! multirate schemes the sub-steps read a harmonic profile from its expansion about the step's
+//! middle, [`clutchpack_model::LocalProfile`]: the same angle and speed to rounding.)
 //!
 //! ## Theory: the two schemes
 //! [`MultibodyEngine::scheme_explanation`] says which one runs and why.
@@ -151,9 +153,10 @@
 //! motion over the world step with its own sub-steps (`engine/multirate.rs`):
 //! - *The sub-step* is the classical Runge-Kutta method (order 4) on the disc's motion,
 //!   `J omega_d' = T(phi, phi') - C2 omega_d` (Hu et al. eq (5)), with
-//!   `phi = theta_s(t) - theta_d` and the shaft's angle and speed exact from the profile: in
-//!   free flight without drag the disc turns at constant speed and the sub-step is exact
-//!   whatever its length. Its length is the shared step's controller applied to this coupling
+//!   `phi = theta_s(t) - theta_d` and the shaft's angle and speed exact from the profile (a
+//!   harmonic one from its expansion about the world step's middle, equal to rounding,
+//!   `Prescribed` in `engine/substep.rs`): in free flight without drag the disc turns at
+//!   constant speed and the sub-step is exact whatever its length. Its length is the shared step's controller applied to this coupling
 //!   alone (128 sub-steps per predicted contact), landing on every onset and separation.
 //! - *The kinks.* The `s^1.5` law's load grows as `t^1.5` from an onset (and falls as
 //!   `(t_off - t)^1.5` to a separation), so the step touching a kink is only of order `h^2.5`
@@ -180,7 +183,17 @@
 //!   (`examples/staggered.rs`): 36 % in the shaft profile's sin/cos (two evaluations per
 //!   sub-step), 22 % in the sub-steps' arithmetic and the step controller, 18 % in rapier
 //!   (1 000 world steps), 13 % in the tooth law, 7 % in allocation and the kernel, 2 % in the
-//!   impact trackers.
+//!   impact trackers. Issue 33 (`perf` of the 16-disc brake pack, `clutchpack run` of the
+//!   MuJoCo anchor's `brake_N16.toml`, 225 000 sub-steps per 0.1 s, 175 per impact): the
+//!   profile's `sin` and `cos` at every stage were still 15 %, the controller's local period
+//!   of a contact (two roots, three divisions per sub-step) 10 %. One `sincos` per harmonic
+//!   ([`clutchpack_model::SpeedProfile::speed_and_angle`]), then the expansion about each world
+//!   step's middle (no libm call per stage), the period decided without its roots when it
+//!   cannot bind (`stepping.rs`) and the half play kept as `Rb` is (`hook.rs`): 0.81x the
+//!   engine's time on that pack (`clutchpack bench`, same minute: 55.4-55.9 against
+//!   68.6-68.9 ms) and over 0.3 s whole processes; now about 20 % rapier's world step (joint
+//!   constraints), 8 % each the sub-step's arithmetic and the landing loop, 10 % the tooth
+//!   law, 5 % each the controller and the expansion.
 //!
 //! **Multirate on an inertial shaft** (issue 20; eq 4, `J1 omega_s' = T_drive - C1 omega_s -
 //! sum T_k`; with plates and a drum see "Multirate with a drum" below). The discs no longer meet a carrier whose motion is known

@@ -20,11 +20,13 @@
 use super::inertial::Inertial;
 use super::landing::SubSteps;
 use super::state::{Run, ShaftDrive};
-use super::substep::{checked_sub_step, graded_step, rk4_work, Node, Rk4, ShaftAt, WorldStep};
+use super::substep::{
+    checked_sub_step, graded_step, rk4_work, Node, Prescribed, Rk4, ShaftAt, WorldStep,
+};
 use crate::stack::Face;
 use crate::stepping::{bracketed_root, coupling_step};
 use crate::world::Carrier;
-use clutchpack_model::{EngineError, SpeedProfile};
+use clutchpack_model::{EngineError, LocalProfile, SpeedProfile};
 use std::sync::Arc;
 
 /// Sub-steps of the clamped stack are at most the world step over this (dimensionless), as an
@@ -39,13 +41,25 @@ struct System {
     /// Each coupling's inertia about the axis, kg m^2 (rapier's), and drag `C2`, N m s/rad.
     j: Vec<f64>,
     c2: Vec<f64>,
-    /// The prescribed shaft's profile (`None`: the shaft is inertial).
+    /// The prescribed shaft's profile (`None`: the shaft is inertial), and its expansion
+    /// about the world step's middle ([`Prescribed`]).
     profile: Option<Arc<SpeedProfile>>,
+    local: Option<LocalProfile>,
     /// The inertial carriers integrated with the stack (an inertial shaft, the drum; any
     /// number, in this order).
     spins: Vec<Spin>,
     /// How each coupling's carrier moves.
     mounts: Vec<Mount>,
+}
+
+impl System {
+    /// The prescribed shaft over the world step (`None`: the shaft is inertial).
+    fn shaft(&self) -> Option<Prescribed<'_>> {
+        self.profile.as_deref().map(|profile| Prescribed {
+            profile,
+            local: self.local.as_ref(),
+        })
+    }
 }
 
 /// An inertial carrier integrated with the clamped stack: `J w' = T_ext(t) - C w - sum T_k`
@@ -232,6 +246,7 @@ impl Run {
                 .collect(),
             c2: self.bodies.iter().map(|d| d.drag_n_m_s_rad).collect(),
             profile: profile.clone(),
+            local: ws.drive.and_then(|d| d.local.cloned()),
             spins,
             mounts,
         };
@@ -249,7 +264,7 @@ impl Run {
             turn: vec![0.0; n],
             angle: angle0.clone(),
             w: w0.clone(),
-            shaft: ShaftAt::of(profile.as_deref(), t0),
+            shaft: ShaftAt::of(sys.shaft(), t0),
             impulse: vec![0.0; n_if],
             evaluated_here: false,
             cap: a.max_step_s / STACK_SUB_STEPS,
@@ -443,10 +458,7 @@ impl Run {
         } = *start;
         let n = u0.len();
         let (tm, te) = (t + 0.5 * h, t + h);
-        let (mid, end) = (
-            ShaftAt::of(sys.profile.as_deref(), tm),
-            ShaftAt::of(sys.profile.as_deref(), te),
-        );
+        let (mid, end) = (ShaftAt::of(sys.shaft(), tm), ShaftAt::of(sys.shaft(), te));
         let RkBuffers { k, rk, x0, out } = b;
         x0[..n].copy_from_slice(u0);
         x0[n..].copy_from_slice(w0);
@@ -752,7 +764,7 @@ impl SubSteps for StackSteps {
             *x += dx;
         }
         self.w.clone_from(&step.w_carrier);
-        self.shaft = ShaftAt::of(self.sys.profile.as_deref(), t);
+        self.shaft = ShaftAt::of(self.sys.shaft(), t);
         for (x, dx) in self.impulse.iter_mut().zip(&step.impulse) {
             *x += dx;
         }

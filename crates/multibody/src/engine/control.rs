@@ -25,7 +25,7 @@ impl Run {
             law: &d.law,
             phi: rel.0,
             dphi: rel.1,
-            g0: d.spline.half_play_rad(),
+            g0: self.couplings[i].half_play_rad(),
             rb: self.couplings[i].base_radius_m(),
             m_eff_kg: self.m_eff[i],
             rel_accel_bound: 1.01 * accel_bound,

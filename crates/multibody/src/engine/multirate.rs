@@ -8,8 +8,8 @@ use super::inertial::Inertial;
 use super::landing::SubSteps;
 use super::state::{disc_sample, relative_state, Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, GapDrag, Node, Path, Relative, ShaftAt, SubStep, TurnMoment,
-    WorldStep,
+    checked_sub_step, graded_step, GapDrag, Node, Path, Prescribed, Relative, ShaftAt, SubStep,
+    TurnMoment, WorldStep,
 };
 use crate::hook::{CouplingForces, RelativeState, FLANKS};
 use crate::options::{MultibodyOptions, Stepping};
@@ -61,15 +61,14 @@ pub(super) fn unsupported(
 }
 
 impl Run {
-    /// The speed profile of coupling `i`'s carrier: the prescribed shaft's (the multirate
-    /// scheme runs only on one), `None` for the housing (at rest).
-    fn profile(&self, i: usize) -> Option<std::sync::Arc<SpeedProfile>> {
-        match (self.world.carriers[i], &self.shaft) {
-            (Carrier::Shaft, ShaftDrive::Prescribed(p)) => Some(std::sync::Arc::clone(p)),
-            (Carrier::Shaft, ShaftDrive::Inertial { .. }) => {
-                unreachable!("the inertial shaft's discs go with the shaft")
-            }
-            (Carrier::Housing, _) => None,
+    /// The known path of coupling `i`'s carrier over the world step and the bound of its
+    /// acceleration, rad/s^2: the prescribed shaft's (`drive`; the discs of an inertial shaft
+    /// go with the shaft), or the housing at rest.
+    fn known_path<'a>(&self, i: usize, drive: Option<Prescribed<'a>>) -> (Path<'a>, f64) {
+        match (self.world.carriers[i], drive) {
+            (Carrier::Shaft, Some(p)) => (Path::Profile(p), self.shaft_accel_bound),
+            (Carrier::Shaft, None) => unreachable!("the inertial shaft's discs go with the shaft"),
+            (Carrier::Housing, _) => (Path::Housing, 0.0),
             (Carrier::Drum, _) => unreachable!("the drum's plates go with the drum"),
         }
     }
@@ -222,7 +221,10 @@ impl Run {
         carriers: &[(RigidBodyHandle, Node, Node)],
     ) {
         self.drive_to_means(means, t1 - self.t);
-        let shaft_at = prescribed.map(|p| (p.angle(t1), p.speed(t1)));
+        let shaft_at = prescribed.map(|p| {
+            let (speed, angle) = p.speed_and_angle(t1);
+            (angle, speed)
+        });
         if let Some((angle, _)) = shaft_at {
             let bodies = &mut self.world.physics.bodies;
             bodies[self.world.shaft].set_next_kinematic_rotation(Rotation::from_rotation_z(angle));
@@ -276,11 +278,7 @@ impl Run {
         let t1 = ws.t1;
         let (t0, h) = (self.t, t1 - self.t);
         let phi0 = self.rel[i].phi;
-        let p = self.profile(i);
-        let (path, bound) = match p.as_deref() {
-            Some(p) => (Path::Profile(p), self.shaft_accel_bound),
-            None => (Path::Housing, 0.0),
-        };
+        let (path, bound) = self.known_path(i, ws.drive);
         self.integrate_coupling(i, gap, path, bound, ws)?;
         let (phi1, dphi1) = (self.rel[i].phi, self.rel[i].dphi);
         let (c0, c1) = (path.at(t0), path.at(t1));
@@ -374,7 +372,10 @@ impl Run {
     ) -> Option<f64> {
         let d = &self.bodies[i];
         let f = &self.forces[i];
-        let (g0, rb) = (d.spline.half_play_rad(), self.couplings[i].base_radius_m());
+        let (g0, rb) = (
+            self.couplings[i].half_play_rad(),
+            self.couplings[i].base_radius_m(),
+        );
         let offset = d.law.engagement_offset_m();
         let engaged = f.depth_m > 0.0;
         let mut first: Option<f64> = None;

@@ -37,7 +37,7 @@
 
 use super::energy::EnergyAudit;
 use super::state::{shaft_accel_bound, Run, ShaftDrive};
-use super::substep::{split_remainder, Counts, WorldStep};
+use super::substep::{split_remainder, Counts, Prescribed, WorldStep};
 use super::thermal::Thermal;
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
@@ -413,9 +413,22 @@ impl MultibodySession {
             let run = &mut self.run;
             let t1 = world_step_end(run.t, a.max_step_s, grid, end);
             run.read_relative_states();
+            // the prescribed shaft over the step, expanded about its middle once for every
+            // sub-step's stages
+            let profile = match &run.shaft {
+                ShaftDrive::Prescribed(p) => Some(Arc::clone(p)),
+                ShaftDrive::Inertial { .. } => None,
+            };
+            let local = profile
+                .as_deref()
+                .and_then(|p| Prescribed::expand(p, run.t, t1));
             let mut ws = WorldStep {
                 t1,
                 a: &a,
+                drive: profile.as_deref().map(|profile| Prescribed {
+                    profile,
+                    local: local.as_ref(),
+                }),
                 counts: &mut self.counts,
                 closed: &mut closed,
                 contacts: &mut contacts,
