@@ -253,3 +253,69 @@ fn no_two_files_import_each_other() {
         .collect();
     assert!(pairs.is_empty(), "files that import each other: {pairs:?}");
 }
+
+/// The `clutchpack_*` crates in the `[dependencies]` of a `Cargo.toml` (not the dev- or
+/// build-dependencies), by their short names (`clutchpack_model` -> `model`).
+fn our_dependencies(cargo_toml: &Path) -> std::collections::BTreeSet<String> {
+    let text = std::fs::read_to_string(cargo_toml).unwrap();
+    let mut inside = false;
+    let mut out = std::collections::BTreeSet::new();
+    for line in text.lines().map(str::trim) {
+        if line.starts_with('[') {
+            inside = line == "[dependencies]";
+        } else if inside {
+            if let Some(rest) = line.strip_prefix("clutchpack_") {
+                let name: String = rest
+                    .chars()
+                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                    .collect();
+                out.insert(name);
+            }
+        }
+    }
+    out
+}
+
+/// The crates table's last column ("depends on (ours)") is what each crate's `Cargo.toml`
+/// says (issue 33: the dependency column checked, not only written).
+#[test]
+fn the_crates_tables_dependencies_are_the_manifests() {
+    let text = std::fs::read_to_string(root().join("ARCHITECTURE.md")).unwrap();
+    let table = section(&text, "Crates");
+    let mut rows = 0;
+    for row in table.lines().filter(|l| l.starts_with("| `clutchpack")) {
+        let cols: Vec<&str> = row.split('|').map(str::trim).collect();
+        // "| crate | folder | what | deps |" splits into ["", crate, folder, what, deps, ""]
+        let (folder, deps) = (cols[2], cols[cols.len() - 2]);
+        let folder = folder.split('`').nth(1).expect("a folder in backticks");
+        let manifest = if folder == "crates/cli" {
+            root().join("Cargo.toml")
+        } else {
+            root().join(folder).join("Cargo.toml")
+        };
+        let known = [
+            "model",
+            "scene",
+            "analysis",
+            "reference",
+            "multibody",
+            "record",
+            "study",
+            "sdk",
+            "fmu",
+        ];
+        let said: std::collections::BTreeSet<String> = deps
+            .split(|c: char| !c.is_ascii_alphanumeric())
+            .filter(|w| known.contains(w))
+            .map(str::to_string)
+            .collect();
+        assert_eq!(
+            said,
+            our_dependencies(&manifest),
+            "ARCHITECTURE.md's crates table, {folder}: the dependency column against {}",
+            manifest.display()
+        );
+        rows += 1;
+    }
+    assert_eq!(rows, 11, "the crates table's rows");
+}

@@ -1,10 +1,10 @@
 //! `clutchpack bench`: speed figures as ratios and times, printed, never asserted.
 
 use anyhow::Result;
-use clutchpack_model::cases::staggered_pack;
-use clutchpack_model::{Observer, PackModel};
-use clutchpack_record::{RecordOptions, Replace};
-use clutchpack_scene::Override;
+use clutchpack_sdk::model::cases::staggered_pack;
+use clutchpack_sdk::model::{Observer, PackModel};
+use clutchpack_sdk::record::{RecordOptions, Replace};
+use clutchpack_sdk::scene::Override;
 use clutchpack_sdk::{
     load_scene, EngineChoice, PackEngine, RecordingRequest, RunCollector, RunRequest, Scheme,
     Simulation,
@@ -43,8 +43,9 @@ pub struct BenchArgs {
     /// m^2 driven by a torque; the median is reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub inertial_runs: usize,
-    /// Repetitions of each network timing (`scenes/coupled-clutches.toml` on the reference
-    /// and the multibody engine in turn; the medians are reported); 0 skips that part.
+    /// Repetitions of each network timing (`scenes/coupled-clutches.toml` and
+    /// `scenes/dct-upshift.toml` on the reference and the multibody engine in turn; the
+    /// medians are reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub network_runs: usize,
     /// Repetitions of each thermal timing (`scenes/pack-6-thermal.toml` and the first second
@@ -309,7 +310,7 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         }
         let scene = load_scene(Some(path), &[])?;
         let mut shared = scene.clone();
-        shared.simulation.scheme = clutchpack_scene::SchemeChoice::Shared;
+        shared.simulation.scheme = clutchpack_sdk::scene::SchemeChoice::Shared;
         let configs = [
             (&scene, EngineChoice::Reference),
             (&scene, EngineChoice::Multibody),
@@ -362,8 +363,7 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
 ///    with `[thermal]` and without it (the same scene otherwise, on the same scheme: the
 ///    reference engine's monolithic one, where it runs a thermal pack) in turn `runs` times:
 ///    the medians of the engine's CPU time and the median of the rounds' ratios (thermal
-///    over isothermal). The two
-///    are not the same physics: the thermal run's oil warms (thinner tooth films) and its
+///    over isothermal). The two are not the same physics: the thermal run's oil warms (thinner tooth films) and its
 ///    gaps take the law's viscosity (docs/DECISIONS.md, "Thermal cost").
 fn thermal_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     if runs == 0 {
@@ -396,14 +396,14 @@ fn thermal_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
             }
             th.oil.capacity_j_k = 1e30;
             th.reference_k = th.initial_k;
-            th.gap_viscosity = clutchpack_model::thermal::GapViscosity::Scaled;
+            th.gap_viscosity = clutchpack_sdk::model::thermal::GapViscosity::Scaled;
         }
         for engine in [EngineChoice::Reference, EngineChoice::Multibody] {
             let mut isothermal = thermal.clone();
             isothermal.thermal = None;
             if engine == EngineChoice::Reference {
                 // the reference engine runs a thermal pack monolithic: the same scheme
-                isothermal.simulation.scheme = clutchpack_scene::SchemeChoice::Shared;
+                isothermal.simulation.scheme = clutchpack_sdk::scene::SchemeChoice::Shared;
             }
             let mut times = [Vec::new(), Vec::new(), Vec::new()];
             let mut ratios = [Vec::new(), Vec::new()];
@@ -444,15 +444,26 @@ fn thermal_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     Ok(())
 }
 
-/// 4b. The shipped network scene (`scenes/coupled-clutches.toml`, MODEL.md section 8) on both
-///    engines with the settings `run` gives them (the reference at the scene's tolerance, the
-///    multibody engine at its fixed step), in turn `runs` times (`--network-runs`; the
-///    medians are reported), and how far apart their lock times and final speeds are.
+/// 4b. The shipped network scenes (`scenes/coupled-clutches.toml`, `scenes/dct-upshift.toml`,
+///    MODEL.md section 8) on both engines with the settings `run` gives them (the reference
+///    at the scene's tolerance, the multibody engine at its fixed step), in turn `runs` times
+///    (`--network-runs`; the medians are reported), and how far apart their lock times and
+///    final speeds are.
 fn network_scenes(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     if runs == 0 {
         return Ok(());
     }
-    let file = "scenes/coupled-clutches.toml";
+    for file in ["scenes/coupled-clutches.toml", "scenes/dct-upshift.toml"] {
+        if stop.load(Ordering::SeqCst) {
+            return Ok(());
+        }
+        network_scene(file, runs, stop)?;
+    }
+    Ok(())
+}
+
+/// One network scene of [`network_scenes`].
+fn network_scene(file: &str, runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     let path = std::path::Path::new(file);
     if !path.exists() {
         out!("network {file}: skipped (run from the repository root)");
@@ -587,7 +598,7 @@ fn brake_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         "brake packs (cases::staggered_brake: N discs across +-0.8 of the free play and N + 1 plates on the housing, open gaps, {PACK_DURATION_S} s; {runs} rounds over the sizes); growth = wall per disc / wall per disc at N = 1"
     );
     pack_growth(
-        clutchpack_model::cases::staggered_brake,
+        clutchpack_sdk::model::cases::staggered_brake,
         &[1, 4, 8, 16],
         &engines,
         runs,
@@ -629,7 +640,7 @@ fn inertial_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         "inertial-shaft packs (cases::staggered_inertial: N discs across +-0.8 of the free play on a shaft of 2 kg m^2 driven by a torque, {PACK_DURATION_S} s; {runs} rounds over the sizes); growth = wall per disc / wall per disc at N = 1"
     );
     pack_growth(
-        clutchpack_model::cases::staggered_inertial,
+        clutchpack_sdk::model::cases::staggered_inertial,
         &[1, 4, 8, 16],
         &engines,
         runs,
@@ -719,10 +730,10 @@ struct Stoppable<'a> {
 }
 
 impl Observer for Stoppable<'_> {
-    fn sample(&mut self, s: &clutchpack_model::Sample) {
+    fn sample(&mut self, s: &clutchpack_sdk::model::Sample) {
         self.inner.sample(s);
     }
-    fn impact(&mut self, e: &clutchpack_model::ImpactEvent) {
+    fn impact(&mut self, e: &clutchpack_sdk::model::ImpactEvent) {
         self.inner.impact(e);
     }
     fn progress(&mut self, _t_s: f64) -> bool {

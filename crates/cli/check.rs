@@ -3,7 +3,7 @@
 
 use crate::common::{self, BadInput};
 use anyhow::Result;
-use clutchpack_scene::EngineChoice;
+use clutchpack_sdk::scene::EngineChoice;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -28,9 +28,9 @@ pub struct CheckArgs {
 pub fn check(a: CheckArgs) -> Result<ExitCode> {
     if a.keys {
         if a.markdown {
-            out!("{}", clutchpack_scene::keys_markdown());
+            out!("{}", clutchpack_sdk::scene::keys_markdown());
         } else {
-            out!("{}", clutchpack_scene::keys_doc());
+            out!("{}", clutchpack_sdk::scene::keys_doc());
         }
         return Ok(ExitCode::SUCCESS);
     }

@@ -20,7 +20,7 @@ pub fn engine_parser() -> impl clap::builder::TypedValueParser<Value = EngineCho
 pub fn is_bad_input(e: &anyhow::Error) -> bool {
     e.chain().any(|c| {
         c.is::<BadInput>()
-            || c.is::<clutchpack_scene::SceneError>()
+            || c.is::<clutchpack_sdk::scene::SceneError>()
             || c.downcast_ref::<clutchpack_sdk::Error>()
                 .is_some_and(clutchpack_sdk::Error::is_bad_input)
     })

@@ -1,6 +1,6 @@
 //! The text of `clutchpack replay`: what a recording holds, for a reader at a terminal.
 
-use clutchpack_record::RecordingReader;
+use clutchpack_sdk::record::RecordingReader;
 
 /// What the file holds, as text for `clutchpack replay`: the file and its state, the run
 /// (program, engine, scene and its hash, overrides), the topics with their schemas,
@@ -20,7 +20,7 @@ pub fn describe(r: &RecordingReader) -> String {
         r.path().display(),
         r.file_bytes()
     );
-    if let Some(run) = i.metadata(clutchpack_record::info::META_RUN) {
+    if let Some(run) = i.metadata(clutchpack_sdk::record::info::META_RUN) {
         let g = |k: &str| run.get(k).map(String::as_str).unwrap_or("?");
         let sha = g("scene_sha256");
         let _ = writeln!(
@@ -152,9 +152,9 @@ pub fn describe(r: &RecordingReader) -> String {
     let interfaces = r.interface_stats();
     if !interfaces.is_empty() {
         let _ = writeln!(s, "friction interfaces (from the piston side):");
-        let table = clutchpack_analysis::interface_table(
+        let table = clutchpack_sdk::analysis::interface_table(
             &interfaces,
-            clutchpack_analysis::TableFormat::Text,
+            clutchpack_sdk::analysis::TableFormat::Text,
         );
         for line in table.lines() {
             let _ = writeln!(s, "  {line}");
@@ -178,8 +178,8 @@ fn short(x: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clutchpack_record::synthetic::synthetic_run;
-    use clutchpack_record::{open, RecordOptions, Recorder};
+    use clutchpack_sdk::record::synthetic::synthetic_run;
+    use clutchpack_sdk::record::{open, RecordOptions, Recorder};
 
     /// The text names the file's state, the engine, every topic, the stored summary and the
     /// time span (0 .. 399 samples of 10 us, printed without float noise).

@@ -3,7 +3,7 @@
 
 use crate::common::{self, BadInput};
 use anyhow::{Context, Result};
-use clutchpack_scene::{EngineChoice, Override};
+use clutchpack_sdk::scene::{EngineChoice, Override};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -46,8 +46,8 @@ fn library() -> Result<PathBuf> {
 }
 
 pub fn fmu(a: FmuArgs) -> Result<ExitCode> {
-    let scene = clutchpack_scene::load(&a.scene, &a.sets)?;
-    // the one output policy (`clutchpack_record::check_outputs`): never the scene itself, a
+    let scene = clutchpack_sdk::scene::load(&a.scene, &a.sets)?;
+    // the one output policy (`clutchpack_sdk::record::check_outputs`): never the scene itself, a
     // folder, a device or a FIFO
     crate::outputs::check_outputs(
         &[crate::outputs::Output::file("--out", &a.out)],

@@ -156,7 +156,7 @@ mod tests {
     #[test]
     fn causes_are_printed_once() {
         let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
-        let e = anyhow::Error::new(clutchpack_study::part::PartError::Io {
+        let e = anyhow::Error::new(clutchpack_sdk::study::part::PartError::Io {
             path: "nope".into(),
             source: io,
         })

@@ -6,7 +6,7 @@
 use crate::common::{self, BadInput};
 use crate::outputs::Output;
 use anyhow::{Context, Result};
-use clutchpack_scene::Scene;
+use clutchpack_sdk::scene::Scene;
 use clutchpack_sdk::NetworkRequest;
 use std::path::Path;
 use std::process::ExitCode;
@@ -180,11 +180,11 @@ fn plot(
         .map(|(k, c)| series(&c.name, &|s| s.torque_n_m[k]))
         .collect();
     let panels = [
-        clutchpack_analysis::Panel {
+        clutchpack_sdk::analysis::Panel {
             y_label: "speed [rad/s]".into(),
             series: speeds,
         },
-        clutchpack_analysis::Panel {
+        clutchpack_sdk::analysis::Panel {
             y_label: "torque on body a [N m]".into(),
             series: torques,
         },
@@ -194,7 +194,7 @@ fn plot(
         scene.name
     );
     crate::outputs::write_with(path, |tmp| {
-        clutchpack_analysis::plot_panels(tmp, &title, "t [s]", &panels)
+        clutchpack_sdk::analysis::plot_panels(tmp, &title, "t [s]", &panels)
             .with_context(|| format!("plotting {}", path.display()))
     })
 }

@@ -1,13 +1,13 @@
 //! Output paths, checked before any work and written whole.
 //!
 //! Every command checks all its output paths before it starts ([`check_outputs`], the one
-//! policy of every front end: `clutchpack_record::check_outputs`): the folder exists (the
+//! policy of every front end: `clutchpack_sdk::record::check_outputs`): the folder exists (the
 //! recording's is created) and takes a new file, the path is not a folder, a FIFO or a
 //! device, no two outputs name the same file and no output names an input (the scene being
 //! run). A problem is bad input (exit 2) naming the flag and the path, found in
 //! milliseconds rather than after a long simulation. Every output is then written to a
 //! temporary sibling and renamed into place when complete ([`write_text`], [`write_with`],
-//! `clutchpack_record::Recorder::create_output`), so a reader sees the old file or the
+//! `clutchpack_sdk::record::Recorder::create_output`), so a reader sees the old file or the
 //! complete new one, never half of one.
 
 use crate::common::BadInput;
@@ -15,8 +15,8 @@ use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 
 /// One output of a command: the flag that named it (for messages) and its path; the policy
-/// is `clutchpack_record::check_outputs`, shared with the FMU and Python.
-pub type Output<'a> = clutchpack_record::OutputPath<'a>;
+/// is `clutchpack_sdk::record::check_outputs`, shared with the FMU and Python.
+pub type Output<'a> = clutchpack_sdk::record::OutputPath<'a>;
 
 /// Creates the folder of an output (`flag` names it in messages) and its parents; a file in
 /// the way is said as such, not as the OS's "File exists". Bad input (exit 2) on failure.
@@ -55,12 +55,13 @@ fn folder(path: &Path) -> PathBuf {
 /// documentation), no two outputs the same file, no output the same file as an input.
 /// Errors are bad input (exit 2) naming the flag and the path.
 pub fn check_outputs(outputs: &[Output<'_>], inputs: &[&Path]) -> Result<()> {
-    clutchpack_record::check_outputs(outputs, inputs).map_err(|e| BadInput(e.to_string()).into())
+    clutchpack_sdk::record::check_outputs(outputs, inputs)
+        .map_err(|e| BadInput(e.to_string()).into())
 }
 
 /// Writes `text` to `path` whole (temporary sibling, renamed into place).
 pub fn write_text(path: &Path, text: &str) -> Result<()> {
-    clutchpack_record::write_whole(path, text.as_bytes())
+    clutchpack_sdk::record::write_whole(path, text.as_bytes())
         .with_context(|| format!("writing {}", path.display()))?;
     Ok(())
 }
@@ -69,9 +70,11 @@ pub fn write_text(path: &Path, text: &str) -> Result<()> {
 /// writers that choose the format by extension, like the plots), then renames it into place;
 /// removes the temporary file if `write` fails.
 pub fn write_with(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let (pending, file) =
-        clutchpack_record::PendingFile::create(path, clutchpack_record::Replace::Existing)
-            .with_context(|| format!("creating {}", path.display()))?;
+    let (pending, file) = clutchpack_sdk::record::PendingFile::create(
+        path,
+        clutchpack_sdk::record::Replace::Existing,
+    )
+    .with_context(|| format!("creating {}", path.display()))?;
     drop(file);
     let tmp = pending.tmp_path().to_path_buf();
     match write(&tmp) {

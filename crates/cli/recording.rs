@@ -12,8 +12,8 @@
 use crate::common::BadInput;
 use crate::outputs::Output;
 use anyhow::{Context, Result};
-use clutchpack_analysis::{disc_stats, DiscStats};
-use clutchpack_record::RecordingReader;
+use clutchpack_sdk::analysis::{disc_stats, DiscStats};
+use clutchpack_sdk::record::RecordingReader;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -83,13 +83,13 @@ pub fn replay(a: ReplayArgs) -> Result<ExitCode> {
 #[cfg(feature = "serve")]
 fn serve(reader: &RecordingReader, port: u16, speed: f32, paused: bool) -> Result<()> {
     let stop = crate::signals::flag();
-    let opts = clutchpack_record::ServeOptions {
+    let opts = clutchpack_sdk::record::ServeOptions {
         port,
         speed,
         autoplay: !paused,
         ..Default::default()
     };
-    clutchpack_record::serve(reader, &opts, &stop, |p| {
+    clutchpack_sdk::record::serve(reader, &opts, &stop, |p| {
         eprintln!(
             "serving on ws://127.0.0.1:{p}: in Foxglove, Open connection > Foxglove WebSocket; Ctrl-C to stop"
         )
@@ -163,7 +163,7 @@ fn pct(new: f64, old: f64) -> Option<f64> {
 }
 
 /// Stored fatigue of each disc of a recording, by name.
-type Lives = Vec<(String, Option<clutchpack_record::FatigueSummary>)>;
+type Lives = Vec<(String, Option<clutchpack_sdk::record::FatigueSummary>)>;
 
 /// Builds the comparison rows of runs (name, stats, stored fatigue), the first being the
 /// baseline.
@@ -255,7 +255,7 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
     ];
     let life = |r: &CompareRow| match (r.fatigue_stored, r.life_h) {
         (false, _) => "-".to_string(),
-        (true, h) => clutchpack_analysis::fatigue::format_life_h(h),
+        (true, h) => clutchpack_sdk::analysis::fatigue::format_life_h(h),
     };
     let cells: Vec<[String; 11]> = rows
         .iter()
@@ -360,7 +360,7 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
             .collect();
         let names: Vec<String> = runs.iter().map(|(n, _, _)| n.clone()).collect();
         crate::outputs::write_with(path, |tmp| {
-            clutchpack_analysis::plot_compare(tmp, &names, &discs, &values)
+            clutchpack_sdk::analysis::plot_compare(tmp, &names, &discs, &values)
                 .with_context(|| format!("plotting {}", path.display()))
         })?;
     }
@@ -389,9 +389,9 @@ pub fn export(a: ExportArgs) -> Result<ExitCode> {
     let stop = crate::signals::flag();
     let reader = open_recording(&a.file, a.salvage)?;
     let written =
-        clutchpack_record::export_csv_until(&reader, &a.csv, &stop).map_err(|e| match e {
+        clutchpack_sdk::record::export_csv_until(&reader, &a.csv, &stop).map_err(|e| match e {
             // the input was fine: writing the CSV failed (a full disk, a lost folder): exit 1
-            e @ clutchpack_record::ReadError::Export { .. } => anyhow::Error::from(e),
+            e @ clutchpack_sdk::record::ReadError::Export { .. } => anyhow::Error::from(e),
             e => BadInput(e.to_string()).into(),
         })?;
     for p in &written {
@@ -444,7 +444,7 @@ fn plot_spectrum(reader: &RecordingReader, a: &PlotArgs) -> Result<ExitCode> {
         .map(|(n, h)| {
             (
                 n.clone(),
-                clutchpack_analysis::cycles::exceedance_spectrum(&h.lumped.peaks, duration),
+                clutchpack_sdk::analysis::cycles::exceedance_spectrum(&h.lumped.peaks, duration),
             )
         })
         .collect();
@@ -457,7 +457,7 @@ fn plot_spectrum(reader: &RecordingReader, a: &PlotArgs) -> Result<ExitCode> {
         .metadata("clutchpack.run")
         .and_then(|m| m.get("scene_name").cloned())
         .unwrap_or_else(|| a.file.display().to_string());
-    clutchpack_analysis::fatigue_plot::plot_spectrum(
+    clutchpack_sdk::analysis::fatigue_plot::plot_spectrum(
         &a.out,
         &format!("{scene}: tooth load spectra and damage"),
         &spectra,
@@ -489,7 +489,7 @@ pub fn plot(a: PlotArgs) -> Result<ExitCode> {
         .unwrap_or_else(|| a.file.display().to_string());
     let title = format!("{scene}: per-tooth load");
     crate::outputs::write_with(&a.out, |tmp| {
-        clutchpack_analysis::plot_load_history(tmp, &title, &series)
+        clutchpack_sdk::analysis::plot_load_history(tmp, &title, &series)
             .with_context(|| format!("plotting {}", a.out.display()))
     })?;
     out!("{}", a.out.display());

@@ -3,9 +3,9 @@
 use crate::common;
 use crate::outputs::Output;
 use anyhow::{Context, Result};
-use clutchpack_analysis::{stats_table, TableFormat};
-use clutchpack_record::{RecordOptions, Replace};
-use clutchpack_scene::Override;
+use clutchpack_sdk::analysis::{stats_table, TableFormat};
+use clutchpack_sdk::record::{RecordOptions, Replace};
+use clutchpack_sdk::scene::Override;
 use clutchpack_sdk::{EngineChoice, RecordingRequest, RunRequest, Simulation};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -101,13 +101,13 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         sets.push(Override {
             key: "simulation.duration_s".into(),
             // the one number format of messages: the value is echoed if refused
-            value: clutchpack_model::fmt_num(d),
+            value: clutchpack_sdk::model::fmt_num(d),
         });
     }
     if let Some(r) = a.record_rate {
         sets.push(Override {
             key: "simulation.record_rate_hz".into(),
-            value: clutchpack_model::fmt_num(r),
+            value: clutchpack_sdk::model::fmt_num(r),
         });
     }
     let scene = clutchpack_sdk::load_scene(a.scene.as_deref(), &sets)?;
@@ -135,7 +135,11 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     // Every output checked before any work (crate::outputs); the recording's folder is made.
     let record_path = (!a.no_record).then(|| {
         a.out.clone().unwrap_or_else(|| {
-            clutchpack_record::default_path("recordings", &scene.name, std::time::SystemTime::now())
+            clutchpack_sdk::record::default_path(
+                "recordings",
+                &scene.name,
+                std::time::SystemTime::now(),
+            )
         })
     });
     let mut outs = Vec::new();
@@ -225,7 +229,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             .collect();
         let title = format!("{}: per-tooth load ({} engine)", scene.name, done.engine);
         crate::outputs::write_with(path, |tmp| {
-            clutchpack_analysis::plot_load_history(tmp, &title, &series)
+            clutchpack_sdk::analysis::plot_load_history(tmp, &title, &series)
                 .with_context(|| format!("plotting {}", path.display()))
         })?;
     }
@@ -265,11 +269,11 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                 .collect::<Vec<_>>()
         };
         let mut panels = vec![
-            clutchpack_analysis::Panel {
+            clutchpack_sdk::analysis::Panel {
                 y_label: "largest |peak| per tooth [N]".into(),
                 series: by_body(&|b| b.peak_abs_n),
             },
-            clutchpack_analysis::Panel {
+            clutchpack_sdk::analysis::Panel {
                 y_label: "log10 damage rate [log10 1/h]".into(),
                 // rates below 1e-12 per hour (a million years) are left out
                 series: by_body(&|b| {
@@ -282,7 +286,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             },
         ];
         if windows.iter().any(|w| w.oil_k.is_some()) {
-            panels.push(clutchpack_analysis::Panel {
+            panels.push(clutchpack_sdk::analysis::Panel {
                 y_label: "temperature [K]".into(),
                 series: vec![
                     series("oil", &|w| w.oil_k),
@@ -293,11 +297,11 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         let title = format!(
             "{}: by window of {} s ({} engine)",
             scene.name,
-            clutchpack_model::fmt_num(a.windows.unwrap_or(0.0)),
+            clutchpack_sdk::model::fmt_num(a.windows.unwrap_or(0.0)),
             done.engine
         );
         crate::outputs::write_with(path, |tmp| {
-            clutchpack_analysis::plot_panels(tmp, &title, "window's middle [s]", &panels)
+            clutchpack_sdk::analysis::plot_panels(tmp, &title, "window's middle [s]", &panels)
                 .with_context(|| format!("plotting {}", path.display()))
         })?;
     }
@@ -333,7 +337,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         let cycles: Vec<_> = names
             .iter()
             .zip(&histories)
-            .map(|(n, h)| clutchpack_analysis::disc_cycles(n, h, run_stats.simulated_s))
+            .map(|(n, h)| clutchpack_sdk::analysis::disc_cycles(n, h, run_stats.simulated_s))
             .collect();
         crate::outputs::write_json(path, &cycles)?;
     }
@@ -372,14 +376,15 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         );
         out!(
             "{}",
-            clutchpack_analysis::fatigue_table(&summary.fatigue, TableFormat::Text).trim_end()
+            clutchpack_sdk::analysis::fatigue_table(&summary.fatigue, TableFormat::Text).trim_end()
         );
     }
     if !summary.interfaces.is_empty() {
         out!("friction interfaces (from the piston side)");
         out!(
             "{}",
-            clutchpack_analysis::interface_table(&summary.interfaces, TableFormat::Text).trim_end()
+            clutchpack_sdk::analysis::interface_table(&summary.interfaces, TableFormat::Text)
+                .trim_end()
         );
     }
     if let Some(th) = &summary.thermal {

@@ -4,10 +4,10 @@ use crate::common::BadInput;
 use crate::outputs::Output;
 use crate::signals;
 use anyhow::{Context, Result};
-use clutchpack_study::merge::Merged;
-use clutchpack_study::part::array_syntax;
-use clutchpack_study::stats::{welch, Summary};
-use clutchpack_study::{scheduler, MergeError, Shard, Study};
+use clutchpack_sdk::study::merge::Merged;
+use clutchpack_sdk::study::part::array_syntax;
+use clutchpack_sdk::study::stats::{welch, Summary};
+use clutchpack_sdk::study::{scheduler, MergeError, Shard, Study};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
@@ -132,7 +132,7 @@ pub struct CompareArgs {
     /// The other study's output folder.
     pub b: PathBuf,
     /// The per-disc statistic compared.
-    #[arg(long, default_value = "peak_abs_n", value_parser = clutchpack_study::spec::STATS)]
+    #[arg(long, default_value = "peak_abs_n", value_parser = clutchpack_sdk::study::spec::STATS)]
     pub stat: String,
 }
 
@@ -147,7 +147,7 @@ pub fn study(a: StudyArgs) -> Result<ExitCode> {
 
 /// Loads a study; its problems are bad input (exit 2).
 pub fn load_study(path: &Path) -> Result<Study> {
-    clutchpack_study::load(path).map_err(|e| BadInput(e.to_string()).into())
+    clutchpack_sdk::study::load(path).map_err(|e| BadInput(e.to_string()).into())
 }
 
 /// Threads: `--jobs`, else SLURM_CPUS_PER_TASK (a task may see every core of its node), else
@@ -362,7 +362,7 @@ fn merge(a: MergeArgs) -> Result<ExitCode> {
 fn print_effects(m: &Merged) {
     let Some(d) = m.hardest_disc() else { return };
     out!("hardest-hit disc: {} (largest mean peak); its peak |load| per tooth by factor level (mean, 95 % CI, n):", m.discs[d]);
-    for ef in clutchpack_study::plot::main_effects(m, d) {
+    for ef in clutchpack_sdk::study::plot::main_effects(m, d) {
         for (l, s) in &ef.points {
             out!(
                 "  {} = {}: {:.1} N +- {:.1} N (n = {})",
@@ -523,7 +523,8 @@ fn submit(a: SubmitArgs) -> Result<ExitCode> {
 
 fn compare(a: CompareArgs) -> Result<ExitCode> {
     let load = |d: &Path| -> Result<Merged> {
-        clutchpack_study::collect(d).map_err(|e| BadInput(format!("{}: {e}", d.display())).into())
+        clutchpack_sdk::study::collect(d)
+            .map_err(|e| BadInput(format!("{}: {e}", d.display())).into())
     };
     let (ma, mb) = (load(&a.a)?, load(&a.b)?);
     let text = compare_text(&ma, &mb, &a.stat).map_err(BadInput)?;

@@ -2,11 +2,11 @@
 
 use crate::common::{self, BadInput};
 use anyhow::{Context, Result};
-use clutchpack_analysis::{
+use clutchpack_sdk::analysis::{
     fatigue_spread_table, sweep_fits, sweep_rows, sweep_table, DiscFatigueSpread, PolyFit,
     SweepCase, SweepRow, TableFormat,
 };
-use clutchpack_scene::{Override, Scene};
+use clutchpack_sdk::scene::{Override, Scene};
 use clutchpack_sdk::{CaseRuns, EngineChoice, MemberFatigue, Simulation, MAX_BATCH_CASES};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -145,8 +145,9 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
             key: a.param.clone(),
             value: format!("{v:e}"),
         });
-        let scene = clutchpack_sdk::load_scene(Some(&a.scene), &sets)
-            .with_context(|| format!("case {} = {}", a.param, clutchpack_model::fmt_num(*v)))?;
+        let scene = clutchpack_sdk::load_scene(Some(&a.scene), &sets).with_context(|| {
+            format!("case {} = {}", a.param, clutchpack_sdk::model::fmt_num(*v))
+        })?;
         scenes.push(scene);
     }
     let engine_name = Simulation::new(scenes[0].clone(), a.engine)?
@@ -245,7 +246,7 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
     );
     if let Some(path) = &a.plot {
         crate::outputs::write_with(path, |tmp| {
-            clutchpack_analysis::plot_sweep(tmp, &a.param, &rows, &fits)
+            clutchpack_sdk::analysis::plot_sweep(tmp, &a.param, &rows, &fits)
                 .with_context(|| format!("plotting {}", path.display()))
         })?;
     }

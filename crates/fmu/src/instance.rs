@@ -4,8 +4,8 @@
 //! Python's `Simulation` shares. The C functions (`ffi.rs`) only translate pointers and
 //! statuses; every FMI rule and its message is here, testable without a host.
 
-use clutchpack_scene::Scene;
 use clutchpack_sdk::cosim::{Stage, Variable};
+use clutchpack_sdk::scene::Scene;
 use clutchpack_sdk::{CoSimulation, RunOutcome};
 use std::path::{Path, PathBuf};
 

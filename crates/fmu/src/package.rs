@@ -2,9 +2,9 @@
 //! cdylib) and the scene as resources.
 
 use crate::description::{model_description, Header, MODEL_IDENTIFIER};
-use clutchpack_model::session::Driven;
-use clutchpack_scene::{EngineChoice, Scene};
 use clutchpack_sdk::cosim::variables;
+use clutchpack_sdk::model::session::Driven;
+use clutchpack_sdk::scene::{EngineChoice, Scene};
 use clutchpack_sdk::{SessionRequest, Simulation};
 use std::hash::{Hash, Hasher};
 use std::io::Write;
@@ -103,7 +103,7 @@ pub fn write_fmu(
         &vars,
     );
     let (pending, file) =
-        clutchpack_record::PendingFile::create(out, clutchpack_record::Replace::Existing)
+        clutchpack_sdk::record::PendingFile::create(out, clutchpack_sdk::record::Replace::Existing)
             .map_err(io(out))?;
     let mut zip = zip::ZipWriter::new(file);
     let deflated = zip::write::SimpleFileOptions::default()

@@ -368,6 +368,7 @@ pub fn coupled_clutches() -> crate::network::Network {
         initial_speed_rad_s: w,
         fixed: false,
         drive,
+        firing: None,
         road_load: None,
     };
     let clutch = |name: &str, a: usize, force: Signal| Coupling {
@@ -419,6 +420,85 @@ pub fn coupled_clutches() -> crate::network::Network {
             clutch("clutch2", 1, step(0.4)),
             clutch("clutch3", 2, step(0.9)),
         ],
+    }
+}
+
+/// A spring-damper between two free inertias released from a twist (MODEL.md section 8): `a`
+/// of 0.5 kg m^2 and `b` of 0.3 kg m^2 both at angle 0 and 1 rad/s, joined by `k` = 2000
+/// N m/rad and `d` = 0.8 N m s/rad whose free angle is `-q0` (so the spring starts twisted by
+/// [`RING_DOWN_TWIST_RAD`]). Its twist `theta_a - theta_b + q0` follows the damped
+/// oscillator's closed form `q(t) = q0 e^(-zeta wn t) (cos wd t + zeta wn / wd sin wd t)` with
+/// `wn^2 = k (1/J_a + 1/J_b)`, `2 zeta wn = d (1/J_a + 1/J_b)`.
+pub fn spring_ring_down() -> crate::network::Network {
+    use crate::network::{Body, Coupling, CouplingKind, Network};
+    let body = |name: &str, j: f64| Body {
+        name: name.into(),
+        inertia_kg_m2: j,
+        drag_n_m_s_rad: 0.0,
+        // a body nothing moves is refused; a speed common to both changes nothing in the twist
+        initial_speed_rad_s: 1.0,
+        fixed: false,
+        drive: None,
+        firing: None,
+        road_load: None,
+    };
+    Network {
+        bodies: vec![body("a", 0.5), body("b", 0.3)],
+        couplings: vec![Coupling {
+            name: "damper".into(),
+            a: 0,
+            b: 1,
+            kind: CouplingKind::SpringDamper(SpringDamper {
+                stiffness_n_m_per_rad: 2000.0,
+                damping_n_m_s_per_rad: 0.8,
+                free_angle_rad: -RING_DOWN_TWIST_RAD,
+            }),
+        }],
+    }
+}
+
+/// The twist `q0` that [`spring_ring_down`] starts from, rad.
+pub const RING_DOWN_TWIST_RAD: f64 = 0.02;
+
+/// The twist of [`spring_ring_down`] at `t` (s) by the damped oscillator's closed form, rad.
+pub fn spring_ring_down_twist_rad(t: f64) -> f64 {
+    let net = spring_ring_down();
+    let (j_a, j_b) = (net.bodies[0].inertia_kg_m2, net.bodies[1].inertia_kg_m2);
+    let crate::network::CouplingKind::SpringDamper(sd) = net.couplings[0].kind else {
+        unreachable!()
+    };
+    let inv = 1.0 / j_a + 1.0 / j_b;
+    let wn = (sd.stiffness_n_m_per_rad * inv).sqrt();
+    let zeta = sd.damping_n_m_s_per_rad * inv / (2.0 * wn);
+    let wd = wn * (1.0 - zeta * zeta).sqrt();
+    let q0 = RING_DOWN_TWIST_RAD;
+    q0 * (-zeta * wn * t).exp() * ((wd * t).cos() + zeta * wn / wd * (wd * t).sin())
+}
+
+/// An engine alone on its firing harmonics (MODEL.md section 8; [`crate::network::Firing`]):
+/// a four-stroke four-cylinder crank and flywheel of 0.25 kg m^2 at 100 rad/s, no mean torque,
+/// no drag, the firing order's first two multiples (120 N m and 30 N m, phases 0.3 and -1.0
+/// rad). Its torque is `-dV/dtheta`, so its speed is known at every angle:
+/// `w(theta)^2 = w0^2 + 2 (V(0) - V(theta)) / J`.
+pub fn firing_engine() -> crate::network::Network {
+    use crate::network::{Body, Firing, Network};
+    Network {
+        bodies: vec![Body {
+            name: "engine".into(),
+            inertia_kg_m2: 0.25,
+            drag_n_m_s_rad: 0.0,
+            initial_speed_rad_s: 100.0,
+            fixed: false,
+            drive: None,
+            firing: Some(Firing {
+                cylinders: 4,
+                strokes: 4,
+                amplitudes_n_m: vec![120.0, 30.0],
+                phases_rad: vec![0.3, -1.0],
+            }),
+            road_load: None,
+        }],
+        couplings: Vec::new(),
     }
 }
 

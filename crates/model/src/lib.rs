@@ -76,8 +76,8 @@ pub use fatigue::{FatigueParams, Material, MinerRule, ToothForm};
 pub use impact::{detect_impacts, parabolic_peak, ImpactEvent, ImpactTracker};
 pub use law::{ContactState, Engagement, Hertz, LawKind, OilFilm, ToothLaw};
 pub use pack::{
-    annulus_inner_radius_m, annulus_outer_radius_m, ensemble_angle_rad, BodyMotion, CouplingLoads,
-    DiscModel, NonTorsional, PackBody, PackCoupling, PackCouplingKind, PackModel,
+    annulus_inner_radius_m, annulus_outer_radius_m, ensemble_angle_rad, BodyMotion, Carrier,
+    CouplingLoads, DiscModel, NonTorsional, PackBody, PackCoupling, PackCouplingKind, PackModel,
 };
 pub use session::Engine;
 pub use spline::{Flank, SplineGeometry, ToothKinematics};

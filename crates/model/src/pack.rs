@@ -214,7 +214,32 @@ pub struct CouplingLoads {
     pub loss_rate_w: f64,
 }
 
+/// The body a spline coupling joins a friction disc or separator plate to (MODEL.md section
+/// 5): the one statement of it for both engines ([`PackModel::carrier`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Carrier {
+    /// The shaft (friction discs).
+    Shaft,
+    /// The output drum (separator plates of a clutch).
+    Drum,
+    /// The fixed housing (separator plates of a brake): angle and speed 0.
+    Housing,
+}
+
 impl PackModel {
+    /// The carrier of coupling `i` in the engines' order (the friction discs `0..N`, then the
+    /// separator plates): the shaft for a disc; for a plate the drum when the pack has one,
+    /// else the housing.
+    pub fn carrier(&self, i: usize) -> Carrier {
+        if i < self.discs.len() {
+            Carrier::Shaft
+        } else if self.drum.is_some() {
+            Carrier::Drum
+        } else {
+            Carrier::Housing
+        }
+    }
+
     /// Whether a torsional model (one rotational degree of freedom per body: shaft, discs,
     /// plates, drum; the lumped tooth law; the stack's faces with exact stick and slip)
     /// describes the pack and the reference engine runs it: every disc and plate

@@ -14,16 +14,8 @@ use rapier3d_f64::prelude::{
 };
 use std::f64::consts::PI;
 
-/// The body a spline coupling joins a disc or plate to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Carrier {
-    /// The shaft (friction discs).
-    Shaft,
-    /// The fixed housing (separator plates of a brake).
-    Housing,
-    /// The output drum (separator plates of a clutch).
-    Drum,
-}
+/// The body a spline coupling joins a disc or plate to (the model's one definition).
+pub(crate) use clutchpack_model::Carrier;
 
 /// The rapier world of one pack and the handles of its bodies.
 pub(crate) struct World {
@@ -205,13 +197,7 @@ impl World {
                 .chain((0..np).map(|j| at(StackBody::Plate(j).position())))
                 .collect()
         };
-        let mut carriers = vec![Carrier::Shaft; n];
-        let plate_carrier = if pack.drum.is_some() {
-            Carrier::Drum
-        } else {
-            Carrier::Housing
-        };
-        carriers.extend(std::iter::repeat_n(plate_carrier, np));
+        let carriers: Vec<Carrier> = (0..n + np).map(|i| pack.carrier(i)).collect();
 
         let (shaft, shaft_dynamic) = match &pack.shaft {
             Shaft::Prescribed(_) => {

@@ -12,7 +12,7 @@
 
 mod stepper;
 
-use clutchpack_scene::{EngineChoice, Override};
+use clutchpack_sdk::scene::{EngineChoice, Override};
 use clutchpack_sdk::{Error, RecordingRequest, RunRequest, Simulation};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -35,7 +35,7 @@ fn py_err(e: Error) -> PyErr {
 /// A validated scene: a file, a TOML text or a dict, with its overrides.
 #[pyclass(name = "Scene", module = "clutchpack", frozen)]
 struct Scene {
-    inner: clutchpack_scene::Scene,
+    inner: clutchpack_sdk::scene::Scene,
     /// The scene file, if it came from one.
     path: Option<PathBuf>,
     /// The folder relative paths in the scene resolve against.
@@ -96,7 +96,7 @@ impl Scene {
     fn with_sets(&self, sets: Vec<(String, String)>) -> PyResult<Scene> {
         let mut all = self.sets.clone();
         all.extend(overrides(sets));
-        let inner = clutchpack_scene::parse(
+        let inner = clutchpack_sdk::scene::parse(
             &self.inner.source_text,
             &self.inner.name,
             &self.base_dir,
@@ -120,17 +120,17 @@ impl Scene {
     }
 }
 
-/// The one output policy of every front end (`clutchpack_record::check_outputs`), before any
+/// The one output policy of every front end (`clutchpack_sdk::record::check_outputs`), before any
 /// work: each `(argument, path)` given names a new or regular file in an existing folder, not
 /// a folder, a device or a FIFO, not another output and not the scene file; else
 /// `ValueError` naming the argument.
 fn check_outputs(outputs: &[(&str, Option<&Path>)], scene: &Scene) -> PyResult<()> {
-    let outs: Vec<clutchpack_record::OutputPath> = outputs
+    let outs: Vec<clutchpack_sdk::record::OutputPath> = outputs
         .iter()
-        .filter_map(|(label, p)| p.map(|p| clutchpack_record::OutputPath::file(label, p)))
+        .filter_map(|(label, p)| p.map(|p| clutchpack_sdk::record::OutputPath::file(label, p)))
         .collect();
     let inputs: Vec<&Path> = scene.path.as_deref().into_iter().collect();
-    clutchpack_record::check_outputs(&outs, &inputs)
+    clutchpack_sdk::record::check_outputs(&outs, &inputs)
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
@@ -174,8 +174,8 @@ fn load_scene(
         }
         (None, Some(t)) => {
             let name = name.unwrap_or_else(|| "<scene text>".into());
-            let s =
-                clutchpack_scene::parse(&t, &name, &here, &sets).map_err(|e| py_err(e.into()))?;
+            let s = clutchpack_sdk::scene::parse(&t, &name, &here, &sets)
+                .map_err(|e| py_err(e.into()))?;
             (s, here)
         }
         (p, None) => {
@@ -223,7 +223,7 @@ struct ImpactColumns {
 
 impl ImpactColumns {
     /// `impacts`, their bodies named by `names` (engine order).
-    fn of(impacts: &[clutchpack_model::ImpactEvent], names: &[String]) -> ImpactColumns {
+    fn of(impacts: &[clutchpack_sdk::model::ImpactEvent], names: &[String]) -> ImpactColumns {
         let name_of = |i: usize| names.get(i).cloned().unwrap_or_else(|| format!("disc {i}"));
         ImpactColumns {
             disc: impacts.iter().map(|e| name_of(e.disc)).collect(),
@@ -360,12 +360,12 @@ fn run(
     let mut sim = Simulation::new(scene.inner.clone(), engine_choice(engine)?).map_err(py_err)?;
     let recording = record.map(|path| RecordingRequest {
         path,
-        replace: clutchpack_record::Replace::Existing,
-        options: clutchpack_record::RecordOptions {
+        replace: clutchpack_sdk::record::Replace::Existing,
+        options: clutchpack_sdk::record::RecordOptions {
             deterministic,
             per_tooth: scene.inner.simulation.record_per_tooth,
             contact_samples: scene.inner.simulation.record_contact_samples,
-            ..clutchpack_record::RecordOptions::default()
+            ..clutchpack_sdk::record::RecordOptions::default()
         },
         scene_path: scene.path.clone(),
     });
@@ -504,7 +504,7 @@ fn sweep(
         )
     })?
     .map_err(py_err)?;
-    let rows = clutchpack_analysis::sweep_rows(&runs.cases);
+    let rows = clutchpack_sdk::analysis::sweep_rows(&runs.cases);
     let fatigue: Vec<serde_json::Value> = runs
         .cases
         .iter()
@@ -518,7 +518,7 @@ fn sweep(
                 .collect();
             serde_json::json!({
                 "value": c.value,
-                "discs": clutchpack_analysis::ensemble_fatigue(members, &d_crit),
+                "discs": clutchpack_sdk::analysis::ensemble_fatigue(members, &d_crit),
             })
         })
         .collect();
@@ -618,14 +618,15 @@ fn study_run(
     shard: u64,
     shards: u64,
 ) -> PyResult<(PathBuf, usize, usize, usize, usize, bool)> {
-    let s = clutchpack_study::load(&study).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let s =
+        clutchpack_sdk::study::load(&study).map_err(|e| PyValueError::new_err(e.to_string()))?;
     if shards == 0 || shard >= shards {
         return Err(PyValueError::new_err(format!(
             "shard {shard} of {shards}: the index must be in 0..{shards} (shards >= 1)"
         )));
     }
     let jobs = threads(jobs);
-    let shard = clutchpack_study::Shard {
+    let shard = clutchpack_sdk::study::Shard {
         index: shard,
         count: shards,
     };

@@ -3,7 +3,7 @@
 use crate::output::{PendingFile, Replace};
 use crate::proto;
 use crate::read::{impact_event, segment_of, MessageView, ReadError, RecordingReader};
-use crate::summary::RunSummary;
+use crate::summary::RecordedSummary;
 use crate::topics;
 use clutchpack_analysis::csv_field;
 use clutchpack_model::Flank;
@@ -439,7 +439,7 @@ impl<'a> Export<'a> {
         }
         let summary = match &self.recompute {
             None => reader.summary().cloned(),
-            Some(impacts) => Some(RunSummary::from_impacts(
+            Some(impacts) => Some(RecordedSummary::from_impacts(
                 &self.names,
                 impacts,
                 reader.info().end_s.unwrap_or(0.0),

@@ -139,7 +139,7 @@ pub use read::{
 };
 #[cfg(feature = "serve")]
 pub use serve::{serve, ServeError, ServeOptions};
-pub use summary::{DiscStats, FatigueSummary, RunSummary, MAX_EXTRA_DISCS, TOP_N};
+pub use summary::{DiscStats, FatigueSummary, RecordedSummary, MAX_EXTRA_DISCS, TOP_N};
 pub use threaded::ThreadedRecorder;
 pub use write::{
     auto_chunk_size_bytes, default_path, log_time_ns, RecordError, RecordOptions, Recorder,

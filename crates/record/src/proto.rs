@@ -34,7 +34,7 @@ pub const TOOTH_LOADS: &str = "clutchpack.ToothLoads";
 pub const INTERFACE_STATE: &str = "clutchpack.InterfaceState";
 /// Full schema name of [`Impact`] (topic `/impacts`).
 pub const IMPACT: &str = "clutchpack.Impact";
-/// Full schema name of [`RunSummary`] (topic `/summary`).
+/// Full schema name of [`SummaryMessage`] (topic `/summary`).
 pub const RUN_SUMMARY: &str = "clutchpack.RunSummary";
 /// Full schema name of [`LoadSample`] (topics `/discs/<name>/load`).
 pub const LOAD_SAMPLE: &str = "clutchpack.LoadSample";
@@ -256,7 +256,7 @@ pub struct DiscSummary {
 
 /// The run's summary (topic `/summary`, one message at the end of the run).
 #[derive(Clone, PartialEq, prost::Message)]
-pub struct RunSummary {
+pub struct SummaryMessage {
     /// Simulated time at the end of the run in s.
     #[prost(double, tag = "1")]
     pub t_end_s: f64,
@@ -997,7 +997,7 @@ mod tests {
         check("DiscSummary", ds.encode_to_vec());
         check(
             "RunSummary",
-            RunSummary {
+            SummaryMessage {
                 t_end_s: 1.0,
                 discs: vec![ds],
             }

@@ -11,7 +11,7 @@ use clutchpack_model::ImpactEvent;
 /// How many of the largest `|peak|` the "top" mean takes (10).
 pub use clutchpack_analysis::stats::TOP_N;
 
-/// Disc indices past the named discs that [`RunSummary::from_impacts`] still gives entries.
+/// Disc indices past the named discs that [`RecordedSummary::from_impacts`] still gives entries.
 pub const MAX_EXTRA_DISCS: usize = 1024;
 
 /// The fatigue figures of one disc kept in the recording's `/summary`
@@ -46,10 +46,11 @@ impl From<&clutchpack_analysis::DiscFatigue> for FatigueSummary {
     }
 }
 
-/// A run's summary: one [`DiscStats`] per disc in scene order, and the discs' fatigue when
+/// What a recording stores of its run (its `/summary` topic, [`proto::SummaryMessage`] on
+/// disk): one [`DiscStats`] per disc in scene order, and the discs' fatigue when
 /// the run assessed it.
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct RunSummary {
+pub struct RecordedSummary {
     /// Simulated time at the end of the run in s.
     pub t_end_s: f64,
     /// One entry per disc, in scene order.
@@ -59,13 +60,17 @@ pub struct RunSummary {
     pub fatigue: Vec<Option<FatigueSummary>>,
 }
 
-impl RunSummary {
+impl RecordedSummary {
     /// The summary of `impacts` for discs named `names` (`ImpactEvent::disc` indexes
     /// `names`; impacts of an index beyond it get entries named `disc <index>`, up to
     /// [`MAX_EXTRA_DISCS`] past the names, and impacts beyond that are not counted: a
     /// foreign file's index cannot make this allocate without bound), at the end time
     /// `t_end_s` (s).
-    pub fn from_impacts(names: &[String], impacts: &[ImpactEvent], t_end_s: f64) -> RunSummary {
+    pub fn from_impacts(
+        names: &[String],
+        impacts: &[ImpactEvent],
+        t_end_s: f64,
+    ) -> RecordedSummary {
         let limit = names.len() + MAX_EXTRA_DISCS;
         let n = impacts
             .iter()
@@ -78,7 +83,7 @@ impl RunSummary {
         for e in impacts.iter().filter(|e| e.disc < n) {
             peaks[e.disc].push(e.peak_n);
         }
-        RunSummary {
+        RecordedSummary {
             t_end_s,
             discs: peaks
                 .iter()
@@ -97,8 +102,8 @@ impl RunSummary {
         self.fatigue.get(i).and_then(Option::as_ref)
     }
 
-    pub(crate) fn to_proto(&self) -> proto::RunSummary {
-        proto::RunSummary {
+    pub(crate) fn to_proto(&self) -> proto::SummaryMessage {
+        proto::SummaryMessage {
             t_end_s: self.t_end_s,
             discs: self
                 .discs
@@ -132,7 +137,7 @@ impl RunSummary {
         }
     }
 
-    pub(crate) fn from_proto(p: proto::RunSummary) -> RunSummary {
+    pub(crate) fn from_proto(p: proto::SummaryMessage) -> RecordedSummary {
         let life = |h: f64| (h > 0.0).then_some(h);
         let fatigue: Vec<Option<FatigueSummary>> = p
             .discs
@@ -148,7 +153,7 @@ impl RunSummary {
                 })
             })
             .collect();
-        RunSummary {
+        RecordedSummary {
             t_end_s: p.t_end_s,
             // a file without fatigue keeps the list empty, as the run that wrote it had it
             fatigue: if fatigue.iter().any(Option::is_some) {
@@ -212,14 +217,17 @@ mod tests {
     /// A disc without impacts gets zeros; an impact beyond the names gets its own entry.
     #[test]
     fn empty_discs_and_unknown_indices() {
-        let s =
-            RunSummary::from_impacts(&["a".into()], &[ev(2, 5.0), ev(usize::MAX / 2, 1.0)], 1.0);
+        let s = RecordedSummary::from_impacts(
+            &["a".into()],
+            &[ev(2, 5.0), ev(usize::MAX / 2, 1.0)],
+            1.0,
+        );
         assert_eq!(s.discs.len(), 3, "an absurd index is not counted");
         assert_eq!(s.discs[0], DiscStats::from_peaks("a", &[]));
         assert_eq!(s.discs[0].p99_abs_n, 0.0);
         assert_eq!(s.discs[2].name, "disc 2");
         assert_eq!(s.discs[2].max_positive_n, 5.0);
-        assert_eq!(RunSummary::from_proto(s.to_proto()), s);
+        assert_eq!(RecordedSummary::from_proto(s.to_proto()), s);
         // fatigue figures round-trip; unlimited lives stay unlimited
         let mut f = s.clone();
         f.fatigue = vec![None; 3];
@@ -237,6 +245,6 @@ mod tests {
             max_root_stress_pa: 4e8,
             worst_tooth: Some((17, Some(250.0), 154)),
         });
-        assert_eq!(RunSummary::from_proto(f.to_proto()), f);
+        assert_eq!(RecordedSummary::from_proto(f.to_proto()), f);
     }
 }

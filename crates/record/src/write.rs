@@ -3,7 +3,7 @@
 
 use crate::info::{num, utc_text, RunInfo, META_STATS, SCENE_MEDIA_TYPE};
 use crate::output::{PendingFile, Replace};
-use crate::summary::RunSummary;
+use crate::summary::RecordedSummary;
 use crate::view3d::{self, disc_frame};
 use crate::{proto, topic_segment, topics};
 use clutchpack_model::{
@@ -719,7 +719,7 @@ impl Recorder {
     /// The summary of the impacts written so far (what `finish(None)` stores). Errors only
     /// when the peaks kept on disk (a long run, see `clutchpack_analysis::PeakStats`) cannot
     /// be read back.
-    pub fn summary(&self) -> Result<RunSummary, RecordError> {
+    pub fn summary(&self) -> Result<RecordedSummary, RecordError> {
         let discs = self
             .peaks
             .stats(&self.names)
@@ -728,7 +728,7 @@ impl Recorder {
                 what: "the impact peaks kept in a temporary file".to_string(),
                 cause: mcap::McapError::Io(source),
             })?;
-        Ok(RunSummary {
+        Ok(RecordedSummary {
             t_end_s: self.last_t_s,
             discs,
             fatigue: Vec::new(),
@@ -1290,7 +1290,7 @@ impl Recorder {
     ///
     /// When the disk is full (or the quota exhausted) the temporary file is removed: what it
     /// holds cannot be completed, and leaving it would keep the space taken.
-    pub fn finish(mut self, summary: Option<RunSummary>) -> Result<PathBuf, RecordError> {
+    pub fn finish(mut self, summary: Option<RecordedSummary>) -> Result<PathBuf, RecordError> {
         let result = self.finish_inner(summary);
         if let Err(e) = &result {
             if e.is_disk_full() {
@@ -1302,7 +1302,7 @@ impl Recorder {
         result
     }
 
-    fn finish_inner(&mut self, summary: Option<RunSummary>) -> Result<PathBuf, RecordError> {
+    fn finish_inner(&mut self, summary: Option<RecordedSummary>) -> Result<PathBuf, RecordError> {
         if let Some(e) = self.error.take() {
             return Err(e);
         }

@@ -5,7 +5,7 @@ use clutchpack_model::{Collector, DiscSample, Observer, Sample};
 use clutchpack_record::synthetic::{synthetic_run, SyntheticRun};
 use clutchpack_record::{
     export_csv, from_bytes, from_bytes_with, open, open_with, topics, DamageKind, ReadError,
-    ReadOptions, RecordError, RecordOptions, Recorder, RecordingReader, RunSummary,
+    ReadOptions, RecordError, RecordOptions, RecordedSummary, Recorder, RecordingReader,
 };
 use std::path::PathBuf;
 
@@ -59,7 +59,7 @@ fn round_trip_is_exact() {
         run.impacts.clone()
     });
     let t_end = run.samples.last().unwrap().t_s;
-    let want = RunSummary::from_impacts(&run.info.disc_names(), &run.impacts, t_end);
+    let want = RecordedSummary::from_impacts(&run.info.disc_names(), &run.impacts, t_end);
     assert_eq!(r.summary(), Some(&want));
     assert_eq!(r.summary_or_recomputed(), want);
 
@@ -795,7 +795,7 @@ fn dropped_recorder_closes_the_file() {
     assert_eq!(r.samples().len(), run.samples.len());
     assert_eq!(
         r.summary_or_recomputed().discs,
-        RunSummary::from_impacts(&run.info.disc_names(), &run.impacts, 0.0).discs
+        RecordedSummary::from_impacts(&run.info.disc_names(), &run.impacts, 0.0).discs
     );
 }
 

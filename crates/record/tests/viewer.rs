@@ -82,7 +82,7 @@ fn every_seek_restores_the_whole_pack_and_its_colours() {
             assert!(e.is_some_and(|e| e.lines.len() == 1), "{id} at {t} ns");
         }
         let summary = latest_at(&m[topics::SUMMARY], t).expect("summary from t = 0 on");
-        let summary = proto::RunSummary::decode(summary).unwrap();
+        let summary = proto::SummaryMessage::decode(summary).unwrap();
         assert_eq!(summary.discs.len(), 2);
     }
     assert_eq!(m[topics::SUMMARY][0].0, 0, "/summary is logged at t = 0");

@@ -4,8 +4,8 @@
 
 use crate::gaps::Gaps;
 use clutchpack_model::{
-    DiscModel, DiscSample, Engagement, InterfaceSample, PackModel, Sample, Shaft, StackBody,
-    ToothKinematics,
+    Carrier, DiscModel, DiscSample, Engagement, InterfaceSample, PackModel, Sample, Shaft,
+    StackBody, ToothKinematics,
 };
 use std::sync::Arc;
 
@@ -40,17 +40,6 @@ pub(crate) struct StackEval {
     /// Power of the teeth's forces dissipated on the relative motions, `sum -n F Rb psi`, W
     /// (its integral is the teeth's work, [`System::teeth_work`]).
     pub teeth_power: f64,
-}
-
-/// What a coupling's spline ties its body to.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Carrier {
-    /// The shaft (friction discs).
-    Shaft,
-    /// The output drum (separator plates of a clutch).
-    Drum,
-    /// The fixed housing (separator plates of a brake): angle and speed 0.
-    Housing,
 }
 
 /// The shaft and the couplings in `ids` (global indices: the discs `0..N`, then the plates
@@ -234,13 +223,7 @@ impl System {
     }
 
     fn carrier(&self, slot: usize) -> Carrier {
-        if self.ids[slot] < self.nd {
-            Carrier::Shaft
-        } else if self.pack.drum.is_some() {
-            Carrier::Drum
-        } else {
-            Carrier::Housing
-        }
+        self.pack.carrier(self.ids[slot])
     }
 
     /// Angle (rad) and speed (rad/s) of the carrier of `slot` at `t` for state `y`.

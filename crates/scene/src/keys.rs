@@ -525,8 +525,27 @@ table! {
     }
     children {
         drive: table RawTorqueSignal,
+        firing: table RawFiring,
         road_load: table RawRoadLoad,
     }
+}
+
+/// Most cylinders of an engine accepted (a plausibility bound: W16 and V24 engines exist).
+pub(crate) const MAX_CYLINDERS: u32 = 24;
+
+table! {
+    /// `[bodies.firing]`: an engine's firing-order harmonics, added to its drive and locked to the body's own angle theta (0 at t = 0): sum_k a_k sin(k n_f theta + phi_k) with n_f = 2 cylinders / strokes firings a revolution (docs/DECISIONS.md, "An engine's firing harmonics").
+    RawFiring at "firing" {
+        /// number of cylinders z
+        cylinders: "", Kind::Count { max: MAX_CYLINDERS }, Dflt::Required;
+        /// strokes of the working cycle: 4 (each cylinder fires every second revolution) or 2
+        strokes: "", Kind::Count { max: 4 }, Dflt::Described("default 4");
+        /// a_k: amplitude of the k-th multiple of the firing order (k = 1, 2, ... in order)
+        amplitudes_n_m: "N m", Kind::Numbers, Dflt::Required;
+        /// phi_k: phase of each term at theta = 0, one per amplitude
+        phases_deg: "deg", Kind::Numbers, Dflt::Described("default all 0");
+    }
+    children {}
 }
 
 table! {

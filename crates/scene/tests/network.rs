@@ -179,3 +179,38 @@ fn gear_mesh_keys() {
         "{p:?}"
     );
 }
+
+/// `[bodies.firing]` reaches the model with its phases in radians and 4 strokes by default;
+/// strokes other than 2 or 4, a phase per amplitude missing, no cylinders and firing on the
+/// fixed housing are each reported at their key, all at once.
+#[test]
+fn firing_keys() {
+    let firing = "[bodies.firing]\ncylinders = 4\namplitudes_n_m = [300.0, 90.0]\nphases_deg = [0.0, 90.0]\n";
+    let text = TWO.replace("value_n_m = 50.0\n", &format!("value_n_m = 50.0\n{firing}"));
+    let s = parse(&text, "scenes/net.toml", Path::new("."), &[]).unwrap();
+    let f = s.network.unwrap().bodies[0].firing.clone().expect("firing");
+    assert_eq!((f.cylinders, f.strokes, f.order()), (4, 4, 2.0));
+    assert_eq!(f.amplitudes_n_m, vec![300.0, 90.0]);
+    assert!((f.phases_rad[1] - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    let bad = text
+        .replace("cylinders = 4\n", "strokes = 3\n")
+        .replace("phases_deg = [0.0, 90.0]", "phases_deg = [0.0]");
+    let p = problems(&bad);
+    for (key, says) in [
+        ("bodies[0].firing.cylinders", "required"),
+        ("bodies[0].firing.strokes = 3", "must be 4 or 2"),
+        ("bodies[0].firing.phases_deg", "2"),
+    ] {
+        assert!(
+            p.iter().any(|m| m.contains(key) && m.contains(says)),
+            "{key}: {p:?}"
+        );
+    }
+    let housing = format!("{TWO}\n[[bodies]]\nname = \"housing\"\nfixed = true\n{firing}");
+    let p = problems(&housing);
+    assert!(
+        p.iter()
+            .any(|m| m.contains("bodies[2].firing") && m.contains("fixed body")),
+        "{p:?}"
+    );
+}

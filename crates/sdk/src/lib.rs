@@ -29,12 +29,22 @@ mod fatigue;
 mod network;
 mod recording;
 mod run;
-mod scene;
+mod scene_file;
 mod session;
 mod simulation;
-mod study;
+mod study_run;
 mod summary;
 mod windows;
+
+// The crates a front end needs types of, under one name (as ripgrep's `grep` facade does):
+// the CLI, the FMU and the Python package depend on this crate alone.
+pub use clutchpack_analysis as analysis;
+pub use clutchpack_model as model;
+pub use clutchpack_multibody as multibody;
+pub use clutchpack_record as record;
+pub use clutchpack_reference as reference;
+pub use clutchpack_scene as scene;
+pub use clutchpack_study as study;
 
 pub use batch::{
     ensemble_fatigue, ensemble_member, run_case, run_cases, CaseRuns, MemberFatigue,
@@ -55,10 +65,10 @@ pub use network::{
 };
 pub use recording::open_recording;
 pub use run::{RecordingRequest, RunOutcome, RunRequest};
-pub use scene::{load_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TEXT};
+pub use scene_file::{load_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TEXT};
 pub use session::{Session, SessionRequest, SessionState};
 pub use simulation::{PackEngine, Simulation};
-pub use study::{merge_study, run_study_shard, MergedStudy, PART_FLUSH};
+pub use study_run::{merge_study, run_study_shard, MergedStudy, PART_FLUSH};
 pub use summary::{friction_interfaces, run_info, BodyTemperature, RunSummary, ThermalSummary};
 pub use windows::{BodyWindow, WindowRow};
 

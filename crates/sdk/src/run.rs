@@ -281,7 +281,7 @@ pub(crate) fn finish_recording(
         warnings.push(format!(
             "{e}; the recording's /summary has no impact statistics"
         ));
-        clutchpack_record::RunSummary {
+        clutchpack_record::RecordedSummary {
             t_end_s: result.as_ref().map_or(0.0, |s| s.simulated_s),
             discs: Vec::new(),
             fatigue: Vec::new(),

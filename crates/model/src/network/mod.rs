@@ -10,11 +10,13 @@
 //! conserved: the torque `lambda` on `a` is `-ratio lambda` on `b`).
 
 pub mod clutch;
+pub mod firing;
 pub mod gear;
 pub mod output;
 pub mod signal;
 
 pub use clutch::{ClutchMode, LumpedClutch};
+pub use firing::Firing;
 pub use gear::GearMesh;
 pub use output::{ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample};
 pub use signal::Signal;
@@ -61,17 +63,30 @@ pub struct Body {
     pub fixed: bool,
     /// The driving torque on it, N m, positive in its sense of rotation (`None`: none).
     pub drive: Option<Signal>,
+    /// An engine's firing-order harmonics in its own angle, added to `drive` (`None`: none;
+    /// [`Firing`]).
+    #[serde(default)]
+    pub firing: Option<Firing>,
     /// A load opposing its motion (`None`: none).
     pub road_load: Option<RoadLoad>,
 }
 
 impl Body {
-    /// The external torque on the body at `t` (s) and speed `w` (rad/s), N m: its drive, its
-    /// road load and its drag.
-    pub fn external_torque_n_m(&self, t: f64, w_rad_s: f64) -> f64 {
-        let drive = self.drive.as_ref().map_or(0.0, |s| s.value(t));
+    /// The driving torque at `t` (s) and the body's angle `theta` (rad), N m: its drive
+    /// signal and its firing harmonics.
+    pub fn drive_torque_n_m(&self, t: f64, theta_rad: f64) -> f64 {
+        self.drive.as_ref().map_or(0.0, |s| s.value(t))
+            + self
+                .firing
+                .as_ref()
+                .map_or(0.0, |f| f.torque_n_m(theta_rad))
+    }
+
+    /// The external torque on the body at `t` (s), angle `theta` (rad) and speed `w`
+    /// (rad/s), N m: its drive ([`Self::drive_torque_n_m`]), its road load and its drag.
+    pub fn external_torque_n_m(&self, t: f64, theta_rad: f64, w_rad_s: f64) -> f64 {
         let load = self.road_load.map_or(0.0, |l| l.torque_n_m(w_rad_s));
-        drive + load - self.drag_n_m_s_rad * w_rad_s
+        self.drive_torque_n_m(t, theta_rad) + load - self.drag_n_m_s_rad * w_rad_s
     }
 }
 
@@ -183,11 +198,13 @@ impl Network {
                     "a fixed body does not turn: its speed is 0".into(),
                 ));
             }
-            if b.fixed && (b.drive.is_some() || b.road_load.is_some()) {
+            if b.fixed && (b.drive.is_some() || b.firing.is_some() || b.road_load.is_some()) {
                 out.push(body(
                     i,
                     if b.drive.is_some() {
                         "drive"
+                    } else if b.firing.is_some() {
+                        "firing"
                     } else {
                         "road_load"
                     },
@@ -203,6 +220,9 @@ impl Network {
             }
             if b.drive.as_ref().is_some_and(|d| !d.is_valid()) {
                 out.push(body(i, "drive", "has a value that is not finite".into()));
+            }
+            if let Some(why) = b.firing.as_ref().and_then(Firing::problem) {
+                out.push(body(i, "firing", why));
             }
         }
         let n = self.bodies.len();
@@ -330,7 +350,7 @@ impl Network {
             let group: Vec<usize> = (0..n).filter(|&j| top(&mut linked, j) == t).collect();
             let moved = group.iter().any(|&j| {
                 let b = &self.bodies[j];
-                b.drive.is_some() || b.initial_speed_rad_s != 0.0
+                b.drive.is_some() || b.firing.is_some() || b.initial_speed_rad_s != 0.0
             });
             if !moved && group.iter().any(|&j| !self.bodies[j].fixed) {
                 out.push(body(
@@ -398,6 +418,7 @@ mod tests {
             initial_speed_rad_s: w,
             fixed: false,
             drive: None,
+            firing: None,
             road_load: None,
         }
     }

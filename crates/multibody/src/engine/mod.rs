@@ -338,22 +338,13 @@ impl MultibodyEngine {
     /// with the concrete type: [`MultibodySession::set_end`], the energy audit). Fails with
     /// [`EngineError::Unsupported`] for an input the pack does not have (a shaft speed on an
     /// inertial shaft, a shaft torque on a prescribed one, a drum load without a drum, a
-    /// piston pressure without a stack) and for a driven pressure on the multirate scheme
-    /// asked for explicitly (a pressure over the return spring would clamp the stack, which
-    /// couples the bodies within a world step; the automatic choice runs the shared step
-    /// then).
+    /// piston pressure without a stack). A driven piston pressure runs the multirate scheme
+    /// like the scene's own: the stack open until a call sets a pressure over the return
+    /// spring, clamped as one system from that call on.
     pub fn session(&self, driven: Driven) -> Result<MultibodySession, EngineError> {
         driven.check(&self.pack)?;
         let multirate = match (self.multirate_refused, self.options.stepping) {
-            (None, Stepping::Adaptive(a)) if !driven.piston_pressure => Some(a),
-            (None, _) if self.options.scheme == Scheme::Multirate => {
-                return Err(EngineError::Unsupported(
-                    "the multirate scheme cannot take a driven piston pressure (a pressure \
-                     over the return spring clamps the stack, which couples the bodies within \
-                     a world step): use the automatic or the shared scheme"
-                        .into(),
-                ))
-            }
+            (None, Stepping::Adaptive(a)) => Some(a),
             _ => None,
         };
         MultibodySession::new(

@@ -505,6 +505,12 @@ impl MultibodySession {
             let p = PressureProfile::Constant { pressure_pa };
             if let Some(st) = Arc::make_mut(&mut run.pack).stack.as_mut() {
                 st.piston.pressure = p.clone();
+                // A held pressure over the return spring may push from now on: the multirate
+                // scheme integrates the clamped stack as one system from this call (and for
+                // the rest of the run, as after a scene's ramp starts; a later release is the
+                // clamped system's open faces). Below the spring the hand-over stays where it
+                // was (never, or a call that pushed before).
+                self.clamped_from_s = self.clamped_from_s.min(st.piston.open_until_s().max(t));
             }
             if let Some(s) = run.stack.as_mut() {
                 s.set_pressure(p);

@@ -1,6 +1,7 @@
 //! The multibody engine on a driveline network of lumped parts (MODEL.md section 8): every
 //! body that turns is a rapier3d-f64 rigid body turning about its axis (`bodies.rs`), the
-//! drives, drag, road loads and slipping clutches' torques are applied to it each step, and
+//! drives (with an engine's firing harmonics in its angle), drag, road loads, slipping
+//! clutches' and spring-dampers' torques are applied to it each step, and
 //! the ideal gears and locked clutches are velocity-level constraints solved each step
 //! (`constraint.rs`). The output types are the model's ([`clutchpack_model::network`]), the
 //! reference engine's, so that the two engines' runs compare field by field.
@@ -17,14 +18,16 @@
 //! 2. **Torques at `t`**: each body's drive, road load and drag
 //!    ([`clutchpack_model::network::Body::external_torque_n_m`]), each slipping clutch's
 //!    `tau = sign(w_rel) mu(|w_rel|) cgeo fn` (+tau on `a`, -tau on `b`,
-//!    [`LumpedClutch::slip_torque_n_m`]); then the constraint torques `lambda` of the gears
+//!    [`LumpedClutch::slip_torque_n_m`]), each spring-damper's `T = k (theta_a - theta_b -
+//!    theta_0) + d (w_a - w_b)` (-T on `a`, +T on `b`); then the constraint torques `lambda` of the gears
 //!    and locked clutches that keep every constraint (`constraint::solve`). A locked clutch
 //!    whose `|lambda|` exceeds its static limit `peak mu(0) cgeo fn`
 //!    ([`LumpedClutch::max_static_torque_n_m`]) slips towards it; the one furthest over goes
 //!    first and the solve repeats (as the reference's `settle`). These are the samples'
 //!    torques.
 //! 3. **The step's torques** (the explicit midpoint rule): the same torques at
-//!    `t + h / 2` and the speeds predicted there, `w + (h / 2) T(t) / J`, held over the step.
+//!    `t + h / 2` and the speeds predicted there, `w + (h / 2) T(t) / J` (the angles there
+//!    on the same path, `theta + (h / 4) (w + w_mid)`), held over the step.
 //!    The method is second order (measured: every difference to the reference engine falls
 //!    by 4.0 when the step is halved, `tests/network.rs`) and exact where the torques are
 //!    constant between events.
@@ -85,6 +88,13 @@ fn clutch(net: &Network, k: usize) -> Option<&LumpedClutch> {
     }
 }
 
+fn spring(net: &Network, k: usize) -> Option<&clutchpack_model::SpringDamper> {
+    match &net.couplings[k].kind {
+        CouplingKind::SpringDamper(s) => Some(s),
+        _ => None,
+    }
+}
+
 /// Torques at one state: each body's but the constraints' (N m), each row's, each
 /// coupling's on its body `a`.
 #[derive(Default)]
@@ -140,7 +150,7 @@ impl<'n> Run<'n> {
     /// rows' into `lambda` (MODEL.md section 8), every coupling's into `coupling_torque`.
     fn torques(&mut self, t: f64) {
         let mut out = Torques::default();
-        self.evaluate(t, &self.w, &mut out);
+        self.evaluate(t, self.world.angles(), &self.w, &mut out);
         self.torque = out.body;
         self.lambda = out.lambda;
         self.coupling_torque = out.coupling;
@@ -156,28 +166,34 @@ impl<'n> Run<'n> {
     /// The torques held over the step `[t, t + h]`: those at its midpoint, the speeds there
     /// predicted from the torques `start` at its start (the explicit midpoint rule, second
     /// order: `w_mid = w + (h / 2) T_start / J`; a row's bodies stay consistent since the
-    /// start's torques keep the rows). Returns the speeds they were evaluated at, rad/s.
-    fn step_torques(&mut self, t: f64, h: f64, start: &[f64]) -> Vec<f64> {
+    /// start's torques keep the rows). Returns the speeds (rad/s) and angles (rad) they were
+    /// evaluated at.
+    fn step_torques(&mut self, t: f64, h: f64, start: &[f64]) -> (Vec<f64>, Vec<f64>) {
         let w_mid: Vec<f64> = (0..self.w.len())
             .map(|i| self.w[i] + 0.5 * h * self.inv_inertia[i] * start[i])
             .collect();
+        // the angles there on the same path (the speed affine from w to w_mid: an engine's
+        // firing torque is a function of its angle)
+        let theta_mid: Vec<f64> = (0..self.w.len())
+            .map(|i| self.world.angles()[i] + 0.25 * h * (self.w[i] + w_mid[i]))
+            .collect();
         let mut out = Torques::default();
-        self.evaluate(t + 0.5 * h, &w_mid, &mut out);
+        self.evaluate(t + 0.5 * h, &theta_mid, &w_mid, &mut out);
         self.torque = out.body;
         self.lambda = out.lambda;
         self.coupling_torque = out.coupling;
-        w_mid
+        (w_mid, theta_mid)
     }
 
-    /// The torques at `(t, w)` in the present modes into `out` (MODEL.md section 8).
-    fn evaluate(&self, t: f64, w: &[f64], out: &mut Torques) {
+    /// The torques at `(t, theta, w)` in the present modes into `out` (MODEL.md section 8).
+    fn evaluate(&self, t: f64, theta: &[f64], w: &[f64], out: &mut Torques) {
         let net = self.net;
         out.body.clear();
         out.body.extend(net.bodies.iter().enumerate().map(|(i, b)| {
             if b.fixed {
                 0.0
             } else {
-                b.external_torque_n_m(t, w[i])
+                b.external_torque_n_m(t, theta[i], w[i])
             }
         }));
         out.coupling.clear();
@@ -189,6 +205,14 @@ impl<'n> Run<'n> {
                 out.coupling[k] = tau;
                 out.body[c.a] += tau;
                 out.body[c.b] -= tau;
+            }
+            if let Some(sd) = spring(net, k) {
+                // MODEL.md section 8: T on b, -T on a, at the twist theta_a - theta_b (both
+                // bodies start at angle 0, as the reference engine's twist state does)
+                let t = sd.torque_n_m(theta[c.a] - theta[c.b], w[c.a] - w[c.b]);
+                out.coupling[k] = -t;
+                out.body[c.a] -= t;
+                out.body[c.b] += t;
             }
         }
         // A lambda = -C M^-1 T: the rows' rates vanish, so rows that hold at the step's
@@ -210,8 +234,8 @@ impl<'n> Run<'n> {
     /// Each locked clutch's margin at `(t, w)`, N m: its static limit less the torque that
     /// holds it (`peak mu(0) cgeo fn - |lambda|`; it breaks where this reaches 0); `+inf`
     /// for the other couplings.
-    fn margins(&self, t: f64, w: &[f64], scratch: &mut Torques) -> Vec<f64> {
-        self.evaluate(t, w, scratch);
+    fn margins(&self, t: f64, theta: &[f64], w: &[f64], scratch: &mut Torques) -> Vec<f64> {
+        self.evaluate(t, theta, w, scratch);
         (0..self.net.couplings.len())
             .map(|k| match (clutch(self.net, k), self.modes[k]) {
                 (Some(cl), Some(ClutchMode::Locked)) => {
@@ -377,7 +401,10 @@ impl<'n> Run<'n> {
                 let w: Vec<f64> = (0..self.w.len())
                     .map(|i| self.w[i] + hh * self.inv_inertia[i] * total[i])
                     .collect();
-                self.margins(t + hh, &w, scratch)
+                let theta: Vec<f64> = (0..self.w.len())
+                    .map(|i| self.world.angles()[i] + 0.5 * hh * (self.w[i] + w[i]))
+                    .collect();
+                self.margins(t + hh, &theta, &w, scratch)
             };
             let mut scratch = Torques::default();
             let g0 = at(0.0, &mut scratch);
@@ -412,19 +439,20 @@ impl<'n> Run<'n> {
     }
 }
 
-/// Why the multibody engine cannot run `net` (`None`: it can): it runs lumped clutches and
-/// ideal gears; a gear mesh with backlash and a spring-damper run on the reference engine for
-/// now, the message names the first such coupling.
+/// Why the multibody engine cannot run `net` (`None`: it can): it runs lumped clutches, ideal
+/// gears and spring-dampers; a gear mesh with backlash runs on the reference engine for now,
+/// the message names the first one.
 pub fn unsupported(net: &Network) -> Option<String> {
     net.couplings.iter().find_map(|c| {
         let kind = match c.kind {
-            CouplingKind::Clutch(_) | CouplingKind::IdealGear { .. } => return None,
+            CouplingKind::Clutch(_)
+            | CouplingKind::IdealGear { .. }
+            | CouplingKind::SpringDamper(_) => return None,
             CouplingKind::GearMesh(_) => "a gear mesh",
-            CouplingKind::SpringDamper(_) => "a spring-damper",
         };
         Some(format!(
-            "coupling \"{}\" is {kind}: the multibody engine runs a network's lumped clutches \
-             and ideal gears only, for now (run it with --engine reference)",
+            "coupling \"{}\" is {kind}: the multibody engine runs a network's lumped clutches, \
+             ideal gears and spring-dampers only, for now (run it with --engine reference)",
             c.name
         ))
     })
@@ -518,11 +546,11 @@ pub fn run_network(
         // the step's torques: at its midpoint (explicit midpoint rule), landed with them
         let mut h = run.landing(t, h);
         let start = run.total();
-        let mut w_force = run.step_torques(t, h, &start);
+        let (mut w_force, mut theta_force) = run.step_torques(t, h, &start);
         let h_mid = run.landing(t, h);
         if h_mid < h {
             h = h_mid;
-            w_force = run.step_torques(t, h, &start);
+            (w_force, theta_force) = run.step_torques(t, h, &start);
         }
         // at least 1e-13 (1 + t) s, so that time moves (a landing nearer than that is on
         // the step's end to within the events' own precision)
@@ -547,7 +575,7 @@ pub fn run_network(
                 continue;
             }
             let wbar = 0.5 * (w0[i] + run.w[i]);
-            let drive = b.drive.as_ref().map_or(0.0, |s| s.value(t_force));
+            let drive = b.drive_torque_n_m(t_force, theta_force[i]);
             run.energy.drive_work_j += h * drive * wbar;
             let wf = w_force[i];
             run.energy.load_work_j += h * b.road_load.map_or(0.0, |l| l.torque_n_m(wf)) * wbar;
@@ -557,6 +585,14 @@ pub fn run_network(
             if matches!(run.modes[k], Some(ClutchMode::Slipping(_))) {
                 let wrel = 0.5 * (w0[c.b] + run.w[c.b] - w0[c.a] - run.w[c.a]);
                 run.heat[k] += h * run.coupling_torque[k] * wrel;
+            }
+            if let Some(sd) = spring(net, k) {
+                // the damper's share of the torque held over the step, on the step's mean
+                // twist rate (the spring's share is its potential's change, at the end)
+                let rate = 0.5 * (w0[c.a] + run.w[c.a] - w0[c.b] - run.w[c.b]);
+                let loss = h * sd.damping_n_m_s_per_rad * (w_force[c.a] - w_force[c.b]) * rate;
+                run.heat[k] += loss;
+                run.energy.damper_loss_j += loss;
             }
         }
         t = t_new;
@@ -568,7 +604,15 @@ pub fn run_network(
     }
     let last = run.sample(t);
     obs.sample(&last);
-    run.energy.clutch_heat_j = run.heat.iter().sum();
+    run.energy.clutch_heat_j = run.heat.iter().sum::<f64>() - run.energy.damper_loss_j;
+    let angles = run.world.angles();
+    run.energy.spring_energy_change_j = (0..net.couplings.len())
+        .filter_map(|k| spring(net, k).map(|sd| (k, sd)))
+        .map(|(k, sd)| {
+            let c = &net.couplings[k];
+            sd.potential_j(angles[c.a] - angles[c.b]) - sd.potential_j(0.0)
+        })
+        .sum();
     // per body as J (w - w0) (w + w0) / 2: no cancellation between large energies
     run.energy.kinetic_change_j = net
         .bodies

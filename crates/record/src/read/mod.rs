@@ -35,7 +35,7 @@
 
 use crate::info::RunInfo;
 use crate::proto;
-use crate::summary::RunSummary;
+use crate::summary::RecordedSummary;
 use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use prost::Message as _;
@@ -238,7 +238,7 @@ pub struct RecordingInfo {
     /// Whether the file has a complete, verified summary section and footer.
     pub summary_section: bool,
     /// The stored `/summary` (the last one), if any.
-    pub summary: Option<RunSummary>,
+    pub summary: Option<RecordedSummary>,
 }
 
 impl RecordingInfo {
@@ -506,7 +506,7 @@ impl RecordingReader {
     }
 
     /// The stored `/summary`, if the run finished.
-    pub fn summary(&self) -> Option<&RunSummary> {
+    pub fn summary(&self) -> Option<&RecordedSummary> {
         self.info.summary.as_ref()
     }
 

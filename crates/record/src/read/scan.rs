@@ -104,7 +104,7 @@ pub(super) fn validate(v: &MessageView<'_>) -> Result<(), String> {
         proto::TOOTH_LOADS => proto::ToothLoads::decode(v.data).map(drop),
         proto::INTERFACE_STATE => proto::InterfaceState::decode(v.data).map(drop),
         proto::IMPACT => proto::Impact::decode(v.data).map(drop),
-        proto::RUN_SUMMARY => proto::RunSummary::decode(v.data).map(drop),
+        proto::RUN_SUMMARY => proto::SummaryMessage::decode(v.data).map(drop),
         "foxglove.FrameTransforms" => foxglove::schemas::FrameTransforms::decode(v.data).map(drop),
         "foxglove.SceneUpdate" => foxglove::schemas::SceneUpdate::decode(v.data).map(drop),
         _ => Ok(()),
@@ -618,8 +618,8 @@ pub(super) fn on_record(
             };
             on_message(&view)?;
             if view.schema_name == proto::RUN_SUMMARY {
-                if let Ok(m) = proto::RunSummary::decode(view.data) {
-                    s.info.summary = Some(RunSummary::from_proto(m));
+                if let Ok(m) = proto::SummaryMessage::decode(view.data) {
+                    s.info.summary = Some(RecordedSummary::from_proto(m));
                 }
             }
             let lt = header.log_time;

@@ -4,7 +4,7 @@
 
 use super::RecordingReader;
 use crate::proto;
-use crate::summary::RunSummary;
+use crate::summary::RecordedSummary;
 use crate::topics;
 use clutchpack_model::{DiscSample, Flank, ImpactEvent, Sample};
 use prost::Message as _;
@@ -263,11 +263,11 @@ impl RecordingReader {
 
     /// The stored summary, or (for a run that did not finish) the summary of the recovered
     /// impacts up to the last recovered message.
-    pub fn summary_or_recomputed(&self) -> RunSummary {
+    pub fn summary_or_recomputed(&self) -> RecordedSummary {
         if let Some(s) = self.summary() {
             return s.clone();
         }
-        RunSummary::from_impacts(
+        RecordedSummary::from_impacts(
             &self.disc_names(),
             &self.impacts(),
             self.info.end_s.unwrap_or(0.0),

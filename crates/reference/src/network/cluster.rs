@@ -170,6 +170,7 @@ mod tests {
             initial_speed_rad_s: 0.0,
             fixed: false,
             drive: None,
+            firing: None,
             road_load: None,
         }
     }

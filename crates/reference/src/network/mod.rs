@@ -149,7 +149,7 @@ impl<'n> Equations<'n> {
             self.torque[i] = if b.fixed {
                 0.0
             } else {
-                b.external_torque_n_m(t, w[i])
+                b.external_torque_n_m(t, y[i], w[i])
             };
         }
         for (k, c) in self.net.couplings.iter().enumerate() {
@@ -232,7 +232,7 @@ impl<'n> Equations<'n> {
             if b.fixed {
                 continue;
             }
-            drive += b.drive.as_ref().map_or(0.0, |s| s.value(t)) * w[i];
+            drive += b.drive_torque_n_m(t, y[i]) * w[i];
             load += b.road_load.map_or(0.0, |l| l.torque_n_m(w[i])) * w[i];
             drag += b.drag_n_m_s_rad * w[i] * w[i];
         }

@@ -6,12 +6,13 @@
 
 use super::{Checker, Field};
 use crate::keys::{
-    RawContact as Ct, RawCoupling as C, RawForceSignal as FS, RawNetBody as B, RawOil as O,
-    RawRoadLoad as RL, RawTorqueSignal as TS,
+    RawContact as Ct, RawCoupling as C, RawFiring as F, RawFiring, RawForceSignal as FS,
+    RawNetBody as B, RawOil as O, RawRoadLoad as RL, RawTorqueSignal as TS,
 };
 use crate::schema::{show, Key, RawTable};
 use clutchpack_model::network::{
-    Body, Coupling, CouplingKind, GearMesh, LumpedClutch, Network, NetworkProblem, RoadLoad, Signal,
+    Body, Coupling, CouplingKind, Firing, GearMesh, LumpedClutch, Network, NetworkProblem,
+    RoadLoad, Signal,
 };
 use clutchpack_model::{Hertz, LawKind, OilFilm, ToothLaw};
 use std::path::Path;
@@ -247,6 +248,10 @@ pub(super) fn network(
             Some(d) => signal(ck, &TORQUE_SIGNAL, i, |k| d.value(k), base_dir).map(Some),
             None => Some(None),
         };
+        let firing = match &r.firing {
+            Some(f) => firing(ck, f, i),
+            None => Some(None),
+        };
         let road_load = match &r.road_load {
             Some(l) => {
                 let mut n = |k: &Key| ck.num(&p(k), l.value(k), k).or(k.default_num());
@@ -266,18 +271,26 @@ pub(super) fn network(
             None => Some(None),
         };
         names.push(name.clone());
-        match (name, inertia, fixed, drag, speed, drive, road_load) {
-            (Some(name), Some(j), Some(fixed), Some(c), Some(w), Some(drive), Some(road_load)) => {
-                net.bodies.push(Body {
-                    name,
-                    inertia_kg_m2: j,
-                    drag_n_m_s_rad: c,
-                    initial_speed_rad_s: w,
-                    fixed,
-                    drive,
-                    road_load,
-                })
-            }
+        match (name, inertia, fixed, drag, speed, drive, firing, road_load) {
+            (
+                Some(name),
+                Some(j),
+                Some(fixed),
+                Some(c),
+                Some(w),
+                Some(drive),
+                Some(firing),
+                Some(road_load),
+            ) => net.bodies.push(Body {
+                name,
+                inertia_kg_m2: j,
+                drag_n_m_s_rad: c,
+                initial_speed_rad_s: w,
+                fixed,
+                drive,
+                firing,
+                road_load,
+            }),
             _ => ok = false,
         }
     }
@@ -449,6 +462,53 @@ pub(super) fn network(
         }
     }
     problems.is_empty().then_some(net)
+}
+
+/// `[bodies.firing]` of body `i`: `Some(Some(..))` when valid, `None` after reporting.
+fn firing(ck: &mut Checker, r: &RawFiring, i: usize) -> Option<Option<Firing>> {
+    let p = |k: &Key| format!("bodies[{i}].firing.{}", k.name);
+    let cylinders = ck
+        .count(&p(&F::cylinders), r.value(&F::cylinders), &F::cylinders)
+        .required(ck, &p(&F::cylinders), "required for [bodies.firing]");
+    let strokes = match ck.count(&p(&F::strokes), r.value(&F::strokes), &F::strokes) {
+        Field::Valid(s) if s == 2 || s == 4 => Some(s),
+        Field::Valid(s) => {
+            ck.report(p(&F::strokes), Some(s.to_string()), "must be 4 or 2");
+            None
+        }
+        Field::Absent => Some(4),
+        Field::Invalid => None,
+    };
+    let amplitudes = ck
+        .numbers(&p(&F::amplitudes_n_m), r.value(&F::amplitudes_n_m), None)
+        .required(
+            ck,
+            &p(&F::amplitudes_n_m),
+            "required: the amplitude of each multiple of the firing order, N m",
+        );
+    let amplitudes = match amplitudes {
+        Some(a) if a.is_empty() => {
+            ck.report(
+                p(&F::amplitudes_n_m),
+                Some("[]".into()),
+                "needs at least one amplitude",
+            );
+            None
+        }
+        a => a,
+    };
+    let n = amplitudes.as_ref().map(Vec::len);
+    let phases = match ck.numbers(&p(&F::phases_deg), r.value(&F::phases_deg), n) {
+        Field::Valid(v) => Some(v.iter().map(|d| d.to_radians()).collect()),
+        Field::Absent => n.map(|n| vec![0.0; n]),
+        Field::Invalid => None,
+    };
+    Some(Some(Firing {
+        cylinders: cylinders?,
+        strokes: strokes?,
+        amplitudes_n_m: amplitudes?,
+        phases_rad: phases?,
+    }))
 }
 
 /// A clutch's keys and its `force` table.
