@@ -658,12 +658,23 @@ fn thermal_pack_6_heats_alike() {
 /// Issue 35: the duty cycle's first 3 s on both engines (pack-6-duty-cycle: the engagement,
 /// 1.5 s locked driving the drum, the release, the open pack rattling while the drum's load
 /// brakes it, the second engagement's start): the gaps' drag now heats the oil as much as the
-/// faces heat the plates (31 kJ and 39 kJ). Every final temperature rise within 0.1 % of the
-/// reference engine's. Measured: worst 1.5e-4 of the rise (disc-4, +1.319 K; the oil 1.3e-4
-/// of +9.691 K, the plates within 1.0e-4); the teeth's heat, 936 J and 930 J, differs by the
-/// chaotic rattle's 0.7 %. Run time: 3.2 s and 3.9 s (release).
+/// faces heat the plates (31 kJ and 39 kJ). The scene's faces take `mu(v, T)` from its
+/// `[thermal.friction]` table at their temperatures, window by window, in both engines.
+/// Every final temperature rise within 0.1 % of the reference engine's. Measured: worst
+/// 2.3e-4 of the rise (the oil, +9.692 K; the plates within 1.2e-4, plate-7 +4.092 K; the
+/// discs within 6.6e-5); the faces' heat 39 313.5 and 39 313.0 J (1.2e-5), the teeth's 929 J
+/// and 939 J (the chaotic rattle's 1 %, which is the oil's difference). (Before the table:
+/// worst 1.5e-4, disc-4.)
 #[test]
 fn thermal_duty_cycle_heats_alike() {
+    let s = scene(
+        "scenes/pack-6-duty-cycle.toml",
+        &["simulation.duration_s=3"],
+    );
+    assert!(
+        s.thermal.as_ref().is_some_and(|t| t.friction.is_some()),
+        "the duty cycle's faces take mu(v, T)"
+    );
     let (worst, body) = thermal_agreement(
         "scenes/pack-6-duty-cycle.toml",
         &["simulation.duration_s=3"],

@@ -188,3 +188,58 @@ fn a_restored_fmu_state_gives_identical_outputs() {
         first[999]
     );
 }
+
+/// Issue 35: a thermal scene's FMU has a temperature output per body and the oil (K, after
+/// every other output), FMPy validates it, and driven as the scene runs (pack-8-idle-thermal
+/// with a steady drive, 0.5 s: the inputs held at their start values are the scene's
+/// constant profiles) its final temperatures are `clutchpack run`'s. Measured: every final
+/// temperature within 9.6e-8 K of the run's (the oil +1.409 K: 6.8e-8 of its rise; FMPy's
+/// 1 ms communication points end the engine's steps where the run's do not, so its windows
+/// close on slightly different step ends); bound 1e-6 K, ten times that. At t = 0 the
+/// outputs are the initial temperature.
+#[test]
+fn a_thermal_fmu_outputs_the_runs_temperatures() {
+    let v = check("thermal");
+    assert_eq!(v["problems"], serde_json::json!([]), "{v}");
+    let names: Vec<&str> = v["names"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    let s = &v["summary"];
+    let bodies = s["bodies"].as_array().unwrap();
+    // pack-8: 8 discs, 9 plates, the oil
+    assert_eq!(names.len(), bodies.len() + 1, "{names:?}");
+    assert_eq!(names.first(), Some(&"discs[1].temperature_k"));
+    assert_eq!(names.last(), Some(&"oil.temperature_k"));
+    assert!(names.contains(&"plates[9].temperature_k"), "{names:?}");
+    for u in v["units"].as_array().unwrap() {
+        assert_eq!(u, "K");
+    }
+    for c in v["causalities"].as_array().unwrap() {
+        assert_eq!(c, "output");
+    }
+    let mut run: Vec<f64> = bodies
+        .iter()
+        .map(|b| b["final_k"].as_f64().unwrap())
+        .collect();
+    run.push(s["oil_final_k"].as_f64().unwrap());
+    let fmu: Vec<f64> = v["fmu_final"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let worst = fmu
+        .iter()
+        .zip(&run)
+        .fold(0.0f64, |w, (a, b)| w.max((a - b).abs()));
+    let oil_rise = run[run.len() - 1] - 313.15;
+    eprintln!("thermal FMU: worst final temperature {worst:e} K off the run's; oil +{oil_rise} K");
+    assert!(oil_rise > 0.5, "the oil warms: {oil_rise} K");
+    assert!(worst <= 1e-6, "worst {worst:e} K: {fmu:?} vs {run:?}");
+    for first in v["fmu_first"].as_array().unwrap() {
+        assert_eq!(first.as_f64().unwrap(), 313.15);
+    }
+}

@@ -48,6 +48,11 @@ pub struct BenchArgs {
     /// medians are reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub network_runs: usize,
+    /// Repetitions of each thermal timing (`scenes/pack-6-thermal.toml` and the first second
+    /// of `pack-8-idle-thermal.toml` on each engine, with and without `[thermal]` in turn;
+    /// the medians are reported); 0 skips that part.
+    #[arg(long, default_value_t = 3)]
+    pub thermal_runs: usize,
     /// Only the staggered-pack, brake-pack and inertial-pack parts (skips the paper case, the sweep, the
     /// recording cost and the shipped whole packs).
     #[arg(long)]
@@ -271,6 +276,10 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     if stopped() {
         return Ok(crate::signals::exit_code());
     }
+    thermal_packs(a.thermal_runs, &stop)?;
+    if stopped() {
+        return Ok(crate::signals::exit_code());
+    }
     staggered_packs(a.pack_runs, &stop)?;
     if stopped() {
         return Ok(crate::signals::exit_code());
@@ -346,6 +355,94 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
             scene.pack.plates.len(),
             scene.simulation.duration_s,
         );
+    }
+    Ok(())
+}
+
+/// 4a. Thermal packs (issue 35: "a thermal run costs at most 10 % more than the same
+///    isothermal run"): `scenes/pack-6-thermal.toml` (0.3 s: the rattle, the engagement,
+///    the faces locking) and the first second of `pack-8-idle-thermal.toml` (the open pack
+///    rattling, its oil warming), each on both engines with the settings `run` gives them,
+///    with `[thermal]` and without it (the same scene otherwise, on the same scheme: the
+///    reference engine's monolithic one, where it runs a thermal pack) in turn `runs` times:
+///    the medians of the engine's CPU time and the median of the rounds' ratios (thermal
+///    over isothermal). The two are not the same physics: the thermal run's oil warms (thinner tooth films) and its
+///    gaps take the law's viscosity (docs/DECISIONS.md, "Thermal cost").
+fn thermal_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
+    if runs == 0 {
+        return Ok(());
+    }
+    for (file, duration) in [
+        ("scenes/pack-6-thermal.toml", None),
+        ("scenes/pack-8-idle-thermal.toml", Some(1.0)),
+    ] {
+        let path = std::path::Path::new(file);
+        if !path.exists() {
+            out!("thermal pack {file}: skipped (run from the repository root)");
+            continue;
+        }
+        let sets: Vec<Override> = duration
+            .map(|d: f64| Override {
+                key: "simulation.duration_s".into(),
+                value: d.to_string(),
+            })
+            .into_iter()
+            .collect();
+        let thermal = load_scene(Some(path), &sets)?;
+        // the thermal code path on the isothermal physics: every temperature held at T_ref
+        // (capacities of 1e30 J/K), the films' scale exactly 1 and the gaps at the scene's
+        // viscosity, so the run takes the isothermal run's steps bit for bit
+        let mut held = thermal.clone();
+        if let Some(th) = held.thermal.as_mut() {
+            for b in th.discs.iter_mut().chain(th.plates.iter_mut()) {
+                b.capacity_j_k = 1e30;
+            }
+            th.oil.capacity_j_k = 1e30;
+            th.reference_k = th.initial_k;
+            th.gap_viscosity = clutchpack_sdk::model::thermal::GapViscosity::Scaled;
+        }
+        for engine in [EngineChoice::Reference, EngineChoice::Multibody] {
+            let mut isothermal = thermal.clone();
+            isothermal.thermal = None;
+            if engine == EngineChoice::Reference {
+                // the reference engine runs a thermal pack monolithic: the same scheme
+                isothermal.simulation.scheme = clutchpack_sdk::scene::SchemeChoice::Shared;
+            }
+            let mut times = [Vec::new(), Vec::new(), Vec::new()];
+            let mut ratios = [Vec::new(), Vec::new()];
+            for _ in 0..runs {
+                let mut round = [0.0; 3];
+                for (k, scene) in [&thermal, &isothermal, &held].into_iter().enumerate() {
+                    let done = Simulation::new(scene.clone(), Some(engine))?.run(RunRequest {
+                        stop: Some(&**stop),
+                        ..RunRequest::default()
+                    })?;
+                    done.stats()?;
+                    if stop.load(Ordering::SeqCst) {
+                        return Ok(());
+                    }
+                    // the engine thread's CPU: the machine is shared, its wall time is not
+                    // the run's (both runs are single-threaded here)
+                    round[k] = done.engine_cpu_s;
+                    times[k].push(round[k]);
+                }
+                ratios[0].push(round[0] / round[1]);
+                ratios[1].push(round[2] / round[1]);
+            }
+            let [ratio, held_ratio] = ratios.map(median);
+            let [with, without, held_s] = times.map(median);
+            out!(
+                "thermal pack {}, {} s, {} engine: thermal {with:.3} s, isothermal \
+                 {without:.3} s, thermal held at T_ref {held_s:.3} s of CPU (medians of {runs}, \
+                 in turn): the thermal run costs {:+.1} % (its warming oil's physics and the \
+                 thermal code), the thermal code alone {:+.1} %",
+                thermal.name,
+                thermal.simulation.duration_s,
+                engine.name(),
+                100.0 * (ratio - 1.0),
+                100.0 * (held_ratio - 1.0),
+            );
+        }
     }
     Ok(())
 }

@@ -16,6 +16,11 @@ CHECK is one of:
   Prints the impact lists of each.
 - rollback: get the FMU's state, advance, set the state, advance again; prints both output
   histories.
+- thermal: pack-8-idle-thermal with a steady drive (drive.amplitude_rad_s = 0, so the FMU's
+  inputs held at their start values are the scene's own profiles) for 0.5 s: FMPy's
+  simulate_fmu reads every temperature output at the end; `clutchpack run` of the same
+  scene writes its final temperatures to --summary-json. Prints both, and the temperature
+  outputs' units and whether the description has them.
 
 Every result is JSON on stdout; the assertions and their bounds are in tests/fmu.rs.
 """
@@ -302,12 +307,41 @@ def check_rollback(args):
     return {"first": first, "second": second}
 
 
+THERMAL_SETS = ["--set", "drive.amplitude_rad_s=0", "--set", "simulation.duration_s=0.5"]
+
+
+def check_thermal(args):
+    work = args.work
+    fmu = os.path.join(work, "idle-thermal.fmu")
+    p = build(args, "scenes/pack-8-idle-thermal.toml", fmu, *THERMAL_SETS)
+    if p.returncode != 0:
+        raise SystemExit(p.stderr)
+    md = read_model_description(fmu)
+    temps = [v for v in md.modelVariables if v.name.endswith("temperature_k")]
+    names = [v.name for v in temps]
+    r = fmpy.simulate_fmu(fmu, stop_time=0.5, output_interval=1e-3, output=names)
+    summary = os.path.join(work, "idle-thermal.json")
+    run(args, "run", "scenes/pack-8-idle-thermal.toml", *THERMAL_SETS, "--no-record",
+        "--summary-json", summary)
+    with open(summary) as f:
+        s = json.load(f)
+    return {
+        "names": names,
+        "units": [v.unit for v in temps],
+        "causalities": [v.causality for v in temps],
+        "fmu_final": [float(r[n][-1]) for n in names],
+        "fmu_first": [float(r[n][0]) for n in names],
+        "summary": s["thermal"],
+        "problems": validate_fmu(fmu),
+    }
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", required=True)
     ap.add_argument("--root", required=True)
     ap.add_argument("--work", required=True)
-    ap.add_argument("check", choices=["validate", "paper", "coupling", "rollback"])
+    ap.add_argument("check", choices=["validate", "paper", "coupling", "rollback", "thermal"])
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
     result = {
@@ -315,6 +349,7 @@ def main():
         "paper": check_paper,
         "coupling": check_coupling,
         "rollback": check_rollback,
+        "thermal": check_thermal,
     }[args.check](args)
     json.dump(result, sys.stdout)
 

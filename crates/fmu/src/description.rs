@@ -2,7 +2,7 @@
 //! value goes through quick-xml's writer, which escapes it: scene names and descriptions
 //! never become markup.
 
-use clutchpack_sdk::cosim::{Causality, Kind, Variable, UNITS};
+use clutchpack_sdk::cosim::{uses_unit, Causality, Kind, Variable, UNITS};
 use quick_xml::events::{BytesDecl, BytesEnd, BytesStart, Event};
 use quick_xml::Writer;
 
@@ -80,10 +80,13 @@ pub fn model_description(header: &Header, vars: &[Variable]) -> String {
     ));
     events.push(start("UnitDefinitions", &[]));
     for (name, exps) in UNITS {
+        if !uses_unit(name, vars) {
+            continue;
+        }
         events.push(start("Unit", &[("name", name)]));
         let values: Vec<(String, &str)> = exps
             .iter()
-            .zip(["kg", "m", "s", "rad"])
+            .zip(["kg", "m", "s", "rad", "K"])
             .filter(|(e, _)| **e != 0)
             .map(|(e, b)| (e.to_string(), b))
             .collect();

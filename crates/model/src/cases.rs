@@ -246,6 +246,7 @@ pub fn staggered_brake(n: usize) -> PackModel {
         })
         .collect();
     pack.stack = Some(StackModel {
+        face_friction: Vec::new(),
         face_inner_radius_m: 0.235,
         face_outer_radius_m: 0.290,
         friction: FrictionCurve::Stribeck {

@@ -224,8 +224,13 @@ pub struct StackModel {
     pub face_inner_radius_m: f64,
     /// Outer radius `Ro` of the friction faces, m (> `Ri`).
     pub face_outer_radius_m: f64,
-    /// `mu(v)` of every face.
+    /// `mu(v)` of every face (of each face without its own in [`Self::face_friction`]).
     pub friction: FrictionCurve,
+    /// Each interface's own `mu(v)` (interface `m` joins stack bodies `m` and `m + 1`), set
+    /// by a thermal run from `mu(v, T)` at the face's temperature (MODEL.md section 9);
+    /// empty: every face takes [`Self::friction`].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub face_friction: Vec<FrictionCurve>,
     /// The piston.
     pub piston: Piston,
     /// Viscous drag across open gaps; `None`: no drag.
@@ -236,6 +241,12 @@ pub struct StackModel {
 }
 
 impl StackModel {
+    /// The `mu(v)` of interface `m`: its own curve when [`Self::face_friction`] has one,
+    /// else [`Self::friction`].
+    pub fn friction_of(&self, m: usize) -> &FrictionCurve {
+        self.face_friction.get(m).unwrap_or(&self.friction)
+    }
+
     /// `R_eff` of the faces, m.
     pub fn effective_radius_m(&self) -> f64 {
         effective_radius_m(self.face_inner_radius_m, self.face_outer_radius_m)
@@ -469,6 +480,7 @@ mod tests {
     #[test]
     fn clamp_force_falls_along_the_stack() {
         let s = StackModel {
+            face_friction: Vec::new(),
             face_inner_radius_m: 0.2,
             face_outer_radius_m: 0.25,
             friction: FrictionCurve::constant(0.1),

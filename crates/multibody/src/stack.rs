@@ -130,6 +130,14 @@ impl Stack {
         self.c_gap = -self.model.open_gap_torque_n_m(1.0);
     }
 
+    /// Replaces each face's friction curve (a thermal window's `mu(v, T)` at the faces'
+    /// temperatures, MODEL.md section 9; empty: the stack's own curve on every face): the
+    /// friction follows from the next step on.
+    pub fn set_face_friction(&mut self, curves: &[clutchpack_model::FrictionCurve]) {
+        self.model.face_friction.clear();
+        self.model.face_friction.extend_from_slice(curves);
+    }
+
     /// The length of the step the impulses were last solved for, s (0 before the first).
     pub fn step_s(&self) -> f64 {
         self.h
@@ -159,16 +167,16 @@ impl Stack {
             .clamp_forces_with(self.model.piston.force_n(t_s), normal, out);
     }
 
-    /// The friction torque an interface clamped with `clamp_n` (N) passes at the slip
+    /// The friction torque interface `m` clamped with `clamp_n` (N) passes at the slip
     /// `slip_rad_s` (rad/s), N m: `mu(|v|) F R_eff` (its magnitude; it opposes the slip).
-    pub fn slip_torque_n_m(&self, clamp_n: f64, slip_rad_s: f64) -> f64 {
-        self.model.friction.mu(slip_rad_s * self.r_eff) * clamp_n * self.r_eff
+    pub fn slip_torque_n_m(&self, m: usize, clamp_n: f64, slip_rad_s: f64) -> f64 {
+        self.model.friction_of(m).mu(slip_rad_s * self.r_eff) * clamp_n * self.r_eff
     }
 
-    /// The largest torque a locked interface clamped with `clamp_n` (N) holds, N m:
+    /// The largest torque interface `m` holds locked, clamped with `clamp_n` (N), N m:
     /// `mu(0) F R_eff`.
-    pub fn holding_torque_n_m(&self, clamp_n: f64) -> f64 {
-        self.model.friction.static_mu() * clamp_n * self.r_eff
+    pub fn holding_torque_n_m(&self, m: usize, clamp_n: f64) -> f64 {
+        self.model.friction_of(m).static_mu() * clamp_n * self.r_eff
     }
 
     /// The open gaps' damping `c`, N m s/rad (0 without oil in the gaps).
@@ -202,7 +210,7 @@ impl Stack {
         for m in 0..self.interfaces() {
             if self.body[m] == i || self.body[m + 1] == i {
                 bound += if self.clamp[m] > 0.0 {
-                    let f = &self.model.friction;
+                    let f = self.model.friction_of(m);
                     f.static_mu().max(f.mu(self.slip[m] * self.r_eff)) * self.clamp[m] * self.r_eff
                 } else {
                     self.c_gap * self.slip[m].abs()
@@ -231,7 +239,7 @@ impl Stack {
         let bound: Vec<f64> = (0..n_if)
             .map(|m| {
                 if self.clamp[m] > 0.0 {
-                    let mu = self.model.friction.mu(self.slip[m] * self.r_eff);
+                    let mu = self.model.friction_of(m).mu(self.slip[m] * self.r_eff);
                     h * mu * self.clamp[m] * self.r_eff
                 } else {
                     0.0
@@ -416,7 +424,7 @@ impl Stack {
                     slip_rad_s: self.slip[m],
                     slip_m_s: self.slip[m] * self.r_eff,
                     mu: if clamped {
-                        self.model.friction.mu(self.slip[m] * self.r_eff)
+                        self.model.friction_of(m).mu(self.slip[m] * self.r_eff)
                     } else {
                         0.0
                     },
@@ -443,6 +451,7 @@ mod tests {
 
     fn model(pressure_pa: f64, gap: Option<OpenGap>) -> StackModel {
         StackModel {
+            face_friction: Vec::new(),
             face_inner_radius_m: 0.2,
             face_outer_radius_m: 0.25,
             friction: FrictionCurve::constant(0.1),

@@ -58,6 +58,7 @@ fn engaging() -> PackModel {
         initial_speed_rad_s: 0.0,
     });
     p.stack = Some(StackModel {
+        face_friction: Vec::new(),
         face_inner_radius_m: 0.231,
         face_outer_radius_m: 0.290,
         friction: FrictionCurve::Stribeck {

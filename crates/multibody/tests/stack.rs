@@ -69,6 +69,7 @@ fn pack(n: usize, omega: f64, drum: Option<DrumModel>, stack: StackModel) -> Pac
 
 fn stack(friction: FrictionCurve, pressure: PressureProfile) -> StackModel {
     StackModel {
+        face_friction: Vec::new(),
         face_inner_radius_m: 0.231,
         face_outer_radius_m: 0.290,
         friction,

@@ -489,7 +489,9 @@ impl System {
             ev.slip[m] = slip;
             let torque = match self.faces[m] {
                 Face::Open => -self.c_gap * slip,
-                Face::Slip(dir) => -dir * stack.friction.mu(slip * r_eff) * ev.clamp[m] * r_eff,
+                Face::Slip(dir) => {
+                    -dir * stack.friction_of(m).mu(slip * r_eff) * ev.clamp[m] * r_eff
+                }
                 Face::Locked => 0.0,
             };
             ev.torque[m] = torque;
@@ -540,7 +542,7 @@ impl System {
                 slip_m_s: ev.slip[m] * r_eff,
                 mu: match self.faces[m] {
                     Face::Open => 0.0,
-                    _ => stack.friction.mu(ev.slip[m] * r_eff),
+                    _ => stack.friction_of(m).mu(ev.slip[m] * r_eff),
                 },
                 clamp_n: ev.clamp[m],
                 torque_n_m: ev.torque[m],
@@ -561,7 +563,9 @@ impl System {
             Face::Locked => {
                 ev.raw_clamp[m] <= 0.0
                     || ev.torque[m].abs()
-                        > stack.friction.static_mu() * ev.clamp[m] * stack.effective_radius_m()
+                        > stack.friction_of(m).static_mu()
+                            * ev.clamp[m]
+                            * stack.effective_radius_m()
             }
         }
     }
@@ -593,7 +597,7 @@ impl System {
         let was = self.faces[m];
         self.faces[m] = Face::Locked;
         let held = self.stack_eval(t, y, modes, &c);
-        let bound = stack.friction.static_mu() * held.clamp[m] * stack.effective_radius_m();
+        let bound = stack.friction_of(m).static_mu() * held.clamp[m] * stack.effective_radius_m();
         if held.torque[m].abs() <= bound && was != Face::Locked {
             // lock: the upper bodies (and those locked above them) take the lower's speed
             let mut b = m + 1;
@@ -727,6 +731,7 @@ mod tests {
             initial_speed_rad_s: 0.0,
         });
         pack.stack = Some(StackModel {
+            face_friction: Vec::new(),
             face_inner_radius_m: 0.235,
             face_outer_radius_m: 0.29,
             friction: FrictionCurve::constant(0.1),

@@ -186,6 +186,7 @@ fn per_tooth_effects_are_refused() {
     let mut pack = paper_pack(25e-6);
     pack.plates = vec![pack.discs[0].clone(), pack.discs[0].clone()];
     pack.stack = Some(clutchpack_model::StackModel {
+        face_friction: Vec::new(),
         face_inner_radius_m: 0.235,
         face_outer_radius_m: 0.29,
         friction: clutchpack_model::FrictionCurve::constant(0.1),

@@ -27,6 +27,7 @@ fn open_brake() -> PackModel {
     );
     pack.plates = vec![disc("p0", 0.1), disc("p1", 0.12), disc("p2", 0.14)];
     pack.stack = Some(StackModel {
+        face_friction: Vec::new(),
         face_inner_radius_m: 0.235,
         face_outer_radius_m: 0.29,
         friction: FrictionCurve::constant(0.1),
@@ -122,6 +123,7 @@ fn engagement() -> PackModel {
         initial_speed_rad_s: 0.0,
     });
     pack.stack = Some(StackModel {
+        face_friction: Vec::new(),
         face_inner_radius_m: 0.231,
         face_outer_radius_m: 0.290,
         friction: FrictionCurve::constant(0.1),

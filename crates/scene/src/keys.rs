@@ -427,7 +427,21 @@ table! {
         convection: table RawConvection,
         discs: table RawThermalDiscs,
         plates: table RawThermalPlates,
+        friction: table RawThermalFriction,
     }
+}
+
+table! {
+    /// `[thermal.friction]`: the faces' friction coefficient against slip speed and temperature, mu(v, T) (MODEL.md section 9): bilinear between the points, held at the table's edges (no extrapolation). At every thermal window's end each face takes mu(v, T_face) at the hotter of its two bodies' temperatures, in place of [stack.friction]. Without it the faces keep [stack.friction] all the run.
+    RawThermalFriction at "thermal.friction" {
+        /// slip speeds at the effective radius, from >= 0, strictly increasing, at least 2
+        speeds_m_s: "m/s", Kind::Numbers, Dflt::When("required with [thermal.friction]");
+        /// face temperatures, strictly increasing, at least 2
+        temperatures_k: "K", Kind::Numbers, Dflt::When("required with [thermal.friction]");
+        /// one row per speeds_m_s, each with one mu >= 0 per temperatures_k: mu = [[mu(v0, T0), mu(v0, T1), ...], [mu(v1, T0), ...], ...]
+        mu: "", Kind::NumberRows, Dflt::When("required with [thermal.friction]");
+    }
+    children {}
 }
 
 table! {

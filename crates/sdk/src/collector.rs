@@ -38,6 +38,9 @@ pub struct RunCollector {
     windows: Option<crate::windows::Windows>,
     /// The bodies' names, engine order (for the windows' rows).
     names: Vec<String>,
+    /// A thermal run's latest temperatures, K: the bodies (engine order), then the oil;
+    /// empty before the first (and in an isothermal run).
+    pub temperatures_k: Vec<f64>,
 }
 
 impl RunCollector {
@@ -54,6 +57,7 @@ impl RunCollector {
             last_impact: None,
             windows: None,
             names: Vec::new(),
+            temperatures_k: Vec::new(),
         }
     }
 
@@ -80,6 +84,7 @@ impl RunCollector {
             last_impact: self.last_impact,
             windows: None,
             names: self.names.clone(),
+            temperatures_k: self.temperatures_k.clone(),
         })
     }
 
@@ -308,6 +313,9 @@ impl Observer for RunCollector {
         }
     }
     fn temperatures(&mut self, _t_s: f64, bodies_k: &[f64], oil_k: f64) {
+        self.temperatures_k.clear();
+        self.temperatures_k.extend_from_slice(bodies_k);
+        self.temperatures_k.push(oil_k);
         if let Some(w) = &mut self.windows {
             w.temperatures(bodies_k, oil_k);
         }

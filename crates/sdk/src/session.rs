@@ -178,6 +178,13 @@ impl Session {
         self.inner.snapshot()
     }
 
+    /// A thermal run's latest temperatures, K: the bodies (discs, then plates), then the oil
+    /// (sent at t = 0, at every thermal window's end and at the run's end; empty for an
+    /// isothermal run).
+    pub fn temperatures_k(&self) -> &[f64] {
+        &self.collector.temperatures_k
+    }
+
     /// Impacts closed so far.
     pub fn impact_count(&self) -> usize {
         self.collector.impact_count()

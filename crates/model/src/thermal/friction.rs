@@ -136,6 +136,11 @@ fn locate(axis: &[f64], x: f64) -> (usize, f64) {
     (i, (x - axis[i]) / (axis[i + 1] - axis[i]))
 }
 
+/// A row's coefficient at the fraction `ft` across temperature cell `j`.
+fn column(row: &[f64], j: usize, ft: f64) -> f64 {
+    row[j] + ft * (row[j + 1] - row[j])
+}
+
 impl FrictionMap {
     /// Builds the map: `speeds_m_s` (m/s, >= 0, strictly increasing, at least 2),
     /// `temperatures_k` (K, > 0, strictly increasing, at least 2) and `mu[i][j]` at speed `i`
@@ -177,19 +182,51 @@ impl FrictionMap {
 
     /// `mu` at slip speed `v_m_s` (m/s; its magnitude is used, as [`crate::FrictionCurve`]
     /// does) and temperature `t_k` (K), dimensionless: bilinear in the cell that holds the
-    /// point, each coordinate clamped to its axis first.
+    /// point, each coordinate clamped to its axis first. Interpolated in temperature first,
+    /// then in speed as [`crate::Table::value`] interpolates (the end rows returned as they
+    /// are), so that [`Self::curve_at`] gives the same bits.
     pub fn mu(&self, v_m_s: f64, t_k: f64) -> f64 {
-        let (i, fv) = locate(&self.speeds_m_s, v_m_s.abs());
         let (j, ft) = locate(&self.temperatures_k, t_k);
-        let m = &self.mu;
-        let low = m[i][j] + ft * (m[i][j + 1] - m[i][j]);
-        let high = m[i + 1][j] + ft * (m[i + 1][j + 1] - m[i + 1][j]);
+        let at = |i: usize| column(&self.mu[i], j, ft);
+        let (s, v) = (&self.speeds_m_s, v_m_s.abs());
+        let n = s.len();
+        if v <= s[0] {
+            return at(0);
+        }
+        if v >= s[n - 1] {
+            return at(n - 1);
+        }
+        let (i, fv) = locate(s, v);
+        let (low, high) = (at(i), at(i + 1));
         low + fv * (high - low)
     }
 
     /// `mu(0, T)`: the coefficient that holds a locked interface at `t_k` (K).
     pub fn static_mu(&self, t_k: f64) -> f64 {
         self.mu(0.0, t_k)
+    }
+
+    /// The slip-speed curve `v -> mu(v, T)` at the temperature `t_k` (K), as the stack's
+    /// faces take it ([`crate::FrictionCurve::Table`] on the map's speeds): each row's
+    /// coefficient interpolated in temperature exactly as [`Self::mu`] does, so the curve
+    /// gives [`Self::mu`]`(v, t_k)` bit for bit at every slip speed (linear between the rows,
+    /// held beyond them).
+    pub fn curve_at(&self, t_k: f64) -> crate::FrictionCurve {
+        let (j, ft) = locate(&self.temperatures_k, t_k);
+        let column = self.mu.iter().map(|row| column(row, j, ft)).collect();
+        let table = crate::Table::new(self.speeds_m_s.clone(), column)
+            .expect("a validated map's speeds increase and its coefficients are finite");
+        crate::FrictionCurve::Table(table)
+    }
+
+    /// The slip speeds of the map, m/s (increasing, from >= 0).
+    pub fn speeds_m_s(&self) -> &[f64] {
+        &self.speeds_m_s
+    }
+
+    /// The temperatures of the map, K (increasing).
+    pub fn temperatures_k(&self) -> &[f64] {
+        &self.temperatures_k
     }
 }
 
@@ -226,6 +263,20 @@ mod tests {
         assert!((m.mu(50.0, 200.0) - 0.14).abs() < 1e-15);
         assert!((m.static_mu(250.0) - 0.12).abs() < 1e-15);
         assert!((m.mu(1.0, 1000.0) - 0.105).abs() < 1e-15);
+    }
+
+    /// The curve at a temperature is the map at that temperature, bit for bit, at every slip
+    /// speed (on the rows, between them, beyond both ends, either sign).
+    #[test]
+    fn curve_at_a_temperature_is_the_map() {
+        let m = map();
+        for t in [250.0, 313.15, 330.0, 353.15, 371.3, 393.15, 450.0] {
+            let c = m.curve_at(t);
+            for v in [0.0, 0.3, 1.0, 1.7, 2.0, 3.5, -0.8] {
+                assert_eq!(c.mu(v).to_bits(), m.mu(v, t).to_bits(), "v {v}, T {t}");
+            }
+            assert_eq!(c.static_mu(), m.static_mu(t));
+        }
     }
 
     /// Bad grids are refused, each error naming the value and what was expected.

@@ -47,7 +47,9 @@ pub mod viscosity;
 pub mod window;
 
 pub use friction::{FrictionMap, FrictionMapError};
-pub use pack::{GapViscosity, ThermalBody, ThermalModel, ThermalOil, ThermalReport, ViscosityLaw};
+pub use pack::{
+    FrictionTable, GapViscosity, ThermalBody, ThermalModel, ThermalOil, ThermalReport, ViscosityLaw,
+};
 pub use viscosity::{Viscosity, ViscosityError, ViscosityTable, Vogel, Walther};
 pub use window::{FaceMode, ThermalWindows};
 

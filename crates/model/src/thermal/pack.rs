@@ -4,6 +4,7 @@
 //! which an engine advances the temperatures; and what a thermal run reports
 //! ([`ThermalReport`]). Data only: the scene crate validates it, the engines integrate it.
 
+use super::friction::{FrictionMap, FrictionMapError};
 use super::viscosity::{Viscosity, ViscosityError, ViscosityTable, Vogel, Walther};
 use serde::{Deserialize, Serialize};
 
@@ -63,6 +64,30 @@ impl ViscosityLaw {
     }
 }
 
+/// The faces' friction coefficient against slip speed and temperature, `mu(v, T)`, as the
+/// points a scene gives (`[thermal.friction]`; validated: [`FrictionTable::fit`] succeeds).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FrictionTable {
+    /// Slip speeds at the effective radius, m/s (from >= 0, strictly increasing).
+    pub speeds_m_s: Vec<f64>,
+    /// Temperatures, K (strictly increasing).
+    pub temperatures_k: Vec<f64>,
+    /// `mu[i][j]` at `speeds_m_s[i]` and `temperatures_k[j]` (dimensionless, >= 0).
+    pub mu: Vec<Vec<f64>>,
+}
+
+impl FrictionTable {
+    /// The fitted map ([`FrictionMap`]: bilinear, held at its edges); the error names the
+    /// bad value.
+    pub fn fit(&self) -> Result<FrictionMap, FrictionMapError> {
+        FrictionMap::new(
+            self.speeds_m_s.clone(),
+            self.temperatures_k.clone(),
+            self.mu.clone(),
+        )
+    }
+}
+
 /// What viscosity the open gaps' drag (MODEL.md section 5) takes in a thermal run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -119,6 +144,11 @@ pub struct ThermalModel {
     pub plates: Vec<ThermalBody>,
     /// The oil.
     pub oil: ThermalOil,
+    /// The faces' `mu(v, T)`, taken at each window's end at each face's temperature (the
+    /// hotter of its two bodies; docs/DECISIONS.md, "Friction against temperature");
+    /// `None`: the stack's own `mu(v)` all the run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionTable>,
 }
 
 /// What a thermal run reports at its end (MODEL.md section 9's checks). Bodies: the discs,

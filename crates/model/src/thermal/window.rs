@@ -15,18 +15,20 @@
 //! (`[t_w, t]`, its true length) with its heat as constant powers, by classical RK4 on the
 //! linear lumped equations (MODEL.md section 9: `C dT/dt = P - G (T - T_oil)`, the oil's with
 //! the cooler), in sub-steps of at most a twentieth of the fastest time constant; then the
-//! film scale `eta(T_oil) / eta(T_ref)` and the gaps' viscosity are recomputed and, when they
-//! changed, the engine gets the pack with the new parameters.
+//! film scale `eta(T_oil) / eta(T_ref)` and the gaps' viscosity are recomputed, and with a
+//! `mu(v, T)` table each face's friction curve `v -> mu(v, T_face)` at its temperature (the
+//! hotter of its two bodies); when any of them changed, the engine gets the pack with the
+//! new parameters.
 //!
 //! The splitting error is first order in the window (the parameters lag the temperatures by
 //! up to one window); the heat is booked exactly as integrated, so the balance (heat
 //! generated = stored + cooler) closes to rounding whatever the window.
 
 use super::{
-    body_temperature_rate_k_s, cooler_heat_w, effusivity_share, GapViscosity, ThermalModel,
-    ThermalReport, Viscosity,
+    body_temperature_rate_k_s, cooler_heat_w, effusivity_share, FrictionMap, GapViscosity,
+    ThermalModel, ThermalReport, Viscosity,
 };
-use crate::{EngineError, PackModel, StackBody};
+use crate::{EngineError, FrictionCurve, PackModel, StackBody};
 
 /// How a friction interface passed its heat over a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -65,6 +67,10 @@ pub struct ThermalWindows {
     /// The film scale in use, and the gaps' viscosity (Pa s).
     scale: f64,
     gap_eta: f64,
+    /// The faces' `mu(v, T)` (`None`: the stack's own curve all the run) and each face's
+    /// curve in use (empty without a map).
+    friction: Option<FrictionMap>,
+    face_curves: Vec<FrictionCurve>,
     report: ThermalReport,
 }
 
@@ -76,6 +82,14 @@ impl ThermalWindows {
         let law = model.viscosity.fit().map_err(|e| {
             EngineError::Unsupported(format!("thermal.oil: the viscosity law: {e}"))
         })?;
+        let friction = match &model.friction {
+            Some(table) => Some(
+                table
+                    .fit()
+                    .map_err(|e| EngineError::Unsupported(format!("thermal.friction: {e}")))?,
+            ),
+            None => None,
+        };
         let nd = pack.discs.len();
         let bodies: Vec<_> = model.discs.iter().chain(&model.plates).copied().collect();
         if bodies.len() != nd + pack.plates.len() {
@@ -126,6 +140,8 @@ impl ThermalWindows {
             window_k: 0,
             scale: 1.0,
             gap_eta: base_gap,
+            friction: None,
+            face_curves: Vec::new(),
             report: ThermalReport {
                 final_k: vec![t0; n],
                 max_k: vec![t0; n],
@@ -139,6 +155,11 @@ impl ThermalWindows {
         let (scale, gap) = th.parameters();
         th.scale = scale;
         th.gap_eta = gap;
+        // each face's curve at t = 0 (a map without a stack has no face to give it to)
+        if n_if > 0 {
+            th.friction = friction;
+            th.face_curves = th.face_friction().unwrap_or_default();
+        }
         Ok(th)
     }
 
@@ -158,6 +179,32 @@ impl ThermalWindows {
             GapViscosity::Scaled => self.base_gap * scale,
         };
         (scale, gap)
+    }
+
+    /// The temperature a face's friction takes, K: the hotter of interface `m`'s two bodies
+    /// (docs/DECISIONS.md, "Friction against temperature": heat enters the bodies at the
+    /// face, so the face is at least as hot as either lumped body while it slips).
+    pub fn face_temperature_k(&self, m: usize) -> f64 {
+        let nd = self.n_discs;
+        let lower = self.temp[StackBody::at(m).body_index(nd)];
+        let upper = self.temp[StackBody::at(m + 1).body_index(nd)];
+        lower.max(upper)
+    }
+
+    /// Each face's curve `v -> mu(v, T_face)` at the current temperatures (MODEL.md section
+    /// 9's `mu(v, T)`, bilinear, held at its edges); `None` without a map.
+    fn face_friction(&self) -> Option<Vec<FrictionCurve>> {
+        let map = self.friction.as_ref()?;
+        Some(
+            (0..self.interfaces())
+                .map(|m| map.curve_at(self.face_temperature_k(m)))
+                .collect(),
+        )
+    }
+
+    /// Each face's friction curve in use (empty without a `mu(v, T)` map).
+    pub fn face_curves(&self) -> &[FrictionCurve] {
+        &self.face_curves
     }
 
     /// The tooth films' scale in use, `eta(T_oil) / eta(T_ref)` at the last window's end
@@ -182,8 +229,13 @@ impl ThermalWindows {
         {
             d.law.oil.viscosity_pa_s = self.base_film[b] * self.scale;
         }
-        if let Some(g) = out.stack.as_mut().and_then(|s| s.open_gap.as_mut()) {
-            g.viscosity_pa_s = self.gap_eta;
+        if let Some(s) = out.stack.as_mut() {
+            if let Some(g) = s.open_gap.as_mut() {
+                g.viscosity_pa_s = self.gap_eta;
+            }
+            if self.friction.is_some() {
+                s.face_friction.clone_from(&self.face_curves);
+            }
         }
         out
     }
@@ -193,7 +245,11 @@ impl ThermalWindows {
     pub fn initial_pack(&self, pack: &PackModel) -> Option<PackModel> {
         let changed = self.scale != 1.0
             || (self.gap_eta != self.base_gap
-                && pack.stack.as_ref().is_some_and(|s| s.open_gap.is_some()));
+                && pack.stack.as_ref().is_some_and(|s| s.open_gap.is_some()))
+            || pack
+                .stack
+                .as_ref()
+                .is_some_and(|s| self.face_curves.iter().any(|c| *c != s.friction));
         changed.then(|| self.apply(pack))
     }
 
@@ -265,11 +321,16 @@ impl ThermalWindows {
                 ),
             });
         }
-        if scale == self.scale && gap == self.gap_eta {
+        let curves = self.face_friction();
+        let faces_changed = curves.as_ref().is_some_and(|c| *c != self.face_curves);
+        if scale == self.scale && gap == self.gap_eta && !faces_changed {
             return Ok(None);
         }
         self.scale = scale;
         self.gap_eta = gap;
+        if let Some(c) = curves {
+            self.face_curves = c;
+        }
         self.report.updates += 1;
         Ok(Some(self.apply(pack)))
     }
@@ -405,6 +466,7 @@ mod tests {
                 flow_capacity_w_k: 0.0,
                 inlet_k: 313.15,
             },
+            friction: None,
         }
     }
 
@@ -455,5 +517,48 @@ mod tests {
         let eta = swapped.discs[0].law.oil.viscosity_pa_s;
         assert_eq!(eta, p.discs[0].law.oil.viscosity_pa_s * w.film_scale());
         assert!(w.temperatures_k()[3] > 313.15);
+    }
+
+    /// With a `mu(v, T)` table each face takes `mu` at the hotter of its two bodies at every
+    /// window's end: a table constant in `v` and linear in `T`, `mu = 0.12 - 2e-4 (T -
+    /// 313.15 K)`, and 10 J into interface 0 (adiabatic, equal effusivities: +0.05 K for plate
+    /// 0 and disc 0) gives interface 0 and 1 (disc 0, plate 1: disc 0 the hotter) `mu = 0.12
+    /// - 1e-5` (1e-15 absolute: roundings), and the pack's other curves follow.
+    #[test]
+    fn faces_take_mu_at_the_hotter_body() {
+        use crate::thermal::FrictionTable;
+        let p = pack();
+        let mut m = model(0.0);
+        m.friction = Some(FrictionTable {
+            speeds_m_s: vec![0.0, 5.0],
+            temperatures_k: vec![313.15, 413.15],
+            mu: vec![vec![0.12, 0.10], vec![0.12, 0.10]],
+        });
+        let mut w = ThermalWindows::new(m, &p).unwrap();
+        // at t = 0 every face at 313.15 K: mu 0.12, which differs from the scene's curve
+        let start = w
+            .initial_pack(&p)
+            .expect("the table's curves replace the scene's");
+        let s0 = start.stack.as_ref().unwrap();
+        assert_eq!(s0.face_friction.len(), 2);
+        assert_eq!(s0.friction_of(1).mu(1.0), 0.12);
+        w.book_face(0, 10.0, FaceMode::Clamped);
+        let swapped = w
+            .close_windows(1.0e-3, &p)
+            .unwrap()
+            .expect("the faces warmed");
+        let s = swapped.stack.as_ref().unwrap();
+        let want = 0.12 - 2e-4 * 0.05;
+        for face in 0..2 {
+            for v in [0.0, 2.0, 7.0] {
+                let mu = s.friction_of(face).mu(v);
+                assert!((mu - want).abs() < 1e-15, "face {face}, v {v}: {mu}");
+            }
+        }
+        // face 1 joins disc 0 (+0.05 K) and plate 1 (cold): the hotter body's
+        assert!((w.face_temperature_k(1) - (313.15 + 0.05)).abs() < 1e-12);
+        assert_eq!(w.face_curves().len(), 2);
+        // no more heat: the temperatures hold, the curves too, nothing to swap
+        assert!(w.close_windows(2.0e-3, &p).unwrap().is_none());
     }
 }

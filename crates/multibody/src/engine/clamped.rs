@@ -153,7 +153,7 @@ impl Run {
             };
             let v = u[sys.body[m + 1]] - u[sys.body[m]];
             st.face[m] = if st.clamp[m] > 0.0 {
-                -dir * stack.slip_torque_n_m(st.clamp[m], v)
+                -dir * stack.slip_torque_n_m(m, st.clamp[m], v)
             } else {
                 -c_gap * v
             };
@@ -345,7 +345,7 @@ impl Run {
                 if self.faces[m] != Face::Locked {
                     continue;
                 }
-                let hold = stack.holding_torque_n_m(s.clamp[m]);
+                let hold = stack.holding_torque_n_m(m, s.clamp[m]);
                 let excess = s.face[m].abs() - hold;
                 if excess > 0.0 && worst.is_none_or(|(e, _)| excess > e) {
                     worst = Some((excess, m));

@@ -152,8 +152,8 @@ fn external_work_j(a: &super::EnergyAudit) -> f64 {
 
 impl Run {
     /// Swaps the viscosity-dependent parameters of `pack` (the same bodies and stack, a
-    /// thermal window's new tooth films and open gaps) into the run: the couplings' tooth
-    /// laws, the bodies' models and the stack's open gaps.
+    /// thermal window's new tooth films, open gaps and faces' friction curves) into the run:
+    /// the couplings' tooth laws, the bodies' models and the stack's open gaps and faces.
     pub(super) fn set_parameters(&mut self, pack: PackModel) {
         let bodies: Arc<[DiscModel]> = pack.discs.iter().chain(&pack.plates).cloned().collect();
         for (c, b) in self.couplings.iter_mut().zip(bodies.iter()) {
@@ -161,6 +161,7 @@ impl Run {
         }
         if let (Some(s), Some(m)) = (self.stack.as_mut(), pack.stack.as_ref()) {
             s.set_open_gap(m.open_gap);
+            s.set_face_friction(&m.face_friction);
         }
         self.bodies = bodies;
         self.pack = Arc::new(pack);

@@ -247,6 +247,35 @@ impl Checker {
         }
     }
 
+    /// An array of rows, each an array of finite numbers ([`Self::numbers`]: a bad item is
+    /// reported at `key[i][j]`, a row that is not an array at `key[i]`).
+    pub fn number_rows(&mut self, path: &str, v: Option<&Value>) -> Field<Vec<Vec<f64>>> {
+        let Some(v) = v else { return Field::Absent };
+        let Some(rows) = v.as_array() else {
+            self.report(
+                path,
+                Some(show(v)),
+                "must be an array of rows (arrays of numbers)",
+            );
+            return Field::Invalid;
+        };
+        let mut out = Some(Vec::with_capacity(rows.len()));
+        for (i, row) in rows.iter().enumerate() {
+            match self.numbers(&format!("{path}[{i}]"), Some(row), None) {
+                Field::Valid(r) => {
+                    if let Some(o) = out.as_mut() {
+                        o.push(r)
+                    }
+                }
+                _ => out = None,
+            }
+        }
+        match out {
+            Some(o) => Field::Valid(o),
+            None => Field::Invalid,
+        }
+    }
+
     /// Reports a key that is present but not allowed in this configuration.
     pub fn not_allowed(&mut self, key: &str, v: Option<&Value>, rule: &str) -> bool {
         match v {

@@ -139,6 +139,7 @@ pub(super) fn stack(ck: &mut Checker, r: &St) -> Option<StackModel> {
         return None;
     }
     Some(StackModel {
+        face_friction: Vec::new(),
         face_inner_radius_m: ri,
         face_outer_radius_m: ro,
         friction: friction?,

@@ -6,13 +6,13 @@
 
 use super::Checker;
 use crate::keys::{
-    RawConvection as Cv, RawStack, RawThermal as Th, RawThermalDiscs as D, RawThermalOil as O,
-    RawThermalPlates as Pl,
+    RawConvection as Cv, RawStack, RawThermal as Th, RawThermalDiscs as D,
+    RawThermalFriction as Fr, RawThermalOil as O, RawThermalPlates as Pl,
 };
 use crate::schema::{fmt_num, Key, RawTable};
 use clutchpack_model::thermal::{
-    laminar_gap_h_w_m2_k, GapHeating, GapViscosity, ThermalBody, ThermalModel, ThermalOil,
-    ThermalProperties, ViscosityError, ViscosityLaw,
+    laminar_gap_h_w_m2_k, FrictionMapError, FrictionTable, GapHeating, GapViscosity, ThermalBody,
+    ThermalModel, ThermalOil, ThermalProperties, ViscosityError, ViscosityLaw,
 };
 use std::f64::consts::PI;
 
@@ -69,6 +69,7 @@ pub(super) fn thermal(
         onum(ck, &O::cooler_capacity_rate_w_k).or(O::cooler_capacity_rate_w_k.default_num());
     let inlet = onum(ck, &O::inlet_temperature_k).optional();
     let lambda = onum(ck, &O::conductivity_w_m_k).or(O::conductivity_w_m_k.default_num());
+    let friction = friction(ck, r.friction.as_ref());
 
     // the faces' annulus, from [stack]
     let Some(stack) = stack else {
@@ -152,7 +153,105 @@ pub(super) fn thermal(
             flow_capacity_w_k: cooler?,
             inlet_k: inlet?.unwrap_or(initial),
         },
+        friction: friction?,
     })
+}
+
+/// `[thermal.friction]`: the faces' `mu(v, T)` (MODEL.md section 9), fitted once here so that
+/// a scene that validates runs; `Some(None)` without the table, `None` when it is bad (the
+/// problem reported at the key and value the map refuses, with its rule).
+fn friction(ck: &mut Checker, f: Option<&Fr>) -> Option<Option<FrictionTable>> {
+    let Some(f) = f else { return Some(None) };
+    let hint = "required with [thermal.friction]; set it there";
+    let speeds = ck
+        .numbers(&Fr::speeds_m_s.rel(), f.value(&Fr::speeds_m_s), None)
+        .required(ck, &Fr::speeds_m_s.rel(), hint);
+    let temps = ck
+        .numbers(
+            &Fr::temperatures_k.rel(),
+            f.value(&Fr::temperatures_k),
+            None,
+        )
+        .required(ck, &Fr::temperatures_k.rel(), hint);
+    let mu = ck
+        .number_rows(&Fr::mu.rel(), f.value(&Fr::mu))
+        .required(ck, &Fr::mu.rel(), hint);
+    let table = FrictionTable {
+        speeds_m_s: speeds?,
+        temperatures_k: temps?,
+        mu: mu?,
+    };
+    let err = match table.fit() {
+        Ok(_) => return Some(Some(table)),
+        Err(e) => e,
+    };
+    let axis_key = |axis: &str| {
+        if axis == "speed" {
+            Fr::speeds_m_s.rel()
+        } else {
+            Fr::temperatures_k.rel()
+        }
+    };
+    let mu_key = Fr::mu.rel();
+    let (key, value, rule) = match &err {
+        FrictionMapError::TooShort { axis, len } => (
+            axis_key(axis),
+            Some(format!("[...{len} values]")),
+            "must have at least 2 values".to_string(),
+        ),
+        FrictionMapError::AxisValue {
+            axis,
+            index,
+            value,
+            expected,
+            ..
+        } => (
+            format!("{}[{index}]", axis_key(axis)),
+            Some(fmt_num(*value)),
+            format!("must be finite and {expected}"),
+        ),
+        FrictionMapError::AxisNotIncreasing {
+            axis,
+            index,
+            value,
+            previous,
+            ..
+        } => (
+            format!("{}[{index}]", axis_key(axis)),
+            Some(fmt_num(*value)),
+            format!(
+                "must exceed the value before it ({}): the values must strictly increase",
+                fmt_num(*previous)
+            ),
+        ),
+        FrictionMapError::RowCount(rows, speeds) => (
+            mu_key.clone(),
+            Some(format!("[...{rows} rows]")),
+            format!(
+                "must have one row per entry of {} ({speeds})",
+                Fr::speeds_m_s.rel()
+            ),
+        ),
+        FrictionMapError::RowLength { row, len, expected } => (
+            format!("{mu_key}[{row}]"),
+            Some(format!("[...{len} values]")),
+            format!(
+                "must have one value per entry of {} ({expected})",
+                Fr::temperatures_k.rel()
+            ),
+        ),
+        FrictionMapError::Mu {
+            speed_index,
+            temperature_index,
+            value,
+        } => (
+            format!("{mu_key}[{speed_index}][{temperature_index}]"),
+            Some(fmt_num(*value)),
+            "must be finite and >= 0 (a friction coefficient)".to_string(),
+        ),
+    };
+    ck.report(key, value, rule);
+    None
 }
 
 /// `[thermal.convection]`: the conductance per area of a face, W/(m^2 K).
@@ -501,6 +600,102 @@ mod tests {
         assert_eq!(
             s.engine(Some(EngineChoice::Multibody), "x").unwrap(),
             EngineChoice::Multibody
+        );
+    }
+
+    /// `[thermal.friction]`: a good table is the model's (its rows as given); every bad one
+    /// is named at its key with the value and the rule, never a panic.
+    #[test]
+    fn friction_table_is_read_and_bad_ones_named() {
+        let head = format!("[thermal]\ninitial_temperature_k = 353.15\n{OIL}");
+        let table = |speeds: &str, temps: &str, mu: &str| {
+            format!(
+                "{head}[thermal.friction]\nspeeds_m_s = {speeds}\ntemperatures_k = {temps}\n\
+                 mu = {mu}\n"
+            )
+        };
+        let s = pack6(&table(
+            "[0.0, 2.0]",
+            "[313.15, 393.15]",
+            "[[0.13, 0.11], [0.14, 0.12]]",
+        ))
+        .unwrap();
+        let f = s.thermal.unwrap().friction.expect("the table");
+        assert_eq!(f.speeds_m_s, vec![0.0, 2.0]);
+        assert_eq!(f.temperatures_k, vec![313.15, 393.15]);
+        assert_eq!(f.mu, vec![vec![0.13, 0.11], vec![0.14, 0.12]]);
+        assert!(f.fit().is_ok());
+        let has = |extra: String, key: &str, value: Option<&str>, rule: &str| {
+            let ps = problems(&extra);
+            assert!(
+                ps.iter().any(|p| p.key == key
+                    && p.rule.contains(rule)
+                    && (value.is_none() || p.value.as_deref() == value)),
+                "no {key} = {value:?}: ...{rule}... in {ps:?}"
+            )
+        };
+        let mu2 = "[[0.13, 0.11], [0.14, 0.12]]";
+        has(
+            table("[0.0]", "[313.15, 393.15]", "[[0.13, 0.11]]"),
+            "thermal.friction.speeds_m_s",
+            None,
+            "at least 2",
+        );
+        has(
+            table("[-0.5, 2.0]", "[313.15, 393.15]", mu2),
+            "thermal.friction.speeds_m_s[0]",
+            Some("-0.5"),
+            ">= 0",
+        );
+        has(
+            table("[0.0, 2.0]", "[393.15, 313.15]", mu2),
+            "thermal.friction.temperatures_k[1]",
+            Some("313.15"),
+            "strictly increase",
+        );
+        has(
+            table("[0.0, 2.0]", "[313.15, 393.15]", "[[0.13, 0.11]]"),
+            "thermal.friction.mu",
+            None,
+            "one row per entry of thermal.friction.speeds_m_s (2)",
+        );
+        has(
+            table("[0.0, 2.0]", "[313.15, 393.15]", "[[0.13, 0.11], [0.14]]"),
+            "thermal.friction.mu[1]",
+            None,
+            "one value per entry of thermal.friction.temperatures_k (2)",
+        );
+        has(
+            table(
+                "[0.0, 2.0]",
+                "[313.15, 393.15]",
+                "[[0.13, 0.11], [0.14, -0.02]]",
+            ),
+            "thermal.friction.mu[1][1]",
+            Some("-0.02"),
+            ">= 0",
+        );
+        has(
+            table(
+                "[0.0, 2.0]",
+                "[313.15, 393.15]",
+                "[[0.13, 0.11], [0.14, \"x\"]]",
+            ),
+            "thermal.friction.mu[1][1]",
+            None,
+            "must be a number",
+        );
+        has(
+            table("[0.0, 2.0]", "[313.15, 393.15]", "0.1"),
+            "thermal.friction.mu",
+            Some("0.1"),
+            "array of rows",
+        );
+        has(
+            format!("{head}[thermal.friction]\nspeeds_m_s = [0.0, 1.0]\n"),
+            "thermal.friction.temperatures_k",
+            None,
+            "missing",
         );
     }
 

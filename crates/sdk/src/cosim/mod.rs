@@ -11,8 +11,8 @@ mod variables;
 
 pub use inputs::{driven_from_names, driven_names, Input};
 pub use variables::{
-    variables, BodyField, Causality, ImpactField, InterfaceField, Kind, Quantity, Variable,
-    UNCONNECTED, UNITS,
+    uses_unit, variables, BodyField, Causality, ImpactField, InterfaceField, Kind, Quantity,
+    Variable, UNCONNECTED, UNITS,
 };
 
 use crate::{RecordingRequest, RunOutcome, Session, SessionRequest, SessionState, Simulation};
@@ -493,6 +493,10 @@ impl CoSimulation {
                 ImpactField::Peak => e.peak_n,
                 ImpactField::Body => 0.0,
             }),
+            Quantity::BodyTemperature(i) => self.temperature_k(i),
+            Quantity::OilTemperature => {
+                self.temperature_k(self.scene.pack.discs.len() + self.scene.pack.plates.len())
+            }
             _ => self.reals[vr as usize],
         })
     }
@@ -510,6 +514,18 @@ impl CoSimulation {
                 x.map(|x| (v.name.clone(), x))
             })
             .collect()
+    }
+
+    /// A thermal run's temperature `i` now, K (the bodies, then the oil), from the last
+    /// thermal window the engine closed; the scene's initial temperature before the run starts.
+    fn temperature_k(&self, i: usize) -> f64 {
+        let now = match (&self.session, &self.outcome) {
+            (Some(s), _) => s.temperatures_k().get(i).copied(),
+            (None, Some(o)) => o.collector.temperatures_k.get(i).copied(),
+            _ => None,
+        };
+        now.or(self.scene.thermal.as_ref().map(|t| t.initial_k))
+            .unwrap_or(0.0)
     }
 
     fn max_load(&self, i: usize) -> f64 {

@@ -89,6 +89,10 @@ pub enum Quantity {
     Impacts,
     /// The impact that closed last.
     LastImpact(ImpactField),
+    /// A thermal run's temperature of body `i` (the discs, then the plates), K.
+    BodyTemperature(usize),
+    /// A thermal run's oil temperature, K.
+    OilTemperature,
 }
 
 /// What the last impact's outputs give.
@@ -135,17 +139,26 @@ pub const UNCONNECTED: &str = "Give it a signal: unconnected, it holds this star
                                scene's value at t = 0) for the whole run, not the scene's \
                                profile over time";
 
-/// The units the variables use, with their SI base-unit exponents `(kg, m, s, rad)`.
-pub const UNITS: [(&str, [i32; 4]); 8] = [
-    ("s", [0, 0, 1, 0]),
-    ("rad", [0, 0, 0, 1]),
-    ("rad/s", [0, 0, -1, 1]),
-    ("N", [1, 1, -2, 0]),
-    ("N.m", [1, 2, -2, 0]),
-    ("Pa", [1, -1, -2, 0]),
-    ("J", [1, 2, -2, 0]),
-    ("1", [0, 0, 0, 0]),
+/// The units the variables use, with their SI base-unit exponents `(kg, m, s, rad, K)`
+/// (`K` only for a thermal scene's temperatures: [`uses_unit`]).
+pub const UNITS: [(&str, [i32; 5]); 9] = [
+    ("s", [0, 0, 1, 0, 0]),
+    ("rad", [0, 0, 0, 1, 0]),
+    ("rad/s", [0, 0, -1, 1, 0]),
+    ("N", [1, 1, -2, 0, 0]),
+    ("N.m", [1, 2, -2, 0, 0]),
+    ("Pa", [1, -1, -2, 0, 0]),
+    ("J", [1, 2, -2, 0, 0]),
+    ("1", [0, 0, 0, 0, 0]),
+    ("K", [0, 0, 0, 0, 1]),
 ];
+
+/// Whether a model description lists the unit `name` for `vars`: every unit of [`UNITS`]
+/// but `K`, which only a thermal scene's temperatures use (an isothermal scene's FMU keeps
+/// the description it had).
+pub fn uses_unit(name: &str, vars: &[Variable]) -> bool {
+    name != "K" || vars.iter().any(|v| v.unit == Some("K"))
+}
 
 /// The co-simulation variables (the FMU's) of `scene`, whose run the engine `engine` (`reference` or
 /// `multibody`) makes with the inputs `driven` (an FMU drives what [`Driven::all_for`] gives
@@ -389,6 +402,32 @@ pub fn variables(scene: &Scene, engine: &str, driven: Driven) -> Vec<Variable> {
         start_real: None,
         start_string: None,
     });
+    // a thermal scene's temperatures (MODEL.md section 9), after every other output so that
+    // the value references of those stay what an isothermal scene's are
+    if scene.thermal.is_some() {
+        for (i, body) in pack.discs.iter().chain(&pack.plates).enumerate() {
+            let (list, k) = if i < nd {
+                ("discs", i + 1)
+            } else {
+                ("plates", i - nd + 1)
+            };
+            v.output(
+                &format!("{list}[{k}].temperature_k"),
+                Quantity::BodyTemperature(i),
+                "K",
+                &format!(
+                    "{}: its lumped temperature at the last thermal window's end",
+                    body.name
+                ),
+            );
+        }
+        v.output(
+            "oil.temperature_k",
+            Quantity::OilTemperature,
+            "K",
+            "the oil's temperature at the last thermal window's end",
+        );
+    }
     v.0
 }
 
