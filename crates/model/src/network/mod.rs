@@ -120,6 +120,32 @@ pub struct Coupling {
     pub kind: CouplingKind,
 }
 
+impl Coupling {
+    /// Its lumped clutch, if it is one.
+    pub fn clutch(&self) -> Option<&LumpedClutch> {
+        match &self.kind {
+            CouplingKind::Clutch(c) => Some(c),
+            _ => None,
+        }
+    }
+
+    /// Its spring-damper, if it is one.
+    pub fn spring(&self) -> Option<&crate::spring::SpringDamper> {
+        match &self.kind {
+            CouplingKind::SpringDamper(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// Its gear mesh, if it is one.
+    pub fn mesh(&self) -> Option<&GearMesh> {
+        match &self.kind {
+            CouplingKind::GearMesh(g) => Some(g),
+            _ => None,
+        }
+    }
+}
+
 /// A driveline: bodies and the couplings between them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct Network {

@@ -57,8 +57,8 @@ mod constraint;
 
 use bodies::NetworkWorld;
 use clutchpack_model::network::{
-    ClutchEvent, ClutchMode, CouplingKind, LumpedClutch, Network, NetworkEnergy, NetworkObserver,
-    NetworkRun, NetworkSample,
+    ClutchEvent, ClutchMode, CouplingKind, Network, NetworkEnergy, NetworkObserver, NetworkRun,
+    NetworkSample,
 };
 use clutchpack_model::EngineError;
 use constraint::Row;
@@ -78,20 +78,6 @@ impl Default for NetworkStepOptions {
             step_s: 1e-4,
             record_rate_hz: 1000.0,
         }
-    }
-}
-
-fn clutch(net: &Network, k: usize) -> Option<&LumpedClutch> {
-    match &net.couplings[k].kind {
-        CouplingKind::Clutch(c) => Some(c),
-        _ => None,
-    }
-}
-
-fn spring(net: &Network, k: usize) -> Option<&clutchpack_model::SpringDamper> {
-    match &net.couplings[k].kind {
-        CouplingKind::SpringDamper(s) => Some(s),
-        _ => None,
     }
 }
 
@@ -199,14 +185,16 @@ impl<'n> Run<'n> {
         out.coupling.clear();
         out.coupling.resize(net.couplings.len(), 0.0);
         for (k, c) in net.couplings.iter().enumerate() {
-            if let (Some(cl), Some(ClutchMode::Slipping(s))) = (clutch(net, k), self.modes[k]) {
+            if let (Some(cl), Some(ClutchMode::Slipping(s))) =
+                (net.couplings[k].clutch(), self.modes[k])
+            {
                 // MODEL.md section 8: tau = sign(w_rel) mu(|w_rel|) cgeo fn, +tau on a, -tau on b
                 let tau = cl.slip_torque_n_m(s, w[c.b] - w[c.a], cl.normal_force_n(t));
                 out.coupling[k] = tau;
                 out.body[c.a] += tau;
                 out.body[c.b] -= tau;
             }
-            if let Some(sd) = spring(net, k) {
+            if let Some(sd) = net.couplings[k].spring() {
                 // MODEL.md section 8: T on b, -T on a, at the twist theta_a - theta_b (both
                 // bodies start at angle 0, as the reference engine's twist state does)
                 let t = sd.torque_n_m(theta[c.a] - theta[c.b], w[c.a] - w[c.b]);
@@ -237,7 +225,7 @@ impl<'n> Run<'n> {
     fn margins(&self, t: f64, theta: &[f64], w: &[f64], scratch: &mut Torques) -> Vec<f64> {
         self.evaluate(t, theta, w, scratch);
         (0..self.net.couplings.len())
-            .map(|k| match (clutch(self.net, k), self.modes[k]) {
+            .map(|k| match (self.net.couplings[k].clutch(), self.modes[k]) {
                 (Some(cl), Some(ClutchMode::Locked)) => {
                     cl.max_static_torque_n_m(cl.normal_force_n(t)) - scratch.coupling[k].abs()
                 }
@@ -264,7 +252,9 @@ impl<'n> Run<'n> {
         let before = self.modes.clone();
         let w_before = self.w.clone();
         for (k, c) in net.couplings.iter().enumerate() {
-            let Some(cl) = clutch(net, k) else { continue };
+            let Some(cl) = net.couplings[k].clutch() else {
+                continue;
+            };
             let f = cl.normal_force_n(t);
             let (wa, wb) = (self.w[c.a], self.w[c.b]);
             let w_rel = wb - wa;
@@ -312,7 +302,9 @@ impl<'n> Run<'n> {
                 if *mode != Some(ClutchMode::Locked) {
                     continue;
                 }
-                let Some(cl) = clutch(net, k) else { continue };
+                let Some(cl) = net.couplings[k].clutch() else {
+                    continue;
+                };
                 let over =
                     self.coupling_torque[k].abs() - cl.max_static_torque_n_m(cl.normal_force_n(t));
                 if over > 0.0 && worst.is_none_or(|(_, o)| over > o) {
@@ -362,7 +354,9 @@ impl<'n> Run<'n> {
         let mut any_locked = false;
         let total = self.total();
         for (k, c) in net.couplings.iter().enumerate() {
-            let Some(cl) = clutch(net, k) else { continue };
+            let Some(cl) = net.couplings[k].clutch() else {
+                continue;
+            };
             if let Some(ClutchMode::Slipping(s)) = self.modes[k] {
                 let (wa, wb) = (self.w[c.a], self.w[c.b]);
                 let s = f64::from(s);
@@ -496,7 +490,7 @@ pub fn run_network(
             .collect(),
         world,
         modes: (0..m)
-            .map(|k| clutch(net, k).map(|_| ClutchMode::Free))
+            .map(|k| net.couplings[k].clutch().map(|_| ClutchMode::Free))
             .collect(),
         rows: Vec::new(),
         torque: vec![0.0; n],
@@ -586,7 +580,7 @@ pub fn run_network(
                 let wrel = 0.5 * (w0[c.b] + run.w[c.b] - w0[c.a] - run.w[c.a]);
                 run.heat[k] += h * run.coupling_torque[k] * wrel;
             }
-            if let Some(sd) = spring(net, k) {
+            if let Some(sd) = net.couplings[k].spring() {
                 // the damper's share of the torque held over the step, on the step's mean
                 // twist rate (the spring's share is its potential's change, at the end)
                 let rate = 0.5 * (w0[c.a] + run.w[c.a] - w0[c.b] - run.w[c.b]);
@@ -607,7 +601,7 @@ pub fn run_network(
     run.energy.clutch_heat_j = run.heat.iter().sum::<f64>() - run.energy.damper_loss_j;
     let angles = run.world.angles();
     run.energy.spring_energy_change_j = (0..net.couplings.len())
-        .filter_map(|k| spring(net, k).map(|sd| (k, sd)))
+        .filter_map(|k| net.couplings[k].spring().map(|sd| (k, sd)))
         .map(|(k, sd)| {
             let c = &net.couplings[k];
             sd.potential_j(angles[c.a] - angles[c.b]) - sd.potential_j(0.0)

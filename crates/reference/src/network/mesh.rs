@@ -4,7 +4,7 @@
 //! that holds it, and the separation, which closes a [`clutchpack_model::ImpactEvent`] (the spline's type:
 //! the same statistics and fatigue apply).
 
-use super::{mesh, mesh_kinematics, Equations, NetworkObserver};
+use super::{mesh_kinematics, Equations, NetworkObserver};
 use crate::dopri::Dense;
 use crate::stepper::golden_peak;
 use clutchpack_model::ImpactTracker;
@@ -32,7 +32,7 @@ impl Meshes {
     /// The force on `k`'s flank at `t` on `dense`, as the event's peak is signed (eq 6:
     /// negative when body `a` leads, `x > 0`).
     fn load(eq: &mut Equations, k: usize, dense: &Dense, t: f64, ybuf: &mut [f64]) -> f64 {
-        let g = mesh(eq.net, k).expect("a mesh");
+        let g = eq.net.couplings[k].mesh().expect("a mesh");
         let Some(e) = eq.contacts[k] else { return 0.0 };
         dense.eval(t, ybuf);
         -g.force_n(&mesh_kinematics(eq.net, k, g, ybuf), &e)
@@ -72,7 +72,9 @@ impl Meshes {
         obs: &mut dyn NetworkObserver,
     ) {
         for k in 0..self.trackers.len() {
-            let Some(g) = mesh(eq.net, k) else { continue };
+            let Some(g) = eq.net.couplings[k].mesh() else {
+                continue;
+            };
             if crossed.is_some_and(|c| c[k] > 0.0) {
                 continue;
             }

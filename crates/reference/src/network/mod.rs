@@ -37,7 +37,7 @@ use modes::settle;
 
 use crate::dopri::{next_step, Dense, Dopri5};
 use cluster::Clusters;
-use clutchpack_model::network::{ClutchMode, CouplingKind, GearMesh, LumpedClutch, Network};
+use clutchpack_model::network::{ClutchMode, CouplingKind, GearMesh, Network};
 // the output types are the model's, shared with the multibody engine
 pub use clutchpack_model::network::{
     ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
@@ -79,27 +79,6 @@ struct Equations<'n> {
     residual: Vec<f64>,
     coupling_torque: Vec<f64>,
     mesh_force: Vec<f64>,
-}
-
-fn clutch(net: &Network, k: usize) -> Option<&LumpedClutch> {
-    match &net.couplings[k].kind {
-        CouplingKind::Clutch(c) => Some(c),
-        _ => None,
-    }
-}
-
-fn spring(net: &Network, k: usize) -> Option<&clutchpack_model::SpringDamper> {
-    match &net.couplings[k].kind {
-        CouplingKind::SpringDamper(s) => Some(s),
-        _ => None,
-    }
-}
-
-fn mesh(net: &Network, k: usize) -> Option<&GearMesh> {
-    match &net.couplings[k].kind {
-        CouplingKind::GearMesh(g) => Some(g),
-        _ => None,
-    }
 }
 
 /// A mesh's tooth kinematics at the state `y = [angles, speeds, ...]`.
@@ -154,7 +133,8 @@ impl<'n> Equations<'n> {
         }
         for (k, c) in self.net.couplings.iter().enumerate() {
             self.coupling_torque[k] = 0.0;
-            if let (Some(cl), Some(ClutchMode::Slipping(s))) = (clutch(self.net, k), self.modes[k])
+            if let (Some(cl), Some(ClutchMode::Slipping(s))) =
+                (self.net.couplings[k].clutch(), self.modes[k])
             {
                 // MODEL.md section 8: tau = sign(w_rel) mu(|w_rel|) cgeo fn, +tau on a, -tau on b
                 let tau = cl.slip_torque_n_m(s, w[c.b] - w[c.a], cl.normal_force_n(t));
@@ -162,14 +142,14 @@ impl<'n> Equations<'n> {
                 self.torque[c.a] += tau;
                 self.torque[c.b] -= tau;
             }
-            if let Some(sd) = spring(self.net, k) {
+            if let Some(sd) = self.net.couplings[k].spring() {
                 // MODEL.md section 8: T on b, -T on a; the twist is its own state
                 let t = sd.torque_n_m(y[2 * n + k], w[c.a] - w[c.b]);
                 self.coupling_torque[k] = -t;
                 self.torque[c.a] -= t;
                 self.torque[c.b] += t;
             }
-            if let (Some(g), Some(e)) = (mesh(self.net, k), self.contacts[k]) {
+            if let (Some(g), Some(e)) = (self.net.couplings[k].mesh(), self.contacts[k]) {
                 // MODEL.md section 8: F signed as x; -Rb_a F on a, -+Rb_b F on b
                 let f = g.force_n(&mesh_kinematics(self.net, k, g, y), &e);
                 let (ta, tb) = g.torques_n_m(f);
@@ -206,7 +186,7 @@ impl<'n> Equations<'n> {
         self.forces(t, y);
         w_dot.copy_from_slice(&self.acc);
         for (k, c) in self.net.couplings.iter().enumerate() {
-            x_dot[k] = match (mesh(self.net, k), spring(self.net, k)) {
+            x_dot[k] = match (self.net.couplings[k].mesh(), self.net.couplings[k].spring()) {
                 (Some(g), _) => g.displacement((0.0, 0.0), (w[c.a], w[c.b])).1,
                 (_, Some(_)) => w[c.a] - w[c.b],
                 _ => 0.0,
@@ -217,9 +197,9 @@ impl<'n> Equations<'n> {
             let c = &self.net.couplings[k];
             counters[k] = if matches!(self.modes[k], Some(ClutchMode::Slipping(_))) {
                 self.coupling_torque[k] * (w[c.b] - w[c.a])
-            } else if let Some(sd) = spring(self.net, k) {
+            } else if let Some(sd) = self.net.couplings[k].spring() {
                 sd.loss_rate_w(w[c.a] - w[c.b])
-            } else if let (Some(g), Some(_)) = (mesh(self.net, k), self.contacts[k]) {
+            } else if let (Some(g), Some(_)) = (self.net.couplings[k].mesh(), self.contacts[k]) {
                 // power into the mesh: F v pairs (the torques' work on the bodies, negated)
                 let (_, v) = g.displacement((0.0, 0.0), (w[c.a], w[c.b]));
                 self.mesh_force[k] * v * g.pairs
@@ -253,7 +233,7 @@ impl<'n> Equations<'n> {
             self.rigid_torques();
         }
         for (k, c) in self.net.couplings.iter().enumerate() {
-            if let Some(g) = mesh(self.net, k) {
+            if let Some(g) = self.net.couplings[k].mesh() {
                 let depth = g
                     .law
                     .engagement_depth_m(&mesh_kinematics(self.net, k, g, y));
@@ -264,7 +244,7 @@ impl<'n> Equations<'n> {
                 };
                 continue;
             }
-            let Some(cl) = clutch(self.net, k) else {
+            let Some(cl) = self.net.couplings[k].clutch() else {
                 out[k] = 1.0;
                 continue;
             };
@@ -315,7 +295,7 @@ pub fn run_network(
     let mut atol = vec![tol; dim];
     // the meshes' x on their backlash's scale; other slots and the counters out of the norm
     for k in 0..m {
-        atol[2 * n + k] = match (mesh(net, k), spring(net, k)) {
+        atol[2 * n + k] = match (net.couplings[k].mesh(), net.couplings[k].spring()) {
             (Some(g), _) => tol * g.backlash_m,
             (_, Some(_)) => tol,
             _ => f64::INFINITY,
@@ -329,12 +309,12 @@ pub fn run_network(
         y[n + i] = b.initial_speed_rad_s;
     }
     for k in 0..m {
-        if let Some(g) = mesh(net, k) {
+        if let Some(g) = net.couplings[k].mesh() {
             y[2 * n + k] = g.initial_offset_m;
         }
     }
     let initial_modes: Vec<Option<ClutchMode>> = (0..m)
-        .map(|k| clutch(net, k).map(|_| ClutchMode::Free))
+        .map(|k| net.couplings[k].clutch().map(|_| ClutchMode::Free))
         .collect();
     let mut eq = Equations::new(net, initial_modes);
     let kinetic = |y: &[f64]| -> f64 {
@@ -484,12 +464,12 @@ pub fn run_network(
     let mut heat = y[c0..c0 + m].to_vec();
     let (mut mesh_work, mut damper_loss, mut spring_change) = (0.0, 0.0, 0.0);
     for (k, h) in heat.iter_mut().enumerate() {
-        if mesh(net, k).is_some() {
+        if net.couplings[k].mesh().is_some() {
             mesh_work += *h;
-        } else if let Some(sd) = spring(net, k) {
+        } else if let Some(sd) = net.couplings[k].spring() {
             damper_loss += *h;
             spring_change += sd.potential_j(y[2 * n + k]) - sd.potential_j(0.0);
-        } else if clutch(net, k).is_none() {
+        } else if net.couplings[k].clutch().is_none() {
             *h = 0.0;
         }
     }

@@ -2,7 +2,7 @@
 //! which clutches lock, slip or go free, settled together, and the speeds of a new rigid group
 //! made common with its momentum kept.
 
-use super::{clutch, sample, ClutchEvent, Equations, NetworkObserver};
+use super::{sample, ClutchEvent, Equations, NetworkObserver};
 use clutchpack_model::network::ClutchMode;
 
 /// Settles the clutches' modes at an event at `t` (MODEL.md section 8; Modelica's `Clutch`):
@@ -23,7 +23,9 @@ pub(super) fn settle(
     let state_before = sample(eq, t, y);
     let mut modes = before.clone();
     for (k, c) in net.couplings.iter().enumerate() {
-        let Some(cl) = clutch(net, k) else { continue };
+        let Some(cl) = net.couplings[k].clutch() else {
+            continue;
+        };
         let f = cl.normal_force_n(t);
         let w_rel = y[n + c.b] - y[n + c.a];
         let scale = 1e-10 * (1.0 + y[n + c.a].abs() + y[n + c.b].abs());
@@ -61,7 +63,7 @@ pub(super) fn settle(
             if *mode != Some(ClutchMode::Locked) {
                 continue;
             }
-            let cl = clutch(net, k).expect("only clutches lock");
+            let cl = net.couplings[k].clutch().expect("only clutches lock");
             let over = eq.coupling_torque[k].abs() - cl.max_static_torque_n_m(cl.normal_force_n(t));
             if over > 0.0 && worst.is_none_or(|(_, o)| over > o) {
                 worst = Some((k, over));
