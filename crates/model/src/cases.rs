@@ -423,6 +423,37 @@ pub fn coupled_clutches() -> crate::network::Network {
     }
 }
 
+/// A dry steel gear mesh (MODEL.md section 8): base radii 30 and 90 mm, 0.1 mm of backlash,
+/// one pair of teeth in contact, the section 2 Hertz law (210 GPa, 5 mm curvature, no loss),
+/// no oil; at its free play's centre (`initial_offset_m` 0). `internal`: a ring gear.
+pub fn dry_gear_mesh(internal: bool) -> crate::network::GearMesh {
+    crate::network::GearMesh {
+        base_radius_a_m: 0.03,
+        base_radius_b_m: 0.09,
+        internal,
+        backlash_m: 1e-4,
+        pairs: 1.0,
+        initial_offset_m: 0.0,
+        law: ToothLaw {
+            kind: LawKind::Dry,
+            hertz: Hertz {
+                modulus_pa: 210e9,
+                curvature_radius_m: 5e-3,
+                loss_coefficient_s_m: 0.0,
+            },
+            oil: OilFilm {
+                thickness_m: 0.0,
+                viscosity_pa_s: 0.0,
+                leakage_coefficient: 0.421,
+                width_m: 1e-2,
+                length_m: 1e-2,
+                v_floor_m_s: 0.01,
+                h_min_m: 1e-7,
+            },
+        },
+    }
+}
+
 /// A spring-damper between two free inertias released from a twist (MODEL.md section 8): `a`
 /// of 0.5 kg m^2 and `b` of 0.3 kg m^2 both at angle 0 and 1 rad/s, joined by `k` = 2000
 /// N m/rad and `d` = 0.8 N m s/rad whose free angle is `-q0` (so the spring starts twisted by

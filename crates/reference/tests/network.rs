@@ -205,29 +205,8 @@ fn free_impact_across_a_gear_mesh_matches_closed_form() {
     use clutchpack_model::network::*;
     let (j_a, j_b, v0) = (0.02, 0.5, 0.3);
     let g = GearMesh {
-        base_radius_a_m: 0.03,
-        base_radius_b_m: 0.09,
-        internal: false,
-        backlash_m: 1e-4,
-        pairs: 1.0,
         initial_offset_m: 0.5e-4 - 1e-7,
-        law: ToothLaw {
-            kind: LawKind::Dry,
-            hertz: Hertz {
-                modulus_pa: 210e9,
-                curvature_radius_m: 5e-3,
-                loss_coefficient_s_m: 0.0,
-            },
-            oil: OilFilm {
-                thickness_m: 0.0,
-                viscosity_pa_s: 0.0,
-                leakage_coefficient: 0.421,
-                width_m: 1e-2,
-                length_m: 1e-2,
-                v_floor_m_s: 0.01,
-                h_min_m: 1e-7,
-            },
-        },
+        ..cases::dry_gear_mesh(false)
     };
     let body = |name: &str, j: f64, w: f64| Body {
         name: name.into(),

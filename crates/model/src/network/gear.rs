@@ -110,34 +110,9 @@ impl GearMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::law::{Hertz, LawKind, OilFilm};
 
     fn mesh(internal: bool) -> GearMesh {
-        GearMesh {
-            base_radius_a_m: 0.03,
-            base_radius_b_m: 0.09,
-            internal,
-            backlash_m: 1e-4,
-            pairs: 1.0,
-            initial_offset_m: 0.0,
-            law: ToothLaw {
-                kind: LawKind::Dry,
-                hertz: Hertz {
-                    modulus_pa: 210e9,
-                    curvature_radius_m: 5e-3,
-                    loss_coefficient_s_m: 0.0,
-                },
-                oil: OilFilm {
-                    thickness_m: 0.0,
-                    viscosity_pa_s: 0.0,
-                    leakage_coefficient: 0.421,
-                    width_m: 1e-2,
-                    length_m: 1e-2,
-                    v_floor_m_s: 0.01,
-                    h_min_m: 1e-7,
-                },
-            },
-        }
+        crate::cases::dry_gear_mesh(internal)
     }
 
     /// A mesh's force does no work on a rigid rotation of the pair that keeps `x` (power
