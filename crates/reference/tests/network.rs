@@ -201,7 +201,6 @@ fn dual_clutch_inertia_phase_matches_closed_form() {
 /// 1e-7, 1e-7 and 5e-9 J.
 #[test]
 fn free_impact_across_a_gear_mesh_matches_closed_form() {
-    use clutchpack_model::law::{Hertz, LawKind, OilFilm, ToothLaw};
     use clutchpack_model::network::*;
     let (j_a, j_b, v0) = (0.02, 0.5, 0.3);
     let g = GearMesh {
