@@ -14,6 +14,7 @@ fn coupled_clutches_run_writes_summary_and_figure() {
     let o = run(&[
         "run",
         "scenes/coupled-clutches.toml",
+        "--no-record",
         "--summary-json",
         json.to_str().unwrap(),
         "--plot",
@@ -86,6 +87,7 @@ fn coupled_clutches_run_on_the_multibody_engine() {
         "scenes/coupled-clutches.toml",
         "--engine",
         "multibody",
+        "--no-record",
         "--summary-json",
         json.to_str().unwrap(),
     ]);
@@ -114,6 +116,7 @@ fn coupled_clutches_run_on_the_multibody_engine() {
         "simulation.engine=multibody",
         "--duration",
         "0.1",
+        "--no-record",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("with the multibody engine"));
@@ -172,9 +175,15 @@ curvature_radius_m = 5e-3
         scene.to_str().unwrap(),
         "--summary-json",
         json.to_str().unwrap(),
+        "--out",
+        d.join("mesh.mcap").to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("1 tooth impacts"), "{}", stdout(&o));
+    // the recording holds the impact with the summary's peak
+    let reader = clutchpack_record::open(d.join("mesh.mcap")).unwrap();
+    let topic = reader.info().topic("/network/impacts").unwrap();
+    assert_eq!(topic.messages, 1);
     let s = read_json(&json);
     let c = &s["couplings"][0];
     assert_eq!(c["impacts"], 1, "{s}");
@@ -186,4 +195,96 @@ curvature_radius_m = 5e-3
         got < 0.0 && (-got - want).abs() < 1e-6 * want,
         "{got} against {want}"
     );
+}
+
+/// A network run is recorded as a pack run is (`--out`, MCAP): every body's and coupling's
+/// sample read back equals the run's own final state in `--summary-json` (to the last bit
+/// but one: serde_json's default float parser may round the JSON's exact text by an ulp), every
+/// clutch mode change is a log line on `/network/events`, the summary is attached, and
+/// `replay` names the bodies, the couplings and the lock times. Two engines, one scene:
+/// `dct-upshift.toml` on the reference engine and CoupledClutches on the multibody engine.
+#[test]
+fn a_network_run_is_recorded_whole() {
+    let d = scratch("network-recording");
+    for (scene, engine) in [
+        ("scenes/dct-upshift.toml", "reference"),
+        ("scenes/coupled-clutches.toml", "multibody"),
+    ] {
+        let (json, mcap) = (
+            d.join(format!("{engine}.json")),
+            d.join(format!("{engine}.mcap")),
+        );
+        let o = run(&[
+            "run",
+            scene,
+            "--engine",
+            engine,
+            "--summary-json",
+            json.to_str().unwrap(),
+            "--out",
+            mcap.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(stderr(&o).contains("recording: "), "{}", stderr(&o));
+        let s = read_json(&json);
+        let reader = clutchpack_record::open(&mcap).unwrap();
+        assert!(reader.damage().is_none());
+        let net = clutchpack_record::read_network(&reader)
+            .expect("a network recording")
+            .unwrap();
+        let bodies = s["bodies"].as_array().unwrap();
+        let couplings = s["couplings"].as_array().unwrap();
+        assert_eq!(net.bodies.len(), bodies.len());
+        assert_eq!(net.couplings.len(), couplings.len());
+        // one sample per record interval and the last: 2 kHz over 1 s, 1 kHz over 1.5 s
+        let duration = s["simulated_s"].as_f64().unwrap();
+        let rate = if engine == "reference" {
+            2000.0
+        } else {
+            1000.0
+        };
+        assert_eq!(net.samples.len(), (duration * rate).round() as usize + 1);
+        let last = net.samples.last().unwrap();
+        assert_eq!(last.t_s, duration);
+        let same = |a: f64, b: &serde_json::Value| {
+            let b = b.as_f64().unwrap();
+            assert!(
+                (a - b).abs() <= 2.0 * f64::EPSILON * b.abs(),
+                "{a} against {b}"
+            );
+        };
+        for (i, b) in bodies.iter().enumerate() {
+            assert_eq!(net.bodies[i], b["name"].as_str().unwrap());
+            same(last.speed_rad_s[i], &b["final_speed_rad_s"]);
+            same(last.angle_rad[i], &b["final_angle_rad"]);
+        }
+        let mut changes = 0;
+        for (k, c) in couplings.iter().enumerate() {
+            same(last.torque_n_m[k], &c["final_torque_n_m"]);
+            assert_eq!(
+                last.mode[k].map(|m| m.label()),
+                c["final_mode"].as_str(),
+                "{}",
+                c["name"]
+            );
+            changes += c["changes"].as_array().unwrap().len();
+        }
+        // every mode change after t = 0 is a log line (those at t = 0 too)
+        assert!(
+            net.events.len() >= changes && changes > 0,
+            "{:?}",
+            net.events
+        );
+        let stored: serde_json::Value =
+            serde_json::from_slice(net.summary_json.as_deref().unwrap()).unwrap();
+        assert_eq!(stored["couplings"], s["couplings"]);
+        let o = run(&["replay", mcap.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = stdout(&o);
+        assert!(
+            text.contains(&format!("network: {} bodies", bodies.len())),
+            "{text}"
+        );
+        assert!(text.contains("locked at ["), "{text}");
+    }
 }

@@ -149,6 +149,7 @@ pub fn describe(r: &RecordingReader) -> String {
             }
         }
     }
+    describe_network(r, &mut s);
     let interfaces = r.interface_stats();
     if !interfaces.is_empty() {
         let _ = writeln!(s, "friction interfaces (from the piston side):");
@@ -161,6 +162,77 @@ pub fn describe(r: &RecordingReader) -> String {
         }
     }
     s
+}
+
+/// A network recording's bodies and couplings (its `clutchpack.network` metadata) and, from
+/// its attached summary (the JSON of `run --summary-json`), each clutch's lock times and heat
+/// and the energy balance's residual. Nothing for a pack's recording.
+fn describe_network(r: &RecordingReader, s: &mut String) {
+    use std::fmt::Write as _;
+    let i = r.info();
+    let Some(net) = i.metadata(clutchpack_sdk::record::META_NETWORK) else {
+        return;
+    };
+    let count = |k: &str| {
+        net.get(k)
+            .and_then(|v| v.parse::<usize>().ok())
+            .unwrap_or(0)
+    };
+    let g = |k: String| net.get(&k).map(String::as_str).unwrap_or("?").to_string();
+    let bodies: Vec<String> = (0..count("bodies"))
+        .map(|b| g(format!("body.{b}.name")))
+        .collect();
+    let _ = writeln!(
+        s,
+        "network: {} bodies ({})",
+        bodies.len(),
+        bodies.join(", ")
+    );
+    let _ = writeln!(s, "couplings:");
+    for k in 0..count("couplings") {
+        let _ = writeln!(
+            s,
+            "  {:<20} {:<14} {} -> {}",
+            g(format!("coupling.{k}.name")),
+            g(format!("coupling.{k}.kind")),
+            g(format!("coupling.{k}.a")),
+            g(format!("coupling.{k}.b"))
+        );
+    }
+    let stored = i
+        .attachments
+        .iter()
+        .find(|a| a.name == clutchpack_sdk::record::SUMMARY_ATTACHMENT)
+        .and_then(|a| serde_json::from_slice::<serde_json::Value>(&a.data).ok());
+    let Some(summary) = stored else {
+        let _ = writeln!(s, "no stored summary (the run did not finish)");
+        return;
+    };
+    let _ = writeln!(s, "summary (stored; t_end = {} s):", summary["simulated_s"]);
+    for c in summary["couplings"].as_array().into_iter().flatten() {
+        if c["kind"] != "clutch" {
+            continue;
+        }
+        let locks: Vec<String> = c["lock_times_s"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(serde_json::Value::as_f64)
+            .map(short)
+            .collect();
+        let _ = writeln!(
+            s,
+            "  {:<20} heat {:.3} J, locked at [{}] s",
+            c["name"].as_str().unwrap_or("?"),
+            c["heat_j"].as_f64().unwrap_or(f64::NAN),
+            locks.join(", ")
+        );
+    }
+    let _ = writeln!(
+        s,
+        "  energy balance residual {:.3e} J",
+        summary["energy"]["residual_j"].as_f64().unwrap_or(f64::NAN)
+    );
 }
 
 /// A time in s with at most 9 decimals, trailing zeros dropped (`0.00399`, not

@@ -1,7 +1,8 @@
 //! `clutchpack run` of a network scene (`[[bodies]]`, MODEL.md section 8): the clutches' mode
-//! changes and heat, the bodies' final speeds and the energy balance; `--summary-json` and
-//! `--plot` (speeds and coupling torques against time). The pack-only options are refused
-//! before any work (exit 2).
+//! changes and heat, the bodies' final speeds and the energy balance; the recording (MCAP, as
+//! for a pack: `--out`, `--no-record`, a default name under `recordings/`), `--summary-json`
+//! and `--plot` (speeds and coupling torques against time). The pack-only options are
+//! refused before any work (exit 2).
 
 use crate::common::{self, BadInput};
 use crate::outputs::Output;
@@ -22,6 +23,13 @@ pub struct NetworkArgs<'a> {
     pub summary_json: Option<&'a Path>,
     /// `--plot`.
     pub plot: Option<&'a Path>,
+    /// The recording (`--out`, or the default name; `None` with `--no-record`).
+    pub recording: Option<&'a Path>,
+    /// Whether `--out` named the recording (it then replaces an existing file; a default
+    /// name never does).
+    pub out_given: bool,
+    /// `--deterministic`.
+    pub deterministic: bool,
     /// Each pack-only option given (its flag), refused.
     pub pack_only: Vec<&'static str>,
 }
@@ -31,7 +39,7 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     if let Some(flag) = a.pack_only.first() {
         return Err(BadInput(format!(
             "{flag}: not for a network scene ({} has [[bodies]]); a network run gives its \
-             table, --summary-json and --plot (recordings of networks come next)",
+             table, its recording (--out), --summary-json and --plot",
             scene.name
         ))
         .into());
@@ -44,7 +52,26 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
         outs.push(Output::figure("--plot", p));
     }
     let inputs: Vec<&Path> = a.scene_path.into_iter().collect();
+    // the other outputs first, so that a refused one leaves no recording folder behind
     crate::outputs::check_outputs(&outs, &inputs)?;
+    if let Some(p) = a.recording {
+        crate::outputs::create_folder("--out", p)?;
+        outs.push(Output::file("--out", p));
+        crate::outputs::check_outputs(&outs, &inputs)?;
+    }
+    let recording = a.recording.map(|path| clutchpack_sdk::RecordingRequest {
+        path: path.to_path_buf(),
+        replace: if a.out_given {
+            clutchpack_sdk::record::Replace::Existing
+        } else {
+            clutchpack_sdk::record::Replace::Never
+        },
+        options: clutchpack_sdk::record::RecordOptions {
+            deterministic: a.deterministic,
+            ..Default::default()
+        },
+        scene_path: a.scene_path.map(Path::to_path_buf),
+    });
     let pb = common::time_progress(scene.simulation.duration_s, &scene.name);
     let mut progress = |t: f64| common::show_time(&pb, t);
     let done = clutchpack_sdk::run_network_scene(
@@ -52,11 +79,15 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
         a.engine,
         NetworkRequest {
             keep_history: a.plot.is_some(),
+            recording,
             stop: Some(interrupted),
             progress: Some(&mut progress),
         },
     )?;
     pb.finish_and_clear();
+    if let Some(p) = &done.recording {
+        eprintln!("recording: {}", p.display());
+    }
     let s = &done.summary;
     if let Some(path) = a.plot {
         plot(path, &scene, s.engine, &done.history)?;
@@ -160,24 +191,42 @@ fn plot(
     history: &[clutchpack_sdk::NetworkSample],
 ) -> Result<()> {
     let net = scene.network.as_ref().expect("a network scene");
+    let bodies: Vec<(&str, bool)> = net
+        .bodies
+        .iter()
+        .map(|b| (b.name.as_str(), b.fixed))
+        .collect();
+    let couplings: Vec<&str> = net.couplings.iter().map(|c| c.name.as_str()).collect();
+    plot_samples(path, &scene.name, engine, &bodies, &couplings, history)
+}
+
+/// The figure of a network's run: every turning body's speed and every coupling's torque on
+/// its body a against time; `bodies` are (name, fixed) in scene order. `run --plot` of a
+/// network scene and `plot` of a network recording draw it.
+pub fn plot_samples(
+    path: &Path,
+    scene: &str,
+    engine: &str,
+    bodies: &[(&str, bool)],
+    couplings: &[&str],
+    history: &[clutchpack_sdk::NetworkSample],
+) -> Result<()> {
     let series = |name: &str, f: &dyn Fn(&clutchpack_sdk::NetworkSample) -> f64| {
         (
             name.to_string(),
             history.iter().map(|s| (s.t_s, f(s))).collect::<Vec<_>>(),
         )
     };
-    let speeds = net
-        .bodies
+    let speeds = bodies
         .iter()
         .enumerate()
-        .filter(|(_, b)| !b.fixed)
-        .map(|(i, b)| series(&b.name, &|s| s.speed_rad_s[i]))
+        .filter(|(_, (_, fixed))| !fixed)
+        .map(|(i, (name, _))| series(name, &|s| s.speed_rad_s[i]))
         .collect();
-    let torques = net
-        .couplings
+    let torques = couplings
         .iter()
         .enumerate()
-        .map(|(k, c)| series(&c.name, &|s| s.torque_n_m[k]))
+        .map(|(k, name)| series(name, &|s| s.torque_n_m[k]))
         .collect();
     let panels = [
         clutchpack_sdk::analysis::Panel {
@@ -189,10 +238,7 @@ fn plot(
             series: torques,
         },
     ];
-    let title = format!(
-        "{}: speeds and coupling torques ({engine} engine)",
-        scene.name
-    );
+    let title = format!("{scene}: speeds and coupling torques ({engine} engine)");
     crate::outputs::write_with(path, |tmp| {
         clutchpack_sdk::analysis::plot_panels(tmp, &title, "t [s]", &panels)
             .with_context(|| format!("plotting {}", path.display()))

@@ -111,27 +111,6 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         });
     }
     let scene = clutchpack_sdk::load_scene(a.scene.as_deref(), &sets)?;
-    if scene.network.is_some() {
-        let pack_only = [
-            ("--out", a.out.is_some()),
-            ("--impacts-csv", a.impacts_csv.is_some()),
-            ("--fatigue-json", a.fatigue_json.is_some()),
-            ("--windows", a.windows.is_some()),
-            ("--per-tooth", a.per_tooth),
-        ];
-        let args = crate::network::NetworkArgs {
-            scene_path: a.scene.as_deref(),
-            engine: a.engine,
-            summary_json: a.summary_json.as_deref(),
-            plot: a.plot.as_deref(),
-            pack_only: pack_only
-                .iter()
-                .filter(|(_, on)| *on)
-                .map(|(f, _)| *f)
-                .collect(),
-        };
-        return crate::network::run(&args, scene, &interrupted);
-    }
     // Every output checked before any work (crate::outputs); the recording's folder is made.
     let record_path = (!a.no_record).then(|| {
         a.out.clone().unwrap_or_else(|| {
@@ -142,6 +121,31 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             )
         })
     });
+    if scene.network.is_some() {
+        let pack_only = [
+            ("--impacts-csv", a.impacts_csv.is_some()),
+            ("--fatigue-json", a.fatigue_json.is_some()),
+            ("--windows", a.windows.is_some()),
+            ("--per-tooth", a.per_tooth),
+            ("--windows-plot", a.windows_plot.is_some()),
+            ("--no-contact-samples", a.no_contact_samples),
+        ];
+        let args = crate::network::NetworkArgs {
+            scene_path: a.scene.as_deref(),
+            engine: a.engine,
+            summary_json: a.summary_json.as_deref(),
+            plot: a.plot.as_deref(),
+            recording: record_path.as_deref(),
+            out_given: a.out.is_some(),
+            deterministic: a.deterministic,
+            pack_only: pack_only
+                .iter()
+                .filter(|(_, on)| *on)
+                .map(|(f, _)| *f)
+                .collect(),
+        };
+        return crate::network::run(&args, scene, &interrupted);
+    }
     let mut outs = Vec::new();
     for (flag, p) in [
         ("--out", record_path.as_deref()),

@@ -291,23 +291,45 @@ struct RawNetworkRun {
     speed_rad_s: Vec<(String, Vec<f64>)>,
     /// Each coupling's torque on its body a at them, N m, by name.
     torque_n_m: Vec<(String, Vec<f64>)>,
+    /// The recording's path, if one was asked.
+    recording: Option<PathBuf>,
 }
 
-/// Runs a network scene (`[[bodies]]`) on its engine (`simulation.engine`, else the reference
-/// engine), as `clutchpack run` does: the
-/// summary and the sampled speeds and torques. The GIL is released while it runs; Ctrl-C
-/// stops it and raises `KeyboardInterrupt`.
+/// Runs a network scene (`[[bodies]]`) on `engine` (else `simulation.engine`, else the
+/// reference engine), as `clutchpack run` does: the summary and the sampled speeds and
+/// torques, and the recording at `record` if given (replaced if it exists). The GIL is
+/// released while it runs; Ctrl-C stops it and raises `KeyboardInterrupt` (the recording
+/// then holds the run up to there).
 #[pyfunction]
-fn run_network(py: Python<'_>, scene: &Scene) -> PyResult<RawNetworkRun> {
+#[pyo3(signature = (scene, engine=None, record=None, deterministic=false))]
+fn run_network(
+    py: Python<'_>,
+    scene: &Scene,
+    engine: Option<&str>,
+    record: Option<PathBuf>,
+    deterministic: bool,
+) -> PyResult<RawNetworkRun> {
+    check_outputs(&[("record =", record.as_deref())], scene)?;
+    let recording = record.map(|path| RecordingRequest {
+        path,
+        replace: clutchpack_sdk::record::Replace::Existing,
+        options: clutchpack_sdk::record::RecordOptions {
+            deterministic,
+            ..clutchpack_sdk::record::RecordOptions::default()
+        },
+        scene_path: scene.path.clone(),
+    });
+    let engine = engine_choice(engine)?;
     let stop = AtomicBool::new(false);
     let mut interrupt: Option<PyErr> = None;
     let outcome = py.detach(|| {
         let mut progress = signal_poll(&stop, &mut interrupt);
         clutchpack_sdk::run_network_scene(
             &scene.inner,
-            None,
+            engine,
             clutchpack_sdk::NetworkRequest {
                 keep_history: true,
+                recording,
                 stop: Some(&stop),
                 progress: Some(&mut progress),
             },
@@ -336,6 +358,7 @@ fn run_network(py: Python<'_>, scene: &Scene) -> PyResult<RawNetworkRun> {
             .enumerate()
             .map(|(k, c)| (c.name.clone(), column(&|x| x.torque_n_m[k])))
             .collect(),
+        recording: outcome.recording.clone(),
     })
 }
 

@@ -66,7 +66,7 @@ def test_a_network_scene_runs_as_the_cli_runs_it(tmp_path):
     time, and the speeds and torques as columns (Modelica's CoupledClutches: clutch 2 locks
     at 0.7096 s, the reference results' instant within 2e-5 s)."""
     js = tmp_path / "cc.json"
-    cli("run", "scenes/coupled-clutches.toml", "--summary-json", str(js))
+    cli("run", "scenes/coupled-clutches.toml", "--no-record", "--summary-json", str(js))
     r = clutchpack.run("scenes/coupled-clutches.toml")
     assert without_wall(r.summary) == without_wall(json.loads(js.read_text()))
     assert abs(r.summary["couplings"][1]["lock_times_s"][0] - 0.7096214638) < 2e-5
@@ -74,7 +74,17 @@ def test_a_network_scene_runs_as_the_cli_runs_it(tmp_path):
     assert r.samples["J1.speed_rad_s"].iloc[0] == 10.0
     assert "clutch3.torque_n_m" in r.samples.columns
     with pytest.raises(ValueError, match="not for a network scene"):
-        clutchpack.run("scenes/coupled-clutches.toml", record=tmp_path / "x.mcap")
+        clutchpack.run("scenes/coupled-clutches.toml", impacts_csv=tmp_path / "x.csv")
+    # recorded on the multibody engine, as `clutchpack run --engine multibody --out`: the file
+    # is complete and `replay` reads its bodies and clutch lock times back
+    rec = tmp_path / "cc.mcap"
+    m = clutchpack.run("scenes/coupled-clutches.toml", engine="multibody", record=rec)
+    assert m.recording == str(rec) and m.summary["engine"] == "multibody"
+    assert m.engine_line.startswith("engine: multibody")
+    text = cli("replay", str(rec)).stdout
+    assert "network: 4 bodies (J1, J2, J3, J4)" in text, text
+    locks = m.summary["couplings"][1]["lock_times_s"]
+    assert abs(locks[0] - 0.7096214638) < 2e-5, locks
 
 
 def test_read_gives_what_the_run_gave(tmp_path):

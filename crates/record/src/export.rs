@@ -165,6 +165,9 @@ struct Export<'a> {
     /// came.
     interfaces: BTreeMap<String, (usize, String, Option<Csv>)>,
     impacts: Option<Csv>,
+    /// A network recording's files by topic (`network_body_<segment>.csv`,
+    /// `network_coupling_<segment>.csv`), in topic order, once a message came.
+    network: BTreeMap<String, Option<Csv>>,
     /// The impacts, kept only when the summary has to be recomputed from them.
     recompute: Option<Vec<clutchpack_model::ImpactEvent>>,
     error: Option<ReadError>,
@@ -198,11 +201,18 @@ impl<'a> Export<'a> {
             discs: BTreeMap::new(),
             interfaces,
             impacts: None,
-            recompute: reader.summary().is_none().then(Vec::new),
+            network: BTreeMap::new(),
+            // a network recording's summary is its attachment, not recomputed from impacts
+            recompute: (reader.summary().is_none()
+                && reader.info().metadata(crate::META_NETWORK).is_none())
+            .then(Vec::new),
             error: None,
         };
-        let shaft = Csv::create(&dir.join("shaft.csv"), "t_s,angle_rad,speed_rad_s\n");
-        e.shaft = Some(shaft?);
+        // a network recording has no shaft of a pack: its bodies go to files of their own
+        if reader.info().metadata(crate::META_NETWORK).is_none() {
+            let shaft = Csv::create(&dir.join("shaft.csv"), "t_s,angle_rad,speed_rad_s\n");
+            e.shaft = Some(shaft?);
+        }
         let impacts = Csv::create(
             &dir.join("impacts.csv"),
             "disc,disc_index,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n\n",
@@ -219,6 +229,11 @@ impl<'a> Export<'a> {
 
     /// Writes the row of one message, if it is one of ours.
     fn message(&mut self, v: &MessageView<'_>) -> Result<(), ReadError> {
+        if v.topic.starts_with(&topics::network_body(""))
+            || v.topic.starts_with(&topics::network_coupling(""))
+        {
+            return self.network_message(v);
+        }
         match v.schema_name {
             proto::SHAFT_STATE => {
                 let (Ok(m), Some(c)) = (proto::ShaftState::decode(v.data), self.shaft.as_mut())
@@ -378,9 +393,56 @@ impl<'a> Export<'a> {
         })
     }
 
+    /// Writes the row of a network recording's body or coupling message into its file
+    /// (`network_body_<segment>.csv`, `network_coupling_<segment>.csv`).
+    fn network_message(&mut self, v: &MessageView<'_>) -> Result<(), ReadError> {
+        let dir = self.dir;
+        let segment = |prefix: &str| v.topic.strip_prefix(prefix).map(str::to_string);
+        let body = segment(&topics::network_body(""));
+        let coupling = segment(&topics::network_coupling(""));
+        let slot = self.network.entry(v.topic.to_string()).or_default();
+        match (v.schema_name, body, coupling) {
+            (proto::SHAFT_STATE, Some(seg), _) => {
+                let Ok(m) = proto::ShaftState::decode(v.data) else {
+                    return Ok(());
+                };
+                let c = Csv::lazy(
+                    slot,
+                    || dir.join(format!("network_body_{seg}.csv")),
+                    "t_s,angle_rad,speed_rad_s\n",
+                )?;
+                writeln!(c.w, "{:?},{:?},{:?}", m.t_s, m.angle_rad, m.speed_rad_s)
+                    .map_err(|e| c.error(e))
+            }
+            (proto::COUPLING_STATE, _, Some(seg)) => {
+                let Ok(m) = proto::CouplingState::decode(v.data) else {
+                    return Ok(());
+                };
+                let c = Csv::lazy(
+                    slot,
+                    || dir.join(format!("network_coupling_{seg}.csv")),
+                    "t_s,torque_n_m,slip_rad_s,mode,locked,normal_force_n\n",
+                )?;
+                writeln!(
+                    c.w,
+                    "{:?},{:?},{:?},{},{},{:?}",
+                    m.t_s,
+                    m.torque_n_m,
+                    m.slip_rad_s,
+                    csv_field(&m.mode),
+                    u8::from(m.locked),
+                    m.normal_force_n
+                )
+                .map_err(|e| c.error(e))
+            }
+            _ => Ok(()),
+        }
+    }
+
     /// Every open file, in the order of the export's list.
     fn into_files(self) -> Vec<Csv> {
         let mut files: Vec<Csv> = self.shaft.into_iter().collect();
+        files.extend(self.network.into_values().flatten());
         for d in self.discs.into_values() {
             files.extend(d.spline);
             files.extend(d.teeth);

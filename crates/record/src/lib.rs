@@ -19,6 +19,9 @@
 //!   [`RecordingReader::disc_series`]. Truncated, corrupted, empty and foreign files give a
 //!   one-line reason ([`ReadError`], [`Damage`]) and never a panic; a killed run's file is
 //!   read up to its last complete chunk.
+//! - [`NetworkRecorder`] / [`read_network`]: a driveline network's run (MODEL.md section 8)
+//!   as a recording with the same header, metadata and scene attachment: each body's and
+//!   coupling's state, the clutches' mode changes, a 3D view; read back into its samples.
 //! - [`export_csv`]: one CSV per topic of ours.
 //! - `serve` (feature `serve`): plays a recording to Foxglove over its WebSocket protocol.
 //!
@@ -107,6 +110,7 @@
 
 mod export;
 pub mod info;
+mod network;
 pub mod output;
 pub mod proto;
 mod read;
@@ -128,14 +132,17 @@ mod write;
 
 pub use export::{export_csv, export_csv_until};
 pub use info::{sha256_hex, DiscGeometry, FrictionInterface, RunInfo, ShaftGeometry};
+pub use network::{
+    body_frame, coupling_kind_name, NetworkRecorder, META_NETWORK, SUMMARY_ATTACHMENT,
+};
 pub use output::{
     check_outputs, partial_path, write_whole, OutputPath, OutputRefused, PendingFile, Replace,
     NAME_MAX_BYTES,
 };
 pub use read::{
-    from_bytes, from_bytes_with, open, open_complete, open_with, AttachmentInfo, Damage,
-    DamageKind, DiscSeries, InterfaceSeries, LoadHistory, MessageView, ReadError, ReadOptions,
-    RecordingInfo, RecordingReader, TopicInfo,
+    from_bytes, from_bytes_with, open, open_complete, open_with, read_network, AttachmentInfo,
+    Damage, DamageKind, DiscSeries, InterfaceSeries, LoadHistory, MessageView, ReadError,
+    ReadOptions, RecordedNetwork, RecordingInfo, RecordingReader, TopicInfo,
 };
 #[cfg(feature = "serve")]
 pub use serve::{serve, ServeError, ServeOptions};

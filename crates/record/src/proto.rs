@@ -40,6 +40,9 @@ pub const RUN_SUMMARY: &str = "clutchpack.RunSummary";
 pub const LOAD_SAMPLE: &str = "clutchpack.LoadSample";
 /// Full schema name of [`Temperature`] (topics `/discs/<name>/temperature`, `/oil/temperature`).
 pub const TEMPERATURE: &str = "clutchpack.Temperature";
+/// Full schema name of [`CouplingState`] (topics `/network/couplings/<name>` of a network
+/// recording).
+pub const COUPLING_STATE: &str = "clutchpack.CouplingState";
 
 /// The shaft at one sample (topic `/shaft`).
 #[derive(Clone, PartialEq, prost::Message)]
@@ -303,6 +306,35 @@ pub struct Temperature {
     /// number of bodies.
     #[prost(uint32, tag = "3")]
     pub body_index: u32,
+}
+
+/// One coupling of a driveline network at one sample (topics `/network/couplings/<name>`;
+/// MODEL.md section 8). A network's bodies use [`ShaftState`] (`/network/bodies/<name>`).
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct CouplingState {
+    /// Simulated time in s.
+    #[prost(double, tag = "1")]
+    pub t_s: f64,
+    /// Torque of the coupling on its body `a` in N m (positive along the positive rotation;
+    /// body `b` gets the opposite, through the ratio for a gear).
+    #[prost(double, tag = "2")]
+    pub torque_n_m: f64,
+    /// A clutch's slip `w_rel = omega_b - omega_a` in rad/s (the network's convention,
+    /// Modelica's: positive in mode `slip+`; 0 for other kinds).
+    #[prost(double, tag = "3")]
+    pub slip_rad_s: f64,
+    /// A clutch's mode: `free`, `slip+`, `slip-` or `locked` (empty for other kinds).
+    #[prost(string, tag = "4")]
+    pub mode: String,
+    /// Whether a clutch is locked (false for other kinds).
+    #[prost(bool, tag = "5")]
+    pub locked: bool,
+    /// A clutch's normal force in N (>= 0; 0 for other kinds).
+    #[prost(double, tag = "6")]
+    pub normal_force_n: f64,
+    /// Index of the coupling in the scene, from 0.
+    #[prost(uint32, tag = "7")]
+    pub coupling_index: u32,
 }
 
 /// Field type in the schema tables.
@@ -687,6 +719,44 @@ pub(crate) const MESSAGES: &[MessageDef] = &[
             ),
         ],
     },
+    MessageDef {
+        name: "CouplingState",
+        doc: "One coupling of a driveline network at one sample. Topics /network/couplings/<name>.",
+        fields: &[
+            f("t_s", 1, Double, "simulated time, s"),
+            f(
+                "torque_n_m",
+                2,
+                Double,
+                "torque on its body a, N m (body b gets the opposite, through the ratio for a gear)",
+            ),
+            f(
+                "slip_rad_s",
+                3,
+                Double,
+                "a clutch's slip w_rel = omega_b - omega_a, rad/s (positive in mode slip+; 0 for other kinds)",
+            ),
+            f(
+                "mode",
+                4,
+                FieldType::String,
+                "a clutch's mode: free, slip+, slip- or locked (empty for other kinds)",
+            ),
+            f("locked", 5, Bool, "whether a clutch is locked"),
+            f(
+                "normal_force_n",
+                6,
+                Double,
+                "a clutch's normal force, N (0 for other kinds)",
+            ),
+            f(
+                "coupling_index",
+                7,
+                Uint32,
+                "index of the coupling in the scene, from 0",
+            ),
+        ],
+    },
 ];
 
 fn json_name(name: &str) -> String {
@@ -975,6 +1045,19 @@ mod tests {
             }
             .encode_to_vec(),
         );
+        check(
+            "CouplingState",
+            CouplingState {
+                t_s: 1.0,
+                torque_n_m: 2.0,
+                slip_rad_s: 3.0,
+                mode: "locked".into(),
+                locked: true,
+                normal_force_n: 6.0,
+                coupling_index: 7,
+            }
+            .encode_to_vec(),
+        );
         let ds = DiscSummary {
             name: "a".into(),
             index: 2,
@@ -1035,6 +1118,7 @@ mod tests {
             RUN_SUMMARY,
             LOAD_SAMPLE,
             TEMPERATURE,
+            COUPLING_STATE,
         ] {
             let short = name.strip_prefix("clutchpack.").unwrap();
             assert!(MESSAGES.iter().any(|m| m.name == short), "{name}");

@@ -85,3 +85,36 @@ pub const INTERFACES_PREFIX: &str = "/interfaces/";
 pub fn interface(segment: &str) -> String {
     format!("{INTERFACES_PREFIX}{segment}")
 }
+
+/// Prefix of a network recording's topics (MODEL.md section 8).
+pub const NETWORK_PREFIX: &str = "/network/";
+
+/// `/network/bodies/<segment>`, `clutchpack.ShaftState`: a network body's angle and speed at
+/// each sample (every body of a driveline is a shaft).
+pub fn network_body(segment: &str) -> String {
+    format!("{NETWORK_PREFIX}bodies/{segment}")
+}
+
+/// `/network/couplings/<segment>`, `clutchpack.CouplingState`: a coupling's torque, and a
+/// clutch's slip, mode and normal force, at each sample.
+pub fn network_coupling(segment: &str) -> String {
+    format!("{NETWORK_PREFIX}couplings/{segment}")
+}
+
+/// A network's clutch mode changes, `foxglove.Log` (one line each, at its instant:
+/// `K2: slip+ -> locked`).
+pub const NETWORK_EVENTS: &str = "/network/events";
+/// A network's gear-mesh tooth impacts, `clutchpack.Impact` (`disc` = the mesh's name,
+/// `disc_index` = its coupling index), each at its peak time.
+pub const NETWORK_IMPACTS: &str = "/network/impacts";
+/// A network's bodies as joints, `sensor_msgs/msg/JointState` (ROS 2, CDR), one message per
+/// sample: `position` = angle (rad), `velocity` = speed (rad/s), for Rerun.
+pub const NETWORK_BODY_JOINTS: &str = "/network/joints/bodies";
+/// A network's couplings as joints, `sensor_msgs/msg/JointState`: `velocity` = a clutch's
+/// slip `omega_b - omega_a` (rad/s), `effort` = the torque on body `a` (N m). The same topic as a pack's
+/// [`JOINTS`] (a coupling is the joint between its two bodies, as a disc's spline is), so
+/// that the viewers' ready plots of `/joints` show the couplings' torques.
+pub const NETWORK_COUPLING_JOINTS: &str = JOINTS;
+/// The couplings drawn between the bodies, `foxglove.SceneUpdate`: at t = 0, then whenever a
+/// clutch changes mode (each message draws every coupling, coloured by its mode).
+pub const NETWORK_SCENE_COUPLINGS: &str = "/scene/couplings";

@@ -75,7 +75,7 @@ pub(crate) fn timestamp(log_time_ns: u64) -> Timestamp {
     )
 }
 
-fn about_z(angle_rad: f64) -> Quaternion {
+pub(crate) fn about_z(angle_rad: f64) -> Quaternion {
     let h = 0.5 * angle_rad;
     Quaternion {
         x: 0.0,
@@ -85,18 +85,18 @@ fn about_z(angle_rad: f64) -> Quaternion {
     }
 }
 
-fn v3(x: f64, y: f64, z: f64) -> Vector3 {
+pub(crate) fn v3(x: f64, y: f64, z: f64) -> Vector3 {
     Vector3 { x, y, z }
 }
 
-fn pose(x: f64, y: f64, z: f64, angle_rad: f64) -> Option<Pose> {
+pub(crate) fn pose(x: f64, y: f64, z: f64, angle_rad: f64) -> Option<Pose> {
     Some(Pose {
         position: Some(v3(x, y, z)),
         orientation: Some(about_z(angle_rad)),
     })
 }
 
-fn rgba(r: f64, g: f64, b: f64, a: f64) -> Option<Color> {
+pub(crate) fn rgba(r: f64, g: f64, b: f64, a: f64) -> Option<Color> {
     Some(Color { r, g, b, a })
 }
 
@@ -288,7 +288,7 @@ fn tooth_size(d: &DiscGeometry) -> Vector3 {
     )
 }
 
-fn entity(log_time_ns: u64, frame: &str, id: &str) -> SceneEntity {
+pub(crate) fn entity(log_time_ns: u64, frame: &str, id: &str) -> SceneEntity {
     SceneEntity {
         timestamp: Some(timestamp(log_time_ns)),
         frame_id: frame.into(),
@@ -591,7 +591,7 @@ pub(crate) fn teeth_scene(
 const CLOUD_AROUND: u32 = 120;
 
 /// One point of a [`PointCloud`]: position in m (f32 x, y, z) and colour (u8 r, g, b, a).
-fn push_point(data: &mut Vec<u8>, x: f64, y: f64, z: f64, c: [u8; 4]) {
+pub(crate) fn push_point(data: &mut Vec<u8>, x: f64, y: f64, z: f64, c: [u8; 4]) {
     for v in [x, y, z] {
         data.extend_from_slice(&(v as f32).to_le_bytes());
     }
@@ -599,7 +599,7 @@ fn push_point(data: &mut Vec<u8>, x: f64, y: f64, z: f64, c: [u8; 4]) {
 }
 
 /// A point cloud in `frame` from packed points (16 bytes each, see [`push_point`]).
-fn cloud(frame: &str, data: Vec<u8>) -> PointCloud {
+pub(crate) fn cloud(frame: &str, data: Vec<u8>) -> PointCloud {
     use packed_element_field::NumericType;
     let field = |name: &str, offset: u32, t: NumericType| PackedElementField {
         name: name.into(),
@@ -626,7 +626,7 @@ fn cloud(frame: &str, data: Vec<u8>) -> PointCloud {
 
 /// Points on the surface of the annulus `r0..r1`, thickness `h`, centred on its frame: both
 /// faces on seven rings from `r0` to `r1` and both rims, [`CLOUD_AROUND`] points round.
-fn annulus_points(data: &mut Vec<u8>, r0: f64, r1: f64, h: f64, c: [u8; 4]) {
+pub(crate) fn annulus_points(data: &mut Vec<u8>, r0: f64, r1: f64, h: f64, c: [u8; 4]) {
     let rings = 6u32;
     for k in 0..CLOUD_AROUND {
         let a = 2.0 * PI * f64::from(k) / f64::from(CLOUD_AROUND);

@@ -336,6 +336,131 @@ pub struct Recorder {
     thermal: Option<ThermalChannels>,
 }
 
+/// Opens an MCAP writer on `file` (at `path`, for messages) with the recorder's settings:
+/// zstd chunks of `chunk_size_bytes`, the scene attached, and `info`'s metadata records
+/// (with the recorder's options in `clutchpack.run`) followed by `more_metadata`. Shared by
+/// the pack [`Recorder`] and the network recorder ([`crate::NetworkRecorder`]).
+pub(crate) fn open_mcap(
+    path: &Path,
+    file: File,
+    info: &RunInfo,
+    options: &RecordOptions,
+    chunk_size_bytes: u64,
+    more_metadata: Vec<(String, BTreeMap<String, String>)>,
+) -> Result<mcap::Writer<BufWriter<File>>, RecordError> {
+    let write_err = |what: &str, cause| RecordError::Write {
+        path: path.to_path_buf(),
+        what: what.to_string(),
+        cause,
+    };
+    let opts = mcap::WriteOptions::new()
+        .compression(Some(mcap::Compression::Zstd))
+        .compression_level(options.compression_level)
+        // zstd in the writing thread itself (no worker): the recorder already runs beside
+        // the engine (the CLI's recording thread), and a zstd worker made a third busy
+        // thread on a 2-core machine plus a mutex round trip for each of the 7 small
+        // writes of every MCAP message record. Single-threaded zstd output is the same on
+        // every machine, which keeps deterministic recordings byte-identical.
+        .compression_threads(0)
+        .chunk_size(Some(chunk_size_bytes.max(1)))
+        .library(format!(
+            "clutchpack_record {} (mcap-rs {})",
+            env!("CARGO_PKG_VERSION"),
+            mcap::VERSION
+        ))
+        // Chunks are compressed straight into the file and their headers written in
+        // place once complete (the writer seeks back). Building each chunk in memory
+        // instead (`disable_seeking`) held a buffer of the chunk's size, which is what
+        // kept chunks at 1 MiB and so the chunk index growing with the run. A killed
+        // run still leaves every flushed chunk readable: what follows the last one is a
+        // chunk record whose length is a placeholder, which the readers find to run past
+        // the end of the file (`killed_mid_chunk_keeps_the_flushed_chunks`).
+        .disable_seeking(false);
+    let mut w = opts
+        .create(BufWriter::with_capacity(1 << 16, file))
+        .map_err(|e| write_err("header", e))?;
+
+    let wall_ns = if options.deterministic {
+        0
+    } else {
+        SystemTime::now()
+            .duration_since(UNIX_EPOCH)
+            .map(|d| d.as_nanos() as u64)
+            .unwrap_or(0)
+    };
+    w.attach(&mcap::Attachment {
+        log_time: 0,
+        create_time: wall_ns,
+        name: info.scene_file_name().to_string(),
+        media_type: SCENE_MEDIA_TYPE.to_string(),
+        data: Cow::Borrowed(info.scene_text.as_bytes()),
+    })
+    .map_err(|e| write_err("scene attachment", e))?;
+
+    let mut extra = vec![
+        (
+            "deterministic".to_string(),
+            options.deterministic.to_string(),
+        ),
+        ("per_tooth".to_string(), options.per_tooth.to_string()),
+        (
+            "contact_samples".to_string(),
+            options.contact_samples.to_string(),
+        ),
+        ("tf_interval_s".to_string(), num(options.tf_interval_s)),
+        (
+            "scene_interval_s".to_string(),
+            num(options.scene_interval_s),
+        ),
+    ];
+    if !options.deterministic {
+        extra.push((
+            "recorded_at_utc".to_string(),
+            utc_text(Duration::from_nanos(wall_ns)),
+        ));
+    }
+    for (name, metadata) in info.to_metadata(&extra).into_iter().chain(more_metadata) {
+        w.write_metadata(&mcap::records::Metadata { name, metadata })
+            .map_err(|e| write_err("metadata", e))?;
+    }
+    Ok(w)
+}
+
+/// Ends an MCAP file opened by [`open_mcap`]: the `clutchpack.stats` metadata record `stats`,
+/// the summary section, the flush, and the move into place of an output written whole
+/// (`pending` is taken only then: after an error the caller may still discard it).
+pub(crate) fn close_mcap(
+    mut w: mcap::Writer<BufWriter<File>>,
+    path: &Path,
+    stats: BTreeMap<String, String>,
+    pending: &mut Option<PendingFile>,
+) -> Result<PathBuf, RecordError> {
+    let write_err = |what: &str, cause| RecordError::Write {
+        path: path.to_path_buf(),
+        what: what.to_string(),
+        cause,
+    };
+    w.write_metadata(&mcap::records::Metadata {
+        name: META_STATS.into(),
+        metadata: stats,
+    })
+    .map_err(|e| write_err("stats metadata", e))?;
+    w.finish().map_err(|e| write_err("summary section", e))?;
+    let mut inner = w.into_inner();
+    inner.flush().map_err(|cause| RecordError::Close {
+        path: path.to_path_buf(),
+        cause,
+    })?;
+    drop(inner);
+    match pending.take() {
+        Some(p) => p.commit().map_err(|cause| RecordError::Close {
+            path: path.to_path_buf(),
+            cause,
+        }),
+        None => Ok(path.to_path_buf()),
+    }
+}
+
 /// Impacts held for ordering at most (about 5 MB): beyond, the earliest is written even if
 /// an earlier peak may still come (a contact held for the whole run, e.g. a locked disc).
 const MAX_HELD_IMPACTS: usize = 1 << 16;
@@ -417,83 +542,10 @@ impl Recorder {
             what: what.to_string(),
             cause,
         };
-        let opts = mcap::WriteOptions::new()
-            .compression(Some(mcap::Compression::Zstd))
-            .compression_level(options.compression_level)
-            // zstd in the writing thread itself (no worker): the recorder already runs beside
-            // the engine (the CLI's recording thread), and a zstd worker made a third busy
-            // thread on a 2-core machine plus a mutex round trip for each of the 7 small
-            // writes of every MCAP message record. Single-threaded zstd output is the same on
-            // every machine, which keeps deterministic recordings byte-identical.
-            .compression_threads(0)
-            .chunk_size(Some(
-                options
-                    .chunk_size_bytes
-                    .unwrap_or_else(|| {
-                        auto_chunk_size_bytes(info.discs.len(), info.interfaces.len())
-                    })
-                    .max(1),
-            ))
-            .library(format!(
-                "clutchpack_record {} (mcap-rs {})",
-                env!("CARGO_PKG_VERSION"),
-                mcap::VERSION
-            ))
-            // Chunks are compressed straight into the file and their headers written in
-            // place once complete (the writer seeks back). Building each chunk in memory
-            // instead (`disable_seeking`) held a buffer of the chunk's size, which is what
-            // kept chunks at 1 MiB and so the chunk index growing with the run. A killed
-            // run still leaves every flushed chunk readable: what follows the last one is a
-            // chunk record whose length is a placeholder, which the readers find to run past
-            // the end of the file (`killed_mid_chunk_keeps_the_flushed_chunks`).
-            .disable_seeking(false);
-        let mut w = opts
-            .create(BufWriter::with_capacity(1 << 16, file))
-            .map_err(|e| write_err("header", e))?;
-
-        let wall_ns = if options.deterministic {
-            0
-        } else {
-            SystemTime::now()
-                .duration_since(UNIX_EPOCH)
-                .map(|d| d.as_nanos() as u64)
-                .unwrap_or(0)
-        };
-        w.attach(&mcap::Attachment {
-            log_time: 0,
-            create_time: wall_ns,
-            name: info.scene_file_name().to_string(),
-            media_type: SCENE_MEDIA_TYPE.to_string(),
-            data: Cow::Borrowed(info.scene_text.as_bytes()),
-        })
-        .map_err(|e| write_err("scene attachment", e))?;
-
-        let mut extra = vec![
-            (
-                "deterministic".to_string(),
-                options.deterministic.to_string(),
-            ),
-            ("per_tooth".to_string(), options.per_tooth.to_string()),
-            (
-                "contact_samples".to_string(),
-                options.contact_samples.to_string(),
-            ),
-            ("tf_interval_s".to_string(), num(options.tf_interval_s)),
-            (
-                "scene_interval_s".to_string(),
-                num(options.scene_interval_s),
-            ),
-        ];
-        if !options.deterministic {
-            extra.push((
-                "recorded_at_utc".to_string(),
-                utc_text(Duration::from_nanos(wall_ns)),
-            ));
-        }
-        for (name, metadata) in info.to_metadata(&extra) {
-            w.write_metadata(&mcap::records::Metadata { name, metadata })
-                .map_err(|e| write_err("metadata", e))?;
-        }
+        let chunk = options
+            .chunk_size_bytes
+            .unwrap_or_else(|| auto_chunk_size_bytes(info.discs.len(), info.interfaces.len()));
+        let mut w = open_mcap(&path, file, info, options, chunk, Vec::new())?;
 
         // schemas and channels
         let fds = proto::file_descriptor_set();
@@ -1318,12 +1370,7 @@ impl Recorder {
         // the latest message of each topic, so the summary is there from the first frame
         self.put(self.ch.summary, 0, &summary.to_proto(), "/summary")?;
         let path = self.path.clone();
-        let write_err = |what: &str, cause| RecordError::Write {
-            path: path.clone(),
-            what: what.to_string(),
-            cause,
-        };
-        let Some(mut w) = self.writer.take() else {
+        let Some(w) = self.writer.take() else {
             return Err(self.failed_err());
         };
         let mut meta = BTreeMap::new();
@@ -1341,24 +1388,7 @@ impl Recorder {
                 meta.insert("finished_at_utc".into(), utc_text(now));
             }
         }
-        w.write_metadata(&mcap::records::Metadata {
-            name: META_STATS.into(),
-            metadata: meta,
-        })
-        .map_err(|e| write_err("stats metadata", e))?;
-        w.finish().map_err(|e| write_err("summary section", e))?;
-        let mut inner = w.into_inner();
-        inner.flush().map_err(|cause| RecordError::Close {
-            path: path.clone(),
-            cause,
-        })?;
-        drop(inner);
-        match self.pending.take() {
-            Some(p) => p
-                .commit()
-                .map_err(|cause| RecordError::Close { path, cause }),
-            None => Ok(path),
-        }
+        close_mcap(w, &path, meta, &mut self.pending)
     }
 
     fn keep(&mut self, r: Result<(), RecordError>) {

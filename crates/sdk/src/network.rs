@@ -6,9 +6,8 @@
 //! ([`clutchpack_model::network::NetworkRun`]), so the summary is built the same way.
 
 use crate::{Error, Result};
-use clutchpack_model::network::{
-    ClutchEvent, ClutchMode, CouplingKind, NetworkObserver, NetworkSample,
-};
+use clutchpack_model::network::{ClutchEvent, ClutchMode, NetworkObserver, NetworkSample};
+use clutchpack_record::NetworkRecorder;
 use clutchpack_reference::network::NetworkOptions;
 use clutchpack_scene::{EngineChoice, Scene};
 use serde::Serialize;
@@ -19,6 +18,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 pub struct NetworkRequest<'a> {
     /// Keep every sample (the figure's data; memory grows with the run).
     pub keep_history: bool,
+    /// Record the run (MCAP: every body, coupling and clutch event, the 3D view;
+    /// [`clutchpack_record::NetworkRecorder`]). Of the options the compression, chunk size and
+    /// determinism apply.
+    pub recording: Option<crate::RecordingRequest>,
     /// Set to stop the run (a signal); the outcome then holds what ran.
     pub stop: Option<&'a AtomicBool>,
     /// Called with the simulated time reached, s.
@@ -125,6 +128,8 @@ pub struct NetworkOutcome {
     pub summary: NetworkSummary,
     /// Every sample, if asked ([`NetworkRequest::keep_history`]).
     pub history: Vec<NetworkSample>,
+    /// The recording's path, if one was asked ([`NetworkRequest::recording`]).
+    pub recording: Option<std::path::PathBuf>,
 }
 
 struct Keep<'a, 'r> {
@@ -138,10 +143,32 @@ struct Keep<'a, 'r> {
     meshes: std::collections::HashMap<usize, (u64, f64)>,
     history: Vec<NetworkSample>,
     stopped: bool,
+    /// The recording, until its first error.
+    recorder: Option<NetworkRecorder>,
+    /// The recording's first error (it then stops the run).
+    record_error: Option<clutchpack_record::RecordError>,
+}
+
+impl Keep<'_, '_> {
+    /// Runs `write` on the recorder, keeping its first error (after which nothing more is
+    /// recorded and the run stops).
+    fn record(
+        &mut self,
+        write: impl FnOnce(
+            &mut NetworkRecorder,
+        ) -> std::result::Result<(), clutchpack_record::RecordError>,
+    ) {
+        if let Some(r) = self.recorder.as_mut() {
+            if let Err(e) = write(r) {
+                self.record_error = Some(e);
+            }
+        }
+    }
 }
 
 impl NetworkObserver for Keep<'_, '_> {
     fn sample(&mut self, s: &NetworkSample) {
+        self.record(|r| r.write_sample(s));
         self.range
             .resize(s.torque_n_m.len(), (f64::INFINITY, f64::NEG_INFINITY));
         for (r, t) in self.range.iter_mut().zip(&s.torque_n_m) {
@@ -152,9 +179,11 @@ impl NetworkObserver for Keep<'_, '_> {
         }
     }
     fn clutch_event(&mut self, e: &ClutchEvent) {
+        self.record(|r| r.write_clutch_event(e));
         self.events.push(*e);
     }
     fn mesh_impact(&mut self, e: &clutchpack_model::ImpactEvent) {
+        self.record(|r| r.write_mesh_impact(e));
         let m = self.meshes.entry(e.disc).or_insert((0, 0.0));
         m.0 += 1;
         if e.peak_n.abs() > m.1.abs() {
@@ -176,7 +205,7 @@ impl NetworkObserver for Keep<'_, '_> {
         }
         let stop = self.req.stop.is_some_and(|s| s.load(Ordering::Relaxed));
         self.stopped |= stop;
-        !stop
+        !stop && self.record_error.is_none()
     }
 }
 
@@ -218,6 +247,15 @@ pub fn run_network_scene(
         }
     }
     let sim = &scene.simulation;
+    let recorder = match &req.recording {
+        Some(r) => {
+            let info = crate::summary::run_info(scene, engine.name(), r.scene_path.as_deref());
+            Some(NetworkRecorder::create_output(
+                &r.path, r.replace, &info, net, &r.options,
+            )?)
+        }
+        None => None,
+    };
     let mut keep = Keep {
         req: &mut req,
         events: Vec::new(),
@@ -226,6 +264,8 @@ pub fn run_network_scene(
         meshes: Default::default(),
         history: Vec::new(),
         stopped: false,
+        recorder,
+        record_error: None,
     };
     let start = std::time::Instant::now();
     let run = match engine {
@@ -244,11 +284,27 @@ pub fn run_network_scene(
             };
             clutchpack_multibody::network::run_network(net, sim.duration_s, &options, &mut keep)
         }
+    };
+    let run = match run {
+        Ok(run) => run,
+        Err(source) => {
+            // the recording holds the run up to the failure
+            let recorded = keep.recorder.take().map(|r| r.finish(None));
+            let kept = match recorded {
+                Some(Ok(p)) => {
+                    format!(" (the recording {} holds the run up to there)", p.display())
+                }
+                _ => String::new(),
+            };
+            return Err(Error::Engine {
+                context: format!("{} ({} engine, network){kept}", scene.name, engine.name()),
+                source,
+            });
+        }
+    };
+    if let Some(e) = keep.record_error.take() {
+        return Err(e.into());
     }
-    .map_err(|source| Error::Engine {
-        context: format!("{} ({} engine, network)", scene.name, engine.name()),
-        source,
-    })?;
     let wall_time_s = start.elapsed().as_secs_f64();
     let last = &run.last;
     let couplings = net
@@ -273,12 +329,7 @@ pub fn run_network_scene(
                 .collect();
             CouplingSummary {
                 name: c.name.clone(),
-                kind: match c.kind {
-                    CouplingKind::Clutch(_) => "clutch",
-                    CouplingKind::IdealGear { .. } => "ideal_gear",
-                    CouplingKind::GearMesh(_) => "gear_mesh",
-                    CouplingKind::SpringDamper(_) => "spring_damper",
-                },
+                kind: clutchpack_record::coupling_kind_name(&c.kind),
                 heat_j: run.heat_j[k],
                 final_torque_n_m: last.torque_n_m[k],
                 final_mode: last.mode[k].map(ClutchMode::label),
@@ -321,8 +372,18 @@ pub fn run_network_scene(
             residual_j: e.residual_j(),
         },
     };
+    let recording = match keep.recorder.take() {
+        Some(r) => {
+            let json = serde_json::to_vec_pretty(&summary).map_err(|e| {
+                Error::BadInput(format!("the summary of {} as JSON: {e}", scene.name))
+            })?;
+            Some(r.finish(Some(&json))?)
+        }
+        None => None,
+    };
     Ok(NetworkOutcome {
         summary,
         history: keep.history,
+        recording,
     })
 }

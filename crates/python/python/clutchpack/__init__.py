@@ -193,16 +193,14 @@ def run(
 
 
 def _run_network(sc: Scene, engine: Optional[str], record: Any, impacts_csv: Any) -> Result:
-    """A network scene's run (``[[bodies]]``): the summary (``couplings`` with each clutch's
-    mode changes, lock times and heat; ``bodies``; ``energy``) and ``samples`` with ``t_s``,
-    ``<body>.speed_rad_s`` and ``<coupling>.torque_n_m`` columns. Recordings, impact CSVs and
-    the multibody engine are for pack scenes, for now."""
-    for what, given in (("record", record), ("impacts_csv", impacts_csv)):
-        if given is not None:
-            raise ValueError(f"{what}: not for a network scene ({sc.name} has [[bodies]])")
-    if engine not in (None, "reference"):
-        raise ValueError(f"engine = {engine!r}: a network runs on the reference engine, for now")
-    raw = _clutchpack.run_network(sc)
+    """A network scene's run (``[[bodies]]``) on ``engine`` (else the scene's, else the
+    reference engine): the summary (``couplings`` with each clutch's mode changes, lock times
+    and heat; ``bodies``; ``energy``), ``samples`` with ``t_s``, ``<body>.speed_rad_s`` and
+    ``<coupling>.torque_n_m`` columns, and the recording at ``record`` if given (as
+    ``clutchpack run --out``). Impact CSVs are for pack scenes."""
+    if impacts_csv is not None:
+        raise ValueError(f"impacts_csv: not for a network scene ({sc.name} has [[bodies]])")
+    raw = _clutchpack.run_network(sc, engine, None if record is None else os.fspath(record))
     samples = pd.DataFrame({"t_s": np.asarray(raw.sample_t_s, dtype=float)})
     for name, values in raw.speed_rad_s:
         samples[f"{name}.speed_rad_s"] = np.asarray(values, dtype=float)
@@ -212,8 +210,8 @@ def _run_network(sc: Scene, engine: Optional[str], record: Any, impacts_csv: Any
         summary=json.loads(raw.summary_json),
         impacts=pd.DataFrame(columns=IMPACT_COLUMNS),
         samples=samples,
-        recording=None,
-        engine_line="engine: reference (a driveline network)",
+        recording=None if raw.recording is None else os.fspath(raw.recording),
+        engine_line=f"engine: {json.loads(raw.summary_json)['engine']} (a driveline network)",
         scene_text=sc.text,
         overrides=list(sc.overrides),
         warnings=[],

@@ -55,6 +55,7 @@ class RawNetworkRun:
     sample_t_s: List[float]
     speed_rad_s: List[Tuple[str, List[float]]]
     torque_n_m: List[Tuple[str, List[float]]]
+    recording: Optional[str]
 
 class RawRecording:
     summary_json: str
@@ -79,7 +80,12 @@ def run(
     keep_samples: bool = True,
     deterministic: bool = False,
 ) -> RawRun: ...
-def run_network(scene: Scene) -> RawNetworkRun: ...
+def run_network(
+    scene: Scene,
+    engine: Optional[str] = None,
+    record: Optional[_Path] = None,
+    deterministic: bool = False,
+) -> RawNetworkRun: ...
 def sweep(
     scene: Scene,
     param: str,

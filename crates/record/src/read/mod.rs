@@ -46,8 +46,10 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
+mod network;
 mod scan;
 mod series;
+pub use network::{read_network, RecordedNetwork};
 use scan::*;
 pub(crate) use series::impact_event;
 pub(crate) use series::segment_of;

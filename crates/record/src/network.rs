@@ -1,0 +1,685 @@
+//! Recording a driveline network's run (MODEL.md section 8): [`NetworkRecorder`] writes an
+//! MCAP file with every body's angle and speed, every coupling's torque (a clutch's slip,
+//! mode and normal force too), the clutches' mode changes as log lines, the gear meshes'
+//! impacts, and a 3D view of the bodies turning side by side with the couplings drawn between
+//! them and coloured by mode. The file's header, scene attachment and metadata are the pack
+//! recordings' ([`crate::write::open_mcap`]), so `clutchpack replay` tells its provenance the
+//! same way; `clutchpack.run` has `kind = network`, and `clutchpack.network` names the bodies
+//! and couplings.
+//!
+//! Topics (log time = simulated time in ns):
+//!
+//! | topic | schema | when |
+//! | --- | --- | --- |
+//! | `/network/bodies/<segment>` | `clutchpack.ShaftState` | each sample |
+//! | `/network/couplings/<segment>` | `clutchpack.CouplingState` | each sample |
+//! | `/joints` (couplings: slip, torque), `/network/joints/bodies` (angle, speed) | `sensor_msgs/msg/JointState` | each sample (Rerun, Lichtblick) |
+//! | `/network/events` | `foxglove.Log` | each clutch mode change, at its instant |
+//! | `/network/impacts` | `clutchpack.Impact` | each gear-mesh impact, at its peak |
+//! | `/tf` | `foxglove.FrameTransforms` | each sample: `world` -> `body/<segment>` |
+//! | `/scene` | `foxglove.SceneUpdate` | t = 0: every body as a disc with a marker and its name |
+//! | `/scene/couplings` | `foxglove.SceneUpdate` | t = 0 and at each mode change |
+//! | `/pack/body/<segment>` | `foxglove.PointCloud` | t = 0: each body as points, for Rerun |
+//!
+//! The summary of the run (the JSON of `run --summary-json`) is attached at the end as
+//! `summary.json`.
+
+use crate::info::{num, RunInfo};
+use crate::output::{PendingFile, Replace};
+use crate::view3d::{about_z, entity, pose, rgba, timestamp, v3};
+use crate::write::{close_mcap, open_mcap, unique_segments, RecordError, RecordOptions};
+use crate::{log_time_ns, proto, ros2, topics};
+use clutchpack_model::network::{ClutchEvent, ClutchMode, CouplingKind, Network, NetworkSample};
+use clutchpack_model::{Flank, ImpactEvent};
+use foxglove::schemas::{
+    line_primitive, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms,
+    LinePrimitive, Log, Point3, SceneUpdate, TextPrimitive,
+};
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// Name of the `clutchpack.network` metadata record (bodies and couplings, in scene order).
+pub const META_NETWORK: &str = "clutchpack.network";
+/// Name of the attachment holding the run's summary (JSON), written by
+/// [`NetworkRecorder::finish`].
+pub const SUMMARY_ATTACHMENT: &str = "summary.json";
+
+/// Thickness of the steel disc a body is drawn as, m: its drawn radius is that of a disc of
+/// this thickness with the body's inertia (the drawing says how heavy a body is, not its
+/// shape), between [`MIN_DRAWN_RADIUS_M`] and [`MAX_DRAWN_RADIUS_M`].
+const DRAWN_THICKNESS_M: f64 = 0.02;
+/// Smallest drawn radius, m (a fixed body's).
+const MIN_DRAWN_RADIUS_M: f64 = 0.05;
+/// Largest drawn radius, m (a vehicle reduced to a shaft would be metres wide).
+const MAX_DRAWN_RADIUS_M: f64 = 0.4;
+/// Steel, kg/m^3.
+const STEEL_DENSITY_KG_M3: f64 = 7850.0;
+
+/// The drawn radius of a body of inertia `j` (kg m^2), m: a steel disc
+/// [`DRAWN_THICKNESS_M`] thick, `J = pi rho t r^4 / 2`, clamped.
+fn drawn_radius_m(j: f64, fixed: bool) -> f64 {
+    if fixed || j.is_nan() || j <= 0.0 {
+        return MIN_DRAWN_RADIUS_M;
+    }
+    (2.0 * j / (std::f64::consts::PI * STEEL_DENSITY_KG_M3 * DRAWN_THICKNESS_M))
+        .powf(0.25)
+        .clamp(MIN_DRAWN_RADIUS_M, MAX_DRAWN_RADIUS_M)
+}
+
+/// The colour of a coupling in `/scene/couplings`: grey for a gear or a spring, and for a
+/// clutch by mode (free light grey, slipping orange, locked green).
+fn coupling_color(mode: Option<ClutchMode>) -> Option<foxglove::schemas::Color> {
+    match mode {
+        None => rgba(0.55, 0.58, 0.62, 1.0),
+        Some(ClutchMode::Free) => rgba(0.8, 0.8, 0.8, 1.0),
+        Some(ClutchMode::Locked) => rgba(0.1, 0.75, 0.25, 1.0),
+        Some(_) => rgba(1.0, 0.55, 0.0, 1.0),
+    }
+}
+
+/// A coupling's kind as the summary names it.
+pub fn coupling_kind_name(kind: &CouplingKind) -> &'static str {
+    match kind {
+        CouplingKind::Clutch(_) => "clutch",
+        CouplingKind::IdealGear { .. } => "ideal_gear",
+        CouplingKind::GearMesh(_) => "gear_mesh",
+        CouplingKind::SpringDamper(_) => "spring_damper",
+    }
+}
+
+/// The `clutchpack.network` metadata: `bodies`, `couplings` (counts), `body.<i>.name`,
+/// `body.<i>.inertia_kg_m2`, `body.<i>.fixed`, `coupling.<k>.name`, `.kind`, `.a`, `.b`
+/// (body names).
+fn network_metadata(net: &Network) -> BTreeMap<String, String> {
+    let mut m = BTreeMap::new();
+    m.insert("bodies".into(), net.bodies.len().to_string());
+    m.insert("couplings".into(), net.couplings.len().to_string());
+    for (i, b) in net.bodies.iter().enumerate() {
+        m.insert(format!("body.{i}.name"), b.name.clone());
+        m.insert(format!("body.{i}.inertia_kg_m2"), num(b.inertia_kg_m2));
+        m.insert(format!("body.{i}.fixed"), b.fixed.to_string());
+    }
+    for (k, c) in net.couplings.iter().enumerate() {
+        m.insert(format!("coupling.{k}.name"), c.name.clone());
+        m.insert(
+            format!("coupling.{k}.kind"),
+            coupling_kind_name(&c.kind).into(),
+        );
+        m.insert(format!("coupling.{k}.a"), net.bodies[c.a].name.clone());
+        m.insert(format!("coupling.{k}.b"), net.bodies[c.b].name.clone());
+    }
+    m
+}
+
+struct Channels {
+    bodies: Vec<u16>,
+    couplings: Vec<u16>,
+    body_joints: u16,
+    coupling_joints: u16,
+    events: u16,
+    impacts: u16,
+    tf: u16,
+    scene: u16,
+    scene_couplings: u16,
+}
+
+/// Streams a network run into an MCAP file: call [`Self::write_sample`],
+/// [`Self::write_clutch_event`] and [`Self::write_mesh_impact`] as the engine gives them,
+/// then [`Self::finish`] (also after a stop or an engine error: the file then holds what
+/// ran). The first error is returned and nothing more is written after it.
+pub struct NetworkRecorder {
+    path: PathBuf,
+    pending: Option<PendingFile>,
+    writer: Option<mcap::Writer<BufWriter<File>>>,
+    net: Network,
+    ch: Channels,
+    body_names: Vec<String>,
+    coupling_names: Vec<String>,
+    /// x of each body's centre in the world frame, m
+    x_m: Vec<f64>,
+    /// the largest drawn radius, m (the couplings' lanes start beyond it)
+    max_radius_m: f64,
+    sequences: BTreeMap<u16, u32>,
+    buf: Vec<u8>,
+    tf: FrameTransforms,
+    /// the clutch modes last drawn in `/scene/couplings`
+    drawn_modes: Vec<Option<ClutchMode>>,
+    /// `/network/joints/*` values, reused: the bodies' angles and speeds, the couplings'
+    /// slips and torques
+    joint_values: [Vec<f64>; 4],
+    messages: u64,
+    last_t_s: f64,
+    deterministic: bool,
+    started: std::time::Instant,
+    failed: bool,
+}
+
+impl NetworkRecorder {
+    /// Creates the recording of `net` as an output written whole (as
+    /// [`crate::Recorder::create_output`]: a temporary file beside `target`, moved into place
+    /// by [`Self::finish`]). `info` gives the scene, engine and settings (its discs are
+    /// empty); of `options` the compression, determinism and chunk size apply.
+    pub fn create_output(
+        target: impl AsRef<Path>,
+        replace: Replace,
+        info: &RunInfo,
+        net: &Network,
+        options: &RecordOptions,
+    ) -> Result<NetworkRecorder, RecordError> {
+        let target = target.as_ref();
+        let (pending, file) =
+            PendingFile::create(target, replace).map_err(|cause| RecordError::Create {
+                path: target.to_path_buf(),
+                cause,
+            })?;
+        let path = pending.tmp_path().to_path_buf();
+        let write_err = |what: &str, cause| RecordError::Write {
+            path: path.clone(),
+            what: what.to_string(),
+            cause,
+        };
+        let mut kinds = info.clone();
+        kinds.params.insert("kind".into(), "network".into());
+        let chunk = options.chunk_size_bytes.unwrap_or(1 << 20);
+        let meta = vec![(META_NETWORK.to_string(), network_metadata(net))];
+        let mut w = open_mcap(&path, file, &kinds, options, chunk, meta)?;
+        let fds = proto::file_descriptor_set();
+        use foxglove::Encode as _;
+        let fx = |s: Option<foxglove::Schema>| s.map(|s| s.data.into_owned()).unwrap_or_default();
+        let schema = |w: &mut mcap::Writer<_>, name: &str, enc: &str, data: &[u8]| {
+            w.add_schema(name, enc, data)
+                .map_err(|e| write_err("schema", e))
+        };
+        let s_body = schema(&mut w, proto::SHAFT_STATE, "protobuf", &fds)?;
+        let s_coupling = schema(&mut w, proto::COUPLING_STATE, "protobuf", &fds)?;
+        let s_impact = schema(&mut w, proto::IMPACT, "protobuf", &fds)?;
+        let s_log = schema(
+            &mut w,
+            "foxglove.Log",
+            "protobuf",
+            &fx(foxglove::schemas::Log::get_schema()),
+        )?;
+        let s_tf = schema(
+            &mut w,
+            "foxglove.FrameTransforms",
+            "protobuf",
+            &fx(FrameTransforms::get_schema()),
+        )?;
+        let s_scene = schema(
+            &mut w,
+            "foxglove.SceneUpdate",
+            "protobuf",
+            &fx(SceneUpdate::get_schema()),
+        )?;
+        let s_joints = schema(
+            &mut w,
+            ros2::JOINT_STATE,
+            "ros2msg",
+            ros2::JOINT_STATE_SCHEMA.as_bytes(),
+        )?;
+        let channel = |w: &mut mcap::Writer<_>,
+                       schema_id: u16,
+                       topic: &str,
+                       enc: &str,
+                       meta: BTreeMap<String, String>| {
+            w.add_channel(schema_id, topic, enc, &meta)
+                .map_err(|e| write_err("channel", e))
+        };
+        let body_names: Vec<String> = net.bodies.iter().map(|b| b.name.clone()).collect();
+        let coupling_names: Vec<String> = net.couplings.iter().map(|c| c.name.clone()).collect();
+        let body_segments = unique_segments(&body_names);
+        let coupling_segments = unique_segments(&coupling_names);
+        let mut bodies = Vec::with_capacity(body_names.len());
+        for (i, (name, seg)) in body_names.iter().zip(&body_segments).enumerate() {
+            let meta = [
+                ("body".to_string(), name.clone()),
+                ("body_index".to_string(), i.to_string()),
+            ]
+            .into();
+            bodies.push(channel(
+                &mut w,
+                s_body,
+                &topics::network_body(seg),
+                "protobuf",
+                meta,
+            )?);
+        }
+        let mut couplings = Vec::with_capacity(coupling_names.len());
+        for (k, (c, seg)) in net.couplings.iter().zip(&coupling_segments).enumerate() {
+            let meta = [
+                ("coupling".to_string(), c.name.clone()),
+                ("coupling_index".to_string(), k.to_string()),
+                ("kind".to_string(), coupling_kind_name(&c.kind).to_string()),
+            ]
+            .into();
+            couplings.push(channel(
+                &mut w,
+                s_coupling,
+                &topics::network_coupling(seg),
+                "protobuf",
+                meta,
+            )?);
+        }
+        let none = BTreeMap::new;
+        let ch = Channels {
+            bodies,
+            couplings,
+            body_joints: channel(&mut w, s_joints, topics::NETWORK_BODY_JOINTS, "cdr", none())?,
+            coupling_joints: channel(
+                &mut w,
+                s_joints,
+                topics::NETWORK_COUPLING_JOINTS,
+                "cdr",
+                none(),
+            )?,
+            events: channel(&mut w, s_log, topics::NETWORK_EVENTS, "protobuf", none())?,
+            impacts: channel(
+                &mut w,
+                s_impact,
+                topics::NETWORK_IMPACTS,
+                "protobuf",
+                none(),
+            )?,
+            tf: channel(&mut w, s_tf, topics::TF, "protobuf", none())?,
+            scene: channel(&mut w, s_scene, topics::SCENE, "protobuf", none())?,
+            scene_couplings: channel(
+                &mut w,
+                s_scene,
+                topics::NETWORK_SCENE_COUPLINGS,
+                "protobuf",
+                none(),
+            )?,
+        };
+        let s_cloud = schema(
+            &mut w,
+            "foxglove.PointCloud",
+            "protobuf",
+            &fx(foxglove::schemas::PointCloud::get_schema()),
+        )?;
+        let mut clouds = Vec::with_capacity(body_segments.len());
+        for seg in &body_segments {
+            let topic = format!("{}{}", topics::PACK_PREFIX, body_frame(seg));
+            clouds.push(channel(&mut w, s_cloud, &topic, "protobuf", none())?);
+        }
+        // the bodies side by side along x, a drawn radius apart plus a gap
+        let radii: Vec<f64> = net
+            .bodies
+            .iter()
+            .map(|b| drawn_radius_m(b.inertia_kg_m2, b.fixed))
+            .collect();
+        let mut x_m = Vec::with_capacity(radii.len());
+        let mut x = 0.0;
+        for (i, r) in radii.iter().enumerate() {
+            if i > 0 {
+                x += radii[i - 1] + 0.1 + r;
+            }
+            x_m.push(x);
+        }
+        let frames: Vec<String> = body_segments.iter().map(|s| body_frame(s)).collect();
+        let tf = FrameTransforms {
+            transforms: frames
+                .iter()
+                .zip(&x_m)
+                .map(|(f, x)| FrameTransform {
+                    timestamp: Some(timestamp(0)),
+                    parent_frame_id: crate::view3d::WORLD_FRAME.into(),
+                    child_frame_id: f.clone(),
+                    translation: Some(v3(*x, 0.0, 0.0)),
+                    rotation: Some(about_z(0.0)),
+                })
+                .collect(),
+        };
+        let n = body_names.len();
+        let m = coupling_names.len();
+        let mut rec = NetworkRecorder {
+            path,
+            pending: Some(pending),
+            writer: Some(w),
+            net: net.clone(),
+            ch,
+            body_names,
+            coupling_names,
+            x_m,
+            max_radius_m: radii.iter().fold(MIN_DRAWN_RADIUS_M, |a, &r| a.max(r)),
+            sequences: BTreeMap::new(),
+            buf: Vec::with_capacity(1024),
+            tf,
+            drawn_modes: net
+                .couplings
+                .iter()
+                .map(|c| c.clutch().map(|_| ClutchMode::Free))
+                .collect(),
+            joint_values: [vec![0.0; n], vec![0.0; n], vec![0.0; m], vec![0.0; m]],
+            messages: 0,
+            last_t_s: 0.0,
+            deterministic: options.deterministic,
+            started: std::time::Instant::now(),
+            failed: false,
+        };
+        let scene = rec.static_scene(&frames, &radii);
+        rec.put(rec.ch.scene, 0, &scene, "/scene")?;
+        for ((ch, frame), &r) in clouds.into_iter().zip(&frames).zip(&radii) {
+            rec.put(ch, 0, &body_points(frame, r), "body points")?;
+        }
+        let couplings = rec.coupling_scene(0);
+        rec.put(rec.ch.scene_couplings, 0, &couplings, "/scene/couplings")?;
+        Ok(rec)
+    }
+
+    /// Every body as a disc in its frame, with a marker on its rim (so its rotation shows)
+    /// and its name above it.
+    fn static_scene(&self, frames: &[String], radii: &[f64]) -> SceneUpdate {
+        let entities = frames
+            .iter()
+            .zip(radii)
+            .zip(&self.net.bodies)
+            .map(|((frame, &r), b)| {
+                let mut e = entity(0, frame, frame);
+                let grey = if b.fixed { 0.35 } else { 0.62 };
+                e.cylinders.push(CylinderPrimitive {
+                    pose: pose(0.0, 0.0, 0.0, 0.0),
+                    size: Some(v3(2.0 * r, 2.0 * r, DRAWN_THICKNESS_M)),
+                    bottom_scale: 1.0,
+                    top_scale: 1.0,
+                    color: rgba(grey, grey * 0.8, grey * 0.55, 1.0),
+                });
+                e.cubes.push(CubePrimitive {
+                    pose: pose(0.8 * r, 0.0, 0.0, 0.0),
+                    size: Some(v3(0.3 * r, 0.12 * r, DRAWN_THICKNESS_M * 1.5)),
+                    color: rgba(0.1, 0.1, 0.1, 1.0),
+                });
+                e.texts.push(TextPrimitive {
+                    pose: pose(0.0, 0.0, 0.05 + DRAWN_THICKNESS_M, 0.0),
+                    billboard: true,
+                    font_size: 14.0,
+                    scale_invariant: true,
+                    color: rgba(1.0, 1.0, 1.0, 1.0),
+                    text: b.name.clone(),
+                });
+                e
+            })
+            .collect();
+        SceneUpdate {
+            deletions: Vec::new(),
+            entities,
+        }
+    }
+
+    /// Every coupling as a wire from body `a`'s centre out to its own lane in front of the
+    /// bodies, along it and back to body `b`'s centre (a diagram of the driveline under the
+    /// turning bodies), coloured by its mode, its name (and a clutch's mode) on its lane.
+    fn coupling_scene(&self, log_time_ns: u64) -> SceneUpdate {
+        let mut e = entity(log_time_ns, crate::view3d::WORLD_FRAME, "couplings");
+        let z = -0.6 * DRAWN_THICKNESS_M;
+        for (k, c) in self.net.couplings.iter().enumerate() {
+            let lane = -(self.max_radius_m + 0.08 + 0.07 * k as f64);
+            let (xa, xb) = (self.x_m[c.a], self.x_m[c.b]);
+            let color = coupling_color(self.drawn_modes[k]);
+            let p = |x: f64, y: f64| Point3 { x, y, z };
+            e.lines.push(LinePrimitive {
+                r#type: line_primitive::Type::LineStrip as i32,
+                pose: pose(0.0, 0.0, 0.0, 0.0),
+                thickness: 4.0,
+                scale_invariant: true,
+                points: vec![p(xa, 0.0), p(xa, lane), p(xb, lane), p(xb, 0.0)],
+                color,
+                ..Default::default()
+            });
+            let label = match self.drawn_modes[k] {
+                Some(mode) => format!("{} ({})", c.name, mode.label()),
+                None => c.name.clone(),
+            };
+            e.texts.push(TextPrimitive {
+                pose: pose(0.5 * (xa + xb), lane, z + 0.01, 0.0),
+                billboard: true,
+                font_size: 12.0,
+                scale_invariant: true,
+                color,
+                text: label,
+            });
+        }
+        SceneUpdate {
+            deletions: Vec::new(),
+            entities: vec![e],
+        }
+    }
+
+    /// The file being written (the temporary file until [`Self::finish`]).
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Messages written so far.
+    pub fn messages(&self) -> u64 {
+        self.messages
+    }
+
+    fn put<M: prost::Message>(
+        &mut self,
+        channel: u16,
+        log_time: u64,
+        msg: &M,
+        what: &str,
+    ) -> Result<(), RecordError> {
+        self.buf.clear();
+        // encoding into a Vec cannot run out of space
+        let _ = msg.encode(&mut self.buf);
+        self.put_buf(channel, log_time, what)
+    }
+
+    fn put_buf(&mut self, channel: u16, log_time: u64, what: &str) -> Result<(), RecordError> {
+        let failed = RecordError::AlreadyFailed {
+            path: self.path.clone(),
+        };
+        if self.failed {
+            return Err(failed);
+        }
+        let Some(w) = self.writer.as_mut() else {
+            return Err(failed);
+        };
+        let seq = self.sequences.entry(channel).or_insert(0);
+        *seq = seq.wrapping_add(1);
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: *seq,
+            log_time,
+            publish_time: log_time,
+        };
+        if let Err(cause) = w.write_to_known_channel(&header, &self.buf) {
+            self.failed = true;
+            return Err(RecordError::Write {
+                path: self.path.clone(),
+                what: what.to_string(),
+                cause,
+            });
+        }
+        self.messages += 1;
+        Ok(())
+    }
+
+    /// Writes one sample: each body's and coupling's topic, the joints, `/tf`.
+    pub fn write_sample(&mut self, s: &NetworkSample) -> Result<(), RecordError> {
+        let t = s.t_s;
+        let ns = log_time_ns(t);
+        self.last_t_s = t;
+        for i in 0..self.ch.bodies.len() {
+            let msg = proto::ShaftState {
+                t_s: t,
+                angle_rad: s.angle_rad[i],
+                speed_rad_s: s.speed_rad_s[i],
+            };
+            self.put(self.ch.bodies[i], ns, &msg, "body state")?;
+        }
+        for k in 0..self.ch.couplings.len() {
+            let c = &self.net.couplings[k];
+            let mode = s.mode[k];
+            let msg = proto::CouplingState {
+                t_s: t,
+                torque_n_m: s.torque_n_m[k],
+                slip_rad_s: clutch_slip_rad_s(s, c, k),
+                mode: mode.map(|m| m.label().to_string()).unwrap_or_default(),
+                locked: mode == Some(ClutchMode::Locked),
+                normal_force_n: c.clutch().map_or(0.0, |cl| cl.normal_force_n(t)),
+                coupling_index: k as u32,
+            };
+            self.put(self.ch.couplings[k], ns, &msg, "coupling state")?;
+        }
+        let [angles, speeds, _, _] = &mut self.joint_values;
+        angles.copy_from_slice(&s.angle_rad);
+        speeds.copy_from_slice(&s.speed_rad_s);
+        ros2::joint_state(&mut self.buf, ns, &self.body_names, angles, speeds, &[]);
+        self.put_buf(self.ch.body_joints, ns, "body joints")?;
+        let [_, _, slips, torques] = &mut self.joint_values;
+        for (k, c) in self.net.couplings.iter().enumerate() {
+            slips[k] = clutch_slip_rad_s(s, c, k);
+        }
+        torques.copy_from_slice(&s.torque_n_m);
+        ros2::joint_state(&mut self.buf, ns, &self.coupling_names, &[], slips, torques);
+        self.put_buf(self.ch.coupling_joints, ns, "coupling joints")?;
+        let ts = timestamp(ns);
+        for (tr, angle) in self.tf.transforms.iter_mut().zip(&s.angle_rad) {
+            tr.timestamp = Some(ts);
+            tr.rotation = Some(about_z(*angle));
+        }
+        let tf = std::mem::take(&mut self.tf);
+        let r = self.put(self.ch.tf, ns, &tf, "/tf");
+        self.tf = tf;
+        r?;
+        if s.mode != self.drawn_modes {
+            self.drawn_modes.clone_from(&s.mode);
+            let scene = self.coupling_scene(ns);
+            self.put(self.ch.scene_couplings, ns, &scene, "/scene/couplings")?;
+        }
+        Ok(())
+    }
+
+    /// Writes a clutch's mode change as a log line on `/network/events`.
+    pub fn write_clutch_event(&mut self, e: &ClutchEvent) -> Result<(), RecordError> {
+        let ns = log_time_ns(e.t_s);
+        let msg = Log {
+            timestamp: Some(timestamp(ns)),
+            level: foxglove::schemas::log::Level::Info as i32,
+            message: format!(
+                "{}: {} -> {} at t = {:.6} s",
+                self.coupling_names
+                    .get(e.coupling)
+                    .map_or("?", String::as_str),
+                e.from.label(),
+                e.to.label(),
+                e.t_s
+            ),
+            name: "clutchpack".into(),
+            file: String::new(),
+            line: 0,
+        };
+        self.put(self.ch.events, ns, &msg, "/network/events")
+    }
+
+    /// Writes a gear mesh's tooth impact on `/network/impacts`, logged at its peak (`disc`
+    /// of the event is the coupling's index).
+    pub fn write_mesh_impact(&mut self, e: &ImpactEvent) -> Result<(), RecordError> {
+        let msg = proto::Impact {
+            disc: self
+                .coupling_names
+                .get(e.disc)
+                .cloned()
+                .unwrap_or_else(|| format!("coupling {}", e.disc)),
+            disc_index: e.disc as u32,
+            t_on_s: e.t_on_s,
+            t_peak_s: e.t_peak_s,
+            t_off_s: e.t_off_s,
+            flank: match e.flank {
+                Flank::ShaftLeads => proto::Flank::ShaftLeads,
+                Flank::DiscLeads => proto::Flank::DiscLeads,
+            } as i32,
+            v_on_m_s: e.v_on_m_s,
+            peak_n: e.peak_n,
+        };
+        self.put(
+            self.ch.impacts,
+            log_time_ns(e.t_peak_s),
+            &msg,
+            "/network/impacts",
+        )
+    }
+
+    /// Attaches `summary_json` (the run's summary, if given) and closes the file, moving it
+    /// into place. Call it after a stop or an engine error too: the file then holds what ran.
+    pub fn finish(mut self, summary_json: Option<&[u8]>) -> Result<PathBuf, RecordError> {
+        let failed = RecordError::AlreadyFailed {
+            path: self.path.clone(),
+        };
+        let Some(mut w) = self.writer.take().filter(|_| !self.failed) else {
+            return Err(failed);
+        };
+        let path = self.path.clone();
+        if let Some(json) = summary_json {
+            w.attach(&mcap::Attachment {
+                log_time: log_time_ns(self.last_t_s),
+                create_time: 0,
+                name: SUMMARY_ATTACHMENT.into(),
+                media_type: "application/json".into(),
+                data: Cow::Borrowed(json),
+            })
+            .map_err(|cause| RecordError::Write {
+                path: path.clone(),
+                what: "summary attachment".into(),
+                cause,
+            })?;
+        }
+        let mut stats = BTreeMap::new();
+        stats.insert("simulated_s".into(), num(self.last_t_s));
+        stats.insert("messages".into(), self.messages.to_string());
+        if !self.deterministic {
+            stats.insert("wall_s".into(), num(self.started.elapsed().as_secs_f64()));
+        }
+        let r = close_mcap(w, &path, stats, &mut self.pending);
+        if let Err(e) = &r {
+            if e.is_disk_full() {
+                if let Some(p) = self.pending.take() {
+                    p.discard();
+                }
+            }
+        }
+        r
+    }
+}
+
+/// A body drawn as points in its frame `frame` (for Rerun, which does not draw scene
+/// updates): an annulus from `0.2 r` to `r` (m) with a dark sector, so that it turns visibly.
+fn body_points(frame: &str, r: f64) -> foxglove::schemas::PointCloud {
+    let mut data = Vec::new();
+    crate::view3d::annulus_points(
+        &mut data,
+        0.2 * r,
+        r,
+        DRAWN_THICKNESS_M,
+        [158, 122, 82, 255],
+    );
+    for k in 0..8 {
+        let x = r * (0.65 + 0.04 * f64::from(k));
+        for y in [-0.03 * r, 0.0, 0.03 * r] {
+            crate::view3d::push_point(&mut data, x, y, 0.6 * DRAWN_THICKNESS_M, [20, 20, 20, 255]);
+        }
+    }
+    crate::view3d::cloud(frame, data)
+}
+
+/// A clutch's slip `w_rel = omega_b - omega_a` in `s`, rad/s (the network's sign convention,
+/// MODEL.md section 8 and `clutchpack_model::network::clutch`: positive in mode `slip+`; 0 for
+/// another kind of coupling).
+fn clutch_slip_rad_s(s: &NetworkSample, c: &clutchpack_model::network::Coupling, k: usize) -> f64 {
+    if s.mode[k].is_some() {
+        s.speed_rad_s[c.b] - s.speed_rad_s[c.a]
+    } else {
+        0.0
+    }
+}
+
+/// The frame of the network body whose topic segment is `segment` (`body/<segment>`).
+pub fn body_frame(segment: &str) -> String {
+    format!("body/{segment}")
+}
