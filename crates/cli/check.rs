@@ -43,14 +43,6 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
             if let Some(net) = &s.network {
                 // a network runs on either engine (its own rules checked in the load)
                 let engine = s.engine(a.engine, &p.display().to_string())?;
-                if engine == EngineChoice::Multibody {
-                    if let Some(why) = clutchpack_sdk::multibody_network_unsupported(net) {
-                        return Err(clutchpack_sdk::Error::BadInput(format!(
-                            "{}: {why}",
-                            p.display()
-                        )));
-                    }
-                }
                 return Ok(format!(
                     "network of {} bodies and {} couplings, {} s, {} engine",
                     net.bodies.len(),

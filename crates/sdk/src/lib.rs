@@ -59,9 +59,8 @@ pub use cosim::{CoSimulation, SavedCoSimulation};
 pub use error::{Error, Result};
 pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
 pub use network::{
-    multibody_network_unsupported, multibody_step_s, run_network_scene, BodySummary,
-    CouplingSummary, EnergySummary, ModeChange, NetworkOutcome, NetworkRequest, NetworkSummary,
-    MULTIBODY_NETWORK_STEP_S,
+    multibody_step_s, run_network_scene, BodySummary, CouplingSummary, EnergySummary, ModeChange,
+    NetworkOutcome, NetworkRequest, NetworkSummary, MULTIBODY_NETWORK_STEP_S,
 };
 pub use recording::open_recording;
 pub use run::{RecordingRequest, RunOutcome, RunRequest};

@@ -216,12 +216,6 @@ pub fn multibody_step_s(scene: &Scene) -> f64 {
     scene.simulation.max_step_s.min(MULTIBODY_NETWORK_STEP_S)
 }
 
-/// Why the multibody engine cannot run the network `net` (`None`: it can; it runs lumped
-/// clutches and ideal gears), for `check` to say what `run` would.
-pub fn multibody_network_unsupported(net: &clutchpack_model::network::Network) -> Option<String> {
-    clutchpack_multibody::network::unsupported(net)
-}
-
 /// The longest fixed step of the multibody engine on a network, s.
 pub const MULTIBODY_NETWORK_STEP_S: f64 = 1e-4;
 
@@ -241,11 +235,6 @@ pub fn run_network_scene(
         )));
     };
     let engine = scene.engine(asked, &scene.name)?;
-    if engine == EngineChoice::Multibody {
-        if let Some(why) = clutchpack_multibody::network::unsupported(net) {
-            return Err(Error::BadInput(format!("{}: {why}", scene.name)));
-        }
-    }
     let sim = &scene.simulation;
     let recorder = match &req.recording {
         Some(r) => {

@@ -1,14 +1,23 @@
 //! The multibody engine on a driveline network of lumped parts (MODEL.md section 8): every
 //! body that turns is a rapier3d-f64 rigid body turning about its axis (`bodies.rs`), the
 //! drives (with an engine's firing harmonics in its angle), drag, road loads, slipping
-//! clutches' and spring-dampers' torques are applied to it each step, and
+//! clutches', spring-dampers' and gear meshes' torques are applied to it each step (the
+//! meshes' contacts in `mesh.rs`), and
 //! the ideal gears and locked clutches are velocity-level constraints solved each step
 //! (`constraint.rs`). The output types are the model's ([`clutchpack_model::network`]), the
 //! reference engine's, so that the two engines' runs compare field by field.
 //!
 //! # Method
 //! Fixed steps of `step_s` (shortened to land on the signals' breakpoints, the sample times
-//! and the events below). At the start of a step at `t`, with the speeds `w`:
+//! and the events below, and while a gear mesh is in contact). At the start of a step at `t`,
+//! with the speeds `w`:
+//! 0. **Mesh contacts** (`mesh.rs`): a gear mesh whose engagement depth (its tooth law's, on
+//!    the penetration `|x| - b/2`) is above 0 opens a contact event there (the law's memory
+//!    taken, its Hertz duration predicted at the closing speed), one whose depth is at or
+//!    below 0 closes it (an [`clutchpack_model::ImpactEvent`] to
+//!    [`NetworkObserver::mesh_impact`]). While in contact the step is at most the predicted
+//!    duration over 256 and the local period of the linearised law over 256 (over 64 once
+//!    the contact outlasts four predicted durations: a loaded mesh).
 //! 1. **Modes** (Modelica's `Clutch`, as the reference engine settles them; MODEL.md section
 //!    8): a clutch is free while `fn(t) <= 0`; a free clutch that engages slips if its slip
 //!    is not zero and is tried locked otherwise; a slipping clutch whose slip `s w_rel` has
@@ -19,7 +28,10 @@
 //!    ([`clutchpack_model::network::Body::external_torque_n_m`]), each slipping clutch's
 //!    `tau = sign(w_rel) mu(|w_rel|) cgeo fn` (+tau on `a`, -tau on `b`,
 //!    [`LumpedClutch::slip_torque_n_m`](clutchpack_model::network::LumpedClutch::slip_torque_n_m)), each spring-damper's `T = k (theta_a - theta_b -
-//!    theta_0) + d (w_a - w_b)` (-T on `a`, +T on `b`); then the constraint torques `lambda` of the gears
+//!    theta_0) + d (w_a - w_b)` (-T on `a`, +T on `b`), each gear mesh's force per pair `F`,
+//!    signed as its `x`, from the model's law at `x` and its rate (MODEL.md section 8:
+//!    `-Rb_a F` on `a`, `-Rb_b F` on `b`, internal `+Rb_b F`, times the pairs,
+//!    [`GearMesh::torques_n_m`](clutchpack_model::network::GearMesh::torques_n_m)); then the constraint torques `lambda` of the gears
 //!    and locked clutches that keep every constraint (`constraint::solve`). A locked clutch
 //!    whose `|lambda|` exceeds its static limit `peak mu(0) cgeo fn`
 //!    ([`LumpedClutch::max_static_torque_n_m`](clutchpack_model::network::LumpedClutch::max_static_torque_n_m)) slips towards it; the one furthest over goes
@@ -36,8 +48,12 @@
 //!    slipping clutch whose slip would change sign shortens the step to land on its zero
 //!    (exactly, to rounding); a clutch force `fn` that would cross zero (a sine; a ramp's bend
 //!    is a breakpoint already), and a locked clutch's holding torque that would reach its
-//!    static limit (a break), are bisected on that trajectory to 1e-13 s and landed on. The
-//!    step's torques are then taken again at the shorter step's midpoint.
+//!    static limit (a break), and a gear mesh's engagement depth that would cross 0 (its `x`
+//!    is quadratic over the step: an onset or a separation), are bisected on that trajectory
+//!    to 1e-13 s and landed on. The step's torques are then taken again at the shorter step's
+//!    midpoint (a mesh's crossing landed on a hair short of its instant by that change is
+//!    reached by the next, tiny step: further landing passes on the new torques changed no
+//!    impact of `tests/network.rs` in its 15th digit).
 //! 5. **Step**: the torques go to the rapier bodies, and rapier (one solver iteration:
 //!    semi-implicit Euler) steps `w += h T / J`; the engine keeps each body's angle
 //!    unwrapped as `theta += h (w_k + w_{k+1}) / 2` (the exact turn of the affine speed) and
@@ -46,7 +62,9 @@
 //!
 //! # Energy
 //! Every torque's work is counted over a step with the step's mean speed `(w_k + w_{k+1}) / 2`
-//! (the drives', the road loads', the drag's and each slipping clutch's `tau (w_b - w_a)`).
+//! (the drives', the road loads', the drag's, each slipping clutch's `tau (w_b - w_a)` and
+//! each mesh's `F pairs (x_{k+1} - x_k)`, the work done on the mesh: its impact losses, plus
+//! the elastic energy of a contact still closed at the end).
 //! Since `J (w_{k+1} - w_k) = h T`, those works sum to the change of kinetic energy exactly
 //! (the discrete energy identity of the scheme), the constraint torques doing no work when
 //! the constraints hold at both ends of the step: the balance closes to rounding, while the
@@ -54,6 +72,7 @@
 
 mod bodies;
 mod constraint;
+mod mesh;
 
 use bodies::NetworkWorld;
 use clutchpack_model::network::{
@@ -62,6 +81,7 @@ use clutchpack_model::network::{
 };
 use clutchpack_model::EngineError;
 use constraint::Row;
+use mesh::Mesh;
 
 /// Settings of a network run on the multibody engine.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,12 +102,13 @@ impl Default for NetworkStepOptions {
 }
 
 /// Torques at one state: each body's but the constraints' (N m), each row's, each
-/// coupling's on its body `a`.
+/// coupling's on its body `a`, and each gear mesh's force per pair (N, signed as its `x`).
 #[derive(Default)]
 struct Torques {
     body: Vec<f64>,
     lambda: Vec<f64>,
     coupling: Vec<f64>,
+    mesh_force: Vec<f64>,
 }
 
 /// The state of a run between steps.
@@ -107,6 +128,10 @@ struct Run<'n> {
     lambda: Vec<f64>,
     /// Each coupling's torque on its body `a`, N m.
     coupling_torque: Vec<f64>,
+    /// The gear meshes (their `x` and contacts), in the couplings' order.
+    meshes: Vec<Mesh>,
+    /// Each mesh's force per pair, N, signed as its `x` (with the torques).
+    mesh_force: Vec<f64>,
     heat: Vec<f64>,
     energy: NetworkEnergy,
     events: u64,
@@ -136,10 +161,26 @@ impl<'n> Run<'n> {
     /// rows' into `lambda` (MODEL.md section 8), every coupling's into `coupling_torque`.
     fn torques(&mut self, t: f64) {
         let mut out = Torques::default();
-        self.evaluate(t, self.world.angles(), &self.w, &mut out);
+        let x: Vec<f64> = self.meshes.iter().map(|m| m.x).collect();
+        self.evaluate(t, self.world.angles(), &self.w, &x, &mut out);
+        self.keep(out);
+    }
+
+    /// Keeps `out` as the torques held.
+    fn keep(&mut self, out: Torques) {
         self.torque = out.body;
         self.lambda = out.lambda;
         self.coupling_torque = out.coupling;
+        self.mesh_force = out.mesh_force;
+    }
+
+    /// Each body's acceleration under the torques `total` (N m), rad/s^2.
+    fn accelerations(&self, total: &[f64]) -> Vec<f64> {
+        total
+            .iter()
+            .zip(&self.inv_inertia)
+            .map(|(t, j)| j * t)
+            .collect()
     }
 
     /// Each body's total torque (N m): its own, the slipping clutches' and the rows'.
@@ -163,16 +204,17 @@ impl<'n> Run<'n> {
         let theta_mid: Vec<f64> = (0..self.w.len())
             .map(|i| self.world.angles()[i] + 0.25 * h * (self.w[i] + w_mid[i]))
             .collect();
+        // each mesh's x there on the same path
+        let x_mid = mesh::positions(&self.meshes, 0.5 * h, &self.w, &self.accelerations(start));
         let mut out = Torques::default();
-        self.evaluate(t + 0.5 * h, &theta_mid, &w_mid, &mut out);
-        self.torque = out.body;
-        self.lambda = out.lambda;
-        self.coupling_torque = out.coupling;
+        self.evaluate(t + 0.5 * h, &theta_mid, &w_mid, &x_mid, &mut out);
+        self.keep(out);
         (w_mid, theta_mid)
     }
 
-    /// The torques at `(t, theta, w)` in the present modes into `out` (MODEL.md section 8).
-    fn evaluate(&self, t: f64, theta: &[f64], w: &[f64], out: &mut Torques) {
+    /// The torques at `(t, theta, w)`, the meshes at `x` (m, one per mesh), in the present
+    /// modes and contacts into `out` (MODEL.md section 8).
+    fn evaluate(&self, t: f64, theta: &[f64], w: &[f64], x: &[f64], out: &mut Torques) {
         let net = self.net;
         out.body.clear();
         out.body.extend(net.bodies.iter().enumerate().map(|(i, b)| {
@@ -203,6 +245,8 @@ impl<'n> Run<'n> {
                 out.body[c.b] += t;
             }
         }
+        let (body, coupling) = (&mut out.body, &mut out.coupling);
+        mesh::add_torques(&self.meshes, x, w, body, coupling, &mut out.mesh_force);
         // A lambda = -C M^-1 T: the rows' rates vanish, so rows that hold at the step's
         // start hold at its end (the speeds are projected after each step against rounding)
         let rhs: Vec<f64> = self
@@ -222,8 +266,15 @@ impl<'n> Run<'n> {
     /// Each locked clutch's margin at `(t, w)`, N m: its static limit less the torque that
     /// holds it (`peak mu(0) cgeo fn - |lambda|`; it breaks where this reaches 0); `+inf`
     /// for the other couplings.
-    fn margins(&self, t: f64, theta: &[f64], w: &[f64], scratch: &mut Torques) -> Vec<f64> {
-        self.evaluate(t, theta, w, scratch);
+    fn margins(
+        &self,
+        t: f64,
+        theta: &[f64],
+        w: &[f64],
+        x: &[f64],
+        scratch: &mut Torques,
+    ) -> Vec<f64> {
+        self.evaluate(t, theta, w, x, scratch);
         (0..self.net.couplings.len())
             .map(|k| match (self.net.couplings[k].clutch(), self.modes[k]) {
                 (Some(cl), Some(ClutchMode::Locked)) => {
@@ -347,12 +398,17 @@ impl<'n> Run<'n> {
     }
 
     /// The length of the step from `t`, at most `h`, that lands on the first slip reaching
-    /// zero and the first clutch force crossing zero within it.
+    /// zero, the first clutch force crossing zero and the first mesh contact's onset or
+    /// separation within it.
     fn landing(&self, t: f64, h: f64) -> f64 {
         let net = self.net;
         let mut best = h;
         let mut any_locked = false;
         let total = self.total();
+        let acc = self.accelerations(&total);
+        if !self.meshes.is_empty() {
+            best = mesh::landing(&self.meshes, t, best, &self.w, &acc);
+        }
         for (k, c) in net.couplings.iter().enumerate() {
             let Some(cl) = net.couplings[k].clutch() else {
                 continue;
@@ -398,7 +454,8 @@ impl<'n> Run<'n> {
                 let theta: Vec<f64> = (0..self.w.len())
                     .map(|i| self.world.angles()[i] + 0.5 * hh * (self.w[i] + w[i]))
                     .collect();
-                self.margins(t + hh, &theta, &w, scratch)
+                let x = mesh::positions(&self.meshes, hh, &self.w, &acc);
+                self.margins(t + hh, &theta, &w, &x, scratch)
             };
             let mut scratch = Torques::default();
             let g0 = at(0.0, &mut scratch);
@@ -433,25 +490,6 @@ impl<'n> Run<'n> {
     }
 }
 
-/// Why the multibody engine cannot run `net` (`None`: it can): it runs lumped clutches, ideal
-/// gears and spring-dampers; a gear mesh with backlash runs on the reference engine for now,
-/// the message names the first one.
-pub fn unsupported(net: &Network) -> Option<String> {
-    net.couplings.iter().find_map(|c| {
-        let kind = match c.kind {
-            CouplingKind::Clutch(_)
-            | CouplingKind::IdealGear { .. }
-            | CouplingKind::SpringDamper(_) => return None,
-            CouplingKind::GearMesh(_) => "a gear mesh",
-        };
-        Some(format!(
-            "coupling \"{}\" is {kind}: the multibody engine runs a network's lumped clutches, \
-             ideal gears and spring-dampers only, for now (run it with --engine reference)",
-            c.name
-        ))
-    })
-}
-
 /// Runs `net` on the multibody engine for `duration_s` seconds; samples and clutch events go
 /// to `obs` as they happen. A network with problems ([`Network::problems`]), a duration or a
 /// step that is not finite and positive are refused.
@@ -462,9 +500,6 @@ pub fn run_network(
     obs: &mut dyn NetworkObserver,
 ) -> Result<NetworkRun, EngineError> {
     net.check_run(duration_s)?;
-    if let Some(why) = unsupported(net) {
-        return Err(EngineError::Unsupported(why));
-    }
     let h_max = options.step_s;
     if !(h_max.is_finite() && h_max > 0.0) {
         return Err(EngineError::Unsupported(format!(
@@ -496,6 +531,8 @@ pub fn run_network(
         torque: vec![0.0; n],
         lambda: Vec::new(),
         coupling_torque: vec![0.0; m],
+        meshes: Mesh::of(net),
+        mesh_force: Vec::new(),
         heat: vec![0.0; m],
         energy: NetworkEnergy::default(),
         events: 0,
@@ -528,7 +565,9 @@ pub fn run_network(
             } else {
                 f64::INFINITY
             });
-        let h = (stop - t).min(h_max).max(0.0);
+        // a contact's onset or separation at t (landed on), before the torques at t
+        let h_contact = mesh::start_step(&mut run.meshes, t, &run.w, obs);
+        let h = (stop - t).min(h_max).min(h_contact).max(0.0);
         run.settle(t, obs);
         if (near(t, t_sample) || t_sample <= t) && t_sample < duration_s && t < duration_s {
             obs.sample(&run.sample(t));
@@ -553,7 +592,14 @@ pub fn run_network(
         let t_new = if h == stop - t { stop } else { t + h };
         let h = t_new - t;
         let w0 = run.w.clone();
-        run.w = run.world.step(&run.total(), h);
+        let total = run.total();
+        let acc = run.accelerations(&total);
+        let paths: Vec<mesh::Path> = run
+            .meshes
+            .iter()
+            .map(|mesh| mesh.path(t, h, &w0, &acc))
+            .collect();
+        run.w = run.world.step(&total, h);
         // rapier's speeds keep the rows to rounding; remove it (momentum kept)
         constraint::project(&run.rows, &run.inv_inertia, &mut run.w);
         run.world.set_speeds(&run.w);
@@ -589,6 +635,11 @@ pub fn run_network(
                 run.energy.damper_loss_j += loss;
             }
         }
+        for (j, mesh) in run.meshes.iter_mut().enumerate() {
+            let work = mesh.advance(&paths[j], &run.w, run.mesh_force[j]);
+            run.heat[mesh.coupling] += work;
+            run.energy.mesh_work_j += work;
+        }
         t = t_new;
         steps += 1;
         if !obs.progress(t) {
@@ -596,9 +647,13 @@ pub fn run_network(
             break;
         }
     }
+    for mesh in &mut run.meshes {
+        mesh.finish(t, obs);
+    }
     let last = run.sample(t);
     obs.sample(&last);
-    run.energy.clutch_heat_j = run.heat.iter().sum::<f64>() - run.energy.damper_loss_j;
+    run.energy.clutch_heat_j =
+        run.heat.iter().sum::<f64>() - run.energy.damper_loss_j - run.energy.mesh_work_j;
     let angles = run.world.angles();
     run.energy.spring_energy_change_j = (0..net.couplings.len())
         .filter_map(|k| net.couplings[k].spring().map(|sd| (k, sd)))
