@@ -10,6 +10,7 @@
 //! (SIGINT) stops it within about 50 ms of wall time, its outputs complete (the recording
 //! finished), and then raises `KeyboardInterrupt`.
 
+mod network;
 mod stepper;
 
 use clutchpack_sdk::scene::{EngineChoice, Override};
@@ -280,88 +281,6 @@ fn signal_poll<'a>(stop: &'a AtomicBool, interrupt: &'a mut Option<PyErr>) -> im
     }
 }
 
-/// What one network run gave, for the Python half.
-#[pyclass(name = "RawNetworkRun", module = "clutchpack", frozen, get_all)]
-struct RawNetworkRun {
-    /// `--summary-json`'s content for a network (JSON text).
-    summary_json: String,
-    /// Sample times, s.
-    sample_t_s: Vec<f64>,
-    /// Each body's speed at them, rad/s, by name.
-    speed_rad_s: Vec<(String, Vec<f64>)>,
-    /// Each coupling's torque on its body a at them, N m, by name.
-    torque_n_m: Vec<(String, Vec<f64>)>,
-    /// The recording's path, if one was asked.
-    recording: Option<PathBuf>,
-}
-
-/// Runs a network scene (`[[bodies]]`) on `engine` (else `simulation.engine`, else the
-/// reference engine), as `clutchpack run` does: the summary and the sampled speeds and
-/// torques, and the recording at `record` if given (replaced if it exists). The GIL is
-/// released while it runs; Ctrl-C stops it and raises `KeyboardInterrupt` (the recording
-/// then holds the run up to there).
-#[pyfunction]
-#[pyo3(signature = (scene, engine=None, record=None, deterministic=false))]
-fn run_network(
-    py: Python<'_>,
-    scene: &Scene,
-    engine: Option<&str>,
-    record: Option<PathBuf>,
-    deterministic: bool,
-) -> PyResult<RawNetworkRun> {
-    check_outputs(&[("record =", record.as_deref())], scene)?;
-    let recording = record.map(|path| RecordingRequest {
-        path,
-        replace: clutchpack_sdk::record::Replace::Existing,
-        options: clutchpack_sdk::record::RecordOptions {
-            deterministic,
-            ..clutchpack_sdk::record::RecordOptions::default()
-        },
-        scene_path: scene.path.clone(),
-    });
-    let engine = engine_choice(engine)?;
-    let stop = AtomicBool::new(false);
-    let mut interrupt: Option<PyErr> = None;
-    let outcome = py.detach(|| {
-        let mut progress = signal_poll(&stop, &mut interrupt);
-        clutchpack_sdk::run_network_scene(
-            &scene.inner,
-            engine,
-            clutchpack_sdk::NetworkRequest {
-                keep_history: true,
-                recording,
-                stop: Some(&stop),
-                progress: Some(&mut progress),
-            },
-        )
-    });
-    let outcome = outcome.map_err(py_err)?;
-    if let Some(e) = interrupt {
-        return Err(e);
-    }
-    let h = &outcome.history;
-    let s = &outcome.summary;
-    let column = |f: &dyn Fn(&clutchpack_sdk::NetworkSample) -> f64| h.iter().map(f).collect();
-    Ok(RawNetworkRun {
-        summary_json: serde_json::to_string(s)
-            .map_err(|e| PyRuntimeError::new_err(e.to_string()))?,
-        sample_t_s: h.iter().map(|x| x.t_s).collect(),
-        speed_rad_s: s
-            .bodies
-            .iter()
-            .enumerate()
-            .map(|(i, b)| (b.name.clone(), column(&|x| x.speed_rad_s[i])))
-            .collect(),
-        torque_n_m: s
-            .couplings
-            .iter()
-            .enumerate()
-            .map(|(k, c)| (c.name.clone(), column(&|x| x.torque_n_m[k])))
-            .collect(),
-        recording: outcome.recording.clone(),
-    })
-}
-
 #[pyfunction]
 #[pyo3(signature = (scene, engine=None, record=None, impacts_csv=None, keep_samples=true, deterministic=false))]
 fn run(
@@ -462,8 +381,12 @@ fn interruptible<T: Send>(
     let out = py.detach(|| {
         std::thread::scope(|s| {
             let worker = s.spawn(f);
+            // a short call (a co-simulation's small step) returns within microseconds: poll
+            // from 20 us, doubling to 10 ms, so that it does not wait a whole 10 ms
+            let mut wait = Duration::from_micros(20);
             while !worker.is_finished() {
-                std::thread::sleep(Duration::from_millis(10));
+                std::thread::sleep(wait);
+                wait = (wait * 2).min(Duration::from_millis(10));
                 if interrupt.is_none() {
                     if let Err(e) = Python::attach(|py| py.check_signals()) {
                         interrupt = Some(e);
@@ -683,14 +606,16 @@ fn _clutchpack(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
     m.add_class::<ImpactColumns>()?;
     m.add_class::<RawRun>()?;
-    m.add_class::<RawNetworkRun>()?;
+    m.add_class::<network::RawNetworkRun>()?;
     m.add_class::<RawRecording>()?;
     m.add_class::<stepper::Stepper>()?;
     m.add_class::<stepper::StepperState>()?;
+    m.add_class::<network::NetworkStepper>()?;
+    m.add_class::<network::NetworkStepperState>()?;
     m.add_function(wrap_pyfunction!(load_scene, m)?)?;
     m.add_function(wrap_pyfunction!(scene_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
-    m.add_function(wrap_pyfunction!(run_network, m)?)?;
+    m.add_function(wrap_pyfunction!(network::run_network, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(study_run, m)?)?;

@@ -27,6 +27,7 @@ pub mod cosim;
 mod error;
 mod fatigue;
 mod network;
+mod network_cosim;
 mod recording;
 mod run;
 mod scene_file;
@@ -61,6 +62,9 @@ pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFati
 pub use network::{
     multibody_step_s, run_network_scene, BodySummary, CouplingSummary, EnergySummary, ModeChange,
     NetworkOutcome, NetworkRequest, NetworkSummary, MULTIBODY_NETWORK_STEP_S,
+};
+pub use network_cosim::{
+    network_inputs, NetworkSimulation, NetworkVariable, SavedNetworkSimulation,
 };
 pub use recording::open_recording;
 pub use run::{RecordingRequest, RunOutcome, RunRequest};

@@ -132,8 +132,11 @@ pub struct NetworkOutcome {
     pub recording: Option<std::path::PathBuf>,
 }
 
-struct Keep<'a, 'r> {
-    req: &'a mut NetworkRequest<'r>,
+/// What a network run keeps as it goes (its own state, across the calls of a
+/// [`NetworkSimulation`]).
+#[derive(Default)]
+pub(crate) struct Keep {
+    keep_history: bool,
     events: Vec<ClutchEvent>,
     /// (t, each coupling's torque step) at each switching instant.
     steps: Vec<(f64, Vec<f64>)>,
@@ -144,12 +147,22 @@ struct Keep<'a, 'r> {
     history: Vec<NetworkSample>,
     stopped: bool,
     /// The recording, until its first error.
-    recorder: Option<NetworkRecorder>,
+    pub recorder: Option<NetworkRecorder>,
     /// The recording's first error (it then stops the run).
-    record_error: Option<clutchpack_record::RecordError>,
+    pub record_error: Option<clutchpack_record::RecordError>,
 }
 
-impl Keep<'_, '_> {
+impl Keep {
+    /// A fresh keep that records with `recorder` (if any) and keeps every sample if
+    /// `keep_history`.
+    pub fn new(recorder: Option<NetworkRecorder>, keep_history: bool) -> Keep {
+        Keep {
+            keep_history,
+            recorder,
+            ..Keep::default()
+        }
+    }
+
     /// Runs `write` on the recorder, keeping its first error (after which nothing more is
     /// recorded and the run stops).
     fn record(
@@ -164,27 +177,51 @@ impl Keep<'_, '_> {
             }
         }
     }
+
+    /// A copy without the recording (a saved state of a session that does not record).
+    pub fn clone_unrecorded(&self) -> Keep {
+        Keep {
+            keep_history: self.keep_history,
+            events: self.events.clone(),
+            steps: self.steps.clone(),
+            range: self.range.clone(),
+            meshes: self.meshes.clone(),
+            history: self.history.clone(),
+            stopped: self.stopped,
+            recorder: None,
+            record_error: None,
+        }
+    }
 }
 
-impl NetworkObserver for Keep<'_, '_> {
+/// The observer of one call of an engine: what it gives goes into `keep`; `stop` and
+/// `progress` are the call's.
+pub(crate) struct Obs<'k, 'a> {
+    pub keep: &'k mut Keep,
+    pub stop: Option<&'a AtomicBool>,
+    pub progress: Option<&'a mut dyn FnMut(f64)>,
+}
+
+impl NetworkObserver for Obs<'_, '_> {
     fn sample(&mut self, s: &NetworkSample) {
-        self.record(|r| r.write_sample(s));
-        self.range
+        let k = &mut *self.keep;
+        k.record(|r| r.write_sample(s));
+        k.range
             .resize(s.torque_n_m.len(), (f64::INFINITY, f64::NEG_INFINITY));
-        for (r, t) in self.range.iter_mut().zip(&s.torque_n_m) {
+        for (r, t) in k.range.iter_mut().zip(&s.torque_n_m) {
             *r = (r.0.min(*t), r.1.max(*t));
         }
-        if self.req.keep_history {
-            self.history.push(s.clone());
+        if k.keep_history {
+            k.history.push(s.clone());
         }
     }
     fn clutch_event(&mut self, e: &ClutchEvent) {
-        self.record(|r| r.write_clutch_event(e));
-        self.events.push(*e);
+        self.keep.record(|r| r.write_clutch_event(e));
+        self.keep.events.push(*e);
     }
     fn mesh_impact(&mut self, e: &clutchpack_model::ImpactEvent) {
-        self.record(|r| r.write_mesh_impact(e));
-        let m = self.meshes.entry(e.disc).or_insert((0, 0.0));
+        self.keep.record(|r| r.write_mesh_impact(e));
+        let m = self.keep.meshes.entry(e.disc).or_insert((0, 0.0));
         m.0 += 1;
         if e.peak_n.abs() > m.1.abs() {
             m.1 = e.peak_n;
@@ -197,15 +234,15 @@ impl NetworkObserver for Keep<'_, '_> {
             .zip(&before.torque_n_m)
             .map(|(a, b)| a - b)
             .collect();
-        self.steps.push((after.t_s, steps));
+        self.keep.steps.push((after.t_s, steps));
     }
     fn progress(&mut self, t: f64) -> bool {
-        if let Some(p) = self.req.progress.as_mut() {
+        if let Some(p) = self.progress.as_mut() {
             p(t);
         }
-        let stop = self.req.stop.is_some_and(|s| s.load(Ordering::Relaxed));
-        self.stopped |= stop;
-        !stop && self.record_error.is_none()
+        let stop = self.stop.is_some_and(|s| s.load(Ordering::Relaxed));
+        self.keep.stopped |= stop;
+        !stop && self.keep.record_error.is_none()
     }
 }
 
@@ -226,7 +263,7 @@ pub const MULTIBODY_NETWORK_STEP_S: f64 = 1e-4;
 pub fn run_network_scene(
     scene: &Scene,
     asked: Option<EngineChoice>,
-    mut req: NetworkRequest,
+    req: NetworkRequest,
 ) -> Result<NetworkOutcome> {
     let Some(net) = &scene.network else {
         return Err(Error::BadInput(format!(
@@ -236,65 +273,95 @@ pub fn run_network_scene(
     };
     let engine = scene.engine(asked, &scene.name)?;
     let sim = &scene.simulation;
-    let recorder = match &req.recording {
-        Some(r) => {
-            let info = crate::summary::run_info(scene, engine.name(), r.scene_path.as_deref());
-            Some(NetworkRecorder::create_output(
-                &r.path, r.replace, &info, net, &r.options,
-            )?)
-        }
-        None => None,
-    };
-    let mut keep = Keep {
-        req: &mut req,
-        events: Vec::new(),
-        steps: Vec::new(),
-        range: Vec::new(),
-        meshes: Default::default(),
-        history: Vec::new(),
-        stopped: false,
-        recorder,
-        record_error: None,
+    let mut keep = Keep::new(
+        start_recording(scene, engine, req.recording.as_ref())?,
+        req.keep_history,
+    );
+    let mut obs = Obs {
+        keep: &mut keep,
+        stop: req.stop,
+        progress: req.progress,
     };
     let start = std::time::Instant::now();
     let run = match engine {
-        EngineChoice::Reference => {
-            let options = NetworkOptions {
-                tolerance: sim.tolerance,
-                max_step_s: sim.max_step_s,
-                record_rate_hz: sim.record_rate_hz,
-            };
-            clutchpack_reference::network::run_network(net, sim.duration_s, &options, &mut keep)
-        }
+        EngineChoice::Reference => clutchpack_reference::network::run_network(
+            net,
+            sim.duration_s,
+            &reference_options(scene),
+            &mut obs,
+        ),
         EngineChoice::Multibody => {
             let options = clutchpack_multibody::network::NetworkStepOptions {
                 step_s: multibody_step_s(scene),
                 record_rate_hz: sim.record_rate_hz,
             };
-            clutchpack_multibody::network::run_network(net, sim.duration_s, &options, &mut keep)
+            clutchpack_multibody::network::run_network(net, sim.duration_s, &options, &mut obs)
         }
     };
-    let run = match run {
-        Ok(run) => run,
-        Err(source) => {
-            // the recording holds the run up to the failure
-            let recorded = keep.recorder.take().map(|r| r.finish(None));
-            let kept = match recorded {
-                Some(Ok(p)) => {
-                    format!(" (the recording {} holds the run up to there)", p.display())
-                }
-                _ => String::new(),
-            };
-            return Err(Error::Engine {
-                context: format!("{} ({} engine, network){kept}", scene.name, engine.name()),
-                source,
-            });
-        }
+    let run = run.map_err(|source| engine_failed(scene, engine, &mut keep, source))?;
+    conclude(scene, engine, keep, run, start.elapsed().as_secs_f64())
+}
+
+/// The reference engine's settings for a network scene: its tolerance, longest step and
+/// sample rate.
+pub(crate) fn reference_options(scene: &Scene) -> NetworkOptions {
+    let sim = &scene.simulation;
+    NetworkOptions {
+        tolerance: sim.tolerance,
+        max_step_s: sim.max_step_s,
+        record_rate_hz: sim.record_rate_hz,
+    }
+}
+
+/// The recording of a network run, if asked.
+pub(crate) fn start_recording(
+    scene: &Scene,
+    engine: EngineChoice,
+    request: Option<&crate::RecordingRequest>,
+) -> Result<Option<NetworkRecorder>> {
+    let (Some(r), Some(net)) = (request, &scene.network) else {
+        return Ok(None);
+    };
+    let info = crate::summary::run_info(scene, engine.name(), r.scene_path.as_deref());
+    Ok(Some(NetworkRecorder::create_output(
+        &r.path, r.replace, &info, net, &r.options,
+    )?))
+}
+
+/// An engine failure as the error to report, the recording finished first (it holds the run
+/// up to the failure, and the message says where it is).
+pub(crate) fn engine_failed(
+    scene: &Scene,
+    engine: EngineChoice,
+    keep: &mut Keep,
+    source: clutchpack_model::EngineError,
+) -> Error {
+    let recorded = keep.recorder.take().map(|r| r.finish(None));
+    let kept = match recorded {
+        Some(Ok(p)) => format!(" (the recording {} holds the run up to there)", p.display()),
+        _ => String::new(),
+    };
+    Error::Engine {
+        context: format!("{} ({} engine, network){kept}", scene.name, engine.name()),
+        source,
+    }
+}
+
+/// The outcome of a finished (or stopped) network run: its summary from what `keep` kept and
+/// the engine's `run`, and the recording finished with the summary attached.
+pub(crate) fn conclude(
+    scene: &Scene,
+    engine: EngineChoice,
+    mut keep: Keep,
+    run: clutchpack_model::network::NetworkRun,
+    wall_time_s: f64,
+) -> Result<NetworkOutcome> {
+    let Some(net) = &scene.network else {
+        return Err(Error::BadInput(format!("{} is not a network", scene.name)));
     };
     if let Some(e) = keep.record_error.take() {
         return Err(e.into());
     }
-    let wall_time_s = start.elapsed().as_secs_f64();
     let last = &run.last;
     let couplings = net
         .couplings

@@ -302,6 +302,18 @@ class Simulation:
     impact (``last_impact.*``), as the FMU's (indices from 1). ``advance_to`` releases the GIL;
     Ctrl-C stops it (the run stands at an earlier time, everything before kept) and raises
     ``KeyboardInterrupt``.
+
+    A network scene (``[[bodies]]``, on the reference engine) has the inputs
+    ``bodies.<body>.drive_torque_n_m`` (N m) and ``couplings.<clutch>.normal_force_n`` (N),
+    held from the instant they are set (no slopes), and the outputs
+    ``bodies.<body>.speed_rad_s`` and ``.angle_rad``, ``couplings.<name>.torque_n_m`` and, for
+    a clutch, ``.slip_rad_s`` (w_b - w_a), ``.mode`` (Modelica's numbers: 2 free, 1 and -1
+    slipping, 0 locked) and ``.heat_j``; ``finish`` returns the network's summary:
+
+        >>> sim = clutchpack.Simulation("scenes/dct-upshift.toml",
+        ...     drive=["couplings.K1.normal_force_n", "couplings.K2.normal_force_n"])
+        >>> for k in range(1, 1001):
+        ...     sim.advance_to(k * 1e-3, **schedule(k * 1e-3))
     """
 
     def __init__(
@@ -320,7 +332,9 @@ class Simulation:
             drive = [drive]
         sc = load_scene(scene, set)
         self.scene: Scene = sc
-        self._s = _clutchpack.Stepper(
+        # a network scene's run has its own stepper, with the same methods
+        stepper = _clutchpack.NetworkStepper if sc.is_network else _clutchpack.Stepper
+        self._s = stepper(
             sc, engine, list(drive), os.fspath(record) if record is not None else None, stop_time
         )
         #: Every variable: name -> (causality, unit, description).

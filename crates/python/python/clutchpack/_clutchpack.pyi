@@ -128,3 +128,32 @@ class Stepper:
     def restore(self, state: StepperState) -> None: ...
     def finish(self) -> str:
         """The run's summary (JSON text)."""
+
+class NetworkStepperState:
+    """A saved state of a NetworkStepper."""
+
+class NetworkStepper:
+    """A network scene's run advanced call by call (``clutchpack.Simulation`` wraps it);
+    ``drive``: ``"bodies.<body>.drive_torque_n_m"``, ``"couplings.<clutch>.normal_force_n"``."""
+    def __init__(
+        self,
+        scene: Scene,
+        engine: Optional[str] = None,
+        drive: Sequence[str] = ...,
+        record: Optional[str] = None,
+        stop_time: Optional[float] = None,
+    ) -> None: ...
+    @property
+    def time(self) -> float:
+        """The run's time, s."""
+    def variables(self) -> List[Tuple[str, str, str, str]]:
+        """(name, causality, unit, description) of every variable."""
+    def set_input(
+        self, name: str, value: float, slope: Optional[float] = None, curvature: Optional[float] = None
+    ) -> None: ...
+    def advance_to(self, t: float) -> None: ...
+    def outputs(self) -> List[Tuple[str, float]]: ...
+    def save(self) -> NetworkStepperState: ...
+    def restore(self, state: NetworkStepperState) -> None: ...
+    def finish(self) -> str:
+        """The network run's summary (JSON text)."""

@@ -13,6 +13,7 @@ use clutchpack_model::ImpactTracker;
 const PROBES: usize = 16;
 
 /// Every mesh's open contact event and the step holding its largest force so far.
+#[derive(Clone)]
 pub(super) struct Meshes {
     trackers: Vec<ImpactTracker>,
     /// Per coupling: the dense output of the step with the largest |F| so far, and where.
@@ -35,7 +36,7 @@ impl Meshes {
         let g = eq.net.couplings[k].mesh().expect("a mesh");
         let Some(e) = eq.contacts[k] else { return 0.0 };
         dense.eval(t, ybuf);
-        -g.force_n(&mesh_kinematics(eq.net, k, g, ybuf), &e)
+        -g.force_n(&mesh_kinematics(&eq.net, k, g, ybuf), &e)
     }
 
     /// Observes the meshes in contact over the accepted step `[t0, t1]` of `dense`.
@@ -78,7 +79,7 @@ impl Meshes {
             if crossed.is_some_and(|c| c[k] > 0.0) {
                 continue;
             }
-            let kin = mesh_kinematics(eq.net, k, g, y);
+            let kin = mesh_kinematics(&eq.net, k, g, y);
             let inside = g.law.engagement_depth_m(&kin) > 0.0;
             match (eq.contacts[k], inside) {
                 (None, true) => {

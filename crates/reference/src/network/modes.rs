@@ -17,7 +17,7 @@ pub(super) fn settle(
     obs: &mut dyn NetworkObserver,
     events: &mut u64,
 ) {
-    let net = eq.net;
+    let net = std::sync::Arc::clone(&eq.net);
     let n = net.bodies.len();
     let before = eq.modes.clone();
     let state_before = sample(eq, t, y);
@@ -99,7 +99,7 @@ pub(super) fn settle(
 /// Sets every rigid group's speeds to its common speed, momentum kept
 /// (`w_group = sum g_i J_i w_i / sum g_i^2 J_i`, `w_i = g_i w_group`; 0 for a fixed group).
 fn project_speeds(eq: &Equations, y: &mut [f64]) {
-    let net = eq.net;
+    let net = std::sync::Arc::clone(&eq.net);
     let n = net.bodies.len();
     let cl = &eq.clusters;
     let mut p = vec![0.0; cl.inertia.len()];

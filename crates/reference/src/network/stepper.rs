@@ -1,0 +1,426 @@
+//! Stepping a network's equations (`super::Equations`): [`NetworkStepper`], the adaptive
+//! DOPRI5 integration with its events located and the modes settled (the method is in the
+//! module's docs), advanced call by call with inputs set in between, and [`run_network`], one
+//! call to the end.
+
+use super::modes::settle;
+use super::{mesh, sample, Equations, NetworkOptions};
+use crate::dopri::{next_step, Dense, Dopri5};
+use clutchpack_model::network::{
+    ClutchMode, CouplingKind, Network, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
+};
+use clutchpack_model::EngineError;
+use std::sync::Arc;
+
+/// Runs `net` for `duration_s` seconds; samples and clutch events go to `obs` as they happen.
+/// A network with problems ([`Network::problems`]) is refused.
+pub fn run_network(
+    net: &Network,
+    duration_s: f64,
+    options: &NetworkOptions,
+    obs: &mut dyn NetworkObserver,
+) -> Result<NetworkRun, EngineError> {
+    let mut run = NetworkStepper::new(net, duration_s, options, obs)?;
+    run.advance_to(duration_s, obs)?;
+    Ok(run.finish(obs))
+}
+
+/// An input of a network that a session's caller may set (MODEL.md section 8, "Inputs"): the
+/// value is held from the instant it is set (a zero-order hold) and replaces the scene's
+/// signal from then on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum NetworkInput {
+    /// The drive torque on body `i`, N m (positive in its sense of rotation; its firing
+    /// harmonics, if any, still add to it).
+    Drive(usize),
+    /// The normal force of the clutch that is coupling `k`, N (>= 0; 0: free).
+    ClutchForce(usize),
+}
+
+/// A network run advanced call by call ([`NetworkStepper::advance_to`]), with inputs set
+/// between calls ([`NetworkStepper::set_input`]); [`run_network`] is one call to the end.
+/// Every call ends a step at its time, as a breakpoint of the signals does, so a run split
+/// into calls differs from the whole run by the steps' placement only (within the
+/// tolerance).
+#[derive(Clone)]
+pub struct NetworkStepper {
+    eq: Equations,
+    options: NetworkOptions,
+    /// The run's end, s (samples stop there).
+    duration_s: f64,
+    y: Vec<f64>,
+    atol: Vec<f64>,
+    meshes: mesh::Meshes,
+    breakpoints: Vec<f64>,
+    next_bp: usize,
+    stepper: Dopri5,
+    dense: Dense,
+    dy: Vec<f64>,
+    ybuf: Vec<f64>,
+    g0: Vec<f64>,
+    g1: Vec<f64>,
+    /// Sample interval, s (infinite: none but the first and last).
+    period: f64,
+    next_sample: u64,
+    t: f64,
+    h: f64,
+    steps: u64,
+    events: u64,
+    kinetic0: f64,
+}
+
+impl NetworkStepper {
+    /// Starts `net` at t = 0 for a run of `duration_s` s: the modes settled and the first
+    /// sample sent to `obs`. A network with problems ([`Network::problems`]) is refused.
+    pub fn new(
+        net: &Network,
+        duration_s: f64,
+        options: &NetworkOptions,
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<NetworkStepper, EngineError> {
+        net.check_run(duration_s)?;
+        let n = net.bodies.len();
+        let m = net.couplings.len();
+        let dim = 2 * n + 2 * m + 3;
+        let tol = options.tolerance;
+        let mut atol = vec![tol; dim];
+        // the meshes' x on their backlash's scale; other slots and the counters out of the norm
+        for k in 0..m {
+            atol[2 * n + k] = match (net.couplings[k].mesh(), net.couplings[k].spring()) {
+                (Some(g), _) => tol * g.backlash_m,
+                (_, Some(_)) => tol,
+                _ => f64::INFINITY,
+            };
+        }
+        atol[2 * n + m..]
+            .iter_mut()
+            .for_each(|a| *a = f64::INFINITY);
+        let mut y = vec![0.0; dim];
+        for (i, b) in net.bodies.iter().enumerate() {
+            y[n + i] = b.initial_speed_rad_s;
+        }
+        for k in 0..m {
+            if let Some(g) = net.couplings[k].mesh() {
+                y[2 * n + k] = g.initial_offset_m;
+            }
+        }
+        let initial_modes: Vec<Option<ClutchMode>> = (0..m)
+            .map(|k| net.couplings[k].clutch().map(|_| ClutchMode::Free))
+            .collect();
+        let mut eq = Equations::new(Arc::new(net.clone()), initial_modes);
+        let kinetic0 = kinetic(net, &y);
+        let mut events = 0u64;
+        settle(&mut eq, 0.0, &mut y, &[], obs, &mut events);
+        let mut meshes = mesh::Meshes::new(m, dim);
+        meshes.switch(&mut eq, 0.0, &y, None, obs);
+        let mut stepper = Dopri5::new(dim);
+        let mut dy = vec![0.0; dim];
+        eq.rhs(0.0, &y, &mut dy);
+        stepper.set_start_derivative(&dy);
+        let period = if options.record_rate_hz > 0.0 {
+            1.0 / options.record_rate_hz
+        } else {
+            f64::INFINITY
+        };
+        obs.sample(&sample(&mut eq, 0.0, &y));
+        Ok(NetworkStepper {
+            breakpoints: net.breakpoints(duration_s),
+            next_bp: 0,
+            options: *options,
+            duration_s,
+            atol,
+            meshes,
+            stepper,
+            dense: Dense::default(),
+            dy,
+            ybuf: vec![0.0; dim],
+            g0: vec![0.0; m],
+            g1: vec![0.0; m],
+            period,
+            next_sample: 1,
+            t: 0.0,
+            h: options.max_step_s.min(1e-4).min(duration_s.max(1e-12)),
+            steps: 0,
+            events,
+            kinetic0,
+            y,
+            eq,
+        })
+    }
+
+    /// The time the run stands at, s.
+    pub fn time_s(&self) -> f64 {
+        self.t
+    }
+
+    /// The network as run (with the inputs set so far in place of the scene's signals).
+    pub fn network(&self) -> &Network {
+        &self.eq.net
+    }
+
+    /// The state now as a sample (every body's angle and speed, every coupling's torque and
+    /// a clutch's mode).
+    pub fn sample_now(&mut self) -> NetworkSample {
+        sample(&mut self.eq, self.t, &self.y)
+    }
+
+    /// Heat of each clutch, work done on each gear mesh, or each damper's loss, since t = 0,
+    /// J, by coupling (0 for an ideal gear).
+    pub fn heat_j(&self) -> Vec<f64> {
+        let (n, m) = (self.eq.net.bodies.len(), self.eq.net.couplings.len());
+        let c0 = 2 * n + m;
+        (0..m)
+            .map(|k| {
+                let c = &self.eq.net.couplings[k];
+                if c.clutch().is_some() || c.mesh().is_some() || c.spring().is_some() {
+                    self.y[c0 + k]
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+
+    /// Sets `input` to `value` from now on (N m or N): the scene's signal is replaced by the
+    /// held value, and the run restarts here as at a jump of a signal (the clutches' modes
+    /// settled, events sent to `obs`). A value that is not finite, a negative force, or an
+    /// input naming a body or coupling that cannot take it is refused.
+    pub fn set_input(
+        &mut self,
+        input: NetworkInput,
+        value: f64,
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<(), EngineError> {
+        let bad = |why: String| Err(EngineError::Unsupported(why));
+        if !value.is_finite() {
+            return bad(format!("input value {value}: expected a finite number"));
+        }
+        let net = Arc::make_mut(&mut self.eq.net);
+        match input {
+            NetworkInput::Drive(i) => {
+                let Some(b) = net.bodies.get_mut(i).filter(|b| !b.fixed) else {
+                    return bad(format!("body {i}: no turning body takes a drive there"));
+                };
+                b.drive = Some(clutchpack_model::network::Signal::Constant(value));
+            }
+            NetworkInput::ClutchForce(k) => {
+                let Some(CouplingKind::Clutch(cl)) = net.couplings.get_mut(k).map(|c| &mut c.kind)
+                else {
+                    return bad(format!("coupling {k}: not a clutch"));
+                };
+                if value < 0.0 {
+                    return bad(format!("normal force {value} N: expected >= 0"));
+                }
+                cl.force = clutchpack_model::network::Signal::Constant(value / cl.fn_max_n);
+            }
+        }
+        // the signal's breakpoints after now are those of the network as it is now
+        let t = self.t;
+        self.breakpoints = self.eq.net.breakpoints(self.duration_s);
+        self.next_bp = self.breakpoints.partition_point(|&b| b <= t);
+        self.g1.iter_mut().for_each(|g| *g = 1.0);
+        settle(
+            &mut self.eq,
+            t,
+            &mut self.y,
+            &self.g1,
+            obs,
+            &mut self.events,
+        );
+        self.eq.rhs(t, &self.y, &mut self.dy);
+        self.stepper.set_start_derivative(&self.dy);
+        Ok(())
+    }
+
+    /// Advances to `t_end` s (at most the run's end), a step ending there; samples, clutch
+    /// events and mesh impacts go to `obs` as they happen. Stops early (without error) when
+    /// `obs` asks to ([`NetworkObserver::progress`]).
+    pub fn advance_to(
+        &mut self,
+        t_end: f64,
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<(), EngineError> {
+        let t_end = t_end.min(self.duration_s);
+        let tol = self.options.tolerance;
+        let Self {
+            eq,
+            y,
+            atol,
+            meshes,
+            breakpoints,
+            next_bp,
+            stepper,
+            dense,
+            dy,
+            ybuf,
+            g0,
+            g1,
+            t,
+            h,
+            ..
+        } = self;
+        while *t < t_end {
+            let bp = breakpoints.get(*next_bp).copied();
+            let stop = bp.map_or(t_end, |b| b.min(t_end));
+            let at_bp = bp == Some(stop);
+            if at_bp && stop - *t <= 1e-13 * (1.0 + *t) {
+                // an event left the run at a breakpoint: the signals jump here
+                *t = stop;
+                *next_bp += 1;
+                g1.iter_mut().for_each(|g| *g = 1.0);
+                settle(eq, *t, y, g1, obs, &mut self.events);
+                eq.rhs(*t, y, dy);
+                stepper.set_start_derivative(dy);
+                continue;
+            }
+            let land = *t + *h >= stop * (1.0 - 1e-15);
+            let h_try = if land { stop - *t } else { *h };
+            let err = {
+                let mut f = |tt: f64, yy: &[f64], d: &mut [f64]| eq.rhs(tt, yy, d);
+                stepper.try_step(&mut f, *t, y, h_try, atol, tol)
+            };
+            if !err.is_finite() || h_try < 1e-15 * (1.0 + *t) {
+                return Err(EngineError::Diverged {
+                    t_s: *t,
+                    reason: format!("the step collapsed to {h_try:e} s (error norm {err})"),
+                });
+            }
+            if err > 1.0 {
+                *h = next_step(h_try, err).max(h_try * 0.1);
+                continue;
+            }
+            stepper.dense_into(*t, y, h_try, dense);
+            // events: the first quarter point where a guard turns <= 0
+            eq.guards(*t, y, g0);
+            let mut event: Option<(f64, f64)> = None; // (ta, tb) bracketing the first crossing
+            let mut ta = *t;
+            for q in 1..=4 {
+                let tq = *t + h_try * f64::from(q) / 4.0;
+                let tq = if q == 4 { *t + h_try } else { tq };
+                dense.eval(tq, ybuf);
+                eq.guards(tq, ybuf, g1);
+                if g0.iter().zip(g1.iter()).any(|(a, b)| *a > 0.0 && *b <= 0.0) {
+                    event = Some((ta, tq));
+                    break;
+                }
+                ta = tq;
+            }
+            let (t_new, at_event) = match event {
+                Some((mut a, mut b)) => {
+                    // bisect the earliest crossing: the guards that were > 0 at t
+                    let armed: Vec<bool> = g0.iter().map(|g| *g > 0.0).collect();
+                    while b - a > 1e-13 * (1.0 + b) {
+                        let mid = 0.5 * (a + b);
+                        dense.eval(mid, ybuf);
+                        eq.guards(mid, ybuf, g1);
+                        if g1.iter().zip(&armed).any(|(g, on)| *on && *g <= 0.0) {
+                            b = mid;
+                        } else {
+                            a = mid;
+                        }
+                    }
+                    // the guards that crossed, at the instant the run restarts from
+                    dense.eval(b, ybuf);
+                    eq.guards(b, ybuf, g1);
+                    for (g, on) in g1.iter_mut().zip(&armed) {
+                        if !on {
+                            *g = 1.0;
+                        }
+                    }
+                    (b, true)
+                }
+                None => {
+                    g1.iter_mut().for_each(|g| *g = 1.0);
+                    (*t + h_try, land)
+                }
+            };
+            meshes.observe(eq, dense, *t, t_new);
+            // samples up to t_new from the dense output
+            while (self.next_sample as f64) * self.period <= t_new
+                && (self.next_sample as f64) * self.period < self.duration_s
+            {
+                let ts = self.next_sample as f64 * self.period;
+                dense.eval(ts, ybuf);
+                obs.sample(&sample(eq, ts, ybuf));
+                self.next_sample += 1;
+            }
+            if t_new < *t + h_try {
+                dense.eval(t_new, ybuf);
+                y.copy_from_slice(ybuf);
+            } else {
+                y.copy_from_slice(&stepper.y_new);
+            }
+            *t = if land && event.is_none() { stop } else { t_new };
+            self.steps += 1;
+            if land && event.is_none() && at_bp {
+                *next_bp += 1;
+            }
+            if at_event {
+                meshes.switch(eq, *t, y, Some(g1), obs);
+                settle(eq, *t, y, g1, obs, &mut self.events);
+                eq.rhs(*t, y, dy);
+                stepper.set_start_derivative(dy);
+            } else {
+                stepper.accept();
+                *h = next_step(h_try, err);
+            }
+            *h = h.min(self.options.max_step_s);
+            if !obs.progress(*t) {
+                break;
+            }
+        }
+        Ok(())
+    }
+
+    /// Ends the run where it stands: the open mesh contacts closed, the last sample sent to
+    /// `obs`, and the run's heat, energy balance and counts.
+    pub fn finish(mut self, obs: &mut dyn NetworkObserver) -> NetworkRun {
+        let (t, net) = (self.t, Arc::clone(&self.eq.net));
+        let (n, m) = (net.bodies.len(), net.couplings.len());
+        self.meshes.finish(&mut self.eq, t, obs);
+        let last = sample(&mut self.eq, t, &self.y);
+        obs.sample(&last);
+        let y = &self.y;
+        let c0 = 2 * n + m; // the counters
+        let mut heat = y[c0..c0 + m].to_vec();
+        let (mut mesh_work, mut damper_loss, mut spring_change) = (0.0, 0.0, 0.0);
+        for (k, h) in heat.iter_mut().enumerate() {
+            if net.couplings[k].mesh().is_some() {
+                mesh_work += *h;
+            } else if let Some(sd) = net.couplings[k].spring() {
+                damper_loss += *h;
+                spring_change += sd.potential_j(y[2 * n + k]) - sd.potential_j(0.0);
+            } else if net.couplings[k].clutch().is_none() {
+                *h = 0.0;
+            }
+        }
+        let energy = NetworkEnergy {
+            drive_work_j: y[c0 + m],
+            load_work_j: y[c0 + m + 1],
+            drag_loss_j: y[c0 + m + 2],
+            clutch_heat_j: heat.iter().sum::<f64>() - mesh_work - damper_loss,
+            mesh_work_j: mesh_work,
+            damper_loss_j: damper_loss,
+            spring_energy_change_j: spring_change,
+            kinetic_change_j: kinetic(&net, y) - self.kinetic0,
+        };
+        NetworkRun {
+            last,
+            heat_j: heat,
+            energy,
+            steps: self.steps,
+            events: self.events,
+        }
+    }
+}
+
+/// The bodies' kinetic energy at the state `y`, J.
+fn kinetic(net: &Network, y: &[f64]) -> f64 {
+    let n = net.bodies.len();
+    net.bodies
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| !b.fixed)
+        .map(|(i, b)| 0.5 * b.inertia_kg_m2 * y[n + i] * y[n + i])
+        .sum()
+}

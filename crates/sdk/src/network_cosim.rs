@@ -1,0 +1,408 @@
+//! A network scene's run advanced call by call (MODEL.md section 8, "Inputs"): every drive
+//! torque and clutch normal force has one public name, the caller sets the inputs it drives
+//! between calls (each held from the instant it is set, as the pack's co-simulation holds its
+//! inputs: docs/DECISIONS.md "Co-simulation"), and the outputs (every body's speed and angle,
+//! every coupling's torque, a clutch's slip, mode and heat) are read by name. Python's
+//! `Simulation` of a network scene wraps it. The reference engine runs it
+//! ([`clutchpack_reference::network::NetworkStepper`]); the multibody engine's network runner
+//! is not steppable yet.
+
+use crate::network::{
+    conclude, engine_failed, reference_options, start_recording, Keep, NetworkOutcome, Obs,
+};
+use crate::{Error, RecordingRequest, Result};
+use clutchpack_model::network::{ClutchMode, Network, NetworkSample};
+use clutchpack_reference::network::{NetworkInput, NetworkStepper};
+use clutchpack_scene::{EngineChoice, Scene};
+use std::sync::atomic::AtomicBool;
+
+/// One variable of a network co-simulation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NetworkVariable {
+    /// Its public name (`bodies.<body>.speed_rad_s`, `couplings.<clutch>.normal_force_n`).
+    pub name: String,
+    /// `input` or `output`.
+    pub causality: &'static str,
+    /// Its SI unit (`rad/s`, `N m`, `N`, `J`, `1`).
+    pub unit: &'static str,
+    /// What it is, with its sign.
+    pub description: String,
+}
+
+/// The inputs of `net` by their public names: each turning body's drive torque
+/// (`bodies.<body>.drive_torque_n_m`, N m) and each clutch's normal force
+/// (`couplings.<clutch>.normal_force_n`, N).
+pub fn network_inputs(net: &Network) -> Vec<(String, NetworkInput)> {
+    let bodies = net
+        .bodies
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| !b.fixed)
+        .map(|(i, b)| {
+            (
+                format!("bodies.{}.drive_torque_n_m", b.name),
+                NetworkInput::Drive(i),
+            )
+        });
+    let clutches = net
+        .couplings
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.clutch().is_some())
+        .map(|(k, c)| {
+            (
+                format!("couplings.{}.normal_force_n", c.name),
+                NetworkInput::ClutchForce(k),
+            )
+        });
+    bodies.chain(clutches).collect()
+}
+
+/// The value of `input` in `net` at `t` (s): a drive signal's torque (N m, without the
+/// firing harmonics, which stay locked to the angle) or a clutch's normal force (N).
+fn input_value(net: &Network, input: NetworkInput, t: f64) -> f64 {
+    match input {
+        NetworkInput::Drive(i) => net.bodies[i].drive.as_ref().map_or(0.0, |s| s.value(t)),
+        NetworkInput::ClutchForce(k) => net.couplings[k]
+            .clutch()
+            .map_or(0.0, |c| c.normal_force_n(t).max(0.0)),
+    }
+}
+
+/// A network run advanced call by call, with the inputs the caller drives set between calls.
+pub struct NetworkSimulation {
+    scene: Scene,
+    stepper: NetworkStepper,
+    keep: Keep,
+    /// The driven inputs, by name.
+    driven: Vec<(String, NetworkInput)>,
+    /// Every input the network has, by name (to name them in errors).
+    all_inputs: Vec<(String, NetworkInput)>,
+    started: std::time::Instant,
+    /// Set when an engine failure left the run unusable.
+    failed: bool,
+}
+
+/// A saved state of a [`NetworkSimulation`] (without a recording).
+pub struct SavedNetworkSimulation {
+    stepper: NetworkStepper,
+    keep: Keep,
+}
+
+impl NetworkSimulation {
+    /// Starts the network scene `scene` at t = 0 on `engine` (else the scene's choice, else
+    /// the reference engine), the caller driving the inputs named in `drive` (their public
+    /// names, [`network_inputs`]; each holds the scene's value at t = 0 until it is set),
+    /// recording to `recording` if asked, the run ending at `stop_time_s` if given (else the
+    /// scene's duration). Unknown names, a pack scene, or the multibody engine are bad input.
+    pub fn start(
+        scene: &Scene,
+        engine: Option<EngineChoice>,
+        drive: &[String],
+        recording: Option<&RecordingRequest>,
+        stop_time_s: Option<f64>,
+    ) -> Result<NetworkSimulation> {
+        let Some(net) = &scene.network else {
+            return Err(Error::BadInput(format!(
+                "{} is a pack scene, not a network ([[bodies]])",
+                scene.name
+            )));
+        };
+        let engine = scene.engine(engine, &scene.name)?;
+        if engine != EngineChoice::Reference {
+            return Err(Error::BadInput(format!(
+                "{}: a network run advanced call by call runs on the reference engine for now \
+                 (engine = \"reference\"); the multibody engine runs a network scene whole \
+                 (`clutchpack run`, `clutchpack.run`)",
+                scene.name
+            )));
+        }
+        let all_inputs = network_inputs(net);
+        let mut driven = Vec::with_capacity(drive.len());
+        for name in drive {
+            let Some(found) = all_inputs.iter().find(|(n, _)| n == name) else {
+                let names: Vec<&str> = all_inputs.iter().map(|(n, _)| n.as_str()).collect();
+                return Err(Error::BadInput(format!(
+                    "drive: {name:?} is not an input of {}; its inputs are {}",
+                    scene.name,
+                    names.join(", ")
+                )));
+            };
+            if !driven.iter().any(|(n, _)| n == name) {
+                driven.push(found.clone());
+            }
+        }
+        let duration = match stop_time_s {
+            Some(t) if t.is_finite() && t > 0.0 => t,
+            Some(t) => {
+                return Err(Error::BadInput(format!(
+                    "stop_time = {t}: expected a finite number of seconds > 0"
+                )))
+            }
+            None => scene.simulation.duration_s,
+        };
+        let mut keep = Keep::new(start_recording(scene, engine, recording)?, false);
+        let started = std::time::Instant::now();
+        let mut obs = Obs {
+            keep: &mut keep,
+            stop: None,
+            progress: None,
+        };
+        let mut stepper = NetworkStepper::new(net, duration, &reference_options(scene), &mut obs)
+            .map_err(|source| engine_failed(scene, engine, &mut keep, source))?;
+        // a driven input holds the scene's value at t = 0 until it is set
+        let mut obs = Obs {
+            keep: &mut keep,
+            stop: None,
+            progress: None,
+        };
+        for (_, input) in &driven {
+            let v = input_value(net, *input, 0.0);
+            stepper
+                .set_input(*input, v, &mut obs)
+                .map_err(|e| Error::BadInput(e.to_string()))?;
+        }
+        Ok(NetworkSimulation {
+            scene: scene.clone(),
+            stepper,
+            keep,
+            driven,
+            all_inputs,
+            started,
+            failed: false,
+        })
+    }
+
+    /// Every variable: the driven inputs, then the outputs ([`Self::outputs`]'s names).
+    pub fn variables(&self) -> Vec<NetworkVariable> {
+        let net = self.stepper.network();
+        let mut out: Vec<NetworkVariable> = self
+            .driven
+            .iter()
+            .map(|(name, input)| NetworkVariable {
+                name: name.clone(),
+                causality: "input",
+                unit: match input {
+                    NetworkInput::Drive(_) => "N m",
+                    NetworkInput::ClutchForce(_) => "N",
+                },
+                description: match input {
+                    NetworkInput::Drive(i) => format!(
+                        "drive torque on {}, N m (positive in its sense of rotation; its firing harmonics add to it)",
+                        net.bodies[*i].name
+                    ),
+                    NetworkInput::ClutchForce(k) => format!(
+                        "normal force of clutch {}, N (>= 0; 0: free)",
+                        net.couplings[*k].name
+                    ),
+                },
+            })
+            .collect();
+        let var = |name: String, unit: &'static str, description: String| NetworkVariable {
+            name,
+            causality: "output",
+            unit,
+            description,
+        };
+        for b in &net.bodies {
+            out.push(var(
+                format!("bodies.{}.speed_rad_s", b.name),
+                "rad/s",
+                format!("speed of {}, rad/s", b.name),
+            ));
+            out.push(var(
+                format!("bodies.{}.angle_rad", b.name),
+                "rad",
+                format!("angle of {} from t = 0, rad", b.name),
+            ));
+        }
+        for c in &net.couplings {
+            out.push(var(
+                format!("couplings.{}.torque_n_m", c.name),
+                "N m",
+                format!("torque of {} on its body a, N m", c.name),
+            ));
+            if c.clutch().is_some() {
+                out.push(var(
+                    format!("couplings.{}.slip_rad_s", c.name),
+                    "rad/s",
+                    format!("slip w_b - w_a of {}, rad/s", c.name),
+                ));
+                out.push(var(
+                    format!("couplings.{}.mode", c.name),
+                    "1",
+                    format!(
+                        "mode of {} as Modelica's Clutch numbers it: 2 free, 1 slipping forward, 0 locked, -1 slipping backward",
+                        c.name
+                    ),
+                ));
+                out.push(var(
+                    format!("couplings.{}.heat_j", c.name),
+                    "J",
+                    format!("heat {} has made since t = 0, J", c.name),
+                ));
+            }
+        }
+        out
+    }
+
+    /// The time the run stands at, s.
+    pub fn time_s(&self) -> f64 {
+        self.stepper.time_s()
+    }
+
+    /// The scene being run.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Sets the driven input `name` to `value` (N m or N), held from now on. An input that is
+    /// not driven (or not one of the network's), a value that is not finite, or a negative
+    /// force is bad input; the run is unchanged then.
+    pub fn set_input(&mut self, name: &str, value: f64) -> Result<()> {
+        self.usable()?;
+        let Some((_, input)) = self.driven.iter().find(|(n, _)| n == name) else {
+            let why = if self.all_inputs.iter().any(|(n, _)| n == name) {
+                "is not driven (name it in `drive` when the simulation starts)"
+            } else {
+                "is not an input of this network"
+            };
+            let names: Vec<&str> = self.driven.iter().map(|(n, _)| n.as_str()).collect();
+            return Err(Error::BadInput(format!(
+                "{name:?} {why}; the driven inputs are [{}]",
+                names.join(", ")
+            )));
+        };
+        let mut obs = Obs {
+            keep: &mut self.keep,
+            stop: None,
+            progress: None,
+        };
+        self.stepper
+            .set_input(*input, value, &mut obs)
+            .map_err(|e| Error::BadInput(format!("{name} = {value}: {e}")))
+    }
+
+    /// Advances to `t` s (at most the run's end); `stop` stops it early (a signal; the run
+    /// then stands at an earlier time with everything before kept). An engine failure leaves
+    /// the run unusable but for [`Self::finish`].
+    pub fn advance_to(&mut self, t: f64, stop: Option<&AtomicBool>) -> Result<()> {
+        self.usable()?;
+        if !t.is_finite() || t < self.time_s() {
+            return Err(Error::BadInput(format!(
+                "advance_to({t}): expected a time >= the current {} s",
+                self.time_s()
+            )));
+        }
+        let mut obs = Obs {
+            keep: &mut self.keep,
+            stop,
+            progress: None,
+        };
+        if let Err(source) = self.stepper.advance_to(t, &mut obs) {
+            self.failed = true;
+            let engine = EngineChoice::Reference;
+            return Err(engine_failed(&self.scene, engine, &mut self.keep, source));
+        }
+        if let Some(e) = self.keep.record_error.take() {
+            self.failed = true;
+            return Err(e.into());
+        }
+        Ok(())
+    }
+
+    fn usable(&self) -> Result<()> {
+        if self.failed {
+            return Err(Error::BadInput(format!(
+                "{}: the run failed at t = {} s; only finish() remains",
+                self.scene.name,
+                self.time_s()
+            )));
+        }
+        Ok(())
+    }
+
+    /// Every output now, by name (SI units; [`Self::variables`] gives each unit).
+    pub fn outputs(&mut self) -> Vec<(String, f64)> {
+        let s: NetworkSample = self.stepper.sample_now();
+        let heat = self.stepper.heat_j();
+        let net = self.stepper.network();
+        let mut out = Vec::new();
+        for (name, input) in &self.driven {
+            out.push((name.clone(), input_value(net, *input, s.t_s)));
+        }
+        for (i, b) in net.bodies.iter().enumerate() {
+            out.push((format!("bodies.{}.speed_rad_s", b.name), s.speed_rad_s[i]));
+            out.push((format!("bodies.{}.angle_rad", b.name), s.angle_rad[i]));
+        }
+        for (k, c) in net.couplings.iter().enumerate() {
+            out.push((format!("couplings.{}.torque_n_m", c.name), s.torque_n_m[k]));
+            if c.clutch().is_some() {
+                out.push((
+                    format!("couplings.{}.slip_rad_s", c.name),
+                    s.speed_rad_s[c.b] - s.speed_rad_s[c.a],
+                ));
+                let mode = s.mode[k].unwrap_or(ClutchMode::Free);
+                out.push((
+                    format!("couplings.{}.mode", c.name),
+                    f64::from(mode.modelica_code()),
+                ));
+                out.push((format!("couplings.{}.heat_j", c.name), heat[k]));
+            }
+        }
+        out
+    }
+
+    /// Saves the whole state, to [`Self::restore`] later (not while recording: a file cannot
+    /// go back in time).
+    pub fn save(&self) -> Result<SavedNetworkSimulation> {
+        if self.keep.recorder.is_some() {
+            return Err(Error::BadInput(
+                "save(): not while recording (a recording cannot go back in time)".into(),
+            ));
+        }
+        self.usable()?;
+        Ok(SavedNetworkSimulation {
+            stepper: self.stepper.clone(),
+            keep: self.keep.clone_unrecorded(),
+        })
+    }
+
+    /// Goes back to a state saved by [`Self::save`] of this run.
+    pub fn restore(&mut self, saved: &SavedNetworkSimulation) -> Result<()> {
+        if self.keep.recorder.is_some() {
+            return Err(Error::BadInput(
+                "restore(): not while recording (a recording cannot go back in time)".into(),
+            ));
+        }
+        self.stepper = saved.stepper.clone();
+        self.keep = saved.keep.clone_unrecorded();
+        self.failed = false;
+        Ok(())
+    }
+
+    /// Ends the run where it stands: the summary (`run --summary-json`'s for a network), the
+    /// recording finished with it.
+    pub fn finish(self) -> Result<NetworkOutcome> {
+        let NetworkSimulation {
+            scene,
+            stepper,
+            mut keep,
+            started,
+            ..
+        } = self;
+        let mut obs = Obs {
+            keep: &mut keep,
+            stop: None,
+            progress: None,
+        };
+        let run = stepper.finish(&mut obs);
+        conclude(
+            &scene,
+            EngineChoice::Reference,
+            keep,
+            run,
+            started.elapsed().as_secs_f64(),
+        )
+    }
+}
