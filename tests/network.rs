@@ -64,11 +64,21 @@ fn coupled_clutches_run_writes_summary_and_figure() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--impacts-csv: not for a network scene"));
     assert!(!csv.exists());
+    // a network has an FMU (tests/fmu.rs drives one); a sweep is for packs
     let o = run(&[
         "fmu",
         "scenes/coupled-clutches.toml",
         "--out",
         d.join("cc.fmu").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&[
+        "sweep",
+        "scenes/coupled-clutches.toml",
+        "--param",
+        "simulation.duration_s",
+        "--values",
+        "1",
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("network scene"), "{}", stderr(&o));

@@ -16,6 +16,8 @@ CHECK is one of:
   Prints the impact lists of each.
 - rollback: get the FMU's state, advance, set the state, advance again; prints both output
   histories.
+- network: the DCT upshift's FMU (a network scene): its inputs, FMPy's validation, the shift
+  driven by the clutch forces' schedule through FMPy against `clutchpack run`
 - thermal: pack-8-idle-thermal with a steady drive (drive.amplitude_rad_s = 0, so the FMU's
   inputs held at their start values are the scene's own profiles) for 0.5 s: FMPy's
   simulate_fmu reads every temperature output at the end; `clutchpack run` of the same
@@ -336,12 +338,62 @@ def check_thermal(args):
     }
 
 
+def check_network(args):
+    """The DCT upshift's FMU (a network scene): its inputs, FMPy's validation, and the shift
+    driven through it: the clutches' normal forces from the scene's own schedule (K1's ramp,
+    K2's table) at each 1 ms step's midpoint and the engine's mean torque, against
+    `clutchpack run` of the scene."""
+    work = args.work
+    fmu = os.path.join(work, "dct-upshift.fmu")
+    p = build(args, "scenes/dct-upshift.toml", fmu)
+    if p.returncode != 0:
+        raise SystemExit(p.stderr)
+    md = read_model_description(fmu)
+    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+
+    def k1(t):
+        return 10000.0 * min(1.0, max(0.0, 1.0 - (t - 0.2) / 0.15))
+
+    def k2(t):
+        return 10000.0 * float(np.interp(t, [0.0, 0.2, 0.35, 0.7, 0.8], [0.0, 0.0, 0.45, 0.45, 1.0]))
+
+    h = 1e-3
+    ts = np.arange(0.0, 1.0 + h / 2, h)
+    signals = np.array(
+        [(t, 250.0, k1(t + h / 2), k2(t + h / 2)) for t in ts],
+        dtype=[("time", float), ("bodies.crank.drive_torque_n_m", float),
+               ("couplings.K1.normal_force_n", float), ("couplings.K2.normal_force_n", float)],
+    )
+    outs = ["couplings.K2.mode", "couplings.K2.heat_j", "bodies.vehicle.speed_rad_s",
+            "bodies.engine.speed_rad_s"]
+    r = fmpy.simulate_fmu(fmu, stop_time=1.0, step_size=h, input=signals, output=outs)
+    locked = np.nonzero(r["couplings.K2.mode"] == 0)[0]
+    summary = os.path.join(work, "dct.json")
+    run(args, "run", "scenes/dct-upshift.toml", "--no-record", "--summary-json", summary)
+    with open(summary) as f:
+        s = json.load(f)
+    k2s = next(c for c in s["couplings"] if c["name"] == "K2")
+    vehicle = next(b for b in s["bodies"] if b["name"] == "vehicle")
+    return {
+        "inputs": inputs,
+        "problems": validate_fmu(fmu),
+        "fmu_first_locked_s": float(r["time"][locked[0]]) if len(locked) else None,
+        "fmu_heat_j": float(r["couplings.K2.heat_j"][-1]),
+        "fmu_vehicle_rad_s": float(r["bodies.vehicle.speed_rad_s"][-1]),
+        "run_lock_s": k2s["lock_times_s"],
+        "run_heat_j": k2s["heat_j"],
+        "run_vehicle_rad_s": vehicle["final_speed_rad_s"],
+    }
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", required=True)
     ap.add_argument("--root", required=True)
     ap.add_argument("--work", required=True)
-    ap.add_argument("check", choices=["validate", "paper", "coupling", "rollback", "thermal"])
+    ap.add_argument(
+        "check", choices=["validate", "paper", "coupling", "rollback", "thermal", "network"]
+    )
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
     result = {
@@ -350,6 +402,7 @@ def main():
         "coupling": check_coupling,
         "rollback": check_rollback,
         "thermal": check_thermal,
+        "network": check_network,
     }[args.check](args)
     json.dump(result, sys.stdout)
 

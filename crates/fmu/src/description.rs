@@ -23,6 +23,9 @@ pub struct Header<'a> {
     pub stop_time_s: f64,
     /// The default experiment's communication step, s.
     pub step_s: f64,
+    /// Whether the inputs take derivatives (`canInterpolateInputs`): a pack's shaft speed
+    /// and torque do; a network's inputs are held values.
+    pub interpolates_inputs: bool,
 }
 
 fn start(name: &str, attrs: &[(&str, &str)]) -> Event<'static> {
@@ -68,7 +71,14 @@ pub fn model_description(header: &Header, vars: &[Variable]) -> String {
             ("modelIdentifier", MODEL_IDENTIFIER),
             ("needsExecutionTool", "false"),
             ("canHandleVariableCommunicationStepSize", "true"),
-            ("canInterpolateInputs", "true"),
+            (
+                "canInterpolateInputs",
+                if header.interpolates_inputs {
+                    "true"
+                } else {
+                    "false"
+                },
+            ),
             ("maxOutputDerivativeOrder", "0"),
             ("canRunAsynchronuously", "false"),
             ("canBeInstantiatedOnlyOncePerProcess", "false"),

@@ -29,6 +29,8 @@ pub enum PackageError {
 
 /// The communication step of the model description's default experiment, s.
 pub const DEFAULT_STEP_S: f64 = 1e-5;
+/// The communication step of a network scene's default experiment, s.
+pub const NETWORK_STEP_S: f64 = 1e-3;
 
 /// Whether `scene` can be an FMU with `engine` (`None`: the scene's choice): the engine must
 /// start a session driving every input the pack has. The error says why not.
@@ -36,6 +38,22 @@ pub fn check_representable(
     scene: &Scene,
     engine: Option<EngineChoice>,
 ) -> Result<EngineChoice, PackageError> {
+    if let Some(net) = &scene.network {
+        if let Some(why) = clutchpack_sdk::network_name_problems(net).first() {
+            return Err(PackageError::Unrepresentable(format!(
+                "{}: {why}",
+                scene.name
+            )));
+        }
+        // a network drives every input it has: a run of it must start so
+        let names: Vec<String> = clutchpack_sdk::network_inputs(net)
+            .into_iter()
+            .map(|(n, _)| n)
+            .collect();
+        clutchpack_sdk::NetworkSimulation::start(scene, engine, &names, None, None)
+            .map_err(|e| PackageError::Unrepresentable(e.to_string()))?;
+        return Ok(EngineChoice::Reference);
+    }
     let sim = Simulation::new(scene.clone(), engine)
         .map_err(|e| PackageError::Unrepresentable(e.to_string()))?;
     sim.start(SessionRequest {
@@ -98,7 +116,14 @@ pub fn write_fmu(
             description: &scene.description,
             guid: &guid,
             stop_time_s: scene.simulation.duration_s,
-            step_s: DEFAULT_STEP_S,
+            // a network's default experiment steps at its sample interval (its events are
+            // located inside the steps, its inputs take no slopes)
+            step_s: if scene.network.is_some() {
+                NETWORK_STEP_S
+            } else {
+                DEFAULT_STEP_S
+            },
+            interpolates_inputs: scene.network.is_none(),
         },
         &vars,
     );

@@ -64,7 +64,8 @@ pub use network::{
     NetworkOutcome, NetworkRequest, NetworkSummary, MULTIBODY_NETWORK_STEP_S,
 };
 pub use network_cosim::{
-    network_inputs, NetworkSimulation, NetworkVariable, SavedNetworkSimulation,
+    network_inputs, network_name_problems, network_outputs, NetworkSimulation, NetworkVariable,
+    SavedNetworkSimulation,
 };
 pub use recording::open_recording;
 pub use run::{RecordingRequest, RunOutcome, RunRequest};

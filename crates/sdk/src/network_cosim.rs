@@ -23,24 +23,25 @@ pub struct NetworkVariable {
     pub name: String,
     /// `input` or `output`.
     pub causality: &'static str,
-    /// Its SI unit (`rad/s`, `N m`, `N`, `J`, `1`).
+    /// Its SI unit, as the FMU's unit definitions name it (`rad/s`, `N.m`, `N`, `J`, `1`).
     pub unit: &'static str,
     /// What it is, with its sign.
     pub description: String,
 }
 
-/// The inputs of `net` by their public names: each turning body's drive torque
-/// (`bodies.<body>.drive_torque_n_m`, N m) and each clutch's normal force
-/// (`couplings.<clutch>.normal_force_n`, N).
+/// The inputs of `net` by their public names: the drive torque of each turning body the scene
+/// drives (`bodies.<body>.drive_torque_n_m`, N m: a body with `[bodies.drive]` or
+/// `[bodies.firing]`; give a body `drive = 0` to make it an input) and each clutch's normal
+/// force (`couplings.<clutch>.normal_force_n`, N).
 pub fn network_inputs(net: &Network) -> Vec<(String, NetworkInput)> {
     let bodies = net
         .bodies
         .iter()
         .enumerate()
-        .filter(|(_, b)| !b.fixed)
+        .filter(|(_, b)| !b.fixed && (b.drive.is_some() || b.firing.is_some()))
         .map(|(i, b)| {
             (
-                format!("bodies.{}.drive_torque_n_m", b.name),
+                format!("bodies.{}.drive_torque_n_m", segment(&b.name)),
                 NetworkInput::Drive(i),
             )
         });
@@ -51,11 +52,27 @@ pub fn network_inputs(net: &Network) -> Vec<(String, NetworkInput)> {
         .filter(|(_, c)| c.clutch().is_some())
         .map(|(k, c)| {
             (
-                format!("couplings.{}.normal_force_n", c.name),
+                format!("couplings.{}.normal_force_n", segment(&c.name)),
                 NetworkInput::ClutchForce(k),
             )
         });
     bodies.chain(clutches).collect()
+}
+
+/// A body's or coupling's name as a segment of a variable's name: the FMI structured name's
+/// (`K2`, `'input-1'`: [`crate::cosim::fmi_name_segment`]); a name FMI cannot write (outside
+/// ASCII) is kept as it is (an FMU of it is refused: [`network_name_problems`]).
+fn segment(name: &str) -> String {
+    crate::cosim::fmi_name_segment(name).unwrap_or_else(|_| name.to_string())
+}
+
+/// Why `net`'s names cannot be an FMU's variable names (empty: they can).
+pub fn network_name_problems(net: &Network) -> Vec<String> {
+    let names = net.bodies.iter().map(|b| &b.name);
+    names
+        .chain(net.couplings.iter().map(|c| &c.name))
+        .filter_map(|n| crate::cosim::fmi_name_segment(n).err())
+        .collect()
 }
 
 /// The value of `input` in `net` at `t` (s): a drive signal's torque (N m, without the
@@ -67,6 +84,101 @@ fn input_value(net: &Network, input: NetworkInput, t: f64) -> f64 {
             .clutch()
             .map_or(0.0, |c| c.normal_force_n(t).max(0.0)),
     }
+}
+
+/// The variable of the input `input` of `net`, named `name`.
+fn input_variable(net: &Network, name: &str, input: NetworkInput) -> NetworkVariable {
+    let (unit, description) = match input {
+        NetworkInput::Drive(i) => (
+            "N.m",
+            format!(
+                "drive torque on {}, N m (positive in its sense of rotation; its firing \
+                 harmonics add to it)",
+                net.bodies[i].name
+            ),
+        ),
+        NetworkInput::ClutchForce(k) => (
+            "N",
+            format!(
+                "normal force of clutch {}, N (>= 0; 0: free)",
+                net.couplings[k].name
+            ),
+        ),
+    };
+    NetworkVariable {
+        name: name.to_string(),
+        causality: "input",
+        unit,
+        description,
+    }
+}
+
+/// Every input of `net` as a variable, with its value at t = 0 in the scene (what an FMU's
+/// input holds until its host sets it).
+pub fn network_input_variables(net: &Network) -> Vec<(NetworkVariable, f64)> {
+    network_inputs(net)
+        .into_iter()
+        .map(|(name, input)| {
+            (
+                input_variable(net, &name, input),
+                input_value(net, input, 0.0),
+            )
+        })
+        .collect()
+}
+
+/// The outputs of `net`, in the order [`NetworkSimulation::outputs`] gives their values: per
+/// body its speed and angle; per coupling its torque on body a, and for a clutch its slip
+/// `w_b - w_a`, its mode (Modelica's numbers) and its heat.
+pub fn network_outputs(net: &Network) -> Vec<NetworkVariable> {
+    let var = |name: String, unit: &'static str, description: String| NetworkVariable {
+        name,
+        causality: "output",
+        unit,
+        description,
+    };
+    let mut out = Vec::new();
+    for b in &net.bodies {
+        out.push(var(
+            format!("bodies.{}.speed_rad_s", segment(&b.name)),
+            "rad/s",
+            format!("speed of {}, rad/s", b.name),
+        ));
+        out.push(var(
+            format!("bodies.{}.angle_rad", segment(&b.name)),
+            "rad",
+            format!("angle of {} from t = 0, rad", b.name),
+        ));
+    }
+    for c in &net.couplings {
+        out.push(var(
+            format!("couplings.{}.torque_n_m", segment(&c.name)),
+            "N.m",
+            format!("torque of {} on its body a, N m", c.name),
+        ));
+        if c.clutch().is_some() {
+            out.push(var(
+                format!("couplings.{}.slip_rad_s", segment(&c.name)),
+                "rad/s",
+                format!("slip w_b - w_a of {}, rad/s", c.name),
+            ));
+            out.push(var(
+                format!("couplings.{}.mode", segment(&c.name)),
+                "1",
+                format!(
+                    "mode of {} as Modelica's Clutch numbers it: 2 free, 1 slipping forward, \
+                     0 locked, -1 slipping backward",
+                    c.name
+                ),
+            ));
+            out.push(var(
+                format!("couplings.{}.heat_j", segment(&c.name)),
+                "J",
+                format!("heat {} has made since t = 0, J", c.name),
+            ));
+        }
+    }
+    out
 }
 
 /// A network run advanced call by call, with the inputs the caller drives set between calls.
@@ -179,70 +291,9 @@ impl NetworkSimulation {
         let mut out: Vec<NetworkVariable> = self
             .driven
             .iter()
-            .map(|(name, input)| NetworkVariable {
-                name: name.clone(),
-                causality: "input",
-                unit: match input {
-                    NetworkInput::Drive(_) => "N m",
-                    NetworkInput::ClutchForce(_) => "N",
-                },
-                description: match input {
-                    NetworkInput::Drive(i) => format!(
-                        "drive torque on {}, N m (positive in its sense of rotation; its firing harmonics add to it)",
-                        net.bodies[*i].name
-                    ),
-                    NetworkInput::ClutchForce(k) => format!(
-                        "normal force of clutch {}, N (>= 0; 0: free)",
-                        net.couplings[*k].name
-                    ),
-                },
-            })
+            .map(|(name, input)| input_variable(net, name, *input))
             .collect();
-        let var = |name: String, unit: &'static str, description: String| NetworkVariable {
-            name,
-            causality: "output",
-            unit,
-            description,
-        };
-        for b in &net.bodies {
-            out.push(var(
-                format!("bodies.{}.speed_rad_s", b.name),
-                "rad/s",
-                format!("speed of {}, rad/s", b.name),
-            ));
-            out.push(var(
-                format!("bodies.{}.angle_rad", b.name),
-                "rad",
-                format!("angle of {} from t = 0, rad", b.name),
-            ));
-        }
-        for c in &net.couplings {
-            out.push(var(
-                format!("couplings.{}.torque_n_m", c.name),
-                "N m",
-                format!("torque of {} on its body a, N m", c.name),
-            ));
-            if c.clutch().is_some() {
-                out.push(var(
-                    format!("couplings.{}.slip_rad_s", c.name),
-                    "rad/s",
-                    format!("slip w_b - w_a of {}, rad/s", c.name),
-                ));
-                out.push(var(
-                    format!("couplings.{}.mode", c.name),
-                    "1",
-                    format!(
-                        "mode of {} as Modelica's Clutch numbers it: 2 free, 1 slipping forward, 0 locked, -1 slipping backward",
-                        c.name
-                    ),
-                ));
-                out.push(var(
-                    format!("couplings.{}.heat_j", c.name),
-                    "J",
-                    format!("heat {} has made since t = 0, J", c.name),
-                ));
-            }
-        }
+        out.extend(network_outputs(net));
         out
     }
 
@@ -322,35 +373,41 @@ impl NetworkSimulation {
         Ok(())
     }
 
-    /// Every output now, by name (SI units; [`Self::variables`] gives each unit).
+    /// Every output now, by name, in [`network_outputs`]' order (SI units; [`Self::variables`]
+    /// gives each unit).
     pub fn outputs(&mut self) -> Vec<(String, f64)> {
         let s: NetworkSample = self.stepper.sample_now();
         let heat = self.stepper.heat_j();
         let net = self.stepper.network();
-        let mut out = Vec::new();
-        for (name, input) in &self.driven {
-            out.push((name.clone(), input_value(net, *input, s.t_s)));
-        }
-        for (i, b) in net.bodies.iter().enumerate() {
-            out.push((format!("bodies.{}.speed_rad_s", b.name), s.speed_rad_s[i]));
-            out.push((format!("bodies.{}.angle_rad", b.name), s.angle_rad[i]));
+        let mut values = Vec::new();
+        for i in 0..net.bodies.len() {
+            values.push(s.speed_rad_s[i]);
+            values.push(s.angle_rad[i]);
         }
         for (k, c) in net.couplings.iter().enumerate() {
-            out.push((format!("couplings.{}.torque_n_m", c.name), s.torque_n_m[k]));
+            values.push(s.torque_n_m[k]);
             if c.clutch().is_some() {
-                out.push((
-                    format!("couplings.{}.slip_rad_s", c.name),
-                    s.speed_rad_s[c.b] - s.speed_rad_s[c.a],
-                ));
+                values.push(s.speed_rad_s[c.b] - s.speed_rad_s[c.a]);
                 let mode = s.mode[k].unwrap_or(ClutchMode::Free);
-                out.push((
-                    format!("couplings.{}.mode", c.name),
-                    f64::from(mode.modelica_code()),
-                ));
-                out.push((format!("couplings.{}.heat_j", c.name), heat[k]));
+                values.push(f64::from(mode.modelica_code()));
+                values.push(heat[k]);
             }
         }
-        out
+        network_outputs(net)
+            .into_iter()
+            .map(|v| v.name)
+            .zip(values)
+            .collect()
+    }
+
+    /// The value now of each driven input, by name (N m or N).
+    pub fn input_values(&self) -> Vec<(String, f64)> {
+        let net = self.stepper.network();
+        let t = self.stepper.time_s();
+        self.driven
+            .iter()
+            .map(|(name, input)| (name.clone(), input_value(net, *input, t)))
+            .collect()
     }
 
     /// Saves the whole state, to [`Self::restore`] later (not while recording: a file cannot

@@ -20,8 +20,9 @@ impl Simulation {
     pub fn new(scene: Scene, asked: Option<EngineChoice>) -> Result<Simulation> {
         if scene.network.is_some() {
             return Err(crate::Error::BadInput(format!(
-                "{} is a network scene ([[bodies]]): `clutchpack run` and `check` take it; \
-                 sweeps, studies, recordings, the FMU and Python take pack scenes only, for now",
+                "{} is a network scene ([[bodies]]): `clutchpack run`, `check`, `fmu` and \
+                 Python's `run` and `Simulation` take it; sweeps and studies take pack scenes \
+                 only, for now",
                 scene.name
             )));
         }

@@ -7,12 +7,13 @@
 //! communication points, pointers) stay in the fmu crate.
 
 mod inputs;
+mod network;
 mod variables;
 
 pub use inputs::{driven_from_names, driven_names, Input};
 pub use variables::{
-    uses_unit, variables, BodyField, Causality, ImpactField, InterfaceField, Kind, Quantity,
-    Variable, UNCONNECTED, UNITS,
+    fmi_name_segment, uses_unit, variables, BodyField, Causality, ImpactField, InterfaceField,
+    Kind, Quantity, Variable, UNCONNECTED, UNITS,
 };
 
 use crate::{RecordingRequest, RunOutcome, Session, SessionRequest, SessionState, Simulation};
@@ -48,14 +49,23 @@ pub struct SavedCoSimulation {
     run: u64,
     /// The scene of that run, for messages.
     scene: String,
-    session: SessionState,
+    session: SavedRun,
     reals: Vec<f64>,
     slopes: Vec<[f64; 2]>,
     snapshot: Snapshot,
+    /// A network's outputs and inputs as handed over when saved.
+    network: (Vec<f64>, Vec<f64>),
+}
+
+/// The engine's state in a [`SavedCoSimulation`]: a pack's session or a network's run.
+enum SavedRun {
+    // both boxed: the two differ in size by kilobytes
+    Pack(Box<SessionState>),
+    Network(Box<crate::SavedNetworkSimulation>),
 }
 
 /// One co-simulated run of a scene: its variable table with the values set, over a
-/// [`Session`].
+/// [`Session`] (a pack) or a [`crate::NetworkSimulation`] (a network scene).
 pub struct CoSimulation {
     scene: Scene,
     /// The inputs the caller drives.
@@ -84,6 +94,14 @@ pub struct CoSimulation {
     /// The files the run reads (the FMU's resources, Python's scene file): no output may
     /// name one.
     inputs: Vec<PathBuf>,
+    /// A network scene's run, while it goes.
+    network: Option<crate::NetworkSimulation>,
+    /// A network scene's finished run.
+    network_outcome: Option<crate::NetworkOutcome>,
+    /// A network's outputs as last computed, in [`crate::network_outputs`]' order.
+    network_outputs: Vec<f64>,
+    /// A network's inputs as last handed to its run, in [`crate::network_inputs`]' order.
+    network_pushed: Vec<f64>,
 }
 
 impl CoSimulation {
@@ -98,9 +116,15 @@ impl CoSimulation {
     /// the scene's profiles; Python's `Simulation`). Driving nothing, the run is the scene's
     /// run split into calls. Inputs the pack does not have are an error naming them.
     pub fn driving(scene: Scene, driven: Driven) -> Result<CoSimulation, String> {
-        driven
-            .check(&scene.pack)
-            .map_err(|e| format!("{}: {e}", scene.name))?;
+        // a network drives every input it has (`network_inputs`); a pack, what `driven` names
+        let driven = if scene.network.is_some() {
+            Driven::NONE
+        } else {
+            driven
+                .check(&scene.pack)
+                .map_err(|e| format!("{}: {e}", scene.name))?;
+            driven
+        };
         let engine = scene.engine(None, &scene.name).map_err(|e| e.to_string())?;
         let vars = variables(&scene, engine.name(), driven);
         let mut co = CoSimulation {
@@ -118,6 +142,10 @@ impl CoSimulation {
             damage_cache: Default::default(),
             run: 0,
             inputs: Vec::new(),
+            network: None,
+            network_outcome: None,
+            network_outputs: Vec::new(),
+            network_pushed: Vec::new(),
         };
         co.reset();
         Ok(co)
@@ -155,6 +183,12 @@ impl CoSimulation {
         self.outcome = None;
         self.damage_cache.take();
         self.run = 0;
+        if let Some(n) = self.network.take() {
+            let _ = n.finish();
+        }
+        self.network_outcome = None;
+        self.network_outputs.clear();
+        self.network_pushed.clear();
     }
 
     /// Where the run is.
@@ -163,7 +197,7 @@ impl CoSimulation {
             Stage::Ended
         } else if self.failed {
             Stage::Failed
-        } else if self.session.is_some() {
+        } else if self.session.is_some() || self.network.is_some() {
             Stage::Running
         } else {
             Stage::Setup
@@ -194,7 +228,11 @@ impl CoSimulation {
         let wanted = Input::from_name(name);
         self.vars
             .iter()
-            .find(|v| wanted.is_some_and(|i| v.quantity == Quantity::Input(i)))
+            .find(|v| match v.quantity {
+                Quantity::Input(i) => wanted == Some(i),
+                Quantity::NetworkInput(_) => v.name == name,
+                _ => false,
+            })
             .map(|v| v.vr)
             .ok_or_else(|| {
                 let inputs: Vec<&str> = self
@@ -283,6 +321,9 @@ impl CoSimulation {
             options: RecordOptions::default(),
             scene_path: None,
         });
+        if self.scene.network.is_some() {
+            return self.start_network(engine, recording, stop_time_s);
+        }
         let sim = Simulation::new(self.scene.clone(), Some(engine)).map_err(|e| e.to_string())?;
         let mut session = sim
             .start(SessionRequest {
@@ -337,10 +378,14 @@ impl CoSimulation {
                 Err(format!("{}: the run has ended", v.name))
             }
             Causality::Input => {
-                let Quantity::Input(i) = v.quantity else {
-                    unreachable!("an input variable stands for an input")
-                };
-                i.check(value, "")?;
+                match v.quantity {
+                    Quantity::Input(i) => i.check(value, "")?,
+                    // a clutch's normal force (unit N) is >= 0; a drive torque takes any sign
+                    Quantity::NetworkInput(_) if v.unit == Some("N") && value < 0.0 => {
+                        return Err(format!("{} = {value}: expected a force >= 0 N", v.name));
+                    }
+                    _ => {}
+                }
                 self.reals[vr as usize] = value;
                 self.slopes[vr as usize] = [0.0; 2];
                 Ok(())
@@ -497,6 +542,7 @@ impl CoSimulation {
             Quantity::OilTemperature => {
                 self.temperature_k(self.scene.pack.discs.len() + self.scene.pack.plates.len())
             }
+            Quantity::NetworkOutput(j) => self.network_outputs.get(j).copied().unwrap_or(0.0),
             _ => self.reals[vr as usize],
         })
     }
@@ -564,6 +610,9 @@ impl CoSimulation {
                 self.stage()
             ));
         }
+        if self.network.is_some() {
+            return self.advance_network(t_end, stop);
+        }
         self.check_held_inputs(t_end)?;
         let inputs = self.inputs();
         let session = self.session.as_mut().expect("a session while running");
@@ -610,6 +659,12 @@ impl CoSimulation {
 
     /// The time the run stands at, s (after [`CoSimulation::finish`]: where it ended).
     pub fn time_s(&self) -> f64 {
+        if let Some(n) = &self.network {
+            return n.time_s();
+        }
+        if let Some(o) = &self.network_outcome {
+            return o.summary.simulated_s;
+        }
         match (&self.session, &self.outcome) {
             (Some(s), _) => s.time_s(),
             (None, Some(o)) => o.result.as_ref().map_or(0.0, |r| r.simulated_s),
@@ -632,6 +687,12 @@ impl CoSimulation {
             }
             self.outcome = Some(outcome);
         }
+        if let Some(n) = self.network.take() {
+            match n.finish() {
+                Ok(o) => self.network_outcome = Some(o),
+                Err(e) => warnings.push(format!("the network run could not be finished: {e}")),
+            }
+        }
         self.ended = true;
         warnings
     }
@@ -641,8 +702,28 @@ impl CoSimulation {
         self.outcome.as_ref()
     }
 
+    /// A network scene's finished run, after [`CoSimulation::finish`].
+    pub fn network_outcome(&self) -> Option<&crate::NetworkOutcome> {
+        self.network_outcome.as_ref()
+    }
+
     /// Saves the whole state (not while recording: a recording cannot be rewound).
     pub fn save(&self) -> Result<SavedCoSimulation, String> {
+        if let Some(n) = self
+            .network
+            .as_ref()
+            .filter(|_| self.stage() == Stage::Running)
+        {
+            return Ok(SavedCoSimulation {
+                run: self.run,
+                scene: self.scene.name.clone(),
+                session: SavedRun::Network(Box::new(n.save().map_err(|e| e.to_string())?)),
+                reals: self.reals.clone(),
+                slopes: self.slopes.clone(),
+                snapshot: self.snapshot.clone(),
+                network: (self.network_outputs.clone(), self.network_pushed.clone()),
+            });
+        }
         let s = self
             .session
             .as_ref()
@@ -651,10 +732,11 @@ impl CoSimulation {
         Ok(SavedCoSimulation {
             run: self.run,
             scene: self.scene.name.clone(),
-            session: s.save().map_err(|e| e.to_string())?,
+            session: SavedRun::Pack(Box::new(s.save().map_err(|e| e.to_string())?)),
             reals: self.reals.clone(),
             slopes: self.slopes.clone(),
             snapshot: self.snapshot.clone(),
+            network: Default::default(),
         })
     }
 
@@ -669,10 +751,18 @@ impl CoSimulation {
                 state.scene, self.scene.name
             ));
         }
-        let s = self.session.as_mut().filter(|_| !self.ended).ok_or(
-            "a state can be restored while the run goes (after fmi2ExitInitializationMode)",
-        )?;
-        s.restore(&state.session).map_err(|e| e.to_string())?;
+        let going = "a state can be restored while the run goes (after fmi2ExitInitializationMode)";
+        match &state.session {
+            SavedRun::Pack(saved) => {
+                let s = self.session.as_mut().filter(|_| !self.ended).ok_or(going)?;
+                s.restore(saved).map_err(|e| e.to_string())?;
+            }
+            SavedRun::Network(saved) => {
+                let n = self.network.as_mut().filter(|_| !self.ended).ok_or(going)?;
+                n.restore(saved).map_err(|e| e.to_string())?;
+                (self.network_outputs, self.network_pushed) = state.network.clone();
+            }
+        }
         self.reals.clone_from(&state.reals);
         self.slopes.clone_from(&state.slopes);
         self.snapshot = state.snapshot.clone();

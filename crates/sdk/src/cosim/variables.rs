@@ -93,6 +93,11 @@ pub enum Quantity {
     BodyTemperature(usize),
     /// A thermal run's oil temperature, K.
     OilTemperature,
+    /// A network's input `j`, in [`crate::network_inputs`]' order (a drive torque, N m, or a
+    /// clutch's normal force, N).
+    NetworkInput(usize),
+    /// A network's output `j`, in [`crate::network_outputs`]' order.
+    NetworkOutput(usize),
 }
 
 /// What the last impact's outputs give.
@@ -166,28 +171,11 @@ pub fn uses_unit(name: &str, vars: &[Variable]) -> bool {
 pub fn variables(scene: &Scene, engine: &str, driven: Driven) -> Vec<Variable> {
     let mut v = Table::default();
     let pack = &scene.pack;
-    v.string(
-        "engine",
-        Quantity::Engine,
-        "the engine: \"reference\" (one rotational degree of freedom per body) or \
-         \"multibody\" (rapier3d bodies, per-tooth contacts)",
-        engine,
-    );
-    v.param(
-        "duration_limit_s",
-        Quantity::DurationLimit,
-        "s",
-        "the latest time the FMU may be advanced to; a step past it fails (a guard against \
-         a runaway host; the scene's simulation.duration_s by default)",
-        scene.simulation.duration_s,
-    );
-    v.string(
-        "recording_path",
-        Quantity::RecordingPath,
-        "an MCAP file to record the co-simulated run to (empty: no recording); replaced \
-         if it exists",
-        "",
-    );
+    parameters(&mut v, scene, engine);
+    if let Some(net) = &scene.network {
+        network_variables(&mut v, net);
+        return v.0;
+    }
     // every input a host is given, with what it holds when the host connects nothing to it
     // (docs/DECISIONS.md "Co-simulation": an FMU drives every input it has)
     let starts = [
@@ -431,6 +419,70 @@ pub fn variables(scene: &Scene, engine: &str, driven: Driven) -> Vec<Variable> {
     v.0
 }
 
+/// The parameters every co-simulation has: the engine, the duration limit, the recording's
+/// path.
+fn parameters(v: &mut Table, scene: &Scene, engine: &str) {
+    v.string(
+        "engine",
+        Quantity::Engine,
+        "the engine: \"reference\" (one rotational degree of freedom per body) or \
+         \"multibody\" (rapier3d bodies, per-tooth contacts)",
+        engine,
+    );
+    v.param(
+        "duration_limit_s",
+        Quantity::DurationLimit,
+        "s",
+        "the latest time the FMU may be advanced to; a step past it fails (a guard against \
+         a runaway host; the scene's simulation.duration_s by default)",
+        scene.simulation.duration_s,
+    );
+    v.string(
+        "recording_path",
+        Quantity::RecordingPath,
+        "an MCAP file to record the co-simulated run to (empty: no recording); replaced \
+         if it exists",
+        "",
+    );
+}
+
+/// A network scene's inputs (every turning body's drive torque, every clutch's normal force;
+/// each starting at the scene's value at t = 0) and outputs ([`crate::network_outputs`]).
+fn network_variables(v: &mut Table, net: &clutchpack_model::network::Network) {
+    for (j, (var, start)) in crate::network_cosim::network_input_variables(net)
+        .into_iter()
+        .enumerate()
+    {
+        v.push(Variable {
+            name: var.name,
+            quantity: Quantity::NetworkInput(j),
+            kind: Kind::Real,
+            causality: Causality::Input,
+            vr: 0,
+            unit: Some(var.unit),
+            description: format!(
+                "{}; held until the next communication point. {UNCONNECTED}",
+                var.description
+            ),
+            start_real: Some(start),
+            start_string: None,
+        });
+    }
+    for (j, var) in crate::network_outputs(net).into_iter().enumerate() {
+        v.push(Variable {
+            name: var.name,
+            quantity: Quantity::NetworkOutput(j),
+            kind: Kind::Real,
+            causality: Causality::Output,
+            vr: 0,
+            unit: Some(var.unit),
+            description: var.description,
+            start_real: None,
+            start_string: None,
+        });
+    }
+}
+
 /// Builds the list, numbering value references per base type.
 #[derive(Default)]
 struct Table(Vec<Variable>);
@@ -491,5 +543,70 @@ impl Table {
             start_real: None,
             start_string: None,
         });
+    }
+}
+
+/// `name` as one segment of an FMI 2.0 structured variable name (the model description's
+/// `variableNamingConvention = "structured"`, FMI 2.0 section 2.2.9): as it is when it is an
+/// identifier (`[A-Za-z_][A-Za-z0-9_]*`: `K2`, `crank`), else a quoted name (`'input-1'`),
+/// with `'`, `"`, `?`, `\` and the control characters the grammar names escaped. The one
+/// quoting of FMI names: every network variable's name goes through it. A character the
+/// grammar cannot write at all (one outside ASCII, another control character) is an error
+/// naming it.
+pub fn fmi_name_segment(name: &str) -> Result<String, String> {
+    let mut chars = name.chars();
+    let identifier = chars
+        .next()
+        .is_some_and(|c| c == '_' || c.is_ascii_alphabetic())
+        && chars.all(|c| c == '_' || c.is_ascii_alphanumeric());
+    if identifier {
+        return Ok(name.to_string());
+    }
+    let mut out = String::with_capacity(name.len() + 2);
+    out.push('\'');
+    for c in name.chars() {
+        match c {
+            '\'' => out.push_str("\\'"),
+            '"' => out.push_str("\\\""),
+            '?' => out.push_str("\\?"),
+            '\\' => out.push_str("\\\\"),
+            '\u{7}' => out.push_str("\\a"),
+            '\u{8}' => out.push_str("\\b"),
+            '\u{c}' => out.push_str("\\f"),
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            '\u{b}' => out.push_str("\\v"),
+            ' '..='~' => out.push(c),
+            _ => {
+                return Err(format!(
+                    "{name:?}: the character {c:?} cannot be written in an FMI variable name \
+                     (ASCII only): rename it in the scene"
+                ))
+            }
+        }
+    }
+    out.push('\'');
+    Ok(out)
+}
+
+#[cfg(test)]
+mod name_tests {
+    use super::fmi_name_segment;
+
+    /// Identifiers pass as they are; other names are quoted with the grammar's escapes; a
+    /// character outside ASCII is refused with the name.
+    #[test]
+    fn fmi_names_are_identifiers_or_quoted() {
+        assert_eq!(fmi_name_segment("K2").unwrap(), "K2");
+        assert_eq!(fmi_name_segment("_a1").unwrap(), "_a1");
+        assert_eq!(fmi_name_segment("input-1").unwrap(), "'input-1'");
+        assert_eq!(fmi_name_segment("1st").unwrap(), "'1st'");
+        assert_eq!(fmi_name_segment("a b").unwrap(), "'a b'");
+        assert_eq!(fmi_name_segment("it's").unwrap(), "'it\\'s'");
+        assert_eq!(fmi_name_segment("a\\b?").unwrap(), "'a\\\\b\\?'");
+        assert_eq!(fmi_name_segment("").unwrap(), "''");
+        let e = fmi_name_segment("vélo").unwrap_err();
+        assert!(e.contains("vélo") && e.contains("'é'"), "{e}");
     }
 }

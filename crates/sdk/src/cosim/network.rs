@@ -1,0 +1,87 @@
+//! The network half of [`CoSimulation`]: a network scene's run ([`crate::NetworkSimulation`])
+//! started with every input driven, its inputs handed over when they change, its outputs
+//! read after each advance (docs/DECISIONS.md, "Network recordings and inputs").
+
+use super::{CoSimulation, Quantity, RUNS};
+use crate::RecordingRequest;
+use clutchpack_scene::EngineChoice;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+impl CoSimulation {
+    /// [`CoSimulation::start`] of a network scene: its run driving every input, each at its
+    /// value as set.
+    pub(super) fn start_network(
+        &mut self,
+        engine: EngineChoice,
+        recording: Option<RecordingRequest>,
+        stop_time_s: Option<f64>,
+    ) -> Result<(), String> {
+        let names: Vec<String> = self
+            .vars
+            .iter()
+            .filter(|v| matches!(v.quantity, Quantity::NetworkInput(_)))
+            .map(|v| v.name.clone())
+            .collect();
+        let sim = crate::NetworkSimulation::start(
+            &self.scene,
+            Some(engine),
+            &names,
+            recording.as_ref(),
+            stop_time_s,
+        )
+        .map_err(|e| e.to_string())?;
+        self.network = Some(sim);
+        self.network_pushed = vec![f64::NAN; names.len()];
+        self.push_network_inputs()?;
+        self.refresh_network_outputs();
+        self.run = RUNS.fetch_add(1, Ordering::Relaxed);
+        Ok(())
+    }
+
+    /// Hands the network's inputs that changed since the last call to its run (held from
+    /// now on).
+    fn push_network_inputs(&mut self) -> Result<(), String> {
+        let Some(sim) = self.network.as_mut() else {
+            return Ok(());
+        };
+        for v in &self.vars {
+            let Quantity::NetworkInput(j) = v.quantity else {
+                continue;
+            };
+            let x = self.reals[v.vr as usize];
+            if self.network_pushed.get(j) != Some(&x) {
+                sim.set_input(&v.name, x).map_err(|e| e.to_string())?;
+                self.network_pushed[j] = x;
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads the network's outputs now.
+    fn refresh_network_outputs(&mut self) {
+        if let Some(sim) = self.network.as_mut() {
+            self.network_outputs = sim.outputs().into_iter().map(|(_, x)| x).collect();
+        }
+    }
+
+    /// [`CoSimulation::advance_to`] of a network scene.
+    pub(super) fn advance_network(
+        &mut self,
+        t_end: f64,
+        stop: Option<&AtomicBool>,
+    ) -> Result<bool, String> {
+        self.push_network_inputs()?;
+        let sim = self.network.as_mut().expect("a network while running");
+        let result = sim.advance_to(t_end, stop);
+        let reached = (sim.time_s() - t_end).abs() <= 1e-12 * t_end.abs().max(1.0);
+        self.refresh_network_outputs();
+        match result {
+            Ok(()) => Ok(reached),
+            Err(e @ crate::Error::BadInput(_)) => Err(e.to_string()),
+            Err(e) => {
+                self.failed = true;
+                Err(e.to_string())
+            }
+        }
+    }
+}
