@@ -20,7 +20,7 @@
 
 use crate::part::{array_syntax, read_part, CaseRecord, PartError, StudyHeader};
 use crate::stats::Summary;
-use clutchpack_analysis::DiscStats;
+use clutchpack_analysis::{csv_field, DiscStats};
 use std::path::{Path, PathBuf};
 
 /// A complete study: its header and every case's record, in case order.
@@ -377,14 +377,6 @@ impl Merged {
             }
         }
         out
-    }
-}
-
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
     }
 }
 
