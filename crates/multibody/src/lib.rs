@@ -9,8 +9,10 @@
 //!   position-based kinematic body following the prescribed speed, eq 3, or a dynamic body on
 //!   a revolute joint to the housing for an inertial shaft, eq 4), and one dynamic body per
 //!   friction disc joined to the shaft by a cylindrical impulse joint (rotation about `+z` and
-//!   axial slide free; radial translations and tilts locked), or optionally held by rapier's
-//!   locked axes ([`DiscMount`], the same motion at about half the cost per step). A disc
+//!   axial slide free; radial translations and tilts locked), or held by rapier's
+//!   locked axes ([`DiscMount`], the same motion at about half the cost per step; the
+//!   default for the multirate scheme, whose world only carries the bodies between world
+//!   steps, the joint for the shared step). A disc
 //!   with `radial_float` has its radial translations free too (only the teeth hold it); an
 //!   eccentric disc (`initial_offset_m` without float) is held at its offset in the shaft's
 //!   frame by a cylindrical joint anchored there. Each

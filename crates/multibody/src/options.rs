@@ -128,9 +128,19 @@ impl Default for BodyShapes {
 /// How a disc is held on the shaft axis (rotation about it and the axial slide free).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum DiscMount {
-    /// A generic impulse joint to the shaft locking the two radial translations and the two
-    /// tilts (ARCHITECTURE.md). The default.
+    /// [`DiscMount::LockedAxes`] when the multirate scheme runs the pack, the
+    /// [`DiscMount::Joint`] on the shared step ([`DiscMount::for_scheme`]). The default.
+    ///
+    /// In the multirate scheme the couplings integrate their own motion and the rapier world
+    /// only carries each body from one world step to the next (each body driven to its mean
+    /// speed over the step, its speed set at the step's end): the joints' constraints hold
+    /// nothing there but cost a third of a brake pack's run. Measured: every shipped scene the
+    /// multirate scheme runs gives the same impacts and summary to the bit on either mount
+    /// (docs/DECISIONS.md, "Sub-steps per contact and the world's mount").
     #[default]
+    Auto,
+    /// A generic impulse joint to the shaft locking the two radial translations and the two
+    /// tilts (ARCHITECTURE.md).
     Joint,
     /// Rapier's per-body locked axes (world x, y translations and rotations), no constraint
     /// to solve. The same motion whenever the shaft's axis stays on the world z axis, which
@@ -139,6 +149,18 @@ pub enum DiscMount {
     /// tilts locked; an eccentric disc that does not float always gets a joint (its offset
     /// turns with the shaft).
     LockedAxes,
+}
+
+impl DiscMount {
+    /// The mount a run builds its world with: [`DiscMount::Auto`] resolved for the scheme
+    /// (`multirate`: the multirate scheme runs the pack), any other as asked.
+    pub fn for_scheme(self, multirate: bool) -> DiscMount {
+        match self {
+            DiscMount::Auto if multirate => DiscMount::LockedAxes,
+            DiscMount::Auto => DiscMount::Joint,
+            m => m,
+        }
+    }
 }
 
 /// Options of the multibody engine.

@@ -165,7 +165,9 @@ fn floating_joint(anchor1: Vector) -> GenericJointBuilder {
 impl World {
     /// Builds the world at t = 0: shaft angle 0 at its initial speed, each disc at
     /// `theta_d = -phi(0)` turning at `omega_s(0) - dphi(0)`; each plate likewise relative to
-    /// its carrier (the housing at rest, or the drum at angle 0 and its initial speed).
+    /// its carrier (the housing at rest, or the drum at angle 0 and its initial speed). The
+    /// discs are held by `mount` as resolved for the run's scheme
+    /// ([`DiscMount::for_scheme`]; an unresolved [`DiscMount::Auto`] holds them by the joint).
     pub fn build(
         pack: &PackModel,
         shapes: &BodyShapes,

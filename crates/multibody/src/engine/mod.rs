@@ -151,12 +151,13 @@ impl MultibodyEngine {
                 }
             });
         }
-        // Build once now so that a scene the world cannot hold fails here, not in `run`.
-        World::build(&pack, &options.shapes, options.mount)?;
         let multirate_refused = match options.scheme {
             Scheme::Shared => Some("asked for"),
             Scheme::Auto | Scheme::Multirate => multirate::unsupported(&pack, &options, &per_tooth),
         };
+        // Build once now so that a scene the world cannot hold fails here, not in `run`.
+        let mount = options.mount.for_scheme(multirate_refused.is_none());
+        World::build(&pack, &options.shapes, mount)?;
         if let (Scheme::Multirate, Some(why)) = (options.scheme, multirate_refused) {
             return bad(format!("the multirate scheme cannot run this pack: {why}"));
         }

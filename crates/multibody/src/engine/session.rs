@@ -131,7 +131,7 @@ impl MultibodySession {
             }
             None => None,
         };
-        let mut run = Run::new(pack, options, per_tooth)?;
+        let mut run = Run::new(pack, options, per_tooth, multirate.is_some())?;
         run.exact_drum_load = driven.drum_load;
         run.evaluate(0.0)?;
         let kinetic_j = run.kinetic_energy();

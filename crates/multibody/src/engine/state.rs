@@ -190,8 +190,9 @@ impl Run {
         pack: Arc<PackModel>,
         opts: &MultibodyOptions,
         per_tooth: &[bool],
+        multirate: bool,
     ) -> Result<Run, EngineError> {
-        let world = World::build(&pack, &opts.shapes, opts.mount)?;
+        let world = World::build(&pack, &opts.shapes, opts.mount.for_scheme(multirate))?;
         let bodies: Arc<[DiscModel]> = pack.discs.iter().chain(&pack.plates).cloned().collect();
         let couplings: Vec<Coupling> = bodies
             .iter()
