@@ -212,7 +212,7 @@ fn scene_from_json(json: &str, name: &str, sets: Vec<(String, String)>) -> PyRes
 /// at onset (m/s), signed peak per-tooth load (N), one entry per impact.
 #[pyclass(name = "ImpactColumns", module = "clutchpack", frozen, get_all)]
 #[derive(Clone)]
-struct ImpactColumns {
+pub struct ImpactColumns {
     disc: Vec<String>,
     t_on_s: Vec<f64>,
     t_peak_s: Vec<f64>,
@@ -224,7 +224,10 @@ struct ImpactColumns {
 
 impl ImpactColumns {
     /// `impacts`, their bodies named by `names` (engine order).
-    fn of(impacts: &[clutchpack_sdk::model::ImpactEvent], names: &[String]) -> ImpactColumns {
+    pub(crate) fn of(
+        impacts: &[clutchpack_sdk::model::ImpactEvent],
+        names: &[String],
+    ) -> ImpactColumns {
         let name_of = |i: usize| names.get(i).cloned().unwrap_or_else(|| format!("disc {i}"));
         ImpactColumns {
             disc: impacts.iter().map(|e| name_of(e.disc)).collect(),
@@ -484,7 +487,7 @@ fn sweep(
 
 /// What a recording holds, for the Python half.
 #[pyclass(name = "RawRecording", module = "clutchpack", frozen, get_all)]
-struct RawRecording {
+pub struct RawRecording {
     /// The summary (JSON text): scene, engine, duration, per-body statistics and fatigue.
     summary_json: String,
     /// The scene's TOML text and overrides, as run.
@@ -496,6 +499,11 @@ struct RawRecording {
     loads: Vec<(String, Vec<f64>, Vec<f64>)>,
     /// Why the file was salvaged, if it was damaged.
     warning: Option<String>,
+    /// A network recording's sample times, s (empty for a pack's).
+    sample_t_s: Vec<f64>,
+    /// A network recording's columns at those times: `<body>.speed_rad_s` (rad/s) and
+    /// `<coupling>.torque_n_m` (N m), as `run_network` gives them.
+    sample_columns: Vec<(String, Vec<f64>)>,
 }
 
 /// Reads the recording at `path`; a damaged one only with `salvage` (what could be read).
@@ -507,6 +515,13 @@ fn read(py: Python<'_>, path: PathBuf, salvage: bool) -> PyResult<RawRecording> 
 
 fn read_recording(path: &Path, salvage: bool) -> Result<RawRecording, Error> {
     let (reader, warning) = clutchpack_sdk::open_recording(path, salvage)?;
+    if let Some(net) = clutchpack_sdk::record::read_network(&reader) {
+        let net = net.map_err(|e| Error::BadInput(format!("{}: {e}", path.display())))?;
+        if let Some(e) = reader.reread_error() {
+            return Err(Error::BadInput(e.to_string()));
+        }
+        return Ok(network::raw_network_recording(&reader, net, warning));
+    }
     let names = reader.disc_names();
     let impacts = reader.impacts();
     let summary = reader.summary_or_recomputed();
@@ -547,6 +562,8 @@ fn read_recording(path: &Path, salvage: bool) -> Result<RawRecording, Error> {
         impacts: ImpactColumns::of(&impacts, &names),
         loads,
         warning,
+        sample_t_s: Vec::new(),
+        sample_columns: Vec::new(),
     })
 }
 

@@ -28,6 +28,48 @@ pub struct RawNetworkRun {
     recording: Option<PathBuf>,
 }
 
+/// A network recording read back for `clutchpack.read`: the attached summary (the run's
+/// `--summary-json`; the scene and engine alone if the run did not finish), the scene, and
+/// the samples as the columns `run_network` gives.
+pub fn raw_network_recording(
+    reader: &clutchpack_sdk::record::RecordingReader,
+    net: clutchpack_sdk::record::RecordedNetwork,
+    warning: Option<String>,
+) -> crate::RawRecording {
+    let info = reader.run_info();
+    let summary_json = net
+        .summary_json
+        .as_deref()
+        .and_then(|j| String::from_utf8(j.to_vec()).ok())
+        .unwrap_or_else(|| {
+            serde_json::json!({
+                "scene": info.as_ref().map(|i| i.scene_name.clone()),
+                "engine": info.as_ref().map(|i| i.engine.clone()),
+            })
+            .to_string()
+        });
+    let column = |f: &dyn Fn(&clutchpack_sdk::NetworkSample) -> f64| -> Vec<f64> {
+        net.samples.iter().map(f).collect()
+    };
+    let mut sample_columns = Vec::new();
+    for (i, b) in net.bodies.iter().enumerate() {
+        sample_columns.push((format!("{b}.speed_rad_s"), column(&|s| s.speed_rad_s[i])));
+    }
+    for (k, c) in net.couplings.iter().enumerate() {
+        sample_columns.push((format!("{c}.torque_n_m"), column(&|s| s.torque_n_m[k])));
+    }
+    crate::RawRecording {
+        summary_json,
+        scene_text: info.as_ref().map(|i| i.scene_text.clone()),
+        overrides: info.map(|i| i.overrides).unwrap_or_default(),
+        impacts: crate::ImpactColumns::of(&[], &[]),
+        loads: Vec::new(),
+        warning,
+        sample_t_s: net.samples.iter().map(|s| s.t_s).collect(),
+        sample_columns,
+    }
+}
+
 /// Runs a network scene (`[[bodies]]`) on `engine` (else `simulation.engine`, else the
 /// reference engine), as `clutchpack run` does: the summary and the sampled speeds and
 /// torques, and the recording at `record` if given (replaced if it exists). The GIL is

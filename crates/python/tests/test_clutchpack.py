@@ -85,6 +85,11 @@ def test_a_network_scene_runs_as_the_cli_runs_it(tmp_path):
     assert "network: 4 bodies (J1, J2, J3, J4)" in text, text
     locks = m.summary["couplings"][1]["lock_times_s"]
     assert abs(locks[0] - 0.7096214638) < 2e-5, locks
+    # read back: the run's summary and samples, exactly (the recording holds every sample)
+    back = clutchpack.read(rec)
+    assert back.summary == m.summary
+    pd.testing.assert_frame_equal(back.samples, m.samples, check_exact=True)
+    assert back.impacts.empty and back.recording == str(rec)
 
 
 def test_a_simulation_drives_a_dct_shift_by_name(tmp_path):

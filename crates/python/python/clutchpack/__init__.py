@@ -220,7 +220,9 @@ def _run_network(sc: Scene, engine: Optional[str], record: Any, impacts_csv: Any
 
 def read(path: PathLike, salvage: bool = False) -> Result:
     """A recording as a ``Result``: its summary, impacts and each body's load series
-    (``loads[name]``: DataFrame ``t_s``, ``load_n``), and the scene it was run from. A
+    (``loads[name]``: DataFrame ``t_s``, ``load_n``), and the scene it was run from; a network
+    recording's summary is the run's and its ``samples`` are the run's (``t_s``,
+    ``<body>.speed_rad_s``, ``<coupling>.torque_n_m``). A
     damaged file (cut by a kill) raises ``ValueError`` unless ``salvage``: then what could be
     read, with the damage in ``warnings``."""
     raw = _clutchpack.read(os.fspath(path), salvage=salvage)
@@ -228,10 +230,16 @@ def read(path: PathLike, salvage: bool = False) -> Result:
         name: pd.DataFrame({"t_s": np.asarray(t, dtype=float), "load_n": np.asarray(v, dtype=float)})
         for name, t, v in raw.loads
     }
+    # a network recording: its samples as `run` gives them (t_s, speeds, torques)
+    samples = pd.DataFrame()
+    if raw.sample_t_s:
+        samples = pd.DataFrame({"t_s": np.asarray(raw.sample_t_s, dtype=float)})
+        for name, values in raw.sample_columns:
+            samples[name] = np.asarray(values, dtype=float)
     return Result(
         summary=json.loads(raw.summary_json),
         impacts=_impacts(raw),
-        samples=pd.DataFrame(),
+        samples=samples,
         recording=os.fspath(path),
         scene_text=raw.scene_text,
         overrides=list(raw.overrides),

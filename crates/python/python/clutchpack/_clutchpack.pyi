@@ -64,6 +64,8 @@ class RawRecording:
     impacts: ImpactColumns
     loads: List[Tuple[str, List[float], List[float]]]
     warning: Optional[str]
+    sample_t_s: List[float]
+    sample_columns: List[Tuple[str, List[float]]]
 
 def load_scene(
     path: Optional[_Path] = None,
