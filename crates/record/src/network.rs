@@ -30,7 +30,7 @@ use crate::view3d::{about_z, entity, pose, rgba, timestamp, v3};
 use crate::write::{close_mcap, open_mcap, unique_segments, RecordError, RecordOptions};
 use crate::{log_time_ns, proto, ros2, topics};
 use clutchpack_model::network::{ClutchEvent, ClutchMode, CouplingKind, Network, NetworkSample};
-use clutchpack_model::{Flank, ImpactEvent};
+use clutchpack_model::ImpactEvent;
 use foxglove::schemas::{
     line_primitive, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms,
     LinePrimitive, Log, Point3, SceneUpdate, TextPrimitive,
@@ -581,23 +581,12 @@ impl NetworkRecorder {
     /// Writes a gear mesh's tooth impact on `/network/impacts`, logged at its peak (`disc`
     /// of the event is the coupling's index).
     pub fn write_mesh_impact(&mut self, e: &ImpactEvent) -> Result<(), RecordError> {
-        let msg = proto::Impact {
-            disc: self
-                .coupling_names
-                .get(e.disc)
-                .cloned()
-                .unwrap_or_else(|| format!("coupling {}", e.disc)),
-            disc_index: e.disc as u32,
-            t_on_s: e.t_on_s,
-            t_peak_s: e.t_peak_s,
-            t_off_s: e.t_off_s,
-            flank: match e.flank {
-                Flank::ShaftLeads => proto::Flank::ShaftLeads,
-                Flank::DiscLeads => proto::Flank::DiscLeads,
-            } as i32,
-            v_on_m_s: e.v_on_m_s,
-            peak_n: e.peak_n,
-        };
+        let name = self
+            .coupling_names
+            .get(e.disc)
+            .cloned()
+            .unwrap_or_else(|| format!("coupling {}", e.disc));
+        let msg = proto::Impact::of(e, name);
         self.put(
             self.ch.impacts,
             log_time_ns(e.t_peak_s),

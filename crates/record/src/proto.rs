@@ -201,6 +201,25 @@ pub struct Impact {
     pub peak_n: f64,
 }
 
+impl Impact {
+    /// The message of the impact `e` of the body (or gear mesh) named `name`.
+    pub fn of(e: &clutchpack_model::ImpactEvent, name: String) -> Impact {
+        Impact {
+            disc: name,
+            disc_index: e.disc as u32,
+            t_on_s: e.t_on_s,
+            t_peak_s: e.t_peak_s,
+            t_off_s: e.t_off_s,
+            flank: match e.flank {
+                clutchpack_model::Flank::ShaftLeads => Flank::ShaftLeads,
+                clutchpack_model::Flank::DiscLeads => Flank::DiscLeads,
+            } as i32,
+            v_on_m_s: e.v_on_m_s,
+            peak_n: e.peak_n,
+        }
+    }
+}
+
 /// Statistics of one disc's impact peaks (wire form of `clutchpack_analysis::DiscStats`).
 #[derive(Clone, PartialEq, prost::Message)]
 pub struct DiscSummary {

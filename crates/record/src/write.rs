@@ -6,9 +6,7 @@ use crate::output::{PendingFile, Replace};
 use crate::summary::RecordedSummary;
 use crate::view3d::{self, disc_frame};
 use crate::{proto, topic_segment, topics};
-use clutchpack_model::{
-    DiscSample, Flank, ImpactEvent, InterfaceSample, Observer, RunStats, Sample,
-};
+use clutchpack_model::{DiscSample, ImpactEvent, InterfaceSample, Observer, RunStats, Sample};
 use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -1312,23 +1310,12 @@ impl Recorder {
 
     /// Writes one impact on `/impacts` and its disc's topic, logged at its peak time.
     fn put_impact(&mut self, e: &ImpactEvent) -> Result<(), RecordError> {
-        let msg = proto::Impact {
-            disc: self
-                .names
-                .get(e.disc)
-                .cloned()
-                .unwrap_or_else(|| format!("disc {}", e.disc)),
-            disc_index: e.disc as u32,
-            t_on_s: e.t_on_s,
-            t_peak_s: e.t_peak_s,
-            t_off_s: e.t_off_s,
-            flank: match e.flank {
-                Flank::ShaftLeads => proto::Flank::ShaftLeads,
-                Flank::DiscLeads => proto::Flank::DiscLeads,
-            } as i32,
-            v_on_m_s: e.v_on_m_s,
-            peak_n: e.peak_n,
-        };
+        let name = self
+            .names
+            .get(e.disc)
+            .cloned()
+            .unwrap_or_else(|| format!("disc {}", e.disc));
+        let msg = proto::Impact::of(e, name);
         self.put(self.ch.impacts, log_time_ns(e.t_peak_s), &msg, "/impacts")?;
         if let Some(&ch) = self.ch.disc_impacts.get(e.disc) {
             self.put(ch, log_time_ns(e.t_peak_s), &msg, "impacts")?;
