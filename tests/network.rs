@@ -306,3 +306,48 @@ fn a_network_run_is_recorded_whole() {
         assert!(text.contains("locked at ["), "{text}");
     }
 }
+
+/// `scenes/launch.toml`, a launch from rest through a slipping clutch: on both engines the
+/// clutch slips at exactly `mu cgeo fn` while its force is held (0.35 x 8000 N x 0.12 x
+/// 0.68 m = 228.48 N m; measured to rounding, asserted 1e-9 N m), locks once (at 0.761 s),
+/// at the same instant on both engines (measured 6.7e-10 s apart; asserted 1e-8 s) with the
+/// same heat (20.67 kJ, measured 4.9e-9 relative; asserted 1e-7), and each engine's energy
+/// balance closes (measured 3e-10 and 1.5e-9 J of 76 kJ of drive work; asserted 1e-7 J).
+#[test]
+fn a_launch_locks_once_at_the_same_instant_on_both_engines() {
+    let d = scratch("network-launch");
+    let mut lock = Vec::new();
+    let mut heat = Vec::new();
+    for engine in ["reference", "multibody"] {
+        let json = d.join(format!("{engine}.json"));
+        let o = run(&[
+            "run",
+            "scenes/launch.toml",
+            "--engine",
+            engine,
+            "--no-record",
+            "--summary-json",
+            json.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{engine}: {}", stderr(&o));
+        let s = read_json(&json);
+        let c = &s["couplings"][0];
+        assert_eq!(c["name"], "clutch");
+        let locks = c["lock_times_s"].as_array().unwrap();
+        assert_eq!(locks.len(), 1, "{engine}: {c}");
+        lock.push(locks[0].as_f64().unwrap());
+        heat.push(c["heat_j"].as_f64().unwrap());
+        let slipping = -0.35 * 8000.0 * 0.12 * 0.68;
+        let min = c["min_torque_n_m"].as_f64().unwrap();
+        assert!(
+            (min - slipping).abs() < 1e-9,
+            "{engine}: {min} against {slipping}"
+        );
+        let residual = s["energy"]["residual_j"].as_f64().unwrap();
+        assert!(residual.abs() < 1e-7, "{engine}: balance {residual} J");
+    }
+    eprintln!("launch: K locks at {lock:?} s with {heat:?} J");
+    assert!((lock[0] - lock[1]).abs() < 1e-8, "{lock:?}");
+    assert!((heat[0] - heat[1]).abs() < 1e-7 * heat[0], "{heat:?}");
+    assert!(lock[0] > 0.7 && lock[0] < 0.8, "{lock:?}");
+}
