@@ -304,6 +304,39 @@ fn a_network_run_is_recorded_whole() {
             "{text}"
         );
         assert!(text.contains("locked at ["), "{text}");
+        // export: one CSV per body and coupling; a clutch's slip w_b - w_a has its mode's sign
+        let csv = d.join(format!("{engine}-csv"));
+        let o = run(&[
+            "export",
+            mcap.to_str().unwrap(),
+            "--csv",
+            csv.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(!csv.join("shaft.csv").exists());
+        let mut slipping = 0;
+        for c in couplings.iter().filter(|c| c["kind"] == "clutch") {
+            let name = c["name"].as_str().unwrap();
+            let file = csv.join(format!("network_coupling_{name}.csv"));
+            let text = std::fs::read_to_string(&file).unwrap();
+            for row in text.lines().skip(1) {
+                let f: Vec<&str> = row.split(',').collect();
+                let slip: f64 = f[2].parse().unwrap();
+                match f[3] {
+                    "slip+" => assert!(slip > 0.0, "{name}: {row}"),
+                    "slip-" => assert!(slip < 0.0, "{name}: {row}"),
+                    "locked" => assert!(slip.abs() < 1e-9, "{name}: {row}"),
+                    _ => continue,
+                }
+                slipping += usize::from(f[3].starts_with("slip"));
+            }
+        }
+        assert!(slipping > 100, "{slipping} slipping rows");
+        // plot draws the run's figure from the file
+        let png = d.join(format!("{engine}.png"));
+        let o = run(&["plot", mcap.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
     }
 }
 
@@ -350,4 +383,72 @@ fn a_launch_locks_once_at_the_same_instant_on_both_engines() {
     assert!((lock[0] - lock[1]).abs() < 1e-8, "{lock:?}");
     assert!((heat[0] - heat[1]).abs() < 1e-7 * heat[0], "{heat:?}");
     assert!(lock[0] > 0.7 && lock[0] < 0.8, "{lock:?}");
+}
+
+/// `compare` of two network recordings (the DCT upshift with K1 released over 0.15 s and over
+/// 0.05 s): per run and clutch the heat, the first lock and the largest torque against the
+/// first run's, and which clutch takes the most heat (K2 in the slower shift: releasing K1
+/// sooner starts K2's inertia phase sooner, 13 ms, with 6 % less heat). A pack recording
+/// among network ones is refused.
+#[test]
+fn compare_of_two_shift_schedules_names_the_hottest_clutch() {
+    let d = scratch("network-compare");
+    let (slow, fast) = (d.join("slow.mcap"), d.join("fast.mcap"));
+    for (out, sets) in [
+        (&slow, vec![]),
+        (&fast, vec!["--set", "couplings[1].force.duration_s=0.05"]),
+    ] {
+        let mut args = vec![
+            "run",
+            "scenes/dct-upshift.toml",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(sets);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let o = run(&["compare", slow.to_str().unwrap(), fast.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(
+        text.contains("the clutch that takes the most heat: K2 in") && text.contains("slow.mcap"),
+        "{text}"
+    );
+    let o = run(&[
+        "compare",
+        slow.to_str().unwrap(),
+        fast.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let rows: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let k2 = rows
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["clutch"] == "K2" && r["run"].as_str().unwrap().ends_with("fast.mcap"))
+        .unwrap();
+    let heat = k2["heat_change_pct"].as_f64().unwrap();
+    let shift = k2["lock_shift_s"].as_f64().unwrap();
+    assert!(heat < -3.0 && heat > -10.0, "{k2}");
+    assert!(shift < -0.005 && shift > -0.03, "{k2}");
+    let pack = d.join("pack.mcap");
+    let o = run(&[
+        "run",
+        "scenes/hu-table2.toml",
+        "--duration",
+        "0.002",
+        "--out",
+        pack.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&["compare", pack.to_str().unwrap(), slow.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("networks with networks"),
+        "{}",
+        stderr(&o)
+    );
 }

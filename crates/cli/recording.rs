@@ -214,6 +214,7 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
         crate::outputs::check_outputs(&[Output::figure("--plot", p)], &inputs)?;
     }
     let mut runs = Vec::new();
+    let mut networks = Vec::new();
     for f in &a.files {
         let reader = open_recording(f, a.salvage)?;
         if reader
@@ -221,12 +222,8 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
             .metadata(clutchpack_sdk::record::META_NETWORK)
             .is_some()
         {
-            return Err(BadInput(format!(
-                "{}: a network recording (lumped couplings, no disc): `compare` compares the \
-                 discs of pack recordings; `clutchpack replay` or `plot` shows a network's run",
-                f.display()
-            ))
-            .into());
+            networks.push((f.display().to_string(), network_clutches(f, &reader)?));
+            continue;
         }
         let stats = recording_stats(&reader);
         reread_ok(&reader)?;
@@ -248,6 +245,18 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
             })
             .unwrap_or_default();
         runs.push((f.display().to_string(), stats, lives));
+    }
+    match (runs.is_empty(), networks.is_empty()) {
+        (true, false) => return compare_networks(&a, &networks),
+        (false, false) => {
+            return Err(BadInput(format!(
+                "{}: a network recording among pack recordings: compare packs with packs \
+                 (their discs) or networks with networks (their clutches)",
+                networks[0].0
+            ))
+            .into())
+        }
+        _ => {}
     }
     // after reading: a bad file's error stays the only line
     eprintln!("{}", crate::study::ONE_SAMPLE_NOTE);
@@ -375,6 +384,92 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
             clutchpack_sdk::analysis::plot_compare(tmp, &names, &discs, &values)
                 .with_context(|| format!("plotting {}", path.display()))
         })?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The clutches of a network recording, from its attached summary (the run's
+/// `--summary-json`); a recording of a run that did not finish has none: bad input, saying so.
+fn network_clutches(
+    f: &Path,
+    reader: &RecordingReader,
+) -> Result<Vec<clutchpack_sdk::analysis::ClutchRun>> {
+    let summary = reader
+        .info()
+        .attachments
+        .iter()
+        .find(|x| x.name == clutchpack_sdk::record::SUMMARY_ATTACHMENT)
+        .and_then(|x| serde_json::from_slice::<serde_json::Value>(&x.data).ok())
+        .ok_or_else(|| {
+            BadInput(format!(
+                "{}: a network recording without its summary (the run did not finish): \
+                 nothing to compare",
+                f.display()
+            ))
+        })?;
+    Ok(summary["couplings"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter(|c| c["kind"] == "clutch")
+        .map(|c| {
+            let num = |k: &str| c[k].as_f64().unwrap_or(0.0);
+            clutchpack_sdk::analysis::ClutchRun {
+                name: c["name"].as_str().unwrap_or("?").to_string(),
+                heat_j: num("heat_j"),
+                first_lock_s: c["lock_times_s"]
+                    .as_array()
+                    .and_then(|l| l.first())
+                    .and_then(serde_json::Value::as_f64),
+                max_abs_torque_n_m: num("min_torque_n_m").abs().max(num("max_torque_n_m").abs()),
+            }
+        })
+        .collect())
+}
+
+/// `compare` of network recordings: per run and clutch its heat, first lock and largest
+/// torque against the first run's, and which clutch of which run takes the most heat.
+fn compare_networks(
+    a: &CompareArgs,
+    networks: &[(String, Vec<clutchpack_sdk::analysis::ClutchRun>)],
+) -> Result<ExitCode> {
+    use clutchpack_sdk::analysis::{
+        clutch_compare_rows, clutch_compare_table, hottest_clutch, TableFormat,
+    };
+    if a.plot.is_some() {
+        return Err(BadInput(
+            "--plot: the bar chart of discs' peaks is for pack recordings; `clutchpack plot` \
+             draws each network run's speeds and torques"
+                .into(),
+        )
+        .into());
+    }
+    let rows = clutch_compare_rows(networks);
+    let format = match a.format {
+        CompareFormat::Json => {
+            out!("{}", serde_json::to_string_pretty(&rows)?);
+            return Ok(ExitCode::SUCCESS);
+        }
+        CompareFormat::Csv => TableFormat::Csv,
+        CompareFormat::Markdown => TableFormat::Markdown,
+        CompareFormat::Table => TableFormat::Text,
+    };
+    out!("{}", clutch_compare_table(&rows, format).trim_end());
+    if format == TableFormat::Text {
+        out!("changes against the first run, per cent; shift: the first lock's, s");
+        if let Some(h) = hottest_clutch(&rows) {
+            out!(
+                "the clutch that takes the most heat: {} in {} ({:.1} J{})",
+                h.clutch,
+                h.run,
+                h.heat_j,
+                h.heat_change_pct
+                    .filter(|p| p.abs() > 0.0)
+                    .map_or(String::new(), |p| format!(
+                        ", {p:+.1} % against the first run"
+                    ))
+            );
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -41,6 +41,7 @@
 
 #![warn(missing_docs)]
 
+pub mod clutches;
 pub mod cycles;
 pub mod fatigue;
 pub mod fatigue_plot;
@@ -68,6 +69,9 @@ impl Lcg {
     }
 }
 
+pub use clutches::{
+    clutch_compare_rows, clutch_compare_table, hottest_clutch, ClutchCompareRow, ClutchRun,
+};
 pub use fatigue::{
     assess, disc_cycles, ensemble_fatigue, DiscCycles, DiscFatigue, DiscFatigueSpread,
     FatigueCollector,
