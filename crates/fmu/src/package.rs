@@ -50,9 +50,9 @@ pub fn check_representable(
             .into_iter()
             .map(|(n, _)| n)
             .collect();
-        clutchpack_sdk::NetworkSimulation::start(scene, engine, &names, None, None)
+        let sim = clutchpack_sdk::NetworkSimulation::start(scene, engine, &names, None, None)
             .map_err(|e| PackageError::Unrepresentable(e.to_string()))?;
-        return Ok(EngineChoice::Reference);
+        return Ok(sim.engine());
     }
     let sim = Simulation::new(scene.clone(), engine)
         .map_err(|e| PackageError::Unrepresentable(e.to_string()))?;

@@ -171,8 +171,8 @@ fn running(guard: &mut Option<NetworkSimulation>) -> PyResult<&mut NetworkSimula
 
 #[pymethods]
 impl NetworkStepper {
-    /// Starts the network scene `scene` at t = 0 on `engine` (else the scene's choice; the
-    /// reference engine runs a network call by call), the caller driving the inputs named in
+    /// Starts the network scene `scene` at t = 0 on `engine` (else the scene's choice, else
+    /// the reference engine; either engine runs a network call by call), the caller driving the inputs named in
     /// `drive` (`bodies.<body>.drive_torque_n_m`, `couplings.<clutch>.normal_force_n`; the
     /// rest follow the scene), recording to `record` if given, the run ending at `stop_time`
     /// (s) if given.

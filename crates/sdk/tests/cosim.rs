@@ -167,3 +167,25 @@ fn a_network_co_simulation_names_its_inputs_and_rolls_back() {
     let _ = co.finish();
     assert!(co.network_outcome().is_some());
 }
+
+/// A network scene's run advanced call by call ([`clutchpack_sdk::NetworkSimulation`]) runs on
+/// the multibody engine too, at the whole run's fixed step: `dct-upshift` in calls of 1 ms,
+/// nothing driven (its samples at 1 kHz end a step at every call already), gives the whole
+/// run's summary but the wall time, figure for figure (steps, events, speeds, heats).
+#[test]
+fn a_network_simulation_runs_on_the_multibody_engine() {
+    use clutchpack_scene::EngineChoice;
+    let s = scene("dct-upshift.toml");
+    let engine = Some(EngineChoice::Multibody);
+    let request = clutchpack_sdk::NetworkRequest::default();
+    let whole = clutchpack_sdk::run_network_scene(&s, engine, request).unwrap();
+    let mut sim = clutchpack_sdk::NetworkSimulation::start(&s, engine, &[], None, None).unwrap();
+    assert_eq!(sim.engine(), EngineChoice::Multibody);
+    let calls = (s.simulation.duration_s / 1e-3).round() as u32;
+    for k in 1..=calls {
+        sim.advance_to(f64::from(k) * 1e-3, None).unwrap();
+    }
+    let mut called = sim.finish().unwrap().summary;
+    called.wall_time_s = whole.summary.wall_time_s;
+    assert_eq!(called, whole.summary);
+}

@@ -19,7 +19,7 @@ pub use clutch::{ClutchMode, LumpedClutch};
 pub use firing::Firing;
 pub use gear::GearMesh;
 pub use output::{ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample};
-pub use signal::Signal;
+pub use signal::{NetworkInput, Signal};
 
 use serde::{Deserialize, Serialize};
 

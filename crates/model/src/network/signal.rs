@@ -198,3 +198,53 @@ mod tests {
         assert!(!Signal::Constant(f64::NAN).is_valid());
     }
 }
+
+/// An input of a network that a session's caller may set (MODEL.md section 8, "Inputs"): the
+/// value is held from the instant it is set (a zero-order hold) and replaces the scene's
+/// signal from then on ([`super::Network::hold_input`]). Both engines' steppers take it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum NetworkInput {
+    /// The drive torque on body `i`, N m (positive in its sense of rotation; its firing
+    /// harmonics, if any, still add to it).
+    Drive(usize),
+    /// The normal force of the clutch that is coupling `k`, N (>= 0; 0: free).
+    ClutchForce(usize),
+}
+
+impl super::Network {
+    /// Replaces the signal of `input` by the constant `value` (N m for a drive, N for a
+    /// clutch's normal force, stored normalized by the clutch's `fn_max_n`): the engines'
+    /// `set_input`, which then restart at that instant as at a signal's jump. A value that
+    /// is not finite, a negative force, or an input naming a body or coupling that cannot
+    /// take it is refused, the network unchanged.
+    pub fn hold_input(
+        &mut self,
+        input: NetworkInput,
+        value: f64,
+    ) -> Result<(), crate::EngineError> {
+        let bad = |why: String| Err(crate::EngineError::Unsupported(why));
+        if !value.is_finite() {
+            return bad(format!("input value {value}: expected a finite number"));
+        }
+        match input {
+            NetworkInput::Drive(i) => {
+                let Some(b) = self.bodies.get_mut(i).filter(|b| !b.fixed) else {
+                    return bad(format!("body {i}: no turning body takes a drive there"));
+                };
+                b.drive = Some(Signal::Constant(value));
+            }
+            NetworkInput::ClutchForce(k) => {
+                let Some(super::CouplingKind::Clutch(cl)) =
+                    self.couplings.get_mut(k).map(|c| &mut c.kind)
+                else {
+                    return bad(format!("coupling {k}: not a clutch"));
+                };
+                if value < 0.0 {
+                    return bad(format!("normal force {value} N: expected >= 0"));
+                }
+                cl.force = Signal::Constant(value / cl.fn_max_n);
+            }
+        }
+        Ok(())
+    }
+}

@@ -28,6 +28,36 @@ pub(crate) struct NetworkWorld {
     angle: Vec<f64>,
 }
 
+/// A copy of the world, exact: every part of rapier's state is cloned but the physics and
+/// collision pipelines, which are not `Clone` and hold only workspace rebuilt at every step
+/// (as the pack's `World`'s copy, `world.rs`): the copy steps as the original, to the bit
+/// (`tests/network.rs`).
+impl Clone for NetworkWorld {
+    fn clone(&self) -> NetworkWorld {
+        let p = &self.physics;
+        NetworkWorld {
+            physics: PhysicsWorld {
+                gravity: p.gravity,
+                integration_parameters: p.integration_parameters,
+                physics_pipeline: rapier3d_f64::pipeline::PhysicsPipeline::new(),
+                collision_pipeline: rapier3d_f64::pipeline::CollisionPipeline::new(),
+                islands: p.islands.clone(),
+                broad_phase: p.broad_phase.clone(),
+                narrow_phase: p.narrow_phase.clone(),
+                bodies: p.bodies.clone(),
+                colliders: p.colliders.clone(),
+                impulse_joints: p.impulse_joints.clone(),
+                multibody_joints: p.multibody_joints.clone(),
+                soft_bodies: p.soft_bodies.clone(),
+                ccd_solver: p.ccd_solver.clone(),
+            },
+            handles: self.handles.clone(),
+            fixed: self.fixed.clone(),
+            angle: self.angle.clone(),
+        }
+    }
+}
+
 impl NetworkWorld {
     /// Builds the world at t = 0: every body at angle 0 turning at its initial speed.
     pub fn build(net: &Network) -> NetworkWorld {

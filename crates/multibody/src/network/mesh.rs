@@ -69,6 +69,7 @@ impl Path {
 }
 
 /// One gear mesh of the network and its contact state.
+#[derive(Clone)]
 pub(super) struct Mesh {
     /// The coupling's index and its bodies `a`, `b`.
     pub coupling: usize,

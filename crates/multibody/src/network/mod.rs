@@ -5,7 +5,10 @@
 //! meshes' contacts in `mesh.rs`), and
 //! the ideal gears and locked clutches are velocity-level constraints solved each step
 //! (`constraint.rs`). The output types are the model's ([`clutchpack_model::network`]), the
-//! reference engine's, so that the two engines' runs compare field by field.
+//! reference engine's, so that the two engines' runs compare field by field. A run is a
+//! [`NetworkStepper`] (`stepper.rs`), advanced call by call with inputs
+//! ([`NetworkInput`]) set in between as the reference engine's is; [`run_network`] is one
+//! call to the end.
 //!
 //! # Method
 //! Fixed steps of `step_s` (shortened to land on the signals' breakpoints, the sample times
@@ -73,15 +76,18 @@
 mod bodies;
 mod constraint;
 mod mesh;
+mod stepper;
+
+pub use clutchpack_model::network::NetworkInput;
+pub use stepper::{run_network, NetworkStepper};
 
 use bodies::NetworkWorld;
 use clutchpack_model::network::{
-    ClutchEvent, ClutchMode, CouplingKind, Network, NetworkEnergy, NetworkObserver, NetworkRun,
-    NetworkSample,
+    ClutchEvent, ClutchMode, CouplingKind, Network, NetworkEnergy, NetworkObserver, NetworkSample,
 };
-use clutchpack_model::EngineError;
 use constraint::Row;
 use mesh::Mesh;
+use std::sync::Arc;
 
 /// Settings of a network run on the multibody engine.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -112,8 +118,10 @@ struct Torques {
 }
 
 /// The state of a run between steps.
-struct Run<'n> {
-    net: &'n Network,
+#[derive(Clone)]
+struct Run {
+    /// The network as run (the stepper's own: an input set replaces its signal).
+    net: Arc<Network>,
     world: NetworkWorld,
     modes: Vec<Option<ClutchMode>>,
     /// Each body's speed, rad/s (the rapier bodies', 0 for the fixed body).
@@ -137,7 +145,7 @@ struct Run<'n> {
     events: u64,
 }
 
-impl<'n> Run<'n> {
+impl Run {
     /// The rows of the gears and the locked clutches.
     fn build_rows(&mut self) {
         self.rows.clear();
@@ -215,7 +223,7 @@ impl<'n> Run<'n> {
     /// The torques at `(t, theta, w)`, the meshes at `x` (m, one per mesh), in the present
     /// modes and contacts into `out` (MODEL.md section 8).
     fn evaluate(&self, t: f64, theta: &[f64], w: &[f64], x: &[f64], out: &mut Torques) {
-        let net = self.net;
+        let net = &*self.net;
         out.body.clear();
         out.body.extend(net.bodies.iter().enumerate().map(|(i, b)| {
             if b.fixed {
@@ -299,7 +307,7 @@ impl<'n> Run<'n> {
     /// rules of the reference engine's `settle`), merges the new rigid groups' speeds and
     /// leaves the step's torques computed.
     fn settle(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
-        let net = self.net;
+        let net = Arc::clone(&self.net);
         let before = self.modes.clone();
         let w_before = self.w.clone();
         for (k, c) in net.couplings.iter().enumerate() {
@@ -401,7 +409,7 @@ impl<'n> Run<'n> {
     /// zero, the first clutch force crossing zero and the first mesh contact's onset or
     /// separation within it.
     fn landing(&self, t: f64, h: f64) -> f64 {
-        let net = self.net;
+        let net = &*self.net;
         let mut best = h;
         let mut any_locked = false;
         let total = self.total();
@@ -488,193 +496,4 @@ impl<'n> Run<'n> {
             mode: self.modes.clone(),
         }
     }
-}
-
-/// Runs `net` on the multibody engine for `duration_s` seconds; samples and clutch events go
-/// to `obs` as they happen. A network with problems ([`Network::problems`]), a duration or a
-/// step that is not finite and positive are refused.
-pub fn run_network(
-    net: &Network,
-    duration_s: f64,
-    options: &NetworkStepOptions,
-    obs: &mut dyn NetworkObserver,
-) -> Result<NetworkRun, EngineError> {
-    net.check_run(duration_s)?;
-    let h_max = options.step_s;
-    if !(h_max.is_finite() && h_max > 0.0) {
-        return Err(EngineError::Unsupported(format!(
-            "step {h_max} s must be finite and > 0"
-        )));
-    }
-    if !(options.record_rate_hz.is_finite() && options.record_rate_hz >= 0.0) {
-        return Err(EngineError::Unsupported(format!(
-            "record rate {} Hz must be finite and >= 0",
-            options.record_rate_hz
-        )));
-    }
-    let n = net.bodies.len();
-    let m = net.couplings.len();
-    let world = NetworkWorld::build(net);
-    let mut run = Run {
-        net,
-        w: world.speeds(),
-        inv_inertia: net
-            .bodies
-            .iter()
-            .map(|b| if b.fixed { 0.0 } else { 1.0 / b.inertia_kg_m2 })
-            .collect(),
-        world,
-        modes: (0..m)
-            .map(|k| net.couplings[k].clutch().map(|_| ClutchMode::Free))
-            .collect(),
-        rows: Vec::new(),
-        torque: vec![0.0; n],
-        lambda: Vec::new(),
-        coupling_torque: vec![0.0; m],
-        meshes: Mesh::of(net),
-        mesh_force: Vec::new(),
-        heat: vec![0.0; m],
-        energy: NetworkEnergy::default(),
-        events: 0,
-    };
-    let w_start = run.w.clone();
-    let breakpoints = net.breakpoints(duration_s);
-    let mut next_bp = 0;
-    let period = if options.record_rate_hz > 0.0 {
-        1.0 / options.record_rate_hz
-    } else {
-        f64::INFINITY
-    };
-    let mut next_sample = 0u64;
-    let mut t = 0.0;
-    let mut steps = 0u64;
-    let near = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + b.abs());
-    loop {
-        while next_bp < breakpoints.len() && breakpoints[next_bp] <= t + 1e-12 * (1.0 + t) {
-            next_bp += 1;
-            run.events += 1;
-        }
-        let t_sample = next_sample as f64 * period;
-        let stop = breakpoints
-            .get(next_bp)
-            .copied()
-            .unwrap_or(duration_s)
-            .min(duration_s)
-            .min(if t_sample > t {
-                t_sample
-            } else {
-                f64::INFINITY
-            });
-        // a contact's onset or separation at t (landed on), before the torques at t
-        let h_contact = mesh::start_step(&mut run.meshes, t, &run.w, obs);
-        let h = (stop - t).min(h_max).min(h_contact).max(0.0);
-        run.settle(t, obs);
-        if (near(t, t_sample) || t_sample <= t) && t_sample < duration_s && t < duration_s {
-            obs.sample(&run.sample(t));
-            next_sample += 1;
-        }
-        if t >= duration_s || near(t, duration_s) {
-            break;
-        }
-        // the step's torques: at its midpoint (explicit midpoint rule), landed with them
-        let mut h = run.landing(t, h);
-        let start = run.total();
-        let (mut w_force, mut theta_force) = run.step_torques(t, h, &start);
-        let h_mid = run.landing(t, h);
-        if h_mid < h {
-            h = h_mid;
-            (w_force, theta_force) = run.step_torques(t, h, &start);
-        }
-        // at least 1e-13 (1 + t) s, so that time moves (a landing nearer than that is on
-        // the step's end to within the events' own precision)
-        h = h.max(1e-13 * (1.0 + t)).min(stop - t);
-        let t_force = t + 0.5 * h;
-        let t_new = if h == stop - t { stop } else { t + h };
-        let h = t_new - t;
-        let w0 = run.w.clone();
-        let total = run.total();
-        let acc = run.accelerations(&total);
-        let paths: Vec<mesh::Path> = run
-            .meshes
-            .iter()
-            .map(|mesh| mesh.path(t, h, &w0, &acc))
-            .collect();
-        run.w = run.world.step(&total, h);
-        // rapier's speeds keep the rows to rounding; remove it (momentum kept)
-        constraint::project(&run.rows, &run.inv_inertia, &mut run.w);
-        run.world.set_speeds(&run.w);
-        if run.w.iter().any(|v| !v.is_finite()) {
-            return Err(EngineError::Diverged {
-                t_s: t,
-                reason: "a body's speed is not finite".into(),
-            });
-        }
-        // the works over the step, with the step's mean speeds (the discrete energy identity)
-        for (i, b) in net.bodies.iter().enumerate() {
-            if b.fixed {
-                continue;
-            }
-            let wbar = 0.5 * (w0[i] + run.w[i]);
-            let drive = b.drive_torque_n_m(t_force, theta_force[i]);
-            run.energy.drive_work_j += h * drive * wbar;
-            let wf = w_force[i];
-            run.energy.load_work_j += h * b.road_load.map_or(0.0, |l| l.torque_n_m(wf)) * wbar;
-            run.energy.drag_loss_j += h * b.drag_n_m_s_rad * wf * wbar;
-        }
-        for (k, c) in net.couplings.iter().enumerate() {
-            if matches!(run.modes[k], Some(ClutchMode::Slipping(_))) {
-                let wrel = 0.5 * (w0[c.b] + run.w[c.b] - w0[c.a] - run.w[c.a]);
-                run.heat[k] += h * run.coupling_torque[k] * wrel;
-            }
-            if let Some(sd) = net.couplings[k].spring() {
-                // the damper's share of the torque held over the step, on the step's mean
-                // twist rate (the spring's share is its potential's change, at the end)
-                let rate = 0.5 * (w0[c.a] + run.w[c.a] - w0[c.b] - run.w[c.b]);
-                let loss = h * sd.damping_n_m_s_per_rad * (w_force[c.a] - w_force[c.b]) * rate;
-                run.heat[k] += loss;
-                run.energy.damper_loss_j += loss;
-            }
-        }
-        for (j, mesh) in run.meshes.iter_mut().enumerate() {
-            let work = mesh.advance(&paths[j], &run.w, run.mesh_force[j]);
-            run.heat[mesh.coupling] += work;
-            run.energy.mesh_work_j += work;
-        }
-        t = t_new;
-        steps += 1;
-        if !obs.progress(t) {
-            run.settle(t, obs);
-            break;
-        }
-    }
-    for mesh in &mut run.meshes {
-        mesh.finish(t, obs);
-    }
-    let last = run.sample(t);
-    obs.sample(&last);
-    run.energy.clutch_heat_j =
-        run.heat.iter().sum::<f64>() - run.energy.damper_loss_j - run.energy.mesh_work_j;
-    let angles = run.world.angles();
-    run.energy.spring_energy_change_j = (0..net.couplings.len())
-        .filter_map(|k| net.couplings[k].spring().map(|sd| (k, sd)))
-        .map(|(k, sd)| {
-            let c = &net.couplings[k];
-            sd.potential_j(angles[c.a] - angles[c.b]) - sd.potential_j(0.0)
-        })
-        .sum();
-    // per body as J (w - w0) (w + w0) / 2: no cancellation between large energies
-    run.energy.kinetic_change_j = net
-        .bodies
-        .iter()
-        .zip(w_start.iter().zip(&run.w))
-        .filter(|(b, _)| !b.fixed)
-        .map(|(b, (w0, w))| 0.5 * b.inertia_kg_m2 * (w - w0) * (w + w0))
-        .sum();
-    Ok(NetworkRun {
-        last,
-        heat_j: run.heat,
-        energy: run.energy,
-        steps,
-        events: run.events,
-    })
 }

@@ -311,7 +311,7 @@ class Simulation:
     Ctrl-C stops it (the run stands at an earlier time, everything before kept) and raises
     ``KeyboardInterrupt``.
 
-    A network scene (``[[bodies]]``, on the reference engine) has the inputs
+    A network scene (``[[bodies]]``, on either engine) has the inputs
     ``bodies.<body>.drive_torque_n_m`` (N m) and ``couplings.<clutch>.normal_force_n`` (N),
     held from the instant they are set (no slopes), and the outputs
     ``bodies.<body>.speed_rad_s`` and ``.angle_rad``, ``couplings.<name>.torque_n_m`` and, for

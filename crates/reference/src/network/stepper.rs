@@ -6,8 +6,9 @@
 use super::modes::settle;
 use super::{mesh, sample, Equations, NetworkOptions};
 use crate::dopri::{next_step, Dense, Dopri5};
+pub use clutchpack_model::network::NetworkInput;
 use clutchpack_model::network::{
-    ClutchMode, CouplingKind, Network, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
+    ClutchMode, Network, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
 };
 use clutchpack_model::EngineError;
 use std::sync::Arc;
@@ -23,18 +24,6 @@ pub fn run_network(
     let mut run = NetworkStepper::new(net, duration_s, options, obs)?;
     run.advance_to(duration_s, obs)?;
     Ok(run.finish(obs))
-}
-
-/// An input of a network that a session's caller may set (MODEL.md section 8, "Inputs"): the
-/// value is held from the instant it is set (a zero-order hold) and replaces the scene's
-/// signal from then on.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum NetworkInput {
-    /// The drive torque on body `i`, N m (positive in its sense of rotation; its firing
-    /// harmonics, if any, still add to it).
-    Drive(usize),
-    /// The normal force of the clutch that is coupling `k`, N (>= 0; 0: free).
-    ClutchForce(usize),
 }
 
 /// A network run advanced call by call ([`NetworkStepper::advance_to`]), with inputs set
@@ -191,29 +180,7 @@ impl NetworkStepper {
         value: f64,
         obs: &mut dyn NetworkObserver,
     ) -> Result<(), EngineError> {
-        let bad = |why: String| Err(EngineError::Unsupported(why));
-        if !value.is_finite() {
-            return bad(format!("input value {value}: expected a finite number"));
-        }
-        let net = Arc::make_mut(&mut self.eq.net);
-        match input {
-            NetworkInput::Drive(i) => {
-                let Some(b) = net.bodies.get_mut(i).filter(|b| !b.fixed) else {
-                    return bad(format!("body {i}: no turning body takes a drive there"));
-                };
-                b.drive = Some(clutchpack_model::network::Signal::Constant(value));
-            }
-            NetworkInput::ClutchForce(k) => {
-                let Some(CouplingKind::Clutch(cl)) = net.couplings.get_mut(k).map(|c| &mut c.kind)
-                else {
-                    return bad(format!("coupling {k}: not a clutch"));
-                };
-                if value < 0.0 {
-                    return bad(format!("normal force {value} N: expected >= 0"));
-                }
-                cl.force = clutchpack_model::network::Signal::Constant(value / cl.fn_max_n);
-            }
-        }
+        Arc::make_mut(&mut self.eq.net).hold_input(input, value)?;
         // the signal's breakpoints after now are those of the network as it is now
         let t = self.t;
         self.breakpoints = self.eq.net.breakpoints(self.duration_s);

@@ -1,0 +1,361 @@
+//! A driveline network on the multibody engine advanced call by call: [`NetworkStepper`],
+//! the method of the module's docs (`mod.rs`: fixed steps landed on the breakpoints, the
+//! samples and the events; the modes settled at the start of each step) with inputs set
+//! between calls, and [`run_network`], one call to the end.
+
+use super::bodies::NetworkWorld;
+use super::mesh::{self, Mesh};
+use super::{constraint, NetworkStepOptions, Run};
+use clutchpack_model::network::{
+    ClutchMode, Network, NetworkEnergy, NetworkInput, NetworkObserver, NetworkRun, NetworkSample,
+};
+use clutchpack_model::EngineError;
+use std::sync::Arc;
+
+/// Runs `net` on the multibody engine for `duration_s` seconds; samples and clutch events go
+/// to `obs` as they happen. A network with problems ([`Network::problems`]), a duration or a
+/// step that is not finite and positive are refused.
+pub fn run_network(
+    net: &Network,
+    duration_s: f64,
+    options: &NetworkStepOptions,
+    obs: &mut dyn NetworkObserver,
+) -> Result<NetworkRun, EngineError> {
+    let mut run = NetworkStepper::new(net, duration_s, options, obs)?;
+    run.advance_to(duration_s, obs)?;
+    Ok(run.finish(obs))
+}
+
+/// Whether `a` is `b` within the events' precision, `1e-12 (1 + |b|)` s.
+fn near(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-12 * (1.0 + b.abs())
+}
+
+/// A network run on the multibody engine advanced call by call
+/// ([`NetworkStepper::advance_to`]), with inputs set between calls
+/// ([`NetworkStepper::set_input`]); [`run_network`] is one call to the end. Every call ends
+/// a step at its time, as a breakpoint of the signals does, so a run split into calls
+/// differs from the whole run by the steps' placement only (second order in the step).
+/// A clone advances as the original, to the bit (the rapier world is copied whole but its
+/// workspace, `bodies.rs`): a saved state.
+#[derive(Clone)]
+pub struct NetworkStepper {
+    run: Run,
+    /// The longest step, s.
+    h_max: f64,
+    /// The run's end, s (samples stop there).
+    duration_s: f64,
+    /// Each body's speed at t = 0, rad/s (the kinetic energy's change at the end).
+    w_start: Vec<f64>,
+    /// The signals' breakpoints up to the end, s, and the first not yet reached.
+    breakpoints: Vec<f64>,
+    next_bp: usize,
+    /// Sample interval, s (infinite: none but the last), and the next sample's number.
+    period: f64,
+    next_sample: u64,
+    /// The sample time the step from `t` stops at, s (taken before the sample at `t`).
+    t_sample: f64,
+    /// The longest step the open mesh contacts allow from `t`, s.
+    h_contact: f64,
+    /// The time the run stands at, s.
+    t: f64,
+    /// Steps taken.
+    steps: u64,
+    /// Whether the start of a step at `t` (breakpoints passed, contacts switched, modes
+    /// settled, a sample due) is done.
+    started: bool,
+}
+
+impl NetworkStepper {
+    /// Starts `net` at t = 0 for a run of `duration_s` s: the modes settled, the mesh
+    /// contacts opened and the first sample sent to `obs`. A network with problems
+    /// ([`Network::problems`]), a duration or a step that is not finite and positive, or a
+    /// record rate that is not finite and >= 0 are refused.
+    pub fn new(
+        net: &Network,
+        duration_s: f64,
+        options: &NetworkStepOptions,
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<NetworkStepper, EngineError> {
+        net.check_run(duration_s)?;
+        let h_max = options.step_s;
+        if !(h_max.is_finite() && h_max > 0.0) {
+            return Err(EngineError::Unsupported(format!(
+                "step {h_max} s must be finite and > 0"
+            )));
+        }
+        if !(options.record_rate_hz.is_finite() && options.record_rate_hz >= 0.0) {
+            return Err(EngineError::Unsupported(format!(
+                "record rate {} Hz must be finite and >= 0",
+                options.record_rate_hz
+            )));
+        }
+        let n = net.bodies.len();
+        let m = net.couplings.len();
+        let world = NetworkWorld::build(net);
+        let run = Run {
+            w: world.speeds(),
+            inv_inertia: net
+                .bodies
+                .iter()
+                .map(|b| if b.fixed { 0.0 } else { 1.0 / b.inertia_kg_m2 })
+                .collect(),
+            world,
+            modes: (0..m)
+                .map(|k| net.couplings[k].clutch().map(|_| ClutchMode::Free))
+                .collect(),
+            rows: Vec::new(),
+            torque: vec![0.0; n],
+            lambda: Vec::new(),
+            coupling_torque: vec![0.0; m],
+            meshes: Mesh::of(net),
+            mesh_force: Vec::new(),
+            heat: vec![0.0; m],
+            energy: NetworkEnergy::default(),
+            events: 0,
+            net: Arc::new(net.clone()),
+        };
+        let mut stepper = NetworkStepper {
+            w_start: run.w.clone(),
+            run,
+            h_max,
+            duration_s,
+            breakpoints: net.breakpoints(duration_s),
+            next_bp: 0,
+            period: if options.record_rate_hz > 0.0 {
+                1.0 / options.record_rate_hz
+            } else {
+                f64::INFINITY
+            },
+            next_sample: 0,
+            t_sample: 0.0,
+            h_contact: f64::INFINITY,
+            t: 0.0,
+            steps: 0,
+            started: false,
+        };
+        stepper.start_step(obs);
+        Ok(stepper)
+    }
+
+    /// The time the run stands at, s.
+    pub fn time_s(&self) -> f64 {
+        self.t
+    }
+
+    /// The network as run (with the inputs set so far in place of the scene's signals).
+    pub fn network(&self) -> &Network {
+        &self.run.net
+    }
+
+    /// The state now as a sample (every body's angle, rad, and speed, rad/s, every
+    /// coupling's torque on its body `a`, N m, and a clutch's mode).
+    pub fn sample_now(&mut self) -> NetworkSample {
+        self.run.sample(self.t)
+    }
+
+    /// Heat of each clutch, work done on each gear mesh, or each damper's loss, since t = 0,
+    /// J, by coupling (0 for an ideal gear or a spring-damper's spring).
+    pub fn heat_j(&self) -> Vec<f64> {
+        self.run.heat.clone()
+    }
+
+    /// Sets `input` to `value` from now on (N m or N; [`Network::hold_input`]): the scene's
+    /// signal is replaced by the held value in the stepper's own network, its breakpoints
+    /// after now taken again, and the run restarts here as at a jump of a signal (counted as
+    /// an event; the clutches' modes settled at once, MODEL.md section 8, events sent to
+    /// `obs`). A value that is not finite, a negative force, or an input naming a body or
+    /// coupling that cannot take it is refused, the run unchanged.
+    pub fn set_input(
+        &mut self,
+        input: NetworkInput,
+        value: f64,
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<(), EngineError> {
+        Arc::make_mut(&mut self.run.net).hold_input(input, value)?;
+        let t = self.t;
+        self.breakpoints = self.run.net.breakpoints(self.duration_s);
+        self.next_bp = self
+            .breakpoints
+            .partition_point(|&b| b <= t + 1e-12 * (1.0 + t));
+        self.run.events += 1;
+        self.run.settle(t, obs);
+        Ok(())
+    }
+
+    /// Advances to `t_end` s (at most the run's end), a step ending there (within the
+    /// events' precision, `1e-12 (1 + t)` s, as the run's end); samples, clutch events and
+    /// mesh impacts go to `obs` as they happen. Stops early (without error) when `obs` asks
+    /// to ([`NetworkObserver::progress`]).
+    pub fn advance_to(
+        &mut self,
+        t_end: f64,
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<(), EngineError> {
+        let t_end = t_end.min(self.duration_s);
+        loop {
+            if !self.started {
+                self.start_step(obs);
+            }
+            if self.t >= t_end || near(self.t, t_end) {
+                return Ok(());
+            }
+            self.step(t_end)?;
+            if !obs.progress(self.t) {
+                self.run.settle(self.t, obs);
+                return Ok(());
+            }
+        }
+    }
+
+    /// The start of a step at `t` (the module's method, steps 0 and 1): the breakpoints
+    /// reached passed (each an event), the mesh contacts opened or closed and the step they
+    /// allow taken, the modes settled, and the sample due at `t` sent to `obs`.
+    fn start_step(&mut self, obs: &mut dyn NetworkObserver) {
+        let t = self.t;
+        let bps = &self.breakpoints;
+        while self.next_bp < bps.len() && bps[self.next_bp] <= t + 1e-12 * (1.0 + t) {
+            self.next_bp += 1;
+            self.run.events += 1;
+        }
+        self.t_sample = self.next_sample as f64 * self.period;
+        // a contact's onset or separation at t (landed on), before the torques at t
+        self.h_contact = mesh::start_step(&mut self.run.meshes, t, &self.run.w, obs);
+        self.run.settle(t, obs);
+        let t_sample = self.t_sample;
+        if (near(t, t_sample) || t_sample <= t) && t_sample < self.duration_s && t < self.duration_s
+        {
+            obs.sample(&self.run.sample(t));
+            self.next_sample += 1;
+        }
+        self.started = true;
+    }
+
+    /// One step from `t` (the module's method, steps 2 to 5), ending at `t_end` s at the
+    /// latest, and its works counted (the module's "Energy").
+    fn step(&mut self, t_end: f64) -> Result<(), EngineError> {
+        let t = self.t;
+        let t_sample = self.t_sample;
+        let stop = self
+            .breakpoints
+            .get(self.next_bp)
+            .copied()
+            .unwrap_or(self.duration_s)
+            .min(self.duration_s)
+            .min(if t_sample > t {
+                t_sample
+            } else {
+                f64::INFINITY
+            })
+            .min(t_end);
+        let h = (stop - t).min(self.h_max).min(self.h_contact).max(0.0);
+        let run = &mut self.run;
+        // the step's torques: at its midpoint (explicit midpoint rule), landed with them
+        let mut h = run.landing(t, h);
+        let start = run.total();
+        let (mut w_force, mut theta_force) = run.step_torques(t, h, &start);
+        let h_mid = run.landing(t, h);
+        if h_mid < h {
+            h = h_mid;
+            (w_force, theta_force) = run.step_torques(t, h, &start);
+        }
+        // at least 1e-13 (1 + t) s, so that time moves (a landing nearer than that is on
+        // the step's end to within the events' own precision)
+        h = h.max(1e-13 * (1.0 + t)).min(stop - t);
+        let t_force = t + 0.5 * h;
+        let t_new = if h == stop - t { stop } else { t + h };
+        let h = t_new - t;
+        let w0 = run.w.clone();
+        let total = run.total();
+        let acc = run.accelerations(&total);
+        let paths: Vec<mesh::Path> = run
+            .meshes
+            .iter()
+            .map(|mesh| mesh.path(t, h, &w0, &acc))
+            .collect();
+        run.w = run.world.step(&total, h);
+        // rapier's speeds keep the rows to rounding; remove it (momentum kept)
+        constraint::project(&run.rows, &run.inv_inertia, &mut run.w);
+        run.world.set_speeds(&run.w);
+        if run.w.iter().any(|v| !v.is_finite()) {
+            return Err(EngineError::Diverged {
+                t_s: t,
+                reason: "a body's speed is not finite".into(),
+            });
+        }
+        let net = Arc::clone(&run.net);
+        // the works over the step, with the step's mean speeds (the discrete energy identity)
+        for (i, b) in net.bodies.iter().enumerate() {
+            if b.fixed {
+                continue;
+            }
+            let wbar = 0.5 * (w0[i] + run.w[i]);
+            let drive = b.drive_torque_n_m(t_force, theta_force[i]);
+            run.energy.drive_work_j += h * drive * wbar;
+            let wf = w_force[i];
+            run.energy.load_work_j += h * b.road_load.map_or(0.0, |l| l.torque_n_m(wf)) * wbar;
+            run.energy.drag_loss_j += h * b.drag_n_m_s_rad * wf * wbar;
+        }
+        for (k, c) in net.couplings.iter().enumerate() {
+            if matches!(run.modes[k], Some(ClutchMode::Slipping(_))) {
+                let wrel = 0.5 * (w0[c.b] + run.w[c.b] - w0[c.a] - run.w[c.a]);
+                run.heat[k] += h * run.coupling_torque[k] * wrel;
+            }
+            if let Some(sd) = net.couplings[k].spring() {
+                // the damper's share of the torque held over the step, on the step's mean
+                // twist rate (the spring's share is its potential's change, at the end)
+                let rate = 0.5 * (w0[c.a] + run.w[c.a] - w0[c.b] - run.w[c.b]);
+                let loss = h * sd.damping_n_m_s_per_rad * (w_force[c.a] - w_force[c.b]) * rate;
+                run.heat[k] += loss;
+                run.energy.damper_loss_j += loss;
+            }
+        }
+        for (j, mesh) in run.meshes.iter_mut().enumerate() {
+            let work = mesh.advance(&paths[j], &run.w, run.mesh_force[j]);
+            run.heat[mesh.coupling] += work;
+            run.energy.mesh_work_j += work;
+        }
+        self.t = t_new;
+        self.steps += 1;
+        self.started = false;
+        Ok(())
+    }
+
+    /// Ends the run where it stands: the open mesh contacts closed, the last sample sent to
+    /// `obs`, and the run's heat (J), energy balance (the module's "Energy") and counts.
+    pub fn finish(mut self, obs: &mut dyn NetworkObserver) -> NetworkRun {
+        let t = self.t;
+        let run = &mut self.run;
+        for mesh in &mut run.meshes {
+            mesh.finish(t, obs);
+        }
+        let last = run.sample(t);
+        obs.sample(&last);
+        run.energy.clutch_heat_j =
+            run.heat.iter().sum::<f64>() - run.energy.damper_loss_j - run.energy.mesh_work_j;
+        let net = &run.net;
+        let angles = run.world.angles();
+        run.energy.spring_energy_change_j = (0..net.couplings.len())
+            .filter_map(|k| net.couplings[k].spring().map(|sd| (k, sd)))
+            .map(|(k, sd)| {
+                let c = &net.couplings[k];
+                sd.potential_j(angles[c.a] - angles[c.b]) - sd.potential_j(0.0)
+            })
+            .sum();
+        // per body as J (w - w0) (w + w0) / 2: no cancellation between large energies
+        run.energy.kinetic_change_j = net
+            .bodies
+            .iter()
+            .zip(self.w_start.iter().zip(&run.w))
+            .filter(|(b, _)| !b.fixed)
+            .map(|(b, (w0, w))| 0.5 * b.inertia_kg_m2 * (w - w0) * (w + w0))
+            .sum();
+        NetworkRun {
+            last,
+            heat_j: std::mem::take(&mut run.heat),
+            energy: run.energy,
+            steps: self.steps,
+            events: run.events,
+        }
+    }
+}
