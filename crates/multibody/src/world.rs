@@ -51,23 +51,8 @@ pub(crate) struct World {
 /// `tests/session.rs`, "a clone advances as the original").
 impl Clone for World {
     fn clone(&self) -> World {
-        let p = &self.physics;
         World {
-            physics: PhysicsWorld {
-                gravity: p.gravity,
-                integration_parameters: p.integration_parameters,
-                physics_pipeline: rapier3d_f64::pipeline::PhysicsPipeline::new(),
-                collision_pipeline: rapier3d_f64::pipeline::CollisionPipeline::new(),
-                islands: p.islands.clone(),
-                broad_phase: p.broad_phase.clone(),
-                narrow_phase: p.narrow_phase.clone(),
-                bodies: p.bodies.clone(),
-                colliders: p.colliders.clone(),
-                impulse_joints: p.impulse_joints.clone(),
-                multibody_joints: p.multibody_joints.clone(),
-                soft_bodies: p.soft_bodies.clone(),
-                ccd_solver: p.ccd_solver.clone(),
-            },
+            physics: copy_physics(&self.physics),
             shaft: self.shaft,
             shaft_dynamic: self.shaft_dynamic,
             housing: self.housing,
@@ -401,6 +386,28 @@ pub(crate) fn exponential_map_deficit(body: &RigidBody, dt: f64) -> Vector {
 /// Rotation angle of `q` about `+z` in (-pi, pi], for rotations about `+z` (tilts are locked).
 pub(crate) fn angle_about_z(q: &Rotation) -> f64 {
     2.0 * q.z.atan2(q.w)
+}
+
+/// A copy of rapier's world `p`, exact but for the physics and collision pipelines, which
+/// are not `Clone` and hold only workspace rebuilt at every step (see [`World`]'s `Clone`):
+/// the copy steps as the original, to the bit. The pack's [`World`] and the network's world
+/// are copied through it.
+pub(crate) fn copy_physics(p: &PhysicsWorld) -> PhysicsWorld {
+    PhysicsWorld {
+        gravity: p.gravity,
+        integration_parameters: p.integration_parameters,
+        physics_pipeline: rapier3d_f64::pipeline::PhysicsPipeline::new(),
+        collision_pipeline: rapier3d_f64::pipeline::CollisionPipeline::new(),
+        islands: p.islands.clone(),
+        broad_phase: p.broad_phase.clone(),
+        narrow_phase: p.narrow_phase.clone(),
+        bodies: p.bodies.clone(),
+        colliders: p.colliders.clone(),
+        impulse_joints: p.impulse_joints.clone(),
+        multibody_joints: p.multibody_joints.clone(),
+        soft_bodies: p.soft_bodies.clone(),
+        ccd_solver: p.ccd_solver.clone(),
+    }
 }
 
 #[cfg(test)]

@@ -27,7 +27,9 @@
 use crate::info::{num, RunInfo};
 use crate::output::{PendingFile, Replace};
 use crate::view3d::{about_z, entity, pose, rgba, timestamp, v3};
-use crate::write::{close_mcap, open_mcap, unique_segments, RecordError, RecordOptions};
+use crate::write::{
+    close_mcap, open_mcap, unique_segments, write_message, RecordError, RecordOptions,
+};
 use crate::{log_time_ns, proto, ros2, topics};
 use clutchpack_model::network::{ClutchEvent, ClutchMode, CouplingKind, Network, NetworkSample};
 use clutchpack_model::ImpactEvent;
@@ -480,15 +482,7 @@ impl NetworkRecorder {
         let Some(w) = self.writer.as_mut() else {
             return Err(failed);
         };
-        let seq = self.sequences.entry(channel).or_insert(0);
-        *seq = seq.wrapping_add(1);
-        let header = mcap::records::MessageHeader {
-            channel_id: channel,
-            sequence: *seq,
-            log_time,
-            publish_time: log_time,
-        };
-        if let Err(cause) = w.write_to_known_channel(&header, &self.buf) {
+        if let Err(cause) = write_message(w, &mut self.sequences, channel, log_time, &self.buf) {
             self.failed = true;
             return Err(RecordError::Write {
                 path: self.path.clone(),

@@ -424,6 +424,27 @@ pub(crate) fn open_mcap(
     Ok(w)
 }
 
+/// Writes `data` as the next message on `channel` at `log_time` (ns, also its publish time),
+/// numbered by the channel's count in `sequences`: every message of both recorders goes
+/// through it.
+pub(crate) fn write_message(
+    w: &mut mcap::Writer<BufWriter<File>>,
+    sequences: &mut BTreeMap<u16, u32>,
+    channel: u16,
+    log_time: u64,
+    data: &[u8],
+) -> Result<(), mcap::McapError> {
+    let seq = sequences.entry(channel).or_insert(0);
+    *seq = seq.wrapping_add(1);
+    let header = mcap::records::MessageHeader {
+        channel_id: channel,
+        sequence: *seq,
+        log_time,
+        publish_time: log_time,
+    };
+    w.write_to_known_channel(&header, data)
+}
+
 /// Ends an MCAP file opened by [`open_mcap`]: the `clutchpack.stats` metadata record `stats`,
 /// the summary section, the flush, and the move into place of an output written whole
 /// (`pending` is taken only then: after an error the caller may still discard it).
@@ -819,15 +840,7 @@ impl Recorder {
         let Some(w) = self.writer.as_mut() else {
             return Err(self.failed_err());
         };
-        let seq = self.sequences.entry(channel).or_insert(0);
-        *seq = seq.wrapping_add(1);
-        let header = mcap::records::MessageHeader {
-            channel_id: channel,
-            sequence: *seq,
-            log_time,
-            publish_time: log_time,
-        };
-        if let Err(source) = w.write_to_known_channel(&header, &self.buf) {
+        if let Err(source) = write_message(w, &mut self.sequences, channel, log_time, &self.buf) {
             self.failed = true;
             return Err(RecordError::Write {
                 path: self.path.clone(),

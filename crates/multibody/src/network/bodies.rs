@@ -34,23 +34,8 @@ pub(crate) struct NetworkWorld {
 /// (`tests/network.rs`).
 impl Clone for NetworkWorld {
     fn clone(&self) -> NetworkWorld {
-        let p = &self.physics;
         NetworkWorld {
-            physics: PhysicsWorld {
-                gravity: p.gravity,
-                integration_parameters: p.integration_parameters,
-                physics_pipeline: rapier3d_f64::pipeline::PhysicsPipeline::new(),
-                collision_pipeline: rapier3d_f64::pipeline::CollisionPipeline::new(),
-                islands: p.islands.clone(),
-                broad_phase: p.broad_phase.clone(),
-                narrow_phase: p.narrow_phase.clone(),
-                bodies: p.bodies.clone(),
-                colliders: p.colliders.clone(),
-                impulse_joints: p.impulse_joints.clone(),
-                multibody_joints: p.multibody_joints.clone(),
-                soft_bodies: p.soft_bodies.clone(),
-                ccd_solver: p.ccd_solver.clone(),
-            },
+            physics: crate::world::copy_physics(&self.physics),
             handles: self.handles.clone(),
             fixed: self.fixed.clone(),
             angle: self.angle.clone(),
