@@ -275,7 +275,7 @@ pub fn run_network_scene(
     let engine = scene.engine(asked, &scene.name)?;
     let sim = &scene.simulation;
     let mut keep = Keep::new(
-        start_recording(scene, engine, req.recording.as_ref())?,
+        start_recording(scene, engine, req.recording.as_ref(), None)?,
         req.keep_history,
     );
     let mut obs = Obs {
@@ -315,15 +315,21 @@ pub(crate) fn reference_options(scene: &Scene) -> NetworkOptions {
 }
 
 /// The recording of a network run, if asked.
+/// `co_simulation`: the inputs the caller drives and where the run ends, for a run advanced
+/// call by call (its recording says so, as a pack's co-simulated recording does).
 pub(crate) fn start_recording(
     scene: &Scene,
     engine: EngineChoice,
     request: Option<&crate::RecordingRequest>,
+    co_simulation: Option<(&[String], Option<f64>)>,
 ) -> Result<Option<NetworkRecorder>> {
     let (Some(r), Some(net)) = (request, &scene.network) else {
         return Ok(None);
     };
-    let info = crate::summary::run_info(scene, engine.name(), r.scene_path.as_deref());
+    let mut info = crate::summary::run_info(scene, engine.name(), r.scene_path.as_deref());
+    if let Some((driven, stop_time_s)) = co_simulation {
+        crate::session::co_simulation_params(&mut info.params, driven, stop_time_s);
+    }
     Ok(Some(NetworkRecorder::create_output(
         &r.path, r.replace, &info, net, &r.options,
     )?))

@@ -363,7 +363,11 @@ impl NetworkSimulation {
             }
             None => scene.simulation.duration_s,
         };
-        let mut keep = Keep::new(start_recording(scene, engine, recording)?, false);
+        let driven_names: Vec<String> = driven.iter().map(|(n, _)| n.clone()).collect();
+        let mut keep = Keep::new(
+            start_recording(scene, engine, recording, Some((&driven_names, stop_time_s)))?,
+            false,
+        );
         let started = std::time::Instant::now();
         let mut obs = Obs {
             keep: &mut keep,

@@ -69,7 +69,11 @@ impl Simulation {
         let recorder = match &request.recording {
             Some(r) => {
                 let mut info = run_info(scene, self.engine_name(), r.scene_path.as_deref());
-                co_simulation_params(&mut info.params, &request);
+                let driven: Vec<String> = crate::cosim::driven_names(&request.driven)
+                    .into_iter()
+                    .map(String::from)
+                    .collect();
+                co_simulation_params(&mut info.params, &driven, request.stop_time_s);
                 Some(ThreadedRecorder::start(Recorder::create_output(
                     &r.path, r.replace, &info, &r.options,
                 )?))
@@ -93,17 +97,19 @@ impl Simulation {
 
 /// What a co-simulated run's recording says of how it was made (`clutchpack.params`): not the
 /// scene's `duration_s` (the caller decides where the run ends: `stop_time_s` if it was
-/// given; the stored statistics say where it ended) and which inputs the caller drove.
-fn co_simulation_params(
+/// given; the stored statistics say where it ended) and which inputs the caller drove, by
+/// their public names. A pack's session and a network's run advanced call by call both write
+/// it.
+pub(crate) fn co_simulation_params(
     params: &mut std::collections::BTreeMap<String, String>,
-    request: &SessionRequest,
+    driven: &[String],
+    stop_time_s: Option<f64>,
 ) {
     params.remove("duration_s");
     params.insert("co_simulation".into(), "true".into());
-    if let Some(t) = request.stop_time_s {
+    if let Some(t) = stop_time_s {
         params.insert("stop_time_s".into(), t.to_string());
     }
-    let driven = crate::cosim::driven_names(&request.driven);
     params.insert(
         "driven_inputs".into(),
         if driven.is_empty() {

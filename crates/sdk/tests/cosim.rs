@@ -189,3 +189,43 @@ fn a_network_simulation_runs_on_the_multibody_engine() {
     called.wall_time_s = whole.summary.wall_time_s;
     assert_eq!(called, whole.summary);
 }
+
+/// A network run advanced call by call and recorded says so in its recording's provenance, as
+/// a pack's co-simulated recording does: `co_simulation = true`, the inputs the caller drove
+/// by name, no scene duration (the caller decided where it ended).
+#[test]
+fn a_co_simulated_network_recording_says_what_was_driven() {
+    let dir = std::env::temp_dir().join(format!("clutchpack-netcosim-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("driven.mcap");
+    let request = clutchpack_sdk::RecordingRequest {
+        path: path.clone(),
+        replace: clutchpack_sdk::record::Replace::Existing,
+        options: Default::default(),
+        scene_path: None,
+    };
+    let drive = ["couplings.K2.normal_force_n".to_string()];
+    let mut sim = clutchpack_sdk::NetworkSimulation::start(
+        &scene("dct-upshift.toml"),
+        None,
+        &drive,
+        Some(&request),
+        None,
+    )
+    .unwrap();
+    sim.set_input(&drive[0], 1000.0).unwrap();
+    sim.advance_to(0.01, None).unwrap();
+    sim.finish().unwrap();
+    let reader = clutchpack_sdk::record::open(&path).unwrap();
+    let params = reader.info().metadata("clutchpack.params").unwrap().clone();
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(
+        params.get("co_simulation").map(String::as_str),
+        Some("true")
+    );
+    assert_eq!(
+        params.get("driven_inputs").map(String::as_str),
+        Some("couplings.K2.normal_force_n")
+    );
+    assert!(!params.contains_key("duration_s"), "{params:?}");
+}
