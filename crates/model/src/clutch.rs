@@ -142,6 +142,18 @@ pub enum PressureProfile {
 }
 
 impl PressureProfile {
+    /// Appends every instant (s) where the pressure jumps or bends: a ramp's start and end,
+    /// a table's rows.
+    pub fn breakpoints(&self, out: &mut Vec<f64>) {
+        match self {
+            PressureProfile::Constant { .. } => {}
+            PressureProfile::Ramp {
+                start_s, rise_s, ..
+            } => out.extend([*start_s, start_s + rise_s]),
+            PressureProfile::Table(t) => out.extend_from_slice(&t.t_s),
+        }
+    }
+
     /// Pressure at `t_s`, Pa.
     pub fn pressure_pa(&self, t_s: f64) -> f64 {
         match self {

@@ -89,6 +89,7 @@ pub fn coupling_kind_name(kind: &CouplingKind) -> &'static str {
         CouplingKind::IdealGear { .. } => "ideal_gear",
         CouplingKind::GearMesh(_) => "gear_mesh",
         CouplingKind::SpringDamper(_) => "spring_damper",
+        CouplingKind::Pack(_) => "pack",
     }
 }
 

@@ -80,6 +80,11 @@ pub(crate) struct System {
     ///
     /// [`Dopri5::norm_len`]: crate::dopri::Dopri5::norm_len
     pub teeth_work: bool,
+    /// Whether the carriers are bodies outside the system (a pack on a network, MODEL.md
+    /// section 8; [`System::carried`]): the state holds neither the shaft nor the drum, the
+    /// discs ride on carrier `a` and every plate on carrier `b`, and the caller gives the
+    /// carriers' motion ([`Self::rhs_with`], [`Self::reactions_n_m`]).
+    pub carried: bool,
 }
 
 impl System {
@@ -91,6 +96,19 @@ impl System {
             !sys.pack.is_whole()
                 || sys.ids == (0..sys.nd + sys.pack.plates.len()).collect::<Vec<_>>()
         );
+        sys
+    }
+
+    /// Every coupling of `pack` (discs, then plates) on carriers outside the system: the
+    /// discs' carrier `a` and the plates' carrier `b` are bodies of a network (MODEL.md
+    /// section 8), whose motion the caller gives; the pack's own shaft and drum are not used.
+    /// The state carries the teeth's work ([`Self::teeth_work`]).
+    pub fn carried(pack: Arc<PackModel>) -> System {
+        let ids = (0..pack.discs.len() + pack.plates.len()).collect();
+        let mut sys = System::build(pack, ids);
+        sys.off = 0;
+        sys.carried = true;
+        sys.teeth_work = true;
         sys
     }
 
@@ -115,6 +133,7 @@ impl System {
             faces,
             gaps: None,
             teeth_work: false,
+            carried: false,
             rb: pack
                 .discs
                 .iter()
@@ -159,7 +178,12 @@ impl System {
 
     /// Index of the first interface's heat in the state.
     fn heat_at(&self) -> usize {
-        self.drum_at() + if self.pack.drum.is_some() { 2 } else { 0 }
+        self.drum_at()
+            + if self.pack.drum.is_some() && !self.carried {
+                2
+            } else {
+                0
+            }
     }
 
     /// The heat each friction interface has dissipated since t = 0 in state `y`, J (empty
@@ -223,7 +247,17 @@ impl System {
     }
 
     fn carrier(&self, slot: usize) -> Carrier {
-        self.pack.carrier(self.ids[slot])
+        let id = self.ids[slot];
+        if self.carried {
+            // carrier a plays the shaft's part, carrier b the drum's (0 when b is fixed)
+            if id < self.nd {
+                Carrier::Shaft
+            } else {
+                Carrier::Drum
+            }
+        } else {
+            self.pack.carrier(id)
+        }
     }
 
     /// Angle (rad) and speed (rad/s) of the carrier of `slot` at `t` for state `y`.
@@ -277,20 +311,7 @@ impl System {
         let inertial = matches!(self.pack.shaft, Shaft::Inertial { .. });
         let (mut shaft_torque, mut drum_torque) = (0.0, 0.0);
         if inertial || self.pack.drum.is_some() {
-            for slot in 0..self.ids.len() {
-                if modes[slot].is_none() {
-                    continue;
-                }
-                let d = self.disc(slot);
-                let f = self.load(slot, y, &modes[slot]);
-                // Hu et al. eq (4): the spline reaction n F Rb acts back on the carrier
-                let reaction = d.spline.teeth as f64 * f * self.rb[self.ids[slot]];
-                match self.carrier(slot) {
-                    Carrier::Shaft => shaft_torque += reaction,
-                    Carrier::Drum => drum_torque += reaction,
-                    Carrier::Housing => {}
-                }
-            }
+            [shaft_torque, drum_torque] = self.reactions_n_m(y, modes);
         }
         if !self.pack.couplings.is_empty() {
             // MODEL.md section 8: the couplings between the shaft and the drum (a spring-damper:
@@ -322,6 +343,30 @@ impl System {
             None => (0.0, 0.0),
         };
         [omega_s, alpha_s, omega_r, alpha_r]
+    }
+
+    /// The spline reactions on the disc carrier (the shaft) and on the plate carrier (the
+    /// drum), N m, at state `y` with contact modes `modes` (Hu et al. eq (4): `n F Rb` summed
+    /// over the carrier's couplings in contact; nothing on the housing). The teeth are
+    /// compliant: the reactions follow from the state alone, so a network (MODEL.md section
+    /// 8) takes them before it solves its bodies' accelerations.
+    pub fn reactions_n_m(&self, y: &[f64], modes: &[Option<Engagement>]) -> [f64; 2] {
+        let (mut shaft_torque, mut drum_torque) = (0.0, 0.0);
+        for slot in 0..self.ids.len() {
+            if modes[slot].is_none() {
+                continue;
+            }
+            let d = self.disc(slot);
+            let f = self.load(slot, y, &modes[slot]);
+            // Hu et al. eq (4): the spline reaction n F Rb acts back on the carrier
+            let reaction = d.spline.teeth as f64 * f * self.rb[self.ids[slot]];
+            match self.carrier(slot) {
+                Carrier::Shaft => shaft_torque += reaction,
+                Carrier::Drum => drum_torque += reaction,
+                Carrier::Housing => {}
+            }
+        }
+        [shaft_torque, drum_torque]
     }
 
     /// Speed and acceleration of the carrier of `slot` from [`Self::carriers`].
@@ -366,6 +411,22 @@ impl System {
             dy[self.drum_at()] = c[2];
             dy[self.drum_at() + 1] = c[3];
         }
+        self.rhs_with(t, y, modes, &c, dy);
+    }
+
+    /// The couplings' part of [`Self::rhs`] (every slot's relative angle and speed, the
+    /// faces' heat, the teeth's work) with the carriers' speeds and accelerations `c`
+    /// (`[omega_s, alpha_s, omega_r, alpha_r]`, rad/s and rad/s^2, as [`Self::carriers`]
+    /// gives them; a network's bodies for a [`Self::carried`] system).
+    pub fn rhs_with(
+        &self,
+        t: f64,
+        y: &[f64],
+        modes: &[Option<Engagement>],
+        c: &[f64; 4],
+        dy: &mut [f64],
+    ) {
+        let c = *c;
         if self.pack.stack.is_some() {
             // every body is a stack body: its acceleration comes from the stack's balance
             let ev = self.stack_eval(t, y, modes, &c);
@@ -577,8 +638,22 @@ impl System {
     /// A lock sets the slip exactly to zero, moving the bodies above it (with those locked to
     /// them) to the speed below.
     pub fn settle_face(&mut self, m: usize, t: f64, y: &mut [f64], modes: &[Option<Engagement>]) {
-        let stack = self.pack.stack.as_ref().expect("a stack");
         let c = self.carriers(t, y, modes);
+        self.settle_face_with(m, t, y, modes, &c);
+    }
+
+    /// [`Self::settle_face`] with the carriers' speeds and accelerations `c` given (a
+    /// [`Self::carried`] system).
+    pub fn settle_face_with(
+        &mut self,
+        m: usize,
+        t: f64,
+        y: &mut [f64],
+        modes: &[Option<Engagement>],
+        c: &[f64; 4],
+    ) {
+        let c = *c;
+        let stack = self.pack.stack.as_ref().expect("a stack");
         let ev = self.stack_eval(t, y, modes, &c);
         if ev.raw_clamp[m] <= 0.0 {
             self.faces[m] = Face::Open;
@@ -627,7 +702,7 @@ impl System {
             y[self.off + 2 * slot] = d.initial_rel_angle_rad;
             y[self.off + 2 * slot + 1] = d.initial_rel_speed_rad_s;
         }
-        if let Some(drum) = &self.pack.drum {
+        if let (Some(drum), false) = (&self.pack.drum, self.carried) {
             y[self.drum_at() + 1] = drum.initial_speed_rad_s;
         }
         y

@@ -1,7 +1,7 @@
 //! Drivelines as networks (MODEL.md section 8): named rotational bodies (shafts, drums, an
 //! engine's crank, a vehicle reduced to a shaft) joined by couplings (lumped clutches, ideal
-//! gears; next the resolved packs, gear meshes and spring-dampers), each coupling a term in
-//! both bodies' equations, equal and opposite in its own coordinate.
+//! gears, gear meshes, spring-dampers and resolved packs), each coupling a term in both
+//! bodies' equations, equal and opposite in its own coordinate.
 //!
 //! Conventions: every body turns about its own axis; angles in rad, speeds in rad/s, torques
 //! in N m, positive in the body's sense of rotation. A coupling between bodies `a` and `b`
@@ -105,6 +105,11 @@ pub enum CouplingKind {
     /// A torsional spring-damper (a damper spring, a dual-mass flywheel; MODEL.md section 8):
     /// `T = k (theta_a - theta_b - theta_0) + d (w_a - w_b)` on `b`, `-T` on `a`.
     SpringDamper(crate::spring::SpringDamper),
+    /// A resolved pack (MODEL.md sections 2-5 and 8): its friction discs splined to body `a`,
+    /// its separator plates to body `b` (a drum; the housing when `b` is fixed), each disc and
+    /// plate a body of its own with its tooth contacts, and its stack and piston. The pack's
+    /// own `shaft` and `drum` are not used: the network's bodies `a` and `b` carry it.
+    Pack(Box<crate::PackModel>),
 }
 
 /// A coupling between two bodies of a network.
@@ -141,6 +146,14 @@ impl Coupling {
     pub fn mesh(&self) -> Option<&GearMesh> {
         match &self.kind {
             CouplingKind::GearMesh(g) => Some(g),
+            _ => None,
+        }
+    }
+
+    /// Its resolved pack, if it is one.
+    pub fn pack(&self) -> Option<&crate::PackModel> {
+        match &self.kind {
+            CouplingKind::Pack(p) => Some(p),
             _ => None,
         }
     }
@@ -322,6 +335,28 @@ impl Network {
                         ));
                     }
                 }
+                CouplingKind::Pack(p) => {
+                    if self.bodies[c.a].fixed {
+                        out.push(coupling(
+                            k,
+                            "a",
+                            format!(
+                                "\"{}\" is fixed: the friction discs' carrier must turn (the plates' carrier b may be the fixed housing)",
+                                self.bodies[c.a].name
+                            ),
+                        ));
+                    }
+                    if !p.couplings.is_empty() {
+                        out.push(coupling(
+                            k,
+                            "pack",
+                            "the pack's own [[couplings]] join its shaft and drum, which the network's bodies replace: put them in the network's [[couplings]]".into(),
+                        ));
+                    }
+                    if p.discs.is_empty() {
+                        out.push(coupling(k, "pack", "the pack has no friction discs".into()));
+                    }
+                }
                 CouplingKind::IdealGear { ratio } => {
                     if !(ratio.is_finite() && *ratio != 0.0) {
                         out.push(coupling(k, "ratio", format!("{ratio} must be nonzero")));
@@ -421,8 +456,14 @@ impl Network {
             }
         }
         for c in &self.couplings {
-            if let CouplingKind::Clutch(cl) = &c.kind {
-                cl.force.breakpoints(&mut out);
+            match &c.kind {
+                CouplingKind::Clutch(cl) => cl.force.breakpoints(&mut out),
+                CouplingKind::Pack(p) => {
+                    if let Some(s) = &p.stack {
+                        s.piston.pressure.breakpoints(&mut out);
+                    }
+                }
+                _ => {}
             }
         }
         out.retain(|t| *t > 0.0 && *t < end_s);

@@ -54,13 +54,18 @@ pub struct NetworkEnergy {
     pub damper_loss_j: f64,
     /// The spring-dampers' stored energy at the end less at the start, J.
     pub spring_energy_change_j: f64,
-    /// Kinetic energy at the end less at the start, J.
+    /// What the resolved packs took (>= 0 but for a contact's elastic energy), J: their
+    /// faces' heat, their teeth's work (impact losses, plus the elastic energy of a contact
+    /// still closed at the end) and their discs' and plates' oil drag.
+    pub pack_loss_j: f64,
+    /// Kinetic energy at the end less at the start (the packs' discs and plates with the
+    /// bodies), J.
     pub kinetic_change_j: f64,
 }
 
 impl NetworkEnergy {
-    /// `drive + load - drag - heat - mesh work - damper loss - spring energy change - kinetic
-    /// change`, J: zero to the integrator's tolerance.
+    /// `drive + load - drag - heat - mesh work - damper loss - spring energy change - pack
+    /// loss - kinetic change`, J: zero to the integrator's tolerance.
     pub fn residual_j(&self) -> f64 {
         self.drive_work_j + self.load_work_j
             - self.drag_loss_j
@@ -68,6 +73,7 @@ impl NetworkEnergy {
             - self.mesh_work_j
             - self.damper_loss_j
             - self.spring_energy_change_j
+            - self.pack_loss_j
             - self.kinetic_change_j
     }
 }
@@ -101,6 +107,10 @@ pub trait NetworkObserver {
     /// A gear mesh's tooth contact closed (its `disc` is the coupling's index; the peak is
     /// the force per tooth pair, negative when body `a` leads: `x > 0`).
     fn mesh_impact(&mut self, _impact: &ImpactEvent) {}
+    /// A tooth contact of a resolved pack's disc or plate closed: `coupling` is the pack's
+    /// coupling index, the impact's `disc` the body's index in the pack (its discs, then its
+    /// plates), its peak the per-tooth load as the pack engines sign it.
+    fn pack_impact(&mut self, _coupling: usize, _impact: &ImpactEvent) {}
     /// Polled after every step with the time reached, s; `false` stops the run there.
     fn progress(&mut self, _t_s: f64) -> bool {
         true

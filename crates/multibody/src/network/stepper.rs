@@ -78,6 +78,14 @@ impl NetworkStepper {
         obs: &mut dyn NetworkObserver,
     ) -> Result<NetworkStepper, EngineError> {
         net.check_run(duration_s)?;
+        if let Some(c) = net.couplings.iter().find(|c| c.pack().is_some()) {
+            return Err(EngineError::Unsupported(format!(
+                "coupling \"{}\" is a resolved pack: a pack on a network runs on the reference \
+                 engine (--engine reference); the multibody engine runs a pack scene, or a \
+                 network of lumped clutches, gears and spring-dampers",
+                c.name
+            )));
+        }
         let h_max = options.step_s;
         if !(h_max.is_finite() && h_max > 0.0) {
             return Err(EngineError::Unsupported(format!(

@@ -26,7 +26,10 @@ pub(crate) struct Clusters {
 pub(crate) fn rigid_ratio(net: &Network, k: usize) -> f64 {
     match net.couplings[k].kind {
         CouplingKind::IdealGear { ratio } => ratio,
-        CouplingKind::Clutch(_) | CouplingKind::GearMesh(_) | CouplingKind::SpringDamper(_) => 1.0,
+        CouplingKind::Clutch(_)
+        | CouplingKind::GearMesh(_)
+        | CouplingKind::SpringDamper(_)
+        | CouplingKind::Pack(_) => 1.0,
     }
 }
 

@@ -19,7 +19,9 @@
 //! - a locked clutch: `peak mu(0) cgeo fn - |tau|` reaching 0 (it breaks), `fn` reaching 0;
 //! - a free clutch: `fn` rising above 0 (it engages);
 //! - a gear mesh: the engagement depth of its tooth law reaching 0 from either side (a tooth
-//!   contact's onset, where the law's per-event memory is taken, and its separation).
+//!   contact's onset, where the law's per-event memory is taken, and its separation);
+//! - a resolved pack: each disc's and plate's tooth contacts and each face's stick and slip
+//!   (`packs.rs`, which also holds the pack's share of the state and of the right-hand side).
 //!
 //! A crossing is bisected on the dense output to 1e-13 s relative; the run restarts there
 //! with the modes settled as Modelica's `Clutch` settles them (Otter, Elmqvist and Mattsson
@@ -32,6 +34,7 @@
 pub(crate) mod cluster;
 mod mesh;
 mod modes;
+mod packs;
 mod stepper;
 
 pub use stepper::{run_network, NetworkInput, NetworkStepper};
@@ -76,6 +79,8 @@ struct Equations {
     /// Each gear mesh's contact event (its law's memory), `None` in free flight.
     contacts: Vec<Option<Engagement>>,
     clusters: Clusters,
+    /// The resolved packs, in coupling order (their state after the network's counters).
+    packs: Vec<packs::NetPack>,
     // scratch
     torque: Vec<f64>,
     acc: Vec<f64>,
@@ -103,7 +108,9 @@ impl Equations {
     fn new(net: Arc<Network>, modes: Vec<Option<ClutchMode>>) -> Self {
         let (n, m) = (net.bodies.len(), net.couplings.len());
         let clusters = Clusters::build(&net, &rigid(&net, &modes));
+        let packs = packs::build(&net, 2 * n + 2 * m + 3, m);
         Equations {
+            packs,
             net,
             modes,
             contacts: vec![None; m],
@@ -115,6 +122,18 @@ impl Equations {
             coupling_torque: vec![0.0; m],
             mesh_force: vec![0.0; m],
         }
+    }
+
+    /// The state's length: the bodies' angles and speeds, a slot and a counter per coupling,
+    /// the drives', loads' and drag's counters, then every pack's state.
+    fn dim(&self) -> usize {
+        let (n, m) = (self.net.bodies.len(), self.net.couplings.len());
+        2 * n + 2 * m + 3 + self.packs.iter().map(packs::NetPack::len).sum::<usize>()
+    }
+
+    /// The guards' count: one per coupling, then every pack's.
+    fn guard_len(&self) -> usize {
+        self.net.couplings.len() + self.packs.iter().map(packs::NetPack::guards).sum::<usize>()
     }
 
     fn set_modes(&mut self, modes: &[Option<ClutchMode>]) {
@@ -162,6 +181,13 @@ impl Equations {
                 self.torque[c.a] += ta;
                 self.torque[c.b] += tb;
             }
+        }
+        for p in &self.packs {
+            // packs.rs, pass (1): the spline reactions (Hu et al. eq 4) on both carriers
+            let [ta, tb] = p.sys.reactions_n_m(p.part(y), &p.modes);
+            self.coupling_torque[p.k] = ta;
+            self.torque[p.a] += ta;
+            self.torque[p.b] += tb;
         }
         self.clusters
             .accelerations(&self.torque, &mut self.acc, &mut self.group);
@@ -223,6 +249,14 @@ impl Equations {
         counters[m] = drive;
         counters[m + 1] = load;
         counters[m + 2] = drag;
+        for p in &self.packs {
+            // packs.rs, pass (3): each pack's bodies against their carriers' motion
+            let c = p.carriers(w, &self.acc);
+            let (at, d) = (p.at, p.sys.dim());
+            p.sys
+                .rhs_with(t, &y[at..at + d], &p.modes, &c, &mut dy[at..at + d]);
+            dy[at + d] = p.drag_power_w(y, w);
+        }
     }
 
     /// The event functions at `(t, y)`, one per clutch (> 0 while its mode holds; 0 for other
@@ -268,6 +302,10 @@ impl Equations {
                 None => 1.0,
             };
         }
+        for p in &self.packs {
+            let g = &mut out[p.guard_at..p.guard_at + p.guards()];
+            p.guard_values(t, y, w, g);
+        }
     }
 }
 
@@ -278,7 +316,9 @@ fn rigid(net: &Network, modes: &[Option<ClutchMode>]) -> Vec<bool> {
         .map(|(k, c)| match c.kind {
             CouplingKind::IdealGear { .. } => true,
             CouplingKind::Clutch(_) => modes[k] == Some(ClutchMode::Locked),
-            CouplingKind::GearMesh(_) | CouplingKind::SpringDamper(_) => false,
+            CouplingKind::GearMesh(_) | CouplingKind::SpringDamper(_) | CouplingKind::Pack(_) => {
+                false
+            }
         })
         .collect()
 }

@@ -4,7 +4,7 @@
 //! call to the end.
 
 use super::modes::settle;
-use super::{mesh, sample, Equations, NetworkOptions};
+use super::{mesh, packs, sample, Equations, NetworkOptions};
 use crate::dopri::{next_step, Dense, Dopri5};
 pub use clutchpack_model::network::NetworkInput;
 use clutchpack_model::network::{
@@ -70,7 +70,11 @@ impl NetworkStepper {
         net.check_run(duration_s)?;
         let n = net.bodies.len();
         let m = net.couplings.len();
-        let dim = 2 * n + 2 * m + 3;
+        let initial_modes: Vec<Option<ClutchMode>> = (0..m)
+            .map(|k| net.couplings[k].clutch().map(|_| ClutchMode::Free))
+            .collect();
+        let mut eq = Equations::new(Arc::new(net.clone()), initial_modes);
+        let dim = eq.dim();
         let tol = options.tolerance;
         let mut atol = vec![tol; dim];
         // the meshes' x on their backlash's scale; other slots and the counters out of the norm
@@ -85,6 +89,17 @@ impl NetworkStepper {
             .iter_mut()
             .for_each(|a| *a = f64::INFINITY);
         let mut y = vec![0.0; dim];
+        for p in &eq.packs {
+            // each body's relative angle on its spline's half play, its relative speed on
+            // the tolerance in rad/s; the heat and the works out of the norm (as in the pack
+            // engine's stepper)
+            let nb = p.sys.ids.len();
+            for slot in 0..nb {
+                atol[p.at + 2 * slot] = tol * p.sys.disc(slot).spline.half_play_rad();
+                atol[p.at + 2 * slot + 1] = tol;
+            }
+            y[p.at..p.at + p.sys.dim()].copy_from_slice(&p.sys.initial_state());
+        }
         for (i, b) in net.bodies.iter().enumerate() {
             y[n + i] = b.initial_speed_rad_s;
         }
@@ -93,12 +108,10 @@ impl NetworkStepper {
                 y[2 * n + k] = g.initial_offset_m;
             }
         }
-        let initial_modes: Vec<Option<ClutchMode>> = (0..m)
-            .map(|k| net.couplings[k].clutch().map(|_| ClutchMode::Free))
-            .collect();
-        let mut eq = Equations::new(Arc::new(net.clone()), initial_modes);
-        let kinetic0 = kinetic(net, &y);
+        let kinetic0 = kinetic(&eq, &y);
         let mut events = 0u64;
+        let mut ybuf = vec![0.0; dim];
+        packs::switch(&mut eq.packs, n, 0.0, &mut y, None, &mut ybuf, obs);
         settle(&mut eq, 0.0, &mut y, &[], obs, &mut events);
         let mut meshes = mesh::Meshes::new(m, dim);
         meshes.switch(&mut eq, 0.0, &y, None, obs);
@@ -122,9 +135,9 @@ impl NetworkStepper {
             stepper,
             dense: Dense::default(),
             dy,
-            ybuf: vec![0.0; dim],
-            g0: vec![0.0; m],
-            g1: vec![0.0; m],
+            g0: vec![0.0; eq.guard_len()],
+            g1: vec![0.0; eq.guard_len()],
+            ybuf,
             period,
             next_sample: 1,
             t: 0.0,
@@ -166,6 +179,14 @@ impl NetworkStepper {
                 } else {
                     0.0
                 }
+            })
+            .enumerate()
+            .map(|(k, h)| {
+                self.eq
+                    .packs
+                    .iter()
+                    .find(|p| p.k == k)
+                    .map_or(h, |p| p.face_heat_j(&self.y))
             })
             .collect()
     }
@@ -302,6 +323,9 @@ impl NetworkStepper {
                 }
             };
             meshes.observe(eq, dense, *t, t_new);
+            for p in eq.packs.iter_mut() {
+                p.observe(dense, *t, t_new, ybuf);
+            }
             // samples up to t_new from the dense output
             while (self.next_sample as f64) * self.period <= t_new
                 && (self.next_sample as f64) * self.period < self.duration_s
@@ -324,6 +348,8 @@ impl NetworkStepper {
             }
             if at_event {
                 meshes.switch(eq, *t, y, Some(g1), obs);
+                let n = eq.net.bodies.len();
+                packs::switch(&mut eq.packs, n, *t, y, Some(g1), ybuf, obs);
                 settle(eq, *t, y, g1, obs, &mut self.events);
                 eq.rhs(*t, y, dy);
                 stepper.set_start_derivative(dy);
@@ -345,31 +371,41 @@ impl NetworkStepper {
         let (t, net) = (self.t, Arc::clone(&self.eq.net));
         let (n, m) = (net.bodies.len(), net.couplings.len());
         self.meshes.finish(&mut self.eq, t, obs);
+        for p in self.eq.packs.iter_mut() {
+            p.finish(t, &mut self.ybuf, obs);
+        }
         let last = sample(&mut self.eq, t, &self.y);
         obs.sample(&last);
         let y = &self.y;
         let c0 = 2 * n + m; // the counters
         let mut heat = y[c0..c0 + m].to_vec();
         let (mut mesh_work, mut damper_loss, mut spring_change) = (0.0, 0.0, 0.0);
+        let mut clutch_heat = 0.0;
         for (k, h) in heat.iter_mut().enumerate() {
-            if net.couplings[k].mesh().is_some() {
+            if net.couplings[k].clutch().is_some() {
+                clutch_heat += *h;
+            } else if net.couplings[k].mesh().is_some() {
                 mesh_work += *h;
             } else if let Some(sd) = net.couplings[k].spring() {
                 damper_loss += *h;
                 spring_change += sd.potential_j(y[2 * n + k]) - sd.potential_j(0.0);
-            } else if net.couplings[k].clutch().is_none() {
+            } else {
                 *h = 0.0;
             }
+        }
+        for p in &self.eq.packs {
+            heat[p.k] = p.face_heat_j(y);
         }
         let energy = NetworkEnergy {
             drive_work_j: y[c0 + m],
             load_work_j: y[c0 + m + 1],
             drag_loss_j: y[c0 + m + 2],
-            clutch_heat_j: heat.iter().sum::<f64>() - mesh_work - damper_loss,
+            clutch_heat_j: clutch_heat,
             mesh_work_j: mesh_work,
             damper_loss_j: damper_loss,
             spring_energy_change_j: spring_change,
-            kinetic_change_j: kinetic(&net, y) - self.kinetic0,
+            pack_loss_j: self.eq.packs.iter().map(|p| p.loss_j(y)).sum(),
+            kinetic_change_j: kinetic(&self.eq, y) - self.kinetic0,
         };
         NetworkRun {
             last,
@@ -381,13 +417,16 @@ impl NetworkStepper {
     }
 }
 
-/// The bodies' kinetic energy at the state `y`, J.
-fn kinetic(net: &Network, y: &[f64]) -> f64 {
+/// The bodies' kinetic energy at the state `y`, J, with every pack's discs and plates.
+fn kinetic(eq: &Equations, y: &[f64]) -> f64 {
+    let net = &eq.net;
     let n = net.bodies.len();
+    let w = &y[n..2 * n];
     net.bodies
         .iter()
         .enumerate()
         .filter(|(_, b)| !b.fixed)
         .map(|(i, b)| 0.5 * b.inertia_kg_m2 * y[n + i] * y[n + i])
-        .sum()
+        .sum::<f64>()
+        + eq.packs.iter().map(|p| p.kinetic_j(y, w)).sum::<f64>()
 }

@@ -1,0 +1,306 @@
+//! Resolved packs on a network (MODEL.md sections 2-5 and 8): each pack's friction discs on
+//! the network's body `a`, its separator plates on body `b`, every disc and plate a degree of
+//! freedom of its own against its carrier (the pack engine's [`System`], carried by the
+//! network's bodies: [`System::carried`]), its stack's faces with exact stick and slip.
+//!
+//! # The right-hand side in three passes
+//! The teeth are compliant, so their loads follow from the state alone: (1) every pack's
+//! spline reactions on its two carriers ([`System::reactions_n_m`]) join the other torques on
+//! the network's bodies; (2) the network solves its bodies' accelerations (its rigid groups as
+//! without packs); (3) each pack's own relative accelerations follow with its carriers'
+//! speeds and accelerations given ([`System::rhs_with`]).
+//!
+//! # Events
+//! Every disc's and plate's engagement depth (a tooth contact's onset and separation) and every
+//! face's switching condition (it clamps, sticks, breaks or opens) join the network's guard
+//! vector, after the couplings' own; one DOPRI5 over all, each crossing bisected on the dense
+//! output. A contact's onset takes the tooth law's per-event memory; its peak is located on
+//! the dense output of the step that holds it (as the gear meshes' are); its separation
+//! sends the impact ([`super::NetworkObserver::pack_impact`]).
+//!
+//! # State
+//! Per pack, after the network's own state: its [`System`]'s (each body's relative angle and
+//! speed against its carrier, each face's heat, the teeth's work), then the work of its
+//! bodies' oil drag (J).
+
+use super::NetworkObserver;
+use crate::dopri::Dense;
+use crate::stepper::golden_peak;
+use crate::system::System;
+use clutchpack_model::network::Network;
+use clutchpack_model::{Engagement, ImpactTracker};
+use std::sync::Arc;
+
+/// Samples of a load per step in contact before the refinement (as the meshes').
+const PROBES: usize = 16;
+
+/// One resolved pack of a network run.
+#[derive(Clone)]
+pub(super) struct NetPack {
+    /// Its coupling's index.
+    pub k: usize,
+    /// The friction discs' carrier (body index).
+    pub a: usize,
+    /// The plates' carrier (body index).
+    pub b: usize,
+    /// Its equations, on carriers outside it.
+    pub sys: System,
+    /// Index of its first state component in the network's state.
+    pub at: usize,
+    /// Index of its first guard in the network's guard vector.
+    pub guard_at: usize,
+    /// Each body's contact mode (discs, then plates).
+    pub modes: Vec<Option<Engagement>>,
+    trackers: Vec<ImpactTracker>,
+    /// Per body: the dense output of the step with the largest |F| so far, and where.
+    best: Vec<Option<(Dense, f64, f64)>>,
+}
+
+impl NetPack {
+    /// Its state's length: the system's, then the drag's work.
+    pub fn len(&self) -> usize {
+        self.sys.dim() + 1
+    }
+
+    /// Its guards: one per body, then one per face.
+    pub fn guards(&self) -> usize {
+        self.sys.ids.len() + self.sys.faces.len()
+    }
+
+    /// Its system's part of the network state `y`.
+    pub fn part<'y>(&self, y: &'y [f64]) -> &'y [f64] {
+        &y[self.at..self.at + self.sys.dim()]
+    }
+
+    /// The carriers' speeds and accelerations as [`System::rhs_with`] takes them, from the
+    /// bodies' speeds `w` (rad/s) and accelerations `acc` (rad/s^2).
+    pub fn carriers(&self, w: &[f64], acc: &[f64]) -> [f64; 4] {
+        [w[self.a], acc[self.a], w[self.b], acc[self.b]]
+    }
+
+    /// The absolute speed (rad/s) of the body in `slot` at the network state `y` (`w` the
+    /// bodies' speeds).
+    fn body_speed(&self, slot: usize, y: &[f64], w: &[f64]) -> f64 {
+        let carrier = if slot < self.sys.pack.discs.len() {
+            w[self.a]
+        } else {
+            w[self.b]
+        };
+        carrier - y[self.at + 2 * slot + 1]
+    }
+
+    /// The power of its bodies' oil drag (W, >= 0): `sum C w_b^2`.
+    pub fn drag_power_w(&self, y: &[f64], w: &[f64]) -> f64 {
+        (0..self.sys.ids.len())
+            .map(|slot| {
+                let wb = self.body_speed(slot, y, w);
+                self.sys.disc(slot).drag_n_m_s_rad * wb * wb
+            })
+            .sum()
+    }
+
+    /// Its bodies' kinetic energy (J) at the network state `y`.
+    pub fn kinetic_j(&self, y: &[f64], w: &[f64]) -> f64 {
+        (0..self.sys.ids.len())
+            .map(|slot| {
+                let wb = self.body_speed(slot, y, w);
+                0.5 * self.sys.disc(slot).inertia_kg_m2 * wb * wb
+            })
+            .sum()
+    }
+
+    /// What it has turned into heat or stored in its teeth since t = 0 at the state `y`, J:
+    /// its faces' heat, its teeth's work (their impact losses, plus the elastic energy of a
+    /// contact still closed) and its bodies' drag.
+    pub fn loss_j(&self, y: &[f64]) -> f64 {
+        let part = self.part(y);
+        self.sys.interface_heat_j(part).iter().sum::<f64>()
+            + self.sys.teeth_work_j(part)
+            + y[self.at + self.sys.dim()]
+    }
+
+    /// Its faces' heat since t = 0 at the state `y`, J.
+    pub fn face_heat_j(&self, y: &[f64]) -> f64 {
+        self.sys.interface_heat_j(self.part(y)).iter().sum()
+    }
+
+    /// The guards at the network state `y` with the bodies' speeds `w`, into `out` (its
+    /// slice): per body its engagement depth (m; negated in free flight, so that an onset and
+    /// a separation both cross from above), per face -1 where its mode must change, else 1.
+    pub fn guard_values(&self, t: f64, y: &[f64], w: &[f64], out: &mut [f64]) {
+        let part = self.part(y);
+        let nb = self.sys.ids.len();
+        for slot in 0..nb {
+            let depth = self.sys.depth(slot, part);
+            out[slot] = if self.modes[slot].is_some() {
+                depth
+            } else {
+                -depth
+            };
+        }
+        if self.sys.faces.is_empty() {
+            return;
+        }
+        // the faces' conditions need the carriers' speeds only
+        let c = [w[self.a], 0.0, w[self.b], 0.0];
+        let ev = self.sys.stack_eval(t, part, &self.modes, &c);
+        for m in 0..self.sys.faces.len() {
+            out[nb + m] = if self.sys.face_switches(m, &ev) {
+                -1.0
+            } else {
+                1.0
+            };
+        }
+    }
+
+    /// The signed per-tooth load (N) of `slot` at `t` on `dense`.
+    fn load(&self, slot: usize, dense: &Dense, t: f64, ybuf: &mut [f64]) -> f64 {
+        if self.modes[slot].is_none() {
+            return 0.0;
+        }
+        dense.eval(t, ybuf);
+        self.sys.load(slot, self.part(ybuf), &self.modes[slot])
+    }
+
+    /// Observes its bodies in contact over the accepted step `[t0, t1]` of `dense`.
+    pub fn observe(&mut self, dense: &Dense, t0: f64, t1: f64, ybuf: &mut [f64]) {
+        for slot in 0..self.sys.ids.len() {
+            if self.modes[slot].is_none() {
+                continue;
+            }
+            let mut top: Option<(f64, f64)> = None;
+            for j in 1..=PROBES {
+                let t = t0 + (t1 - t0) * j as f64 / PROBES as f64;
+                let f = self.load(slot, dense, t, ybuf);
+                if top.is_none_or(|(_, b)| f.abs() > b) {
+                    top = Some((t, f.abs()));
+                }
+            }
+            let (t, f) = top.expect("probes");
+            let prior = self.best[slot].as_ref().map_or(-1.0, |b| b.2);
+            if f > prior {
+                self.best[slot] = Some((dense.clone(), t, f));
+            }
+        }
+    }
+
+    /// Opens and closes contact events at an event at `t` (`crossed[slot] <= 0`: the body's
+    /// guard crossed; `None`: every body checked, as at t = 0).
+    pub fn switch_teeth(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        crossed: Option<&[f64]>,
+        ybuf: &mut [f64],
+        obs: &mut dyn NetworkObserver,
+    ) {
+        for slot in 0..self.sys.ids.len() {
+            if crossed.is_some_and(|c| c[slot] > 0.0) {
+                continue;
+            }
+            let kin = self.sys.kin(slot, self.part(y));
+            let inside = self.sys.depth(slot, self.part(y)) > 0.0;
+            match (self.modes[slot], inside) {
+                (None, true) => {
+                    self.modes[slot] = Some(self.sys.disc(slot).law.engage(&kin));
+                    self.trackers[slot].begin(t, kin.flank, kin.v_n_m_s);
+                    self.best[slot] = None;
+                }
+                (Some(_), false) => {
+                    self.close(slot, t, ybuf, obs);
+                    self.modes[slot] = None;
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// Settles the faces whose guards crossed (`crossed[m] <= 0`; `None`: every face, as at
+    /// t = 0 or when an input changes) at `t`, the state `y` (a lock sets the slip to zero
+    /// there), the bodies' speeds and accelerations in `c`.
+    pub fn settle_faces(&mut self, t: f64, y: &mut [f64], crossed: Option<&[f64]>, c: &[f64; 4]) {
+        let nb = self.sys.ids.len();
+        let (at, dim) = (self.at, self.sys.dim());
+        for m in 0..self.sys.faces.len() {
+            if crossed.is_some_and(|g| g[nb + m] > 0.0) {
+                continue;
+            }
+            self.sys
+                .settle_face_with(m, t, &mut y[at..at + dim], &self.modes, c);
+        }
+    }
+
+    /// Closes `slot`'s open event at `t`: its peak refined on the best step's dense output.
+    fn close(&mut self, slot: usize, t: f64, ybuf: &mut [f64], obs: &mut dyn NetworkObserver) {
+        if let Some((dense, tb, _)) = self.best[slot].take() {
+            let span = dense.h / PROBES as f64;
+            let (a, b) = (
+                (tb - span).max(dense.t0),
+                (tb + span).min(dense.t0 + dense.h),
+            );
+            let (tp, fp) = golden_peak(a, b, |tt| self.load(slot, &dense, tt, ybuf));
+            self.trackers[slot].observe(tp, fp);
+        }
+        if let Some(e) = self.trackers[slot].end(t) {
+            obs.pack_impact(self.k, &e);
+        }
+    }
+
+    /// Closes every open event at the end of the run at `t`.
+    pub fn finish(&mut self, t: f64, ybuf: &mut [f64], obs: &mut dyn NetworkObserver) {
+        for slot in 0..self.sys.ids.len() {
+            if self.modes[slot].is_some() {
+                self.close(slot, t, ybuf, obs);
+            }
+        }
+    }
+}
+
+/// The network's packs, their state from `first` on and their guards from `first_guard` on,
+/// in coupling order.
+pub(super) fn build(net: &Network, first: usize, first_guard: usize) -> Vec<NetPack> {
+    let (mut at, mut guard_at) = (first, first_guard);
+    let mut out = Vec::new();
+    for (k, c) in net.couplings.iter().enumerate() {
+        let Some(pack) = c.pack() else { continue };
+        let sys = System::carried(Arc::new(pack.clone()));
+        let nb = sys.ids.len();
+        let p = NetPack {
+            k,
+            a: c.a,
+            b: c.b,
+            at,
+            guard_at,
+            modes: vec![None; nb],
+            trackers: (0..nb).map(ImpactTracker::new).collect(),
+            best: vec![None; nb],
+            sys,
+        };
+        at += p.len();
+        guard_at += p.guards();
+        out.push(p);
+    }
+    out
+}
+
+/// At an event at `t` (or at t = 0 and when an input changes, `crossed = None`): every pack's
+/// tooth contacts opened and closed where their guards crossed, then its faces settled (with
+/// the carriers' speeds of the state `y`; a face's settling needs no acceleration).
+pub(super) fn switch(
+    packs: &mut [NetPack],
+    n: usize,
+    t: f64,
+    y: &mut [f64],
+    crossed: Option<&[f64]>,
+    ybuf: &mut [f64],
+    obs: &mut dyn NetworkObserver,
+) {
+    for p in packs {
+        let mine = crossed.map(|g| &g[p.guard_at..p.guard_at + p.guards()]);
+        p.switch_teeth(t, y, mine, ybuf, obs);
+        if !p.sys.faces.is_empty() {
+            let c = [y[n + p.a], 0.0, y[n + p.b], 0.0];
+            p.settle_faces(t, y, mine, &c);
+        }
+    }
+}
