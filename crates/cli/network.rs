@@ -133,6 +133,29 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
             c.largest_peak_n
         );
     }
+    for c in s.couplings.iter().filter(|c| !c.pack_bodies.is_empty()) {
+        out!(
+            "  {:<16} pack: {} tooth impacts; per body (impacts, largest peak per tooth):",
+            c.name,
+            c.impacts
+        );
+        let worst = c
+            .pack_bodies
+            .iter()
+            .max_by(|x, y| x.largest_peak_n.abs().total_cmp(&y.largest_peak_n.abs()));
+        for b in &c.pack_bodies {
+            let mark = match worst {
+                Some(w) if w.name == b.name && b.impacts > 0 => "  <- the largest",
+                _ => "",
+            };
+            out!(
+                "    {:<14} {:>6} {:>12.3} N{mark}",
+                b.name,
+                b.impacts,
+                b.largest_peak_n
+            );
+        }
+    }
     let mut changes: Vec<(&str, &clutchpack_sdk::ModeChange)> = s
         .couplings
         .iter()
@@ -164,11 +187,12 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     }
     let (e, residual_j) = (&s.energy.terms, s.energy.residual_j);
     out!(
-        "energy: drives {:.6} J, loads {:.6} J, drag {:.6} J, clutch heat {:.6} J, kinetic change {:.6} J (balance {:.3e} J)",
+        "energy: drives {:.6} J, loads {:.6} J, drag {:.6} J, clutch heat {:.6} J, packs {:.6} J, kinetic change {:.6} J (balance {:.3e} J)",
         e.drive_work_j,
         e.load_work_j,
         e.drag_loss_j,
         e.clutch_heat_j,
+        e.pack_loss_j,
         e.kinetic_change_j,
         residual_j
     );

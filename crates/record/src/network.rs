@@ -15,7 +15,7 @@
 //! | `/network/couplings/<segment>` | `clutchpack.CouplingState` | each sample |
 //! | `/joints` (couplings: slip, torque), `/network/joints/bodies` (angle, speed) | `sensor_msgs/msg/JointState` | each sample (Rerun, Lichtblick) |
 //! | `/network/events` | `foxglove.Log` | each clutch mode change, at its instant |
-//! | `/network/impacts` | `clutchpack.Impact` | each gear-mesh impact, at its peak |
+//! | `/network/impacts` | `clutchpack.Impact` | each gear-mesh impact and each tooth impact of a pack's disc or plate (`<pack>/<body>`), at its peak |
 //! | `/tf` | `foxglove.FrameTransforms` | each sample: `world` -> `body/<segment>` |
 //! | `/scene` | `foxglove.SceneUpdate` | t = 0: every body as a disc with a marker and its name |
 //! | `/scene/couplings` | `foxglove.SceneUpdate` | t = 0 and at each mode change |
@@ -571,6 +571,35 @@ impl NetworkRecorder {
             line: 0,
         };
         self.put(self.ch.events, ns, &msg, "/network/events")
+    }
+
+    /// Writes the tooth impact of a resolved pack's disc or plate on `/network/impacts`,
+    /// logged at its peak, named `<pack>/<body>` (`coupling` the pack's index; `disc` of the
+    /// event the body's index in the pack, its discs then its plates).
+    pub fn write_pack_impact(
+        &mut self,
+        coupling: usize,
+        e: &ImpactEvent,
+    ) -> Result<(), RecordError> {
+        let pack = self
+            .coupling_names
+            .get(coupling)
+            .cloned()
+            .unwrap_or_default();
+        let body = self
+            .net
+            .couplings
+            .get(coupling)
+            .and_then(|c| c.pack())
+            .and_then(|p| p.discs.iter().chain(&p.plates).nth(e.disc))
+            .map_or_else(|| format!("body {}", e.disc), |d| d.name.clone());
+        let msg = proto::Impact::of(e, format!("{pack}/{body}"));
+        self.put(
+            self.ch.impacts,
+            log_time_ns(e.t_peak_s),
+            &msg,
+            "/network/impacts",
+        )
     }
 
     /// Writes a gear mesh's tooth impact on `/network/impacts`, logged at its peak (`disc`

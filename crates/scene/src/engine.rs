@@ -63,7 +63,34 @@ impl Scene {
             (None, None) if parts.is_empty() => return Ok(EngineChoice::Reference),
             (None, None) => return Ok(EngineChoice::Multibody),
         };
-        if choice == EngineChoice::Multibody || parts.is_empty() {
+        if choice == EngineChoice::Multibody {
+            // a resolved pack on a network runs on the reference engine only (issue 34)
+            let packs = self
+                .network
+                .iter()
+                .flat_map(|n| n.couplings.iter().enumerate());
+            let problems: Vec<Problem> = packs
+                .filter(|(_, c)| c.pack().is_some())
+                .map(|(k, c)| {
+                    Problem::new(
+                        format!("couplings[{k}].kind"),
+                        Some("\"pack\"".into()),
+                        format!(
+                            "the multibody engine (chosen by {why}) does not run a resolved pack on a network yet (\"{}\"): use the reference engine",
+                            c.name
+                        ),
+                    )
+                })
+                .collect();
+            if !problems.is_empty() {
+                return Err(SceneError::Invalid {
+                    origin: origin.to_string(),
+                    problems,
+                });
+            }
+            return Ok(choice);
+        }
+        if parts.is_empty() {
             return Ok(choice);
         }
         let problems = parts

@@ -510,7 +510,7 @@ table! {
 const SIGNAL_KINDS: Kind = Kind::Choice(&["constant", "step", "ramp", "sine", "table"]);
 
 table! {
-    /// One `[[bodies]]` entry: a rotational body of a driveline network (MODEL.md section 8). A scene with `[[bodies]]` is a network scene: its bodies and `[[couplings]]` replace `[shaft]`, `[drive]`, `[[discs]]`, `[[plates]]`, `[drum]` and `[stack]` (resolved packs on a network come next).
+    /// One `[[bodies]]` entry: a rotational body of a driveline network (MODEL.md section 8). A scene with `[[bodies]]` is a network scene: its bodies and `[[couplings]]` replace `[shaft]`, `[drive]`, `[[discs]]`, `[[plates]]`, `[drum]` and `[stack]`; a resolved pack is a coupling of kind "pack" naming its pack scene file.
     RawNetBody at "" {
         /// the body's name, unique; couplings name their bodies by it
         name: "", Kind::Text, Dflt::Required;
@@ -595,8 +595,8 @@ table! {
     RawCoupling at "" {
         /// the coupling's name, unique (tables, summaries and figures name it)
         name: "", Kind::Text, Dflt::Described("default \"<kind>-<i+1>\" (\"clutch-2\")");
-        /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash; "gear_mesh": a gear pair with backlash and the tooth law of [couplings.contact] and [couplings.oil] along its line of action (gear rattle); "spring_damper": a torsional spring with a viscous damper in parallel (a clutch damper, a dual-mass flywheel; one-pack scenes, between "shaft" and "drum")
-        kind: "", Kind::Choice(&["clutch", "ideal_gear", "gear_mesh", "spring_damper"]), Dflt::Required;
+        /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash; "gear_mesh": a gear pair with backlash and the tooth law of [couplings.contact] and [couplings.oil] along its line of action (gear rattle); "spring_damper": a torsional spring with a viscous damper in parallel (a clutch damper, a dual-mass flywheel; one-pack scenes, between "shaft" and "drum"); "pack": a resolved pack of the pack scene in `pack` (network scenes; the reference engine), its friction discs on body a, its plates on body b
+        kind: "", Kind::Choice(&["clutch", "ideal_gear", "gear_mesh", "spring_damper", "pack"]), Dflt::Required;
         /// the name of body a (a one-pack scene: "shaft" or "drum", the drum with [drum]; a prescribed shaft drives b through a spring_damper)
         a: "", Kind::Text, Dflt::Required;
         /// the name of body b, not a
@@ -631,6 +631,8 @@ table! {
         stiffness_n_m_per_rad: "N m/rad", Kind::Number(Rule::Closed(0.0, MAX_COUPLING_STIFFNESS_N_M_PER_RAD)), Dflt::When("spring_damper: required");
         /// spring_damper: viscous damping d
         damping_n_m_s_per_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
+        /// pack: a pack scene file (its [[discs]], [[plates]], [stack], ... as a pack scene has them; relative to this scene's folder); its [shaft], [drive], [drum] and [simulation] are not used here: bodies a and b carry it
+        pack: "", Kind::Text, Dflt::When("pack: required");
         /// spring_damper: free angle theta_0, the twist theta_a - theta_b at which the spring carries no torque (both bodies start at angle 0, so a non-zero theta_0 starts the spring twisted)
         free_angle_rad: "rad", FINITE, Dflt::Num(0.0);
     }

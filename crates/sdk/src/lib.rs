@@ -61,7 +61,7 @@ pub use error::{Error, Result};
 pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
 pub use network::{
     multibody_step_s, run_network_scene, BodySummary, CouplingSummary, EnergySummary, ModeChange,
-    NetworkOutcome, NetworkRequest, NetworkSummary, MULTIBODY_NETWORK_STEP_S,
+    NetworkOutcome, NetworkRequest, NetworkSummary, PackBodySummary, MULTIBODY_NETWORK_STEP_S,
 };
 pub use network_cosim::{
     network_inputs, network_name_problems, network_outputs, NetworkSimulation, NetworkVariable,

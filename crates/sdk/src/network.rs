@@ -47,10 +47,10 @@ pub struct ModeChange {
 pub struct CouplingSummary {
     /// Its name.
     pub name: String,
-    /// `clutch`, `ideal_gear`, `gear_mesh` or `spring_damper`.
+    /// `clutch`, `ideal_gear`, `gear_mesh`, `spring_damper` or `pack`.
     pub kind: &'static str,
-    /// Heat of a clutch, work done on a gear mesh, or a damper's loss, over the run, J (0 for
-    /// an ideal gear).
+    /// Heat of a clutch or of a pack's faces, work done on a gear mesh, or a damper's loss,
+    /// over the run, J (0 for an ideal gear).
     pub heat_j: f64,
     /// Torque on its body a at the end, N m.
     pub final_torque_n_m: f64,
@@ -59,17 +59,34 @@ pub struct CouplingSummary {
     pub final_mode: Option<&'static str>,
     /// The instants a clutch locked, s.
     pub lock_times_s: Vec<f64>,
-    /// A gear mesh's tooth impacts (closed contacts) over the run (0 for other kinds).
+    /// A gear mesh's or a pack's tooth impacts (closed contacts) over the run (0 for other
+    /// kinds).
     pub impacts: u64,
-    /// A gear mesh's largest impact peak per tooth pair, N, signed as the impacts' (negative
-    /// when body a leads); 0 without impacts.
+    /// A gear mesh's largest impact peak per tooth pair, or a pack's largest per-tooth peak
+    /// over its discs and plates, N, signed as the impacts' (negative when body a, or a
+    /// pack's carrier, leads); 0 without impacts.
     pub largest_peak_n: f64,
+    /// A pack's discs, then its plates, each with its impacts (absent for other kinds).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pack_bodies: Vec<PackBodySummary>,
     /// The smallest torque on its body a over the samples, N m.
     pub min_torque_n_m: f64,
     /// The largest torque on its body a over the samples, N m.
     pub max_torque_n_m: f64,
     /// Every mode change after t = 0, in time order.
     pub changes: Vec<ModeChange>,
+}
+
+/// One disc's or plate's results in a pack on a network.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PackBodySummary {
+    /// Its name in the pack scene.
+    pub name: String,
+    /// Its tooth impacts (closed contacts) over the run.
+    pub impacts: u64,
+    /// Its largest per-tooth peak, N, signed as in Hu et al. eq (6) (negative when its
+    /// carrier leads); 0 without impacts.
+    pub largest_peak_n: f64,
 }
 
 /// One body's results.
@@ -91,8 +108,8 @@ pub struct EnergySummary {
     /// The balance's terms, J.
     #[serde(flatten)]
     pub terms: clutchpack_model::network::NetworkEnergy,
-    /// `drive + load - drag - heat - mesh work - damper loss - spring energy change - kinetic
-    /// change`, J (zero to the integrator's tolerance).
+    /// `drive + load - drag - heat - mesh work - damper loss - spring energy change - pack
+    /// loss - kinetic change`, J (zero to the integrator's tolerance).
     pub residual_j: f64,
 }
 
@@ -144,6 +161,8 @@ pub(crate) struct Keep {
     range: Vec<(f64, f64)>,
     /// Per coupling: (impacts, largest peak) of a gear mesh.
     meshes: std::collections::HashMap<usize, (u64, f64)>,
+    /// Per (pack coupling, body in the pack): (impacts, largest peak).
+    pack_bodies: std::collections::HashMap<(usize, usize), (u64, f64)>,
     history: Vec<NetworkSample>,
     stopped: bool,
     /// The recording, until its first error.
@@ -186,6 +205,7 @@ impl Keep {
             steps: self.steps.clone(),
             range: self.range.clone(),
             meshes: self.meshes.clone(),
+            pack_bodies: self.pack_bodies.clone(),
             history: self.history.clone(),
             stopped: self.stopped,
             recorder: None,
@@ -225,6 +245,16 @@ impl NetworkObserver for Obs<'_, '_> {
         m.0 += 1;
         if e.peak_n.abs() > m.1.abs() {
             m.1 = e.peak_n;
+        }
+    }
+    fn pack_impact(&mut self, coupling: usize, e: &clutchpack_model::ImpactEvent) {
+        self.keep.record(|r| r.write_pack_impact(coupling, e));
+        for key in [(coupling, e.disc), (coupling, usize::MAX)] {
+            let m = self.keep.pack_bodies.entry(key).or_insert((0, 0.0));
+            m.0 += 1;
+            if e.peak_n.abs() > m.1.abs() {
+                m.1 = e.peak_n;
+            }
         }
     }
     fn switched(&mut self, before: &NetworkSample, after: &NetworkSample) {
@@ -402,8 +432,31 @@ pub(crate) fn conclude(
                     .filter(|e| e.coupling == k && e.to == ClutchMode::Locked)
                     .map(|e| e.t_s)
                     .collect(),
-                impacts: keep.meshes.get(&k).map_or(0, |m| m.0),
-                largest_peak_n: keep.meshes.get(&k).map_or(0.0, |m| m.1),
+                impacts: keep
+                    .meshes
+                    .get(&k)
+                    .or(keep.pack_bodies.get(&(k, usize::MAX)))
+                    .map_or(0, |m| m.0),
+                largest_peak_n: keep
+                    .meshes
+                    .get(&k)
+                    .or(keep.pack_bodies.get(&(k, usize::MAX)))
+                    .map_or(0.0, |m| m.1),
+                pack_bodies: c.pack().map_or_else(Vec::new, |p| {
+                    p.discs
+                        .iter()
+                        .chain(&p.plates)
+                        .enumerate()
+                        .map(|(i, d)| {
+                            let m = keep.pack_bodies.get(&(k, i)).copied().unwrap_or((0, 0.0));
+                            PackBodySummary {
+                                name: d.name.clone(),
+                                impacts: m.0,
+                                largest_peak_n: m.1,
+                            }
+                        })
+                        .collect()
+                }),
                 min_torque_n_m: keep.range.get(k).map_or(0.0, |r| r.0),
                 max_torque_n_m: keep.range.get(k).map_or(0.0, |r| r.1),
                 changes,

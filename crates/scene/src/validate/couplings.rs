@@ -11,7 +11,7 @@ use clutchpack_model::{PackBody, PackCoupling, PackCouplingKind, SpringDamper};
 /// What a `kind` names (the order of the key's choices).
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Kind {
-    /// A kind of a network only (a clutch, an ideal gear, a gear mesh).
+    /// A kind of a network only (a clutch, an ideal gear, a gear mesh, a resolved pack).
     Network,
     SpringDamper,
 }
@@ -20,7 +20,7 @@ enum Kind {
 const BODIES: [(&str, PackBody); 2] = [("shaft", PackBody::Shaft), ("drum", PackBody::Drum)];
 
 /// The keys of the network's kinds, refused in a spring-damper's entry.
-const OTHER_KEYS: [&Key; 13] = [
+const OTHER_KEYS: [&Key; 14] = [
     &C::ratio,
     &C::mu,
     &C::mu_speeds_rad_s,
@@ -34,6 +34,7 @@ const OTHER_KEYS: [&Key; 13] = [
     &C::backlash_m,
     &C::pairs,
     &C::mesh_offset_m,
+    &C::pack,
 ];
 
 /// The path of key `k` of entry `i`: `couplings[2].b`.
@@ -95,6 +96,7 @@ fn coupling(
                 Kind::Network,
                 Kind::Network,
                 Kind::SpringDamper,
+                Kind::Network,
             ],
         )
         .required(ck, &path(&C::kind), "\"spring_damper\"");
@@ -103,7 +105,7 @@ fn coupling(
             path(&C::kind),
             r.value(&C::kind).map(show),
             "a one-pack scene's couplings join its shaft and drum: only \"spring_damper\" \
-             (clutch, ideal_gear and gear_mesh join the bodies of a network: [[bodies]])",
+             (clutch, ideal_gear, gear_mesh and pack join the bodies of a network: [[bodies]])",
         );
         return None;
     }

@@ -377,8 +377,8 @@ pub(crate) fn validate(
 }
 
 /// A network scene (`[[bodies]]`, MODEL.md section 8): the pack's sections are refused (a
-/// resolved pack on a network comes next), the simulation settings that only a pack uses
-/// too; the `pack` is an empty placeholder that nothing runs.
+/// resolved pack on a network is a coupling naming its own pack scene file), the simulation
+/// settings that only a pack uses too; the `pack` is an empty placeholder that nothing runs.
 fn network_scene(
     ck: &mut Checker,
     raw: &RawScene,
@@ -404,7 +404,7 @@ fn network_scene(
             ck.report(
                 section,
                 None,
-                "not in a network scene yet: a network ([[bodies]]) runs lumped parts (clutches, ideal gears); resolved packs on a network come next (issue 34)",
+                "not in a network scene: a network ([[bodies]]) holds a resolved pack in its own pack scene file, [[couplings]] kind = \"pack\" with pack = \"<file>.toml\"",
             );
         }
     }

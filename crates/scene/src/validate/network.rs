@@ -300,6 +300,7 @@ pub(super) fn network(
         Gear,
         Mesh,
         Spring,
+        Pack,
     }
     for (k, r) in couplings.iter().enumerate() {
         let p = |key: &Key| item("couplings", key, k);
@@ -316,7 +317,13 @@ pub(super) fn network(
                 &p(&C::kind),
                 r.value(&C::kind),
                 &C::kind,
-                &[Kind::Clutch, Kind::Gear, Kind::Mesh, Kind::Spring],
+                &[
+                    Kind::Clutch,
+                    Kind::Gear,
+                    Kind::Mesh,
+                    Kind::Spring,
+                    Kind::Pack,
+                ],
             )
             .required(ck, &p(&C::kind), "required");
         let body = |ck: &mut Checker, key: &Key| {
@@ -391,7 +398,15 @@ pub(super) fn network(
         if !matches!(kind, Kind::Spring) {
             refuse(ck, &spring_keys, &[], "a spring_damper");
         }
+        if !matches!(kind, Kind::Pack) {
+            refuse(ck, &[&C::pack], &[], "a pack");
+        }
         match kind {
+            Kind::Pack => {
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(ck, &clutch_keys, &[force], "a clutch");
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
+            }
             Kind::Spring => {
                 refuse(ck, &[&C::ratio], &[], "an ideal gear");
                 refuse(ck, &clutch_keys, &[force], "a clutch");
@@ -417,6 +432,7 @@ pub(super) fn network(
                 .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
                 .map(|ratio| CouplingKind::IdealGear { ratio }),
             Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
+            Kind::Pack => pack(ck, r, k, base_dir).map(|p| CouplingKind::Pack(Box::new(p))),
             Kind::Spring => {
                 let num = |ck: &mut Checker, key: &Key| ck.num(&p(key), r.value(key), key);
                 let k_ = num(ck, &C::stiffness_n_m_per_rad).required(
@@ -462,6 +478,84 @@ pub(super) fn network(
         }
     }
     problems.is_empty().then_some(net)
+}
+
+/// The pack scene of a `kind = "pack"` coupling `k` (key `pack`, relative to the network
+/// scene's folder), read by the pack scene's own loader: its problems are reported at
+/// `couplings[k].pack` with the pack file's key paths. A network scene there, a thermal pack
+/// and a pack the reference engine cannot run (radial float, offsets, spacing errors) are
+/// refused.
+fn pack(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<clutchpack_model::PackModel> {
+    let key = item("couplings", &C::pack, k);
+    let file = ck.text(&key, r.value(&C::pack)).required(
+        ck,
+        &key,
+        "required for kind = \"pack\": a pack scene file",
+    )?;
+    let shown = Some(format!("\"{file}\""));
+    let path = base_dir.join(&file);
+    let scene = match crate::load(&path, &[]) {
+        Ok(s) => s,
+        Err(crate::SceneError::Read { error, .. }) => {
+            ck.report(
+                key,
+                shown,
+                format!("cannot read {}: {error}", path.display()),
+            );
+            return None;
+        }
+        Err(e) => {
+            let lines: Vec<String> = e.problems().iter().map(|p| p.to_string()).collect();
+            ck.report(
+                key,
+                shown,
+                format!(
+                    "the pack scene {} has problems: {}",
+                    path.display(),
+                    lines.join("; ")
+                ),
+            );
+            return None;
+        }
+    };
+    let refuse = |ck: &mut Checker, why: String| {
+        ck.report(key.clone(), shown.clone(), why);
+        None
+    };
+    if scene.network.is_some() {
+        return refuse(
+            ck,
+            format!("{} is a network scene, not a pack", path.display()),
+        );
+    }
+    if scene.thermal.is_some() {
+        return refuse(
+            ck,
+            format!(
+                "{} has a [thermal] section: a pack on a network runs isothermal (remove it, or run the pack alone)",
+                path.display()
+            ),
+        );
+    }
+    if let Some(part) = scene.pack.non_torsional_parts().first() {
+        use clutchpack_model::NonTorsional as N;
+        let what = match *part {
+            N::RadialFloat(i) => format!("discs[{i}] floats radially"),
+            N::InitialOffset(i) => format!("discs[{i}] starts off the axis"),
+            N::SpacingErrors(i) => format!("discs[{i}] has tooth spacing errors"),
+            N::PlatePerTooth(j) => {
+                format!("plates[{j}] floats, starts off the axis or has spacing errors")
+            }
+        };
+        return refuse(
+            ck,
+            format!(
+                "{}: {what}, which needs the multibody engine; a pack on a network runs on the reference engine (one rotational degree of freedom per disc)",
+                path.display()
+            ),
+        );
+    }
+    Some(scene.pack)
 }
 
 /// `[bodies.firing]` of body `i`: `Some(Some(..))` when valid, `None` after reporting.
