@@ -560,6 +560,64 @@ pub fn engaging_clutch() -> PackModel {
     pack
 }
 
+/// A dual-clutch transmission's wet clutch as a resolved pack (MODEL.md sections 5 and 8;
+/// every value ASSUMED, of a DCT's clutch): `n` friction discs (`disc-1` ...; 0.004 kg m^2,
+/// 40 teeth at 0.07 m, 20 deg, 0.3 mm backlash) and `n + 1` separator plates (`plate-1` ...;
+/// 0.003 kg m^2, 48 teeth at 0.1 m, 30 deg, 0.3 mm), the dry Hertz law of the paper's
+/// contact with `p = 0.5 s/m`, no drag, faces 0.075-0.095 m with a constant `mu = 0.1`, no
+/// oil gap and no spline friction, so that every face is clamped by the piston's whole
+/// `clamp_n` (N, constant) and the pack slips with `2 n mu F R_eff`. Its own shaft is the
+/// paper's drive (a network's body replaces it).
+pub fn wet_clutch(n: usize, clamp_n: f64) -> PackModel {
+    let body = |name: String, j: f64, spline: SplineGeometry| {
+        let mut law = paper_law(LawKind::Dry, 0.0);
+        law.hertz.loss_coefficient_s_m = 0.5;
+        DiscModel {
+            name,
+            spline,
+            law,
+            inertia_kg_m2: j,
+            drag_n_m_s_rad: 0.0,
+            initial_rel_angle_rad: 0.0,
+            initial_rel_speed_rad_s: 0.0,
+            radial_float: false,
+            tooth_spacing_errors_m: Vec::new(),
+            initial_offset_m: [0.0, 0.0],
+        }
+    };
+    let spline = |teeth: u32, r: f64, alpha_deg: f64| SplineGeometry {
+        teeth,
+        pitch_radius_m: r,
+        pressure_angle_rad: alpha_deg.to_radians(),
+        backlash_m: 0.3e-3,
+    };
+    let mut pack = PackModel::new(
+        Shaft::Prescribed(paper_drive()),
+        (1..=n)
+            .map(|k| body(format!("disc-{k}"), 0.004, spline(40, 0.07, 20.0)))
+            .collect(),
+    );
+    pack.plates = (1..=n + 1)
+        .map(|k| body(format!("plate-{k}"), 0.003, spline(48, 0.1, 30.0)))
+        .collect();
+    pack.stack = Some(StackModel {
+        face_friction: Vec::new(),
+        face_inner_radius_m: 0.075,
+        face_outer_radius_m: 0.095,
+        friction: FrictionCurve::constant(0.1),
+        piston: Piston {
+            area_m2: 0.01,
+            pressure: PressureProfile::Constant {
+                pressure_pa: clamp_n / 0.01,
+            },
+            return_spring_n: 0.0,
+        },
+        open_gap: None,
+        spline_friction: 0.0,
+    });
+    pack
+}
+
 /// A pack with an inertial shaft as a network (MODEL.md section 8): body `shaft` (the pack's
 /// `J1`, `C1` as drag, its drive torque: `J1 d(omega)/dt` of a harmonic speed profile as a sum
 /// of sines), body `drum` (its inertia, load as a constant drive, drag and speed) or the fixed

@@ -131,3 +131,100 @@ fn one_pack_between_two_inertias_is_the_pack_scenes_run() {
         e.residual_j()
     );
 }
+
+/// The inertia phase of a dual-clutch power-on upshift (MODEL.md section 8) with both
+/// clutches resolved packs ([`clutchpack_model::cases::wet_clutch`]: discs on the input
+/// shafts, plates on the engine), against the closed form of the lumped test
+/// (`tests/network.rs`, `dual_clutch_inertia_phase_matches_closed_form`): the off-going pack
+/// open, the on-coming one clamped with a constant force, so that it slips with
+/// `T_c = 2 N mu F R_eff`; the engine side's inertia is the engine's and every plate's (they
+/// ride on its spline). The phase lasts `t_i = J dw / (T_c - T_e)`, the on-coming pack takes
+/// `E_i = T_c dw t_i / 2`. Issue 34's bound is 1 %. Measured: the last face locks 8.3e-4
+/// late (at 78.78 ms: the faces lock, break and lock again over 1.1 ms while the discs and
+/// plates rattle at the synchronisation, 514 tooth impacts in all), the heat 1.7e-3 low;
+/// asserted 2e-3 and 4e-3. The lumped shift agrees to 3e-6: the rest is the packs' rattle.
+#[test]
+fn dual_clutch_shift_with_resolved_packs_matches_closed_form() {
+    use clutchpack_model::cases::wet_clutch;
+    use clutchpack_model::network::*;
+    let (j_e, t_e, r1, r2, w_out) = (0.25, 200.0, 3.5, 2.1, 40.0);
+    let (n1, n2, clamp) = (4, 5, 4700.0);
+    let body = |name: &str, j: f64, w: f64, drive: Option<Signal>| Body {
+        name: name.into(),
+        inertia_kg_m2: j,
+        drag_n_m_s_rad: 0.0,
+        initial_speed_rad_s: w,
+        fixed: false,
+        drive,
+        firing: None,
+        road_load: None,
+    };
+    let (k1, k2) = (wet_clutch(n1, 0.0), wet_clutch(n2, clamp));
+    let stack = k2.stack.as_ref().unwrap();
+    let t_c = 2.0 * n2 as f64 * 0.1 * clamp * stack.effective_radius_m();
+    let plates: f64 = k1
+        .plates
+        .iter()
+        .chain(&k2.plates)
+        .map(|p| p.inertia_kg_m2)
+        .sum();
+    let pack = |name: &str, a: usize, p: PackModel| Coupling {
+        name: name.into(),
+        a,
+        b: 0,
+        kind: CouplingKind::Pack(Box::new(p)),
+    };
+    let gear = |name: &str, a: usize, ratio: f64| Coupling {
+        name: name.into(),
+        a,
+        b: 3,
+        kind: CouplingKind::IdealGear { ratio },
+    };
+    let net = Network {
+        bodies: vec![
+            body("engine", j_e, r1 * w_out, Some(Signal::Constant(t_e))),
+            body("shaft-1", 0.02, r1 * w_out, None),
+            body("shaft-2", 0.02, r2 * w_out, None),
+            body("vehicle", 1e6, w_out, None),
+        ],
+        couplings: vec![
+            pack("K1", 1, k1),
+            pack("K2", 2, k2),
+            gear("gear-1", 1, r1),
+            gear("gear-2", 2, r2),
+        ],
+    };
+    #[derive(Default)]
+    struct Faces(Vec<(usize, f64, usize, usize)>, usize);
+    impl NetworkObserver for Faces {
+        fn pack_faces(&mut self, k: usize, t: f64, locked: usize, _c: usize, faces: usize) {
+            self.0.push((k, t, locked, faces));
+        }
+        fn pack_impact(&mut self, _k: usize, _e: &ImpactEvent) {
+            self.1 += 1;
+        }
+    }
+    let mut obs = Faces::default();
+    let run = run_network(&net, 0.12, &NetworkOptions::default(), &mut obs).unwrap();
+    let dw = r1 * w_out * (1.0 - r2 / r1);
+    let t_i = (j_e + plates) * dw / (t_c - t_e);
+    let e_i = t_c * dw * t_i / 2.0;
+    let lock = obs
+        .0
+        .iter()
+        .find(|(k, t, locked, faces)| *k == 1 && *t > 0.0 && locked == faces)
+        .expect("the on-coming pack locks")
+        .1;
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+    println!(
+        "T_c {t_c} N m; lock at {lock} s (closed form {t_i}, {:e}), heat {} J (closed form {e_i}, {:e}); {} impacts, {} steps",
+        rel(lock, t_i),
+        run.heat_j[1],
+        rel(run.heat_j[1], e_i),
+        obs.1,
+        run.steps
+    );
+    assert!(rel(lock, t_i) < 2e-3);
+    assert!(rel(run.heat_j[1], e_i) < 4e-3);
+    assert!(run.energy.residual_j().abs() < 1e-8 * run.energy.drive_work_j);
+}

@@ -54,10 +54,11 @@ pub struct CouplingSummary {
     pub heat_j: f64,
     /// Torque on its body a at the end, N m.
     pub final_torque_n_m: f64,
-    /// A clutch's mode at the end (absent for a gear).
+    /// A clutch's mode at the end (absent for a gear); a pack's faces: "locked" (all
+    /// locked), "slipping" (some clamped), "free".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub final_mode: Option<&'static str>,
-    /// The instants a clutch locked, s.
+    /// The instants a clutch locked, or all of a pack's faces locked, s.
     pub lock_times_s: Vec<f64>,
     /// A gear mesh's or a pack's tooth impacts (closed contacts) over the run (0 for other
     /// kinds).
@@ -163,6 +164,9 @@ pub(crate) struct Keep {
     meshes: std::collections::HashMap<usize, (u64, f64)>,
     /// Per (pack coupling, body in the pack): (impacts, largest peak).
     pack_bodies: std::collections::HashMap<(usize, usize), (u64, f64)>,
+    /// Per pack coupling: its faces' mode as a clutch's label ("free", "slipping",
+    /// "locked"), and the instants all its faces locked.
+    pack_modes: std::collections::HashMap<usize, (&'static str, Vec<f64>)>,
     history: Vec<NetworkSample>,
     stopped: bool,
     /// The recording, until its first error.
@@ -206,6 +210,7 @@ impl Keep {
             range: self.range.clone(),
             meshes: self.meshes.clone(),
             pack_bodies: self.pack_bodies.clone(),
+            pack_modes: self.pack_modes.clone(),
             history: self.history.clone(),
             stopped: self.stopped,
             recorder: None,
@@ -256,6 +261,24 @@ impl NetworkObserver for Obs<'_, '_> {
                 m.1 = e.peak_n;
             }
         }
+    }
+    fn pack_faces(&mut self, coupling: usize, t: f64, locked: usize, clamped: usize, faces: usize) {
+        let mode = if locked == faces {
+            "locked"
+        } else if clamped > 0 {
+            "slipping"
+        } else {
+            "free"
+        };
+        let m = self
+            .keep
+            .pack_modes
+            .entry(coupling)
+            .or_insert(("free", Vec::new()));
+        if mode == "locked" && m.0 != "locked" {
+            m.1.push(t);
+        }
+        m.0 = mode;
     }
     fn switched(&mut self, before: &NetworkSample, after: &NetworkSample) {
         let steps = after
@@ -425,12 +448,20 @@ pub(crate) fn conclude(
                 kind: clutchpack_record::coupling_kind_name(&c.kind),
                 heat_j: run.heat_j[k],
                 final_torque_n_m: last.torque_n_m[k],
-                final_mode: last.mode[k].map(ClutchMode::label),
+                final_mode: last.mode[k]
+                    .map(ClutchMode::label)
+                    .or(keep.pack_modes.get(&k).map(|m| m.0)),
                 lock_times_s: keep
                     .events
                     .iter()
                     .filter(|e| e.coupling == k && e.to == ClutchMode::Locked)
                     .map(|e| e.t_s)
+                    .chain(
+                        keep.pack_modes
+                            .get(&k)
+                            .into_iter()
+                            .flat_map(|m| m.1.clone()),
+                    )
                     .collect(),
                 impacts: keep
                     .meshes

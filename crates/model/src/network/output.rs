@@ -111,6 +111,18 @@ pub trait NetworkObserver {
     /// coupling index, the impact's `disc` the body's index in the pack (its discs, then its
     /// plates), its peak the per-tooth load as the pack engines sign it.
     fn pack_impact(&mut self, _coupling: usize, _impact: &ImpactEvent) {}
+    /// A resolved pack's faces changed mode at `t_s` (s): `locked` of its `faces` friction
+    /// faces are locked now (all of them: the pack has locked, its carriers turn as one but
+    /// for the splines' play), `clamped` are clamped (locked or slipping).
+    fn pack_faces(
+        &mut self,
+        _coupling: usize,
+        _t_s: f64,
+        _locked: usize,
+        _clamped: usize,
+        _faces: usize,
+    ) {
+    }
     /// Polled after every step with the time reached, s; `false` stops the run there.
     fn progress(&mut self, _t_s: f64) -> bool {
         true

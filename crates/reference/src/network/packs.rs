@@ -26,7 +26,7 @@
 use super::NetworkObserver;
 use crate::dopri::Dense;
 use crate::stepper::golden_peak;
-use crate::system::System;
+use crate::system::{Face, System};
 use clutchpack_model::network::Network;
 use clutchpack_model::{Engagement, ImpactTracker};
 use std::sync::Arc;
@@ -230,6 +230,15 @@ impl NetPack {
         }
     }
 
+    /// How many of its faces are locked, and how many clamped (locked or slipping).
+    fn face_counts(&self) -> (usize, usize) {
+        let f = &self.sys.faces;
+        (
+            f.iter().filter(|m| **m == Face::Locked).count(),
+            f.iter().filter(|m| **m != Face::Open).count(),
+        )
+    }
+
     /// Closes `slot`'s open event at `t`: its peak refined on the best step's dense output.
     fn close(&mut self, slot: usize, t: f64, ybuf: &mut [f64], obs: &mut dyn NetworkObserver) {
         if let Some((dense, tb, _)) = self.best[slot].take() {
@@ -299,8 +308,13 @@ pub(super) fn switch(
         let mine = crossed.map(|g| &g[p.guard_at..p.guard_at + p.guards()]);
         p.switch_teeth(t, y, mine, ybuf, obs);
         if !p.sys.faces.is_empty() {
+            let before = p.face_counts();
             let c = [y[n + p.a], 0.0, y[n + p.b], 0.0];
             p.settle_faces(t, y, mine, &c);
+            let (locked, clamped) = p.face_counts();
+            if (locked, clamped) != before || crossed.is_none() && t == 0.0 {
+                obs.pack_faces(p.k, t, locked, clamped, p.sys.faces.len());
+            }
         }
     }
 }
