@@ -101,6 +101,16 @@ impl Dense {
         }
     }
 
+    /// Interpolated components `from..out.len()` at `t` (within the step) into `out` (the
+    /// others left as they are).
+    pub fn eval_from(&self, t: f64, from: usize, out: &mut [f64]) {
+        let th = fraction(self.t0, self.h, t);
+        for i in from..out.len() {
+            let c = [self.r1[i], self.r2[i], self.r3[i], self.r4[i], self.r5[i]];
+            out[i] = interpolate(&c, th);
+        }
+    }
+
     /// The interpolant of component `i` alone: `(t0, h, coefficients)` for [`eval_component`].
     pub fn component(&self, i: usize) -> (f64, f64, [f64; 5]) {
         let c = [self.r1[i], self.r2[i], self.r3[i], self.r4[i], self.r5[i]];

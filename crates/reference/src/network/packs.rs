@@ -15,8 +15,10 @@
 //! face's switching condition (it clamps, sticks, breaks or opens) join the network's guard
 //! vector, after the couplings' own; one DOPRI5 over all, each crossing bisected on the dense
 //! output. A contact's onset takes the tooth law's per-event memory; its peak is located on
-//! the dense output of the step that holds it (as the gear meshes' are); its separation
-//! sends the impact ([`super::NetworkObserver::pack_impact`]).
+//! the dense output of the step that holds it: the load probed at the quarter points of every
+//! step in contact (the state interpolated once per point for every pack), and a largest probe
+//! inside the step above the event's largest so far refined there by golden-section search;
+//! its separation sends the impact ([`super::NetworkObserver::pack_impact`]).
 //!
 //! # State
 //! Per pack, after the network's own state: its [`System`]'s (each body's relative angle and
@@ -31,8 +33,10 @@ use clutchpack_model::network::Network;
 use clutchpack_model::{Engagement, ImpactTracker};
 use std::sync::Arc;
 
-/// Samples of a load per step in contact before the refinement (as the meshes').
-const PROBES: usize = 16;
+/// Samples of a load per step in contact before the refinement: the step's quarter points
+/// (a contact takes tens of steps, so the load is smooth within one; the refinement searches
+/// a quarter step either side of the largest).
+const PROBES: usize = 4;
 
 /// One resolved pack of a network run.
 #[derive(Clone)]
@@ -52,8 +56,10 @@ pub(super) struct NetPack {
     /// Each body's contact mode (discs, then plates).
     pub modes: Vec<Option<Engagement>>,
     trackers: Vec<ImpactTracker>,
-    /// Per body: the dense output of the step with the largest |F| so far, and where.
-    best: Vec<Option<(Dense, f64, f64)>>,
+    /// Per body: the largest |F| of its open event so far, N.
+    best: Vec<f64>,
+    /// Per body: the largest probe of the step being observed, `(t s, signed F N)`.
+    top: Vec<(f64, f64)>,
 }
 
 impl NetPack {
@@ -141,6 +147,21 @@ impl NetPack {
         if self.sys.faces.is_empty() {
             return;
         }
+        let open = self.sys.faces.iter().all(|f| *f == Face::Open);
+        if open
+            && self
+                .sys
+                .pack
+                .stack
+                .as_ref()
+                .map_or(0.0, |s| s.piston.force_n(t))
+                <= 0.0
+        {
+            // an open face clamps when its clamp force turns positive, and that is at most
+            // the piston's
+            out[nb..].iter_mut().for_each(|g| *g = 1.0);
+            return;
+        }
         // the faces' conditions need the carriers' speeds only
         let c = [w[self.a], 0.0, w[self.b], 0.0];
         let ev = self.sys.stack_eval(t, part, &self.modes, &c);
@@ -153,37 +174,6 @@ impl NetPack {
         }
     }
 
-    /// The signed per-tooth load (N) of `slot` at `t` on `dense`.
-    fn load(&self, slot: usize, dense: &Dense, t: f64, ybuf: &mut [f64]) -> f64 {
-        if self.modes[slot].is_none() {
-            return 0.0;
-        }
-        dense.eval(t, ybuf);
-        self.sys.load(slot, self.part(ybuf), &self.modes[slot])
-    }
-
-    /// Observes its bodies in contact over the accepted step `[t0, t1]` of `dense`.
-    pub fn observe(&mut self, dense: &Dense, t0: f64, t1: f64, ybuf: &mut [f64]) {
-        for slot in 0..self.sys.ids.len() {
-            if self.modes[slot].is_none() {
-                continue;
-            }
-            let mut top: Option<(f64, f64)> = None;
-            for j in 1..=PROBES {
-                let t = t0 + (t1 - t0) * j as f64 / PROBES as f64;
-                let f = self.load(slot, dense, t, ybuf);
-                if top.is_none_or(|(_, b)| f.abs() > b) {
-                    top = Some((t, f.abs()));
-                }
-            }
-            let (t, f) = top.expect("probes");
-            let prior = self.best[slot].as_ref().map_or(-1.0, |b| b.2);
-            if f > prior {
-                self.best[slot] = Some((dense.clone(), t, f));
-            }
-        }
-    }
-
     /// Opens and closes contact events at an event at `t` (`crossed[slot] <= 0`: the body's
     /// guard crossed; `None`: every body checked, as at t = 0).
     pub fn switch_teeth(
@@ -191,7 +181,6 @@ impl NetPack {
         t: f64,
         y: &[f64],
         crossed: Option<&[f64]>,
-        ybuf: &mut [f64],
         obs: &mut dyn NetworkObserver,
     ) {
         for slot in 0..self.sys.ids.len() {
@@ -204,10 +193,10 @@ impl NetPack {
                 (None, true) => {
                     self.modes[slot] = Some(self.sys.disc(slot).law.engage(&kin));
                     self.trackers[slot].begin(t, kin.flank, kin.v_n_m_s);
-                    self.best[slot] = None;
+                    self.best[slot] = 0.0;
                 }
                 (Some(_), false) => {
-                    self.close(slot, t, ybuf, obs);
+                    self.close(slot, t, obs);
                     self.modes[slot] = None;
                 }
                 _ => {}
@@ -239,27 +228,18 @@ impl NetPack {
         )
     }
 
-    /// Closes `slot`'s open event at `t`: its peak refined on the best step's dense output.
-    fn close(&mut self, slot: usize, t: f64, ybuf: &mut [f64], obs: &mut dyn NetworkObserver) {
-        if let Some((dense, tb, _)) = self.best[slot].take() {
-            let span = dense.h / PROBES as f64;
-            let (a, b) = (
-                (tb - span).max(dense.t0),
-                (tb + span).min(dense.t0 + dense.h),
-            );
-            let (tp, fp) = golden_peak(a, b, |tt| self.load(slot, &dense, tt, ybuf));
-            self.trackers[slot].observe(tp, fp);
-        }
+    /// Closes `slot`'s open event at `t` (its peak was located as the steps went).
+    fn close(&mut self, slot: usize, t: f64, obs: &mut dyn NetworkObserver) {
         if let Some(e) = self.trackers[slot].end(t) {
             obs.pack_impact(self.k, &e);
         }
     }
 
     /// Closes every open event at the end of the run at `t`.
-    pub fn finish(&mut self, t: f64, ybuf: &mut [f64], obs: &mut dyn NetworkObserver) {
+    pub fn finish(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
         for slot in 0..self.sys.ids.len() {
             if self.modes[slot].is_some() {
-                self.close(slot, t, ybuf, obs);
+                self.close(slot, t, obs);
             }
         }
     }
@@ -282,7 +262,8 @@ pub(super) fn build(net: &Network, first: usize, first_guard: usize) -> Vec<NetP
             guard_at,
             modes: vec![None; nb],
             trackers: (0..nb).map(ImpactTracker::new).collect(),
-            best: vec![None; nb],
+            best: vec![0.0; nb],
+            top: vec![(0.0, 0.0); nb],
             sys,
         };
         at += p.len();
@@ -301,12 +282,11 @@ pub(super) fn switch(
     t: f64,
     y: &mut [f64],
     crossed: Option<&[f64]>,
-    ybuf: &mut [f64],
     obs: &mut dyn NetworkObserver,
 ) {
     for p in packs {
         let mine = crossed.map(|g| &g[p.guard_at..p.guard_at + p.guards()]);
-        p.switch_teeth(t, y, mine, ybuf, obs);
+        p.switch_teeth(t, y, mine, obs);
         if !p.sys.faces.is_empty() {
             let before = p.face_counts();
             let c = [y[n + p.a], 0.0, y[n + p.b], 0.0];
@@ -315,6 +295,64 @@ pub(super) fn switch(
             if (locked, clamped) != before || crossed.is_none() && t == 0.0 {
                 obs.pack_faces(p.k, t, locked, clamped, p.sys.faces.len());
             }
+        }
+    }
+}
+
+/// Observes every pack's bodies in contact over the accepted step `[t0, t1]` of `dense`: the
+/// load probed at [`PROBES`] points (the packs' state interpolated once per point); where a
+/// body's largest probe exceeds its event's largest so far, the event sees it, refined by
+/// golden-section search on the step when it lies inside it (a peak), as it is at the step's
+/// end (still rising).
+pub(super) fn observe(packs: &mut [NetPack], dense: &Dense, t0: f64, t1: f64, ybuf: &mut [f64]) {
+    let Some(from) = packs.first().map(|p| p.at) else {
+        return;
+    };
+    if packs.iter().all(|p| p.modes.iter().all(Option::is_none)) {
+        return;
+    }
+    for p in packs.iter_mut() {
+        p.top.iter_mut().for_each(|x| *x = (t0, 0.0));
+    }
+    for j in 1..=PROBES {
+        let t = if j == PROBES {
+            t1
+        } else {
+            t0 + (t1 - t0) * j as f64 / PROBES as f64
+        };
+        dense.eval_from(t, from, ybuf);
+        for p in packs.iter_mut() {
+            let part = &ybuf[p.at..p.at + p.sys.dim()];
+            for slot in 0..p.sys.ids.len() {
+                if p.modes[slot].is_none() {
+                    continue;
+                }
+                let f = p.sys.load(slot, part, &p.modes[slot]);
+                if f.abs() > p.top[slot].1.abs() {
+                    p.top[slot] = (t, f);
+                }
+            }
+        }
+    }
+    let span = (t1 - t0) / PROBES as f64;
+    for p in packs.iter_mut() {
+        for slot in 0..p.sys.ids.len() {
+            let (t, f) = p.top[slot];
+            if p.modes[slot].is_none() || f.abs() <= p.best[slot] {
+                continue;
+            }
+            let (tp, fp) = if t < t1 {
+                let (at, dim) = (p.at, p.sys.dim());
+                let (sys, mode) = (&p.sys, &p.modes[slot]);
+                golden_peak((t - span).max(t0), (t + span).min(t1), |tt| {
+                    dense.eval_from(tt, from, ybuf);
+                    sys.load(slot, &ybuf[at..at + dim], mode)
+                })
+            } else {
+                (t, f)
+            };
+            p.trackers[slot].observe(tp, fp);
+            p.best[slot] = fp.abs().max(f.abs());
         }
     }
 }

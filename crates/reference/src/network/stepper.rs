@@ -110,8 +110,8 @@ impl NetworkStepper {
         }
         let kinetic0 = kinetic(&eq, &y);
         let mut events = 0u64;
-        let mut ybuf = vec![0.0; dim];
-        packs::switch(&mut eq.packs, n, 0.0, &mut y, None, &mut ybuf, obs);
+        let ybuf = vec![0.0; dim];
+        packs::switch(&mut eq.packs, n, 0.0, &mut y, None, obs);
         settle(&mut eq, 0.0, &mut y, &[], obs, &mut events);
         let mut meshes = mesh::Meshes::new(m, dim);
         meshes.switch(&mut eq, 0.0, &y, None, obs);
@@ -323,9 +323,7 @@ impl NetworkStepper {
                 }
             };
             meshes.observe(eq, dense, *t, t_new);
-            for p in eq.packs.iter_mut() {
-                p.observe(dense, *t, t_new, ybuf);
-            }
+            packs::observe(&mut eq.packs, dense, *t, t_new, ybuf);
             // samples up to t_new from the dense output
             while (self.next_sample as f64) * self.period <= t_new
                 && (self.next_sample as f64) * self.period < self.duration_s
@@ -349,7 +347,7 @@ impl NetworkStepper {
             if at_event {
                 meshes.switch(eq, *t, y, Some(g1), obs);
                 let n = eq.net.bodies.len();
-                packs::switch(&mut eq.packs, n, *t, y, Some(g1), ybuf, obs);
+                packs::switch(&mut eq.packs, n, *t, y, Some(g1), obs);
                 settle(eq, *t, y, g1, obs, &mut self.events);
                 eq.rhs(*t, y, dy);
                 stepper.set_start_derivative(dy);
@@ -372,7 +370,7 @@ impl NetworkStepper {
         let (n, m) = (net.bodies.len(), net.couplings.len());
         self.meshes.finish(&mut self.eq, t, obs);
         for p in self.eq.packs.iter_mut() {
-            p.finish(t, &mut self.ybuf, obs);
+            p.finish(t, obs);
         }
         let last = sample(&mut self.eq, t, &self.y);
         obs.sample(&last);
