@@ -356,3 +356,39 @@ pub(super) fn observe(packs: &mut [NetPack], dense: &Dense, t0: f64, t1: f64, yb
         }
     }
 }
+
+/// At the start of a step with the guards `g` at `(t, y)`: settles the faces of every pack
+/// whose guard is not positive there (a face whose mode must change but whose guard did not
+/// cross from above, as when a face's own settling or a neighbour's lock left it so: the
+/// bisection only locates guards that were positive at a step's start). Returns whether a
+/// face changed (the caller restarts the integration there).
+pub(super) fn heal(
+    packs: &mut [NetPack],
+    n: usize,
+    t: f64,
+    y: &mut [f64],
+    g: &[f64],
+    obs: &mut dyn NetworkObserver,
+) -> bool {
+    let mut changed = false;
+    for p in packs.iter_mut() {
+        let mine = &g[p.guard_at..p.guard_at + p.guards()];
+        let nb = p.sys.ids.len();
+        if mine[nb..].iter().all(|x| *x > 0.0) {
+            continue;
+        }
+        let (faces, before) = (p.sys.faces.clone(), p.face_counts());
+        let mut only_faces = mine.to_vec();
+        only_faces[..nb].iter_mut().for_each(|x| *x = 1.0);
+        let c = [y[n + p.a], 0.0, y[n + p.b], 0.0];
+        p.settle_faces(t, y, Some(&only_faces), &c);
+        if p.sys.faces != faces {
+            changed = true;
+            let (locked, clamped) = p.face_counts();
+            if (locked, clamped) != before {
+                obs.pack_faces(p.k, t, locked, clamped, p.sys.faces.len());
+            }
+        }
+    }
+    changed
+}

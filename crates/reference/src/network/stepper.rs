@@ -113,6 +113,7 @@ impl NetworkStepper {
         let ybuf = vec![0.0; dim];
         packs::switch(&mut eq.packs, n, 0.0, &mut y, None, obs);
         settle(&mut eq, 0.0, &mut y, &[], obs, &mut events);
+        heal_faces(&mut eq, 0.0, &mut y, obs);
         let mut meshes = mesh::Meshes::new(m, dim);
         meshes.switch(&mut eq, 0.0, &y, None, obs);
         let mut stepper = Dopri5::new(dim);
@@ -215,6 +216,7 @@ impl NetworkStepper {
             obs,
             &mut self.events,
         );
+        heal_faces(&mut self.eq, t, &mut self.y, obs);
         self.eq.rhs(t, &self.y, &mut self.dy);
         self.stepper.set_start_derivative(&self.dy);
         Ok(())
@@ -257,6 +259,7 @@ impl NetworkStepper {
                 *next_bp += 1;
                 g1.iter_mut().for_each(|g| *g = 1.0);
                 settle(eq, *t, y, g1, obs, &mut self.events);
+                heal_faces(eq, *t, y, obs);
                 eq.rhs(*t, y, dy);
                 stepper.set_start_derivative(dy);
                 continue;
@@ -349,6 +352,7 @@ impl NetworkStepper {
                 let n = eq.net.bodies.len();
                 packs::switch(&mut eq.packs, n, *t, y, Some(g1), obs);
                 settle(eq, *t, y, g1, obs, &mut self.events);
+                heal_faces(eq, *t, y, obs);
                 eq.rhs(*t, y, dy);
                 stepper.set_start_derivative(dy);
             } else {
@@ -427,4 +431,21 @@ fn kinetic(eq: &Equations, y: &[f64]) -> f64 {
         .map(|(i, b)| 0.5 * b.inertia_kg_m2 * y[n + i] * y[n + i])
         .sum::<f64>()
         + eq.packs.iter().map(|p| p.kinetic_j(y, w)).sum::<f64>()
+}
+
+/// Settles the packs' faces that an event or a settling left switching (their guards not
+/// positive: `packs::heal`), until none is (at most a few rounds: each settles faces whose
+/// neighbours' changes moved them).
+fn heal_faces(eq: &mut Equations, t: f64, y: &mut [f64], obs: &mut dyn NetworkObserver) {
+    if eq.packs.iter().all(|p| p.sys.faces.is_empty()) {
+        return;
+    }
+    let mut g = vec![0.0; eq.guard_len()];
+    let n = eq.net.bodies.len();
+    for _ in 0..4 {
+        eq.guards(t, y, &mut g);
+        if !packs::heal(&mut eq.packs, n, t, y, &g, obs) {
+            break;
+        }
+    }
 }
