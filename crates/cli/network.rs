@@ -90,7 +90,7 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     }
     let s = &done.summary;
     if let Some(path) = a.plot {
-        plot(path, &scene, s.engine, &done.history)?;
+        plot(path, &scene, s.engine, &done)?;
     }
     if let Some(path) = a.summary_json {
         crate::outputs::write_json(path, s)?;
@@ -207,12 +207,13 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     Ok(ExitCode::SUCCESS)
 }
 
-/// The figure: the bodies' speeds and the couplings' torques against time.
+/// The figure: the bodies' speeds and the couplings' torques against time, and the packs'
+/// tooth impacts.
 fn plot(
     path: &Path,
     scene: &Scene,
     engine: &str,
-    history: &[clutchpack_sdk::NetworkSample],
+    outcome: &clutchpack_sdk::NetworkOutcome,
 ) -> Result<()> {
     let net = scene.network.as_ref().expect("a network scene");
     let bodies: Vec<(&str, bool)> = net
@@ -221,12 +222,23 @@ fn plot(
         .map(|b| (b.name.as_str(), b.fixed))
         .collect();
     let couplings: Vec<&str> = net.couplings.iter().map(|c| c.name.as_str()).collect();
-    plot_samples(path, &scene.name, engine, &bodies, &couplings, history)
+    plot_samples(
+        path,
+        &scene.name,
+        engine,
+        &bodies,
+        &couplings,
+        &outcome.history,
+        &outcome.impacts,
+    )
 }
 
 /// The figure of a network's run: every turning body's speed and every coupling's torque on
-/// its body a against time; `bodies` are (name, fixed) in scene order. `run --plot` of a
-/// network scene and `plot` of a network recording draw it.
+/// its body a against time; `bodies` are (name, fixed) in scene order. With `impacts`
+/// (`(name, t_peak s, peak N)` as [`clutchpack_sdk::NetworkOutcome::impacts`] names them) a
+/// third panel: each impact's |peak| per tooth at its time, one colour per pack's discs, per
+/// pack's plates and per gear mesh. `run --plot` of a network scene and `plot` of a network
+/// recording draw it.
 pub fn plot_samples(
     path: &Path,
     scene: &str,
@@ -234,6 +246,7 @@ pub fn plot_samples(
     bodies: &[(&str, bool)],
     couplings: &[&str],
     history: &[clutchpack_sdk::NetworkSample],
+    impacts: &[(String, f64, f64)],
 ) -> Result<()> {
     let series = |name: &str, f: &dyn Fn(&clutchpack_sdk::NetworkSample) -> f64| {
         (
@@ -252,17 +265,44 @@ pub fn plot_samples(
         .enumerate()
         .map(|(k, name)| series(name, &|s| s.torque_n_m[k]))
         .collect();
-    let panels = [
+    let mut panels = vec![
         clutchpack_sdk::analysis::Panel {
             y_label: "speed [rad/s]".into(),
             series: speeds,
+            markers_only: false,
         },
         clutchpack_sdk::analysis::Panel {
             y_label: "torque on body a [N m]".into(),
             series: torques,
+            markers_only: false,
         },
     ];
-    let title = format!("{scene}: speeds and coupling torques ({engine} engine)");
+    if !impacts.is_empty() {
+        // one series per pack's discs, per pack's plates, per mesh: "K1/discs/disc-3" -> "K1 discs"
+        let mut groups: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+        for (name, t, peak) in impacts {
+            let mut parts = name.splitn(3, '/');
+            let group = match (parts.next(), parts.next()) {
+                (Some(pack), Some(role)) => format!("{pack} {role}"),
+                _ => name.clone(),
+            };
+            match groups.iter_mut().find(|g| g.0 == group) {
+                Some(g) => g.1.push((*t, peak.abs())),
+                None => groups.push((group, vec![(*t, peak.abs())])),
+            }
+        }
+        groups.sort_by(|a, b| a.0.cmp(&b.0));
+        panels.push(clutchpack_sdk::analysis::Panel {
+            y_label: "impact |peak| per tooth [N]".into(),
+            series: groups,
+            markers_only: true,
+        });
+    }
+    let title = if impacts.is_empty() {
+        format!("{scene}: speeds and coupling torques ({engine} engine)")
+    } else {
+        format!("{scene}: speeds, coupling torques and tooth impacts ({engine} engine)")
+    };
     crate::outputs::write_with(path, |tmp| {
         clutchpack_sdk::analysis::plot_panels(tmp, &title, "t [s]", &panels)
             .with_context(|| format!("plotting {}", path.display()))

@@ -388,12 +388,17 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The clutches of a network recording, from its attached summary (the run's
-/// `--summary-json`); a recording of a run that did not finish has none: bad input, saying so.
-fn network_clutches(
-    f: &Path,
-    reader: &RecordingReader,
-) -> Result<Vec<clutchpack_sdk::analysis::ClutchRun>> {
+/// A network run's clutches (lumped clutches and resolved packs) and its packs' discs and
+/// plates.
+type NetworkRun = (
+    Vec<clutchpack_sdk::analysis::ClutchRun>,
+    Vec<clutchpack_sdk::analysis::PackBodyRun>,
+);
+
+/// The clutches (lumped and resolved packs) and the packs' bodies of a network recording,
+/// from its attached summary (the run's `--summary-json`); a recording of a run that did not
+/// finish has none: bad input, saying so.
+fn network_clutches(f: &Path, reader: &RecordingReader) -> Result<NetworkRun> {
     let summary = reader
         .info()
         .attachments
@@ -407,11 +412,27 @@ fn network_clutches(
                 f.display()
             ))
         })?;
-    Ok(summary["couplings"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter(|c| c["kind"] == "clutch")
+    let couplings = summary["couplings"].as_array().cloned().unwrap_or_default();
+    let bodies = couplings
+        .iter()
+        .filter(|c| c["kind"] == "pack")
+        .flat_map(|c| {
+            let pack = c["name"].as_str().unwrap_or("?").to_string();
+            c["pack_bodies"]
+                .as_array()
+                .cloned()
+                .unwrap_or_default()
+                .into_iter()
+                .map(move |b| clutchpack_sdk::analysis::PackBodyRun {
+                    name: format!("{pack}/{}", b["name"].as_str().unwrap_or("?")),
+                    impacts: b["impacts"].as_u64().unwrap_or(0),
+                    peak_abs_n: b["largest_peak_n"].as_f64().unwrap_or(0.0).abs(),
+                })
+        })
+        .collect();
+    let clutches = couplings
+        .iter()
+        .filter(|c| c["kind"] == "clutch" || c["kind"] == "pack")
         .map(|c| {
             let num = |k: &str| c[k].as_f64().unwrap_or(0.0);
             clutchpack_sdk::analysis::ClutchRun {
@@ -424,17 +445,18 @@ fn network_clutches(
                 max_abs_torque_n_m: num("min_torque_n_m").abs().max(num("max_torque_n_m").abs()),
             }
         })
-        .collect())
+        .collect();
+    Ok((clutches, bodies))
 }
 
-/// `compare` of network recordings: per run and clutch its heat, first lock and largest
-/// torque against the first run's, and which clutch of which run takes the most heat.
-fn compare_networks(
-    a: &CompareArgs,
-    networks: &[(String, Vec<clutchpack_sdk::analysis::ClutchRun>)],
-) -> Result<ExitCode> {
+/// `compare` of network recordings: per run and clutch (lumped or a resolved pack) its heat,
+/// first lock and largest torque against the first run's, and which clutch of which run takes
+/// the most heat; per run and pack body its impacts and largest peak, and which one is hit
+/// hardest. JSON: `{"clutches": [...], "pack_bodies": [...]}`.
+fn compare_networks(a: &CompareArgs, networks: &[(String, NetworkRun)]) -> Result<ExitCode> {
     use clutchpack_sdk::analysis::{
-        clutch_compare_rows, clutch_compare_table, hottest_clutch, TableFormat,
+        clutch_compare_rows, clutch_compare_table, hardest_hit, hottest_clutch,
+        largest_peak_change, pack_body_compare_rows, pack_body_compare_table, TableFormat,
     };
     if a.plot.is_some() {
         return Err(BadInput(
@@ -444,10 +466,20 @@ fn compare_networks(
         )
         .into());
     }
-    let rows = clutch_compare_rows(networks);
+    let clutches: Vec<_> = networks
+        .iter()
+        .map(|(run, (c, _))| (run.clone(), c.clone()))
+        .collect();
+    let bodies: Vec<_> = networks
+        .iter()
+        .map(|(run, (_, b))| (run.clone(), b.clone()))
+        .collect();
+    let rows = clutch_compare_rows(&clutches);
+    let body_rows = pack_body_compare_rows(&bodies);
     let format = match a.format {
         CompareFormat::Json => {
-            out!("{}", serde_json::to_string_pretty(&rows)?);
+            let both = serde_json::json!({ "clutches": rows, "pack_bodies": body_rows });
+            out!("{}", serde_json::to_string_pretty(&both)?);
             return Ok(ExitCode::SUCCESS);
         }
         CompareFormat::Csv => TableFormat::Csv,
@@ -455,6 +487,9 @@ fn compare_networks(
         CompareFormat::Table => TableFormat::Text,
     };
     out!("{}", clutch_compare_table(&rows, format).trim_end());
+    if !body_rows.is_empty() {
+        out!("{}", pack_body_compare_table(&body_rows, format).trim_end());
+    }
     if format == TableFormat::Text {
         out!("changes against the first run, per cent; shift: the first lock's, s");
         if let Some(h) = hottest_clutch(&rows) {
@@ -468,6 +503,28 @@ fn compare_networks(
                     .map_or(String::new(), |p| format!(
                         ", {p:+.1} % against the first run"
                     ))
+            );
+        }
+        if let Some(h) = hardest_hit(&body_rows).filter(|h| h.impacts > 0) {
+            out!(
+                "the pack body hit hardest: {} in {} ({:.3} N per tooth{})",
+                h.body,
+                h.run,
+                h.peak_abs_n,
+                h.peak_change_pct
+                    .filter(|p| p.abs() > 0.0)
+                    .map_or(String::new(), |p| format!(
+                        ", {p:+.1} % against the first run"
+                    ))
+            );
+        }
+        if let Some(c) = largest_peak_change(&body_rows) {
+            out!(
+                "the largest change of a pack body's peak: {} in {} ({:+.1} %, {:.3} N per tooth)",
+                c.body,
+                c.run,
+                c.peak_change_pct.unwrap_or(0.0),
+                c.peak_abs_n
             );
         }
     }
@@ -606,6 +663,7 @@ fn plot_network(
         &bodies,
         &couplings,
         &net.samples,
+        &net.impacts,
     )?;
     out!("{}", a.out.display());
     Ok(ExitCode::SUCCESS)

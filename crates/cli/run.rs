@@ -276,6 +276,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             clutchpack_sdk::analysis::Panel {
                 y_label: "largest |peak| per tooth [N]".into(),
                 series: by_body(&|b| b.peak_abs_n),
+                markers_only: false,
             },
             clutchpack_sdk::analysis::Panel {
                 y_label: "log10 damage rate [log10 1/h]".into(),
@@ -287,6 +288,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                         f64::NAN
                     }
                 }),
+                markers_only: false,
             },
         ];
         if windows.iter().any(|w| w.oil_k.is_some()) {
@@ -296,6 +298,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
                     series("oil", &|w| w.oil_k),
                     series("hottest body", &|w| w.hottest_body_k),
                 ],
+                markers_only: false,
             });
         }
         let title = format!(

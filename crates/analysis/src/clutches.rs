@@ -1,7 +1,8 @@
 //! Comparing the clutches of several runs of one driveline network (MODEL.md section 8): per
-//! run and clutch its heat, its first lock, its largest torque, with the changes against the
-//! first run, and which clutch of which run takes the most heat. `clutchpack compare` of
-//! network recordings prints it.
+//! run and clutch (a lumped clutch or a resolved pack) its heat, its first lock, its largest
+//! torque, with the changes against the first run, and which clutch of which run takes the
+//! most heat; per run and disc or plate of a resolved pack its impacts and largest peak, and
+//! which one is hit hardest. `clutchpack compare` of network recordings prints it.
 
 use crate::table::{col, csv_field, fmt_num, render, TableFormat};
 use serde::Serialize;
@@ -133,6 +134,117 @@ pub fn clutch_compare_table(rows: &[ClutchCompareRow], format: TableFormat) -> S
     render(format, &cols, &cells)
 }
 
+/// One disc or plate of a resolved pack in one run, as its run's summary gives it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PackBodyRun {
+    /// `<pack>/<disc or plate>`.
+    pub name: String,
+    /// Its tooth impacts over the run.
+    pub impacts: u64,
+    /// Its largest |peak| per tooth, N.
+    pub peak_abs_n: f64,
+}
+
+/// One (run, pack body) row of the comparison.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PackBodyCompareRow {
+    /// The run (its file).
+    pub run: String,
+    /// `<pack>/<disc or plate>`.
+    pub body: String,
+    /// Its tooth impacts over the run.
+    pub impacts: u64,
+    /// Its largest |peak| per tooth, N.
+    pub peak_abs_n: f64,
+    /// Change of the largest |peak| against the first run's same body, per cent.
+    pub peak_change_pct: Option<f64>,
+}
+
+/// The rows of `runs` (run name, its packs' bodies), each body against the first run's body
+/// of the same name.
+pub fn pack_body_compare_rows(runs: &[(String, Vec<PackBodyRun>)]) -> Vec<PackBodyCompareRow> {
+    let first = runs.first().map(|(_, b)| b.as_slice()).unwrap_or_default();
+    runs.iter()
+        .flat_map(|(run, bodies)| {
+            bodies.iter().map(move |b| PackBodyCompareRow {
+                run: run.clone(),
+                body: b.name.clone(),
+                impacts: b.impacts,
+                peak_abs_n: b.peak_abs_n,
+                peak_change_pct: first
+                    .iter()
+                    .find(|f| f.name == b.name)
+                    .and_then(|f| pct(b.peak_abs_n, f.peak_abs_n)),
+            })
+        })
+        .collect()
+}
+
+/// The row of the body hit hardest (the largest |peak| per tooth; the first of equals), if
+/// any.
+pub fn hardest_hit(rows: &[PackBodyCompareRow]) -> Option<&PackBodyCompareRow> {
+    rows.iter()
+        .fold(None, |best: Option<&PackBodyCompareRow>, r| match best {
+            Some(b) if b.peak_abs_n >= r.peak_abs_n => Some(b),
+            _ => Some(r),
+        })
+}
+
+/// The row whose largest |peak| changed most against the first run (in magnitude, per cent;
+/// the first of equals), if any changed.
+pub fn largest_peak_change(rows: &[PackBodyCompareRow]) -> Option<&PackBodyCompareRow> {
+    let m = |x: &PackBodyCompareRow| x.peak_change_pct.unwrap_or(0.0).abs();
+    rows.iter()
+        .filter(|r| m(r) > 0.0)
+        .fold(None, |best: Option<&PackBodyCompareRow>, r| match best {
+            Some(b) if m(b) >= m(r) => Some(b),
+            _ => Some(r),
+        })
+}
+
+/// The packs' bodies as a table. Columns (text and markdown): `run`, `pack body`,
+/// `impacts`, `max |peak| [N]`, `change`; CSV: the [`PackBodyCompareRow`] field names.
+pub fn pack_body_compare_table(rows: &[PackBodyCompareRow], format: TableFormat) -> String {
+    if format == TableFormat::Csv {
+        let mut out = String::from("run,body,impacts,peak_abs_n,peak_change_pct\n");
+        for r in rows {
+            let _ = writeln!(
+                out,
+                "{},{},{},{:?},{}",
+                csv_field(&r.run),
+                csv_field(&r.body),
+                r.impacts,
+                r.peak_abs_n,
+                r.peak_change_pct
+                    .map(|v| format!("{v:?}"))
+                    .unwrap_or_default()
+            );
+        }
+        return out;
+    }
+    let cols = vec![
+        col("run", false),
+        col("pack body", false),
+        col("impacts", true),
+        col("max |peak| [N]", true),
+        col("change", true),
+    ];
+    let cells: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            vec![
+                r.run.clone(),
+                r.body.clone(),
+                r.impacts.to_string(),
+                fmt_num(r.peak_abs_n),
+                r.peak_change_pct
+                    .map_or_else(|| "-".to_string(), |p| format!("{p:+.1} %")),
+            ]
+        })
+        .collect();
+    render(format, &cols, &cells)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -182,5 +294,45 @@ mod tests {
         assert!(text.contains("+20.0 %") && text.contains("never"), "{text}");
         let csv = clutch_compare_table(&rows, TableFormat::Csv);
         assert_eq!(csv.lines().count(), 6);
+    }
+
+    /// Each pack body against the first run's of the same name; the hardest hit is found.
+    #[test]
+    fn pack_bodies_compare_with_the_first_runs() {
+        let body = |name: &str, impacts: u64, peak: f64| PackBodyRun {
+            name: name.into(),
+            impacts,
+            peak_abs_n: peak,
+        };
+        let runs = vec![
+            (
+                "slow".to_string(),
+                vec![body("K2/disc-1", 8, 30.0), body("K2/plate-1", 9, 10.0)],
+            ),
+            (
+                "fast".to_string(),
+                vec![body("K2/disc-1", 7, 45.0), body("K2/plate-1", 9, 5.0)],
+            ),
+        ];
+        let rows = pack_body_compare_rows(&runs);
+        assert_eq!(rows.len(), 4);
+        assert!((rows[2].peak_change_pct.unwrap() - 50.0).abs() < 1e-12);
+        assert!((rows[3].peak_change_pct.unwrap() + 50.0).abs() < 1e-12);
+        let h = hardest_hit(&rows).unwrap();
+        assert_eq!((h.run.as_str(), h.body.as_str()), ("fast", "K2/disc-1"));
+        // +50 % and -50 %: the first of equals
+        let c = largest_peak_change(&rows).unwrap();
+        assert_eq!((c.run.as_str(), c.body.as_str()), ("fast", "K2/disc-1"));
+        let text = pack_body_compare_table(&rows, TableFormat::Text);
+        assert!(
+            text.contains("+50.0 %") && text.contains("pack body"),
+            "{text}"
+        );
+        assert_eq!(
+            pack_body_compare_table(&rows, TableFormat::Csv)
+                .lines()
+                .count(),
+            5
+        );
     }
 }

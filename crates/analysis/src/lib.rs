@@ -70,7 +70,9 @@ impl Lcg {
 }
 
 pub use clutches::{
-    clutch_compare_rows, clutch_compare_table, hottest_clutch, ClutchCompareRow, ClutchRun,
+    clutch_compare_rows, clutch_compare_table, hardest_hit, hottest_clutch, largest_peak_change,
+    pack_body_compare_rows, pack_body_compare_table, ClutchCompareRow, ClutchRun,
+    PackBodyCompareRow, PackBodyRun,
 };
 pub use fatigue::{
     assess, disc_cycles, ensemble_fatigue, DiscCycles, DiscFatigue, DiscFatigueSpread,

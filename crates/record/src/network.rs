@@ -15,7 +15,7 @@
 //! | `/network/couplings/<segment>` | `clutchpack.CouplingState` | each sample |
 //! | `/joints` (couplings: slip, torque), `/network/joints/bodies` (angle, speed) | `sensor_msgs/msg/JointState` | each sample (Rerun, Lichtblick) |
 //! | `/network/events` | `foxglove.Log` | each clutch mode change, at its instant |
-//! | `/network/impacts` | `clutchpack.Impact` | each gear-mesh impact and each tooth impact of a pack's disc or plate (`<pack>/<body>`), at its peak |
+//! | `/network/impacts` | `clutchpack.Impact` | each gear-mesh impact and each tooth impact of a pack's disc or plate (`<pack>/discs/<disc>`, `<pack>/plates/<plate>`), at its peak |
 //! | `/tf` | `foxglove.FrameTransforms` | each sample: `world` -> `body/<segment>` |
 //! | `/scene` | `foxglove.SceneUpdate` | t = 0: every body as a disc with a marker and its name |
 //! | `/scene/couplings` | `foxglove.SceneUpdate` | t = 0 and at each mode change |
@@ -79,6 +79,25 @@ fn coupling_color(mode: Option<ClutchMode>) -> Option<foxglove::schemas::Color> 
         Some(ClutchMode::Free) => rgba(0.8, 0.8, 0.8, 1.0),
         Some(ClutchMode::Locked) => rgba(0.1, 0.75, 0.25, 1.0),
         Some(_) => rgba(1.0, 0.55, 0.0, 1.0),
+    }
+}
+
+/// The name of a tooth impact on `/network/impacts`: a gear mesh's (`body` `None`) its
+/// coupling's name; a pack's disc's or plate's (`body` its index in the pack, discs then
+/// plates) `<pack>/discs/<disc>` or `<pack>/plates/<plate>`.
+pub fn impact_name(net: &Network, coupling: usize, body: Option<usize>) -> String {
+    let Some(c) = net.couplings.get(coupling) else {
+        return format!("coupling {coupling}");
+    };
+    match (body, c.pack()) {
+        (Some(i), Some(p)) => {
+            let role = if i < p.discs.len() { "discs" } else { "plates" };
+            match p.discs.iter().chain(&p.plates).nth(i) {
+                Some(d) => format!("{}/{role}/{}", c.name, d.name),
+                None => format!("{}/{role}/body {i}", c.name),
+            }
+        }
+        _ => c.name.clone(),
     }
 }
 
@@ -574,26 +593,15 @@ impl NetworkRecorder {
     }
 
     /// Writes the tooth impact of a resolved pack's disc or plate on `/network/impacts`,
-    /// logged at its peak, named `<pack>/<body>` (`coupling` the pack's index; `disc` of the
-    /// event the body's index in the pack, its discs then its plates).
+    /// logged at its peak, named `<pack>/discs/<disc>` or `<pack>/plates/<plate>` (`coupling`
+    /// the pack's index; `disc` of the event the body's index in the pack, its discs then its
+    /// plates).
     pub fn write_pack_impact(
         &mut self,
         coupling: usize,
         e: &ImpactEvent,
     ) -> Result<(), RecordError> {
-        let pack = self
-            .coupling_names
-            .get(coupling)
-            .cloned()
-            .unwrap_or_default();
-        let body = self
-            .net
-            .couplings
-            .get(coupling)
-            .and_then(|c| c.pack())
-            .and_then(|p| p.discs.iter().chain(&p.plates).nth(e.disc))
-            .map_or_else(|| format!("body {}", e.disc), |d| d.name.clone());
-        let msg = proto::Impact::of(e, format!("{pack}/{body}"));
+        let msg = proto::Impact::of(e, impact_name(&self.net, coupling, Some(e.disc)));
         self.put(
             self.ch.impacts,
             log_time_ns(e.t_peak_s),
@@ -605,12 +613,7 @@ impl NetworkRecorder {
     /// Writes a gear mesh's tooth impact on `/network/impacts`, logged at its peak (`disc`
     /// of the event is the coupling's index).
     pub fn write_mesh_impact(&mut self, e: &ImpactEvent) -> Result<(), RecordError> {
-        let name = self
-            .coupling_names
-            .get(e.disc)
-            .cloned()
-            .unwrap_or_else(|| format!("coupling {}", e.disc));
-        let msg = proto::Impact::of(e, name);
+        let msg = proto::Impact::of(e, impact_name(&self.net, e.disc, None));
         self.put(
             self.ch.impacts,
             log_time_ns(e.t_peak_s),

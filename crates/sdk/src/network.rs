@@ -146,6 +146,10 @@ pub struct NetworkOutcome {
     pub summary: NetworkSummary,
     /// Every sample, if asked ([`NetworkRequest::keep_history`]).
     pub history: Vec<NetworkSample>,
+    /// Every tooth impact as `(name, t_peak s, peak N)`, if the history is kept: a gear
+    /// mesh's by its coupling's name, a pack's disc's or plate's as `<pack>/discs/<disc>` or
+    /// `<pack>/plates/<plate>` (the recording's names on `/network/impacts`).
+    pub impacts: Vec<(String, f64, f64)>,
     /// The recording's path, if one was asked ([`NetworkRequest::recording`]).
     pub recording: Option<std::path::PathBuf>,
 }
@@ -168,6 +172,8 @@ pub(crate) struct Keep {
     /// "locked"), and the instants all its faces locked.
     pack_modes: std::collections::HashMap<usize, (&'static str, Vec<f64>)>,
     history: Vec<NetworkSample>,
+    /// With the history: every impact as (coupling, body in a pack, t_peak s, peak N).
+    impact_log: Vec<(usize, Option<usize>, f64, f64)>,
     stopped: bool,
     /// The recording, until its first error.
     pub recorder: Option<NetworkRecorder>,
@@ -212,6 +218,7 @@ impl Keep {
             pack_bodies: self.pack_bodies.clone(),
             pack_modes: self.pack_modes.clone(),
             history: self.history.clone(),
+            impact_log: self.impact_log.clone(),
             stopped: self.stopped,
             recorder: None,
             record_error: None,
@@ -246,6 +253,11 @@ impl NetworkObserver for Obs<'_, '_> {
     }
     fn mesh_impact(&mut self, e: &clutchpack_model::ImpactEvent) {
         self.keep.record(|r| r.write_mesh_impact(e));
+        if self.keep.keep_history {
+            self.keep
+                .impact_log
+                .push((e.disc, None, e.t_peak_s, e.peak_n));
+        }
         let m = self.keep.meshes.entry(e.disc).or_insert((0, 0.0));
         m.0 += 1;
         if e.peak_n.abs() > m.1.abs() {
@@ -254,6 +266,11 @@ impl NetworkObserver for Obs<'_, '_> {
     }
     fn pack_impact(&mut self, coupling: usize, e: &clutchpack_model::ImpactEvent) {
         self.keep.record(|r| r.write_pack_impact(coupling, e));
+        if self.keep.keep_history {
+            self.keep
+                .impact_log
+                .push((coupling, Some(e.disc), e.t_peak_s, e.peak_n));
+        }
         for key in [(coupling, e.disc), (coupling, usize::MAX)] {
             let m = self.keep.pack_bodies.entry(key).or_insert((0, 0.0));
             m.0 += 1;
@@ -528,8 +545,17 @@ pub(crate) fn conclude(
         }
         None => None,
     };
+    let impacts = keep
+        .impact_log
+        .iter()
+        .map(|&(k, body, t, peak)| {
+            let name = clutchpack_record::impact_name(net, k, body);
+            (name, t, peak)
+        })
+        .collect();
     Ok(NetworkOutcome {
         summary,
+        impacts,
         history: keep.history,
         recording,
     })

@@ -10,6 +10,8 @@ pub struct Panel {
     pub y_label: String,
     /// `(name, points)`, each drawn as a line with markers, named in the panel's legend.
     pub series: Vec<(String, Vec<(f64, f64)>)>,
+    /// Markers only, no lines (a scatter of events: impacts' peaks).
+    pub markers_only: bool,
 }
 
 pub(super) struct Panels<'a> {
@@ -56,6 +58,14 @@ impl Figure for Panels<'_> {
             for (k, (name, pts)) in panel.series.iter().enumerate() {
                 let c = color(k);
                 let pts: Vec<(f64, f64)> = pts.iter().filter(finite).copied().collect();
+                if panel.markers_only {
+                    chart
+                        .draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))
+                        .map_err(msg)?
+                        .label(name.as_str())
+                        .legend(move |(x, y)| Circle::new((x + 9, y), 4, c.filled()));
+                    continue;
+                }
                 chart
                     .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
                     .map_err(msg)?

@@ -19,6 +19,10 @@ pub struct RecordedNetwork {
     /// Every sample, in time order, as the engine gave it (a clutch's mode from its label;
     /// other couplings' `None`).
     pub samples: Vec<NetworkSample>,
+    /// Every tooth impact on `/network/impacts` as `(name, t_peak s, peak N)`: a gear mesh's
+    /// by its coupling's name, a pack's disc's or plate's as `<pack>/discs/<disc>` or
+    /// `<pack>/plates/<plate>`; in file order.
+    pub impacts: Vec<(String, f64, f64)>,
     /// The clutch mode changes' log lines (`K2: slip- -> locked at t = ... s`), in file order.
     pub events: Vec<String>,
     /// The attached summary (the JSON of `run --summary-json`), if the run finished.
@@ -53,6 +57,7 @@ pub fn read_network(reader: &crate::RecordingReader) -> Option<Result<RecordedNe
     // samples by log time (ns): each body's and coupling's message fill one sample
     let mut by_time: BTreeMap<u64, NetworkSample> = BTreeMap::new();
     let mut events = Vec::new();
+    let mut impacts = Vec::new();
     let mut error: Option<String> = None;
     let (n, m) = (bodies.len(), couplings.len());
     reader.for_each_message(|msg| {
@@ -72,7 +77,12 @@ pub fn read_network(reader: &crate::RecordingReader) -> Option<Result<RecordedNe
                 msg.topic, msg.log_time_ns
             )
         };
-        if msg.topic == topics::NETWORK_EVENTS {
+        if msg.topic == topics::NETWORK_IMPACTS {
+            match proto::Impact::decode(msg.data) {
+                Ok(i) => impacts.push((i.disc, i.t_peak_s, i.peak_n)),
+                Err(e) => error = Some(bad(e)),
+            }
+        } else if msg.topic == topics::NETWORK_EVENTS {
             match Log::decode(msg.data) {
                 Ok(l) => events.push(l.message),
                 Err(e) => error = Some(bad(e)),
@@ -133,6 +143,7 @@ pub fn read_network(reader: &crate::RecordingReader) -> Option<Result<RecordedNe
         fixed,
         couplings,
         samples,
+        impacts,
         events,
         summary_json,
     }))
