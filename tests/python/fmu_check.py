@@ -16,6 +16,7 @@ CHECK is one of:
   Prints the impact lists of each.
 - rollback: get the FMU's state, advance, set the state, advance again; prints both output
   histories.
+- network_packs: the same with both clutches resolved packs, driven by their pistons' pressures
 - network: the DCT upshift's FMU (a network scene): its inputs, FMPy's validation, the shift
   driven by the clutch forces' schedule through FMPy against `clutchpack run`
 - thermal: pack-8-idle-thermal with a steady drive (drive.amplitude_rad_s = 0, so the FMU's
@@ -386,13 +387,64 @@ def check_network(args):
     }
 
 
+def check_network_packs(args):
+    """The FMU of the DCT upshift with both clutches resolved packs: its inputs (the engine's
+    torque and both pistons' pressures), FMPy's validation, and the shift driven through it
+    (the scene's own pressure schedules at each 1 ms step's midpoint) against `clutchpack run`
+    of the scene."""
+    work = args.work
+    fmu = os.path.join(work, "dct-upshift-packs.fmu")
+    p = build(args, "scenes/dct-upshift-packs.toml", fmu)
+    if p.returncode != 0:
+        raise SystemExit(p.stderr)
+    md = read_model_description(fmu)
+    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+
+    def k1(t):  # scenes/dct-k1.toml's [stack.pressure]
+        return float(np.interp(t, [0.0, 0.2, 0.35], [1.05e6, 1.05e6, 0.0]))
+
+    def k2(t):  # scenes/dct-k2.toml's
+        return float(np.interp(t, [0.0, 0.2, 0.35, 0.7, 0.8], [0.0, 0.0, 0.45e6, 0.45e6, 1.05e6]))
+
+    h = 1e-3
+    ts = np.arange(0.0, 1.0 + h / 2, h)
+    signals = np.array(
+        [(t, 250.0, k1(t + h / 2), k2(t + h / 2)) for t in ts],
+        dtype=[("time", float), ("bodies.crank.drive_torque_n_m", float),
+               ("couplings.K1.pressure_pa", float), ("couplings.K2.pressure_pa", float)],
+    )
+    outs = ["couplings.K2.heat_j", "couplings.K1.heat_j", "bodies.vehicle.speed_rad_s",
+            "bodies.engine.speed_rad_s", "bodies.'input-2'.speed_rad_s"]
+    r = fmpy.simulate_fmu(fmu, stop_time=1.0, step_size=h, input=signals, output=outs)
+    # the on-coming pack's lock: the engine's speed meets the even input shaft's
+    slip = np.abs(r["bodies.engine.speed_rad_s"] - r["bodies.'input-2'.speed_rad_s"])
+    after = np.nonzero((r["time"] > 0.4) & (slip < 0.5))[0]
+    summary = os.path.join(work, "dct-packs.json")
+    run(args, "run", "scenes/dct-upshift-packs.toml", "--no-record", "--summary-json", summary)
+    with open(summary) as f:
+        s = json.load(f)
+    k2s = next(c for c in s["couplings"] if c["name"] == "K2")
+    vehicle = next(b for b in s["bodies"] if b["name"] == "vehicle")
+    return {
+        "inputs": inputs,
+        "problems": validate_fmu(fmu),
+        "fmu_synchronised_s": float(r["time"][after[0]]) if len(after) else None,
+        "fmu_heat_j": float(r["couplings.K2.heat_j"][-1]),
+        "fmu_vehicle_rad_s": float(r["bodies.vehicle.speed_rad_s"][-1]),
+        "run_lock_s": k2s["lock_times_s"],
+        "run_heat_j": k2s["heat_j"],
+        "run_vehicle_rad_s": vehicle["final_speed_rad_s"],
+    }
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", required=True)
     ap.add_argument("--root", required=True)
     ap.add_argument("--work", required=True)
     ap.add_argument(
-        "check", choices=["validate", "paper", "coupling", "rollback", "thermal", "network"]
+        "check",
+        choices=["validate", "paper", "coupling", "rollback", "thermal", "network", "network_packs"],
     )
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
@@ -403,6 +455,7 @@ def main():
         "rollback": check_rollback,
         "thermal": check_thermal,
         "network": check_network,
+        "network_packs": check_network_packs,
     }[args.check](args)
     json.dump(result, sys.stdout)
 

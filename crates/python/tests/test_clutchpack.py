@@ -138,6 +138,37 @@ def test_a_simulation_drives_a_dct_shift_by_name(tmp_path):
         clutchpack.Simulation("scenes/dct-upshift.toml", drive=["couplings.K3.normal_force_n"])
 
 
+def test_a_simulation_drives_the_pistons_of_resolved_packs(tmp_path):
+    """The DCT upshift with both clutches resolved packs (issue 34): Python drives both
+    pistons' pressures by name (`couplings.<pack>.pressure_pa`) from the pack files' own
+    schedules held at each 1 ms interval's midpoint, and gets the scene's shift: K2's faces'
+    heat within 1e-4 of `clutchpack.run`'s (measured 1.2e-5 through the FMU driven so), K2
+    locked at the end, and every disc and plate of both packs in the summary."""
+    whole = clutchpack.run("scenes/dct-upshift-packs.toml")
+    k2 = next(c for c in whole.summary["couplings"] if c["name"] == "K2")
+
+    def k1(t):
+        return float(np.interp(t, [0.0, 0.2, 0.35], [1.05e6, 1.05e6, 0.0]))
+
+    def k2_p(t):
+        return float(np.interp(t, [0.0, 0.2, 0.35, 0.7, 0.8], [0.0, 0.0, 0.45e6, 0.45e6, 1.05e6]))
+
+    names = ["couplings.K1.pressure_pa", "couplings.K2.pressure_pa"]
+    sim = clutchpack.Simulation("scenes/dct-upshift-packs.toml", drive=names)
+    assert sim.inputs == names
+    for k in range(1, 1001):
+        mid = (k - 0.5) * 1e-3
+        sim.advance_to(k * 1e-3, **{names[0]: k1(mid), names[1]: k2_p(mid)})
+    summary = sim.finish()
+    got = next(c for c in summary["couplings"] if c["name"] == "K2")
+    assert abs(got["heat_j"] - k2["heat_j"]) < 1e-4 * k2["heat_j"], (got["heat_j"], k2["heat_j"])
+    assert got["final_mode"] == "locked"
+    assert [len(c.get("pack_bodies", [])) for c in summary["couplings"]][1:3] == [9, 11]
+    with pytest.raises(ValueError, match="expected >= 0"):
+        sim = clutchpack.Simulation("scenes/dct-upshift-packs.toml", drive=names)
+        sim.advance_to(0.01, **{names[0]: -1.0, names[1]: 0.0})
+
+
 def test_read_gives_what_the_run_gave(tmp_path):
     rec = tmp_path / "r.mcap"
     r = clutchpack.run("scenes/pack-4-rattle.toml", duration=0.2, record=rec)

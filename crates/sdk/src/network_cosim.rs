@@ -149,8 +149,9 @@ pub struct NetworkVariable {
 
 /// The inputs of `net` by their public names: the drive torque of each turning body the scene
 /// drives (`bodies.<body>.drive_torque_n_m`, N m: a body with `[bodies.drive]` or
-/// `[bodies.firing]`; give a body `drive = 0` to make it an input) and each clutch's normal
-/// force (`couplings.<clutch>.normal_force_n`, N).
+/// `[bodies.firing]`; give a body `drive = 0` to make it an input), each clutch's normal
+/// force (`couplings.<clutch>.normal_force_n`, N) and each resolved pack's piston pressure
+/// (`couplings.<pack>.pressure_pa`, Pa; a pack with a `[stack]`).
 pub fn network_inputs(net: &Network) -> Vec<(String, NetworkInput)> {
     let bodies = net
         .bodies
@@ -174,7 +175,18 @@ pub fn network_inputs(net: &Network) -> Vec<(String, NetworkInput)> {
                 NetworkInput::ClutchForce(k),
             )
         });
-    bodies.chain(clutches).collect()
+    let packs = net
+        .couplings
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.pack().is_some_and(|p| p.stack.is_some()))
+        .map(|(k, c)| {
+            (
+                format!("couplings.{}.pressure_pa", segment(&c.name)),
+                NetworkInput::PackPressure(k),
+            )
+        });
+    bodies.chain(clutches).chain(packs).collect()
 }
 
 /// A body's or coupling's name as a segment of a variable's name: the FMI structured name's
@@ -194,13 +206,18 @@ pub fn network_name_problems(net: &Network) -> Vec<String> {
 }
 
 /// The value of `input` in `net` at `t` (s): a drive signal's torque (N m, without the
-/// firing harmonics, which stay locked to the angle) or a clutch's normal force (N).
+/// firing harmonics, which stay locked to the angle), a clutch's normal force (N) or a pack's
+/// piston pressure (Pa).
 fn input_value(net: &Network, input: NetworkInput, t: f64) -> f64 {
     match input {
         NetworkInput::Drive(i) => net.bodies[i].drive.as_ref().map_or(0.0, |s| s.value(t)),
         NetworkInput::ClutchForce(k) => net.couplings[k]
             .clutch()
             .map_or(0.0, |c| c.normal_force_n(t).max(0.0)),
+        NetworkInput::PackPressure(k) => net.couplings[k]
+            .pack()
+            .and_then(|p| p.stack.as_ref())
+            .map_or(0.0, |s| s.piston.pressure.pressure_pa(t)),
     }
 }
 
@@ -219,6 +236,14 @@ fn input_variable(net: &Network, name: &str, input: NetworkInput) -> NetworkVari
             "N",
             format!(
                 "normal force of clutch {}, N (>= 0; 0: free)",
+                net.couplings[k].name
+            ),
+        ),
+        NetworkInput::PackPressure(k) => (
+            "Pa",
+            format!(
+                "piston pressure of pack {}, Pa (>= 0; the piston pushes with p A less its \
+                 return spring)",
                 net.couplings[k].name
             ),
         ),
@@ -246,8 +271,9 @@ pub fn network_input_variables(net: &Network) -> Vec<(NetworkVariable, f64)> {
 }
 
 /// The outputs of `net`, in the order [`NetworkSimulation::outputs`] gives their values: per
-/// body its speed and angle; per coupling its torque on body a, and for a clutch its slip
-/// `w_b - w_a`, its mode (Modelica's numbers) and its heat.
+/// body its speed and angle; per coupling its torque on body a, for a clutch its slip
+/// `w_b - w_a`, its mode (Modelica's numbers) and its heat, for a resolved pack its faces'
+/// heat.
 pub fn network_outputs(net: &Network) -> Vec<NetworkVariable> {
     let var = |name: String, unit: &'static str, description: String| NetworkVariable {
         name,
@@ -293,6 +319,13 @@ pub fn network_outputs(net: &Network) -> Vec<NetworkVariable> {
                 format!("couplings.{}.heat_j", segment(&c.name)),
                 "J",
                 format!("heat {} has made since t = 0, J", c.name),
+            ));
+        }
+        if c.pack().is_some() {
+            out.push(var(
+                format!("couplings.{}.heat_j", segment(&c.name)),
+                "J",
+                format!("heat the faces of pack {} have made since t = 0, J", c.name),
             ));
         }
     }
@@ -509,6 +542,9 @@ impl NetworkSimulation {
                 values.push(s.speed_rad_s[c.b] - s.speed_rad_s[c.a]);
                 let mode = s.mode[k].unwrap_or(ClutchMode::Free);
                 values.push(f64::from(mode.modelica_code()));
+                values.push(heat[k]);
+            }
+            if c.pack().is_some() {
                 values.push(heat[k]);
             }
         }

@@ -209,11 +209,15 @@ pub enum NetworkInput {
     Drive(usize),
     /// The normal force of the clutch that is coupling `k`, N (>= 0; 0: free).
     ClutchForce(usize),
+    /// The piston pressure of the resolved pack that is coupling `k`, Pa (>= 0; its piston
+    /// force is `p A - F_return`, MODEL.md section 5).
+    PackPressure(usize),
 }
 
 impl super::Network {
     /// Replaces the signal of `input` by the constant `value` (N m for a drive, N for a
-    /// clutch's normal force, stored normalized by the clutch's `fn_max_n`): the engines'
+    /// clutch's normal force, stored normalized by the clutch's `fn_max_n`, Pa for a pack's
+    /// piston pressure): the engines'
     /// `set_input`, which then restart at that instant as at a signal's jump. A value that
     /// is not finite, a negative force, or an input naming a body or coupling that cannot
     /// take it is refused, the network unchanged.
@@ -243,6 +247,19 @@ impl super::Network {
                     return bad(format!("normal force {value} N: expected >= 0"));
                 }
                 cl.force = Signal::Constant(value / cl.fn_max_n);
+            }
+            NetworkInput::PackPressure(k) => {
+                let stack = match self.couplings.get_mut(k).map(|c| &mut c.kind) {
+                    Some(super::CouplingKind::Pack(p)) => p.stack.as_mut(),
+                    _ => return bad(format!("coupling {k}: not a resolved pack")),
+                };
+                let Some(stack) = stack else {
+                    return bad(format!("coupling {k}: the pack has no [stack] (no piston)"));
+                };
+                if value < 0.0 {
+                    return bad(format!("piston pressure {value} Pa: expected >= 0"));
+                }
+                stack.piston.pressure = crate::PressureProfile::Constant { pressure_pa: value };
             }
         }
         Ok(())

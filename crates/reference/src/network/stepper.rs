@@ -203,6 +203,13 @@ impl NetworkStepper {
         obs: &mut dyn NetworkObserver,
     ) -> Result<(), EngineError> {
         Arc::make_mut(&mut self.eq.net).hold_input(input, value)?;
+        if let NetworkInput::PackPressure(k) = input {
+            // the pack's equations carry their own model: its piston's pressure held too
+            let pack = self.eq.net.couplings[k].pack().expect("a pack").clone();
+            if let Some(p) = self.eq.packs.iter_mut().find(|p| p.k == k) {
+                p.sys.set_pack(Arc::new(pack));
+            }
+        }
         // the signal's breakpoints after now are those of the network as it is now
         let t = self.t;
         self.breakpoints = self.eq.net.breakpoints(self.duration_s);
