@@ -388,8 +388,7 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// A network run's clutches (lumped clutches and resolved packs) and its packs' discs and
-/// plates.
+/// A network run's clutches (lumped and resolved packs) and its packs' discs and plates.
 type NetworkRun = (
     Vec<clutchpack_sdk::analysis::ClutchRun>,
     Vec<clutchpack_sdk::analysis::PackBodyRun>,

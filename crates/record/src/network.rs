@@ -92,10 +92,12 @@ pub fn impact_name(net: &Network, coupling: usize, body: Option<usize>) -> Strin
     match (body, c.pack()) {
         (Some(i), Some(p)) => {
             let role = if i < p.discs.len() { "discs" } else { "plates" };
-            match p.discs.iter().chain(&p.plates).nth(i) {
-                Some(d) => format!("{}/{role}/{}", c.name, d.name),
-                None => format!("{}/{role}/body {i}", c.name),
-            }
+            let body = p.discs.iter().chain(&p.plates).nth(i);
+            format!(
+                "{}/{role}/{}",
+                c.name,
+                body.map_or("?", |d| d.name.as_str())
+            )
         }
         _ => c.name.clone(),
     }

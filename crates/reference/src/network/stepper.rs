@@ -48,6 +48,9 @@ pub struct NetworkStepper {
     ybuf: Vec<f64>,
     g0: Vec<f64>,
     g1: Vec<f64>,
+    /// The time `g0` holds the guards at (the end of the last full step, whose last probe
+    /// they are; NaN: none), so that the next step does not evaluate them again.
+    g0_at: f64,
     /// Sample interval, s (infinite: none but the first and last).
     period: f64,
     next_sample: u64,
@@ -137,6 +140,7 @@ impl NetworkStepper {
             dense: Dense::default(),
             dy,
             g0: vec![0.0; eq.guard_len()],
+            g0_at: f64::NAN,
             g1: vec![0.0; eq.guard_len()],
             ybuf,
             period,
@@ -215,6 +219,7 @@ impl NetworkStepper {
         self.breakpoints = self.eq.net.breakpoints(self.duration_s);
         self.next_bp = self.breakpoints.partition_point(|&b| b <= t);
         self.g1.iter_mut().for_each(|g| *g = 1.0);
+        self.g0_at = f64::NAN;
         settle(
             &mut self.eq,
             t,
@@ -252,6 +257,7 @@ impl NetworkStepper {
             ybuf,
             g0,
             g1,
+            g0_at,
             t,
             h,
             ..
@@ -264,6 +270,7 @@ impl NetworkStepper {
                 // an event left the run at a breakpoint: the signals jump here
                 *t = stop;
                 *next_bp += 1;
+                *g0_at = f64::NAN;
                 g1.iter_mut().for_each(|g| *g = 1.0);
                 settle(eq, *t, y, g1, obs, &mut self.events);
                 heal_faces(eq, *t, y, obs);
@@ -289,7 +296,9 @@ impl NetworkStepper {
             }
             stepper.dense_into(*t, y, h_try, dense);
             // events: the first quarter point where a guard turns <= 0
-            eq.guards(*t, y, g0);
+            if *g0_at != *t {
+                eq.guards(*t, y, g0);
+            }
             let mut event: Option<(f64, f64)> = None; // (ta, tb) bracketing the first crossing
             let mut ta = *t;
             for q in 1..=4 {
@@ -328,6 +337,11 @@ impl NetworkStepper {
                     (b, true)
                 }
                 None => {
+                    if !land {
+                        // the last probe was at the step's end: the next step's start
+                        g0.copy_from_slice(g1);
+                        *g0_at = *t + h_try;
+                    }
                     g1.iter_mut().for_each(|g| *g = 1.0);
                     (*t + h_try, land)
                 }
@@ -355,6 +369,7 @@ impl NetworkStepper {
                 *next_bp += 1;
             }
             if at_event {
+                *g0_at = f64::NAN;
                 meshes.switch(eq, *t, y, Some(g1), obs);
                 let n = eq.net.bodies.len();
                 packs::switch(&mut eq.packs, n, *t, y, Some(g1), obs);

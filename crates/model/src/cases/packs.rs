@@ -1,0 +1,194 @@
+//! Cases of resolved packs with carriers of their own (MODEL.md sections 5 and 8): an engaging
+//! clutch on an inertial shaft, a DCT's wet clutch, and any pack with an inertial shaft as the
+//! network that runs it (a network's run of it is the pack's own run).
+
+use super::{paper_drive, paper_law, staggered_brake, staggered_inertial};
+use crate::clutch::{DrumModel, FrictionCurve, Piston, PressureProfile, StackModel};
+use crate::drive::{Shaft, ShaftExcitation, SpeedProfile};
+use crate::law::LawKind;
+use crate::pack::{DiscModel, PackModel};
+use crate::spline::SplineGeometry;
+
+/// An engaging clutch on an inertial shaft (MODEL.md sections 5 and 8): [`staggered_brake`]`(4)`
+/// with its five plates on a drum instead of the housing and the shaft of
+/// [`staggered_inertial`]; the drum (1.5 kg m^2, a load of -40 N m, drag 0.05 N m s/rad)
+/// starts at 90 rad/s against the shaft's 100, and the piston's pressure ramps from 0 at 20 ms
+/// to 120 kPa at 35 ms, so that the discs and plates rattle, the faces clamp and slip, and
+/// the drum is pulled up to the shaft's speed and locks to it.
+pub fn engaging_clutch() -> PackModel {
+    let mut pack = staggered_brake(4);
+    pack.shaft = staggered_inertial(4).shaft;
+    pack.drum = Some(DrumModel {
+        inertia_kg_m2: 1.5,
+        load_torque_n_m: -40.0,
+        drag_n_m_s_rad: 0.05,
+        initial_speed_rad_s: 90.0,
+    });
+    for p in &mut pack.plates {
+        p.initial_rel_speed_rad_s = 0.0;
+    }
+    let stack = pack.stack.as_mut().expect("the brake has a stack");
+    stack.piston.pressure = PressureProfile::Ramp {
+        start_s: 0.02,
+        rise_s: 0.015,
+        pressure_pa: 120e3,
+    };
+    pack
+}
+
+/// A dual-clutch transmission's wet clutch as a resolved pack (MODEL.md sections 5 and 8;
+/// every value ASSUMED, of a DCT's clutch): `n` friction discs (`disc-1` ...; 0.004 kg m^2,
+/// 40 teeth at 0.07 m, 20 deg, 0.3 mm backlash) and `n + 1` separator plates (`plate-1` ...;
+/// 0.003 kg m^2, 48 teeth at 0.1 m, 30 deg, 0.3 mm), the dry Hertz law of the paper's
+/// contact with `p = 0.5 s/m`, no drag, faces 0.075-0.095 m with a constant `mu = 0.1`, no
+/// oil gap and no spline friction, so that every face is clamped by the piston's whole
+/// `clamp_n` (N, constant) and the pack slips with `2 n mu F R_eff`. Its own shaft is the
+/// paper's drive (a network's body replaces it).
+pub fn wet_clutch(n: usize, clamp_n: f64) -> PackModel {
+    let body = |name: String, j: f64, spline: SplineGeometry| {
+        let mut law = paper_law(LawKind::Dry, 0.0);
+        law.hertz.loss_coefficient_s_m = 0.5;
+        DiscModel {
+            name,
+            spline,
+            law,
+            inertia_kg_m2: j,
+            drag_n_m_s_rad: 0.0,
+            initial_rel_angle_rad: 0.0,
+            initial_rel_speed_rad_s: 0.0,
+            radial_float: false,
+            tooth_spacing_errors_m: Vec::new(),
+            initial_offset_m: [0.0, 0.0],
+        }
+    };
+    let spline = |teeth: u32, r: f64, alpha_deg: f64| SplineGeometry {
+        teeth,
+        pitch_radius_m: r,
+        pressure_angle_rad: alpha_deg.to_radians(),
+        backlash_m: 0.3e-3,
+    };
+    let mut pack = PackModel::new(
+        Shaft::Prescribed(paper_drive()),
+        (1..=n)
+            .map(|k| body(format!("disc-{k}"), 0.004, spline(40, 0.07, 20.0)))
+            .collect(),
+    );
+    pack.plates = (1..=n + 1)
+        .map(|k| body(format!("plate-{k}"), 0.003, spline(48, 0.1, 30.0)))
+        .collect();
+    pack.stack = Some(StackModel {
+        face_friction: Vec::new(),
+        face_inner_radius_m: 0.075,
+        face_outer_radius_m: 0.095,
+        friction: FrictionCurve::constant(0.1),
+        piston: Piston {
+            area_m2: 0.01,
+            pressure: PressureProfile::Constant {
+                pressure_pa: clamp_n / 0.01,
+            },
+            return_spring_n: 0.0,
+        },
+        open_gap: None,
+        spline_friction: 0.0,
+    });
+    pack
+}
+
+/// A pack with an inertial shaft as a network (MODEL.md section 8): body `shaft` (the pack's
+/// `J1`, `C1` as drag, its drive torque: `J1 d(omega)/dt` of a harmonic speed profile as a sum
+/// of sines), body `drum` (its inertia, load as a constant drive, drag and speed) or the fixed
+/// `housing` when the plates sit on it, and the pack between them (its shaft and drum then
+/// unused). `None` unless the shaft is inertial and driven by a harmonic speed profile, and
+/// the pack has no couplings of its own. A network run of it is the pack's own run.
+pub fn pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
+    use crate::network::{Body, Coupling, CouplingKind, Network, Signal};
+    let Shaft::Inertial {
+        inertia_kg_m2,
+        damping_n_m_s_rad,
+        excitation: ShaftExcitation::Profile(SpeedProfile::Harmonics { harmonics, .. }),
+    } = &pack.shaft
+    else {
+        return None;
+    };
+    if !pack.couplings.is_empty() {
+        return None;
+    }
+    // J1 d/dt (A sin(2 pi f t + phase)) = J1 A 2 pi f sin(2 pi f t + phase + pi / 2)
+    let drive = Signal::Sum(
+        harmonics
+            .iter()
+            .map(|h| Signal::Sine {
+                offset: 0.0,
+                amplitude: inertia_kg_m2
+                    * h.amplitude_rad_s
+                    * std::f64::consts::TAU
+                    * h.frequency_hz,
+                frequency_hz: h.frequency_hz,
+                phase_rad: h.phase_rad + std::f64::consts::FRAC_PI_2,
+                start_s: 0.0,
+            })
+            .collect(),
+    );
+    let shaft = Body {
+        name: "shaft".into(),
+        inertia_kg_m2: *inertia_kg_m2,
+        drag_n_m_s_rad: *damping_n_m_s_rad,
+        initial_speed_rad_s: pack.shaft.initial_speed_rad_s(),
+        fixed: false,
+        drive: Some(drive),
+        firing: None,
+        road_load: None,
+    };
+    let carrier = match &pack.drum {
+        Some(d) => Body {
+            name: "drum".into(),
+            inertia_kg_m2: d.inertia_kg_m2,
+            drag_n_m_s_rad: d.drag_n_m_s_rad,
+            initial_speed_rad_s: d.initial_speed_rad_s,
+            fixed: false,
+            drive: Some(Signal::Constant(d.load_torque_n_m)),
+            firing: None,
+            road_load: None,
+        },
+        None => Body {
+            name: "housing".into(),
+            inertia_kg_m2: 0.0,
+            drag_n_m_s_rad: 0.0,
+            initial_speed_rad_s: 0.0,
+            fixed: true,
+            drive: None,
+            firing: None,
+            road_load: None,
+        },
+    };
+    Some(Network {
+        bodies: vec![shaft, carrier],
+        couplings: vec![Coupling {
+            name: "pack".into(),
+            a: 0,
+            b: 1,
+            kind: CouplingKind::Pack(Box::new(pack.clone())),
+        }],
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The network of a pack drives its shaft with the pack's own torque: `J1 d(omega)/dt`.
+    #[test]
+    fn a_pack_as_network_drives_the_shaft_as_the_pack() {
+        let pack = engaging_clutch();
+        let net = pack_as_network(&pack).expect("an inertial shaft");
+        assert!(net.problems().is_empty(), "{:?}", net.problems());
+        for t in [0.0, 0.0013, 0.017, 0.04] {
+            let (a, b) = (
+                net.bodies[0].drive_torque_n_m(t, 0.0),
+                pack.shaft.drive_torque_n_m(t),
+            );
+            assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{t}: {a} {b}");
+        }
+        assert_eq!(net.bodies[1].initial_speed_rad_s, 90.0);
+    }
+}
