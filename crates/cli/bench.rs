@@ -44,8 +44,9 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 3)]
     pub inertial_runs: usize,
     /// Repetitions of each network timing (`scenes/coupled-clutches.toml` and
-    /// `scenes/dct-upshift.toml` on the reference and the multibody engine in turn; the
-    /// medians are reported); 0 skips that part.
+    /// `scenes/dct-upshift.toml` on the reference and the multibody engine in turn, and
+    /// `scenes/dct-upshift-packs.toml` against its two packs run alone; the medians are
+    /// reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub network_runs: usize,
     /// Repetitions of each thermal timing (`scenes/pack-6-thermal.toml` and the first second
@@ -462,6 +463,66 @@ fn network_scenes(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         }
         network_scene(file, runs, stop)?;
     }
+    packs_on_a_network(runs, stop)
+}
+
+/// 4c. `scenes/dct-upshift-packs.toml` (both clutches resolved packs, on the reference
+///    engine, the only one that runs them) against its two packs run alone on their own
+///    prescribed hubs for the same time (`scenes/dct-k1.toml`, `scenes/dct-k2.toml`), in turn
+///    `runs` times: the medians, and the median of the rounds' ratios (issue 34 asks at most
+///    1.5x).
+fn packs_on_a_network(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
+    let files = [
+        "scenes/dct-upshift-packs.toml",
+        "scenes/dct-k1.toml",
+        "scenes/dct-k2.toml",
+    ];
+    if let Some(f) = files.iter().find(|f| !std::path::Path::new(f).exists()) {
+        out!("packs on a network: skipped ({f} not found: run from the repository root)");
+        return Ok(());
+    }
+    let mut scenes = Vec::new();
+    for f in files {
+        scenes.push(load_scene(Some(std::path::Path::new(f)), &[])?);
+    }
+    let (mut network, mut alone, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
+    let mut steps = 0;
+    for _ in 0..runs {
+        let done = clutchpack_sdk::run_network_scene(
+            &scenes[0],
+            Some(EngineChoice::Reference),
+            clutchpack_sdk::NetworkRequest {
+                stop: Some(&**stop),
+                ..Default::default()
+            },
+        )?;
+        steps = done.summary.steps;
+        let mut packs = 0.0;
+        for scene in &scenes[1..] {
+            let run =
+                Simulation::new(scene.clone(), Some(EngineChoice::Reference))?.run(RunRequest {
+                    stop: Some(&**stop),
+                    ..RunRequest::default()
+                })?;
+            run.stats()?;
+            packs += run.wall_time_s;
+        }
+        if stop.load(Ordering::SeqCst) {
+            return Ok(());
+        }
+        network.push(done.summary.wall_time_s);
+        alone.push(packs);
+        ratios.push(done.summary.wall_time_s / packs);
+    }
+    out!(
+        "packs on a network: {} ({} s, {steps} steps) {:.4} s against its two packs alone \
+         {:.4} s: {:.2}x (medians of {runs}, in turn; issue 34 asks at most 1.5x)",
+        scenes[0].name,
+        scenes[0].simulation.duration_s,
+        median(network),
+        median(alone),
+        median(ratios)
+    );
     Ok(())
 }
 

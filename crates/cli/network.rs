@@ -139,10 +139,14 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
             c.name,
             c.impacts
         );
-        let worst = c
-            .pack_bodies
-            .iter()
-            .max_by(|x, y| x.largest_peak_n.abs().total_cmp(&y.largest_peak_n.abs()));
+        // the first of equals (a locked pack's discs share their load)
+        let worst = c.pack_bodies.iter().fold(
+            None,
+            |w: Option<&clutchpack_sdk::PackBodySummary>, b| match w {
+                Some(w) if w.largest_peak_n.abs() >= b.largest_peak_n.abs() => Some(w),
+                _ => Some(b),
+            },
+        );
         for b in &c.pack_bodies {
             let mark = match worst {
                 Some(w) if w.name == b.name && b.impacts > 0 => "  <- the largest",
