@@ -460,7 +460,7 @@ fn compare_of_two_shift_schedules_names_the_hottest_clutch() {
 /// the lumped scene's 0.5755 s, since the plates add 0.033 kg m^2 to the engine side and the
 /// discs' spline friction holds back part of K2's clamp); the energy balance closes
 /// (measured 1.9e-8 J of 80 kJ); the figure has the impacts' panel; the recording holds every
-/// impact; `compare` with a faster K2 apply names the clutch that takes the most heat and the
+/// impact and turns each pack's discs and plates in 3D; `compare` with a faster K2 apply names the clutch that takes the most heat and the
 /// pack body whose peak changes most.
 #[test]
 fn dct_upshift_with_resolved_packs_names_its_discs() {
@@ -524,6 +524,21 @@ fn dct_upshift_with_resolved_packs_names_its_discs() {
         line.contains(&format!(" {impacts} ")),
         "{line} ({impacts} impacts)"
     );
+    // every sample's /tf turns the bodies, and each pack's discs and plates in their frames
+    let text = stdout(&o);
+    let count = |topic: &str| -> u64 {
+        let l = text
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("{topic} ")))
+            .unwrap_or_default();
+        l.split_whitespace()
+            .nth(2)
+            .and_then(|c| c.parse().ok())
+            .unwrap_or(0)
+    };
+    let samples = count("/network/bodies/crank");
+    assert!(samples > 1000, "{samples}");
+    assert_eq!(count("/tf"), 3 * samples);
 
     // a faster apply of K2 (its pressure up in 50 ms instead of 150 ms)
     let fast_k2 = d.join("dct-k2-fast.toml");

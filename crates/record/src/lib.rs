@@ -111,6 +111,7 @@
 mod export;
 pub mod info;
 mod network;
+mod network_packs;
 pub mod output;
 pub mod proto;
 mod read;

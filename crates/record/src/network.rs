@@ -169,6 +169,8 @@ pub struct NetworkRecorder {
     sequences: BTreeMap<u16, u32>,
     buf: Vec<u8>,
     tf: FrameTransforms,
+    /// the resolved packs' discs and plates in 3D
+    packs: crate::network_packs::PacksDrawing,
     /// the clutch modes last drawn in `/scene/couplings`
     drawn_modes: Vec<Option<ClutchMode>>,
     /// `/network/joints/*` values, reused: the bodies' angles and speeds, the couplings'
@@ -358,7 +360,9 @@ impl NetworkRecorder {
         };
         let n = body_names.len();
         let m = coupling_names.len();
+        let packs = crate::network_packs::PacksDrawing::new(net, &x_m, &radii, DRAWN_THICKNESS_M);
         let mut rec = NetworkRecorder {
+            packs,
             path,
             pending: Some(pending),
             writer: Some(w),
@@ -396,7 +400,7 @@ impl NetworkRecorder {
     /// Every body as a disc in its frame, with a marker on its rim (so its rotation shows)
     /// and its name above it.
     fn static_scene(&self, frames: &[String], radii: &[f64]) -> SceneUpdate {
-        let entities = frames
+        let mut entities: Vec<_> = frames
             .iter()
             .zip(radii)
             .zip(&self.net.bodies)
@@ -426,6 +430,7 @@ impl NetworkRecorder {
                 e
             })
             .collect();
+        entities.extend(self.packs.entities());
         SceneUpdate {
             deletions: Vec::new(),
             entities,
@@ -610,6 +615,21 @@ impl NetworkRecorder {
             &msg,
             "/network/impacts",
         )
+    }
+
+    /// Writes the angles `angle_rad` (rad, discs then plates) of the resolved pack that is
+    /// coupling `coupling` at `t_s` (s) as its rings' frames on `/tf`.
+    pub fn write_pack_sample(
+        &mut self,
+        coupling: usize,
+        t_s: f64,
+        angle_rad: &[f64],
+    ) -> Result<(), RecordError> {
+        let ns = log_time_ns(t_s);
+        match self.packs.transforms(coupling, ns, angle_rad) {
+            Some(tf) => self.put(self.ch.tf, ns, &tf, "/tf"),
+            None => Ok(()),
+        }
     }
 
     /// Writes a gear mesh's tooth impact on `/network/impacts`, logged at its peak (`disc`

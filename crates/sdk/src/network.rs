@@ -279,6 +279,10 @@ impl NetworkObserver for Obs<'_, '_> {
             }
         }
     }
+    fn pack_sample(&mut self, coupling: usize, t: f64, angle_rad: &[f64], _speed: &[f64]) {
+        self.keep
+            .record(|r| r.write_pack_sample(coupling, t, angle_rad));
+    }
     fn pack_faces(&mut self, coupling: usize, t: f64, locked: usize, clamped: usize, faces: usize) {
         let mode = if locked == faces {
             "locked"

@@ -111,6 +111,17 @@ pub trait NetworkObserver {
     /// coupling index, the impact's `disc` the body's index in the pack (its discs, then its
     /// plates), its peak the per-tooth load as the pack engines sign it.
     fn pack_impact(&mut self, _coupling: usize, _impact: &ImpactEvent) {}
+    /// A resolved pack's discs and plates at a sample's instant `t_s` (s), sent after the
+    /// [`Self::sample`] of that instant: each body's absolute angle (rad) and speed (rad/s),
+    /// its discs then its plates.
+    fn pack_sample(
+        &mut self,
+        _coupling: usize,
+        _t_s: f64,
+        _angle_rad: &[f64],
+        _speed_rad_s: &[f64],
+    ) {
+    }
     /// A resolved pack's faces changed mode at `t_s` (s): `locked` of its `faces` friction
     /// faces are locked now (all of them: the pack has locked, its carriers turn as one but
     /// for the splines' play), `clamped` are clamped (locked or slipping).

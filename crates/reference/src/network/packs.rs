@@ -392,3 +392,25 @@ pub(super) fn heal(
     }
     changed
 }
+
+/// Sends every pack's discs and plates at the network state `y` at `t` (s) to `obs`: each
+/// body's absolute angle (its carrier's less its relative angle, rad) and speed (rad/s).
+pub(super) fn emit_samples(
+    packs: &[NetPack],
+    n: usize,
+    t: f64,
+    y: &[f64],
+    obs: &mut dyn NetworkObserver,
+) {
+    for p in packs {
+        let nd = p.sys.pack.discs.len();
+        let (angles, speeds): (Vec<f64>, Vec<f64>) = (0..p.sys.ids.len())
+            .map(|slot| {
+                let c = if slot < nd { p.a } else { p.b };
+                let k = p.at + 2 * slot;
+                (y[c] - y[k], y[n + c] - y[k + 1])
+            })
+            .unzip();
+        obs.pack_sample(p.k, t, &angles, &speeds);
+    }
+}

@@ -129,6 +129,7 @@ impl NetworkStepper {
             f64::INFINITY
         };
         obs.sample(&sample(&mut eq, 0.0, &y));
+        packs::emit_samples(&eq.packs, n, 0.0, &y, obs);
         Ok(NetworkStepper {
             breakpoints: net.breakpoints(duration_s),
             next_bp: 0,
@@ -355,6 +356,7 @@ impl NetworkStepper {
                 let ts = self.next_sample as f64 * self.period;
                 dense.eval(ts, ybuf);
                 obs.sample(&sample(eq, ts, ybuf));
+                packs::emit_samples(&eq.packs, eq.net.bodies.len(), ts, ybuf, obs);
                 self.next_sample += 1;
             }
             if t_new < *t + h_try {
@@ -400,6 +402,7 @@ impl NetworkStepper {
         }
         let last = sample(&mut self.eq, t, &self.y);
         obs.sample(&last);
+        packs::emit_samples(&self.eq.packs, n, t, &self.y, obs);
         let y = &self.y;
         let c0 = 2 * n + m; // the counters
         let mut heat = y[c0..c0 + m].to_vec();
