@@ -15,7 +15,7 @@
 //! | `/network/couplings/<segment>` | `clutchpack.CouplingState` | each sample |
 //! | `/joints` (couplings: slip, torque), `/network/joints/bodies` (angle, speed) | `sensor_msgs/msg/JointState` | each sample (Rerun, Lichtblick) |
 //! | `/network/events` | `foxglove.Log` | each clutch mode change, at its instant |
-//! | `/network/impacts` | `clutchpack.Impact` | each gear-mesh impact and each tooth impact of a pack's disc or plate (`<pack>/discs/<disc>`, `<pack>/plates/<plate>`), at its peak |
+//! | `/network/impacts` | `clutchpack.Impact` | each gear-mesh impact and each tooth impact of a pack's disc or plate (`<pack>/discs/<disc>`, `<pack>/plates/<plate>`), logged when its contact closes (in time order; the message holds its peak's time) |
 //! | `/tf` | `foxglove.FrameTransforms` | each sample: `world` -> `body/<segment>` |
 //! | `/scene` | `foxglove.SceneUpdate` | t = 0: every body as a disc with a marker and its name |
 //! | `/scene/couplings` | `foxglove.SceneUpdate` | t = 0 and at each mode change |
@@ -600,9 +600,9 @@ impl NetworkRecorder {
     }
 
     /// Writes the tooth impact of a resolved pack's disc or plate on `/network/impacts`,
-    /// logged at its peak, named `<pack>/discs/<disc>` or `<pack>/plates/<plate>` (`coupling`
-    /// the pack's index; `disc` of the event the body's index in the pack, its discs then its
-    /// plates).
+    /// logged when its contact closes (the message holds its peak), named
+    /// `<pack>/discs/<disc>` or `<pack>/plates/<plate>` (`coupling` the pack's index; `disc`
+    /// of the event the body's index in the pack, its discs then its plates).
     pub fn write_pack_impact(
         &mut self,
         coupling: usize,
@@ -611,7 +611,7 @@ impl NetworkRecorder {
         let msg = proto::Impact::of(e, impact_name(&self.net, coupling, Some(e.disc)));
         self.put(
             self.ch.impacts,
-            log_time_ns(e.t_peak_s),
+            log_time_ns(e.t_off_s),
             &msg,
             "/network/impacts",
         )
@@ -632,13 +632,13 @@ impl NetworkRecorder {
         }
     }
 
-    /// Writes a gear mesh's tooth impact on `/network/impacts`, logged at its peak (`disc`
-    /// of the event is the coupling's index).
+    /// Writes a gear mesh's tooth impact on `/network/impacts`, logged when its contact
+    /// closes (`disc` of the event is the coupling's index).
     pub fn write_mesh_impact(&mut self, e: &ImpactEvent) -> Result<(), RecordError> {
         let msg = proto::Impact::of(e, impact_name(&self.net, e.disc, None));
         self.put(
             self.ch.impacts,
-            log_time_ns(e.t_peak_s),
+            log_time_ns(e.t_off_s),
             &msg,
             "/network/impacts",
         )
