@@ -1132,3 +1132,28 @@ fn a_network_advanced_in_calls_with_driven_clutch_forces_is_the_scenes_run() {
         .set_input(NetworkInput::Drive(99), 1.0, &mut obs)
         .is_err());
 }
+
+/// At `record_rate_hz = 0` both engines give the first and the last sample only (the
+/// multibody engine used to skip the first: 0 times an infinite period is NaN).
+#[test]
+fn without_a_record_rate_both_engines_give_the_first_and_last_samples() {
+    let net = cases::coupled_clutches();
+    let mut mb = Keep::default();
+    let options = NetworkStepOptions {
+        step_s: 1e-4,
+        record_rate_hz: 0.0,
+    };
+    run_network(&net, 0.1, &options, &mut mb).unwrap();
+    let mut rf = Keep::default();
+    let options = reference::NetworkOptions {
+        record_rate_hz: 0.0,
+        ..reference::NetworkOptions::default()
+    };
+    reference::run_network(&net, 0.1, &options, &mut rf).unwrap();
+    for k in [&mb, &rf] {
+        let t: Vec<f64> = k.1.iter().map(|s| s.t_s).collect();
+        assert_eq!(t.len(), 2, "{t:?}");
+        assert_eq!(t[0], 0.0);
+        assert!((t[1] - 0.1).abs() < 1e-12, "{t:?}");
+    }
+}

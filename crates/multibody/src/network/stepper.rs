@@ -226,7 +226,12 @@ impl NetworkStepper {
             self.next_bp += 1;
             self.run.events += 1;
         }
-        self.t_sample = self.next_sample as f64 * self.period;
+        // the first sample at t = 0 whatever the rate (0 x an infinite period is NaN)
+        self.t_sample = if self.next_sample == 0 {
+            0.0
+        } else {
+            self.next_sample as f64 * self.period
+        };
         // a contact's onset or separation at t (landed on), before the torques at t
         self.h_contact = mesh::start_step(&mut self.run.meshes, t, &self.run.w, obs);
         self.run.settle(t, obs);
