@@ -339,18 +339,54 @@ def check_thermal(args):
     }
 
 
+def drive_dct(args, scene, name, inputs, outs):
+    """Builds the FMU of `scene`, drives it with FMPy for 1 s at 1 ms steps (the engine's mean
+    torque 250 N m and `inputs`: {input name: its schedule f(t)}, each held at the step's
+    midpoint value) reading `outs`, and runs the scene with `clutchpack run`: (the FMU's input
+    names, FMPy's validation problems, FMPy's result, the run's summary)."""
+    work = args.work
+    fmu = os.path.join(work, name + ".fmu")
+    p = build(args, scene, fmu)
+    if p.returncode != 0:
+        raise SystemExit(p.stderr)
+    md = read_model_description(fmu)
+    names = [v.name for v in md.modelVariables if v.causality == "input"]
+    h = 1e-3
+    ts = np.arange(0.0, 1.0 + h / 2, h)
+    signals = np.array(
+        [(t, 250.0, *(f(t + h / 2) for f in inputs.values())) for t in ts],
+        dtype=[("time", float), ("bodies.crank.drive_torque_n_m", float)]
+        + [(n, float) for n in inputs],
+    )
+    r = fmpy.simulate_fmu(fmu, stop_time=1.0, step_size=h, input=signals, output=outs)
+    summary = os.path.join(work, name + ".json")
+    run(args, "run", scene, "--no-record", "--summary-json", summary)
+    with open(summary) as f:
+        s = json.load(f)
+    return names, validate_fmu(fmu), r, s
+
+
+def dct_result(names, problems, r, s):
+    """What the DCT checks return: K2's heat and the vehicle's final speed through the FMU
+    and in the run, and K2's lock times in the run."""
+    k2s = next(c for c in s["couplings"] if c["name"] == "K2")
+    vehicle = next(b for b in s["bodies"] if b["name"] == "vehicle")
+    return {
+        "inputs": names,
+        "problems": problems,
+        "fmu_heat_j": float(r["couplings.K2.heat_j"][-1]),
+        "fmu_vehicle_rad_s": float(r["bodies.vehicle.speed_rad_s"][-1]),
+        "run_lock_s": k2s["lock_times_s"],
+        "run_heat_j": k2s["heat_j"],
+        "run_vehicle_rad_s": vehicle["final_speed_rad_s"],
+    }
+
+
 def check_network(args):
     """The DCT upshift's FMU (a network scene): its inputs, FMPy's validation, and the shift
     driven through it: the clutches' normal forces from the scene's own schedule (K1's ramp,
     K2's table) at each 1 ms step's midpoint and the engine's mean torque, against
     `clutchpack run` of the scene."""
-    work = args.work
-    fmu = os.path.join(work, "dct-upshift.fmu")
-    p = build(args, "scenes/dct-upshift.toml", fmu)
-    if p.returncode != 0:
-        raise SystemExit(p.stderr)
-    md = read_model_description(fmu)
-    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
 
     def k1(t):
         return 10000.0 * min(1.0, max(0.0, 1.0 - (t - 0.2) / 0.15))
@@ -358,47 +394,22 @@ def check_network(args):
     def k2(t):
         return 10000.0 * float(np.interp(t, [0.0, 0.2, 0.35, 0.7, 0.8], [0.0, 0.0, 0.45, 0.45, 1.0]))
 
-    h = 1e-3
-    ts = np.arange(0.0, 1.0 + h / 2, h)
-    signals = np.array(
-        [(t, 250.0, k1(t + h / 2), k2(t + h / 2)) for t in ts],
-        dtype=[("time", float), ("bodies.crank.drive_torque_n_m", float),
-               ("couplings.K1.normal_force_n", float), ("couplings.K2.normal_force_n", float)],
-    )
     outs = ["couplings.K2.mode", "couplings.K2.heat_j", "bodies.vehicle.speed_rad_s",
             "bodies.engine.speed_rad_s"]
-    r = fmpy.simulate_fmu(fmu, stop_time=1.0, step_size=h, input=signals, output=outs)
+    names, problems, r, s = drive_dct(
+        args, "scenes/dct-upshift.toml", "dct-upshift",
+        {"couplings.K1.normal_force_n": k1, "couplings.K2.normal_force_n": k2}, outs)
     locked = np.nonzero(r["couplings.K2.mode"] == 0)[0]
-    summary = os.path.join(work, "dct.json")
-    run(args, "run", "scenes/dct-upshift.toml", "--no-record", "--summary-json", summary)
-    with open(summary) as f:
-        s = json.load(f)
-    k2s = next(c for c in s["couplings"] if c["name"] == "K2")
-    vehicle = next(b for b in s["bodies"] if b["name"] == "vehicle")
-    return {
-        "inputs": inputs,
-        "problems": validate_fmu(fmu),
-        "fmu_first_locked_s": float(r["time"][locked[0]]) if len(locked) else None,
-        "fmu_heat_j": float(r["couplings.K2.heat_j"][-1]),
-        "fmu_vehicle_rad_s": float(r["bodies.vehicle.speed_rad_s"][-1]),
-        "run_lock_s": k2s["lock_times_s"],
-        "run_heat_j": k2s["heat_j"],
-        "run_vehicle_rad_s": vehicle["final_speed_rad_s"],
-    }
+    out = dct_result(names, problems, r, s)
+    out["fmu_first_locked_s"] = float(r["time"][locked[0]]) if len(locked) else None
+    return out
 
 
 def check_network_packs(args):
     """The FMU of the DCT upshift with both clutches resolved packs: its inputs (the engine's
     torque and both pistons' pressures), FMPy's validation, and the shift driven through it
-    (the scene's own pressure schedules at each 1 ms step's midpoint) against `clutchpack run`
-    of the scene."""
-    work = args.work
-    fmu = os.path.join(work, "dct-upshift-packs.fmu")
-    p = build(args, "scenes/dct-upshift-packs.toml", fmu)
-    if p.returncode != 0:
-        raise SystemExit(p.stderr)
-    md = read_model_description(fmu)
-    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+    (the pack files' own pressure schedules at each 1 ms step's midpoint) against `clutchpack
+    run` of the scene."""
 
     def k1(t):  # scenes/dct-k1.toml's [stack.pressure]
         return float(np.interp(t, [0.0, 0.2, 0.35], [1.05e6, 1.05e6, 0.0]))
@@ -406,35 +417,17 @@ def check_network_packs(args):
     def k2(t):  # scenes/dct-k2.toml's
         return float(np.interp(t, [0.0, 0.2, 0.35, 0.7, 0.8], [0.0, 0.0, 0.45e6, 0.45e6, 1.05e6]))
 
-    h = 1e-3
-    ts = np.arange(0.0, 1.0 + h / 2, h)
-    signals = np.array(
-        [(t, 250.0, k1(t + h / 2), k2(t + h / 2)) for t in ts],
-        dtype=[("time", float), ("bodies.crank.drive_torque_n_m", float),
-               ("couplings.K1.pressure_pa", float), ("couplings.K2.pressure_pa", float)],
-    )
-    outs = ["couplings.K2.heat_j", "couplings.K1.heat_j", "bodies.vehicle.speed_rad_s",
-            "bodies.engine.speed_rad_s", "bodies.'input-2'.speed_rad_s"]
-    r = fmpy.simulate_fmu(fmu, stop_time=1.0, step_size=h, input=signals, output=outs)
+    outs = ["couplings.K2.heat_j", "bodies.vehicle.speed_rad_s", "bodies.engine.speed_rad_s",
+            "bodies.'input-2'.speed_rad_s"]
+    names, problems, r, s = drive_dct(
+        args, "scenes/dct-upshift-packs.toml", "dct-upshift-packs",
+        {"couplings.K1.pressure_pa": k1, "couplings.K2.pressure_pa": k2}, outs)
     # the on-coming pack's lock: the engine's speed meets the even input shaft's
     slip = np.abs(r["bodies.engine.speed_rad_s"] - r["bodies.'input-2'.speed_rad_s"])
     after = np.nonzero((r["time"] > 0.4) & (slip < 0.5))[0]
-    summary = os.path.join(work, "dct-packs.json")
-    run(args, "run", "scenes/dct-upshift-packs.toml", "--no-record", "--summary-json", summary)
-    with open(summary) as f:
-        s = json.load(f)
-    k2s = next(c for c in s["couplings"] if c["name"] == "K2")
-    vehicle = next(b for b in s["bodies"] if b["name"] == "vehicle")
-    return {
-        "inputs": inputs,
-        "problems": validate_fmu(fmu),
-        "fmu_synchronised_s": float(r["time"][after[0]]) if len(after) else None,
-        "fmu_heat_j": float(r["couplings.K2.heat_j"][-1]),
-        "fmu_vehicle_rad_s": float(r["bodies.vehicle.speed_rad_s"][-1]),
-        "run_lock_s": k2s["lock_times_s"],
-        "run_heat_j": k2s["heat_j"],
-        "run_vehicle_rad_s": vehicle["final_speed_rad_s"],
-    }
+    out = dct_result(names, problems, r, s)
+    out["fmu_synchronised_s"] = float(r["time"][after[0]]) if len(after) else None
+    return out
 
 
 def main():

@@ -2,11 +2,10 @@
 //! clutch on an inertial shaft, a DCT's wet clutch, and any pack with an inertial shaft as the
 //! network that runs it (a network's run of it is the pack's own run).
 
-use super::{paper_drive, paper_law, staggered_brake, staggered_inertial};
+use super::{bench_disc, paper_drive, staggered_brake, staggered_inertial};
 use crate::clutch::{DrumModel, FrictionCurve, Piston, PressureProfile, StackModel};
 use crate::drive::{Shaft, ShaftExcitation, SpeedProfile};
-use crate::law::LawKind;
-use crate::pack::{DiscModel, PackModel};
+use crate::pack::PackModel;
 use crate::spline::SplineGeometry;
 
 /// An engaging clutch on an inertial shaft (MODEL.md sections 5 and 8): [`staggered_brake`]`(4)`
@@ -45,21 +44,13 @@ pub fn engaging_clutch() -> PackModel {
 /// `clamp_n` (N, constant) and the pack slips with `2 n mu F R_eff`. Its own shaft is the
 /// paper's drive (a network's body replaces it).
 pub fn wet_clutch(n: usize, clamp_n: f64) -> PackModel {
+    // the benchmark disc's dry law with the paper's curvature: the paper's law, p = 0.5 s/m
     let body = |name: String, j: f64, spline: SplineGeometry| {
-        let mut law = paper_law(LawKind::Dry, 0.0);
-        law.hertz.loss_coefficient_s_m = 0.5;
-        DiscModel {
-            name,
-            spline,
-            law,
-            inertia_kg_m2: j,
-            drag_n_m_s_rad: 0.0,
-            initial_rel_angle_rad: 0.0,
-            initial_rel_speed_rad_s: 0.0,
-            radial_float: false,
-            tooth_spacing_errors_m: Vec::new(),
-            initial_offset_m: [0.0, 0.0],
-        }
+        let mut d = bench_disc(&name);
+        d.law.hertz.curvature_radius_m = 1.75e-3;
+        d.spline = spline;
+        d.inertia_kg_m2 = j;
+        d
     };
     let spline = |teeth: u32, r: f64, alpha_deg: f64| SplineGeometry {
         teeth,
