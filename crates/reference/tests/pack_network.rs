@@ -229,3 +229,55 @@ fn dual_clutch_shift_with_resolved_packs_matches_closed_form() {
     assert!(rel(run.heat_j[1], e_i) < 4e-3);
     assert!(run.energy.residual_j().abs() < 1e-8 * run.energy.drive_work_j);
 }
+
+/// An open brake on an inertial shaft ([`clutchpack_model::cases::staggered_brake`]`(4)` with
+/// the shaft of `staggered_inertial`: four discs out of step, five plates on the fixed
+/// housing, the open stack's oil gaps between them) as a network of the shaft and the fixed
+/// housing. Measured: the 36 impacts of the first 15 ms within 5.6e-9 s and 2.7e-5 of their
+/// peaks (asserted 2e-8 s and 1e-4); after that the discs' rattle against the inertial shaft
+/// grows as sensitive to the steps as to the tolerance (the pack's own run at 1e-10 and 1e-11
+/// ends 0.30 rad/s apart), and the network ends 0.31 rad/s from the pack's run at 1e-10 and
+/// 0.017 from the one at 1e-11 (asserted 0.5), its gaps' heat 9.3e-5 from it (the pack's own
+/// runs 1.1e-4 apart; asserted 1e-3); the energy balance closes with the gaps' heat in the
+/// pack's losses.
+#[test]
+fn an_open_brake_on_a_network_is_the_pack_run_impact_for_impact() {
+    use clutchpack_model::cases::{staggered_brake, staggered_inertial};
+    let mut pack = staggered_brake(4);
+    pack.shaft = staggered_inertial(4).shaft;
+    let (duration, tol) = (0.06, 1e-10);
+    let (alone, shaft, heat) = pack_run(&pack, duration, tol);
+    let net = pack_as_network(&pack).expect("an inertial shaft");
+    assert!(net.bodies[1].fixed, "the plates on the housing");
+    let mut obs = Packs::default();
+    let options = NetworkOptions {
+        tolerance: tol,
+        max_step_s: 1e-4,
+        record_rate_hz: 1000.0,
+    };
+    let run = run_network(&net, duration, &options, &mut obs).expect("the network runs");
+    let on_net = sorted(&obs.impacts.iter().map(|(_, e)| *e).collect::<Vec<_>>());
+    let (n, on, peak) = worst(&alone, &on_net, 0.015);
+    let (tighter, tighter_shaft, tighter_heat) = pack_run(&pack, duration, tol / 10.0);
+    let e = run.energy;
+    println!(
+        "pack at tol / 10: {} impacts, shaft {tighter_shaft} rad/s, heat {tighter_heat} J",
+        tighter.len()
+    );
+    println!(
+        "open brake: {n} impacts, worst onset {on:e} s, peak {peak:e}; shaft {shaft} / {} rad/s; gaps' heat {heat} / {} J; balance {:e} J",
+        run.last.speed_rad_s[0],
+        run.heat_j[0],
+        e.residual_j()
+    );
+    assert!(n >= 30, "{n}");
+    assert!(on <= 2e-8, "{on}");
+    assert!(peak <= 1e-4, "{peak}");
+    assert!((run.last.speed_rad_s[0] - shaft).abs() <= 0.5, "{shaft}");
+    assert!(
+        (run.heat_j[0] - heat).abs() <= 1e-3 * heat,
+        "{} {heat}",
+        run.heat_j[0]
+    );
+    assert!(e.residual_j().abs() <= 1e-8 * e.drive_work_j.abs().max(e.pack_loss_j));
+}
