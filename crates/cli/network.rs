@@ -135,28 +135,41 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     }
     for c in s.couplings.iter().filter(|c| !c.pack_bodies.is_empty()) {
         out!(
-            "  {:<16} pack: {} tooth impacts; per body (impacts, largest peak per tooth):",
+            "  {:<16} pack: {} tooth impacts; per body: impacts, largest peak per tooth, \
+             its teeth's damage per hour of this duty and life:",
             c.name,
             c.impacts
         );
         // the first of equals (a locked pack's discs share their load)
-        let worst = c.pack_bodies.iter().fold(
-            None,
-            |w: Option<&clutchpack_sdk::PackBodySummary>, b| match w {
-                Some(w) if w.largest_peak_n.abs() >= b.largest_peak_n.abs() => Some(w),
-                _ => Some(b),
-            },
-        );
+        let first_max = |key: &dyn Fn(&clutchpack_sdk::PackBodySummary) -> f64| {
+            c.pack_bodies.iter().fold(
+                None,
+                |w: Option<&clutchpack_sdk::PackBodySummary>, b| match w {
+                    Some(w) if key(w) >= key(b) => Some(w),
+                    _ => Some(b),
+                },
+            )
+        };
+        let largest = first_max(&|b| b.largest_peak_n.abs());
+        let most_damaged = first_max(&|b| b.damage_rate_per_h);
         for b in &c.pack_bodies {
-            let mark = match worst {
-                Some(w) if w.name == b.name && b.impacts > 0 => "  <- the largest",
-                _ => "",
-            };
+            let mut mark = String::new();
+            if largest.is_some_and(|w| w.name == b.name) && b.impacts > 0 {
+                mark.push_str("  <- the largest peak");
+            }
+            if most_damaged.is_some_and(|w| w.name == b.name) && b.damage_rate_per_h > 0.0 {
+                mark.push_str("  <- the shortest life");
+            }
+            let life = b
+                .life_h
+                .map_or_else(|| "unlimited".to_string(), |h| format!("{h:.3e} h"));
             out!(
-                "    {:<14} {:>6} {:>12.3} N{mark}",
+                "    {:<14} {:>6} {:>12.3} N  {:>10.3e} /h  {:>12}{mark}",
                 b.name,
                 b.impacts,
-                b.largest_peak_n
+                b.largest_peak_n,
+                b.damage_rate_per_h,
+                life
             );
         }
     }

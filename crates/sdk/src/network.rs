@@ -88,6 +88,13 @@ pub struct PackBodySummary {
     /// Its largest per-tooth peak, N, signed as in Hu et al. eq (6) (negative when its
     /// carrier leads); 0 without impacts.
     pub largest_peak_n: f64,
+    /// Fatigue damage of its spline teeth per hour of this duty, 1/h (>= 0): the rainflow
+    /// cycles of its per-tooth load (its samples and impacts, as a pack run counts them)
+    /// against the S-N curve of the pack file's `fatigue.*` and `material.*` (MODEL.md
+    /// section 7).
+    pub damage_rate_per_h: f64,
+    /// Its teeth's life at this duty, h (`None`: no damage, unlimited).
+    pub life_h: Option<f64>,
 }
 
 /// One body's results.
@@ -168,6 +175,8 @@ pub(crate) struct Keep {
     meshes: std::collections::HashMap<usize, (u64, f64)>,
     /// Per (pack coupling, body in the pack): (impacts, largest peak).
     pack_bodies: std::collections::HashMap<(usize, usize), (u64, f64)>,
+    /// Per pack coupling: its bodies' load histories for the fatigue (samples and impacts).
+    pack_fatigue: std::collections::BTreeMap<usize, clutchpack_analysis::FatigueCollector>,
     /// Per pack coupling: its faces' mode as a clutch's label ("free", "slipping",
     /// "locked"), and the instants all its faces locked.
     pack_modes: std::collections::HashMap<usize, (&'static str, Vec<f64>)>,
@@ -217,6 +226,7 @@ impl Keep {
             meshes: self.meshes.clone(),
             pack_bodies: self.pack_bodies.clone(),
             pack_modes: self.pack_modes.clone(),
+            pack_fatigue: self.pack_fatigue.clone(),
             history: self.history.clone(),
             impact_log: self.impact_log.clone(),
             stopped: self.stopped,
@@ -266,6 +276,11 @@ impl NetworkObserver for Obs<'_, '_> {
     }
     fn pack_impact(&mut self, coupling: usize, e: &clutchpack_model::ImpactEvent) {
         self.keep.record(|r| r.write_pack_impact(coupling, e));
+        self.keep
+            .pack_fatigue
+            .entry(coupling)
+            .or_default()
+            .impact(e);
         if self.keep.keep_history {
             self.keep
                 .impact_log
@@ -279,9 +294,32 @@ impl NetworkObserver for Obs<'_, '_> {
             }
         }
     }
-    fn pack_sample(&mut self, coupling: usize, t: f64, angle_rad: &[f64], _speed: &[f64]) {
+    fn pack_sample(
+        &mut self,
+        coupling: usize,
+        t: f64,
+        angle_rad: &[f64],
+        _speed: &[f64],
+        load_n: &[f64],
+    ) {
         self.keep
             .record(|r| r.write_pack_sample(coupling, t, angle_rad));
+        let sample = clutchpack_model::Sample {
+            t_s: t,
+            discs: load_n
+                .iter()
+                .map(|&l| clutchpack_model::DiscSample {
+                    load_n: l,
+                    ..Default::default()
+                })
+                .collect(),
+            ..Default::default()
+        };
+        self.keep
+            .pack_fatigue
+            .entry(coupling)
+            .or_default()
+            .sample(&sample);
     }
     fn pack_faces(&mut self, coupling: usize, t: f64, locked: usize, clamped: usize, faces: usize) {
         let mode = if locked == faces {
@@ -428,6 +466,41 @@ pub(crate) fn engine_failed(
     }
 }
 
+/// Every resolved pack's bodies' fatigue from what `keep` collected over `duration_s` of
+/// duty, with the pack files' parameters (the scene's `fatigue`: every pack's bodies in
+/// coupling order), by coupling.
+fn pack_fatigue(
+    scene: &Scene,
+    net: &clutchpack_model::network::Network,
+    keep: &mut Keep,
+    duration_s: f64,
+) -> std::collections::BTreeMap<usize, Vec<clutchpack_analysis::DiscFatigue>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut offset = 0;
+    for (k, c) in net.couplings.iter().enumerate() {
+        let Some(p) = c.pack() else { continue };
+        let bodies: Vec<&clutchpack_model::DiscModel> = p.discs.iter().chain(&p.plates).collect();
+        let params: Vec<_> = bodies
+            .iter()
+            .enumerate()
+            .map(|(i, d)| {
+                let f = scene.fatigue.get(offset + i).copied().unwrap_or_default();
+                (d.spline, f)
+            })
+            .collect();
+        offset += bodies.len();
+        let names: Vec<String> = bodies.iter().map(|d| d.name.clone()).collect();
+        let collector = keep.pack_fatigue.remove(&k).unwrap_or_default();
+        if duration_s > 0.0 {
+            out.insert(
+                k,
+                crate::fatigue::assess_fatigue(collector, &params, &names, duration_s),
+            );
+        }
+    }
+    out
+}
+
 /// The outcome of a finished (or stopped) network run: its summary from what `keep` kept and
 /// the engine's `run`, and the recording finished with the summary attached.
 pub(crate) fn conclude(
@@ -444,6 +517,7 @@ pub(crate) fn conclude(
         return Err(e.into());
     }
     let last = &run.last;
+    let fatigue = pack_fatigue(scene, net, &mut keep, last.t_s);
     let couplings = net
         .couplings
         .iter()
@@ -501,10 +575,13 @@ pub(crate) fn conclude(
                         .enumerate()
                         .map(|(i, d)| {
                             let m = keep.pack_bodies.get(&(k, i)).copied().unwrap_or((0, 0.0));
+                            let f = fatigue.get(&k).and_then(|f| f.get(i));
                             PackBodySummary {
                                 name: d.name.clone(),
                                 impacts: m.0,
                                 largest_peak_n: m.1,
+                                damage_rate_per_h: f.map_or(0.0, |f| f.lumped.damage_rate_per_h),
+                                life_h: f.and_then(|f| f.lumped.life_h),
                             }
                         })
                         .collect()

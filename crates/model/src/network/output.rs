@@ -112,7 +112,8 @@ pub trait NetworkObserver {
     /// plates), its peak the per-tooth load as the pack engines sign it.
     fn pack_impact(&mut self, _coupling: usize, _impact: &ImpactEvent) {}
     /// A resolved pack's discs and plates at a sample's instant `t_s` (s), sent after the
-    /// [`Self::sample`] of that instant: each body's absolute angle (rad) and speed (rad/s),
+    /// [`Self::sample`] of that instant: each body's absolute angle (rad), speed (rad/s) and
+    /// per-tooth load (N, signed as in Hu et al. eq (6): negative when its carrier leads),
     /// its discs then its plates.
     fn pack_sample(
         &mut self,
@@ -120,6 +121,7 @@ pub trait NetworkObserver {
         _t_s: f64,
         _angle_rad: &[f64],
         _speed_rad_s: &[f64],
+        _load_n: &[f64],
     ) {
     }
     /// A resolved pack's faces changed mode at `t_s` (s): `locked` of its `faces` friction

@@ -394,7 +394,8 @@ pub(super) fn heal(
 }
 
 /// Sends every pack's discs and plates at the network state `y` at `t` (s) to `obs`: each
-/// body's absolute angle (its carrier's less its relative angle, rad) and speed (rad/s).
+/// body's absolute angle (its carrier's less its relative angle, rad), speed (rad/s) and
+/// per-tooth load (N).
 pub(super) fn emit_samples(
     packs: &[NetPack],
     n: usize,
@@ -411,6 +412,10 @@ pub(super) fn emit_samples(
                 (y[c] - y[k], y[n + c] - y[k + 1])
             })
             .unzip();
-        obs.pack_sample(p.k, t, &angles, &speeds);
+        let part = p.part(y);
+        let loads: Vec<f64> = (0..p.sys.ids.len())
+            .map(|slot| p.sys.load(slot, part, &p.modes[slot]))
+            .collect();
+        obs.pack_sample(p.k, t, &angles, &speeds, &loads);
     }
 }

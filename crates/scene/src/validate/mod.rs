@@ -414,6 +414,10 @@ fn network_scene(
         raw.couplings.as_deref().unwrap_or(&[]),
         base_dir,
     );
+    let (network, fatigue) = match network {
+        Some((n, f)) => (Some(n), f),
+        None => (None, Vec::new()),
+    };
     Some(Validated {
         name: name?,
         description: description?,
@@ -428,7 +432,7 @@ fn network_scene(
             stack: None,
             couplings: Vec::new(),
         },
-        fatigue: Vec::new(),
+        fatigue,
         thermal: None,
         network: Some(network?),
     })

@@ -208,9 +208,11 @@ pub(super) fn network(
     bodies: &[B],
     couplings: &[C],
     base_dir: &Path,
-) -> Option<Network> {
+) -> Option<(Network, Vec<clutchpack_model::FatigueParams>)> {
     let mut ok = true;
     let mut net = Network::default();
+    // every resolved pack's bodies' fatigue parameters, in coupling order
+    let mut fatigue = Vec::new();
     // every body's name as written (a coupling is checked against them even when another key
     // of a body is bad, so that one run lists every problem)
     let mut names: Vec<Option<String>> = Vec::new();
@@ -432,7 +434,10 @@ pub(super) fn network(
                 .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
                 .map(|ratio| CouplingKind::IdealGear { ratio }),
             Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
-            Kind::Pack => pack(ck, r, k, base_dir).map(|p| CouplingKind::Pack(Box::new(p))),
+            Kind::Pack => pack(ck, r, k, base_dir).map(|(p, f)| {
+                fatigue.extend(f);
+                CouplingKind::Pack(Box::new(p))
+            }),
             Kind::Spring => {
                 let num = |ck: &mut Checker, key: &Key| ck.num(&p(key), r.value(key), key);
                 let k_ = num(ck, &C::stiffness_n_m_per_rad).required(
@@ -477,15 +482,23 @@ pub(super) fn network(
             } => ck.report(format!("couplings[{index}].{field}"), None, message.clone()),
         }
     }
-    problems.is_empty().then_some(net)
+    problems.is_empty().then_some((net, fatigue))
 }
 
 /// The pack scene of a `kind = "pack"` coupling `k` (key `pack`, relative to the network
 /// scene's folder), read by the pack scene's own loader: its problems are reported at
 /// `couplings[k].pack` with the pack file's key paths. A network scene there, a thermal pack
 /// and a pack the reference engine cannot run (radial float, offsets, spacing errors) are
-/// refused.
-fn pack(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<clutchpack_model::PackModel> {
+/// refused. With the pack, its bodies' fatigue parameters (its discs', then its plates').
+fn pack(
+    ck: &mut Checker,
+    r: &C,
+    k: usize,
+    base_dir: &Path,
+) -> Option<(
+    clutchpack_model::PackModel,
+    Vec<clutchpack_model::FatigueParams>,
+)> {
     let key = item("couplings", &C::pack, k);
     let file = ck.text(&key, r.value(&C::pack)).required(
         ck,
@@ -555,7 +568,7 @@ fn pack(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<clutchpack
             ),
         );
     }
-    Some(scene.pack)
+    Some((scene.pack, scene.fatigue))
 }
 
 /// `[bodies.firing]` of body `i`: `Some(Some(..))` when valid, `None` after reporting.
