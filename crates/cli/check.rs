@@ -43,8 +43,27 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
             if let Some(net) = &s.network {
                 // a network runs on either engine (its own rules checked in the load)
                 let engine = s.engine(a.engine, &p.display().to_string())?;
+                // its resolved packs: `K1 (4 discs, 5 plates)`
+                let packs: Vec<String> = net
+                    .couplings
+                    .iter()
+                    .filter_map(|c| {
+                        let pk = c.pack()?;
+                        Some(format!(
+                            "{} ({} discs, {} plates)",
+                            c.name,
+                            pk.discs.len(),
+                            pk.plates.len()
+                        ))
+                    })
+                    .collect();
+                let packs = if packs.is_empty() {
+                    String::new()
+                } else {
+                    format!("; resolved packs {}", packs.join(", "))
+                };
                 return Ok(format!(
-                    "network of {} bodies and {} couplings, {} s, {} engine",
+                    "network of {} bodies and {} couplings{packs}, {} s, {} engine",
                     net.bodies.len(),
                     net.couplings.len(),
                     s.simulation.duration_s,
