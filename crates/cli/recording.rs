@@ -662,7 +662,10 @@ fn plot_network(
         &bodies,
         &couplings,
         &net.samples,
-        &net.impacts,
+        &net.impacts
+            .iter()
+            .map(|(name, e)| (name.clone(), e.t_peak_s, e.peak_n))
+            .collect::<Vec<_>>(),
     )?;
     out!("{}", a.out.display());
     Ok(ExitCode::SUCCESS)

@@ -62,7 +62,17 @@ pub fn raw_network_recording(
         summary_json,
         scene_text: info.as_ref().map(|i| i.scene_text.clone()),
         overrides: info.map(|i| i.overrides).unwrap_or_default(),
-        impacts: crate::ImpactColumns::of(&[], &[]),
+        // the events' `disc` indices are per pack: name each by its own name
+        impacts: {
+            let events: Vec<_> = net
+                .impacts
+                .iter()
+                .enumerate()
+                .map(|(i, (_, e))| clutchpack_sdk::model::ImpactEvent { disc: i, ..*e })
+                .collect();
+            let names: Vec<String> = net.impacts.iter().map(|(n, _)| n.clone()).collect();
+            crate::ImpactColumns::of(&events, &names)
+        },
         loads: Vec::new(),
         warning,
         sample_t_s: net.samples.iter().map(|s| s.t_s).collect(),

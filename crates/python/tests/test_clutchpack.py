@@ -143,9 +143,17 @@ def test_a_simulation_drives_the_pistons_of_resolved_packs(tmp_path):
     pistons' pressures by name (`couplings.<pack>.pressure_pa`) from the pack files' own
     schedules held at each 1 ms interval's midpoint, and gets the scene's shift: K2's faces'
     heat within 1e-4 of `clutchpack.run`'s (measured 1.2e-5 through the FMU driven so), K2
-    locked at the end, and every disc and plate of both packs in the summary."""
-    whole = clutchpack.run("scenes/dct-upshift-packs.toml")
+    locked at the end, and every disc and plate of both packs in the summary; `read` of its
+    recording gives every tooth impact of both packs by name."""
+    rec = tmp_path / "packs.mcap"
+    whole = clutchpack.run("scenes/dct-upshift-packs.toml", record=rec)
     k2 = next(c for c in whole.summary["couplings"] if c["name"] == "K2")
+    # read gives every tooth impact of both packs, named <pack>/discs/<disc> or /plates/
+    back = clutchpack.read(rec)
+    total = sum(b["impacts"] for c in whole.summary["couplings"] for b in c.get("pack_bodies", []))
+    assert len(back.impacts) == total > 100, (len(back.impacts), total)
+    assert set(back.impacts["disc"].str.split("/").str[1]) == {"discs", "plates"}
+    assert back.impacts["disc"].str.startswith("K2/discs/disc-1").any()
 
     def k1(t):
         return float(np.interp(t, [0.0, 0.2, 0.35], [1.05e6, 1.05e6, 0.0]))

@@ -19,10 +19,10 @@ pub struct RecordedNetwork {
     /// Every sample, in time order, as the engine gave it (a clutch's mode from its label;
     /// other couplings' `None`).
     pub samples: Vec<NetworkSample>,
-    /// Every tooth impact on `/network/impacts` as `(name, t_peak s, peak N)`: a gear mesh's
-    /// by its coupling's name, a pack's disc's or plate's as `<pack>/discs/<disc>` or
-    /// `<pack>/plates/<plate>`; in file order.
-    pub impacts: Vec<(String, f64, f64)>,
+    /// Every tooth impact on `/network/impacts` with its name: a gear mesh's its coupling's,
+    /// a pack's disc's or plate's `<pack>/discs/<disc>` or `<pack>/plates/<plate>`
+    /// ([`crate::impact_name`]); in file order (their contacts' closing).
+    pub impacts: Vec<(String, clutchpack_model::ImpactEvent)>,
     /// The clutch mode changes' log lines (`K2: slip- -> locked at t = ... s`), in file order.
     pub events: Vec<String>,
     /// The attached summary (the JSON of `run --summary-json`), if the run finished.
@@ -79,7 +79,7 @@ pub fn read_network(reader: &crate::RecordingReader) -> Option<Result<RecordedNe
         };
         if msg.topic == topics::NETWORK_IMPACTS {
             match proto::Impact::decode(msg.data) {
-                Ok(i) => impacts.push((i.disc, i.t_peak_s, i.peak_n)),
+                Ok(i) => impacts.push((i.disc.clone(), super::series::impact_event(&i))),
                 Err(e) => error = Some(bad(e)),
             }
         } else if msg.topic == topics::NETWORK_EVENTS {
