@@ -662,10 +662,7 @@ fn plot_network(
         &bodies,
         &couplings,
         &net.samples,
-        &net.impacts
-            .iter()
-            .map(|(name, e)| (name.clone(), e.t_peak_s, e.peak_n))
-            .collect::<Vec<_>>(),
+        &net.impact_peaks(),
     )?;
     out!("{}", a.out.display());
     Ok(ExitCode::SUCCESS)

@@ -29,6 +29,16 @@ pub struct RecordedNetwork {
     pub summary_json: Option<Vec<u8>>,
 }
 
+impl RecordedNetwork {
+    /// Each impact as `(name, t_peak s, peak N)`, in file order (`run --plot`'s impacts).
+    pub fn impact_peaks(&self) -> Vec<(String, f64, f64)> {
+        self.impacts
+            .iter()
+            .map(|(name, e)| (name.clone(), e.t_peak_s, e.peak_n))
+            .collect()
+    }
+}
+
 /// Reads a network recording back into its samples: `None` when `reader`'s file is not one
 /// (no `clutchpack.network` metadata). A message that does not decode, or a sample missing a
 /// body's or a coupling's message, is an error naming the topic and the time.
