@@ -457,7 +457,7 @@ impl Run {
 }
 
 /// One coupling alone against its carrier's known motion (a prescribed shaft's profile, the
-/// housing at rest, an inertial carrier's nodes), [`Relative::rk4`] for its steps.
+/// housing at rest, an inertial carrier's nodes), [`Relative::step`] for its steps.
 struct Alone<'a> {
     /// The coupling, the open gaps' drag on its body, its carrier's path and the bound of
     /// the carrier's acceleration, rad/s^2.
@@ -517,7 +517,7 @@ impl SubSteps for Alone<'_> {
         Ok(want)
     }
 
-    fn rk4(&self, run: &Run, h: f64) -> SubStep {
+    fn step(&self, run: &Run, h: f64) -> SubStep {
         let rel = Relative {
             path: self.path,
             coupling: &run.couplings[self.i],
@@ -526,14 +526,14 @@ impl SubSteps for Alone<'_> {
             gap: self.gap,
             start_torque_n_m: self.start_torque_n_m,
         };
-        rel.rk4(self.t, self.shaft, self.phi, self.dphi, h)
+        rel.step(self.t, self.shaft, self.phi, self.dphi, h)
     }
 
     fn phi_end(&self, step: &SubStep, _: usize) -> f64 {
         step.phi
     }
 
-    fn evals_per_rk4(&self) -> u64 {
+    fn evals_per_step(&self) -> u64 {
         3
     }
 
