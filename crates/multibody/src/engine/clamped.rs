@@ -211,9 +211,9 @@ impl Run {
         let n = self.couplings.len();
         let stack = self.stack.as_ref().expect("a stack");
         let n_if = stack.interfaces();
-        if self.faces.len() != n_if {
+        if self.multirate.faces.len() != n_if {
             // the first clamped step: every face slips the way it slips now
-            self.faces = (0..n_if)
+            self.multirate.faces = (0..n_if)
                 .map(|m| Face::Slipping(stack.slip[m].signum()))
                 .collect();
         }
@@ -292,7 +292,12 @@ impl Run {
             self.set_carrier_state(c.role, st.angle[k], st.w[k]);
         }
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
-        let locked: Vec<bool> = self.faces.iter().map(|f| *f == Face::Locked).collect();
+        let locked: Vec<bool> = self
+            .multirate
+            .faces
+            .iter()
+            .map(|f| *f == Face::Locked)
+            .collect();
         // `s0` holds the stage at t1 with the faces as they end (`break_faces`)
         self.stack.as_mut().expect("a stack").record_step(
             h_world,
@@ -308,13 +313,13 @@ impl Run {
     /// to their momentum-weighted mean (the rounding of the landing; the kinetic energy that
     /// takes is the face's heat), then the break check decides whether it holds.
     fn lock_face(&mut self, sys: &System, m: usize, u: &mut [f64]) {
-        self.faces[m] = Face::Locked;
+        self.multirate.faces[m] = Face::Locked;
         let nb = sys.body.len();
         let (mut lo, mut hi) = (m, m + 1);
-        while lo > 0 && self.faces[lo - 1] == Face::Locked {
+        while lo > 0 && self.multirate.faces[lo - 1] == Face::Locked {
             lo -= 1;
         }
-        while hi + 1 < nb && self.faces[hi] == Face::Locked {
+        while hi + 1 < nb && self.multirate.faces[hi] == Face::Locked {
             hi += 1;
         }
         let (mut p, mut j, mut e0) = (0.0, 0.0, 0.0);
@@ -343,11 +348,11 @@ impl Run {
             for (x, f) in s.teeth.iter_mut().zip(&self.forces) {
                 *x = f.moment[2];
             }
-            self.stack_stage(sys, &self.faces, t, u, w, s);
+            self.stack_stage(sys, &self.multirate.faces, t, u, w, s);
             let stack = self.stack.as_ref().expect("a stack");
             let mut worst: Option<(f64, usize)> = None;
-            for m in 0..self.faces.len() {
-                if self.faces[m] != Face::Locked {
+            for m in 0..self.multirate.faces.len() {
+                if self.multirate.faces[m] != Face::Locked {
                     continue;
                 }
                 let hold = stack.holding_torque_n_m(m, s.clamp[m]);
@@ -361,7 +366,7 @@ impl Run {
             };
             // the upper side gets less than it needs: it falls behind (slip < 0) if it needed
             // a positive torque
-            self.faces[m] = Face::Slipping(-s.face[m].signum());
+            self.multirate.faces[m] = Face::Slipping(-s.face[m].signum());
         }
     }
 }
@@ -636,14 +641,14 @@ impl SubSteps for StackSteps {
         if !self.evaluated_here {
             ws.counts.evals += n as u64;
         }
-        run.stack_stage(sys, &run.faces, t, &self.u, &self.w, &mut self.s0);
+        run.stack_stage(sys, &run.multirate.faces, t, &self.u, &self.w, &mut self.s0);
         // An open face takes the sign of its slip (for when it clamps). A clamped one found
         // slipping against its sign crossed zero unlanded (closer to a sub-step's start
         // than the landing looks): it locks now if it holds (its friction must never push
         // the slip along).
         let mut turned = false;
-        for m in 0..run.faces.len() {
-            let Face::Slipping(dir) = run.faces[m] else {
+        for m in 0..run.multirate.faces.len() {
+            let Face::Slipping(dir) = run.multirate.faces[m] else {
                 continue;
             };
             let v = self.u[sys.body[m + 1]] - self.u[sys.body[m]];
@@ -654,7 +659,7 @@ impl SubSteps for StackSteps {
                 run.lock_face(sys, m, &mut self.u);
                 turned = true;
             } else {
-                run.faces[m] = Face::Slipping(v.signum());
+                run.multirate.faces[m] = Face::Slipping(v.signum());
             }
         }
         if turned {
@@ -688,7 +693,7 @@ impl SubSteps for StackSteps {
             want = want.min(graded_step(w, &f, run.events.event_age_s(i, t)));
         }
         let want = checked_sub_step(want, a, t, || "the clamped stack".into())?;
-        self.faces.clone_from(&run.faces);
+        self.faces.clone_from(&run.multirate.faces);
         Ok(want)
     }
 

@@ -131,7 +131,7 @@ impl Run {
         let mut gaps = self.gap_drags(&self.omega_d, &zero, h);
         for i in 0..n {
             let theta = self.carrier_angle(i) - self.rel[i].phi;
-            self.moments[i] = TurnMoment::start(t0, theta, self.omega_d[i]);
+            self.multirate.moments[i] = TurnMoment::start(t0, theta, self.omega_d[i]);
         }
         if self.stack.is_some() {
             // the plates' predicted mean speeds, for the discs, held over the step (their
@@ -177,7 +177,7 @@ impl Run {
             let slope: Vec<f64> = (0..n)
                 .map(|j| {
                     if j < n_discs {
-                        self.moments[j].slope()
+                        self.multirate.moments[j].slope()
                     } else {
                         0.0
                     }
@@ -435,7 +435,7 @@ impl Run {
         }
         self.forces[i] = f;
         self.rel[i] = rel_state;
-        self.moments[i].add(t, shaft.angle - phi, shaft.speed - dphi);
+        self.multirate.moments[i].add(t, shaft.angle - phi, shaft.speed - dphi);
         let steps_per_contact = ws.a.steps_per_contact;
         let m_eff = self.m_eff[i];
         let step_of = |v| contact_duration_s(&d.law, f.kin.flank, v, m_eff) / steps_per_contact;
