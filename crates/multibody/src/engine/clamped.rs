@@ -84,6 +84,7 @@ enum Mount {
 }
 
 /// What the system does at one stage.
+#[derive(Debug, Clone)]
 struct Stage {
     /// Each coupling body's acceleration, rad/s^2, and the inertial carriers' ([`System::spins`]
     /// order).
@@ -261,6 +262,9 @@ impl Run {
         // the inertial carriers' angles and speeds
         let (angle0, w0): (Vec<f64>, Vec<f64>) =
             sys.spins.iter().map(|c| self.carrier_state(c.role)).unzip();
+        let bufs = (self.multirate.stack_buffers.take())
+            .filter(|b| b.fits(n, n_spin))
+            .unwrap_or_else(|| RkBuffers::new(n, n_spin));
         let mut st = StackSteps {
             all: (0..n).collect(),
             t: t0,
@@ -274,7 +278,7 @@ impl Run {
             evaluated_here: false,
             cap: a.max_step_s / STACK_SUB_STEPS,
             s0: Stage::new(n, n_spin),
-            bufs: std::cell::RefCell::new(RkBuffers::new(n, n_spin)),
+            bufs: std::cell::RefCell::new(bufs),
             phi_h: vec![0.0; n],
             u_h: vec![0.0; n],
             faces: Vec::new(),
@@ -306,6 +310,7 @@ impl Run {
             &st.s0.face,
         );
         self.finish_world_step(&means, t1, profile.as_deref(), &carriers);
+        self.multirate.stack_buffers = Some(st.bufs.into_inner());
         Ok(())
     }
 
@@ -372,6 +377,7 @@ impl Run {
 }
 
 /// One classical Runge-Kutta step of the clamped stack ([`Run::stack_step`]).
+#[derive(Debug, Clone)]
 struct StackStep {
     /// Each coupling body's turn, rad, speed at the end, rad/s, and relative angle at the end.
     turn: Vec<f64>,
@@ -395,8 +401,10 @@ struct StackStep {
 }
 
 /// The buffers of [`Run::stack_step`], reused along the sub-steps (a step allocating its
-/// stages was a fifth of the clamped stack's time, perf).
-struct RkBuffers {
+/// stages was a fifth of the clamped stack's time, perf) and from one world step to the next
+/// (`MultirateState::stack_buffers`: the memory stays where the caches have it).
+#[derive(Debug, Clone)]
+pub(super) struct RkBuffers {
     /// The stages 2, 3 and 4.
     k: [Stage; 3],
     /// The step of the bodies (coupling order) and the inertial carriers after them, with
@@ -407,6 +415,11 @@ struct RkBuffers {
 }
 
 impl RkBuffers {
+    /// Whether these are the buffers for `n` coupling bodies and `n_spin` inertial carriers.
+    fn fits(&self, n: usize, n_spin: usize) -> bool {
+        self.out.u.len() == n && self.out.w_carrier.len() == n_spin
+    }
+
     /// The buffers for `n` coupling bodies and `n_spin` inertial carriers.
     fn new(n: usize, n_spin: usize) -> RkBuffers {
         let v = || vec![0.0; n];

@@ -1,8 +1,9 @@
 //! What each scheme keeps in a run beside the state they share (`state.rs`): the shared
 //! step's loads, kicks and teeth's motion ([`SharedStep`], `forces.rs` and `control.rs`), and
-//! the multirate schemes' moments of speed and clamped faces ([`MultirateState`],
-//! `multirate.rs` and `clamped.rs`).
+//! the multirate schemes' moments of speed, clamped faces and the clamped stack's step
+//! buffers ([`MultirateState`], `multirate.rs` and `clamped.rs`).
 
+use super::clamped::RkBuffers;
 use super::substep::TurnMoment;
 use crate::integrate::{Kick, Load, LoadHistory, Motion};
 use crate::stack::Face;
@@ -76,12 +77,14 @@ impl SharedStep {
 
 /// What only the multirate schemes keep in a run: each body's first moment of speed over the
 /// world step being taken (its neighbours' gap drag reads its slope), and the clamped stack's
-/// faces in its integration (`clamped.rs`; empty until its first step). Written by
-/// `multirate.rs` and `clamped.rs`.
+/// faces in its integration (`clamped.rs`; empty until its first step) with its step's buffers.
+/// Written by `multirate.rs` and `clamped.rs`.
 #[derive(Debug, Clone)]
 pub(super) struct MultirateState {
     pub(super) moments: Vec<TurnMoment>,
     pub(super) faces: Vec<Face>,
+    /// The clamped stack's step buffers, kept from one world step to the next.
+    pub(super) stack_buffers: Option<RkBuffers>,
 }
 
 impl MultirateState {
@@ -90,6 +93,7 @@ impl MultirateState {
         MultirateState {
             moments: vec![TurnMoment::default(); n],
             faces: Vec::new(),
+            stack_buffers: None,
         }
     }
 }

@@ -193,7 +193,7 @@ pub(super) fn split_remainder(want: f64, rem: f64) -> f64 {
 
 /// The buffers of the one classical Runge-Kutta step of the multirate schemes
 /// ([`Rk4::rk4`]): each body's accelerations at the four stages, the stages' turns and speeds
-/// (scratch), each power's values at the four stages, and the step's result. `V` holds one
+/// (scratch), the powers' partial sums over the stages, and the step's result. `V` holds one
 /// value per body, `P` one per power the scheme integrates: `[f64; 1]` and `[f64; 3]` for a
 /// coupling alone (no allocation on its hot path), `Vec<f64>`s for a system (allocated once
 /// per world step, [`Rk4::new`]).
@@ -205,12 +205,15 @@ pub(super) struct Rk4<V, P> {
     /// (scratch).
     th: V,
     x: V,
-    /// Each power at the four stages (W, or N m for an impulse).
-    p: [P; 4],
+    /// Each power's sum at the two middle stages, and a stage's powers (W, or N m for an
+    /// impulse; scratch).
+    mid: P,
+    p: P,
     /// Each body's turn over the step, rad, and its speed at the end, rad/s.
     pub(super) turn: V,
     pub(super) u1: V,
-    /// Each power's integral over the step, J (N m s for an impulse).
+    /// Each power's integral over the step, J (N m s for an impulse; its value at the first
+    /// stage along the step).
     pub(super) work: P,
 }
 
@@ -223,7 +226,8 @@ impl Rk4<Vec<f64>, Vec<f64>> {
             k: [v(), v(), v(), v()],
             th: v(),
             x: v(),
-            p: [p(), p(), p(), p()],
+            mid: p(),
+            p: p(),
             turn: v(),
             u1: v(),
             work: p(),
@@ -260,20 +264,15 @@ impl<V: AsMut<[f64]>, P: AsMut<[f64]>> Rk4<V, P> {
             k,
             th,
             x,
+            mid,
             p,
             turn,
             u1,
             work,
         } = self;
         let [k1, k2, k3, k4] = k.each_mut().map(|x| x.as_mut());
-        let [p1, p2, p3, p4] = p.each_mut().map(|x| x.as_mut());
-        let (th, x, turn, u1, work) = (
-            th.as_mut(),
-            x.as_mut(),
-            turn.as_mut(),
-            u1.as_mut(),
-            work.as_mut(),
-        );
+        let (th, x, turn, u1) = (th.as_mut(), x.as_mut(), turn.as_mut(), u1.as_mut());
+        let (mid, p, work) = (mid.as_mut(), p.as_mut(), work.as_mut());
         let n = u0.len();
         let ([k1, k2, k3, k4], th, x, turn, u1) = (
             [&mut k1[..n], &mut k2[..n], &mut k3[..n], &mut k4[..n]],
@@ -283,30 +282,34 @@ impl<V: AsMut<[f64]>, P: AsMut<[f64]>> Rk4<V, P> {
             &mut u1[..n],
         );
         th.fill(0.0);
-        stage(0, t, th, u0, k1, p1);
+        // the powers folded as they come (p1 in `work`, p2 + p3 in `mid`): the quadrature's
+        // own sums in its own order, in three buffers rather than five
+        stage(0, t, th, u0, k1, work);
         for i in 0..n {
             th[i] = 0.5 * h * u0[i];
             x[i] = u0[i] + 0.5 * h * k1[i];
         }
-        stage(1, tm, th, x, k2, p2);
+        stage(1, tm, th, x, k2, mid);
         for i in 0..n {
             th[i] = 0.5 * h * u0[i] + 0.25 * hh * k1[i];
             x[i] = u0[i] + 0.5 * h * k2[i];
         }
-        stage(2, tm, th, x, k3, p3);
+        stage(2, tm, th, x, k3, p);
+        for (m, &p3) in mid.iter_mut().zip(&*p) {
+            *m += p3;
+        }
         for i in 0..n {
             th[i] = h * u0[i] + 0.5 * hh * k2[i];
             x[i] = u0[i] + h * k3[i];
         }
-        stage(3, te, th, x, k4, p4);
+        stage(3, te, th, x, k4, p);
         let h6 = h / 6.0;
         for i in 0..n {
             turn[i] = h * u0[i] + h * h6 * (k1[i] + k2[i] + k3[i]);
             u1[i] = u0[i] + h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
         }
-        let stages = p1.iter().zip(&*p2).zip(&*p3).zip(&*p4);
-        for (w, (((a, b), c), d)) in work.iter_mut().zip(stages) {
-            *w = h6 * (a + 2.0 * (b + c) + d);
+        for ((w, &m), &p4) in work.iter_mut().zip(&*mid).zip(&*p) {
+            *w = h6 * (*w + 2.0 * m + p4);
         }
     }
 }
