@@ -207,7 +207,7 @@
 //!   the reactions at `t`, as the shared step's controller) is shorter than the world step,
 //!   go with the shaft.
 //! - *The shaft and its cluster* are integrated as one system, the classical Runge-Kutta
-//!   method on every body's own motion (`Run::carrier_rk4`: the shaft `J1 w' = T_drive(t) -
+//!   method on every body's own motion (`Run::carrier_step`: the shaft `J1 w' = T_drive(t) -
 //!   C1 w - sum T_k`, each disc `J w_d' = T_k - C2 w_d`), with sub-steps of the shortest any
 //!   member wants (the prescribed scheme's controller and grading, each coupling with its own
 //!   reduced mass `m_eff = md mc / (md + mc)`), at most a quarter of the world step (the

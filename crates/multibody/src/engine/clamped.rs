@@ -21,7 +21,7 @@ use super::inertial::Inertial;
 use super::landing::SubSteps;
 use super::state::{Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, rk4_work, Node, Prescribed, Rk4, ShaftAt, WorldStep,
+    checked_sub_step, cut, graded_step, Node, Prescribed, Rk4, ShaftAt, WorldStep,
 };
 use crate::stack::Face;
 use crate::stepping::{bracketed_root, coupling_step};
@@ -84,6 +84,7 @@ enum Mount {
 }
 
 /// What the system does at one stage.
+#[derive(Debug, Clone)]
 struct Stage {
     /// Each coupling body's acceleration, rad/s^2, and the inertial carriers' ([`System::spins`]
     /// order).
@@ -98,6 +99,9 @@ struct Stage {
     clamp: Vec<f64>,
     /// Each stack position's torque, N m (scratch).
     torque: Vec<f64>,
+    /// The inertial carriers' external torques ([`System::spins`] order): the drive on an
+    /// inertial shaft (eq 4), the drum's load, N m.
+    external: Vec<f64>,
 }
 
 impl Stage {
@@ -111,6 +115,7 @@ impl Stage {
             face: vec![0.0; n_if],
             clamp: vec![0.0; n_if],
             torque: vec![0.0; n],
+            external: vec![0.0; n_spin],
         }
     }
 }
@@ -186,6 +191,7 @@ impl Run {
         for (k, c) in sys.spins.iter().enumerate() {
             // the drive (eq 4) or the load, the damping, the teeth's reactions
             let external = self.external_torque(c.role, ts);
+            st.external[k] = external;
             let on: f64 = (0..u.len())
                 .filter(|&i| sys.mounts[i] == Mount::Spin(k))
                 .map(|i| st.teeth[i])
@@ -206,9 +212,9 @@ impl Run {
         let n = self.couplings.len();
         let stack = self.stack.as_ref().expect("a stack");
         let n_if = stack.interfaces();
-        if self.faces.len() != n_if {
+        if self.multirate.faces.len() != n_if {
             // the first clamped step: every face slips the way it slips now
-            self.faces = (0..n_if)
+            self.multirate.faces = (0..n_if)
                 .map(|m| Face::Slipping(stack.slip[m].signum()))
                 .collect();
         }
@@ -256,6 +262,9 @@ impl Run {
         // the inertial carriers' angles and speeds
         let (angle0, w0): (Vec<f64>, Vec<f64>) =
             sys.spins.iter().map(|c| self.carrier_state(c.role)).unzip();
+        let bufs = (self.multirate.stack_buffers.take())
+            .filter(|b| b.fits(n, n_spin))
+            .unwrap_or_else(|| RkBuffers::new(n, n_spin));
         let mut st = StackSteps {
             all: (0..n).collect(),
             t: t0,
@@ -269,7 +278,7 @@ impl Run {
             evaluated_here: false,
             cap: a.max_step_s / STACK_SUB_STEPS,
             s0: Stage::new(n, n_spin),
-            bufs: std::cell::RefCell::new(RkBuffers::new(n, n_spin)),
+            bufs: std::cell::RefCell::new(bufs),
             phi_h: vec![0.0; n],
             u_h: vec![0.0; n],
             faces: Vec::new(),
@@ -287,7 +296,12 @@ impl Run {
             self.set_carrier_state(c.role, st.angle[k], st.w[k]);
         }
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
-        let locked: Vec<bool> = self.faces.iter().map(|f| *f == Face::Locked).collect();
+        let locked: Vec<bool> = self
+            .multirate
+            .faces
+            .iter()
+            .map(|f| *f == Face::Locked)
+            .collect();
         // `s0` holds the stage at t1 with the faces as they end (`break_faces`)
         self.stack.as_mut().expect("a stack").record_step(
             h_world,
@@ -296,6 +310,7 @@ impl Run {
             &st.s0.face,
         );
         self.finish_world_step(&means, t1, profile.as_deref(), &carriers);
+        self.multirate.stack_buffers = Some(st.bufs.into_inner());
         Ok(())
     }
 
@@ -303,13 +318,13 @@ impl Run {
     /// to their momentum-weighted mean (the rounding of the landing; the kinetic energy that
     /// takes is the face's heat), then the break check decides whether it holds.
     fn lock_face(&mut self, sys: &System, m: usize, u: &mut [f64]) {
-        self.faces[m] = Face::Locked;
+        self.multirate.faces[m] = Face::Locked;
         let nb = sys.body.len();
         let (mut lo, mut hi) = (m, m + 1);
-        while lo > 0 && self.faces[lo - 1] == Face::Locked {
+        while lo > 0 && self.multirate.faces[lo - 1] == Face::Locked {
             lo -= 1;
         }
-        while hi + 1 < nb && self.faces[hi] == Face::Locked {
+        while hi + 1 < nb && self.multirate.faces[hi] == Face::Locked {
             hi += 1;
         }
         let (mut p, mut j, mut e0) = (0.0, 0.0, 0.0);
@@ -338,11 +353,11 @@ impl Run {
             for (x, f) in s.teeth.iter_mut().zip(&self.forces) {
                 *x = f.moment[2];
             }
-            self.stack_stage(sys, &self.faces, t, u, w, s);
+            self.stack_stage(sys, &self.multirate.faces, t, u, w, s);
             let stack = self.stack.as_ref().expect("a stack");
             let mut worst: Option<(f64, usize)> = None;
-            for m in 0..self.faces.len() {
-                if self.faces[m] != Face::Locked {
+            for m in 0..self.multirate.faces.len() {
+                if self.multirate.faces[m] != Face::Locked {
                     continue;
                 }
                 let hold = stack.holding_torque_n_m(m, s.clamp[m]);
@@ -356,12 +371,13 @@ impl Run {
             };
             // the upper side gets less than it needs: it falls behind (slip < 0) if it needed
             // a positive torque
-            self.faces[m] = Face::Slipping(-s.face[m].signum());
+            self.multirate.faces[m] = Face::Slipping(-s.face[m].signum());
         }
     }
 }
 
-/// One classical Runge-Kutta step of the clamped stack ([`Run::stack_rk4`]).
+/// One classical Runge-Kutta step of the clamped stack ([`Run::stack_step`]).
+#[derive(Debug, Clone)]
 struct StackStep {
     /// Each coupling body's turn, rad, speed at the end, rad/s, and relative angle at the end.
     turn: Vec<f64>,
@@ -384,19 +400,26 @@ struct StackStep {
     load_j: f64,
 }
 
-/// The buffers of [`Run::stack_rk4`], reused along the sub-steps (a step allocating its
-/// stages was a fifth of the clamped stack's time, perf).
-struct RkBuffers {
+/// The buffers of [`Run::stack_step`], reused along the sub-steps (a step allocating its
+/// stages was a fifth of the clamped stack's time, perf) and from one world step to the next
+/// (`MultirateState::stack_buffers`: the memory stays where the caches have it).
+#[derive(Debug, Clone)]
+pub(super) struct RkBuffers {
     /// The stages 2, 3 and 4.
     k: [Stage; 3],
-    /// The step of the bodies (coupling order) and the inertial carriers after them, and
-    /// their speeds at its start.
-    rk: Rk4<Vec<f64>>,
+    /// The step of the bodies (coupling order) and the inertial carriers after them, with
+    /// their powers ([`powers`]), and their speeds at its start.
+    rk: Rk4<Vec<f64>, Vec<f64>>,
     x0: Vec<f64>,
     out: StackStep,
 }
 
 impl RkBuffers {
+    /// Whether these are the buffers for `n` coupling bodies and `n_spin` inertial carriers.
+    fn fits(&self, n: usize, n_spin: usize) -> bool {
+        self.out.u.len() == n && self.out.w_carrier.len() == n_spin
+    }
+
     /// The buffers for `n` coupling bodies and `n_spin` inertial carriers.
     fn new(n: usize, n_spin: usize) -> RkBuffers {
         let v = || vec![0.0; n];
@@ -407,7 +430,7 @@ impl RkBuffers {
                 Stage::new(n, n_spin),
                 Stage::new(n, n_spin),
             ],
-            rk: Rk4::new(n + n_spin),
+            rk: Rk4::new(n + n_spin, powers(n, n_spin, n - 1).iter().sum()),
             x0: vec![0.0; n + n_spin],
             out: StackStep {
                 turn: v(),
@@ -426,7 +449,7 @@ impl RkBuffers {
     }
 }
 
-/// Where a sub-step of the clamped stack starts ([`Run::stack_rk4`]).
+/// Where a sub-step of the clamped stack starts ([`Run::stack_step`]).
 struct StackStart<'a> {
     /// The faces, held over the sub-step.
     faces: &'a [Face],
@@ -443,10 +466,10 @@ struct StackStart<'a> {
 }
 
 impl Run {
-    /// One classical Runge-Kutta step of length `h` of the clamped stack and the inertial
-    /// carriers from `start` (the faces held, the first stage already evaluated), into
-    /// `b.out`; the works integrated by the same stages.
-    fn stack_rk4(&self, sys: &System, start: &StackStart, h: f64, b: &mut RkBuffers) {
+    /// One classical Runge-Kutta step ([`Rk4::rk4`]) of length `h` of the clamped stack and
+    /// the inertial carriers from `start` (the faces held, the first stage already
+    /// evaluated), into `b.out`; the works integrated by the same stages.
+    fn stack_step(&self, sys: &System, start: &StackStart, h: f64, b: &mut RkBuffers) {
         let StackStart {
             faces,
             k1,
@@ -456,43 +479,74 @@ impl Run {
             u0,
             w0,
         } = *start;
-        let n = u0.len();
+        let (n, n_spin, n_if) = (u0.len(), w0.len(), faces.len());
         let (tm, te) = (t + 0.5 * h, t + h);
         let (mid, end) = (ShaftAt::of(sys.shaft(), tm), ShaftAt::of(sys.shaft(), te));
         let RkBuffers { k, rk, x0, out } = b;
         x0[..n].copy_from_slice(u0);
         x0[n..].copy_from_slice(w0);
-        rk.k[0][..n].copy_from_slice(&k1.acc);
-        rk.k[0][n..].copy_from_slice(&k1.acc_carrier);
-        // a stage: the teeth probed with the carriers turned from t (a prescribed shaft's
-        // exact, the inertial ones, after the bodies, by `th[n..]` at `x[n..]`) and the bodies
-        // by `th[..n]` at `x[..n]`
-        rk.step(t, h, x0, |s, ts, th, x, acc| {
-            let st = &mut k[s - 1];
-            let at = if s < 3 { mid } else { end };
+        let lens = powers(n, n_spin, n_if);
+        // a stage: the first given, the others with the teeth probed with the carriers turned
+        // from t (a prescribed shaft's exact, the inertial ones, after the bodies, by
+        // `th[n..]` at `x[n..]`) and the bodies by `th[..n]` at `x[..n]`; its powers
+        // ([`powers`])
+        rk.rk4(t, h, x0, |s, ts, th, x, acc, power| {
+            let at = [shaft, mid, mid, end][s];
             let ((th, c_turn), (u, w)) = (th.split_at(n), x.split_at(n));
-            for i in 0..n {
-                let (turn, speed) = match sys.mounts[i] {
-                    Mount::Profile => (at.angle - shaft.angle, at.speed),
-                    Mount::Housing => (0.0, 0.0),
-                    Mount::Spin(k) => (c_turn[k], w[k]),
-                };
-                st.teeth[i] = self.couplings[i].probe_torque(phi[i] + turn - th[i], speed - u[i]);
-            }
-            self.stack_stage(sys, faces, ts, u, w, st);
+            let st: &Stage = if s == 0 {
+                k1
+            } else {
+                let st = &mut k[s - 1];
+                for i in 0..n {
+                    let (turn, speed) = match sys.mounts[i] {
+                        Mount::Profile => (at.angle - shaft.angle, at.speed),
+                        Mount::Housing => (0.0, 0.0),
+                        Mount::Spin(k) => (c_turn[k], w[k]),
+                    };
+                    st.teeth[i] =
+                        self.couplings[i].probe_torque(phi[i] + turn - th[i], speed - u[i]);
+                }
+                self.stack_stage(sys, faces, ts, u, w, st);
+                st
+            };
             acc[..n].copy_from_slice(&st.acc);
             acc[n..].copy_from_slice(&st.acc_carrier);
+            let [drive, sq, sq_carrier, external, impulse, face_work, friction] = cut(power, lens);
+            for ((d, &mount), &torque) in drive.iter_mut().zip(&sys.mounts).zip(&st.teeth) {
+                if mount == Mount::Profile {
+                    *d = torque * at.speed;
+                }
+            }
+            for (q, &u) in sq.iter_mut().zip(u) {
+                *q = u * u;
+            }
+            for k in 0..n_spin {
+                sq_carrier[k] = w[k] * w[k];
+                external[k] = st.external[k] * w[k];
+            }
+            let out = impulse.iter_mut().zip(face_work).zip(friction);
+            let of = faces
+                .iter()
+                .zip(&st.face)
+                .zip(&st.clamp)
+                .zip(sys.body.windows(2));
+            for (((impulse, work), friction), (((mode, &face), &clamp), b)) in out.zip(of) {
+                *impulse = face;
+                if *mode != Face::Locked {
+                    let v = u[b[1]] - u[b[0]];
+                    *work = face * v;
+                    // the friction's part: the stages where the face is clamped
+                    *friction = if clamp > 0.0 { face * v } else { 0.0 };
+                }
+            }
         });
-        let [k2, k3, k4] = k;
-        let (u2, u3, u4) = (&rk.u[0][..n], &rk.u[1][..n], &rk.u[2][..n]);
-        let (w2, w3, w4) = (&rk.u[0][n..], &rk.u[1][n..], &rk.u[2][n..]);
-        let quad = |a: f64, b: f64, c: f64, d: f64| rk4_work(h, [a, b, c, d]);
+        let [drive, sq, sq_carrier, external, impulse, face_work, friction] =
+            cut(&mut rk.work, lens);
         out.carrier_turn.copy_from_slice(&rk.turn[n..]);
         out.w_carrier.copy_from_slice(&rk.u1[n..]);
         out.turn.copy_from_slice(&rk.turn[..n]);
         out.u.copy_from_slice(&rk.u1[..n]);
         (out.drive_j, out.drag_j, out.load_j) = (0.0, 0.0, 0.0);
-        let sq = |x: f64| x * x;
         for i in 0..n {
             let turn = out.turn[i];
             let carrier_turn = match sys.mounts[i] {
@@ -502,52 +556,38 @@ impl Run {
             };
             out.phi[i] = phi[i] + carrier_turn - turn;
             if sys.mounts[i] == Mount::Profile {
-                out.drive_j += quad(
-                    k1.teeth[i] * shaft.speed,
-                    k2.teeth[i] * mid.speed,
-                    k3.teeth[i] * mid.speed,
-                    k4.teeth[i] * end.speed,
-                );
+                out.drive_j += drive[i];
             }
-            out.drag_j -= sys.c2[i] * quad(sq(u0[i]), sq(u2[i]), sq(u3[i]), sq(u4[i]));
+            out.drag_j -= sys.c2[i] * sq[i];
         }
         for (k, spin) in sys.spins.iter().enumerate() {
-            let (a, b, c, d) = (w0[k], w2[k], w3[k], w4[k]);
-            out.drag_j -= spin.damping * quad(sq(a), sq(b), sq(c), sq(d));
+            out.drag_j -= spin.damping * sq_carrier[k];
             // the external torque's work: the drive's on an inertial shaft (eq 4), the
             // drum's load
-            let [e1, em, e4] = [t, tm, te].map(|ts| self.external_torque(spin.role, ts));
-            let work = quad(e1 * a, em * b, em * c, e4 * d);
+            let work = external[k];
             match spin.role {
                 Inertial::Shaft => out.drive_j += work,
                 Inertial::Drum => out.load_j += work,
             }
         }
-        for m in 0..faces.len() {
-            out.impulse[m] = quad(k1.face[m], k2.face[m], k3.face[m], k4.face[m]);
-            out.face_j[m] = 0.0;
-            out.friction_j[m] = 0.0;
-            if faces[m] != Face::Locked {
-                let (lo, up) = (sys.body[m], sys.body[m + 1]);
-                let v = |u: &[f64]| u[up] - u[lo];
-                out.face_j[m] = quad(
-                    k1.face[m] * v(u0),
-                    k2.face[m] * v(u2),
-                    k3.face[m] * v(u3),
-                    k4.face[m] * v(u4),
-                );
-                // the friction's part: the stages where the face is clamped
-                let fr = |s: &Stage, u: &[f64]| {
-                    if s.clamp[m] > 0.0 {
-                        s.face[m] * v(u)
-                    } else {
-                        0.0
-                    }
-                };
-                out.friction_j[m] = quad(fr(k1, u0), fr(k2, u2), fr(k3, u3), fr(k4, u4));
-            }
+        for m in 0..n_if {
+            out.impulse[m] = impulse[m];
+            let slipping = faces[m] != Face::Locked;
+            out.face_j[m] = if slipping { face_work[m] } else { 0.0 };
+            out.friction_j[m] = if slipping { friction[m] } else { 0.0 };
         }
     }
+}
+
+/// The lengths of the clamped stack's powers by kind ([`cut`]), for `n` coupling bodies,
+/// `n_spin` inertial carriers and `n_if` interfaces: the drive's on each body's teeth (a
+/// prescribed shaft's; not written on another carrier), each body's speed squared (the drag's
+/// over -C2), each inertial carrier's speed squared and its external torque's (the drive's on
+/// an inertial shaft, eq 4; the drum's load), each interface's torque (its impulse), its work
+/// on the slip and the part of it done while clamped (the friction's; not written for a
+/// locked face).
+fn powers(n: usize, n_spin: usize, n_if: usize) -> [usize; 7] {
+    [n, n, n_spin, n_spin, n_if, n_if, n_if]
 }
 
 /// The clamped stack's sub-steps as the one landing loop drives them
@@ -614,14 +654,14 @@ impl SubSteps for StackSteps {
         if !self.evaluated_here {
             ws.counts.evals += n as u64;
         }
-        run.stack_stage(sys, &run.faces, t, &self.u, &self.w, &mut self.s0);
+        run.stack_stage(sys, &run.multirate.faces, t, &self.u, &self.w, &mut self.s0);
         // An open face takes the sign of its slip (for when it clamps). A clamped one found
         // slipping against its sign crossed zero unlanded (closer to a sub-step's start
         // than the landing looks): it locks now if it holds (its friction must never push
         // the slip along).
         let mut turned = false;
-        for m in 0..run.faces.len() {
-            let Face::Slipping(dir) = run.faces[m] else {
+        for m in 0..run.multirate.faces.len() {
+            let Face::Slipping(dir) = run.multirate.faces[m] else {
                 continue;
             };
             let v = self.u[sys.body[m + 1]] - self.u[sys.body[m]];
@@ -632,7 +672,7 @@ impl SubSteps for StackSteps {
                 run.lock_face(sys, m, &mut self.u);
                 turned = true;
             } else {
-                run.faces[m] = Face::Slipping(v.signum());
+                run.multirate.faces[m] = Face::Slipping(v.signum());
             }
         }
         if turned {
@@ -666,11 +706,11 @@ impl SubSteps for StackSteps {
             want = want.min(graded_step(w, &f, run.events.event_age_s(i, t)));
         }
         let want = checked_sub_step(want, a, t, || "the clamped stack".into())?;
-        self.faces.clone_from(&run.faces);
+        self.faces.clone_from(&run.multirate.faces);
         Ok(want)
     }
 
-    fn rk4(&self, run: &Run, h: f64) {
+    fn step(&self, run: &Run, h: f64) {
         let start = StackStart {
             faces: &self.faces,
             k1: &self.s0,
@@ -680,7 +720,7 @@ impl SubSteps for StackSteps {
             u0: &self.u,
             w0: &self.w,
         };
-        run.stack_rk4(&self.sys, &start, h, &mut self.bufs.borrow_mut());
+        run.stack_step(&self.sys, &start, h, &mut self.bufs.borrow_mut());
     }
 
     fn phi_end(&self, _: &(), k: usize) -> f64 {
@@ -723,7 +763,7 @@ impl SubSteps for StackSteps {
                 let x = bracketed_root(
                     |x| {
                         trials.set(trials.get() + 1);
-                        self.rk4(run, x);
+                        self.step(run, x);
                         g(&self.bufs.borrow().out.u)
                     },
                     0.0,
@@ -737,7 +777,7 @@ impl SubSteps for StackSteps {
         }
     }
 
-    fn evals_per_rk4(&self) -> u64 {
+    fn evals_per_step(&self) -> u64 {
         3 * self.phi.len() as u64
     }
 

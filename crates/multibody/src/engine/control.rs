@@ -153,7 +153,8 @@ impl Run {
             let j = self.bodies[i].inertia_kg_m2;
             inv_j[i] = 1.0 / j;
             w_pred[i] = bodies[self.world.discs[i]].angvel().z
-                + (self.loads[i].kick.impulse_component(5, h) + self.teeth_impulse(i, h)) / j;
+                + (self.shared.loads[i].kick.impulse_component(5, h) + self.teeth_impulse(i, h))
+                    / j;
         }
         if let Some(s) = self.stack.as_mut() {
             s.solve(h, &w_pred, &inv_j);
@@ -188,7 +189,8 @@ impl Run {
                     .map(|i| self.teeth_impulse(i, x))
                     .sum();
                 x * (w_s
-                    + (self.shaft_loads.kick.impulse_component(5, x) + self.drive_impulse(x)
+                    + (self.shared.shaft_loads.kick.impulse_component(5, x)
+                        + self.drive_impulse(x)
                         - teeth)
                         / j1)
             }
@@ -200,7 +202,9 @@ impl Run {
                     .map(|i| self.teeth_impulse(i, x))
                     .sum();
                 x * (bodies[hd].angvel().z
-                    + (d.loads.kick.impulse_component(5, x) + self.drum_load_impulse(x) - teeth)
+                    + (self.shared.drum_loads.kick.impulse_component(5, x)
+                        + self.drum_load_impulse(x)
+                        - teeth)
                         / d.model.inertia_kg_m2)
             }
             _ => 0.0,
@@ -224,7 +228,7 @@ impl Run {
                 continue;
             }
             let w_d = bodies[self.world.discs[i]].angvel().z;
-            let kick = &self.loads[i].kick;
+            let kick = &self.shared.loads[i].kick;
             let j = d.inertia_kg_m2;
             let stack = self.stack_torque(i);
             let g0 = d.spline.half_play_rad();

@@ -19,14 +19,15 @@ impl Run {
         // accelerations over the last step.
         self.omega_s = match &self.shaft {
             ShaftDrive::Prescribed(p) => p.speed(self.t),
-            ShaftDrive::Inertial { j1, .. } => {
-                self.shaft_loads
-                    .full_history
-                    .synchronised(self.t, shaft.angvel().z, 5, 1.0 / *j1)
-            }
+            ShaftDrive::Inertial { j1, .. } => self.shared.shaft_loads.full_history.synchronised(
+                self.t,
+                shaft.angvel().z,
+                5,
+                1.0 / *j1,
+            ),
         };
         if let (Some(d), Some(h)) = (self.drum.as_mut(), self.world.drum) {
-            d.omega = d.loads.full_history.synchronised(
+            d.omega = self.shared.drum_loads.full_history.synchronised(
                 self.t,
                 bodies[h].angvel().z,
                 5,
@@ -38,16 +39,17 @@ impl Run {
         let mut teeth_past_shaft = 0.0;
         let mut teeth_past_drum = 0.0;
         for i in 0..self.couplings.len() {
-            self.teeth_past[i] = 0.0;
-            let Some((t0, phi0, dphi0, _)) = self.prev_motion[i] else {
+            self.shared.teeth_past[i] = 0.0;
+            let Some((t0, phi0, dphi0, _)) = self.shared.prev_motion[i] else {
                 continue;
             };
             let disc = &bodies[self.world.discs[i]];
             let j = self.bodies[i].inertia_kg_m2;
-            let est = self.loads[i]
-                .full_history
-                .synchronised(self.t, disc.angvel().z, 5, 1.0 / j)
-                + self.stack_past(i) / j;
+            let est =
+                self.shared.loads[i]
+                    .full_history
+                    .synchronised(self.t, disc.angvel().z, 5, 1.0 / j)
+                    + self.stack_past(i) / j;
             let rel = relative_state(
                 &bodies[self.carrier_body(i)],
                 self.carrier_speed(i),
@@ -58,31 +60,40 @@ impl Run {
             let h1 = self.t - t0;
             if h1 > 0.0 {
                 let c = &self.couplings[i];
-                self.teeth_past[i] =
+                self.shared.teeth_past[i] =
                     past_impulse((phi0, dphi0), (rel.phi, rel.dphi), h1, |p, d| {
                         c.probe_torque(p, d)
                     });
                 match self.world.carriers[i] {
-                    Carrier::Shaft => teeth_past_shaft += self.teeth_past[i],
-                    Carrier::Drum => teeth_past_drum += self.teeth_past[i],
+                    Carrier::Shaft => teeth_past_shaft += self.shared.teeth_past[i],
+                    Carrier::Drum => teeth_past_drum += self.shared.teeth_past[i],
                     Carrier::Housing => {}
                 }
             }
         }
         let load_past = self.drum_load_past();
         if let ShaftDrive::Inertial { j1, .. } = self.shaft {
-            if self.shaft_loads.history.len() > 0 {
+            if self.shared.shaft_loads.history.len() > 0 {
                 self.omega_s = shaft.angvel().z
-                    + (self.shaft_loads.history.synchronised(self.t, 0.0, 5, 1.0)
+                    + (self
+                        .shared
+                        .shaft_loads
+                        .history
+                        .synchronised(self.t, 0.0, 5, 1.0)
                         + self.drive_past()
                         - teeth_past_shaft)
                         / j1;
             }
         }
         if let (Some(d), Some(h)) = (self.drum.as_mut(), self.world.drum) {
-            if d.loads.history.len() > 0 {
+            if self.shared.drum_loads.history.len() > 0 {
                 d.omega = bodies[h].angvel().z
-                    + (d.loads.history.synchronised(self.t, 0.0, 5, 1.0) + load_past
+                    + (self
+                        .shared
+                        .drum_loads
+                        .history
+                        .synchronised(self.t, 0.0, 5, 1.0)
+                        + load_past
                         - teeth_past_drum)
                         / d.model.inertia_kg_m2;
             }
@@ -95,13 +106,15 @@ impl Run {
             let disc = &bodies[self.world.discs[i]];
             let j = self.bodies[i].inertia_kg_m2;
             let mean = disc.angvel().z;
-            let omega_d = if self.prev_motion[i].is_some() {
-                mean + (self.teeth_past[i]
-                    + self.loads[i].history.synchronised(self.t, 0.0, 5, 1.0)
+            let omega_d = if self.shared.prev_motion[i].is_some() {
+                mean + (self.shared.teeth_past[i]
+                    + self.shared.loads[i]
+                        .history
+                        .synchronised(self.t, 0.0, 5, 1.0)
                     + self.stack_past(i))
                     / j
             } else {
-                self.loads[i]
+                self.shared.loads[i]
                     .full_history
                     .synchronised(self.t, mean, 5, 1.0 / j)
             };
@@ -244,7 +257,7 @@ impl Run {
             let e_local = Vector::new(self.rel[i].offset[0], self.rel[i].offset[1], 0.0);
             let force = qs * f_local;
             let torque = qs * (m_local - e_local.cross(f_local)) + Vector::new(0.0, 0.0, drag);
-            self.loads[i].full = [force.x, force.y, force.z, torque.x, torque.y, torque.z];
+            self.shared.loads[i].full = [force.x, force.y, force.z, torque.x, torque.y, torque.z];
             // The stack's torque over the step just taken stands for its torque at t.
             let stack = match &self.stack {
                 Some(s) => s
@@ -261,9 +274,9 @@ impl Run {
             // The teeth's torque about the axis is integrated along the step instead
             // (`teeth_impulse`); the rest (radial forces, tilting moments, the moment of the
             // radial force about an offset centre) goes through the polynomial kick.
-            let mut partial = self.loads[i].full;
+            let mut partial = self.shared.loads[i].full;
             partial[5] -= f.moment[2];
-            self.loads[i].load = partial;
+            self.shared.loads[i].load = partial;
             match carrier {
                 Carrier::Shaft => {
                     shaft_torque_full -= reaction;
@@ -277,7 +290,9 @@ impl Run {
                 }
                 Carrier::Housing => {}
             }
-            self.loads[i].kick = self.loads[i].history.kick(self.t, &self.loads[i].load);
+            self.shared.loads[i].kick = self.shared.loads[i]
+                .history
+                .kick(self.t, &self.shared.loads[i].load);
         }
         let drive_now = self.drive_torque(self.t);
         // MODEL.md section 8: the couplings between the shaft and the drum (a spring-damper),
@@ -297,12 +312,13 @@ impl Run {
                     shaft_torque_full.z += c.shaft_n_m;
                 }
                 let l = |t: Vector| [shaft_force.x, shaft_force.y, shaft_force.z, t.x, t.y, t.z];
-                self.shaft_loads.load = l(shaft_torque);
-                self.shaft_loads.full = l(shaft_torque_full);
-                self.shaft_loads.kick = self
+                self.shared.shaft_loads.load = l(shaft_torque);
+                self.shared.shaft_loads.full = l(shaft_torque_full);
+                self.shared.shaft_loads.kick = self
+                    .shared
                     .shaft_loads
                     .history
-                    .kick(self.t, &self.shaft_loads.load);
+                    .kick(self.t, &self.shared.shaft_loads.load);
                 shaft_torque_full.z / j1
             }
         };
@@ -311,7 +327,7 @@ impl Run {
                 // The drum: its load torque, its drag, the plates' spline reactions.
                 let own = dr.model.load_torque_n_m - dr.model.drag_n_m_s_rad * dr.omega;
                 // A driven load is integrated exactly (`drum_load_impulse`), not extrapolated.
-                drum_torque.z += if self.exact_drum_load {
+                drum_torque.z += if self.shared.exact_drum_load {
                     -dr.model.drag_n_m_s_rad * dr.omega
                 } else {
                     own
@@ -322,25 +338,28 @@ impl Run {
                     drum_torque_full.z += c.drum_n_m;
                 }
                 let l = |t: Vector| [drum_force.x, drum_force.y, drum_force.z, t.x, t.y, t.z];
-                dr.loads.load = l(drum_torque);
-                dr.loads.full = l(drum_torque_full);
-                dr.loads.kick = dr.loads.history.kick(self.t, &dr.loads.load);
-                dr.accel = drum_torque_full.z / dr.model.inertia_kg_m2;
-                dr.accel
+                self.shared.drum_loads.load = l(drum_torque);
+                self.shared.drum_loads.full = l(drum_torque_full);
+                self.shared.drum_loads.kick = self
+                    .shared
+                    .drum_loads
+                    .history
+                    .kick(self.t, &self.shared.drum_loads.load);
+                drum_torque_full.z / dr.model.inertia_kg_m2
             }
             None => 0.0,
         };
-        for c in &self.teeth_cache {
+        for c in &self.shared.teeth_cache {
             c.set((f64::NAN, 0.0));
         }
-        for (i, m) in self.teeth_motion.iter_mut().enumerate() {
+        for (i, m) in self.shared.teeth_motion.iter_mut().enumerate() {
             let carrier_accel = match self.world.carriers[i] {
                 Carrier::Shaft => shaft_accel,
                 Carrier::Drum => drum_accel,
                 Carrier::Housing => 0.0,
             };
             let ddphi = carrier_accel - disc_accel[i];
-            let (jerk, jerk_step) = match self.prev_motion[i] {
+            let (jerk, jerk_step) = match self.shared.prev_motion[i] {
                 Some((t0, _, _, dd0)) if self.t > t0 => {
                     ((ddphi - dd0) / (self.t - t0), self.t - t0)
                 }
@@ -370,14 +389,14 @@ impl Run {
     /// The impulse of the teeth of coupling `i` on its body about the axis over a step of
     /// length `x` from `t` (both halves of the kick), N m s.
     pub(super) fn teeth_impulse(&self, i: usize, x: f64) -> f64 {
-        let (cx, cv) = self.teeth_cache[i].get();
+        let (cx, cv) = self.shared.teeth_cache[i].get();
         if cx == x {
             return cv;
         }
         let c = &self.couplings[i];
-        let v = self.teeth_past[i]
-            + future_impulse(&self.teeth_motion[i], x, |p, d| c.probe_torque(p, d));
-        self.teeth_cache[i].set((x, v));
+        let v = self.shared.teeth_past[i]
+            + future_impulse(&self.shared.teeth_motion[i], x, |p, d| c.probe_torque(p, d));
+        self.shared.teeth_cache[i].set((x, v));
         v
     }
 
@@ -406,7 +425,7 @@ impl Run {
     /// A driven drum load at `t`, N m: the drum's, or before its last change (`load_switch`)
     /// the value held until then.
     fn drum_load(&self, t: f64) -> f64 {
-        match (self.load_switch, &self.drum) {
+        match (self.shared.load_switch, &self.drum) {
             (Some((t_switch, before)), _) if t < t_switch => before,
             (_, Some(d)) => d.model.load_torque_n_m,
             (_, None) => 0.0,
@@ -417,7 +436,7 @@ impl Run {
     /// the load is not driven: it is then in the drum's polynomial kick).
     pub(super) fn drum_load_past(&self) -> f64 {
         match self.t_prev {
-            Some(t0) if self.exact_drum_load && self.t > t0 => {
+            Some(t0) if self.shared.exact_drum_load && self.t > t0 => {
                 crate::integrate::ramp_integral(t0, self.t - t0, true, |t| self.drum_load(t))
             }
             _ => 0.0,
@@ -427,7 +446,7 @@ impl Run {
     /// The kick of a driven drum load for a step of length `x` from `t` (both halves, N m s; 0
     /// when the load is not driven).
     pub(super) fn drum_load_impulse(&self, x: f64) -> f64 {
-        if !self.exact_drum_load {
+        if !self.shared.exact_drum_load {
             return 0.0;
         }
         self.drum_load_past()
@@ -466,7 +485,7 @@ impl Run {
         };
         let mut teeth_on_shaft = 0.0;
         let mut teeth_on_drum = 0.0;
-        for (i, body) in self.loads.iter_mut().enumerate() {
+        for (i, body) in self.shared.loads.iter_mut().enumerate() {
             let mut load = body.kick.applied(h);
             load[5] += teeth[i] + stack[i];
             match self.world.carriers[i] {
@@ -477,31 +496,42 @@ impl Run {
             apply(&mut bodies[self.world.discs[i]], load);
             body.history.push(self.t, body.load);
             body.full_history.push(self.t, body.full);
-            let m = &self.teeth_motion[i];
-            self.prev_motion[i] = Some((self.t, m.phi, m.dphi, m.ddphi));
+            let m = &self.shared.teeth_motion[i];
+            self.shared.prev_motion[i] = Some((self.t, m.phi, m.dphi, m.ddphi));
         }
         let shaft = &mut bodies[self.world.shaft];
         match &self.shaft {
             ShaftDrive::Prescribed(p) => {
-                self.theta_next = p.angle(t_next);
-                shaft.set_next_kinematic_rotation(Rotation::from_rotation_z(self.theta_next));
+                self.shared.theta_next = p.angle(t_next);
+                shaft
+                    .set_next_kinematic_rotation(Rotation::from_rotation_z(self.shared.theta_next));
             }
             ShaftDrive::Inertial { .. } => {
-                let mut load = self.shaft_loads.kick.applied(h);
+                let mut load = self.shared.shaft_loads.kick.applied(h);
                 load[5] += teeth_on_shaft + drive / h;
                 apply(shaft, load);
-                self.shaft_loads.history.push(self.t, self.shaft_loads.load);
-                self.shaft_loads
+                self.shared
+                    .shaft_loads
+                    .history
+                    .push(self.t, self.shared.shaft_loads.load);
+                self.shared
+                    .shaft_loads
                     .full_history
-                    .push(self.t, self.shaft_loads.full);
+                    .push(self.t, self.shared.shaft_loads.full);
             }
         }
-        if let (Some(d), Some(hd)) = (self.drum.as_mut(), self.world.drum) {
-            let mut load = d.loads.kick.applied(h);
+        if let (Some(_), Some(hd)) = (&self.drum, self.world.drum) {
+            let mut load = self.shared.drum_loads.kick.applied(h);
             load[5] += teeth_on_drum + drum_load / h;
             apply(&mut bodies[hd], load);
-            d.loads.history.push(self.t, d.loads.load);
-            d.loads.full_history.push(self.t, d.loads.full);
+            self.shared
+                .drum_loads
+                .history
+                .push(self.t, self.shared.drum_loads.load);
+            self.shared
+                .drum_loads
+                .full_history
+                .push(self.t, self.shared.drum_loads.full);
         }
     }
 
@@ -518,7 +548,7 @@ impl Run {
         self.t_prev = Some(self.t);
         self.t = t_next;
         self.theta_s = match self.shaft {
-            ShaftDrive::Prescribed(_) => self.theta_next,
+            ShaftDrive::Prescribed(_) => self.shared.theta_next,
             ShaftDrive::Inertial { .. } => {
                 let q_after = *self.world.physics.bodies[self.world.shaft].rotation();
                 self.theta_s + angle_about_z(&(q_before.inverse() * q_after))

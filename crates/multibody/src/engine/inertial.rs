@@ -7,7 +7,7 @@
 use super::landing::SubSteps;
 use super::state::{Run, ShaftDrive};
 use super::substep::{
-    checked_sub_step, graded_step, rk4_work, Carried, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep,
+    checked_sub_step, cut, graded_step, Carried, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep,
 };
 use crate::stepping::coupling_step;
 use crate::world::Carrier;
@@ -51,7 +51,7 @@ struct CarrierDynamics {
     torque: [f64; 3],
 }
 
-/// An inertial carrier's cluster at a sub-step's start ([`Run::carrier_rk4`]).
+/// An inertial carrier's cluster at a sub-step's start ([`Run::carrier_step`]).
 #[derive(Debug, Clone, Copy)]
 struct Cluster<'a> {
     /// The couplings integrated with the carrier, their bodies' inverse inertias,
@@ -67,23 +67,34 @@ struct Cluster<'a> {
     dphi: &'a [f64],
 }
 
-/// The buffers of [`Run::carrier_rk4`], reused along a world step's sub-steps (allocating
+/// The buffers of [`Run::carrier_step`], reused along a world step's sub-steps (allocating
 /// them per step was a tenth of an inertial-shaft pack's instructions, callgrind): the step of
-/// the cluster's bodies and the carrier after them, their speeds at its start, and zero turns.
+/// the cluster's bodies and the carrier after them, with their powers (for `n` couplings:
+/// each body's speed squared and the carrier's, the gaps' drag's on each body, the external
+/// torque's), and their speeds at its start; and the couplings' states of accepted steps,
+/// handed back for the next steps' results (allocating a step's two vectors was 3 % of a
+/// one-disc inertial pack's instructions, in `malloc` and `free`, callgrind).
 struct CarrierBuffers {
-    rk: Rk4<Vec<f64>>,
+    rk: Rk4<Vec<f64>, Vec<f64>>,
     u0: Vec<f64>,
-    zero: Vec<f64>,
+    spare: Vec<Vec<f64>>,
 }
 
 impl CarrierBuffers {
     /// The buffers for a carrier with `n` couplings.
     fn new(n: usize) -> CarrierBuffers {
         CarrierBuffers {
-            rk: Rk4::new(n + 1),
+            rk: Rk4::new(n + 1, 2 * n + 2),
             u0: vec![0.0; n + 1],
-            zero: vec![0.0; n + 1],
+            spare: Vec::new(),
         }
+    }
+
+    /// An empty vector for a step's result (a spare one if any).
+    fn vector(&mut self) -> Vec<f64> {
+        let mut v = self.spare.pop().unwrap_or_default();
+        v.clear();
+        v
     }
 }
 
@@ -205,17 +216,17 @@ impl Run {
             .z
     }
 
-    /// One classical Runge-Kutta step of length `h` of an inertial carrier (dynamics `dy`)
-    /// and the couplings of its cluster `cl` from their states at `cl.t`, integrated as one
-    /// system: the carrier
+    /// One classical Runge-Kutta step ([`Rk4::rk4`]) of length `h` of an inertial carrier
+    /// (dynamics `dy`) and the couplings of its cluster `cl` from their states at `cl.t`,
+    /// integrated as one system: the carrier
     /// `J w' = T_ext(t) - C w - sum T_k` (the shaft: Hu et al. eq 4; the drum: its load and
     /// drag), each body `J w_d' = T_k - C2 w_d + g_k(w_d)` (eq 5 and the gaps' drag), `T_k`
     /// the teeth's torque on body `k` at `phi_k = theta_c - theta_d`. As in
-    /// [`Relative::rk4`](super::substep::Relative::rk4) the bodies' own motions are integrated,
-    /// not the relative ones. The teeth's torques cancel in the total angular momentum at
-    /// every stage, so the step conserves it exactly (a linear invariant) but for the external
-    /// torque, the damping and the gaps.
-    fn carrier_rk4(
+    /// [`Relative::step`](super::substep::Relative::step) the bodies' own motions are
+    /// integrated, not the relative ones. The teeth's torques cancel in the total angular
+    /// momentum at every stage, so the step conserves it exactly (a linear invariant) but for
+    /// the external torque, the damping and the gaps.
+    fn carrier_step(
         &self,
         cl: &Cluster,
         dy: &CarrierDynamics,
@@ -226,24 +237,28 @@ impl Run {
             members: cluster,
             inv_j,
             gaps,
-            t,
             w0,
             phi,
             dphi,
+            ..
         } = *cl;
         let n = cluster.len();
         let (inv_j1, c1) = (dy.inv_j, dy.damping);
-        let CarrierBuffers { rk, u0, zero } = b;
+        let (mut phi1, mut dphi1) = (b.vector(), b.vector());
+        let CarrierBuffers { rk, u0, .. } = b;
         // the bodies' speeds, then the carrier's
         for k in 0..n {
             u0[k] = w0 - dphi[k];
         }
         u0[n] = w0;
-        let (tm, te) = (t + 0.5 * h, t + h);
         let [e1, em, e4] = dy.torque;
         // The accelerations at stage `s` (0 to 3) at `ts`: body k turned by `th[k]` from t
-        // at `u[k]`, the carrier (last) by `th[n]` at `u[n]`.
-        let stage = |s: usize, ts: f64, th: &[f64], u: &[f64], acc: &mut [f64]| {
+        // at `u[k]`, the carrier (last) by `th[n]` at `u[n]`; the powers: each body's speed
+        // squared (the drag's over -C2) and the carrier's, the gaps' drag's on each body, the
+        // external torque's.
+        rk.rk4(cl.t, h, u0, |s, ts, th, u, acc, power| {
+            let (th, u, acc) = (&th[..=n], &u[..=n], &mut acc[..=n]);
+            let [sq, gap_power, external] = cut(power, [n + 1, n, 1]);
             let (sc, w) = (th[n], u[n]);
             let mut teeth = 0.0;
             for k in 0..n {
@@ -253,38 +268,35 @@ impl Run {
                     phi: phi[k],
                     inv_j: inv_j[k],
                     c2: self.bodies[i].drag_n_m_s_rad,
-                    gap: gaps[k],
+                    gap: &gaps[k],
                 };
-                let torque;
-                (torque, acc[k]) = body.stage(ts, sc, w, th[k], u[k]);
+                let (torque, a, g) = body.stage(ts, sc, w, th[k], u[k]);
+                acc[k] = a;
                 teeth += torque;
+                sq[k] = u[k] * u[k];
+                gap_power[k] = g * u[k];
             }
             let ext = [e1, em, em, e4][s];
             acc[n] = (ext - c1 * w - teeth) * inv_j1;
-        };
-        stage(0, t, zero, u0, &mut rk.k[0]);
-        rk.step(t, h, u0, stage);
-        let [u2, u3, u4] = &rk.u;
-        let (w2, w3, w4) = (u2[n], u3[n], u4[n]);
+            sq[n] = w * w;
+            external[0] = ext * w;
+        });
+        let [sq, gap_work, external] = cut(&mut rk.work, [n + 1, n, 1]);
         let (turn, speed) = (rk.turn[n], rk.u1[n]);
-        let sq = |a: f64, b: f64, c: f64, d: f64| rk4_work(h, [a * a, b * b, c * c, d * d]);
-        let mut drag_j = -c1 * sq(w0, w2, w3, w4);
+        let mut drag_j = -c1 * sq[n];
         let mut gap_j = 0.0;
-        let mut phi1 = Vec::with_capacity(n);
-        let mut dphi1 = Vec::with_capacity(n);
         for k in 0..n {
             phi1.push(phi[k] + turn - rk.turn[k]);
             dphi1.push(speed - rk.u1[k]);
-            drag_j -= self.bodies[cluster[k]].drag_n_m_s_rad * sq(u0[k], u2[k], u3[k], u4[k]);
-            let g = |ts: f64, u: f64| gaps[k].torque(ts, u) * u;
-            gap_j += rk4_work(h, [g(t, u0[k]), g(tm, u2[k]), g(tm, u3[k]), g(te, u4[k])]);
+            drag_j -= self.bodies[cluster[k]].drag_n_m_s_rad * sq[k];
+            gap_j += gap_work[k];
         }
         CarrierStep {
             turn,
             speed,
             phi: phi1,
             dphi: dphi1,
-            external_j: rk4_work(h, [e1 * w0, em * w2, em * w3, e4 * w4]),
+            external_j: external[0],
             drag_j,
             gap_j,
         }
@@ -496,7 +508,7 @@ impl SubSteps for CarrierSteps<'_> {
         checked_sub_step(want, a, t, || who.into())
     }
 
-    fn rk4(&self, run: &Run, h: f64) -> CarrierStep {
+    fn step(&self, run: &Run, h: f64) -> CarrierStep {
         let b = &mut self.bufs.borrow_mut();
         let dy = run.carrier_dynamics(self.c, self.t, h);
         let start = Cluster {
@@ -508,14 +520,14 @@ impl SubSteps for CarrierSteps<'_> {
             phi: &self.phi,
             dphi: &self.dphi,
         };
-        run.carrier_rk4(&start, &dy, h, b)
+        run.carrier_step(&start, &dy, h, b)
     }
 
     fn phi_end(&self, step: &CarrierStep, k: usize) -> f64 {
         step.phi[k]
     }
 
-    fn evals_per_rk4(&self) -> u64 {
+    fn evals_per_step(&self) -> u64 {
         4 * self.cluster.len() as u64
     }
 
@@ -530,8 +542,12 @@ impl SubSteps for CarrierSteps<'_> {
         self.t = t;
         self.angle += step.turn;
         self.w = step.speed;
-        self.phi.clone_from(&step.phi);
-        self.dphi.clone_from(&step.dphi);
+        // the step's vectors become the state, the state's go back to the buffers
+        let (phi, dphi) = (
+            std::mem::replace(&mut self.phi, step.phi),
+            std::mem::replace(&mut self.dphi, step.dphi),
+        );
+        self.bufs.get_mut().spare.extend([phi, dphi]);
         ws.counts.substeps += 1;
         ws.counts.evals += 5 * self.cluster.len() as u64;
         match self.c {

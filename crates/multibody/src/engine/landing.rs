@@ -27,7 +27,7 @@ impl Run {
             let want = s.want(self, ws)?;
             let rem = t1 - t;
             let mut h = split_remainder(want, rem);
-            let mut step = s.rk4(self, h);
+            let mut step = s.step(self, h);
             s.keep(&step);
             // Never step over an onset or a separation of any coupling, nor over the scheme's
             // own events: land on the first.
@@ -44,24 +44,24 @@ impl Run {
                 let (i, phi0) = (s.members()[k], s.phi(k));
                 let crossing = self.depth_crossing(i, phi0, s.phi_kept(&step, k), h, |x| {
                     trials.set(trials.get() + 1);
-                    s.phi_end(&s.rk4(self, x), k)
+                    s.phi_end(&s.step(self, x), k)
                 });
                 if let Some(x) = crossing {
                     consider(x, None);
                 }
             }
             s.events(self, h, &mut consider, &trials);
-            ws.counts.evals += trials.get() * s.evals_per_rk4();
+            ws.counts.evals += trials.get() * s.evals_per_step();
             let mut event = None;
             if let Some((x, e)) = first {
                 h = x;
-                step = s.rk4(self, x);
-                ws.counts.evals += s.evals_per_rk4();
+                step = s.step(self, x);
+                ws.counts.evals += s.evals_per_step();
                 event = e;
             } else if trials.get() > 0 && s.trials_overwrite() {
                 // the searches left another step in the scheme's buffers
-                step = s.rk4(self, h);
-                ws.counts.evals += s.evals_per_rk4();
+                step = s.step(self, h);
+                ws.counts.evals += s.evals_per_step();
             }
             let t = if h == rem { t1 } else { t + h };
             s.accept(self, step, t, event, ws)?;
@@ -85,8 +85,9 @@ pub(super) trait SubSteps {
     /// The sub-step the controller wants from `t`, s (checked: the run's failure when it
     /// collapsed); readies the step's start (what the schemes count goes to `ws`).
     fn want(&mut self, run: &mut Run, ws: &mut WorldStep) -> Result<f64, EngineError>;
-    /// One classical Runge-Kutta step of length `h` from `t`.
-    fn rk4(&self, run: &Run, h: f64) -> Self::Step;
+    /// One step of length `h` from `t` (the one classical Runge-Kutta step, `Rk4::rk4`, on
+    /// the scheme's right-hand side).
+    fn step(&self, run: &Run, h: f64) -> Self::Step;
     /// Member `k`'s relative angle at the end of `step`, rad.
     fn phi_end(&self, step: &Self::Step, k: usize) -> f64;
     /// Keeps what the searches need of the full step `step` (a scheme whose trial steps
@@ -112,7 +113,7 @@ pub(super) trait SubSteps {
     ) {
     }
     /// Tooth-law evaluations of one step.
-    fn evals_per_rk4(&self) -> u64;
+    fn evals_per_step(&self) -> u64;
     /// Takes `step`, ending at `t`, landed on the scheme's own event `event` if any: the
     /// state, the counts, the works, each member's sub-step end ([`Run::end_sub_step`]).
     fn accept(

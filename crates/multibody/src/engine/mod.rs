@@ -16,6 +16,7 @@ mod forces;
 mod inertial;
 mod landing;
 mod multirate;
+mod scheme_state;
 mod session;
 mod state;
 mod substep;

@@ -131,7 +131,7 @@ impl Run {
         let mut gaps = self.gap_drags(&self.omega_d, &zero, h);
         for i in 0..n {
             let theta = self.carrier_angle(i) - self.rel[i].phi;
-            self.moments[i] = TurnMoment::start(t0, theta, self.omega_d[i]);
+            self.multirate.moments[i] = TurnMoment::start(t0, theta, self.omega_d[i]);
         }
         if self.stack.is_some() {
             // the plates' predicted mean speeds, for the discs, held over the step (their
@@ -177,7 +177,7 @@ impl Run {
             let slope: Vec<f64> = (0..n)
                 .map(|j| {
                     if j < n_discs {
-                        self.moments[j].slope()
+                        self.multirate.moments[j].slope()
                     } else {
                         0.0
                     }
@@ -435,7 +435,7 @@ impl Run {
         }
         self.forces[i] = f;
         self.rel[i] = rel_state;
-        self.moments[i].add(t, shaft.angle - phi, shaft.speed - dphi);
+        self.multirate.moments[i].add(t, shaft.angle - phi, shaft.speed - dphi);
         let steps_per_contact = ws.a.steps_per_contact;
         let m_eff = self.m_eff[i];
         let step_of = |v| contact_duration_s(&d.law, f.kin.flank, v, m_eff) / steps_per_contact;
@@ -457,7 +457,7 @@ impl Run {
 }
 
 /// One coupling alone against its carrier's known motion (a prescribed shaft's profile, the
-/// housing at rest, an inertial carrier's nodes), [`Relative::rk4`] for its steps.
+/// housing at rest, an inertial carrier's nodes), [`Relative::step`] for its steps.
 struct Alone<'a> {
     /// The coupling, the open gaps' drag on its body, its carrier's path and the bound of
     /// the carrier's acceleration, rad/s^2.
@@ -517,7 +517,7 @@ impl SubSteps for Alone<'_> {
         Ok(want)
     }
 
-    fn rk4(&self, run: &Run, h: f64) -> SubStep {
+    fn step(&self, run: &Run, h: f64) -> SubStep {
         let rel = Relative {
             path: self.path,
             coupling: &run.couplings[self.i],
@@ -526,14 +526,14 @@ impl SubSteps for Alone<'_> {
             gap: self.gap,
             start_torque_n_m: self.start_torque_n_m,
         };
-        rel.rk4(self.t, self.shaft, self.phi, self.dphi, h)
+        rel.step(self.t, self.shaft, self.phi, self.dphi, h)
     }
 
     fn phi_end(&self, step: &SubStep, _: usize) -> f64 {
         step.phi
     }
 
-    fn evals_per_rk4(&self) -> u64 {
+    fn evals_per_step(&self) -> u64 {
         3
     }
 

@@ -132,7 +132,7 @@ impl MultibodySession {
             None => None,
         };
         let mut run = Run::new(pack, options, per_tooth, multirate.is_some())?;
-        run.exact_drum_load = driven.drum_load;
+        run.shared.exact_drum_load = driven.drum_load;
         run.evaluate(0.0)?;
         let kinetic_j = run.kinetic_energy();
         run.energy.start(run.potential_j, kinetic_j);
@@ -505,8 +505,8 @@ impl MultibodySession {
         if let Some(load) = inputs.drum_load_n_m {
             if let Some(d) = run.drum.as_mut() {
                 let before = d.model.load_torque_n_m;
-                if run.load_switch.is_none_or(|(ts, _)| ts != t) {
-                    run.load_switch = Some((t, before));
+                if run.shared.load_switch.is_none_or(|(ts, _)| ts != t) {
+                    run.shared.load_switch = Some((t, before));
                 }
                 d.model.load_torque_n_m = load;
             }

@@ -1,11 +1,12 @@
-//! The world state of one run: the rapier world, the drives of the shaft and the drum, each
-//! body's loads and kicks, the couplings and their memories, the clock; and what is read from
-//! it (relative states, carriers, samples).
+//! The world state of one run: the rapier world, the drives of the shaft and the drum, the
+//! couplings and their memories, the clock, and each scheme's own part (the shared step's
+//! loads and kicks, the multirate schemes' moments and faces); and what is read from it
+//! (relative states, carriers, samples).
 
 use super::energy::EnergyBook;
 use super::events::EventBook;
+use super::scheme_state::{MultirateState, SharedStep};
 use crate::hook::{Coupling, CouplingForces, RelativeState};
-use crate::integrate::{Kick, Load, LoadHistory, Motion};
 use crate::options::MultibodyOptions;
 use crate::stack::Stack;
 use crate::stepping::profile_acceleration_bound;
@@ -53,34 +54,12 @@ pub(super) enum ShaftDrive {
 
 /// The output drum as the run loop drives it: a body with inertia, a load torque and drag,
 /// carrying the separator plates.
-/// The loads of one body (a disc, a plate, an inertial shaft, the drum) and their kick
-/// (`integrate.rs`).
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct BodyLoads {
-    /// Physical loads at `t` (world frame), leaving out the teeth's torque about the axis,
-    /// whose kick is integrated along the step (`Run::teeth_impulse`), and the stack's torque,
-    /// solved per step (`stack.rs`).
-    pub(super) load: Load,
-    /// Their values at the two evaluations before.
-    pub(super) history: LoadHistory,
-    /// The kick of `load` for the next step.
-    pub(super) kick: Kick,
-    /// The full loads (teeth included), for the first estimate of the synchronised speed.
-    pub(super) full: Load,
-    /// Their values at the two evaluations before.
-    pub(super) full_history: LoadHistory,
-}
-
 #[derive(Debug, Clone)]
 pub(super) struct DrumRun {
     pub(super) model: DrumModel,
     /// Speed at `t` (synchronised) and unwrapped angle, rad/s and rad.
     pub(super) omega: f64,
     pub(super) theta: f64,
-    /// Its loads and their kick.
-    pub(super) loads: BodyLoads,
-    /// Acceleration at `t`, rad/s^2.
-    pub(super) accel: f64,
 }
 
 /// The state of one run: the world, the hook's memories, the events, the clock.
@@ -90,10 +69,12 @@ pub(super) struct DrumRun {
 ///
 /// Who writes what: the models and the couplings are set here and only read after; the
 /// impact events and the energy audit are books written through their own methods
-/// (`events.rs`, `energy.rs`); the teeth's kicks and the loads only by the shared step
-/// (`forces.rs`); the clock and the kinematic state (`t`, the shaft's angle and speed, the
-/// bodies' speeds, the relative states and the forces, the teeth's potential, the world's
-/// poses) by the two schemes that advance it, the shared step (`forces.rs`) and the
+/// (`events.rs`, `energy.rs`); what only one scheme keeps is that scheme's own part
+/// (`scheme_state.rs`): the teeth's kicks and the loads in [`SharedStep`], written by the
+/// shared step only (`forces.rs`), the bodies' moments and the clamped faces in
+/// [`MultirateState`], by the multirate step only; the clock and the kinematic state (`t`,
+/// the shaft's angle and speed, the bodies' speeds, the relative states and the forces, the
+/// teeth's potential, the world's poses) by the two schemes that advance it, the shared step (`forces.rs`) and the
 /// multirate step (`multirate.rs`, `inertial.rs`); the stack and the drum by the shared step
 /// and their own methods (`stack.rs`), and by the multirate step (the open gaps' heat, the
 /// drum's angle and speed).
@@ -121,30 +102,14 @@ pub(super) struct Run {
     /// The hook's results at `t` (filled by [`Run::evaluate`]).
     pub(super) rel: Vec<RelativeState>,
     pub(super) forces: Vec<CouplingForces>,
-    /// The loads of each coupled body and of an inertial shaft (the drum keeps its own).
-    pub(super) loads: Vec<BodyLoads>,
-    pub(super) shaft_loads: BodyLoads,
-    /// `(t, phi, dphi, ddphi)` of each coupling at the last evaluation.
-    pub(super) prev_motion: Vec<Option<(f64, f64, f64, f64)>>,
-    /// The teeth: the past half of their kick (N m s on the body, about the axis) and the
-    /// relative motion at `t` for the future half.
-    pub(super) teeth_past: Vec<f64>,
-    /// The last `(x, teeth_impulse(i, x))` of each coupling since the last evaluation (the
-    /// step's impulse is asked for by the stack, the landing and the forces).
-    pub(super) teeth_cache: Vec<std::cell::Cell<(f64, f64)>>,
-    pub(super) teeth_motion: Vec<Motion>,
+    /// What only the shared step keeps from one step to the next (`scheme_state.rs`).
+    pub(super) shared: SharedStep,
     /// Body speeds at `t` (synchronised with the poses), rad/s.
     pub(super) omega_d: Vec<f64>,
-    /// Multirate scheme: each body's first moment of speed over the world step being taken
-    /// (its neighbours' gap drag reads its slope).
-    pub(super) moments: Vec<super::substep::TurnMoment>,
-    /// The clamped stack's faces in its multirate integration (`clamped.rs`; empty until
-    /// its first step).
-    pub(super) faces: Vec<crate::stack::Face>,
+    /// What only the multirate schemes keep (`scheme_state.rs`).
+    pub(super) multirate: MultirateState,
     /// Time of the evaluation before the last step.
     pub(super) t_prev: Option<f64>,
-    /// Prescribed shaft: its angle at the end of the step being taken.
-    pub(super) theta_next: f64,
     /// Time, unwrapped shaft angle and shaft speed.
     pub(super) t: f64,
     pub(super) theta_s: f64,
@@ -157,12 +122,6 @@ pub(super) struct Run {
     /// N m: the torque before it, for the past half of the kick of the step that ends there
     /// (`forces.rs`). `None`: the pack's excitation holds for all `t`.
     pub(super) drive_switch: Option<(f64, f64)>,
-    /// Whether the drum's load torque is a driven input, integrated exactly as a held value
-    /// (its kick `L_before h1 / 2 + L h0 / 2`) rather than through the polynomial kick of the
-    /// drum's other loads (byte-identical runs need the latter for the scene's constant load).
-    pub(super) exact_drum_load: bool,
-    /// A driven drum load changed at this time, s, from this value, N m (as `drive_switch`).
-    pub(super) load_switch: Option<(f64, f64)>,
 }
 
 /// Bound of the shaft's acceleration from its drive alone, rad/s^2: the profile's for a
@@ -240,8 +199,6 @@ impl Run {
             model,
             omega: model.initial_speed_rad_s,
             theta: 0.0,
-            loads: BodyLoads::default(),
-            accel: 0.0,
         });
         let stack = pack
             .stack
@@ -259,25 +216,16 @@ impl Run {
             events: EventBook::new(nd),
             rel: Vec::with_capacity(nd),
             forces: Vec::with_capacity(nd),
-            loads: vec![BodyLoads::default(); nd],
-            shaft_loads: BodyLoads::default(),
-            prev_motion: vec![None; nd],
-            teeth_past: vec![0.0; nd],
-            teeth_cache: vec![std::cell::Cell::new((f64::NAN, 0.0)); nd],
-            teeth_motion: vec![Motion::default(); nd],
+            shared: SharedStep::new(nd),
             omega_d: Vec::with_capacity(nd),
-            moments: vec![Default::default(); nd],
-            faces: Vec::new(),
+            multirate: MultirateState::new(nd),
             t_prev: None,
-            theta_next: 0.0,
             t: 0.0,
             theta_s: 0.0,
             omega_s: pack.shaft.initial_speed_rad_s(),
             potential_j: 0.0,
             energy: EnergyBook::default(),
             drive_switch: None,
-            exact_drum_load: false,
-            load_switch: None,
             pack,
         })
     }

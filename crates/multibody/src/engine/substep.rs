@@ -1,9 +1,9 @@
 //! The sub-step kernel of the multirate schemes (`multirate.rs`, `inertial.rs`, `clamped.rs`):
-//! the one classical Runge-Kutta step of a set of bodies ([`Rk4`]) and the one quadrature of
-//! the works along it ([`rk4_work`]); a coupling's step against its carrier's path
-//! ([`Relative`]), graded towards the tooth law's kinks, with the open gaps' drag held over
-//! the step; the world-step context the schemes pass down ([`WorldStep`]); and what the
-//! multirate schemes count.
+//! the one classical Runge-Kutta step of a set of bodies, with the one quadrature of the works
+//! along it ([`Rk4::rk4`]), to which each scheme gives its right-hand side; a coupling's step
+//! against its carrier's path ([`Relative`]), graded towards the tooth law's kinks, with the
+//! open gaps' drag held over the step; the world-step context the schemes pass down
+//! ([`WorldStep`]); and what the multirate schemes count.
 
 use crate::hook::{Coupling, CouplingForces};
 use crate::options::AdaptiveStepping;
@@ -191,94 +191,137 @@ pub(super) fn split_remainder(want: f64, rem: f64) -> f64 {
     }
 }
 
-/// The classical Runge-Kutta step of a set of bodies, the one integrator of the multirate
-/// schemes (a coupling alone against its carrier's path, [`Relative::rk4`]; an inertial
-/// carrier with its cluster, `Run::carrier_rk4`; the clamped stack with its inertial
-/// carriers, `Run::stack_rk4`): its stages' accelerations and speeds, kept for the schemes'
-/// energy quadratures, and its result. `V` holds one value per body: `[f64; 1]` for a coupling
-/// alone (no allocation on its hot path), a `Vec<f64>` for a system.
+/// The buffers of the one classical Runge-Kutta step of the multirate schemes
+/// ([`Rk4::rk4`]): each body's accelerations at the four stages, the stages' turns and speeds
+/// (scratch), the powers' partial sums over the stages, and the step's result. `V` holds one
+/// value per body, `P` one per power the scheme integrates: `[f64; 1]` and `[f64; 3]` for a
+/// coupling alone (no allocation on its hot path), `Vec<f64>`s for a system (allocated once
+/// per world step, [`Rk4::new`]).
 #[derive(Debug, Clone, Default)]
-pub(super) struct Rk4<V> {
-    /// Each body's acceleration at the four stages, rad/s^2 (`k[0]`, at the step's start, is
-    /// the caller's).
-    pub(super) k: [V; 4],
-    /// Each body's speed at the stages 2, 3 and 4, rad/s.
-    pub(super) u: [V; 3],
-    /// Each body's turn from the start at the stage being evaluated, rad (scratch).
+pub(super) struct Rk4<V, P> {
+    /// Each body's acceleration at the four stages, rad/s^2.
+    k: [V; 4],
+    /// Each body's turn from the start, rad, and speed, rad/s, at the stage being evaluated
+    /// (scratch).
     th: V,
+    x: V,
+    /// Each power's sum at the two middle stages, and a stage's powers (W, or N m for an
+    /// impulse; scratch).
+    mid: P,
+    p: P,
     /// Each body's turn over the step, rad, and its speed at the end, rad/s.
     pub(super) turn: V,
     pub(super) u1: V,
+    /// Each power's integral over the step, J (N m s for an impulse; its value at the first
+    /// stage along the step).
+    pub(super) work: P,
 }
 
-impl Rk4<Vec<f64>> {
-    /// The buffers for `n` bodies.
-    pub(super) fn new(n: usize) -> Rk4<Vec<f64>> {
+impl Rk4<Vec<f64>, Vec<f64>> {
+    /// The buffers for `n` bodies and `powers` powers.
+    pub(super) fn new(n: usize, powers: usize) -> Rk4<Vec<f64>, Vec<f64>> {
         let v = || vec![0.0; n];
+        let p = || vec![0.0; powers];
         Rk4 {
             k: [v(), v(), v(), v()],
-            u: [v(), v(), v()],
             th: v(),
+            x: v(),
+            mid: p(),
+            p: p(),
             turn: v(),
             u1: v(),
+            work: p(),
         }
     }
 }
 
-impl<V: AsRef<[f64]> + AsMut<[f64]>> Rk4<V> {
-    /// One classical Runge-Kutta step (Kutta 1901: nodes 0, 1/2, 1/2, 1, weights 1/6, 1/3,
-    /// 1/3, 1/6) of length `h` from `t` of the bodies' motion `theta' = u`,
-    /// `u' = a(t, theta - theta(t), u)`, from their speeds `u0` and their accelerations at `t`
-    /// in `k[0]`. `stage(s, ts, th, u, acc)` writes into `acc` the bodies' accelerations at
-    /// stage `s` (1, 2, 3: the second to the fourth) at `ts` with the bodies turned by `th`
-    /// (rad) from `t` and turning at `u` (rad/s). Written for the angle, as the method on the
-    /// first-order system (angle, speed) gives it: each body turns by
-    /// `h u0 + h^2/6 (k1 + k2 + k3)` and ends at `u0 + h/6 (k1 + 2 k2 + 2 k3 + k4)`.
-    pub(super) fn step(
+impl<V: AsMut<[f64]>, P: AsMut<[f64]>> Rk4<V, P> {
+    /// The one classical Runge-Kutta step of the multirate schemes (Kutta 1901: nodes 0, 1/2,
+    /// 1/2, 1, weights 1/6, 1/3, 1/3, 1/6), of length `h` from `t`, of the bodies' motion
+    /// `theta' = u`, `u' = a(t, theta - theta(t), u)` from their speeds `u0`, with the works
+    /// of the scheme's powers integrated by the same stages (the augmented system, so that
+    /// the audit closes to the method's order). A coupling alone against its carrier's path
+    /// ([`Relative::step`]), an inertial carrier with its cluster (`inertial.rs`) and the
+    /// clamped stack with its inertial carriers (`clamped.rs`) each give their right-hand side
+    /// as `stage(s, ts, th, u, acc, power)`, which writes into `acc` the bodies' accelerations
+    /// and into `power` the powers at stage `s` (0 to 3) at `ts`, the bodies turned by `th`
+    /// (rad) from `t` and turning at `u` (rad/s).
+    ///
+    /// Written for the angle, as the method on the first-order system (angle, speed) gives
+    /// it: each body turns by `h u0 + h^2/6 (k1 + k2 + k3)` and ends at
+    /// `u0 + h/6 (k1 + 2 k2 + 2 k3 + k4)`; each power `p` does the work
+    /// `h/6 (p1 + 2 (p2 + p3) + p4)` (the one energy quadrature of the multirate schemes).
+    pub(super) fn rk4(
         &mut self,
         t: f64,
         h: f64,
         u0: &[f64],
-        mut stage: impl FnMut(usize, f64, &[f64], &[f64], &mut [f64]),
+        mut stage: impl FnMut(usize, f64, &[f64], &[f64], &mut [f64], &mut [f64]),
     ) {
         let hh = h * h;
         let (tm, te) = (t + 0.5 * h, t + h);
-        let Rk4 { k, u, th, turn, u1 } = self;
+        let Rk4 {
+            k,
+            th,
+            x,
+            mid,
+            p,
+            turn,
+            u1,
+            work,
+        } = self;
         let [k1, k2, k3, k4] = k.each_mut().map(|x| x.as_mut());
-        let [u2, u3, u4] = u.each_mut().map(|x| x.as_mut());
-        let (th, turn, u1) = (th.as_mut(), turn.as_mut(), u1.as_mut());
+        let (th, x, turn, u1) = (th.as_mut(), x.as_mut(), turn.as_mut(), u1.as_mut());
+        let (mid, p, work) = (mid.as_mut(), p.as_mut(), work.as_mut());
         let n = u0.len();
+        let ([k1, k2, k3, k4], th, x, turn, u1) = (
+            [&mut k1[..n], &mut k2[..n], &mut k3[..n], &mut k4[..n]],
+            &mut th[..n],
+            &mut x[..n],
+            &mut turn[..n],
+            &mut u1[..n],
+        );
+        th.fill(0.0);
+        // the powers folded as they come (p1 in `work`, p2 + p3 in `mid`): the quadrature's
+        // own sums in its own order, in three buffers rather than five
+        stage(0, t, th, u0, k1, work);
         for i in 0..n {
             th[i] = 0.5 * h * u0[i];
-            u2[i] = u0[i] + 0.5 * h * k1[i];
+            x[i] = u0[i] + 0.5 * h * k1[i];
         }
-        stage(1, tm, th, u2, k2);
+        stage(1, tm, th, x, k2, mid);
         for i in 0..n {
             th[i] = 0.5 * h * u0[i] + 0.25 * hh * k1[i];
-            u3[i] = u0[i] + 0.5 * h * k2[i];
+            x[i] = u0[i] + 0.5 * h * k2[i];
         }
-        stage(2, tm, th, u3, k3);
+        stage(2, tm, th, x, k3, p);
+        for (m, &p3) in mid.iter_mut().zip(&*p) {
+            *m += p3;
+        }
         for i in 0..n {
             th[i] = h * u0[i] + 0.5 * hh * k2[i];
-            u4[i] = u0[i] + h * k3[i];
+            x[i] = u0[i] + h * k3[i];
         }
-        stage(3, te, th, u4, k4);
+        stage(3, te, th, x, k4, p);
         let h6 = h / 6.0;
         for i in 0..n {
             turn[i] = h * u0[i] + h * h6 * (k1[i] + k2[i] + k3[i]);
             u1[i] = u0[i] + h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
         }
+        for ((w, &m), &p4) in work.iter_mut().zip(&*mid).zip(&*p) {
+            *w = h6 * (*w + 2.0 * m + p4);
+        }
     }
 }
 
-/// The work of a power over a classical Runge-Kutta step of length `h` (s) from its values
-/// `p` at the step's four stages (W, or N m for an impulse), J (N m s): the method's own
-/// weights, `h/6 (p1 + 2 p2 + 2 p3 + p4)`, so that the works of the drive, the drag, the
-/// load, the gaps and the faces are integrated by the same stages as the motion (the
-/// augmented system) and the audit closes to the method's order. The one energy quadrature of
-/// the multirate schemes.
-pub(super) fn rk4_work(h: f64, p: [f64; 4]) -> f64 {
-    h / 6.0 * (p[0] + 2.0 * (p[1] + p[2]) + p[3])
+/// `v` cut into consecutive slices of the lengths `lens` (a scheme's powers by kind).
+#[inline]
+pub(super) fn cut<const K: usize>(mut v: &mut [f64], lens: [usize; K]) -> [&mut [f64]; K] {
+    lens.map(|n| {
+        let (a, rest) = std::mem::take(&mut v).split_at_mut(n);
+        v = rest;
+        a
+    })
 }
 
 /// One sub-step's outcome: the relative state at its end and the work done along it.
@@ -299,8 +342,8 @@ pub(super) struct SubStep {
 }
 
 /// A coupling's body on its carrier at the stages of a sub-step: the one body law of the
-/// steps of a coupling alone ([`Relative::rk4`]) and of an inertial carrier's cluster
-/// (`Run::carrier_rk4`), Hu et al. eq (5) with the open gaps' drag,
+/// steps of a coupling alone ([`Relative::step`]) and of an inertial carrier's cluster
+/// (`Run::carrier_step`), Hu et al. eq (5) with the open gaps' drag,
 /// `J omega_d' = T(phi, phi') - C2 omega_d + g(omega_d)`. (The clamped stack's bodies sum
 /// their torques over the groups their locked faces make, `clamped.rs`.)
 #[derive(Clone, Copy)]
@@ -313,22 +356,25 @@ pub(super) struct Carried<'a> {
     pub(super) inv_j: f64,
     pub(super) c2: f64,
     /// The open gaps' drag on the body.
-    pub(super) gap: GapDrag,
+    pub(super) gap: &'a GapDrag,
 }
 
 impl Carried<'_> {
     /// The body's acceleration, rad/s^2, at `ts` (s) turning at `u` (rad/s) with the teeth's
-    /// torque `torque` (N m) on it.
-    pub(super) fn accel(&self, ts: f64, torque: f64, u: f64) -> f64 {
-        (torque - self.c2 * u + self.gap.torque(ts, u)) * self.inv_j
+    /// torque `torque` (N m) on it, and the open gaps' drag on it there, N m.
+    pub(super) fn accel(&self, ts: f64, torque: f64, u: f64) -> (f64, f64) {
+        let gap = self.gap.torque(ts, u);
+        ((torque - self.c2 * u + gap) * self.inv_j, gap)
     }
 
-    /// The teeth's torque on the body, N m, and its acceleration, rad/s^2, at a stage at `ts`:
-    /// the carrier turned by `turn` (rad) from the sub-step's start and turning at `speed`
-    /// (rad/s), the body turned by `th` and turning at `u`.
-    pub(super) fn stage(&self, ts: f64, turn: f64, speed: f64, th: f64, u: f64) -> (f64, f64) {
+    /// The teeth's torque on the body, N m, its acceleration, rad/s^2, and the open gaps'
+    /// drag on it, N m, at a stage at `ts`: the carrier turned by `turn` (rad) from the
+    /// sub-step's start and turning at `speed` (rad/s), the body turned by `th` and turning
+    /// at `u`.
+    pub(super) fn stage(&self, ts: f64, turn: f64, speed: f64, th: f64, u: f64) -> (f64, f64, f64) {
         let torque = self.coupling.probe_torque(self.phi + turn - th, speed - u);
-        (torque, self.accel(ts, torque, u))
+        let (acc, gap) = self.accel(ts, torque, u);
+        (torque, acc, gap)
     }
 }
 
@@ -357,13 +403,12 @@ pub(super) struct Relative<'a> {
 }
 
 impl Relative<'_> {
-    /// One classical Runge-Kutta step of length `h` from `(phi, dphi)` at `t`, with the work
-    /// of the drive and the drag integrated by the same stages (the augmented system).
-    pub(super) fn rk4(&self, t: f64, shaft: ShaftAt, phi: f64, dphi: f64, h: f64) -> SubStep {
+    /// One classical Runge-Kutta step ([`Rk4::rk4`]) of length `h` from `(phi, dphi)` at `t`,
+    /// with the work of the drive, the drag and the gaps integrated by the same stages.
+    pub(super) fn step(&self, t: f64, shaft: ShaftAt, phi: f64, dphi: f64, h: f64) -> SubStep {
         let p = self.path;
         let (tm, te) = (t + 0.5 * h, t + h);
         let (mid, end) = (p.at(tm), p.at(te));
-        let gap = self.gap;
         let (w0, wm, we) = (shaft.speed, mid.speed, end.speed);
         // The shaft's turn from t, exact.
         let (sm, se) = (mid.angle - shaft.angle, end.angle - shaft.angle);
@@ -375,29 +420,34 @@ impl Relative<'_> {
             phi,
             inv_j: self.inv_j,
             c2: self.c2,
-            gap,
+            gap: &self.gap,
         };
-        // the teeth's torque at the four stages, N m
-        let mut teeth = [self.start_torque_n_m, 0.0, 0.0, 0.0];
-        let mut rk = Rk4::<[f64; 1]>::default();
-        rk.k[0] = [body.accel(t, teeth[0], u0)];
-        // a stage: the shaft turned from t at its speed there (exact), the disc turned by
-        // `th` at `u`
-        rk.step(t, h, &[u0], |s, ts, th, u, acc| {
-            let (turn, speed) = if s < 3 { (sm, wm) } else { (se, we) };
-            (teeth[s], acc[0]) = body.stage(ts, turn, speed, th[0], u[0]);
+        // the powers: the shaft's on the teeth, the disc's speed squared (the drag's, over
+        // -C2), the gaps' drag's
+        let mut rk = Rk4::<[f64; 1], [f64; 3]>::default();
+        // a stage: the teeth's torque at the start given, else probed with the shaft turned
+        // from t at its speed there (exact) and the disc turned by `th` at `u`
+        rk.rk4(t, h, &[u0], |s, ts, th, u, acc, power| {
+            let (u, speed) = (u[0], [w0, wm, wm, we][s]);
+            let (torque, a, g) = if s == 0 {
+                let torque = self.start_torque_n_m;
+                let (a, g) = body.accel(ts, torque, u);
+                (torque, a, g)
+            } else {
+                let turn = if s < 3 { sm } else { se };
+                body.stage(ts, turn, speed, th[0], u)
+            };
+            acc[0] = a;
+            power.copy_from_slice(&[torque * speed, u * u, g * u]);
         });
-        let [t1, t2, t3, t4] = teeth;
-        let [[u2], [u3], [u4]] = rk.u;
-        let (th, u1) = (rk.turn[0], rk.u1[0]);
-        let g = |ts: f64, u: f64| gap.torque(ts, u) * u;
+        let [drive, sq, gap_j] = rk.work;
         SubStep {
             shaft: end,
-            phi: phi + se - th,
-            dphi: we - u1,
-            drive_j: rk4_work(h, [t1 * w0, t2 * wm, t3 * wm, t4 * we]),
-            drag_j: -self.c2 * rk4_work(h, [u0 * u0, u2 * u2, u3 * u3, u4 * u4]),
-            gap_j: rk4_work(h, [g(t, u0), g(tm, u2), g(tm, u3), g(te, u4)]),
+            phi: phi + se - rk.turn[0],
+            dphi: we - rk.u1[0],
+            drive_j: drive,
+            drag_j: -self.c2 * sq,
+            gap_j,
             evals: 3,
         }
     }
@@ -629,7 +679,7 @@ mod tests {
             let (mut phi, mut dphi, mut drag) = (0.0, -w0, 0.0);
             for k in 0..n {
                 let t = k as f64 * h;
-                let s = rel.rk4(t, prescribed.at(t), phi, dphi, h);
+                let s = rel.step(t, prescribed.at(t), phi, dphi, h);
                 (phi, dphi, drag) = (s.phi, s.dphi, drag + s.drag_j);
             }
             let wd = w0 * (-r * duration).exp();
