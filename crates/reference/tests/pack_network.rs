@@ -42,6 +42,16 @@ fn pack_run(pack: &PackModel, duration: f64, tol: f64) -> (Vec<ImpactEvent>, f64
     (sorted(&c.impacts), shaft, heat)
 }
 
+/// The network's settings beside [`pack_run`]'s: tolerance `tol`, steps of at most 0.1 ms,
+/// samples at 1 kHz.
+fn network_options(tol: f64) -> NetworkOptions {
+    NetworkOptions {
+        tolerance: tol,
+        max_step_s: 1e-4,
+        record_rate_hz: 1000.0,
+    }
+}
+
 /// `v` in the order the impacts opened (engines send them as they close).
 fn sorted(v: &[ImpactEvent]) -> Vec<ImpactEvent> {
     let mut v = v.to_vec();
@@ -87,11 +97,7 @@ fn one_pack_between_two_inertias_is_the_pack_scenes_run() {
     let (tighter, shaft_t, heat_t) = pack_run(&pack, duration, tol / 10.0);
     let net = pack_as_network(&pack).expect("an inertial shaft");
     let mut obs = Packs::default();
-    let options = NetworkOptions {
-        tolerance: tol,
-        max_step_s: 1e-4,
-        record_rate_hz: 1000.0,
-    };
+    let options = network_options(tol);
     let run = run_network(&net, duration, &options, &mut obs).expect("the network runs");
     let on_net = sorted(&obs.impacts.iter().map(|(_, e)| *e).collect::<Vec<_>>());
     let net_heat = run.heat_j[0];
@@ -250,11 +256,7 @@ fn an_open_brake_on_a_network_is_the_pack_run_impact_for_impact() {
     let net = pack_as_network(&pack).expect("an inertial shaft");
     assert!(net.bodies[1].fixed, "the plates on the housing");
     let mut obs = Packs::default();
-    let options = NetworkOptions {
-        tolerance: tol,
-        max_step_s: 1e-4,
-        record_rate_hz: 1000.0,
-    };
+    let options = network_options(tol);
     let run = run_network(&net, duration, &options, &mut obs).expect("the network runs");
     let on_net = sorted(&obs.impacts.iter().map(|(_, e)| *e).collect::<Vec<_>>());
     let (n, on, peak) = worst(&alone, &on_net, 0.015);

@@ -171,8 +171,8 @@ pub(crate) struct Keep {
     steps: Vec<(f64, Vec<f64>)>,
     /// Per coupling: the smallest and largest torque sampled.
     range: Vec<(f64, f64)>,
-    /// Per coupling: (impacts, largest peak) of a gear mesh.
-    meshes: std::collections::HashMap<usize, (u64, f64)>,
+    /// Per coupling: (impacts, largest peak) of a gear mesh or of a pack's bodies together.
+    impacts: std::collections::HashMap<usize, (u64, f64)>,
     /// Per (pack coupling, body in the pack): (impacts, largest peak).
     pack_bodies: std::collections::HashMap<(usize, usize), (u64, f64)>,
     /// Per pack coupling: its bodies' load histories for the fatigue (samples and impacts).
@@ -223,7 +223,7 @@ impl Keep {
             events: self.events.clone(),
             steps: self.steps.clone(),
             range: self.range.clone(),
-            meshes: self.meshes.clone(),
+            impacts: self.impacts.clone(),
             pack_bodies: self.pack_bodies.clone(),
             pack_modes: self.pack_modes.clone(),
             pack_fatigue: self.pack_fatigue.clone(),
@@ -233,6 +233,15 @@ impl Keep {
             recorder: None,
             record_error: None,
         }
+    }
+}
+
+/// Counts one more impact of peak `peak_n` (N) in `(impacts, largest peak)`, keeping the
+/// peak of largest magnitude with its sign.
+fn tally(m: &mut (u64, f64), peak_n: f64) {
+    m.0 += 1;
+    if peak_n.abs() > m.1.abs() {
+        m.1 = peak_n;
     }
 }
 
@@ -268,11 +277,7 @@ impl NetworkObserver for Obs<'_, '_> {
                 .impact_log
                 .push((e.disc, None, e.t_peak_s, e.peak_n));
         }
-        let m = self.keep.meshes.entry(e.disc).or_insert((0, 0.0));
-        m.0 += 1;
-        if e.peak_n.abs() > m.1.abs() {
-            m.1 = e.peak_n;
-        }
+        tally(self.keep.impacts.entry(e.disc).or_default(), e.peak_n);
     }
     fn pack_impact(&mut self, coupling: usize, e: &clutchpack_model::ImpactEvent) {
         self.keep.record(|r| r.write_pack_impact(coupling, e));
@@ -286,13 +291,9 @@ impl NetworkObserver for Obs<'_, '_> {
                 .impact_log
                 .push((coupling, Some(e.disc), e.t_peak_s, e.peak_n));
         }
-        for key in [(coupling, e.disc), (coupling, usize::MAX)] {
-            let m = self.keep.pack_bodies.entry(key).or_insert((0, 0.0));
-            m.0 += 1;
-            if e.peak_n.abs() > m.1.abs() {
-                m.1 = e.peak_n;
-            }
-        }
+        tally(self.keep.impacts.entry(coupling).or_default(), e.peak_n);
+        let body = self.keep.pack_bodies.entry((coupling, e.disc));
+        tally(body.or_default(), e.peak_n);
     }
     fn pack_sample(
         &mut self,
@@ -558,16 +559,8 @@ pub(crate) fn conclude(
                             .flat_map(|m| m.1.clone()),
                     )
                     .collect(),
-                impacts: keep
-                    .meshes
-                    .get(&k)
-                    .or(keep.pack_bodies.get(&(k, usize::MAX)))
-                    .map_or(0, |m| m.0),
-                largest_peak_n: keep
-                    .meshes
-                    .get(&k)
-                    .or(keep.pack_bodies.get(&(k, usize::MAX)))
-                    .map_or(0.0, |m| m.1),
+                impacts: keep.impacts.get(&k).map_or(0, |m| m.0),
+                largest_peak_n: keep.impacts.get(&k).map_or(0.0, |m| m.1),
                 pack_bodies: c.pack().map_or_else(Vec::new, |p| {
                     p.discs
                         .iter()
