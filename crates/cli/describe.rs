@@ -3,7 +3,8 @@
 use clutchpack_sdk::record::RecordingReader;
 
 /// What the file holds, as text for `clutchpack replay`: the file and its state, the run
-/// (program, engine, scene and its hash, overrides), the topics with their schemas,
+/// (program, engine, scene and its hash, overrides; the inputs a co-simulation's caller
+/// drove), the topics with their schemas,
 /// message counts and time spans, and the per-disc summary (stored, or recomputed from
 /// the recovered impacts and marked so). Lines end with `\n`.
 pub fn describe(r: &RecordingReader) -> String {
@@ -33,6 +34,17 @@ pub fn describe(r: &RecordingReader) -> String {
             g("scene_file"),
             sha.chars().take(12).collect::<String>(),
             g("overrides")
+        );
+    }
+    // a run advanced call by call (Python's Simulation, an FMU): which inputs its caller drove
+    let params = i.metadata(clutchpack_sdk::record::info::META_PARAMS);
+    if let Some(p) = params.filter(|p| p.get("co_simulation").is_some_and(|v| v == "true")) {
+        let _ = writeln!(
+            s,
+            "co-simulation: inputs driven by the caller: {}{}",
+            p.get("driven_inputs").map_or("?", String::as_str),
+            p.get("stop_time_s")
+                .map_or(String::new(), |t| format!("; stop time {t} s"))
         );
     }
     match (i.start_s, i.end_s) {

@@ -162,7 +162,8 @@ def test_a_simulation_drives_the_pistons_of_resolved_packs(tmp_path):
         return float(np.interp(t, [0.0, 0.2, 0.35, 0.7, 0.8], [0.0, 0.0, 0.45e6, 0.45e6, 1.05e6]))
 
     names = ["couplings.K1.pressure_pa", "couplings.K2.pressure_pa"]
-    sim = clutchpack.Simulation("scenes/dct-upshift-packs.toml", drive=names)
+    driven = tmp_path / "driven.mcap"
+    sim = clutchpack.Simulation("scenes/dct-upshift-packs.toml", drive=names, record=driven)
     assert sim.inputs == names
     for k in range(1, 1001):
         mid = (k - 0.5) * 1e-3
@@ -172,6 +173,9 @@ def test_a_simulation_drives_the_pistons_of_resolved_packs(tmp_path):
     assert abs(got["heat_j"] - k2["heat_j"]) < 1e-4 * k2["heat_j"], (got["heat_j"], k2["heat_j"])
     assert got["final_mode"] == "locked"
     assert [len(c.get("pack_bodies", [])) for c in summary["couplings"]][1:3] == [9, 11]
+    # the recording says which inputs the caller drove
+    text = cli("replay", str(driven)).stdout
+    assert "co-simulation: inputs driven by the caller: " + ", ".join(names) in text, text
     with pytest.raises(ValueError, match="expected >= 0"):
         sim = clutchpack.Simulation("scenes/dct-upshift-packs.toml", drive=names)
         sim.advance_to(0.01, **{names[0]: -1.0, names[1]: 0.0})
