@@ -21,6 +21,10 @@ pub struct NetworkArgs<'a> {
     pub engine: Option<clutchpack_sdk::EngineChoice>,
     /// `--summary-json`.
     pub summary_json: Option<&'a Path>,
+    /// `--impacts-csv`: every tooth impact of the gear meshes and the packs' bodies.
+    pub impacts_csv: Option<&'a Path>,
+    /// `--fatigue-json`: every pack body's counted cycles and spectra.
+    pub fatigue_json: Option<&'a Path>,
     /// `--plot`.
     pub plot: Option<&'a Path>,
     /// The recording (`--out`, or the default name; `None` with `--no-record`).
@@ -39,7 +43,8 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     if let Some(flag) = a.pack_only.first() {
         return Err(BadInput(format!(
             "{flag}: not for a network scene ({} has [[bodies]]); a network run gives its \
-             table, its recording (--out), --summary-json and --plot",
+             table, its recording (--out), --summary-json, --impacts-csv, --fatigue-json \
+             and --plot",
             scene.name
         ))
         .into());
@@ -47,6 +52,12 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     let mut outs = Vec::new();
     if let Some(p) = a.summary_json {
         outs.push(Output::file("--summary-json", p));
+    }
+    if let Some(p) = a.impacts_csv {
+        outs.push(Output::file("--impacts-csv", p));
+    }
+    if let Some(p) = a.fatigue_json {
+        outs.push(Output::file("--fatigue-json", p));
     }
     if let Some(p) = a.plot {
         outs.push(Output::figure("--plot", p));
@@ -82,6 +93,8 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
             recording,
             stop: Some(interrupted),
             progress: Some(&mut progress),
+            impacts_csv: a.impacts_csv.map(Path::to_path_buf),
+            keep_cycles: a.fatigue_json.is_some(),
         },
     )?;
     pb.finish_and_clear();
@@ -94,6 +107,9 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     }
     if let Some(path) = a.summary_json {
         crate::outputs::write_json(path, s)?;
+    }
+    if let Some(path) = a.fatigue_json {
+        crate::outputs::write_json(path, &done.cycles)?;
     }
     out!(
         "{}: {:.3} s simulated with the {} engine (network of {} bodies, {} couplings) in {:.3} s wall ({} steps, {} events)",
@@ -248,6 +264,94 @@ fn plot(
         &outcome.history,
         &outcome.impacts,
     )
+}
+
+/// `plot --spectrum` of a network recording: the exceedance spectrum of the contact peaks of
+/// every body with tooth impacts (a pack's discs and plates, a gear mesh), in coupling order.
+fn plot_spectrum(
+    net: &clutchpack_sdk::record::RecordedNetwork,
+    scene: &str,
+    a: &crate::recording::PlotArgs,
+) -> Result<ExitCode> {
+    let duration = net.samples.last().map_or(0.0, |s| s.t_s);
+    let mut peaks: Vec<(String, Vec<f64>)> = Vec::new();
+    for (name, e) in &net.impacts {
+        match peaks.iter_mut().find(|(n, _)| n == name) {
+            Some((_, p)) => p.push(e.peak_n),
+            None => peaks.push((name.clone(), vec![e.peak_n])),
+        }
+    }
+    if peaks.is_empty() || duration <= 0.0 {
+        return Err(BadInput(format!(
+            "--spectrum: {} holds no tooth impacts (its couplings are lumped: a spectrum needs \
+             a resolved pack or a gear mesh)",
+            a.file.display()
+        ))
+        .into());
+    }
+    // in coupling order (the impacts come in the order their contacts closed)
+    let coupling_of = |name: &str| {
+        net.couplings
+            .iter()
+            .position(|c| name == c || name.starts_with(&format!("{c}/")))
+            .unwrap_or(usize::MAX)
+    };
+    // a pack's discs before its plates, each in their numbering (`plate-2` before `plate-10`)
+    let role = |name: &str| match name.split('/').nth(1) {
+        Some("discs") => 0,
+        Some("plates") => 1,
+        _ => 2,
+    };
+    peaks.sort_by_key(|(n, _)| (coupling_of(n), role(n), n.len(), n.clone()));
+    let spectra: Vec<(String, Vec<(f64, f64)>)> = peaks
+        .into_iter()
+        .map(|(n, p)| {
+            let s = clutchpack_sdk::analysis::cycles::exceedance_spectrum(&p, duration);
+            (n, s)
+        })
+        .collect();
+    clutchpack_sdk::analysis::fatigue_plot::plot_spectrum(
+        &a.out,
+        &format!("{scene}: tooth load spectra"),
+        &spectra,
+        &[],
+    )
+    .with_context(|| format!("plotting {}", a.out.display()))?;
+    out!("{}", a.out.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `plot` of a network recording: the figure of `run --plot` (speeds and coupling torques).
+pub fn plot_recording(
+    reader: &clutchpack_sdk::record::RecordingReader,
+    a: &crate::recording::PlotArgs,
+    net: std::result::Result<clutchpack_sdk::record::RecordedNetwork, String>,
+) -> Result<ExitCode> {
+    let net = net.map_err(|e| BadInput(format!("{}: {e}", a.file.display())))?;
+    crate::recording::reread_ok(reader)?;
+    let run = reader.info().metadata("clutchpack.run");
+    let get = |k: &str| run.and_then(|m| m.get(k).cloned()).unwrap_or_default();
+    if a.spectrum {
+        return plot_spectrum(&net, &get("scene_name"), a);
+    }
+    let bodies: Vec<(&str, bool)> = net
+        .bodies
+        .iter()
+        .zip(&net.fixed)
+        .map(|(n, f)| (n.as_str(), *f))
+        .collect();
+    let couplings: Vec<&str> = net.couplings.iter().map(String::as_str).collect();
+    plot_samples(
+        &a.out,
+        &get("scene_name"),
+        &get("engine"),
+        &bodies,
+        &couplings,
+        &net.samples,
+        &net.impact_peaks(),
+    )?;
+    out!("{}", a.out.display());
+    Ok(ExitCode::SUCCESS)
 }
 
 /// The figure of a network's run: every turning body's speed and every coupling's torque on

@@ -631,48 +631,11 @@ fn plot_spectrum(reader: &RecordingReader, a: &PlotArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// `plot` of a network recording: the figure of `run --plot` (speeds and coupling torques).
-fn plot_network(
-    reader: &RecordingReader,
-    a: &PlotArgs,
-    net: std::result::Result<clutchpack_sdk::record::RecordedNetwork, String>,
-) -> Result<ExitCode> {
-    if a.spectrum {
-        return Err(BadInput(format!(
-            "--spectrum: {} is a network recording (lumped couplings, no disc teeth)",
-            a.file.display()
-        ))
-        .into());
-    }
-    let net = net.map_err(|e| BadInput(format!("{}: {e}", a.file.display())))?;
-    reread_ok(reader)?;
-    let run = reader.info().metadata("clutchpack.run");
-    let get = |k: &str| run.and_then(|m| m.get(k).cloned()).unwrap_or_default();
-    let bodies: Vec<(&str, bool)> = net
-        .bodies
-        .iter()
-        .zip(&net.fixed)
-        .map(|(n, f)| (n.as_str(), *f))
-        .collect();
-    let couplings: Vec<&str> = net.couplings.iter().map(String::as_str).collect();
-    crate::network::plot_samples(
-        &a.out,
-        &get("scene_name"),
-        &get("engine"),
-        &bodies,
-        &couplings,
-        &net.samples,
-        &net.impact_peaks(),
-    )?;
-    out!("{}", a.out.display());
-    Ok(ExitCode::SUCCESS)
-}
-
 pub fn plot(a: PlotArgs) -> Result<ExitCode> {
     crate::outputs::check_outputs(&[Output::figure("--out", &a.out)], &[a.file.as_path()])?;
     let reader = open_recording(&a.file, a.salvage)?;
     if let Some(net) = clutchpack_sdk::record::read_network(&reader) {
-        return plot_network(&reader, &a, net);
+        return crate::network::plot_recording(&reader, &a, net);
     }
     if a.spectrum {
         return plot_spectrum(&reader, &a);

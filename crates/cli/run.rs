@@ -35,12 +35,15 @@ pub struct RunArgs {
     pub summary_json: Option<PathBuf>,
     /// Write the counted cycles of each disc as JSON: exact (range, count) pairs, range
     /// histogram, range-mean matrix, exceedance spectrum, and per resolved tooth its ranges
-    /// (an existing FILE is replaced). Keeps every cycle in memory until the run ends.
+    /// (an existing FILE is replaced). Keeps every cycle in memory until the run ends. A
+    /// network scene gives every resolved pack's discs and plates, named
+    /// `<pack>/discs/<disc>` and `<pack>/plates/<plate>`.
     #[arg(long, value_name = "FILE")]
     pub fatigue_json: Option<PathBuf>,
     /// Write one CSV row per impact: disc,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n (an
     /// existing FILE is replaced). Written as the impacts close; a stopped or failed run
-    /// leaves the rows up to there.
+    /// leaves the rows up to there. A network scene's first column is `name`: a gear mesh's
+    /// name, or a pack's `<pack>/discs/<disc>` and `<pack>/plates/<plate>`.
     #[arg(long, value_name = "FILE")]
     pub impacts_csv: Option<PathBuf>,
     /// Also give the figures window by window, S seconds each: per window the impacts, the
@@ -123,8 +126,6 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     });
     if scene.network.is_some() {
         let pack_only = [
-            ("--impacts-csv", a.impacts_csv.is_some()),
-            ("--fatigue-json", a.fatigue_json.is_some()),
             ("--windows", a.windows.is_some()),
             ("--per-tooth", a.per_tooth),
             ("--windows-plot", a.windows_plot.is_some()),
@@ -134,6 +135,8 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             scene_path: a.scene.as_deref(),
             engine: a.engine,
             summary_json: a.summary_json.as_deref(),
+            impacts_csv: a.impacts_csv.as_deref(),
+            fatigue_json: a.fatigue_json.as_deref(),
             plot: a.plot.as_deref(),
             recording: record_path.as_deref(),
             out_given: a.out.is_some(),

@@ -117,6 +117,7 @@ pub fn run_network(
                 recording,
                 stop: Some(&stop),
                 progress: Some(&mut progress),
+                ..Default::default()
             },
         )
     });

@@ -100,15 +100,7 @@ impl RunCollector {
     /// Each coupling's S-N curve for the collectors: (root stress per newton of tooth load,
     /// Pa/N; material), from [`Self::with_fatigue`]'s parameters.
     fn curves(&self) -> Vec<(f64, clutchpack_model::Material)> {
-        self.fatigue_params
-            .iter()
-            .map(|(g, p)| {
-                (
-                    clutchpack_model::fatigue::stress_per_newton(g, &p.form),
-                    p.material,
-                )
-            })
-            .collect()
+        crate::fatigue::curves(&self.fatigue_params)
     }
 
     /// Also keeps the figures of every window of `len_s` (s) of the bodies `names` (engine
@@ -140,7 +132,7 @@ impl RunCollector {
     /// renamed into place by [`Self::finish_impacts_csv`]); `names` are the disc names in
     /// engine order.
     pub fn with_impacts_csv(mut self, path: &Path, names: &[String]) -> Result<RunCollector> {
-        self.csv = Some(ImpactsCsv::create(path, names)?);
+        self.csv = Some(ImpactsCsv::create(path, names, "disc")?);
         Ok(self)
     }
 
@@ -191,8 +183,10 @@ impl RunCollector {
     }
 }
 
-/// The impacts CSV of a run, written row by row to a temporary sibling of its path.
-struct ImpactsCsv {
+/// The impacts CSV of a run, written row by row to a temporary sibling of its path: a
+/// header, then `name,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n` per impact, where the
+/// first column (`disc` for a pack run, `name` for a network run) names the impact's body.
+pub(crate) struct ImpactsCsv {
     pending: clutchpack_record::PendingFile,
     out: std::io::BufWriter<std::fs::File>,
     names: Vec<String>,
@@ -201,7 +195,9 @@ struct ImpactsCsv {
 }
 
 impl ImpactsCsv {
-    fn create(path: &Path, names: &[String]) -> Result<ImpactsCsv> {
+    /// Starts the CSV at `path` (a temporary sibling until [`Self::finish`]); `names[i]`
+    /// names the impacts whose `disc` is `i`, and `first` heads their column.
+    pub(crate) fn create(path: &Path, names: &[String], first: &str) -> Result<ImpactsCsv> {
         let (pending, file) =
             clutchpack_record::PendingFile::create(path, clutchpack_record::Replace::Existing)
                 .map_err(Error::io(path))?;
@@ -211,7 +207,7 @@ impl ImpactsCsv {
             names: names.to_vec(),
             error: None,
         };
-        c.write(|w| writeln!(w, "disc,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n"));
+        c.write(|w| writeln!(w, "{first},t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n"));
         Ok(c)
     }
 
@@ -223,7 +219,8 @@ impl ImpactsCsv {
         }
     }
 
-    fn row(&mut self, e: &ImpactEvent) {
+    /// Writes the row of `e` (named by its `disc` index).
+    pub(crate) fn row(&mut self, e: &ImpactEvent) {
         let name = self
             .names
             .get(e.disc)
@@ -244,7 +241,8 @@ impl ImpactsCsv {
         });
     }
 
-    fn finish(mut self) -> Result<()> {
+    /// Flushes the rows and renames the file into place (a write error discards it).
+    pub(crate) fn finish(mut self) -> Result<()> {
         use std::io::Write as _;
         let path = self.pending.target().to_path_buf();
         let flushed = match self.error.take() {

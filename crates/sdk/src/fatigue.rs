@@ -18,6 +18,22 @@ pub fn fatigue_params(scene: &Scene) -> Vec<(SplineGeometry, FatigueParams)> {
         .collect()
 }
 
+/// Each coupling's S-N curve for a summing [`FatigueCollector`]: (root stress per newton of
+/// tooth load, Pa/N; material) from its spline and fatigue parameters.
+pub(crate) fn curves(
+    params: &[(SplineGeometry, FatigueParams)],
+) -> Vec<(f64, clutchpack_model::Material)> {
+    params
+        .iter()
+        .map(|(g, p)| {
+            (
+                clutchpack_model::fatigue::stress_per_newton(g, &p.form),
+                p.material,
+            )
+        })
+        .collect()
+}
+
 /// The fatigue of every coupling named `names` from the histories of `collector`, with
 /// `params` per coupling (defaults past its end), over `duration_s` of simulated duty.
 pub fn assess_fatigue(

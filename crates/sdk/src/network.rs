@@ -26,6 +26,13 @@ pub struct NetworkRequest<'a> {
     pub stop: Option<&'a AtomicBool>,
     /// Called with the simulated time reached, s.
     pub progress: Option<&'a mut dyn FnMut(f64)>,
+    /// Write every tooth impact (a gear mesh's, a pack's disc's or plate's) to this CSV file
+    /// as it comes: `name,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n`, named as
+    /// [`NetworkOutcome::impacts`] names them; complete up to a stop or a failure.
+    pub impacts_csv: Option<std::path::PathBuf>,
+    /// Keep every resolved pack body's counted load cycles for [`NetworkOutcome::cycles`]
+    /// (memory grows with the run; without, the fatigue is summed as it is counted).
+    pub keep_cycles: bool,
 }
 
 /// One mode change of a clutch.
@@ -159,6 +166,10 @@ pub struct NetworkOutcome {
     pub impacts: Vec<(String, f64, f64)>,
     /// The recording's path, if one was asked ([`NetworkRequest::recording`]).
     pub recording: Option<std::path::PathBuf>,
+    /// Every resolved pack body's counted load cycles and load spectra, named
+    /// `<pack>/discs/<disc>` or `<pack>/plates/<plate>`, if asked
+    /// ([`NetworkRequest::keep_cycles`]; `run --fatigue-json`).
+    pub cycles: Vec<clutchpack_analysis::DiscCycles>,
 }
 
 /// What a network run keeps as it goes (its own state, across the calls of a
@@ -166,6 +177,8 @@ pub struct NetworkOutcome {
 #[derive(Default)]
 pub(crate) struct Keep {
     keep_history: bool,
+    /// Keep every pack body's counted cycles ([`NetworkRequest::keep_cycles`]).
+    keep_cycles: bool,
     events: Vec<ClutchEvent>,
     /// (t, each coupling's torque step) at each switching instant.
     steps: Vec<(f64, Vec<f64>)>,
@@ -175,8 +188,12 @@ pub(crate) struct Keep {
     impacts: std::collections::HashMap<usize, (u64, f64)>,
     /// Per (pack coupling, body in the pack): (impacts, largest peak).
     pack_bodies: std::collections::HashMap<(usize, usize), (u64, f64)>,
-    /// Per pack coupling: its bodies' load histories for the fatigue (samples and impacts).
+    /// Per pack coupling: its bodies' load histories for the fatigue (samples and impacts),
+    /// summed on each body's S-N curve as they are counted ([`Keep::with_packs`]).
     pack_fatigue: std::collections::BTreeMap<usize, clutchpack_analysis::FatigueCollector>,
+    /// The impacts CSV being written, if asked, and each coupling's first row name's index
+    /// in it (a mesh's name, a pack's first body's).
+    csv: Option<(crate::collector::ImpactsCsv, Vec<usize>)>,
     /// Per pack coupling: its faces' mode as a clutch's label ("free", "slipping",
     /// "locked"), and the instants all its faces locked.
     pack_modes: std::collections::HashMap<usize, (&'static str, Vec<f64>)>,
@@ -201,6 +218,63 @@ impl Keep {
         }
     }
 
+    /// Collects every resolved pack's bodies' fatigue on their S-N curves (the pack files'
+    /// parameters), keeping every counted cycle too if `keep_cycles`.
+    pub fn with_packs(mut self, scene: &Scene, keep_cycles: bool) -> Keep {
+        self.keep_cycles = keep_cycles;
+        if let Some(net) = &scene.network {
+            for (k, (_, params)) in pack_params(scene, net) {
+                let curves = crate::fatigue::curves(&params);
+                self.pack_fatigue.insert(
+                    k,
+                    clutchpack_analysis::FatigueCollector::summing(curves, keep_cycles),
+                );
+            }
+        }
+        self
+    }
+
+    /// Also writes every tooth impact to the CSV file `path` as it comes
+    /// ([`NetworkRequest::impacts_csv`]).
+    pub fn with_impacts_csv(mut self, path: &std::path::Path, scene: &Scene) -> Result<Keep> {
+        let Some(net) = &scene.network else {
+            return Ok(self);
+        };
+        let (mut names, mut first) = (Vec::new(), Vec::new());
+        for (k, c) in net.couplings.iter().enumerate() {
+            first.push(names.len());
+            match c.pack() {
+                Some(p) => names.extend(
+                    (0..p.discs.len() + p.plates.len())
+                        .map(|i| clutchpack_record::impact_name(net, k, Some(i))),
+                ),
+                None => names.push(clutchpack_record::impact_name(net, k, None)),
+            }
+        }
+        let csv = crate::collector::ImpactsCsv::create(path, &names, "name")?;
+        self.csv = Some((csv, first));
+        Ok(self)
+    }
+
+    /// Writes `e`, an impact of coupling `coupling` (of its body `body` in a pack), to the
+    /// impacts CSV if one is written.
+    fn csv_row(&mut self, coupling: usize, body: Option<usize>, e: &clutchpack_model::ImpactEvent) {
+        if let Some((csv, first)) = self.csv.as_mut() {
+            let disc = first
+                .get(coupling)
+                .map_or(usize::MAX, |f| f + body.unwrap_or(0));
+            csv.row(&clutchpack_model::ImpactEvent { disc, ..*e });
+        }
+    }
+
+    /// Completes the impacts CSV (if one is written) and renames it into place.
+    pub(crate) fn finish_csv(&mut self) -> Result<()> {
+        match self.csv.take() {
+            Some((csv, _)) => csv.finish(),
+            None => Ok(()),
+        }
+    }
+
     /// Runs `write` on the recorder, keeping its first error (after which nothing more is
     /// recorded and the run stops).
     fn record(
@@ -220,6 +294,7 @@ impl Keep {
     pub fn clone_unrecorded(&self) -> Keep {
         Keep {
             keep_history: self.keep_history,
+            keep_cycles: self.keep_cycles,
             events: self.events.clone(),
             steps: self.steps.clone(),
             range: self.range.clone(),
@@ -227,6 +302,7 @@ impl Keep {
             pack_bodies: self.pack_bodies.clone(),
             pack_modes: self.pack_modes.clone(),
             pack_fatigue: self.pack_fatigue.clone(),
+            csv: None,
             history: self.history.clone(),
             impact_log: self.impact_log.clone(),
             stopped: self.stopped,
@@ -272,6 +348,7 @@ impl NetworkObserver for Obs<'_, '_> {
     }
     fn mesh_impact(&mut self, e: &clutchpack_model::ImpactEvent) {
         self.keep.record(|r| r.write_mesh_impact(e));
+        self.keep.csv_row(e.disc, None, e);
         if self.keep.keep_history {
             self.keep
                 .impact_log
@@ -281,6 +358,7 @@ impl NetworkObserver for Obs<'_, '_> {
     }
     fn pack_impact(&mut self, coupling: usize, e: &clutchpack_model::ImpactEvent) {
         self.keep.record(|r| r.write_pack_impact(coupling, e));
+        self.keep.csv_row(coupling, Some(e.disc), e);
         self.keep
             .pack_fatigue
             .entry(coupling)
@@ -387,10 +465,11 @@ pub fn run_network_scene(
     };
     let engine = scene.engine(asked, &scene.name)?;
     let sim = &scene.simulation;
-    let mut keep = Keep::new(
-        start_recording(scene, engine, req.recording.as_ref(), None)?,
-        req.keep_history,
-    );
+    let mut keep = Keep::new(None, req.keep_history).with_packs(scene, req.keep_cycles);
+    if let Some(path) = &req.impacts_csv {
+        keep = keep.with_impacts_csv(path, scene)?;
+    }
+    keep.recorder = start_recording(scene, engine, req.recording.as_ref(), None)?;
     let mut obs = Obs {
         keep: &mut keep,
         stop: req.stop,
@@ -457,6 +536,9 @@ pub(crate) fn engine_failed(
     source: clutchpack_model::EngineError,
 ) -> Error {
     let recorded = keep.recorder.take().map(|r| r.finish(None));
+    // the impacts CSV holds the run up to the failure too (a write error of its own is lost
+    // behind the engine's, which is the one to report)
+    let _ = keep.finish_csv();
     let kept = match recorded {
         Some(Ok(p)) => format!(" (the recording {} holds the run up to there)", p.display()),
         _ => String::new(),
@@ -467,15 +549,13 @@ pub(crate) fn engine_failed(
     }
 }
 
-/// Every resolved pack's bodies' fatigue from what `keep` collected over `duration_s` of
-/// duty, with the pack files' parameters (the scene's `fatigue`: every pack's bodies in
+/// Every resolved pack's bodies' names and their spline and fatigue parameters (the pack
+/// files' `fatigue.*` and `material.*`: the scene's `fatigue` holds every pack's bodies in
 /// coupling order), by coupling.
-fn pack_fatigue(
+fn pack_params(
     scene: &Scene,
     net: &clutchpack_model::network::Network,
-    keep: &mut Keep,
-    duration_s: f64,
-) -> std::collections::BTreeMap<usize, Vec<clutchpack_analysis::DiscFatigue>> {
+) -> std::collections::BTreeMap<usize, (Vec<String>, Vec<FatigueInput>)> {
     let mut out = std::collections::BTreeMap::new();
     let mut offset = 0;
     for (k, c) in net.couplings.iter().enumerate() {
@@ -490,14 +570,45 @@ fn pack_fatigue(
             })
             .collect();
         offset += bodies.len();
-        let names: Vec<String> = bodies.iter().map(|d| d.name.clone()).collect();
+        let names = bodies.iter().map(|d| d.name.clone()).collect();
+        out.insert(k, (names, params));
+    }
+    out
+}
+
+/// A body's spline geometry and fatigue parameters.
+type FatigueInput = (
+    clutchpack_model::SplineGeometry,
+    clutchpack_model::FatigueParams,
+);
+
+/// Every resolved pack's bodies' fatigue from what `keep` collected over `duration_s` of
+/// duty, by coupling; and with `cycles`, every body's counted cycles
+/// ([`NetworkOutcome::cycles`]).
+fn pack_fatigue(
+    scene: &Scene,
+    net: &clutchpack_model::network::Network,
+    keep: &mut Keep,
+    duration_s: f64,
+    cycles: &mut Vec<clutchpack_analysis::DiscCycles>,
+) -> std::collections::BTreeMap<usize, Vec<clutchpack_analysis::DiscFatigue>> {
+    let mut out = std::collections::BTreeMap::new();
+    for (k, (names, params)) in pack_params(scene, net) {
         let collector = keep.pack_fatigue.remove(&k).unwrap_or_default();
-        if duration_s > 0.0 {
-            out.insert(
-                k,
-                crate::fatigue::assess_fatigue(collector, &params, &names, duration_s),
-            );
+        if duration_s <= 0.0 {
+            continue;
         }
+        let histories = collector.finish(names.len());
+        if keep.keep_cycles {
+            cycles.extend(names.iter().zip(&histories).enumerate().map(|(i, (_, h))| {
+                let name = clutchpack_record::impact_name(net, k, Some(i));
+                clutchpack_analysis::disc_cycles(&name, h, duration_s)
+            }));
+        }
+        out.insert(
+            k,
+            crate::fatigue::assess_histories(&histories, &params, &names, duration_s),
+        );
     }
     out
 }
@@ -517,8 +628,10 @@ pub(crate) fn conclude(
     if let Some(e) = keep.record_error.take() {
         return Err(e.into());
     }
+    keep.finish_csv()?;
     let last = &run.last;
-    let fatigue = pack_fatigue(scene, net, &mut keep, last.t_s);
+    let mut cycles = Vec::new();
+    let fatigue = pack_fatigue(scene, net, &mut keep, last.t_s, &mut cycles);
     let couplings = net
         .couplings
         .iter()
@@ -632,5 +745,6 @@ pub(crate) fn conclude(
         impacts,
         history: keep.history,
         recording,
+        cycles,
     })
 }

@@ -400,7 +400,8 @@ impl NetworkSimulation {
         let mut keep = Keep::new(
             start_recording(scene, engine, recording, Some((&driven_names, stop_time_s)))?,
             false,
-        );
+        )
+        .with_packs(scene, false);
         let started = std::time::Instant::now();
         let mut obs = Obs {
             keep: &mut keep,
