@@ -535,6 +535,27 @@ fn dct_upshift_with_resolved_packs_names_its_discs() {
     assert!(residual.abs() < 1e-6, "{residual}");
     assert!(s["energy"]["pack_loss_j"].as_f64().unwrap() > 5000.0);
     assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
+    // each pack's joints (read by the independent reader): every disc's and plate's
+    // per-tooth load at the samples, never above its located largest peak
+    let rec = super::read_independently(&slow, false);
+    for pack in [&k1, &k2] {
+        let topic = format!("/network/packs/{}/joints", pack["name"].as_str().unwrap());
+        let joints = &rec["joints"][&topic];
+        let mut loaded = 0;
+        for b in pack["pack_bodies"].as_array().unwrap() {
+            let name = b["name"].as_str().unwrap();
+            let sampled = joints[name]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{topic} {name}"));
+            let peak = b["largest_peak_n"].as_f64().unwrap().abs();
+            assert!(
+                sampled <= peak * (1.0 + 1e-9),
+                "{topic} {name}: {sampled} > {peak}"
+            );
+            loaded += usize::from(sampled > 0.0);
+        }
+        assert!(loaded > 0, "{topic}: {joints}");
+    }
     let o = run(&["replay", slow.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let line = stdout(&o)

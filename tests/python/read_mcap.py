@@ -226,8 +226,14 @@ def indexed_pass(path, report, stats):
             raise Failure("the file has a footer but no summary section")
         report["summary_section"] = True
         counts = {}
+        joints = report["joints"]
         for schema, channel, message, decoded in reader.iter_decoded_messages(log_time_order=True):
             counts[channel.topic] = counts.get(channel.topic, 0) + 1
+            if schema.name == "sensor_msgs/msg/JointState":
+                # per topic and joint name: the largest |effort| (e.g. a pack body's load, N)
+                by_name = joints.setdefault(channel.topic, {})
+                for name, effort in zip(decoded.name, decoded.effort):
+                    by_name[name] = max(by_name.get(name, 0.0), abs(effort))
         for topic, t in report["topics"].items():
             if counts.get(topic, 0) != t["count"]:
                 raise Failure(
@@ -282,6 +288,7 @@ def main():
         "metadata": [],
         "attachments": [],
         "summary": None,
+        "joints": {},
     }
     failure = None
     try:

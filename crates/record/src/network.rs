@@ -14,6 +14,7 @@
 //! | `/network/bodies/<segment>` | `clutchpack.ShaftState` | each sample |
 //! | `/network/couplings/<segment>` | `clutchpack.CouplingState` | each sample |
 //! | `/joints` (couplings: slip, torque), `/network/joints/bodies` (angle, speed) | `sensor_msgs/msg/JointState` | each sample (Rerun, Lichtblick) |
+//! | `/network/packs/<segment>/joints` | `sensor_msgs/msg/JointState` | each sample: a resolved pack's discs and plates (angle, speed, per-tooth load) |
 //! | `/network/events` | `foxglove.Log` | each clutch mode change, at its instant |
 //! | `/network/impacts` | `clutchpack.Impact` | each gear-mesh impact and each tooth impact of a pack's disc or plate (`<pack>/discs/<disc>`, `<pack>/plates/<plate>`), logged when its contact closes (in time order; the message holds its peak's time) |
 //! | `/tf` | `foxglove.FrameTransforms` | each sample: `world` -> `body/<segment>` |
@@ -148,6 +149,8 @@ struct Channels {
     tf: u16,
     scene: u16,
     scene_couplings: u16,
+    /// Per resolved pack (by coupling): its joints' channel and its bodies' names.
+    pack_joints: BTreeMap<usize, (u16, Vec<String>)>,
 }
 
 /// Streams a network run into an MCAP file: call [`Self::write_sample`],
@@ -290,7 +293,17 @@ impl NetworkRecorder {
             )?);
         }
         let none = BTreeMap::new;
+        let mut pack_joints = BTreeMap::new();
+        for (k, (c, seg)) in net.couplings.iter().zip(&coupling_segments).enumerate() {
+            if let Some(p) = c.pack() {
+                let topic = topics::network_pack_joints(seg);
+                let id = channel(&mut w, s_joints, &topic, "cdr", none())?;
+                let names = p.discs.iter().chain(&p.plates).map(|d| d.name.clone());
+                pack_joints.insert(k, (id, names.collect()));
+            }
+        }
         let ch = Channels {
+            pack_joints,
             bodies,
             couplings,
             body_joints: channel(&mut w, s_joints, topics::NETWORK_BODY_JOINTS, "cdr", none())?,
@@ -617,15 +630,23 @@ impl NetworkRecorder {
         )
     }
 
-    /// Writes the angles `angle_rad` (rad, discs then plates) of the resolved pack that is
-    /// coupling `coupling` at `t_s` (s) as its rings' frames on `/tf`.
+    /// Writes the resolved pack that is coupling `coupling` at `t_s` (s), its discs' then
+    /// plates' angles `angle_rad` (rad), speeds `speed_rad_s` (rad/s) and per-tooth loads
+    /// `load_n` (N): its joints, and its rings' frames on `/tf`.
     pub fn write_pack_sample(
         &mut self,
         coupling: usize,
         t_s: f64,
         angle_rad: &[f64],
+        speed_rad_s: &[f64],
+        load_n: &[f64],
     ) -> Result<(), RecordError> {
         let ns = log_time_ns(t_s);
+        if let Some((id, names)) = self.ch.pack_joints.get(&coupling) {
+            let id = *id;
+            ros2::joint_state(&mut self.buf, ns, names, angle_rad, speed_rad_s, load_n);
+            self.put_buf(id, ns, "pack joints")?;
+        }
         match self.packs.transforms(coupling, ns, angle_rad) {
             Some(tf) => self.put(self.ch.tf, ns, &tf, "/tf"),
             None => Ok(()),

@@ -101,6 +101,15 @@ pub fn network_coupling(segment: &str) -> String {
     format!("{NETWORK_PREFIX}couplings/{segment}")
 }
 
+/// `/network/packs/<segment>/joints`, `sensor_msgs/msg/JointState` (ROS 2, CDR): a resolved
+/// pack's discs and plates at each sample, one joint per body named as in its pack file
+/// (discs, then plates): `position` = its angle (rad, absolute), `velocity` = its speed
+/// (rad/s), `effort` = its per-tooth spline load (N, signed as the impacts'), so that the
+/// viewers plot every disc's load as they plot a pack run's [`JOINTS`].
+pub fn network_pack_joints(segment: &str) -> String {
+    format!("{NETWORK_PREFIX}packs/{segment}/joints")
+}
+
 /// A network's clutch mode changes, `foxglove.Log` (one line each, at its instant:
 /// `K2: slip+ -> locked`).
 pub const NETWORK_EVENTS: &str = "/network/events";

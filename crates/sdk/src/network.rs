@@ -378,11 +378,11 @@ impl NetworkObserver for Obs<'_, '_> {
         coupling: usize,
         t: f64,
         angle_rad: &[f64],
-        _speed: &[f64],
+        speed_rad_s: &[f64],
         load_n: &[f64],
     ) {
         self.keep
-            .record(|r| r.write_pack_sample(coupling, t, angle_rad));
+            .record(|r| r.write_pack_sample(coupling, t, angle_rad, speed_rad_s, load_n));
         let sample = clutchpack_model::Sample {
             t_s: t,
             discs: load_n
