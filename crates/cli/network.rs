@@ -25,6 +25,8 @@ pub struct NetworkArgs<'a> {
     pub impacts_csv: Option<&'a Path>,
     /// `--fatigue-json`: every pack body's counted cycles and spectra.
     pub fatigue_json: Option<&'a Path>,
+    /// `--windows S`: every pack's figures window by window.
+    pub windows_s: Option<f64>,
     /// `--plot`.
     pub plot: Option<&'a Path>,
     /// The recording (`--out`, or the default name; `None` with `--no-record`).
@@ -43,8 +45,8 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     if let Some(flag) = a.pack_only.first() {
         return Err(BadInput(format!(
             "{flag}: not for a network scene ({} has [[bodies]]); a network run gives its \
-             table, its recording (--out), --summary-json, --impacts-csv, --fatigue-json \
-             and --plot",
+             table, its recording (--out), --summary-json, --impacts-csv, --fatigue-json, \
+             --windows and --plot",
             scene.name
         ))
         .into());
@@ -95,6 +97,7 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
             progress: Some(&mut progress),
             impacts_csv: a.impacts_csv.map(Path::to_path_buf),
             keep_cycles: a.fatigue_json.is_some(),
+            windows_s: a.windows_s,
         },
     )?;
     pb.finish_and_clear();
@@ -187,6 +190,10 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
                 b.damage_rate_per_h,
                 life
             );
+        }
+        if !c.windows.is_empty() {
+            out!("  {}:", c.name);
+            crate::run::print_windows(&c.windows);
         }
     }
     let mut changes: Vec<(&str, &clutchpack_sdk::ModeChange)> = s

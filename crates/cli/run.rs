@@ -126,7 +126,6 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     });
     if scene.network.is_some() {
         let pack_only = [
-            ("--windows", a.windows.is_some()),
             ("--per-tooth", a.per_tooth),
             ("--windows-plot", a.windows_plot.is_some()),
             ("--no-contact-samples", a.no_contact_samples),
@@ -137,6 +136,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             summary_json: a.summary_json.as_deref(),
             impacts_csv: a.impacts_csv.as_deref(),
             fatigue_json: a.fatigue_json.as_deref(),
+            windows_s: a.windows,
             plot: a.plot.as_deref(),
             recording: record_path.as_deref(),
             out_given: a.out.is_some(),
@@ -423,60 +423,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             th.balance_error_j
         );
     }
-    if !summary.windows.is_empty() {
-        out!("by window (the worst body in each; damage rate: lumped teeth, MODEL.md section 7)");
-        out!(
-            "{:>8} {:>8} {:>8} {:>11} {:<12} {:>10} {:>12} {:<12} {:>9} {:>9}",
-            "t0_s",
-            "t1_s",
-            "impacts",
-            "peak_abs_n",
-            "body",
-            "p99_abs_n",
-            "damage_1/h",
-            "body",
-            "oil_k",
-            "hottest_k"
-        );
-        let k = |t: Option<f64>| t.map_or("-".to_string(), |t| format!("{t:.2}"));
-        for w in &summary.windows {
-            out!(
-                "{:>8.3} {:>8.3} {:>8} {:>11.1} {:<12} {:>10.1} {:>12.4e} {:<12} {:>9} {:>9}",
-                w.t0_s,
-                w.t1_s,
-                w.impacts,
-                w.peak_abs_n,
-                w.peak_body,
-                w.p99_abs_n,
-                w.damage_rate_per_h,
-                w.damage_body,
-                k(w.oil_k),
-                k(w.hottest_body_k)
-            );
-        }
-    }
-    if let Some(first) = summary.windows.first() {
-        out!("largest per-tooth |peak| (N) and damage rate (1/h) by body and window end (s)");
-        let mut head = format!("{:<12}", "body");
-        for w in &summary.windows {
-            head.push_str(&format!(" {:>10.3}", w.t1_s));
-        }
-        out!("{head}");
-        for (i, b) in first.bodies.iter().enumerate() {
-            let mut peaks = format!("{:<12}", b.name);
-            let mut rates = format!("{:<12}", "");
-            for w in &summary.windows {
-                let bw = w.bodies.get(i);
-                peaks.push_str(&format!(" {:>10.1}", bw.map_or(0.0, |b| b.peak_abs_n)));
-                rates.push_str(&format!(
-                    " {:>10.3e}",
-                    bw.map_or(0.0, |b| b.damage_rate_per_h)
-                ));
-            }
-            out!("{peaks}");
-            out!("{rates}");
-        }
-    }
+    print_windows(&summary.windows);
     if let Some(e) = recording_error {
         return Err(e);
     }
@@ -498,4 +445,63 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         return Ok(crate::signals::exit_code());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Prints a run's figures window by window (`--windows`): the worst body in each window, then
+/// each body's largest peak and damage rate by window (nothing without windows).
+pub fn print_windows(windows: &[clutchpack_sdk::WindowRow]) {
+    if !windows.is_empty() {
+        out!("by window (the worst body in each; damage rate: lumped teeth, MODEL.md section 7)");
+        out!(
+            "{:>8} {:>8} {:>8} {:>11} {:<12} {:>10} {:>12} {:<12} {:>9} {:>9}",
+            "t0_s",
+            "t1_s",
+            "impacts",
+            "peak_abs_n",
+            "body",
+            "p99_abs_n",
+            "damage_1/h",
+            "body",
+            "oil_k",
+            "hottest_k"
+        );
+        let k = |t: Option<f64>| t.map_or("-".to_string(), |t| format!("{t:.2}"));
+        for w in windows {
+            out!(
+                "{:>8.3} {:>8.3} {:>8} {:>11.1} {:<12} {:>10.1} {:>12.4e} {:<12} {:>9} {:>9}",
+                w.t0_s,
+                w.t1_s,
+                w.impacts,
+                w.peak_abs_n,
+                w.peak_body,
+                w.p99_abs_n,
+                w.damage_rate_per_h,
+                w.damage_body,
+                k(w.oil_k),
+                k(w.hottest_body_k)
+            );
+        }
+    }
+    if let Some(first) = windows.first() {
+        out!("largest per-tooth |peak| (N) and damage rate (1/h) by body and window end (s)");
+        let mut head = format!("{:<12}", "body");
+        for w in windows {
+            head.push_str(&format!(" {:>10.3}", w.t1_s));
+        }
+        out!("{head}");
+        for (i, b) in first.bodies.iter().enumerate() {
+            let mut peaks = format!("{:<12}", b.name);
+            let mut rates = format!("{:<12}", "");
+            for w in windows {
+                let bw = w.bodies.get(i);
+                peaks.push_str(&format!(" {:>10.1}", bw.map_or(0.0, |b| b.peak_abs_n)));
+                rates.push_str(&format!(
+                    " {:>10.3e}",
+                    bw.map_or(0.0, |b| b.damage_rate_per_h)
+                ));
+            }
+            out!("{peaks}");
+            out!("{rates}");
+        }
+    }
 }

@@ -33,6 +33,9 @@ pub struct NetworkRequest<'a> {
     /// Keep every resolved pack body's counted load cycles for [`NetworkOutcome::cycles`]
     /// (memory grows with the run; without, the fatigue is summed as it is counted).
     pub keep_cycles: bool,
+    /// Give every resolved pack's figures window by window, windows of this length in s
+    /// (`run --windows S`; [`CouplingSummary::windows`]).
+    pub windows_s: Option<f64>,
 }
 
 /// One mode change of a clutch.
@@ -74,6 +77,10 @@ pub struct CouplingSummary {
     /// over its discs and plates, N, signed as the impacts' (negative when body a, or a
     /// pack's carrier, leads); 0 without impacts.
     pub largest_peak_n: f64,
+    /// A resolved pack's figures window by window, if asked ([`NetworkRequest::windows_s`];
+    /// its bodies in pack order, named as in the pack file).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub windows: Vec<crate::WindowRow>,
     /// A pack's discs, then its plates, each with its impacts (absent for other kinds).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pack_bodies: Vec<PackBodySummary>,
@@ -194,6 +201,8 @@ pub(crate) struct Keep {
     /// The impacts CSV being written, if asked, and each coupling's first row name's index
     /// in it (a mesh's name, a pack's first body's).
     csv: Option<(crate::collector::ImpactsCsv, Vec<usize>)>,
+    /// Per pack coupling, if asked: its windows and its bodies' names.
+    windows: std::collections::BTreeMap<usize, (crate::windows::Windows, Vec<String>)>,
     /// Per pack coupling: its faces' mode as a clutch's label ("free", "slipping",
     /// "locked"), and the instants all its faces locked.
     pack_modes: std::collections::HashMap<usize, (&'static str, Vec<f64>)>,
@@ -219,12 +228,17 @@ impl Keep {
     }
 
     /// Collects every resolved pack's bodies' fatigue on their S-N curves (the pack files'
-    /// parameters), keeping every counted cycle too if `keep_cycles`.
-    pub fn with_packs(mut self, scene: &Scene, keep_cycles: bool) -> Keep {
+    /// parameters), keeping every counted cycle too if `keep_cycles`, and their figures in
+    /// windows of `windows_s` (s) if given.
+    pub fn with_packs(mut self, scene: &Scene, keep_cycles: bool, windows_s: Option<f64>) -> Keep {
         self.keep_cycles = keep_cycles;
         if let Some(net) = &scene.network {
-            for (k, (_, params)) in pack_params(scene, net) {
+            for (k, (names, params)) in pack_params(scene, net) {
                 let curves = crate::fatigue::curves(&params);
+                if let Some(len_s) = windows_s {
+                    let w = crate::windows::Windows::new(len_s, params.clone());
+                    self.windows.insert(k, (w, names));
+                }
                 self.pack_fatigue.insert(
                     k,
                     clutchpack_analysis::FatigueCollector::summing(curves, keep_cycles),
@@ -303,6 +317,7 @@ impl Keep {
             pack_modes: self.pack_modes.clone(),
             pack_fatigue: self.pack_fatigue.clone(),
             csv: None,
+            windows: std::collections::BTreeMap::new(),
             history: self.history.clone(),
             impact_log: self.impact_log.clone(),
             stopped: self.stopped,
@@ -359,6 +374,9 @@ impl NetworkObserver for Obs<'_, '_> {
     fn pack_impact(&mut self, coupling: usize, e: &clutchpack_model::ImpactEvent) {
         self.keep.record(|r| r.write_pack_impact(coupling, e));
         self.keep.csv_row(coupling, Some(e.disc), e);
+        if let Some((w, _)) = self.keep.windows.get_mut(&coupling) {
+            w.impact(e);
+        }
         self.keep
             .pack_fatigue
             .entry(coupling)
@@ -394,11 +412,15 @@ impl NetworkObserver for Obs<'_, '_> {
                 .collect(),
             ..Default::default()
         };
-        self.keep
-            .pack_fatigue
-            .entry(coupling)
-            .or_default()
-            .sample(&sample);
+        let collector = self.keep.pack_fatigue.entry(coupling).or_default();
+        if let Some((w, names)) = self.keep.windows.get_mut(&coupling) {
+            // the windows that ended before this sample close on the samples up to their end
+            while t > w.end_s() {
+                let t1 = w.end_s();
+                w.close(t1, names, collector);
+            }
+        }
+        collector.sample(&sample);
     }
     fn pack_faces(&mut self, coupling: usize, t: f64, locked: usize, clamped: usize, faces: usize) {
         let mode = if locked == faces {
@@ -465,7 +487,16 @@ pub fn run_network_scene(
     };
     let engine = scene.engine(asked, &scene.name)?;
     let sim = &scene.simulation;
-    let mut keep = Keep::new(None, req.keep_history).with_packs(scene, req.keep_cycles);
+    crate::windows::check(req.windows_s, sim.duration_s)?;
+    if req.windows_s.is_some() && !net.couplings.iter().any(|c| c.pack().is_some()) {
+        return Err(Error::BadInput(format!(
+            "windows (`--windows`, `windows_s`): {} has no resolved pack (kind = \"pack\") \
+             whose bodies' figures they would give",
+            scene.name
+        )));
+    }
+    let mut keep =
+        Keep::new(None, req.keep_history).with_packs(scene, req.keep_cycles, req.windows_s);
     if let Some(path) = &req.impacts_csv {
         keep = keep.with_impacts_csv(path, scene)?;
     }
@@ -631,6 +662,15 @@ pub(crate) fn conclude(
     keep.finish_csv()?;
     let last = &run.last;
     let mut cycles = Vec::new();
+    let mut windows = std::collections::BTreeMap::new();
+    for (k, (mut w, names)) in std::mem::take(&mut keep.windows) {
+        if let Some(collector) = keep.pack_fatigue.get(&k) {
+            if last.t_s > w.end_s() - w.len_s() {
+                w.close(last.t_s, &names, collector);
+            }
+        }
+        windows.insert(k, w.rows);
+    }
     let fatigue = pack_fatigue(scene, net, &mut keep, last.t_s, &mut cycles);
     let couplings = net
         .couplings
@@ -674,6 +714,7 @@ pub(crate) fn conclude(
                     .collect(),
                 impacts: keep.impacts.get(&k).map_or(0, |m| m.0),
                 largest_peak_n: keep.impacts.get(&k).map_or(0.0, |m| m.1),
+                windows: windows.remove(&k).unwrap_or_default(),
                 pack_bodies: c.pack().map_or_else(Vec::new, |p| {
                     p.discs
                         .iter()

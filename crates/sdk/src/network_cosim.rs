@@ -401,7 +401,7 @@ impl NetworkSimulation {
             start_recording(scene, engine, recording, Some((&driven_names, stop_time_s)))?,
             false,
         )
-        .with_packs(scene, false);
+        .with_packs(scene, false, None);
         let started = std::time::Instant::now();
         let mut obs = Obs {
             keep: &mut keep,

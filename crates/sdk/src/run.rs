@@ -134,18 +134,7 @@ impl Simulation {
     /// be created (the impacts CSV, the recording) are errors before any work; after that,
     /// whatever ends the run, the outcome holds it and every output is complete up to there.
     pub fn run(&mut self, request: RunRequest<'_>) -> Result<RunOutcome> {
-        let duration_s = self.scene().simulation.duration_s;
-        if let Some(len_s) = request.windows_s.filter(|s| {
-            !(*s > 0.0 && s.is_finite() && duration_s / *s <= crate::windows::MAX_WINDOWS)
-        }) {
-            return Err(Error::BadInput(format!(
-                "windows of {} s (`--windows`, `windows_s`): the window length must be a \
-                 positive number of seconds giving at most {} windows over the run's {} s",
-                clutchpack_model::fmt_num(len_s),
-                clutchpack_model::fmt_num(crate::windows::MAX_WINDOWS),
-                clutchpack_model::fmt_num(duration_s)
-            )));
-        }
+        crate::windows::check(request.windows_s, self.scene().simulation.duration_s)?;
         let names = self.body_names();
         let scene = self.scene();
         let mut collector = RunCollector::new(names.len(), request.keep_history)

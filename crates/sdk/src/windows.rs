@@ -18,6 +18,21 @@ use serde::{Deserialize, Serialize};
 /// Most windows a run may ask for (each row holds every body's figures).
 pub const MAX_WINDOWS: f64 = 1e5;
 
+/// `Err` (bad input) unless `windows_s` (s), if given, is a positive window length giving at
+/// most [`MAX_WINDOWS`] windows over a run of `duration_s` (s).
+pub(crate) fn check(windows_s: Option<f64>, duration_s: f64) -> crate::Result<()> {
+    match windows_s.filter(|s| !(*s > 0.0 && s.is_finite() && duration_s / *s <= MAX_WINDOWS)) {
+        Some(len_s) => Err(crate::Error::BadInput(format!(
+            "windows of {} s (`--windows`, `windows_s`): the window length must be a positive \
+             number of seconds giving at most {} windows over the run's {} s",
+            clutchpack_model::fmt_num(len_s),
+            clutchpack_model::fmt_num(MAX_WINDOWS),
+            clutchpack_model::fmt_num(duration_s)
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// One window of a run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WindowRow {
