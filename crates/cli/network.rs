@@ -191,6 +191,10 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
                 life
             );
         }
+        if let Some(th) = &c.thermal {
+            out!("  {}:", c.name);
+            crate::run::print_thermal(th);
+        }
         if !c.windows.is_empty() {
             out!("  {}:", c.name);
             crate::run::print_windows(&c.windows);

@@ -398,30 +398,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         );
     }
     if let Some(th) = &summary.thermal {
-        out!("temperatures (K; [thermal], MODEL.md section 9)");
-        out!("{:<12} {:>10} {:>10}", "body", "final", "max");
-        for b in &th.bodies {
-            out!("{:<12} {:>10.3} {:>10.3}", b.name, b.final_k, b.max_k);
-        }
-        out!(
-            "{:<12} {:>10.3} {:>10.3}",
-            "oil",
-            th.oil_final_k,
-            th.oil_max_k
-        );
-        out!(
-            "heat (J): generated {:.6} (faces {:.6}, gaps {:.6}, teeth {:.6}) = stored {:.6} \
-             (bodies {:.6}, oil {:.6}) + cooler {:.6}; balance error {:.3e}",
-            th.generated_j,
-            th.friction_heat_j,
-            th.gap_heat_j,
-            th.impact_heat_j,
-            th.stored_bodies_j + th.stored_oil_j,
-            th.stored_bodies_j,
-            th.stored_oil_j,
-            th.cooler_j,
-            th.balance_error_j
-        );
+        print_thermal(th);
     }
     print_windows(&summary.windows);
     if let Some(e) = recording_error {
@@ -504,4 +481,32 @@ pub fn print_windows(windows: &[clutchpack_sdk::WindowRow]) {
             out!("{rates}");
         }
     }
+}
+
+/// Prints a thermal run's temperatures (K) and heat balance (J) (MODEL.md section 9).
+pub fn print_thermal(th: &clutchpack_sdk::ThermalSummary) {
+    out!("temperatures (K; [thermal], MODEL.md section 9)");
+    out!("{:<12} {:>10} {:>10}", "body", "final", "max");
+    for b in &th.bodies {
+        out!("{:<12} {:>10.3} {:>10.3}", b.name, b.final_k, b.max_k);
+    }
+    out!(
+        "{:<12} {:>10.3} {:>10.3}",
+        "oil",
+        th.oil_final_k,
+        th.oil_max_k
+    );
+    out!(
+        "heat (J): generated {:.6} (faces {:.6}, gaps {:.6}, teeth {:.6}) = stored {:.6} \
+         (bodies {:.6}, oil {:.6}) + cooler {:.6}; balance error {:.3e}",
+        th.generated_j,
+        th.friction_heat_j,
+        th.gap_heat_j,
+        th.impact_heat_j,
+        th.stored_bodies_j + th.stored_oil_j,
+        th.stored_bodies_j,
+        th.stored_oil_j,
+        th.cooler_j,
+        th.balance_error_j
+    );
 }

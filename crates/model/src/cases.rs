@@ -392,6 +392,7 @@ pub fn coupled_clutches() -> crate::network::Network {
         start_s,
     };
     Network {
+        pack_thermal: Default::default(),
         bodies: vec![
             body(
                 "J1",
@@ -477,6 +478,7 @@ pub fn spring_ring_down() -> crate::network::Network {
         road_load: None,
     };
     Network {
+        pack_thermal: Default::default(),
         bodies: vec![body("a", 0.5), body("b", 0.3)],
         couplings: vec![Coupling {
             name: "damper".into(),
@@ -517,6 +519,7 @@ pub fn spring_ring_down_twist_rad(t: f64) -> f64 {
 pub fn firing_engine() -> crate::network::Network {
     use crate::network::{Body, Firing, Network};
     Network {
+        pack_thermal: Default::default(),
         bodies: vec![Body {
             name: "engine".into(),
             inertia_kg_m2: 0.25,

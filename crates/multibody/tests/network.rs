@@ -205,6 +205,7 @@ fn geared_dual_clutch_matches_the_reference_engine() {
         kind: CouplingKind::IdealGear { ratio },
     };
     let net = Network {
+        pack_thermal: Default::default(),
         bodies: vec![
             body("engine", j_e, r1 * w_out, Some(Signal::Constant(t_e))),
             body("shaft-1", 0.02, r1 * w_out, None),
@@ -301,6 +302,7 @@ fn brake_to_the_ground_stops_and_holds() {
         road_load: None,
     };
     let net = Network {
+        pack_thermal: Default::default(),
         bodies: vec![body("ground", true, 0.0), body("wheel", false, 30.0)],
         couplings: vec![Coupling {
             name: "brake".into(),
@@ -381,6 +383,7 @@ fn upshift_handover_converges_to_the_reference_engine() {
         duration_s: 0.06,
     };
     let net = Network {
+        pack_thermal: Default::default(),
         bodies: vec![
             engine,
             body("shaft-1", 0.02, r1 * w_out),
@@ -513,6 +516,7 @@ fn brake_and_parallel_clutches_match_the_reference_engine() {
         start_s,
     };
     let net = Network {
+        pack_thermal: Default::default(),
         bodies: vec![ground, engine, body("shaft", 0.05, 0.0), wheel],
         couplings: vec![
             clutch("clutch-a", 1, 2, 3000.0, Signal::Constant(1.0)),
@@ -695,6 +699,7 @@ fn free_body(name: &str, j: f64, w: f64) -> Body {
 /// Two bodies joined by the gear mesh `g` alone.
 fn meshed(pinion: Body, wheel: Body, g: GearMesh) -> Network {
     Network {
+        pack_thermal: Default::default(),
         bodies: vec![pinion, wheel],
         couplings: vec![Coupling {
             name: "mesh".into(),

@@ -15,6 +15,7 @@
 //! | `/network/couplings/<segment>` | `clutchpack.CouplingState` | each sample |
 //! | `/joints` (couplings: slip, torque), `/network/joints/bodies` (angle, speed) | `sensor_msgs/msg/JointState` | each sample (Rerun, Lichtblick) |
 //! | `/network/packs/<segment>/joints` | `sensor_msgs/msg/JointState` | each sample: a resolved pack's discs and plates (angle, speed, per-tooth load) |
+//! | `/network/packs/<segment>/temperature/<body>` | `clutchpack.Temperature` | a thermal pack's bodies and oil (`oil`), at t = 0 and each thermal window's end |
 //! | `/network/events` | `foxglove.Log` | each clutch mode change, at its instant |
 //! | `/network/impacts` | `clutchpack.Impact` | each gear-mesh impact and each tooth impact of a pack's disc or plate (`<pack>/discs/<disc>`, `<pack>/plates/<plate>`), logged when its contact closes (in time order; the message holds its peak's time) |
 //! | `/tf` | `foxglove.FrameTransforms` | each sample: `world` -> `body/<segment>` |
@@ -151,6 +152,9 @@ struct Channels {
     scene_couplings: u16,
     /// Per resolved pack (by coupling): its joints' channel and its bodies' names.
     pack_joints: BTreeMap<usize, (u16, Vec<String>)>,
+    /// Per thermal resolved pack (by coupling): its bodies' temperature channels, then its
+    /// oil's.
+    pack_temperatures: BTreeMap<usize, Vec<u16>>,
 }
 
 /// Streams a network run into an MCAP file: call [`Self::write_sample`],
@@ -302,7 +306,37 @@ impl NetworkRecorder {
                 pack_joints.insert(k, (id, names.collect()));
             }
         }
+        let mut pack_temperatures = BTreeMap::new();
+        if !net.pack_thermal.is_empty() {
+            let s_temp = schema(&mut w, proto::TEMPERATURE, "protobuf", &fds)?;
+            for (&k, seg) in net
+                .pack_thermal
+                .keys()
+                .zip(net.pack_thermal.keys().map(|&k| &coupling_segments[k]))
+            {
+                let Some(p) = net.couplings[k].pack() else {
+                    continue;
+                };
+                let names: Vec<String> = p
+                    .discs
+                    .iter()
+                    .chain(&p.plates)
+                    .map(|d| d.name.clone())
+                    .collect();
+                let mut ids = Vec::with_capacity(names.len() + 1);
+                for body in unique_segments(&names)
+                    .iter()
+                    .map(String::as_str)
+                    .chain(["oil"])
+                {
+                    let topic = topics::network_pack_temperature(seg, body);
+                    ids.push(channel(&mut w, s_temp, &topic, "protobuf", none())?);
+                }
+                pack_temperatures.insert(k, ids);
+            }
+        }
         let ch = Channels {
+            pack_temperatures,
             pack_joints,
             bodies,
             couplings,
@@ -651,6 +685,30 @@ impl NetworkRecorder {
             Some(tf) => self.put(self.ch.tf, ns, &tf, "/tf"),
             None => Ok(()),
         }
+    }
+
+    /// Writes a thermal resolved pack's temperatures at `t_s` (s), K: its discs', its
+    /// plates', then its oil's, each on its own topic
+    /// ([`topics::network_pack_temperature`]).
+    pub fn write_pack_temperatures(
+        &mut self,
+        coupling: usize,
+        t_s: f64,
+        temperatures_k: &[f64],
+    ) -> Result<(), RecordError> {
+        let Some(ids) = self.ch.pack_temperatures.get(&coupling).cloned() else {
+            return Ok(());
+        };
+        let ns = log_time_ns(t_s);
+        for (i, (id, &temperature_k)) in ids.into_iter().zip(temperatures_k).enumerate() {
+            let msg = proto::Temperature {
+                t_s,
+                temperature_k,
+                body_index: i as u32,
+            };
+            self.put(id, ns, &msg, "pack temperature")?;
+        }
+        Ok(())
     }
 
     /// Writes a gear mesh's tooth impact on `/network/impacts`, logged when its contact

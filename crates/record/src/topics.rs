@@ -110,6 +110,13 @@ pub fn network_pack_joints(segment: &str) -> String {
     format!("{NETWORK_PREFIX}packs/{segment}/joints")
 }
 
+/// `/network/packs/<segment>/temperature/<body>`, `clutchpack.Temperature`: a thermal
+/// resolved pack's body's temperature in K (`<body>` its segment; the oil's is `oil`) at t = 0
+/// and at the end of each thermal window (MODEL.md section 9).
+pub fn network_pack_temperature(pack: &str, body: &str) -> String {
+    format!("{NETWORK_PREFIX}packs/{pack}/temperature/{body}")
+}
+
 /// A network's clutch mode changes, `foxglove.Log` (one line each, at its instant:
 /// `K2: slip+ -> locked`).
 pub const NETWORK_EVENTS: &str = "/network/events";

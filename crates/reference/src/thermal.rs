@@ -14,7 +14,7 @@
 //! never change takes the isothermal run's steps bit for bit).
 
 use crate::stepper::Stepper;
-use crate::system::Face;
+use crate::system::{Face, System};
 use clutchpack_model::thermal::{FaceMode, ThermalModel, ThermalReport, ThermalWindows};
 use clutchpack_model::{EngineError, PackModel};
 use std::sync::Arc;
@@ -49,19 +49,26 @@ impl Thermal {
     /// Books the heat of the step `st` just took, with each interface's mode during it
     /// (`faces`, read before the step's switch is applied).
     pub fn book_step(&mut self, st: &Stepper) {
+        self.book(&st.sys, &st.y);
+    }
+
+    /// Books the heat of the step that just ended at the state `y` of `sys` (the system's
+    /// own part of a network's state: `network::packs`), each interface by its mode during
+    /// the step (`sys.faces`, read before the step's switch is applied).
+    pub fn book(&mut self, sys: &System, y: &[f64]) {
         // the faces: friction to the two bodies by effusivity, an open gap's drag to the oil
-        let counters = st.sys.interface_heat_j(&st.y);
+        let counters = sys.interface_heat_j(y);
         for (m, &q_now) in counters.iter().enumerate() {
             let dq = q_now - self.counters[m];
             self.counters[m] = q_now;
-            let mode = match st.sys.faces[m] {
+            let mode = match sys.faces[m] {
                 Face::Open => FaceMode::Open,
                 Face::Slip(_) | Face::Locked => FaceMode::Clamped,
             };
             self.windows.book_face(m, dq, mode);
         }
         // the teeth: -n F Rb psi over the step, integrated in the state
-        let q = st.sys.teeth_work_j(&st.y);
+        let q = sys.teeth_work_j(y);
         self.windows.book_teeth(q - self.teeth);
         self.teeth = q;
     }

@@ -145,6 +145,7 @@ fn dual_clutch_inertia_phase_matches_closed_form() {
         kind: CouplingKind::IdealGear { ratio },
     };
     let net = Network {
+        pack_thermal: Default::default(),
         bodies: vec![
             body("engine", j_e, r1 * w_out, Some(Signal::Constant(t_e))),
             body("shaft-1", 0.02, r1 * w_out, None),
@@ -218,6 +219,7 @@ fn free_impact_across_a_gear_mesh_matches_closed_form() {
         road_load: None,
     };
     let net = Network {
+        pack_thermal: Default::default(),
         bodies: vec![body("pinion", j_a, v0 / 0.03), body("wheel", j_b, 0.0)],
         couplings: vec![Coupling {
             name: "mesh".into(),

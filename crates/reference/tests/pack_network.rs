@@ -188,6 +188,7 @@ fn dual_clutch_shift_with_resolved_packs_matches_closed_form() {
         kind: CouplingKind::IdealGear { ratio },
     };
     let net = Network {
+        pack_thermal: Default::default(),
         bodies: vec![
             body("engine", j_e, r1 * w_out, Some(Signal::Constant(t_e))),
             body("shaft-1", 0.02, r1 * w_out, None),

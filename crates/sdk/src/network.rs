@@ -77,6 +77,10 @@ pub struct CouplingSummary {
     /// over its discs and plates, N, signed as the impacts' (negative when body a, or a
     /// pack's carrier, leads); 0 without impacts.
     pub largest_peak_n: f64,
+    /// A thermal resolved pack's temperatures (K) and heat balance (J) over the run (its pack
+    /// file's `[thermal]`, MODEL.md section 9; absent for other couplings).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<crate::ThermalSummary>,
     /// A resolved pack's figures window by window, if asked ([`NetworkRequest::windows_s`];
     /// its bodies in pack order, named as in the pack file).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -422,6 +426,15 @@ impl NetworkObserver for Obs<'_, '_> {
         }
         collector.sample(&sample);
     }
+    fn pack_temperatures(&mut self, coupling: usize, t: f64, temperatures_k: &[f64]) {
+        self.keep
+            .record(|r| r.write_pack_temperatures(coupling, t, temperatures_k));
+        if let Some((w, _)) = self.keep.windows.get_mut(&coupling) {
+            if let Some((oil, bodies)) = temperatures_k.split_last() {
+                w.temperatures(bodies, *oil);
+            }
+        }
+    }
     fn pack_faces(&mut self, coupling: usize, t: f64, locked: usize, clamped: usize, faces: usize) {
         let mode = if locked == faces {
             "locked"
@@ -715,6 +728,20 @@ pub(crate) fn conclude(
                 impacts: keep.impacts.get(&k).map_or(0, |m| m.0),
                 largest_peak_n: keep.impacts.get(&k).map_or(0.0, |m| m.1),
                 windows: windows.remove(&k).unwrap_or_default(),
+                thermal: run
+                    .pack_thermal
+                    .iter()
+                    .find(|(j, _)| *j == k)
+                    .map(|(_, r)| {
+                        let names: Vec<String> = c.pack().map_or_else(Vec::new, |p| {
+                            p.discs
+                                .iter()
+                                .chain(&p.plates)
+                                .map(|d| d.name.clone())
+                                .collect()
+                        });
+                        crate::ThermalSummary::new(r, &names)
+                    }),
                 pack_bodies: c.pack().map_or_else(Vec::new, |p| {
                     p.discs
                         .iter()

@@ -40,7 +40,7 @@ pub struct RunSummary {
 }
 
 /// One body's temperatures in a thermal run, K.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BodyTemperature {
     /// The body's name (a disc or a plate).
     pub name: String,
@@ -51,7 +51,7 @@ pub struct BodyTemperature {
 }
 
 /// A thermal run's temperatures (K) and heat balance (J) (MODEL.md section 9).
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ThermalSummary {
     /// Per body (friction discs, then separator plates).
     pub bodies: Vec<BodyTemperature>,

@@ -153,6 +153,7 @@ pub fn pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
         },
     };
     Some(Network {
+        pack_thermal: Default::default(),
         bodies: vec![shaft, carrier],
         couplings: vec![Coupling {
             name: "pack".into(),

@@ -166,6 +166,10 @@ pub struct Network {
     pub bodies: Vec<Body>,
     /// The couplings.
     pub couplings: Vec<Coupling>,
+    /// The thermal model of each resolved pack that carries temperatures (its pack file's
+    /// `[thermal]`, MODEL.md section 9), by coupling index; the others run isothermal.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub pack_thermal: std::collections::BTreeMap<usize, crate::thermal::ThermalModel>,
 }
 
 /// A problem with a network, naming the body or coupling (by index) and what is wrong; the
@@ -517,6 +521,7 @@ mod tests {
     #[test]
     fn problems_name_the_part() {
         let mut net = Network {
+            pack_thermal: Default::default(),
             bodies: vec![
                 body("a", 3.0),
                 body("b", 1.0),

@@ -92,6 +92,9 @@ pub struct NetworkRun {
     pub steps: u64,
     /// Events located (mode changes and breakpoints).
     pub events: u64,
+    /// Each thermal resolved pack's temperatures and heat over the run (MODEL.md section 9),
+    /// by coupling index, in coupling order.
+    pub pack_thermal: Vec<(usize, crate::thermal::ThermalReport)>,
 }
 
 /// What receives a network run's output, in time order.
@@ -124,6 +127,9 @@ pub trait NetworkObserver {
         _load_n: &[f64],
     ) {
     }
+    /// A thermal resolved pack's temperatures at `t_s` (s), K: its discs', then its plates',
+    /// then its oil's; at t = 0 and at the end of each thermal window (MODEL.md section 9).
+    fn pack_temperatures(&mut self, _coupling: usize, _t_s: f64, _temperatures_k: &[f64]) {}
     /// A resolved pack's faces changed mode at `t_s` (s): `locked` of its `faces` friction
     /// faces are locked now (all of them: the pack has locked, its carriers turn as one but
     /// for the splines' play), `clamped` are clamped (locked or slipping).

@@ -369,6 +369,8 @@ impl NetworkStepper {
             energy: run.energy,
             steps: self.steps,
             events: run.events,
+            // resolved packs (thermal or not) are the reference engine's for now
+            pack_thermal: Vec::new(),
         }
     }
 }

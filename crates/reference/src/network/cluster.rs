@@ -184,6 +184,7 @@ mod tests {
     #[test]
     fn geared_chain_reduces_and_carries_torque() {
         let net = Network {
+            pack_thermal: Default::default(),
             bodies: vec![body("a", 1.0), body("b", 2.0), body("c", 3.0)],
             couplings: vec![
                 Coupling {

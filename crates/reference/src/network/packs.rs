@@ -60,6 +60,10 @@ pub(super) struct NetPack {
     best: Vec<f64>,
     /// Per body: the largest probe of the step being observed, `(t s, signed F N)`.
     top: Vec<(f64, f64)>,
+    /// Its temperatures, if its pack file has `[thermal]` (MODEL.md section 9): the heat of
+    /// every accepted step booked, the pack's viscosity-dependent parameters swapped at each
+    /// thermal window's end ([`crate::thermal::Thermal`], as a pack run).
+    pub thermal: Option<Box<crate::thermal::Thermal>>,
 }
 
 impl NetPack {
@@ -264,6 +268,7 @@ pub(super) fn build(net: &Network, first: usize, first_guard: usize) -> Vec<NetP
             trackers: (0..nb).map(ImpactTracker::new).collect(),
             best: vec![0.0; nb],
             top: vec![(0.0, 0.0); nb],
+            thermal: None,
             sys,
         };
         at += p.len();

@@ -6,6 +6,7 @@
 use super::modes::settle;
 use super::{mesh, packs, sample, Equations, NetworkOptions};
 use crate::dopri::{next_step, Dense, Dopri5};
+use crate::thermal::Thermal;
 pub use clutchpack_model::network::NetworkInput;
 use clutchpack_model::network::{
     ClutchMode, Network, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
@@ -77,6 +78,17 @@ impl NetworkStepper {
             .map(|k| net.couplings[k].clutch().map(|_| ClutchMode::Free))
             .collect();
         let mut eq = Equations::new(Arc::new(net.clone()), initial_modes);
+        // the thermal packs: their parameters at the initial temperatures (MODEL.md section 9)
+        for p in eq.packs.iter_mut() {
+            if let Some(model) = net.pack_thermal.get(&p.k) {
+                let th = Thermal::new(model.clone(), &p.sys.pack)?;
+                if let Some(pack) = th.initial_pack(&p.sys.pack) {
+                    p.sys.set_pack(Arc::new(pack));
+                }
+                obs.pack_temperatures(p.k, 0.0, th.temperatures_k());
+                p.thermal = Some(Box::new(th));
+            }
+        }
         let dim = eq.dim();
         let tol = options.tolerance;
         let mut atol = vec![tol; dim];
@@ -367,6 +379,13 @@ impl NetworkStepper {
             }
             *t = if land && event.is_none() { stop } else { t_new };
             self.steps += 1;
+            // the thermal packs' heat of the step, by their faces' modes along it (before the
+            // step's switch applies), as a pack run books it
+            for p in eq.packs.iter_mut() {
+                if let Some(th) = p.thermal.as_mut() {
+                    th.book(&p.sys, &y[p.at..p.at + p.sys.dim()]);
+                }
+            }
             if land && event.is_none() && at_bp {
                 *next_bp += 1;
             }
@@ -382,6 +401,13 @@ impl NetworkStepper {
             } else {
                 stepper.accept();
                 *h = next_step(h_try, err);
+            }
+            if close_thermal_windows(eq, *t, obs)? {
+                // new viscosity-dependent parameters: the integration restarts from the state
+                *g0_at = f64::NAN;
+                heal_faces(eq, *t, y, obs);
+                eq.rhs(*t, y, dy);
+                stepper.set_start_derivative(dy);
             }
             *h = h.min(self.options.max_step_s);
             if !obs.progress(*t) {
@@ -399,6 +425,18 @@ impl NetworkStepper {
         self.meshes.finish(&mut self.eq, t, obs);
         for p in self.eq.packs.iter_mut() {
             p.finish(t, obs);
+        }
+        // the thermal packs' last (partial) windows close at the run's end
+        let mut pack_thermal = Vec::new();
+        for p in self.eq.packs.iter_mut() {
+            if let Some(th) = p.thermal.as_mut() {
+                let windows = th.windows();
+                let report = th.finish(t);
+                if th.windows() != windows {
+                    obs.pack_temperatures(p.k, t, th.temperatures_k());
+                }
+                pack_thermal.push((p.k, report));
+            }
         }
         let last = sample(&mut self.eq, t, &self.y);
         obs.sample(&last);
@@ -440,8 +478,35 @@ impl NetworkStepper {
             energy,
             steps: self.steps,
             events: self.events,
+            pack_thermal,
         }
     }
+}
+
+/// Closes the thermal windows of every thermal pack that ended by `t` (s), sending the new
+/// temperatures to `obs` and swapping in each pack's new parameters; whether any pack's
+/// parameters changed (the integration then restarts).
+fn close_thermal_windows(
+    eq: &mut Equations,
+    t: f64,
+    obs: &mut dyn NetworkObserver,
+) -> Result<bool, EngineError> {
+    let mut swapped = false;
+    for p in eq.packs.iter_mut() {
+        let Some(th) = p.thermal.as_mut() else {
+            continue;
+        };
+        let windows = th.windows();
+        let closed = th.close_windows(t, &p.sys.pack)?;
+        if th.windows() != windows {
+            obs.pack_temperatures(p.k, t, th.temperatures_k());
+        }
+        if let Some(pack) = closed {
+            p.sys.set_pack(Arc::new(pack));
+            swapped = true;
+        }
+    }
+    Ok(swapped)
 }
 
 /// The bodies' kinetic energy at the state `y`, J, with every pack's discs and plates.

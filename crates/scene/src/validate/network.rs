@@ -434,8 +434,11 @@ pub(super) fn network(
                 .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
                 .map(|ratio| CouplingKind::IdealGear { ratio }),
             Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
-            Kind::Pack => pack(ck, r, k, base_dir).map(|(p, f)| {
+            Kind::Pack => pack(ck, r, k, base_dir).map(|(p, f, thermal)| {
                 fatigue.extend(f);
+                if let Some(th) = thermal {
+                    net.pack_thermal.insert(k, th);
+                }
                 CouplingKind::Pack(Box::new(p))
             }),
             Kind::Spring => {
@@ -487,9 +490,10 @@ pub(super) fn network(
 
 /// The pack scene of a `kind = "pack"` coupling `k` (key `pack`, relative to the network
 /// scene's folder), read by the pack scene's own loader: its problems are reported at
-/// `couplings[k].pack` with the pack file's key paths. A network scene there, a thermal pack
-/// and a pack the reference engine cannot run (radial float, offsets, spacing errors) are
-/// refused. With the pack, its bodies' fatigue parameters (its discs', then its plates').
+/// `couplings[k].pack` with the pack file's key paths. A network scene there and a pack the
+/// reference engine cannot run (radial float, offsets, spacing errors) are refused. With the
+/// pack, its bodies' fatigue parameters (its discs', then its plates') and its `[thermal]`
+/// model, if it has one (the pack then carries its temperatures on the network).
 fn pack(
     ck: &mut Checker,
     r: &C,
@@ -498,6 +502,7 @@ fn pack(
 ) -> Option<(
     clutchpack_model::PackModel,
     Vec<clutchpack_model::FatigueParams>,
+    Option<clutchpack_model::thermal::ThermalModel>,
 )> {
     let key = item("couplings", &C::pack, k);
     let file = ck.text(&key, r.value(&C::pack)).required(
@@ -541,15 +546,6 @@ fn pack(
             format!("{} is a network scene, not a pack", path.display()),
         );
     }
-    if scene.thermal.is_some() {
-        return refuse(
-            ck,
-            format!(
-                "{} has a [thermal] section: a pack on a network runs isothermal (remove it, or run the pack alone)",
-                path.display()
-            ),
-        );
-    }
     if let Some(part) = scene.pack.non_torsional_parts().first() {
         use clutchpack_model::NonTorsional as N;
         let what = match *part {
@@ -568,7 +564,7 @@ fn pack(
             ),
         );
     }
-    Some((scene.pack, scene.fatigue))
+    Some((scene.pack, scene.fatigue, scene.thermal))
 }
 
 /// `[bodies.firing]` of body `i`: `Some(Some(..))` when valid, `None` after reporting.
