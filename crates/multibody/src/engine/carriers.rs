@@ -42,6 +42,10 @@ pub(super) struct CarrierRun {
     pub(super) motion: Motion,
     /// Its external torque.
     pub(super) external: External,
+    /// Bound of the acceleration its profile (prescribed) or its drive (`External::Drive`)
+    /// alone gives it, rad/s^2 (>= 0); 0 for the housing and for a carrier under a load, whose
+    /// bound is the load over `J`, formed where it is used.
+    pub(super) drive_bound: f64,
     /// Whether the shared step integrates its external torque exactly as a function of time
     /// (`Run::external_impulse`: a drive, a driven load) rather than through the polynomial
     /// kick of its other loads (a scene's constant load: byte-identical runs need that).

@@ -698,7 +698,7 @@ impl SubSteps for StackSteps {
             .collect();
         for i in 0..n {
             let carrier = match sys.mounts[i] {
-                Mount::Profile => run.shaft_accel_bound,
+                Mount::Profile => run.carriers[run.world.carrier_of[i]].drive_bound,
                 Mount::Housing => 0.0,
                 Mount::Spin(k) => spin_bound[k],
             };

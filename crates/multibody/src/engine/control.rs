@@ -43,7 +43,7 @@ impl Run {
         let mut a_carrier: Vec<f64> = (self.carriers.iter().enumerate())
             .map(|(c, k)| match k.motion {
                 Motion::Fixed => 0.0,
-                Motion::Prescribed(_) => self.shaft_accel_bound,
+                Motion::Prescribed(_) => k.drive_bound,
                 Motion::Inertial { j, damping } => {
                     let reaction: f64 = self
                         .forces
@@ -54,9 +54,7 @@ impl Run {
                         .sum();
                     match k.external {
                         External::Load(l) => (l.abs() + damping * k.speed.abs() + reaction) / j,
-                        External::Drive => {
-                            self.shaft_accel_bound + (damping * k.speed.abs() + reaction) / j
-                        }
+                        External::Drive => k.drive_bound + (damping * k.speed.abs() + reaction) / j,
                         External::None => (damping * k.speed.abs() + reaction) / j,
                     }
                 }

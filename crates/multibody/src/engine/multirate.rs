@@ -64,8 +64,9 @@ impl Run {
     /// acceleration, rad/s^2: the prescribed shaft's (`drive`; the discs of an inertial shaft
     /// go with the shaft), or the housing at rest.
     fn known_path<'a>(&self, i: usize, drive: Option<Prescribed<'a>>) -> (Path<'a>, f64) {
-        match (&self.carriers[self.world.carrier_of[i]].motion, drive) {
-            (Motion::Prescribed(_), Some(p)) => (Path::Profile(p), self.shaft_accel_bound),
+        let k = &self.carriers[self.world.carrier_of[i]];
+        match (&k.motion, drive) {
+            (Motion::Prescribed(_), Some(p)) => (Path::Profile(p), k.drive_bound),
             (Motion::Fixed, _) => (Path::Housing, 0.0),
             _ => unreachable!("an inertial carrier's couplings go with it"),
         }

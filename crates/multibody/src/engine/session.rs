@@ -541,7 +541,7 @@ impl MultibodySession {
                 s.set_pressure(p);
             }
         }
-        run.shaft_accel_bound = shaft_accel_bound(&run.pack.shaft);
+        run.carriers[SHAFT].drive_bound = shaft_accel_bound(&run.pack.shaft);
         run.input_changed(shaft_jump, multirate);
     }
 }

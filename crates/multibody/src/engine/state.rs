@@ -75,8 +75,6 @@ pub(super) struct Run {
     /// The carrier bodies (`carriers.rs`), in the world's order (`World::carriers`): how each
     /// moves, its external torque, its angle and speed at `t`.
     pub(super) carriers: Vec<CarrierRun>,
-    /// Bound of the drive's shaft acceleration, rad/s^2.
-    pub(super) shaft_accel_bound: f64,
     pub(super) stack: Option<Stack>,
     pub(super) couplings: Vec<Coupling>,
     /// Effective mass per tooth of each coupling, kg (reduced with an inertial carrier).
@@ -151,6 +149,7 @@ impl Run {
                 let still = |motion, external, speed| CarrierRun {
                     motion,
                     external,
+                    drive_bound: 0.0,
                     exact: false,
                     switch: None,
                     name: "housing",
@@ -160,6 +159,7 @@ impl Run {
                 match (c.role, &pack.shaft, &pack.drum) {
                     (Carrier::Housing, _, _) => still(Motion::Fixed, External::None, 0.0),
                     (Carrier::Shaft, Shaft::Prescribed(p), _) => CarrierRun {
+                        drive_bound: shaft_accel_bound(&pack.shaft),
                         exact: true,
                         name: "shaft",
                         ..still(
@@ -177,6 +177,7 @@ impl Run {
                         },
                         _,
                     ) => CarrierRun {
+                        drive_bound: shaft_accel_bound(&pack.shaft),
                         exact: true,
                         name: "inertial shaft",
                         ..still(
@@ -204,7 +205,6 @@ impl Run {
             })
             .collect();
         let n_carriers = carriers.len();
-        let shaft_accel_bound = shaft_accel_bound(&pack.shaft);
         let m_eff = bodies
             .iter()
             .zip(&world.carrier_of)
@@ -227,7 +227,6 @@ impl Run {
             bodies,
             world,
             carriers,
-            shaft_accel_bound,
             stack,
             couplings,
             m_eff,
@@ -389,7 +388,7 @@ impl Run {
     pub(super) fn inertial_accel_bound(&self, c: usize, w: f64, reaction: f64) -> f64 {
         let (inv_j, damping) = self.carriers[c].inertia();
         let own = match self.carriers[c].external {
-            External::Drive => self.shaft_accel_bound,
+            External::Drive => self.carriers[c].drive_bound,
             External::Load(l) => l.abs() * inv_j,
             External::None => 0.0,
         };
