@@ -191,7 +191,7 @@ impl Run {
         }
         for (k, c) in sys.spins.iter().enumerate() {
             // the drive (eq 4) or the load, the damping, the teeth's reactions
-            let external = self.external_torque(c.carrier, ts);
+            let external = self.external_at(c.carrier, ts);
             st.external[k] = external;
             let on: f64 = (0..u.len())
                 .filter(|&i| sys.mounts[i] == Mount::Spin(k))

@@ -100,10 +100,10 @@ impl Run {
     /// Inertial carrier `c`'s dynamics over a sub-step of length `h` from `t`: its inertia and
     /// damping ([`CarrierRun::inertia`](super::carriers::CarrierRun::inertia)) and its
     /// external torque (the shaft's drive, eq 4, at the step's start, middle and end; the
-    /// drum's load, held over a world step; [`Run::external_torque`]).
+    /// drum's load, held over a world step; [`Run::external_at`]).
     fn carrier_dynamics(&self, c: usize, t: f64, h: f64) -> CarrierDynamics {
         let (inv_j, damping) = self.carriers[c].inertia();
-        let torque = [t, t + 0.5 * h, t + h].map(|ts| self.external_torque(c, ts));
+        let torque = [t, t + 0.5 * h, t + h].map(|ts| self.external_at(c, ts));
         CarrierDynamics {
             inv_j,
             damping,

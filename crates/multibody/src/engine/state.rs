@@ -359,8 +359,11 @@ impl Run {
         (k.angle, k.speed) = (angle, speed);
     }
 
-    /// The external torque on carrier `c` at `t` (s), N m: the drive (eq 4) or a load, or
-    /// before a driven torque's last change (`switch`) the value held until then.
+    /// The external torque on carrier `c` at `t` (s), N m, positive along the positive
+    /// rotation: the drive (Hu et al. eq 4) as a function of time, a load held between inputs,
+    /// or before a driven torque's last change (`switch`) the value held until then (only the
+    /// shared step's past half-kick reaches back before it; the multirate schemes' sub-steps
+    /// start at or after it).
     pub(super) fn external_at(&self, c: usize, t: f64) -> f64 {
         let k = &self.carriers[c];
         match (k.switch, k.external) {
@@ -368,16 +371,6 @@ impl Run {
             (_, External::Drive) => self.pack.shaft.drive_torque_n_m(t),
             (_, External::Load(l)) => l,
             (_, External::None) => 0.0,
-        }
-    }
-
-    /// The external torque on inertial carrier `c` at `ts` (s) as the multirate schemes take
-    /// it, N m: the drive (Hu et al. eq 4) as a function of time, a load held over a world step.
-    pub(super) fn external_torque(&self, c: usize, ts: f64) -> f64 {
-        match self.carriers[c].external {
-            External::Drive => self.drive_torque(ts),
-            External::Load(l) => l,
-            External::None => 0.0,
         }
     }
 
