@@ -258,7 +258,8 @@
 //!
 //! **Multirate with a drum, and the piston's start** (issue 20). The drum is an inertial
 //! carrier as the inertial shaft is: each world step it is integrated with the plates that may
-//! touch it by the same kernel (`engine/inertial.rs`, `Inertial::Drum`: the drum
+//! touch it by the same kernel (`engine/inertial.rs`, on the drum's entry of the run's table
+//! of carriers, `engine/carriers.rs`: the drum
 //! `J w' = T_load - C w - sum T_k` with its load held over the world step, each plate
 //! `J w_p' = T_k - C2 w_p` plus its gaps' drag, held as for plates on the housing), the
 //! others flying free against its nodes; the same order, momentum and energy behaviour as

@@ -17,23 +17,36 @@ use std::f64::consts::PI;
 /// The body a spline coupling joins a disc or plate to (the model's one definition).
 pub(crate) use clutchpack_model::Carrier;
 
+/// A body that carries spline couplings, as the rapier world holds it: the fixed housing,
+/// the shaft (position-based kinematic for a prescribed speed, dynamic for eq 4), the output
+/// drum of a clutch (dynamic, on a revolute joint to the housing).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CarrierBody {
+    /// Its role in the pack (the model's description; for names and outputs only).
+    pub role: Carrier,
+    /// Its rapier body.
+    pub handle: RigidBodyHandle,
+    /// Whether rapier integrates it (an inertial shaft, the drum): its rotation then gets the
+    /// exact exponential map after each step ([`exponential_map_deficit`]).
+    pub dynamic: bool,
+}
+
+/// Index in [`World::carriers`] of the shaft (always there): after the fixed housing (0), and
+/// followed by the drum when the pack has one.
+pub(crate) const SHAFT: usize = 1;
+
 /// The rapier world of one pack and the handles of its bodies.
 pub(crate) struct World {
     /// All rapier state.
     pub physics: PhysicsWorld,
-    /// The shaft: position-based kinematic (prescribed speed) or dynamic (eq 4).
-    pub shaft: RigidBodyHandle,
-    /// Whether the shaft is a dynamic body (an inertial shaft).
-    pub shaft_dynamic: bool,
-    /// The fixed housing.
-    pub housing: RigidBodyHandle,
-    /// The output drum of a clutch: a dynamic body on a revolute joint to the housing.
-    pub drum: Option<RigidBodyHandle>,
+    /// The carrier bodies in the order the world inserts them: the housing, the shaft
+    /// ([`SHAFT`]), the drum if any.
+    pub carriers: Vec<CarrierBody>,
     /// One dynamic body per spline-coupled body: the friction discs in scene order, then the
     /// separator plates in scene order (the engine's coupling order).
     pub discs: Vec<RigidBodyHandle>,
-    /// The carrier of each of them.
-    pub carriers: Vec<Carrier>,
+    /// The carrier of each of them: an index into [`World::carriers`].
+    pub carrier_of: Vec<usize>,
     /// Axial position of each one's mid-plane, m (discs and plates alternate in a stack).
     pub disc_axial_m: Vec<f64>,
     /// Turn owed to each disc by [`exponential_map_deficit`] and not yet applied to its
@@ -53,12 +66,9 @@ impl Clone for World {
     fn clone(&self) -> World {
         World {
             physics: copy_physics(&self.physics),
-            shaft: self.shaft,
-            shaft_dynamic: self.shaft_dynamic,
-            housing: self.housing,
-            drum: self.drum,
-            discs: self.discs.clone(),
             carriers: self.carriers.clone(),
+            discs: self.discs.clone(),
+            carrier_of: self.carrier_of.clone(),
             disc_axial_m: self.disc_axial_m.clone(),
             owed: self.owed.clone(),
         }
@@ -184,7 +194,6 @@ impl World {
                 .chain((0..np).map(|j| at(StackBody::Plate(j).position())))
                 .collect()
         };
-        let carriers: Vec<Carrier> = (0..n + np).map(|i| pack.carrier(i)).collect();
 
         let (shaft, shaft_dynamic) = match &pack.shaft {
             Shaft::Prescribed(_) => {
@@ -251,17 +260,34 @@ impl World {
                 Some(h)
             }
         };
+        let body = |role, handle, dynamic| CarrierBody {
+            role,
+            handle,
+            dynamic,
+        };
+        let mut carriers = vec![
+            body(Carrier::Housing, housing, false),
+            body(Carrier::Shaft, shaft, shaft_dynamic),
+        ];
+        // the initial speed of each carrier, rad/s
+        let mut speeds = vec![0.0, omega0];
+        if let (Some(h), Some(dr)) = (drum, &pack.drum) {
+            carriers.push(body(Carrier::Drum, h, true));
+            speeds.push(dr.initial_speed_rad_s);
+        }
+        let carrier_of: Vec<usize> = (0..n + np)
+            .map(|i| {
+                let role = pack.carrier(i);
+                carriers
+                    .iter()
+                    .position(|c| c.role == role)
+                    .expect("a carrier")
+            })
+            .collect();
 
         let mut discs = Vec::with_capacity(n + np);
         for (i, d) in pack.discs.iter().chain(&pack.plates).enumerate() {
-            let (carrier, omega_c) = match carriers[i] {
-                Carrier::Shaft => (shaft, omega0),
-                Carrier::Housing => (housing, 0.0),
-                Carrier::Drum => (
-                    drum.expect("a drum"),
-                    pack.drum.map_or(0.0, |dr| dr.initial_speed_rad_s),
-                ),
-            };
+            let (carrier, omega_c) = (carriers[carrier_of[i]].handle, speeds[carrier_of[i]]);
             let mprops = disc_mass_properties(d.inertia_kg_m2, d.spline.pitch_radius_m, shapes);
             let [ex, ey] = d.initial_offset_m;
             // The centre starts at its offset in the shaft's frame (the world frame at t = 0),
@@ -308,13 +334,10 @@ impl World {
         }
         Ok(World {
             physics,
-            shaft,
-            shaft_dynamic,
-            housing,
-            drum,
+            carriers,
             owed: vec![Vector::ZERO; discs.len()],
             discs,
-            carriers,
+            carrier_of,
             disc_axial_m,
         })
     }
@@ -332,16 +355,16 @@ impl World {
                 *owed = Vector::ZERO;
             }
         }
-        if self.shaft_dynamic {
-            let body = &mut self.physics.bodies[self.shaft];
+        for c in self.carriers.iter().filter(|c| c.dynamic) {
+            let body = &mut self.physics.bodies[c.handle];
             let d = exponential_map_deficit(body, dt);
             turn(body, d);
         }
-        if let Some(h) = self.drum {
-            let body = &mut self.physics.bodies[h];
-            let d = exponential_map_deficit(body, dt);
-            turn(body, d);
-        }
+    }
+
+    /// The index in [`World::carriers`] of the output drum, if the pack has one.
+    pub fn drum(&self) -> Option<usize> {
+        self.carriers.iter().position(|c| c.role == Carrier::Drum)
     }
 
     /// The turn about `+z` owed to disc `i` and not yet in its rapier pose, rad.

@@ -5,9 +5,10 @@
 
 use super::energy::Powers;
 
-use super::state::{Run, ShaftDrive};
+use super::carriers::{External, Motion};
+use super::state::Run;
 use crate::stepping::contact_duration_s;
-use crate::world::Carrier;
+use crate::world::SHAFT;
 use clutchpack_model::Observer;
 
 impl Run {
@@ -47,50 +48,54 @@ impl Run {
                 0.5 * d.inertia_kg_m2 * w * w + 0.5 * b.mass() * b.linvel().length_squared()
             })
             .sum();
-        if let ShaftDrive::Inertial { j1, .. } = self.shaft {
-            e += 0.5 * j1 * self.omega_s * self.omega_s;
-        }
-        if let Some(d) = &self.drum {
-            e += 0.5 * d.model.inertia_kg_m2 * d.omega * d.omega;
+        for k in &self.carriers {
+            if let Motion::Inertial { j, .. } = k.motion {
+                e += 0.5 * j * k.speed * k.speed;
+            }
         }
         e
     }
 
     /// Adds the work done since the last evaluation (trapezoidal rule) to the energy audit.
     pub(super) fn audit_energy(&mut self) {
-        let (drive, shaft_damping) = match self.shaft {
-            ShaftDrive::Prescribed(_) => (0.0, 0.0),
-            ShaftDrive::Inertial { c1, .. } => (
-                self.drive_torque(self.t) * self.omega_s,
-                -c1 * self.omega_s * self.omega_s,
-            ),
-        };
-        let drag: f64 = self
+        let mut drag: f64 = self
             .bodies
             .iter()
             .zip(&self.omega_d)
             .map(|(d, w)| -d.drag_n_m_s_rad * w * w)
             .sum();
-        let (drum_drag, load) = match &self.drum {
-            Some(d) => (
-                -d.model.drag_n_m_s_rad * d.omega * d.omega,
-                d.model.load_torque_n_m * d.omega,
-            ),
-            None => (0.0, 0.0),
-        };
+        // each carrier's damping power and its external torque's (the drive's, a load's):
+        // none for a carrier that is not a body of its own
+        let (mut drive, mut load) = (None, None);
+        for (c, k) in self.carriers.iter().enumerate() {
+            let (external, damping) = match k.motion {
+                Motion::Inertial { damping, .. } => (
+                    self.external_at(c, self.t) * k.speed,
+                    -damping * k.speed * k.speed,
+                ),
+                _ => (0.0, 0.0),
+            };
+            drag += damping;
+            let book = match k.external {
+                External::Drive => &mut drive,
+                External::Load(_) => &mut load,
+                External::None => continue,
+            };
+            *book = Some(book.map_or(external, |p: f64| p + external));
+        }
         let mut now = Powers {
             t: self.t,
-            theta_s: self.theta_s,
+            theta_s: self.carriers[SHAFT].angle,
             spline_torque: self
                 .forces
                 .iter()
-                .zip(&self.world.carriers)
-                .filter(|(_, c)| **c == Carrier::Shaft)
+                .zip(&self.world.carrier_of)
+                .filter(|(_, &c)| c == SHAFT)
                 .map(|(f, _)| f.moment[2])
                 .sum(),
-            drive,
-            drag: drag + shaft_damping + drum_drag,
-            load,
+            drive: drive.unwrap_or(0.0),
+            drag,
+            load: load.unwrap_or(0.0),
             coupling_loss: 0.0,
             coupling_potential_j: 0.0,
         };
@@ -102,7 +107,7 @@ impl Run {
             now.coupling_loss = -c.loss_rate_w;
             now.coupling_potential_j = c.potential_j;
         }
-        let prescribed = matches!(self.shaft, ShaftDrive::Prescribed(_));
+        let prescribed = matches!(self.carriers[SHAFT].motion, Motion::Prescribed(_));
         self.energy.add_powers(now, prescribed);
     }
 }

@@ -17,15 +17,14 @@
 // positions m and m + 1) mirror the equations; iterator chains would obscure them.
 #![allow(clippy::needless_range_loop)]
 
-use super::inertial::Inertial;
+use super::carriers::{External, Motion};
 use super::landing::SubSteps;
-use super::state::{Run, ShaftDrive};
+use super::state::Run;
 use super::substep::{
     checked_sub_step, cut, graded_step, Node, Prescribed, Rk4, ShaftAt, WorldStep,
 };
 use crate::stack::Face;
 use crate::stepping::{bracketed_root, coupling_step};
-use crate::world::Carrier;
 use clutchpack_model::{EngineError, LocalProfile, SpeedProfile};
 use std::sync::Arc;
 
@@ -65,8 +64,10 @@ impl System {
 /// An inertial carrier integrated with the clamped stack: `J w' = T_ext(t) - C w - sum T_k`
 /// over the couplings it carries (the shaft: Hu et al. eq 4; the drum: its load and drag).
 struct Spin {
-    /// Its role (what its external torque is, where its state lives).
-    role: Inertial,
+    /// Its index in the run's carriers (its external torque, its state).
+    carrier: usize,
+    /// Whether its external torque's work is a load's in the audit (else the drive's).
+    load: bool,
     /// `1 / J`, 1/(kg m^2), and the damping `C`, N m s/rad.
     inv_j: f64,
     damping: f64,
@@ -190,7 +191,7 @@ impl Run {
         }
         for (k, c) in sys.spins.iter().enumerate() {
             // the drive (eq 4) or the load, the damping, the teeth's reactions
-            let external = self.external_torque(c.role, ts);
+            let external = self.external_at(c.carrier, ts);
             st.external[k] = external;
             let on: f64 = (0..u.len())
                 .filter(|&i| sys.mounts[i] == Mount::Spin(k))
@@ -205,10 +206,11 @@ impl Run {
     /// body's impulse.
     pub(super) fn clamped_step(&mut self, ws: &mut WorldStep) -> Result<(), EngineError> {
         let (t1, a) = (ws.t1, ws.a);
-        let profile = match &self.shaft {
-            ShaftDrive::Prescribed(p) => Some(Arc::clone(p)),
-            ShaftDrive::Inertial { .. } => None,
-        };
+        // the prescribed carrier's profile (the shaft's, if prescribed: `ws.drive`)
+        let profile = self.carriers.iter().find_map(|k| match &k.motion {
+            Motion::Prescribed(p) => Some(Arc::clone(p)),
+            _ => None,
+        });
         let n = self.couplings.len();
         let stack = self.stack.as_ref().expect("a stack");
         let n_if = stack.interfaces();
@@ -218,32 +220,29 @@ impl Run {
                 .map(|m| Face::Slipping(stack.slip[m].signum()))
                 .collect();
         }
-        // the inertial carriers: an inertial shaft, then the drum
-        let roles = [
-            profile.is_none().then_some(Inertial::Shaft),
-            self.drum.as_ref().map(|_| Inertial::Drum),
-        ];
-        let spins: Vec<Spin> = roles
-            .into_iter()
-            .flatten()
-            .map(|role| {
-                let (inv_j, damping) = self.carrier_inertia(role);
+        // the inertial carriers in table order (an inertial shaft, then the drum)
+        let spins: Vec<Spin> = (self.inertial_carriers().into_iter())
+            .map(|carrier| {
+                let (inv_j, damping) = self.carriers[carrier].inertia();
                 Spin {
-                    role,
+                    carrier,
+                    load: matches!(self.carriers[carrier].external, External::Load(_)),
                     inv_j,
                     damping,
                 }
             })
             .collect();
-        let spin_of = |c: Carrier| spins.iter().position(|s| s.role.carrier() == c);
         let mounts = (0..n)
-            .map(
-                |i| match (self.world.carriers[i], spin_of(self.world.carriers[i])) {
-                    (_, Some(k)) => Mount::Spin(k),
-                    (Carrier::Housing, None) => Mount::Housing,
-                    (_, None) => Mount::Profile,
-                },
-            )
+            .map(|i| {
+                let c = self.world.carrier_of[i];
+                match self.carriers[c].motion {
+                    Motion::Fixed => Mount::Housing,
+                    Motion::Prescribed(_) => Mount::Profile,
+                    Motion::Inertial { .. } => {
+                        Mount::Spin(spins.iter().position(|s| s.carrier == c).expect("a spin"))
+                    }
+                }
+            })
             .collect();
         let sys = System {
             body: stack.body.clone(),
@@ -260,8 +259,11 @@ impl Run {
         let t0 = self.t;
         let h_world = t1 - t0;
         // the inertial carriers' angles and speeds
-        let (angle0, w0): (Vec<f64>, Vec<f64>) =
-            sys.spins.iter().map(|c| self.carrier_state(c.role)).unzip();
+        let (angle0, w0): (Vec<f64>, Vec<f64>) = sys
+            .spins
+            .iter()
+            .map(|c| self.carrier_state(c.carrier))
+            .unzip();
         let bufs = (self.multirate.stack_buffers.take())
             .filter(|b| b.fits(n, n_spin))
             .unwrap_or_else(|| RkBuffers::new(n, n_spin));
@@ -292,8 +294,8 @@ impl Run {
         for (k, c) in st.sys.spins.iter().enumerate() {
             let node = |t, angle, speed| Node { t, angle, speed };
             let (start, end) = (node(t0, angle0[k], w0[k]), node(t1, st.angle[k], st.w[k]));
-            carriers.push((self.carrier_body_of(c.role), start, end));
-            self.set_carrier_state(c.role, st.angle[k], st.w[k]);
+            carriers.push((c.carrier, start, end));
+            self.set_carrier_state(c.carrier, st.angle[k], st.w[k]);
         }
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let locked: Vec<bool> = self
@@ -309,7 +311,7 @@ impl Run {
             &locked,
             &st.s0.face,
         );
-        self.finish_world_step(&means, t1, profile.as_deref(), &carriers);
+        self.finish_world_step(&means, t1, &carriers);
         self.multirate.stack_buffers = Some(st.bufs.into_inner());
         Ok(())
     }
@@ -565,9 +567,10 @@ impl Run {
             // the external torque's work: the drive's on an inertial shaft (eq 4), the
             // drum's load
             let work = external[k];
-            match spin.role {
-                Inertial::Shaft => out.drive_j += work,
-                Inertial::Drum => out.load_j += work,
+            if spin.load {
+                out.load_j += work;
+            } else {
+                out.drive_j += work;
             }
         }
         for m in 0..n_if {
@@ -691,11 +694,11 @@ impl SubSteps for StackSteps {
                 .sum()
         };
         let spin_bound: Vec<f64> = (sys.spins.iter().enumerate())
-            .map(|(k, c)| run.inertial_accel_bound(c.role, self.w[k], reaction(k)))
+            .map(|(k, c)| run.inertial_accel_bound(c.carrier, self.w[k], reaction(k)))
             .collect();
         for i in 0..n {
             let carrier = match sys.mounts[i] {
-                Mount::Profile => run.shaft_accel_bound,
+                Mount::Profile => run.carriers[run.world.carrier_of[i]].drive_bound,
                 Mount::Housing => 0.0,
                 Mount::Spin(k) => spin_bound[k],
             };

@@ -1,10 +1,11 @@
 //! Step control: the step each coupling allows, the stack's impulses for a step, and the
 //! landing of steps on contact onsets and separations.
 
-use super::state::{Run, ShaftDrive};
+use super::carriers::{joined_torque, External, Motion};
+use super::state::Run;
 use crate::options::AdaptiveStepping;
 use crate::stepping::{coupling_step, CouplingView};
-use crate::world::Carrier;
+use crate::world::SHAFT;
 
 impl Run {
     /// What the step controller ([`coupling_step`]) reads of coupling `i` at `t` (s): its
@@ -36,46 +37,38 @@ impl Run {
 
     /// The step the adaptive controller wants at `t`, s, and whether it is a contact step.
     pub(super) fn desired_step(&self, a: &AdaptiveStepping) -> (f64, bool) {
-        let a_shaft = match self.shaft {
-            ShaftDrive::Prescribed(_) => self.shaft_accel_bound,
-            ShaftDrive::Inertial { j1, c1 } => {
-                // The drive, the damping, and the teeth's reactions at t (contacts elsewhere
-                // in the pack jolt the shaft).
-                let reaction: f64 = self
-                    .forces
-                    .iter()
-                    .zip(&self.world.carriers)
-                    .filter(|(_, c)| **c == Carrier::Shaft)
-                    .map(|(f, _)| f.moment[2].abs())
-                    .sum();
-                self.shaft_accel_bound + (c1 * self.omega_s.abs() + reaction) / j1
-            }
-        };
-        let a_drum = match &self.drum {
-            Some(d) => {
-                let reaction: f64 = self
-                    .forces
-                    .iter()
-                    .zip(&self.world.carriers)
-                    .filter(|(_, c)| **c == Carrier::Drum)
-                    .map(|(f, _)| f.moment[2].abs())
-                    .sum();
-                (d.model.load_torque_n_m.abs() + d.model.drag_n_m_s_rad * d.omega.abs() + reaction)
-                    / d.model.inertia_kg_m2
-            }
-            None => 0.0,
-        };
+        // Each carrier's acceleration bound: a prescribed one's profile's, an inertial one's
+        // external torque (the drive's bound, or the load), its damping and the teeth's
+        // reactions at t (contacts elsewhere in the pack jolt it).
+        let mut a_carrier: Vec<f64> = (self.carriers.iter().enumerate())
+            .map(|(c, k)| match k.motion {
+                Motion::Fixed => 0.0,
+                Motion::Prescribed(_) => k.drive_bound,
+                Motion::Inertial { j, damping } => {
+                    let reaction: f64 = self
+                        .forces
+                        .iter()
+                        .zip(&self.world.carrier_of)
+                        .filter(|(_, &of)| of == c)
+                        .map(|(f, _)| f.moment[2].abs())
+                        .sum();
+                    match k.external {
+                        External::Load(l) => (l.abs() + damping * k.speed.abs() + reaction) / j,
+                        External::Drive => k.drive_bound + (damping * k.speed.abs() + reaction) / j,
+                        External::None => (damping * k.speed.abs() + reaction) / j,
+                    }
+                }
+            })
+            .collect();
         let mut want = a.max_step_s;
-        let (mut a_shaft, mut a_drum) = (a_shaft, a_drum);
         if !self.pack.couplings.is_empty() {
-            // the couplings' torques jolt the shaft and the drum too; and their free
+            // the couplings' torques jolt the inertial carriers too; and their free
             // oscillation is resolved like a contact (MODEL.md section 8)
-            let c = self.coupling_loads();
-            if let ShaftDrive::Inertial { j1, .. } = self.shaft {
-                a_shaft += c.shaft_n_m.abs() / j1;
-            }
-            if let Some(d) = &self.drum {
-                a_drum += c.drum_n_m.abs() / d.model.inertia_kg_m2;
+            let loads = self.coupling_loads();
+            for (c, k) in self.carriers.iter().enumerate() {
+                if let Motion::Inertial { j, .. } = k.motion {
+                    a_carrier[c] += joined_torque(&loads, self.world.carriers[c].role).abs() / j;
+                }
             }
             want = want.min(self.coupling_period_s() / a.steps_per_contact);
         }
@@ -88,17 +81,12 @@ impl Run {
                     .map_or(0.0, |_| s.torque_bound(i))
             });
             let a_disc = (d.drag_n_m_s_rad * self.omega_d[i].abs() + stack) / d.inertia_kg_m2;
-            let a_carrier = match self.world.carriers[i] {
-                Carrier::Shaft => a_shaft,
-                Carrier::Drum => a_drum,
-                Carrier::Housing => 0.0,
-            };
             let rel = self.rel[i];
             let view = self.coupling_view(
                 i,
                 &self.forces[i],
                 (rel.phi, rel.dphi),
-                a_carrier + a_disc,
+                a_carrier[self.world.carrier_of[i]] + a_disc,
                 self.t,
             );
             let (dt, c) = coupling_step(&view, a);
@@ -114,14 +102,12 @@ impl Run {
     /// s: `2 pi / omega_n`, `omega_n = sqrt(k (1/J_a + 1/J_b))` with a prescribed shaft as an
     /// infinite inertia (MODEL.md section 8); infinite without couplings.
     pub(super) fn coupling_period_s(&self) -> f64 {
-        let j_shaft = match self.shaft {
-            ShaftDrive::Inertial { j1, .. } => j1,
-            ShaftDrive::Prescribed(_) => f64::INFINITY,
+        let j_of = |c: usize| match self.carriers[c].motion {
+            Motion::Inertial { j, .. } => j,
+            _ => f64::INFINITY,
         };
-        let j_drum = self
-            .drum
-            .as_ref()
-            .map_or(f64::INFINITY, |d| d.model.inertia_kg_m2);
+        let j_shaft = j_of(SHAFT);
+        let j_drum = self.world.drum().map_or(f64::INFINITY, j_of);
         let inertia = |b| match b {
             clutchpack_model::PackBody::Shaft => j_shaft,
             clutchpack_model::PackBody::Drum => j_drum,
@@ -176,48 +162,37 @@ impl Run {
     /// order.
     pub(super) fn landing(&self, h: f64, tiny: f64) -> Option<f64> {
         let bodies = &self.world.physics.bodies;
-        let theta_s0 = match self.shaft {
-            ShaftDrive::Prescribed(_) => self.theta_s,
-            ShaftDrive::Inertial { .. } => 0.0,
-        };
-        let w_s = bodies[self.world.shaft].angvel().z;
-        let shaft_turn = |x: f64| match &self.shaft {
-            ShaftDrive::Prescribed(p) => p.angle(self.t + x) - theta_s0,
-            &ShaftDrive::Inertial { j1, .. } => {
-                let teeth: f64 = (0..self.couplings.len())
-                    .filter(|&i| self.world.carriers[i] == Carrier::Shaft)
-                    .map(|i| self.teeth_impulse(i, x))
-                    .sum();
-                x * (w_s
-                    + (self.shared.shaft_loads.kick.impulse_component(5, x)
-                        + self.drive_impulse(x)
-                        - teeth)
-                        / j1)
+        // Carrier c's turn after x s: a prescribed one's by its profile, the housing's none,
+        // an inertial one's by its speed and kicks (its loads', its external torque's, the
+        // teeth's reactions).
+        let turn_of = |c: usize, x: f64| {
+            let k = &self.carriers[c];
+            match &k.motion {
+                Motion::Fixed => 0.0,
+                Motion::Prescribed(p) => p.angle(self.t + x) - k.angle,
+                &Motion::Inertial { j, .. } => {
+                    let teeth: f64 = (0..self.couplings.len())
+                        .filter(|&i| self.world.carrier_of[i] == c)
+                        .map(|i| self.teeth_impulse(i, x))
+                        .sum();
+                    x * (bodies[self.world.carriers[c].handle].angvel().z
+                        + (self.shared.carrier_loads[c].kick.impulse_component(5, x)
+                            + self.external_impulse(c, x)
+                            - teeth)
+                            / j)
+                }
             }
-        };
-        let drum_turn = |x: f64| match (&self.drum, self.world.drum) {
-            (Some(d), Some(hd)) => {
-                let teeth: f64 = (0..self.couplings.len())
-                    .filter(|&i| self.world.carriers[i] == Carrier::Drum)
-                    .map(|i| self.teeth_impulse(i, x))
-                    .sum();
-                x * (bodies[hd].angvel().z
-                    + (self.shared.drum_loads.kick.impulse_component(5, x)
-                        + self.drum_load_impulse(x)
-                        - teeth)
-                        / d.model.inertia_kg_m2)
-            }
-            _ => 0.0,
         };
         // The carriers' turns over the whole step, computed once (a drum's sums every plate's
         // teeth).
-        let (shaft_turn_h, drum_turn_h) = (shaft_turn(h), drum_turn(h));
-        let carrier_turn = |i: usize, x: f64| match self.world.carriers[i] {
-            Carrier::Shaft if x == h => shaft_turn_h,
-            Carrier::Drum if x == h => drum_turn_h,
-            Carrier::Shaft => shaft_turn(x),
-            Carrier::Drum => drum_turn(x),
-            Carrier::Housing => 0.0,
+        let turn_h: Vec<f64> = (0..self.carriers.len()).map(|c| turn_of(c, h)).collect();
+        let carrier_turn = |i: usize, x: f64| {
+            let c = self.world.carrier_of[i];
+            if x == h {
+                turn_h[c]
+            } else {
+                turn_of(c, x)
+            }
         };
         let mut best: Option<f64> = None;
         for (i, d) in self.bodies.iter().enumerate() {

@@ -2,9 +2,10 @@
 //! the physical loads on every body and their kicks, the teeth's and the drive's impulses over
 //! a step, and the step itself (forces handed to rapier, the world advanced).
 
-use super::state::{relative_state, Run, ShaftDrive};
-use crate::integrate::{future_impulse, past_impulse, Load, Motion};
-use crate::world::{angle_about_z, Carrier};
+use super::carriers::{joined_torque, Motion};
+use super::state::{relative_state, Run};
+use crate::integrate::{future_impulse, past_impulse, Load};
+use crate::world::{angle_about_z, SHAFT};
 use clutchpack_model::EngineError;
 use rapier3d_f64::prelude::{RigidBody, Rotation, Vector};
 
@@ -14,30 +15,28 @@ impl Run {
     /// (|phi| beyond half a pitch).
     pub(super) fn evaluate(&mut self, t_last_good: f64) -> Result<(), EngineError> {
         let bodies = &self.world.physics.bodies;
-        let shaft = &bodies[self.world.shaft];
-        // First estimates of the speeds at t: rapier's mean speeds plus the extrapolated
-        // accelerations over the last step.
-        self.omega_s = match &self.shaft {
-            ShaftDrive::Prescribed(p) => p.speed(self.t),
-            ShaftDrive::Inertial { j1, .. } => self.shared.shaft_loads.full_history.synchronised(
-                self.t,
-                shaft.angvel().z,
-                5,
-                1.0 / *j1,
-            ),
-        };
-        if let (Some(d), Some(h)) = (self.drum.as_mut(), self.world.drum) {
-            d.omega = self.shared.drum_loads.full_history.synchronised(
-                self.t,
-                bodies[h].angvel().z,
-                5,
-                1.0 / d.model.inertia_kg_m2,
-            );
+        // First estimates of the carriers' speeds at t: a prescribed one's profile, an
+        // inertial one's rapier mean speed plus the extrapolated accelerations over the last
+        // step.
+        for (c, k) in self.carriers.iter_mut().enumerate() {
+            let carrier = &bodies[self.world.carriers[c].handle];
+            match &k.motion {
+                Motion::Prescribed(p) => k.speed = p.speed(self.t),
+                Motion::Inertial { j, .. } => {
+                    k.speed = self.shared.carrier_loads[c].full_history.synchronised(
+                        self.t,
+                        carrier.angvel().z,
+                        5,
+                        1.0 / *j,
+                    );
+                }
+                Motion::Fixed => {}
+            }
         }
         // The teeth's torque integrated along the last step (the past half of the kick), which
-        // also gives the synchronised speeds without extrapolating across a kink.
-        let mut teeth_past_shaft = 0.0;
-        let mut teeth_past_drum = 0.0;
+        // also gives the synchronised speeds without extrapolating across a kink; summed per
+        // carrier.
+        let mut teeth_past_on = vec![0.0; self.carriers.len()];
         for i in 0..self.couplings.len() {
             self.shared.teeth_past[i] = 0.0;
             let Some((t0, phi0, dphi0, _)) = self.shared.prev_motion[i] else {
@@ -64,38 +63,21 @@ impl Run {
                     past_impulse((phi0, dphi0), (rel.phi, rel.dphi), h1, |p, d| {
                         c.probe_torque(p, d)
                     });
-                match self.world.carriers[i] {
-                    Carrier::Shaft => teeth_past_shaft += self.shared.teeth_past[i],
-                    Carrier::Drum => teeth_past_drum += self.shared.teeth_past[i],
-                    Carrier::Housing => {}
-                }
+                teeth_past_on[self.world.carrier_of[i]] += self.shared.teeth_past[i];
             }
         }
-        let load_past = self.drum_load_past();
-        if let ShaftDrive::Inertial { j1, .. } = self.shaft {
-            if self.shared.shaft_loads.history.len() > 0 {
-                self.omega_s = shaft.angvel().z
-                    + (self
-                        .shared
-                        .shaft_loads
-                        .history
-                        .synchronised(self.t, 0.0, 5, 1.0)
-                        + self.drive_past()
-                        - teeth_past_shaft)
-                        / j1;
-            }
-        }
-        if let (Some(d), Some(h)) = (self.drum.as_mut(), self.world.drum) {
-            if self.shared.drum_loads.history.len() > 0 {
-                d.omega = bodies[h].angvel().z
-                    + (self
-                        .shared
-                        .drum_loads
-                        .history
-                        .synchronised(self.t, 0.0, 5, 1.0)
-                        + load_past
-                        - teeth_past_drum)
-                        / d.model.inertia_kg_m2;
+        // An inertial carrier's speed at t from its mean speed over the last step, the past
+        // halves of its loads' kick, of its external torque's and of the teeth's reactions.
+        for c in 0..self.carriers.len() {
+            let Motion::Inertial { j, .. } = self.carriers[c].motion else {
+                continue;
+            };
+            let loads = &self.shared.carrier_loads[c];
+            if loads.history.len() > 0 {
+                let past = self.external_past(c);
+                self.carriers[c].speed = bodies[self.world.carriers[c].handle].angvel().z
+                    + (loads.history.synchronised(self.t, 0.0, 5, 1.0) + past - teeth_past_on[c])
+                        / j;
             }
         }
         self.rel.clear();
@@ -201,7 +183,7 @@ impl Run {
     pub(super) fn input_changed(&mut self, shaft_jump: f64, multirate: bool) {
         self.potential_j = 0.0;
         for i in 0..self.couplings.len() {
-            if self.world.carriers[i] == Carrier::Shaft && shaft_jump != 0.0 {
+            if self.world.carrier_of[i] == SHAFT && shaft_jump != 0.0 {
                 let rel = &mut self.rel[i];
                 rel.dphi += shaft_jump;
                 // rate = dv - omega_s z x d in the shaft's frame
@@ -237,16 +219,16 @@ impl Run {
     /// drive, the drum's load) and the kicks for the next step.
     pub(super) fn compute_loads(&mut self) {
         let bodies = &self.world.physics.bodies;
-        let mut shaft_force = Vector::ZERO;
-        let mut shaft_torque = Vector::ZERO;
-        let mut shaft_torque_full = Vector::ZERO;
-        let mut drum_force = Vector::ZERO;
-        let mut drum_torque = Vector::ZERO;
-        let mut drum_torque_full = Vector::ZERO;
+        // per carrier: the couplings' force on it, their torque on it less the teeth's about
+        // the axis, and their full torque (world frame)
+        let nc = self.carriers.len();
+        let mut carrier_force = vec![Vector::ZERO; nc];
+        let mut carrier_torque = vec![Vector::ZERO; nc];
+        let mut carrier_torque_full = vec![Vector::ZERO; nc];
         let mut disc_accel = vec![0.0; self.forces.len()];
         for (i, f) in self.forces.iter().enumerate() {
             let d = &self.bodies[i];
-            let carrier = self.world.carriers[i];
+            let c = self.world.carrier_of[i];
             let qs = *bodies[self.carrier_body(i)].rotation();
             // Hu et al. eq (5): drag -C2 omega_d.
             let drag = -d.drag_n_m_s_rad * self.omega_d[i];
@@ -277,95 +259,59 @@ impl Run {
             let mut partial = self.shared.loads[i].full;
             partial[5] -= f.moment[2];
             self.shared.loads[i].load = partial;
-            match carrier {
-                Carrier::Shaft => {
-                    shaft_torque_full -= reaction;
-                    shaft_force -= force;
-                    shaft_torque -= reaction - Vector::new(0.0, 0.0, f.moment[2]);
-                }
-                Carrier::Drum => {
-                    drum_torque_full -= reaction;
-                    drum_force -= force;
-                    drum_torque -= reaction - Vector::new(0.0, 0.0, f.moment[2]);
-                }
-                Carrier::Housing => {}
-            }
+            carrier_torque_full[c] -= reaction;
+            carrier_force[c] -= force;
+            carrier_torque[c] -= reaction - Vector::new(0.0, 0.0, f.moment[2]);
             self.shared.loads[i].kick = self.shared.loads[i]
                 .history
                 .kick(self.t, &self.shared.loads[i].load);
         }
-        let drive_now = self.drive_torque(self.t);
         // MODEL.md section 8: the couplings between the shaft and the drum (a spring-damper),
         // smooth in time: through the polynomial kick, as the drag
         let joined = (!self.pack.couplings.is_empty()).then(|| self.coupling_loads());
-        let shaft_accel = match &self.shaft {
-            ShaftDrive::Prescribed(p) => p.acceleration(self.t),
-            &ShaftDrive::Inertial { j1, c1 } => {
-                // Hu et al. eq (4): the drive torque, the spline reactions, damping -C1 omega.
-                // The drive is a known function of time: its kick is integrated exactly
-                // (`drive_impulse`), not extrapolated.
-                let damping = -c1 * self.omega_s;
-                shaft_torque.z += damping;
-                shaft_torque_full.z += damping + drive_now;
-                if let Some(c) = joined {
-                    shaft_torque.z += c.shaft_n_m;
-                    shaft_torque_full.z += c.shaft_n_m;
+        let mut carrier_accel = vec![0.0; nc];
+        for c in 0..nc {
+            let k = &self.carriers[c];
+            carrier_accel[c] = match &k.motion {
+                Motion::Fixed => 0.0,
+                Motion::Prescribed(p) => p.acceleration(self.t),
+                &Motion::Inertial { j, damping } => {
+                    // Hu et al. eq (4) for an inertial shaft: the drive torque, the spline
+                    // reactions, damping -C1 w; the drum: its load torque, its drag, the
+                    // plates' spline reactions. An external torque known as a function of
+                    // time (the drive, a driven load) is integrated exactly
+                    // (`external_impulse`), not extrapolated.
+                    let own = self.external_at(c, self.t);
+                    let damping = -damping * k.speed;
+                    carrier_torque[c].z += if k.exact { damping } else { own + damping };
+                    carrier_torque_full[c].z += own + damping;
+                    if let Some(l) = joined {
+                        let on = joined_torque(&l, self.world.carriers[c].role);
+                        carrier_torque[c].z += on;
+                        carrier_torque_full[c].z += on;
+                    }
+                    let f = carrier_force[c];
+                    let l = |t: Vector| [f.x, f.y, f.z, t.x, t.y, t.z];
+                    let loads = &mut self.shared.carrier_loads[c];
+                    loads.load = l(carrier_torque[c]);
+                    loads.full = l(carrier_torque_full[c]);
+                    loads.kick = loads.history.kick(self.t, &loads.load);
+                    carrier_torque_full[c].z / j
                 }
-                let l = |t: Vector| [shaft_force.x, shaft_force.y, shaft_force.z, t.x, t.y, t.z];
-                self.shared.shaft_loads.load = l(shaft_torque);
-                self.shared.shaft_loads.full = l(shaft_torque_full);
-                self.shared.shaft_loads.kick = self
-                    .shared
-                    .shaft_loads
-                    .history
-                    .kick(self.t, &self.shared.shaft_loads.load);
-                shaft_torque_full.z / j1
-            }
-        };
-        let drum_accel = match self.drum.as_mut() {
-            Some(dr) => {
-                // The drum: its load torque, its drag, the plates' spline reactions.
-                let own = dr.model.load_torque_n_m - dr.model.drag_n_m_s_rad * dr.omega;
-                // A driven load is integrated exactly (`drum_load_impulse`), not extrapolated.
-                drum_torque.z += if self.shared.exact_drum_load {
-                    -dr.model.drag_n_m_s_rad * dr.omega
-                } else {
-                    own
-                };
-                drum_torque_full.z += own;
-                if let Some(c) = joined {
-                    drum_torque.z += c.drum_n_m;
-                    drum_torque_full.z += c.drum_n_m;
-                }
-                let l = |t: Vector| [drum_force.x, drum_force.y, drum_force.z, t.x, t.y, t.z];
-                self.shared.drum_loads.load = l(drum_torque);
-                self.shared.drum_loads.full = l(drum_torque_full);
-                self.shared.drum_loads.kick = self
-                    .shared
-                    .drum_loads
-                    .history
-                    .kick(self.t, &self.shared.drum_loads.load);
-                drum_torque_full.z / dr.model.inertia_kg_m2
-            }
-            None => 0.0,
-        };
+            };
+        }
         for c in &self.shared.teeth_cache {
             c.set((f64::NAN, 0.0));
         }
         for (i, m) in self.shared.teeth_motion.iter_mut().enumerate() {
-            let carrier_accel = match self.world.carriers[i] {
-                Carrier::Shaft => shaft_accel,
-                Carrier::Drum => drum_accel,
-                Carrier::Housing => 0.0,
-            };
-            let ddphi = carrier_accel - disc_accel[i];
+            let ddphi = carrier_accel[self.world.carrier_of[i]] - disc_accel[i];
             let (jerk, jerk_step) = match self.shared.prev_motion[i] {
                 Some((t0, _, _, dd0)) if self.t > t0 => {
                     ((ddphi - dd0) / (self.t - t0), self.t - t0)
                 }
                 _ => (0.0, 0.0),
             };
-            *m = Motion {
+            *m = crate::integrate::Motion {
                 phi: self.rel[i].phi,
                 dphi: self.rel[i].dphi,
                 ddphi,
@@ -380,10 +326,10 @@ impl Run {
     /// shaft's and the drum's angles and speeds at `t`).
     pub(super) fn coupling_loads(&self) -> clutchpack_model::CouplingLoads {
         let drum = self
-            .drum
-            .as_ref()
-            .map_or((0.0, 0.0), |d| (d.theta, d.omega));
-        self.pack.coupling_loads((self.theta_s, self.omega_s), drum)
+            .world
+            .drum()
+            .map_or((0.0, 0.0), |d| self.carrier_state(d));
+        self.pack.coupling_loads(self.carrier_state(SHAFT), drum)
     }
 
     /// The impulse of the teeth of coupling `i` on its body about the axis over a step of
@@ -400,67 +346,37 @@ impl Run {
         v
     }
 
-    /// The drive torque on an inertial shaft integrated against the rising ramp of the last
-    /// step (N m s; 0 before the first step or for a prescribed shaft).
-    pub(super) fn drive_past(&self) -> f64 {
+    /// The external torque on inertial carrier `c` (the drive on an inertial shaft, a driven
+    /// drum load) integrated against the rising ramp of the last step, N m s: its share of the
+    /// speed synchronised to `t`. 0 before the first step, for a carrier that is not inertial,
+    /// or whose external torque goes through the polynomial kick (not `exact`).
+    pub(super) fn external_past(&self, c: usize) -> f64 {
+        let k = &self.carriers[c];
         let Some(t0) = self.t_prev else {
             return 0.0;
         };
         let h = self.t - t0;
-        if h <= 0.0 || matches!(self.shaft, ShaftDrive::Prescribed(_)) {
+        if h <= 0.0 || !k.exact || !k.is_inertial() {
             return 0.0;
         }
-        crate::integrate::ramp_integral(t0, h, true, |t| self.drive_torque(t))
+        crate::integrate::ramp_integral(t0, h, true, |t| self.external_at(c, t))
+    }
+
+    /// The kick of inertial carrier `c`'s external torque for a step of length `x` from `t`
+    /// (both halves, N m s; 0 as for [`Run::external_past`]).
+    pub(super) fn external_impulse(&self, c: usize, x: f64) -> f64 {
+        let k = &self.carriers[c];
+        if !k.exact || !k.is_inertial() {
+            return 0.0;
+        }
+        self.external_past(c)
+            + crate::integrate::ramp_integral(self.t, x, false, |t| self.external_at(c, t))
     }
 
     /// The drive torque on an inertial shaft at `t`, N m: the pack's excitation, or before a
-    /// driven torque's last change (`drive_switch`) the value held until then.
+    /// driven torque's last change the value held until then ([`Run::external_at`]).
     pub(super) fn drive_torque(&self, t: f64) -> f64 {
-        match self.drive_switch {
-            Some((t_switch, before)) if t < t_switch => before,
-            _ => self.pack.shaft.drive_torque_n_m(t),
-        }
-    }
-
-    /// A driven drum load at `t`, N m: the drum's, or before its last change (`load_switch`)
-    /// the value held until then.
-    fn drum_load(&self, t: f64) -> f64 {
-        match (self.shared.load_switch, &self.drum) {
-            (Some((t_switch, before)), _) if t < t_switch => before,
-            (_, Some(d)) => d.model.load_torque_n_m,
-            (_, None) => 0.0,
-        }
-    }
-
-    /// A driven drum load integrated against the rising ramp of the last step, N m s (0 when
-    /// the load is not driven: it is then in the drum's polynomial kick).
-    pub(super) fn drum_load_past(&self) -> f64 {
-        match self.t_prev {
-            Some(t0) if self.shared.exact_drum_load && self.t > t0 => {
-                crate::integrate::ramp_integral(t0, self.t - t0, true, |t| self.drum_load(t))
-            }
-            _ => 0.0,
-        }
-    }
-
-    /// The kick of a driven drum load for a step of length `x` from `t` (both halves, N m s; 0
-    /// when the load is not driven).
-    pub(super) fn drum_load_impulse(&self, x: f64) -> f64 {
-        if !self.shared.exact_drum_load {
-            return 0.0;
-        }
-        self.drum_load_past()
-            + crate::integrate::ramp_integral(self.t, x, false, |t| self.drum_load(t))
-    }
-
-    /// The kick of the drive torque on an inertial shaft for a step of length `x` from `t`
-    /// (both halves, N m s).
-    pub(super) fn drive_impulse(&self, x: f64) -> f64 {
-        if matches!(self.shaft, ShaftDrive::Prescribed(_)) {
-            return 0.0;
-        }
-        self.drive_past()
-            + crate::integrate::ramp_integral(self.t, x, false, |t| self.drive_torque(t))
+        self.external_at(SHAFT, t)
     }
 
     /// Resets and applies every body's forces for the step from `t` to `t_next`: each body's
@@ -474,8 +390,8 @@ impl Run {
         let stack: Vec<f64> = (0..self.couplings.len())
             .map(|i| self.stack_torque(i))
             .collect();
-        let drive = self.drive_impulse(h);
-        let drum_load = self.drum_load_impulse(h);
+        let nc = self.carriers.len();
+        let external: Vec<f64> = (0..nc).map(|c| self.external_impulse(c, h)).collect();
         let bodies = &mut self.world.physics.bodies;
         let apply = |body: &mut RigidBody, l: Load| {
             body.reset_forces(false);
@@ -483,80 +399,62 @@ impl Run {
             body.add_force(Vector::new(l[0], l[1], l[2]), false);
             body.add_torque(Vector::new(l[3], l[4], l[5]), false);
         };
-        let mut teeth_on_shaft = 0.0;
-        let mut teeth_on_drum = 0.0;
+        let mut teeth_on = vec![0.0; nc];
         for (i, body) in self.shared.loads.iter_mut().enumerate() {
             let mut load = body.kick.applied(h);
             load[5] += teeth[i] + stack[i];
-            match self.world.carriers[i] {
-                Carrier::Shaft => teeth_on_shaft -= teeth[i],
-                Carrier::Drum => teeth_on_drum -= teeth[i],
-                Carrier::Housing => {}
-            }
+            teeth_on[self.world.carrier_of[i]] -= teeth[i];
             apply(&mut bodies[self.world.discs[i]], load);
             body.history.push(self.t, body.load);
             body.full_history.push(self.t, body.full);
             let m = &self.shared.teeth_motion[i];
             self.shared.prev_motion[i] = Some((self.t, m.phi, m.dphi, m.ddphi));
         }
-        let shaft = &mut bodies[self.world.shaft];
-        match &self.shaft {
-            ShaftDrive::Prescribed(p) => {
-                self.shared.theta_next = p.angle(t_next);
-                shaft
-                    .set_next_kinematic_rotation(Rotation::from_rotation_z(self.shared.theta_next));
+        for c in 0..nc {
+            let body = &mut bodies[self.world.carriers[c].handle];
+            match &self.carriers[c].motion {
+                Motion::Fixed => {}
+                Motion::Prescribed(p) => {
+                    self.shared.angle_next[c] = p.angle(t_next);
+                    body.set_next_kinematic_rotation(Rotation::from_rotation_z(
+                        self.shared.angle_next[c],
+                    ));
+                }
+                Motion::Inertial { .. } => {
+                    let loads = &mut self.shared.carrier_loads[c];
+                    let mut load = loads.kick.applied(h);
+                    load[5] += teeth_on[c] + external[c] / h;
+                    apply(body, load);
+                    loads.history.push(self.t, loads.load);
+                    loads.full_history.push(self.t, loads.full);
+                }
             }
-            ShaftDrive::Inertial { .. } => {
-                let mut load = self.shared.shaft_loads.kick.applied(h);
-                load[5] += teeth_on_shaft + drive / h;
-                apply(shaft, load);
-                self.shared
-                    .shaft_loads
-                    .history
-                    .push(self.t, self.shared.shaft_loads.load);
-                self.shared
-                    .shaft_loads
-                    .full_history
-                    .push(self.t, self.shared.shaft_loads.full);
-            }
-        }
-        if let (Some(_), Some(hd)) = (&self.drum, self.world.drum) {
-            let mut load = self.shared.drum_loads.kick.applied(h);
-            load[5] += teeth_on_drum + drum_load / h;
-            apply(&mut bodies[hd], load);
-            self.shared
-                .drum_loads
-                .history
-                .push(self.t, self.shared.drum_loads.load);
-            self.shared
-                .drum_loads
-                .full_history
-                .push(self.t, self.shared.drum_loads.full);
         }
     }
 
-    /// Steps the world to `t_next` (after [`Run::apply_forces`]) and updates the shaft and
-    /// drum angles and the stack's work.
+    /// Steps the world to `t_next` (after [`Run::apply_forces`]) and updates the carriers'
+    /// angles and the stack's work.
     pub(super) fn advance(&mut self, t_next: f64) {
         let h = t_next - self.t;
-        let q_before = *self.world.physics.bodies[self.world.shaft].rotation();
-        let drum_before = self
-            .world
-            .drum
-            .map(|hd| *self.world.physics.bodies[hd].rotation());
+        let rotation = |world: &crate::world::World, c: usize| {
+            *world.physics.bodies[world.carriers[c].handle].rotation()
+        };
+        let before: Vec<Rotation> = (0..self.carriers.len())
+            .map(|c| rotation(&self.world, c))
+            .collect();
         self.world.step(h);
         self.t_prev = Some(self.t);
         self.t = t_next;
-        self.theta_s = match self.shaft {
-            ShaftDrive::Prescribed(_) => self.shared.theta_next,
-            ShaftDrive::Inertial { .. } => {
-                let q_after = *self.world.physics.bodies[self.world.shaft].rotation();
-                self.theta_s + angle_about_z(&(q_before.inverse() * q_after))
+        for (c, q0) in before.into_iter().enumerate() {
+            let k = &mut self.carriers[c];
+            match k.motion {
+                Motion::Fixed => {}
+                Motion::Prescribed(_) => k.angle = self.shared.angle_next[c],
+                Motion::Inertial { .. } => {
+                    let q1 = rotation(&self.world, c);
+                    k.angle += angle_about_z(&(q0.inverse() * q1));
+                }
             }
-        };
-        if let (Some(d), Some(hd), Some(q0)) = (self.drum.as_mut(), self.world.drum, drum_before) {
-            let q1 = *self.world.physics.bodies[hd].rotation();
-            d.theta += angle_about_z(&(q0.inverse() * q1));
         }
         if let Some(s) = self.stack.as_mut() {
             let bodies = &self.world.physics.bodies;

@@ -5,12 +5,11 @@
 //! the carrier's motion (`multirate.rs`'s per-coupling integration).
 
 use super::landing::SubSteps;
-use super::state::{Run, ShaftDrive};
+use super::state::Run;
 use super::substep::{
     checked_sub_step, cut, graded_step, Carried, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep,
 };
 use crate::stepping::coupling_step;
-use crate::world::Carrier;
 use clutchpack_model::EngineError;
 use rapier3d_f64::prelude::Vector;
 
@@ -19,25 +18,6 @@ use rapier3d_f64::prelude::Vector;
 /// error per step in the angle grows as the fifth power of the step (see
 /// [`Run::integrate_carrier`]).
 const SHAFT_SUB_STEPS: f64 = 4.0;
-
-/// An inertial carrier of couplings, integrated with the bodies that may touch it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Inertial {
-    /// The inertial shaft (Hu et al. eq 4), carrying the friction discs.
-    Shaft,
-    /// The output drum, carrying the separator plates.
-    Drum,
-}
-
-impl Inertial {
-    /// The carrier of the couplings this one carries.
-    pub(super) fn carrier(self) -> Carrier {
-        match self {
-            Inertial::Shaft => Carrier::Shaft,
-            Inertial::Drum => Carrier::Drum,
-        }
-    }
-}
 
 /// An inertial carrier's own dynamics over a sub-step: `J w' = T_ext(t) - C w - sum T_k`.
 #[derive(Debug, Clone, Copy)]
@@ -117,93 +97,17 @@ struct CarrierStep {
 }
 
 impl Run {
-    /// The bound of inertial carrier `c`'s acceleration at speed `w` with the teeth's torques
-    /// `reaction` (sum of magnitudes, N m) on it, rad/s^2: the drive's bound (the shaft) or the
-    /// load (the drum), the damping, the reactions (as the shared step's controller,
-    /// `control.rs`).
-    pub(super) fn inertial_accel_bound(&self, c: Inertial, w: f64, reaction: f64) -> f64 {
-        let (inv_j, damping, own) = match (c, &self.drum) {
-            (Inertial::Shaft, _) => {
-                let (inv_j, damping) = self.carrier_inertia(c);
-                (inv_j, damping, self.shaft_accel_bound)
-            }
-            (Inertial::Drum, Some(d)) => {
-                let inv_j = 1.0 / d.model.inertia_kg_m2;
-                (
-                    inv_j,
-                    d.model.drag_n_m_s_rad,
-                    d.model.load_torque_n_m.abs() * inv_j,
-                )
-            }
-            (Inertial::Drum, None) => unreachable!("a drum"),
-        };
-        own + (damping * w.abs() + reaction) * inv_j
-    }
-
-    /// Inertial carrier `c`'s inverse inertia, 1/(kg m^2), and damping, N m s/rad: the
-    /// model's (not rapier's inertia, which is 0 until its first step computes the body's
-    /// mass properties).
-    pub(super) fn carrier_inertia(&self, c: Inertial) -> (f64, f64) {
-        match (c, &self.shaft, &self.drum) {
-            (Inertial::Shaft, ShaftDrive::Inertial { j1, c1 }, _) => (1.0 / j1, *c1),
-            (Inertial::Drum, _, Some(d)) => (1.0 / d.model.inertia_kg_m2, d.model.drag_n_m_s_rad),
-            _ => unreachable!("{c:?} is not an inertial carrier of this pack"),
-        }
-    }
-
     /// Inertial carrier `c`'s dynamics over a sub-step of length `h` from `t`: its inertia and
-    /// damping ([`Run::carrier_inertia`]) and its external torque (the shaft's drive, eq 4, at
-    /// the step's start, middle and end; the drum's load, held over a world step).
-    fn carrier_dynamics(&self, c: Inertial, t: f64, h: f64) -> CarrierDynamics {
-        let (inv_j, damping) = self.carrier_inertia(c);
-        let torque = [t, t + 0.5 * h, t + h].map(|ts| self.external_torque(c, ts));
+    /// damping ([`CarrierRun::inertia`](super::carriers::CarrierRun::inertia)) and its
+    /// external torque (the shaft's drive, eq 4, at the step's start, middle and end; the
+    /// drum's load, held over a world step; [`Run::external_at`]).
+    fn carrier_dynamics(&self, c: usize, t: f64, h: f64) -> CarrierDynamics {
+        let (inv_j, damping) = self.carriers[c].inertia();
+        let torque = [t, t + 0.5 * h, t + h].map(|ts| self.external_at(c, ts));
         CarrierDynamics {
             inv_j,
             damping,
             torque,
-        }
-    }
-
-    /// The external torque on inertial carrier `c` at `ts` (s), N m: the shaft's drive (Hu et
-    /// al. eq 4), the drum's load (held over a world step).
-    pub(super) fn external_torque(&self, c: Inertial, ts: f64) -> f64 {
-        match (c, &self.drum) {
-            (Inertial::Shaft, _) => self.drive_torque(ts),
-            (Inertial::Drum, Some(d)) => d.model.load_torque_n_m,
-            (Inertial::Drum, None) => unreachable!("a drum"),
-        }
-    }
-
-    /// Inertial carrier `c`'s unwrapped angle, rad, and speed, rad/s, at `t`.
-    pub(super) fn carrier_state(&self, c: Inertial) -> (f64, f64) {
-        match (c, &self.drum) {
-            (Inertial::Shaft, _) => (self.theta_s, self.omega_s),
-            (Inertial::Drum, Some(d)) => (d.theta, d.omega),
-            (Inertial::Drum, None) => unreachable!("a drum"),
-        }
-    }
-
-    /// Sets inertial carrier `c`'s unwrapped angle, rad, and speed, rad/s (at a world step's
-    /// end).
-    pub(super) fn set_carrier_state(&mut self, c: Inertial, angle: f64, speed: f64) {
-        match (c, self.drum.as_mut()) {
-            (Inertial::Drum, Some(d)) => (d.theta, d.omega) = (angle, speed),
-            _ => (self.theta_s, self.omega_s) = (angle, speed),
-        }
-    }
-
-    /// The couplings carried by inertial carrier `c`.
-    fn carried_by(&self, c: Inertial) -> Vec<usize> {
-        (0..self.couplings.len())
-            .filter(|&i| self.world.carriers[i] == c.carrier())
-            .collect()
-    }
-
-    /// Inertial carrier `c`'s rapier body.
-    pub(super) fn carrier_body_of(&self, c: Inertial) -> rapier3d_f64::prelude::RigidBodyHandle {
-        match c {
-            Inertial::Shaft => self.world.shaft,
-            Inertial::Drum => self.world.drum.expect("a drum"),
         }
     }
 
@@ -313,7 +217,7 @@ impl Run {
     /// follow).
     fn integrate_carrier(
         &mut self,
-        c: Inertial,
+        c: usize,
         cluster: &[usize],
         gaps: &[GapDrag],
         ws: &mut WorldStep,
@@ -356,7 +260,7 @@ impl Run {
     /// mean speed over the step into `means`; returns the carrier's nodes at `t` and `t1`.
     pub(super) fn advance_carrier(
         &mut self,
-        c: Inertial,
+        c: usize,
         gaps: &[GapDrag],
         means: &mut [f64],
         ws: &mut WorldStep,
@@ -409,21 +313,17 @@ impl Run {
 
     /// The world's step of the multirate schemes from `t` to `t1`, after each coupling body's
     /// torque was set to drift it by its mean speed ([`Run::drive_to_means`]): each inertial
-    /// carrier's body (`carriers`: its handle and its nodes at `t` and `t1`) gets its mean
+    /// carrier's body (`carriers`: its index in the table and its nodes at `t` and `t1`) gets its mean
     /// speed set for the step instead of a torque (rapier's inverse inertia of such a body
     /// reads 0 until its first step computes the body's mass properties, and the torque from
     /// it, infinite, left every body at rest from then on: measured); then every body's speed
     /// is set to its speed at `t1`, and the clock advances.
-    pub(super) fn step_world_multirate(
-        &mut self,
-        t1: f64,
-        carriers: &[(rapier3d_f64::prelude::RigidBodyHandle, Node, Node)],
-    ) {
+    pub(super) fn step_world_multirate(&mut self, t1: f64, carriers: &[(usize, Node, Node)]) {
         let t0 = self.t;
         let h = t1 - t0;
         let bodies = &mut self.world.physics.bodies;
-        for &(handle, start, end) in carriers {
-            let body = &mut bodies[handle];
+        for &(c, start, end) in carriers {
+            let body = &mut bodies[self.world.carriers[c].handle];
             body.reset_forces(false);
             body.reset_torques(false);
             let mean = (end.angle - start.angle) / h;
@@ -435,8 +335,9 @@ impl Run {
             let body = &mut bodies[self.world.discs[i]];
             body.set_angvel(Vector::new(0.0, 0.0, self.omega_d[i]), false);
         }
-        for &(handle, _, end) in carriers {
-            bodies[handle].set_angvel(Vector::new(0.0, 0.0, end.speed), false);
+        for &(c, _, end) in carriers {
+            bodies[self.world.carriers[c].handle]
+                .set_angvel(Vector::new(0.0, 0.0, end.speed), false);
         }
         self.t_prev = Some(t0);
         self.t = t1;
@@ -448,7 +349,7 @@ impl Run {
 struct CarrierSteps<'a> {
     /// The carrier and the couplings integrated with it, their bodies' inverse inertias,
     /// 1/(kg m^2), and the open gaps' drag on each.
-    c: Inertial,
+    c: usize,
     cluster: &'a [usize],
     inv_j: Vec<f64>,
     gaps: Vec<GapDrag>,
@@ -501,10 +402,7 @@ impl SubSteps for CarrierSteps<'_> {
             let (wk, _) = coupling_step(&view, a);
             want = want.min(graded_step(wk, &f, run.events.event_age_s(i, t)));
         }
-        let who = match self.c {
-            Inertial::Shaft => "inertial shaft",
-            Inertial::Drum => "drum",
-        };
+        let who = run.carriers[self.c].name;
         checked_sub_step(want, a, t, || who.into())
     }
 
@@ -550,13 +448,7 @@ impl SubSteps for CarrierSteps<'_> {
         self.bufs.get_mut().spare.extend([phi, dphi]);
         ws.counts.substeps += 1;
         ws.counts.evals += 5 * self.cluster.len() as u64;
-        match self.c {
-            Inertial::Shaft => run.energy.add_sub_step(step.external_j, step.drag_j),
-            Inertial::Drum => {
-                run.energy.add_sub_step(0.0, step.drag_j);
-                run.energy.add_load_work(step.external_j);
-            }
-        }
+        run.book_external(self.c, step.external_j, step.drag_j);
         run.energy.add_stack_work(step.gap_j);
         let (angle, w) = (self.angle, self.w);
         self.nodes.push(Node { t, angle, speed: w });

@@ -8,6 +8,7 @@
 //! validates the pack and starts sessions.
 
 mod accounting;
+mod carriers;
 mod clamped;
 mod control;
 mod energy;

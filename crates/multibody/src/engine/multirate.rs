@@ -4,9 +4,9 @@
 //! rapier body, which carries the disc's state from one world step to the next (a coupling's
 //! sub-steps go through the one landing loop, `landing.rs`, as [`Alone`]).
 
-use super::inertial::Inertial;
+use super::carriers::Motion;
 use super::landing::SubSteps;
-use super::state::{disc_sample, relative_state, Run, ShaftDrive};
+use super::state::{disc_sample, relative_state, Run};
 use super::substep::{
     checked_sub_step, graded_step, GapDrag, Node, Path, Prescribed, Relative, ShaftAt, SubStep,
     TurnMoment, WorldStep,
@@ -14,9 +14,8 @@ use super::substep::{
 use crate::hook::{CouplingForces, RelativeState, FLANKS};
 use crate::options::{MultibodyOptions, Stepping};
 use crate::stepping::{bracketed_root, contact_duration_s, coupling_step};
-use crate::world::Carrier;
-use clutchpack_model::{EngineError, PackModel, SpeedProfile};
-use rapier3d_f64::prelude::{RigidBodyHandle, Rotation, Vector};
+use clutchpack_model::{EngineError, PackModel};
+use rapier3d_f64::prelude::{Rotation, Vector};
 
 /// Why the multirate scheme cannot run this pack with these options (`None`: it can).
 ///
@@ -65,11 +64,11 @@ impl Run {
     /// acceleration, rad/s^2: the prescribed shaft's (`drive`; the discs of an inertial shaft
     /// go with the shaft), or the housing at rest.
     fn known_path<'a>(&self, i: usize, drive: Option<Prescribed<'a>>) -> (Path<'a>, f64) {
-        match (self.world.carriers[i], drive) {
-            (Carrier::Shaft, Some(p)) => (Path::Profile(p), self.shaft_accel_bound),
-            (Carrier::Shaft, None) => unreachable!("the inertial shaft's discs go with the shaft"),
-            (Carrier::Housing, _) => (Path::Housing, 0.0),
-            (Carrier::Drum, _) => unreachable!("the drum's plates go with the drum"),
+        let k = &self.carriers[self.world.carrier_of[i]];
+        match (&k.motion, drive) {
+            (Motion::Prescribed(_), Some(p)) => (Path::Profile(p), k.drive_bound),
+            (Motion::Fixed, _) => (Path::Housing, 0.0),
+            _ => unreachable!("an inertial carrier's couplings go with it"),
         }
     }
 
@@ -152,16 +151,11 @@ impl Run {
             gaps = self.gap_drags(&w, &zero, h);
         }
         let mut means = vec![0.0; n];
-        // the inertial carriers' bodies and their states at t and t1, for the world's step
+        // the inertial carriers and their states at t and t1, for the world's step
         let mut carriers = Vec::new();
-        let prescribed = match &self.shaft {
-            ShaftDrive::Prescribed(p) => Some(std::sync::Arc::clone(p)),
-            ShaftDrive::Inertial { .. } => None,
-        };
         // the discs, with an inertial shaft as their carrier or each alone
-        let shaft = prescribed.is_none().then_some(Inertial::Shaft);
         let (discs, plates) = (0..n_discs, n_discs..n);
-        self.advance_group(discs, shaft, &gaps, &mut means, &mut carriers, ws)?;
+        self.advance_group(discs, &gaps, &mut means, &mut carriers, ws)?;
         if self.stack.is_some() {
             // the discs' speeds over the step, for the plates: the affine function with their
             // mean and their first moment, from their sub-steps
@@ -187,8 +181,7 @@ impl Run {
         }
         // the plates: each alone on the housing, then the drum with its own (as an inertial
         // shaft with its discs), their gaps' drag from the discs' speeds as on the housing
-        let drum = self.world.drum.map(|_| Inertial::Drum);
-        self.advance_group(plates, drum, &gaps, &mut means, &mut carriers, ws)?;
+        self.advance_group(plates, &gaps, &mut means, &mut carriers, ws)?;
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let c = self.gap_coefficient();
         if let Some(s) = self.stack.as_mut() {
@@ -204,62 +197,70 @@ impl Run {
         // The world's step: each body's impulse in two halves, `J (mean - w(t))` applied as a
         // torque over the step (rapier's semi-implicit Euler then drifts the body by
         // exactly `mean h`) and `J (w(t1) - mean)` as the speed set at its end.
-        self.finish_world_step(&means, t1, prescribed.as_deref(), &carriers);
+        self.finish_world_step(&means, t1, &carriers);
         Ok(())
     }
 
     /// The world's step of the multirate schemes from `t` to `t1` after the couplings'
     /// sub-steps: each coupling body driven to its mean speed `means` over the step
-    /// ([`Run::drive_to_means`]), a prescribed shaft to its angle at `t1`, the inertial
-    /// carriers to theirs ([`Run::step_world_multirate`], `carriers`), every body's speed
-    /// then set to its speed at `t1`.
+    /// ([`Run::drive_to_means`]), the prescribed carriers to their angles at `t1`, the
+    /// inertial carriers to theirs ([`Run::step_world_multirate`], `carriers`: index, nodes at
+    /// `t` and `t1`), every body's speed then set to its speed at `t1`.
     pub(super) fn finish_world_step(
         &mut self,
         means: &[f64],
         t1: f64,
-        prescribed: Option<&SpeedProfile>,
-        carriers: &[(RigidBodyHandle, Node, Node)],
+        carriers: &[(usize, Node, Node)],
     ) {
         self.drive_to_means(means, t1 - self.t);
-        let shaft_at = prescribed.map(|p| {
-            let (speed, angle) = p.speed_and_angle(t1);
-            (angle, speed)
-        });
-        if let Some((angle, _)) = shaft_at {
+        // each prescribed carrier's angle and speed at t1
+        let prescribed: Vec<(usize, f64, f64)> = (self.carriers.iter().enumerate())
+            .filter_map(|(c, k)| match &k.motion {
+                Motion::Prescribed(p) => {
+                    let (speed, angle) = p.speed_and_angle(t1);
+                    Some((c, angle, speed))
+                }
+                _ => None,
+            })
+            .collect();
+        for &(c, angle, _) in &prescribed {
             let bodies = &mut self.world.physics.bodies;
-            bodies[self.world.shaft].set_next_kinematic_rotation(Rotation::from_rotation_z(angle));
+            bodies[self.world.carriers[c].handle]
+                .set_next_kinematic_rotation(Rotation::from_rotation_z(angle));
         }
         self.step_world_multirate(t1, carriers);
-        if let Some((angle, speed)) = shaft_at {
-            (self.theta_s, self.omega_s) = (angle, speed);
+        for (c, angle, speed) in prescribed {
+            self.set_carrier_state(c, angle, speed);
         }
     }
 
     /// Advances the couplings `group` (the discs, or the plates) from `t` to `t1`, the open
-    /// gaps' drag `gaps` on each: those carried by the inertial carrier `inertial` together
-    /// with it ([`Run::advance_carrier`], its body and nodes then pushed onto `carriers` for
-    /// the world's step), every other one alone against its carrier's known motion
-    /// ([`Run::advance_alone`]) first. Writes each one's speed at `t1` into `omega_d` and its
-    /// mean speed over the step into `means`.
+    /// gaps' drag `gaps` on each: every one on a carrier of known motion alone against it
+    /// ([`Run::advance_alone`]) first, then each inertial carrier of the group's couplings
+    /// (table order) together with those it carries ([`Run::advance_carrier`], its index and
+    /// nodes then pushed onto `carriers` for the world's step). Writes each one's speed at
+    /// `t1` into `omega_d` and its mean speed over the step into `means`.
     fn advance_group(
         &mut self,
         group: std::ops::Range<usize>,
-        inertial: Option<Inertial>,
         gaps: &[GapDrag],
         means: &mut [f64],
-        carriers: &mut Vec<(RigidBodyHandle, Node, Node)>,
+        carriers: &mut Vec<(usize, Node, Node)>,
         ws: &mut WorldStep,
     ) -> Result<(), EngineError> {
-        let carrier = inertial.map(Inertial::carrier);
+        let mut inertial = Vec::new();
         for i in group {
-            if Some(self.world.carriers[i]) != carrier {
+            let c = self.world.carrier_of[i];
+            if !self.carriers[c].is_inertial() {
                 self.advance_alone(i, gaps[i], means, ws)?;
+            } else if !inertial.contains(&c) {
+                inertial.push(c);
             }
         }
-        if let Some(c) = inertial {
-            let handle = self.carrier_body_of(c);
+        inertial.sort_unstable();
+        for c in inertial {
             let (start, end) = self.advance_carrier(c, gaps, means, ws)?;
-            carriers.push((handle, start, end));
+            carriers.push((c, start, end));
         }
         Ok(())
     }

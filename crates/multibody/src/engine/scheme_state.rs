@@ -8,7 +8,7 @@ use super::substep::TurnMoment;
 use crate::integrate::{Kick, Load, LoadHistory, Motion};
 use crate::stack::Face;
 
-/// The loads of one body (a disc, a plate, an inertial shaft, the drum) and their kick
+/// The loads of one body (a disc, a plate, an inertial carrier) and their kick
 /// (`integrate.rs`).
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct BodyLoads {
@@ -30,13 +30,13 @@ pub(super) struct BodyLoads {
 /// `control.rs`; the multirate schemes integrate their own sub-steps and read it only at a
 /// run's first evaluation, when it holds no history yet): the loads of every body with their
 /// histories and kicks, the teeth's motion and the past half of their kick, a prescribed
-/// shaft's next angle, and how a driven drum load is integrated.
+/// carrier's next angle.
 #[derive(Debug, Clone)]
 pub(super) struct SharedStep {
-    /// The loads of each coupled body, of an inertial shaft and of the drum.
+    /// The loads of each coupled body, and of each carrier (`Run::carriers` order; written
+    /// for the inertial ones).
     pub(super) loads: Vec<BodyLoads>,
-    pub(super) shaft_loads: BodyLoads,
-    pub(super) drum_loads: BodyLoads,
+    pub(super) carrier_loads: Vec<BodyLoads>,
     /// `(t, phi, dphi, ddphi)` of each coupling at the last evaluation.
     pub(super) prev_motion: Vec<Option<(f64, f64, f64, f64)>>,
     /// The teeth: the past half of their kick (N m s on the body, about the axis) and the
@@ -46,31 +46,22 @@ pub(super) struct SharedStep {
     /// step's impulse is asked for by the stack, the landing and the forces).
     pub(super) teeth_cache: Vec<std::cell::Cell<(f64, f64)>>,
     pub(super) teeth_motion: Vec<Motion>,
-    /// Prescribed shaft: its angle at the end of the step being taken.
-    pub(super) theta_next: f64,
-    /// Whether the drum's load torque is a driven input, integrated exactly as a held value
-    /// (its kick `L_before h1 / 2 + L h0 / 2`) rather than through the polynomial kick of the
-    /// drum's other loads (byte-identical runs need the latter for the scene's constant load).
-    pub(super) exact_drum_load: bool,
-    /// A driven drum load changed at this time, s, from this value, N m (as
-    /// `Run::drive_switch`).
-    pub(super) load_switch: Option<(f64, f64)>,
+    /// Each prescribed carrier's angle at the end of the step being taken, rad (`Run::carriers`
+    /// order).
+    pub(super) angle_next: Vec<f64>,
 }
 
 impl SharedStep {
-    /// The state before the first step of a pack with `n` couplings.
-    pub(super) fn new(n: usize) -> SharedStep {
+    /// The state before the first step of a pack with `n` couplings and `n_carriers` carriers.
+    pub(super) fn new(n: usize, n_carriers: usize) -> SharedStep {
         SharedStep {
             loads: vec![BodyLoads::default(); n],
-            shaft_loads: BodyLoads::default(),
-            drum_loads: BodyLoads::default(),
+            carrier_loads: vec![BodyLoads::default(); n_carriers],
             prev_motion: vec![None; n],
             teeth_past: vec![0.0; n],
             teeth_cache: vec![std::cell::Cell::new((f64::NAN, 0.0)); n],
             teeth_motion: vec![Motion::default(); n],
-            theta_next: 0.0,
-            exact_drum_load: false,
-            load_switch: None,
+            angle_next: vec![0.0; n_carriers],
         }
     }
 }

@@ -35,11 +35,13 @@
 //! until an input changes it. A copy advanced as the original gives the same outputs bit
 //! for bit (`tests/session.rs`).
 
+use super::carriers::{External, Motion};
 use super::energy::EnergyAudit;
-use super::state::{shaft_accel_bound, Run, ShaftDrive};
+use super::state::{shaft_accel_bound, Run};
 use super::substep::{split_remainder, Counts, Prescribed, WorldStep};
 use super::thermal::Thermal;
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
+use crate::world::SHAFT;
 use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::thermal::ThermalModel;
 use clutchpack_model::{
@@ -132,7 +134,12 @@ impl MultibodySession {
             None => None,
         };
         let mut run = Run::new(pack, options, per_tooth, multirate.is_some())?;
-        run.shared.exact_drum_load = driven.drum_load;
+        // a driven drum load is integrated exactly as a held value (its kick
+        // `L_before h1 / 2 + L h0 / 2`) rather than through the polynomial kick of the drum's
+        // other loads (byte-identical runs need the latter for the scene's constant load)
+        if let Some(d) = run.world.drum() {
+            run.carriers[d].exact = driven.drum_load;
+        }
         run.evaluate(0.0)?;
         let kinetic_j = run.kinetic_energy();
         run.energy.start(run.potential_j, kinetic_j);
@@ -415,9 +422,9 @@ impl MultibodySession {
             run.read_relative_states();
             // the prescribed shaft over the step, expanded about its middle once for every
             // sub-step's stages
-            let profile = match &run.shaft {
-                ShaftDrive::Prescribed(p) => Some(Arc::clone(p)),
-                ShaftDrive::Inertial { .. } => None,
+            let profile = match &run.carriers[SHAFT].motion {
+                Motion::Prescribed(p) => Some(Arc::clone(p)),
+                _ => None,
             };
             let local = profile
                 .as_deref()
@@ -473,24 +480,27 @@ impl MultibodySession {
             || inputs.shaft_speed_slope_rad_s2.is_some()
             || inputs.shaft_speed_curvature_rad_s3.is_some()
         {
-            let w = inputs.shaft_speed_rad_s.unwrap_or(run.omega_s);
+            let (angle, speed) = run.carrier_state(SHAFT);
+            let w = inputs.shaft_speed_rad_s.unwrap_or(speed);
             let held = SpeedProfile::Held {
                 t0_s: t,
-                angle0_rad: run.theta_s,
+                angle0_rad: angle,
                 speed_rad_s: w,
                 accel_rad_s2: inputs.shaft_speed_slope_rad_s2.unwrap_or(0.0),
                 jerk_rad_s3: inputs.shaft_speed_curvature_rad_s3.unwrap_or(0.0),
             };
             Arc::make_mut(&mut run.pack).shaft = Shaft::Prescribed(held.clone());
-            run.shaft = ShaftDrive::Prescribed(Arc::new(held));
-            shaft_jump = w - run.omega_s;
-            run.omega_s = w;
+            let shaft = &mut run.carriers[SHAFT];
+            shaft.motion = Motion::Prescribed(Arc::new(held));
+            shaft_jump = w - shaft.speed;
+            shaft.speed = w;
         }
         if inputs.shaft_torque_n_m.is_some() || inputs.shaft_torque_slope_n_m_s.is_some() {
             let before = run.drive_torque(t);
             let torque = inputs.shaft_torque_n_m.unwrap_or(before);
-            if run.drive_switch.is_none_or(|(ts, _)| ts != t) {
-                run.drive_switch = Some((t, before));
+            let shaft = &mut run.carriers[SHAFT];
+            if shaft.switch.is_none_or(|(ts, _)| ts != t) {
+                shaft.switch = Some((t, before));
             }
             if let Shaft::Inertial { excitation, .. } = &mut Arc::make_mut(&mut run.pack).shaft {
                 let initial_speed_rad_s = excitation.initial_speed_rad_s();
@@ -503,12 +513,14 @@ impl MultibodySession {
             }
         }
         if let Some(load) = inputs.drum_load_n_m {
-            if let Some(d) = run.drum.as_mut() {
-                let before = d.model.load_torque_n_m;
-                if run.shared.load_switch.is_none_or(|(ts, _)| ts != t) {
-                    run.shared.load_switch = Some((t, before));
+            if let Some(d) = run.world.drum() {
+                let drum = &mut run.carriers[d];
+                if let External::Load(before) = drum.external {
+                    if drum.switch.is_none_or(|(ts, _)| ts != t) {
+                        drum.switch = Some((t, before));
+                    }
                 }
-                d.model.load_torque_n_m = load;
+                drum.external = External::Load(load);
             }
             if let Some(d) = Arc::make_mut(&mut run.pack).drum.as_mut() {
                 d.load_torque_n_m = load;
@@ -529,7 +541,7 @@ impl MultibodySession {
                 s.set_pressure(p);
             }
         }
-        run.shaft_accel_bound = shaft_accel_bound(&run.pack.shaft);
+        run.carriers[SHAFT].drive_bound = shaft_accel_bound(&run.pack.shaft);
         run.input_changed(shaft_jump, multirate);
     }
 }
@@ -597,7 +609,7 @@ impl Session for MultibodySession {
         Snapshot {
             sample: run.sample(self.options.record_tooth_loads),
             interfaces: run.stack.as_ref().map_or(Vec::new(), |s| s.samples()),
-            drum: run.drum.as_ref().map(|d| (d.theta, d.omega)),
+            drum: run.world.drum().map(|d| run.carrier_state(d)),
         }
     }
 

@@ -1,8 +1,10 @@
-//! The world state of one run: the rapier world, the drives of the shaft and the drum, the
-//! couplings and their memories, the clock, and each scheme's own part (the shared step's
+//! The world state of one run: the rapier world, the table of carrier bodies (`carriers.rs`:
+//! the housing, the shaft, the drum, each with its motion, external torque, angle and speed),
+//! the couplings and their memories, the clock, and each scheme's own part (the shared step's
 //! loads and kicks, the multirate schemes' moments and faces); and what is read from it
 //! (relative states, carriers, samples).
 
+use super::carriers::{CarrierRun, External, Motion};
 use super::energy::EnergyBook;
 use super::events::EventBook;
 use super::scheme_state::{MultirateState, SharedStep};
@@ -10,10 +12,9 @@ use crate::hook::{Coupling, CouplingForces, RelativeState};
 use crate::options::MultibodyOptions;
 use crate::stack::Stack;
 use crate::stepping::profile_acceleration_bound;
-use crate::world::{angle_about_z, Carrier, World};
+use crate::world::{angle_about_z, Carrier, World, SHAFT};
 use clutchpack_model::{
-    DiscModel, DiscSample, DrumModel, EngineError, PackModel, Sample, Shaft, ShaftExcitation,
-    SpeedProfile,
+    DiscModel, DiscSample, EngineError, PackModel, Sample, Shaft, ShaftExcitation,
 };
 use rapier3d_f64::prelude::{RigidBody, Vector};
 use std::sync::Arc;
@@ -42,30 +43,12 @@ pub(super) fn relative_state(
     }
 }
 
-/// The shaft as the run loop drives it.
-#[derive(Debug, Clone)]
-pub(super) enum ShaftDrive {
-    /// Follows a speed profile exactly (eq 3); shared (`Arc`) so that a loop can hold it while
-    /// it writes the run's state.
-    Prescribed(Arc<SpeedProfile>),
-    /// A body (eq 4): inertia `J1`, damping `C1`.
-    Inertial { j1: f64, c1: f64 },
-}
-
-/// The output drum as the run loop drives it: a body with inertia, a load torque and drag,
-/// carrying the separator plates.
-#[derive(Debug, Clone)]
-pub(super) struct DrumRun {
-    pub(super) model: DrumModel,
-    /// Speed at `t` (synchronised) and unwrapped angle, rad/s and rad.
-    pub(super) omega: f64,
-    pub(super) theta: f64,
-}
-
 /// The state of one run: the world, the hook's memories, the events, the clock.
 ///
 /// Couplings are numbered as the engine's output: the friction discs (carrier: the shaft),
-/// then the separator plates (carrier: the drum, or the housing).
+/// then the separator plates (carrier: the drum, or the housing). The carriers are a table
+/// (`carriers`, in the world's order, `World::carriers`), each coupling's an index into it
+/// (`World::carrier_of`).
 ///
 /// Who writes what: the models and the couplings are set here and only read after; the
 /// impact events and the energy audit are books written through their own methods
@@ -75,9 +58,9 @@ pub(super) struct DrumRun {
 /// [`MultirateState`], by the multirate step only; the clock and the kinematic state (`t`,
 /// the shaft's angle and speed, the bodies' speeds, the relative states and the forces, the
 /// teeth's potential, the world's poses) by the two schemes that advance it, the shared step (`forces.rs`) and the
-/// multirate step (`multirate.rs`, `inertial.rs`); the stack and the drum by the shared step
-/// and their own methods (`stack.rs`), and by the multirate step (the open gaps' heat, the
-/// drum's angle and speed).
+/// multirate step (`multirate.rs`, `inertial.rs`); the stack and the carriers by the shared
+/// step and their own methods (`stack.rs`), and by the multirate step (the open gaps' heat,
+/// the inertial carriers' angles and speeds).
 ///
 /// A run owns everything it reads (the model behind an `Arc`, shared with the engine and the
 /// clones of a session until an input changes it), so that a session can hold it and clone it.
@@ -89,10 +72,9 @@ pub(super) struct Run {
     /// The coupled bodies' models: the discs, then the plates.
     pub(super) bodies: Arc<[DiscModel]>,
     pub(super) world: World,
-    pub(super) shaft: ShaftDrive,
-    /// Bound of the drive's shaft acceleration, rad/s^2.
-    pub(super) shaft_accel_bound: f64,
-    pub(super) drum: Option<DrumRun>,
+    /// The carrier bodies (`carriers.rs`), in the world's order (`World::carriers`): how each
+    /// moves, its external torque, its angle and speed at `t`.
+    pub(super) carriers: Vec<CarrierRun>,
     pub(super) stack: Option<Stack>,
     pub(super) couplings: Vec<Coupling>,
     /// Effective mass per tooth of each coupling, kg (reduced with an inertial carrier).
@@ -110,18 +92,12 @@ pub(super) struct Run {
     pub(super) multirate: MultirateState,
     /// Time of the evaluation before the last step.
     pub(super) t_prev: Option<f64>,
-    /// Time, unwrapped shaft angle and shaft speed.
+    /// Time, s.
     pub(super) t: f64,
-    pub(super) theta_s: f64,
-    pub(super) omega_s: f64,
     /// Elastic energy in the teeth at `t`, J.
     pub(super) potential_j: f64,
     /// The energy audit (written through its methods only, `energy.rs`).
     pub(super) energy: EnergyBook,
-    /// A driven drive torque on an inertial shaft changed at this time, s, from this value,
-    /// N m: the torque before it, for the past half of the kick of the step that ends there
-    /// (`forces.rs`). `None`: the pack's excitation holds for all `t`.
-    pub(super) drive_switch: Option<(f64, f64)>,
 }
 
 /// Bound of the shaft's acceleration from its drive alone, rad/s^2: the profile's for a
@@ -164,42 +140,85 @@ impl Run {
             })
             .collect();
         let nd = couplings.len();
-        let shaft = match &pack.shaft {
-            Shaft::Prescribed(p) => ShaftDrive::Prescribed(Arc::new(p.clone())),
-            Shaft::Inertial {
-                inertia_kg_m2,
-                damping_n_m_s_rad,
-                ..
-            } => ShaftDrive::Inertial {
-                j1: *inertia_kg_m2,
-                c1: *damping_n_m_s_rad,
-            },
-        };
-        let shaft_accel_bound = shaft_accel_bound(&pack.shaft);
-        let m_eff = bodies
+        // the carriers in the world's order: the housing at rest, the shaft (eq 3 or 4), the
+        // drum (its inertia, drag and load)
+        let carriers: Vec<CarrierRun> = world
+            .carriers
             .iter()
-            .zip(&world.carriers)
-            .map(|(d, carrier)| {
-                let md = d.spline.effective_mass_kg(d.inertia_kg_m2);
-                let carrier_inertia = match (carrier, &shaft) {
-                    (Carrier::Shaft, ShaftDrive::Inertial { j1, .. }) => Some(*j1),
-                    (Carrier::Drum, _) => pack.drum.map(|dr| dr.inertia_kg_m2),
-                    _ => None,
+            .map(|c| {
+                let still = |motion, external, speed| CarrierRun {
+                    motion,
+                    external,
+                    drive_bound: 0.0,
+                    exact: false,
+                    switch: None,
+                    name: "housing",
+                    angle: 0.0,
+                    speed,
                 };
-                match carrier_inertia {
-                    Some(j) => {
-                        let mc = d.spline.effective_mass_kg(j);
-                        md * mc / (md + mc)
-                    }
-                    None => md,
+                match (c.role, &pack.shaft, &pack.drum) {
+                    (Carrier::Housing, _, _) => still(Motion::Fixed, External::None, 0.0),
+                    (Carrier::Shaft, Shaft::Prescribed(p), _) => CarrierRun {
+                        drive_bound: shaft_accel_bound(&pack.shaft),
+                        exact: true,
+                        name: "shaft",
+                        ..still(
+                            Motion::Prescribed(Arc::new(p.clone())),
+                            External::Drive,
+                            pack.shaft.initial_speed_rad_s(),
+                        )
+                    },
+                    (
+                        Carrier::Shaft,
+                        Shaft::Inertial {
+                            inertia_kg_m2,
+                            damping_n_m_s_rad,
+                            ..
+                        },
+                        _,
+                    ) => CarrierRun {
+                        drive_bound: shaft_accel_bound(&pack.shaft),
+                        exact: true,
+                        name: "inertial shaft",
+                        ..still(
+                            Motion::Inertial {
+                                j: *inertia_kg_m2,
+                                damping: *damping_n_m_s_rad,
+                            },
+                            External::Drive,
+                            pack.shaft.initial_speed_rad_s(),
+                        )
+                    },
+                    (Carrier::Drum, _, Some(dr)) => CarrierRun {
+                        name: "drum",
+                        ..still(
+                            Motion::Inertial {
+                                j: dr.inertia_kg_m2,
+                                damping: dr.drag_n_m_s_rad,
+                            },
+                            External::Load(dr.load_torque_n_m),
+                            dr.initial_speed_rad_s,
+                        )
+                    },
+                    (Carrier::Drum, _, None) => unreachable!("a drum body without a drum"),
                 }
             })
             .collect();
-        let drum = pack.drum.map(|model| DrumRun {
-            model,
-            omega: model.initial_speed_rad_s,
-            theta: 0.0,
-        });
+        let n_carriers = carriers.len();
+        let m_eff = bodies
+            .iter()
+            .zip(&world.carrier_of)
+            .map(|(d, &c)| {
+                let md = d.spline.effective_mass_kg(d.inertia_kg_m2);
+                match carriers[c].motion {
+                    Motion::Inertial { j, .. } => {
+                        let mc = d.spline.effective_mass_kg(j);
+                        md * mc / (md + mc)
+                    }
+                    _ => md,
+                }
+            })
+            .collect();
         let stack = pack
             .stack
             .as_ref()
@@ -207,25 +226,20 @@ impl Run {
         Ok(Run {
             bodies,
             world,
-            shaft,
-            shaft_accel_bound,
-            drum,
+            carriers,
             stack,
             couplings,
             m_eff,
             events: EventBook::new(nd),
             rel: Vec::with_capacity(nd),
             forces: Vec::with_capacity(nd),
-            shared: SharedStep::new(nd),
+            shared: SharedStep::new(nd, n_carriers),
             omega_d: Vec::with_capacity(nd),
             multirate: MultirateState::new(nd),
             t_prev: None,
             t: 0.0,
-            theta_s: 0.0,
-            omega_s: pack.shaft.initial_speed_rad_s(),
             potential_j: 0.0,
             energy: EnergyBook::default(),
-            drive_switch: None,
             pack,
         })
     }
@@ -251,37 +265,25 @@ impl Run {
 
     /// The speed of coupling `i`'s carrier at `t`, rad/s.
     pub(super) fn carrier_speed(&self, i: usize) -> f64 {
-        match self.world.carriers[i] {
-            Carrier::Shaft => self.omega_s,
-            Carrier::Housing => 0.0,
-            Carrier::Drum => self.drum.as_ref().map_or(0.0, |d| d.omega),
-        }
+        self.carriers[self.world.carrier_of[i]].speed
     }
 
     /// The unwrapped angle of coupling `i`'s carrier at `t`, rad.
     pub(super) fn carrier_angle(&self, i: usize) -> f64 {
-        match self.world.carriers[i] {
-            Carrier::Shaft => self.theta_s,
-            Carrier::Housing => 0.0,
-            Carrier::Drum => self.drum.as_ref().map_or(0.0, |d| d.theta),
-        }
+        self.carriers[self.world.carrier_of[i]].angle
     }
 
     /// The rapier body of coupling `i`'s carrier.
     pub(super) fn carrier_body(&self, i: usize) -> rapier3d_f64::prelude::RigidBodyHandle {
-        match self.world.carriers[i] {
-            Carrier::Shaft => self.world.shaft,
-            Carrier::Housing => self.world.housing,
-            Carrier::Drum => self.world.drum.expect("a drum"),
-        }
+        self.world.carriers[self.world.carrier_of[i]].handle
     }
 
     /// The sample at `t`.
     pub(super) fn sample(&self, tooth_loads: bool) -> Sample {
         Sample {
             t_s: self.t,
-            shaft_angle_rad: self.theta_s,
-            shaft_speed_rad_s: self.omega_s,
+            shaft_angle_rad: self.carriers[SHAFT].angle,
+            shaft_speed_rad_s: self.carriers[SHAFT].speed,
             discs: (0..self.forces.len())
                 .map(|i| self.disc_sample(i, tooth_loads))
                 .collect(),
@@ -326,5 +328,75 @@ pub(super) fn disc_sample(
         stiffness: f.stiffness,
         tooth_loads_n,
         center_offset_m: rel.offset,
+    }
+}
+
+/// The carriers' table (`carriers.rs`) as the schemes read and write it.
+impl Run {
+    /// The couplings carried by carrier `c`.
+    pub(super) fn carried_by(&self, c: usize) -> Vec<usize> {
+        (0..self.couplings.len())
+            .filter(|&i| self.world.carrier_of[i] == c)
+            .collect()
+    }
+
+    /// The inertial carriers, in table order.
+    pub(super) fn inertial_carriers(&self) -> Vec<usize> {
+        (0..self.carriers.len())
+            .filter(|&c| self.carriers[c].is_inertial())
+            .collect()
+    }
+
+    /// Carrier `c`'s unwrapped angle, rad, and speed, rad/s, at `t`.
+    pub(super) fn carrier_state(&self, c: usize) -> (f64, f64) {
+        let k = &self.carriers[c];
+        (k.angle, k.speed)
+    }
+
+    /// Sets carrier `c`'s unwrapped angle, rad, and speed, rad/s (at a world step's end).
+    pub(super) fn set_carrier_state(&mut self, c: usize, angle: f64, speed: f64) {
+        let k = &mut self.carriers[c];
+        (k.angle, k.speed) = (angle, speed);
+    }
+
+    /// The external torque on carrier `c` at `t` (s), N m, positive along the positive
+    /// rotation: the drive (Hu et al. eq 4) as a function of time, a load held between inputs,
+    /// or before a driven torque's last change (`switch`) the value held until then (only the
+    /// shared step's past half-kick reaches back before it; the multirate schemes' sub-steps
+    /// start at or after it).
+    pub(super) fn external_at(&self, c: usize, t: f64) -> f64 {
+        let k = &self.carriers[c];
+        match (k.switch, k.external) {
+            (Some((t_switch, before)), _) if t < t_switch => before,
+            (_, External::Drive) => self.pack.shaft.drive_torque_n_m(t),
+            (_, External::Load(l)) => l,
+            (_, External::None) => 0.0,
+        }
+    }
+
+    /// The bound of inertial carrier `c`'s acceleration at speed `w` with the teeth's torques
+    /// `reaction` (sum of magnitudes, N m) on it, rad/s^2: its external torque's bound (the
+    /// drive's, or a load's), the damping, the reactions (as the shared step's controller,
+    /// `control.rs`).
+    pub(super) fn inertial_accel_bound(&self, c: usize, w: f64, reaction: f64) -> f64 {
+        let (inv_j, damping) = self.carriers[c].inertia();
+        let own = match self.carriers[c].external {
+            External::Drive => self.carriers[c].drive_bound,
+            External::Load(l) => l.abs() * inv_j,
+            External::None => 0.0,
+        };
+        own + (damping * w.abs() + reaction) * inv_j
+    }
+
+    /// Books the work of inertial carrier `c`'s external torque (J) in the energy audit: the
+    /// drive's or the load's.
+    pub(super) fn book_external(&mut self, c: usize, work_j: f64, drag_j: f64) {
+        match self.carriers[c].external {
+            External::Load(_) => {
+                self.energy.add_sub_step(0.0, drag_j);
+                self.energy.add_load_work(work_j);
+            }
+            _ => self.energy.add_sub_step(work_j, drag_j),
+        }
     }
 }
