@@ -52,6 +52,7 @@ mod run;
 mod signals;
 mod study;
 mod sweep;
+mod tables;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -193,11 +193,11 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
         }
         if let Some(th) = &c.thermal {
             out!("  {}:", c.name);
-            crate::run::print_thermal(th);
+            crate::tables::print_thermal(th);
         }
         if !c.windows.is_empty() {
             out!("  {}:", c.name);
-            crate::run::print_windows(&c.windows);
+            crate::tables::print_windows(&c.windows);
         }
     }
     let mut changes: Vec<(&str, &clutchpack_sdk::ModeChange)> = s
@@ -282,7 +282,8 @@ fn plot(
 fn plot_spectrum(
     net: &clutchpack_sdk::record::RecordedNetwork,
     scene: &str,
-    a: &crate::recording::PlotArgs,
+    file: &Path,
+    out: &Path,
 ) -> Result<ExitCode> {
     let duration = net.samples.last().map_or(0.0, |s| s.t_s);
     let mut peaks: Vec<(String, Vec<f64>)> = Vec::new();
@@ -296,7 +297,7 @@ fn plot_spectrum(
         return Err(BadInput(format!(
             "--spectrum: {} holds no tooth impacts (its couplings are lumped: a spectrum needs \
              a resolved pack or a gear mesh)",
-            a.file.display()
+            file.display()
         ))
         .into());
     }
@@ -322,28 +323,30 @@ fn plot_spectrum(
         })
         .collect();
     clutchpack_sdk::analysis::fatigue_plot::plot_spectrum(
-        &a.out,
+        out,
         &format!("{scene}: tooth load spectra"),
         &spectra,
         &[],
     )
-    .with_context(|| format!("plotting {}", a.out.display()))?;
-    out!("{}", a.out.display());
+    .with_context(|| format!("plotting {}", out.display()))?;
+    out!("{}", out.display());
     Ok(ExitCode::SUCCESS)
 }
 
-/// `plot` of a network recording: the figure of `run --plot` (speeds and coupling torques).
+/// `plot` of the network recording `file` (read by `reader` into `net`) to the figure `out`:
+/// the figure of `run --plot` (speeds and coupling torques), or with `spectrum` the tooth
+/// load spectra.
 pub fn plot_recording(
     reader: &clutchpack_sdk::record::RecordingReader,
-    a: &crate::recording::PlotArgs,
-    net: std::result::Result<clutchpack_sdk::record::RecordedNetwork, String>,
+    net: &clutchpack_sdk::record::RecordedNetwork,
+    file: &Path,
+    out: &Path,
+    spectrum: bool,
 ) -> Result<ExitCode> {
-    let net = net.map_err(|e| BadInput(format!("{}: {e}", a.file.display())))?;
-    crate::recording::reread_ok(reader)?;
     let run = reader.info().metadata("clutchpack.run");
     let get = |k: &str| run.and_then(|m| m.get(k).cloned()).unwrap_or_default();
-    if a.spectrum {
-        return plot_spectrum(&net, &get("scene_name"), a);
+    if spectrum {
+        return plot_spectrum(net, &get("scene_name"), file, out);
     }
     let bodies: Vec<(&str, bool)> = net
         .bodies
@@ -353,7 +356,7 @@ pub fn plot_recording(
         .collect();
     let couplings: Vec<&str> = net.couplings.iter().map(String::as_str).collect();
     plot_samples(
-        &a.out,
+        out,
         &get("scene_name"),
         &get("engine"),
         &bodies,
@@ -361,7 +364,7 @@ pub fn plot_recording(
         &net.samples,
         &net.impact_peaks(),
     )?;
-    out!("{}", a.out.display());
+    out!("{}", out.display());
     Ok(ExitCode::SUCCESS)
 }
 

@@ -635,7 +635,9 @@ pub fn plot(a: PlotArgs) -> Result<ExitCode> {
     crate::outputs::check_outputs(&[Output::figure("--out", &a.out)], &[a.file.as_path()])?;
     let reader = open_recording(&a.file, a.salvage)?;
     if let Some(net) = clutchpack_sdk::record::read_network(&reader) {
-        return crate::network::plot_recording(&reader, &a, net);
+        let net = net.map_err(|e| BadInput(format!("{}: {e}", a.file.display())))?;
+        reread_ok(&reader)?;
+        return crate::network::plot_recording(&reader, &net, &a.file, &a.out, a.spectrum);
     }
     if a.spectrum {
         return plot_spectrum(&reader, &a);

@@ -28,6 +28,7 @@ mod error;
 mod fatigue;
 mod network;
 mod network_cosim;
+mod network_keep;
 mod recording;
 mod run;
 mod scene_file;

@@ -9,9 +9,9 @@
 //! [`crate::network::multibody_step_s`], as a whole run of the scene).
 
 use crate::network::{
-    conclude, engine_failed, multibody_step_s, reference_options, start_recording, Keep,
-    NetworkOutcome, Obs,
+    conclude, engine_failed, multibody_step_s, reference_options, start_recording, NetworkOutcome,
 };
+use crate::network_keep::{Keep, Obs};
 use crate::{Error, RecordingRequest, Result};
 use clutchpack_model::network::{
     ClutchMode, Network, NetworkInput, NetworkObserver, NetworkRun, NetworkSample,
