@@ -714,28 +714,19 @@ fn a_brake_on_a_network_has_the_pack_runs_peaks_and_fatigue() {
     let (a, b) = (d.join("pack.json"), d.join("net.json"));
     let (a_csv, b_csv) = (d.join("pack.csv"), d.join("net.csv"));
     let (a_cycles, b_cycles) = (d.join("pack-cycles.json"), d.join("net-cycles.json"));
-    let o = run(&[
-        "run",
+    pack_on_a_heavy_shaft(
         "scenes/pack-8-brake.toml",
-        "--engine",
-        "reference",
-        "--set",
-        "shaft.mode=inertial",
-        "--set",
-        "shaft.inertia_kg_m2=3000",
-        "--duration",
-        "0.05",
-        "--no-record",
-        "--summary-json",
-        a.to_str().unwrap(),
-        "--impacts-csv",
-        a_csv.to_str().unwrap(),
-        "--fatigue-json",
-        a_cycles.to_str().unwrap(),
-        "--windows",
-        "0.01",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+        &[
+            "--summary-json",
+            a.to_str().unwrap(),
+            "--impacts-csv",
+            a_csv.to_str().unwrap(),
+            "--fatigue-json",
+            a_cycles.to_str().unwrap(),
+            "--windows",
+            "0.01",
+        ],
+    );
     let mcap = d.join("net.mcap");
     let o = run(&[
         "run",
@@ -894,6 +885,28 @@ fn same_impacts_and_spectra(pack: (&Path, &Path), net: (&Path, &Path), name: &st
     assert!(spectrum < 2e-2, "{spectrum}");
 }
 
+/// Runs the pack scene `pack_file` alone on the reference engine for 50 ms with its shaft
+/// made the heavy inertia of [`brake_network`] (`shaft.mode=inertial`, 3000 kg m^2, driven by
+/// `J d(omega)/dt` of its profile), with the outputs `outputs` (no recording).
+fn pack_on_a_heavy_shaft(pack_file: &str, outputs: &[&str]) {
+    let mut args = vec![
+        "run",
+        pack_file,
+        "--engine",
+        "reference",
+        "--set",
+        "shaft.mode=inertial",
+        "--set",
+        "shaft.inertia_kg_m2=3000",
+        "--duration",
+        "0.05",
+        "--no-record",
+    ];
+    args.extend_from_slice(outputs);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
 /// A network of a heavy shaft (3000 kg m^2, at 200 rad/s, driven by `J d(omega)/dt` of
 /// 200 + 4.378 sin(2 pi 104 t): the paper's drive) and the fixed housing, joined by the pack
 /// scene `pack_file` as the coupling `brake`, run for `duration_s` s: the scene's text.
@@ -948,22 +961,10 @@ fn a_thermal_brake_on_a_network_has_the_pack_runs_temperatures() {
     )
     .unwrap();
     let (a, b, mcap) = (d.join("pack.json"), d.join("net.json"), d.join("net.mcap"));
-    let o = run(&[
-        "run",
+    pack_on_a_heavy_shaft(
         "scenes/pack-8-idle-thermal.toml",
-        "--engine",
-        "reference",
-        "--set",
-        "shaft.mode=inertial",
-        "--set",
-        "shaft.inertia_kg_m2=3000",
-        "--duration",
-        "0.05",
-        "--no-record",
-        "--summary-json",
-        a.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+        &["--summary-json", a.to_str().unwrap()],
+    );
     let o = run(&[
         "run",
         scene.to_str().unwrap(),

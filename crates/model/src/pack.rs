@@ -249,6 +249,17 @@ impl PackModel {
         self.non_torsional_parts().is_empty()
     }
 
+    /// Every body the pack's splines carry, in the engines' order: its friction discs, then
+    /// its separator plates.
+    pub fn bodies(&self) -> impl Iterator<Item = &DiscModel> {
+        self.discs.iter().chain(&self.plates)
+    }
+
+    /// The names of [`Self::bodies`], in that order.
+    pub fn body_names(&self) -> Vec<String> {
+        self.bodies().map(|d| d.name.clone()).collect()
+    }
+
     /// Whether the pack has separator plates, a drum, a stack or couplings (a whole pack,
     /// MODEL.md sections 5 and 8), beyond friction discs on a shaft.
     pub fn is_whole(&self) -> bool {

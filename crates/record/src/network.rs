@@ -94,7 +94,7 @@ pub fn impact_name(net: &Network, coupling: usize, body: Option<usize>) -> Strin
     match (body, c.pack()) {
         (Some(i), Some(p)) => {
             let role = if i < p.discs.len() { "discs" } else { "plates" };
-            let body = p.discs.iter().chain(&p.plates).nth(i);
+            let body = p.bodies().nth(i);
             format!(
                 "{}/{role}/{}",
                 c.name,
@@ -302,8 +302,7 @@ impl NetworkRecorder {
             if let Some(p) = c.pack() {
                 let topic = topics::network_pack_joints(seg);
                 let id = channel(&mut w, s_joints, &topic, "cdr", none())?;
-                let names = p.discs.iter().chain(&p.plates).map(|d| d.name.clone());
-                pack_joints.insert(k, (id, names.collect()));
+                pack_joints.insert(k, (id, p.body_names()));
             }
         }
         let mut pack_temperatures = BTreeMap::new();
@@ -317,12 +316,7 @@ impl NetworkRecorder {
                 let Some(p) = net.couplings[k].pack() else {
                     continue;
                 };
-                let names: Vec<String> = p
-                    .discs
-                    .iter()
-                    .chain(&p.plates)
-                    .map(|d| d.name.clone())
-                    .collect();
+                let names = p.body_names();
                 let mut ids = Vec::with_capacity(names.len() + 1);
                 for body in unique_segments(&names)
                     .iter()

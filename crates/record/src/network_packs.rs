@@ -49,12 +49,7 @@ impl PacksDrawing {
             .enumerate()
             .filter_map(|(k, c)| {
                 let p = c.pack()?;
-                let names: Vec<String> = p
-                    .discs
-                    .iter()
-                    .chain(&p.plates)
-                    .map(|d| d.name.clone())
-                    .collect();
+                let names = p.body_names();
                 let pack_segment = unique_segments(std::slice::from_ref(&c.name)).remove(0);
                 let segments = unique_segments(&names);
                 let nd = p.discs.len();

@@ -381,19 +381,11 @@ pub(crate) fn conclude(
                     .iter()
                     .find(|(j, _)| *j == k)
                     .map(|(_, r)| {
-                        let names: Vec<String> = c.pack().map_or_else(Vec::new, |p| {
-                            p.discs
-                                .iter()
-                                .chain(&p.plates)
-                                .map(|d| d.name.clone())
-                                .collect()
-                        });
+                        let names = c.pack().map_or_else(Vec::new, |p| p.body_names());
                         crate::ThermalSummary::new(r, &names)
                     }),
                 pack_bodies: c.pack().map_or_else(Vec::new, |p| {
-                    p.discs
-                        .iter()
-                        .chain(&p.plates)
+                    p.bodies()
                         .enumerate()
                         .map(|(i, d)| {
                             let m = keep.pack_bodies.get(&(k, i)).copied().unwrap_or((0, 0.0));

@@ -311,7 +311,7 @@ pub(crate) fn pack_params(
     let mut offset = 0;
     for (k, c) in net.couplings.iter().enumerate() {
         let Some(p) = c.pack() else { continue };
-        let bodies: Vec<&clutchpack_model::DiscModel> = p.discs.iter().chain(&p.plates).collect();
+        let bodies: Vec<&clutchpack_model::DiscModel> = p.bodies().collect();
         let params: Vec<_> = bodies
             .iter()
             .enumerate()
