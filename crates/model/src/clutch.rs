@@ -229,6 +229,22 @@ pub struct OpenGap {
     pub gap_m: f64,
 }
 
+/// What a friction face of the stack does between two stick-slip events (MODEL.md section
+/// 5), as both engines track it. The reference engine opens a face whose clamp force is zero
+/// ([`Face::Open`]); the multibody engine keeps such a face as [`Face::Slip`] with its last
+/// sign, for when it clamps again (its clamp force, zero, gives no torque).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Face {
+    /// No clamp force: an oil gap (Couette drag).
+    Open,
+    /// Clamped and slipping; the sign (+1 or -1) of its slip `omega_upper - omega_lower`
+    /// (rad/s, upper: the body further from the piston).
+    Slip(f64),
+    /// Clamped and stuck: the two faces turn as one while the torque that holds them stays
+    /// within `mu(0) F R_eff`.
+    Locked,
+}
+
 /// The axial stack and its friction interfaces.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StackModel {

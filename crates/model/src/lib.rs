@@ -68,7 +68,7 @@ pub mod stream;
 pub mod thermal;
 
 pub use clutch::{
-    DrumModel, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackBody,
+    DrumModel, Face, FrictionCurve, InterfaceSample, OpenGap, Piston, PressureProfile, StackBody,
     StackModel,
 };
 pub use drive::{Harmonic, LocalProfile, Shaft, ShaftExcitation, SpeedProfile, Table, TableError};

@@ -40,16 +40,9 @@ use clutchpack_model::{InterfaceSample, PressureProfile, StackBody, StackModel};
 const MAX_SWEEPS: usize = 5000;
 
 /// A friction face's state between the sub-steps of the clamped stack's multirate
-/// integration (`engine/clamped.rs`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Face {
-    /// Stuck: its two bodies turn as one while the torque that holds them stays within
-    /// `mu(0) F R_eff`.
-    Locked,
-    /// Slipping, with the sign of the slip `omega_upper - omega_lower` (an open face, `F = 0`,
-    /// too: its sign is kept for when it clamps).
-    Slipping(f64),
-}
+/// integration (`engine/clamped.rs`): the model's one definition, for both engines (this
+/// engine keeps an open face, `F = 0`, as `Slip` with its last sign, for when it clamps).
+pub(crate) use clutchpack_model::Face;
 
 /// The stack's state during a run.
 #[derive(Debug, Clone)]

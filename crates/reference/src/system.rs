@@ -9,16 +9,9 @@ use clutchpack_model::{
 };
 use std::sync::Arc;
 
-/// What a friction interface does between two stick-slip events (MODEL.md section 5).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Face {
-    /// No clamp force: an oil gap (Couette drag).
-    Open,
-    /// Clamped and slipping; the sign (+1 or -1) of its slip `omega_upper - omega_lower`.
-    Slip(f64),
-    /// Clamped and stuck: the two faces turn as one.
-    Locked,
-}
+/// What a friction interface does between two stick-slip events: the model's one
+/// definition, for both engines.
+pub(crate) use clutchpack_model::Face;
 
 /// The stack's forces at one instant ([`System::stack_eval`]); interfaces from the piston,
 /// bodies in stack order.

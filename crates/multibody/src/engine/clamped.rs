@@ -154,7 +154,7 @@ impl Run {
         }
         for m in 0..n_if {
             st.face[m] = 0.0;
-            let Face::Slipping(dir) = faces[m] else {
+            let Face::Slip(dir) = faces[m] else {
                 continue;
             };
             let v = u[sys.body[m + 1]] - u[sys.body[m]];
@@ -217,7 +217,7 @@ impl Run {
         if self.multirate.faces.len() != n_if {
             // the first clamped step: every face slips the way it slips now
             self.multirate.faces = (0..n_if)
-                .map(|m| Face::Slipping(stack.slip[m].signum()))
+                .map(|m| Face::Slip(stack.slip[m].signum()))
                 .collect();
         }
         // the inertial carriers in table order (an inertial shaft, then the drum)
@@ -373,7 +373,7 @@ impl Run {
             };
             // the upper side gets less than it needs: it falls behind (slip < 0) if it needed
             // a positive torque
-            self.multirate.faces[m] = Face::Slipping(-s.face[m].signum());
+            self.multirate.faces[m] = Face::Slip(-s.face[m].signum());
         }
     }
 }
@@ -664,7 +664,7 @@ impl SubSteps for StackSteps {
         // the slip along).
         let mut turned = false;
         for m in 0..run.multirate.faces.len() {
-            let Face::Slipping(dir) = run.multirate.faces[m] else {
+            let Face::Slip(dir) = run.multirate.faces[m] else {
                 continue;
             };
             let v = self.u[sys.body[m + 1]] - self.u[sys.body[m]];
@@ -675,7 +675,7 @@ impl SubSteps for StackSteps {
                 run.lock_face(sys, m, &mut self.u);
                 turned = true;
             } else {
-                run.multirate.faces[m] = Face::Slipping(v.signum());
+                run.multirate.faces[m] = Face::Slip(v.signum());
             }
         }
         if turned {
@@ -753,7 +753,7 @@ impl SubSteps for StackSteps {
         trials: &std::cell::Cell<u64>,
     ) {
         for m in 0..self.faces.len() {
-            let Face::Slipping(dir) = self.faces[m] else {
+            let Face::Slip(dir) = self.faces[m] else {
                 continue;
             };
             if self.s0.clamp[m] <= 0.0 {
