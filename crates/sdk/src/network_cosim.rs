@@ -92,6 +92,16 @@ impl Stepper {
         }
     }
 
+    /// The temperatures of the thermal pack that is coupling `k`, K (its discs', plates',
+    /// then oil's; `None` for another coupling, and on the multibody engine, which runs no
+    /// pack on a network).
+    fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
+        match self {
+            Stepper::Reference(s) => s.pack_temperatures_k(k),
+            Stepper::Multibody(_) => None,
+        }
+    }
+
     /// Each coupling's heat (a mesh's work, a damper's loss) since t = 0, J.
     fn heat_j(&self) -> Vec<f64> {
         match self {
@@ -273,7 +283,9 @@ pub fn network_input_variables(net: &Network) -> Vec<(NetworkVariable, f64)> {
 /// The outputs of `net`, in the order [`NetworkSimulation::outputs`] gives their values: per
 /// body its speed and angle; per coupling its torque on body a, for a clutch its slip
 /// `w_b - w_a`, its mode (Modelica's numbers) and its heat, for a resolved pack its faces'
-/// heat.
+/// heat and, if it carries temperatures (`[thermal]`), each disc's, plate's and its oil's
+/// (`couplings.<pack>.discs[i].temperature_k`, `.plates[j].temperature_k`,
+/// `.oil.temperature_k`, K).
 pub fn network_outputs(net: &Network) -> Vec<NetworkVariable> {
     let var = |name: String, unit: &'static str, description: String| NetworkVariable {
         name,
@@ -294,7 +306,7 @@ pub fn network_outputs(net: &Network) -> Vec<NetworkVariable> {
             format!("angle of {} from t = 0, rad", b.name),
         ));
     }
-    for c in &net.couplings {
+    for (k, c) in net.couplings.iter().enumerate() {
         out.push(var(
             format!("couplings.{}.torque_n_m", segment(&c.name)),
             "N.m",
@@ -321,12 +333,37 @@ pub fn network_outputs(net: &Network) -> Vec<NetworkVariable> {
                 format!("heat {} has made since t = 0, J", c.name),
             ));
         }
-        if c.pack().is_some() {
+        if let Some(p) = c.pack() {
             out.push(var(
                 format!("couplings.{}.heat_j", segment(&c.name)),
                 "J",
                 format!("heat the faces of pack {} have made since t = 0, J", c.name),
             ));
+            if net.pack_thermal.contains_key(&k) {
+                // as a thermal pack scene's own outputs name them, under the coupling
+                let lists = [("discs", p.discs.len()), ("plates", p.plates.len())];
+                for (list, n) in lists {
+                    for i in 0..n {
+                        out.push(var(
+                            format!("couplings.{}.{list}[{i}].temperature_k", segment(&c.name)),
+                            "K",
+                            format!(
+                                "{list}[{i}] of pack {}: its lumped temperature at the last \
+                                 thermal window's end, K",
+                                c.name
+                            ),
+                        ));
+                    }
+                }
+                out.push(var(
+                    format!("couplings.{}.oil.temperature_k", segment(&c.name)),
+                    "K",
+                    format!(
+                        "the oil of pack {}: its temperature at the last thermal window's end, K",
+                        c.name
+                    ),
+                ));
+            }
         }
     }
     out
@@ -547,6 +584,13 @@ impl NetworkSimulation {
             }
             if c.pack().is_some() {
                 values.push(heat[k]);
+                if net.pack_thermal.contains_key(&k) {
+                    let bodies = c.pack().map_or(0, |p| p.discs.len() + p.plates.len());
+                    match self.stepper.pack_temperatures_k(k) {
+                        Some(t) => values.extend_from_slice(t),
+                        None => values.extend(std::iter::repeat_n(f64::NAN, bodies + 1)),
+                    }
+                }
             }
         }
         network_outputs(net)

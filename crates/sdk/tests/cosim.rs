@@ -229,3 +229,49 @@ fn a_co_simulated_network_recording_says_what_was_driven() {
     );
     assert!(!params.contains_key("duration_s"), "{params:?}");
 }
+
+/// A network whose pack carries temperatures (`dct-upshift-packs.toml` with K2 from
+/// `dct-k2-thermal.toml`) outputs every body's and the oil's temperature of that pack, as a
+/// thermal pack scene's co-simulation does, under the coupling's name
+/// (`couplings.K2.plates[1].temperature_k`, K); advanced in one call, they equal the whole
+/// run's final temperatures (measured: to the bit; asserted within 1e-9 K); K1 (isothermal)
+/// has none.
+#[test]
+fn a_thermal_pack_on_a_network_outputs_its_temperatures() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/dct-upshift-packs.toml");
+    let set: clutchpack_scene::Override = "couplings[2].pack=dct-k2-thermal.toml".parse().unwrap();
+    let s = clutchpack_scene::load(&file, &[set]).unwrap();
+    let whole = clutchpack_sdk::run_network_scene(&s, None, Default::default()).unwrap();
+    let k2 = whole
+        .summary
+        .couplings
+        .iter()
+        .find(|c| c.name == "K2")
+        .unwrap();
+    let thermal = k2.thermal.as_ref().unwrap();
+    let mut sim = clutchpack_sdk::NetworkSimulation::start(&s, None, &[], None, None).unwrap();
+    let names: Vec<String> = sim.variables().into_iter().map(|v| v.name).collect();
+    assert!(!names
+        .iter()
+        .any(|n| n.starts_with("couplings.K1.") && n.ends_with("temperature_k")));
+    let temperatures: Vec<&String> = names
+        .iter()
+        .filter(|n| n.starts_with("couplings.K2.") && n.ends_with(".temperature_k"))
+        .collect();
+    assert_eq!(temperatures.len(), 5 + 6 + 1, "{names:?}");
+    sim.advance_to(s.simulation.duration_s, None).unwrap();
+    let out = sim.outputs();
+    let get = |name: &str| out.iter().find(|(n, _)| n == name).unwrap().1;
+    let mut worst = (get("couplings.K2.oil.temperature_k") - thermal.oil_final_k).abs();
+    for (i, b) in thermal.bodies.iter().enumerate() {
+        let name = if i < 5 {
+            format!("couplings.K2.discs[{i}].temperature_k")
+        } else {
+            format!("couplings.K2.plates[{}].temperature_k", i - 5)
+        };
+        worst = worst.max((get(&name) - b.final_k).abs());
+    }
+    assert!(worst < 1e-9, "{worst}");
+    // the hottest plate has heated well above the oil's 353.15 K start
+    assert!(get("couplings.K2.plates[1].temperature_k") > 370.0);
+}

@@ -178,6 +178,14 @@ impl NetworkStepper {
         &self.eq.net
     }
 
+    /// The temperatures of the thermal resolved pack that is coupling `k` at its last thermal
+    /// window's end, K: its discs', its plates', then its oil's (`None` for another
+    /// coupling).
+    pub fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
+        let p = self.eq.packs.iter().find(|p| p.k == k)?;
+        p.thermal.as_ref().map(|th| th.temperatures_k())
+    }
+
     /// The state now as a sample (every body's angle and speed, every coupling's torque and
     /// a clutch's mode).
     pub fn sample_now(&mut self) -> NetworkSample {
