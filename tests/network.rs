@@ -728,21 +728,20 @@ fn a_brake_on_a_network_has_the_pack_runs_peaks_and_fatigue() {
         ],
     );
     let mcap = d.join("net.mcap");
-    let o = run(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        mcap.to_str().unwrap(),
-        "--summary-json",
-        b.to_str().unwrap(),
-        "--impacts-csv",
-        b_csv.to_str().unwrap(),
-        "--fatigue-json",
-        b_cycles.to_str().unwrap(),
-        "--windows",
-        "0.01",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    run_network(
+        &scene,
+        &mcap,
+        &[
+            "--summary-json",
+            b.to_str().unwrap(),
+            "--impacts-csv",
+            b_csv.to_str().unwrap(),
+            "--fatigue-json",
+            b_cycles.to_str().unwrap(),
+            "--windows",
+            "0.01",
+        ],
+    );
     same_impacts_and_spectra((&a_csv, &a_cycles), (&b_csv, &b_cycles), "brake");
     let png = d.join("spectra.png");
     let o = run(&[
@@ -907,6 +906,19 @@ fn pack_on_a_heavy_shaft(pack_file: &str, outputs: &[&str]) {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
+/// Runs the network scene file `scene`, recorded to `mcap`, with the outputs `outputs`.
+fn run_network(scene: &Path, mcap: &Path, outputs: &[&str]) {
+    let mut args = vec![
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        mcap.to_str().unwrap(),
+    ];
+    args.extend_from_slice(outputs);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
 /// A network of a heavy shaft (3000 kg m^2, at 200 rad/s, driven by `J d(omega)/dt` of
 /// 200 + 4.378 sin(2 pi 104 t): the paper's drive) and the fixed housing, joined by the pack
 /// scene `pack_file` as the coupling `brake`, run for `duration_s` s: the scene's text.
@@ -965,15 +977,7 @@ fn a_thermal_brake_on_a_network_has_the_pack_runs_temperatures() {
         "scenes/pack-8-idle-thermal.toml",
         &["--summary-json", a.to_str().unwrap()],
     );
-    let o = run(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        mcap.to_str().unwrap(),
-        "--summary-json",
-        b.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    run_network(&scene, &mcap, &["--summary-json", b.to_str().unwrap()]);
     let (pack, net) = (read_json(&a), read_json(&b));
     let (x, y) = (&pack["thermal"], &net["couplings"][0]["thermal"]);
     assert_eq!(x["windows"], 50);
