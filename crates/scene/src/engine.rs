@@ -64,19 +64,20 @@ impl Scene {
             (None, None) => return Ok(EngineChoice::Multibody),
         };
         if choice == EngineChoice::Multibody {
-            // a resolved pack on a network runs on the reference engine only (issue 34)
-            let packs = self
-                .network
-                .iter()
-                .flat_map(|n| n.couplings.iter().enumerate());
+            // a thermal pack on a network runs on the reference engine only
+            let packs = self.network.iter().flat_map(|n| {
+                n.couplings
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| n.pack_thermal.contains_key(k))
+            });
             let problems: Vec<Problem> = packs
-                .filter(|(_, c)| c.pack().is_some())
                 .map(|(k, c)| {
                     Problem::new(
-                        format!("couplings[{k}].kind"),
-                        Some("\"pack\"".into()),
+                        format!("couplings[{k}].pack"),
+                        None,
                         format!(
-                            "the multibody engine (chosen by {why}) does not run a resolved pack on a network yet (\"{}\"): use the reference engine",
+                            "the multibody engine (chosen by {why}) does not run a thermal pack on a network yet (\"{}\": its pack file has [thermal]): use the reference engine",
                             c.name
                         ),
                     )

@@ -173,22 +173,22 @@ impl Run {
     }
 
     /// Re-evaluates the state at `t` after a session's driven input changed there
-    /// (`session.rs`): the relative motion of every coupling on the shaft by the shaft's speed
-    /// jump `shaft_jump` (rad/s; the bodies' speeds are continuous, so `dphi` and the offset's
-    /// rate in the shaft's turning frame jump), the tooth loads at it (the contact memories
-    /// keep their events), the clamp forces; on the shared step (not `multirate`, whose
-    /// sub-steps do their own audit and read no kicks) also the energy audit's powers (a
+    /// (`session.rs`): the relative motion of every coupling on carrier `carrier` by that
+    /// carrier's speed jump `jump` (rad/s; the bodies' speeds are continuous, so `dphi` and the
+    /// offset's rate in the carrier's turning frame jump), the tooth loads at it (the contact
+    /// memories keep their events), the clamp forces; on the shared step (not `multirate`,
+    /// whose sub-steps do their own audit and read no kicks) also the energy audit's powers (a
     /// zero-length interval, no work) and the loads and kicks of the next step. The past half
     /// of the teeth's kick keeps the motion before the jump, as the step that ended at `t` had.
-    pub(super) fn input_changed(&mut self, shaft_jump: f64, multirate: bool) {
+    pub(super) fn input_changed(&mut self, carrier: usize, jump: f64, multirate: bool) {
         self.potential_j = 0.0;
         for i in 0..self.couplings.len() {
-            if self.world.carrier_of[i] == SHAFT && shaft_jump != 0.0 {
+            if self.world.carrier_of[i] == carrier && jump != 0.0 {
                 let rel = &mut self.rel[i];
-                rel.dphi += shaft_jump;
+                rel.dphi += jump;
                 // rate = dv - omega_s z x d in the shaft's frame
-                rel.offset_rate[0] += shaft_jump * rel.offset[1];
-                rel.offset_rate[1] -= shaft_jump * rel.offset[0];
+                rel.offset_rate[0] += jump * rel.offset[1];
+                rel.offset_rate[1] -= jump * rel.offset[0];
             }
             let f = self.couplings[i].evaluate(&self.rel[i]);
             self.potential_j += f.potential_j;

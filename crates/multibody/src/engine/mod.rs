@@ -8,6 +8,7 @@
 //! validates the pack and starts sessions.
 
 mod accounting;
+mod carried;
 mod carriers;
 mod clamped;
 mod control;

@@ -69,7 +69,7 @@ enum Loop {
 /// module docs for where a call stops, how inputs act and how a copy is made).
 #[derive(Clone)]
 pub struct MultibodySession {
-    run: Run,
+    pub(super) run: Run,
     options: MultibodyOptions,
     scheme: Loop,
     driven: Driven,
@@ -542,7 +542,7 @@ impl MultibodySession {
             }
         }
         run.carriers[SHAFT].drive_bound = shaft_accel_bound(&run.pack.shaft);
-        run.input_changed(shaft_jump, multirate);
+        run.input_changed(SHAFT, shaft_jump, multirate);
     }
 }
 

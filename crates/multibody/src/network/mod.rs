@@ -76,6 +76,7 @@
 mod bodies;
 mod constraint;
 mod mesh;
+mod packs;
 mod stepper;
 
 pub use clutchpack_model::network::NetworkInput;
@@ -140,6 +141,8 @@ struct Run {
     meshes: Vec<Mesh>,
     /// Each mesh's force per pair, N, signed as its `x` (with the torques).
     mesh_force: Vec<f64>,
+    /// The resolved packs (`packs.rs`), in the couplings' order.
+    packs: Vec<packs::NetPack>,
     heat: Vec<f64>,
     energy: NetworkEnergy,
     events: u64,
@@ -189,6 +192,26 @@ impl Run {
             .zip(&self.inv_inertia)
             .map(|(t, j)| j * t)
             .collect()
+    }
+
+    /// Column `i` of the inverse inertia projected on the rows, `P = M^-1 - M^-1 C^T
+    /// (C M^-1 C^T)^-1 C M^-1` (1/(kg m^2)): every body's acceleration under a unit torque
+    /// on body `i` (`packs.rs`).
+    fn response(&self, i: usize) -> Vec<f64> {
+        let mut unit = vec![0.0; self.w.len()];
+        unit[i] = 1.0;
+        let rhs: Vec<f64> = self
+            .rows
+            .iter()
+            .map(|r| {
+                -(r.coef_a * self.inv_inertia[r.a] * unit[r.a]
+                    + r.coef_b * self.inv_inertia[r.b] * unit[r.b])
+            })
+            .collect();
+        let mut lambda = Vec::new();
+        constraint::solve(&self.rows, &self.inv_inertia, &rhs, &mut lambda);
+        constraint::add_torques(&self.rows, &lambda, &mut unit);
+        self.accelerations(&unit)
     }
 
     /// Each body's total torque (N m): its own, the slipping clutches' and the rows'.
@@ -252,6 +275,12 @@ impl Run {
                 out.body[c.a] -= t;
                 out.body[c.b] += t;
             }
+        }
+        // the packs' reactions of the last step: the estimate of this one's (`packs.rs`)
+        for p in &self.packs {
+            out.body[p.a] += p.reaction[0];
+            out.body[p.b] += p.reaction[1];
+            out.coupling[p.k] = p.reaction[0];
         }
         let (body, coupling) = (&mut out.body, &mut out.coupling);
         mesh::add_torques(&self.meshes, x, w, body, coupling, &mut out.mesh_force);

@@ -5,6 +5,7 @@
 
 use super::bodies::NetworkWorld;
 use super::mesh::{self, Mesh};
+use super::packs::NetPack;
 use super::{constraint, NetworkStepOptions, Run};
 use clutchpack_model::network::{
     ClutchMode, Network, NetworkEnergy, NetworkInput, NetworkObserver, NetworkRun, NetworkSample,
@@ -78,14 +79,6 @@ impl NetworkStepper {
         obs: &mut dyn NetworkObserver,
     ) -> Result<NetworkStepper, EngineError> {
         net.check_run(duration_s)?;
-        if let Some(c) = net.couplings.iter().find(|c| c.pack().is_some()) {
-            return Err(EngineError::Unsupported(format!(
-                "coupling \"{}\" is a resolved pack: a pack on a network runs on the reference \
-                 engine (--engine reference); the multibody engine runs a pack scene, or a \
-                 network of lumped clutches, gears and spring-dampers",
-                c.name
-            )));
-        }
         let h_max = options.step_s;
         if !(h_max.is_finite() && h_max > 0.0) {
             return Err(EngineError::Unsupported(format!(
@@ -101,7 +94,7 @@ impl NetworkStepper {
         let n = net.bodies.len();
         let m = net.couplings.len();
         let world = NetworkWorld::build(net);
-        let run = Run {
+        let mut run = Run {
             w: world.speeds(),
             inv_inertia: net
                 .bodies
@@ -118,11 +111,15 @@ impl NetworkStepper {
             coupling_torque: vec![0.0; m],
             meshes: Mesh::of(net),
             mesh_force: Vec::new(),
+            packs: Vec::new(),
             heat: vec![0.0; m],
             energy: NetworkEnergy::default(),
             events: 0,
             net: Arc::new(net.clone()),
         };
+        // the packs' carriers are their bodies' rigid groups at t = 0 (the gears' rows)
+        run.build_rows();
+        run.packs = NetPack::of(net, &run.w, |i| run.response(i), options)?;
         let mut stepper = NetworkStepper {
             w_start: run.w.clone(),
             run,
@@ -142,6 +139,9 @@ impl NetworkStepper {
             steps: 0,
             started: false,
         };
+        for p in stepper.run.packs.iter_mut() {
+            p.faces_to(0.0, obs);
+        }
         stepper.start_step(obs);
         Ok(stepper)
     }
@@ -180,6 +180,15 @@ impl NetworkStepper {
         value: f64,
         obs: &mut dyn NetworkObserver,
     ) -> Result<(), EngineError> {
+        if let NetworkInput::PackPressure(k) = input {
+            if self.run.packs.iter().any(|p| p.k == k) {
+                return Err(EngineError::Unsupported(format!(
+                    "coupling \"{}\": a resolved pack's pressure as an input runs on the \
+                     reference engine (--engine reference)",
+                    self.run.net.couplings[k].name
+                )));
+            }
+        }
         Arc::make_mut(&mut self.run.net).hold_input(input, value)?;
         let t = self.t;
         self.breakpoints = self.run.net.breakpoints(self.duration_s);
@@ -208,7 +217,7 @@ impl NetworkStepper {
             if self.t >= t_end || near(self.t, t_end) {
                 return Ok(());
             }
-            self.step(t_end)?;
+            self.step(t_end, obs)?;
             if !obs.progress(self.t) {
                 self.run.settle(self.t, obs);
                 return Ok(());
@@ -239,6 +248,10 @@ impl NetworkStepper {
         if (near(t, t_sample) || t_sample <= t) && t_sample < self.duration_s && t < self.duration_s
         {
             obs.sample(&self.run.sample(t));
+            let theta = self.run.world.angles();
+            for p in &self.run.packs {
+                p.sample_to(t, theta, obs);
+            }
             self.next_sample += 1;
         }
         self.started = true;
@@ -246,7 +259,7 @@ impl NetworkStepper {
 
     /// One step from `t` (the module's method, steps 2 to 5), ending at `t_end` s at the
     /// latest, and its works counted (the module's "Energy").
-    fn step(&mut self, t_end: f64) -> Result<(), EngineError> {
+    fn step(&mut self, t_end: f64, obs: &mut dyn NetworkObserver) -> Result<(), EngineError> {
         let t = self.t;
         let t_sample = self.t_sample;
         let stop = self
@@ -279,8 +292,9 @@ impl NetworkStepper {
         let t_new = if h == stop - t { stop } else { t + h };
         let h = t_new - t;
         let w0 = run.w.clone();
-        let total = run.total();
-        let acc = run.accelerations(&total);
+        let mut total = run.total();
+        let mut acc = run.accelerations(&total);
+        run.advance_packs(t_new, &mut total, &mut acc, obs)?;
         let paths: Vec<mesh::Path> = run
             .meshes
             .iter()
@@ -328,6 +342,12 @@ impl NetworkStepper {
             run.heat[mesh.coupling] += work;
             run.energy.mesh_work_j += work;
         }
+        for p in run.packs.iter_mut() {
+            let [ra, rb] = p.reaction;
+            let (wa, wb) = (0.5 * (w0[p.a] + run.w[p.a]), 0.5 * (w0[p.b] + run.w[p.b]));
+            p.work_in_j -= h * (ra * wa + rb * wb);
+            p.faces_to(t_new, obs);
+        }
         self.t = t_new;
         self.steps += 1;
         self.started = false;
@@ -342,8 +362,14 @@ impl NetworkStepper {
         for mesh in &mut run.meshes {
             mesh.finish(t, obs);
         }
+        for p in run.packs.iter_mut() {
+            p.finish(obs);
+        }
         let last = run.sample(t);
         obs.sample(&last);
+        for p in &run.packs {
+            p.sample_to(t, run.world.angles(), obs);
+        }
         run.energy.clutch_heat_j =
             run.heat.iter().sum::<f64>() - run.energy.damper_loss_j - run.energy.mesh_work_j;
         let net = &run.net;
@@ -363,6 +389,14 @@ impl NetworkStepper {
             .filter(|(b, _)| !b.fixed)
             .map(|(b, (w0, w))| 0.5 * b.inertia_kg_m2 * (w - w0) * (w + w0))
             .sum();
+        // the packs' discs and plates with the bodies; each pack's loss is the carriers' work
+        // on it less its bodies' kinetic change (`packs.rs`, "Energy")
+        for p in &run.packs {
+            let dk = p.kinetic_change_j();
+            run.energy.kinetic_change_j += dk;
+            run.energy.pack_loss_j += p.work_in_j - dk;
+            run.heat[p.k] = p.face_heat_j();
+        }
         NetworkRun {
             last,
             heat_j: std::mem::take(&mut run.heat),

@@ -1,0 +1,382 @@
+//! Resolved packs on a network on the multibody engine (MODEL.md sections 2-5 and 8): each
+//! pack is a multibody pack session ([`MultibodySession`], its discs and plates rapier bodies
+//! on their splines, its stack, the multirate scheme) whose shaft and drum are the network's
+//! bodies `a` and `b`, advanced over each network step inside it.
+//!
+//! # Method
+//! A network step `[t, t + h]` holds every torque but the packs' over the step (the module's
+//! method, step 3). The packs' spline reactions are stiff and act within the step (a tooth
+//! contact lasts microseconds), so they are not held: each pack integrates them itself, its
+//! carriers being the network's bodies reduced to one degree of freedom each:
+//! - **Carrier `a` (and `b`)** turns with its rigid group (the bodies the ideal gears and the
+//!   locked clutches tie to it). With `P` the network's inverse inertia projected on the
+//!   constraints (`P = M^-1 - M^-1 C^T (C M^-1 C^T)^-1 C M^-1`, symmetric), a torque `T` on
+//!   the bodies accelerates `a` by `(P T)_a`: the carrier is an inertia `J_a = 1 / P_aa` (the
+//!   group's inertia reflected to `a`) under the held torque `(P T)_a / P_aa` of everything
+//!   else in the network. `a` and `b` in one rigid group (`P_ab != 0`) is refused.
+//! - **The pack's step**: the session's shaft takes `J_a` and the drum `J_b` (inertial
+//!   carriers, eq 4), the held torques as its drive and load inputs, and is advanced to
+//!   `t + h` (a communication point, landed on exactly). Its mean reaction on `a` over the
+//!   step is `R_a = J_a (w_a(t + h) - w_a(t)) / h - T_a`, exact for the session's motion:
+//!   the network applies it to `a` (and `R_b` to `b`) with the other torques, so the group's
+//!   speed at `t + h` is the pack's carrier's.
+//! - **Several packs on one group** (a dual-clutch's two packs on the engine and on the
+//!   geared input shafts): the packs advance in the couplings' order, each with the reactions
+//!   of those already advanced over this step and the others' of the step before (their
+//!   estimate, also in the torques at the step's midpoint). A pack's carrier then ends the
+//!   step off the network's speed by the change of the later packs' reactions over `h / J`;
+//!   at the start of the next step every carrier's speed is set to its body's
+//!   ([`MultibodySession::set_carrier_speed`]), as after a lock merges the speeds of a group.
+//!   The angles are the pack's own (its teeth's loads depend only on its relative angles).
+//!
+//! # Outputs
+//! Each closed tooth contact goes to [`NetworkObserver::pack_impact`] as it closes; at each
+//! network sample the pack's discs and plates to [`NetworkObserver::pack_sample`] (their
+//! angles shifted by the carrier's network angle less its pack angle); a change of the
+//! faces' locked or clamped count, seen at the end of a network step, to
+//! [`NetworkObserver::pack_faces`] at that time (a lock is timed to a network step).
+//!
+//! # Energy
+//! The work the carriers do on a pack over a step is `-h (R_a wbar_a + R_b wbar_b)` with the
+//! network's mean speeds (the discrete energy identity of the network's step); the pack's
+//! loss is that work less its discs' and plates' kinetic energy change.
+
+use super::{NetworkStepOptions, Run};
+use crate::engine::MultibodySession;
+use crate::options::MultibodyOptions;
+use crate::MultibodyEngine;
+use clutchpack_model::network::{Network, NetworkObserver};
+use clutchpack_model::session::{Driven, Inputs, Session, Snapshot};
+use clutchpack_model::{DrumModel, EngineError, ImpactEvent, Observer, Shaft, ShaftExcitation};
+use std::sync::Arc;
+
+/// One resolved pack of a multibody network run.
+#[derive(Clone)]
+pub(super) struct NetPack {
+    /// Its coupling's index.
+    pub k: usize,
+    /// The friction discs' carrier (body index).
+    pub a: usize,
+    /// The plates' carrier (body index); its drum is `None` when it is the fixed body.
+    pub b: usize,
+    session: MultibodySession,
+    /// Whether the plates sit on the fixed body (no drum).
+    pub housing: bool,
+    /// The discs' then the plates' inertias, kg m^2.
+    inertia: Vec<f64>,
+    /// How many of them are friction discs (on `a`).
+    n_discs: usize,
+    /// `P_aa` and `P_bb` the session's carriers were built with, 1/(kg m^2).
+    p_diag: [f64; 2],
+    /// The pack's mean torque on `a` and on `b` over the last step, N m (positive along the
+    /// positive rotation): the estimate of the next.
+    pub reaction: [f64; 2],
+    /// Work of the carriers on the pack since t = 0, J.
+    pub work_in_j: f64,
+    /// The discs' and plates' kinetic energy at t = 0, J.
+    kinetic0_j: f64,
+    /// Faces locked and clamped at the last check.
+    faces: (usize, usize),
+}
+
+/// The pack session's observer inside a network run: its impacts go to the network's
+/// observer as the pack's, the rest is read from snapshots.
+struct Forward<'a> {
+    k: usize,
+    obs: &'a mut dyn NetworkObserver,
+}
+
+impl Observer for Forward<'_> {
+    fn impact(&mut self, event: &ImpactEvent) {
+        self.obs.pack_impact(self.k, event);
+    }
+}
+
+/// Whether `x` is 0 against the scale `s` (a cross term of `P` between two rigid groups).
+fn negligible(x: f64, s: f64) -> bool {
+    x.abs() <= 1e-12 * s
+}
+
+impl NetPack {
+    /// The packs of `net` with their carriers' speeds `w` (rad/s) at t = 0 and the columns
+    /// of `P` of each body (`p(i)`), on the engine's steps of at most `options.step_s`.
+    /// Refused: a thermal pack, a pack whose carriers are one rigid group, a pack the pack
+    /// engine refuses.
+    pub fn of(
+        net: &Network,
+        w: &[f64],
+        p: impl Fn(usize) -> Vec<f64>,
+        options: &NetworkStepOptions,
+    ) -> Result<Vec<NetPack>, EngineError> {
+        let mut out = Vec::new();
+        for (k, c) in net.couplings.iter().enumerate() {
+            let Some(model) = c.pack() else { continue };
+            if net.pack_thermal.contains_key(&k) {
+                return Err(EngineError::Unsupported(format!(
+                    "coupling \"{}\" is a thermal pack: a thermal pack on a network runs on the \
+                     reference engine (--engine reference)",
+                    c.name
+                )));
+            }
+            let (pa, pb) = (p(c.a), p(c.b));
+            let housing = net.bodies[c.b].fixed;
+            if !housing && !negligible(pa[c.b], (pa[c.a] * pb[c.b]).sqrt()) {
+                return Err(EngineError::Unsupported(format!(
+                    "coupling \"{}\": its discs' and plates' carriers are one rigid group (gears \
+                     or locked clutches tie them): not on the multibody engine",
+                    c.name
+                )));
+            }
+            let mut pack = model.clone();
+            pack.shaft = Shaft::Inertial {
+                inertia_kg_m2: 1.0 / pa[c.a],
+                damping_n_m_s_rad: 0.0,
+                excitation: ShaftExcitation::Held {
+                    t0_s: 0.0,
+                    torque_n_m: 0.0,
+                    rate_n_m_s: 0.0,
+                    initial_speed_rad_s: w[c.a],
+                },
+            };
+            pack.drum = (!housing).then(|| DrumModel {
+                inertia_kg_m2: 1.0 / pb[c.b],
+                load_torque_n_m: 0.0,
+                drag_n_m_s_rad: 0.0,
+                initial_speed_rad_s: w[c.b],
+            });
+            let inertia: Vec<f64> = pack
+                .discs
+                .iter()
+                .chain(&pack.plates)
+                .map(|d| d.inertia_kg_m2)
+                .collect();
+            let record = if options.record_rate_hz > 0.0 {
+                options.record_rate_hz
+            } else {
+                1e3
+            };
+            let engine = MultibodyEngine::new(
+                pack,
+                MultibodyOptions::with_settings(record, options.step_s, false),
+            )
+            .map_err(|e| in_pack(&c.name, e))?;
+            let session = engine
+                .session(Driven {
+                    shaft_torque: true,
+                    drum_load: !housing,
+                    ..Driven::NONE
+                })
+                .map_err(|e| in_pack(&c.name, e))?;
+            let mut pack = NetPack {
+                k,
+                a: c.a,
+                b: c.b,
+                session,
+                housing,
+                inertia,
+                n_discs: model.discs.len(),
+                p_diag: [pa[c.a], if housing { 0.0 } else { pb[c.b] }],
+                reaction: [0.0; 2],
+                work_in_j: 0.0,
+                kinetic0_j: 0.0,
+                faces: (0, 0),
+            };
+            pack.kinetic0_j = pack.kinetic_j(&pack.session.snapshot());
+            out.push(pack);
+        }
+        Ok(out)
+    }
+
+    /// The discs' and plates' kinetic energy in `snap`, J.
+    fn kinetic_j(&self, snap: &Snapshot) -> f64 {
+        snap.sample
+            .discs
+            .iter()
+            .zip(&self.inertia)
+            .map(|(d, j)| 0.5 * j * d.speed_rad_s * d.speed_rad_s)
+            .sum()
+    }
+
+    /// The discs' and plates' kinetic energy now less at t = 0, J.
+    pub fn kinetic_change_j(&self) -> f64 {
+        self.kinetic_j(&self.session.snapshot()) - self.kinetic0_j
+    }
+
+    /// Sets the carriers' speeds to the network's `w` (rad/s) where they differ, and checks
+    /// that their rigid groups' inertias (`P`'s columns `pa`, `pb`) are those the session was
+    /// built with (a clutch locking a group on or off a pack's carrier changes them).
+    pub fn sync(
+        &mut self,
+        w: &[f64],
+        pa: &[f64],
+        pb: &[f64],
+        name: &str,
+    ) -> Result<(), EngineError> {
+        let same = |x: f64, y: f64| (x - y).abs() <= 1e-9 * y.abs();
+        if !same(pa[self.a], self.p_diag[0])
+            || (!self.housing && !same(pb[self.b], self.p_diag[1]))
+            || (!self.housing && !negligible(pa[self.b], (pa[self.a] * pb[self.b]).sqrt()))
+        {
+            return Err(EngineError::Unsupported(format!(
+                "coupling \"{name}\": a clutch locked or released on the rigid group of its \
+                 carriers, which changes their inertia: not on the multibody engine yet \
+                 (--engine reference)"
+            )));
+        }
+        self.session
+            .set_carrier_speed(false, w[self.a])
+            .map_err(|e| in_pack(name, e))?;
+        if !self.housing {
+            self.session
+                .set_carrier_speed(true, w[self.b])
+                .map_err(|e| in_pack(name, e))?;
+        }
+        Ok(())
+    }
+
+    /// Advances the pack over `[t, t1]` with the held torques `ta` on its shaft and `tb` on
+    /// its drum (N m, everything else in the network's), sending its closed impacts to
+    /// `obs`; returns its mean reactions on `a` and `b` over the step (N m) and keeps them.
+    pub fn advance(
+        &mut self,
+        t1: f64,
+        ta: f64,
+        tb: f64,
+        name: &str,
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<[f64; 2], EngineError> {
+        let t = self.session.time_s();
+        let h = t1 - t;
+        self.session
+            .set_inputs(&Inputs {
+                shaft_torque_n_m: Some(ta),
+                drum_load_n_m: (!self.housing).then_some(tb),
+                ..Inputs::default()
+            })
+            .map_err(|e| in_pack(name, e))?;
+        let speed = |s: &MultibodySession, drum: bool| s.carrier_motion(drum).map_or(0.0, |m| m.1);
+        let (wa0, wb0) = (speed(&self.session, false), speed(&self.session, true));
+        let mut fwd = Forward { k: self.k, obs };
+        self.session
+            .advance_to(t1, &mut fwd)
+            .map_err(|e| in_pack(name, e))?;
+        let (wa1, wb1) = (speed(&self.session, false), speed(&self.session, true));
+        let ra = (wa1 - wa0) / (h * self.p_diag[0]) - ta;
+        let rb = if self.housing {
+            0.0
+        } else {
+            (wb1 - wb0) / (h * self.p_diag[1]) - tb
+        };
+        self.reaction = [ra, rb];
+        Ok(self.reaction)
+    }
+
+    /// Sends the faces' new locked and clamped counts to `obs` at `t` (s) if they changed, or
+    /// whatever they are at t = 0 (as the reference engine does).
+    pub fn faces_to(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
+        let snap = self.session.snapshot();
+        if snap.interfaces.is_empty() {
+            return;
+        }
+        // a face's `locked` is its last step's; at t = 0, before any, a clamped face without
+        // slip is locked (the reference engine's settling at the start)
+        let locked = snap
+            .interfaces
+            .iter()
+            .filter(|f| f.locked || t == 0.0 && f.clamp_n > 0.0 && f.slip_rad_s.abs() <= 1e-9)
+            .count();
+        let clamped = snap.interfaces.iter().filter(|f| f.clamp_n > 0.0).count();
+        if (locked, clamped) != self.faces || t == 0.0 {
+            self.faces = (locked, clamped);
+            obs.pack_faces(self.k, t, locked, clamped, snap.interfaces.len());
+        }
+    }
+
+    /// Sends the discs and plates at `t` (s) to `obs`, their angles shifted by the carriers'
+    /// network angles `theta` (rad) less the pack's own.
+    pub fn sample_to(&self, t: f64, theta: &[f64], obs: &mut dyn NetworkObserver) {
+        let snap = self.session.snapshot();
+        let shaft = self.session.carrier_motion(false).map_or(0.0, |m| m.0);
+        let drum = self.session.carrier_motion(true).map_or(0.0, |m| m.0);
+        let angle: Vec<f64> = snap
+            .sample
+            .discs
+            .iter()
+            .enumerate()
+            .map(|(i, d)| {
+                if i < self.n_discs {
+                    d.angle_rad + theta[self.a] - shaft
+                } else {
+                    d.angle_rad + theta[self.b] - drum
+                }
+            })
+            .collect();
+        let speed: Vec<f64> = snap.sample.discs.iter().map(|d| d.speed_rad_s).collect();
+        let load: Vec<f64> = snap.sample.discs.iter().map(|d| d.load_n).collect();
+        obs.pack_sample(self.k, t, &angle, &speed, &load);
+    }
+
+    /// Its faces' heat since t = 0 (friction and the open gaps' drag), J.
+    pub fn face_heat_j(&self) -> f64 {
+        let snap = self.session.snapshot();
+        snap.interfaces.iter().map(|f| f.dissipated_j).sum()
+    }
+
+    /// Ends the pack's session at the run's end: its open contacts closed and sent to `obs`.
+    pub fn finish(&mut self, obs: &mut dyn NetworkObserver) {
+        let mut fwd = Forward { k: self.k, obs };
+        self.session.finish(&mut fwd);
+    }
+}
+
+impl Run {
+    /// Advances every pack over the step to `t1` (s) inside the network's step whose held
+    /// torques are `total` (N m) and accelerations `acc` (rad/s^2), with the packs'
+    /// reactions of the step before in them; replaces those by this step's as each pack
+    /// advances (the module's method), its impacts sent to `obs`.
+    pub(super) fn advance_packs(
+        &mut self,
+        t1: f64,
+        total: &mut [f64],
+        acc: &mut [f64],
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<(), EngineError> {
+        let net = Arc::clone(&self.net);
+        for j in 0..self.packs.len() {
+            let (a, b) = (self.packs[j].a, self.packs[j].b);
+            let (pa, pb) = (self.response(a), self.response(b));
+            let name = &net.couplings[self.packs[j].k].name;
+            let p = &mut self.packs[j];
+            p.sync(&self.w, &pa, &pb, name)?;
+            let [ra0, rb0] = p.reaction;
+            // everything else's torque on each carrier's group, reduced to the carrier:
+            // (P T)_a / P_aa less this pack's own estimate
+            let ta = (acc[a] - pa[a] * ra0 - pb[a] * rb0) / pa[a];
+            let tb = if p.housing {
+                0.0
+            } else {
+                (acc[b] - pa[b] * ra0 - pb[b] * rb0) / pb[b]
+            };
+            let [ra, rb] = p.advance(t1, ta, tb, name, obs)?;
+            for (i, x) in acc.iter_mut().enumerate() {
+                *x += pa[i] * (ra - ra0) + pb[i] * (rb - rb0);
+            }
+            total[a] += ra - ra0;
+            total[b] += rb - rb0;
+        }
+        Ok(())
+    }
+}
+
+/// `e` said of the pack of coupling `name`.
+fn in_pack(name: &str, e: EngineError) -> EngineError {
+    match e {
+        EngineError::Unsupported(m) => {
+            EngineError::Unsupported(format!("coupling \"{name}\" (a resolved pack): {m}"))
+        }
+        EngineError::Diverged { t_s, reason } => EngineError::Diverged {
+            t_s,
+            reason: format!("in coupling \"{name}\" (a resolved pack): {reason}"),
+        },
+    }
+}
