@@ -68,8 +68,8 @@ fn fmpy_validates_every_shipped_scene_that_an_fmu_can_represent() {
             built += 1;
             networks += usize::from(
                 scene == "coupled-clutches.toml"
-                    || scene == "dct-upshift.toml"
-                    || scene == "dct-upshift-packs.toml",
+                    || scene == "dct-upshift-lumped.toml"
+                    || scene == "dct-upshift.toml",
             );
             assert_eq!(r["problems"], serde_json::json!([]), "{scene}: {message}");
         } else {
@@ -247,7 +247,7 @@ fn a_thermal_fmu_outputs_the_runs_temperatures() {
     }
 }
 
-/// Issue 34: the FMU of `dct-upshift.toml` (a network scene) has the engine's torque and both
+/// Issue 34: the FMU of `dct-upshift-lumped.toml` (a network scene) has the engine's torque and both
 /// clutches' normal forces as inputs, and nothing else (the bodies the scene drives and its
 /// clutches), FMPy validates it, and FMPy driving the shift through it (the scene's own force
 /// schedule held at each 1 ms step's midpoint, the mean engine torque) gives the scene's run:
@@ -286,7 +286,7 @@ fn a_network_fmu_takes_the_clutch_forces_and_engine_torque() {
     );
 }
 
-/// Issue 34: the FMU of `dct-upshift-packs.toml` (both clutches resolved packs) takes the
+/// Issue 34: the FMU of `dct-upshift.toml` (both clutches resolved packs) takes the
 /// engine's torque and both pistons' pressures (`couplings.<pack>.pressure_pa`), FMPy
 /// validates it, and FMPy driving the shift through it (the pack files' own pressure
 /// schedules held at each 1 ms step's midpoint) gives the scene's run: K2's heat within 1e-4

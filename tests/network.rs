@@ -241,12 +241,12 @@ curvature_radius_m = 5e-3
 /// but one: serde_json's default float parser may round the JSON's exact text by an ulp), every
 /// clutch mode change is a log line on `/network/events`, the summary is attached, and
 /// `replay` names the bodies, the couplings and the lock times. Two engines, one scene:
-/// `dct-upshift.toml` on the reference engine and CoupledClutches on the multibody engine.
+/// `dct-upshift-lumped.toml` on the reference engine and CoupledClutches on the multibody engine.
 #[test]
 fn a_network_run_is_recorded_whole() {
     let d = scratch("network-recording");
     for (scene, engine) in [
-        ("scenes/dct-upshift.toml", "reference"),
+        ("scenes/dct-upshift-lumped.toml", "reference"),
         ("scenes/coupled-clutches.toml", "multibody"),
     ] {
         let (json, mcap) = (
@@ -421,7 +421,7 @@ fn compare_of_two_shift_schedules_names_the_hottest_clutch() {
     ] {
         let mut args = vec![
             "run",
-            "scenes/dct-upshift.toml",
+            "scenes/dct-upshift-lumped.toml",
             "--out",
             out.to_str().unwrap(),
         ];
@@ -475,7 +475,7 @@ fn compare_of_two_shift_schedules_names_the_hottest_clutch() {
     );
 }
 
-/// `scenes/dct-upshift-packs.toml`: the DCT upshift with both clutches resolved packs. The
+/// `scenes/dct-upshift.toml`: the DCT upshift with both clutches resolved packs. The
 /// summary gives every disc and plate of both packs with its impacts and largest peak; K1
 /// ends free, K2 locks once at the end of the inertia phase (measured 0.6104 s: later than
 /// the lumped scene's 0.5755 s, since the plates add 0.033 kg m^2 to the engine side and the
@@ -490,7 +490,7 @@ fn dct_upshift_with_resolved_packs_names_its_discs() {
     let csv = d.join("impacts.csv");
     let o = run(&[
         "run",
-        "scenes/dct-upshift-packs.toml",
+        "scenes/dct-upshift.toml",
         "--summary-json",
         json.to_str().unwrap(),
         "--impacts-csv",
@@ -610,7 +610,7 @@ fn dct_upshift_with_resolved_packs_names_its_discs() {
     let set = format!("couplings[2].pack={}", fast_k2.display());
     let o = run(&[
         "run",
-        "scenes/dct-upshift-packs.toml",
+        "scenes/dct-upshift.toml",
         "--set",
         &set,
         "--out",
@@ -645,7 +645,7 @@ fn dct_upshift_with_resolved_packs_names_its_discs() {
 #[test]
 fn a_bad_pack_coupling_is_named_at_its_key() {
     let d = scratch("network-bad-pack");
-    let net = std::fs::read_to_string("scenes/dct-upshift-packs.toml").unwrap();
+    let net = std::fs::read_to_string("scenes/dct-upshift.toml").unwrap();
     let scenes = std::fs::canonicalize("scenes").unwrap();
     let net = net
         .replace("pack = \"dct-k1.toml\"", "pack = \"missing.toml\"")
@@ -670,7 +670,7 @@ fn a_bad_pack_coupling_is_named_at_its_key() {
     );
     let o = run(&[
         "run",
-        "scenes/dct-upshift-packs.toml",
+        "scenes/dct-upshift.toml",
         "--engine",
         "multibody",
         "--no-record",
@@ -686,10 +686,10 @@ fn a_bad_pack_coupling_is_named_at_its_key() {
     );
     let o = run(&[
         "run",
-        "scenes/dct-upshift-packs.toml",
+        "scenes/dct-upshift.toml",
         "--no-record",
         "--set",
-        "couplings[1].pack=dct-upshift.toml",
+        "couplings[1].pack=dct-upshift-lumped.toml",
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(

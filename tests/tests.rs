@@ -8,6 +8,7 @@ mod fatigue;
 mod fmu;
 mod hardening;
 mod network;
+mod network_engines;
 mod python_package;
 mod reliability;
 mod session;

@@ -44,8 +44,8 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 3)]
     pub inertial_runs: usize,
     /// Repetitions of each network timing (`scenes/coupled-clutches.toml` and
-    /// `scenes/dct-upshift.toml` on the reference and the multibody engine in turn, and
-    /// `scenes/dct-upshift-packs.toml` against its two packs run alone; the medians are
+    /// `scenes/dct-upshift-lumped.toml` on the reference and the multibody engine in turn, and
+    /// `scenes/dct-upshift.toml` against its two packs run alone; the medians are
     /// reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub network_runs: usize,
@@ -448,7 +448,7 @@ fn thermal_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     Ok(())
 }
 
-/// 4b. The shipped network scenes (`scenes/coupled-clutches.toml`, `scenes/dct-upshift.toml`,
+/// 4b. The shipped network scenes (`scenes/coupled-clutches.toml`, `scenes/dct-upshift-lumped.toml`,
 ///    MODEL.md section 8) on both engines with the settings `run` gives them (the reference
 ///    at the scene's tolerance, the multibody engine at its fixed step), in turn `runs` times
 ///    (`--network-runs`; the medians are reported), and how far apart their lock times and
@@ -457,7 +457,10 @@ fn network_scenes(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     if runs == 0 {
         return Ok(());
     }
-    for file in ["scenes/coupled-clutches.toml", "scenes/dct-upshift.toml"] {
+    for file in [
+        "scenes/coupled-clutches.toml",
+        "scenes/dct-upshift-lumped.toml",
+    ] {
         if stop.load(Ordering::SeqCst) {
             return Ok(());
         }
@@ -466,14 +469,14 @@ fn network_scenes(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     packs_on_a_network(runs, stop)
 }
 
-/// 4c. `scenes/dct-upshift-packs.toml` (both clutches resolved packs, on the reference
+/// 4c. `scenes/dct-upshift.toml` (both clutches resolved packs, on the reference
 ///    engine, the only one that runs them) against its two packs run alone on their own
 ///    prescribed hubs for the same time (`scenes/dct-k1.toml`, `scenes/dct-k2.toml`), in turn
 ///    `runs` times: the medians, and the median of the rounds' ratios (issue 34 asks at most
 ///    1.5x).
 fn packs_on_a_network(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     let files = [
-        "scenes/dct-upshift-packs.toml",
+        "scenes/dct-upshift.toml",
         "scenes/dct-k1.toml",
         "scenes/dct-k2.toml",
     ];

@@ -397,7 +397,7 @@ def check_network(args):
     outs = ["couplings.K2.mode", "couplings.K2.heat_j", "bodies.vehicle.speed_rad_s",
             "bodies.engine.speed_rad_s"]
     names, problems, r, s = drive_dct(
-        args, "scenes/dct-upshift.toml", "dct-upshift",
+        args, "scenes/dct-upshift-lumped.toml", "dct-upshift-lumped",
         {"couplings.K1.normal_force_n": k1, "couplings.K2.normal_force_n": k2}, outs)
     locked = np.nonzero(r["couplings.K2.mode"] == 0)[0]
     out = dct_result(names, problems, r, s)
@@ -420,7 +420,7 @@ def check_network_packs(args):
     outs = ["couplings.K2.heat_j", "bodies.vehicle.speed_rad_s", "bodies.engine.speed_rad_s",
             "bodies.'input-2'.speed_rad_s"]
     names, problems, r, s = drive_dct(
-        args, "scenes/dct-upshift-packs.toml", "dct-upshift-packs",
+        args, "scenes/dct-upshift.toml", "dct-upshift",
         {"couplings.K1.pressure_pa": k1, "couplings.K2.pressure_pa": k2}, outs)
     # the on-coming pack's lock: the engine's speed meets the even input shaft's
     slip = np.abs(r["bodies.engine.speed_rad_s"] - r["bodies.'input-2'.speed_rad_s"])

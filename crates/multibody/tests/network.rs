@@ -570,7 +570,7 @@ fn brake_and_parallel_clutches_match_the_reference_engine() {
     }
 }
 
-/// The shipped DCT upshift (`scenes/dct-upshift.toml`: a crank with its firing harmonics, a
+/// The shipped DCT upshift (`scenes/dct-upshift-lumped.toml`: a crank with its firing harmonics, a
 /// dual-mass flywheel, two clutches, three ideal gears, a vehicle with a road load, K2's apply
 /// from a table) on both engines. Measured at 1e-4 and 5e-5 s: the mode changes within 1.6e-7
 /// and 4.8e-8 s, the speeds at 1 s within 3.8e-7 and 9.8e-8 of the largest, K2's 9.96 kJ
@@ -581,8 +581,8 @@ fn brake_and_parallel_clutches_match_the_reference_engine() {
 /// (h / 1e-4)^2, K2's heat within 8e-7 h / 1e-4.
 #[test]
 fn dct_upshift_scene_matches_the_reference_engine() {
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/dct-upshift.toml");
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes/dct-upshift-lumped.toml");
     let scene = clutchpack_scene::load(&path, &[]).unwrap();
     let net = scene.network.expect("a network scene");
     let d = scene.simulation.duration_s;

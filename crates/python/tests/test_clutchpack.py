@@ -101,7 +101,7 @@ def test_a_simulation_drives_a_dct_shift_by_name(tmp_path):
     The outputs follow the clutch (Modelica's mode numbers: 2 free, -1 slipping backward, 0
     locked), a recording of it is a network recording, and an undriven input, a slope or an
     unknown name are refused."""
-    whole = clutchpack.run("scenes/dct-upshift.toml")
+    whole = clutchpack.run("scenes/dct-upshift-lumped.toml")
     k2 = next(c for c in whole.summary["couplings"] if c["name"] == "K2")
 
     def k1_force(t):
@@ -112,7 +112,7 @@ def test_a_simulation_drives_a_dct_shift_by_name(tmp_path):
 
     rec = tmp_path / "shift.mcap"
     names = ["couplings.K1.normal_force_n", "couplings.K2.normal_force_n"]
-    sim = clutchpack.Simulation("scenes/dct-upshift.toml", drive=names, record=rec)
+    sim = clutchpack.Simulation("scenes/dct-upshift-lumped.toml", drive=names, record=rec)
     assert sim.inputs == names
     assert sim.variables["couplings.K2.mode"][1] == "1"
     modes = []
@@ -129,13 +129,13 @@ def test_a_simulation_drives_a_dct_shift_by_name(tmp_path):
     assert abs(got["heat_j"] - k2["heat_j"]) < 5e-4 * k2["heat_j"], (got, k2)
     text = cli("replay", str(rec)).stdout
     assert "network: 6 bodies" in text and "K2" in text, text
-    sim = clutchpack.Simulation("scenes/dct-upshift.toml", drive=names[1:])
+    sim = clutchpack.Simulation("scenes/dct-upshift-lumped.toml", drive=names[1:])
     with pytest.raises(ValueError, match="is not driven"):
         sim.advance_to(0.01, **{names[0]: 0.0})
     with pytest.raises(ValueError, match="takes no slope"):
         sim.advance_to(0.01, slopes={names[1]: 1.0}, **{names[1]: 0.0})
     with pytest.raises(ValueError, match="is not an input of"):
-        clutchpack.Simulation("scenes/dct-upshift.toml", drive=["couplings.K3.normal_force_n"])
+        clutchpack.Simulation("scenes/dct-upshift-lumped.toml", drive=["couplings.K3.normal_force_n"])
 
 
 def test_a_simulation_drives_the_pistons_of_resolved_packs(tmp_path):
@@ -146,7 +146,7 @@ def test_a_simulation_drives_the_pistons_of_resolved_packs(tmp_path):
     locked at the end, and every disc and plate of both packs in the summary; `read` of its
     recording gives every tooth impact of both packs by name."""
     rec = tmp_path / "packs.mcap"
-    whole = clutchpack.run("scenes/dct-upshift-packs.toml", record=rec)
+    whole = clutchpack.run("scenes/dct-upshift.toml", record=rec)
     k2 = next(c for c in whole.summary["couplings"] if c["name"] == "K2")
     # read gives every tooth impact of both packs, named <pack>/discs/<disc> or /plates/
     back = clutchpack.read(rec)
@@ -163,7 +163,7 @@ def test_a_simulation_drives_the_pistons_of_resolved_packs(tmp_path):
 
     names = ["couplings.K1.pressure_pa", "couplings.K2.pressure_pa"]
     driven = tmp_path / "driven.mcap"
-    sim = clutchpack.Simulation("scenes/dct-upshift-packs.toml", drive=names, record=driven)
+    sim = clutchpack.Simulation("scenes/dct-upshift.toml", drive=names, record=driven)
     assert sim.inputs == names
     for k in range(1, 1001):
         mid = (k - 0.5) * 1e-3
@@ -177,7 +177,7 @@ def test_a_simulation_drives_the_pistons_of_resolved_packs(tmp_path):
     text = cli("replay", str(driven)).stdout
     assert "co-simulation: inputs driven by the caller: " + ", ".join(names) in text, text
     with pytest.raises(ValueError, match="expected >= 0"):
-        sim = clutchpack.Simulation("scenes/dct-upshift-packs.toml", drive=names)
+        sim = clutchpack.Simulation("scenes/dct-upshift.toml", drive=names)
         sim.advance_to(0.01, **{names[0]: -1.0, names[1]: 0.0})
 
 

@@ -124,7 +124,7 @@ fn an_unconnected_fmu_input_holds_its_start_value_while_python_follows_the_scene
 /// deterministic, the state whole).
 #[test]
 fn a_network_co_simulation_names_its_inputs_and_rolls_back() {
-    let mut co = CoSimulation::new(scene("dct-upshift.toml")).unwrap();
+    let mut co = CoSimulation::new(scene("dct-upshift-lumped.toml")).unwrap();
     let names: Vec<&str> = co
         .variables()
         .iter()
@@ -169,13 +169,13 @@ fn a_network_co_simulation_names_its_inputs_and_rolls_back() {
 }
 
 /// A network scene's run advanced call by call ([`clutchpack_sdk::NetworkSimulation`]) runs on
-/// the multibody engine too, at the whole run's fixed step: `dct-upshift` in calls of 1 ms,
+/// the multibody engine too, at the whole run's fixed step: `dct-upshift-lumped` in calls of 1 ms,
 /// nothing driven (its samples at 1 kHz end a step at every call already), gives the whole
 /// run's summary but the wall time, figure for figure (steps, events, speeds, heats).
 #[test]
 fn a_network_simulation_runs_on_the_multibody_engine() {
     use clutchpack_scene::EngineChoice;
-    let s = scene("dct-upshift.toml");
+    let s = scene("dct-upshift-lumped.toml");
     let engine = Some(EngineChoice::Multibody);
     let request = clutchpack_sdk::NetworkRequest::default();
     let whole = clutchpack_sdk::run_network_scene(&s, engine, request).unwrap();
@@ -206,7 +206,7 @@ fn a_co_simulated_network_recording_says_what_was_driven() {
     };
     let drive = ["couplings.K2.normal_force_n".to_string()];
     let mut sim = clutchpack_sdk::NetworkSimulation::start(
-        &scene("dct-upshift.toml"),
+        &scene("dct-upshift-lumped.toml"),
         None,
         &drive,
         Some(&request),
@@ -230,7 +230,7 @@ fn a_co_simulated_network_recording_says_what_was_driven() {
     assert!(!params.contains_key("duration_s"), "{params:?}");
 }
 
-/// A network whose pack carries temperatures (`dct-upshift-packs.toml` with K2 from
+/// A network whose pack carries temperatures (`dct-upshift.toml` with K2 from
 /// `dct-k2-thermal.toml`) outputs every body's and the oil's temperature of that pack, as a
 /// thermal pack scene's co-simulation does, under the coupling's name
 /// (`couplings.K2.plates[1].temperature_k`, K); advanced in one call, they equal the whole
@@ -238,7 +238,7 @@ fn a_co_simulated_network_recording_says_what_was_driven() {
 /// has none.
 #[test]
 fn a_thermal_pack_on_a_network_outputs_its_temperatures() {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/dct-upshift-packs.toml");
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/dct-upshift.toml");
     let set: clutchpack_scene::Override = "couplings[2].pack=dct-k2-thermal.toml".parse().unwrap();
     let s = clutchpack_scene::load(&file, &[set]).unwrap();
     let whole = clutchpack_sdk::run_network_scene(&s, None, Default::default()).unwrap();

@@ -318,7 +318,7 @@ class Simulation:
     a clutch, ``.slip_rad_s`` (w_b - w_a), ``.mode`` (Modelica's numbers: 2 free, 1 and -1
     slipping, 0 locked) and ``.heat_j``; ``finish`` returns the network's summary:
 
-        >>> sim = clutchpack.Simulation("scenes/dct-upshift.toml",
+        >>> sim = clutchpack.Simulation("scenes/dct-upshift-lumped.toml",
         ...     drive=["couplings.K1.normal_force_n", "couplings.K2.normal_force_n"])
         >>> for k in range(1, 1001):
         ...     sim.advance_to(k * 1e-3, **schedule(k * 1e-3))
