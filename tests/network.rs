@@ -641,7 +641,7 @@ fn dct_upshift_with_resolved_packs_names_its_discs() {
 
 /// A pack coupling's problems are bad input before any work (exit 2) at the coupling's key:
 /// a pack file that is not there, one with its own problems (named with its key), a network
-/// scene as a pack, and the multibody engine asked for a network with a thermal pack.
+/// scene as a pack.
 #[test]
 fn a_bad_pack_coupling_is_named_at_its_key() {
     let d = scratch("network-bad-pack");
@@ -667,22 +667,6 @@ fn a_bad_pack_coupling_is_named_at_its_key() {
         err.contains("couplings[2].pack = \"bad-k2.toml\": the pack scene")
             && err.contains("defaults.spline.teeth"),
         "{err}"
-    );
-    let o = run(&[
-        "run",
-        "scenes/dct-upshift.toml",
-        "--engine",
-        "multibody",
-        "--no-record",
-        "--set",
-        "couplings[2].pack=dct-k2-thermal.toml",
-    ]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("couplings[2].pack: the multibody engine")
-            && stderr(&o).contains("thermal pack"),
-        "{}",
-        stderr(&o)
     );
     let o = run(&[
         "run",

@@ -45,8 +45,8 @@ pub struct BenchArgs {
     pub inertial_runs: usize,
     /// Repetitions of each network timing (`scenes/coupled-clutches.toml` and
     /// `scenes/dct-upshift-lumped.toml` on the reference and the multibody engine in turn, and
-    /// `scenes/dct-upshift.toml` against its two packs run alone; the medians are
-    /// reported); 0 skips that part.
+    /// `scenes/dct-upshift.toml` against its two packs run alone, on each engine; the medians
+    /// are reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub network_runs: usize,
     /// Repetitions of each thermal timing (`scenes/pack-6-thermal.toml` and the first second
@@ -469,12 +469,19 @@ fn network_scenes(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     packs_on_a_network(runs, stop)
 }
 
-/// 4c. `scenes/dct-upshift.toml` (both clutches resolved packs, on the reference
-///    engine, the only one that runs them) against its two packs run alone on their own
-///    prescribed hubs for the same time (`scenes/dct-k1.toml`, `scenes/dct-k2.toml`), in turn
-///    `runs` times: the medians, and the median of the rounds' ratios (issue 34 asks at most
-///    1.5x).
+/// 4c. `scenes/dct-upshift.toml` (both clutches resolved packs) on each engine against its
+///    two packs run alone on their own prescribed hubs for the same time on the same engine
+///    (`scenes/dct-k1.toml`, `scenes/dct-k2.toml`), in turn `runs` times: the medians, and the
+///    median of the rounds' ratios (issue 34 asks at most 1.5x).
 fn packs_on_a_network(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
+    for engine in [EngineChoice::Reference, EngineChoice::Multibody] {
+        packs_on_a_network_on(engine, runs, stop)?;
+    }
+    Ok(())
+}
+
+/// [`packs_on_a_network`] on one engine.
+fn packs_on_a_network_on(engine: EngineChoice, runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     let files = [
         "scenes/dct-upshift.toml",
         "scenes/dct-k1.toml",
@@ -493,7 +500,7 @@ fn packs_on_a_network(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     for _ in 0..runs {
         let done = clutchpack_sdk::run_network_scene(
             &scenes[0],
-            Some(EngineChoice::Reference),
+            Some(engine),
             clutchpack_sdk::NetworkRequest {
                 stop: Some(&**stop),
                 ..Default::default()
@@ -502,11 +509,10 @@ fn packs_on_a_network(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         steps = done.summary.steps;
         let mut packs = 0.0;
         for scene in &scenes[1..] {
-            let run =
-                Simulation::new(scene.clone(), Some(EngineChoice::Reference))?.run(RunRequest {
-                    stop: Some(&**stop),
-                    ..RunRequest::default()
-                })?;
+            let run = Simulation::new(scene.clone(), Some(engine))?.run(RunRequest {
+                stop: Some(&**stop),
+                ..RunRequest::default()
+            })?;
             run.stats()?;
             packs += run.wall_time_s;
         }
@@ -518,8 +524,9 @@ fn packs_on_a_network(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         ratios.push(done.summary.wall_time_s / packs);
     }
     out!(
-        "packs on a network: {} ({} s, {steps} steps) {:.4} s against its two packs alone \
-         {:.4} s: {:.2}x (medians of {runs}, in turn; issue 34 asks at most 1.5x)",
+        "packs on a network, {}: {} ({} s, {steps} steps) {:.4} s against its two packs \
+         alone {:.4} s: {:.2}x (medians of {runs}, in turn; issue 34 asks at most 1.5x)",
+        engine.name(),
         scenes[0].name,
         scenes[0].simulation.duration_s,
         median(network),

@@ -350,7 +350,7 @@ mod stack;
 mod stepping;
 mod world;
 
-pub use engine::{EnergyAudit, MultibodyEngine, MultibodySession};
+pub use engine::{Carried, EnergyAudit, MultibodyEngine, MultibodySession};
 pub use options::{
     AdaptiveStepping, BodyShapes, DiscMount, MultibodyOptions, Scheme, Stepping, ToothResolution,
 };

@@ -64,31 +64,6 @@ impl Scene {
             (None, None) => return Ok(EngineChoice::Multibody),
         };
         if choice == EngineChoice::Multibody {
-            // a thermal pack on a network runs on the reference engine only
-            let packs = self.network.iter().flat_map(|n| {
-                n.couplings
-                    .iter()
-                    .enumerate()
-                    .filter(|(k, _)| n.pack_thermal.contains_key(k))
-            });
-            let problems: Vec<Problem> = packs
-                .map(|(k, c)| {
-                    Problem::new(
-                        format!("couplings[{k}].pack"),
-                        None,
-                        format!(
-                            "the multibody engine (chosen by {why}) does not run a thermal pack on a network yet (\"{}\": its pack file has [thermal]): use the reference engine",
-                            c.name
-                        ),
-                    )
-                })
-                .collect();
-            if !problems.is_empty() {
-                return Err(SceneError::Invalid {
-                    origin: origin.to_string(),
-                    problems,
-                });
-            }
             return Ok(choice);
         }
         if parts.is_empty() {

@@ -93,12 +93,11 @@ impl Stepper {
     }
 
     /// The temperatures of the thermal pack that is coupling `k`, K (its discs', plates',
-    /// then oil's; `None` for another coupling, and on the multibody engine, which runs no
-    /// pack on a network).
+    /// then oil's; `None` for another coupling).
     fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
         match self {
             Stepper::Reference(s) => s.pack_temperatures_k(k),
-            Stepper::Multibody(_) => None,
+            Stepper::Multibody(s) => s.pack_temperatures_k(k),
         }
     }
 

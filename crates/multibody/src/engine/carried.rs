@@ -1,57 +1,111 @@
 //! A pack session whose carriers are a driveline network's bodies (`crate::network`, MODEL.md
-//! section 8): the network reads the shaft's and the drum's motion at each of its steps and
-//! sets their speeds back to its own when they differ (another pack's reaction on the same
-//! rigid group, a clutch locking), between the session's calls.
+//! section 8): the network reads the shaft's and the drum's motion after each of its steps,
+//! and before the next sets their speeds back to its own (another pack's reaction on the same
+//! rigid group, a clutch locking) and their torques from the rest of the network.
 
 use super::session::MultibodySession;
 use crate::world::SHAFT;
+use clutchpack_model::session::{Inputs, Session};
 use clutchpack_model::EngineError;
 use rapier3d_f64::prelude::Vector;
 
-impl MultibodySession {
-    /// The carrier `drum` names (`false`: the shaft, `true`: the drum): its index in the
-    /// run's table, `None` for a drum the pack does not have.
-    fn carrier_index(&self, drum: bool) -> Option<usize> {
-        if drum {
-            self.run.world.drum()
-        } else {
-            Some(SHAFT)
-        }
-    }
+/// What a network sets on one inertial carrier of a pack session before a step: its speed
+/// (rad/s) and the torque of the rest of the network on it (N m), both positive along the
+/// positive rotation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Carried {
+    /// Its speed from now on, rad/s.
+    pub speed_rad_s: f64,
+    /// The torque held on it from now on, N m: the shaft's drive, the drum's load.
+    pub torque_n_m: f64,
+}
 
+impl MultibodySession {
     /// The shaft's (`drum` false) or the drum's unwrapped angle (rad) and speed (rad/s) now,
     /// positive along the positive rotation; `None` for a drum the pack does not have.
     pub fn carrier_motion(&self, drum: bool) -> Option<(f64, f64)> {
-        self.carrier_index(drum).map(|c| self.run.carrier_state(c))
+        let c = if drum { self.run.world.drum()? } else { SHAFT };
+        Some(self.run.carrier_state(c))
     }
 
-    /// Sets the speed of the inertial shaft (`drum` false) or drum to `speed_rad_s` (rad/s)
-    /// now, its angle and every disc's and plate's motion kept: the relative speeds of the
-    /// bodies on it jump, as at a prescribed shaft's driven speed jump (the tooth loads and
-    /// clamp forces re-evaluated at once). The kinetic energy this adds is outside the
-    /// session's energy audit (the network books it). Refused for a carrier that is not
-    /// inertial, a drum the pack does not have, or a speed that is not finite.
-    pub fn set_carrier_speed(&mut self, drum: bool, speed_rad_s: f64) -> Result<(), EngineError> {
-        let Some(c) = self.carrier_index(drum) else {
-            return Err(EngineError::Unsupported("the pack has no drum".into()));
-        };
-        if !speed_rad_s.is_finite() || !self.run.carriers[c].is_inertial() {
+    /// Sets the inertial shaft's and the inertial drum's speeds and torques (`drum` `None`
+    /// for plates on the housing) now, their angles and every disc's and plate's motion kept:
+    /// the relative speeds of the bodies on a carrier jump, as at a prescribed shaft's driven
+    /// speed jump, and the state is re-evaluated once (tooth loads, clamp forces). The shaft's
+    /// torque is its drive input and the drum's its load input ([`Session::set_inputs`]: the
+    /// session must drive them). The kinetic energy a speed jump adds is outside the
+    /// session's energy audit (the network books it). Refused: a carrier that is not
+    /// inertial, a drum the pack does not have, a value that is not finite.
+    pub fn set_carriers(
+        &mut self,
+        shaft: Carried,
+        drum: Option<Carried>,
+    ) -> Result<(), EngineError> {
+        let drum_index = self.run.world.drum();
+        let mut targets = vec![(SHAFT, shaft)];
+        match (drum, drum_index) {
+            (Some(d), Some(c)) => targets.push((c, d)),
+            (None, _) => {}
+            (Some(_), None) => {
+                return Err(EngineError::Unsupported("the pack has no drum".into()));
+            }
+        }
+        for &(c, to) in &targets {
+            let k = &self.run.carriers[c];
+            if !(to.speed_rad_s.is_finite() && to.torque_n_m.is_finite() && k.is_inertial()) {
+                return Err(EngineError::Unsupported(format!(
+                    "the {}'s speed and torque can be set only on an inertial carrier, to finite \
+                     values ({to:?})",
+                    k.name
+                )));
+            }
+        }
+        for &(c, to) in &targets {
+            let (angle, before) = self.run.carrier_state(c);
+            if let Some(th) = self.thermal.as_mut() {
+                let j = 1.0 / self.run.carriers[c].inertia().0;
+                th.carried(0.5 * j * (to.speed_rad_s - before) * (to.speed_rad_s + before));
+            }
+            self.run.set_carrier_state(c, angle, to.speed_rad_s);
+            let handle = self.run.world.carriers[c].handle;
+            self.run.world.physics.bodies[handle]
+                .set_angvel(Vector::new(0.0, 0.0, to.speed_rad_s), false);
+            self.run.carrier_jumped(c, to.speed_rad_s - before);
+        }
+        // the torques as driven inputs: re-evaluates the state once, with the jumps above
+        self.set_inputs(&Inputs {
+            shaft_torque_n_m: Some(shaft.torque_n_m),
+            drum_load_n_m: drum.map(|d| d.torque_n_m),
+            ..Inputs::default()
+        })
+    }
+
+    /// A thermal run's temperatures as at its last thermal window's end, K: every disc's,
+    /// then every plate's, then the oil's (`None`: an isothermal run).
+    pub fn temperatures_k(&self) -> Option<&[f64]> {
+        self.thermal.as_ref().map(|th| th.temperatures_k())
+    }
+
+    /// Holds the piston's pressure at `pressure_pa` (Pa) from now on, in place of the pack's
+    /// schedule (a network's input, `NetworkInput::PackPressure`): as a driven pressure of a
+    /// pack session ([`Session::set_inputs`]), without the session having been started with
+    /// it driven, so that the scene's schedule runs until the first value is held. Refused: a
+    /// pack without a stack, a pressure that is not finite and >= 0.
+    pub fn hold_pressure(&mut self, pressure_pa: f64) -> Result<(), EngineError> {
+        if self.run.pack.stack.is_none() {
+            return Err(EngineError::Unsupported(
+                "the pack has no piston (no stack)".into(),
+            ));
+        }
+        if !(pressure_pa.is_finite() && pressure_pa >= 0.0) {
             return Err(EngineError::Unsupported(format!(
-                "the {}'s speed can be set only on an inertial carrier, to a finite value \
-                 ({speed_rad_s} rad/s)",
-                self.run.carriers[c].name
+                "piston pressure {pressure_pa} Pa: must be finite and >= 0"
             )));
         }
-        let (angle, before) = self.run.carrier_state(c);
-        let jump = speed_rad_s - before;
-        if jump == 0.0 {
-            return Ok(());
-        }
-        self.run.set_carrier_state(c, angle, speed_rad_s);
-        let handle = self.run.world.carriers[c].handle;
-        self.run.world.physics.bodies[handle].set_angvel(Vector::new(0.0, 0.0, speed_rad_s), false);
-        let multirate = self.is_multirate();
-        self.run.input_changed(c, jump, multirate);
+        self.apply_inputs(&Inputs {
+            piston_pressure_pa: Some(pressure_pa),
+            ..Inputs::default()
+        });
         Ok(())
     }
 }

@@ -181,15 +181,9 @@ impl Run {
     /// zero-length interval, no work) and the loads and kicks of the next step. The past half
     /// of the teeth's kick keeps the motion before the jump, as the step that ended at `t` had.
     pub(super) fn input_changed(&mut self, carrier: usize, jump: f64, multirate: bool) {
+        self.carrier_jumped(carrier, jump);
         self.potential_j = 0.0;
         for i in 0..self.couplings.len() {
-            if self.world.carrier_of[i] == carrier && jump != 0.0 {
-                let rel = &mut self.rel[i];
-                rel.dphi += jump;
-                // rate = dv - omega_s z x d in the shaft's frame
-                rel.offset_rate[0] += jump * rel.offset[1];
-                rel.offset_rate[1] -= jump * rel.offset[0];
-            }
             let f = self.couplings[i].evaluate(&self.rel[i]);
             self.potential_j += f.potential_j;
             self.forces[i] = f;
@@ -198,6 +192,24 @@ impl Run {
         if !multirate {
             self.audit_energy();
             self.compute_loads();
+        }
+    }
+
+    /// The relative motion of every coupling on carrier `carrier` after that carrier's speed
+    /// jumped by `jump` (rad/s) at `t`: `dphi` and the offset's rate in its turning frame jump
+    /// (nothing re-evaluated: [`Run::input_changed`] does that).
+    pub(super) fn carrier_jumped(&mut self, carrier: usize, jump: f64) {
+        if jump == 0.0 {
+            return;
+        }
+        for i in 0..self.couplings.len() {
+            if self.world.carrier_of[i] == carrier {
+                let rel = &mut self.rel[i];
+                rel.dphi += jump;
+                // rate = dv - omega_s z x d in the carrier's frame
+                rel.offset_rate[0] += jump * rel.offset[1];
+                rel.offset_rate[1] -= jump * rel.offset[0];
+            }
         }
     }
 

@@ -24,6 +24,7 @@ mod state;
 mod substep;
 mod thermal;
 
+pub use carried::Carried;
 pub use energy::EnergyAudit;
 pub use session::MultibodySession;
 

@@ -104,7 +104,7 @@ pub struct MultibodySession {
     /// The energy audit (complete once finished).
     energy: EnergyAudit,
     /// The temperatures of a thermal run (`thermal.rs`); `None`: isothermal.
-    thermal: Option<Box<Thermal>>,
+    pub(super) thermal: Option<Box<Thermal>>,
 }
 
 impl MultibodySession {
@@ -471,7 +471,7 @@ impl MultibodySession {
     }
 
     /// Applies `inputs` (checked) at the current time and re-evaluates what they change.
-    fn apply_inputs(&mut self, inputs: &Inputs) {
+    pub(super) fn apply_inputs(&mut self, inputs: &Inputs) {
         let multirate = self.is_multirate();
         let run = &mut self.run;
         let t = run.t;

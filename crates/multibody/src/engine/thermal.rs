@@ -16,7 +16,9 @@
 //! of a coupling's spring: the teeth are the only other torques on the bodies, so that
 //! difference is their work, exact up to the integration error of the audit (with lossless
 //! teeth, `p = 0`, on the duty cycle: 2.8e-6 J off the elastic energy left in them,
-//! `tests/thermal.rs`). A step whose window closes with new parameters swaps them
+//! `tests/thermal.rs`). A pack carried by a network (`carried.rs`) has its carriers' torques
+//! held between calls, which world steps land on: their work is then `T (theta_1 - theta_0)`
+//! exactly, and a carrier's speed set by the network is not the teeth's work. A step whose window closes with new parameters swaps them
 //! into the spline couplings' tooth laws (a paper-law contact keeps the stiffness it took at its
 //! onset, eqs 8-9; the new film reaches it at its next contact) and the stack's open gaps.
 
@@ -39,6 +41,14 @@ pub(super) struct Thermal {
     stack_j: f64,
     kinetic_j: f64,
     spring_j: f64,
+    /// Whether the carriers' external torques are held between the run's calls (a pack carried
+    /// by a network, `carried.rs`): their work is then booked exactly, `T (theta_1 - theta_0)`.
+    held: bool,
+    /// The audit's drag and couplings' dampers' work, J, the time, s, and each carrier's
+    /// angle, rad, at the last booking (for `held`).
+    drag_j: f64,
+    t_j: f64,
+    angles: Vec<f64>,
 }
 
 impl Thermal {
@@ -63,6 +73,10 @@ impl Thermal {
                 stack_j: 0.0,
                 kinetic_j: 0.0,
                 spring_j: 0.0,
+                held: false,
+                drag_j: 0.0,
+                t_j: 0.0,
+                angles: Vec::new(),
             },
             pack,
         ))
@@ -82,6 +96,10 @@ impl Thermal {
         self.stack_j = a.stack_work_j;
         self.spring_j = a.coupling_potential_j;
         self.kinetic_j = run.kinetic_energy();
+        self.drag_j = a.drag_work_j + a.coupling_work_j;
+        self.t_j = run.t;
+        self.angles.clear();
+        self.angles.extend(run.carriers.iter().map(|k| k.angle));
         if let Some(s) = &run.stack {
             let n_if = self.counters.len();
             self.counters.copy_from_slice(&s.dissipated_j[..n_if]);
@@ -113,10 +131,23 @@ impl Thermal {
         }
         let a = run.energy.so_far();
         let kinetic = run.kinetic_energy();
+        let external = if self.held {
+            // the carriers' torques are held over the step (world steps land on the calls
+            // where they change): their work is T times the turn, exactly, where the audit's
+            // trapezoid would leave its error on the large flows through the carriers
+            let t_mid = 0.5 * (self.t_j + run.t);
+            let carriers: f64 = (0..run.carriers.len())
+                .filter(|&c| run.carriers[c].is_inertial())
+                .map(|c| run.external_at(c, t_mid) * (run.carriers[c].angle - self.angles[c]))
+                .sum();
+            carriers + (a.drag_work_j + a.coupling_work_j - self.drag_j)
+        } else {
+            external_work_j(a) - self.external_j
+        };
         // the teeth's work on the relative motion: what the external work put in beyond the
         // kinetic energy's and the springs' energy's change (the teeth's torques are the only
         // others on the bodies)
-        let teeth = (external_work_j(a) - self.external_j) + (a.stack_work_j - self.stack_j)
+        let teeth = external + (a.stack_work_j - self.stack_j)
             - (kinetic - self.kinetic_j)
             - (a.coupling_potential_j - self.spring_j);
         self.windows.book_teeth(teeth);
@@ -130,6 +161,19 @@ impl Thermal {
             run.set_parameters(pack);
         }
         Ok(())
+    }
+
+    /// The kinetic energy changed by `dk_j` (J) outside the run's steps (a network setting a
+    /// carrier's speed, `carried.rs`): not the teeth's work, so not booked as theirs; and the
+    /// carriers' torques are held between calls from now on (their work booked exactly).
+    pub(super) fn carried(&mut self, dk_j: f64) {
+        self.kinetic_j += dk_j;
+        self.held = true;
+    }
+
+    /// Every body's temperature, then the oil's, K, as at the last window's end.
+    pub(super) fn temperatures_k(&self) -> &[f64] {
+        self.windows.temperatures_k()
     }
 
     /// Closes the last window at `t` (s), sends its temperatures, and returns the report.

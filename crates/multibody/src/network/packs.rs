@@ -26,7 +26,7 @@
 //!   estimate, also in the torques at the step's midpoint). A pack's carrier then ends the
 //!   step off the network's speed by the change of the later packs' reactions over `h / J`;
 //!   at the start of the next step every carrier's speed is set to its body's
-//!   ([`MultibodySession::set_carrier_speed`]), as after a lock merges the speeds of a group.
+//!   ([`MultibodySession::set_carriers`]), as after a lock merges the speeds of a group.
 //!   The angles are the pack's own (its teeth's loads depend only on its relative angles).
 //!
 //! # Outputs
@@ -34,7 +34,10 @@
 //! network sample the pack's discs and plates to [`NetworkObserver::pack_sample`] (their
 //! angles shifted by the carrier's network angle less its pack angle); a change of the
 //! faces' locked or clamped count, seen at the end of a network step, to
-//! [`NetworkObserver::pack_faces`] at that time (a lock is timed to a network step).
+//! [`NetworkObserver::pack_faces`] at that time (a lock is timed to a network step); a thermal
+//! pack's temperatures at each window's end to [`NetworkObserver::pack_temperatures`] (the
+//! session's thermal run: its heat booked world step by world step, as in a pack run; a
+//! carrier's speed set by the network is not booked as the teeth's work).
 //!
 //! # Energy
 //! The work the carriers do on a pack over a step is `-h (R_a wbar_a + R_b wbar_b)` with the
@@ -42,11 +45,12 @@
 //! loss is that work less its discs' and plates' kinetic energy change.
 
 use super::{NetworkStepOptions, Run};
-use crate::engine::MultibodySession;
+use crate::engine::{Carried, MultibodySession};
 use crate::options::MultibodyOptions;
 use crate::MultibodyEngine;
 use clutchpack_model::network::{Network, NetworkObserver};
-use clutchpack_model::session::{Driven, Inputs, Session, Snapshot};
+use clutchpack_model::session::{Driven, Session, Snapshot};
+use clutchpack_model::thermal::ThermalReport;
 use clutchpack_model::{DrumModel, EngineError, ImpactEvent, Observer, Shaft, ShaftExcitation};
 use std::sync::Arc;
 
@@ -90,6 +94,11 @@ impl Observer for Forward<'_> {
     fn impact(&mut self, event: &ImpactEvent) {
         self.obs.pack_impact(self.k, event);
     }
+    fn temperatures(&mut self, t_s: f64, bodies_k: &[f64], oil_k: f64) {
+        let mut all = bodies_k.to_vec();
+        all.push(oil_k);
+        self.obs.pack_temperatures(self.k, t_s, &all);
+    }
 }
 
 /// Whether `x` is 0 against the scale `s` (a cross term of `P` between two rigid groups).
@@ -111,13 +120,6 @@ impl NetPack {
         let mut out = Vec::new();
         for (k, c) in net.couplings.iter().enumerate() {
             let Some(model) = c.pack() else { continue };
-            if net.pack_thermal.contains_key(&k) {
-                return Err(EngineError::Unsupported(format!(
-                    "coupling \"{}\" is a thermal pack: a thermal pack on a network runs on the \
-                     reference engine (--engine reference)",
-                    c.name
-                )));
-            }
             let (pa, pb) = (p(c.a), p(c.b));
             let housing = net.bodies[c.b].fixed;
             if !housing && !negligible(pa[c.b], (pa[c.a] * pb[c.b]).sqrt()) {
@@ -155,11 +157,13 @@ impl NetPack {
             } else {
                 1e3
             };
+            // a thermal pack carries its temperatures as in a pack run (MODEL.md section 9)
             let engine = MultibodyEngine::new(
                 pack,
                 MultibodyOptions::with_settings(record, options.step_s, false),
             )
-            .map_err(|e| in_pack(&c.name, e))?;
+            .map_err(|e| in_pack(&c.name, e))?
+            .with_thermal(net.pack_thermal.get(&k).cloned());
             let session = engine
                 .session(Driven {
                     shaft_torque: true,
@@ -202,16 +206,10 @@ impl NetPack {
         self.kinetic_j(&self.session.snapshot()) - self.kinetic0_j
     }
 
-    /// Sets the carriers' speeds to the network's `w` (rad/s) where they differ, and checks
-    /// that their rigid groups' inertias (`P`'s columns `pa`, `pb`) are those the session was
-    /// built with (a clutch locking a group on or off a pack's carrier changes them).
-    pub fn sync(
-        &mut self,
-        w: &[f64],
-        pa: &[f64],
-        pb: &[f64],
-        name: &str,
-    ) -> Result<(), EngineError> {
+    /// Checks that the carriers' rigid groups' inertias (`P`'s columns `pa`, `pb`) are those
+    /// the session was built with (a clutch locking a group on or off a pack's carrier changes
+    /// them).
+    pub fn check_groups(&self, pa: &[f64], pb: &[f64], name: &str) -> Result<(), EngineError> {
         let same = |x: f64, y: f64| (x - y).abs() <= 1e-9 * y.abs();
         if !same(pa[self.a], self.p_diag[0])
             || (!self.housing && !same(pb[self.b], self.p_diag[1]))
@@ -223,52 +221,52 @@ impl NetPack {
                  (--engine reference)"
             )));
         }
-        self.session
-            .set_carrier_speed(false, w[self.a])
-            .map_err(|e| in_pack(name, e))?;
-        if !self.housing {
-            self.session
-                .set_carrier_speed(true, w[self.b])
-                .map_err(|e| in_pack(name, e))?;
-        }
         Ok(())
     }
 
-    /// Advances the pack over `[t, t1]` with the held torques `ta` on its shaft and `tb` on
-    /// its drum (N m, everything else in the network's), sending its closed impacts to
-    /// `obs`; returns its mean reactions on `a` and `b` over the step (N m) and keeps them.
+    /// Advances the pack over `[t, t1]`, its carriers set to the network's speeds `w` (rad/s)
+    /// and under the held torques `ta` on its shaft and `tb` on its drum (N m, everything else
+    /// in the network's), sending its closed impacts to `obs`; returns its mean reactions on
+    /// `a` and `b` over the step (N m) and keeps them.
     pub fn advance(
         &mut self,
+        w: &[f64],
         t1: f64,
-        ta: f64,
-        tb: f64,
+        (ta, tb): (f64, f64),
         name: &str,
         obs: &mut dyn NetworkObserver,
     ) -> Result<[f64; 2], EngineError> {
-        let t = self.session.time_s();
-        let h = t1 - t;
+        let h = t1 - self.session.time_s();
+        let (wa0, wb0) = (w[self.a], w[self.b]);
+        let shaft = Carried {
+            speed_rad_s: wa0,
+            torque_n_m: ta,
+        };
+        let drum = (!self.housing).then_some(Carried {
+            speed_rad_s: wb0,
+            torque_n_m: tb,
+        });
         self.session
-            .set_inputs(&Inputs {
-                shaft_torque_n_m: Some(ta),
-                drum_load_n_m: (!self.housing).then_some(tb),
-                ..Inputs::default()
-            })
+            .set_carriers(shaft, drum)
             .map_err(|e| in_pack(name, e))?;
-        let speed = |s: &MultibodySession, drum: bool| s.carrier_motion(drum).map_or(0.0, |m| m.1);
-        let (wa0, wb0) = (speed(&self.session, false), speed(&self.session, true));
         let mut fwd = Forward { k: self.k, obs };
         self.session
             .advance_to(t1, &mut fwd)
             .map_err(|e| in_pack(name, e))?;
-        let (wa1, wb1) = (speed(&self.session, false), speed(&self.session, true));
-        let ra = (wa1 - wa0) / (h * self.p_diag[0]) - ta;
+        let speed = |drum: bool| self.session.carrier_motion(drum).map_or(0.0, |m| m.1);
+        let ra = (speed(false) - wa0) / (h * self.p_diag[0]) - ta;
         let rb = if self.housing {
             0.0
         } else {
-            (wb1 - wb0) / (h * self.p_diag[1]) - tb
+            (speed(true) - wb0) / (h * self.p_diag[1]) - tb
         };
         self.reaction = [ra, rb];
         Ok(self.reaction)
+    }
+
+    /// Holds its piston's pressure at `pressure_pa` (Pa) from now on (a network input).
+    pub fn hold_pressure(&mut self, pressure_pa: f64) -> Result<(), EngineError> {
+        self.session.hold_pressure(pressure_pa)
     }
 
     /// Sends the faces' new locked and clamped counts to `obs` at `t` (s) if they changed, or
@@ -322,10 +320,17 @@ impl NetPack {
         snap.interfaces.iter().map(|f| f.dissipated_j).sum()
     }
 
-    /// Ends the pack's session at the run's end: its open contacts closed and sent to `obs`.
-    pub fn finish(&mut self, obs: &mut dyn NetworkObserver) {
+    /// A thermal pack's temperatures as at its last window's end, K (its discs', plates',
+    /// then oil's); `None` for an isothermal pack.
+    pub fn temperatures_k(&self) -> Option<&[f64]> {
+        self.session.temperatures_k()
+    }
+
+    /// Ends the pack's session at the run's end: its open contacts closed and sent to `obs`,
+    /// a thermal pack's last window closed (its temperatures sent); its temperatures' report.
+    pub fn finish(&mut self, obs: &mut dyn NetworkObserver) -> Option<ThermalReport> {
         let mut fwd = Forward { k: self.k, obs };
-        self.session.finish(&mut fwd);
+        self.session.finish(&mut fwd).thermal
     }
 }
 
@@ -347,7 +352,7 @@ impl Run {
             let (pa, pb) = (self.response(a), self.response(b));
             let name = &net.couplings[self.packs[j].k].name;
             let p = &mut self.packs[j];
-            p.sync(&self.w, &pa, &pb, name)?;
+            p.check_groups(&pa, &pb, name)?;
             let [ra0, rb0] = p.reaction;
             // everything else's torque on each carrier's group, reduced to the carrier:
             // (P T)_a / P_aa less this pack's own estimate
@@ -357,7 +362,7 @@ impl Run {
             } else {
                 (acc[b] - pa[b] * ra0 - pb[b] * rb0) / pb[b]
             };
-            let [ra, rb] = p.advance(t1, ta, tb, name, obs)?;
+            let [ra, rb] = p.advance(&self.w, t1, (ta, tb), name, obs)?;
             for (i, x) in acc.iter_mut().enumerate() {
                 *x += pa[i] * (ra - ra0) + pb[i] * (rb - rb0);
             }

@@ -156,6 +156,12 @@ impl NetworkStepper {
         &self.run.net
     }
 
+    /// The temperatures of the thermal pack that is coupling `k`, K (its discs', plates',
+    /// then oil's, as at its last thermal window's end); `None` for another coupling.
+    pub fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
+        self.run.packs.iter().find(|p| p.k == k)?.temperatures_k()
+    }
+
     /// The state now as a sample (every body's angle, rad, and speed, rad/s, every
     /// coupling's torque on its body `a`, N m, and a clutch's mode).
     pub fn sample_now(&mut self) -> NetworkSample {
@@ -180,16 +186,13 @@ impl NetworkStepper {
         value: f64,
         obs: &mut dyn NetworkObserver,
     ) -> Result<(), EngineError> {
+        Arc::make_mut(&mut self.run.net).hold_input(input, value)?;
         if let NetworkInput::PackPressure(k) = input {
-            if self.run.packs.iter().any(|p| p.k == k) {
-                return Err(EngineError::Unsupported(format!(
-                    "coupling \"{}\": a resolved pack's pressure as an input runs on the \
-                     reference engine (--engine reference)",
-                    self.run.net.couplings[k].name
-                )));
+            // the pack's session holds it too (the network's copy keeps the breakpoints)
+            if let Some(p) = self.run.packs.iter_mut().find(|p| p.k == k) {
+                p.hold_pressure(value)?;
             }
         }
-        Arc::make_mut(&mut self.run.net).hold_input(input, value)?;
         let t = self.t;
         self.breakpoints = self.run.net.breakpoints(self.duration_s);
         self.next_bp = self
@@ -362,8 +365,11 @@ impl NetworkStepper {
         for mesh in &mut run.meshes {
             mesh.finish(t, obs);
         }
+        let mut pack_thermal = Vec::new();
         for p in run.packs.iter_mut() {
-            p.finish(obs);
+            if let Some(report) = p.finish(obs) {
+                pack_thermal.push((p.k, report));
+            }
         }
         let last = run.sample(t);
         obs.sample(&last);
@@ -403,8 +409,7 @@ impl NetworkStepper {
             energy: run.energy,
             steps: self.steps,
             events: run.events,
-            // resolved packs (thermal or not) are the reference engine's for now
-            pack_thermal: Vec::new(),
+            pack_thermal,
         }
     }
 }
