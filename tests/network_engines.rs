@@ -214,3 +214,134 @@ fn a_thermal_pack_on_the_shift_has_the_same_temperatures_on_both_engines() {
         num(&m, "impact_heat_j")
     );
 }
+
+/// A lumped clutch that locks a third body onto a pack's carrier changes the carrier's
+/// inertia mid-run (its rigid group grows from the hub's 0.02 kg m^2 to 0.32): the multibody
+/// engine's pack session takes the new inertia at the lock. `dct-k1.toml` clamped between an
+/// engine (100 N m) and a hub, clutch C (200 N m) applied at 50 ms onto a slower body: on
+/// both engines C locks at the same instant (measured 2026-11-27: 1.0e-8 s apart), the
+/// speeds at 0.3 s (one rigid body by then: 2.4e-11) and C's heat agree, and K1's discs' and
+/// plates' largest tooth loads.
+#[test]
+fn a_clutch_locking_onto_a_packs_carrier_agrees_on_both_engines() {
+    let d = scratch("network-engines-lock");
+    let scene = d.join("net.toml");
+    let pack = std::fs::canonicalize("scenes/dct-k1.toml").unwrap();
+    std::fs::write(
+        &scene,
+        format!(
+            r#"
+name = "pack-and-a-lock"
+[simulation]
+duration_s = 0.3
+record_rate_hz = 2000.0
+max_step_s = 1e-3
+[[bodies]]
+name = "engine"
+inertia_kg_m2 = 0.1
+initial_speed_rad_s = 300.0
+[bodies.drive]
+kind = "constant"
+value_n_m = 100.0
+[[bodies]]
+name = "hub"
+inertia_kg_m2 = 0.02
+initial_speed_rad_s = 300.0
+[[bodies]]
+name = "extra"
+inertia_kg_m2 = 0.3
+initial_speed_rad_s = 250.0
+[[couplings]]
+name = "K1"
+kind = "pack"
+a = "hub"
+b = "engine"
+pack = "{}"
+[[couplings]]
+name = "C"
+kind = "clutch"
+a = "hub"
+b = "extra"
+mu = 0.5
+peak = 1.1
+cgeo_m = 0.1
+max_normal_force_n = 4000.0
+[couplings.force]
+kind = "step"
+height = 1.0
+start_s = 0.05
+"#,
+            pack.display()
+        ),
+    )
+    .unwrap();
+    let go = |engine: &str| {
+        let json = d.join(format!("{engine}.json"));
+        let o = run(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--engine",
+            engine,
+            "--no-record",
+            "--summary-json",
+            json.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        read_json(&json)
+    };
+    let (rs, ms) = (go("reference"), go("multibody"));
+    let coupling = |s: &Value, name: &str| {
+        s["couplings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["name"] == name)
+            .unwrap()
+            .clone()
+    };
+    let lock = |s: &Value| coupling(s, "C")["lock_times_s"][0].as_f64().unwrap();
+    let (lr, lm) = (lock(&rs), lock(&ms));
+    eprintln!("C locks at {lr} s and {lm} s");
+    assert!((lr - lm).abs() <= 1e-4, "C locks at {lr} s against {lm} s");
+    let heat = |s: &Value| coupling(s, "C")["heat_j"].as_f64().unwrap();
+    let (hr, hm) = (heat(&rs), heat(&ms));
+    assert!(
+        (hr - hm).abs() <= 1e-3 * hr,
+        "C's heat {hr} J against {hm} J"
+    );
+    let mut worst = 0.0f64;
+    for (r, m) in rs["bodies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(ms["bodies"].as_array().unwrap())
+    {
+        let (a, b) = (
+            r["final_speed_rad_s"].as_f64().unwrap(),
+            m["final_speed_rad_s"].as_f64().unwrap(),
+        );
+        worst = worst.max((a - b).abs() / a.abs());
+    }
+    eprintln!("speeds at 0.3 s within {worst:.2e}");
+    assert!(worst <= 2e-4, "speeds {worst}");
+    // K1's bodies, carried on one flank from t = 0 (their contacts never close): each
+    // body's largest load (measured 1.5e-7 apart) and K1's largest torque on the hub (the
+    // multibody engine's is the mean over a network step: 2.4e-4)
+    let bodies = |s: &Value| coupling(s, "K1")["pack_bodies"].as_array().unwrap().clone();
+    let mut peak = 0.0f64;
+    for (r, m) in bodies(&rs).iter().zip(&bodies(&ms)) {
+        let (a, b) = (
+            r["largest_peak_n"].as_f64().unwrap(),
+            m["largest_peak_n"].as_f64().unwrap(),
+        );
+        peak = peak.max(((a - b) / a).abs());
+    }
+    assert_eq!(bodies(&rs).len(), 9);
+    assert!(peak <= 1e-5, "K1's bodies' peaks {peak}");
+    let torque = |s: &Value| coupling(s, "K1")["max_torque_n_m"].as_f64().unwrap();
+    let (tr, tm) = (torque(&rs), torque(&ms));
+    assert!(
+        (tr - tm).abs() <= 1e-3 * tr,
+        "K1's torque {tr} against {tm} N m"
+    );
+}

@@ -80,6 +80,56 @@ impl MultibodySession {
         })
     }
 
+    /// Sets the inertia of the inertial shaft (`drum` false) or drum to `j_kg_m2` (kg m^2,
+    /// > 0) from now on, its speed kept (a network's clutch locking another body onto the
+    /// carrier's rigid group, or releasing one, changes the group's inertia): the pack's model,
+    /// the carrier's motion and the couplings' effective masses (the step control's impact
+    /// durations) follow. The kinetic energy this changes is outside the session's energy
+    /// audit (the network books the lock). Refused: a carrier that is not inertial, a drum the
+    /// pack does not have, an inertia that is not finite and > 0.
+    pub fn set_carrier_inertia(&mut self, drum: bool, j_kg_m2: f64) -> Result<(), EngineError> {
+        let c = if drum {
+            self.run
+                .world
+                .drum()
+                .ok_or_else(|| EngineError::Unsupported("the pack has no drum".into()))?
+        } else {
+            SHAFT
+        };
+        let super::carriers::Motion::Inertial { j, damping } = self.run.carriers[c].motion else {
+            return Err(EngineError::Unsupported(format!(
+                "the {} is not a body of its own: it has no inertia to set",
+                self.run.carriers[c].name
+            )));
+        };
+        if !(j_kg_m2.is_finite() && j_kg_m2 > 0.0) {
+            return Err(EngineError::Unsupported(format!(
+                "carrier inertia {j_kg_m2} kg m^2: must be finite and > 0"
+            )));
+        }
+        if j_kg_m2 == j {
+            return Ok(());
+        }
+        let w = self.run.carrier_state(c).1;
+        if let Some(th) = self.thermal.as_mut() {
+            th.carried(0.5 * (j_kg_m2 - j) * w * w);
+        }
+        self.run.carriers[c].motion = super::carriers::Motion::Inertial {
+            j: j_kg_m2,
+            damping,
+        };
+        let pack = std::sync::Arc::make_mut(&mut self.run.pack);
+        if drum {
+            if let Some(d) = pack.drum.as_mut() {
+                d.inertia_kg_m2 = j_kg_m2;
+            }
+        } else if let clutchpack_model::Shaft::Inertial { inertia_kg_m2, .. } = &mut pack.shaft {
+            *inertia_kg_m2 = j_kg_m2;
+        }
+        self.run.refresh_effective_masses();
+        Ok(())
+    }
+
     /// A thermal run's temperatures as at its last thermal window's end, K: every disc's,
     /// then every plate's, then the oil's (`None`: an isothermal run).
     pub fn temperatures_k(&self) -> Option<&[f64]> {

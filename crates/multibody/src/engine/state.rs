@@ -103,6 +103,29 @@ pub(super) struct Run {
 /// Bound of the shaft's acceleration from its drive alone, rad/s^2: the profile's for a
 /// prescribed shaft or an inertial one driven by a profile (eq 4), the largest drive torque
 /// over `J1` for a torque drive.
+/// Each coupling's effective mass along its line of action, kg: the body's, in series with
+/// its carrier's when the carrier is a body of its own (the step control's impact duration).
+fn effective_masses(
+    bodies: &[DiscModel],
+    carrier_of: &[usize],
+    carriers: &[CarrierRun],
+) -> Vec<f64> {
+    bodies
+        .iter()
+        .zip(carrier_of)
+        .map(|(d, &c)| {
+            let md = d.spline.effective_mass_kg(d.inertia_kg_m2);
+            match carriers[c].motion {
+                Motion::Inertial { j, .. } => {
+                    let mc = d.spline.effective_mass_kg(j);
+                    md * mc / (md + mc)
+                }
+                _ => md,
+            }
+        })
+        .collect()
+}
+
 pub(super) fn shaft_accel_bound(shaft: &Shaft) -> f64 {
     match shaft {
         Shaft::Prescribed(p) => profile_acceleration_bound(p),
@@ -205,20 +228,7 @@ impl Run {
             })
             .collect();
         let n_carriers = carriers.len();
-        let m_eff = bodies
-            .iter()
-            .zip(&world.carrier_of)
-            .map(|(d, &c)| {
-                let md = d.spline.effective_mass_kg(d.inertia_kg_m2);
-                match carriers[c].motion {
-                    Motion::Inertial { j, .. } => {
-                        let mc = d.spline.effective_mass_kg(j);
-                        md * mc / (md + mc)
-                    }
-                    _ => md,
-                }
-            })
-            .collect();
+        let m_eff = effective_masses(&bodies, &world.carrier_of, &carriers);
         let stack = pack
             .stack
             .as_ref()
@@ -351,6 +361,11 @@ impl Run {
     pub(super) fn carrier_state(&self, c: usize) -> (f64, f64) {
         let k = &self.carriers[c];
         (k.angle, k.speed)
+    }
+
+    /// Recomputes each coupling's effective mass (`m_eff`) after a carrier's inertia changed.
+    pub(super) fn refresh_effective_masses(&mut self) {
+        self.m_eff = effective_masses(&self.bodies, &self.world.carrier_of, &self.carriers);
     }
 
     /// Sets carrier `c`'s unwrapped angle, rad, and speed, rad/s (at a world step's end).

@@ -20,6 +20,9 @@
 //!   step is `R_a = J_a (w_a(t + h) - w_a(t)) / h - T_a`, exact for the session's motion:
 //!   the network applies it to `a` (and `R_b` to `b`) with the other torques, so the group's
 //!   speed at `t + h` is the pack's carrier's.
+//!   A clutch that locks or releases on a carrier's group changes `P_aa`: the session's
+//!   carrier takes the new inertia at the next step ([`MultibodySession::set_carrier_inertia`]),
+//!   its speed the network's merged one.
 //! - **Several packs on one group** (a dual-clutch's two packs on the engine and on the
 //!   geared input shafts): the packs advance in the couplings' order, each with the reactions
 //!   of those already advanced over this step and the others' of the step before (their
@@ -109,8 +112,8 @@ fn negligible(x: f64, s: f64) -> bool {
 impl NetPack {
     /// The packs of `net` with their carriers' speeds `w` (rad/s) at t = 0 and the columns
     /// of `P` of each body (`p(i)`), on the engine's steps of at most `options.step_s`.
-    /// Refused: a thermal pack, a pack whose carriers are one rigid group, a pack the pack
-    /// engine refuses.
+    /// A thermal pack (`net.pack_thermal`) carries its temperatures. Refused: discs on the
+    /// fixed body, a pack whose carriers are one rigid group, a pack the pack engine refuses.
     pub fn of(
         net: &Network,
         w: &[f64],
@@ -120,6 +123,13 @@ impl NetPack {
         let mut out = Vec::new();
         for (k, c) in net.couplings.iter().enumerate() {
             let Some(model) = c.pack() else { continue };
+            if net.bodies[c.a].fixed {
+                return Err(EngineError::Unsupported(format!(
+                    "coupling \"{}\": its friction discs' carrier is the fixed body (put the \
+                     plates there: body b)",
+                    c.name
+                )));
+            }
             let (pa, pb) = (p(c.a), p(c.b));
             let housing = net.bodies[c.b].fixed;
             if !housing && !negligible(pa[c.b], (pa[c.a] * pb[c.b]).sqrt()) {
@@ -206,20 +216,28 @@ impl NetPack {
         self.kinetic_j(&self.session.snapshot()) - self.kinetic0_j
     }
 
-    /// Checks that the carriers' rigid groups' inertias (`P`'s columns `pa`, `pb`) are those
-    /// the session was built with (a clutch locking a group on or off a pack's carrier changes
-    /// them).
-    pub fn check_groups(&self, pa: &[f64], pb: &[f64], name: &str) -> Result<(), EngineError> {
-        let same = |x: f64, y: f64| (x - y).abs() <= 1e-9 * y.abs();
-        if !same(pa[self.a], self.p_diag[0])
-            || (!self.housing && !same(pb[self.b], self.p_diag[1]))
-            || (!self.housing && !negligible(pa[self.b], (pa[self.a] * pb[self.b]).sqrt()))
-        {
+    /// Follows the carriers' rigid groups (`P`'s columns `pa`, `pb`): a clutch locking a body
+    /// onto a carrier's group or releasing one changes the carrier's inertia `1 / P_aa`, which
+    /// the session then takes ([`MultibodySession::set_carrier_inertia`]). Refused: the two
+    /// carriers in one rigid group.
+    pub fn follow_groups(&mut self, pa: &[f64], pb: &[f64], name: &str) -> Result<(), EngineError> {
+        if !self.housing && !negligible(pa[self.b], (pa[self.a] * pb[self.b]).sqrt()) {
             return Err(EngineError::Unsupported(format!(
-                "coupling \"{name}\": a clutch locked or released on the rigid group of its \
-                 carriers, which changes their inertia: not on the multibody engine yet \
-                 (--engine reference)"
+                "coupling \"{name}\": a clutch locked its discs' and plates' carriers into one \
+                 rigid group: not on the multibody engine (--engine reference)"
             )));
+        }
+        if pa[self.a] != self.p_diag[0] {
+            self.session
+                .set_carrier_inertia(false, 1.0 / pa[self.a])
+                .map_err(|e| in_pack(name, e))?;
+            self.p_diag[0] = pa[self.a];
+        }
+        if !self.housing && pb[self.b] != self.p_diag[1] {
+            self.session
+                .set_carrier_inertia(true, 1.0 / pb[self.b])
+                .map_err(|e| in_pack(name, e))?;
+            self.p_diag[1] = pb[self.b];
         }
         Ok(())
     }
@@ -352,7 +370,7 @@ impl Run {
             let (pa, pb) = (self.response(a), self.response(b));
             let name = &net.couplings[self.packs[j].k].name;
             let p = &mut self.packs[j];
-            p.check_groups(&pa, &pb, name)?;
+            p.follow_groups(&pa, &pb, name)?;
             let [ra0, rb0] = p.reaction;
             // everything else's torque on each carrier's group, reduced to the carrier:
             // (P T)_a / P_aa less this pack's own estimate
