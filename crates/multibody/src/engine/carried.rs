@@ -81,7 +81,7 @@ impl MultibodySession {
     }
 
     /// Sets the inertia of the inertial shaft (`drum` false) or drum to `j_kg_m2` (kg m^2,
-    /// > 0) from now on, its speed kept (a network's clutch locking another body onto the
+    /// positive) from now on, its speed kept (a network's clutch locking another body onto the
     /// carrier's rigid group, or releasing one, changes the group's inertia): the pack's model,
     /// the carrier's motion and the couplings' effective masses (the step control's impact
     /// durations) follow. The kinetic energy this changes is outside the session's energy
