@@ -55,22 +55,21 @@ fn coupled_clutches_run_writes_summary_and_figure() {
     assert!(e["residual_j"].as_f64().unwrap().abs() < 1e-9, "{e}");
     assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
 
-    let windows = d.join("windows.png");
+    let tables = d.join("tables.json");
     let o = run(&[
         "run",
         "scenes/coupled-clutches.toml",
-        "--windows",
-        "0.1",
-        "--windows-plot",
-        windows.to_str().unwrap(),
+        "--per-tooth",
+        "--summary-json",
+        tables.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("--windows-plot: not for a network scene"),
+        stderr(&o).contains("--per-tooth: not for a network scene"),
         "{}",
         stderr(&o)
     );
-    assert!(!windows.exists());
+    assert!(!tables.exists());
     // windows give a pack's bodies' figures: a network of lumped clutches has none
     let o = run(&[
         "run",
@@ -712,6 +711,8 @@ fn a_brake_on_a_network_has_the_pack_runs_peaks_and_fatigue() {
             a_cycles.to_str().unwrap(),
             "--windows",
             "0.01",
+            "--windows-plot",
+            d.join("pack-windows.png").to_str().unwrap(),
         ],
     );
     let mcap = d.join("net.mcap");
@@ -727,8 +728,14 @@ fn a_brake_on_a_network_has_the_pack_runs_peaks_and_fatigue() {
             b_cycles.to_str().unwrap(),
             "--windows",
             "0.01",
+            "--windows-plot",
+            d.join("windows.png").to_str().unwrap(),
         ],
     );
+    // the windows' figures: the pack run's bodies', the network's pack's worst body's
+    for f in ["pack-windows.png", "windows.png"] {
+        assert!(std::fs::metadata(d.join(f)).unwrap().len() > 10_000, "{f}");
+    }
     same_impacts_and_spectra((&a_csv, &a_cycles), (&b_csv, &b_cycles), "brake");
     let png = d.join("spectra.png");
     let o = run(&[

@@ -53,6 +53,7 @@ mod signals;
 mod study;
 mod sweep;
 mod tables;
+mod windows_plot;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -27,6 +27,8 @@ pub struct NetworkArgs<'a> {
     pub fatigue_json: Option<&'a Path>,
     /// `--windows S`: every pack's figures window by window.
     pub windows_s: Option<f64>,
+    /// `--windows-plot FILE`: those figures against time, every pack's bodies.
+    pub windows_plot: Option<&'a Path>,
     /// `--plot`.
     pub plot: Option<&'a Path>,
     /// The recording (`--out`, or the default name; `None` with `--no-record`).
@@ -46,7 +48,7 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
         return Err(BadInput(format!(
             "{flag}: not for a network scene ({} has [[bodies]]); a network run gives its \
              table, its recording (--out), --summary-json, --impacts-csv, --fatigue-json, \
-             --windows and --plot",
+             --windows, --windows-plot and --plot",
             scene.name
         ))
         .into());
@@ -63,6 +65,9 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     }
     if let Some(p) = a.plot {
         outs.push(Output::figure("--plot", p));
+    }
+    if let Some(p) = a.windows_plot {
+        outs.push(Output::figure("--windows-plot", p));
     }
     let inputs: Vec<&Path> = a.scene_path.into_iter().collect();
     // the other outputs first, so that a refused one leaves no recording folder behind
@@ -107,6 +112,21 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     let s = &done.summary;
     if let Some(path) = a.plot {
         plot(path, &scene, s.engine, &done)?;
+    }
+    if let Some(path) = a.windows_plot {
+        let groups: Vec<(Option<&str>, &[clutchpack_sdk::WindowRow])> = s
+            .couplings
+            .iter()
+            .filter(|c| !c.windows.is_empty())
+            .map(|c| (Some(c.name.as_str()), c.windows.as_slice()))
+            .collect();
+        let title = format!(
+            "{}: every pack by window of {} s ({} engine)",
+            s.scene,
+            clutchpack_sdk::model::fmt_num(a.windows_s.unwrap_or(0.0)),
+            s.engine
+        );
+        crate::windows_plot::write(path, &title, &groups)?;
     }
     if let Some(path) = a.summary_json {
         crate::outputs::write_json(path, s)?;

@@ -54,8 +54,9 @@ pub struct RunArgs {
     pub windows: Option<f64>,
     /// Plot the windows' figures against time (PNG or SVG by extension; an existing FILE is
     /// replaced): each body's largest peak per tooth and its damage rate (log10; the bodies
-    /// whose largest peak is at least a tenth of the run's) and, in a thermal run, the oil's
-    /// and the hottest body's temperature. Needs `--windows`.
+    /// whose largest peak is at least a tenth of the run's; of a network, each pack's worst
+    /// body's) and, in a thermal run, the oil's and the hottest body's temperature. Needs
+    /// `--windows`.
     #[arg(long, value_name = "FILE", requires = "windows")]
     pub windows_plot: Option<PathBuf>,
     /// Plot the per-tooth load history of each disc (PNG or SVG by extension; an existing
@@ -127,7 +128,6 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     if scene.network.is_some() {
         let pack_only = [
             ("--per-tooth", a.per_tooth),
-            ("--windows-plot", a.windows_plot.is_some()),
             ("--no-contact-samples", a.no_contact_samples),
         ];
         let args = crate::network::NetworkArgs {
@@ -137,6 +137,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             impacts_csv: a.impacts_csv.as_deref(),
             fatigue_json: a.fatigue_json.as_deref(),
             windows_s: a.windows,
+            windows_plot: a.windows_plot.as_deref(),
             plot: a.plot.as_deref(),
             recording: record_path.as_deref(),
             out_given: a.out.is_some(),
@@ -241,79 +242,13 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         })?;
     }
     if let Some(path) = &a.windows_plot {
-        let windows = &done.windows;
-        let mid = |w: &clutchpack_sdk::WindowRow| 0.5 * (w.t0_s + w.t1_s);
-        let series = |name: &str, f: &dyn Fn(&clutchpack_sdk::WindowRow) -> Option<f64>| {
-            let pts = windows
-                .iter()
-                .filter_map(|w| f(w).map(|y| (mid(w), y)))
-                .collect();
-            (name.to_string(), pts)
-        };
-        let bodies = windows.first().map_or(0, |w| w.bodies.len());
-        // the bodies that hit at all: a largest peak of at least a tenth of the run's (a
-        // plate resting on its flank would only crowd the figure)
-        let largest = |i: usize| {
-            windows
-                .iter()
-                .filter_map(|w| w.bodies.get(i))
-                .map(|b| b.peak_abs_n)
-                .fold(0.0, f64::max)
-        };
-        let top = (0..bodies).map(largest).fold(0.0, f64::max);
-        let shown: Vec<usize> = (0..bodies).filter(|&i| largest(i) >= 0.1 * top).collect();
-        let by_body = |f: &dyn Fn(&clutchpack_sdk::BodyWindow) -> f64| {
-            shown
-                .iter()
-                .map(|&i| {
-                    let name = windows[0].bodies[i].name.clone();
-                    let pts = windows
-                        .iter()
-                        .filter_map(|w| w.bodies.get(i).map(|b| (mid(w), f(b))))
-                        .collect();
-                    (name, pts)
-                })
-                .collect::<Vec<_>>()
-        };
-        let mut panels = vec![
-            clutchpack_sdk::analysis::Panel {
-                y_label: "largest |peak| per tooth [N]".into(),
-                series: by_body(&|b| b.peak_abs_n),
-                markers_only: false,
-            },
-            clutchpack_sdk::analysis::Panel {
-                y_label: "log10 damage rate [log10 1/h]".into(),
-                // rates below 1e-12 per hour (a million years) are left out
-                series: by_body(&|b| {
-                    if b.damage_rate_per_h >= 1e-12 {
-                        b.damage_rate_per_h.log10()
-                    } else {
-                        f64::NAN
-                    }
-                }),
-                markers_only: false,
-            },
-        ];
-        if windows.iter().any(|w| w.oil_k.is_some()) {
-            panels.push(clutchpack_sdk::analysis::Panel {
-                y_label: "temperature [K]".into(),
-                series: vec![
-                    series("oil", &|w| w.oil_k),
-                    series("hottest body", &|w| w.hottest_body_k),
-                ],
-                markers_only: false,
-            });
-        }
         let title = format!(
             "{}: by window of {} s ({} engine)",
             scene.name,
             clutchpack_sdk::model::fmt_num(a.windows.unwrap_or(0.0)),
             done.engine
         );
-        crate::outputs::write_with(path, |tmp| {
-            clutchpack_sdk::analysis::plot_panels(tmp, &title, "window's middle [s]", &panels)
-                .with_context(|| format!("plotting {}", path.display()))
-        })?;
+        crate::windows_plot::write(path, &title, &[(None, &done.windows)])?;
     }
     let run_stats = match done.stats() {
         Ok(s) if s.stopped_early => {
