@@ -289,7 +289,8 @@ fn thermal_pack_outputs_on(engine: clutchpack_scene::EngineChoice) {
 /// (`couplings.<pack>.pressure_pa`): `dct-upshift.toml` driven from the pack files' own
 /// schedules, held at each 1 ms interval's midpoint, gives the scene's shift on that engine:
 /// K2 locked at the end and its heat within 1e-4 of the whole run's (measured 2026-11-27:
-/// 1.1e-5), its lock within 1 ms (measured 3.0e-4 s: a lock is timed to the network step).
+/// 1.1e-5), its lock within 1 ms (measured 3.0e-4 s: a lock is timed to the network step);
+/// the output `couplings.K2.heat_j` at the end is the summary's.
 #[test]
 fn the_multibody_engine_drives_a_packs_pressure_by_name() {
     use clutchpack_scene::EngineChoice;
@@ -323,11 +324,22 @@ fn the_multibody_engine_drives_a_packs_pressure_by_name() {
         sim.set_input(&names[1], ramp(mid, &k2)).unwrap();
         sim.advance_to(f64::from(k) * 1e-3, None).unwrap();
     }
+    // the heat output is the pack's faces' heat so far, as the summary's at the end
+    let out = sim.outputs();
+    let heat_out = out
+        .iter()
+        .find(|(n, _)| n == "couplings.K2.heat_j")
+        .unwrap()
+        .1;
     let driven = sim.finish().unwrap().summary;
     let k2_of = |s: &clutchpack_sdk::NetworkSummary| {
         s.couplings.iter().find(|c| c.name == "K2").unwrap().clone()
     };
     let (a, b) = (k2_of(&whole.summary), k2_of(&driven));
+    assert!(
+        (heat_out - b.heat_j).abs() <= 1e-9 * b.heat_j,
+        "{heat_out} J against {b:?}"
+    );
     let rel = (b.heat_j - a.heat_j).abs() / a.heat_j;
     assert!(
         rel <= 1e-4,

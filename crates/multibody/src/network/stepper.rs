@@ -168,10 +168,16 @@ impl NetworkStepper {
         self.run.sample(self.t)
     }
 
-    /// Heat of each clutch, work done on each gear mesh, or each damper's loss, since t = 0,
-    /// J, by coupling (0 for an ideal gear or a spring-damper's spring).
+    /// Heat of each clutch or resolved pack's faces, work done on each gear mesh, or each
+    /// damper's loss, since t = 0, J, by coupling (0 for an ideal gear or a spring-damper's
+    /// spring).
     pub fn heat_j(&self) -> Vec<f64> {
-        self.run.heat.clone()
+        let mut heat = self.run.heat.clone();
+        // a resolved pack's: its faces' (and open gaps') heat so far
+        for p in &self.run.packs {
+            heat[p.k] = p.face_heat_j();
+        }
+        heat
     }
 
     /// Sets `input` to `value` from now on (N m or N; [`Network::hold_input`]): the scene's
