@@ -35,25 +35,48 @@ fn impacts(csv: &Path) -> BTreeMap<String, Vec<Impact>> {
     out
 }
 
-/// Runs `scenes/dct-upshift.toml` on `engine` into `dir`: its summary and its impacts.
-fn dct_upshift(engine: &str, dir: &Path) -> (Value, BTreeMap<String, Vec<Impact>>) {
-    let (json, csv) = (
-        dir.join(format!("{engine}.json")),
-        dir.join(format!("{engine}.csv")),
-    );
-    let o = run(&[
+/// The largest relative difference of the bodies' final speeds of two network summaries.
+fn speeds_apart(a: &Value, b: &Value) -> f64 {
+    let speeds = |s: &Value| -> Vec<f64> {
+        s["bodies"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| b["final_speed_rad_s"].as_f64().unwrap())
+            .collect()
+    };
+    speeds(a)
+        .iter()
+        .zip(speeds(b))
+        .map(|(x, y)| (x - y).abs() / x.abs())
+        .fold(0.0, f64::max)
+}
+
+/// Runs the network scene `scene` on `engine` without a recording, with the options `more`:
+/// its summary (written into `dir`).
+fn summary_on(scene: &str, engine: &str, dir: &Path, more: &[&str]) -> Value {
+    let json = dir.join(format!("{engine}.json"));
+    let mut args = vec![
         "run",
-        "scenes/dct-upshift.toml",
+        scene,
         "--engine",
         engine,
         "--no-record",
         "--summary-json",
         json.to_str().unwrap(),
-        "--impacts-csv",
-        csv.to_str().unwrap(),
-    ]);
+    ];
+    args.extend_from_slice(more);
+    let o = run(&args);
     assert!(o.status.success(), "{}", stderr(&o));
-    (read_json(&json), impacts(&csv))
+    read_json(&json)
+}
+
+/// Runs `scenes/dct-upshift.toml` on `engine` into `dir`: its summary and its impacts.
+fn dct_upshift(engine: &str, dir: &Path) -> (Value, BTreeMap<String, Vec<Impact>>) {
+    let csv = dir.join(format!("{engine}.csv"));
+    let more = ["--impacts-csv", csv.to_str().unwrap()];
+    let s = summary_on("scenes/dct-upshift.toml", engine, dir, &more);
+    (s, impacts(&csv))
 }
 
 /// The multibody engine (each pack's discs and plates rapier bodies, advanced inside the
@@ -130,22 +153,8 @@ fn dct_upshift_impacts_and_locks_agree_on_both_engines() {
         );
     }
     assert_eq!(locks, 3, "K1 at 0 and again, K2 at the shift's end");
-    for (r, m) in ref_sum["bodies"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .zip(mb_sum["bodies"].as_array().unwrap())
-    {
-        let (a, b) = (
-            r["final_speed_rad_s"].as_f64().unwrap(),
-            m["final_speed_rad_s"].as_f64().unwrap(),
-        );
-        assert!(
-            (a - b).abs() <= 2e-4 * a.abs(),
-            "{}: {a} against {b} rad/s",
-            r["name"]
-        );
-    }
+    let speeds = speeds_apart(&ref_sum, &mb_sum);
+    assert!(speeds <= 2e-4, "the final speeds differ by {speeds:.3e}");
     // the network's balance with the packs' share as the carriers' work on them (measured
     // 6.1e-5 J of 78.4 kJ driven)
     let residual = mb_sum["energy"]["residual_j"].as_f64().unwrap();
@@ -166,20 +175,8 @@ fn dct_upshift_impacts_and_locks_agree_on_both_engines() {
 fn a_thermal_pack_on_the_shift_has_the_same_temperatures_on_both_engines() {
     let d = scratch("network-engines-thermal");
     let thermal = |engine: &str| {
-        let json = d.join(format!("{engine}.json"));
-        let o = run(&[
-            "run",
-            "scenes/dct-upshift.toml",
-            "--engine",
-            engine,
-            "--no-record",
-            "--set",
-            "couplings[2].pack=dct-k2-thermal.toml",
-            "--summary-json",
-            json.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        let s = read_json(&json);
+        let hot = ["--set", "couplings[2].pack=dct-k2-thermal.toml"];
+        let s = summary_on("scenes/dct-upshift.toml", engine, &d, &hot);
         s["couplings"]
             .as_array()
             .unwrap()
@@ -275,20 +272,7 @@ start_s = 0.05
         ),
     )
     .unwrap();
-    let go = |engine: &str| {
-        let json = d.join(format!("{engine}.json"));
-        let o = run(&[
-            "run",
-            scene.to_str().unwrap(),
-            "--engine",
-            engine,
-            "--no-record",
-            "--summary-json",
-            json.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        read_json(&json)
-    };
+    let go = |engine: &str| summary_on(scene.to_str().unwrap(), engine, &d, &[]);
     let (rs, ms) = (go("reference"), go("multibody"));
     let coupling = |s: &Value, name: &str| {
         s["couplings"]
@@ -309,19 +293,7 @@ start_s = 0.05
         (hr - hm).abs() <= 1e-3 * hr,
         "C's heat {hr} J against {hm} J"
     );
-    let mut worst = 0.0f64;
-    for (r, m) in rs["bodies"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .zip(ms["bodies"].as_array().unwrap())
-    {
-        let (a, b) = (
-            r["final_speed_rad_s"].as_f64().unwrap(),
-            m["final_speed_rad_s"].as_f64().unwrap(),
-        );
-        worst = worst.max((a - b).abs() / a.abs());
-    }
+    let worst = speeds_apart(&rs, &ms);
     eprintln!("speeds at 0.3 s within {worst:.2e}");
     assert!(worst <= 2e-4, "speeds {worst}");
     // K1's bodies, carried on one flank from t = 0 (their contacts never close): each
