@@ -100,9 +100,6 @@ pub(super) struct Run {
     pub(super) energy: EnergyBook,
 }
 
-/// Bound of the shaft's acceleration from its drive alone, rad/s^2: the profile's for a
-/// prescribed shaft or an inertial one driven by a profile (eq 4), the largest drive torque
-/// over `J1` for a torque drive.
 /// Each coupling's effective mass along its line of action, kg: the body's, in series with
 /// its carrier's when the carrier is a body of its own (the step control's impact duration).
 fn effective_masses(
@@ -126,6 +123,9 @@ fn effective_masses(
         .collect()
 }
 
+/// Bound of the shaft's acceleration from its drive alone, rad/s^2: the profile's for a
+/// prescribed shaft or an inertial one driven by a profile (eq 4), the largest drive torque
+/// over `J1` for a torque drive.
 pub(super) fn shaft_accel_bound(shaft: &Shaft) -> f64 {
     match shaft {
         Shaft::Prescribed(p) => profile_acceleration_bound(p),

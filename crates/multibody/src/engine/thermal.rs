@@ -18,9 +18,10 @@
 //! teeth, `p = 0`, on the duty cycle: 2.8e-6 J off the elastic energy left in them,
 //! `tests/thermal.rs`). A pack carried by a network (`carried.rs`) has its carriers' torques
 //! held between calls, which world steps land on: their work is then `T (theta_1 - theta_0)`
-//! exactly, and a carrier's speed set by the network is not the teeth's work. A step whose window closes with new parameters swaps them
-//! into the spline couplings' tooth laws (a paper-law contact keeps the stiffness it took at its
-//! onset, eqs 8-9; the new film reaches it at its next contact) and the stack's open gaps.
+//! exactly, and a carrier's speed set by the network is not the teeth's work. A step whose
+//! window closes with new parameters swaps them into the spline couplings' tooth laws (a
+//! paper-law contact keeps the stiffness it took at its onset, eqs 8-9; the new film reaches it
+//! at its next contact) and the stack's open gaps.
 
 use super::state::Run;
 use clutchpack_model::thermal::{FaceMode, ThermalModel, ThermalReport, ThermalWindows};
