@@ -130,6 +130,12 @@ impl MultibodySession {
         Ok(())
     }
 
+    /// The stack's friction interfaces now (empty without a stack): what
+    /// [`Session::snapshot`] holds of them, without the bodies' sample.
+    pub fn interfaces(&self) -> Vec<clutchpack_model::InterfaceSample> {
+        self.run.stack.as_ref().map_or(Vec::new(), |s| s.samples())
+    }
+
     /// A thermal run's temperatures as at its last thermal window's end, K: every disc's,
     /// then every plate's, then the oil's (`None`: an isothermal run).
     pub fn temperatures_k(&self) -> Option<&[f64]> {

@@ -608,7 +608,7 @@ impl Session for MultibodySession {
         let run = &self.run;
         Snapshot {
             sample: run.sample(self.options.record_tooth_loads),
-            interfaces: run.stack.as_ref().map_or(Vec::new(), |s| s.samples()),
+            interfaces: self.interfaces(),
             drum: run.world.drum().map(|d| run.carrier_state(d)),
         }
     }

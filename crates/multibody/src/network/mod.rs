@@ -118,6 +118,9 @@ struct Torques {
     mesh_force: Vec<f64>,
 }
 
+/// Columns of `P` (1/(kg m^2)) by body, with the rows they were computed for.
+type Columns = (Vec<Row>, Vec<Option<Arc<[f64]>>>);
+
 /// The state of a run between steps.
 #[derive(Clone)]
 struct Run {
@@ -143,6 +146,8 @@ struct Run {
     mesh_force: Vec<f64>,
     /// The resolved packs (`packs.rs`), in the couplings' order.
     packs: Vec<packs::NetPack>,
+    /// The columns of `P` computed for these rows, by body (`packs.rs`, `Run::column`).
+    columns: Columns,
     heat: Vec<f64>,
     energy: NetworkEnergy,
     events: u64,

@@ -290,21 +290,20 @@ impl NetPack {
     /// Sends the faces' new locked and clamped counts to `obs` at `t` (s) if they changed, or
     /// whatever they are at t = 0 (as the reference engine does).
     pub fn faces_to(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
-        let snap = self.session.snapshot();
-        if snap.interfaces.is_empty() {
+        let faces = self.session.interfaces();
+        if faces.is_empty() {
             return;
         }
         // a face's `locked` is its last step's; at t = 0, before any, a clamped face without
         // slip is locked (the reference engine's settling at the start)
-        let locked = snap
-            .interfaces
+        let locked = faces
             .iter()
             .filter(|f| f.locked || t == 0.0 && f.clamp_n > 0.0 && f.slip_rad_s.abs() <= 1e-9)
             .count();
-        let clamped = snap.interfaces.iter().filter(|f| f.clamp_n > 0.0).count();
+        let clamped = faces.iter().filter(|f| f.clamp_n > 0.0).count();
         if (locked, clamped) != self.faces || t == 0.0 {
             self.faces = (locked, clamped);
-            obs.pack_faces(self.k, t, locked, clamped, snap.interfaces.len());
+            obs.pack_faces(self.k, t, locked, clamped, faces.len());
         }
     }
 
@@ -334,8 +333,11 @@ impl NetPack {
 
     /// Its faces' heat since t = 0 (friction and the open gaps' drag), J.
     pub fn face_heat_j(&self) -> f64 {
-        let snap = self.session.snapshot();
-        snap.interfaces.iter().map(|f| f.dissipated_j).sum()
+        self.session
+            .interfaces()
+            .iter()
+            .map(|f| f.dissipated_j)
+            .sum()
     }
 
     /// A thermal pack's temperatures as at its last window's end, K (its discs', plates',
@@ -367,7 +369,7 @@ impl Run {
         let net = Arc::clone(&self.net);
         for j in 0..self.packs.len() {
             let (a, b) = (self.packs[j].a, self.packs[j].b);
-            let (pa, pb) = (self.response(a), self.response(b));
+            let (pa, pb) = (self.column(a), self.column(b));
             let name = &net.couplings[self.packs[j].k].name;
             let p = &mut self.packs[j];
             p.follow_groups(&pa, &pb, name)?;
@@ -388,6 +390,20 @@ impl Run {
             total[b] += rb - rb0;
         }
         Ok(())
+    }
+}
+
+impl Run {
+    /// Column `i` of `P` ([`Run::response`]), kept while the rows are those it was computed
+    /// with (they change only where a clutch locks or releases).
+    fn column(&mut self, i: usize) -> Arc<[f64]> {
+        if self.columns.0 != self.rows || self.columns.1.len() != self.w.len() {
+            self.columns = (self.rows.clone(), vec![None; self.w.len()]);
+        }
+        if self.columns.1[i].is_none() {
+            self.columns.1[i] = Some(self.response(i).into());
+        }
+        Arc::clone(self.columns.1[i].as_ref().unwrap())
     }
 }
 

@@ -112,6 +112,7 @@ impl NetworkStepper {
             meshes: Mesh::of(net),
             mesh_force: Vec::new(),
             packs: Vec::new(),
+            columns: (Vec::new(), Vec::new()),
             heat: vec![0.0; m],
             energy: NetworkEnergy::default(),
             events: 0,
