@@ -19,10 +19,9 @@
 
 use super::carriers::{External, Motion};
 use super::landing::SubSteps;
+use super::scheme_state::{powers, RkBuffers, Stage};
 use super::state::Run;
-use super::substep::{
-    checked_sub_step, cut, graded_step, Node, Prescribed, Rk4, ShaftAt, WorldStep,
-};
+use super::substep::{checked_sub_step, cut, graded_step, Node, Prescribed, ShaftAt, WorldStep};
 use crate::stack::Face;
 use crate::stepping::{bracketed_root, coupling_step};
 use clutchpack_model::{EngineError, LocalProfile, SpeedProfile};
@@ -82,43 +81,6 @@ enum Mount {
     Housing,
     /// Inertial carrier `k` of [`System::spins`], integrated with the stack.
     Spin(usize),
-}
-
-/// What the system does at one stage.
-#[derive(Debug, Clone)]
-struct Stage {
-    /// Each coupling body's acceleration, rad/s^2, and the inertial carriers' ([`System::spins`]
-    /// order).
-    acc: Vec<f64>,
-    acc_carrier: Vec<f64>,
-    /// The teeth's torque on each coupling body, N m.
-    teeth: Vec<f64>,
-    /// Each interface's torque on its upper body, N m: friction or the gap's drag of a
-    /// slipping or open face, the holding torque of a locked one.
-    face: Vec<f64>,
-    /// Each interface's clamp force, N.
-    clamp: Vec<f64>,
-    /// Each stack position's torque, N m (scratch).
-    torque: Vec<f64>,
-    /// The inertial carriers' external torques ([`System::spins`] order): the drive on an
-    /// inertial shaft (eq 4), the drum's load, N m.
-    external: Vec<f64>,
-}
-
-impl Stage {
-    /// A stage's buffers for `n` coupling bodies and `n_spin` inertial carriers.
-    fn new(n: usize, n_spin: usize) -> Stage {
-        let n_if = n - 1;
-        Stage {
-            acc: vec![0.0; n],
-            acc_carrier: vec![0.0; n_spin],
-            teeth: vec![0.0; n],
-            face: vec![0.0; n_if],
-            clamp: vec![0.0; n_if],
-            torque: vec![0.0; n],
-            external: vec![0.0; n_spin],
-        }
-    }
 }
 
 impl Run {
@@ -378,79 +340,6 @@ impl Run {
     }
 }
 
-/// One classical Runge-Kutta step of the clamped stack ([`Run::stack_step`]).
-#[derive(Debug, Clone)]
-struct StackStep {
-    /// Each coupling body's turn, rad, speed at the end, rad/s, and relative angle at the end.
-    turn: Vec<f64>,
-    u: Vec<f64>,
-    phi: Vec<f64>,
-    /// The inertial carriers' turns, rad, and speeds at the end, rad/s ([`System::spins`]
-    /// order).
-    carrier_turn: Vec<f64>,
-    w_carrier: Vec<f64>,
-    /// Each interface's impulse on its upper body, N m s, and the work of its torque on the
-    /// slip (friction, the gap's drag; 0 locked), J (<= 0).
-    impulse: Vec<f64>,
-    face_j: Vec<f64>,
-    /// The part of `face_j` done while clamped (the stages with a clamp force `> 0`), J.
-    friction_j: Vec<f64>,
-    /// Work of the drive (a prescribed shaft's on the discs' teeth, an inertial shaft's drive
-    /// torque, eq 4), of the drag (bodies, the carriers' damping) and of the drum's load, J.
-    drive_j: f64,
-    drag_j: f64,
-    load_j: f64,
-}
-
-/// The buffers of [`Run::stack_step`], reused along the sub-steps (a step allocating its
-/// stages was a fifth of the clamped stack's time, perf) and from one world step to the next
-/// (`MultirateState::stack_buffers`: the memory stays where the caches have it).
-#[derive(Debug, Clone)]
-pub(super) struct RkBuffers {
-    /// The stages 2, 3 and 4.
-    k: [Stage; 3],
-    /// The step of the bodies (coupling order) and the inertial carriers after them, with
-    /// their powers ([`powers`]), and their speeds at its start.
-    rk: Rk4<Vec<f64>, Vec<f64>>,
-    x0: Vec<f64>,
-    out: StackStep,
-}
-
-impl RkBuffers {
-    /// Whether these are the buffers for `n` coupling bodies and `n_spin` inertial carriers.
-    fn fits(&self, n: usize, n_spin: usize) -> bool {
-        self.out.u.len() == n && self.out.w_carrier.len() == n_spin
-    }
-
-    /// The buffers for `n` coupling bodies and `n_spin` inertial carriers.
-    fn new(n: usize, n_spin: usize) -> RkBuffers {
-        let v = || vec![0.0; n];
-        let c = || vec![0.0; n_spin];
-        RkBuffers {
-            k: [
-                Stage::new(n, n_spin),
-                Stage::new(n, n_spin),
-                Stage::new(n, n_spin),
-            ],
-            rk: Rk4::new(n + n_spin, powers(n, n_spin, n - 1).iter().sum()),
-            x0: vec![0.0; n + n_spin],
-            out: StackStep {
-                turn: v(),
-                u: v(),
-                phi: v(),
-                carrier_turn: c(),
-                w_carrier: c(),
-                impulse: vec![0.0; n - 1],
-                face_j: vec![0.0; n - 1],
-                friction_j: vec![0.0; n - 1],
-                drive_j: 0.0,
-                drag_j: 0.0,
-                load_j: 0.0,
-            },
-        }
-    }
-}
-
 /// Where a sub-step of the clamped stack starts ([`Run::stack_step`]).
 struct StackStart<'a> {
     /// The faces, held over the sub-step.
@@ -580,17 +469,6 @@ impl Run {
             out.friction_j[m] = if slipping { friction[m] } else { 0.0 };
         }
     }
-}
-
-/// The lengths of the clamped stack's powers by kind ([`cut`]), for `n` coupling bodies,
-/// `n_spin` inertial carriers and `n_if` interfaces: the drive's on each body's teeth (a
-/// prescribed shaft's; not written on another carrier), each body's speed squared (the drag's
-/// over -C2), each inertial carrier's speed squared and its external torque's (the drive's on
-/// an inertial shaft, eq 4; the drum's load), each interface's torque (its impulse), its work
-/// on the slip and the part of it done while clamped (the friction's; not written for a
-/// locked face).
-fn powers(n: usize, n_spin: usize, n_if: usize) -> [usize; 7] {
-    [n, n, n_spin, n_spin, n_if, n_if, n_if]
 }
 
 /// The clamped stack's sub-steps as the one landing loop drives them

@@ -2,7 +2,10 @@
 //! `Simulation` takes too), the older Python names kept as aliases, and the one check of an
 //! input against the bound of the scene key it stands for (`clutchpack_scene::MAX_SPEED_RAD_S`,
 //! `MAX_PRESSURE_PA`, `MAX_TORQUE_N_M`), so that a co-simulation cannot ask what a scene
-//! could not (docs/DECISIONS.md, "Co-simulation hardening").
+//! could not (docs/DECISIONS.md, "Co-simulation hardening"); and the one quoting of a name
+//! as an FMI variable name's segment ([`fmi_name_segment`]; here, below the two tables that
+//! name variables, so that the network's (`network_cosim.rs`) need not import the pack's
+//! (`variables.rs`), which imports it).
 
 use clutchpack_model::session::{Driven, Inputs};
 
@@ -184,6 +187,50 @@ pub fn driven_from_names<S: AsRef<str>>(names: &[S]) -> Result<Driven, String> {
     Ok(driven)
 }
 
+/// `name` as one segment of an FMI 2.0 structured variable name (the model description's
+/// `variableNamingConvention = "structured"`, FMI 2.0 section 2.2.9): as it is when it is an
+/// identifier (`[A-Za-z_][A-Za-z0-9_]*`: `K2`, `crank`), else a quoted name (`'input-1'`),
+/// with `'`, `"`, `?`, `\` and the control characters the grammar names escaped. The one
+/// quoting of FMI names: every network variable's name goes through it. A character the
+/// grammar cannot write at all (one outside ASCII, another control character) is an error
+/// naming it.
+pub fn fmi_name_segment(name: &str) -> Result<String, String> {
+    let mut chars = name.chars();
+    let identifier = chars
+        .next()
+        .is_some_and(|c| c == '_' || c.is_ascii_alphabetic())
+        && chars.all(|c| c == '_' || c.is_ascii_alphanumeric());
+    if identifier {
+        return Ok(name.to_string());
+    }
+    let mut out = String::with_capacity(name.len() + 2);
+    out.push('\'');
+    for c in name.chars() {
+        match c {
+            '\'' => out.push_str("\\'"),
+            '"' => out.push_str("\\\""),
+            '?' => out.push_str("\\?"),
+            '\\' => out.push_str("\\\\"),
+            '\u{7}' => out.push_str("\\a"),
+            '\u{8}' => out.push_str("\\b"),
+            '\u{c}' => out.push_str("\\f"),
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            '\u{b}' => out.push_str("\\v"),
+            ' '..='~' => out.push(c),
+            _ => {
+                return Err(format!(
+                    "{name:?}: the character {c:?} cannot be written in an FMI variable name \
+                     (ASCII only): rename it in the scene"
+                ))
+            }
+        }
+    }
+    out.push('\'');
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -216,5 +263,26 @@ mod tests {
         );
         assert!(Input::PistonPressure.check(-1.0, "").is_err());
         assert!(Input::PistonPressure.check(1e6, "").is_ok());
+    }
+}
+
+#[cfg(test)]
+mod name_tests {
+    use super::fmi_name_segment;
+
+    /// Identifiers pass as they are; other names are quoted with the grammar's escapes; a
+    /// character outside ASCII is refused with the name.
+    #[test]
+    fn fmi_names_are_identifiers_or_quoted() {
+        assert_eq!(fmi_name_segment("K2").unwrap(), "K2");
+        assert_eq!(fmi_name_segment("_a1").unwrap(), "_a1");
+        assert_eq!(fmi_name_segment("input-1").unwrap(), "'input-1'");
+        assert_eq!(fmi_name_segment("1st").unwrap(), "'1st'");
+        assert_eq!(fmi_name_segment("a b").unwrap(), "'a b'");
+        assert_eq!(fmi_name_segment("it's").unwrap(), "'it\\'s'");
+        assert_eq!(fmi_name_segment("a\\b?").unwrap(), "'a\\\\b\\?'");
+        assert_eq!(fmi_name_segment("").unwrap(), "''");
+        let e = fmi_name_segment("vélo").unwrap_err();
+        assert!(e.contains("vélo") && e.contains("'é'"), "{e}");
     }
 }

@@ -10,10 +10,10 @@ mod inputs;
 mod network;
 mod variables;
 
-pub use inputs::{driven_from_names, driven_names, Input};
+pub use inputs::{driven_from_names, driven_names, fmi_name_segment, Input};
 pub use variables::{
-    fmi_name_segment, uses_unit, variables, BodyField, Causality, ImpactField, InterfaceField,
-    Kind, Quantity, Variable, UNCONNECTED, UNITS,
+    uses_unit, variables, BodyField, Causality, ImpactField, InterfaceField, Kind, Quantity,
+    Variable, UNCONNECTED, UNITS,
 };
 
 use crate::{RecordingRequest, RunOutcome, Session, SessionRequest, SessionState, Simulation};
