@@ -1,5 +1,5 @@
 //! ARCHITECTURE.md cannot drift (issue 22): every source file, every crate and every file over
-//! 700 lines is named there, as `crates/scene/tests/readme.rs` keeps the README's key table.
+//! 700 lines is named there, as `crates/scene/tests/keys_doc.rs` keeps docs/scene-keys.md's key table.
 
 use std::path::{Path, PathBuf};
 

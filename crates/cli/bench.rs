@@ -35,8 +35,8 @@ pub struct BenchArgs {
     /// skips that part.
     #[arg(long, default_value_t = 3)]
     pub whole_runs: usize,
-    /// Repetitions of each brake-pack timing (N discs and N + 1 plates, open gaps: the MuJoCo
-    /// anchor's pack; the median is reported); 0 skips that part.
+    /// Repetitions of each brake-pack timing (N discs and N + 1 plates, open gaps: the pack
+    /// `bench/mujoco/brake.py` times in MuJoCo; the median is reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub brake_runs: usize,
     /// Repetitions of each inertial-shaft pack timing (N staggered discs on a shaft of 2 kg
@@ -660,9 +660,9 @@ fn staggered_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
 }
 
 /// 5. The real pack of issue 20: N staggered discs and N + 1 separator plates on the housing
-///    with the open gaps' drag (`cases::staggered_brake`, the MuJoCo anchor's
-///    `time_brake.sh N` pack), per disc, as the pack grows: N = 1, 4, 8 and 16 for 0.1 s,
-///    each engine with its default scheme.
+///    with the open gaps' drag (`cases::staggered_brake`, the pack
+///    `bench/mujoco/brake.py` times in MuJoCo), per disc, as the pack grows: N = 1, 4, 8
+///    and 16 for 0.1 s, each engine with its default scheme.
 fn brake_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
     if runs == 0 {
         return Ok(());

@@ -20,7 +20,7 @@ pub struct CheckArgs {
     /// Print the reference of every scene key and exit.
     #[arg(long)]
     pub keys: bool,
-    /// With `--keys`: print the reference as the README's Markdown table.
+    /// With `--keys`: print the reference as docs/scene-keys.md's Markdown table.
     #[arg(long, requires = "keys")]
     pub markdown: bool,
 }

@@ -231,8 +231,8 @@ pub fn staggered_rel_angle_rad(i: usize, n: usize, g0_rad: f64) -> f64 {
 /// on the fixed housing (`plate-1` ... `plate-(n+1)`: 0.1382 kg m^2, 132 teeth at 0.305 m, 30
 /// deg, 0.5 mm backlash, the discs' dry law, no drag, centred at rest), stacked plate, disc,
 /// plate, ..., plate, and the open stack's Couette drag between neighbours (0.01 Pa s across
-/// 1 mm, faces 0.235-0.290 m; the piston released). The pack of the MuJoCo anchor's
-/// `time_brake.sh N`.
+/// 1 mm, faces 0.235-0.290 m; the piston released). The pack
+/// `bench/mujoco/brake.py` times in MuJoCo.
 pub fn staggered_brake(n: usize) -> PackModel {
     let mut pack = staggered_pack(n);
     pack.plates = (0..=n)

@@ -1,10 +1,10 @@
 //! The real pack of issue 20 (`clutchpack_model::cases::staggered_brake`): N staggered
 //! benchmark discs on the prescribed shaft and N + 1 separator plates on the fixed housing,
-//! with the open gaps' Couette drag between neighbours (the MuJoCo anchor's `time_brake.sh
-//! N` pack); 10 ms simulated, samples at 10 kHz, the engine's default scheme (multirate: the
-//! bodies are independent within a world step but for the gaps' drag, held over it).
-//! `clutchpack bench` times the same packs over 0.1 s for N = 1, 4, 8, 16 with the per-disc
-//! growth.
+//! with the open gaps' Couette drag between neighbours (the pack `bench/mujoco/brake.py`
+//! times in MuJoCo); 10 ms simulated, samples at 10 kHz, the engine's default scheme
+//! (multirate: the bodies are independent within a world step but for the gaps' drag, held
+//! over it). `clutchpack bench` times the same packs over 0.1 s for N = 1, 4, 8, 16 with the
+//! per-disc growth.
 
 use clutchpack_model::cases::staggered_brake;
 use clutchpack_model::{Collector, Engine};

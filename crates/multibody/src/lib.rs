@@ -124,7 +124,7 @@
 //! below). Within a world step the bodies are then independent: each one's teeth couple it only
 //! to a carrier whose motion is known in advance (the shaft's profile, the housing at rest),
 //! and neighbours pull on each other only through the open gaps' Couette drag, a coupling of
-//! time constant `J / c` of seconds (2.2 s on the MuJoCo anchor's brake) against a world step
+//! time constant `J / c` of seconds (2.2 s on `cases::staggered_brake`) against a world step
 //! of 0.1 ms. Each body's sub-steps take that drag with its own speed exact and its
 //! neighbours' as a known function of time: the discs' neighbours (plates) held at their mean
 //! speed predicted from their acceleration at the step's start; the plates' neighbours (discs,
@@ -186,7 +186,7 @@
 //!   sub-step), 22 % in the sub-steps' arithmetic and the step controller, 18 % in rapier
 //!   (1 000 world steps), 13 % in the tooth law, 7 % in allocation and the kernel, 2 % in the
 //!   impact trackers. Issue 33 (`perf` of the 16-disc brake pack, `clutchpack run` of the
-//!   MuJoCo anchor's `brake_N16.toml`, 225 000 sub-steps per 0.1 s, 175 per impact): the
+//!   `brake-16.toml` of `bench/mujoco/brake.py`, 225 000 sub-steps per 0.1 s, 175 per impact): the
 //!   profile's `sin` and `cos` at every stage were still 15 %, the controller's local period
 //!   of a contact (two roots, three divisions per sub-step) 10 %. One `sincos` per harmonic
 //!   ([`clutchpack_model::SpeedProfile::speed_and_angle`]), then the expansion about each world
@@ -308,11 +308,11 @@
 //!
 //! **Where a whole pack's time goes today** (issue 20; the 16-disc brake pack, 16 staggered
 //! discs and 17 plates on the housing with the open gaps' drag, which runs the shared step;
-//! `perf record --call-graph dwarf` of `clutchpack run` on the MuJoCo anchor's
-//! `brake_N16.toml`, 20 ms, release build): 52 % in rapier's world step (the 34 bodies'
-//! joint constraints rebuilt and solved at every shared step: 84 590 steps per 0.1 s, 84 per
-//! impact), 14 % in the hook's evaluation, 13 % in the step controller, 12.5 % in the stack's
-//! solve, 5 % in `powf` (`s^1.5`, contact durations), 7 % in copies. Every one of these is
+//! `perf record --call-graph dwarf` of `clutchpack run` on the `brake-16.toml` of
+//! `bench/mujoco/brake.py`, 20 ms, release build): 52 % in rapier's world step (the 34
+//! bodies' joint constraints rebuilt and solved at every shared step: 84 590 steps per 0.1 s,
+//! 84 per impact), 14 % in the hook's evaluation, 13 % in the step controller, 12.5 % in the
+//! stack's solve, 5 % in `powf` (`s^1.5`, contact durations), 7 % in copies. Every one of these is
 //! paid per shared step, so the cure is fewer world steps (the multirate scheme), not a
 //! faster step. Before the kinematics kept `Rb` (`hook.rs`), a cosine per tooth-law call was
 //! 16 % of the run on its own: keeping it made the 16-disc brake 12 % faster (1.80 -> 1.56 s

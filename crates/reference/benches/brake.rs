@@ -1,6 +1,6 @@
-//! The open brake pack of issues 20 and 21 (`cases::staggered_brake`, the MuJoCo anchor's
-//! `time_brake.sh N` pack): N staggered discs on the prescribed shaft, N + 1 plates on the
-//! housing, the open gaps' drag between neighbours; 10 ms simulated with the default
+//! The open brake pack of issues 20 and 21 (`cases::staggered_brake`, the pack
+//! `bench/mujoco/brake.py` times in MuJoCo): N staggered discs on the prescribed shaft, N + 1
+//! plates on the housing, the open gaps' drag between neighbours; 10 ms simulated with the default
 //! settings, samples discarded. The open pack's multirate scheme (the default) for N = 1 and
 //! 16, and the monolithic scheme (its oracle) at the same sizes. What to look for: time per
 //! disc about constant in N for the multirate scheme, growing for the monolithic one.

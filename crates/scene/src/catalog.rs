@@ -1,6 +1,6 @@
 //! The key catalogue, derived from the definitions in [`crate::keys`]: every key path of the
 //! file, the "expected one of" lists, the `--set` key check, `check --keys` ([`keys_doc`])
-//! and the README table ([`keys_markdown`]).
+//! and docs/scene-keys.md's table ([`keys_markdown`]).
 //!
 //! Paths are written as in the file, with `[]` standing for any index of an array of tables:
 //! `discs[].spline.teeth`.
@@ -153,9 +153,10 @@ pub fn keys_doc() -> String {
     s
 }
 
-/// The README's scene-key table (Markdown), generated from the same definitions as
-/// [`keys_doc`]; printed by `clutchpack check --keys --markdown`. A test checks that the
-/// README holds exactly this text, so they cannot drift.
+/// The scene-key table of docs/scene-keys.md (Markdown), generated from the same definitions
+/// as [`keys_doc`]; printed by `clutchpack check --keys --markdown`. A test
+/// (`tests/keys_doc.rs`) checks that the document holds exactly this text, so they cannot
+/// drift.
 pub fn keys_markdown() -> String {
     use std::fmt::Write;
     let cell = |t: &str| t.replace('|', "\\|");

@@ -2,7 +2,7 @@
 //! default and meaning. **This is the one place to add a key.** Each [`table!`] below
 //! defines one table's raw serde struct (read by [`crate::parse`]), one [`Key`] per leaf (read
 //! by the validation through `RawX::key_name`, for its rule, unit and default), and the lines
-//! of `clutchpack check --keys` and of the README's key table.
+//! of `clutchpack check --keys` and of docs/scene-keys.md's key table.
 //!
 //! To add a key to an existing table: add one line to its `table!` (doc comment, name, unit,
 //! kind with its rule, default), then use the value where the typed model is built (the

@@ -143,7 +143,7 @@
 //! Each key is defined once, in `keys` (its table, name, unit, kind and range rule, default
 //! and meaning); that one definition makes the raw serde struct of its table, drives its
 //! check in the validation, the "expected one of" lists, the `--set` key check,
-//! [`keys_doc`] (`clutchpack check --keys`) and [`keys_markdown`] (the README's table). Two
+//! [`keys_doc`] (`clutchpack check --keys`) and [`keys_markdown`] (docs/scene-keys.md's table). Two
 //! stages: the raw structs mirror the file (tables typed, values kept as written; unknown keys
 //! collected with `serde_ignored`), then `validate` (one module per section: simulation,
 //! drive and shaft, bodies, stack and drum, thermal) converts them to the typed model, collecting

@@ -1,7 +1,7 @@
 //! The language of the key definitions: what a key is ([`Key`]: name, unit, kind and rule,
 //! default, doc) and the [`table!`] macro that turns one table's definitions into its raw
 //! serde struct and its key list. The definitions themselves are in [`crate::keys`]; what is
-//! derived from them (every key path, `check --keys`, the README table) in
+//! derived from them (every key path, `check --keys`, docs/scene-keys.md's table) in
 //! [`crate::catalog`].
 //!
 //! Paths are written as in the file, with `[]` standing for any index of an array of tables:
