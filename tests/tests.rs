@@ -115,7 +115,7 @@ fn paper_sweep(extra: &[&str], dir: &Path) -> Value {
     read_json(&json)
 }
 
-/// The paper's table, one case per film thickness (the command the README quotes).
+/// The paper's table, one case per film thickness (the command the README's table quotes).
 #[test]
 fn sweep_reproduces_the_paper_table() {
     let d = scratch("sweep_single");

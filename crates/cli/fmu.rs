@@ -1,5 +1,5 @@
-//! `clutchpack fmu`: packs a scene into an FMI 2.0 co-simulation FMU (README, "Co-simulation
-//! (FMI 2.0)").
+//! `clutchpack fmu`: packs a scene into an FMI 2.0 co-simulation FMU
+//! (docs/cosimulation.md).
 
 use crate::common::{self, BadInput};
 use anyhow::{Context, Result};

@@ -136,7 +136,7 @@ pub enum DiscMount {
     /// speed over the step, its speed set at the step's end): the joints' constraints hold
     /// nothing there but cost a third of a brake pack's run. Measured: every shipped scene the
     /// multirate scheme runs gives the same impacts and summary to the bit on either mount
-    /// (docs/DECISIONS.md, "Sub-steps per contact and the world's mount").
+    /// (docs/DECISIONS.md, "Multirate scheme of the multibody engine").
     #[default]
     Auto,
     /// A generic impulse joint to the shaft locking the two radial translations and the two

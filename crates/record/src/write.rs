@@ -39,7 +39,7 @@ pub struct RecordOptions {
     /// grows with a recorded run, and chunks that grow with the pack keep the index's heap
     /// per recorded byte the same for every pack: pack-8-brake (35 MB of file per simulated
     /// second) at 4 MiB chunks grew from 20 MB of peak RSS at 10 s to 73 MB at 600 s; at
-    /// 24 MiB see README, "Memory of long runs" (docs/DECISIONS.md).
+    /// 24 MiB see docs/performance.md, "Memory of long runs" (and docs/DECISIONS.md).
     pub chunk_size_bytes: Option<u64>,
     /// zstd level (1..=19; 0 = zstd's default, 3). Default 1, zstd's fastest: on a 3 s
     /// paper-case run its file was 1.5 % larger than level 3's.
