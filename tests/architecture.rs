@@ -541,3 +541,155 @@ fn the_crates_tables_dependencies_are_the_manifests() {
     }
     assert_eq!(rows, 11, "the crates table's rows");
 }
+
+/// The project's text files (sources, documents, scenes, scripts) under `dir`, build
+/// outputs and version control apart.
+fn text_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if p.is_dir() {
+            if !["target", ".git", "__pycache__", "dist"].contains(&name.as_str()) {
+                text_files(&p, out);
+            }
+        } else if ["rs", "md", "toml", "py", "sh", "c", "txt"]
+            .iter()
+            .any(|x| name.ends_with(&format!(".{x}")))
+        {
+            out.push(p);
+        }
+    }
+}
+
+/// Every file and its text (lossy), for the document checks below.
+fn project_texts() -> Vec<(String, String)> {
+    let mut files = Vec::new();
+    text_files(root(), &mut files);
+    files
+        .iter()
+        .map(|p| {
+            let text = String::from_utf8_lossy(&std::fs::read(p).unwrap()).into_owned();
+            let rel = p.strip_prefix(root()).unwrap().display().to_string();
+            (rel, text)
+        })
+        .collect()
+}
+
+/// Issue 44: a user who clones the project has the repository alone, so no file names a
+/// path outside it (the README's MuJoCo comparison pointed at a folder beside the clone;
+/// `bench/mujoco/brake.py` is the project's own now).
+#[test]
+fn no_file_names_a_path_outside_the_repository() {
+    // spelt in pieces, so that this file does not name them itself
+    let outside = [
+        concat!("..", "/shared/"),
+        concat!("/work", "/shared"),
+        concat!("/work", "/.library"),
+    ];
+    let found: Vec<String> = project_texts()
+        .iter()
+        .flat_map(|(f, text)| {
+            outside
+                .iter()
+                .filter(|o| text.contains(*o))
+                .map(move |o| format!("{f}: {o}"))
+        })
+        .collect();
+    assert!(found.is_empty(), "paths outside the repository: {found:?}");
+}
+
+/// Issue 44: every section of docs/MODEL.md that a file cites ("MODEL.md section 8",
+/// "MODEL.md sections 5 and 8") exists there (sections 8 and 9 were cited about 150 times
+/// while the document stopped at 7).
+#[test]
+fn every_cited_model_section_exists() {
+    let model = std::fs::read_to_string(root().join("docs/MODEL.md")).unwrap();
+    let mut cited = std::collections::BTreeMap::<u32, String>::new();
+    for (f, text) in project_texts() {
+        let flat = text.replace(['\n', '/', '!'], " ");
+        let flat = flat.split_whitespace().collect::<Vec<_>>().join(" ");
+        for (i, _) in flat.match_indices("MODEL.md section") {
+            let rest = flat[i + "MODEL.md section".len()..].trim_start_matches('s');
+            // the numbers of `section 8`, `sections 1, 2 and 5` (not `section 8: 5000 N`)
+            let mut words = rest.split_whitespace();
+            while let Some(word) = words.next() {
+                let Ok(n) = word
+                    .trim_end_matches([',', ')', ';', ':', '.'])
+                    .parse::<u32>()
+                else {
+                    break;
+                };
+                cited.entry(n).or_insert_with(|| f.clone());
+                if !word.ends_with(',') && words.next() != Some("and") {
+                    break;
+                }
+            }
+        }
+    }
+    assert!(cited.len() >= 9, "too few cited sections found: {cited:?}");
+    let missing: Vec<String> = cited
+        .iter()
+        .filter(|(n, _)| !model.contains(&format!("\n## {n}. ")))
+        .map(|(n, f)| format!("section {n} (cited in {f})"))
+        .collect();
+    assert!(missing.is_empty(), "docs/MODEL.md lacks {missing:?}");
+}
+
+/// Issue 44: a citation of docs/DECISIONS.md by name (`docs/DECISIONS.md, "Thermal cost"`,
+/// `DECISIONS.md ("Studies")`) names one of its section titles (the part before the
+/// parenthesis is enough) or one of its bold points, so that regrouping and retitling the
+/// document cannot leave a citation pointing nowhere.
+#[test]
+fn every_decisions_citation_names_a_section_or_point() {
+    let doc = std::fs::read_to_string(root().join("docs/DECISIONS.md")).unwrap();
+    let titles: Vec<&str> = doc
+        .lines()
+        .filter_map(|l| l.strip_prefix("### ").or(l.strip_prefix("## ")))
+        .collect();
+    let bold: Vec<&str> = doc.split("**").skip(1).step_by(2).collect();
+    let mut checked = 0;
+    let mut bad = Vec::new();
+    for (f, text) in project_texts() {
+        // the document itself, and this file, which names it in code
+        if f == "docs/DECISIONS.md" || f == "tests/architecture.rs" {
+            continue;
+        }
+        let flat: String = text
+            .lines()
+            .map(|l| l.trim().trim_start_matches(['/', '!', '#']).trim())
+            .collect::<Vec<_>>()
+            .join(" ");
+        for (i, _) in flat.match_indices("DECISIONS") {
+            let after = &flat[i + "DECISIONS".len()..];
+            let after = after.strip_prefix(".md").unwrap_or(after);
+            // `, "A"`, ` ("A")`, `, "A" and "B"`: the quoted names right after the file
+            let Some(start) = after.find('"') else {
+                continue;
+            };
+            let lead = &after[..start];
+            if lead.len() > 4 || lead.contains(['.', ';']) {
+                continue;
+            }
+            let mut rest = &after[start..];
+            while let Some(q) = rest.strip_prefix('"') {
+                let Some(end) = q.find('"') else { break };
+                let name = &q[..end];
+                checked += 1;
+                if !titles.iter().chain(&bold).any(|t| t.starts_with(name)) {
+                    bad.push(format!("{f}: {name:?}"));
+                }
+                rest = q[end + 1..].trim_start();
+                rest = rest
+                    .strip_prefix("and ")
+                    .or(rest.strip_prefix(", "))
+                    .unwrap_or(rest)
+                    .trim_start();
+            }
+        }
+    }
+    assert!(checked >= 30, "too few citations found ({checked})");
+    assert!(
+        bad.is_empty(),
+        "citations of docs/DECISIONS.md that name no section or point: {bad:#?}"
+    );
+}
