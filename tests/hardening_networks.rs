@@ -245,3 +245,33 @@ fn outputs_over_the_files_a_scene_reads_are_refused() {
         assert_eq!(std::fs::read(d.join(input)).unwrap(), before, "{input}");
     }
 }
+
+/// Item 10: an empty body name passed `check` and `run`, and `clutchpack fmu` packed an FMU
+/// whose variables `bodies.''.speed_rad_s` failed `fmpy validate`. A name is part of every
+/// output and variable name of its part: empty, a separator (`.`, `[`, `]`), a quote or a
+/// space at an end is refused at its key, by every command, before any work.
+#[test]
+fn empty_body_name_is_refused() {
+    let lumped = repo("scenes/dct-upshift-lumped.toml");
+    let d = scratch("hard3-names");
+    let fmu = d.join("x.fmu").display().to_string();
+    for (set, key) in [
+        ("bodies[5].name=\"\"", "bodies[5].name"),
+        ("bodies[5].name=\"a.b\"", "bodies[5].name"),
+        ("bodies[5].name=\" vehicle\"", "bodies[5].name"),
+        ("couplings[1].name=\"\"", "couplings[1].name"),
+    ] {
+        for args in [
+            vec!["check", &lumped, "--set", set],
+            vec!["run", &lumped, "--no-record", "--set", set],
+            vec!["fmu", &lumped, "--out", &fmu, "--set", set],
+        ] {
+            let err = exit_2(&run(&args), &format!("{args:?}"));
+            assert!(
+                err.contains(key) && err.contains("must not"),
+                "{args:?}: {err}"
+            );
+        }
+        assert!(!d.join("x.fmu").exists());
+    }
+}

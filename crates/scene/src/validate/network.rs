@@ -12,8 +12,8 @@ use crate::keys::{
 use crate::keys::{MAX_FIRING_HARMONICS, MAX_FORCE_SIGNAL, MAX_TORQUE_N_M};
 use crate::schema::{fmt_num, show, Key, RawTable};
 use clutchpack_model::network::{
-    Body, Coupling, CouplingKind, Firing, GearMesh, LumpedClutch, Network, NetworkProblem,
-    RoadLoad, Signal,
+    name_problem, Body, Coupling, CouplingKind, Firing, GearMesh, LumpedClutch, Network,
+    NetworkProblem, RoadLoad, Signal,
 };
 use clutchpack_model::{Hertz, LawKind, OilFilm, ToothLaw};
 use std::path::Path;
@@ -229,6 +229,10 @@ pub(super) fn network(
             &p(&B::name),
             "required: couplings name their bodies by it",
         );
+        if let Some(why) = name.as_deref().and_then(name_problem) {
+            ck.report(p(&B::name), name.as_ref().map(|n| format!("{n:?}")), why);
+            ok = false;
+        }
         let fixed = ck.boolean(&p(&B::fixed), r.value(&B::fixed)).or(false);
         let inertia = ck.num(
             &p(&B::inertia_kg_m2),
@@ -330,6 +334,10 @@ pub(super) fn network(
             k + 1
         );
         let name = ck.text(&p(&C::name), r.value(&C::name)).or(default_name);
+        if let Some(why) = name.as_deref().and_then(name_problem) {
+            ck.report(p(&C::name), name.as_ref().map(|n| format!("{n:?}")), why);
+            ok = false;
+        }
         let kind = ck
             .choice(
                 &p(&C::kind),
