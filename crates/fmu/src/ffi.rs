@@ -206,30 +206,6 @@ pub fn resource_folder(uri: &str) -> Result<PathBuf, String> {
     Ok(PathBuf::from(path.as_ref()))
 }
 
-/// The files of the FMU the host extracted, whose resources are in `resources`: its scene,
-/// GUID, model description, and its binaries (the shared library the host has loaded: a
-/// recording written over it would make the next instance fail to load). No output of an
-/// instance may name any of them.
-fn own_files(resources: &std::path::Path) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = ["scene.json", "scene.toml", "guid.txt"]
-        .iter()
-        .map(|f| resources.join(f))
-        .collect();
-    if let Some(root) = resources.parent() {
-        files.push(root.join("modelDescription.xml"));
-        // binaries/<platform>/<model identifier>.<so, dll, dylib>: one level of folders
-        let entries = |dir: &std::path::Path| -> Vec<PathBuf> {
-            std::fs::read_dir(dir)
-                .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
-                .unwrap_or_default()
-        };
-        for platform in entries(&root.join("binaries")) {
-            files.extend(entries(&platform).into_iter().filter(|p| p.is_file()));
-        }
-    }
-    files
-}
-
 /// `fmi2GetTypesPlatform`.
 #[no_mangle]
 pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
@@ -277,7 +253,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
         let resources = resource_folder(uri)?;
         let scene = load_resources(&resources, guid)?;
         // no recording may be written over the FMU's own files
-        Ok(Instance::new(scene)?.reading(own_files(&resources)))
+        Ok(Instance::new(scene)?.reading(crate::instance::own_files(&resources)))
     }));
     match made {
         Ok(Ok(instance)) => {

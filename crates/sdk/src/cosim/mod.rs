@@ -6,7 +6,7 @@
 //! the outputs by value reference or by name. FMI's own rules (its state machine, the host's
 //! communication points, pointers) stay in the fmu crate.
 
-mod inputs;
+pub(crate) mod inputs;
 mod network;
 mod variables;
 
@@ -389,7 +389,7 @@ impl CoSimulation {
                                 .map(|(_, input)| *input)
                         });
                         if let Some(input) = input {
-                            crate::network_cosim::check_network_input(input, &v.name, value)?;
+                            crate::cosim::inputs::check_network_input(input, &v.name, value)?;
                         }
                     }
                     _ => {}
