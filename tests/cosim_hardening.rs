@@ -216,3 +216,43 @@ fn co_simulated_runs_end_without_absurd_peaks_and_say_what_made_them() {
         .get("stop_time_s")
         .is_none());
 }
+
+/// Hardening 3, item 6: `recording_path` over the FMU's own shared library (in the folder the
+/// host extracted) replaced it, and the next instance failed to load. Refused at
+/// fmi2ExitInitializationMode naming the parameter; the library is intact and a second
+/// instance from the same folder runs a step.
+#[test]
+fn fmu_recording_path_over_its_own_binary_is_refused() {
+    refused(
+        "recording_path_is_the_fmus_binary",
+        &[
+            "recording_path",
+            "is an input of this run",
+            "second instance ran",
+        ],
+    );
+}
+
+/// Hardening 3, item 7: a network FMU's inputs were checked for finiteness only: a drive
+/// torque of 1e30 N m set before fmi2ExitInitializationMode made the first 1 ms step run for
+/// minutes, a normal force of 1e30 N took fmi2OK. Both answer fmi2Error at fmi2SetReal,
+/// naming the input and the scene key's bound.
+#[test]
+fn network_fmu_inputs_are_checked_against_their_scene_keys_bounds() {
+    refused(
+        "network_drive_torque_out_of_bounds",
+        &[
+            "bodies.crank.drive_torque_n_m = 1e30 N m",
+            "[-10000000, 10000000]",
+            "bodies[].drive.value_n_m",
+        ],
+    );
+    refused(
+        "network_clutch_force_out_of_bounds",
+        &[
+            "couplings.K2.normal_force_n = 1e30 N",
+            "[0, 100000000]",
+            "couplings[].max_normal_force_n",
+        ],
+    );
+}

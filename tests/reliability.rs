@@ -375,23 +375,23 @@ fn impossible_or_mismatched_scenes_are_refused_with_the_key() {
 
 /// A small seeded generator (xorshift64*), so that the fuzz test is reproducible without a
 /// dependency.
-struct Rng(u64);
+pub(super) struct Rng(pub(super) u64);
 
 impl Rng {
-    fn next(&mut self) -> u64 {
+    pub(super) fn next(&mut self) -> u64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
         self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
     }
-    fn below(&mut self, n: usize) -> usize {
+    pub(super) fn below(&mut self, n: usize) -> usize {
         (self.next() % n as u64) as usize
     }
 }
 
 /// One mutation of a scene text: a value replaced by a hostile one, a line dropped or
 /// doubled, or a key renamed.
-fn mutate(text: &str, rng: &mut Rng) -> String {
+pub(super) fn mutate(text: &str, rng: &mut Rng) -> String {
     const VALUES: [&str; 28] = [
         "0",
         "-1",
@@ -560,4 +560,4 @@ fn mutated_scenes_give_exit_0_or_2_and_never_a_panic() {
 }
 
 /// The one run failure the fuzz test tolerates (see its documentation).
-const KNOWN_GAP: &str = "the simulation diverged";
+pub(super) const KNOWN_GAP: &str = "the simulation diverged";

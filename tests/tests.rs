@@ -7,6 +7,7 @@ mod cross_engine;
 mod fatigue;
 mod fmu;
 mod hardening;
+mod hardening_networks;
 mod network;
 mod network_engines;
 mod python_package;

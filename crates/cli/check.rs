@@ -17,6 +17,10 @@ pub struct CheckArgs {
     /// the scene's `simulation.engine`, else the one that fits the pack).
     #[arg(long, value_parser = common::engine_parser())]
     pub engine: Option<EngineChoice>,
+    /// Override a scene key in every scene checked, `KEY=VALUE` (TOML value) as `run --set`
+    /// takes it: what `run` with the same overrides would accept. Repeatable.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<clutchpack_sdk::scene::Override>,
     /// Print the reference of every scene key and exit.
     #[arg(long)]
     pub keys: bool,
@@ -39,7 +43,7 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
         // The scene's rules, then what `run` decides before any step: the engine and whether
         // it can run the scene (`Simulation::new`, the one home of that decision: an engine
         // that cannot run the pack, a scheme it cannot run it with), with `run`'s message.
-        let checked = clutchpack_sdk::load_scene(Some(p), &[]).and_then(|s| {
+        let checked = clutchpack_sdk::load_scene(Some(p), &a.sets).and_then(|s| {
             if let Some(net) = &s.network {
                 // a network runs on either engine (its own rules checked in the load)
                 let engine = s.engine(a.engine, &p.display().to_string())?;

@@ -49,10 +49,10 @@ pub fn fmu(a: FmuArgs) -> Result<ExitCode> {
     let scene = clutchpack_sdk::scene::load(&a.scene, &a.sets)?;
     // the one output policy (`clutchpack_sdk::record::check_outputs`): never the scene itself, a
     // folder, a device or a FIFO
-    crate::outputs::check_outputs(
-        &[crate::outputs::Output::file("--out", &a.out)],
-        &[a.scene.as_path()],
-    )?;
+    let inputs: Vec<&std::path::Path> = std::iter::once(a.scene.as_path())
+        .chain(scene.inputs.iter().map(|p| p.as_path()))
+        .collect();
+    crate::outputs::check_outputs(&[crate::outputs::Output::file("--out", &a.out)], &inputs)?;
     let engine = clutchpack_fmu::check_representable(&scene, a.engine).map_err(|e| match e {
         clutchpack_fmu::PackageError::Unrepresentable(why) => {
             anyhow::Error::new(BadInput(format!("{}: {why}", a.scene.display())))

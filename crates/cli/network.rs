@@ -69,7 +69,12 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     if let Some(p) = a.windows_plot {
         outs.push(Output::figure("--windows-plot", p));
     }
-    let inputs: Vec<&Path> = a.scene_path.into_iter().collect();
+    // the scene file and every file it read (its packs' files, its tables)
+    let inputs: Vec<&Path> = a
+        .scene_path
+        .into_iter()
+        .chain(scene.inputs.iter().map(|p| p.as_path()))
+        .collect();
     // the other outputs first, so that a refused one leaves no recording folder behind
     crate::outputs::check_outputs(&outs, &inputs)?;
     if let Some(p) = a.recording {

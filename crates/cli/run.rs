@@ -167,7 +167,13 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             });
         }
     }
-    let inputs: Vec<&std::path::Path> = a.scene.as_deref().into_iter().collect();
+    // the scene file and every file it read (its tables): never overwritten by an output
+    let inputs: Vec<&std::path::Path> = a
+        .scene
+        .as_deref()
+        .into_iter()
+        .chain(scene.inputs.iter().map(|p| p.as_path()))
+        .collect();
     // the other outputs first, so that a refused one leaves no recording folder behind
     let others: Vec<Output> = outs
         .iter()

@@ -130,6 +130,43 @@ def case_recording_path_is_the_fmus_scene(a):
     s.exitInitializationMode()
 
 
+def case_recording_path_is_the_fmus_binary(a):
+    """A recording over the FMU's own shared library (in the folder the host extracted) would
+    replace it: refused, and a second instance from the same folder still loads and runs."""
+    s, cb = slave(a.paper)
+    binaries = os.path.join(s.dir, "binaries")
+    so = [os.path.join(r, f) for r, _, fs in os.walk(binaries) for f in fs]
+    assert so, f"no binary under {binaries}"
+    size = os.path.getsize(so[0])
+    s.instantiate(callbacks=cb)
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.setString([s.vr["recording_path"]], [so[0]])
+    try:
+        s.exitInitializationMode()
+    finally:
+        # the library is intact and a second instance from the same folder runs
+        assert os.path.getsize(so[0]) == size, "the FMU's binary was replaced"
+        t = start(a.paper, name="second", unzipped=s.dir)
+        t.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
+        LOG.append("second instance ran")
+
+
+def case_network_drive_torque_out_of_bounds(a):
+    """A network's drive torque beyond the scene key's bound, set before the run starts
+    (it made the first 1 ms step run for minutes)."""
+    s, cb = slave(a.network)
+    s.instantiate(callbacks=cb)
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.setReal([s.vr["bodies.crank.drive_torque_n_m"]], [1e30])
+
+
+def case_network_clutch_force_out_of_bounds(a):
+    s = start(a.network)
+    s.setReal([s.vr["couplings.K2.normal_force_n"]], [1e30])
+
+
 def case_shaft_speed_out_of_bounds(a):
     s = start(a.paper)
     s.setReal([s.vr["shaft.speed_rad_s"]], [1e9])
@@ -261,6 +298,7 @@ def main():
     ap.add_argument("--paper")
     ap.add_argument("--brake")
     ap.add_argument("--engagement")
+    ap.add_argument("--network")
     a = ap.parse_args()
     os.makedirs(a.work, exist_ok=True)
     if a.case == "ENDS":
@@ -271,7 +309,8 @@ def main():
         return
     fmus = {}
     for key, scene in [("paper", "hu-table2"), ("brake", "pack-8-brake"),
-                       ("engagement", "pack-6-engagement")]:
+                       ("engagement", "pack-6-engagement"),
+                       ("network", "dct-upshift-lumped")]:
         out = os.path.join(a.work, scene + ".fmu")
         p = subprocess.run([a.bin, "fmu", os.path.join(a.root, "scenes", scene + ".toml"),
                             "--out", out], capture_output=True, text=True)
@@ -285,7 +324,7 @@ def main():
         p = subprocess.run(
             [sys.executable, __file__, "--bin", a.bin, "--root", a.root, "--work", work,
              "--case", name, "--paper", fmus["paper"], "--brake", fmus["brake"],
-             "--engagement", fmus["engagement"]],
+             "--engagement", fmus["engagement"], "--network", fmus["network"]],
             capture_output=True, text=True, timeout=300,
         )
         last = p.stdout.strip().splitlines()[-1] if p.stdout.strip() else "{}"

@@ -253,11 +253,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
         let resources = resource_folder(uri)?;
         let scene = load_resources(&resources, guid)?;
         // no recording may be written over the FMU's own files
-        let inputs = ["scene.json", "scene.toml", "guid.txt"]
-            .iter()
-            .map(|f| resources.join(f))
-            .collect();
-        Ok(Instance::new(scene)?.reading(inputs))
+        Ok(Instance::new(scene)?.reading(crate::instance::own_files(&resources)))
     }));
     match made {
         Ok(Ok(instance)) => {

@@ -36,6 +36,30 @@ pub struct Instance {
     stop_time_s: Option<f64>,
 }
 
+/// The files of the FMU the host extracted, whose resources are in `resources`: its scene,
+/// GUID, model description, and its binaries (the shared library the host has loaded: a
+/// recording written over it would make the next instance fail to load). No output of an
+/// instance may name any of them.
+pub fn own_files(resources: &std::path::Path) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = ["scene.json", "scene.toml", "guid.txt"]
+        .iter()
+        .map(|f| resources.join(f))
+        .collect();
+    if let Some(root) = resources.parent() {
+        files.push(root.join("modelDescription.xml"));
+        // binaries/<platform>/<model identifier>.<so, dll, dylib>: one level of folders
+        let entries = |dir: &std::path::Path| -> Vec<PathBuf> {
+            std::fs::read_dir(dir)
+                .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+                .unwrap_or_default()
+        };
+        for platform in entries(&root.join("binaries")) {
+            files.extend(entries(&platform).into_iter().filter(|p| p.is_file()));
+        }
+    }
+    files
+}
+
 /// Reads the scene an FMU carries: `resources/scene.json` (the validated scene, written by
 /// `clutchpack fmu`), checking `resources/guid.txt` against the host's GUID.
 pub fn load_resources(resources: &Path, guid: &str) -> Result<Scene, String> {

@@ -130,7 +130,13 @@ fn check_outputs(outputs: &[(&str, Option<&Path>)], scene: &Scene) -> PyResult<(
         .iter()
         .filter_map(|(label, p)| p.map(|p| clutchpack_sdk::record::OutputPath::file(label, p)))
         .collect();
-    let inputs: Vec<&Path> = scene.path.as_deref().into_iter().collect();
+    // the scene file and every file it read (its tables, a network's pack files)
+    let inputs: Vec<&Path> = scene
+        .path
+        .as_deref()
+        .into_iter()
+        .chain(scene.inner.inputs.iter().map(|p| p.as_path()))
+        .collect();
     clutchpack_sdk::record::check_outputs(&outs, &inputs)
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }

@@ -9,17 +9,29 @@
 use clutchpack_model::{Table, TableError};
 use std::path::Path;
 
-/// Reads columns `time_s` and `value_column` of the CSV file at `path` into a table.
+/// Reads columns `time_s` and `value_column` of the CSV file at `path` into a table whose
+/// values lie within `range` (the plausibility bound of the key the column stands for: a row
+/// of 1e300 N m would pass as finite and make the run take hours or diverge).
 /// `shown` is the file name used in messages (as written in the scene). The error is a
 /// one-line message naming the file and, where it applies, the line.
-pub(crate) fn read_table(path: &Path, shown: &str, value_column: &str) -> Result<Table, String> {
+pub(crate) fn read_table(
+    path: &Path,
+    shown: &str,
+    value_column: &str,
+    range: (f64, f64),
+) -> Result<Table, String> {
     let text =
         crate::read_input(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-    parse_table(&text, shown, value_column)
+    parse_table(&text, shown, value_column, range)
 }
 
 /// Parses CSV text (see [`read_table`]).
-pub(crate) fn parse_table(text: &str, shown: &str, value_column: &str) -> Result<Table, String> {
+pub(crate) fn parse_table(
+    text: &str,
+    shown: &str,
+    value_column: &str,
+    (lo, hi): (f64, f64),
+) -> Result<Table, String> {
     // (1-based line number, fields) of each non-blank, non-comment line
     let mut rows = text
         .lines()
@@ -49,7 +61,17 @@ pub(crate) fn parse_table(text: &str, shown: &str, value_column: &str) -> Result
                 .map_err(|_| format!("{shown}: line {line}: {name} = {f:?} is not a number"))
         };
         t.push(field(it, "time_s")?);
-        y.push(field(iy, value_column)?);
+        let v = field(iy, value_column)?;
+        if v.is_finite() && !(lo..=hi).contains(&v) {
+            return Err(format!(
+                "{shown}: line {line}: {value_column} = {} is outside [{}, {}] (plausibility \
+                 bound of the key it stands for)",
+                crate::schema::fmt_num(v),
+                crate::schema::fmt_num(lo),
+                crate::schema::fmt_num(hi),
+            ));
+        }
+        y.push(v);
         lines.push(line);
     }
     Table::new(t, y).map_err(|e| match e {
@@ -66,12 +88,15 @@ pub(crate) fn parse_table(text: &str, shown: &str, value_column: &str) -> Result
 mod tests {
     use super::*;
 
+    const ANY: (f64, f64) = (f64::MIN, f64::MAX);
+
     #[test]
     fn reads_named_columns_and_skips_comments() {
         let t = parse_table(
             "# a comment\nspeed_rad_s, time_s\n200, 0\n\n210, 0.1\n",
             "d.csv",
             "speed_rad_s",
+            ANY,
         )
         .unwrap();
         assert_eq!(t.t_s, [0.0, 0.1]);
@@ -80,19 +105,38 @@ mod tests {
 
     #[test]
     fn errors_name_file_and_line() {
-        let e = parse_table("time_s,torque_n_m\n0,1\n0,2\n", "d.csv", "torque_n_m").unwrap_err();
+        let e =
+            parse_table("time_s,torque_n_m\n0,1\n0,2\n", "d.csv", "torque_n_m", ANY).unwrap_err();
         assert_eq!(
             e,
             "d.csv: line 3: time 0 s does not increase over the row before"
         );
-        let e = parse_table("time_s,torque_n_m\n0,x\n", "d.csv", "torque_n_m").unwrap_err();
+        let e = parse_table("time_s,torque_n_m\n0,x\n", "d.csv", "torque_n_m", ANY).unwrap_err();
         assert!(e.contains("line 2") && e.contains("\"x\""), "{e}");
-        let e = parse_table("time_s,speed\n0,1\n", "d.csv", "speed_rad_s").unwrap_err();
+        let e = parse_table("time_s,speed\n0,1\n", "d.csv", "speed_rad_s", ANY).unwrap_err();
         assert!(e.contains("no column \"speed_rad_s\""), "{e}");
-        let e = parse_table("time_s,speed_rad_s\n0,1\n", "d.csv", "speed_rad_s").unwrap_err();
+        let e = parse_table("time_s,speed_rad_s\n0,1\n", "d.csv", "speed_rad_s", ANY).unwrap_err();
         assert!(e.contains("at least 2 rows"), "{e}");
-        let e =
-            parse_table("time_s,speed_rad_s\n0,1\n1,nan\n", "d.csv", "speed_rad_s").unwrap_err();
+        let e = parse_table(
+            "time_s,speed_rad_s\n0,1\n1,nan\n",
+            "d.csv",
+            "speed_rad_s",
+            ANY,
+        )
+        .unwrap_err();
         assert_eq!(e, "d.csv: line 3: value is not finite");
+    }
+
+    /// A row beyond the bound of the key its column stands for is refused at its line (issue
+    /// 48's reproducer: a torque row of 1e300 N m passed as finite).
+    #[test]
+    fn rows_beyond_the_keys_bound_are_refused_at_their_line() {
+        let text = "time_s,torque_n_m\n0,1\n1,1e300\n";
+        let e = parse_table(text, "d.csv", "torque_n_m", (-1e7, 1e7)).unwrap_err();
+        assert!(
+            e.starts_with("d.csv: line 3: torque_n_m = 1e300 is outside"),
+            "{e}"
+        );
+        assert!(parse_table(text, "d.csv", "torque_n_m", ANY).is_ok());
     }
 }

@@ -532,6 +532,22 @@ table! {
 
 /// Most cylinders of an engine accepted (a plausibility bound: W16 and V24 engines exist).
 pub(crate) const MAX_CYLINDERS: u32 = 24;
+/// Most firing-order harmonics of one engine accepted (a plausibility bound: an engine's
+/// torque spectrum above the 12th multiple of its firing order is below measurement noise;
+/// each term costs every step a sine).
+pub(crate) const MAX_FIRING_HARMONICS: usize = 64;
+/// Largest magnitude of a clutch's normalized normal force accepted (`[couplings.force]`'s
+/// values and table rows; the normal force is `max_normal_force_n` times it, 1 when fully
+/// applied in Modelica's convention).
+pub const MAX_FORCE_SIGNAL: f64 = 1e3;
+/// A normalized clutch force: within +-[`MAX_FORCE_SIGNAL`].
+const FORCE: Kind = Kind::Number(Rule::Closed(-MAX_FORCE_SIGNAL, MAX_FORCE_SIGNAL));
+/// Largest free angle of a spring-damper accepted, rad (160 turns: a wound spring's preload
+/// is a few turns at most); its preload torque `k theta_0` is held to [`MAX_TORQUE_N_M`] too.
+pub(crate) const MAX_FREE_ANGLE_RAD: f64 = 1e3;
+/// Largest normal force of a lumped clutch accepted, N (a wet clutch's piston carries about
+/// 1e4 to 1e5 N; the largest industrial brakes below 1e7 N).
+pub const MAX_NORMAL_FORCE_N: f64 = 1e8;
 
 table! {
     /// `[bodies.firing]`: an engine's firing-order harmonics, added to its drive and locked to the body's own angle theta (0 at t = 0): sum_k a_k sin(k n_f theta + phi_k) with n_f = 2 cylinders / strokes firings a revolution (docs/DECISIONS.md, "An engine's firing harmonics").
@@ -614,7 +630,7 @@ table! {
         /// clutch: torque per friction force, N (ro + ri) / 2 for N faces under uniform wear (Modelica's cgeo)
         cgeo_m: "m", NON_NEGATIVE, Dflt::Num(1.0);
         /// clutch: the normal force at force = 1 (Modelica's fn_max)
-        max_normal_force_n: "N", NON_NEGATIVE, Dflt::When("clutch: required");
+        max_normal_force_n: "N", Kind::Number(Rule::Closed(0.0, MAX_NORMAL_FORCE_N)), Dflt::When("clutch: required");
         /// gear_mesh: base radius of the gear on body a
         base_radius_a_m: "m", Kind::Number(Rule::Bounded { floor: MIN_PITCH_RADIUS_M, ceil: MAX_PITCH_RADIUS_M }), Dflt::When("gear_mesh: required");
         /// gear_mesh: base radius of the gear on body b
@@ -634,7 +650,7 @@ table! {
         /// pack: a pack scene file (its [[discs]], [[plates]], [stack], ... as a pack scene has them; relative to this scene's folder); its [shaft], [drive], [drum] and [simulation] are not used here: bodies a and b carry it
         pack: "", Kind::Text, Dflt::When("pack: required");
         /// spring_damper: free angle theta_0, the twist theta_a - theta_b at which the spring carries no torque (both bodies start at angle 0, so a non-zero theta_0 starts the spring twisted)
-        free_angle_rad: "rad", FINITE, Dflt::Num(0.0);
+        free_angle_rad: "rad", Kind::Number(Rule::Closed(-MAX_FREE_ANGLE_RAD, MAX_FREE_ANGLE_RAD)), Dflt::Num(0.0);
     }
     children {
         force: table RawForceSignal,
@@ -649,13 +665,13 @@ table! {
         /// "constant" (value), "step" (offset, then + height from start_s), "ramp" (offset rising by height over duration_s from start_s), "sine" (offset + amplitude sin(2 pi f (t - start_s) + phase) from start_s), "table" (file)
         kind: "", SIGNAL_KINDS, Dflt::Required;
         /// constant: the force
-        value: "", FINITE, Dflt::When("constant: required");
+        value: "", FORCE, Dflt::When("constant: required");
         /// step, ramp, sine: the force before start_s (sine: the mean)
-        offset: "", FINITE, Dflt::Num(0.0);
+        offset: "", FORCE, Dflt::Num(0.0);
         /// step, ramp: the change
-        height: "", FINITE, Dflt::When("step and ramp: required");
+        height: "", FORCE, Dflt::When("step and ramp: required");
         /// sine: the amplitude
-        amplitude: "", FINITE, Dflt::When("sine: required");
+        amplitude: "", FORCE, Dflt::When("sine: required");
         /// sine: the frequency
         frequency_hz: "Hz", FREQUENCY, Dflt::When("sine: required");
         /// sine: the phase at start_s

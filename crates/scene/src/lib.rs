@@ -164,7 +164,7 @@ mod validate;
 
 pub use catalog::{keys_doc, keys_markdown};
 pub use error::{Problem, SceneError};
-pub use keys::{MAX_PRESSURE_PA, MAX_SPEED_RAD_S, MAX_TORQUE_N_M};
+pub use keys::{MAX_NORMAL_FORCE_N, MAX_PRESSURE_PA, MAX_SPEED_RAD_S, MAX_TORQUE_N_M};
 pub use overrides::{Override, OverrideError};
 
 use std::path::Path;
@@ -253,6 +253,13 @@ pub struct Scene {
     /// that no pack engine runs (`clutchpack_sdk::Simulation::new` refuses the scene).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub network: Option<clutchpack_model::network::Network>,
+    /// Every file this scene was read from: the scene file (when loaded from a path), the
+    /// CSV tables it names, a network's pack files and theirs, in the order they were read.
+    /// Outputs of a run are refused over any of them (`clutchpack_record::check_outputs`).
+    /// Paths as found (relative to the working folder where the scene's path was); not
+    /// stored with the scene (a recording or an FMU carries the scene's text, not its paths).
+    #[serde(skip)]
+    pub inputs: Vec<std::path::PathBuf>,
 }
 
 /// Reads an input text file (a scene, a CSV table, a study file) whole. A path that is not a
@@ -282,7 +289,9 @@ pub fn load(path: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
         error,
     })?;
     let base_dir = path.parent().unwrap_or(Path::new(""));
-    parse(&text, &path.display().to_string(), base_dir, overrides)
+    let mut scene = parse(&text, &path.display().to_string(), base_dir, overrides)?;
+    scene.inputs.insert(0, path.to_path_buf());
+    Ok(scene)
 }
 
 /// Validates scene text. `origin` is the file name used in messages (its stem is the default
@@ -341,6 +350,7 @@ pub fn parse(
             fatigue: v.fatigue,
             thermal: v.thermal,
             network: v.network,
+            inputs: std::mem::take(&mut ck.files),
         }),
         _ => {
             debug_assert!(

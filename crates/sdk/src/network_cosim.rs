@@ -513,6 +513,7 @@ impl NetworkSimulation {
                 names.join(", ")
             )));
         };
+        crate::cosim::inputs::check_network_input(*input, name, value).map_err(Error::BadInput)?;
         let mut obs = Obs {
             keep: &mut self.keep,
             stop: None,
@@ -520,7 +521,12 @@ impl NetworkSimulation {
         };
         self.stepper
             .set_input(*input, value, &mut obs)
-            .map_err(|e| Error::BadInput(format!("{name} = {value}: {e}")))
+            .map_err(|e| {
+                Error::BadInput(format!(
+                    "{name} = {}: {e}",
+                    clutchpack_model::fmt_num(value)
+                ))
+            })
     }
 
     /// Advances to `t` s (at most the run's end); `stop` stops it early (a signal; the run

@@ -196,6 +196,25 @@ pub enum NetworkProblem {
     },
 }
 
+/// Why `name` cannot name a body or a coupling of a network, if it cannot: a name is part of
+/// every output and co-simulation variable that concerns its part (`bodies.<name>.speed_rad_s`,
+/// `couplings.<name>.heat_j`, a figure's legend), so it is not empty, has no character that
+/// separates the parts of such a name (`.`, `[`, `]`), no quote, and no control character or
+/// space at either end.
+pub fn name_problem(name: &str) -> Option<&'static str> {
+    if name.is_empty() {
+        Some("must not be empty (outputs and co-simulation variables are named by it)")
+    } else if name.chars().any(|c| c.is_control()) {
+        Some("must not contain control characters")
+    } else if name.trim() != name {
+        Some("must not begin or end with a space")
+    } else if name.contains(['.', '[', ']', '"', '\'', '\\']) {
+        Some("must not contain '.', '[', ']', quotes or '\\' (they separate or quote the parts of a variable name such as bodies.<name>.speed_rad_s)")
+    } else {
+        None
+    }
+}
+
 impl Network {
     /// The index of the body named `name`.
     pub fn body_index(&self, name: &str) -> Option<usize> {
@@ -223,6 +242,9 @@ impl Network {
             out.push(body(0, "name", "a network needs at least one body".into()));
         }
         for (i, b) in self.bodies.iter().enumerate() {
+            if let Some(why) = name_problem(&b.name) {
+                out.push(body(i, "name", why.into()));
+            }
             if self.bodies[..i].iter().any(|o| o.name == b.name) {
                 out.push(body(i, "name", format!("\"{}\" names two bodies", b.name)));
             }
@@ -288,6 +310,9 @@ impl Network {
             i
         }
         for (k, c) in self.couplings.iter().enumerate() {
+            if let Some(why) = name_problem(&c.name) {
+                out.push(coupling(k, "name", why.into()));
+            }
             if self.couplings[..k].iter().any(|o| o.name == c.name) {
                 out.push(coupling(
                     k,

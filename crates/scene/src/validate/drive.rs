@@ -3,7 +3,9 @@
 
 use super::{Checker, Field};
 use crate::csv;
-use crate::keys::{RawDrive as D, RawHarmonic as H, RawShaft as S};
+use crate::keys::{
+    RawDrive as D, RawHarmonic as H, RawShaft as S, MAX_SPEED_RAD_S, MAX_TORQUE_N_M,
+};
 use crate::schema::{show, Key, RawTable};
 use clutchpack_model::{Harmonic, Shaft, ShaftExcitation, SpeedProfile, Table};
 use std::path::Path;
@@ -212,7 +214,13 @@ pub(super) fn drive(
                 )
                 .or(false);
             file.zip(hold).and_then(|(file, hold)| {
-                match csv::read_table(&base_dir.join(&file), &file, column) {
+                let range = if kind == DriveKind::SpeedTable {
+                    (-MAX_SPEED_RAD_S, MAX_SPEED_RAD_S)
+                } else {
+                    (-MAX_TORQUE_N_M, MAX_TORQUE_N_M)
+                };
+                ck.files.push(base_dir.join(&file));
+                match csv::read_table(&base_dir.join(&file), &file, column, range) {
                     Ok(table) if hold => Some(if kind == DriveKind::SpeedTable {
                         Drive::Profile(SpeedProfile::Table(table.held()))
                     } else {

@@ -86,6 +86,9 @@ impl<T> Field<T> {
 pub(crate) struct Checker {
     /// Every problem found so far.
     pub problems: Vec<Problem>,
+    /// Every file the scene's values were read from so far (its tables, its packs' files and
+    /// theirs): [`crate::Scene::inputs`].
+    pub files: Vec<std::path::PathBuf>,
 }
 
 impl Checker {

@@ -9,10 +9,11 @@ use crate::keys::{
     RawContact as Ct, RawCoupling as C, RawFiring as F, RawFiring, RawForceSignal as FS,
     RawNetBody as B, RawOil as O, RawRoadLoad as RL, RawTorqueSignal as TS,
 };
-use crate::schema::{show, Key, RawTable};
+use crate::keys::{MAX_FIRING_HARMONICS, MAX_FORCE_SIGNAL, MAX_TORQUE_N_M};
+use crate::schema::{fmt_num, show, Key, RawTable};
 use clutchpack_model::network::{
-    Body, Coupling, CouplingKind, Firing, GearMesh, LumpedClutch, Network, NetworkProblem,
-    RoadLoad, Signal,
+    name_problem, Body, Coupling, CouplingKind, Firing, GearMesh, LumpedClutch, Network,
+    NetworkProblem, RoadLoad, Signal,
 };
 use clutchpack_model::{Hertz, LawKind, OilFilm, ToothLaw};
 use std::path::Path;
@@ -38,6 +39,8 @@ struct SignalKeys {
     interpolation: Key,
     /// The CSV column of the values.
     column: &'static str,
+    /// The plausibility bound of the values (the value keys' own range), for a table's rows.
+    range: (f64, f64),
     /// The array whose items hold the table: `bodies` or `couplings`.
     array: &'static str,
 }
@@ -55,6 +58,7 @@ const TORQUE_SIGNAL: SignalKeys = SignalKeys {
     file: TS::file,
     interpolation: TS::interpolation,
     column: "torque_n_m",
+    range: (-MAX_TORQUE_N_M, MAX_TORQUE_N_M),
     array: "bodies",
 };
 
@@ -71,6 +75,7 @@ const FORCE_SIGNAL: SignalKeys = SignalKeys {
     file: FS::file,
     interpolation: FS::interpolation,
     column: "force",
+    range: (-MAX_FORCE_SIGNAL, MAX_FORCE_SIGNAL),
     array: "couplings",
 };
 
@@ -190,7 +195,8 @@ fn signal<'v>(
                     &[false, true],
                 )
                 .or(false)?;
-            match crate::csv::read_table(&base_dir.join(&file), &file, keys.column) {
+            ck.files.push(base_dir.join(&file));
+            match crate::csv::read_table(&base_dir.join(&file), &file, keys.column, keys.range) {
                 Ok(t) => Signal::Table(if hold { t.held() } else { t }),
                 Err(e) => {
                     ck.report(p(&keys.file), Some(format!("\"{file}\"")), e);
@@ -223,6 +229,10 @@ pub(super) fn network(
             &p(&B::name),
             "required: couplings name their bodies by it",
         );
+        if let Some(why) = name.as_deref().and_then(name_problem) {
+            ck.report(p(&B::name), name.as_ref().map(|n| format!("{n:?}")), why);
+            ok = false;
+        }
         let fixed = ck.boolean(&p(&B::fixed), r.value(&B::fixed)).or(false);
         let inertia = ck.num(
             &p(&B::inertia_kg_m2),
@@ -272,6 +282,16 @@ pub(super) fn network(
             }
             None => Some(None),
         };
+        // a drag the engines can integrate: the bodies' rule on its time constant J / C
+        let drag = match (fixed, inertia, drag) {
+            (Some(false), Some(j), Some(c)) if c > 0.0 => super::bodies::drag_resolvable(
+                ck,
+                (&p(&B::inertia_kg_m2), j),
+                (&p(&B::drag_n_m_s_rad), c),
+            )
+            .then_some(c),
+            (_, _, c) => c,
+        };
         names.push(name.clone());
         match (name, inertia, fixed, drag, speed, drive, firing, road_load) {
             (
@@ -314,6 +334,10 @@ pub(super) fn network(
             k + 1
         );
         let name = ck.text(&p(&C::name), r.value(&C::name)).or(default_name);
+        if let Some(why) = name.as_deref().and_then(name_problem) {
+            ck.report(p(&C::name), name.as_ref().map(|n| format!("{n:?}")), why);
+            ok = false;
+        }
         let kind = ck
             .choice(
                 &p(&C::kind),
@@ -452,11 +476,28 @@ pub(super) fn network(
                     num(ck, &C::damping_n_m_s_per_rad).or(C::damping_n_m_s_per_rad.default_num());
                 let theta0 = num(ck, &C::free_angle_rad).or(C::free_angle_rad.default_num());
                 (|| {
-                    Some(CouplingKind::SpringDamper(clutchpack_model::SpringDamper {
+                    let spring = clutchpack_model::SpringDamper {
                         stiffness_n_m_per_rad: k_?,
                         damping_n_m_s_per_rad: d?,
                         free_angle_rad: theta0?,
-                    }))
+                    };
+                    // (only when every body was valid: their indices are then the same)
+                    let all_bodies = net.bodies.len() == bodies.len();
+                    let inertia = |i: Option<usize>| -> Option<f64> {
+                        let b = net.bodies.get(i?).filter(|_| all_bodies)?;
+                        Some(if b.fixed {
+                            f64::INFINITY
+                        } else {
+                            b.inertia_kg_m2
+                        })
+                    };
+                    let (ja, jb) = (inertia(a), inertia(b));
+                    match (ja, jb) {
+                        (Some(ja), Some(jb)) => spring_resolvable(ck, k, &spring, ja, jb)
+                            .then_some(CouplingKind::SpringDamper(spring)),
+                        // a body already reported
+                        _ => Some(CouplingKind::SpringDamper(spring)),
+                    }
                 })()
             }
         };
@@ -512,40 +553,47 @@ fn pack(
     )?;
     let shown = Some(format!("\"{file}\""));
     let path = base_dir.join(&file);
-    let scene = match crate::load(&path, &[]) {
+    let refuse = |ck: &mut Checker, why: String| {
+        ck.report(key.clone(), shown.clone(), why);
+        None
+    };
+    let text = match crate::read_input(&path) {
+        Ok(t) => t,
+        Err(error) => return refuse(ck, format!("cannot read {}: {error}", path.display())),
+    };
+    // A network scene is refused before it is validated: validating it would load its own
+    // packs, and a pack file that names a network back (itself, or a -> b -> a) would recurse
+    // until the stack overflows.
+    if text
+        .parse::<toml::Table>()
+        .is_ok_and(|t| t.contains_key("bodies"))
+    {
+        return refuse(
+            ck,
+            format!(
+                "{} is a network scene, not a pack (it has [[bodies]]): a pack file holds one \
+                 pack ([shaft], [[discs]], ...), and a network never names a network",
+                path.display()
+            ),
+        );
+    }
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let scene = match crate::parse(&text, &path.display().to_string(), folder, &[]) {
         Ok(s) => s,
-        Err(crate::SceneError::Read { error, .. }) => {
-            ck.report(
-                key,
-                shown,
-                format!("cannot read {}: {error}", path.display()),
-            );
-            return None;
-        }
         Err(e) => {
             let lines: Vec<String> = e.problems().iter().map(|p| p.to_string()).collect();
-            ck.report(
-                key,
-                shown,
+            return refuse(
+                ck,
                 format!(
                     "the pack scene {} has problems: {}",
                     path.display(),
                     lines.join("; ")
                 ),
             );
-            return None;
         }
     };
-    let refuse = |ck: &mut Checker, why: String| {
-        ck.report(key.clone(), shown.clone(), why);
-        None
-    };
-    if scene.network.is_some() {
-        return refuse(
-            ck,
-            format!("{} is a network scene, not a pack", path.display()),
-        );
-    }
+    ck.files.push(path.clone());
+    ck.files.extend(scene.inputs.iter().cloned());
     if let Some(part) = scene.pack.non_torsional_parts().first() {
         use clutchpack_model::NonTorsional as N;
         let what = match *part {
@@ -565,6 +613,84 @@ fn pack(
         );
     }
     Some((scene.pack, scene.fatigue, scene.thermal))
+}
+
+/// Shortest time scale of a spring-damper accepted, s: its damping time constant
+/// `J_r / d` and `sqrt(J_r / k)` (the natural period over 2 pi) on the two bodies' reduced
+/// inertia `J_r = J_a J_b / (J_a + J_b)` (`J_a` alone when b is fixed). The bodies' bound on
+/// a drag's time constant ([`super::bodies::MIN_DRAG_TIME_S`]): the engines integrate the
+/// spring explicitly or by its own multirate step, both needing steps below these scales.
+const MIN_SPRING_TIME_S: f64 = super::bodies::MIN_DRAG_TIME_S;
+
+/// Whether the engines can integrate spring-damper `k` between bodies of inertias `ja` and
+/// `jb` (kg m^2; infinite for a fixed body) in useful time, and its preload torque
+/// `k |theta_0|` is a plausible torque. Reports each failure at its key, with the largest
+/// accepted value.
+fn spring_resolvable(
+    ck: &mut Checker,
+    k: usize,
+    s: &clutchpack_model::SpringDamper,
+    ja: f64,
+    jb: f64,
+) -> bool {
+    let p = |key: &Key| item("couplings", key, k);
+    let jr = if ja.is_infinite() {
+        jb
+    } else if jb.is_infinite() {
+        ja
+    } else {
+        ja * jb / (ja + jb)
+    };
+    let mut good = true;
+    let (d, stiff, theta0) = (
+        s.damping_n_m_s_per_rad,
+        s.stiffness_n_m_per_rad,
+        s.free_angle_rad,
+    );
+    if d > 0.0 && jr / d < MIN_SPRING_TIME_S {
+        ck.report(
+            p(&C::damping_n_m_s_per_rad),
+            Some(fmt_num(d)),
+            format!(
+                "must be at most {} N m s/rad between bodies of reduced inertia {} kg m^2 \
+                 (plausibility bound: a damping time constant J / d of at least {} s); this \
+                 one is {:.3e} s",
+                fmt_num(jr / MIN_SPRING_TIME_S),
+                fmt_num(jr),
+                fmt_num(MIN_SPRING_TIME_S),
+                jr / d
+            ),
+        );
+        good = false;
+    }
+    if stiff > 0.0 && (jr / stiff).sqrt() < MIN_SPRING_TIME_S {
+        ck.report(
+            p(&C::stiffness_n_m_per_rad),
+            Some(fmt_num(stiff)),
+            format!(
+                "must be at most {} N m/rad between bodies of reduced inertia {} kg m^2 \
+                 (plausibility bound: sqrt(J / k) of at least {} s, its natural period over 2 pi)",
+                fmt_num(jr / (MIN_SPRING_TIME_S * MIN_SPRING_TIME_S)),
+                fmt_num(jr),
+                fmt_num(MIN_SPRING_TIME_S),
+            ),
+        );
+        good = false;
+    }
+    if stiff * theta0.abs() > MAX_TORQUE_N_M {
+        ck.report(
+            p(&C::free_angle_rad),
+            Some(fmt_num(theta0)),
+            format!(
+                "its preload torque k |theta_0| = {} N m must be at most {} N m (plausibility \
+                 bound of a torque)",
+                fmt_num(stiff * theta0.abs()),
+                fmt_num(MAX_TORQUE_N_M)
+            ),
+        );
+        good = false;
+    }
+    good
 }
 
 /// `[bodies.firing]` of body `i`: `Some(Some(..))` when valid, `None` after reporting.
@@ -598,7 +724,35 @@ fn firing(ck: &mut Checker, r: &RawFiring, i: usize) -> Option<Option<Firing>> {
             );
             None
         }
-        a => a,
+        Some(a) if a.len() > MAX_FIRING_HARMONICS => {
+            ck.report(
+                p(&F::amplitudes_n_m),
+                Some(format!("[...{} entries]", a.len())),
+                format!(
+                    "at most {MAX_FIRING_HARMONICS} harmonics (plausibility bound: an engine's \
+                     spectrum above the 12th multiple of its firing order is below noise)"
+                ),
+            );
+            None
+        }
+        Some(a) => {
+            let mut good = true;
+            for (j, x) in a.iter().enumerate() {
+                if x.abs() > MAX_TORQUE_N_M {
+                    ck.report(
+                        format!("{}[{j}]", p(&F::amplitudes_n_m)),
+                        Some(fmt_num(*x)),
+                        format!(
+                            "must be within [-{0}, {0}] N m (plausibility bound of a torque)",
+                            fmt_num(MAX_TORQUE_N_M)
+                        ),
+                    );
+                    good = false;
+                }
+            }
+            good.then_some(a)
+        }
+        None => None,
     };
     let n = amplitudes.as_ref().map(Vec::len);
     let phases = match ck.numbers(&p(&F::phases_deg), r.value(&F::phases_deg), n) {

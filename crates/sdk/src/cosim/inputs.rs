@@ -152,6 +152,50 @@ impl Input {
     }
 }
 
+/// `Ok` if `value` may be given to the network input `input` (named `name` in messages):
+/// within the bound of the scene key it stands for, so that a co-simulation cannot ask what
+/// a scene cannot (a drive torque of 1e30 N m made the first 1 ms step run for minutes).
+/// A drive torque within +-`MAX_TORQUE_N_M` (`bodies[].drive.value_n_m`), a clutch's normal
+/// force within `[0, MAX_NORMAL_FORCE_N]` (`couplings[].max_normal_force_n`), a pack's
+/// piston pressure within `[0, MAX_PRESSURE_PA]` (`stack.pressure.pressure_pa`). The one
+/// place a network input is checked against its bound (the FMU's `fmi2SetReal` and every
+/// `set_input` call it).
+pub fn check_network_input(
+    input: clutchpack_model::network::NetworkInput,
+    name: &str,
+    value: f64,
+) -> Result<(), String> {
+    use clutchpack_scene::{MAX_NORMAL_FORCE_N, MAX_PRESSURE_PA, MAX_TORQUE_N_M};
+    let (lo, hi, unit, key) = match input {
+        clutchpack_model::network::NetworkInput::Drive(_) => (
+            -MAX_TORQUE_N_M,
+            MAX_TORQUE_N_M,
+            "N m",
+            "bodies[].drive.value_n_m",
+        ),
+        clutchpack_model::network::NetworkInput::ClutchForce(_) => (
+            0.0,
+            MAX_NORMAL_FORCE_N,
+            "N",
+            "couplings[].max_normal_force_n",
+        ),
+        clutchpack_model::network::NetworkInput::PackPressure(_) => {
+            (0.0, MAX_PRESSURE_PA, "Pa", "stack.pressure.pressure_pa")
+        }
+    };
+    if (lo..=hi).contains(&value) {
+        return Ok(());
+    }
+    let e = clutchpack_model::fmt_num;
+    Err(format!(
+        "{name} = {} {unit}: expected a value in [{}, {}] {unit}, the bound of the scene key it \
+         stands for ({key})",
+        e(value),
+        e(lo),
+        e(hi)
+    ))
+}
+
 /// The public names of the inputs `driven` drives, in the table's order.
 pub fn driven_names(driven: &Driven) -> Vec<&'static str> {
     Input::ALL

@@ -6,7 +6,7 @@
 //! the outputs by value reference or by name. FMI's own rules (its state machine, the host's
 //! communication points, pointers) stay in the fmu crate.
 
-mod inputs;
+pub(crate) mod inputs;
 mod network;
 mod variables;
 
@@ -380,9 +380,17 @@ impl CoSimulation {
             Causality::Input => {
                 match v.quantity {
                     Quantity::Input(i) => i.check(value, "")?,
-                    // a clutch's normal force (unit N) is >= 0; a drive torque takes any sign
-                    Quantity::NetworkInput(_) if v.unit == Some("N") && value < 0.0 => {
-                        return Err(format!("{} = {value}: expected a force >= 0 N", v.name));
+                    // the bound of the scene key it stands for, checked when set (before the
+                    // run starts too: fmi2SetReal answers at once, not at the next step)
+                    Quantity::NetworkInput(j) => {
+                        let input = self.scene.network.as_ref().and_then(|net| {
+                            crate::network_cosim::network_inputs(net)
+                                .get(j)
+                                .map(|(_, input)| *input)
+                        });
+                        if let Some(input) = input {
+                            crate::cosim::inputs::check_network_input(input, &v.name, value)?;
+                        }
                     }
                     _ => {}
                 }
