@@ -83,8 +83,8 @@ pub use session::Engine;
 pub use spline::{Flank, SplineGeometry, ToothKinematics};
 pub use spring::SpringDamper;
 pub use stream::{
-    Collector, DiscSample, EngineError, NullObserver, Observer, RunStats, Sample, STALL_SPAN_S,
-    STALL_STEPS,
+    guard_state, Collector, DiscSample, EngineError, NullObserver, Observer, RunStats, Sample,
+    RUNAWAY_SPEED_RAD_S, STALL_SPAN_S, STALL_STEPS,
 };
 
 /// A number for messages, the one format every front end echoes values in: Rust's shortest

@@ -160,6 +160,46 @@ pub const STALL_STEPS: u64 = 1 << 16;
 /// coefficient of 1e19 s/m, a drive at 1e19 Hz) falls below it and would run for days.
 pub const STALL_SPAN_S: f64 = 4e-6;
 
+/// Largest speed magnitude of a body in an engine's state, rad/s: ten times the largest a
+/// scene or a co-simulation input may give (the scene crate's `MAX_SPEED_RAD_S`, 1e5 rad/s,
+/// about 950 000 rpm). A state beyond it is no driveline: an explicit step past its stability
+/// limit (a coupling stiffer or a damping larger than the step can take) grows the state
+/// geometrically, and [`guard_state`] stops the run there rather than let it end with
+/// 1e200-sized or NaN outputs (issue 48, item 2).
+pub const RUNAWAY_SPEED_RAD_S: f64 = 1e6;
+
+/// The engines' one divergence guard of a state (packs, networks, thermal states; issue 48:
+/// "a run either integrates or says it diverged"): `Ok` when every value of `values` is
+/// finite and at most `bound` in magnitude (`f64::INFINITY`: finite only), else
+/// [`EngineError::Diverged`] at `t_s` (s, the time of the last good state) naming the first
+/// offending value: `what` (its kind, e.g. "a body's speed") with its index, the value and
+/// `unit`.
+pub fn guard_state(
+    t_s: f64,
+    what: &str,
+    unit: &str,
+    values: &[f64],
+    bound: f64,
+) -> Result<(), EngineError> {
+    // one comparison per value (NaN fails it): the check stays off the profile of a step
+    match values.iter().position(|v| !(v.abs() <= bound)) {
+        None => Ok(()),
+        Some(i) => Err(EngineError::Diverged {
+            t_s,
+            reason: if values[i].is_finite() {
+                format!(
+                    "{what} {i} reached {:.3e} {unit}, beyond {bound:e} {unit}: the integration \
+                     ran away (a coupling stiffer, or a damping or force larger, than the step \
+                     can take)",
+                    values[i]
+                )
+            } else {
+                format!("{what} {i} is not finite ({})", values[i])
+            },
+        }),
+    }
+}
+
 /// Why an engine could not finish.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum EngineError {

@@ -410,6 +410,26 @@ const THICKNESS: Kind = Kind::Number(Rule::Bounded {
     ceil: 0.1,
 });
 
+/// Smallest heat capacity of a thermal body or of the oil accepted, J/K (2 g of steel is
+/// about 1 J/K; the thinnest real plate, 85 J/K). Issue 48: `1e-9` J/K passed `check` and
+/// made the thermal window's sub-steps explode.
+pub(crate) const MIN_HEAT_CAPACITY_J_K: f64 = 1e-2;
+/// A heat capacity in J/K: at least [`MIN_HEAT_CAPACITY_J_K`].
+const HEAT_CAPACITY: Kind = Kind::Number(Rule::Bounded {
+    floor: MIN_HEAT_CAPACITY_J_K,
+    ceil: f64::INFINITY,
+});
+/// Largest cooler capacity rate accepted, W/K (500 kg/s of oil through the cooler; a
+/// transmission's is 10 to 1000 W/K).
+pub(crate) const MAX_COOLER_RATE_W_K: f64 = 1e6;
+/// Largest heat transfer coefficient of a face accepted, W/(m^2 K) (boiling water is below
+/// 1e5; an oil film on a clutch face, 1e2 to 1e4).
+pub(crate) const MAX_HEAT_TRANSFER_W_M2_K: f64 = 1e6;
+/// Smallest laminar oil gap accepted, m (1 um; a clutch's open gaps are 0.05 to 1 mm).
+pub(crate) const MIN_OIL_GAP_M: f64 = 1e-6;
+/// Largest thermal conductivity of the oil accepted, W/(m K) (copper's is 400; an oil's, 0.13).
+pub(crate) const MAX_CONDUCTIVITY_W_M_K: f64 = 1e3;
+
 table! {
     /// `[thermal]`: temperatures of every disc, plate and the oil, fed back into the tooth film and the open gaps' drag (MODEL.md section 9; both engines: the reference engine's monolithic scheme, either scheme of the multibody engine). Temperatures in K.
     RawThermal at "thermal" {
@@ -458,13 +478,13 @@ table! {
         /// walther: density for eta = nu rho; ASSUMED default: an ATF near 80 deg C
         density_kg_m3: "kg/m^3", Kind::Number(Rule::Bounded { floor: 100.0, ceil: 3000.0 }), Dflt::Num(850.0);
         /// heat capacity m c_p of the oil volume (sump or cooling flow)
-        heat_capacity_j_k: "J/K", POSITIVE, Dflt::Required;
+        heat_capacity_j_k: "J/K", HEAT_CAPACITY, Dflt::Required;
         /// the cooler's capacity rate m_dot c_p; 0: no cooler
-        cooler_capacity_rate_w_k: "W/K", NON_NEGATIVE, Dflt::Num(0.0);
+        cooler_capacity_rate_w_k: "W/K", Kind::Number(Rule::Closed(0.0, MAX_COOLER_RATE_W_K)), Dflt::Num(0.0);
         /// temperature of the oil the cooler returns
         inlet_temperature_k: "K", TEMPERATURE, Dflt::Described("default thermal.initial_temperature_k");
         /// thermal conductivity lambda of the oil (laminar_gap convection); ASSUMED default: an ATF
-        conductivity_w_m_k: "W/(m K)", POSITIVE, Dflt::Num(0.13);
+        conductivity_w_m_k: "W/(m K)", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_CONDUCTIVITY_W_M_K }), Dflt::Num(0.13);
     }
     children {}
 }
@@ -475,9 +495,9 @@ table! {
         /// "adiabatic" (none), "given" (h_w_m2_k) or "laminar_gap": h = 7.541 lambda / (2 s), fully developed, both walls heated (VDI Heat Atlas Gb 7)
         kind: "", Kind::Choice(&["adiabatic", "given", "laminar_gap"]), Dflt::Choice("laminar_gap");
         /// given: the heat transfer coefficient of every face
-        h_w_m2_k: "W/(m^2 K)", POSITIVE, Dflt::When("given: required, an error otherwise");
+        h_w_m2_k: "W/(m^2 K)", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_HEAT_TRANSFER_W_M2_K }), Dflt::When("given: required, an error otherwise");
         /// laminar_gap: the oil gap s at each face
-        gap_m: "m", POSITIVE, Dflt::Described("laminar_gap: default stack.open_gap.gap_m, else required; an error otherwise");
+        gap_m: "m", Kind::Number(Rule::Bounded { floor: MIN_OIL_GAP_M, ceil: f64::INFINITY }), Dflt::Described("laminar_gap: default stack.open_gap.gap_m, else required; an error otherwise");
     }
     children {}
 }
@@ -490,7 +510,7 @@ table! {
         /// thickness of each of the two linings; ASSUMED default
         lining_thickness_m: "m", THICKNESS, Dflt::Num(0.5e-3);
         /// heat capacity m c of one disc, instead of the geometry's
-        heat_capacity_j_k: "J/K", POSITIVE, Dflt::Described("default: steel core and paper linings (clutchpack_model::thermal::ThermalProperties)");
+        heat_capacity_j_k: "J/K", HEAT_CAPACITY, Dflt::Described("default: steel core and paper linings (clutchpack_model::thermal::ThermalProperties)");
     }
     children {}
 }
@@ -501,7 +521,7 @@ table! {
         /// thickness of a plate; ASSUMED default: MODEL.md section 9's plate
         thickness_m: "m", THICKNESS, Dflt::Num(1.8e-3);
         /// heat capacity m c of one plate, instead of the geometry's
-        heat_capacity_j_k: "J/K", POSITIVE, Dflt::Described("default: steel (clutchpack_model::thermal::ThermalProperties::STEEL)");
+        heat_capacity_j_k: "J/K", HEAT_CAPACITY, Dflt::Described("default: steel (clutchpack_model::thermal::ThermalProperties::STEEL)");
     }
     children {}
 }

@@ -976,3 +976,68 @@ fn bad_couplings_name_their_key_path() {
         "{e}"
     );
 }
+
+/// Issue 48, item 3: a thermal pack with a tiny heat capacity or a huge cooler or convection
+/// passed `check`, then the thermal window's sub-steps (a twentieth of the fastest time
+/// constant) exploded to about 1e300 and the run never ended. Each is refused at its key: by
+/// the key's own plausibility bound (a capacity under 1e-2 J/K, a cooler over 1e6 W/K, an
+/// oil gap under 1 um, a heat transfer coefficient over 1e6 W/(m^2 K)), or, for values each
+/// within its bound, by the fastest time constant's (under 1e-3 s: reported at the capacity
+/// that sets it). The shipped thermal scene itself passes.
+#[test]
+fn thermal_keys_tiny_heat_capacity_refused() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/pack-6-thermal.toml");
+    load(&path, &[]).expect("the shipped scene passes");
+    for (set, key, says) in [
+        (
+            "thermal.oil.heat_capacity_j_k=1e-9",
+            "thermal.oil.heat_capacity_j_k",
+            "plausibility bound",
+        ),
+        (
+            "thermal.discs.heat_capacity_j_k=1e-9",
+            "thermal.discs.heat_capacity_j_k",
+            "plausibility bound",
+        ),
+        (
+            "thermal.plates.heat_capacity_j_k=1e-9",
+            "thermal.plates.heat_capacity_j_k",
+            "plausibility bound",
+        ),
+        (
+            "thermal.oil.cooler_capacity_rate_w_k=1e300",
+            "thermal.oil.cooler_capacity_rate_w_k",
+            "in [0, 1e6]",
+        ),
+        (
+            "thermal.convection.gap_m=1e-300",
+            "thermal.convection.gap_m",
+            "plausibility bound",
+        ),
+        // each value within its bound, the oil's time constant 1 J/K / 1e5 W/K = 1e-5 s
+        (
+            "thermal.oil.heat_capacity_j_k=1.0",
+            "thermal.oil.heat_capacity_j_k",
+            "time constant",
+        ),
+    ] {
+        let mut o = sets(&[set]);
+        if set.ends_with("=1.0") {
+            o.extend(sets(&["thermal.oil.cooler_capacity_rate_w_k=1e5"]));
+        }
+        let e = match load(&path, &o) {
+            Ok(_) => panic!("{set}: accepted"),
+            Err(e) => e,
+        };
+        let p = problem_at(&e, key);
+        assert!(p.rule.contains(says), "{set}: {}", p.rule);
+    }
+    // a given heat transfer coefficient beyond its bound
+    let o = sets(&[
+        "thermal.convection.kind=\"given\"",
+        "thermal.convection.h_w_m2_k=1e300",
+    ]);
+    let e = load(&path, &o).err().expect("h = 1e300 accepted");
+    let p = problem_at(&e, "thermal.convection.h_w_m2_k");
+    assert!(p.rule.contains("plausibility bound"), "{}", p.rule);
+}

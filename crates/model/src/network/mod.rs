@@ -25,7 +25,10 @@ use serde::{Deserialize, Serialize};
 
 /// A load that opposes motion: `-sign(w) (a + b |w| + c w^2)` (N m), zero at rest (a
 /// vehicle's rolling resistance, losses and air drag reduced to a shaft; at `w = 0` the
-/// constant part does not hold the body: it is not static friction).
+/// constant part does not hold the body: it is not static friction). A body it brings to rest
+/// while the other torques on it stay within `a` stays there (the equation's own solution
+/// across the jump at zero speed; the reference engine holds it so, docs/DECISIONS.md, "A
+/// road load at rest").
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RoadLoad {
     /// `a`, N m (>= 0).

@@ -151,6 +151,65 @@ pub struct ThermalModel {
     pub friction: Option<FrictionTable>,
 }
 
+/// Fewest seconds the fastest time constant of a thermal model may have (the scene crate
+/// refuses a model below it; docs/DECISIONS.md, "Plausibility bounds"): the windows' RK4
+/// sub-steps are a twentieth of it, so a window of `step_s` takes at most
+/// `step_s / (0.05 MIN_TIME_CONSTANT_S)` of them (2e5 for the longest window, 10 s). The
+/// thinnest real plate on the thinnest oil gap (1 mm of steel, 10 um of oil) is about 0.04 s.
+pub const MIN_TIME_CONSTANT_S: f64 = 1e-3;
+
+/// Most RK4 sub-steps one advance of the temperatures may take (a window and the engine's
+/// step past its end, `ThermalWindows::close_windows`); beyond it the run stops with
+/// [`crate::EngineError::Diverged`] rather than spend minutes in one window (issue 48,
+/// item 3). A model that validates needs at most 2e5 per window (see
+/// [`MIN_TIME_CONSTANT_S`]); 1e6 sub-steps of a 20-body pack take about half a second.
+pub const MAX_SUB_STEPS: f64 = 1e6;
+
+/// Which capacity sets a thermal model's fastest time constant
+/// ([`ThermalModel::fastest_time_constant_s`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FastestBody {
+    /// A friction disc (every disc has the same capacity and conductance).
+    Disc,
+    /// A separator plate.
+    Plate,
+    /// The oil, against the bodies' conductances and the cooler.
+    Oil,
+}
+
+impl ThermalModel {
+    /// The fastest time constant of the lumped equations, s (infinite: every body adiabatic
+    /// and no cooler), and which capacity sets it: each body's `C / G` (MODEL.md section 9,
+    /// [`super::time_constant_s`]) and the oil's `C_oil / (sum G + m_dot c_p)`. The windows'
+    /// sub-steps are a twentieth of it.
+    pub fn fastest_time_constant_s(&self) -> (f64, FastestBody) {
+        let mut tau = f64::INFINITY;
+        let mut which = FastestBody::Oil;
+        let mut g_sum = 0.0;
+        for (b, kind) in self
+            .discs
+            .iter()
+            .map(|b| (b, FastestBody::Disc))
+            .chain(self.plates.iter().map(|b| (b, FastestBody::Plate)))
+        {
+            if b.conductance_w_k > 0.0 {
+                let t = b.capacity_j_k / b.conductance_w_k;
+                if t < tau {
+                    (tau, which) = (t, kind);
+                }
+            }
+            g_sum += b.conductance_w_k;
+        }
+        if g_sum + self.oil.flow_capacity_w_k > 0.0 {
+            let t = self.oil.capacity_j_k / (g_sum + self.oil.flow_capacity_w_k);
+            if t < tau {
+                (tau, which) = (t, FastestBody::Oil);
+            }
+        }
+        (tau, which)
+    }
+}
+
 /// What a thermal run reports at its end (MODEL.md section 9's checks). Bodies: the discs,
 /// then the plates, as the engines number them. Temperatures in K, heats in J (>= 0).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]

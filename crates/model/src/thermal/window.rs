@@ -24,11 +24,12 @@
 //! up to one window); the heat is booked exactly as integrated, so the balance (heat
 //! generated = stored + cooler) closes to rounding whatever the window.
 
+use super::pack::MAX_SUB_STEPS;
 use super::{
     body_temperature_rate_k_s, cooler_heat_w, effusivity_share, FrictionMap, GapViscosity,
     ThermalModel, ThermalReport, Viscosity,
 };
-use crate::{EngineError, FrictionCurve, PackModel, StackBody};
+use crate::{guard_state, EngineError, FrictionCurve, PackModel, StackBody};
 
 /// How a friction interface passed its heat over a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -309,7 +310,7 @@ impl ThermalWindows {
         while (self.window_k + 1) as f64 * step <= t {
             self.window_k += 1;
         }
-        self.advance(t);
+        self.advance(t)?;
         let (scale, gap) = self.parameters();
         if !(scale.is_finite() && scale > 0.0 && gap.is_finite()) {
             return Err(EngineError::Diverged {
@@ -336,35 +337,39 @@ impl ThermalWindows {
     }
 
     /// Advances the temperatures from the window's start to `t` (s) with its heat as
-    /// constant powers (MODEL.md section 9's lumped equations, classical RK4).
-    fn advance(&mut self, t: f64) {
+    /// constant powers (MODEL.md section 9's lumped equations, classical RK4). Fails (nothing
+    /// advanced) when that would take more than [`MAX_SUB_STEPS`] sub-steps, or when a
+    /// temperature is not finite after it (the engines' one guard, [`guard_state`]).
+    fn advance(&mut self, t: f64) -> Result<(), EngineError> {
         let dt = t - self.window_t0;
-        self.window_t0 = t;
         if dt <= 0.0 {
-            return;
+            self.window_t0 = t;
+            return Ok(());
         }
+        // the fastest time constant, s: a twentieth of it per RK4 sub-step
+        let (tau, _) = self.model.fastest_time_constant_s();
+        let subs = if tau.is_finite() {
+            let subs = (dt / (0.05 * tau)).ceil();
+            if !(subs <= MAX_SUB_STEPS) {
+                return Err(EngineError::Diverged {
+                    t_s: self.window_t0,
+                    reason: format!(
+                        "the thermal window of {dt:.3e} s would take {subs:.3e} sub-steps (the \
+                         fastest time constant is {tau:.3e} s; at most {MAX_SUB_STEPS:e}): \
+                         check the heat capacities, the convection and the cooler of [thermal]"
+                    ),
+                });
+            }
+            (subs as usize).max(1)
+        } else {
+            1
+        };
+        self.window_t0 = t;
         self.report.windows += 1;
         let n = self.capacity.len();
         let power: Vec<f64> = self.heat.iter().map(|q| q / dt).collect();
         self.heat.iter_mut().for_each(|q| *q = 0.0);
         let oil = &self.model.oil;
-        // the fastest time constant, s: a twentieth of it per RK4 sub-step
-        let mut tau = f64::INFINITY;
-        let mut g_sum = 0.0;
-        for b in 0..n {
-            if self.conductance[b] > 0.0 {
-                tau = tau.min(self.capacity[b] / self.conductance[b]);
-            }
-            g_sum += self.conductance[b];
-        }
-        if g_sum + oil.flow_capacity_w_k > 0.0 {
-            tau = tau.min(oil.capacity_j_k / (g_sum + oil.flow_capacity_w_k));
-        }
-        let subs = if tau.is_finite() {
-            ((dt / (0.05 * tau)).ceil() as usize).max(1)
-        } else {
-            1
-        };
         let h = dt / subs as f64;
         // state: the bodies, the oil, the cooler's heat (J)
         let rate = |y: &[f64], out: &mut [f64]| {
@@ -412,17 +417,30 @@ impl ThermalWindows {
                 y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
             }
         }
+        guard_state(
+            t,
+            "the temperature of thermal body",
+            "K",
+            &y[..=n],
+            f64::INFINITY,
+        )?;
         self.report.cooler_j += y[n + 1];
         self.temp.copy_from_slice(&y[..=n]);
         for b in 0..n {
             self.report.max_k[b] = self.report.max_k[b].max(self.temp[b]);
         }
         self.report.oil_max_k = self.report.oil_max_k.max(self.temp[n]);
+        Ok(())
     }
 
-    /// Closes the last window at `t` (s) and returns the run's report.
+    /// Closes the last window at `t` (s) and returns the run's report. The last window is
+    /// shorter than the ones `close_windows` advanced, so it fails only where they would
+    /// have (a run stopped by such a failure reports the temperatures at its last window's
+    /// end).
     pub fn finish(&mut self, t: f64) -> ThermalReport {
-        self.advance(t);
+        if self.advance(t).is_err() {
+            self.window_t0 = t;
+        }
         let n = self.capacity.len();
         let t0 = self.model.initial_k;
         let mut r = self.report.clone();
@@ -496,6 +514,34 @@ mod tests {
         assert!((r.generated_j() - 15.0).abs() < 1e-12);
         // the stored heat is C (T - T_0) at 313 K: rounding of 6e-14 K times 100 J/K a body
         assert!((r.accounted_j() - r.generated_j()).abs() < 1e-10);
+    }
+
+    /// Issue 48, item 3: a model made in code past the scene's bounds (a disc of 1e-9 J/K on
+    /// 5 W/K: a time constant of 2e-10 s, 1e7 sub-steps for one window of 1 ms) stops with
+    /// "diverged" at once, naming the sub-steps, instead of spinning in the window; the
+    /// temperatures are left as they were. The scene's bound needs at most 2e5 per window.
+    #[test]
+    fn thermal_window_that_would_take_too_many_sub_steps_diverges() {
+        let p = pack();
+        let mut m = model(5.0);
+        m.discs[0].capacity_j_k = 1e-9;
+        assert_eq!(
+            m.fastest_time_constant_s().1,
+            super::super::pack::FastestBody::Disc
+        );
+        let mut w = ThermalWindows::new(m, &p).unwrap();
+        let t0 = w.temperatures_k().to_vec();
+        let e = w.close_windows(1e-3, &p).unwrap_err();
+        assert!(
+            matches!(&e, EngineError::Diverged { reason, .. } if reason.contains("sub-steps")),
+            "{e}"
+        );
+        assert_eq!(w.temperatures_k(), &t0[..]);
+        // the shipped bound: 1e-3 s gives 20 sub-steps a window of 1 ms
+        let mut ok = model(5.0);
+        ok.discs[0].capacity_j_k = 5.0 * super::super::pack::MIN_TIME_CONSTANT_S;
+        let mut w = ThermalWindows::new(ok, &p).unwrap();
+        assert!(w.close_windows(1e-3, &p).is_ok());
     }
 
     /// A window closes at the first time at or after its end; the film scale follows the

@@ -10,7 +10,7 @@ use super::{constraint, NetworkStepOptions, Run};
 use clutchpack_model::network::{
     ClutchMode, Network, NetworkEnergy, NetworkInput, NetworkObserver, NetworkRun, NetworkSample,
 };
-use clutchpack_model::EngineError;
+use clutchpack_model::{guard_state, EngineError, RUNAWAY_SPEED_RAD_S};
 use std::sync::Arc;
 
 /// Runs `net` on the multibody engine for `duration_s` seconds; samples and clutch events go
@@ -305,6 +305,9 @@ impl NetworkStepper {
         let mut total = run.total();
         let mut acc = run.accelerations(&total);
         run.advance_packs(t_new, &mut total, &mut acc, obs)?;
+        // the torques the world takes must be numbers (rapier would make a NaN torque's
+        // speeds zero, not NaN, and the run would end as if it had integrated)
+        guard_state(t, "the torque on body", "N m", &total, f64::INFINITY)?;
         let paths: Vec<mesh::Path> = run
             .meshes
             .iter()
@@ -314,12 +317,10 @@ impl NetworkStepper {
         // rapier's speeds keep the rows to rounding; remove it (momentum kept)
         constraint::project(&run.rows, &run.inv_inertia, &mut run.w);
         run.world.set_speeds(&run.w);
-        if run.w.iter().any(|v| !v.is_finite()) {
-            return Err(EngineError::Diverged {
-                t_s: t,
-                reason: "a body's speed is not finite".into(),
-            });
-        }
+        // the engines' one guard (issue 48, item 2): a fixed step past its stability limit
+        // grows the speeds geometrically; stop with the reference engine's divergence error
+        // rather than finish with 1e200-sized and NaN outputs
+        guard_state(t, "the speed of body", "rad/s", &run.w, RUNAWAY_SPEED_RAD_S)?;
         let net = Arc::clone(&run.net);
         // the works over the step, with the step's mean speeds (the discrete energy identity)
         for (i, b) in net.bodies.iter().enumerate() {

@@ -21,7 +21,9 @@
 //! - a gear mesh: the engagement depth of its tooth law reaching 0 from either side (a tooth
 //!   contact's onset, where the law's per-event memory is taken, and its separation);
 //! - a resolved pack: each disc's and plate's tooth contacts and each face's stick and slip
-//!   (`packs.rs`, which also holds the pack's share of the state and of the right-hand side).
+//!   (`packs.rs`, which also holds the pack's share of the state and of the right-hand side);
+//! - a body with a road load's constant part `a > 0`: its speed reaching 0 (moving), or the
+//!   other torques on its rigid group leaving the load's breakaway (held at rest).
 //!
 //! A crossing is bisected on the dense output to 1e-13 s relative; the run restarts there
 //! with the modes settled as Modelica's `Clutch` settles them (Otter, Elmqvist and Mattsson
@@ -30,6 +32,15 @@
 //! torque otherwise (startForward / startBackward); the check repeats until every locked clutch
 //! holds. Locking sets the group's speeds to its common speed (momentum kept; the slip there is
 //! below 1e-12 rad/s).
+//!
+//! A road load opposes motion and jumps from `-a` to `+a` through zero speed (the model's
+//! `RoadLoad`): a body it brings to rest while the other torques on its rigid group stay
+//! within the load's breakaway `sum |g_i| a_i` would chatter across zero in steps of 1e-7 s
+//! (issue 48, item 4: ten million steps per simulated second). It is held at rest instead, as
+//! a clutch's stick is held (`modes.rs`, `hold_road_loads`): the group's speed set to 0, the
+//! held bodies' loads the reaction that keeps it there (the discontinuous equation's own
+//! solution, Filippov's sliding mode at zero speed: what the chatter averages to), until the
+//! other torques exceed the breakaway and the group starts towards them.
 
 pub(crate) mod cluster;
 mod mesh;
@@ -88,6 +99,16 @@ struct Equations {
     residual: Vec<f64>,
     coupling_torque: Vec<f64>,
     mesh_force: Vec<f64>,
+    /// Whether each body is held at rest by its road load (the module's docs).
+    held: Vec<bool>,
+    /// The direction each body with a road load's constant part moved in at the last
+    /// settling (+1, -1; 0: at rest, or no such load): its guard is its speed along it.
+    moving: Vec<f64>,
+    /// Each rigid group's torque `sum g_i T_i` without the holding reactions (N m, on its
+    /// speed) and the breakaway its held bodies give, `sum |g_i| a_i` (N m), as the last
+    /// [`Equations::forces`] found them (while any body is held).
+    hold_torque: Vec<f64>,
+    hold_capacity: Vec<f64>,
 }
 
 /// A mesh's tooth kinematics at the state `y = [angles, speeds, ...]`.
@@ -121,6 +142,53 @@ impl Equations {
             residual: Vec::new(),
             coupling_torque: vec![0.0; m],
             mesh_force: vec![0.0; m],
+            held: vec![false; n],
+            moving: vec![0.0; n],
+            hold_torque: Vec::new(),
+            hold_capacity: Vec::new(),
+        }
+    }
+
+    /// The first guard of the bodies' road loads (after the couplings' and the packs').
+    fn body_guard_at(&self) -> usize {
+        self.net.couplings.len() + self.packs.iter().map(packs::NetPack::guards).sum::<usize>()
+    }
+
+    /// The breakaway of body `i`'s road load, N m: its constant part (0: none, or fixed).
+    fn breakaway(&self, i: usize) -> f64 {
+        let b = &self.net.bodies[i];
+        if b.fixed {
+            0.0
+        } else {
+            b.road_load.map_or(0.0, |l| l.constant_n_m)
+        }
+    }
+
+    /// The held bodies' reactions added to `torque` (each group's torque, clamped to its
+    /// breakaway, shared by the held bodies in proportion to `|g_i| a_i`), after their own
+    /// road loads and drags were taken at zero speed; each group's torque and breakaway kept
+    /// for the guards.
+    fn hold(&mut self) {
+        let groups = self.clusters.inertia.len();
+        self.hold_torque.clear();
+        self.hold_torque.resize(groups, 0.0);
+        self.hold_capacity.clear();
+        self.hold_capacity.resize(groups, 0.0);
+        for i in 0..self.torque.len() {
+            let (c, g) = (self.clusters.of[i], self.clusters.g[i]);
+            self.hold_torque[c] += g * self.torque[i];
+            if self.held[i] {
+                let a = self.breakaway(i);
+                self.hold_capacity[c] += g.abs() * a;
+            }
+        }
+        for i in 0..self.torque.len() {
+            if self.held[i] {
+                let (c, g) = (self.clusters.of[i], self.clusters.g[i]);
+                let (cap, gt) = (self.hold_capacity[c], self.hold_torque[c]);
+                let share = g.abs() * self.breakaway(i) / cap;
+                self.torque[i] += (-gt).clamp(-cap, cap) * share / g;
+            }
         }
     }
 
@@ -133,7 +201,7 @@ impl Equations {
 
     /// The guards' count: one per coupling, then every pack's.
     fn guard_len(&self) -> usize {
-        self.net.couplings.len() + self.packs.iter().map(packs::NetPack::guards).sum::<usize>()
+        self.body_guard_at() + self.net.bodies.len()
     }
 
     fn set_modes(&mut self, modes: &[Option<ClutchMode>]) {
@@ -150,6 +218,9 @@ impl Equations {
         for (i, b) in self.net.bodies.iter().enumerate() {
             self.torque[i] = if b.fixed {
                 0.0
+            } else if self.held[i] {
+                // at rest: its load is the holding reaction (`hold`), its drag nothing
+                b.external_torque_n_m(t, y[i], 0.0)
             } else {
                 b.external_torque_n_m(t, y[i], w[i])
             };
@@ -189,8 +260,23 @@ impl Equations {
             self.torque[p.a] += ta;
             self.torque[p.b] += tb;
         }
+        let any_held = self.held.contains(&true);
+        if any_held {
+            self.hold();
+        }
         self.clusters
             .accelerations(&self.torque, &mut self.acc, &mut self.group);
+        if any_held {
+            // a group held within its breakaway does not move: exactly (the reactions'
+            // sum cancels the other torques only to rounding)
+            for i in 0..self.acc.len() {
+                let c = self.clusters.of[i];
+                if self.hold_capacity[c] > 0.0 && self.hold_torque[c].abs() <= self.hold_capacity[c]
+                {
+                    self.acc[i] = 0.0;
+                }
+            }
+        }
     }
 
     /// The rigid couplings' torques at the state of the last [`Self::forces`].
@@ -266,7 +352,8 @@ impl Equations {
         let n = self.net.bodies.len();
         let w = &y[n..2 * n];
         let any_locked = self.modes.contains(&Some(ClutchMode::Locked));
-        if any_locked {
+        let any_held = self.held.contains(&true);
+        if any_locked || any_held {
             self.forces(t, y);
             self.rigid_torques();
         }
@@ -305,6 +392,19 @@ impl Equations {
         for p in &self.packs {
             let g = &mut out[p.guard_at..p.guard_at + p.guards()];
             p.guard_values(t, y, w, g);
+        }
+        // the road loads: a held group's breakaway less its torque, a moving body's speed
+        // along its direction
+        let at = self.body_guard_at();
+        for i in 0..n {
+            out[at + i] = if self.held[i] {
+                let c = self.clusters.of[i];
+                self.hold_capacity[c] - self.hold_torque[c].abs()
+            } else if self.moving[i] != 0.0 {
+                self.moving[i] * w[i]
+            } else {
+                1.0
+            };
         }
     }
 }

@@ -78,6 +78,7 @@ pub(super) fn settle(
         }
     }
     eq.set_modes(&modes);
+    hold_road_loads(eq, t, y, crossed);
     *events += 1;
     if before != modes {
         obs.switched(&state_before, &sample(eq, t, y));
@@ -116,4 +117,66 @@ fn project_speeds(eq: &Equations, y: &mut [f64]) {
             cl.g[i] * p[c] / cl.inertia[c]
         };
     }
+}
+
+/// Settles the road loads at `t` (the module docs of `mod.rs`; issue 48, item 4): a held body
+/// whose group now moves (a clutch locked it to a moving group) is released; a body whose
+/// speed reached zero (`crossed`: its guard `<= 0`) or stands at zero is held with its group
+/// at rest while the group's other torques stay within the held bodies' breakaway, and
+/// otherwise starts (or goes on) towards them. Each body left moving takes its direction.
+fn hold_road_loads(eq: &mut Equations, t: f64, y: &mut [f64], crossed: &[f64]) {
+    let n = eq.net.bodies.len();
+    let loaded: Vec<usize> = (0..n).filter(|&i| eq.breakaway(i) > 0.0).collect();
+    if loaded.is_empty() {
+        return;
+    }
+    let at = eq.body_guard_at();
+    // a held body whose guard reached zero: its group's torque reached the breakaway
+    let broke: Vec<bool> = (0..n)
+        .map(|i| eq.held[i] && crossed.get(at + i).is_some_and(|g| *g <= 0.0))
+        .collect();
+    for &i in &loaded {
+        if eq.held[i] && y[n + i] != 0.0 {
+            eq.held[i] = false;
+        }
+        let reached = !broke[i] && crossed.get(at + i).is_some_and(|g| *g <= 0.0);
+        if !eq.held[i] && (reached || y[n + i] == 0.0) && !eq.clusters.fixed[eq.clusters.of[i]] {
+            // the group at rest (a located zero of its speed: within 1e-12 rad/s of it)
+            let c = eq.clusters.of[i];
+            for j in 0..n {
+                if eq.clusters.of[j] == c {
+                    y[n + j] = 0.0;
+                }
+            }
+            eq.held[i] = true;
+        }
+    }
+    if !eq.held.contains(&true) {
+        for &i in &loaded {
+            eq.moving[i] = if y[n + i] == 0.0 {
+                0.0
+            } else {
+                y[n + i].signum()
+            };
+        }
+        return;
+    }
+    // the groups' torques without the reactions; a group over its breakaway starts
+    eq.forces(t, y);
+    for &i in &loaded {
+        let c = eq.clusters.of[i];
+        let (gt, cap) = (eq.hold_torque[c], eq.hold_capacity[c]);
+        if eq.held[i] && (gt.abs() > cap || broke[i]) {
+            eq.held[i] = false;
+        }
+        eq.moving[i] = if eq.held[i] {
+            0.0
+        } else if y[n + i] != 0.0 {
+            y[n + i].signum()
+        } else {
+            // at rest, starting: towards the group's torque, in the body's own sense
+            (gt * eq.clusters.g[i]).signum()
+        };
+    }
+    eq.forces(t, y);
 }

@@ -11,7 +11,7 @@ pub use clutchpack_model::network::NetworkInput;
 use clutchpack_model::network::{
     ClutchMode, Network, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
 };
-use clutchpack_model::EngineError;
+use clutchpack_model::{guard_state, EngineError, RUNAWAY_SPEED_RAD_S};
 use std::sync::Arc;
 
 /// Runs `net` for `duration_s` seconds; samples and clutch events go to `obs` as they happen.
@@ -287,6 +287,14 @@ impl NetworkStepper {
             let bp = breakpoints.get(*next_bp).copied();
             let stop = bp.map_or(t_end, |b| b.min(t_end));
             let at_bp = bp == Some(stop);
+            if !at_bp && stop - *t <= 1e-13 * (1.0 + *t) {
+                // a call's end within the events' precision of where the run stands (frames
+                // added up by a host: 0.1 after ten of 0.01 is 0.09999999999999999; a frame
+                // ending a few ulps past a breakpoint landed on): reached, not a step of
+                // 1e-17 s that would count as a collapse (issue 48, item 8)
+                *t = stop;
+                continue;
+            }
             if at_bp && stop - *t <= 1e-13 * (1.0 + *t) {
                 // an event left the run at a breakpoint: the signals jump here
                 *t = stop;
@@ -385,6 +393,15 @@ impl NetworkStepper {
             } else {
                 y.copy_from_slice(&stepper.y_new);
             }
+            // the engines' one guard of a state (issue 48, item 2), as the multibody engine's
+            let n = eq.net.bodies.len();
+            guard_state(
+                *t,
+                "the speed of body",
+                "rad/s",
+                &y[n..2 * n],
+                RUNAWAY_SPEED_RAD_S,
+            )?;
             *t = if land && event.is_none() { stop } else { t_new };
             self.steps += 1;
             // the thermal packs' heat of the step, by their faces' modes along it (before the
@@ -400,7 +417,6 @@ impl NetworkStepper {
             if at_event {
                 *g0_at = f64::NAN;
                 meshes.switch(eq, *t, y, Some(g1), obs);
-                let n = eq.net.bodies.len();
                 packs::switch(&mut eq.packs, n, *t, y, Some(g1), obs);
                 settle(eq, *t, y, g1, obs, &mut self.events);
                 heal_faces(eq, *t, y, obs);

@@ -11,8 +11,9 @@ use crate::keys::{
 };
 use crate::schema::{fmt_num, Key, RawTable};
 use clutchpack_model::thermal::{
-    laminar_gap_h_w_m2_k, FrictionMapError, FrictionTable, GapHeating, GapViscosity, ThermalBody,
-    ThermalModel, ThermalOil, ThermalProperties, ViscosityError, ViscosityLaw,
+    laminar_gap_h_w_m2_k, pack::FastestBody, pack::MIN_TIME_CONSTANT_S, FrictionMapError,
+    FrictionTable, GapHeating, GapViscosity, ThermalBody, ThermalModel, ThermalOil,
+    ThermalProperties, ViscosityError, ViscosityLaw,
 };
 use std::f64::consts::PI;
 
@@ -140,7 +141,7 @@ pub(super) fn thermal(
         conductance_w_k: g,
     };
     let initial = initial?;
-    Some(ThermalModel {
+    let model = ThermalModel {
         viscosity: viscosity?,
         reference_k: reference?.unwrap_or(initial),
         gap_viscosity: gap_viscosity?,
@@ -154,7 +155,71 @@ pub(super) fn thermal(
             inlet_k: inlet?.unwrap_or(initial),
         },
         friction: friction?,
-    })
+    };
+    time_constant_resolvable(ck, &model).then_some(model)
+}
+
+/// Whether the fastest time constant of `model` is at least
+/// [`clutchpack_model::thermal::MIN_TIME_CONSTANT_S`] (docs/DECISIONS.md, "Plausibility
+/// bounds"; issue 48): else reported at the capacity that sets it, with what it would need.
+fn time_constant_resolvable(ck: &mut Checker, model: &ThermalModel) -> bool {
+    let (tau, which) = model.fastest_time_constant_s();
+    if tau >= MIN_TIME_CONSTANT_S {
+        return true;
+    }
+    let (key, capacity, conductance) = match which {
+        FastestBody::Disc => (
+            &D::heat_capacity_j_k,
+            model.discs[0].capacity_j_k,
+            model.discs[0].conductance_w_k,
+        ),
+        FastestBody::Plate => (
+            &Pl::heat_capacity_j_k,
+            model.plates[0].capacity_j_k,
+            model.plates[0].conductance_w_k,
+        ),
+        FastestBody::Oil => (
+            &O::heat_capacity_j_k,
+            model.oil.capacity_j_k,
+            capacity_rate_sum(model),
+        ),
+    };
+    ck.report(
+        key.rel(),
+        Some(fmt_num(capacity)),
+        format!(
+            "with {} W/K to the oil{} its time constant is {} s, under the {} s that the \
+             thermal window's sub-steps need (plausibility bound): a capacity of at least {} \
+             J/K, or less convection{}",
+            fmt_num(conductance),
+            if which == FastestBody::Oil {
+                " and the cooler"
+            } else {
+                ""
+            },
+            fmt_num(tau),
+            fmt_num(MIN_TIME_CONSTANT_S),
+            fmt_num(MIN_TIME_CONSTANT_S * conductance),
+            if which == FastestBody::Oil {
+                " or a smaller cooler"
+            } else {
+                ""
+            },
+        ),
+    );
+    false
+}
+
+/// The oil's conductance to everything it exchanges heat with, W/K: every body's and the
+/// cooler's capacity rate.
+fn capacity_rate_sum(model: &ThermalModel) -> f64 {
+    model
+        .discs
+        .iter()
+        .chain(&model.plates)
+        .map(|b| b.conductance_w_k)
+        .sum::<f64>()
+        + model.oil.flow_capacity_w_k
 }
 
 /// `[thermal.friction]`: the faces' `mu(v, T)` (MODEL.md section 9), fitted once here so that
