@@ -38,7 +38,7 @@ fn a_meshing_error_prints_its_speeds_short() {
         .find(|l| l.contains("do not mesh"))
         .unwrap_or_else(|| panic!("no meshing error: {err}"));
     assert!(line.contains("couplings[3].ratio"), "{line}");
-    assert!(line.contains("is 8.571428571428571e301 rad/s"), "{line}");
+    assert!(line.ends_with("is 8.571428571428571e301"), "{line}");
     assert!(line.len() < 250, "{} characters: {line}", line.len());
 }
 

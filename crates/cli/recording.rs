@@ -505,7 +505,10 @@ fn compare_networks(a: &CompareArgs, networks: &[(String, NetworkRun)]) -> Resul
         CompareFormat::Markdown => TableFormat::Markdown,
         CompareFormat::Table => TableFormat::Text,
     };
-    out!("{}", clutch_compare_table(&rows, format).trim_end());
+    if !rows.is_empty() {
+        // none when every run was cut short (no summary: its clutches are not compared)
+        out!("{}", clutch_compare_table(&rows, format).trim_end());
+    }
     if !body_rows.is_empty() {
         out!("{}", pack_body_compare_table(&body_rows, format).trim_end());
     }
