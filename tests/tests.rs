@@ -12,6 +12,7 @@ mod network;
 mod network_engines;
 mod python_package;
 mod reliability;
+mod salvage_and_messages;
 mod session;
 mod slurm;
 mod study;

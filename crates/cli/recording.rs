@@ -395,22 +395,42 @@ type NetworkRun = (
 );
 
 /// The clutches (lumped and resolved packs) and the packs' bodies of a network recording,
-/// from its attached summary (the run's `--summary-json`); a recording of a run that did not
-/// finish has none: bad input, saying so.
+/// from its attached summary (the run's `--summary-json`). A recording of a run that did not
+/// finish (killed; read with `--salvage`) has none: its packs' bodies from the impacts it
+/// holds (with the contacts still open where it ends), its clutches left out (their heat is
+/// the summary's), said on stderr; with no impact either, bad input.
 fn network_clutches(f: &Path, reader: &RecordingReader) -> Result<NetworkRun> {
-    let summary = reader
+    let Some(summary) = reader
         .info()
         .attachments
         .iter()
         .find(|x| x.name == clutchpack_sdk::record::SUMMARY_ATTACHMENT)
         .and_then(|x| serde_json::from_slice::<serde_json::Value>(&x.data).ok())
-        .ok_or_else(|| {
-            BadInput(format!(
-                "{}: a network recording without its summary (the run did not finish): \
-                 nothing to compare",
+    else {
+        let net = clutchpack_sdk::record::read_network(reader)
+            .transpose()
+            .map_err(|e| BadInput(format!("{}: {e}", f.display())))?;
+        let bodies = net.as_ref().map_or_else(Vec::new, |n| {
+            clutchpack_sdk::analysis::PackBodyRun::from_impacts(&n.couplings, &n.impacts)
+        });
+        let Some(net) = net.filter(|_| !bodies.is_empty()) else {
+            return Err(BadInput(format!(
+                "{}: a network recording without its summary (the run did not finish) and \
+                 without a pack's impact: nothing to compare",
                 f.display()
             ))
-        })?;
+            .into());
+        };
+        eprintln!(
+            "note: {}: no summary (the run did not finish): its packs' bodies from the {} \
+             impacts it holds ({} contacts still open where it ends, closed there); its \
+             clutches are not compared",
+            f.display(),
+            net.impacts.len(),
+            net.open_contacts
+        );
+        return Ok((Vec::new(), bodies));
+    };
     let couplings = summary["couplings"].as_array().cloned().unwrap_or_default();
     let bodies = couplings
         .iter()
@@ -485,7 +505,10 @@ fn compare_networks(a: &CompareArgs, networks: &[(String, NetworkRun)]) -> Resul
         CompareFormat::Markdown => TableFormat::Markdown,
         CompareFormat::Table => TableFormat::Text,
     };
-    out!("{}", clutch_compare_table(&rows, format).trim_end());
+    if !rows.is_empty() {
+        // none when every run was cut short (no summary: its clutches are not compared)
+        out!("{}", clutch_compare_table(&rows, format).trim_end());
+    }
     if !body_rows.is_empty() {
         out!("{}", pack_body_compare_table(&body_rows, format).trim_end());
     }

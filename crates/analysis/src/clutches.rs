@@ -145,6 +145,52 @@ pub struct PackBodyRun {
     pub peak_abs_n: f64,
 }
 
+impl PackBodyRun {
+    /// The pack bodies of a run from its tooth impacts (a recording cut short, whose summary
+    /// was never written): each `(name, impact)` named `<pack>/discs/<disc>` or
+    /// `<pack>/plates/<plate>` (the recording's names) counted under `<pack>/<disc or plate>`
+    /// (the summary's), with its largest |peak|; the packs in the order of `couplings` (the
+    /// run's couplings' names), each pack's discs before its plates, each in the order of its
+    /// first impact. A gear mesh's impacts (no pack) are not a pack body's.
+    pub fn from_impacts(
+        couplings: &[String],
+        impacts: &[(String, clutchpack_model::ImpactEvent)],
+    ) -> Vec<PackBodyRun> {
+        let mut out: Vec<((usize, bool), PackBodyRun)> = Vec::new();
+        for (name, e) in impacts {
+            let mut parts = name.splitn(3, '/');
+            let (Some(pack), Some(role), Some(body)) = (parts.next(), parts.next(), parts.next())
+            else {
+                continue;
+            };
+            let name = format!("{pack}/{body}");
+            let order = (
+                couplings
+                    .iter()
+                    .position(|c| c == pack)
+                    .unwrap_or(usize::MAX),
+                role == "plates",
+            );
+            match out.iter_mut().find(|(_, b)| b.name == name) {
+                Some((_, b)) => {
+                    b.impacts += 1;
+                    b.peak_abs_n = b.peak_abs_n.max(e.peak_n.abs());
+                }
+                None => out.push((
+                    order,
+                    PackBodyRun {
+                        name,
+                        impacts: 1,
+                        peak_abs_n: e.peak_n.abs(),
+                    },
+                )),
+            }
+        }
+        out.sort_by_key(|(order, _)| *order);
+        out.into_iter().map(|(_, b)| b).collect()
+    }
+}
+
 /// One (run, pack body) row of the comparison.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PackBodyCompareRow {

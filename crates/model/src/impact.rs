@@ -75,6 +75,26 @@ impl ImpactTracker {
         }
     }
 
+    /// The open event as it would close at `t_s` (its peak the largest located so far), the
+    /// event left open: what a recording keeps of a contact that has not closed yet.
+    pub fn peek(&self, t_s: f64) -> Option<ImpactEvent> {
+        self.open.map(|e| ImpactEvent { t_off_s: t_s, ..e })
+    }
+
+    /// [`Self::peek`] with a probe not yet observed: `(t_peak s, |load| N)`, the largest
+    /// magnitude probed along the steps of an engine that refines the peak only when the
+    /// contact closes; taken when larger than the peak observed, signed by the flank
+    /// (negative when the shaft, or the carrier, leads).
+    pub fn peek_with(&self, t_s: f64, probe: Option<(f64, f64)>) -> Option<ImpactEvent> {
+        self.peek(t_s).map(|mut e| {
+            if let Some((t_peak, magnitude)) = probe.filter(|p| p.1 > e.peak_n.abs()) {
+                e.t_peak_s = t_peak;
+                e.peak_n = -e.flank.phi_sign() * magnitude;
+            }
+            e
+        })
+    }
+
     /// Closes the open event at `t_s` and returns it.
     pub fn end(&mut self, t_s: f64) -> Option<ImpactEvent> {
         self.last = None;

@@ -644,5 +644,8 @@ fn _clutchpack(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study_run, m)?)?;
     m.add_function(wrap_pyfunction!(study_merge, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    // the most cases a sweep runs (values x members), for the Python half's check of
+    // `ensemble`, which names the argument
+    m.add("MAX_BATCH_CASES", clutchpack_sdk::MAX_BATCH_CASES)?;
     Ok(())
 }

@@ -82,19 +82,27 @@ pub fn raw_network_recording(
 
 /// Runs a network scene (`[[bodies]]`) on `engine` (else `simulation.engine`, else the
 /// reference engine), as `clutchpack run` does: the summary and the sampled speeds and
-/// torques, and the recording at `record` if given (replaced if it exists). The GIL is
-/// released while it runs; Ctrl-C stops it and raises `KeyboardInterrupt` (the recording
-/// then holds the run up to there).
+/// torques, the recording at `record` and every tooth impact in the CSV file `impacts_csv`
+/// (`run --impacts-csv`'s, through the same request) if given (each replaced if it exists).
+/// The GIL is released while it runs; Ctrl-C stops it and raises `KeyboardInterrupt` (the
+/// recording and the CSV then hold the run up to there).
 #[pyfunction]
-#[pyo3(signature = (scene, engine=None, record=None, deterministic=false))]
+#[pyo3(signature = (scene, engine=None, record=None, deterministic=false, impacts_csv=None))]
 pub fn run_network(
     py: Python<'_>,
     scene: &Scene,
     engine: Option<&str>,
     record: Option<PathBuf>,
     deterministic: bool,
+    impacts_csv: Option<PathBuf>,
 ) -> PyResult<RawNetworkRun> {
-    check_outputs(&[("record =", record.as_deref())], scene)?;
+    check_outputs(
+        &[
+            ("record =", record.as_deref()),
+            ("impacts_csv =", impacts_csv.as_deref()),
+        ],
+        scene,
+    )?;
     let recording = record.map(|path| RecordingRequest {
         path,
         replace: clutchpack_sdk::record::Replace::Existing,
@@ -117,6 +125,7 @@ pub fn run_network(
                 recording,
                 stop: Some(&stop),
                 progress: Some(&mut progress),
+                impacts_csv,
                 ..Default::default()
             },
         )

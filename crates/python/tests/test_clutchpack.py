@@ -73,8 +73,6 @@ def test_a_network_scene_runs_as_the_cli_runs_it(tmp_path):
     assert len(r.samples) == 1501  # 0 to 1.5 s every ms
     assert r.samples["J1.speed_rad_s"].iloc[0] == 10.0
     assert "clutch3.torque_n_m" in r.samples.columns
-    with pytest.raises(ValueError, match="not for a network scene"):
-        clutchpack.run("scenes/coupled-clutches.toml", impacts_csv=tmp_path / "x.csv")
     # recorded on the multibody engine, as `clutchpack run --engine multibody --out`: the file
     # is complete and `replay` reads its bodies and clutch lock times back
     rec = tmp_path / "cc.mcap"
@@ -517,3 +515,112 @@ def test_a_thermal_simulation_outputs_its_temperatures():
     assert abs(out["oil.temperature_k"] - th["oil_final_k"]) < 1e-9
     for i, body in enumerate(th["bodies"][:6]):
         assert abs(out[f"discs[{i + 1}].temperature_k"] - body["final_k"]) < 1e-9, body["name"]
+
+
+def test_a_network_state_restores_only_into_its_simulation():
+    """Issue 48, item 9: a network Simulation's saved state restores only into the
+    Simulation that saved it: a `dct-upshift.toml` Simulation handed a state of a
+    `dct-upshift-lumped.toml` one, or of another Simulation of its own scene, raises
+    ValueError naming both scenes and goes on as it was (it became the lumped network, its
+    summary still naming dct-upshift); its own state restores."""
+    other = clutchpack.Simulation("scenes/dct-upshift-lumped.toml")
+    other.advance_to(0.02)
+    foreign = other.save()
+    twin = clutchpack.Simulation("scenes/dct-upshift.toml")
+    twin.advance_to(0.01)
+    sibling = twin.save()
+    sim = clutchpack.Simulation("scenes/dct-upshift.toml")
+    sim.advance_to(0.01)
+    own = sim.save()
+    sim.advance_to(0.015)
+    for state, scene in [(foreign, "dct-upshift-lumped"), (sibling, "dct-upshift")]:
+        with pytest.raises(ValueError, match=f'another run \\(scene "{scene}";'):
+            sim.restore(state)
+        assert sim.time == 0.015
+    sim.restore(own)
+    assert sim.time == 0.01
+    sim.advance_to(0.02)
+    assert sim.finish()["scene"] == "dct-upshift"
+
+
+@pytest.mark.parametrize(
+    "call,exc,words",
+    [
+        (lambda: clutchpack.sweep("scenes/hu-table2.toml", "defaults.oil.film_thickness_m",
+                                  [0.0], ensemble=2**64), ValueError,
+         "ensemble = 18446744073709551616: expected an integer in 1..=1000000"),
+        (lambda: clutchpack.Simulation("scenes/hu-table2.toml",
+                                       drive=["shaft_speed", "shaft.speed_rad_s"]),
+         ValueError, "shaft.speed_rad_s is named twice"),
+        (lambda: clutchpack.Simulation("scenes/dct-upshift-lumped.toml",
+                                       drive=["couplings.K2.normal_force_n"] * 2),
+         ValueError, '"couplings.K2.normal_force_n" is named twice'),
+        (lambda: clutchpack.Simulation(
+            "scenes/dct-upshift-lumped.toml", drive=["couplings.K1.normal_force_n"]
+        ).advance_to(0.01, **{"couplings.K1.normal_force_n": True}),
+         TypeError, "couplings.K1.normal_force_n = True: expected a number"),
+        (lambda: clutchpack.Simulation("scenes/hu-table2.toml", drive=["shaft_speed"])
+         .advance_to(0.01, **{"shaft.speed_rad_s": 200.0}, slopes={"shaft.speed_rad_s": False}),
+         TypeError, "slopes['shaft.speed_rad_s'] = False: expected a number"),
+    ],
+)
+def test_messages_name_the_argument_in_a_few_words(call, exc, words):
+    """Issue 48, item 11: an ensemble beyond the native integers (OverflowError naming
+    nothing), an input named twice in `drive` (accepted), a bool as an input's value (True
+    taken as 1 N) raise ValueError or TypeError naming the argument and its rule."""
+    with pytest.raises(exc) as e:
+        call()
+    assert words in str(e.value), e.value
+
+
+def test_messages_of_a_study_into_a_file_and_of_a_meshing_error(tmp_path):
+    """Issue 48, item 11: `study.run(out=<a file>)` says that the output folder is a file,
+    naming it (it said only "File exists (os error 17)"); a gear ratio of 1e300 whose
+    speeds do not mesh is refused in one line under 250 characters (it was 453: the speed
+    `ratio x w_b` in 303 digits), its numbers as `clutchpack check` echoes values."""
+    out = tmp_path / "out.txt"
+    out.write_text("mine")
+    with pytest.raises(ValueError) as e:
+        clutchpack.study.run("studies/paper-mc-1000.toml", out)
+    assert f"{out} is a file, not a folder" in str(e.value), e.value
+    assert out.read_text() == "mine"
+    with pytest.raises(ValueError) as e:
+        clutchpack.load_scene("scenes/dct-upshift-lumped.toml", set={"couplings[3].ratio": 1e300})
+    line = next(l for l in str(e.value).splitlines() if "do not mesh" in l)
+    assert line.endswith("is 8.571428571428571e301") and len(line) < 250, line
+
+
+def test_a_network_run_writes_the_impacts_csv_as_the_cli(tmp_path):
+    """Issue 48, item 11: `run(impacts_csv=)` of a network scene writes the CSV that
+    `clutchpack run --impacts-csv` writes (the same request of the sdk), byte for byte: the
+    packs' bodies' impacts of half a second of the DCT upshift (it raised "not for a network
+    scene")."""
+    theirs, ours = tmp_path / "cli.csv", tmp_path / "py.csv"
+    cli("run", "scenes/dct-upshift.toml", "--duration", "0.5", "--no-record",
+        "--impacts-csv", str(theirs))
+    clutchpack.run("scenes/dct-upshift.toml", duration=0.5, impacts_csv=ours)
+    text = ours.read_text()
+    assert text == theirs.read_text()
+    assert text.startswith("name,t_on_s,") and "K2/discs/" in text, text[:300]
+
+
+def test_a_recorded_simulation_dropped_without_finish_leaves_a_complete_recording(tmp_path):
+    """Issue 48, item 12: a recorded Simulation (a network's, a pack's) that is dropped
+    without `finish()` leaves its recording complete under its own name, as `finish` would
+    (the strict reader takes it, the network's run summary attached), not as a `.partial-`
+    file."""
+    import gc
+
+    net, pack = tmp_path / "net.mcap", tmp_path / "pack.mcap"
+    sim = clutchpack.Simulation("scenes/dct-upshift-lumped.toml", record=net)
+    sim.advance_to(0.05)
+    del sim
+    sim = clutchpack.Simulation("scenes/hu-table2.toml", record=pack)
+    sim.advance_to(0.02)
+    del sim
+    gc.collect()
+    assert sorted(os.listdir(tmp_path)) == ["net.mcap", "pack.mcap"]
+    back = clutchpack.read(net)
+    assert back.summary["scene"] == "dct-upshift-lumped" and not back.warnings
+    assert abs(back.samples["t_s"].iloc[-1] - 0.05) < 1e-9
+    assert clutchpack.read(pack).summary["duration_s"] == pytest.approx(0.02)

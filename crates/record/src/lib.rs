@@ -134,7 +134,8 @@ mod write;
 pub use export::{export_csv, export_csv_until};
 pub use info::{sha256_hex, DiscGeometry, FrictionInterface, RunInfo, ShaftGeometry};
 pub use network::{
-    body_frame, coupling_kind_name, impact_name, NetworkRecorder, META_NETWORK, SUMMARY_ATTACHMENT,
+    body_frame, coupling_kind_name, impact_name, NetworkRecorder, META_NETWORK,
+    OPEN_CONTACTS_EVERY_S, SUMMARY_ATTACHMENT,
 };
 pub use output::{
     check_outputs, partial_path, write_whole, OutputPath, OutputRefused, PendingFile, Replace,

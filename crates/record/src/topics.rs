@@ -123,6 +123,12 @@ pub const NETWORK_EVENTS: &str = "/network/events";
 /// A network's gear-mesh tooth impacts, `clutchpack.Impact` (`disc` = the mesh's name,
 /// `disc_index` = its coupling index), each at its peak time.
 pub const NETWORK_IMPACTS: &str = "/network/impacts";
+/// A network's tooth contacts still open, `clutchpack.Impact` named as on
+/// [`NETWORK_IMPACTS`], each as it would close at the instant it is logged (`t_off_s`, its
+/// peak so far), every [`crate::OPEN_CONTACTS_EVERY_S`] of simulated time: what a run cut
+/// short (a kill) keeps of contacts that last (a locked pack's teeth carry its torque for
+/// seconds); a contact's closed impact supersedes them (`read_network`).
+pub const NETWORK_CONTACTS: &str = "/network/contacts";
 /// A network's bodies as joints, `sensor_msgs/msg/JointState` (ROS 2, CDR), one message per
 /// sample: `position` = angle (rad), `velocity` = speed (rad/s), for Rerun.
 pub const NETWORK_BODY_JOINTS: &str = "/network/joints/bodies";

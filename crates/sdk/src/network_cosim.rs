@@ -380,12 +380,20 @@ pub struct NetworkSimulation {
     started: std::time::Instant,
     /// Set when an engine failure left the run unusable.
     failed: bool,
+    /// This run's number (`crate::cosim::next_run`): its saved states carry it, and only
+    /// they restore into it.
+    run: u64,
 }
 
-/// A saved state of a [`NetworkSimulation`] (without a recording).
+/// A saved state of a [`NetworkSimulation`] (without a recording): it belongs to the run
+/// that saved it and restores only into it.
 pub struct SavedNetworkSimulation {
     stepper: Stepper,
     keep: Keep,
+    /// The run that saved it.
+    run: u64,
+    /// That run's scene, for messages.
+    scene: String,
 }
 
 impl NetworkSimulation {
@@ -419,9 +427,12 @@ impl NetworkSimulation {
                     names.join(", ")
                 )));
             };
-            if !driven.iter().any(|(n, _)| n == name) {
-                driven.push(found.clone());
+            if driven.iter().any(|(n, _)| n == name) {
+                return Err(Error::BadInput(format!(
+                    "drive: {name:?} is named twice; name each input once"
+                )));
             }
+            driven.push(found.clone());
         }
         let duration = match stop_time_s {
             Some(t) if t.is_finite() && t > 0.0 => t,
@@ -466,6 +477,7 @@ impl NetworkSimulation {
             all_inputs,
             started,
             failed: false,
+            run: crate::cosim::next_run(),
         })
     }
 
@@ -627,11 +639,16 @@ impl NetworkSimulation {
         Ok(SavedNetworkSimulation {
             stepper: self.stepper.clone(),
             keep: self.keep.clone_unrecorded(),
+            run: self.run,
+            scene: self.scene.name.clone(),
         })
     }
 
-    /// Goes back to a state saved by [`Self::save`] of this run.
+    /// Goes back to a state saved by [`Self::save`] of this run; a state of another run (of
+    /// this scene or another) is bad input and leaves the run as it was.
     pub fn restore(&mut self, saved: &SavedNetworkSimulation) -> Result<()> {
+        crate::cosim::same_run(saved.run, &saved.scene, self.run, &self.scene.name)
+            .map_err(Error::BadInput)?;
         if self.keep.recorder.is_some() {
             return Err(Error::BadInput(
                 "restore(): not while recording (a recording cannot go back in time)".into(),
@@ -645,21 +662,35 @@ impl NetworkSimulation {
 
     /// Ends the run where it stands: the summary (`run --summary-json`'s for a network), the
     /// recording finished with it.
-    pub fn finish(self) -> Result<NetworkOutcome> {
-        let NetworkSimulation {
-            scene,
-            stepper,
-            mut keep,
-            started,
-            ..
-        } = self;
+    pub fn finish(mut self) -> Result<NetworkOutcome> {
+        self.conclude_here()
+    }
+
+    /// [`Self::finish`] in place: what the run kept is taken (a recording's file closed and
+    /// moved into place), so that dropping it afterwards does nothing more.
+    fn conclude_here(&mut self) -> Result<NetworkOutcome> {
+        let mut keep = std::mem::take(&mut self.keep);
         let mut obs = Obs {
             keep: &mut keep,
             stop: None,
             progress: None,
         };
-        let engine = stepper.engine();
-        let run = stepper.finish(&mut obs);
-        conclude(&scene, engine, keep, run, started.elapsed().as_secs_f64())
+        let engine = self.stepper.engine();
+        // the engine's finish takes its stepper whole; this one is not used after it
+        let run = self.stepper.clone().finish(&mut obs);
+        let wall_s = self.started.elapsed().as_secs_f64();
+        conclude(&self.scene, engine, keep, run, wall_s)
+    }
+}
+
+/// A recorded run dropped without [`NetworkSimulation::finish`] (a Python `Simulation`
+/// collected, a script that ends) is finished as `finish` would: its recording complete,
+/// with its summary, under its own name (as a run stopped by a signal leaves it), not left
+/// as a `.partial-` file that only a salvage reads.
+impl Drop for NetworkSimulation {
+    fn drop(&mut self) {
+        if self.keep.recorder.is_some() {
+            let _ = self.conclude_here();
+        }
     }
 }

@@ -42,6 +42,9 @@ pub(crate) struct Keep {
     /// With the history: every impact as (coupling, body in a pack, t_peak s, peak N).
     pub(crate) impact_log: Vec<(usize, Option<usize>, f64, f64)>,
     pub(crate) stopped: bool,
+    /// When the recording logs the open tooth contacts next, s
+    /// ([`clutchpack_record::OPEN_CONTACTS_EVERY_S`]).
+    pub(crate) open_contacts_at_s: f64,
     /// The recording, until its first error.
     pub recorder: Option<NetworkRecorder>,
     /// The recording's first error (it then stops the run).
@@ -153,6 +156,7 @@ impl Keep {
             history: self.history.clone(),
             impact_log: self.impact_log.clone(),
             stopped: self.stopped,
+            open_contacts_at_s: self.open_contacts_at_s,
             recorder: None,
             record_error: None,
         }
@@ -289,6 +293,19 @@ impl NetworkObserver for Obs<'_, '_> {
             .map(|(a, b)| a - b)
             .collect();
         self.keep.steps.push((after.t_s, steps));
+    }
+    fn wants_open_contacts(&mut self, t: f64) -> bool {
+        self.keep.recorder.is_some() && t >= self.keep.open_contacts_at_s
+    }
+    fn open_contacts(
+        &mut self,
+        t: f64,
+        open: &[(usize, Option<usize>, clutchpack_model::ImpactEvent)],
+    ) {
+        // on the grid of OPEN_CONTACTS_EVERY_S, whatever the steps
+        let every = clutchpack_record::OPEN_CONTACTS_EVERY_S;
+        self.keep.open_contacts_at_s = ((t / every).floor() + 1.0) * every;
+        self.keep.record(|r| r.write_open_contacts(t, open));
     }
     fn progress(&mut self, t: f64) -> bool {
         if let Some(p) = self.progress.as_mut() {

@@ -254,6 +254,35 @@ impl Session {
     /// Ends the run at [`Session::time_s`]: closes the open contact events, finishes the
     /// recording, and gives what a whole run gives.
     pub fn finish(mut self) -> RunOutcome {
+        let (result, recording, warnings, recorder_cpu_s) = self.conclude_here();
+        RunOutcome {
+            scene: std::mem::take(&mut self.scene),
+            engine: self.engine,
+            result,
+            wall_time_s: self.started.elapsed().as_secs_f64(),
+            engine_cpu_s: 0.0,
+            recorder_cpu_s,
+            body_names: std::mem::take(&mut self.body_names),
+            collector: std::mem::replace(&mut self.collector, RunCollector::new(0, false)),
+            impacts_csv: None,
+            recording,
+            windows: Vec::new(),
+            warnings,
+        }
+    }
+
+    /// [`Session::finish`] in place: the open contact events closed, the recording (taken)
+    /// finished; the run's result, the recording's, the warnings and the recorder's CPU
+    /// time, s.
+    #[allow(clippy::type_complexity)]
+    fn conclude_here(
+        &mut self,
+    ) -> (
+        std::result::Result<RunStats, EngineError>,
+        Option<std::result::Result<std::path::PathBuf, clutchpack_record::RecordError>>,
+        Vec<String>,
+        f64,
+    ) {
         let result = match self.failure.take() {
             Some(e) => Err(e),
             None => {
@@ -275,19 +304,18 @@ impl Session {
             recorder_cpu_s = cpu;
             r
         });
-        RunOutcome {
-            scene: self.scene,
-            engine: self.engine,
-            result,
-            wall_time_s: self.started.elapsed().as_secs_f64(),
-            engine_cpu_s: 0.0,
-            recorder_cpu_s,
-            body_names: self.body_names,
-            collector: self.collector,
-            impacts_csv: None,
-            recording,
-            windows: Vec::new(),
-            warnings,
+        (result, recording, warnings, recorder_cpu_s)
+    }
+}
+
+/// A recorded run dropped without [`Session::finish`] (a Python `Simulation` collected, a
+/// script that ends, an FMU instance freed) is finished as `finish` would: its recording
+/// complete, with its statistics, under its own name (as a run stopped by a signal leaves
+/// it), not left as a `.partial-` file that only a salvage reads.
+impl Drop for Session {
+    fn drop(&mut self) {
+        if self.recorder.is_some() {
+            let _ = self.conclude_here();
         }
     }
 }

@@ -14,7 +14,7 @@ pub const PART_FLUSH: Duration = Duration::from_secs(5);
 /// Runs the cases of `shard` of `study` that its part in `out` lacks, on `jobs` threads,
 /// each with the study's engine (else the scene's choice); stops starting cases once `stop`
 /// is set, the part complete up to there. `progress(done, total)` after each case. A part of
-/// another study in `out` is bad input.
+/// another study in `out`, or an `out` that is a file (or lies under one), is bad input.
 pub fn run_study_shard(
     study: &Study,
     out: &Path,
@@ -23,6 +23,15 @@ pub fn run_study_shard(
     stop: &AtomicBool,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<ShardOutcome> {
+    // a file where the folder (or one of its parents) should be: said as such, before the
+    // folder is made (else only the operating system's "File exists" or "Not a directory")
+    if let Some(file) = out.ancestors().find(|p| p.exists() && !p.is_dir()) {
+        return Err(Error::BadInput(format!(
+            "{}: the study's output folder (its parts go into it), but {} is a file, not a folder",
+            out.display(),
+            file.display()
+        )));
+    }
     let engine = study.engine;
     clutchpack_study::run_shard(
         study,

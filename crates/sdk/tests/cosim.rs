@@ -357,3 +357,143 @@ fn the_multibody_engine_drives_a_packs_pressure_by_name() {
     );
     eprintln!("K2 heat {rel:.2e} apart, lock {dt:.2e} s apart");
 }
+
+/// Issue 48, item 9: a network simulation's saved state restores only into the run that
+/// saved it. A `dct-upshift.toml` run handed a state of a `dct-upshift-lumped.toml` run (or of
+/// another run of its own scene) refuses it, naming both scenes, and goes on as it was: its
+/// time, and a summary that still names its scene and its two resolved packs; its own state
+/// restores. The co-simulation layer (the FMU's network path) refuses it too.
+#[test]
+fn network_restore_refuses_a_state_of_another_simulation() {
+    use clutchpack_sdk::NetworkSimulation;
+    let (packs, lumped) = (scene("dct-upshift.toml"), scene("dct-upshift-lumped.toml"));
+    let mut other = NetworkSimulation::start(&lumped, None, &[], None, None).unwrap();
+    other.advance_to(0.02, None).unwrap();
+    let foreign = other.save().unwrap();
+    let mut twin = NetworkSimulation::start(&packs, None, &[], None, None).unwrap();
+    twin.advance_to(0.01, None).unwrap();
+    let sibling = twin.save().unwrap();
+
+    let mut sim = NetworkSimulation::start(&packs, None, &[], None, None).unwrap();
+    sim.advance_to(0.01, None).unwrap();
+    let own = sim.save().unwrap();
+    sim.advance_to(0.015, None).unwrap();
+    for (state, from) in [(&foreign, "dct-upshift-lumped"), (&sibling, "dct-upshift")] {
+        let e = sim.restore(state).unwrap_err();
+        assert!(e.is_bad_input(), "{e}");
+        let text = e.to_string();
+        let names = format!("scene {from:?}; this instance runs \"dct-upshift\"");
+        assert!(
+            text.contains("another run") && text.contains(&names),
+            "{text}"
+        );
+        assert_eq!(sim.time_s(), 0.015);
+    }
+    sim.restore(&own).unwrap();
+    assert_eq!(sim.time_s(), 0.01);
+    sim.advance_to(0.02, None).unwrap();
+    let summary = sim.finish().unwrap().summary;
+    assert_eq!(summary.scene, "dct-upshift");
+    let names: Vec<&str> = summary.couplings.iter().map(|c| c.name.as_str()).collect();
+    assert!(names.contains(&"K1") && names.contains(&"K2"), "{names:?}");
+
+    // the FMU's network path: a co-simulation of one scene refuses another's state
+    let mut a = CoSimulation::new(lumped).unwrap();
+    a.start(None).unwrap();
+    a.advance_to(0.01, None).unwrap();
+    let state = a.save().unwrap();
+    let mut b = CoSimulation::new(packs).unwrap();
+    b.start(None).unwrap();
+    let e = b.restore(&state).unwrap_err();
+    assert!(e.contains("another run"), "{e}");
+}
+
+/// Issue 48, item 11: an input named twice in `drive` (by one name, or by its name and its
+/// older alias; a network's by its one name) is refused naming it, as an unknown one is.
+#[test]
+fn drive_naming_an_input_twice_is_refused() {
+    for names in [
+        ["piston.pressure_pa", "piston.pressure_pa"],
+        ["piston_pressure", "piston.pressure_pa"],
+    ] {
+        let e = driven_from_names(&names).unwrap_err();
+        assert!(
+            e.contains("piston.pressure_pa is named twice"),
+            "{names:?}: {e}"
+        );
+    }
+    let k2 = "couplings.K2.normal_force_n".to_string();
+    let e = clutchpack_sdk::NetworkSimulation::start(
+        &scene("dct-upshift-lumped.toml"),
+        None,
+        &[k2.clone(), k2],
+        None,
+        None,
+    )
+    .err()
+    .expect("refused");
+    assert!(e.is_bad_input(), "{e}");
+    assert!(
+        e.to_string()
+            .contains("\"couplings.K2.normal_force_n\" is named twice"),
+        "{e}"
+    );
+}
+
+/// The files in `dir`, by name, sorted.
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// Issue 48, item 12: a recorded run dropped without `finish` (a Python `Simulation`
+/// collected, a script that ends) leaves its recording complete under its own name, as
+/// `finish` would (the strict reader opens it, its summary attached), not as a `.partial-`
+/// file: a network's run and a pack's session alike.
+#[test]
+fn a_recorded_run_dropped_without_finish_leaves_a_complete_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let request = |name: &str| clutchpack_sdk::RecordingRequest {
+        path: dir.path().join(name),
+        replace: clutchpack_sdk::record::Replace::Existing,
+        options: Default::default(),
+        scene_path: None,
+    };
+    let net = request("network.mcap");
+    let mut sim = clutchpack_sdk::NetworkSimulation::start(
+        &scene("dct-upshift-lumped.toml"),
+        None,
+        &[],
+        Some(&net),
+        None,
+    )
+    .unwrap();
+    sim.advance_to(0.05, None).unwrap();
+    drop(sim);
+    let pack = request("pack.mcap");
+    let s = clutchpack_sdk::Simulation::new(scene("hu-table2.toml"), None).unwrap();
+    let mut session = s
+        .start(clutchpack_sdk::SessionRequest {
+            driven: Driven::NONE,
+            stop_time_s: None,
+            recording: Some(pack.clone()),
+            keep_history: false,
+        })
+        .unwrap();
+    session.advance_to(0.02, None).unwrap();
+    drop(session);
+    assert_eq!(files_in(dir.path()), ["network.mcap", "pack.mcap"]);
+    let reader = clutchpack_sdk::record::open(&net.path).unwrap();
+    let recorded = clutchpack_sdk::record::read_network(&reader)
+        .unwrap()
+        .unwrap();
+    assert!(recorded.summary_json.is_some());
+    let last = recorded.samples.last().unwrap().t_s;
+    assert!((last - 0.05).abs() < 1e-9, "{last}");
+    let reader = clutchpack_sdk::record::open(&pack.path).unwrap();
+    assert!(reader.summary().is_some());
+}

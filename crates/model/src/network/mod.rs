@@ -256,7 +256,7 @@ impl Network {
                 out.push(body(
                     i,
                     "inertia_kg_m2",
-                    format!("{} must be > 0", b.inertia_kg_m2),
+                    format!("{} must be > 0", crate::fmt_num(b.inertia_kg_m2)),
                 ));
             }
             if b.fixed && b.initial_speed_rad_s != 0.0 {
@@ -391,7 +391,11 @@ impl Network {
                 }
                 CouplingKind::IdealGear { ratio } => {
                     if !(ratio.is_finite() && *ratio != 0.0) {
-                        out.push(coupling(k, "ratio", format!("{ratio} must be nonzero")));
+                        out.push(coupling(
+                            k,
+                            "ratio",
+                            format!("{} must be nonzero", crate::fmt_num(*ratio)),
+                        ));
                         continue;
                     }
                     let (ba, bb) = (&self.bodies[c.a], &self.bodies[c.b]);
@@ -426,8 +430,12 @@ impl Network {
                             k,
                             "ratio",
                             format!(
-                                "the speeds at t = 0 do not mesh: \"{}\" turns at {wa} rad/s but ratio x \"{}\"'s {wb} rad/s is {want}",
-                                ba.name, bb.name
+                                "the speeds at t = 0 do not mesh: \"{}\" turns at {} rad/s but ratio x \"{}\"'s {} rad/s is {}",
+                                ba.name,
+                                crate::fmt_num(wa),
+                                bb.name,
+                                crate::fmt_num(wb),
+                                crate::fmt_num(want)
                             ),
                         ));
                     }
@@ -472,7 +480,8 @@ impl Network {
         }
         if !(duration_s.is_finite() && duration_s >= 0.0) {
             return Err(crate::EngineError::Unsupported(format!(
-                "duration {duration_s} s must be finite and >= 0"
+                "duration {} s must be finite and >= 0",
+                crate::fmt_num(duration_s)
             )));
         }
         Ok(())

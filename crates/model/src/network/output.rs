@@ -142,6 +142,18 @@ pub trait NetworkObserver {
         _faces: usize,
     ) {
     }
+    /// Whether it wants the tooth contacts open at `t_s` (s, the end of an accepted step)
+    /// through [`Self::open_contacts`]: asked after every step, so it answers cheaply; no by
+    /// default.
+    fn wants_open_contacts(&mut self, _t_s: f64) -> bool {
+        false
+    }
+    /// The tooth contacts open at `t_s` (s), when [`Self::wants_open_contacts`] asked: each as
+    /// `(coupling, body in a pack, event)`, the event as it would close at `t_s` (its onset,
+    /// its peak located so far, `t_off_s = t_s`), as [`Self::mesh_impact`] (`body` `None`)
+    /// and [`Self::pack_impact`] give closed ones. A contact stays open for seconds where a
+    /// locked pack's teeth carry its torque: what a run cut short would otherwise lose.
+    fn open_contacts(&mut self, _t_s: f64, _open: &[(usize, Option<usize>, ImpactEvent)]) {}
     /// Polled after every step with the time reached, s; `false` stops the run there.
     fn progress(&mut self, _t_s: f64) -> bool {
         true

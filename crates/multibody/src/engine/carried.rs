@@ -130,6 +130,12 @@ impl MultibodySession {
         Ok(())
     }
 
+    /// Every tooth contact open now, as it would close at the session's time (its peak the
+    /// largest so far; `disc` the coupling's index, discs then plates), left open.
+    pub fn open_impacts(&self) -> Vec<clutchpack_model::ImpactEvent> {
+        self.run.events.open(self.run.t).collect()
+    }
+
     /// The stack's friction interfaces now (empty without a stack): what
     /// [`Session::snapshot`] holds of them, without the bodies' sample.
     pub fn interfaces(&self) -> Vec<clutchpack_model::InterfaceSample> {

@@ -180,6 +180,11 @@ impl EventBook {
         }
     }
 
+    /// Every open event as it would close at `t` (its peak the largest so far), left open.
+    pub(super) fn open(&self, t: f64) -> impl Iterator<Item = ImpactEvent> + '_ {
+        self.tracks.iter().filter_map(move |k| k.tracker.peek(t))
+    }
+
     /// Closes the events still open at the end of the run, `t`.
     pub(super) fn finish(&mut self, t: f64) -> Vec<ImpactEvent> {
         self.tracks

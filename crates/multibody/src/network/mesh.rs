@@ -315,6 +315,13 @@ impl Mesh {
         }
     }
 
+    /// The open contact as it would close at `t` s (its peak the largest probed so far),
+    /// left open.
+    pub fn open(&self, t: f64) -> Option<clutchpack_model::ImpactEvent> {
+        let probe = self.best.as_ref().map(|(path, tau, f)| (path.t0 + tau, *f));
+        self.tracker.peek_with(t, probe)
+    }
+
     /// Closes an open contact at the end of the run, `t` s (its separation then).
     pub fn finish(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
         if self.contact.is_some() {

@@ -331,6 +331,14 @@ impl NetPack {
         obs.pack_sample(self.k, t, &angle, &speed, &load);
     }
 
+    /// Every open contact of its discs and plates as it would close now (`(its coupling, the
+    /// body, event)`, the peak the largest so far), appended to `out`.
+    pub fn open(&self, out: &mut Vec<(usize, Option<usize>, ImpactEvent)>) {
+        for e in self.session.open_impacts() {
+            out.push((self.k, Some(e.disc), e));
+        }
+    }
+
     /// Its faces' heat since t = 0 (friction and the open gaps' drag), J.
     pub fn face_heat_j(&self) -> f64 {
         self.session

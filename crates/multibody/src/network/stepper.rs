@@ -228,6 +228,16 @@ impl NetworkStepper {
                 return Ok(());
             }
             self.step(t_end, obs)?;
+            if obs.wants_open_contacts(self.t) {
+                let mut open = Vec::new();
+                for m in &self.run.meshes {
+                    open.extend(m.open(self.t).map(|e| (m.coupling, None, e)));
+                }
+                for p in &self.run.packs {
+                    p.open(&mut open);
+                }
+                obs.open_contacts(self.t, &open);
+            }
             if !obs.progress(self.t) {
                 self.run.settle(self.t, obs);
                 return Ok(());

@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 
 from . import _clutchpack, study
-from ._args import _integer, _time
+from ._args import _integer, _number, _time
 from ._clutchpack import Scene
 
 __version__: str = _clutchpack.__version__
@@ -168,7 +168,7 @@ def run(
         s["simulation.duration_s"] = _time("duration", duration)
     sc = load_scene(scene, s)
     if sc.is_network:
-        return _run_network(sc, engine, record, impacts_csv)
+        return _run_network(sc, engine, record, impacts_csv, deterministic)
     raw = _clutchpack.run(
         sc,
         engine=engine,
@@ -192,15 +192,23 @@ def run(
     )
 
 
-def _run_network(sc: Scene, engine: Optional[str], record: Any, impacts_csv: Any) -> Result:
+def _run_network(
+    sc: Scene, engine: Optional[str], record: Any, impacts_csv: Any, deterministic: bool
+) -> Result:
     """A network scene's run (``[[bodies]]``) on ``engine`` (else the scene's, else the
     reference engine): the summary (``couplings`` with each clutch's mode changes, lock times
     and heat; ``bodies``; ``energy``), ``samples`` with ``t_s``, ``<body>.speed_rad_s`` and
-    ``<coupling>.torque_n_m`` columns, and the recording at ``record`` if given (as
-    ``clutchpack run --out``). Impact CSVs are for pack scenes."""
-    if impacts_csv is not None:
-        raise ValueError(f"impacts_csv: not for a network scene ({sc.name} has [[bodies]])")
-    raw = _clutchpack.run_network(sc, engine, None if record is None else os.fspath(record))
+    ``<coupling>.torque_n_m`` columns, the recording at ``record`` if given (as
+    ``clutchpack run --out``), and every tooth impact (a gear mesh's, a resolved pack's disc's
+    or plate's) in the CSV file ``impacts_csv`` if given (as ``--impacts-csv``: its first
+    column ``name``, ``<pack>/discs/<disc>``)."""
+    raw = _clutchpack.run_network(
+        sc,
+        engine,
+        None if record is None else os.fspath(record),
+        deterministic=deterministic,
+        impacts_csv=None if impacts_csv is None else os.fspath(impacts_csv),
+    )
     samples = pd.DataFrame({"t_s": np.asarray(raw.sample_t_s, dtype=float)})
     for name, values in raw.speed_rad_s:
         samples[f"{name}.speed_rad_s"] = np.asarray(values, dtype=float)
@@ -269,7 +277,7 @@ def sweep(
 ) -> Sweep:
     """Runs ``scene`` once per value of the key ``param`` (as ``clutchpack sweep``), each value
     as an ensemble of ``ensemble`` members spread across the free play, on ``jobs`` threads."""
-    ensemble = _integer("ensemble", ensemble, 1)
+    ensemble = _integer("ensemble", ensemble, 1, _clutchpack.MAX_BATCH_CASES)
     jobs = None if jobs is None else _integer("jobs", jobs, 1)
     sc = load_scene(scene, set)
     text = _clutchpack.sweep(
@@ -372,7 +380,12 @@ class Simulation:
         if alone:
             raise ValueError(f"slopes[{alone[0]!r}]: set the input's value with its slope")
         for name, value in inputs.items():
-            self._s.set_input(name, float(value), (slopes or {}).get(name))
+            slope = (slopes or {}).get(name)
+            self._s.set_input(
+                name,
+                _number(name, value),
+                None if slope is None else _number(f"slopes[{name!r}]", slope),
+            )
         self._s.advance_to(float(t))
         return self
 

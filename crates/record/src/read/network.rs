@@ -21,8 +21,14 @@ pub struct RecordedNetwork {
     pub samples: Vec<NetworkSample>,
     /// Every tooth impact on `/network/impacts` with its name: a gear mesh's its coupling's,
     /// a pack's disc's or plate's `<pack>/discs/<disc>` or `<pack>/plates/<plate>`
-    /// ([`crate::impact_name`]); in file order (their contacts' closing).
+    /// ([`crate::impact_name`]); in file order (their contacts' closing); then the
+    /// [`Self::open_contacts`] last.
     pub impacts: Vec<(String, clutchpack_model::ImpactEvent)>,
+    /// How many of [`Self::impacts`], the last, are contacts still open where the file ends
+    /// (a run killed while they lasted): each as `/network/contacts` last logged it, closed
+    /// then (its peak so far), as a run stopped there would have closed it. 0 in a finished
+    /// recording (its run closed every contact at its end).
+    pub open_contacts: usize,
     /// The clutch mode changes' log lines (`K2: slip- -> locked at t = ... s`), in file order.
     pub events: Vec<String>,
     /// The attached summary (the JSON of `run --summary-json`), if the run finished.
@@ -68,6 +74,7 @@ pub fn read_network(reader: &crate::RecordingReader) -> Option<Result<RecordedNe
     let mut by_time: BTreeMap<u64, NetworkSample> = BTreeMap::new();
     let mut events = Vec::new();
     let mut impacts = Vec::new();
+    let mut contacts = Vec::new();
     let mut error: Option<String> = None;
     let (n, m) = (bodies.len(), couplings.len());
     reader.for_each_message(|msg| {
@@ -87,9 +94,14 @@ pub fn read_network(reader: &crate::RecordingReader) -> Option<Result<RecordedNe
                 msg.topic, msg.log_time_ns
             )
         };
-        if msg.topic == topics::NETWORK_IMPACTS {
+        if msg.topic == topics::NETWORK_IMPACTS || msg.topic == topics::NETWORK_CONTACTS {
+            let into = if msg.topic == topics::NETWORK_IMPACTS {
+                &mut impacts
+            } else {
+                &mut contacts
+            };
             match proto::Impact::decode(msg.data) {
-                Ok(i) => impacts.push((i.disc.clone(), super::series::impact_event(&i))),
+                Ok(i) => into.push((i.disc.clone(), super::series::impact_event(&i))),
                 Err(e) => error = Some(bad(e)),
             }
         } else if msg.topic == topics::NETWORK_EVENTS {
@@ -133,6 +145,7 @@ pub fn read_network(reader: &crate::RecordingReader) -> Option<Result<RecordedNe
     if let Some(e) = error {
         return Some(Err(e));
     }
+    let open_contacts = still_open(&mut impacts, contacts);
     let samples: Vec<NetworkSample> = by_time.into_values().collect();
     if let Some(s) = samples
         .iter()
@@ -154,7 +167,31 @@ pub fn read_network(reader: &crate::RecordingReader) -> Option<Result<RecordedNe
         couplings,
         samples,
         impacts,
+        open_contacts,
         events,
         summary_json,
     }))
+}
+
+/// Appends to `impacts` the logged open `contacts` whose impact never closed in the file
+/// (a contact is its name and its onset), each at its last logged state, in the order they
+/// opened; returns how many.
+fn still_open(
+    impacts: &mut Vec<(String, clutchpack_model::ImpactEvent)>,
+    contacts: Vec<(String, clutchpack_model::ImpactEvent)>,
+) -> usize {
+    let key = |(n, e): &(String, clutchpack_model::ImpactEvent)| (n.clone(), e.t_on_s.to_bits());
+    let closed: std::collections::HashSet<_> = impacts.iter().map(key).collect();
+    let mut open: BTreeMap<(String, u64), clutchpack_model::ImpactEvent> = BTreeMap::new();
+    for c in contacts {
+        let k = key(&c);
+        if !closed.contains(&k) {
+            open.insert(k, c.1);
+        }
+    }
+    let mut open: Vec<_> = open.into_iter().map(|((n, _), e)| (n, e)).collect();
+    open.sort_by(|a, b| a.1.t_on_s.total_cmp(&b.1.t_on_s));
+    let n = open.len();
+    impacts.extend(open);
+    n
 }

@@ -39,6 +39,19 @@ impl Meshes {
         -g.force_n(&mesh_kinematics(&eq.net, k, g, ybuf), &e)
     }
 
+    /// Every mesh's open contact as it would close at `t` (`(coupling, None, event)`, its
+    /// peak the largest located so far), appended to `out`.
+    pub fn open(
+        &self,
+        t: f64,
+        out: &mut Vec<(usize, Option<usize>, clutchpack_model::ImpactEvent)>,
+    ) {
+        for (k, tracker) in self.trackers.iter().enumerate() {
+            let probe = self.best[k].as_ref().map(|b| (b.1, b.2));
+            out.extend(tracker.peek_with(t, probe).map(|e| (k, None, e)));
+        }
+    }
+
     /// Observes the meshes in contact over the accepted step `[t0, t1]` of `dense`.
     pub fn observe(&mut self, eq: &mut Equations, dense: &Dense, t0: f64, t1: f64) {
         for k in 0..self.trackers.len() {

@@ -239,6 +239,18 @@ impl NetPack {
         }
     }
 
+    /// Every open contact of its discs and plates as it would close at `t` (`(its coupling,
+    /// the body, event)`, the peak the largest located so far), appended to `out`.
+    pub fn open(
+        &self,
+        t: f64,
+        out: &mut Vec<(usize, Option<usize>, clutchpack_model::ImpactEvent)>,
+    ) {
+        for (slot, tracker) in self.trackers.iter().enumerate() {
+            out.extend(tracker.peek(t).map(|e| (self.k, Some(slot), e)));
+        }
+    }
+
     /// Closes every open event at the end of the run at `t`.
     pub fn finish(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
         for slot in 0..self.sys.ids.len() {

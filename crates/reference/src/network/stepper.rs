@@ -434,6 +434,14 @@ impl NetworkStepper {
                 stepper.set_start_derivative(dy);
             }
             *h = h.min(self.options.max_step_s);
+            if obs.wants_open_contacts(*t) {
+                let mut open = Vec::new();
+                meshes.open(*t, &mut open);
+                for p in &eq.packs {
+                    p.open(*t, &mut open);
+                }
+                obs.open_contacts(*t, &open);
+            }
             if !obs.progress(*t) {
                 break;
             }

@@ -206,7 +206,8 @@ pub fn driven_names(driven: &Driven) -> Vec<&'static str> {
 }
 
 /// The inputs named in `names` (public names or aliases) as a [`Driven`]; an unknown name is
-/// an error that lists the names.
+/// an error that lists the names, an input named twice (by one name or by its name and its
+/// alias) an error naming it.
 pub fn driven_from_names<S: AsRef<str>>(names: &[S]) -> Result<Driven, String> {
     let mut driven = Driven::NONE;
     for n in names {
@@ -226,6 +227,12 @@ pub fn driven_from_names<S: AsRef<str>>(names: &[S]) -> Result<Driven, String> {
                 old.join(", ")
             )
         })?;
+        if i.is_driven(&driven) {
+            return Err(format!(
+                "drive = {n:?}: {} is named twice; name each input once",
+                i.name()
+            ));
+        }
         i.drive(&mut driven);
     }
     Ok(driven)

@@ -27,6 +27,26 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 /// state names the run it belongs to, and restores only into it.
 static RUNS: AtomicU64 = AtomicU64::new(1);
 
+/// A run's number, new for each run started by a co-simulation ([`CoSimulation::start`]) or
+/// a network simulation ([`crate::NetworkSimulation::start`]): what its saved states carry.
+pub(crate) fn next_run() -> u64 {
+    RUNS.fetch_add(1, Ordering::Relaxed)
+}
+
+/// The one check that a saved state restores only into the run that saved it: a state saved
+/// by run `saved` of the scene `saved_scene`, restored into run `run` of `scene` (0: none
+/// started), is refused unless the two runs are one (another instance's, another scene's, or
+/// a state from before a reset would make the run another scene's under its own name).
+pub(crate) fn same_run(saved: u64, saved_scene: &str, run: u64, scene: &str) -> Result<(), String> {
+    if saved != run || run == 0 {
+        return Err(format!(
+            "the state was saved by another run (scene {saved_scene:?}; this instance runs \
+             {scene:?}): a state restores only into the instance and run that saved it"
+        ));
+    }
+    Ok(())
+}
+
 /// Where a co-simulated run is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stage {
@@ -340,7 +360,7 @@ impl CoSimulation {
         }
         self.snapshot = session.snapshot();
         self.session = Some(session);
-        self.run = RUNS.fetch_add(1, Ordering::Relaxed);
+        self.run = next_run();
         Ok(())
     }
 
@@ -752,13 +772,7 @@ impl CoSimulation {
     /// from before a reset; a recorded run saves none, so it is never rewound); a failed run
     /// goes on from the state.
     pub fn restore(&mut self, state: &SavedCoSimulation) -> Result<(), String> {
-        if state.run != self.run || self.run == 0 {
-            return Err(format!(
-                "the state was saved by another run (scene {:?}; this instance runs {:?}): a \
-                 state restores only into the instance and run that saved it",
-                state.scene, self.scene.name
-            ));
-        }
+        same_run(state.run, &state.scene, self.run, &self.scene.name)?;
         let going = "a state can be restored while the run goes (after fmi2ExitInitializationMode)";
         match &state.session {
             SavedRun::Pack(saved) => {

@@ -2,10 +2,10 @@
 //! started with every input driven, its inputs handed over when they change, its outputs
 //! read after each advance (docs/DECISIONS.md, "Network recordings and inputs").
 
-use super::{CoSimulation, Quantity, RUNS};
+use super::{next_run, CoSimulation, Quantity};
 use crate::RecordingRequest;
 use clutchpack_scene::EngineChoice;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 impl CoSimulation {
     /// [`CoSimulation::start`] of a network scene: its run driving every input, each at its
@@ -34,7 +34,7 @@ impl CoSimulation {
         self.network_pushed = vec![f64::NAN; names.len()];
         self.push_network_inputs()?;
         self.refresh_network_outputs();
-        self.run = RUNS.fetch_add(1, Ordering::Relaxed);
+        self.run = next_run();
         Ok(())
     }
 
