@@ -181,8 +181,8 @@ pub fn guard_state(
     values: &[f64],
     bound: f64,
 ) -> Result<(), EngineError> {
-    // one comparison per value (NaN fails it): the check stays off the profile of a step
-    match values.iter().position(|v| !(v.abs() <= bound)) {
+    // two comparisons per value: the check stays off the profile of a step
+    match values.iter().position(|v| v.is_nan() || v.abs() > bound) {
         None => Ok(()),
         Some(i) => Err(EngineError::Diverged {
             t_s,

@@ -1037,7 +1037,9 @@ fn thermal_keys_tiny_heat_capacity_refused() {
         "thermal.convection.kind=\"given\"",
         "thermal.convection.h_w_m2_k=1e300",
     ]);
-    let e = load(&path, &o).err().expect("h = 1e300 accepted");
+    let Err(e) = load(&path, &o) else {
+        panic!("h = 1e300 accepted")
+    };
     let p = problem_at(&e, "thermal.convection.h_w_m2_k");
     assert!(p.rule.contains("plausibility bound"), "{}", p.rule);
 }

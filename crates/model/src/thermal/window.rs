@@ -350,7 +350,7 @@ impl ThermalWindows {
         let (tau, _) = self.model.fastest_time_constant_s();
         let subs = if tau.is_finite() {
             let subs = (dt / (0.05 * tau)).ceil();
-            if !(subs <= MAX_SUB_STEPS) {
+            if subs.is_nan() || subs > MAX_SUB_STEPS {
                 return Err(EngineError::Diverged {
                     t_s: self.window_t0,
                     reason: format!(
