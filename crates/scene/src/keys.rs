@@ -50,10 +50,13 @@ pub(crate) const MAX_CRITICAL_DAMAGE: f64 = 10.0;
 /// Most teeth of one spline accepted.
 pub(crate) const MAX_TEETH: u32 = 10_000;
 
-/// Inertia of a body: `> 0` and at least [`MIN_INERTIA_KG_M2`].
+/// Largest inertia of a body accepted, kg m^2 (a large ship's propeller line is about 1e5;
+/// 1e308 passed as finite and made a clutch's heat `inf * 0`).
+pub(crate) const MAX_INERTIA_KG_M2: f64 = 1e7;
+/// Inertia of a body: at least [`MIN_INERTIA_KG_M2`], at most [`MAX_INERTIA_KG_M2`].
 const INERTIA: Kind = Kind::Number(Rule::Bounded {
     floor: MIN_INERTIA_KG_M2,
-    ceil: f64::INFINITY,
+    ceil: MAX_INERTIA_KG_M2,
 });
 /// Largest speed magnitude accepted, rad/s (about 950 000 rpm): of a scene's speeds and of a
 /// co-simulation's speed input.
