@@ -174,7 +174,7 @@ def test_a_simulation_drives_the_pistons_of_resolved_packs(tmp_path):
     # the recording says which inputs the caller drove
     text = cli("replay", str(driven)).stdout
     assert "co-simulation: inputs driven by the caller: " + ", ".join(names) in text, text
-    with pytest.raises(ValueError, match="expected >= 0"):
+    with pytest.raises(ValueError, match=r"expected a value in \[0, 100000000\] Pa"):
         sim = clutchpack.Simulation("scenes/dct-upshift.toml", drive=names)
         sim.advance_to(0.01, **{names[0]: -1.0, names[1]: 0.0})
 
@@ -587,7 +587,7 @@ def test_messages_of_a_study_into_a_file_and_of_a_meshing_error(tmp_path):
     with pytest.raises(ValueError) as e:
         clutchpack.load_scene("scenes/dct-upshift-lumped.toml", set={"couplings[3].ratio": 1e300})
     line = next(l for l in str(e.value).splitlines() if "do not mesh" in l)
-    assert line.endswith("is 8.571428571428571e301") and len(line) < 250, line
+    assert "is 8.571428571428571e301" in line and len(line) < 250, line
 
 
 def test_a_network_run_writes_the_impacts_csv_as_the_cli(tmp_path):
