@@ -98,15 +98,56 @@ fn fit(d: &Path, data: &Path, params: &[&str], weight: f64) -> (std::process::Ou
     (run(&args), json)
 }
 
-/// From starting values 30 % off (mu low, peak high, the step times one late and one early),
-/// the clutches' `mu` and `peak` and the step times of clutches 2 and 3 are recovered within
-/// 1e-3 relative, each inside its reported 95 % interval, from the four speeds with noise of
-/// 0.01 rad/s (weight 100 = 1/sigma; noise seed 47, the first one tried). The correlations
-/// stay below the identifiability threshold, the fit converges, the fitted scene is valid and
-/// holds the fitted values, and the figure is written.
+/// From starting values 30 % off (mu low, peak high, the step times one late and one early)
+/// and the exact trace, the clutches' `mu` and `peak` and the step times of clutches 2 and 3
+/// are recovered within 1e-3 relative (measured: within 2e-6), the fit converges with no
+/// warning, the fitted scene is valid and holds the fitted values, and the figure is written.
 #[test]
 fn coupled_clutches_friction_and_step_times_are_recovered() {
     let d = scratch("fit-coupled-clutches");
+    let data = trace(&d, 0.0, 0);
+    let params: Vec<&str> = PARAMS.iter().map(|p| p.0).collect();
+    let (o, json) = fit(&d, &data, &params, 1.0);
+    assert!(o.status.success(), "{}", stderr(&o));
+    println!("{}", stdout(&o));
+    let s = read_json(&json);
+    assert_eq!(s["converged"], true, "{s}");
+    assert!(s["warnings"].as_array().unwrap().is_empty(), "{s}");
+    for (k, (_, truth)) in PARAMS.iter().enumerate() {
+        let value = s["params"][k]["value"].as_f64().unwrap();
+        println!("{}: {value} (true {truth})", s["params"][k]["key"]);
+        assert!(
+            (value - truth).abs() < 1e-3 * truth,
+            "{}: {value} vs {truth}",
+            s["params"][k]["key"]
+        );
+    }
+    println!(
+        "CoupledClutches fit: {} runs, {} iterations, {:.2} s wall",
+        s["runs"], s["iterations"], s["wall_time_s"]
+    );
+    let fitted = d.join("cc.fitted.toml");
+    let o = run(&["check", fitted.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&fitted).unwrap();
+    assert!(text.starts_with("# scenes/coupled-clutches.toml fitted"), "{text}");
+    // every clutch's mu set to the one fitted value
+    let v0 = s["params"][0]["value"].as_f64().unwrap();
+    let mu_lines = text.lines().filter(|l| *l == format!("mu = {v0:?}")).count();
+    assert_eq!(mu_lines, 3, "{text}");
+    assert!(std::fs::read_to_string(d.join("fit.svg")).unwrap().contains("<svg"));
+}
+
+/// The same fit on the trace with normal noise of 0.01 rad/s (weight 100 = 1/sigma; noise
+/// seed 47, the first one tried): each true value lies inside its reported 95 % interval;
+/// `mu` and the step times are still within 1e-3 relative (their intervals are narrower
+/// than that: measured half-widths 1.3e-4 of mu, 1.9e-4 and 1.1e-4 of the step times), while
+/// `peak` is honestly uncertain at this noise (measured 1.059, interval 0.91 to 1.20): the
+/// static friction only acts at clutch 1's two breakaways (0.83 s and 1.00 s), which move
+/// the speeds little. Each signal's RMS after the fit is the noise level within 10 %.
+#[test]
+fn coupled_clutches_intervals_hold_the_true_values_under_noise() {
+    let d = scratch("fit-coupled-clutches-noise");
     let data = trace(&d, 0.01, 47);
     let params: Vec<&str> = PARAMS.iter().map(|p| p.0).collect();
     let (o, json) = fit(&d, &data, &params, 100.0);
@@ -114,37 +155,20 @@ fn coupled_clutches_friction_and_step_times_are_recovered() {
     println!("{}", stdout(&o));
     let s = read_json(&json);
     assert_eq!(s["converged"], true, "{s}");
-    assert!(s["warnings"].as_array().unwrap().is_empty(), "{s}");
     for (k, (_, truth)) in PARAMS.iter().enumerate() {
         let p = &s["params"][k];
         let value = p["value"].as_f64().unwrap();
         let (lo, hi) = (p["ci95_low"].as_f64().unwrap(), p["ci95_high"].as_f64().unwrap());
         println!("{}: {value} [{lo}, {hi}] (true {truth})", p["key"]);
-        assert!(
-            (value - truth).abs() < 1e-3 * truth,
-            "{}: {value} vs {truth}",
-            p["key"]
-        );
         assert!(lo <= *truth && *truth <= hi, "{}: {truth} outside [{lo}, {hi}]", p["key"]);
+        if k != 1 {
+            assert!((value - truth).abs() < 1e-3 * truth, "{}: {value} vs {truth}", p["key"]);
+        }
     }
-    println!(
-        "CoupledClutches fit: {} runs, {} iterations, {:.2} s wall",
-        s["runs"], s["iterations"], s["wall_time_s"]
-    );
-    // every signal's RMS at the noise level (0.01 rad/s) after the fit
     for sig in s["signals"].as_array().unwrap() {
         let rms = sig["rms"].as_f64().unwrap();
         assert!((0.009..0.011).contains(&rms), "{sig}");
     }
-    let fitted = d.join("cc.fitted.toml");
-    let o = run(&["check", fitted.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = std::fs::read_to_string(&fitted).unwrap();
-    assert!(text.starts_with("# scenes/coupled-clutches.toml fitted"), "{text}");
-    let scene = load_scene(Some(&fitted), &[]).unwrap();
-    let net = scene.network.unwrap();
-    assert_eq!(net.couplings.len(), 3);
-    assert!(std::fs::read_to_string(d.join("fit.svg")).unwrap().contains("<svg"));
 }
 
 /// Fitted together, `mu` and `max_normal_force_n` are not separately identifiable (a
@@ -183,10 +207,11 @@ fn mu_and_normal_force_are_said_to_be_unidentifiable() {
     // the product is what the data fix: within 1e-3 of 0.5 x 20 N
     let v = |s: &serde_json::Value, k: usize| s["params"][k]["value"].as_f64().unwrap();
     assert!((v(&pair, 0) * v(&pair, 1) - 10.0).abs() < 1e-2, "{pair}");
+    // an infinite end is `null` in JSON
     let width = |s: &serde_json::Value, k: usize| {
         let p = &s["params"][k];
-        (p["ci95_high"].as_f64().unwrap() - p["ci95_low"].as_f64().unwrap())
-            / p["value"].as_f64().unwrap()
+        let end = |k: &str| p[k].as_f64().unwrap_or(f64::INFINITY);
+        (end("ci95_high") - end("ci95_low")) / p["value"].as_f64().unwrap()
     };
     let (o, json) = fit(&d, &data, &["couplings[*].mu=0.35:0.05:2:log"], 100.0);
     assert!(o.status.success(), "{}", stderr(&o));

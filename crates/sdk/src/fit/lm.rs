@@ -131,17 +131,16 @@ pub(crate) fn minimize(
     if stop() {
         return outcome(u, r, None, 0, evaluations, false, STOPPED);
     }
-    let mut jac = match jacobian(&u, &r, upper, opts.fd_step, eval) {
+    let mut jac = match jacobian(&u, &r, upper, opts.fd_step, eval, &mut evaluations) {
         Ok(Some(j)) => j,
         Ok(None) => {
             return Err(crate::Error::BadInput(
                 "a fit needs at least one parameter".into(),
             ))
         }
-        Err(_) if stop() => return outcome(u, r, None, 0, n, false, STOPPED),
+        Err(_) if stop() => return outcome(u, r, None, 0, evaluations, false, STOPPED),
         Err(e) => return Err(e),
     };
-    evaluations += n;
     let (mut lambda, mut nu) = (1e-3, 2.0);
     let mut iteration = 0;
     loop {
@@ -220,8 +219,7 @@ pub(crate) fn minimize(
                 // the Jacobian of the new point is not computed: the best point is returned
                 return outcome(u, r, None, iteration, evaluations, false, STOPPED);
             }
-            evaluations += n;
-            jac = match jacobian(&u, &r, upper, opts.fd_step, eval) {
+            jac = match jacobian(&u, &r, upper, opts.fd_step, eval, &mut evaluations) {
                 Ok(j) => j.expect("n >= 1"),
                 Err(_) if stop() => {
                     return outcome(u, r, None, iteration, evaluations, false, STOPPED)
@@ -253,19 +251,20 @@ pub(crate) const STOPPED: &str = "stopped (the best point so far)";
 
 /// The forward-difference Jacobian at `u` (residuals `r`): one batch of `n` evaluations,
 /// each coordinate stepped by `fd_step` times its size (at least `fd_step`), backwards
-/// where the forward step would leave the box. `None` for `n = 0`.
+/// where the forward step would leave the box or its run failed. `None` for `n = 0`.
 fn jacobian(
     u: &[f64],
     r: &[f64],
     upper: &[f64],
     fd_step: f64,
     eval: &mut Evaluate,
+    evaluations: &mut usize,
 ) -> Result<Option<DMatrix<f64>>> {
     let n = u.len();
     if n == 0 {
         return Ok(None);
     }
-    let steps: Vec<f64> = (0..n)
+    let mut steps: Vec<f64> = (0..n)
         .map(|j| {
             let h = fd_step * u[j].abs().max(1.0);
             if u[j] + h > upper[j] {
@@ -275,14 +274,27 @@ fn jacobian(
             }
         })
         .collect();
-    let points: Vec<Vec<f64>> = (0..n)
-        .map(|j| {
-            let mut p = u.to_vec();
-            p[j] += steps[j];
-            p
-        })
-        .collect();
-    let results = eval(&points);
+    let point = |j: usize, h: f64| {
+        let mut p = u.to_vec();
+        p[j] += h;
+        p
+    };
+    let points: Vec<Vec<f64>> = (0..n).map(|j| point(j, steps[j])).collect();
+    let mut results = eval(&points);
+    *evaluations += n;
+    // a column whose run failed (a run can fail at one parameter value and not beside it:
+    // the engine's step collapsing on an event at the run's end) is taken backwards
+    let failed: Vec<usize> = (0..n).filter(|&j| results[j].is_err()).collect();
+    if !failed.is_empty() {
+        for &j in &failed {
+            steps[j] = -steps[j];
+        }
+        *evaluations += failed.len();
+        let again = eval(&failed.iter().map(|&j| point(j, steps[j])).collect::<Vec<_>>());
+        for (&j, res) in failed.iter().zip(again) {
+            results[j] = res;
+        }
+    }
     let mut jac = DMatrix::zeros(r.len(), n);
     for (j, res) in results.into_iter().enumerate() {
         let rj = res?;
