@@ -38,12 +38,20 @@ pub struct FitArgs {
     /// the key and several keys joined by `,` take one value (`couplings[*].mu`: one mu for
     /// every clutch). START defaults to the scene's value, LO:HI to the key's own rule;
     /// `:log` fits ln(KEY) (bounds > 0). Repeatable.
-    #[arg(long = "param", value_name = "KEY[=START][:LO:HI][:log]", required = true)]
+    #[arg(
+        long = "param",
+        value_name = "KEY[=START][:LO:HI][:log]",
+        required = true
+    )]
     pub params: Vec<FitParam>,
     /// A signal of the run matched to a data column: `SIGNAL[=COLUMN][:WEIGHT]`. A network's
     /// signals: `BODY` or `BODY.speed_rad_s`, `BODY.angle_rad`, `COUPLING.torque_n_m`; COLUMN
     /// defaults to SIGNAL, WEIGHT (> 0; 1/sigma of the measurement) to 1. Repeatable.
-    #[arg(long = "match", value_name = "SIGNAL[=COLUMN][:WEIGHT]", required = true)]
+    #[arg(
+        long = "match",
+        value_name = "SIGNAL[=COLUMN][:WEIGHT]",
+        required = true
+    )]
     pub signals: Vec<FitSignal>,
     /// Engine: `reference` or `multibody`; default: the scene's `simulation.engine`, else
     /// `reference`.
@@ -84,7 +92,10 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
     if !(a.fd_step > 0.0 && a.fd_step < 0.1) {
         return Err(BadInput(format!("--fd-step {}: must be in (0, 0.1)", a.fd_step)).into());
     }
-    let fitted = a.fitted_scene.clone().unwrap_or_else(|| fitted_path(&a.scene));
+    let fitted = a
+        .fitted_scene
+        .clone()
+        .unwrap_or_else(|| fitted_path(&a.scene));
     let mut outs = vec![Output::file("--fitted-scene", &fitted)];
     if let Some(p) = &a.summary_json {
         outs.push(Output::file("--summary-json", p));
@@ -166,7 +177,13 @@ fn print_result(r: &FitResult, scene: &Path) {
         r.wall_time_s,
         r.reason
     );
-    let w = r.params.iter().map(|p| p.key.len()).max().unwrap_or(3).max(9);
+    let w = r
+        .params
+        .iter()
+        .map(|p| p.key.len())
+        .max()
+        .unwrap_or(3)
+        .max(9);
     out!(
         "{:<w$}  {:>14}  {:>14}  {:>11}  {:>29}  {}",
         "parameter",
@@ -218,7 +235,11 @@ fn print_result(r: &FitResult, scene: &Path) {
             s.rms_start
         );
     }
-    out!("weighted SSR {:.6e} over {} degrees of freedom", r.ssr, r.dof);
+    out!(
+        "weighted SSR {:.6e} over {} degrees of freedom",
+        r.ssr,
+        r.dof
+    );
 }
 
 /// The figure: one panel per signal, measured and fitted against time.
@@ -231,11 +252,19 @@ fn plot(path: &Path, r: &FitResult) -> Result<()> {
             series: vec![
                 (
                     "measured".to_string(),
-                    s.time_s.iter().copied().zip(s.measured.iter().copied()).collect(),
+                    s.time_s
+                        .iter()
+                        .copied()
+                        .zip(s.measured.iter().copied())
+                        .collect(),
                 ),
                 (
                     "fitted".to_string(),
-                    s.time_s.iter().copied().zip(s.fitted.iter().copied()).collect(),
+                    s.time_s
+                        .iter()
+                        .copied()
+                        .zip(s.fitted.iter().copied())
+                        .collect(),
                 ),
             ],
             markers_only: false,

@@ -95,7 +95,7 @@ pub(crate) fn expected_text(parent_norm: &str) -> String {
 }
 
 /// A numeric key of the schema, as a fit or a sweep varies it: its unit and its own range
-/// rule (from its line in [`crate::keys`]), and its default if it has a number for one.
+/// rule (from its line in `keys.rs`), and its default if it has a number for one.
 #[derive(Debug, Clone, Copy)]
 pub struct NumericKey {
     /// The key's unit (`"s"`, `"N"`; `""` for none).

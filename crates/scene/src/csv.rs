@@ -172,7 +172,10 @@ mod tests {
         assert_eq!(c.time_s, [0.0, 0.5]);
         assert_eq!(c.values, [vec![2.0, 4.0], vec![1.0, 3.0]]);
         let e = parse_columns("t,a\n0,1\n0,2\n", "m.csv", "t", &["a"]).unwrap_err();
-        assert!(e.contains("line 3") && e.contains("does not increase"), "{e}");
+        assert!(
+            e.contains("line 3") && e.contains("does not increase"),
+            "{e}"
+        );
         let e = parse_columns("t,a\n0,1\n1,NaN\n", "m.csv", "t", &["a"]).unwrap_err();
         assert!(e.contains("line 3") && e.contains("not finite"), "{e}");
         let e = parse_columns("t,a\n0,1\n1,2\n", "m.csv", "t", &["J1"]).unwrap_err();

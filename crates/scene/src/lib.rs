@@ -162,8 +162,8 @@ mod raw;
 mod schema;
 mod validate;
 
-pub use csv::{parse_columns, read_columns, Columns};
 pub use catalog::{keys_doc, keys_markdown, numeric_key, NumericKey};
+pub use csv::{parse_columns, read_columns, Columns};
 pub use error::{Problem, SceneError};
 pub use keys::{MAX_PRESSURE_PA, MAX_SPEED_RAD_S, MAX_TORQUE_N_M};
 pub use overrides::{apply_to_text, expand_wildcards, number_in_text, Override, OverrideError};

@@ -60,8 +60,8 @@ pub use clutchpack_model::session::{Advance, Driven, Inputs, Snapshot};
 pub use collector::{merge_peaks, RunCollector};
 pub use cosim::{CoSimulation, SavedCoSimulation};
 pub use error::{Error, Result};
-pub use fit::{Fit, FitOptions, FitParam, FitRequest, FitResult, FitSignal};
 pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
+pub use fit::{Fit, FitOptions, FitParam, FitRequest, FitResult, FitSignal};
 pub use network::{
     multibody_step_s, run_network_scene, BodySummary, CouplingSummary, EnergySummary, ModeChange,
     NetworkOutcome, NetworkRequest, NetworkSummary, PackBodySummary, MULTIBODY_NETWORK_STEP_S,

@@ -169,7 +169,9 @@ pub(crate) fn minimize(
         let g = jac.transpose() * DVector::from_column_slice(&r);
         let mut damped = a.clone();
         for j in 0..n {
-            let d = a[(j, j)].max(1e-12 * a.diagonal().max()).max(f64::MIN_POSITIVE);
+            let d = a[(j, j)]
+                .max(1e-12 * a.diagonal().max())
+                .max(f64::MIN_POSITIVE);
             damped[(j, j)] += lambda * d;
         }
         let Some(chol) = damped.cholesky() else {
@@ -290,7 +292,12 @@ fn jacobian(
             steps[j] = -steps[j];
         }
         *evaluations += failed.len();
-        let again = eval(&failed.iter().map(|&j| point(j, steps[j])).collect::<Vec<_>>());
+        let again = eval(
+            &failed
+                .iter()
+                .map(|&j| point(j, steps[j]))
+                .collect::<Vec<_>>(),
+        );
         for (&j, res) in failed.iter().zip(again) {
             results[j] = res;
         }
@@ -346,8 +353,10 @@ pub(crate) fn covariance(jac: &DMatrix<f64>, ssr: f64, dof: usize) -> Covariance
     }
     let mut std_error = vec![0.0; n];
     for j in 0..n {
-        let undetermined =
-            norms[j] == 0.0 || singular_dirs.iter().any(|v: &DVector<f64>| v[j].abs() > 1e-6);
+        let undetermined = norms[j] == 0.0
+            || singular_dirs
+                .iter()
+                .any(|v: &DVector<f64>| v[j].abs() > 1e-6);
         std_error[j] = if undetermined {
             f64::INFINITY
         } else {
@@ -413,7 +422,11 @@ mod tests {
         )
         .unwrap();
         assert!(o.converged, "{}", o.reason);
-        assert!((o.u[0] - 2.0).abs() < 1e-10 && (o.u[1] - 0.5).abs() < 1e-10, "{:?}", o.u);
+        assert!(
+            (o.u[0] - 2.0).abs() < 1e-10 && (o.u[1] - 0.5).abs() < 1e-10,
+            "{:?}",
+            o.u
+        );
         // b held below its true value by its bound: the fit ends on the bound
         let o = minimize(
             &[1.0, 0.2],

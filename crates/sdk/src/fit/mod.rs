@@ -115,7 +115,9 @@ impl FromStr for FitSignal {
             None => (rest, 1.0),
         };
         if !(weight.is_finite() && weight > 0.0) {
-            return Err(format!("--match {s:?}: the weight must be > 0, got {weight}"));
+            return Err(format!(
+                "--match {s:?}: the weight must be > 0, got {weight}"
+            ));
         }
         if signal.trim().is_empty() || column.trim().is_empty() {
             return Err(format!("--match {s:?}: expected SIGNAL=COLUMN[:WEIGHT]"));
@@ -340,15 +342,18 @@ impl Fit {
         fit.engine = scene.engine(fit.request.engine, &scene.name)?;
         fit.scene_name = scene.name.clone();
         for s in &fit.request.signals {
-            fit.signals.push((s.clone(), Signal::resolve(&scene, &s.signal)?));
+            fit.signals
+                .push((s.clone(), Signal::resolve(&scene, &s.signal)?));
         }
-        let columns: Vec<&str> = fit.request.signals.iter().map(|s| s.column.as_str()).collect();
-        let data = clutchpack_scene::read_columns(
-            &fit.request.data,
-            &fit.request.time_column,
-            &columns,
-        )
-        .map_err(|e| bad(format!("fit data: {e}")))?;
+        let columns: Vec<&str> = fit
+            .request
+            .signals
+            .iter()
+            .map(|s| s.column.as_str())
+            .collect();
+        let data =
+            clutchpack_scene::read_columns(&fit.request.data, &fit.request.time_column, &columns)
+                .map_err(|e| bad(format!("fit data: {e}")))?;
         let (t0, t1) = (data.time_s[0], *data.time_s.last().expect("2 rows"));
         let end = scene.simulation.duration_s;
         if t0 < 0.0 || t1 > end {
@@ -553,10 +558,9 @@ impl Fit {
                 }
             })
             .collect();
-        let correlation = cov.as_ref().map_or_else(
-            || vec![vec![f64::NAN; n]; n],
-            |c| c.correlation.clone(),
-        );
+        let correlation = cov
+            .as_ref()
+            .map_or_else(|| vec![vec![f64::NAN; n]; n], |c| c.correlation.clone());
         for i in 0..n {
             for j in i + 1..n {
                 let c = correlation[i][j];
@@ -696,12 +700,14 @@ fn check_param(p: &FitParam, text: &str, shown: &str, seen: &mut Vec<String>) ->
             p.lower, p.upper
         )));
     }
-    for (what, x) in [("lower bound", p.lower), ("upper bound", p.upper), ("start", start)] {
+    for (what, x) in [
+        ("lower bound", p.lower),
+        ("upper bound", p.upper),
+        ("start", start),
+    ] {
         if x.is_finite() {
             def.check(x).map_err(|rule| {
-                bad(format!(
-                    "{what} {x} is outside the key's own rule ({rule})"
-                ))
+                bad(format!("{what} {x} is outside the key's own rule ({rule})"))
             })?;
         }
     }
@@ -767,7 +773,10 @@ mod tests {
     #[test]
     fn signals_parse() {
         let s: FitSignal = "J1=w1:2.5".parse().unwrap();
-        assert_eq!((s.signal.as_str(), s.column.as_str(), s.weight), ("J1", "w1", 2.5));
+        assert_eq!(
+            (s.signal.as_str(), s.column.as_str(), s.weight),
+            ("J1", "w1", 2.5)
+        );
         let s: FitSignal = "J2".parse().unwrap();
         assert_eq!((s.column.as_str(), s.weight), ("J2", 1.0));
         assert!("J1=w1:0".parse::<FitSignal>().is_err());

@@ -43,9 +43,18 @@ impl Signal {
             let mut names: Vec<String> = net
                 .bodies
                 .iter()
-                .flat_map(|b| [format!("{}.speed_rad_s", b.name), format!("{}.angle_rad", b.name)])
+                .flat_map(|b| {
+                    [
+                        format!("{}.speed_rad_s", b.name),
+                        format!("{}.angle_rad", b.name),
+                    ]
+                })
                 .collect();
-            names.extend(net.couplings.iter().map(|c| format!("{}.torque_n_m", c.name)));
+            names.extend(
+                net.couplings
+                    .iter()
+                    .map(|c| format!("{}.torque_n_m", c.name)),
+            );
             Error::BadInput(format!(
                 "signal {name:?}: {} does not produce it (it produces: {}; a body's name alone \
                  is its speed)",
