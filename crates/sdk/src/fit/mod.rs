@@ -4,9 +4,10 @@
 //! for every item that sets the key, and several keys joined by `,` take one value), each
 //! within bounds, optionally on a log scale. The measured series are columns of a CSV file
 //! with a time column; each is matched to a signal the scene's run produces
-//! ([`signals`]) with a weight. The residual of measured point `i` of signal `k` is
+//! (a network's `BODY.speed_rad_s` or `BODY`, `BODY.angle_rad`, `COUPLING.torque_n_m`;
+//! `signals.rs`) with a weight. The residual of measured point `i` of signal `k` is
 //! `w_k (y_sim,k(t_i) - y_meas,k,i)`, `y_sim` linear between the run's samples. The solver
-//! is Levenberg-Marquardt ([`lm`]) with a forward-difference Jacobian whose runs go in
+//! is Levenberg-Marquardt (`lm.rs`) with a forward-difference Jacobian whose runs go in
 //! parallel on rayon's threads. [`Fit::new`] checks everything before any run; [`Fit::run`]
 //! fits, reporting progress and honouring a stop flag (the best point so far is returned).
 
@@ -89,7 +90,7 @@ impl FromStr for FitParam {
 /// One measured series matched to a signal: `SIGNAL=COLUMN[:WEIGHT]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitSignal {
-    /// The signal of the run ([`signals`]: `J1`, `J1.speed_rad_s`, `clutch2.torque_n_m`).
+    /// The signal of the run (`J1`, `J1.speed_rad_s`, `clutch2.torque_n_m`).
     pub signal: String,
     /// The column of the data file that measures it (same unit as the signal).
     pub column: String,
