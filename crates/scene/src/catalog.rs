@@ -94,59 +94,6 @@ pub(crate) fn expected_text(parent_norm: &str) -> String {
     format!("expected one of: {}", children(parent_norm).join(", "))
 }
 
-/// A numeric key of the schema, as a fit or a sweep varies it: its unit and its own range
-/// rule (from its line in `keys.rs`), and its default if it has a number for one.
-#[derive(Debug, Clone, Copy)]
-pub struct NumericKey {
-    /// The key's unit (`"s"`, `"N"`; `""` for none).
-    pub unit: &'static str,
-    /// The number an absent key means, if its default is a number.
-    pub default: Option<f64>,
-    rule: crate::schema::Rule,
-}
-
-impl NumericKey {
-    /// `Ok` if `x` is finite and within the key's own rule, else the rule it breaks
-    /// (`must be > 0`).
-    pub fn check(&self, x: f64) -> Result<(), String> {
-        if !x.is_finite() {
-            return Err("must be a finite number".into());
-        }
-        self.rule.check(x, self.unit)
-    }
-
-    /// The key's rule as the reference prints it (`> 0`, `in [1, 100]`).
-    pub fn rule_text(&self) -> String {
-        self.rule.doc()
-    }
-}
-
-/// The definition of the key at `path` (dotted, array items by index or `[]`:
-/// `couplings[1].force.start_s`), if it is a single number; else why not (unknown, a table,
-/// not a number), in the words `--set` uses.
-pub fn numeric_key(path: &str) -> Result<NumericKey, String> {
-    use crate::schema::{Dflt, Kind};
-    let norm = normalize(path);
-    let Some((_, key)) = all_keys().iter().find(|(p, _)| *p == norm) else {
-        return Err(if is_known(&norm) {
-            "a table, not a key holding a number".to_string()
-        } else {
-            crate::overrides::unknown_key_rule(&norm).replace("given with --set ", "")
-        });
-    };
-    match key.kind {
-        Kind::Number(rule) => Ok(NumericKey {
-            unit: key.unit,
-            default: match key.default {
-                Dflt::Num(x) => Some(x),
-                _ => None,
-            },
-            rule,
-        }),
-        _ => Err("not a number key (a fit varies single real numbers)".to_string()),
-    }
-}
-
 /// The tables of body keys: `[defaults]` and each `[[discs]]` for the friction discs,
 /// `[plate_defaults]` and each `[[plates]]` for the separator plates.
 const BODY_TABLES: [&str; 4] = ["defaults", "discs[]", "plate_defaults", "plates[]"];

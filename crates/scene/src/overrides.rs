@@ -142,7 +142,7 @@ fn parse_value(text: &str) -> Value {
 }
 
 /// The rule text for a `--set` key that is not in the schema.
-pub(crate) fn unknown_key_rule(norm: &str) -> String {
+fn unknown_key_rule(norm: &str) -> String {
     // Find the deepest known table along the path, to say what it does take.
     let mut parent = norm;
     loop {
@@ -170,6 +170,59 @@ pub(crate) fn unknown_key_rule(norm: &str) -> String {
             "unknown key given with --set ({})",
             catalog::expected_text(parent)
         )
+    }
+}
+
+/// A numeric key of the schema, as a fit or a sweep varies it: its unit and its own range
+/// rule (from its line in `keys.rs`), and its default if it has a number for one.
+#[derive(Debug, Clone, Copy)]
+pub struct NumericKey {
+    /// The key's unit (`"s"`, `"N"`; `""` for none).
+    pub unit: &'static str,
+    /// The number an absent key means, if its default is a number.
+    pub default: Option<f64>,
+    rule: crate::schema::Rule,
+}
+
+impl NumericKey {
+    /// `Ok` if `x` is finite and within the key's own rule, else the rule it breaks
+    /// (`must be > 0`).
+    pub fn check(&self, x: f64) -> Result<(), String> {
+        if !x.is_finite() {
+            return Err("must be a finite number".into());
+        }
+        self.rule.check(x, self.unit)
+    }
+
+    /// The key's rule as the reference prints it (`> 0`, `in [1, 100]`).
+    pub fn rule_text(&self) -> String {
+        self.rule.doc()
+    }
+}
+
+/// The definition of the key at `path` (dotted, array items by index or `[]`:
+/// `couplings[1].force.start_s`), if it is a single number; else why not (unknown, a table,
+/// not a number), in the words `--set` uses.
+pub fn numeric_key(path: &str) -> Result<NumericKey, String> {
+    use crate::schema::{Dflt, Kind};
+    let norm = catalog::normalize(path);
+    let Some((_, key)) = catalog::all_keys().iter().find(|(p, _)| *p == norm) else {
+        return Err(if catalog::is_known(&norm) {
+            "a table, not a key holding a number".to_string()
+        } else {
+            unknown_key_rule(&norm).replace("given with --set ", "")
+        });
+    };
+    match key.kind {
+        Kind::Number(rule) => Ok(NumericKey {
+            unit: key.unit,
+            default: match key.default {
+                Dflt::Num(x) => Some(x),
+                _ => None,
+            },
+            rule,
+        }),
+        _ => Err("not a number key (a fit varies single real numbers)".to_string()),
     }
 }
 
