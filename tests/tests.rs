@@ -5,6 +5,7 @@ mod architecture;
 mod cosim_hardening;
 mod cross_engine;
 mod fatigue;
+mod fit;
 mod fmu;
 mod hardening;
 mod hardening_networks;

@@ -44,6 +44,7 @@ mod bench;
 mod check;
 mod common;
 mod describe;
+mod fit;
 mod fmu;
 mod network;
 mod outputs;
@@ -96,6 +97,10 @@ enum Command {
     /// Studies: many cases of a scene (design factors, random draws, ensembles), sharded over
     /// threads and Slurm or Kubernetes job arrays, merged into Parquet and CSV tables.
     Study(study::StudyArgs),
+    /// Fit scene keys to measured series (least squares, Levenberg-Marquardt): fitted
+    /// values with standard errors, 95 % intervals and correlations, the residual per
+    /// signal, and the fitted scene written beside the input (docs/calibration.md).
+    Fit(fit::FitArgs),
     /// Validate scene files: exit 0 if all are valid, 2 with every problem listed if not.
     Check(check::CheckArgs),
     /// Pack a scene into an FMI 2.0 co-simulation FMU (linux64), to put the pack between the
@@ -109,6 +114,7 @@ fn main() -> ExitCode {
         Command::Run(a) => run::run(a),
         Command::Sweep(a) => sweep::sweep(a),
         Command::Check(a) => check::check(a),
+        Command::Fit(a) => fit::fit(a),
         Command::Study(a) => study::study(a),
         Command::Bench(a) => bench::bench(a),
         Command::Replay(a) => recording::replay(a),

@@ -1,4 +1,5 @@
-//! Tabulated drive histories: a small CSV reader for `drive.file`.
+//! Tabulated drive histories: a small CSV reader for `drive.file`, and the measured series a
+//! fit reads ([`read_columns`]).
 //!
 //! The file has a header row naming its columns; the two columns used are found by name
 //! (`time_s` and `speed_rad_s` or `torque_n_m`), other columns are ignored. Fields are
@@ -84,6 +85,93 @@ pub(crate) fn parse_table(
     })
 }
 
+/// Columns of a CSV file read by name: the time column and the value columns asked for, in
+/// the order asked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Columns {
+    /// The time column, s, strictly increasing.
+    pub time_s: Vec<f64>,
+    /// Each asked column's values (finite), one per time.
+    pub values: Vec<Vec<f64>>,
+}
+
+/// Reads the columns `time_column` and `columns` of the CSV file at `path` (the format of
+/// `drive.file`: a header row, commas, `#` comments), every value finite and the times
+/// strictly increasing, at least 2 rows. The error is a one-line message naming the file,
+/// the column and, where it applies, the line.
+pub fn read_columns(path: &Path, time_column: &str, columns: &[&str]) -> Result<Columns, String> {
+    let text =
+        crate::read_input(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    parse_columns(&text, &path.display().to_string(), time_column, columns)
+}
+
+/// Parses CSV text (see [`read_columns`]); `shown` names the file in messages.
+pub fn parse_columns(
+    text: &str,
+    shown: &str,
+    time_column: &str,
+    columns: &[&str],
+) -> Result<Columns, String> {
+    let mut rows = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
+        .map(|(n, l)| (n, l.split(',').map(str::trim).collect::<Vec<_>>()));
+    let (_, header) = rows
+        .next()
+        .ok_or_else(|| format!("{shown}: empty file (expected a header row)"))?;
+    let column = |name: &str| {
+        header.iter().position(|h| *h == name).ok_or_else(|| {
+            format!(
+                "{shown}: no column {name:?} in the header row (found: {})",
+                header.join(", ")
+            )
+        })
+    };
+    let it = column(time_column)?;
+    let idx = columns
+        .iter()
+        .map(|c| column(c))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut out = Columns {
+        time_s: Vec::new(),
+        values: vec![Vec::new(); columns.len()],
+    };
+    for (line, fields) in rows {
+        let field = |i: usize, name: &str| -> Result<f64, String> {
+            let f = fields
+                .get(i)
+                .ok_or_else(|| format!("{shown}: line {line}: no value in column {name:?}"))?;
+            let x = f
+                .parse::<f64>()
+                .map_err(|_| format!("{shown}: line {line}: {name} = {f:?} is not a number"))?;
+            if x.is_finite() {
+                Ok(x)
+            } else {
+                Err(format!("{shown}: line {line}: {name} = {f} is not finite"))
+            }
+        };
+        let t = field(it, time_column)?;
+        if let Some(&before) = out.time_s.last() {
+            if t <= before {
+                return Err(format!(
+                    "{shown}: line {line}: {time_column} = {t} does not increase over the row \
+                     before ({before})"
+                ));
+            }
+        }
+        out.time_s.push(t);
+        for (k, (&i, name)) in idx.iter().zip(columns).enumerate() {
+            out.values[k].push(field(i, name)?);
+        }
+    }
+    if out.time_s.len() < 2 {
+        return Err(format!("{shown}: at least 2 rows of data needed"));
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -101,6 +189,22 @@ mod tests {
         .unwrap();
         assert_eq!(t.t_s, [0.0, 0.1]);
         assert_eq!(t.y, [200.0, 210.0]);
+    }
+
+    #[test]
+    fn columns_are_read_by_name_and_checked() {
+        let c = parse_columns("t,a,b\n0,1,2\n0.5,3,4\n", "m.csv", "t", &["b", "a"]).unwrap();
+        assert_eq!(c.time_s, [0.0, 0.5]);
+        assert_eq!(c.values, [vec![2.0, 4.0], vec![1.0, 3.0]]);
+        let e = parse_columns("t,a\n0,1\n0,2\n", "m.csv", "t", &["a"]).unwrap_err();
+        assert!(
+            e.contains("line 3") && e.contains("does not increase"),
+            "{e}"
+        );
+        let e = parse_columns("t,a\n0,1\n1,NaN\n", "m.csv", "t", &["a"]).unwrap_err();
+        assert!(e.contains("line 3") && e.contains("not finite"), "{e}");
+        let e = parse_columns("t,a\n0,1\n1,2\n", "m.csv", "t", &["J1"]).unwrap_err();
+        assert!(e.contains("no column \"J1\""), "{e}");
     }
 
     #[test]

@@ -163,9 +163,13 @@ mod schema;
 mod validate;
 
 pub use catalog::{keys_doc, keys_markdown};
+pub use csv::{parse_columns, read_columns, Columns};
 pub use error::{Problem, SceneError};
 pub use keys::{MAX_NORMAL_FORCE_N, MAX_PRESSURE_PA, MAX_SPEED_RAD_S, MAX_TORQUE_N_M};
-pub use overrides::{Override, OverrideError};
+pub use overrides::{
+    apply_to_text, expand_wildcards, number_in_text, numeric_key, NumericKey, Override,
+    OverrideError,
+};
 
 use std::path::Path;
 use toml::{Table, Value};

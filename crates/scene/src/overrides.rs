@@ -173,6 +173,59 @@ fn unknown_key_rule(norm: &str) -> String {
     }
 }
 
+/// A numeric key of the schema, as a fit or a sweep varies it: its unit and its own range
+/// rule (from its line in `keys.rs`), and its default if it has a number for one.
+#[derive(Debug, Clone, Copy)]
+pub struct NumericKey {
+    /// The key's unit (`"s"`, `"N"`; `""` for none).
+    pub unit: &'static str,
+    /// The number an absent key means, if its default is a number.
+    pub default: Option<f64>,
+    rule: crate::schema::Rule,
+}
+
+impl NumericKey {
+    /// `Ok` if `x` is finite and within the key's own rule, else the rule it breaks
+    /// (`must be > 0`).
+    pub fn check(&self, x: f64) -> Result<(), String> {
+        if !x.is_finite() {
+            return Err("must be a finite number".into());
+        }
+        self.rule.check(x, self.unit)
+    }
+
+    /// The key's rule as the reference prints it (`> 0`, `in [1, 100]`).
+    pub fn rule_text(&self) -> String {
+        self.rule.doc()
+    }
+}
+
+/// The definition of the key at `path` (dotted, array items by index or `[]`:
+/// `couplings[1].force.start_s`), if it is a single number; else why not (unknown, a table,
+/// not a number), in the words `--set` uses.
+pub fn numeric_key(path: &str) -> Result<NumericKey, String> {
+    use crate::schema::{Dflt, Kind};
+    let norm = catalog::normalize(path);
+    let Some((_, key)) = catalog::all_keys().iter().find(|(p, _)| *p == norm) else {
+        return Err(if catalog::is_known(&norm) {
+            "a table, not a key holding a number".to_string()
+        } else {
+            unknown_key_rule(&norm).replace("given with --set ", "")
+        });
+    };
+    match key.kind {
+        Kind::Number(rule) => Ok(NumericKey {
+            unit: key.unit,
+            default: match key.default {
+                Dflt::Num(x) => Some(x),
+                _ => None,
+            },
+            rule,
+        }),
+        _ => Err("not a number key (a fit varies single real numbers)".to_string()),
+    }
+}
+
 /// Applies every override to the document, in order. An override that cannot be applied is
 /// reported (with its key and the word `--set`) and skipped; the others still apply.
 /// Returns the canonical key path of each applied override, to mark later problems at those
@@ -208,6 +261,93 @@ pub(crate) fn apply(
         }
     }
     applied
+}
+
+/// The value at the key path `key` (dotted, array items by index) in the TOML document
+/// `doc`, if the document has it.
+fn value_at<'a>(doc: &'a Table, segs: &[Segment]) -> Option<&'a Value> {
+    let mut here: Option<&Value> = None;
+    for (i, seg) in segs.iter().enumerate() {
+        here = match (seg, here) {
+            (Segment::Key(k), None) if i == 0 => doc.get(k),
+            (Segment::Key(k), Some(Value::Table(t))) => t.get(k),
+            (Segment::Index(n), Some(Value::Array(a))) => a.get(*n),
+            _ => None,
+        };
+        here?;
+    }
+    here
+}
+
+/// The number the scene text `text` gives the key `key` (dotted, array items by index:
+/// `couplings[1].force.start_s`): `Ok(None)` if the file does not set it, an error if the
+/// text is not TOML, the path is malformed, or the value there is not a number.
+pub fn number_in_text(text: &str, key: &str) -> Result<Option<f64>, String> {
+    let doc: Table = text.parse().map_err(|e| format!("not TOML: {e}"))?;
+    let segs = parse_path(key)?;
+    match value_at(&doc, &segs) {
+        None => Ok(None),
+        Some(Value::Float(x)) => Ok(Some(*x)),
+        Some(Value::Integer(i)) => Ok(Some(*i as f64)),
+        Some(v) => Err(format!("{key} = {v} in the file is not a number")),
+    }
+}
+
+/// `key` with every `[*]` replaced by each index of that array in the scene text `text`
+/// whose item sets the rest of the path (`couplings[*].mu` -> `couplings[0].mu`,
+/// `couplings[2].mu` when only those two items set `mu`); a key without `[*]` as it is. An
+/// error if the text is not TOML, the path is malformed, or no item sets the key.
+pub fn expand_wildcards(text: &str, key: &str) -> Result<Vec<String>, String> {
+    if !key.contains("[*]") {
+        return Ok(vec![key.to_string()]);
+    }
+    let doc: Table = text.parse().map_err(|e| format!("not TOML: {e}"))?;
+    let mut keys = vec![String::new()];
+    let parts: Vec<&str> = key.split("[*]").collect();
+    for (i, part) in parts.iter().enumerate() {
+        let last = i + 1 == parts.len();
+        let mut next = Vec::new();
+        for k in &keys {
+            let prefix = format!("{k}{part}");
+            if last {
+                next.push(prefix);
+                continue;
+            }
+            let segs = parse_path(&prefix)?;
+            if let Some(Value::Array(items)) = value_at(&doc, &segs) {
+                next.extend((0..items.len()).map(|n| format!("{prefix}[{n}]")));
+            }
+        }
+        keys = next;
+    }
+    keys.retain(|k| parse_path(k).is_ok_and(|s| value_at(&doc, &s).is_some()));
+    if keys.is_empty() {
+        return Err(format!("no item of the scene sets {key}"));
+    }
+    Ok(keys)
+}
+
+/// The scene text `text` with the overrides applied, as TOML (the file's comments are not
+/// kept): what a fit writes as its fitted scene. `origin` names the text in errors; every
+/// override that cannot be applied is a problem of the error.
+pub fn apply_to_text(
+    text: &str,
+    origin: &str,
+    overrides: &[Override],
+) -> Result<String, crate::SceneError> {
+    let invalid = |problems| crate::SceneError::Invalid {
+        origin: origin.to_string(),
+        problems,
+    };
+    let mut doc: Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| invalid(vec![Problem::new("", None, e.to_string())]))?;
+    let mut problems = Vec::new();
+    apply(&mut doc, overrides, &mut problems);
+    if !problems.is_empty() {
+        return Err(invalid(problems));
+    }
+    toml::to_string(&doc).map_err(|e| invalid(vec![Problem::new("", None, e.to_string())]))
 }
 
 /// Sets `segs[at..]` inside `container` to `value`.
@@ -333,6 +473,24 @@ mod tests {
         assert_eq!(problems.len(), 1);
         assert_eq!(problems[0].key, "discs[1].name");
         assert!(problems[0].rule.contains("past the end"), "{}", problems[0]);
+    }
+
+    #[test]
+    fn wildcards_expand_to_the_items_that_set_the_key() {
+        let text = "[[c]]\nmu = 0.5\n[[c]]\nx = 1\n[[c]]\nmu = 2\n[c.f]\ns = 0.4\n";
+        assert_eq!(
+            expand_wildcards(text, "c[*].mu").unwrap(),
+            ["c[0].mu", "c[2].mu"]
+        );
+        assert_eq!(expand_wildcards(text, "c[*].f.s").unwrap(), ["c[2].f.s"]);
+        assert!(expand_wildcards(text, "c[*].nope").is_err());
+        assert_eq!(number_in_text(text, "c[2].f.s").unwrap(), Some(0.4));
+        assert_eq!(number_in_text(text, "c[0].mu").unwrap(), Some(0.5));
+        assert_eq!(number_in_text(text, "c[1].mu").unwrap(), None);
+        let text = "[[couplings]]\nmu = 0.5\n";
+        let out = apply_to_text(text, "t", &["couplings[0].mu=0.25".parse().unwrap()]).unwrap();
+        assert_eq!(number_in_text(&out, "couplings[0].mu").unwrap(), Some(0.25));
+        assert!(apply_to_text(text, "t", &["couplings[0].nope=1".parse().unwrap()]).is_err());
     }
 
     #[test]

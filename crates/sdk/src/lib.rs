@@ -26,6 +26,7 @@ mod collector;
 pub mod cosim;
 mod error;
 mod fatigue;
+pub mod fit;
 mod network;
 mod network_cosim;
 mod network_keep;
@@ -60,6 +61,7 @@ pub use collector::{merge_peaks, RunCollector};
 pub use cosim::{CoSimulation, SavedCoSimulation};
 pub use error::{Error, Result};
 pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
+pub use fit::{Fit, FitOptions, FitParam, FitRequest, FitResult, FitSignal};
 pub use network::{
     multibody_step_s, run_network_scene, BodySummary, CouplingSummary, EnergySummary, ModeChange,
     NetworkOutcome, NetworkRequest, NetworkSummary, PackBodySummary, MULTIBODY_NETWORK_STEP_S,
