@@ -24,7 +24,7 @@ Example (docs/calibration.md):
     --param 'couplings[2].force.start_s=0.63:0.5:1.3' \\
     --match J1=w1 --match J2=w2 --match J3=w3 --match J4=w4")]
 pub struct FitArgs {
-    /// Scene file (TOML) whose keys are fitted; a network scene ([[bodies]]).
+    /// Scene file (TOML) whose keys are fitted; a network scene (`[[bodies]]`).
     pub scene: PathBuf,
     /// The measured series: a CSV file with a header row, a time column (`--time-column`,
     /// s, strictly increasing, within the run) and one column per matched signal.
