@@ -173,6 +173,27 @@ fn network_keys_without_bounds_are_refused_by_check() {
         "bodies[0].drive.file",
         "torque_n_m = 1e300 is outside",
     );
+    // a road load's quadratic part of 4294967296 on the car (a fuzzed launch.toml ran over
+    // 60 s on the multibody engine), and its constant part beyond the torque bound
+    let launch = repo("scenes/launch.toml");
+    refused_at(
+        &launch,
+        &["bodies[3].road_load.quadratic_n_m_s2_rad2=4294967296"],
+        "bodies[3].road_load.quadratic_n_m_s2_rad2 = 4294967296",
+        "must be in [0, 1e7]",
+    );
+    refused_at(
+        &launch,
+        &["bodies[3].road_load.quadratic_n_m_s2_rad2=1e6"],
+        "bodies[3].road_load.quadratic_n_m_s2_rad2 = 1000000",
+        "time constant",
+    );
+    refused_at(
+        &launch,
+        &["bodies[3].road_load.constant_n_m=1e8"],
+        "bodies[3].road_load.constant_n_m",
+        "must be",
+    );
     // the shipped scenes stay within every bound
     let o = run(&[
         "check",

@@ -620,11 +620,11 @@ table! {
     /// `[bodies.road_load]`: a load opposing motion, -sign(w) (a + b |w| + c w^2), zero at rest (a vehicle reduced to a shaft).
     RawRoadLoad at "road_load" {
         /// a: the constant part (rolling resistance)
-        constant_n_m: "N m", NON_NEGATIVE, Dflt::Num(0.0);
+        constant_n_m: "N m", Kind::Number(Rule::Closed(0.0, MAX_TORQUE_N_M)), Dflt::Num(0.0);
         /// b: the part proportional to speed
         linear_n_m_s_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
         /// c: the part proportional to speed squared (air drag)
-        quadratic_n_m_s2_rad2: "N m s^2/rad^2", NON_NEGATIVE, Dflt::Num(0.0);
+        quadratic_n_m_s2_rad2: "N m s^2/rad^2", Kind::Number(Rule::Closed(0.0, MAX_TORQUE_N_M)), Dflt::Num(0.0);
     }
     children {}
 }

@@ -282,6 +282,42 @@ pub(super) fn network(
             }
             None => Some(None),
         };
+        // a road load's speed terms the engines can integrate: its linear part b is a drag
+        // (J / b), its quadratic part c one of 2 c |w| at the larger of the body's initial
+        // speed and 1e3 rad/s (J / (2 c w), a body at rest speeds up), both under the
+        // bodies' rule on a drag's time constant
+        let road_load = match (fixed, inertia, speed, road_load) {
+            (Some(false), Some(j), Some(w0), Some(Some(l))) => {
+                let linear_ok = l.linear_n_m_s_rad == 0.0
+                    || super::bodies::drag_resolvable(
+                        ck,
+                        (&p(&B::inertia_kg_m2), j),
+                        (&p(&RL::linear_n_m_s_rad), l.linear_n_m_s_rad),
+                    );
+                let c = l.quadratic_n_m_s2_rad2;
+                let w = w0.abs().max(1e3);
+                let most = j / (super::bodies::MIN_DRAG_TIME_S * 2.0 * w);
+                let quadratic_ok = c <= most;
+                if !quadratic_ok {
+                    ck.report(
+                        p(&RL::quadratic_n_m_s2_rad2),
+                        Some(fmt_num(c)),
+                        format!(
+                            "must be at most {} N m s^2/rad^2 with inertia {} kg m^2 \
+                             (plausibility bound: at {} rad/s, the larger of the initial \
+                             speed and 1000 rad/s, the load's damping 2 c w keeps a time \
+                             constant J / (2 c w) of at least {} s)",
+                            fmt_num(most),
+                            fmt_num(j),
+                            fmt_num(w),
+                            fmt_num(super::bodies::MIN_DRAG_TIME_S)
+                        ),
+                    );
+                }
+                (linear_ok && quadratic_ok).then_some(Some(l))
+            }
+            (_, _, _, l) => l,
+        };
         // a drag the engines can integrate: the bodies' rule on its time constant J / C
         let drag = match (fixed, inertia, drag) {
             (Some(false), Some(j), Some(c)) if c > 0.0 => super::bodies::drag_resolvable(
