@@ -194,6 +194,14 @@ fn network_keys_without_bounds_are_refused_by_check() {
         "bodies[3].road_load.constant_n_m",
         "must be",
     );
+    // a plate's loss coefficient of 1e6 s/m (a fuzzed pack-6-thermal.toml ran 0.3 s for
+    // over 60 s; the stall check stops only far larger values)
+    refused_at(
+        &repo("scenes/pack-6-thermal.toml"),
+        &["plate_defaults.contact.loss_coefficient_s_m=1e6"],
+        "plate_defaults.contact.loss_coefficient_s_m = 1000000",
+        "must be in [0, 1000]",
+    );
     // the shipped scenes stay within every bound
     let o = run(&[
         "check",

@@ -31,6 +31,11 @@ pub(crate) const MIN_INERTIA_KG_M2: f64 = 1e-6;
 pub(crate) const MAX_PITCH_RADIUS_M: f64 = 5.0;
 /// Largest equivalent modulus accepted, Pa (ten times diamond's).
 pub(crate) const MAX_MODULUS_PA: f64 = 1e13;
+/// Largest impact loss coefficient accepted, s/m: Hunt and Crossley's `3 (1 - e) / (2 v0)` is
+/// at most 1500 s/m for a closing speed of 1 mm/s even with no rebound (e = 0); the paper's
+/// case is 0.8. A run's cost grows with it (`pack-6-thermal.toml`, 0.3 s: 0.2 s of wall time
+/// at 0.8, 4.3 s at 1e3, 31 s at 1e4, over 60 s at 1e5).
+pub(crate) const MAX_LOSS_COEFFICIENT_S_M: f64 = 1e3;
 /// Largest equivalent curvature radius accepted, m.
 pub(crate) const MAX_CURVATURE_RADIUS_M: f64 = 10.0;
 /// Range of the endurance limit accepted, Pa (polymers to the strongest steels, with margin).
@@ -333,7 +338,7 @@ table! {
         /// equivalent curvature radius r
         curvature_radius_m: "m", Kind::Number(Rule::Bounded { floor: 0.0, ceil: MAX_CURVATURE_RADIUS_M }), Dflt::Required;
         /// impact loss p
-        loss_coefficient_s_m: "s/m", NON_NEGATIVE, Dflt::Num(0.0);
+        loss_coefficient_s_m: "s/m", Kind::Number(Rule::Closed(0.0, MAX_LOSS_COEFFICIENT_S_M)), Dflt::Num(0.0);
     }
     children {}
 }
