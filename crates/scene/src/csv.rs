@@ -10,6 +10,35 @@
 use clutchpack_model::{Table, TableError};
 use std::path::Path;
 
+/// The header row's fields and the rows after it, as (1-based line number, fields), of CSV
+/// text: blank lines and lines starting with `#` skipped, fields split at commas and trimmed.
+/// `shown` names the file in the message of an empty file.
+fn header_and_rows<'t>(
+    text: &'t str,
+    shown: &str,
+) -> Result<(Vec<&'t str>, impl Iterator<Item = (usize, Vec<&'t str>)>), String> {
+    let mut rows = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
+        .map(|(n, l)| (n, l.split(',').map(str::trim).collect::<Vec<_>>()));
+    let (_, header) = rows
+        .next()
+        .ok_or_else(|| format!("{shown}: empty file (expected a header row)"))?;
+    Ok((header, rows))
+}
+
+/// The index of column `name` in `header`, else a message naming the file and the columns found.
+fn column_of(header: &[&str], name: &str, shown: &str) -> Result<usize, String> {
+    header.iter().position(|h| *h == name).ok_or_else(|| {
+        format!(
+            "{shown}: no column {name:?} in the header row (found: {})",
+            header.join(", ")
+        )
+    })
+}
+
 /// Reads columns `time_s` and `value_column` of the CSV file at `path` into a table whose
 /// values lie within `range` (the plausibility bound of the key the column stands for: a row
 /// of 1e300 N m would pass as finite and make the run take hours or diverge).
@@ -33,24 +62,8 @@ pub(crate) fn parse_table(
     value_column: &str,
     (lo, hi): (f64, f64),
 ) -> Result<Table, String> {
-    // (1-based line number, fields) of each non-blank, non-comment line
-    let mut rows = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
-        .map(|(n, l)| (n, l.split(',').map(str::trim).collect::<Vec<_>>()));
-    let (_, header) = rows
-        .next()
-        .ok_or_else(|| format!("{shown}: empty file (expected a header row)"))?;
-    let column = |name: &str| {
-        header.iter().position(|h| *h == name).ok_or_else(|| {
-            format!(
-                "{shown}: no column {name:?} in the header row (found: {})",
-                header.join(", ")
-            )
-        })
-    };
+    let (header, rows) = header_and_rows(text, shown)?;
+    let column = |name: &str| column_of(&header, name, shown);
     let (it, iy) = (column("time_s")?, column(value_column)?);
     let (mut t, mut y, mut lines) = (Vec::new(), Vec::new(), Vec::new());
     for (line, fields) in rows {
@@ -112,23 +125,8 @@ pub fn parse_columns(
     time_column: &str,
     columns: &[&str],
 ) -> Result<Columns, String> {
-    let mut rows = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
-        .map(|(n, l)| (n, l.split(',').map(str::trim).collect::<Vec<_>>()));
-    let (_, header) = rows
-        .next()
-        .ok_or_else(|| format!("{shown}: empty file (expected a header row)"))?;
-    let column = |name: &str| {
-        header.iter().position(|h| *h == name).ok_or_else(|| {
-            format!(
-                "{shown}: no column {name:?} in the header row (found: {})",
-                header.join(", ")
-            )
-        })
-    };
+    let (header, rows) = header_and_rows(text, shown)?;
+    let column = |name: &str| column_of(&header, name, shown);
     let it = column(time_column)?;
     let idx = columns
         .iter()
