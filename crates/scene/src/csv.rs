@@ -10,13 +10,16 @@
 use clutchpack_model::{Table, TableError};
 use std::path::Path;
 
+/// One row of a CSV file: its 1-based line number and its fields.
+type Row<'t> = (usize, Vec<&'t str>);
+
 /// The header row's fields and the rows after it, as (1-based line number, fields), of CSV
 /// text: blank lines and lines starting with `#` skipped, fields split at commas and trimmed.
 /// `shown` names the file in the message of an empty file.
 fn header_and_rows<'t>(
     text: &'t str,
     shown: &str,
-) -> Result<(Vec<&'t str>, impl Iterator<Item = (usize, Vec<&'t str>)>), String> {
+) -> Result<(Vec<&'t str>, impl Iterator<Item = Row<'t>>), String> {
     let mut rows = text
         .lines()
         .enumerate()
