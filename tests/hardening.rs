@@ -8,14 +8,16 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-fn repo(p: &str) -> String {
+/// The path of `p` in the repository, as text.
+pub(super) fn repo(p: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join(p)
         .display()
         .to_string()
 }
 
-fn exit_2(o: &Output, what: &str) -> String {
+/// Exit code 2, no panic, no abort; the message.
+pub(super) fn exit_2(o: &Output, what: &str) -> String {
     let err = stderr(o);
     assert_eq!(o.status.code(), Some(2), "{what}: {err}");
     assert!(!err.contains("panicked"), "{what}: {err}");

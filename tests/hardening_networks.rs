@@ -3,24 +3,8 @@
 //! against; the reproducers are those of the issue. No test times anything: "before the run"
 //! is checked by what was (not) written.
 
+use super::hardening::{exit_2, repo};
 use super::{run, scratch, stderr};
-use std::path::Path;
-use std::process::Output;
-
-fn repo(p: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(p)
-        .display()
-        .to_string()
-}
-
-/// Exit code 2, no panic, no abort; the message.
-fn exit_2(o: &Output, what: &str) -> String {
-    let err = stderr(o);
-    assert_eq!(o.status.code(), Some(2), "{what}: {err}");
-    assert!(!err.contains("panicked"), "{what}: {err}");
-    err
-}
 
 /// Item 1: a pack file that names a network scene back (a network whose pack is the network
 /// itself, or a -> b -> a) recursed until the stack overflowed (SIGABRT from `check`, `run`,
@@ -313,9 +297,8 @@ fn empty_body_name_is_refused() {
 /// saying the run diverged; a run that exits 0 prints no `inf` or `NaN`; nothing panics.
 #[test]
 fn mutated_network_and_thermal_scenes_end_with_exit_0_1_or_2() {
-    use super::reliability::{mutate, Rng, KNOWN_GAP};
-    use std::process::Stdio;
-    use std::time::{Duration, Instant};
+    use super::reliability::{accepted_by_check, mutated_scenes, run_ends_cleanly};
+    use std::time::Duration;
     let d = scratch("hard3-fuzz");
     for f in [
         "dct-k1.toml",
@@ -336,36 +319,8 @@ fn mutated_network_and_thermal_scenes_end_with_exit_0_1_or_2() {
     .iter()
     .map(|n| std::fs::read_to_string(repo(&format!("scenes/{n}.toml"))).unwrap())
     .collect();
-    let mut rng = Rng(0x5eed_4800_0000_0003);
-    let mut files = Vec::new();
-    for k in 0..1200 {
-        let mut text = sources[k % sources.len()].clone();
-        for _ in 0..1 + rng.below(3) {
-            text = mutate(&text, &mut rng);
-        }
-        let f = d.join(format!("n{k:04}.toml"));
-        std::fs::write(&f, text).unwrap();
-        files.push(f);
-    }
-    let mut accepted = Vec::new();
-    for batch in files.chunks(300) {
-        let o = super::bin().arg("check").args(batch).output().unwrap();
-        let (out, err) = (super::stdout(&o), stderr(&o));
-        assert!(
-            matches!(o.status.code(), Some(0) | Some(2)),
-            "check: {:?}: {err}",
-            o.status
-        );
-        assert!(
-            !err.contains("panicked") && !out.contains("panicked"),
-            "{err}"
-        );
-        for f in batch {
-            if out.contains(&format!("{}: ok", f.display())) {
-                accepted.push(f.clone());
-            }
-        }
-    }
+    let files = mutated_scenes(&d, &sources, 1200, 0x5eed_4800_0000_0003, "n");
+    let accepted = accepted_by_check(&files, 300);
     assert!(
         accepted.len() > 100,
         "some mutations are harmless: {}",
@@ -377,47 +332,9 @@ fn mutated_network_and_thermal_scenes_end_with_exit_0_1_or_2() {
     let mut diverged = Vec::new();
     for f in sample {
         for engine in ["reference", "multibody"] {
-            let what = format!("run --engine {engine} {}", f.display());
-            let mut child = super::bin()
-                .args([
-                    "run",
-                    "--no-record",
-                    "--duration",
-                    "0.01",
-                    "--engine",
-                    engine,
-                ])
-                .arg(f)
-                .stdout(Stdio::piped())
-                .stderr(Stdio::piped())
-                .spawn()
-                .unwrap();
-            let t0 = Instant::now();
-            while child.try_wait().unwrap().is_none() {
-                if t0.elapsed() > Duration::from_secs(60) {
-                    let _ = child.kill();
-                    panic!("{what}: did not end within 60 s");
-                }
-                std::thread::sleep(Duration::from_millis(10));
-            }
-            let o = child.wait_with_output().unwrap();
-            let err = stderr(&o);
-            assert!(!err.contains("panicked"), "{what}: {err}");
-            if o.status.code() == Some(1) && err.contains(KNOWN_GAP) {
-                diverged.push(what);
-                continue;
-            }
-            assert!(
-                matches!(o.status.code(), Some(0) | Some(2)),
-                "{what}: {:?}: {err}",
-                o.status
-            );
-            if o.status.success() {
-                let out = super::stdout(&o);
-                let bad = out
-                    .split(|c: char| c.is_whitespace() || c == ',')
-                    .find(|w| matches!(w.to_ascii_lowercase().as_str(), "inf" | "-inf" | "nan"));
-                assert!(bad.is_none(), "{what}: printed {bad:?}:\n{out}");
+            let args = ["--no-record", "--duration", "0.01", "--engine", engine];
+            if !run_ends_cleanly(&args, f, Duration::from_secs(60)) {
+                diverged.push(format!("{engine} {}", f.display()));
             }
         }
     }

@@ -375,23 +375,23 @@ fn impossible_or_mismatched_scenes_are_refused_with_the_key() {
 
 /// A small seeded generator (xorshift64*), so that the fuzz test is reproducible without a
 /// dependency.
-pub(super) struct Rng(pub(super) u64);
+struct Rng(u64);
 
 impl Rng {
-    pub(super) fn next(&mut self) -> u64 {
+    fn next(&mut self) -> u64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
         self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
     }
-    pub(super) fn below(&mut self, n: usize) -> usize {
+    fn below(&mut self, n: usize) -> usize {
         (self.next() % n as u64) as usize
     }
 }
 
 /// One mutation of a scene text: a value replaced by a hostile one, a line dropped or
 /// doubled, or a key renamed.
-pub(super) fn mutate(text: &str, rng: &mut Rng) -> String {
+fn mutate(text: &str, rng: &mut Rng) -> String {
     const VALUES: [&str; 28] = [
         "0",
         "-1",
@@ -454,6 +454,98 @@ pub(super) fn mutate(text: &str, rng: &mut Rng) -> String {
     lines.join("\n") + "\n"
 }
 
+/// `n` mutated scenes (one to three mutations each of `sources`' texts in turn, seeded by
+/// `seed`) written into `dir` as `<prefix><k>.toml`.
+pub(super) fn mutated_scenes(
+    dir: &Path,
+    sources: &[String],
+    n: usize,
+    seed: u64,
+    prefix: &str,
+) -> Vec<PathBuf> {
+    let mut rng = Rng(seed);
+    let mut files = Vec::new();
+    for k in 0..n {
+        let mut text = sources[k % sources.len()].clone();
+        for _ in 0..1 + rng.below(3) {
+            text = mutate(&text, &mut rng);
+        }
+        let f = dir.join(format!("{prefix}{k:04}.toml"));
+        std::fs::write(&f, text).unwrap();
+        files.push(f);
+    }
+    files
+}
+
+/// The files `check` accepts, checked `batch` at a time; every `check` exits 0 or 2 and
+/// nothing panics.
+pub(super) fn accepted_by_check(files: &[PathBuf], batch: usize) -> Vec<PathBuf> {
+    let mut accepted = Vec::new();
+    for chunk in files.chunks(batch) {
+        let o = bin().arg("check").args(chunk).output().unwrap();
+        let (out, err) = (stdout(&o), stderr(&o));
+        assert!(
+            matches!(o.status.code(), Some(0) | Some(2)),
+            "check: {:?}: {err}",
+            o.status
+        );
+        assert!(
+            !err.contains("panicked") && !out.contains("panicked"),
+            "{err}"
+        );
+        for f in chunk {
+            if out.contains(&format!("{}: ok", f.display())) {
+                accepted.push(f.clone());
+            }
+        }
+    }
+    accepted
+}
+
+/// `clutchpack run` with `args` then `file`, killed and failed after `limit` (a hang guard,
+/// not a speed assertion). Nothing panics; the exit code is 0 or 2, or 1 saying the run
+/// diverged (then `false` is returned: the known gap); a run that exits 0 prints no `inf`
+/// or `NaN`.
+pub(super) fn run_ends_cleanly(args: &[&str], file: &Path, limit: Duration) -> bool {
+    let what = format!("run {args:?} {}", file.display());
+    let mut child = bin()
+        .arg("run")
+        .args(args)
+        .arg(file)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            panic!("{what}: did not end within {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let o = child.wait_with_output().unwrap();
+    let err = stderr(&o);
+    assert!(!err.contains("panicked"), "{what}: {err}");
+    if o.status.code() == Some(1) && err.contains(KNOWN_GAP) {
+        return false;
+    }
+    assert!(
+        matches!(o.status.code(), Some(0) | Some(2)),
+        "{what}: {:?}: {err}",
+        o.status
+    );
+    // issue 25: a result is finite or refused, never `inf` or `NaN` with exit 0
+    if o.status.success() {
+        let out = stdout(&o);
+        let bad = out
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .find(|w| matches!(w.to_ascii_lowercase().as_str(), "inf" | "-inf" | "nan"));
+        assert!(bad.is_none(), "{what}: printed {bad:?}:\n{out}");
+    }
+    true
+}
+
 /// A bounded, seeded fuzz test: 3000 scenes, each one to three mutations of a shipped
 /// scene, go through `check` (all in a few invocations) and, for those it accepts and a
 /// sample of the others, a very short `run`. No panic, no crash: every exit code of `check`
@@ -475,83 +567,17 @@ fn mutated_scenes_give_exit_0_or_2_and_never_a_panic() {
     .iter()
     .map(|n| std::fs::read_to_string(repo(&format!("scenes/{n}.toml"))).unwrap())
     .collect();
-    let mut rng = Rng(0x5eed_1234_abcd_0001);
-    let mut files = Vec::new();
-    for k in 0..3000 {
-        let mut text = sources[k % sources.len()].clone();
-        for _ in 0..1 + rng.below(3) {
-            text = mutate(&text, &mut rng);
-        }
-        let f = d.join(format!("m{k:04}.toml"));
-        std::fs::write(&f, text).unwrap();
-        files.push(f);
-    }
-    let mut accepted = Vec::new();
-    for batch in files.chunks(500) {
-        let o = bin().arg("check").args(batch).output().unwrap();
-        let (out, err) = (stdout(&o), stderr(&o));
-        assert!(
-            matches!(o.status.code(), Some(0) | Some(2)),
-            "check: {:?}: {err}",
-            o.status
-        );
-        assert!(
-            !err.contains("panicked") && !out.contains("panicked"),
-            "{err}"
-        );
-        for f in batch {
-            let name = f.display().to_string();
-            if out.contains(&format!("{name}: ok")) {
-                accepted.push(f.clone());
-            }
-        }
-    }
+    let files = mutated_scenes(&d, &sources, 3000, 0x5eed_1234_abcd_0001, "m");
+    let accepted = accepted_by_check(&files, 500);
     assert!(!accepted.is_empty(), "some mutations are harmless");
     // a very short run of a sample of accepted and refused scenes
     let mut sample: Vec<&PathBuf> = accepted.iter().step_by(accepted.len() / 60 + 1).collect();
     sample.extend(files.iter().step_by(100));
     let mut diverged = Vec::new();
     for f in sample {
-        // a hang fails the test (with the file) instead of the CI job
-        let mut child = bin()
-            .args(["run", "--no-record", "--duration", "0.002"])
-            .arg(f)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let t0 = Instant::now();
-        while child.try_wait().unwrap().is_none() {
-            if t0.elapsed() > Duration::from_secs(120) {
-                let _ = child.kill();
-                panic!("run {}: did not end within 120 s", f.display());
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        let o = child.wait_with_output().unwrap();
-        let err = stderr(&o);
-        assert!(!err.contains("panicked"), "run {}: {err}", f.display());
-        if o.status.code() == Some(1) && err.contains(KNOWN_GAP) {
+        let args = ["--no-record", "--duration", "0.002"];
+        if !run_ends_cleanly(&args, f, Duration::from_secs(120)) {
             diverged.push(f.display().to_string());
-            continue;
-        }
-        assert!(
-            matches!(o.status.code(), Some(0) | Some(2)),
-            "run {}: {:?}: {err}",
-            f.display(),
-            o.status
-        );
-        // issue 25: a result is finite or refused, never `inf` or `NaN` with exit 0
-        if o.status.success() {
-            let out = stdout(&o);
-            let bad = out
-                .split(|c: char| c.is_whitespace() || c == ',')
-                .find(|w| matches!(w.to_ascii_lowercase().as_str(), "inf" | "-inf" | "nan"));
-            assert!(
-                bad.is_none(),
-                "run {}: printed {bad:?}:\n{out}",
-                f.display()
-            );
         }
     }
     if !diverged.is_empty() {
@@ -560,4 +586,4 @@ fn mutated_scenes_give_exit_0_or_2_and_never_a_panic() {
 }
 
 /// The one run failure the fuzz test tolerates (see its documentation).
-pub(super) const KNOWN_GAP: &str = "the simulation diverged";
+const KNOWN_GAP: &str = "the simulation diverged";
