@@ -11,6 +11,7 @@ mod hardening;
 mod hardening_networks;
 mod network;
 mod network_engines;
+mod planetary;
 mod python_package;
 mod reliability;
 mod salvage_and_messages;

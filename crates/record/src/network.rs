@@ -118,6 +118,7 @@ pub fn coupling_kind_name(kind: &CouplingKind) -> &'static str {
     match kind {
         CouplingKind::Clutch(_) => "clutch",
         CouplingKind::IdealGear { .. } => "ideal_gear",
+        CouplingKind::Planetary(_) => "planetary",
         CouplingKind::GearMesh(_) => "gear_mesh",
         CouplingKind::SpringDamper(_) => "spring_damper",
         CouplingKind::Pack(_) => "pack",

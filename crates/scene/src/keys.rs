@@ -635,12 +635,12 @@ table! {
 }
 
 table! {
-    /// One `[[couplings]]` entry: a coupling between bodies a and b (MODEL.md section 8): in a network scene between two of its [[bodies]]; in a one-pack scene (no [[bodies]]) a spring_damper between its shaft and its drum. Signs: a clutch's slip is w_b - w_a and its torque acts +tau on a, -tau on b (Modelica's flanges); an ideal gear ties w_a = ratio w_b; a gear mesh's force F, signed as x, acts -Rb_a F on a and -Rb_b F on b (internal: +Rb_b F); a spring_damper's torque T = k (theta_a - theta_b - theta_0) + d (w_a - w_b) acts +T on b, -T on a.
+    /// One `[[couplings]]` entry: a coupling between bodies a and b (MODEL.md section 8): in a network scene between two of its [[bodies]]; in a one-pack scene (no [[bodies]]) a spring_damper between its shaft and its drum. Signs: a clutch's slip is w_b - w_a and its torque acts +tau on a, -tau on b (Modelica's flanges); an ideal gear ties w_a = ratio w_b; a gear mesh's force F, signed as x, acts -Rb_a F on a and -Rb_b F on b (internal: +Rb_b F); a spring_damper's torque T = k (theta_a - theta_b - theta_0) + d (w_a - w_b) acts +T on b, -T on a; a planetary set's torque is the one on its sun (a).
     RawCoupling at "" {
         /// the coupling's name, unique (tables, summaries and figures name it)
         name: "", Kind::Text, Dflt::Described("default \"<kind>-<i+1>\" (\"clutch-2\")");
-        /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash; "gear_mesh": a gear pair with backlash and the tooth law of [couplings.contact] and [couplings.oil] along its line of action (gear rattle); "spring_damper": a torsional spring with a viscous damper in parallel (a clutch damper, a dual-mass flywheel; one-pack scenes, between "shaft" and "drum"); "pack": a resolved pack of the pack scene in `pack` (network scenes; the reference engine), its friction discs on body a, its plates on body b
-        kind: "", Kind::Choice(&["clutch", "ideal_gear", "gear_mesh", "spring_damper", "pack"]), Dflt::Required;
+        /// "clutch": a lumped friction clutch (Modelica's Rotational.Components.Clutch; a brake when one body is fixed); "ideal_gear": a rigid gear without backlash; "gear_mesh": a gear pair with backlash and the tooth law of [couplings.contact] and [couplings.oil] along its line of action (gear rattle); "spring_damper": a torsional spring with a viscous damper in parallel (a clutch damper, a dual-mass flywheel; one-pack scenes, between "shaft" and "drum"); "pack": a resolved pack of the pack scene in `pack` (network scenes), its friction discs on body a, its plates on body b; "planetary": a simple planetary set, its sun body a, its ring body b, its carrier `carrier` (Willis: z_S w_S + z_R w_R = (z_S + z_R) w_C; MODEL.md section 10)
+        kind: "", Kind::Choice(&["clutch", "ideal_gear", "gear_mesh", "spring_damper", "pack", "planetary"]), Dflt::Required;
         /// the name of body a (a one-pack scene: "shaft" or "drum", the drum with [drum]; a prescribed shaft drives b through a spring_damper)
         a: "", Kind::Text, Dflt::Required;
         /// the name of body b, not a
@@ -677,6 +677,14 @@ table! {
         damping_n_m_s_per_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
         /// pack: a pack scene file (its [[discs]], [[plates]], [stack], ... as a pack scene has them; relative to this scene's folder); its [shaft], [drive], [drum] and [simulation] are not used here: bodies a and b carry it
         pack: "", Kind::Text, Dflt::When("pack: required");
+        /// planetary: the name of the carrier body (a third body, not a or b)
+        carrier: "", Kind::Text, Dflt::When("planetary: required");
+        /// planetary: the sun's teeth z_S
+        sun_teeth: "", Kind::Count { max: clutchpack_model::network::planetary::MAX_TEETH }, Dflt::When("planetary: required");
+        /// planetary: the ring's teeth z_R (> z_S; a simple set's z_R - z_S even: the planets have (z_R - z_S) / 2)
+        ring_teeth: "", Kind::Count { max: clutchpack_model::network::planetary::MAX_TEETH }, Dflt::When("planetary: required");
+        /// planetary: a double-pinion set (a Ravigneaux set's building block: z_S w_S - z_R w_R = (z_S - z_R) w_C, the ring turning the other way relative to the carrier)
+        double_pinion: "", Kind::Bool, Dflt::Bool(false);
         /// spring_damper: free angle theta_0, the twist theta_a - theta_b at which the spring carries no torque (both bodies start at angle 0, so a non-zero theta_0 starts the spring twisted)
         free_angle_rad: "rad", Kind::Number(Rule::Closed(-MAX_FREE_ANGLE_RAD, MAX_FREE_ANGLE_RAD)), Dflt::Num(0.0);
     }

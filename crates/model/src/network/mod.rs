@@ -11,14 +11,19 @@
 
 pub mod clutch;
 pub mod firing;
+pub mod friction;
 pub mod gear;
 pub mod output;
+pub mod planetary;
+pub mod rows;
 pub mod signal;
 
 pub use clutch::{ClutchMode, LumpedClutch};
 pub use firing::Firing;
 pub use gear::GearMesh;
 pub use output::{ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample};
+pub use planetary::PlanetarySet;
+pub use rows::Row;
 pub use signal::{NetworkInput, Signal};
 
 use serde::{Deserialize, Serialize};
@@ -113,6 +118,10 @@ pub enum CouplingKind {
     /// plate a body of its own with its tooth contacts, and its stack and piston. The pack's
     /// own `shaft` and `drum` are not used: the network's bodies `a` and `b` carry it.
     Pack(Box<crate::PackModel>),
+    /// A simple planetary set (MODEL.md section 10): body `a` its sun, body `b` its ring,
+    /// the carrier named by the set; Willis' equation `z_S w_S + z_R w_R = (z_S + z_R) w_C`
+    /// a constraint on the three (rigid, ideal, no backlash). Its torque on `a` is the sun's.
+    Planetary(PlanetarySet),
 }
 
 /// A coupling between two bodies of a network.
@@ -129,6 +138,24 @@ pub struct Coupling {
 }
 
 impl Coupling {
+    /// Its constraint row when it is rigid in the mode `mode` ([`rows`]; `k` its index):
+    /// an ideal gear always, `w_a - ratio w_b = 0`; a planetary set always, Willis' equation
+    /// ([`PlanetarySet::row`]); a locked clutch, `w_a - w_b = 0`; `None`
+    /// for the others (their torques are forces, not constraints). The one place that says
+    /// which couplings are rigid, for both engines.
+    pub fn row(&self, k: usize, mode: Option<ClutchMode>) -> Option<Row> {
+        let coef_b = match self.kind {
+            CouplingKind::Planetary(ref p) => return Some(p.row(k, self.a, self.b)),
+            CouplingKind::IdealGear { ratio } => -ratio,
+            CouplingKind::Clutch(_) if mode == Some(ClutchMode::Locked) => -1.0,
+            CouplingKind::Clutch(_)
+            | CouplingKind::GearMesh(_)
+            | CouplingKind::SpringDamper(_)
+            | CouplingKind::Pack(_) => return None,
+        };
+        Some(Row::two(k, (self.a, 1.0), (self.b, coef_b)))
+    }
+
     /// Its lumped clutch, if it is one.
     pub fn clutch(&self) -> Option<&LumpedClutch> {
         match &self.kind {
@@ -389,6 +416,13 @@ impl Network {
                         out.push(coupling(k, "pack", "the pack has no friction discs".into()));
                     }
                 }
+                CouplingKind::Planetary(ps) => {
+                    planetary::network_problems(self, k, c, ps, &mut out);
+                    if ps.carrier < n {
+                        let (tc, tb) = (top(&mut linked, ps.carrier), top(&mut linked, c.b));
+                        linked[tc] = tb;
+                    }
+                }
                 CouplingKind::IdealGear { ratio } => {
                     if !(ratio.is_finite() && *ratio != 0.0) {
                         out.push(coupling(
@@ -440,6 +474,33 @@ impl Network {
                         ));
                     }
                 }
+            }
+        }
+        // the rigid rows that hold always (gears, planetary sets) independent: a redundant one
+        // over-constrains the bodies (the gears' loops are found above with their ratios)
+        if out.is_empty()
+            && self
+                .couplings
+                .iter()
+                .any(|c| matches!(c.kind, CouplingKind::Planetary(_)))
+        {
+            let rows: Vec<Row> = self
+                .couplings
+                .iter()
+                .enumerate()
+                .filter_map(|(k, c)| c.row(k, None))
+                .collect();
+            let inv: Vec<f64> = self
+                .bodies
+                .iter()
+                .map(|b| if b.fixed { 0.0 } else { 1.0 })
+                .collect();
+            for r in rows::redundant(&rows, &inv) {
+                out.push(coupling(
+                    r,
+                    "b",
+                    "over-constrains its bodies: with the ideal gears and planetary sets before it, its constraint is redundant or contradicts them (every member it ties is already tied)".into(),
+                ));
             }
         }
         // every group of connected bodies has something that moves it

@@ -25,7 +25,7 @@
 //!    8): a clutch is free while `fn(t) <= 0`; a free clutch that engages slips if its slip
 //!    is not zero and is tried locked otherwise; a slipping clutch whose slip `s w_rel` has
 //!    reached zero (within `1e-10 (1 + |w_a| + |w_b|)` rad/s) is tried locked. The speeds of
-//!    the new rigid groups are merged, angular momentum kept (`constraint::project`; the
+//!    the new rigid groups are merged, angular momentum kept (`rows::project`, the model's; the
 //!    kinetic energy this removes, rounding after a landed step, is the lock's heat).
 //! 2. **Torques at `t`**: each body's drive, road load and drag
 //!    ([`clutchpack_model::network::Body::external_torque_n_m`]), each slipping clutch's
@@ -35,7 +35,7 @@
 //!    signed as its `x`, from the model's law at `x` and its rate (MODEL.md section 8:
 //!    `-Rb_a F` on `a`, `-Rb_b F` on `b`, internal `+Rb_b F`, times the pairs,
 //!    [`GearMesh::torques_n_m`](clutchpack_model::network::GearMesh::torques_n_m)); then the constraint torques `lambda` of the gears
-//!    and locked clutches that keep every constraint (`constraint::solve`). A locked clutch
+//!    and locked clutches that keep every constraint (the model's `rows::constraint_torques`). A locked clutch
 //!    whose `|lambda|` exceeds its static limit `peak mu(0) cgeo fn`
 //!    ([`LumpedClutch::max_static_torque_n_m`](clutchpack_model::network::LumpedClutch::max_static_torque_n_m)) slips towards it; the one furthest over goes
 //!    first and the solve repeats (as the reference's `settle`). These are the samples'
@@ -74,7 +74,6 @@
 //! works themselves are second-order accurate in the step.
 
 mod bodies;
-mod constraint;
 mod mesh;
 mod packs;
 mod stepper;
@@ -83,10 +82,10 @@ pub use clutchpack_model::network::NetworkInput;
 pub use stepper::{run_network, NetworkStepper};
 
 use bodies::NetworkWorld;
+pub(crate) use clutchpack_model::network::rows::{self as constraint, Row};
 use clutchpack_model::network::{
-    ClutchEvent, ClutchMode, CouplingKind, Network, NetworkEnergy, NetworkObserver, NetworkSample,
+    friction, ClutchEvent, ClutchMode, Network, NetworkEnergy, NetworkObserver, NetworkSample,
 };
-use constraint::Row;
 use mesh::Mesh;
 use std::sync::Arc;
 
@@ -154,22 +153,11 @@ struct Run {
 }
 
 impl Run {
-    /// The rows of the gears and the locked clutches.
+    /// The rows of the gears and the locked clutches ([`clutchpack_model::network::Coupling::row`]).
     fn build_rows(&mut self) {
         self.rows.clear();
         for (k, c) in self.net.couplings.iter().enumerate() {
-            let coef_b = match c.kind {
-                CouplingKind::IdealGear { ratio } => -ratio,
-                CouplingKind::Clutch(_) if self.modes[k] == Some(ClutchMode::Locked) => -1.0,
-                _ => continue,
-            };
-            self.rows.push(Row {
-                coupling: k,
-                a: c.a,
-                b: c.b,
-                coef_a: 1.0,
-                coef_b,
-            });
+            self.rows.extend(c.row(k, self.modes[k]));
         }
     }
 
@@ -205,16 +193,8 @@ impl Run {
     fn response(&self, i: usize) -> Vec<f64> {
         let mut unit = vec![0.0; self.w.len()];
         unit[i] = 1.0;
-        let rhs: Vec<f64> = self
-            .rows
-            .iter()
-            .map(|r| {
-                -(r.coef_a * self.inv_inertia[r.a] * unit[r.a]
-                    + r.coef_b * self.inv_inertia[r.b] * unit[r.b])
-            })
-            .collect();
         let mut lambda = Vec::new();
-        constraint::solve(&self.rows, &self.inv_inertia, &rhs, &mut lambda);
+        constraint::constraint_torques(&self.rows, &self.inv_inertia, &unit, &mut lambda);
         constraint::add_torques(&self.rows, &lambda, &mut unit);
         self.accelerations(&unit)
     }
@@ -291,17 +271,9 @@ impl Run {
         mesh::add_torques(&self.meshes, x, w, body, coupling, &mut out.mesh_force);
         // A lambda = -C M^-1 T: the rows' rates vanish, so rows that hold at the step's
         // start hold at its end (the speeds are projected after each step against rounding)
-        let rhs: Vec<f64> = self
-            .rows
-            .iter()
-            .map(|r| {
-                -(r.coef_a * self.inv_inertia[r.a] * out.body[r.a]
-                    + r.coef_b * self.inv_inertia[r.b] * out.body[r.b])
-            })
-            .collect();
-        constraint::solve(&self.rows, &self.inv_inertia, &rhs, &mut out.lambda);
+        constraint::constraint_torques(&self.rows, &self.inv_inertia, &out.body, &mut out.lambda);
         for (r, l) in self.rows.iter().zip(&out.lambda) {
-            out.coupling[r.coupling] = *l;
+            out.coupling[r.coupling] = r.first_torque_n_m(*l);
         }
     }
 
@@ -348,31 +320,19 @@ impl Run {
             let Some(cl) = net.couplings[k].clutch() else {
                 continue;
             };
-            let f = cl.normal_force_n(t);
             let (wa, wb) = (self.w[c.a], self.w[c.b]);
             let w_rel = wb - wa;
             let scale = 1e-10 * (1.0 + wa.abs() + wb.abs());
-            self.modes[k] = Some(if f <= 0.0 {
-                ClutchMode::Free
-            } else {
-                match before[k] {
-                    Some(ClutchMode::Free) | None => {
-                        if w_rel.abs() > scale {
-                            ClutchMode::Slipping(if w_rel > 0.0 { 1 } else { -1 })
-                        } else {
-                            ClutchMode::Locked
-                        }
-                    }
-                    Some(ClutchMode::Slipping(s)) => {
-                        if f64::from(s) * w_rel <= scale {
-                            ClutchMode::Locked
-                        } else {
-                            ClutchMode::Slipping(s)
-                        }
-                    }
-                    Some(ClutchMode::Locked) => ClutchMode::Locked,
-                }
-            });
+            // the step landed on the slip's zero: within the scale of it
+            let slip_ended =
+                matches!(before[k], Some(ClutchMode::Slipping(s)) if f64::from(s) * w_rel <= scale);
+            self.modes[k] = Some(friction::entered_mode(
+                before[k],
+                cl.normal_force_n(t),
+                w_rel,
+                scale,
+                slip_ended,
+            ));
         }
         let newly_locked = (0..net.couplings.len()).find(|&k| {
             self.modes[k] == Some(ClutchMode::Locked) && before[k] != Some(ClutchMode::Locked)
@@ -390,25 +350,8 @@ impl Run {
                 }
             }
             self.torques(t);
-            let mut worst: Option<(usize, f64)> = None;
-            for (k, mode) in self.modes.iter().enumerate() {
-                if *mode != Some(ClutchMode::Locked) {
-                    continue;
-                }
-                let Some(cl) = net.couplings[k].clutch() else {
-                    continue;
-                };
-                let over =
-                    self.coupling_torque[k].abs() - cl.max_static_torque_n_m(cl.normal_force_n(t));
-                if over > 0.0 && worst.is_none_or(|(_, o)| over > o) {
-                    worst = Some((k, over));
-                }
-            }
-            match worst {
-                Some((k, _)) => {
-                    let s = if self.coupling_torque[k] > 0.0 { 1 } else { -1 };
-                    self.modes[k] = Some(ClutchMode::Slipping(s));
-                }
+            match friction::furthest_over(&net, &self.modes, &self.coupling_torque, t) {
+                Some((k, s)) => self.modes[k] = Some(ClutchMode::Slipping(s)),
                 None => break,
             }
         }

@@ -1,161 +1,261 @@
-//! The rigid groups of a network in one mode: bodies joined by ideal gears and locked clutches
-//! move as one degree of freedom (MODEL.md section 8). For each group: the speed factor of each
-//! body (`w_i = g_i w_group`), the reduced inertia `sum g_i^2 J_i`, and a spanning tree of its
-//! rigid couplings in leaves-first order, from which the torque each rigid coupling carries
-//! follows body by body (the constraint torques of the tree; a rigid loop's extra coupling,
-//! possible only with clutches locked in parallel, carries none).
+//! The rigid groups of a network in one mode (MODEL.md section 8): the rows of the ideal
+//! gears, the locked clutches and any element that ties three bodies (the model's
+//! [`clutchpack_model::network::rows`], the rows the multibody engine solves too) turn the
+//! bodies' accelerations into the constrained ones, `a = P T`, with
+//! `P = M^-1 - M^-1 C^T A^+ C M^-1` (`A = C M^-1 C^T`, 1/(kg m^2)), and their torques into
+//! `lambda = L T`, `L = -A^+ C M^-1`. Both matrices depend only on the rows and the inertias:
+//! they are built once per mode (at each event that changes a mode), column by column, and
+//! each right-hand side is then two matrix products.
+//!
+//! A group is a set of moving bodies the rows connect (a fixed body connects nothing: two
+//! bodies braked to the housing are two groups). Its freedom is the rank of `P` on it: 0 (it
+//! is held by a fixed body: its accelerations are exactly 0), 1 (every member turns as
+//! `w_i = g_i w_r`, its root's speed, a gear train or a locked chain: its accelerations are
+//! `g_i sum_j g_j T_j / J_red` with `J_red = sum g_j^2 J_j`, so that bodies locked together
+//! keep equal speeds to the last bit), or more (a planetary set with none of its members held:
+//! `a = P T` on the group). The road loads' hold at rest acts on groups of freedom 1 (the
+//! module docs of `mod.rs`).
 
-use clutchpack_model::network::{CouplingKind, Network};
+use clutchpack_model::network::rows::{self, Row};
+use clutchpack_model::network::Network;
 
-/// The rigid groups of a network for one set of locked clutches.
+/// A group's freedom: how many degrees of freedom its members keep under the rows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Freedom {
+    /// Held by a fixed body: it does not turn.
+    Fixed,
+    /// One degree of freedom: `w_i = g_i w_root`.
+    One,
+    /// Two or more (a planetary set): accelerations from `P`.
+    Many,
+}
+
+/// The rigid groups of a network for one set of rows.
 #[derive(Debug, Clone)]
 pub(crate) struct Clusters {
     /// The group of each body.
     pub of: Vec<usize>,
-    /// The speed factor of each body against its group: `w_i = g_i w_group`.
+    /// The speed factor of each body against its group's root, `w_i = g_i w_root` (groups of
+    /// freedom one; 0 for a fixed body, 1 elsewhere).
     pub g: Vec<f64>,
-    /// The reduced inertia of each group, kg m^2 (`sum g_i^2 J_i`; unused for a fixed group).
+    /// The reduced inertia of each group of freedom one, kg m^2 (`sum g_i^2 J_i`; 0 for the
+    /// others).
     pub inertia: Vec<f64>,
-    /// Whether each group holds a fixed body (it does not turn).
-    pub fixed: Vec<bool>,
-    /// The tree's edges leaves first: (coupling, child body, parent body).
-    pub order: Vec<(usize, usize, usize)>,
-}
-
-/// `w_a = r w_b` for a rigid coupling: the ideal gear's ratio, 1 for a locked clutch.
-pub(crate) fn rigid_ratio(net: &Network, k: usize) -> f64 {
-    match net.couplings[k].kind {
-        CouplingKind::IdealGear { ratio } => ratio,
-        CouplingKind::Clutch(_)
-        | CouplingKind::GearMesh(_)
-        | CouplingKind::SpringDamper(_)
-        | CouplingKind::Pack(_) => 1.0,
-    }
+    /// Each group's freedom.
+    pub freedom: Vec<Freedom>,
+    /// The rows of this mode.
+    rows: Vec<Row>,
+    /// `P`, row-major n x n, 1/(kg m^2).
+    p: Vec<f64>,
+    /// `L`, row-major (rows) x n, dimensionless.
+    l: Vec<f64>,
 }
 
 impl Clusters {
-    /// The groups when the couplings with `rigid[k]` are rigid (every ideal gear, and the
-    /// locked clutches).
-    pub fn build(net: &Network, rigid: &[bool]) -> Clusters {
+    /// The groups of `net` when `rows` are the rigid constraints (every ideal gear, and the
+    /// locked clutches: [`clutchpack_model::network::Coupling::row`]).
+    pub fn build(net: &Network, rows: Vec<Row>) -> Clusters {
         let n = net.bodies.len();
-        let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
-        for (k, c) in net.couplings.iter().enumerate() {
-            if rigid[k] {
-                adj[c.a].push(k);
-                adj[c.b].push(k);
+        let inv: Vec<f64> = net
+            .bodies
+            .iter()
+            .map(|b| if b.fixed { 0.0 } else { 1.0 / b.inertia_kg_m2 })
+            .collect();
+        // P and L column by column: the response to a unit torque on each body
+        let (m, mut p, mut l) = (rows.len(), vec![0.0; n * n], vec![0.0; rows.len() * n]);
+        let mut lambda = Vec::new();
+        for i in 0..n {
+            let mut unit = vec![0.0; n];
+            unit[i] = 1.0;
+            rows::constraint_torques(&rows, &inv, &unit, &mut lambda);
+            rows::add_torques(&rows, &lambda, &mut unit);
+            for j in 0..n {
+                p[j * n + i] = inv[j] * unit[j];
+            }
+            for r in 0..m {
+                l[r * n + i] = lambda[r];
+            }
+        }
+        // the groups: moving bodies connected by a row's terms (union-find)
+        let mut parent: Vec<usize> = (0..n).collect();
+        fn root(parent: &mut [usize], mut i: usize) -> usize {
+            while parent[i] != i {
+                parent[i] = parent[parent[i]];
+                i = parent[i];
+            }
+            i
+        }
+        for r in &rows {
+            let moving: Vec<usize> = r
+                .terms()
+                .iter()
+                .map(|(i, _)| *i)
+                .filter(|&i| !net.bodies[i].fixed)
+                .collect();
+            for w in moving.windows(2) {
+                let (x, y) = (root(&mut parent, w[0]), root(&mut parent, w[1]));
+                parent[x.max(y)] = x.min(y);
             }
         }
         let mut of = vec![usize::MAX; n];
+        let mut members: Vec<Vec<usize>> = Vec::new();
+        for i in 0..n {
+            let r = root(&mut parent, i);
+            if of[r] == usize::MAX {
+                of[r] = members.len();
+                members.push(Vec::new());
+            }
+            of[i] = of[r];
+            members[of[i]].push(i);
+        }
         let mut g = vec![1.0; n];
-        let mut inertia = Vec::new();
-        let mut fixed = Vec::new();
-        let mut order = Vec::new();
-        // roots: fixed bodies first, so that a fixed group's unknown reaction is its root's
-        let roots = (0..n)
-            .filter(|&i| net.bodies[i].fixed)
-            .chain((0..n).filter(|&i| !net.bodies[i].fixed));
-        let mut queue = Vec::new();
-        for r in roots {
-            if of[r] != usize::MAX {
+        let mut inertia = vec![0.0; members.len()];
+        let mut freedom = vec![Freedom::Fixed; members.len()];
+        for (c, mem) in members.iter().enumerate() {
+            let scale = mem.iter().map(|&i| inv[i]).fold(0.0, f64::max);
+            // the root: the member that moves most freely under its own torque
+            let Some(&r) = mem
+                .iter()
+                .filter(|&&i| p[i * n + i] > 1e-12 * scale)
+                .max_by(|&&a, &&b| p[a * n + a].total_cmp(&p[b * n + b]))
+            else {
+                mem.iter().for_each(|&i| g[i] = 0.0);
+                continue;
+            };
+            let prr = p[r * n + r];
+            let factors: Vec<f64> = mem.iter().map(|&i| p[i * n + r] / prr).collect();
+            // rank one: P_ij = g_i g_j P_rr on the group
+            let one = mem.iter().zip(&factors).all(|(&i, gi)| {
+                mem.iter()
+                    .zip(&factors)
+                    .all(|(&j, gj)| (p[i * n + j] - gi * gj * prr).abs() <= 1e-9 * prr)
+            });
+            if !one {
+                freedom[c] = Freedom::Many;
                 continue;
             }
-            let id = inertia.len();
-            of[r] = id;
-            g[r] = 1.0;
-            queue.clear();
-            queue.push(r);
-            let mut head = 0;
-            let mut tree = Vec::new();
-            while head < queue.len() {
-                let p = queue[head];
-                head += 1;
-                for &k in &adj[p] {
-                    let c = &net.couplings[k];
-                    let ch = if c.a == p { c.b } else { c.a };
-                    if of[ch] != usize::MAX {
-                        continue;
-                    }
-                    let r = rigid_ratio(net, k);
-                    // w_a = r w_b
-                    g[ch] = if ch == c.b { g[p] / r } else { g[p] * r };
-                    of[ch] = id;
-                    tree.push((k, ch, p));
-                    queue.push(ch);
-                }
+            freedom[c] = Freedom::One;
+            let along = speed_factors(net, &rows, mem, r);
+            for (&i, gi) in mem.iter().zip(&factors) {
+                g[i] = along.iter().find(|(k, _)| *k == i).map_or(*gi, |x| x.1);
             }
-            let members = &queue[..];
-            fixed.push(members.iter().any(|&i| net.bodies[i].fixed));
-            inertia.push(
-                members
-                    .iter()
-                    .filter(|&&i| !net.bodies[i].fixed)
-                    .map(|&i| g[i] * g[i] * net.bodies[i].inertia_kg_m2)
-                    .sum(),
-            );
-            order.extend(tree.into_iter().rev());
+            inertia[c] = mem
+                .iter()
+                .map(|&i| {
+                    if net.bodies[i].fixed {
+                        0.0
+                    } else {
+                        g[i] * g[i] * net.bodies[i].inertia_kg_m2
+                    }
+                })
+                .sum();
+        }
+        for (i, b) in net.bodies.iter().enumerate() {
+            if b.fixed {
+                g[i] = 0.0;
+            }
         }
         Clusters {
             of,
             g,
             inertia,
-            fixed,
-            order,
+            freedom,
+            rows,
+            p,
+            l,
         }
     }
 
     /// The accelerations (rad/s^2) of every body from the torques on each (`torque`, N m: all
-    /// but the rigid couplings'): each group's `sum g_i T_i / sum g_i^2 J_i`, times `g_i`.
+    /// but the rows'): 0 in a group a fixed body holds; `g_i sum g_j T_j / J_red` in a group of freedom
+    /// one; `(P T)_i` otherwise.
     pub fn accelerations(&self, torque: &[f64], acc: &mut [f64], group: &mut Vec<f64>) {
+        let n = torque.len();
         group.clear();
         group.resize(self.inertia.len(), 0.0);
         for (i, t) in torque.iter().enumerate() {
             group[self.of[i]] += self.g[i] * t;
         }
         for (c, a) in group.iter_mut().enumerate() {
-            *a = if self.fixed[c] {
-                0.0
-            } else {
-                *a / self.inertia[c]
+            *a = match self.freedom[c] {
+                Freedom::One => *a / self.inertia[c],
+                Freedom::Fixed | Freedom::Many => 0.0,
             };
         }
         for (i, a) in acc.iter_mut().enumerate() {
-            *a = self.g[i] * group[self.of[i]];
+            let c = self.of[i];
+            *a = match self.freedom[c] {
+                Freedom::Fixed => 0.0,
+                Freedom::One => self.g[i] * group[c],
+                Freedom::Many => (0..n).map(|j| self.p[i * n + j] * torque[j]).sum(),
+            };
         }
     }
 
-    /// The torque each rigid coupling carries (N m, on its body `a`: `lambda`, and
-    /// `-r lambda` on `b`), from the bodies' accelerations and the other torques on them;
-    /// `out[k]` is written for the tree's couplings only.
-    pub fn rigid_torques(
-        &self,
-        net: &Network,
-        torque: &[f64],
-        acc: &[f64],
-        out: &mut [f64],
-        residual: &mut Vec<f64>,
-    ) {
-        // residual[i]: what the rigid couplings must put on body i, J a - T, less what its
-        // children's couplings already put on it
-        residual.clear();
-        residual.extend(net.bodies.iter().enumerate().map(|(i, b)| {
-            if b.fixed {
-                0.0
-            } else {
-                b.inertia_kg_m2 * acc[i] - torque[i]
+    /// The torque each rigid coupling puts on its body `a` (N m, written to `out` at its
+    /// coupling: [`Row::first_torque_n_m`] of `lambda = L T`) under the other torques `torque`
+    /// on the bodies (N m).
+    pub fn rigid_torques(&self, torque: &[f64], out: &mut [f64]) {
+        let n = torque.len();
+        for (r, row) in self.rows.iter().enumerate() {
+            let lambda: f64 = (0..n).map(|j| self.l[r * n + j] * torque[j]).sum();
+            out[row.coupling] = row.first_torque_n_m(lambda);
+        }
+    }
+
+    /// Projects the speeds `w` (rad/s) onto the rows, each group's angular momentum kept (a
+    /// lock's merge: [`rows::project`]), the speeds of a group a fixed body holds exactly 0.
+    pub fn project(&self, net: &Network, w: &mut [f64]) {
+        let inv: Vec<f64> = net
+            .bodies
+            .iter()
+            .map(|b| if b.fixed { 0.0 } else { 1.0 / b.inertia_kg_m2 })
+            .collect();
+        rows::project(&self.rows, &inv, w);
+        for (i, v) in w.iter_mut().enumerate() {
+            if self.freedom[self.of[i]] == Freedom::Fixed {
+                *v = 0.0;
             }
-        }));
-        for &(k, ch, p) in &self.order {
-            let c = &net.couplings[k];
-            let r = rigid_ratio(net, k);
-            let on_child = residual[ch];
-            let (lambda, on_parent) = if ch == c.a {
-                (on_child, -r * on_child)
-            } else {
-                let l = -on_child / r;
-                (l, l)
+        }
+    }
+}
+
+/// The speed factors `g_i` against the root `r` of a group of freedom one that the rows give
+/// from the root (each row with one member left unknown gives it), so that bodies a locked
+/// clutch ties get exactly equal factors; a member the rows do not reach that way (a
+/// three-body row with two unknowns) is left out: the caller takes `P`'s ratio.
+fn speed_factors(net: &Network, rows: &[Row], members: &[usize], r: usize) -> Vec<(usize, f64)> {
+    // the root, and the fixed bodies at rest
+    let mut known: Vec<(usize, f64)> = std::iter::once((r, 1.0))
+        .chain(
+            (0..net.bodies.len())
+                .filter(|&i| net.bodies[i].fixed)
+                .map(|i| (i, 0.0)),
+        )
+        .collect();
+    let get = |known: &[(usize, f64)], b: usize| known.iter().find(|(k, _)| *k == b).map(|x| x.1);
+    loop {
+        let mut progress = false;
+        for row in rows {
+            let t = row.terms();
+            if !t.iter().any(|(b, _)| members.contains(b)) {
+                continue;
+            }
+            let mut unknown = t.iter().filter(|(b, _)| get(&known, *b).is_none());
+            let (Some(&(u, cu)), None) = (unknown.next(), unknown.next()) else {
+                continue;
             };
-            out[k] = lambda;
-            residual[p] -= on_parent;
+            // sum_j c_j g_j = 0: g_u = -(sum of the others) / c_u
+            let rest: f64 = t
+                .iter()
+                .filter(|(b, _)| *b != u)
+                .map(|(b, c)| c * get(&known, *b).unwrap_or(0.0))
+                .sum();
+            known.push((u, -rest / cu));
+            progress = true;
+        }
+        if !progress {
+            return known;
         }
     }
 }
@@ -163,7 +263,7 @@ impl Clusters {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clutchpack_model::network::{Body, Coupling};
+    use clutchpack_model::network::{Body, Coupling, CouplingKind};
 
     fn body(name: &str, j: f64) -> Body {
         Body {
@@ -176,6 +276,14 @@ mod tests {
             firing: None,
             road_load: None,
         }
+    }
+
+    fn rows_of(net: &Network) -> Vec<Row> {
+        net.couplings
+            .iter()
+            .enumerate()
+            .filter_map(|(k, c)| c.row(k, None))
+            .collect()
     }
 
     /// A torque on the first of three bodies geared 2:1 and then 3:1: the group's inertia is
@@ -201,9 +309,14 @@ mod tests {
                 },
             ],
         };
-        let cl = Clusters::build(&net, &[true, true]);
+        let cl = Clusters::build(&net, rows_of(&net));
+        assert_eq!(cl.freedom, vec![Freedom::One]);
         let j = 1.0 + 2.0 / 4.0 + 3.0 / 36.0;
-        assert!((cl.inertia[0] - j).abs() < 1e-15);
+        // the root is the body that moves most freely: a's factor 1 on it, the gears' below
+        let jr = cl.inertia[0];
+        let (ga, gb, gc) = (cl.g[0], cl.g[1], cl.g[2]);
+        assert!((gb - ga / 2.0).abs() < 1e-15 * ga.abs() && (gc - gb / 3.0).abs() < 1e-15);
+        assert!((jr / (ga * ga) - j).abs() < 1e-14, "{jr} {ga}");
         let torque = [10.0, 0.0, 0.0];
         let mut acc = [0.0; 3];
         let mut grp = Vec::new();
@@ -211,13 +324,31 @@ mod tests {
         assert!((acc[0] - 10.0 / j).abs() < 1e-14);
         assert!((acc[1] - acc[0] / 2.0).abs() < 1e-14);
         let mut lam = [0.0; 2];
-        let mut res = Vec::new();
-        cl.rigid_torques(&net, &torque, &acc, &mut lam, &mut res);
+        cl.rigid_torques(&torque, &mut lam);
         // body c is driven by g2 alone: -3 lambda2 = J3 a3
         assert!((-3.0 * lam[1] - 3.0 * acc[2]).abs() < 1e-13);
         // body a: J1 a1 = 10 + lambda1
         assert!((acc[0] - 10.0 - lam[0]).abs() < 1e-13);
-        // the root's balance closes
-        assert!(res[0].abs() < 1e-13, "{res:?}");
+    }
+
+    /// A three-body row with none of its bodies fixed leaves the group two degrees of
+    /// freedom: its accelerations keep the row, and with the torques in the Willis ratio
+    /// `z_S : z_R : -(z_S + z_R)` (the set's own ideal torques) the bodies do not accelerate.
+    #[test]
+    fn three_body_row_is_a_group_of_two_freedoms() {
+        let net = Network {
+            pack_thermal: Default::default(),
+            bodies: vec![body("sun", 0.01), body("ring", 0.2), body("carrier", 0.1)],
+            couplings: vec![],
+        };
+        let (zs, zr) = (30.0, 90.0);
+        let rows = vec![Row::three(0, [(0, zs), (1, zr), (2, -(zs + zr))])];
+        let cl = Clusters::build(&net, rows.clone());
+        assert_eq!(cl.freedom, vec![Freedom::Many]);
+        let mut acc = [0.0; 3];
+        cl.accelerations(&[5.0, -1.0, 2.0], &mut acc, &mut Vec::new());
+        assert!(rows[0].apply(&acc).abs() < 1e-11, "{acc:?}");
+        cl.accelerations(&[zs, zr, -(zs + zr)], &mut acc, &mut Vec::new());
+        assert!(acc.iter().all(|a| a.abs() < 1e-10), "{acc:?}");
     }
 }

@@ -50,8 +50,8 @@ mod stepper;
 
 pub use stepper::{run_network, NetworkInput, NetworkStepper};
 
-use cluster::Clusters;
-use clutchpack_model::network::{ClutchMode, CouplingKind, GearMesh, Network};
+use cluster::{Clusters, Freedom};
+use clutchpack_model::network::{ClutchMode, GearMesh, Network, Row};
 // the output types are the model's, shared with the multibody engine
 pub use clutchpack_model::network::{
     ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
@@ -96,7 +96,6 @@ struct Equations {
     torque: Vec<f64>,
     acc: Vec<f64>,
     group: Vec<f64>,
-    residual: Vec<f64>,
     coupling_torque: Vec<f64>,
     mesh_force: Vec<f64>,
     /// Whether each body is held at rest by its road load (the module's docs).
@@ -128,7 +127,7 @@ fn mesh_kinematics(
 impl Equations {
     fn new(net: Arc<Network>, modes: Vec<Option<ClutchMode>>) -> Self {
         let (n, m) = (net.bodies.len(), net.couplings.len());
-        let clusters = Clusters::build(&net, &rigid(&net, &modes));
+        let clusters = Clusters::build(&net, rigid_rows(&net, &modes));
         let packs = packs::build(&net, 2 * n + 2 * m + 3, m);
         Equations {
             packs,
@@ -139,7 +138,6 @@ impl Equations {
             torque: vec![0.0; n],
             acc: vec![0.0; n],
             group: Vec::new(),
-            residual: Vec::new(),
             coupling_torque: vec![0.0; m],
             mesh_force: vec![0.0; m],
             held: vec![false; n],
@@ -206,7 +204,7 @@ impl Equations {
 
     fn set_modes(&mut self, modes: &[Option<ClutchMode>]) {
         self.modes.copy_from_slice(modes);
-        self.clusters = Clusters::build(&self.net, &rigid(&self.net, &self.modes));
+        self.clusters = Clusters::build(&self.net, rigid_rows(&self.net, &self.modes));
     }
 
     /// Bodies' torques (all but the rigid couplings') and accelerations at `(t, y)`; the
@@ -281,13 +279,8 @@ impl Equations {
 
     /// The rigid couplings' torques at the state of the last [`Self::forces`].
     fn rigid_torques(&mut self) {
-        self.clusters.rigid_torques(
-            &self.net,
-            &self.torque,
-            &self.acc,
-            &mut self.coupling_torque,
-            &mut self.residual,
-        );
+        self.clusters
+            .rigid_torques(&self.torque, &mut self.coupling_torque);
     }
 
     /// `dy/dt` of the state `[angles, speeds, meshes' x, counters]`.
@@ -409,17 +402,13 @@ impl Equations {
     }
 }
 
-fn rigid(net: &Network, modes: &[Option<ClutchMode>]) -> Vec<bool> {
+/// The rigid rows in the modes `modes`: every ideal gear and the locked clutches
+/// ([`clutchpack_model::network::Coupling::row`]).
+fn rigid_rows(net: &Network, modes: &[Option<ClutchMode>]) -> Vec<Row> {
     net.couplings
         .iter()
         .enumerate()
-        .map(|(k, c)| match c.kind {
-            CouplingKind::IdealGear { .. } => true,
-            CouplingKind::Clutch(_) => modes[k] == Some(ClutchMode::Locked),
-            CouplingKind::GearMesh(_) | CouplingKind::SpringDamper(_) | CouplingKind::Pack(_) => {
-                false
-            }
-        })
+        .filter_map(|(k, c)| c.row(k, modes[k]))
         .collect()
 }
 

@@ -2,8 +2,8 @@
 //! which clutches lock, slip or go free, settled together, and the speeds of a new rigid group
 //! made common with its momentum kept.
 
-use super::{sample, ClutchEvent, Equations, NetworkObserver};
-use clutchpack_model::network::ClutchMode;
+use super::{sample, ClutchEvent, Equations, Freedom, NetworkObserver};
+use clutchpack_model::network::{friction, ClutchMode};
 
 /// Settles the clutches' modes at an event at `t` (MODEL.md section 8; Modelica's `Clutch`):
 /// free while `fn <= 0`; a clutch whose slip crossed zero (`crossed`: its guard `<= 0`), or
@@ -26,31 +26,17 @@ pub(super) fn settle(
         let Some(cl) = net.couplings[k].clutch() else {
             continue;
         };
-        let f = cl.normal_force_n(t);
         let w_rel = y[n + c.b] - y[n + c.a];
         let scale = 1e-10 * (1.0 + y[n + c.a].abs() + y[n + c.b].abs());
+        // the slip's zero located as this event
         let slip_ended = crossed.get(k).is_some_and(|g| *g <= 0.0);
-        modes[k] = Some(if f <= 0.0 {
-            ClutchMode::Free
-        } else {
-            match modes[k] {
-                Some(ClutchMode::Free) | None => {
-                    if w_rel.abs() > scale {
-                        ClutchMode::Slipping(w_rel.signum() as i8)
-                    } else {
-                        ClutchMode::Locked
-                    }
-                }
-                Some(ClutchMode::Slipping(s)) => {
-                    if slip_ended || f64::from(s) * w_rel <= 0.0 {
-                        ClutchMode::Locked
-                    } else {
-                        ClutchMode::Slipping(s)
-                    }
-                }
-                Some(ClutchMode::Locked) => ClutchMode::Locked,
-            }
-        });
+        modes[k] = Some(friction::entered_mode(
+            modes[k],
+            cl.normal_force_n(t),
+            w_rel,
+            scale,
+            slip_ended,
+        ));
     }
     // lock what locks; release the locked clutch that is furthest over its limit, and again
     for _ in 0..=net.couplings.len() {
@@ -58,22 +44,8 @@ pub(super) fn settle(
         project_speeds(eq, y);
         eq.forces(t, y);
         eq.rigid_torques();
-        let mut worst: Option<(usize, f64)> = None;
-        for (k, mode) in modes.iter().enumerate() {
-            if *mode != Some(ClutchMode::Locked) {
-                continue;
-            }
-            let cl = net.couplings[k].clutch().expect("only clutches lock");
-            let over = eq.coupling_torque[k].abs() - cl.max_static_torque_n_m(cl.normal_force_n(t));
-            if over > 0.0 && worst.is_none_or(|(_, o)| over > o) {
-                worst = Some((k, over));
-            }
-        }
-        match worst {
-            Some((k, _)) => {
-                let s = if eq.coupling_torque[k] > 0.0 { 1 } else { -1 };
-                modes[k] = Some(ClutchMode::Slipping(s));
-            }
+        match friction::furthest_over(&net, &modes, &eq.coupling_torque, t) {
+            Some((k, s)) => modes[k] = Some(ClutchMode::Slipping(s)),
             None => break,
         }
     }
@@ -97,26 +69,11 @@ pub(super) fn settle(
     }
 }
 
-/// Sets every rigid group's speeds to its common speed, momentum kept
-/// (`w_group = sum g_i J_i w_i / sum g_i^2 J_i`, `w_i = g_i w_group`; 0 for a fixed group).
+/// Sets every rigid group's speeds onto its rows, momentum kept (a lock's merge; 0 for a
+/// held group).
 fn project_speeds(eq: &Equations, y: &mut [f64]) {
-    let net = std::sync::Arc::clone(&eq.net);
-    let n = net.bodies.len();
-    let cl = &eq.clusters;
-    let mut p = vec![0.0; cl.inertia.len()];
-    for (i, b) in net.bodies.iter().enumerate() {
-        if !b.fixed {
-            p[cl.of[i]] += cl.g[i] * b.inertia_kg_m2 * y[n + i];
-        }
-    }
-    for i in 0..n {
-        let c = cl.of[i];
-        y[n + i] = if cl.fixed[c] {
-            0.0
-        } else {
-            cl.g[i] * p[c] / cl.inertia[c]
-        };
-    }
+    let n = eq.net.bodies.len();
+    eq.clusters.project(&eq.net, &mut y[n..2 * n]);
 }
 
 /// Settles the road loads at `t` (the module docs of `mod.rs`; issue 48, item 4): a held body
@@ -140,7 +97,10 @@ fn hold_road_loads(eq: &mut Equations, t: f64, y: &mut [f64], crossed: &[f64]) {
             eq.held[i] = false;
         }
         let reached = !broke[i] && crossed.get(at + i).is_some_and(|g| *g <= 0.0);
-        if !eq.held[i] && (reached || y[n + i] == 0.0) && !eq.clusters.fixed[eq.clusters.of[i]] {
+        // the hold acts on a group of one degree of freedom in which the body turns
+        let holdable =
+            eq.clusters.freedom[eq.clusters.of[i]] == Freedom::One && eq.clusters.g[i] != 0.0;
+        if !eq.held[i] && (reached || y[n + i] == 0.0) && holdable {
             // the group at rest (a located zero of its speed: within 1e-12 rad/s of it)
             let c = eq.clusters.of[i];
             for j in 0..n {

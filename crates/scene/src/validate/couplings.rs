@@ -97,6 +97,7 @@ fn coupling(
                 Kind::Network,
                 Kind::SpringDamper,
                 Kind::Network,
+                Kind::Network,
             ],
         )
         .required(ck, &path(&C::kind), "\"spring_damper\"");
@@ -105,7 +106,7 @@ fn coupling(
             path(&C::kind),
             r.value(&C::kind).map(show),
             "a one-pack scene's couplings join its shaft and drum: only \"spring_damper\" \
-             (clutch, ideal_gear, gear_mesh and pack join the bodies of a network: [[bodies]])",
+             (clutch, ideal_gear, gear_mesh, pack and planetary join the bodies of a network: [[bodies]])",
         );
         return None;
     }

@@ -13,7 +13,7 @@ use crate::keys::{MAX_FIRING_HARMONICS, MAX_FORCE_SIGNAL, MAX_TORQUE_N_M};
 use crate::schema::{fmt_num, show, Key, RawTable};
 use clutchpack_model::network::{
     name_problem, Body, Coupling, CouplingKind, Firing, GearMesh, LumpedClutch, Network,
-    NetworkProblem, RoadLoad, Signal,
+    NetworkProblem, PlanetarySet, RoadLoad, Signal,
 };
 use clutchpack_model::{Hertz, LawKind, OilFilm, ToothLaw};
 use std::path::Path;
@@ -359,6 +359,7 @@ pub(super) fn network(
         Mesh,
         Spring,
         Pack,
+        Planetary,
     }
     for (k, r) in couplings.iter().enumerate() {
         let p = |key: &Key| item("couplings", key, k);
@@ -385,6 +386,7 @@ pub(super) fn network(
                     Kind::Mesh,
                     Kind::Spring,
                     Kind::Pack,
+                    Kind::Planetary,
                 ],
             )
             .required(ck, &p(&C::kind), "required");
@@ -463,7 +465,21 @@ pub(super) fn network(
         if !matches!(kind, Kind::Pack) {
             refuse(ck, &[&C::pack], &[], "a pack");
         }
+        let planetary_keys: [&Key; 4] = [
+            &C::carrier,
+            &C::sun_teeth,
+            &C::ring_teeth,
+            &C::double_pinion,
+        ];
+        if !matches!(kind, Kind::Planetary) {
+            refuse(ck, &planetary_keys, &[], "a planetary set");
+        }
         match kind {
+            Kind::Planetary => {
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(ck, &clutch_keys, &[force], "a clutch");
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
+            }
             Kind::Pack => {
                 refuse(ck, &[&C::ratio], &[], "an ideal gear");
                 refuse(ck, &clutch_keys, &[force], "a clutch");
@@ -494,6 +510,28 @@ pub(super) fn network(
                 .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
                 .map(|ratio| CouplingKind::IdealGear { ratio }),
             Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
+            Kind::Planetary => {
+                let carrier = body(ck, &C::carrier);
+                let teeth = |ck: &mut Checker, key: &Key| {
+                    ck.count(&p(key), r.value(key), key).required(
+                        ck,
+                        &p(key),
+                        "required for a planetary set",
+                    )
+                };
+                let (zs, zr) = (teeth(ck, &C::sun_teeth), teeth(ck, &C::ring_teeth));
+                let double = ck
+                    .boolean(&p(&C::double_pinion), r.value(&C::double_pinion))
+                    .or(false);
+                (|| {
+                    Some(CouplingKind::Planetary(PlanetarySet {
+                        sun_teeth: zs?,
+                        ring_teeth: zr?,
+                        carrier: carrier?,
+                        double_pinion: double?,
+                    }))
+                })()
+            }
             Kind::Pack => pack(ck, r, k, base_dir).map(|(p, f, thermal)| {
                 fatigue.extend(f);
                 if let Some(th) = thermal {
