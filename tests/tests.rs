@@ -2,6 +2,7 @@
 //! outputs, and bad input. One test binary (as ripgrep does); each test states what it checks.
 
 mod architecture;
+mod automatics;
 mod cosim_hardening;
 mod cross_engine;
 mod fatigue;
@@ -11,7 +12,6 @@ mod hardening;
 mod hardening_networks;
 mod network;
 mod network_engines;
-mod planetary;
 mod python_package;
 mod reliability;
 mod salvage_and_messages;

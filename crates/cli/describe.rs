@@ -222,7 +222,7 @@ fn describe_network(r: &RecordingReader, s: &mut String) {
     };
     let _ = writeln!(s, "summary (stored; t_end = {} s):", summary["simulated_s"]);
     for c in summary["couplings"].as_array().into_iter().flatten() {
-        if c["kind"] != "clutch" {
+        if c["kind"] != "clutch" && c["kind"] != "one_way_clutch" {
             continue;
         }
         let locks: Vec<String> = c["lock_times_s"]

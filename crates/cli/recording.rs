@@ -451,7 +451,7 @@ fn network_clutches(f: &Path, reader: &RecordingReader) -> Result<NetworkRun> {
         .collect();
     let clutches = couplings
         .iter()
-        .filter(|c| c["kind"] == "clutch" || c["kind"] == "pack")
+        .filter(|c| c["kind"] == "clutch" || c["kind"] == "one_way_clutch" || c["kind"] == "pack")
         .map(|c| {
             let num = |k: &str| c[k].as_f64().unwrap_or(0.0);
             clutchpack_sdk::analysis::ClutchRun {

@@ -384,6 +384,7 @@ pub fn coupled_clutches() -> crate::network::Network {
             cgeo_m: 1.0,
             fn_max_n: 20.0,
             force,
+            one_way: false,
         }),
     };
     let step = |start_s: f64| Signal::Step {

@@ -196,6 +196,7 @@ fn geared_dual_clutch_matches_the_reference_engine() {
             cgeo_m: 0.2,
             fn_max_n: 20_000.0,
             force: Signal::Constant(force),
+            one_way: false,
         }),
     };
     let gear = |name: &str, a: usize, ratio: f64| Coupling {
@@ -314,6 +315,7 @@ fn brake_to_the_ground_stops_and_holds() {
                 cgeo_m: 0.15,
                 fn_max_n: 1000.0,
                 force: Signal::Constant(1.0),
+                one_way: false,
             }),
         }],
     };
@@ -358,6 +360,7 @@ fn upshift_handover_converges_to_the_reference_engine() {
             cgeo_m: 0.2,
             fn_max_n: 20_000.0,
             force,
+            one_way: false,
         }),
     };
     let gear = |name: &str, a: usize, ratio: f64| Coupling {
@@ -488,6 +491,7 @@ fn brake_and_parallel_clutches_match_the_reference_engine() {
             cgeo_m: 0.2,
             fn_max_n,
             force,
+            one_way: false,
         }),
     };
     let mut ground = body("ground", 1.0, 0.0);

@@ -136,6 +136,7 @@ fn dual_clutch_inertia_phase_matches_closed_form() {
             cgeo_m: 0.2,
             fn_max_n: 20_000.0,
             force: Signal::Constant(force),
+            one_way: false,
         }),
     };
     let gear = |name: &str, a: usize, ratio: f64| Coupling {

@@ -63,6 +63,13 @@ pub struct LumpedClutch {
     pub fn_max_n: f64,
     /// The normalized normal force `f_normalized(t)` (0..1; engaged while > 0).
     pub force: Signal,
+    /// A one-way clutch (Modelica's `OneWayClutch`: a freewheel in parallel with this
+    /// clutch, MODEL.md section 10): `w_rel = w_b - w_a` never turns negative; at zero it
+    /// locks, holding any torque `tau <= 0` on `a` (the freewheel) and a positive one up to
+    /// the static limit (the clutch: 0 while it is free); forward it slips as the clutch.
+    /// With no normal force ever, a plain freewheel.
+    #[serde(default)]
+    pub one_way: bool,
 }
 
 impl LumpedClutch {
@@ -98,6 +105,19 @@ impl LumpedClutch {
     /// The largest torque the locked clutch holds, N m: `peak mu(0) cgeo fn` (0 when free).
     pub fn max_static_torque_n_m(&self, normal_n: f64) -> f64 {
         self.peak * self.mu(0.0) * self.cgeo_m * normal_n.max(0.0)
+    }
+
+    /// How far the locked clutch is from breaking at the normal force `normal_n` (N) under
+    /// the torque `tau` (N m, on its body `a`) that holds it, N m: its static limit less
+    /// `|tau|`; a one-way clutch's less `tau` (its freewheel holds any `tau <= 0`). It breaks
+    /// where this reaches 0.
+    pub fn margin_n_m(&self, tau_n_m: f64, normal_n: f64) -> f64 {
+        let limit = self.max_static_torque_n_m(normal_n);
+        if self.one_way {
+            limit - tau_n_m
+        } else {
+            limit - tau_n_m.abs()
+        }
     }
 
     /// The problems with the parameters, as `(field, what is wrong)` (empty when good).
@@ -145,6 +165,7 @@ mod tests {
             cgeo_m: 1.0,
             fn_max_n: 20.0,
             force,
+            one_way: false,
         }
     }
 

@@ -373,6 +373,23 @@ impl Network {
                     for (field, message) in cl.problems() {
                         out.push(coupling(k, field, message));
                     }
+                    let (wa, wb) = (
+                        self.bodies[c.a].initial_speed_rad_s,
+                        self.bodies[c.b].initial_speed_rad_s,
+                    );
+                    if cl.one_way && wb < wa {
+                        out.push(coupling(
+                            k,
+                            "b",
+                            format!(
+                                "a one-way clutch keeps w_b >= w_a, but at t = 0 \"{}\" turns at {} rad/s, below \"{}\"'s {} rad/s",
+                                self.bodies[c.b].name,
+                                crate::fmt_num(wb),
+                                self.bodies[c.a].name,
+                                crate::fmt_num(wa)
+                            ),
+                        ));
+                    }
                 }
                 CouplingKind::GearMesh(g) => {
                     for (field, message) in g.problems() {

@@ -292,7 +292,7 @@ impl Run {
         (0..self.net.couplings.len())
             .map(|k| match (self.net.couplings[k].clutch(), self.modes[k]) {
                 (Some(cl), Some(ClutchMode::Locked)) => {
-                    cl.max_static_torque_n_m(cl.normal_force_n(t)) - scratch.coupling[k].abs()
+                    cl.margin_n_m(scratch.coupling[k], cl.normal_force_n(t))
                 }
                 _ => f64::INFINITY,
             })
@@ -327,6 +327,7 @@ impl Run {
             let slip_ended =
                 matches!(before[k], Some(ClutchMode::Slipping(s)) if f64::from(s) * w_rel <= scale);
             self.modes[k] = Some(friction::entered_mode(
+                cl,
                 before[k],
                 cl.normal_force_n(t),
                 w_rel,
@@ -351,7 +352,7 @@ impl Run {
             }
             self.torques(t);
             match friction::furthest_over(&net, &self.modes, &self.coupling_torque, t) {
-                Some((k, s)) => self.modes[k] = Some(ClutchMode::Slipping(s)),
+                Some((k, to)) => self.modes[k] = Some(to),
                 None => break,
             }
         }
@@ -398,7 +399,13 @@ impl Run {
             let Some(cl) = net.couplings[k].clutch() else {
                 continue;
             };
-            if let Some(ClutchMode::Slipping(s)) = self.modes[k] {
+            // a slip reaching zero; a free one-way clutch's too (its freewheel locks there)
+            let slip = match self.modes[k] {
+                Some(ClutchMode::Slipping(s)) => Some(s),
+                Some(ClutchMode::Free) if cl.one_way => Some(1),
+                _ => None,
+            };
+            if let Some(s) = slip {
                 let (wa, wb) = (self.w[c.a], self.w[c.b]);
                 let s = f64::from(s);
                 let s0 = s * (wb - wa);

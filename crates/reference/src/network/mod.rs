@@ -339,7 +339,8 @@ impl Equations {
     }
 
     /// The event functions at `(t, y)`, one per clutch (> 0 while its mode holds; 0 for other
-    /// couplings): slipping `min(s w_rel, fn)`, locked `min(limit - |tau|, fn)`, free `-fn`
+    /// couplings): slipping `min(s w_rel, fn)`, locked `min(limit - |tau|, fn)` (a one-way
+    /// clutch: `limit - tau`), free `-fn` (a one-way clutch: `min(-fn, w_rel)`)
     /// (its crossing engages).
     fn guards(&mut self, t: f64, y: &[f64], out: &mut [f64]) {
         let n = self.net.bodies.len();
@@ -367,18 +368,21 @@ impl Equations {
                 continue;
             };
             let f = cl.normal_force_n(t);
+            let w_rel = w[c.b] - w[c.a];
             out[k] = match self.modes[k] {
                 Some(ClutchMode::Free) => {
-                    if f > 0.0 {
-                        -f
+                    let engage = if f > 0.0 { -f } else { 1.0 + f.abs() };
+                    // a free one-way clutch's freewheel locks where its slip reaches zero
+                    if cl.one_way {
+                        engage.min(w_rel)
                     } else {
-                        1.0 + f.abs()
+                        engage
                     }
                 }
-                Some(ClutchMode::Slipping(s)) => (f64::from(s) * (w[c.b] - w[c.a])).min(f),
-                Some(ClutchMode::Locked) => {
-                    (cl.max_static_torque_n_m(f) - self.coupling_torque[k].abs()).min(f)
-                }
+                Some(ClutchMode::Slipping(s)) => (f64::from(s) * w_rel).min(f),
+                // a one-way clutch stays locked without a normal force (its freewheel)
+                Some(ClutchMode::Locked) if cl.one_way => cl.margin_n_m(self.coupling_torque[k], f),
+                Some(ClutchMode::Locked) => cl.margin_n_m(self.coupling_torque[k], f).min(f),
                 None => 1.0,
             };
         }

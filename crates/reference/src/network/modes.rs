@@ -28,14 +28,19 @@ pub(super) fn settle(
         };
         let w_rel = y[n + c.b] - y[n + c.a];
         let scale = 1e-10 * (1.0 + y[n + c.a].abs() + y[n + c.b].abs());
-        // the slip's zero located as this event
-        let slip_ended = crossed.get(k).is_some_and(|g| *g <= 0.0);
+        // the slip's zero located as this event: its guard crossed, and the slip is the part
+        // of the guard that did (not the normal force, nor a free clutch's engagement)
+        let f = cl.normal_force_n(t);
+        let slip_ended = crossed.get(k).is_some_and(|g| *g <= 0.0)
+            && match modes[k] {
+                Some(ClutchMode::Slipping(s)) => f64::from(s) * w_rel <= f,
+                Some(ClutchMode::Free) => {
+                    cl.one_way && w_rel <= if f > 0.0 { -f } else { 1.0 + f.abs() }
+                }
+                _ => false,
+            };
         modes[k] = Some(friction::entered_mode(
-            modes[k],
-            cl.normal_force_n(t),
-            w_rel,
-            scale,
-            slip_ended,
+            cl, modes[k], f, w_rel, scale, slip_ended,
         ));
     }
     // lock what locks; release the locked clutch that is furthest over its limit, and again
@@ -45,7 +50,7 @@ pub(super) fn settle(
         eq.forces(t, y);
         eq.rigid_torques();
         match friction::furthest_over(&net, &modes, &eq.coupling_torque, t) {
-            Some((k, s)) => modes[k] = Some(ClutchMode::Slipping(s)),
+            Some((k, to)) => modes[k] = Some(to),
             None => break,
         }
     }

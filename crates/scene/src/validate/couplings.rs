@@ -98,6 +98,8 @@ fn coupling(
                 Kind::SpringDamper,
                 Kind::Network,
                 Kind::Network,
+                Kind::Network,
+                Kind::Network,
             ],
         )
         .required(ck, &path(&C::kind), "\"spring_damper\"");
@@ -106,7 +108,7 @@ fn coupling(
             path(&C::kind),
             r.value(&C::kind).map(show),
             "a one-pack scene's couplings join its shaft and drum: only \"spring_damper\" \
-             (clutch, ideal_gear, gear_mesh, pack and planetary join the bodies of a network: [[bodies]])",
+             (the other kinds join the bodies of a network: [[bodies]])",
         );
         return None;
     }

@@ -360,6 +360,8 @@ pub(super) fn network(
         Spring,
         Pack,
         Planetary,
+        OneWay,
+        Freewheel,
     }
     for (k, r) in couplings.iter().enumerate() {
         let p = |key: &Key| item("couplings", key, k);
@@ -387,6 +389,8 @@ pub(super) fn network(
                     Kind::Spring,
                     Kind::Pack,
                     Kind::Planetary,
+                    Kind::OneWay,
+                    Kind::Freewheel,
                 ],
             )
             .required(ck, &p(&C::kind), "required");
@@ -475,6 +479,16 @@ pub(super) fn network(
             refuse(ck, &planetary_keys, &[], "a planetary set");
         }
         match kind {
+            Kind::Freewheel => {
+                refuse(ck, &[&C::ratio], &[], "an ideal gear");
+                refuse(
+                    ck,
+                    &clutch_keys,
+                    &[force],
+                    "a clutch (a one_way_clutch has them)",
+                );
+                refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
+            }
             Kind::Planetary => {
                 refuse(ck, &[&C::ratio], &[], "an ideal gear");
                 refuse(ck, &clutch_keys, &[force], "a clutch");
@@ -494,7 +508,7 @@ pub(super) fn network(
                 refuse(ck, &clutch_keys, &[force], "a clutch");
                 refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
             }
-            Kind::Clutch => {
+            Kind::Clutch | Kind::OneWay => {
                 refuse(ck, &[&C::ratio], &[], "an ideal gear");
                 refuse(ck, &mesh_keys, &[contact, oil], "a gear mesh");
             }
@@ -510,6 +524,21 @@ pub(super) fn network(
                 .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
                 .map(|ratio| CouplingKind::IdealGear { ratio }),
             Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
+            Kind::OneWay => clutch(ck, r, k, base_dir).map(|cl| {
+                CouplingKind::Clutch(LumpedClutch {
+                    one_way: true,
+                    ..cl
+                })
+            }),
+            // a one-way clutch whose clutch never closes
+            Kind::Freewheel => Some(CouplingKind::Clutch(LumpedClutch {
+                mu_table: vec![(0.0, 0.0)],
+                peak: 1.0,
+                cgeo_m: 0.0,
+                fn_max_n: 0.0,
+                force: Signal::Constant(0.0),
+                one_way: true,
+            })),
             Kind::Planetary => {
                 let carrier = body(ck, &C::carrier);
                 let teeth = |ck: &mut Checker, key: &Key| {
@@ -906,6 +935,7 @@ fn clutch(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<LumpedCl
         cgeo_m: cgeo?,
         fn_max_n: fn_max?,
         force: force?,
+        one_way: false,
     };
     let mut good = true;
     for (field, message) in clutch.problems() {
