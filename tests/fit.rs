@@ -329,3 +329,128 @@ fn bad_fit_input_is_refused_before_any_run() {
         assert!(!fitted.exists(), "{param}: nothing written");
     }
 }
+
+const PACK: &str = "scenes/pack-6-engagement.toml";
+
+/// The pack's co-simulated run (the fit's own route to a pack's signals, driving no input)
+/// on the reference engine with the overrides `sets`: the outputs `names` at `times`.
+fn pack_series(sets: &[&str], names: &[&str], times: &[f64]) -> Vec<Vec<f64>> {
+    use clutchpack_sdk::cosim::Quantity;
+    use clutchpack_sdk::{CoSimulation, Driven};
+    let sets: Vec<clutchpack_sdk::scene::Override> =
+        sets.iter().map(|s| s.parse().unwrap()).collect();
+    let scene = load_scene(Some(Path::new(PACK)), &sets).unwrap();
+    let mut co = CoSimulation::driving(scene, Driven::NONE).unwrap();
+    co.set_string_parameter(Quantity::Engine, "reference")
+        .unwrap();
+    let vrs: Vec<u32> = names
+        .iter()
+        .map(|n| co.variables().iter().find(|v| v.name == *n).unwrap().vr)
+        .collect();
+    co.start(None).unwrap();
+    let mut out = vec![Vec::new(); names.len()];
+    for &t in times {
+        if t > co.time_s() {
+            assert!(co.advance_to(t, None).unwrap());
+        }
+        for (k, &vr) in vrs.iter().enumerate() {
+            out[k].push(co.get_real(vr).unwrap());
+        }
+    }
+    out
+}
+
+/// The pack's run cut to 0.1 s (the drum locks at 0.086 s), for a test in debug.
+const PACK_SHORT: &str = "simulation.duration_s=0.1";
+
+/// The true friction curve of the pack's trace: the scene's kinetic mu (0.13) and a viscous
+/// slope of 2e-4 s/m (the scene's is 0, on its key's bound, where no interval means
+/// anything).
+const PACK_TRUTH: [(&str, f64); 2] = [
+    ("stack.friction.kinetic_mu", 0.13),
+    ("stack.friction.viscous_slope_s_m", 2e-4),
+];
+
+/// pack-6-engagement's trace at the true friction curve: columns `time_s`, `drum` (the
+/// drum's speed, rad/s) and `torque` (the piston-side face's friction torque, N m), every
+/// 1 ms from 0 to 0.1 s.
+fn pack_trace(dir: &Path) -> PathBuf {
+    let times: Vec<f64> = (0..=100).map(|i| i as f64 * 1e-3).collect();
+    let slope = format!("{}={}", PACK_TRUTH[1].0, PACK_TRUTH[1].1);
+    let y = pack_series(
+        &[PACK_SHORT, &slope],
+        &["drum.speed_rad_s", "interfaces[1].torque_n_m"],
+        &times,
+    );
+    let mut text = String::from("time_s,drum,torque\n");
+    for (i, t) in times.iter().enumerate() {
+        text.push_str(&format!("{t:?},{:?},{:?}\n", y[0][i], y[1][i]));
+    }
+    let p = dir.join("pack-trace.csv");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// A resolved pack's fit (issue 47): pack-6-engagement's friction curve, its kinetic mu and
+/// its viscous slope (`mu = kinetic + slope v` over the slip, v from 52 m/s down to 0),
+/// fitted on the reference engine to the drum's speed and the piston-side face's torque
+/// from starting values 23 % and 150 % off (0.10, 5e-4 s/m), both on a log scale with a
+/// forward-difference step of 1 % of ln x. The trace is the project's own run at the true
+/// values (the route the fit takes: the scene's co-simulation read at the measured times).
+/// The face's torque carries the rattle's chaos (its clamp force depends on the spline
+/// friction of the rattling discs: a change of mu by 1e-3 moves it by 15 N m RMS where
+/// a smooth response would move it by 1 N m), so it is weighted 1e-3 (1 / its scatter of
+/// ~1000 N m over a 4 % change of mu), and the step is 1 % for the same reason. Measured:
+/// kinetic mu 0.12967 (-0.25 %), slope 2.113e-4 s/m (+5.6 %), 35 runs; the bounds are 0.5 %
+/// and 10 %. The fit ends where the chaos hides any better step (no convergence warning is
+/// asserted away: it reports converged on the step size), and the fitted scene loads.
+#[test]
+fn pack_engagement_friction_curve_is_recovered_from_drum_speed_and_torque() {
+    let d = scratch("fit-pack-engagement");
+    let data = pack_trace(&d);
+    let json = d.join("fit.json");
+    let fitted = d.join("pack.fitted.toml");
+    let o = run(&[
+        "fit",
+        PACK,
+        "--data",
+        data.to_str().unwrap(),
+        "--engine",
+        "reference",
+        "--set",
+        PACK_SHORT,
+        "--param",
+        "stack.friction.kinetic_mu=0.10:0.05:0.3:log",
+        "--param",
+        "stack.friction.viscous_slope_s_m=5e-4:1e-5:2e-3:log",
+        "--fd-step",
+        "1e-2",
+        "--match",
+        "drum.speed_rad_s=drum",
+        "--match",
+        "interfaces[1].torque_n_m=torque:1e-3",
+        "--fitted-scene",
+        fitted.to_str().unwrap(),
+        "--summary-json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    println!("{}\n{}", stdout(&o), stderr(&o));
+    let s = read_json(&json);
+    println!(
+        "pack fit: {} runs, {} iterations, {:.2} s wall",
+        s["runs"], s["iterations"], s["wall_time_s"]
+    );
+    assert_eq!(s["converged"], true, "{s}");
+    for ((key, truth), bound) in PACK_TRUTH.iter().zip([5e-3, 0.1]) {
+        let k = if key.ends_with("kinetic_mu") { 0 } else { 1 };
+        let value = s["params"][k]["value"].as_f64().unwrap();
+        println!("{key}: {value} (true {truth})");
+        assert!(
+            (value - truth).abs() < bound * truth,
+            "{key}: {value} vs {truth}"
+        );
+    }
+    let o = run(&["check", fitted.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
