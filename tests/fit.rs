@@ -454,3 +454,190 @@ fn pack_engagement_friction_curve_is_recovered_from_drum_speed_and_torque() {
     let o = run(&["check", fitted.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// The paper's Table 2 peaks (Hu et al.; h_o = 0, 25, 50 um), one row per film thickness.
+fn paper_table(dir: &Path) -> PathBuf {
+    let p = dir.join("table2.csv");
+    std::fs::write(
+        &p,
+        "defaults.oil.film_thickness_m,max_pos,max_neg\n\
+         0,945.39,-976.42\n25e-6,867.6,-867.8\n50e-6,503.1,-503.5\n",
+    )
+    .unwrap();
+    p
+}
+
+/// `fit` of the paper's two ASSUMED contact parameters to its Table 2 with `extra` args.
+fn paper_fit(d: &Path, extra: &[&str]) -> (std::process::Output, PathBuf) {
+    let json = d.join("paper.json");
+    let table = paper_table(d);
+    let mut args = vec![
+        "fit",
+        "scenes/hu-table2.toml",
+        "--data",
+        table.to_str().unwrap(),
+        "--variant",
+        "defaults.oil.film_thickness_m",
+        "--param",
+        "defaults.contact.curvature_radius_m:0.5e-3:5e-3:log",
+        "--param",
+        "defaults.contact.loss_coefficient_s_m:0.1:3:log",
+        "--match",
+        "disc.max_positive_n=max_pos:0.01",
+        "--match",
+        "disc.max_negative_n=max_neg:0.01",
+        "--summary-json",
+        json.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    (run(&args), json)
+}
+
+/// The paper's calibration as a fit over scene variants (issue 47): the two ASSUMED contact
+/// parameters of hu-table2.toml (curvature radius, loss coefficient) fitted to the six peaks
+/// of Table 2, each variant's peaks the mean of a 2-member ensemble here (32 in
+/// docs/calibration.md; a rattle's peak is chaotic, one run one sample). The fit lowers the
+/// residuals from the shipped values, reports finite intervals and a correlation short of
+/// +-1 (the two are separately identifiable from three films), counts its runs as
+/// evaluations x 3 variants x 2 members, and lands within 30 % of the shipped values (which
+/// were calibrated by hand against the same table; measured: printed below).
+#[test]
+fn paper_table_peaks_fit_the_contact_parameters_over_variants() {
+    let d = scratch("fit-paper-table");
+    let fitted = d.join("hu.fitted.toml");
+    let (o, json) = paper_fit(
+        &d,
+        &[
+            "--ensemble",
+            "2",
+            "--fd-step",
+            "5e-2",
+            "--fitted-scene",
+            fitted.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    println!("{}\n{}", stdout(&o), stderr(&o));
+    let s = read_json(&json);
+    assert_eq!(s["rows"], "defaults.oil.film_thickness_m");
+    assert_eq!(
+        s["scene_runs"].as_u64().unwrap(),
+        s["runs"].as_u64().unwrap() * 6
+    );
+    for (k, shipped) in [(0, 1.75e-3), (1, 0.8)] {
+        let p = &s["params"][k];
+        let v = p["value"].as_f64().unwrap();
+        assert!(p["std_error"].as_f64().unwrap().is_finite(), "{p}");
+        assert!((v - shipped).abs() < 0.3 * shipped, "{p}");
+    }
+    let c = s["correlation"][0][1].as_f64().unwrap();
+    assert!(c.abs() < 0.99, "correlation {c}");
+    for sig in s["signals"].as_array().unwrap() {
+        assert!(
+            sig["rms"].as_f64().unwrap() < sig["rms_start"].as_f64().unwrap(),
+            "{sig}"
+        );
+    }
+    let o = run(&["check", fitted.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Bad input of the variant route and of the pack's signals is refused before any run
+/// (exit 2) naming the problem: a per-run statistic without --variant, a series with it, a
+/// variant key that is not a number, a variant value outside its key's rule, a pack signal
+/// that does not exist (the message lists the pack's outputs).
+#[test]
+fn bad_variant_and_pack_signal_input_is_refused_before_any_run() {
+    let d = scratch("fit-bad-variant");
+    let table = paper_table(&d);
+    let neg = d.join("neg.csv");
+    std::fs::write(
+        &neg,
+        "defaults.oil.film_thickness_m,max_pos\n-1e-6,900\n0,945\n",
+    )
+    .unwrap();
+    let pack_data = d.join("pack.csv");
+    std::fs::write(&pack_data, "time_s,drum\n0,0\n0.01,1\n").unwrap();
+    let t = table.to_str().unwrap();
+    let r = "defaults.contact.curvature_radius_m:0.5e-3:5e-3";
+    let cases: [(&str, Vec<&str>, &[&str]); 5] = [
+        (
+            "scenes/hu-table2.toml",
+            vec![
+                "--data",
+                t,
+                "--param",
+                r,
+                "--match",
+                "disc.max_positive_n=max_pos",
+            ],
+            &["one value per run", "--variant"],
+        ),
+        (
+            "scenes/hu-table2.toml",
+            vec![
+                "--data",
+                t,
+                "--variant",
+                "defaults.oil.film_thickness_m",
+                "--param",
+                r,
+                "--match",
+                "drum.speed_rad_s=max_pos",
+            ],
+            &["drum.speed_rad_s", "does not produce it"],
+        ),
+        (
+            "scenes/hu-table2.toml",
+            vec![
+                "--data",
+                t,
+                "--variant",
+                "defaults.contact.law",
+                "--param",
+                r,
+                "--match",
+                "disc.max_positive_n=max_pos",
+            ],
+            &["--variant defaults.contact.law", "not a number"],
+        ),
+        (
+            "scenes/hu-table2.toml",
+            vec![
+                "--data",
+                neg.to_str().unwrap(),
+                "--variant",
+                "defaults.oil.film_thickness_m",
+                "--param",
+                r,
+                "--match",
+                "disc.max_positive_n=max_pos",
+            ],
+            &["film_thickness_m", "-0.000001"],
+        ),
+        (
+            PACK,
+            vec![
+                "--data",
+                pack_data.to_str().unwrap(),
+                "--param",
+                "stack.friction.kinetic_mu:0.05:0.3",
+                "--match",
+                "drum.speed=drum",
+            ],
+            &["drum.speed", "drum.speed_rad_s", "interfaces[1].torque_n_m"],
+        ),
+    ];
+    for (scene, args, needles) in cases {
+        let fitted = d.join("x.fitted.toml");
+        let mut all = vec!["fit", scene, "--fitted-scene", fitted.to_str().unwrap()];
+        all.extend(args.iter().copied());
+        let o = run(&all);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{args:?}: expected {n:?} in: {err}");
+        }
+        assert!(!fitted.exists());
+    }
+}

@@ -217,12 +217,23 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
 
 /// The table of fitted values, the correlations and the residuals per signal.
 fn print_result(r: &FitResult, scene: &Path) {
+    let runs = if r.scene_runs == r.runs {
+        format!("{} runs", r.runs)
+    } else {
+        format!(
+            "{} evaluations of {} variants x {} members ({} runs)",
+            r.runs,
+            r.signals.first().map_or(0, |s| s.points),
+            r.ensemble,
+            r.scene_runs
+        )
+    };
     out!(
-        "{} ({}, {} engine): {} runs, {} iterations, {:.2} s wall; {}",
+        "{} ({}, {} engine): {}, {} iterations, {:.2} s wall; {}",
         r.scene,
         scene.display(),
         r.engine,
-        r.runs,
+        runs,
         r.iterations,
         r.wall_time_s,
         r.reason

@@ -167,8 +167,11 @@ pub struct FitResult {
     pub ssr: f64,
     /// Residual points minus parameters.
     pub dof: usize,
-    /// Runs of the scene.
+    /// Evaluations of the residuals: each one run of the scene for a time series, `rows x
+    /// ensemble` runs with `--variant`.
     pub runs: usize,
+    /// Runs of the scene in all.
+    pub scene_runs: usize,
     /// Solver iterations.
     pub iterations: usize,
     /// Wall time of the fit, s.
@@ -604,6 +607,11 @@ impl Fit {
             ssr,
             dof,
             runs,
+            scene_runs: if self.variant_keys.is_empty() {
+                runs
+            } else {
+                runs * self.rows.len() * self.request.ensemble.max(1) as usize
+            },
             iterations: outcome.iterations,
             wall_time_s: started.elapsed().as_secs_f64(),
             converged: outcome.converged,
