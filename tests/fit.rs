@@ -613,7 +613,11 @@ fn bad_variant_and_pack_signal_input_is_refused_before_any_run() {
                 "--match",
                 "disc.max_positive_n=max_pos",
             ],
-            &["film_thickness_m", "-0.000001"],
+            &[
+                "neg.csv",
+                "the variant defaults.oil.film_thickness_m = -1e-6",
+                ">= 0",
+            ],
         ),
         (
             PACK,

@@ -108,3 +108,16 @@ def test_bad_fit_input_raises_the_cli_message(tmp_path, params, match, needle):
     p = cli_fit(tmp_path, data, params, match, check=False)
     assert p.returncode == 2, p.stderr
     assert msg in p.stderr, (msg, p.stderr)
+
+
+def test_numpy_numbers_as_set_values_are_numbers():
+    """Regression (found by examples/python/fit_scipy.py, whose optimizer hands numpy floats
+    to ``set``): a numpy float or integer is written as its number, not as numpy 2's repr
+    ``np.float64(0.35)``, which the scene refused as not a number."""
+    a = clutchpack.run(SCENE, set={"couplings[0].mu": np.float64(0.45)})
+    b = clutchpack.run(SCENE, set={"couplings[0].mu": 0.45})
+    assert a.summary["couplings"] == b.summary["couplings"]
+    sc = clutchpack.load_scene(SCENE, set={"couplings[0].mu": np.float32(0.25),
+                                           "simulation.record_rate_hz": np.int64(500)})
+    assert "couplings[0].mu=0.25" in sc.overrides
+    assert "simulation.record_rate_hz=500" in sc.overrides

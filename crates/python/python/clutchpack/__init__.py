@@ -62,8 +62,11 @@ def _sets(set: Optional[Mapping[str, Any]]) -> List[tuple]:
             text = "true" if v else "false"
         elif isinstance(v, (list, tuple, dict)):
             text = json.dumps(v)
-        elif isinstance(v, float):
-            text = repr(v)
+        elif isinstance(v, (float, np.floating)):
+            # float() first: numpy 2's repr of a numpy float is "np.float64(0.35)"
+            text = repr(float(v))
+        elif isinstance(v, np.integer):
+            text = str(int(v))
         else:
             text = str(v)
         out.append((str(k), text))

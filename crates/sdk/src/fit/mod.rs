@@ -293,7 +293,12 @@ impl Fit {
         if fit.request.variant.is_some() {
             // every variant loads (its value within its key's rule) before any run
             for &x in &data.time_s {
-                fit.scene_at(&start, Some(x))?;
+                fit.scene_at(&start, Some(x)).map_err(|e| {
+                    bad(format!(
+                        "fit data {}: the variant {row_column} = {x:?} does not load: {e}",
+                        data_path.display()
+                    ))
+                })?;
             }
         } else {
             let (t0, t1) = (data.time_s[0], *data.time_s.last().expect("2 rows"));
