@@ -402,8 +402,8 @@ fn pack_trace(dir: &Path) -> PathBuf {
 /// a smooth response would move it by 1 N m), so it is weighted 1e-3 (1 / its scatter of
 /// ~1000 N m over a 4 % change of mu), and the step is 1 % for the same reason. Measured:
 /// kinetic mu 0.12967 (-0.25 %), slope 2.113e-4 s/m (+5.6 %), 35 runs; the bounds are 0.5 %
-/// and 10 %. The fit ends where the chaos hides any better step (no convergence warning is
-/// asserted away: it reports converged on the step size), and the fitted scene loads.
+/// and 10 %. The fit ends where the chaos hides any better step (reported as converged on
+/// the step size), and the fitted scene loads.
 #[test]
 fn pack_engagement_friction_curve_is_recovered_from_drum_speed_and_torque() {
     let d = scratch("fit-pack-engagement");
@@ -500,7 +500,8 @@ fn paper_fit(d: &Path, extra: &[&str]) -> (std::process::Output, PathBuf) {
 /// residuals from the shipped values, reports finite intervals and a correlation short of
 /// +-1 (the two are separately identifiable from three films), counts its runs as
 /// evaluations x 3 variants x 2 members, and lands within 30 % of the shipped values (which
-/// were calibrated by hand against the same table; measured: printed below).
+/// were calibrated by hand against the same table; measured: r 1.786 mm, p 0.810 s/m, 17
+/// evaluations, 102 runs, correlation +0.46).
 #[test]
 fn paper_table_peaks_fit_the_contact_parameters_over_variants() {
     let d = scratch("fit-paper-table");
