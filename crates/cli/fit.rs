@@ -30,7 +30,9 @@ pub struct FitArgs {
     pub scene: PathBuf,
     /// The measured series: a CSV file with a header row, a time column (`--time-column`,
     /// s, strictly increasing, within the run) and one column per matched signal. With
-    /// `--variant KEY`, one row per variant of the scene instead (a column named KEY).
+    /// `--variant KEY`, one row per variant of the scene instead (a column named KEY). Or a
+    /// network scene's recording (`RUN.mcap`, `clutchpack run --out`), whose series are
+    /// named as the signals (`J1.speed_rad_s`, `clutch1.torque_n_m`).
     #[arg(long, value_name = "TRACE.csv", required_unless_present = "coverage")]
     pub data: Option<PathBuf>,
     /// The data's time column.

@@ -16,6 +16,7 @@
 //! [`Fit::coverage`] checks the intervals on synthetic traces (`coverage.rs`).
 
 mod coverage;
+mod data;
 mod lm;
 mod params;
 mod signals;
@@ -46,7 +47,8 @@ pub struct FitRequest {
     pub sets: Vec<Override>,
     /// The engine asked (else the scene's choice).
     pub engine: Option<EngineChoice>,
-    /// The measured series: a CSV file with a header row (`None`: no measured data, only
+    /// The measured series: a CSV file with a header row, or an MCAP recording of a network
+    /// scene (its series named as the signals; `None`: no measured data, only
     /// for [`Fit::coverage`], whose traces are made on the run's record-rate grid).
     pub data: Option<PathBuf>,
     /// The data's time column (s), strictly increasing.
@@ -288,8 +290,13 @@ impl Fit {
             .variant
             .as_deref()
             .unwrap_or(&fit.request.time_column);
-        let data = clutchpack_scene::read_columns(&data_path, row_column, &columns)
-            .map_err(|e| bad(format!("fit data: {e}")))?;
+        if fit.request.variant.is_some() && data::is_recording(&data_path) {
+            return Err(bad(format!(
+                "fit data {}: variants (--variant) are read from a CSV table, not a recording",
+                data_path.display()
+            )));
+        }
+        let data = data::read(&data_path, row_column, &columns)?;
         if fit.request.variant.is_some() {
             // every variant loads (its value within its key's rule) before any run
             for &x in &data.time_s {
