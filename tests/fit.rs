@@ -329,3 +329,390 @@ fn bad_fit_input_is_refused_before_any_run() {
         assert!(!fitted.exists(), "{param}: nothing written");
     }
 }
+
+const PACK: &str = "scenes/pack-6-engagement.toml";
+
+/// The pack's co-simulated run (the fit's own route to a pack's signals, driving no input)
+/// on the reference engine with the overrides `sets`: the outputs `names` at `times`.
+fn pack_series(sets: &[&str], names: &[&str], times: &[f64]) -> Vec<Vec<f64>> {
+    use clutchpack_sdk::cosim::Quantity;
+    use clutchpack_sdk::{CoSimulation, Driven};
+    let sets: Vec<clutchpack_sdk::scene::Override> =
+        sets.iter().map(|s| s.parse().unwrap()).collect();
+    let scene = load_scene(Some(Path::new(PACK)), &sets).unwrap();
+    let mut co = CoSimulation::driving(scene, Driven::NONE).unwrap();
+    co.set_string_parameter(Quantity::Engine, "reference")
+        .unwrap();
+    let vrs: Vec<u32> = names
+        .iter()
+        .map(|n| co.variables().iter().find(|v| v.name == *n).unwrap().vr)
+        .collect();
+    co.start(None).unwrap();
+    let mut out = vec![Vec::new(); names.len()];
+    for &t in times {
+        if t > co.time_s() {
+            assert!(co.advance_to(t, None).unwrap());
+        }
+        for (k, &vr) in vrs.iter().enumerate() {
+            out[k].push(co.get_real(vr).unwrap());
+        }
+    }
+    out
+}
+
+/// The pack's run cut to 0.1 s (the drum locks at 0.086 s), for a test in debug.
+const PACK_SHORT: &str = "simulation.duration_s=0.1";
+
+/// The true friction curve of the pack's trace: the scene's kinetic mu (0.13) and a viscous
+/// slope of 2e-4 s/m (the scene's is 0, on its key's bound, where no interval means
+/// anything).
+const PACK_TRUTH: [(&str, f64); 2] = [
+    ("stack.friction.kinetic_mu", 0.13),
+    ("stack.friction.viscous_slope_s_m", 2e-4),
+];
+
+/// pack-6-engagement's trace at the true friction curve: columns `time_s`, `drum` (the
+/// drum's speed, rad/s) and `torque` (the piston-side face's friction torque, N m), every
+/// 1 ms from 0 to 0.1 s.
+fn pack_trace(dir: &Path) -> PathBuf {
+    let times: Vec<f64> = (0..=100).map(|i| i as f64 * 1e-3).collect();
+    let slope = format!("{}={}", PACK_TRUTH[1].0, PACK_TRUTH[1].1);
+    let y = pack_series(
+        &[PACK_SHORT, &slope],
+        &["drum.speed_rad_s", "interfaces[1].torque_n_m"],
+        &times,
+    );
+    let mut text = String::from("time_s,drum,torque\n");
+    for (i, t) in times.iter().enumerate() {
+        text.push_str(&format!("{t:?},{:?},{:?}\n", y[0][i], y[1][i]));
+    }
+    let p = dir.join("pack-trace.csv");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// A resolved pack's fit (issue 47): pack-6-engagement's friction curve, its kinetic mu and
+/// its viscous slope (`mu = kinetic + slope v` over the slip, v from 52 m/s down to 0),
+/// fitted on the reference engine to the drum's speed and the piston-side face's torque
+/// from starting values 23 % and 150 % off (0.10, 5e-4 s/m), both on a log scale with a
+/// forward-difference step of 1 % of ln x. The trace is the project's own run at the true
+/// values (the route the fit takes: the scene's co-simulation read at the measured times).
+/// The face's torque carries the rattle's chaos (its clamp force depends on the spline
+/// friction of the rattling discs: a change of mu by 1e-3 moves it by 15 N m RMS where
+/// a smooth response would move it by 1 N m), so it is weighted 1e-3 (1 / its scatter of
+/// ~1000 N m over a 4 % change of mu), and the step is 1 % for the same reason. Measured:
+/// kinetic mu 0.12967 (-0.25 %), slope 2.113e-4 s/m (+5.6 %), 35 runs; the bounds are 0.5 %
+/// and 10 %. The fit ends where the chaos hides any better step (reported as converged on
+/// the step size), and the fitted scene loads.
+#[test]
+fn pack_engagement_friction_curve_is_recovered_from_drum_speed_and_torque() {
+    let d = scratch("fit-pack-engagement");
+    let data = pack_trace(&d);
+    let json = d.join("fit.json");
+    let fitted = d.join("pack.fitted.toml");
+    let o = run(&[
+        "fit",
+        PACK,
+        "--data",
+        data.to_str().unwrap(),
+        "--engine",
+        "reference",
+        "--set",
+        PACK_SHORT,
+        "--param",
+        "stack.friction.kinetic_mu=0.10:0.05:0.3:log",
+        "--param",
+        "stack.friction.viscous_slope_s_m=5e-4:1e-5:2e-3:log",
+        "--fd-step",
+        "1e-2",
+        "--match",
+        "drum.speed_rad_s=drum",
+        "--match",
+        "interfaces[1].torque_n_m=torque:1e-3",
+        "--fitted-scene",
+        fitted.to_str().unwrap(),
+        "--summary-json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    println!("{}\n{}", stdout(&o), stderr(&o));
+    let s = read_json(&json);
+    println!(
+        "pack fit: {} runs, {} iterations, {:.2} s wall",
+        s["runs"], s["iterations"], s["wall_time_s"]
+    );
+    assert_eq!(s["converged"], true, "{s}");
+    for ((key, truth), bound) in PACK_TRUTH.iter().zip([5e-3, 0.1]) {
+        let k = if key.ends_with("kinetic_mu") { 0 } else { 1 };
+        let value = s["params"][k]["value"].as_f64().unwrap();
+        println!("{key}: {value} (true {truth})");
+        assert!(
+            (value - truth).abs() < bound * truth,
+            "{key}: {value} vs {truth}"
+        );
+    }
+    let o = run(&["check", fitted.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// The paper's Table 2 peaks (Hu et al.; h_o = 0, 25, 50 um), one row per film thickness.
+fn paper_table(dir: &Path) -> PathBuf {
+    let p = dir.join("table2.csv");
+    std::fs::write(
+        &p,
+        "defaults.oil.film_thickness_m,max_pos,max_neg\n\
+         0,945.39,-976.42\n25e-6,867.6,-867.8\n50e-6,503.1,-503.5\n",
+    )
+    .unwrap();
+    p
+}
+
+/// `fit` of the paper's two ASSUMED contact parameters to its Table 2 with `extra` args.
+fn paper_fit(d: &Path, extra: &[&str]) -> (std::process::Output, PathBuf) {
+    let json = d.join("paper.json");
+    let table = paper_table(d);
+    let mut args = vec![
+        "fit",
+        "scenes/hu-table2.toml",
+        "--data",
+        table.to_str().unwrap(),
+        "--variant",
+        "defaults.oil.film_thickness_m",
+        "--param",
+        "defaults.contact.curvature_radius_m:0.5e-3:5e-3:log",
+        "--param",
+        "defaults.contact.loss_coefficient_s_m:0.1:3:log",
+        "--match",
+        "disc.max_positive_n=max_pos:0.01",
+        "--match",
+        "disc.max_negative_n=max_neg:0.01",
+        "--summary-json",
+        json.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    (run(&args), json)
+}
+
+/// The paper's calibration as a fit over scene variants (issue 47): the two ASSUMED contact
+/// parameters of hu-table2.toml (curvature radius, loss coefficient) fitted to the six peaks
+/// of Table 2, each variant's peaks the mean of a 2-member ensemble here (32 in
+/// docs/calibration.md; a rattle's peak is chaotic, one run one sample). The fit lowers the
+/// residuals from the shipped values, reports finite intervals and a correlation short of
+/// +-1 (the two are separately identifiable from three films), counts its runs as
+/// evaluations x 3 variants x 2 members, and lands within 30 % of the shipped values (which
+/// were calibrated by hand against the same table; measured: r 1.786 mm, p 0.810 s/m, 17
+/// evaluations, 102 runs, correlation +0.46).
+#[test]
+fn paper_table_peaks_fit_the_contact_parameters_over_variants() {
+    let d = scratch("fit-paper-table");
+    let fitted = d.join("hu.fitted.toml");
+    let (o, json) = paper_fit(
+        &d,
+        &[
+            "--ensemble",
+            "2",
+            "--fd-step",
+            "5e-2",
+            "--fitted-scene",
+            fitted.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    println!("{}\n{}", stdout(&o), stderr(&o));
+    let s = read_json(&json);
+    assert_eq!(s["rows"], "defaults.oil.film_thickness_m");
+    assert_eq!(
+        s["scene_runs"].as_u64().unwrap(),
+        s["runs"].as_u64().unwrap() * 6
+    );
+    for (k, shipped) in [(0, 1.75e-3), (1, 0.8)] {
+        let p = &s["params"][k];
+        let v = p["value"].as_f64().unwrap();
+        assert!(p["std_error"].as_f64().unwrap().is_finite(), "{p}");
+        assert!((v - shipped).abs() < 0.3 * shipped, "{p}");
+    }
+    let c = s["correlation"][0][1].as_f64().unwrap();
+    assert!(c.abs() < 0.99, "correlation {c}");
+    for sig in s["signals"].as_array().unwrap() {
+        assert!(
+            sig["rms"].as_f64().unwrap() < sig["rms_start"].as_f64().unwrap(),
+            "{sig}"
+        );
+    }
+    let o = run(&["check", fitted.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Bad input of the variant route and of the pack's signals is refused before any run
+/// (exit 2) naming the problem: a per-run statistic without --variant, a series with it, a
+/// variant key that is not a number, a variant value outside its key's rule, a pack signal
+/// that does not exist (the message lists the pack's outputs).
+#[test]
+fn bad_variant_and_pack_signal_input_is_refused_before_any_run() {
+    let d = scratch("fit-bad-variant");
+    let table = paper_table(&d);
+    let neg = d.join("neg.csv");
+    std::fs::write(
+        &neg,
+        "defaults.oil.film_thickness_m,max_pos\n-1e-6,900\n0,945\n",
+    )
+    .unwrap();
+    let pack_data = d.join("pack.csv");
+    std::fs::write(&pack_data, "time_s,drum\n0,0\n0.01,1\n").unwrap();
+    let t = table.to_str().unwrap();
+    let r = "defaults.contact.curvature_radius_m:0.5e-3:5e-3";
+    let cases: [(&str, Vec<&str>, &[&str]); 5] = [
+        (
+            "scenes/hu-table2.toml",
+            vec![
+                "--data",
+                t,
+                "--param",
+                r,
+                "--match",
+                "disc.max_positive_n=max_pos",
+            ],
+            &["one value per run", "--variant"],
+        ),
+        (
+            "scenes/hu-table2.toml",
+            vec![
+                "--data",
+                t,
+                "--variant",
+                "defaults.oil.film_thickness_m",
+                "--param",
+                r,
+                "--match",
+                "drum.speed_rad_s=max_pos",
+            ],
+            &["drum.speed_rad_s", "does not produce it"],
+        ),
+        (
+            "scenes/hu-table2.toml",
+            vec![
+                "--data",
+                t,
+                "--variant",
+                "defaults.contact.law",
+                "--param",
+                r,
+                "--match",
+                "disc.max_positive_n=max_pos",
+            ],
+            &["--variant defaults.contact.law", "not a number"],
+        ),
+        (
+            "scenes/hu-table2.toml",
+            vec![
+                "--data",
+                neg.to_str().unwrap(),
+                "--variant",
+                "defaults.oil.film_thickness_m",
+                "--param",
+                r,
+                "--match",
+                "disc.max_positive_n=max_pos",
+            ],
+            &[
+                "neg.csv",
+                "the variant defaults.oil.film_thickness_m = -1e-6",
+                ">= 0",
+            ],
+        ),
+        (
+            PACK,
+            vec![
+                "--data",
+                pack_data.to_str().unwrap(),
+                "--param",
+                "stack.friction.kinetic_mu:0.05:0.3",
+                "--match",
+                "drum.speed=drum",
+            ],
+            &["drum.speed", "drum.speed_rad_s", "interfaces[1].torque_n_m"],
+        ),
+    ];
+    for (scene, args, needles) in cases {
+        let fitted = d.join("x.fitted.toml");
+        let mut all = vec!["fit", scene, "--fitted-scene", fitted.to_str().unwrap()];
+        all.extend(args.iter().copied());
+        let o = run(&all);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{args:?}: expected {n:?} in: {err}");
+        }
+        assert!(!fitted.exists());
+    }
+}
+
+/// A recording as the measured data (issue 47: `--data run.mcap`): CoupledClutches recorded
+/// by `clutchpack run --out` at the true values, and mu fitted from 30 % off to J1..J4's
+/// recorded speeds (the columns default to the signals' names, `J1` being J1's speed): the
+/// recording holds the run's own samples, so mu comes back within 1e-6 relative (measured:
+/// 0.5000000024 in 8 runs). A pack's recording and a series the recording lacks are refused (exit 2),
+/// naming the file and listing its series.
+#[test]
+fn a_network_recording_is_measured_data() {
+    let d = scratch("fit-mcap");
+    let rec = d.join("cc.mcap");
+    let o = run(&["run", SCENE, "--out", rec.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json = d.join("fit.json");
+    let fitted = d.join("cc.fitted.toml");
+    let mut args = vec![
+        "fit",
+        SCENE,
+        "--data",
+        rec.to_str().unwrap(),
+        "--param",
+        "couplings[*].mu=0.35:0.05:2:log",
+        "--fitted-scene",
+        fitted.to_str().unwrap(),
+        "--summary-json",
+        json.to_str().unwrap(),
+    ];
+    for m in ["J1", "J2", "J3", "J4"] {
+        args.extend(["--match", m]);
+    }
+    let o = run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = read_json(&json);
+    let mu = s["params"][0]["value"].as_f64().unwrap();
+    println!("mu from the recording: {mu} ({} runs)", s["runs"]);
+    assert!((mu - 0.5).abs() < 1e-6 * 0.5, "{mu}");
+    let last = args.len() - 1;
+    args[last] = "J4=J9";
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("cc.mcap") && err.contains("J9") && err.contains("J4.speed_rad_s"),
+        "{err}"
+    );
+    let pack_rec = d.join("pack.mcap");
+    let o = run(&[
+        "run",
+        "scenes/hu-table2.toml",
+        "--duration",
+        "0.01",
+        "--out",
+        pack_rec.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&[
+        "fit",
+        "scenes/hu-table2.toml",
+        "--data",
+        pack_rec.to_str().unwrap(),
+        "--param",
+        "defaults.contact.loss_coefficient_s_m:0.1:3",
+        "--match",
+        "discs[1].speed_rad_s",
+        "--fitted-scene",
+        fitted.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("clutchpack export"), "{}", stderr(&o));
+}

@@ -10,6 +10,7 @@
 //! (SIGINT) stops it within about 50 ms of wall time, its outputs complete (the recording
 //! finished), and then raises `KeyboardInterrupt`.
 
+mod fit;
 mod network;
 mod stepper;
 
@@ -631,6 +632,7 @@ fn _clutchpack(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RawRun>()?;
     m.add_class::<network::RawNetworkRun>()?;
     m.add_class::<RawRecording>()?;
+    m.add_class::<fit::RawFit>()?;
     m.add_class::<stepper::Stepper>()?;
     m.add_class::<stepper::StepperState>()?;
     m.add_class::<network::NetworkStepper>()?;
@@ -640,6 +642,7 @@ fn _clutchpack(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(network::run_network, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(study_run, m)?)?;
     m.add_function(wrap_pyfunction!(study_merge, m)?)?;

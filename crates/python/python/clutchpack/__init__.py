@@ -35,8 +35,8 @@ from ._clutchpack import Scene
 __version__: str = _clutchpack.__version__
 
 __all__ = [
-    "Scene", "Result", "Sweep", "Simulation", "load_scene", "run", "sweep", "read", "study",
-    "IMPACT_COLUMNS",
+    "Scene", "Result", "Sweep", "Simulation", "FitResult", "load_scene", "run", "sweep", "fit",
+    "read", "study", "IMPACT_COLUMNS",
 ]
 
 #: The columns of ``Result.impacts``, as in ``clutchpack run --impacts-csv``: body name,
@@ -62,8 +62,11 @@ def _sets(set: Optional[Mapping[str, Any]]) -> List[tuple]:
             text = "true" if v else "false"
         elif isinstance(v, (list, tuple, dict)):
             text = json.dumps(v)
-        elif isinstance(v, float):
-            text = repr(v)
+        elif isinstance(v, (float, np.floating)):
+            # float() first: numpy 2's repr of a numpy float is "np.float64(0.35)"
+            text = repr(float(v))
+        elif isinstance(v, np.integer):
+            text = str(int(v))
         else:
             text = str(v)
         out.append((str(k), text))
@@ -292,6 +295,126 @@ def sweep(
                 row[f"{stat}_{k}"] = v
         flat.append(row)
     return Sweep(summary=summary, rows=pd.DataFrame(flat))
+
+
+@dataclass
+class FitResult:
+    """A fit (``fit``), as ``clutchpack fit`` reports it.
+
+    - ``params``: DataFrame indexed by the key as asked: ``value``, ``std_error``,
+      ``ci95_low``, ``ci95_high`` (the 95 % interval), ``start``, ``lower``, ``upper``,
+      ``unit``, ``at_bound``, ``log`` (values in the key's unit).
+    - ``residuals``: DataFrame, one row per measured point: ``signal``, ``x`` (the time in s,
+      or the variant key's value), ``measured``, ``fitted`` and ``residual`` (fitted minus
+      measured, unweighted; the signal's unit).
+    - ``correlation``: DataFrame of the parameters' correlations (|r| > 0.99: not separately
+      identifiable).
+    - ``summary``: dict, what ``clutchpack fit --summary-json`` writes; ``warnings``: its
+      warnings; ``fitted_scene``: the fitted scene's TOML text.
+    """
+
+    params: pd.DataFrame
+    residuals: pd.DataFrame
+    correlation: pd.DataFrame
+    summary: Dict[str, Any]
+    warnings: List[str]
+    fitted_scene: str
+
+
+def _strings(name: str, value: Union[str, Sequence[str]]) -> List[str]:
+    if isinstance(value, str):
+        return [value]
+    if not isinstance(value, Sequence) or not all(isinstance(v, str) for v in value):
+        raise TypeError(f"{name} = {value!r:.80}: expected a string or a list of strings")
+    return list(value)
+
+
+def fit(
+    scene: PathLike,
+    data: PathLike,
+    params: Union[str, Sequence[str]],
+    match: Union[str, Sequence[str]],
+    set: Optional[Mapping[str, Any]] = None,
+    engine: Optional[str] = None,
+    time_column: str = "time_s",
+    variant: Optional[str] = None,
+    ensemble: int = 1,
+    max_iterations: int = 100,
+    fd_step: float = 1e-6,
+    fitted_scene: Optional[PathLike] = None,
+) -> FitResult:
+    """Fits scene keys to measured series, as ``clutchpack fit`` (docs/calibration.md), with
+    the same arguments: ``params`` as ``--param`` (``"KEY[=START][:LO:HI][:log]"``),
+    ``match`` as ``--match`` (``"SIGNAL[=COLUMN][:WEIGHT]"``), ``set`` as ``--set`` (held
+    fixed), ``variant``/``ensemble`` as ``--variant``/``--ensemble``; ``fitted_scene``:
+    also write the fitted scene there. Bad input raises ``ValueError`` with the command
+    line's message, before any run; Ctrl-C raises ``KeyboardInterrupt``."""
+    if isinstance(scene, Scene):
+        raise TypeError("scene: a fit needs the scene's file (a path), not a loaded Scene")
+    ensemble = _integer("ensemble", ensemble, 1)
+    max_iterations = _integer("max_iterations", max_iterations, 0)
+    raw = _clutchpack.fit(
+        os.fspath(scene),
+        os.fspath(data),
+        _strings("params", params),
+        _strings("match", match),
+        sets=_sets(set),
+        engine=engine,
+        time_column=time_column,
+        variant=variant,
+        ensemble=ensemble,
+        max_iterations=max_iterations,
+        fd_step=_number("fd_step", fd_step),
+        fitted_scene=None if fitted_scene is None else os.fspath(fitted_scene),
+    )
+    summary = json.loads(raw.summary_json)
+    keys = [p["key"] for p in summary["params"]]
+    nan = float("nan")
+
+    def num(x: Any) -> float:
+        # an infinite interval end is null in the JSON
+        return nan if x is None else float(x)
+
+    params_df = pd.DataFrame(
+        [
+            {
+                "key": p["key"],
+                "value": p["value"],
+                "std_error": num(p["std_error"]),
+                "ci95_low": num(p["ci95_low"]),
+                "ci95_high": num(p["ci95_high"]),
+                "start": p["start"],
+                "lower": num(p["lower"]),
+                "upper": num(p["upper"]),
+                "unit": p["unit"],
+                "at_bound": p["at_bound"],
+                "log": p["log"],
+            }
+            for p in summary["params"]
+        ]
+    ).set_index("key")
+    frames = []
+    for name, x, measured, fitted in raw.series:
+        m = np.asarray(measured, dtype=float)
+        f = np.asarray(fitted, dtype=float)
+        frames.append(
+            pd.DataFrame(
+                {"signal": name, "x": np.asarray(x, dtype=float), "measured": m, "fitted": f,
+                 "residual": f - m}
+            )
+        )
+    residuals = pd.concat(frames, ignore_index=True)
+    corr = pd.DataFrame(
+        [[num(c) for c in row] for row in summary["correlation"]], index=keys, columns=keys
+    )
+    return FitResult(
+        params=params_df,
+        residuals=residuals,
+        correlation=corr,
+        summary=summary,
+        warnings=list(summary["warnings"]),
+        fitted_scene=raw.fitted_scene,
+    )
 
 
 class Simulation:

@@ -97,6 +97,29 @@ def sweep(
     engine: Optional[str] = None,
 ) -> str: ...
 def read(path: _Path, salvage: bool = False) -> RawRecording: ...
+
+class RawFit:
+    """A fit's summary (JSON text), its series per signal (name, rows, measured, fitted)
+    and the fitted scene's TOML text."""
+
+    summary_json: str
+    series: List[Tuple[str, List[float], List[float], List[float]]]
+    fitted_scene: str
+
+def fit(
+    scene: _Path,
+    data: _Path,
+    params: List[str],
+    matches: List[str],
+    sets: List[Tuple[str, str]] = [],
+    engine: Optional[str] = None,
+    time_column: str = "time_s",
+    variant: Optional[str] = None,
+    ensemble: int = 1,
+    max_iterations: int = 100,
+    fd_step: float = 1e-6,
+    fitted_scene: Optional[_Path] = None,
+) -> RawFit: ...
 def study_run(
     study: _Path, out: _Path, jobs: Optional[int] = None, shard: int = 0, shards: int = 1
 ) -> Tuple[str, int, int, int, int, bool]: ...

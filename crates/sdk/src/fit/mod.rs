@@ -4,22 +4,30 @@
 //! for every item that sets the key, and several keys joined by `,` take one value), each
 //! within bounds, optionally on a log scale. The measured series are columns of a CSV file
 //! with a time column; each is matched to a signal the scene's run produces
-//! (a network's `BODY.speed_rad_s` or `BODY`, `BODY.angle_rad`, `COUPLING.torque_n_m`;
-//! `signals.rs`) with a weight. The residual of measured point `i` of signal `k` is
-//! `w_k (y_sim,k(t_i) - y_meas,k,i)`, `y_sim` linear between the run's samples. The solver
+//! (a network's `BODY.speed_rad_s` or `BODY`, `BODY.angle_rad`, `COUPLING.torque_n_m`; a
+//! pack's co-simulation outputs, `drum.speed_rad_s`, `interfaces[1].torque_n_m`, ...;
+//! `signals.rs`) with a weight. Or the rows are variants of the scene (a key's value per
+//! row) and the signals are statistics of a run's impact peaks, ensemble means if asked.
+//! The residual of measured point `i` of signal `k` is `w_k (y_sim,k(x_i) - y_meas,k,i)`.
+//! The solver
 //! is Levenberg-Marquardt (`lm.rs`) with a forward-difference Jacobian whose runs go in
 //! parallel on rayon's threads. [`Fit::new`] checks everything before any run; [`Fit::run`]
-//! fits, reporting progress and honouring a stop flag (the best point so far is returned).
+//! fits, reporting progress and honouring a stop flag (the best point so far is returned);
+//! [`Fit::coverage`] checks the intervals on synthetic traces (`coverage.rs`).
 
+mod coverage;
+mod data;
 mod lm;
 mod params;
 mod signals;
 
+pub use coverage::{CoverageRequest, CoverageResult, ParamCoverage};
+
 pub use lm::{LmOptions as FitOptions, LmState};
-use params::{check_param, Param};
+use params::{check_param, check_variant, Param};
 pub use params::{FitParam, FitSignal};
 
-use crate::{Error, NetworkRequest, Result};
+use crate::{Error, Result};
 use clutchpack_scene::{EngineChoice, Override, Scene};
 use serde::Serialize;
 use signals::Signal;
@@ -39,10 +47,19 @@ pub struct FitRequest {
     pub sets: Vec<Override>,
     /// The engine asked (else the scene's choice).
     pub engine: Option<EngineChoice>,
-    /// The measured series: a CSV file with a header row.
-    pub data: PathBuf,
+    /// The measured series: a CSV file with a header row, or an MCAP recording of a network
+    /// scene (its series named as the signals; `None`: no measured data, only
+    /// for [`Fit::coverage`], whose traces are made on the run's record-rate grid).
+    pub data: Option<PathBuf>,
     /// The data's time column (s), strictly increasing.
     pub time_column: String,
+    /// Rows as variants of the scene instead of times: the data's column named by this key
+    /// (dotted, `[*]` and `,` as a parameter's) holds each row's value of it (strictly
+    /// increasing), and the signals are per-run statistics (`BODY.max_positive_n`, ...).
+    pub variant: Option<String>,
+    /// Runs per variant whose statistics are averaged (ensemble members,
+    /// [`crate::ensemble_member`]; 0 or 1: the scene's own run).
+    pub ensemble: u64,
     /// The parameters.
     pub params: Vec<FitParam>,
     /// The signals matched to the data's columns.
@@ -60,7 +77,11 @@ pub struct Fit {
     base_dir: PathBuf,
     params: Vec<Param>,
     signals: Vec<(FitSignal, Signal)>,
-    time_s: Vec<f64>,
+    /// The keys each variant row sets (empty: rows are times).
+    variant_keys: Vec<String>,
+    /// The rows: times, s, or the variant keys' values.
+    rows: Vec<f64>,
+    /// Measured values, `[signal][row]` (empty without data).
     measured: Vec<Vec<f64>>,
     scene_name: String,
     engine: EngineChoice,
@@ -119,11 +140,11 @@ pub struct SignalFit {
 pub struct SignalSeries {
     /// The signal.
     pub signal: String,
-    /// Measured times, s.
-    pub time_s: Vec<f64>,
+    /// The rows: measured times, s, or the variant key's values (its unit).
+    pub x: Vec<f64>,
     /// Measured values.
     pub measured: Vec<f64>,
-    /// Simulated at the fitted values, at the measured times.
+    /// Simulated at the fitted values, at the measured rows.
     pub fitted: Vec<f64>,
 }
 
@@ -134,6 +155,10 @@ pub struct FitResult {
     pub scene: String,
     /// The engine that ran it.
     pub engine: &'static str,
+    /// What the rows are: `time_s`, or the variant key.
+    pub rows: String,
+    /// Runs averaged per variant (1 for a time series).
+    pub ensemble: u64,
     /// The parameters, as asked.
     pub params: Vec<FittedParam>,
     /// The correlation matrix of the parameters, in their order.
@@ -144,8 +169,11 @@ pub struct FitResult {
     pub ssr: f64,
     /// Residual points minus parameters.
     pub dof: usize,
-    /// Runs of the scene.
+    /// Evaluations of the residuals: each one run of the scene for a time series, `rows x
+    /// ensemble` runs with `--variant`.
     pub runs: usize,
+    /// Runs of the scene in all.
+    pub scene_runs: usize,
     /// Solver iterations.
     pub iterations: usize,
     /// Wall time of the fit, s.
@@ -191,6 +219,10 @@ impl Fit {
         for p in &request.params {
             params.push(check_param(p, &text, &shown, &mut seen)?);
         }
+        let variant_keys = match &request.variant {
+            Some(key) => check_variant(key, &text, &seen)?,
+            None => Vec::new(),
+        };
         let base_dir = request
             .scene
             .parent()
@@ -201,37 +233,90 @@ impl Fit {
             base_dir,
             params,
             signals: Vec::new(),
-            time_s: Vec::new(),
+            variant_keys,
+            rows: Vec::new(),
             measured: Vec::new(),
             scene_name: String::new(),
             engine: EngineChoice::Reference,
             request,
         };
         let start: Vec<f64> = fit.params.iter().map(|p| p.start).collect();
-        let scene = fit.scene_at(&start)?;
+        let scene = fit.scene_at(&start, None)?;
         fit.engine = scene.engine(fit.request.engine, &scene.name)?;
         fit.scene_name = scene.name.clone();
         for s in &fit.request.signals {
-            fit.signals
-                .push((s.clone(), Signal::resolve(&scene, &s.signal)?));
+            let signal = Signal::resolve(&scene, fit.engine, &s.signal)?;
+            match (signal.per_run(), &fit.request.variant) {
+                (true, None) => {
+                    return Err(bad(format!(
+                        "signal {:?} is one value per run: its rows are variants of the \
+                         scene (--variant KEY), not times",
+                        s.signal
+                    )))
+                }
+                (false, Some(v)) => {
+                    return Err(bad(format!(
+                        "signal {:?} is a series in time: with --variant {v} the rows are \
+                         variants, and the signals one value per run (BODY.max_positive_n, \
+                         BODY.max_negative_n, BODY.p99_abs_n, BODY.mean_top10_abs_n)",
+                        s.signal
+                    )))
+                }
+                _ => {}
+            }
+            fit.signals.push((s.clone(), signal));
         }
+        let Some(data_path) = fit.request.data.clone() else {
+            if fit.request.variant.is_some() {
+                return Err(bad(
+                    "fit: variants (--variant) need a data file giving their values (--data)"
+                        .into(),
+                ));
+            }
+            // no data (a coverage study): the run's record-rate grid
+            let sim = &scene.simulation;
+            let n = (sim.duration_s * sim.record_rate_hz).floor() as usize;
+            fit.rows = (0..=n).map(|i| i as f64 / sim.record_rate_hz).collect();
+            return Ok(fit);
+        };
         let columns: Vec<&str> = fit
             .request
             .signals
             .iter()
             .map(|s| s.column.as_str())
             .collect();
-        let data =
-            clutchpack_scene::read_columns(&fit.request.data, &fit.request.time_column, &columns)
-                .map_err(|e| bad(format!("fit data: {e}")))?;
-        let (t0, t1) = (data.time_s[0], *data.time_s.last().expect("2 rows"));
-        let end = scene.simulation.duration_s;
-        if t0 < 0.0 || t1 > end {
+        let row_column = fit
+            .request
+            .variant
+            .as_deref()
+            .unwrap_or(&fit.request.time_column);
+        if fit.request.variant.is_some() && data::is_recording(&data_path) {
             return Err(bad(format!(
-                "fit data {}: times {t0} to {t1} s lie outside the run (0 to {end} s, \
-                 simulation.duration_s)",
-                fit.request.data.display()
+                "fit data {}: variants (--variant) are read from a CSV table, not a recording",
+                data_path.display()
             )));
+        }
+        let data = data::read(&data_path, row_column, &columns)?;
+        if fit.request.variant.is_some() {
+            // every variant loads (its value within its key's rule) before any run
+            for &x in &data.time_s {
+                fit.scene_at(&start, Some(x)).map_err(|e| {
+                    bad(format!(
+                        "fit data {}: the variant {row_column} = {x:?} does not load: {e}",
+                        data_path.display()
+                    ))
+                })?;
+            }
+        } else {
+            let (t0, t1) = (data.time_s[0], *data.time_s.last().expect("2 rows"));
+            let end = scene.simulation.duration_s;
+            if t0 < 0.0 || t1 > end {
+                return Err(bad(format!(
+                    "fit data {}: times {t0} to {t1} s lie outside the run (0 to {end} s, \
+                     simulation.duration_s)",
+                    data_path.display()
+                )));
+            }
         }
         let m = data.time_s.len() * columns.len();
         if m <= fit.params.len() {
@@ -240,14 +325,21 @@ impl Fit {
                 fit.params.len()
             )));
         }
-        fit.time_s = data.time_s;
+        fit.rows = data.time_s;
         fit.measured = data.values;
         Ok(fit)
     }
 
-    /// The scene with the fixed overrides and the parameters at `values` (the keys' units).
-    fn scene_at(&self, values: &[f64]) -> Result<Scene> {
-        let overrides = self.overrides(values);
+    /// The scene with the fixed overrides, the parameters at `values` (the keys' units)
+    /// and, for a variant row, the variant keys at `row`.
+    fn scene_at(&self, values: &[f64], row: Option<f64>) -> Result<Scene> {
+        let mut overrides = self.overrides(values);
+        if let Some(x) = row {
+            overrides.extend(self.variant_keys.iter().map(|k| Override {
+                key: k.clone(),
+                value: format!("{x:?}"),
+            }));
+        }
         Ok(clutchpack_scene::parse(
             &self.text,
             &self.request.scene.display().to_string(),
@@ -268,28 +360,44 @@ impl Fit {
         o
     }
 
-    /// The simulated signals at the measured times, for the parameters at `values`.
+    /// The simulated signals at the measured rows, `[signal][row]`, for the parameters at
+    /// `values`.
     fn simulate(&self, values: &[f64], stop: Option<&AtomicBool>) -> Result<Vec<Vec<f64>>> {
-        let scene = self.scene_at(values)?;
-        let outcome = crate::run_network_scene(
-            &scene,
-            self.request.engine,
-            NetworkRequest {
-                keep_history: true,
+        use rayon::prelude::*;
+        let signals: Vec<&Signal> = self.signals.iter().map(|(_, s)| s).collect();
+        if self.variant_keys.is_empty() {
+            let scene = self.scene_at(values, None)?;
+            return signals::series(
+                &scene,
+                self.request.engine,
+                self.engine,
+                &signals,
+                &self.rows,
                 stop,
-                ..NetworkRequest::default()
-            },
-        )?;
-        Ok(self
-            .signals
-            .iter()
-            .map(|(_, s)| s.at(&outcome.history, &self.time_s))
+            );
+        }
+        let per_row = self
+            .rows
+            .par_iter()
+            .map(|&x| {
+                let scene = self.scene_at(values, Some(x))?;
+                signals::statistics(
+                    &scene,
+                    self.request.engine,
+                    &signals,
+                    self.request.ensemble,
+                    stop,
+                )
+            })
+            .collect::<Result<Vec<Vec<f64>>>>()?;
+        Ok((0..signals.len())
+            .map(|k| per_row.iter().map(|r| r[k]).collect())
             .collect())
     }
 
     /// The weighted residual vector for the simulated series.
     fn residuals(&self, sim: &[Vec<f64>]) -> Vec<f64> {
-        let mut r = Vec::with_capacity(self.time_s.len() * sim.len());
+        let mut r = Vec::with_capacity(self.rows.len() * sim.len());
         for (k, (s, _)) in self.signals.iter().enumerate() {
             r.extend(
                 sim[k]
@@ -330,6 +438,11 @@ impl Fit {
         progress: &mut dyn FnMut(&LmState, &[f64]),
     ) -> Result<FitResult> {
         use rayon::prelude::*;
+        if self.measured.is_empty() {
+            return Err(Error::BadInput(
+                "fit: no measured data to fit (--data)".into(),
+            ));
+        }
         let started = Instant::now();
         let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
         let mut eval = |points: &[Vec<f64>]| -> Vec<Result<Vec<f64>>> {
@@ -366,7 +479,7 @@ impl Fit {
         };
         // the simulated series back from the weighted residuals: y = r / w + measured
         let series_of = |r: &[f64]| -> Vec<Vec<f64>> {
-            let len = self.time_s.len();
+            let len = self.rows.len();
             self.signals
                 .iter()
                 .enumerate()
@@ -471,7 +584,7 @@ impl Fit {
                 signal: s.signal.clone(),
                 column: s.column.clone(),
                 weight: s.weight,
-                points: self.time_s.len(),
+                points: self.rows.len(),
                 rms: rms(&fitted[k], &self.measured[k]),
                 rms_start: rms(&start[k], &self.measured[k]),
             })
@@ -482,7 +595,7 @@ impl Fit {
             .enumerate()
             .map(|(k, (s, _))| SignalSeries {
                 signal: s.signal.clone(),
-                time_s: self.time_s.clone(),
+                x: self.rows.clone(),
                 measured: self.measured[k].clone(),
                 fitted: fitted[k].clone(),
             })
@@ -490,12 +603,27 @@ impl Fit {
         Ok(FitResult {
             scene: self.scene_name.clone(),
             engine: self.engine.name(),
+            rows: self
+                .request
+                .variant
+                .clone()
+                .unwrap_or_else(|| "time_s".into()),
+            ensemble: if self.request.variant.is_some() {
+                self.request.ensemble.max(1)
+            } else {
+                1
+            },
             params,
             correlation,
             signals,
             ssr,
             dof,
             runs,
+            scene_runs: if self.variant_keys.is_empty() {
+                runs
+            } else {
+                runs * self.rows.len() * self.request.ensemble.max(1) as usize
+            },
             iterations: outcome.iterations,
             wall_time_s: started.elapsed().as_secs_f64(),
             converged: outcome.converged,
@@ -518,7 +646,10 @@ impl Fit {
         let mut head = format!(
             "# {} fitted by `clutchpack fit` to {} ({} runs)\n",
             self.request.scene.display(),
-            self.request.data.display(),
+            self.request
+                .data
+                .as_deref()
+                .map_or_else(|| "no data".into(), |d| d.display().to_string()),
             result.runs
         );
         for p in &result.params {

@@ -116,6 +116,9 @@ pub(super) struct Param {
     pub(super) keys: Vec<String>,
     pub(super) unit: &'static str,
     pub(super) start: f64,
+    /// The scene's own value of its (first) key, else the key's default (the truth of a
+    /// coverage study), the key's unit.
+    pub(super) scene_value: Option<f64>,
     pub(super) lower: f64,
     pub(super) upper: f64,
 }
@@ -207,6 +210,7 @@ pub(super) fn check_param(
         keys,
         unit: def.unit,
         start,
+        scene_value: from_file.or(def.default),
         lower: p.lower,
         upper: p.upper,
     };
@@ -221,6 +225,23 @@ pub(super) fn check_param(
     };
     param.upper = param.to_internal(p.upper);
     Ok(param)
+}
+
+/// The keys a variant column sets (`--variant KEY`: dotted, `[*]` and `,` as a parameter's
+/// key), each numeric, neither fitted nor fixed with `--set` (`seen`).
+pub(super) fn check_variant(key: &str, text: &str, seen: &[String]) -> Result<Vec<String>> {
+    let bad = |m: String| Error::BadInput(format!("--variant {key}: {m}"));
+    let mut keys = Vec::new();
+    for k in key.split(',').map(str::trim) {
+        keys.extend(clutchpack_scene::expand_wildcards(text, k).map_err(bad)?);
+    }
+    for k in &keys {
+        clutchpack_scene::numeric_key(k).map_err(|e| bad(format!("{k}: {e}")))?;
+        if seen.contains(k) {
+            return Err(bad(format!("{k} is also fitted, or fixed with --set")));
+        }
+    }
+    Ok(keys)
 }
 
 #[cfg(test)]

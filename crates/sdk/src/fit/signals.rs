@@ -1,34 +1,88 @@
-//! What a fit compares: the signals a scene's run produces, by name, read from the run's
-//! samples and interpolated at the measured times.
+//! What a fit compares: the signals a scene's run produces, by name, and their values at
+//! the measured rows.
 //!
-//! A network scene (`[[bodies]]`) produces, per body `B`, `B.speed_rad_s` (also written `B`
-//! alone) and `B.angle_rad`, and per coupling `C`, `C.torque_n_m` (the torque on its body
-//! `a`, sign as in [`clutchpack_model::network::NetworkSample`]).
+//! Two kinds of rows. **Time series** (a time column): a network scene (`[[bodies]]`)
+//! produces, per body `B`, `B.speed_rad_s` (also written `B` alone) and `B.angle_rad`, and
+//! per coupling `C`, `C.torque_n_m` (the torque on its body `a`, sign as in
+//! [`clutchpack_model::network::NetworkSample`]), interpolated linearly between the run's
+//! samples; a pack scene produces its co-simulation outputs by their one public name (the
+//! FMU's and Python's: `drum.speed_rad_s`, `pack.carrier_torque_n_m`,
+//! `interfaces[1].torque_n_m`, `discs[2].speed_rad_s`, ...; [`crate::cosim::variables`]),
+//! read at the measured times themselves (the run's communication points). **Variants**
+//! (`--variant KEY`: each row sets KEY): a statistic of one body's impact peaks over the
+//! whole run, `B.max_positive_n`, `B.max_negative_n`, `B.p99_abs_n`, `B.mean_top10_abs_n`
+//! (N per tooth, [`clutchpack_analysis::DiscStats`]), the mean over an ensemble of runs
+//! ([`crate::ensemble_member`]) when one is asked: a rattle is chaotic, so one run's peak is
+//! one sample of a scatter of a few per cent (MODEL.md section 4), and only the ensemble's
+//! mean is a smooth function of the keys.
 
-use crate::{Error, Result};
+use crate::cosim::{Causality, Kind};
+use crate::{CoSimulation, Error, NetworkRequest, Result, RunRequest, Simulation};
+use clutchpack_analysis::DiscStats;
 use clutchpack_model::network::NetworkSample;
-use clutchpack_scene::Scene;
+use clutchpack_model::session::Driven;
+use clutchpack_scene::{EngineChoice, Scene};
+use std::sync::atomic::AtomicBool;
 
-/// One signal of a network run: which series of the samples, and which item.
+/// A statistic of one body's impact peaks over a run (per tooth, N).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum PeakStat {
+    /// Largest positive peak (the body leads).
+    MaxPositive,
+    /// Most negative peak (its carrier leads).
+    MaxNegative,
+    /// 99th percentile of `|peak|`.
+    P99Abs,
+    /// Mean of the ten largest `|peak|`.
+    MeanTop10Abs,
+}
+
+/// The statistics by their names (the fields of [`DiscStats`]).
+const PEAK_STATS: [(&str, PeakStat); 4] = [
+    ("max_positive_n", PeakStat::MaxPositive),
+    ("max_negative_n", PeakStat::MaxNegative),
+    ("p99_abs_n", PeakStat::P99Abs),
+    ("mean_top10_abs_n", PeakStat::MeanTop10Abs),
+];
+
+impl PeakStat {
+    fn of(self, s: &DiscStats) -> f64 {
+        match self {
+            PeakStat::MaxPositive => s.max_positive_n,
+            PeakStat::MaxNegative => s.max_negative_n,
+            PeakStat::P99Abs => s.p99_abs_n,
+            PeakStat::MeanTop10Abs => s.mean_top10_abs_n,
+        }
+    }
+}
+
+/// One signal of a run: which series (or statistic), and which item.
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) enum Signal {
-    /// A body's speed, rad/s.
+    /// A network body's speed, rad/s.
     Speed(usize),
-    /// A body's angle, rad.
+    /// A network body's angle, rad.
     Angle(usize),
-    /// A coupling's torque on its body `a`, N m.
+    /// A network coupling's torque on its body `a`, N m.
     Torque(usize),
+    /// A pack's co-simulation output, by its name.
+    Output(String),
+    /// A statistic of body `i`'s impact peaks (the discs, then the plates), one value per
+    /// run.
+    Peak(usize, PeakStat),
 }
 
 impl Signal {
-    /// The signal called `name` in `scene`, or an error listing the signals the scene has.
-    pub(crate) fn resolve(scene: &Scene, name: &str) -> Result<Signal> {
+    /// Whether it is one value per run (rows are variants), not a series in time.
+    pub(crate) fn per_run(&self) -> bool {
+        matches!(self, Signal::Peak(..))
+    }
+
+    /// The signal called `name` in `scene` run by `engine`, or an error listing the
+    /// signals the scene has.
+    pub(crate) fn resolve(scene: &Scene, engine: EngineChoice, name: &str) -> Result<Signal> {
         let Some(net) = &scene.network else {
-            return Err(Error::BadInput(format!(
-                "signal {name:?}: {} is a pack scene; a fit compares the signals of network \
-                 scenes ([[bodies]]) so far",
-                scene.name
-            )));
+            return Signal::resolve_pack(scene, engine, name);
         };
         let body = |b: &str| net.bodies.iter().position(|x| x.name == b);
         let coupling = |c: &str| net.couplings.iter().position(|x| x.name == c);
@@ -64,17 +118,54 @@ impl Signal {
         })
     }
 
-    /// Its value in one sample.
-    fn value(self, s: &NetworkSample) -> f64 {
-        match self {
+    /// A pack's signal: a statistic of a body's peaks, or a co-simulation output.
+    fn resolve_pack(scene: &Scene, engine: EngineChoice, name: &str) -> Result<Signal> {
+        let pack = &scene.pack;
+        let bodies: Vec<&str> = pack
+            .discs
+            .iter()
+            .chain(&pack.plates)
+            .map(|b| b.name.as_str())
+            .collect();
+        if let Some((body, stat)) = name.rsplit_once('.') {
+            let i = bodies.iter().position(|b| *b == body);
+            let s = PEAK_STATS.iter().find(|(n, _)| *n == stat);
+            if let (Some(i), Some((_, s))) = (i, s) {
+                return Ok(Signal::Peak(i, *s));
+            }
+        }
+        let vars = crate::cosim::variables(scene, engine.name(), Driven::NONE);
+        let outputs: Vec<&str> = vars
+            .iter()
+            .filter(|v| v.causality == Causality::Output && v.kind == Kind::Real)
+            .map(|v| v.name.as_str())
+            .collect();
+        if outputs.contains(&name) {
+            return Ok(Signal::Output(name.to_string()));
+        }
+        let stats: Vec<&str> = PEAK_STATS.iter().map(|(n, _)| *n).collect();
+        Err(Error::BadInput(format!(
+            "signal {name:?}: {} does not produce it (its series in time: {}; one value per \
+             run, with --variant: BODY.{} for BODY in {})",
+            scene.name,
+            outputs.join(", "),
+            stats.join(", BODY."),
+            bodies.join(", ")
+        )))
+    }
+
+    /// Its value in one network sample (NaN for a pack's signal).
+    fn value(&self, s: &NetworkSample) -> f64 {
+        match *self {
             Signal::Speed(i) => s.speed_rad_s[i],
             Signal::Angle(i) => s.angle_rad[i],
             Signal::Torque(k) => s.torque_n_m[k],
+            Signal::Output(_) | Signal::Peak(..) => f64::NAN,
         }
     }
 
     /// Its values at the times `t` (ascending, within the run), linear between the samples.
-    pub(crate) fn at(self, history: &[NetworkSample], t: &[f64]) -> Vec<f64> {
+    pub(crate) fn at(&self, history: &[NetworkSample], t: &[f64]) -> Vec<f64> {
         t.iter()
             .map(|&t| {
                 let k = history.partition_point(|s| s.t_s <= t);
@@ -90,6 +181,118 @@ impl Signal {
             })
             .collect()
     }
+}
+
+/// The error of a stopped evaluation (the fit then returns its best point so far).
+fn stopped() -> Error {
+    Error::BadInput("stopped".into())
+}
+
+/// The time series `signals` of one run of `scene` at the times `t` (s, ascending, within
+/// the run): a network's from its samples, a pack's read at `t` as communication points of a
+/// co-simulated run that drives no input (the scene's own run, split into calls). `asked`
+/// is the engine asked, `engine` the one the scene's rule chose with it.
+pub(crate) fn series(
+    scene: &Scene,
+    asked: Option<EngineChoice>,
+    engine: EngineChoice,
+    signals: &[&Signal],
+    t: &[f64],
+    stop: Option<&AtomicBool>,
+) -> Result<Vec<Vec<f64>>> {
+    if scene.network.is_some() {
+        let outcome = crate::run_network_scene(
+            scene,
+            asked,
+            NetworkRequest {
+                keep_history: true,
+                stop,
+                ..NetworkRequest::default()
+            },
+        )?;
+        return Ok(signals.iter().map(|s| s.at(&outcome.history, t)).collect());
+    }
+    let bad = Error::BadInput;
+    let mut co = CoSimulation::driving(scene.clone(), Driven::NONE).map_err(bad)?;
+    co.set_string_parameter(crate::cosim::Quantity::Engine, engine.name())
+        .map_err(bad)?;
+    let vrs = signals
+        .iter()
+        .map(|s| {
+            let name = match s {
+                Signal::Output(n) => n.as_str(),
+                _ => "",
+            };
+            co.variables()
+                .iter()
+                .find(|v| v.name == name && v.kind == Kind::Real)
+                .map(|v| v.vr)
+                .ok_or_else(|| bad(format!("{s:?} is not a series of a pack's run")))
+        })
+        .collect::<Result<Vec<u32>>>()?;
+    co.start(None).map_err(bad)?;
+    let mut out = vec![Vec::with_capacity(t.len()); signals.len()];
+    for &ti in t {
+        if ti > co.time_s() {
+            match co.advance_to(ti, stop) {
+                Ok(true) => {}
+                Ok(false) => return Err(stopped()),
+                Err(e) => {
+                    // an engine failure comes back typed from the finished run
+                    let _ = co.finish();
+                    if let Some(Err(e)) = co.outcome().map(|o| o.stats().map(|_| ())) {
+                        return Err(e);
+                    }
+                    return Err(bad(e));
+                }
+            }
+        }
+        for (k, &vr) in vrs.iter().enumerate() {
+            out[k].push(co.get_real(vr).map_err(bad)?);
+        }
+    }
+    let _ = co.finish();
+    Ok(out)
+}
+
+/// The per-run statistics `signals` ([`Signal::Peak`]) of `scene`: their mean over the
+/// `ensemble` members of [`crate::ensemble_member`] (run in parallel; `ensemble <= 1`: the
+/// scene's own run).
+pub(crate) fn statistics(
+    scene: &Scene,
+    asked: Option<EngineChoice>,
+    signals: &[&Signal],
+    ensemble: u64,
+    stop: Option<&AtomicBool>,
+) -> Result<Vec<f64>> {
+    use rayon::prelude::*;
+    let count = ensemble.max(1);
+    let members = (0..count)
+        .into_par_iter()
+        .map(|k| {
+            let member = crate::ensemble_member(scene, k, ensemble);
+            let mut sim = Simulation::new(member, asked)?;
+            let outcome = sim.run(RunRequest {
+                stop,
+                ..RunRequest::default()
+            })?;
+            outcome.stats()?;
+            if outcome.stopped_early() {
+                return Err(stopped());
+            }
+            let stats = outcome.body_stats()?;
+            Ok(signals
+                .iter()
+                .map(|s| match s {
+                    Signal::Peak(i, stat) => stat.of(&stats[*i]),
+                    _ => f64::NAN,
+                })
+                .collect::<Vec<f64>>())
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok((0..signals.len())
+        .map(|k| members.iter().map(|m| m[k]).sum::<f64>() / count as f64)
+        .collect())
 }
 
 #[cfg(test)]
