@@ -533,3 +533,117 @@ fn a_one_way_clutch_that_starts_backwards_is_named_at_its_key() {
         assert!(e.contains(key) && e.contains(why), "{to}: {e}");
     }
 }
+
+/// `clutchpack check scenes/eight-speed.toml` prints every gear's ratio from the constraints
+/// alone: the 8HP's exact fractions (MODEL.md section 10), printed to 6 decimals (the bound
+/// 5e-7 is the printing's).
+#[test]
+fn eight_speed_check_prints_every_gears_exact_ratio() {
+    let o = run(&["check", "scenes/eight-speed.toml"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = super::stdout(&o);
+    let want = [
+        ("R", -1744.0 / 529.0),
+        ("1", 108.0 / 23.0),
+        ("2", 72.0 / 23.0),
+        ("3", 162.0 / 77.0),
+        ("4", 5.0 / 3.0),
+        ("5", 8826.0 / 6871.0),
+        ("6", 1.0),
+        ("7", 120.0 / 143.0),
+        ("8", 2.0 / 3.0),
+    ];
+    for (gear, ratio) in want {
+        let line = out
+            .lines()
+            .find(|l| l.contains("closed") && l.split_whitespace().next() == Some(gear))
+            .unwrap_or_else(|| panic!("gear {gear}: {out}"));
+        let got: f64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+        assert!(
+            (got - ratio).abs() < 5e-7,
+            "gear {gear}: {got} against {ratio}"
+        );
+    }
+}
+
+/// The launch in 1st of `scenes/eight-speed.toml` (A, B and C closed, the other two open):
+/// on both engines the output turns at 23/108 of the input throughout, the two engines' final
+/// speeds agree, and the energy balance closes. Measured: the ratio to 2e-15 (every element
+/// locked), the engines within 6.7e-10 relative (the road load's quadratic part varies over
+/// the multibody engine's 1e-4 s steps: second order), the balance to 1.5e-9 J; the bounds
+/// 1e-12, 1e-8 and 1e-8 J.
+#[test]
+fn an_eight_speed_in_first_turns_its_output_at_the_first_gear_ratio_on_both_engines() {
+    let d = scratch("eight-speed");
+    let runs = both("scenes/eight-speed.toml", &d);
+    for s in &runs {
+        let (wi, wo) = (speed(s, 0), speed(s, 1));
+        assert!(
+            wi > 100.0 && (wo / wi - 23.0 / 108.0).abs() < 1e-12,
+            "{wi} {wo}"
+        );
+        assert!(
+            s["energy"]["residual_j"].as_f64().unwrap().abs() < 1e-8,
+            "{}",
+            s["energy"]
+        );
+    }
+    let (a, b) = (speed(&runs[0], 0), speed(&runs[1], 0));
+    assert!((a - b).abs() < 1e-8 * a, "{a} {b}");
+}
+
+/// A gear that is no gear and the keys of `[transmission]` that name the wrong thing are
+/// refused by `check`, exit 2, at their keys.
+#[test]
+fn a_gear_that_is_no_gear_is_named_at_its_key() {
+    let d = scratch("eight-speed-bad");
+    let text = std::fs::read_to_string("scenes/eight-speed.toml").unwrap();
+    let first = "name = \"1\"\nclosed = [\"A\", \"B\", \"C\"]";
+    let cases = [
+        (
+            first,
+            "name = \"1\"\nclosed = [\"A\", \"B\"]",
+            "transmission.gears[1].closed",
+            "more than one degree of freedom",
+        ),
+        (
+            first,
+            "name = \"1\"\nclosed = [\"A\", \"B\", \"C\", \"D\"]",
+            "transmission.gears[1].closed",
+            "holds the input",
+        ),
+        (
+            first,
+            "name = \"1\"\nclosed = [\"A\", \"B\", \"PS1\"]",
+            "transmission.gears[1].closed[2]",
+            "not a shift element",
+        ),
+        (
+            first,
+            "name = \"1\"\nclosed = [\"A\", \"B\", \"F\"]",
+            "transmission.gears[1].closed[2]",
+            "names no coupling",
+        ),
+        (
+            "name = \"2\"",
+            "name = \"1\"",
+            "transmission.gears[2].name",
+            "names two gears",
+        ),
+        (
+            "output = \"output\"",
+            "output = \"wheel\"",
+            "transmission.output",
+            "names no body",
+        ),
+    ];
+    for (from, to, key, why) in cases {
+        assert!(text.contains(from), "{from}");
+        let bad = d.join("bad.toml");
+        std::fs::write(&bad, text.replacen(from, to, 1)).unwrap();
+        let o = run(&["check", bad.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{to}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains(key) && e.contains(why), "{to}: {e}");
+    }
+}

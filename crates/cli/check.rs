@@ -66,8 +66,12 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
                 } else {
                     format!("; resolved packs {}", packs.join(", "))
                 };
+                let gears = s
+                    .transmission
+                    .as_ref()
+                    .map_or(String::new(), |tr| gear_table(net, tr));
                 return Ok(format!(
-                    "network of {} bodies and {} couplings{packs}, {} s, {} engine",
+                    "network of {} bodies and {} couplings{packs}, {} s, {} engine){gears}",
                     net.bodies.len(),
                     net.couplings.len(),
                     s.simulation.duration_s,
@@ -85,6 +89,8 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
             ))
         });
         match checked {
+            // a network's text closes its own parenthesis (a gear table follows it)
+            Ok(what) if what.starts_with("network of") => out!("{}: ok ({what}", p.display()),
             Ok(what) => out!("{}: ok ({what})", p.display()),
             Err(e) => {
                 eprintln!("{e}");
@@ -100,4 +106,54 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
         .into());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The gears of `tr` on `net` (MODEL.md section 10), from the constraints alone: each gear's
+/// ratio `w_in / w_out`, its closed elements and its open elements' slip per unit input
+/// speed, then every body's speed per unit input speed in each gear. The scene's validation
+/// has checked every gear's kinematics.
+fn gear_table(
+    net: &clutchpack_sdk::model::network::Network,
+    tr: &clutchpack_sdk::model::network::Transmission,
+) -> String {
+    use std::fmt::Write as _;
+    let name = |k: usize| net.couplings[k].name.as_str();
+    let mut s = format!(
+        "\ngears of \"{}\" to \"{}\" (ratio w_in / w_out; the open elements' slip w_b - w_a per unit input speed):",
+        net.bodies[tr.input].name, net.bodies[tr.output].name
+    );
+    let kin: Vec<_> = (0..tr.gears.len())
+        .filter_map(|i| tr.kinematics(net, i).ok())
+        .collect();
+    for (g, k) in tr.gears.iter().zip(&kin) {
+        let closed: Vec<&str> = g.closed.iter().map(|&c| name(c)).collect();
+        let open: Vec<String> = k
+            .open_slips
+            .iter()
+            .map(|(c, w)| format!("{} {w:+.4}", name(*c)))
+            .collect();
+        let _ = write!(
+            s,
+            "\n  {:>4}  {:>10.6}  closed {:<12} open {}",
+            g.name,
+            k.ratio,
+            closed.join(" "),
+            open.join(", ")
+        );
+    }
+    let _ = write!(s, "\nspeeds per unit input speed:\n  {:>4}", "gear");
+    let moving: Vec<usize> = (0..net.bodies.len())
+        .filter(|&i| !net.bodies[i].fixed)
+        .collect();
+    for &i in &moving {
+        let _ = write!(s, " {:>9}", net.bodies[i].name);
+    }
+    for (g, k) in tr.gears.iter().zip(&kin) {
+        let _ = write!(s, "\n  {:>4}", g.name);
+        for &i in &moving {
+            // (+ 0.0: a member at rest prints 0, not -0)
+            let _ = write!(s, " {:>9.4}", k.speeds_per_input[i] + 0.0);
+        }
+    }
+    s
 }

@@ -540,6 +540,105 @@ pub fn firing_engine() -> crate::network::Network {
     }
 }
 
+/// The ZF 8HP's structure (MODEL.md section 10: four simple planetary sets of the published
+/// tooth counts S1/R1 48/96, S2/R2 48/96, S3/R3 69/111, S4/R4 23/85; S1 joined to S2, C1 to
+/// R4, R2 to S3, R3 to S4; the input on C2, the output on C4) with its five shift elements
+/// (brakes A on S1-S2 and B on R1, clutches C from the input to S4, D from C3 to the output,
+/// E from S3 to S4), every body of unit inertia, and its gear table (1st ABC, 2nd ABE, 3rd BCE,
+/// 4th BDE, 5th BCD, 6th CDE, 7th ACD, 8th ADE, reverse ABD). The elements are lumped clutches
+/// without force: the kinematics need only which are closed.
+pub fn eight_speed() -> (crate::network::Network, crate::network::Transmission) {
+    use crate::network::{
+        Body, Coupling, CouplingKind, Gear, LumpedClutch, Network, PlanetarySet, Signal,
+        Transmission,
+    };
+    let names = [
+        "input", "output", "S1S2", "R1", "C1R4", "R2S3", "R3S4", "C3", "housing",
+    ];
+    let bodies = names
+        .iter()
+        .map(|&name| Body {
+            name: name.into(),
+            inertia_kg_m2: 1.0,
+            drag_n_m_s_rad: 0.0,
+            initial_speed_rad_s: 0.0,
+            fixed: name == "housing",
+            drive: None,
+            firing: None,
+            road_load: None,
+        })
+        .collect();
+    let set = |name: &str, sun: usize, ring: usize, carrier: usize, zs: u32, zr: u32| Coupling {
+        name: name.into(),
+        a: sun,
+        b: ring,
+        kind: CouplingKind::Planetary(PlanetarySet {
+            sun_teeth: zs,
+            ring_teeth: zr,
+            carrier,
+            double_pinion: false,
+        }),
+    };
+    let element = |name: &str, a: usize, b: usize| Coupling {
+        name: name.into(),
+        a,
+        b,
+        kind: CouplingKind::Clutch(LumpedClutch {
+            mu_table: vec![(0.0, 0.1)],
+            peak: 1.0,
+            cgeo_m: 0.1,
+            fn_max_n: 1e4,
+            force: Signal::Constant(0.0),
+            one_way: false,
+        }),
+    };
+    let couplings = vec![
+        set("PS1", 2, 3, 4, 48, 96),
+        set("PS2", 2, 5, 0, 48, 96),
+        set("PS3", 5, 6, 7, 69, 111),
+        set("PS4", 6, 4, 1, 23, 85),
+        element("A", 2, 8),
+        element("B", 3, 8),
+        element("C", 0, 6),
+        element("D", 7, 1),
+        element("E", 5, 6),
+    ];
+    let table = [
+        ("R", "ABD"),
+        ("1", "ABC"),
+        ("2", "ABE"),
+        ("3", "BCE"),
+        ("4", "BDE"),
+        ("5", "BCD"),
+        ("6", "CDE"),
+        ("7", "ACD"),
+        ("8", "ADE"),
+    ];
+    let gears = table
+        .iter()
+        .map(|(name, closed)| Gear {
+            name: (*name).into(),
+            closed: closed
+                .chars()
+                .map(|c| 4 + (c as usize - 'A' as usize))
+                .collect(),
+        })
+        .collect();
+    let net = Network {
+        pack_thermal: Default::default(),
+        bodies,
+        couplings,
+    };
+    (
+        net,
+        Transmission {
+            input: 0,
+            output: 1,
+            gears,
+        },
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

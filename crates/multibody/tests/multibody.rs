@@ -511,6 +511,7 @@ fn engine_follows_the_scene() {
         fatigue: vec![],
         thermal: None,
         network: None,
+        transmission: None,
         inputs: vec![],
     };
     let mut e = engine_for(&scene).unwrap();

@@ -114,7 +114,32 @@ table! {
         thermal: table RawThermal,
         bodies: array RawNetBody,
         couplings: array RawCoupling,
+        transmission: table RawTransmission,
     }
+}
+
+table! {
+    /// `[transmission]` (network scenes): an automatic transmission's input and output bodies and its gears, each the set of shift elements (clutches and brakes among the [[couplings]]) closed in it (MODEL.md section 10). `clutchpack check` prints each gear's ratio from the constraints alone, every body's speed per unit input speed and every open element's slip.
+    RawTransmission at "transmission" {
+        /// the input body (a [[bodies]] name)
+        input: "", Kind::Text, Dflt::Required;
+        /// the output body (a [[bodies]] name)
+        output: "", Kind::Text, Dflt::Required;
+    }
+    children {
+        gears: array RawGear,
+    }
+}
+
+table! {
+    /// One `[[transmission.gears]]` entry: a gear.
+    RawGear at "transmission.gears[]" {
+        /// the gear's name ("1", "R", ...), unique
+        name: "", Kind::Text, Dflt::Required;
+        /// the shift elements closed in it: names of [[couplings]] of kind clutch or one_way_clutch (a brake: a clutch to a fixed body)
+        closed: "", Kind::Texts, Dflt::Required;
+    }
+    children {}
 }
 
 table! {

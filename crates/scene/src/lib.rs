@@ -257,6 +257,10 @@ pub struct Scene {
     /// that no pack engine runs (`clutchpack_sdk::Simulation::new` refuses the scene).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub network: Option<clutchpack_model::network::Network>,
+    /// An automatic transmission's gears on the network (`[transmission]`, MODEL.md section
+    /// 10); `None` without the section.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transmission: Option<clutchpack_model::network::Transmission>,
     /// Every file this scene was read from: the scene file (when loaded from a path), the
     /// CSV tables it names, a network's pack files and theirs, in the order they were read.
     /// Outputs of a run are refused over any of them (`clutchpack_record::check_outputs`).
@@ -354,6 +358,7 @@ pub fn parse(
             fatigue: v.fatigue,
             thermal: v.thermal,
             network: v.network,
+            transmission: v.transmission,
             inputs: std::mem::take(&mut ck.files),
         }),
         _ => {

@@ -47,6 +47,8 @@ pub(crate) enum Kind {
     Choice(&'static [&'static str]),
     /// An array of finite numbers.
     Numbers,
+    /// An array of strings.
+    Texts,
     /// An array of rows, each an array of finite numbers (a 2-D table).
     NumberRows,
 }
@@ -267,6 +269,7 @@ impl Key {
                 .collect::<Vec<_>>()
                 .join(" | "),
             Kind::Numbers => "array of finite numbers".into(),
+            Kind::Texts => "array of strings".into(),
             Kind::NumberRows => "array of arrays of finite numbers (one per row)".into(),
         };
         let default = match self.default {

@@ -183,6 +183,68 @@ pub fn constraint_torques(
     solve(rows, inv_inertia, &rhs, lambda);
 }
 
+/// `P = M^-1 - M^-1 C^T A^+ C M^-1` (row-major n x n, 1/(kg m^2): every body's
+/// acceleration under a unit torque on each, the rows holding) and `L = -A^+ C M^-1`
+/// (row-major rows x n: each row's torque under those unit torques), column by column from
+/// [`constraint_torques`], for the inverse inertias `inv_inertia` (1/(kg m^2), 0 for a fixed
+/// body). With unit inertias `P` is the projector on the speeds the rows allow.
+pub fn projected(rows: &[Row], inv_inertia: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let (n, m) = (inv_inertia.len(), rows.len());
+    let (mut p, mut l) = (vec![0.0; n * n], vec![0.0; m * n]);
+    let mut lambda = Vec::new();
+    for i in 0..n {
+        let mut unit = vec![0.0; n];
+        unit[i] = 1.0;
+        constraint_torques(rows, inv_inertia, &unit, &mut lambda);
+        add_torques(rows, &lambda, &mut unit);
+        for j in 0..n {
+            p[j * n + i] = inv_inertia[j] * unit[j];
+        }
+        for r in 0..m {
+            l[r * n + i] = lambda[r];
+        }
+    }
+    (p, l)
+}
+
+/// The group of each of `n` bodies: the bodies that move (`moving[i]`) connected by a row's
+/// terms share one; a body that does not move (a fixed body) connects nothing and is a group
+/// of its own. Groups are numbered in the order of their first body.
+pub fn groups(rows: &[Row], moving: &[bool]) -> Vec<usize> {
+    let n = moving.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for r in rows {
+        let mut first: Option<usize> = None;
+        for (i, _) in r.terms().iter().filter(|(i, _)| moving[*i]) {
+            match first {
+                None => first = Some(*i),
+                Some(f) => {
+                    let (x, y) = (root(&mut parent, f), root(&mut parent, *i));
+                    parent[x.max(y)] = x.min(y);
+                }
+            }
+        }
+    }
+    let mut of = vec![usize::MAX; n];
+    let mut next = 0;
+    for i in 0..n {
+        let r = root(&mut parent, i);
+        if of[r] == usize::MAX {
+            of[r] = next;
+            next += 1;
+        }
+        of[i] = of[r];
+    }
+    of
+}
+
 /// Adds `C^T lambda` to the bodies' torques `out` (N m).
 pub fn add_torques(rows: &[Row], lambda: &[f64], out: &mut [f64]) {
     for (r, l) in rows.iter().zip(lambda) {

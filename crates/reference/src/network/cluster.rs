@@ -62,51 +62,13 @@ impl Clusters {
             .map(|b| if b.fixed { 0.0 } else { 1.0 / b.inertia_kg_m2 })
             .collect();
         // P and L column by column: the response to a unit torque on each body
-        let (m, mut p, mut l) = (rows.len(), vec![0.0; n * n], vec![0.0; rows.len() * n]);
-        let mut lambda = Vec::new();
-        for i in 0..n {
-            let mut unit = vec![0.0; n];
-            unit[i] = 1.0;
-            rows::constraint_torques(&rows, &inv, &unit, &mut lambda);
-            rows::add_torques(&rows, &lambda, &mut unit);
-            for j in 0..n {
-                p[j * n + i] = inv[j] * unit[j];
-            }
-            for r in 0..m {
-                l[r * n + i] = lambda[r];
-            }
-        }
-        // the groups: moving bodies connected by a row's terms (union-find)
-        let mut parent: Vec<usize> = (0..n).collect();
-        fn root(parent: &mut [usize], mut i: usize) -> usize {
-            while parent[i] != i {
-                parent[i] = parent[parent[i]];
-                i = parent[i];
-            }
-            i
-        }
-        for r in &rows {
-            let moving: Vec<usize> = r
-                .terms()
-                .iter()
-                .map(|(i, _)| *i)
-                .filter(|&i| !net.bodies[i].fixed)
-                .collect();
-            for w in moving.windows(2) {
-                let (x, y) = (root(&mut parent, w[0]), root(&mut parent, w[1]));
-                parent[x.max(y)] = x.min(y);
-            }
-        }
-        let mut of = vec![usize::MAX; n];
-        let mut members: Vec<Vec<usize>> = Vec::new();
-        for i in 0..n {
-            let r = root(&mut parent, i);
-            if of[r] == usize::MAX {
-                of[r] = members.len();
-                members.push(Vec::new());
-            }
-            of[i] = of[r];
-            members[of[i]].push(i);
+        let (p, l) = rows::projected(&rows, &inv);
+        // the groups: moving bodies connected by a row's terms
+        let moving: Vec<bool> = net.bodies.iter().map(|b| !b.fixed).collect();
+        let of = rows::groups(&rows, &moving);
+        let mut members: Vec<Vec<usize>> = vec![Vec::new(); of.iter().max().map_or(0, |m| m + 1)];
+        for (i, &c) in of.iter().enumerate() {
+            members[c].push(i);
         }
         let mut g = vec![1.0; n];
         let mut inertia = vec![0.0; members.len()];

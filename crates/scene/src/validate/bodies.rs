@@ -59,7 +59,9 @@ impl Params {
                     let len = (k.name == B::initial_offset_m.name).then_some(2);
                     map(ck.numbers(&path, v, len), Val::Numbers)
                 }
-                Kind::NumberRows => unreachable!("{} is not a body key's kind", k.rel()),
+                Kind::NumberRows | Kind::Texts => {
+                    unreachable!("{} is not a body key's kind", k.rel())
+                }
             };
             out.push((k, f));
         }

@@ -18,6 +18,7 @@ mod network;
 mod simulation;
 mod stack;
 mod thermal;
+mod transmission;
 
 use crate::error::Problem;
 use crate::keys::RawScene;
@@ -36,6 +37,7 @@ pub(crate) struct Validated {
     pub fatigue: Vec<clutchpack_model::FatigueParams>,
     pub thermal: Option<clutchpack_model::thermal::ThermalModel>,
     pub network: Option<clutchpack_model::network::Network>,
+    pub transmission: Option<clutchpack_model::network::Transmission>,
 }
 
 /// The outcome of checking one value where it is written.
@@ -210,6 +212,30 @@ impl Checker {
         }
     }
 
+    /// An array of strings (at least one). A bad item is reported at its index (`key[3]`).
+    pub fn texts(&mut self, path: &str, v: Option<&Value>) -> Field<Vec<String>> {
+        let Some(v) = v else { return Field::Absent };
+        let Some(items) = v.as_array().filter(|a| !a.is_empty()) else {
+            self.report(path, Some(show(v)), "must be a non-empty array of strings");
+            return Field::Invalid;
+        };
+        let mut out = Some(Vec::with_capacity(items.len()));
+        for (j, item) in items.iter().enumerate() {
+            match item.as_str() {
+                Some(t) => {
+                    if let Some(o) = out.as_mut() {
+                        o.push(t.to_string());
+                    }
+                }
+                None => {
+                    self.report(format!("{path}[{j}]"), Some(show(item)), "must be a string");
+                    out = None;
+                }
+            }
+        }
+        out.map_or(Field::Invalid, Field::Valid)
+    }
+
     /// An array of finite numbers (integers accepted), of length `len` if given. A bad item is
     /// reported at its index (`key[3]`), a wrong length at `key`.
     pub fn numbers(
@@ -327,6 +353,13 @@ pub(crate) fn validate(
         &mut names,
     );
     let drum = raw.drum.as_ref().map(|r| stack::drum(ck, r));
+    if raw.transmission.is_some() {
+        ck.report(
+            "transmission",
+            None,
+            "only in a network scene: an automatic's gears close couplings between [[bodies]]",
+        );
+    }
     let stack = raw.stack.as_ref().map(|r| stack::stack(ck, r));
     let couplings = couplings::couplings(ck, raw.couplings.as_deref(), raw.drum.is_some());
     // The stack alternates plates and discs: N discs need N + 1 plates; a drum carries plates.
@@ -376,6 +409,7 @@ pub(crate) fn validate(
         },
         thermal: thermal?,
         network: None,
+        transmission: None,
     })
 }
 
@@ -421,6 +455,12 @@ fn network_scene(
         Some((n, f)) => (Some(n), f),
         None => (None, Vec::new()),
     };
+    // the gears of an automatic, on a network that is good
+    let transmission = match (&raw.transmission, &network) {
+        (None, _) => Some(None),
+        (Some(t), Some(net)) => transmission::transmission(ck, t, net).map(Some),
+        (Some(_), None) => None,
+    };
     Some(Validated {
         name: name?,
         description: description?,
@@ -438,5 +478,6 @@ fn network_scene(
         fatigue,
         thermal: None,
         network: Some(network?),
+        transmission: transmission?,
     })
 }
