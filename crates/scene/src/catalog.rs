@@ -221,7 +221,8 @@ mod tests {
                 "plate_defaults",
                 "thermal",
                 "bodies",
-                "couplings"
+                "couplings",
+                "transmission"
             ]
         );
         assert!(children("discs[]").contains(&"name"));
