@@ -17,7 +17,7 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-/// What `bench --frames` was asked (checked by [`FramesRequest::new`] before any work).
+/// What `bench --frames` was asked (checked by [`bench_frames`] before any work).
 pub struct FramesRequest<'a> {
     /// The frame length, s.
     pub frame_s: f64,
@@ -141,8 +141,9 @@ fn quantile(v: &[f64], q: f64) -> f64 {
     v[i]
 }
 
-/// Checks everything before any work: the scene loads, the engine runs it, the frame fits the
-/// duration, the budget is a positive fraction, the summary's path takes a file.
+/// `bench --frames`: checks everything before any work (the scene loads, the engine runs it,
+/// the frame fits the duration, the budget is a positive fraction, the summary's path takes a
+/// file), then runs the rounds and prints each one's figures.
 pub fn bench_frames(r: FramesRequest, stop: &AtomicBool) -> Result<ExitCode> {
     if !(r.budget_fraction.is_finite() && r.budget_fraction > 0.0) {
         return Err(BadInput(format!(

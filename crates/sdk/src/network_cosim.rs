@@ -526,9 +526,7 @@ impl NetworkSimulation {
             )));
         };
         crate::cosim::inputs::check_network_input(*input, name, value).map_err(Error::BadInput)?;
-        // a driven input is held from the start (`start` sets each one): the value it holds
-        // set again changes nothing, and is not passed to the engine, which would restart its
-        // integration there (a host sets every input at every communication point: issue 46)
+        // held from the start: its value set again is not passed on (docs/DECISIONS.md)
         if input_value(self.stepper.network(), *input, self.time_s()) == value {
             return Ok(());
         }
