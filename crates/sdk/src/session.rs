@@ -165,6 +165,19 @@ impl Session {
     /// engine's progress polls) ends the call early. After an engine failure the session only
     /// finishes (everything before the failure is kept).
     pub fn advance_to(&mut self, t_s: f64, stop: Option<&AtomicBool>) -> Result<Advance> {
+        self.advance_polled(t_s, stop, None)
+    }
+
+    /// [`Session::advance_to`] with `progress` called at the engine's progress polls with the
+    /// simulated time reached, s: a front end's own check for a stop on the calling thread
+    /// (Python's signals, polled as a whole run polls them), so that a call needs no second
+    /// thread to stay interruptible.
+    pub fn advance_polled<'a>(
+        &mut self,
+        t_s: f64,
+        stop: Option<&'a AtomicBool>,
+        progress: Option<&'a mut dyn FnMut(f64)>,
+    ) -> Result<Advance> {
         if let Some(e) = &self.failure {
             return Err(self.engine_error(e.clone()));
         }
@@ -172,7 +185,7 @@ impl Session {
             collector: &mut self.collector,
             recorder: self.recorder.as_mut(),
             stop,
-            progress: None,
+            progress,
         };
         match self.inner.advance_to(t_s, &mut obs) {
             Ok(a) => {
