@@ -286,3 +286,78 @@ fn reference_snapshots_inside_an_open_packs_window_are_the_run() {
         }
     }
 }
+
+/// `bench --frames` (issue 46) refuses a frame that does not parse, is not > 0 or is longer
+/// than the run, and a frame without its scene, with exit 2 and a message naming the value,
+/// before any work (nothing printed on stdout).
+#[test]
+fn bench_frames_refuses_bad_frames_before_any_work() {
+    let scene = super::hardening::repo("scenes/hu-table2.toml");
+    for (args, says) in [
+        (
+            vec!["--frames", "abc", &scene],
+            "\"abc\": expected a frame length",
+        ),
+        (
+            vec!["--frames", "0ms", &scene],
+            "expected a frame length > 0",
+        ),
+        (vec!["--frames=-1ms", &scene], "expected a frame length > 0"),
+        (
+            vec!["--frames", "1s", &scene],
+            "longer than the run (0.3 s)",
+        ),
+        (
+            vec!["--frames", "1ms", &scene, "--duration", "0.0005"],
+            "longer than the run (0.0005 s)",
+        ),
+        (vec!["--frames", "1ms"], "name the scene"),
+        (
+            vec!["--frames", "1ms", &scene, "--budget-fraction", "0"],
+            "--budget-fraction 0",
+        ),
+    ] {
+        let o = super::bin()
+            .arg("bench")
+            .args(&args)
+            .output()
+            .expect("the binary runs");
+        let err = super::hardening::exit_2(&o, &format!("{args:?}"));
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(super::stdout(&o).is_empty(), "{args:?}: work was done");
+    }
+}
+
+/// `bench --frames 1ms` on `hu-table2` for 0.02 s: 20 frames, and the outputs of the frames
+/// are the whole run's bit for bit (a session driven by nothing takes the whole run's steps
+/// whatever its calls), as its `--summary-json` says.
+#[test]
+fn bench_frames_runs_and_finds_the_frames_outputs_identical() {
+    let dir = super::scratch("bench-frames");
+    let json = dir.join("frames.json");
+    let o = super::run(&[
+        "bench",
+        "--frames",
+        "1ms",
+        &super::hardening::repo("scenes/hu-table2.toml"),
+        "--duration",
+        "0.02",
+        "--summary-json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", super::stderr(&o));
+    assert!(
+        super::stdout(&o).contains("outputs: identical"),
+        "{}",
+        super::stdout(&o)
+    );
+    let v = super::read_json(&json);
+    assert_eq!(v["frames"], 20);
+    let round = &v["rounds"][0];
+    assert_eq!(round["difference"]["identical"], true, "{v}");
+    assert_eq!(round["whole_steps"], round["framed_steps"], "{v}");
+    assert!(
+        round["difference"]["impacts_whole"].as_u64().unwrap() > 0,
+        "{v}"
+    );
+}

@@ -58,6 +58,46 @@ pub struct BenchArgs {
     /// recording cost and the shipped whole packs).
     #[arg(long)]
     pub pack_only: bool,
+    /// Bench SCENE frame by frame instead: advanced in frames of this length (`1ms`,
+    /// `250us`, `0.001`) through the sdk's session as a real-time host advances it, against
+    /// the same run in one call (wall times and ratio, the frames' distribution, overruns,
+    /// the real-time factor, whether the outputs are the whole run's).
+    #[arg(long, value_name = "DT", allow_hyphen_values = true)]
+    pub frames: Option<String>,
+    /// The scene `--frames` runs (a pack or a network scene).
+    #[arg(value_name = "SCENE", requires = "frames")]
+    pub scene: Option<std::path::PathBuf>,
+    /// With `--frames`: the engine (default: the scene's choice).
+    #[arg(long, value_parser = crate::common::engine_parser(), requires = "frames")]
+    pub engine: Option<EngineChoice>,
+    /// With `--frames`: the simulated time, s (default: the scene's `simulation.duration_s`).
+    #[arg(
+        long,
+        value_name = "S",
+        requires = "frames",
+        allow_negative_numbers = true
+    )]
+    pub duration: Option<f64>,
+    /// With `--frames`: a frame's budget as a fraction of the frame (overruns are counted
+    /// against it).
+    #[arg(
+        long,
+        default_value_t = 0.8,
+        value_name = "F",
+        allow_negative_numbers = true
+    )]
+    pub budget_fraction: f64,
+    /// With `--frames`: the figures as JSON to this file.
+    #[arg(long, value_name = "FILE", requires = "frames")]
+    pub summary_json: Option<std::path::PathBuf>,
+    /// With `--frames`: rounds, each the whole run then the framed run (the median ratio is
+    /// reported).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub rounds: usize,
+    /// With `--frames`: drive every input the scene has, as an FMU does (held at its value at
+    /// t = 0 and set at every call; the whole run is the same driven run in one call).
+    #[arg(long, requires = "frames")]
+    pub drive: bool,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -66,6 +106,23 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 pub fn bench(a: BenchArgs) -> Result<ExitCode> {
+    if let Some((frame_s, scene_path)) =
+        crate::bench_frames::request(a.frames.as_deref(), a.scene.as_ref())?
+    {
+        return crate::bench_frames::bench_frames(
+            crate::bench_frames::FramesRequest {
+                frame_s,
+                scene_path,
+                engine: a.engine,
+                duration_s: a.duration,
+                budget_fraction: a.budget_fraction,
+                summary_json: a.summary_json.as_deref(),
+                rounds: a.rounds,
+                drive: a.drive,
+            },
+            &crate::signals::flag(),
+        );
+    }
     let cores = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1);

@@ -41,6 +41,7 @@ fn stdout_failed(e: &std::io::Error) {
 }
 
 mod bench;
+mod bench_frames;
 mod check;
 mod common;
 mod describe;

@@ -5,7 +5,7 @@
 //! half's `clutchpack.Simulation` wraps the stepper for a network scene, as it wraps `Stepper`
 //! for a pack.
 
-use crate::{check_outputs, engine_choice, interruptible, py_err, signal_poll, Scene};
+use crate::{check_outputs, engine_choice, py_err, signal_poll, Scene};
 use clutchpack_sdk::{NetworkSimulation, RecordingRequest, SavedNetworkSimulation};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -273,8 +273,18 @@ impl NetworkStepper {
     fn advance_to(&mut self, py: Python<'_>, t: f64) -> PyResult<()> {
         let mut guard = self.lock();
         let sim = running(&mut guard)?;
+        // on this thread, Python's signals polled from the engine's progress (issue 46: a
+        // worker thread per call cost a host's frames two wake-ups)
         let stop = AtomicBool::new(false);
-        interruptible(py, &stop, || sim.advance_to(t, Some(&stop)))?.map_err(value_err)
+        let mut interrupt = None;
+        let out = py.detach(|| {
+            let mut poll = signal_poll(&stop, &mut interrupt);
+            sim.advance_polled(t, Some(&stop), Some(&mut poll))
+        });
+        if let Some(e) = interrupt {
+            return Err(e);
+        }
+        out.map_err(value_err)
     }
 
     /// Every output's `(name, value)` now.

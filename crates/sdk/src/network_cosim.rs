@@ -526,6 +526,10 @@ impl NetworkSimulation {
             )));
         };
         crate::cosim::inputs::check_network_input(*input, name, value).map_err(Error::BadInput)?;
+        // held from the start: its value set again is not passed on (docs/DECISIONS.md)
+        if input_value(self.stepper.network(), *input, self.time_s()) == value {
+            return Ok(());
+        }
         let mut obs = Obs {
             keep: &mut self.keep,
             stop: None,
@@ -545,6 +549,18 @@ impl NetworkSimulation {
     /// then stands at an earlier time with everything before kept). An engine failure leaves
     /// the run unusable but for [`Self::finish`].
     pub fn advance_to(&mut self, t: f64, stop: Option<&AtomicBool>) -> Result<()> {
+        self.advance_polled(t, stop, None)
+    }
+
+    /// [`Self::advance_to`] with `progress` called at the engine's progress polls with the
+    /// simulated time reached, s: a front end's own stop check on the calling thread
+    /// (Python's signals), so that a call needs no second thread to stay interruptible.
+    pub fn advance_polled<'a>(
+        &mut self,
+        t: f64,
+        stop: Option<&'a AtomicBool>,
+        progress: Option<&'a mut dyn FnMut(f64)>,
+    ) -> Result<()> {
         self.usable()?;
         if !t.is_finite() || t < self.time_s() {
             return Err(Error::BadInput(format!(
@@ -555,7 +571,7 @@ impl NetworkSimulation {
         let mut obs = Obs {
             keep: &mut self.keep,
             stop,
-            progress: None,
+            progress,
         };
         if let Err(source) = self.stepper.advance_to(t, &mut obs) {
             self.failed = true;

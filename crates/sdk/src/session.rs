@@ -41,6 +41,9 @@ pub struct Session {
     failure: Option<EngineError>,
     stopped: bool,
     started: Instant,
+    /// The inputs set so far, each call's merged over the calls before (`None`: none set
+    /// yet): a call that changes nothing is not passed to the engine ([`Session::set_inputs`]).
+    held: Option<Inputs>,
 }
 
 /// A saved state of a [`Session`] ([`Session::save`]), restored by [`Session::restore`] any
@@ -48,6 +51,7 @@ pub struct Session {
 pub struct SessionState {
     inner: Box<dyn clutchpack_model::session::Session>,
     collector: RunCollector,
+    held: Option<Inputs>,
 }
 
 impl Simulation {
@@ -91,6 +95,7 @@ impl Simulation {
             failure: None,
             stopped: false,
             started: Instant::now(),
+            held: None,
         })
     }
 }
@@ -138,16 +143,41 @@ impl Session {
 
     /// Sets inputs from [`Session::time_s`] on (held until changed); bad input names the
     /// input and why.
+    ///
+    /// A call that changes nothing (every value set the one already held, no derivative set
+    /// now or before) is not passed to the engine: a host sets every input at every
+    /// communication point (`CoSimulation`, the FMU), and re-holding an unchanged input
+    /// restarted the engine's integration there (the reference engine's step controller and
+    /// its first derivative, the multibody engine's drive) and cloned the pack at every
+    /// frame. The held input is the same function of time either way (issue 46).
     pub fn set_inputs(&mut self, inputs: &Inputs) -> Result<()> {
+        if self.held.as_ref().is_some_and(|h| unchanged(h, inputs)) {
+            return Ok(());
+        }
         self.inner
             .set_inputs(inputs)
-            .map_err(|e| Error::BadInput(format!("{}: {e}", self.scene)))
+            .map_err(|e| Error::BadInput(format!("{}: {e}", self.scene)))?;
+        self.held = Some(merged(self.held.as_ref(), inputs));
+        Ok(())
     }
 
     /// Advances to `t_s`, feeding the statistics and the recording; `stop` (checked at the
     /// engine's progress polls) ends the call early. After an engine failure the session only
     /// finishes (everything before the failure is kept).
     pub fn advance_to(&mut self, t_s: f64, stop: Option<&AtomicBool>) -> Result<Advance> {
+        self.advance_polled(t_s, stop, None)
+    }
+
+    /// [`Session::advance_to`] with `progress` called at the engine's progress polls with the
+    /// simulated time reached, s: a front end's own check for a stop on the calling thread
+    /// (Python's signals, polled as a whole run polls them), so that a call needs no second
+    /// thread to stay interruptible.
+    pub fn advance_polled<'a>(
+        &mut self,
+        t_s: f64,
+        stop: Option<&'a AtomicBool>,
+        progress: Option<&'a mut dyn FnMut(f64)>,
+    ) -> Result<Advance> {
         if let Some(e) = &self.failure {
             return Err(self.engine_error(e.clone()));
         }
@@ -155,7 +185,7 @@ impl Session {
             collector: &mut self.collector,
             recorder: self.recorder.as_mut(),
             stop,
-            progress: None,
+            progress,
         };
         match self.inner.advance_to(t_s, &mut obs) {
             Ok(a) => {
@@ -232,6 +262,7 @@ impl Session {
         Ok(SessionState {
             inner: self.inner.boxed_clone(),
             collector: self.collector.try_clone()?,
+            held: self.held,
         })
     }
 
@@ -247,6 +278,7 @@ impl Session {
         }
         self.inner = state.inner.boxed_clone();
         self.collector = state.collector.try_clone()?;
+        self.held = state.held;
         self.failure = None;
         Ok(())
     }
@@ -305,6 +337,41 @@ impl Session {
             r
         });
         (result, recording, warnings, recorder_cpu_s)
+    }
+}
+
+/// Whether setting `new` over the inputs `held` changes nothing: no derivative (a slope
+/// restarts its ramp where it is set, so one set again is a new ramp), and every value `new`
+/// sets is the one held.
+fn unchanged(held: &Inputs, new: &Inputs) -> bool {
+    let flat = |x: &Inputs| {
+        [
+            x.shaft_speed_slope_rad_s2,
+            x.shaft_speed_curvature_rad_s3,
+            x.shaft_torque_slope_n_m_s,
+        ]
+        .iter()
+        .all(|d| d.is_none_or(|v| v == 0.0))
+    };
+    let same = |n: Option<f64>, h: Option<f64>| n.is_none_or(|v| h == Some(v));
+    flat(held)
+        && flat(new)
+        && same(new.shaft_speed_rad_s, held.shaft_speed_rad_s)
+        && same(new.shaft_torque_n_m, held.shaft_torque_n_m)
+        && same(new.drum_load_n_m, held.drum_load_n_m)
+        && same(new.piston_pressure_pa, held.piston_pressure_pa)
+}
+
+/// The inputs held after `new` is set over `held`: each value `new` sets, else the one held;
+/// the derivatives `new`'s (they hold from where they are set).
+fn merged(held: Option<&Inputs>, new: &Inputs) -> Inputs {
+    let h = held.copied().unwrap_or_default();
+    Inputs {
+        shaft_speed_rad_s: new.shaft_speed_rad_s.or(h.shaft_speed_rad_s),
+        shaft_torque_n_m: new.shaft_torque_n_m.or(h.shaft_torque_n_m),
+        drum_load_n_m: new.drum_load_n_m.or(h.drum_load_n_m),
+        piston_pressure_pa: new.piston_pressure_pa.or(h.piston_pressure_pa),
+        ..*new
     }
 }
 

@@ -632,6 +632,17 @@ impl CoSimulation {
     /// earlier time. A bad input leaves the run usable; an engine failure does not
     /// ([`Stage::Failed`]).
     pub fn advance_to(&mut self, t_end: f64, stop: Option<&AtomicBool>) -> Result<bool, String> {
+        self.advance_polled(t_end, stop, None)
+    }
+
+    /// [`CoSimulation::advance_to`] with `progress` called at the engine's progress polls
+    /// ([`Session::advance_polled`]; a network's run does not call it).
+    pub fn advance_polled<'a>(
+        &mut self,
+        t_end: f64,
+        stop: Option<&'a AtomicBool>,
+        progress: Option<&'a mut dyn FnMut(f64)>,
+    ) -> Result<bool, String> {
         if self.stage() != Stage::Running {
             return Err(format!(
                 "advancing in {:?}: allowed only after the run has started",
@@ -647,7 +658,7 @@ impl CoSimulation {
         if self.driven.any() {
             session.set_inputs(&inputs).map_err(|e| e.to_string())?;
         }
-        match session.advance_to(t_end, stop) {
+        match session.advance_polled(t_end, stop, progress) {
             Ok(a) => {
                 self.snapshot = session.snapshot();
                 Ok(a == Advance::Reached)

@@ -1,0 +1,82 @@
+//! Issue 46, item 3: the heap allocations of a host's frame loop once started, counted by a
+//! global allocator (this test binary's only test, so that nothing else allocates while it
+//! counts). The goal is none; this measures where the frame loop stands and keeps it there.
+
+use clutchpack_model::session::Advance;
+use clutchpack_scene::{EngineChoice, Override};
+use clutchpack_sdk::{SessionRequest, Simulation};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// The system allocator, counting allocations and reallocations.
+struct Counting;
+
+static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
+
+// SAFETY: every call is passed to the system allocator unchanged.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: the caller's contract is `System`'s.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: as above.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: as above.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static COUNTING: Counting = Counting;
+
+/// `pack-8-brake` (record rate 10 kHz: ten samples a frame) through the sdk's session as a
+/// host runs it, nothing kept but the running statistics: 20 frames of 1 ms after 20 of
+/// warm-up, the allocations per frame on each engine. Measured (2026-12-07): 1443 on the
+/// reference engine (its open-pack scheme clones every body's integration at each window of
+/// 1 ms, and queues each sample), 207 on the multibody engine (each sample and the stack's
+/// interface samples built as new vectors, the impacts' and contact samples' lists); far
+/// from the goal of none. Asserted within 25 % of those, so that the frame loop does not
+/// allocate more unnoticed.
+#[test]
+fn frame_loop_allocations_per_frame_are_bounded() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/pack-8-brake.toml");
+    let scene = clutchpack_scene::load(&file, &Vec::<Override>::new()).unwrap();
+    for engine in [EngineChoice::Reference, EngineChoice::Multibody] {
+        let sim = Simulation::new(scene.clone(), Some(engine)).unwrap();
+        let mut s = sim
+            .start(SessionRequest {
+                stop_time_s: Some(0.05),
+                ..SessionRequest::default()
+            })
+            .unwrap();
+        let mut t = 0.0;
+        let mut frame = |s: &mut clutchpack_sdk::Session, k: u32| {
+            t = f64::from(k) * 1e-3;
+            assert_eq!(s.advance_to(t, None).unwrap(), Advance::Reached);
+        };
+        for k in 1..=20 {
+            frame(&mut s, k);
+        }
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for k in 21..=40 {
+            frame(&mut s, k);
+        }
+        let per_frame = (ALLOCATIONS.load(Ordering::Relaxed) - before) as f64 / 20.0;
+        println!("{engine:?}: {per_frame} allocations per 1 ms frame");
+        let measured = match engine {
+            EngineChoice::Reference => 1443.0,
+            EngineChoice::Multibody => 207.0,
+        };
+        assert!(
+            per_frame <= 1.25 * measured,
+            "{engine:?}: {per_frame} allocations per frame (measured {measured})"
+        );
+        drop(s.finish());
+    }
+}
