@@ -635,6 +635,8 @@ pub fn eight_speed() -> (crate::network::Network, crate::network::Transmission) 
             input: 0,
             output: 1,
             gears,
+            initial_gear: None,
+            shifts: Vec::new(),
         },
     )
 }

@@ -125,10 +125,36 @@ table! {
         input: "", Kind::Text, Dflt::Required;
         /// the output body (a [[bodies]] name)
         output: "", Kind::Text, Dflt::Required;
+        /// the gear engaged at t = 0 (a gear's name); with it the shift schedule sets every element's force (their [couplings.force] is then refused): closed 1, open 0, changed by [[transmission.shifts]]
+        initial_gear: "", Kind::Text, Dflt::Described("none: the elements' own [couplings.force]");
+        /// with initial_gear: the input's speed at t = 0; every body turning with it (the input's group in the initial gear) starts at its speed per unit input times this (their own initial_speed_rad_s is then refused)
+        initial_input_speed_rad_s: "rad/s", SPEED, Dflt::Described("none: the bodies' own initial speeds");
     }
     children {
         gears: array RawGear,
+        shifts: array RawShift,
     }
+}
+
+table! {
+    /// One `[[transmission.shifts]]` entry (with initial_gear): a clutch-to-clutch shift from the gear engaged before it, which opens one element (the off-going) and closes one (the on-coming). Fill: the on-coming rises from 0 to fill_level; torque phase: the off-going falls from 1 to 0 while the on-coming rises to torque_level; inertia phase: the on-coming rises to 1. Linear between these instants (MODEL.md section 10).
+    RawShift at "transmission.shifts[]" {
+        /// when the shift starts (after the shift before it has ended)
+        at_s: "s", NON_NEGATIVE, Dflt::Required;
+        /// the gear it reaches (a gear's name; not the one engaged)
+        to: "", Kind::Text, Dflt::Required;
+        /// the on-coming element's fill (ASSUMED default)
+        fill_s: "s", Kind::Number(Rule::Bounded { floor: 1e-4, ceil: 10.0 }), Dflt::Num(0.05);
+        /// the on-coming element's normalized force at the end of the fill (its kiss point; ASSUMED default)
+        fill_level: "", Kind::Number(Rule::Closed(0.0, 1.0)), Dflt::Num(0.1);
+        /// the torque phase (ASSUMED default)
+        torque_phase_s: "s", Kind::Number(Rule::Bounded { floor: 1e-4, ceil: 10.0 }), Dflt::Num(0.1);
+        /// the on-coming element's normalized force at the end of the torque phase (ASSUMED default)
+        torque_level: "", Kind::Number(Rule::Closed(0.0, 1.0)), Dflt::Num(0.5);
+        /// the inertia phase (ASSUMED default)
+        inertia_phase_s: "s", Kind::Number(Rule::Bounded { floor: 1e-4, ceil: 10.0 }), Dflt::Num(0.2);
+    }
+    children {}
 }
 
 table! {

@@ -6,12 +6,25 @@
 //! unit input speed follows, the ratio `w_in / w_out`, and the slip `w_b - w_a` of every open
 //! element (its drag depends on it).
 //!
+//! A **shift schedule** (section 10's phases) is compiled here into each element's normalized
+//! force: before the first shift the elements of the initial gear are closed (force 1), the
+//! others open (0); a shift at `t0` from gear G to gear H opens the one element of G not in H
+//! (the off-going) and closes the one of H not in G (the on-coming), the others holding:
+//! - **fill** `[t0, t0 + t_f]`: the on-coming rises from 0 to its fill level (the kiss point);
+//! - **torque phase** `[.., + t_t]`: the off-going falls from 1 to 0 while the on-coming rises
+//!   to its torque-phase level (it takes over the torque);
+//! - **inertia phase** `[.., + t_i]`: the on-coming rises to 1 (it pulls the input down to
+//!   the new gear's speed and locks when its slip reaches zero).
+//!
+//! Each profile is linear between these instants (a [`Signal::Table`]), its corners
+//! breakpoints the engines land on.
+//!
 //! The null space is taken from the projector `P = I - C^T (C C^T)^+ C` on the moving bodies
 //! ([`super::rows::projected`] with unit inertias): rank one on the input's group means one
 //! degree of freedom, and its column at the input is the speeds per unit input.
 
 use super::rows::{self, Row};
-use super::{ClutchMode, Network};
+use super::{ClutchMode, Network, Signal};
 use serde::{Deserialize, Serialize};
 
 /// One gear: the elements closed in it.
@@ -23,7 +36,35 @@ pub struct Gear {
     pub closed: Vec<usize>,
 }
 
-/// An automatic transmission on a network: its input and output bodies and its gears.
+/// One shift of a schedule (the module's docs): when it starts, the gear it reaches and its
+/// phases.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Shift {
+    /// Its start `t0`, s.
+    pub at_s: f64,
+    /// The gear it reaches (index in [`Transmission::gears`]).
+    pub to: usize,
+    /// The on-coming element's fill, s (> 0).
+    pub fill_s: f64,
+    /// The on-coming element's normalized force at the end of the fill (0..1).
+    pub fill_level: f64,
+    /// The torque phase, s (> 0).
+    pub torque_phase_s: f64,
+    /// The on-coming element's normalized force at the end of the torque phase (0..1).
+    pub torque_level: f64,
+    /// The inertia phase, s (> 0).
+    pub inertia_phase_s: f64,
+}
+
+impl Shift {
+    /// Its end, s: `t0 + t_f + t_t + t_i`.
+    pub fn end_s(&self) -> f64 {
+        self.at_s + self.fill_s + self.torque_phase_s + self.inertia_phase_s
+    }
+}
+
+/// An automatic transmission on a network: its input and output bodies, its gears and,
+/// optionally, a shift schedule from an initial gear.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Transmission {
     /// The input body (index in [`Network::bodies`]).
@@ -32,6 +73,13 @@ pub struct Transmission {
     pub output: usize,
     /// The gears, in the order given.
     pub gears: Vec<Gear>,
+    /// The gear engaged at t = 0 (index in [`Self::gears`]); with it the schedule sets every
+    /// element's force ([`Self::schedule`]). `None`: the elements' own force signals.
+    #[serde(default)]
+    pub initial_gear: Option<usize>,
+    /// The shifts, in time order, each starting after the one before has ended.
+    #[serde(default)]
+    pub shifts: Vec<Shift>,
 }
 
 /// A gear's kinematics.
@@ -48,6 +96,149 @@ pub struct GearKinematics {
 }
 
 impl Transmission {
+    /// Each element's normalized force over the schedule (the module's docs):
+    /// `(coupling index, signal)` for every element, or the index of the first shift that is
+    /// not a clutch-to-clutch shift from the gear engaged before it, with the reason. `None`
+    /// without an initial gear.
+    pub fn schedule(&self) -> Option<Result<Vec<(usize, Signal)>, (usize, String)>> {
+        let mut gear = self.initial_gear?;
+        let elements = self.elements();
+        // each element's corners (t, force)
+        let mut knots: Vec<Vec<(f64, f64)>> = elements
+            .iter()
+            .map(|k| {
+                vec![(
+                    0.0,
+                    f64::from(u8::from(self.gears[gear].closed.contains(k))),
+                )]
+            })
+            .collect();
+        let mut free_from = 0.0;
+        for (i, sh) in self.shifts.iter().enumerate() {
+            let (from, to) = (&self.gears[gear], &self.gears[sh.to]);
+            if sh.to == gear {
+                return Some(Err((
+                    i,
+                    format!("gear \"{}\" is already engaged then", to.name),
+                )));
+            }
+            if sh.at_s < free_from {
+                return Some(Err((
+                    i,
+                    format!(
+                        "starts at {} s, before the shift before it ends ({free_from} s)",
+                        sh.at_s
+                    ),
+                )));
+            }
+            let off: Vec<usize> = from
+                .closed
+                .iter()
+                .copied()
+                .filter(|k| !to.closed.contains(k))
+                .collect();
+            let on: Vec<usize> = to
+                .closed
+                .iter()
+                .copied()
+                .filter(|k| !from.closed.contains(k))
+                .collect();
+            if off.len() != 1 || on.len() != 1 {
+                return Some(Err((
+                    i,
+                    format!(
+                        "from gear \"{}\" to \"{}\" opens {} and closes {} elements: a shift hands over from one element to one other (shift through the gears between)",
+                        from.name,
+                        to.name,
+                        off.len(),
+                        on.len()
+                    ),
+                )));
+            }
+            let t0 = sh.at_s;
+            let t1 = t0 + sh.fill_s;
+            let t2 = t1 + sh.torque_phase_s;
+            let t3 = t2 + sh.inertia_phase_s;
+            for (e, k) in elements.iter().enumerate() {
+                let corners: &[(f64, f64)] = if *k == off[0] {
+                    &[(t1, 1.0), (t2, 0.0)]
+                } else if *k == on[0] {
+                    &[
+                        (t0, 0.0),
+                        (t1, sh.fill_level),
+                        (t2, sh.torque_level),
+                        (t3, 1.0),
+                    ]
+                } else {
+                    &[]
+                };
+                for &(t, y) in corners {
+                    // a corner at the instant of the one before replaces it (a shift at 0 s)
+                    match knots[e].last_mut() {
+                        Some(last) if last.0 >= t => last.1 = y,
+                        _ => knots[e].push((t, y)),
+                    }
+                }
+            }
+            gear = sh.to;
+            free_from = t3;
+        }
+        let mut signals = Vec::new();
+        for (k, path) in elements.iter().zip(knots) {
+            let signal = if path.len() == 1 {
+                Signal::Constant(path[0].1)
+            } else {
+                let (t, y): (Vec<f64>, Vec<f64>) = path.into_iter().unzip();
+                match crate::drive::Table::new(t, y) {
+                    Ok(table) => Signal::Table(table),
+                    Err(e) => {
+                        let last = self.shifts.len().saturating_sub(1);
+                        return Some(Err((
+                            last,
+                            format!("its phases give no force profile: {e}"),
+                        )));
+                    }
+                }
+            };
+            signals.push((*k, signal));
+        }
+        Some(Ok(signals))
+    }
+
+    /// Every body's speed at t = 0 (rad/s) with the initial gear engaged and the input at
+    /// `w_in` (rad/s): the input's group at the gear's speeds per unit input, the other bodies
+    /// at `others` (their own). `None` without an initial gear or when it is no gear.
+    pub fn initial_speeds_rad_s(
+        &self,
+        net: &Network,
+        w_in: f64,
+        others: &[f64],
+    ) -> Option<Vec<f64>> {
+        let k = self.kinematics(net, self.initial_gear?).ok()?;
+        let moving: Vec<bool> = net.bodies.iter().map(|b| !b.fixed).collect();
+        let rows: Vec<Row> = net
+            .couplings
+            .iter()
+            .enumerate()
+            .filter_map(|(c, cp)| {
+                let closed = self.gears[self.initial_gear?].closed.contains(&c);
+                cp.row(c, closed.then_some(ClutchMode::Locked))
+            })
+            .collect();
+        let of = rows::groups(&rows, &moving);
+        Some(
+            (0..net.bodies.len())
+                .map(|i| {
+                    if of[i] == of[self.input] {
+                        k.speeds_per_input[i] * w_in
+                    } else {
+                        others[i]
+                    }
+                })
+                .collect(),
+        )
+    }
+
     /// The shift elements: every coupling closed in some gear, in the couplings' order.
     pub fn elements(&self) -> Vec<usize> {
         let mut out: Vec<usize> = self.gears.iter().flat_map(|g| g.closed.clone()).collect();
@@ -190,5 +381,60 @@ mod tests {
             .kinematics(&net, 1)
             .unwrap_err()
             .contains("holds the input"));
+    }
+
+    /// A 1 -> 2 shift at 1 s (A B C to A B E): C, the off-going, holds through the fill and
+    /// falls to 0 over the torque phase; E, the on-coming, fills to 0.1, rises to 0.6 over the
+    /// torque phase and to 1 over the inertia phase; A and B hold. A shift to the engaged gear,
+    /// one that swaps two elements, or one that starts before the last ends is refused.
+    #[test]
+    fn a_schedule_compiles_into_each_elements_force() {
+        use super::Shift;
+        let (net, mut tr) = eight_speed();
+        tr.initial_gear = Some(1);
+        let shift = |at_s: f64, to: usize| Shift {
+            at_s,
+            to,
+            fill_s: 0.05,
+            fill_level: 0.1,
+            torque_phase_s: 0.1,
+            torque_level: 0.6,
+            inertia_phase_s: 0.2,
+        };
+        tr.shifts = vec![shift(1.0, 2)];
+        let sched = tr.schedule().unwrap().unwrap();
+        let force = |name: &str, t: f64| {
+            let k = net.couplings.iter().position(|c| c.name == name).unwrap();
+            sched.iter().find(|(c, _)| *c == k).unwrap().1.value(t)
+        };
+        assert_eq!(
+            (force("A", 2.0), force("B", 2.0), force("D", 2.0)),
+            (1.0, 1.0, 0.0)
+        );
+        assert_eq!(
+            (force("C", 1.05), force("C", 1.1), force("C", 1.15)),
+            (1.0, 0.5, 0.0)
+        );
+        assert_eq!(
+            (force("E", 1.0), force("E", 1.05), force("E", 1.15)),
+            (0.0, 0.1, 0.6)
+        );
+        assert!((force("E", 1.25) - 0.8).abs() < 1e-12 && force("E", 1.35) == 1.0);
+        tr.shifts = vec![shift(1.0, 1)];
+        assert!(tr
+            .schedule()
+            .unwrap()
+            .unwrap_err()
+            .1
+            .contains("already engaged"));
+        tr.shifts = vec![shift(1.0, 4)];
+        assert!(tr
+            .schedule()
+            .unwrap()
+            .unwrap_err()
+            .1
+            .contains("opens 2 and closes 2"));
+        tr.shifts = vec![shift(1.0, 2), shift(1.2, 3)];
+        assert_eq!(tr.schedule().unwrap().unwrap_err().0, 1);
     }
 }

@@ -22,7 +22,7 @@ pub mod signal;
 pub use clutch::{ClutchMode, LumpedClutch};
 pub use firing::Firing;
 pub use gear::GearMesh;
-pub use gears::{Gear, GearKinematics, Transmission};
+pub use gears::{Gear, GearKinematics, Shift, Transmission};
 pub use output::{ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample};
 pub use planetary::PlanetarySet;
 pub use rows::Row;

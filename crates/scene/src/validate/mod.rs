@@ -445,20 +445,30 @@ fn network_scene(
             );
         }
     }
+    // the shift elements whose force a schedule sets (every name a gear closes, when the
+    // transmission has an initial gear)
+    let scheduled = raw
+        .transmission
+        .as_ref()
+        .map_or_else(Vec::new, transmission::scheduled_elements);
     let network = network::network(
         ck,
         bodies,
         raw.couplings.as_deref().unwrap_or(&[]),
         base_dir,
+        &scheduled,
     );
-    let (network, fatigue) = match network {
+    let (mut network, fatigue) = match network {
         Some((n, f)) => (Some(n), f),
         None => (None, Vec::new()),
     };
-    // the gears of an automatic, on a network that is good
-    let transmission = match (&raw.transmission, &network) {
+    // the gears of an automatic, on a network that is good (its schedule sets the elements'
+    // forces and its initial gear the members' speeds)
+    let transmission = match (&raw.transmission, &mut network) {
         (None, _) => Some(None),
-        (Some(t), Some(net)) => transmission::transmission(ck, t, net).map(Some),
+        (Some(t), Some(net)) => {
+            transmission::transmission(ck, t, net, bodies, simulation.as_ref()).map(Some)
+        }
         (Some(_), None) => None,
     };
     Some(Validated {

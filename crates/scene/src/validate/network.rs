@@ -214,6 +214,7 @@ pub(super) fn network(
     bodies: &[B],
     couplings: &[C],
     base_dir: &Path,
+    scheduled: &[String],
 ) -> Option<(Network, Vec<clutchpack_model::FatigueParams>)> {
     let mut ok = true;
     let mut net = Network::default();
@@ -523,8 +524,11 @@ pub(super) fn network(
                 .num(&p(&C::ratio), r.value(&C::ratio), &C::ratio)
                 .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
                 .map(|ratio| CouplingKind::IdealGear { ratio }),
-            Kind::Clutch => clutch(ck, r, k, base_dir).map(CouplingKind::Clutch),
-            Kind::OneWay => clutch(ck, r, k, base_dir).map(|cl| {
+            Kind::Clutch => {
+                let by_schedule = name.as_ref().is_some_and(|n| scheduled.contains(n));
+                clutch(ck, r, k, base_dir, by_schedule).map(CouplingKind::Clutch)
+            }
+            Kind::OneWay => clutch(ck, r, k, base_dir, false).map(|cl| {
                 CouplingKind::Clutch(LumpedClutch {
                     one_way: true,
                     ..cl
@@ -872,7 +876,15 @@ fn firing(ck: &mut Checker, r: &RawFiring, i: usize) -> Option<Option<Firing>> {
 }
 
 /// A clutch's keys and its `force` table.
-fn clutch(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<LumpedClutch> {
+/// A lumped clutch's keys; `by_schedule`: a shift element whose force the transmission's
+/// schedule sets (its `[couplings.force]` is then refused, and a placeholder stands in).
+fn clutch(
+    ck: &mut Checker,
+    r: &C,
+    k: usize,
+    base_dir: &Path,
+    by_schedule: bool,
+) -> Option<LumpedClutch> {
     let p = |key: &Key| item("couplings", key, k);
     let mu = ck.num(&p(&C::mu), r.value(&C::mu), &C::mu);
     let speeds = ck.numbers(&p(&C::mu_speeds_rad_s), r.value(&C::mu_speeds_rad_s), None);
@@ -919,6 +931,15 @@ fn clutch(ck: &mut Checker, r: &C, k: usize, base_dir: &Path) -> Option<LumpedCl
         )
         .required(ck, &p(&C::max_normal_force_n), "required for a clutch");
     let force = match &r.force {
+        Some(_) if by_schedule => {
+            ck.report(
+                format!("couplings[{k}].force"),
+                None,
+                "set by [transmission]'s shift schedule (initial_gear and [[transmission.shifts]]): remove it",
+            );
+            None
+        }
+        None if by_schedule => Some(Signal::Constant(0.0)),
         Some(f) => signal(ck, &FORCE_SIGNAL, k, |key| f.value(key), base_dir),
         None => {
             ck.report(

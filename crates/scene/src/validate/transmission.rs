@@ -4,13 +4,41 @@
 //! closed in some gear.
 
 use super::Checker;
-use crate::keys::{RawGear as G, RawTransmission as T};
+use crate::keys::{RawGear as G, RawNetBody, RawShift as S, RawTransmission as T};
 use crate::schema::{Key, RawTable};
-use clutchpack_model::network::{CouplingKind, Gear, Network, Transmission};
+use crate::Simulation;
+use clutchpack_model::network::{CouplingKind, Gear, Network, Shift, Transmission};
+
+/// The names every gear closes, when `[transmission]` has an initial gear (its schedule then
+/// sets those elements' forces): read from the raw table, before the network is validated.
+pub(super) fn scheduled_elements(raw: &T) -> Vec<String> {
+    if raw.initial_gear.is_none() {
+        return Vec::new();
+    }
+    let mut out: Vec<String> = raw
+        .gears
+        .iter()
+        .flatten()
+        .filter_map(|g| g.closed.as_ref()?.as_array().cloned())
+        .flatten()
+        .filter_map(|v| v.as_str().map(str::to_string))
+        .collect();
+    out.sort();
+    out.dedup();
+    out
+}
 
 /// The transmission of `net` as `[transmission]` describes it, or `None` (each problem
-/// reported at its key).
-pub(super) fn transmission(ck: &mut Checker, raw: &T, net: &Network) -> Option<Transmission> {
+/// reported at its key). With an initial gear its schedule sets every element's force in
+/// `net`, and with `initial_input_speed_rad_s` the speeds of the bodies that turn with the
+/// input (`bodies`: the raw bodies, whose own speeds are then refused).
+pub(super) fn transmission(
+    ck: &mut Checker,
+    raw: &T,
+    net: &mut Network,
+    bodies: &[RawNetBody],
+    simulation: Option<&Simulation>,
+) -> Option<Transmission> {
     let body = |ck: &mut Checker, key: &Key| {
         let path = key.at("transmission");
         let name = ck.text(&path, raw.value(key)).required(
@@ -99,10 +127,114 @@ pub(super) fn transmission(ck: &mut Checker, raw: &T, net: &Network) -> Option<T
             _ => ok = false,
         }
     }
+    let gear_named =
+        |ck: &mut Checker, path: &str, v: Option<&toml::Value>| -> Option<Option<usize>> {
+            let Some(name) = ck.text(path, v).or(String::new()) else {
+                return None;
+            };
+            if v.is_none() {
+                return Some(None);
+            }
+            match gears.iter().position(|g: &Gear| g.name == name) {
+                Some(i) => Some(Some(i)),
+                None => {
+                    let names: Vec<String> =
+                        gears.iter().map(|g| format!("\"{}\"", g.name)).collect();
+                    ck.report(
+                        path,
+                        Some(format!("\"{name}\"")),
+                        format!("names no gear; the gears are {}", names.join(", ")),
+                    );
+                    None
+                }
+            }
+        };
+    let initial_gear = gear_named(
+        ck,
+        &T::initial_gear.at("transmission"),
+        raw.value(&T::initial_gear),
+    );
+    let w_in = ck
+        .num(
+            &T::initial_input_speed_rad_s.at("transmission"),
+            raw.value(&T::initial_input_speed_rad_s),
+            &T::initial_input_speed_rad_s,
+        )
+        .or(f64::NAN);
+    let mut shifts = Vec::new();
+    for (i, r) in raw.shifts.iter().flatten().enumerate() {
+        let at = |key: &Key| format!("transmission.shifts[{i}].{}", key.name);
+        let num =
+            |ck: &mut Checker, key: &Key| ck.num(&at(key), r.value(key), key).or(key.default_num());
+        let at_s = ck.num(&at(&S::at_s), r.value(&S::at_s), &S::at_s).required(
+            ck,
+            &at(&S::at_s),
+            "when the shift starts",
+        );
+        let to = gear_named(ck, &at(&S::to), r.value(&S::to));
+        if r.value(&S::to).is_none() {
+            ck.report(at(&S::to), None, "required: the gear the shift reaches");
+        }
+        let (fill_s, fill_level) = (num(ck, &S::fill_s), num(ck, &S::fill_level));
+        let (torque_phase_s, torque_level) =
+            (num(ck, &S::torque_phase_s), num(ck, &S::torque_level));
+        let inertia_phase_s = num(ck, &S::inertia_phase_s);
+        match (
+            at_s,
+            to.flatten(),
+            fill_s,
+            fill_level,
+            torque_phase_s,
+            torque_level,
+            inertia_phase_s,
+        ) {
+            (
+                Some(at_s),
+                Some(to),
+                Some(fill_s),
+                Some(fill_level),
+                Some(torque_phase_s),
+                Some(torque_level),
+                Some(inertia_phase_s),
+            ) => {
+                shifts.push(Shift {
+                    at_s,
+                    to,
+                    fill_s,
+                    fill_level,
+                    torque_phase_s,
+                    torque_level,
+                    inertia_phase_s,
+                });
+            }
+            _ => ok = false,
+        }
+    }
+    let initial_gear = initial_gear?;
+    if initial_gear.is_none() {
+        if raw.shifts.is_some() {
+            ck.report(
+                "transmission.shifts",
+                None,
+                "needs transmission.initial_gear: the gear the schedule starts from",
+            );
+            ok = false;
+        }
+        if w_in.is_some_and(|w| !w.is_nan()) {
+            ck.report(
+                T::initial_input_speed_rad_s.at("transmission"),
+                None,
+                "needs transmission.initial_gear: the gear that sets the other speeds",
+            );
+            ok = false;
+        }
+    }
     let tr = Transmission {
         input: input?,
         output: output?,
         gears,
+        initial_gear,
+        shifts,
     };
     if !ok {
         return None;
@@ -123,6 +255,59 @@ pub(super) fn transmission(ck: &mut Checker, raw: &T, net: &Network) -> Option<T
                 format!("gear \"{}\" {why}", g.name),
             );
             ok = false;
+        }
+    }
+    if !ok {
+        return None;
+    }
+    let end_s = simulation.map_or(f64::INFINITY, |s| s.duration_s);
+    for (i, sh) in tr.shifts.iter().enumerate() {
+        if sh.end_s() > end_s {
+            ck.report(
+                format!("transmission.shifts[{i}].at_s"),
+                None,
+                format!(
+                    "the shift ends at {} s, after the run's end ({end_s} s)",
+                    clutchpack_model::fmt_num(sh.end_s())
+                ),
+            );
+            ok = false;
+        }
+    }
+    match tr.schedule() {
+        Some(Ok(forces)) => {
+            for (k, force) in forces {
+                if let CouplingKind::Clutch(cl) = &mut net.couplings[k].kind {
+                    cl.force = force;
+                }
+            }
+        }
+        Some(Err((i, why))) => {
+            ck.report(format!("transmission.shifts[{i}].to"), None, why);
+            ok = false;
+        }
+        None => {}
+    }
+    let w_in = w_in.filter(|w| !w.is_nan());
+    if let Some(w_in) = w_in {
+        let own: Vec<f64> = net.bodies.iter().map(|b| b.initial_speed_rad_s).collect();
+        // the gear was checked: it has speeds
+        if let Some(speeds) = tr.initial_speeds_rad_s(net, w_in, &own) {
+            for (i, (b, w)) in net.bodies.iter_mut().zip(speeds).enumerate() {
+                if w != b.initial_speed_rad_s
+                    && bodies
+                        .get(i)
+                        .is_some_and(|r| r.initial_speed_rad_s.is_some())
+                {
+                    ck.report(
+                        format!("bodies[{i}].initial_speed_rad_s"),
+                        None,
+                        "set by transmission.initial_input_speed_rad_s (the body turns with the input in the initial gear): remove it",
+                    );
+                    ok = false;
+                }
+                b.initial_speed_rad_s = w;
+            }
         }
     }
     ok.then_some(tr)
