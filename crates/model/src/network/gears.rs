@@ -36,6 +36,9 @@ pub struct Gear {
     pub closed: Vec<usize>,
 }
 
+/// Each shift element's normalized force over a schedule: `(coupling index, signal)`.
+pub type ElementForces = Vec<(usize, Signal)>;
+
 /// One shift of a schedule (the module's docs): when it starts, the gear it reaches and its
 /// phases.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -100,7 +103,7 @@ impl Transmission {
     /// `(coupling index, signal)` for every element, or the index of the first shift that is
     /// not a clutch-to-clutch shift from the gear engaged before it, with the reason. `None`
     /// without an initial gear.
-    pub fn schedule(&self) -> Option<Result<Vec<(usize, Signal)>, (usize, String)>> {
+    pub fn schedule(&self) -> Option<Result<ElementForces, (usize, String)>> {
         let mut gear = self.initial_gear?;
         let elements = self.elements();
         // each element's corners (t, force)
@@ -407,19 +410,24 @@ mod tests {
             let k = net.couplings.iter().position(|c| c.name == name).unwrap();
             sched.iter().find(|(c, _)| *c == k).unwrap().1.value(t)
         };
-        assert_eq!(
-            (force("A", 2.0), force("B", 2.0), force("D", 2.0)),
-            (1.0, 1.0, 0.0)
-        );
-        assert_eq!(
-            (force("C", 1.05), force("C", 1.1), force("C", 1.15)),
-            (1.0, 0.5, 0.0)
-        );
-        assert_eq!(
-            (force("E", 1.0), force("E", 1.05), force("E", 1.15)),
-            (0.0, 0.1, 0.6)
-        );
-        assert!((force("E", 1.25) - 0.8).abs() < 1e-12 && force("E", 1.35) == 1.0);
+        let close = |name: &str, t: f64, want: f64| {
+            let got = force(name, t);
+            assert!(
+                (got - want).abs() < 1e-12,
+                "{name} at {t} s: {got} against {want}"
+            );
+        };
+        close("A", 2.0, 1.0);
+        close("B", 2.0, 1.0);
+        close("D", 2.0, 0.0);
+        close("C", 1.05, 1.0);
+        close("C", 1.1, 0.5);
+        close("C", 1.151, 0.0);
+        close("E", 1.0, 0.0);
+        close("E", 1.05, 0.1);
+        close("E", 1.15, 0.6);
+        close("E", 1.25, 0.8);
+        close("E", 1.36, 1.0);
         tr.shifts = vec![shift(1.0, 1)];
         assert!(tr
             .schedule()

@@ -9,10 +9,12 @@ use crate::schema::{Key, RawTable};
 use crate::Simulation;
 use clutchpack_model::network::{CouplingKind, Gear, Network, Shift, Transmission};
 
-/// The names every gear closes, when `[transmission]` has an initial gear (its schedule then
-/// sets those elements' forces): read from the raw table, before the network is validated.
+/// The names every gear closes, when `[transmission]` has an initial gear or shifts (its
+/// schedule then sets those elements' forces): read from the raw table, before the network is
+/// validated.
 pub(super) fn scheduled_elements(raw: &T) -> Vec<String> {
-    if raw.initial_gear.is_none() {
+    // (shifts without an initial gear are reported by the transmission, not as missing forces)
+    if raw.initial_gear.is_none() && raw.shifts.is_none() {
         return Vec::new();
     }
     let mut out: Vec<String> = raw
@@ -129,9 +131,7 @@ pub(super) fn transmission(
     }
     let gear_named =
         |ck: &mut Checker, path: &str, v: Option<&toml::Value>| -> Option<Option<usize>> {
-            let Some(name) = ck.text(path, v).or(String::new()) else {
-                return None;
-            };
+            let name = ck.text(path, v).or(String::new())?;
             if v.is_none() {
                 return Some(None);
             }
