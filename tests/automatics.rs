@@ -672,6 +672,30 @@ fn an_eight_speed_shifts_up_clutch_to_clutch_on_both_engines() {
             "{e}"
         );
     }
+    for s in &runs {
+        let shifts = s["shifts"].as_array().unwrap();
+        assert_eq!(shifts.len(), 2, "{s}");
+        for sh in shifts {
+            assert_eq!(
+                (&sh["tie_up"], &sh["flare"]),
+                (&false.into(), &false.into()),
+                "{sh}"
+            );
+            let (tp, ip) = (
+                sh["torque_phase_s"].as_f64().unwrap(),
+                sh["inertia_phase_s"].as_f64().unwrap(),
+            );
+            assert!(tp > 0.05 && ip > 0.0, "{sh}");
+        }
+        // E slips only in the 1 -> 2 shift: its heat there from the 1 kHz samples is its whole
+        // heat from the engine's counter (measured within 0.03 %; bound 0.5 %)
+        let e_total = element(s, "E")["heat_j"].as_f64().unwrap();
+        let e_shift = shifts[0]["on_coming_heat_j"].as_f64().unwrap();
+        assert!(
+            (e_shift - e_total).abs() < 5e-3 * e_total,
+            "{e_shift} {e_total}"
+        );
+    }
     let (r, m) = (&runs[0], &runs[1]);
     for name in ["E", "C"] {
         for (a, b) in locks(r, name).iter().zip(locks(m, name)) {
@@ -718,12 +742,6 @@ fn a_shift_schedule_that_cannot_be_driven_is_named_at_its_key() {
             "before the shift before it ends",
         ),
         (
-            "at_s = 2.0",
-            "at_s = 2.9",
-            "transmission.shifts[1].at_s",
-            "after the run's end",
-        ),
-        (
             "name = \"E\"\nkind = \"clutch\"",
             "name = \"E\"\nkind = \"clutch\"\n[couplings.force]\nkind = \"constant\"\nvalue = 1.0",
             "couplings[8].force",
@@ -745,4 +763,43 @@ fn a_shift_schedule_that_cannot_be_driven_is_named_at_its_key() {
         let e = stderr(&o);
         assert!(e.contains(key) && e.contains(why), "{to}: {e}");
     }
+}
+
+/// The same 1 -> 2 shift with the on-coming element applied harder in the torque phase
+/// (`torque_level` 0.5 instead of 0.1) fights the off-going one: the output torque falls to
+/// about -260 N m from 1262 N m before (a tie-up, flagged), and the on-coming element takes
+/// twice the heat (measured 6339 J against 3158 J). On the reference engine.
+#[test]
+fn a_harder_overlap_is_flagged_a_tie_up_and_heats_the_on_coming_element_more() {
+    let d = scratch("eight-speed-tie-up");
+    let shift = |level: &str, name: &str| -> Value {
+        let json = d.join(format!("{name}.json"));
+        let o = run(&[
+            "run",
+            "scenes/eight-speed.toml",
+            "--no-record",
+            "--duration",
+            "1.9",
+            "--set",
+            &format!("transmission.shifts[0].torque_level={level}"),
+            "--summary-json",
+            json.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        read_json(&json)["shifts"][0].clone()
+    };
+    let (soft, hard) = (shift("0.1", "soft"), shift("0.5", "hard"));
+    assert_eq!(soft["tie_up"], false, "{soft}");
+    assert_eq!(hard["tie_up"], true, "{hard}");
+    let heat = |s: &Value| s["on_coming_heat_j"].as_f64().unwrap();
+    assert!(
+        heat(&hard) > 1.5 * heat(&soft),
+        "{} {}",
+        heat(&hard),
+        heat(&soft)
+    );
+    assert!(
+        hard["output_torque_min_n_m"].as_f64().unwrap() < 0.0,
+        "{hard}"
+    );
 }

@@ -254,6 +254,39 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
             );
         }
     }
+    if !s.shifts.is_empty() {
+        out!("shifts (as the run made them; heat and output torque from the samples):");
+    }
+    for sh in &s.shifts {
+        let at = |t: Option<f64>| t.map_or("never".to_string(), |t| format!("{t:.6} s"));
+        let phase = |t: Option<f64>| t.map_or("-".to_string(), |t| format!("{t:.3} s"));
+        let flags = match (sh.tie_up, sh.flare) {
+            (true, true) => "  TIE-UP, FLARE",
+            (true, false) => "  TIE-UP",
+            (false, true) => "  FLARE",
+            (false, false) => "",
+        };
+        out!(
+            "  {} -> {} at {:.3} s: {} released {}, {} locked {}; torque phase {}, inertia phase {}; heat {} {:.1} J, {} {:.1} J; output torque {:.1} before, {:.1} .. {:.1} during, {:.1} after N m{flags}",
+            sh.from,
+            sh.to,
+            sh.start_s,
+            sh.off_going,
+            at(sh.off_going_released_s),
+            sh.on_coming,
+            at(sh.on_coming_locked_s),
+            phase(sh.torque_phase_s),
+            phase(sh.inertia_phase_s),
+            sh.off_going,
+            sh.off_going_heat_j,
+            sh.on_coming,
+            sh.on_coming_heat_j,
+            sh.output_torque_before_n_m,
+            sh.output_torque_min_n_m,
+            sh.output_torque_max_n_m,
+            sh.output_torque_after_n_m
+        );
+    }
     let (e, residual_j) = (&s.energy.terms, s.energy.residual_j);
     out!(
         "energy: drives {:.6} J, loads {:.6} J, drag {:.6} J, clutch heat {:.6} J, packs {:.6} J, kinetic change {:.6} J (balance {:.3e} J)",

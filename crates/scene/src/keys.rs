@@ -146,11 +146,11 @@ table! {
         /// the on-coming element's fill (ASSUMED default)
         fill_s: "s", Kind::Number(Rule::Bounded { floor: 1e-4, ceil: 10.0 }), Dflt::Num(0.05);
         /// the on-coming element's normalized force at the end of the fill (its kiss point; ASSUMED default)
-        fill_level: "", Kind::Number(Rule::Closed(0.0, 1.0)), Dflt::Num(0.1);
+        fill_level: "", Kind::Number(Rule::Closed(0.0, 1.0)), Dflt::Num(0.02);
         /// the torque phase (ASSUMED default)
         torque_phase_s: "s", Kind::Number(Rule::Bounded { floor: 1e-4, ceil: 10.0 }), Dflt::Num(0.1);
         /// the on-coming element's normalized force at the end of the torque phase (ASSUMED default)
-        torque_level: "", Kind::Number(Rule::Closed(0.0, 1.0)), Dflt::Num(0.5);
+        torque_level: "", Kind::Number(Rule::Closed(0.0, 1.0)), Dflt::Num(0.1);
         /// the inertia phase (ASSUMED default)
         inertia_phase_s: "s", Kind::Number(Rule::Bounded { floor: 1e-4, ceil: 10.0 }), Dflt::Num(0.2);
     }

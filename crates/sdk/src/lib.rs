@@ -34,6 +34,7 @@ mod recording;
 mod run;
 mod scene_file;
 mod session;
+pub mod shifts;
 mod simulation;
 mod study_run;
 mod summary;

@@ -163,6 +163,10 @@ pub struct NetworkSummary {
     pub couplings: Vec<CouplingSummary>,
     /// The energy balance.
     pub energy: EnergySummary,
+    /// An automatic's shifts as the run made them (a `[transmission]` with a schedule;
+    /// otherwise empty and not written).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shifts: Vec<crate::shifts::ShiftSummary>,
 }
 
 /// A network run's outcome.
@@ -429,6 +433,10 @@ pub(crate) fn conclude(
         energy: EnergySummary {
             terms: e,
             residual_j: e.residual_j(),
+        },
+        shifts: match (&keep.shifts, &scene.transmission) {
+            (Some(p), Some(tr)) => p.report(net, tr, &keep.events),
+            _ => Vec::new(),
         },
     };
     let recording = match keep.recorder.take() {

@@ -49,6 +49,8 @@ pub(crate) struct Keep {
     pub recorder: Option<NetworkRecorder>,
     /// The recording's first error (it then stops the run).
     pub record_error: Option<clutchpack_record::RecordError>,
+    /// What an automatic's shifts need of the samples (a transmission with a schedule).
+    pub(crate) shifts: Option<crate::shifts::ShiftProbe>,
 }
 
 impl Keep {
@@ -67,6 +69,9 @@ impl Keep {
     /// windows of `windows_s` (s) if given.
     pub fn with_packs(mut self, scene: &Scene, keep_cycles: bool, windows_s: Option<f64>) -> Keep {
         self.keep_cycles = keep_cycles;
+        if let (Some(net), Some(tr)) = (&scene.network, &scene.transmission) {
+            self.shifts = crate::shifts::ShiftProbe::new(net, tr);
+        }
         if let Some(net) = &scene.network {
             for (k, (names, params)) in pack_params(scene, net) {
                 let curves = crate::fatigue::curves(&params);
@@ -159,6 +164,7 @@ impl Keep {
             open_contacts_at_s: self.open_contacts_at_s,
             recorder: None,
             record_error: None,
+            shifts: self.shifts.clone(),
         }
     }
 }
@@ -191,6 +197,9 @@ impl NetworkObserver for Obs<'_, '_> {
         }
         if k.keep_history {
             k.history.push(s.clone());
+        }
+        if let Some(p) = &mut k.shifts {
+            p.sample(s);
         }
     }
     fn clutch_event(&mut self, e: &ClutchEvent) {

@@ -98,24 +98,60 @@ pub struct GearKinematics {
     pub open_slips: Vec<(usize, f64)>,
 }
 
+/// The torque coupling `c` puts on body `body` per unit of its torque on its body `a` (the
+/// samples' `torque_n_m`): 1 on `a`; on `b` -1 for a clutch, `-ratio` for an ideal gear, the
+/// ring's and the carrier's coefficients over the sun's for a planetary set, -1 for a
+/// spring-damper; 0 for a body it does not touch; `None` where the torque on `a` does not
+/// give it (a gear mesh's, a resolved pack's other side).
+pub fn torque_factor(c: &super::Coupling, body: usize) -> Option<f64> {
+    use super::CouplingKind;
+    if let CouplingKind::Planetary(p) = &c.kind {
+        let row = p.row(0, c.a, c.b);
+        let first = row.terms()[0].1;
+        return Some(
+            row.terms()
+                .iter()
+                .find(|(i, _)| *i == body)
+                .map_or(0.0, |(_, ci)| ci / first),
+        );
+    }
+    if body == c.a {
+        return Some(1.0);
+    }
+    if body != c.b {
+        return Some(0.0);
+    }
+    match &c.kind {
+        CouplingKind::Clutch(_) | CouplingKind::SpringDamper(_) => Some(-1.0),
+        CouplingKind::IdealGear { ratio } => Some(-ratio),
+        CouplingKind::GearMesh(_) | CouplingKind::Pack(_) | CouplingKind::Planetary(_) => None,
+    }
+}
+
+/// One shift's hand-over: the off-going and on-coming elements (coupling indices) and its
+/// phases' corners `t0 <= t1 <= t2 <= t3` (s: start, fill's end, torque phase's end, inertia
+/// phase's end), and the gears it goes from and to (indices in [`Transmission::gears`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Handover {
+    /// The gear engaged before it.
+    pub from: usize,
+    /// The gear it reaches.
+    pub to: usize,
+    /// The element it opens.
+    pub off_going: usize,
+    /// The element it closes.
+    pub on_coming: usize,
+    /// `[t0, t1, t2, t3]`, s.
+    pub corners_s: [f64; 4],
+}
+
 impl Transmission {
-    /// Each element's normalized force over the schedule (the module's docs):
-    /// `(coupling index, signal)` for every element, or the index of the first shift that is
-    /// not a clutch-to-clutch shift from the gear engaged before it, with the reason. `None`
-    /// without an initial gear.
-    pub fn schedule(&self) -> Option<Result<ElementForces, (usize, String)>> {
+    /// Each shift's hand-over, in order, or the index of the first shift that is not a
+    /// clutch-to-clutch shift from the gear engaged before it, with the reason; `None` without
+    /// an initial gear.
+    pub fn handovers(&self) -> Option<Result<Vec<Handover>, (usize, String)>> {
         let mut gear = self.initial_gear?;
-        let elements = self.elements();
-        // each element's corners (t, force)
-        let mut knots: Vec<Vec<(f64, f64)>> = elements
-            .iter()
-            .map(|k| {
-                vec![(
-                    0.0,
-                    f64::from(u8::from(self.gears[gear].closed.contains(k))),
-                )]
-            })
-            .collect();
+        let mut out = Vec::new();
         let mut free_from = 0.0;
         for (i, sh) in self.shifts.iter().enumerate() {
             let (from, to) = (&self.gears[gear], &self.gears[sh.to]);
@@ -158,14 +194,49 @@ impl Transmission {
                     ),
                 )));
             }
-            let t0 = sh.at_s;
-            let t1 = t0 + sh.fill_s;
+            let t1 = sh.at_s + sh.fill_s;
             let t2 = t1 + sh.torque_phase_s;
             let t3 = t2 + sh.inertia_phase_s;
+            out.push(Handover {
+                from: gear,
+                to: sh.to,
+                off_going: off[0],
+                on_coming: on[0],
+                corners_s: [sh.at_s, t1, t2, t3],
+            });
+            gear = sh.to;
+            free_from = t3;
+        }
+        Some(Ok(out))
+    }
+
+    /// Each element's normalized force over the schedule (the module's docs):
+    /// `(coupling index, signal)` for every element, or the index of the first shift that is
+    /// not a clutch-to-clutch shift from the gear engaged before it, with the reason. `None`
+    /// without an initial gear.
+    pub fn schedule(&self) -> Option<Result<ElementForces, (usize, String)>> {
+        let gear = self.initial_gear?;
+        let handovers = match self.handovers()? {
+            Ok(h) => h,
+            Err(e) => return Some(Err(e)),
+        };
+        let elements = self.elements();
+        // each element's corners (t, force)
+        let mut knots: Vec<Vec<(f64, f64)>> = elements
+            .iter()
+            .map(|k| {
+                vec![(
+                    0.0,
+                    f64::from(u8::from(self.gears[gear].closed.contains(k))),
+                )]
+            })
+            .collect();
+        for (h, sh) in handovers.iter().zip(&self.shifts) {
+            let [t0, t1, t2, t3] = h.corners_s;
             for (e, k) in elements.iter().enumerate() {
-                let corners: &[(f64, f64)] = if *k == off[0] {
+                let corners: &[(f64, f64)] = if *k == h.off_going {
                     &[(t1, 1.0), (t2, 0.0)]
-                } else if *k == on[0] {
+                } else if *k == h.on_coming {
                     &[
                         (t0, 0.0),
                         (t1, sh.fill_level),
@@ -183,8 +254,6 @@ impl Transmission {
                     }
                 }
             }
-            gear = sh.to;
-            free_from = t3;
         }
         let mut signals = Vec::new();
         for (k, path) in elements.iter().zip(knots) {

@@ -466,9 +466,7 @@ fn network_scene(
     // forces and its initial gear the members' speeds)
     let transmission = match (&raw.transmission, &mut network) {
         (None, _) => Some(None),
-        (Some(t), Some(net)) => {
-            transmission::transmission(ck, t, net, bodies, simulation.as_ref()).map(Some)
-        }
+        (Some(t), Some(net)) => transmission::transmission(ck, t, net, bodies).map(Some),
         (Some(_), None) => None,
     };
     Some(Validated {

@@ -6,7 +6,6 @@
 use super::Checker;
 use crate::keys::{RawGear as G, RawNetBody, RawShift as S, RawTransmission as T};
 use crate::schema::{Key, RawTable};
-use crate::Simulation;
 use clutchpack_model::network::{CouplingKind, Gear, Network, Shift, Transmission};
 
 /// The names every gear closes, when `[transmission]` has an initial gear or shifts (its
@@ -39,7 +38,6 @@ pub(super) fn transmission(
     raw: &T,
     net: &mut Network,
     bodies: &[RawNetBody],
-    simulation: Option<&Simulation>,
 ) -> Option<Transmission> {
     let body = |ck: &mut Checker, key: &Key| {
         let path = key.at("transmission");
@@ -259,20 +257,6 @@ pub(super) fn transmission(
     }
     if !ok {
         return None;
-    }
-    let end_s = simulation.map_or(f64::INFINITY, |s| s.duration_s);
-    for (i, sh) in tr.shifts.iter().enumerate() {
-        if sh.end_s() > end_s {
-            ck.report(
-                format!("transmission.shifts[{i}].at_s"),
-                None,
-                format!(
-                    "the shift ends at {} s, after the run's end ({end_s} s)",
-                    clutchpack_model::fmt_num(sh.end_s())
-                ),
-            );
-            ok = false;
-        }
     }
     match tr.schedule() {
         Some(Ok(forces)) => {
