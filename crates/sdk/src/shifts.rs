@@ -6,7 +6,9 @@
 //! located mode changes.
 
 use clutchpack_model::network::gears::{torque_factor, Handover};
-use clutchpack_model::network::{ClutchEvent, ClutchMode, Network, NetworkSample, Transmission};
+use clutchpack_model::network::{
+    ClutchEvent, ClutchMode, CouplingKind, Network, NetworkSample, Transmission,
+};
 use serde::Serialize;
 
 /// The output torque below which a shift counts as a tie-up: this fraction of the smaller of
@@ -44,13 +46,15 @@ pub struct ShiftSummary {
     pub off_going_heat_j: f64,
     /// The heat the on-coming element took, J.
     pub on_coming_heat_j: f64,
-    /// The transmission's torque on its output at the shift's start, N m.
+    /// The transmission's torque on its output (its planetary sets' and shift elements'; not
+    /// a final drive's) at the shift's start, N m.
     pub output_torque_before_n_m: f64,
-    /// Its smallest value during the shift (to the next shift or the run's end), N m.
+    /// Its smallest value while the shift is under way (to the later of its scheduled end and
+    /// the on-coming's lock), N m.
     pub output_torque_min_n_m: f64,
     /// Its largest value, N m.
     pub output_torque_max_n_m: f64,
-    /// Its value at the window's end, N m.
+    /// Its value at the next shift's start (or the run's end), N m.
     pub output_torque_after_n_m: f64,
     /// The output torque fell below [`TIE_UP_FRACTION`] of the smaller of its values before
     /// and after.
@@ -89,8 +93,15 @@ impl ShiftProbe {
         if handovers.is_empty() {
             return None;
         }
+        // the transmission's own couplings: its gear sets and its shift elements (a final
+        // drive or a damper on the output is the output's load, not the transmission)
+        let elements_k = tr.elements();
         let mut output_factors = Vec::new();
         for (k, c) in net.couplings.iter().enumerate() {
+            let own = matches!(c.kind, CouplingKind::Planetary(_)) || elements_k.contains(&k);
+            if !own {
+                continue;
+            }
             let f = torque_factor(c, tr.output)?;
             if f != 0.0 {
                 output_factors.push((k, f));
@@ -172,9 +183,18 @@ impl ShiftProbe {
                 .last()
                 .map_or(0.0, |r| r.output_torque_n_m);
             let after = window.last().map_or(before, |r| r.output_torque_n_m);
-            let (min, max) = window.iter().fold((before, before), |(lo, hi), r| {
-                (lo.min(r.output_torque_n_m), hi.max(r.output_torque_n_m))
-            });
+            // the extremes while the shift is under way: to the later of its scheduled end and
+            // the on-coming's lock
+            let active_end = locked
+                .unwrap_or(h.corners_s[3])
+                .max(h.corners_s[3])
+                .min(until);
+            let (min, max) = window
+                .iter()
+                .filter(|r| r.t_s <= active_end)
+                .fold((before, before), |(lo, hi), r| {
+                    (lo.min(r.output_torque_n_m), hi.max(r.output_torque_n_m))
+                });
             let heat = |k: usize| {
                 let e = self.elements.iter().position(|x| x.0 == k).unwrap_or(0);
                 window
