@@ -122,7 +122,8 @@ impl Stepper {
         }
     }
 
-    /// Advances to `t_end` s, a step ending there.
+    /// Advances to `t_end` s (the reference engine may have taken its step past it, answering
+    /// for `t_end` from its dense output).
     fn advance_to(
         &mut self,
         t_end: f64,

@@ -190,6 +190,20 @@ impl Equations {
         }
     }
 
+    /// The bodies' kinetic energy at the state `y`, J, with every pack's discs and plates.
+    fn kinetic_j(&self, y: &[f64]) -> f64 {
+        let net = &self.net;
+        let n = net.bodies.len();
+        let w = &y[n..2 * n];
+        net.bodies
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| !b.fixed)
+            .map(|(i, b)| 0.5 * b.inertia_kg_m2 * y[n + i] * y[n + i])
+            .sum::<f64>()
+            + self.packs.iter().map(|p| p.kinetic_j(y, w)).sum::<f64>()
+    }
+
     /// The state's length: the bodies' angles and speeds, a slot and a counter per coupling,
     /// the drives', loads' and drag's counters, then every pack's state.
     fn dim(&self) -> usize {
