@@ -767,17 +767,23 @@ fn a_shift_schedule_that_cannot_be_driven_is_named_at_its_key() {
 
 /// The same 1 -> 2 shift with the on-coming element applied harder in the torque phase
 /// (`torque_level` 0.5 instead of 0.1) fights the off-going one: the output torque falls to
-/// about -260 N m from 1262 N m before (a tie-up, flagged), and the on-coming element takes
-/// twice the heat (measured 6339 J against 3158 J). On the reference engine.
+/// about -190 N m from 1262 N m before (a tie-up, flagged), and the on-coming element takes
+/// more heat (measured 5037 J against 3158 J: 1.59 times; asserted 1.3). `compare` of the two
+/// runs' recordings names the harder shift as the one that heats its on-coming element most.
+/// On the reference engine.
 #[test]
 fn a_harder_overlap_is_flagged_a_tie_up_and_heats_the_on_coming_element_more() {
     let d = scratch("eight-speed-tie-up");
     let shift = |level: &str, name: &str| -> Value {
-        let json = d.join(format!("{name}.json"));
+        let (json, mcap) = (
+            d.join(format!("{name}.json")),
+            d.join(format!("{name}.mcap")),
+        );
         let o = run(&[
             "run",
             "scenes/eight-speed.toml",
-            "--no-record",
+            "--out",
+            mcap.to_str().unwrap(),
             "--duration",
             "1.9",
             "--set",
@@ -793,7 +799,7 @@ fn a_harder_overlap_is_flagged_a_tie_up_and_heats_the_on_coming_element_more() {
     assert_eq!(hard["tie_up"], true, "{hard}");
     let heat = |s: &Value| s["on_coming_heat_j"].as_f64().unwrap();
     assert!(
-        heat(&hard) > 1.5 * heat(&soft),
+        heat(&hard) > 1.3 * heat(&soft),
         "{} {}",
         heat(&hard),
         heat(&soft)
@@ -801,6 +807,21 @@ fn a_harder_overlap_is_flagged_a_tie_up_and_heats_the_on_coming_element_more() {
     assert!(
         hard["output_torque_min_n_m"].as_f64().unwrap() < 0.0,
         "{hard}"
+    );
+    let o = run(&[
+        "compare",
+        d.join("soft.mcap").to_str().unwrap(),
+        d.join("hard.mcap").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = super::stdout(&o);
+    let verdict = out
+        .lines()
+        .find(|l| l.starts_with("the shift that heats its on-coming element most"))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(
+        verdict.contains("1 -> 2 (E)") && verdict.contains("hard.mcap"),
+        "{out}"
     );
 }
 

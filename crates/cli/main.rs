@@ -51,6 +51,7 @@ mod network;
 mod outputs;
 mod recording;
 mod run;
+mod shift_compare;
 mod signals;
 mod study;
 mod sweep;

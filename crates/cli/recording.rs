@@ -392,6 +392,7 @@ pub fn compare(a: CompareArgs) -> Result<ExitCode> {
 type NetworkRun = (
     Vec<clutchpack_sdk::analysis::ClutchRun>,
     Vec<clutchpack_sdk::analysis::PackBodyRun>,
+    Vec<serde_json::Value>,
 );
 
 /// The clutches (lumped and resolved packs) and the packs' bodies of a network recording,
@@ -429,7 +430,7 @@ fn network_clutches(f: &Path, reader: &RecordingReader) -> Result<NetworkRun> {
             net.impacts.len(),
             net.open_contacts
         );
-        return Ok((Vec::new(), bodies));
+        return Ok((Vec::new(), bodies, Vec::new()));
     };
     let couplings = summary["couplings"].as_array().cloned().unwrap_or_default();
     let bodies = couplings
@@ -465,7 +466,8 @@ fn network_clutches(f: &Path, reader: &RecordingReader) -> Result<NetworkRun> {
             }
         })
         .collect();
-    Ok((clutches, bodies))
+    let shifts = summary["shifts"].as_array().cloned().unwrap_or_default();
+    Ok((clutches, bodies, shifts))
 }
 
 /// `compare` of network recordings: per run and clutch (lumped or a resolved pack) its heat,
@@ -487,17 +489,22 @@ fn compare_networks(a: &CompareArgs, networks: &[(String, NetworkRun)]) -> Resul
     }
     let clutches: Vec<_> = networks
         .iter()
-        .map(|(run, (c, _))| (run.clone(), c.clone()))
+        .map(|(run, (c, _, _))| (run.clone(), c.clone()))
         .collect();
     let bodies: Vec<_> = networks
         .iter()
-        .map(|(run, (_, b))| (run.clone(), b.clone()))
+        .map(|(run, (_, b, _))| (run.clone(), b.clone()))
+        .collect();
+    let shifts: Vec<_> = networks
+        .iter()
+        .map(|(run, (_, _, s))| (run.clone(), s.clone()))
         .collect();
     let rows = clutch_compare_rows(&clutches);
     let body_rows = pack_body_compare_rows(&bodies);
     let format = match a.format {
         CompareFormat::Json => {
-            let both = serde_json::json!({ "clutches": rows, "pack_bodies": body_rows });
+            let both =
+                serde_json::json!({ "clutches": rows, "pack_bodies": body_rows, "shifts": shifts });
             out!("{}", serde_json::to_string_pretty(&both)?);
             return Ok(ExitCode::SUCCESS);
         }
@@ -513,6 +520,9 @@ fn compare_networks(a: &CompareArgs, networks: &[(String, NetworkRun)]) -> Resul
         out!("{}", pack_body_compare_table(&body_rows, format).trim_end());
     }
     if format == TableFormat::Text {
+        for line in crate::shift_compare::lines(&shifts) {
+            out!("{line}");
+        }
         out!("changes against the first run, per cent; shift: the first lock's, s");
         if let Some(h) = hottest_clutch(&rows) {
             out!(
