@@ -239,15 +239,7 @@ fn a_planetary_set_that_cannot_be_built_is_named_at_its_key() {
             "ideal gear",
         ),
     ];
-    for (from, to, key, why) in cases {
-        assert!(text.contains(from), "{from}");
-        let bad = d.join("bad.toml");
-        std::fs::write(&bad, text.replace(from, to)).unwrap();
-        let o = run(&["check", bad.to_str().unwrap()]);
-        assert_eq!(o.status.code(), Some(2), "{to}: {}", stderr(&o));
-        let e = stderr(&o);
-        assert!(e.contains(key) && e.contains(why), "{to}: {e}");
-    }
+    refused_at_their_keys(&d, &text, &cases);
 }
 
 /// `scenes/simple-gear-shift.toml`, Modelica's `Rotational.Examples.SimpleGearShift`, against
@@ -397,6 +389,20 @@ fn without_grazes(c: Vec<(f64, String, String)>) -> Vec<(f64, String, String)> {
     out
 }
 
+/// Each case `(from, to, key, why)`: `text` with its first `from` replaced by `to`, written
+/// into `d`, is refused by `check` with exit 2 and a message naming `key` and saying `why`.
+fn refused_at_their_keys(d: &Path, text: &str, cases: &[(&str, &str, &str, &str)]) {
+    for &(from, to, key, why) in cases {
+        assert!(text.contains(from), "{from}");
+        let bad = d.join("bad.toml");
+        std::fs::write(&bad, text.replacen(from, to, 1)).unwrap();
+        let o = run(&["check", bad.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{to}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains(key) && e.contains(why), "{to}: {e}");
+    }
+}
+
 /// Both engines' summaries of `scene`.
 fn both(scene: &str, d: &Path) -> [Value; 2] {
     ["reference", "multibody"].map(|e| summary(Path::new(scene), e, d))
@@ -523,15 +529,7 @@ fn a_one_way_clutch_that_starts_backwards_is_named_at_its_key() {
             "clutch",
         ),
     ];
-    for (from, to, key, why) in cases {
-        assert!(text.contains(from), "{from}");
-        let bad = d.join("bad.toml");
-        std::fs::write(&bad, text.replace(from, to)).unwrap();
-        let o = run(&["check", bad.to_str().unwrap()]);
-        assert_eq!(o.status.code(), Some(2), "{to}: {}", stderr(&o));
-        let e = stderr(&o);
-        assert!(e.contains(key) && e.contains(why), "{to}: {e}");
-    }
+    refused_at_their_keys(&d, &text, &cases);
 }
 
 /// `clutchpack check scenes/eight-speed.toml` prints every gear's ratio from the constraints
@@ -611,15 +609,7 @@ fn a_gear_that_is_no_gear_is_named_at_its_key() {
             "names no body",
         ),
     ];
-    for (from, to, key, why) in cases {
-        assert!(text.contains(from), "{from}");
-        let bad = d.join("bad.toml");
-        std::fs::write(&bad, text.replacen(from, to, 1)).unwrap();
-        let o = run(&["check", bad.to_str().unwrap()]);
-        assert_eq!(o.status.code(), Some(2), "{to}: {}", stderr(&o));
-        let e = stderr(&o);
-        assert!(e.contains(key) && e.contains(why), "{to}: {e}");
-    }
+    refused_at_their_keys(&d, &text, &cases);
 }
 
 /// The upshifts 1 -> 2 at 1.0 s and 2 -> 3 at 2.0 s of `scenes/eight-speed.toml`, compiled from
@@ -754,15 +744,7 @@ fn a_shift_schedule_that_cannot_be_driven_is_named_at_its_key() {
             "needs transmission.initial_gear",
         ),
     ];
-    for (from, to, key, why) in cases {
-        assert!(text.contains(from), "{from}");
-        let bad = d.join("bad.toml");
-        std::fs::write(&bad, text.replacen(from, to, 1)).unwrap();
-        let o = run(&["check", bad.to_str().unwrap()]);
-        assert_eq!(o.status.code(), Some(2), "{to}: {}", stderr(&o));
-        let e = stderr(&o);
-        assert!(e.contains(key) && e.contains(why), "{to}: {e}");
-    }
+    refused_at_their_keys(&d, &text, &cases);
 }
 
 /// The same 1 -> 2 shift with the on-coming element applied harder in the torque phase
