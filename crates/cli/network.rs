@@ -324,6 +324,11 @@ fn plot(
         .map(|b| (b.name.as_str(), b.fixed))
         .collect();
     let couplings: Vec<&str> = net.couplings.iter().map(|c| c.name.as_str()).collect();
+    // an automatic's output torque (a transmission with a schedule)
+    let output = scene
+        .transmission
+        .as_ref()
+        .and_then(|tr| clutchpack_sdk::shifts::output_torque_series(net, tr, &outcome.history));
     plot_samples(
         path,
         &scene.name,
@@ -332,6 +337,7 @@ fn plot(
         &couplings,
         &outcome.history,
         &outcome.impacts,
+        output,
     )
 }
 
@@ -421,6 +427,7 @@ pub fn plot_recording(
         &couplings,
         &net.samples,
         &net.impact_peaks(),
+        None,
     )?;
     out!("{}", out.display());
     Ok(ExitCode::SUCCESS)
@@ -430,8 +437,11 @@ pub fn plot_recording(
 /// its body a against time; `bodies` are (name, fixed) in scene order. With `impacts`
 /// (`(name, t_peak s, peak N)` as [`clutchpack_sdk::NetworkOutcome::impacts`] names them) a
 /// third panel: each impact's |peak| per tooth at its time, one colour per pack's discs, per
-/// pack's plates and per gear mesh. `run --plot` of a network scene and `plot` of a network
+/// pack's plates and per gear mesh, or, when 10 bodies or fewer have impacts, one colour per
+/// disc and per plate (each body's peaks). With `output` (`(t s, N m)`) a panel of an
+/// automatic's output torque. `run --plot` of a network scene and `plot` of a network
 /// recording draw it.
+#[allow(clippy::too_many_arguments)]
 pub fn plot_samples(
     path: &Path,
     scene: &str,
@@ -440,6 +450,7 @@ pub fn plot_samples(
     couplings: &[&str],
     history: &[clutchpack_sdk::NetworkSample],
     impacts: &[(String, f64, f64)],
+    output: Option<Vec<(f64, f64)>>,
 ) -> Result<()> {
     let series = |name: &str, f: &dyn Fn(&clutchpack_sdk::NetworkSample) -> f64| {
         (
@@ -470,13 +481,26 @@ pub fn plot_samples(
             markers_only: false,
         },
     ];
+    if let Some(output) = output {
+        panels.push(clutchpack_sdk::analysis::Panel {
+            y_label: "output torque [N m]".into(),
+            series: vec![("transmission on its output".into(), output)],
+            markers_only: false,
+        });
+    }
     if !impacts.is_empty() {
-        // one series per pack's discs, per pack's plates, per mesh: "K1/discs/disc-3" -> "K1 discs"
+        // one series per disc and plate ("K1/discs/disc-3" -> "K1 disc-3") when there are few
+        // enough for a legend, else per pack's discs, per pack's plates ("K1 discs"); per mesh
+        let mut names: Vec<&str> = impacts.iter().map(|i| i.0.as_str()).collect();
+        names.sort_unstable();
+        names.dedup();
+        let per_body = names.len() <= 10;
         let mut groups: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
         for (name, t, peak) in impacts {
             let mut parts = name.splitn(3, '/');
-            let group = match (parts.next(), parts.next()) {
-                (Some(pack), Some(role)) => format!("{pack} {role}"),
+            let group = match (parts.next(), parts.next(), parts.next()) {
+                (Some(pack), Some(_), Some(body)) if per_body => format!("{pack} {body}"),
+                (Some(pack), Some(role), _) => format!("{pack} {role}"),
                 _ => name.clone(),
             };
             match groups.iter_mut().find(|g| g.0 == group) {

@@ -112,6 +112,7 @@ mod export;
 pub mod info;
 mod network;
 mod network_packs;
+mod network_view;
 pub mod output;
 pub mod proto;
 mod read;

@@ -19,26 +19,30 @@
 //! | `/network/events` | `foxglove.Log` | each clutch mode change, at its instant |
 //! | `/network/impacts` | `clutchpack.Impact` | each gear-mesh impact and each tooth impact of a pack's disc or plate (`<pack>/discs/<disc>`, `<pack>/plates/<plate>`), logged when its contact closes (in time order; the message holds its peak's time) |
 //! | `/network/contacts` | `clutchpack.Impact` | every [`OPEN_CONTACTS_EVERY_S`]: each contact still open, as it would close then (named as the impacts; superseded by its impact when it closes; what a killed run keeps of contacts that last) |
-//! | `/tf` | `foxglove.FrameTransforms` | each sample: `world` -> `body/<segment>` |
-//! | `/scene` | `foxglove.SceneUpdate` | t = 0: every body as a disc with a marker and its name |
-//! | `/scene/couplings` | `foxglove.SceneUpdate` | t = 0 and at each mode change |
-//! | `/pack/body/<segment>` | `foxglove.PointCloud` | t = 0: each body as points, for Rerun |
+//! | `/tf` | `foxglove.FrameTransforms` | each sample: `world` -> `row/0` -> `row/1` ..., `row/<i>` -> `body/<segment>`; a pack's rings on their carrier's place; each planetary set's `planetary/<set>/set` (chained) -> its sun, ring and carrier -> its planets ([`crate::network_view`]) |
+//! | `/scene` | `foxglove.SceneUpdate` | t = 0: every body as a disc with a marker and its name; the packs' rings; the planetary sets |
+//! | `/scene/couplings` | `foxglove.SceneUpdate` | t = 0 and at each mode change: the couplings' diagram |
+//! | `/scene/status` | `foxglove.SceneUpdate` | an automatic's gear and shift phase, at t = 0 and at each change (a scene with a `[transmission]`) |
+//! | `/pack/body/<segment>`, `/pack/planetary/<set>/<part>`, `/pack/pack/<pack>/<body>` | `foxglove.PointCloud` | t = 0: each body, gearset part and pack ring as points, for Rerun |
+//! | `/pack/network/couplings` | `foxglove.PointCloud` | the couplings' diagram as points (Rerun), with `/scene/couplings` |
 //!
 //! The summary of the run (the JSON of `run --summary-json`) is attached at the end as
 //! `summary.json`.
 
 use crate::info::{num, RunInfo};
+use crate::network_view::{Status, View, DRAWN_THICKNESS_M};
 use crate::output::{PendingFile, Replace};
-use crate::view3d::{about_z, entity, pose, rgba, timestamp, v3};
+use crate::view3d::{entity, pose, rgba, timestamp, v3};
 use crate::write::{
     close_mcap, open_mcap, unique_segments, write_message, RecordError, RecordOptions,
 };
 use crate::{log_time_ns, proto, ros2, topics};
-use clutchpack_model::network::{ClutchEvent, ClutchMode, CouplingKind, Network, NetworkSample};
+use clutchpack_model::network::{
+    ClutchEvent, ClutchMode, CouplingKind, Network, NetworkSample, Transmission,
+};
 use clutchpack_model::ImpactEvent;
 use foxglove::schemas::{
-    line_primitive, CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms,
-    LinePrimitive, Log, Point3, SceneUpdate, TextPrimitive,
+    CubePrimitive, CylinderPrimitive, FrameTransforms, Log, SceneUpdate, TextPrimitive,
 };
 use std::borrow::Cow;
 use std::collections::BTreeMap;
@@ -58,39 +62,6 @@ pub const META_NETWORK: &str = "clutchpack.network";
 /// Name of the attachment holding the run's summary (JSON), written by
 /// [`NetworkRecorder::finish`].
 pub const SUMMARY_ATTACHMENT: &str = "summary.json";
-
-/// Thickness of the steel disc a body is drawn as, m: its drawn radius is that of a disc of
-/// this thickness with the body's inertia (the drawing says how heavy a body is, not its
-/// shape), between [`MIN_DRAWN_RADIUS_M`] and [`MAX_DRAWN_RADIUS_M`].
-const DRAWN_THICKNESS_M: f64 = 0.02;
-/// Smallest drawn radius, m (a fixed body's).
-const MIN_DRAWN_RADIUS_M: f64 = 0.05;
-/// Largest drawn radius, m (a vehicle reduced to a shaft would be metres wide).
-const MAX_DRAWN_RADIUS_M: f64 = 0.4;
-/// Steel, kg/m^3.
-const STEEL_DENSITY_KG_M3: f64 = 7850.0;
-
-/// The drawn radius of a body of inertia `j` (kg m^2), m: a steel disc
-/// [`DRAWN_THICKNESS_M`] thick, `J = pi rho t r^4 / 2`, clamped.
-fn drawn_radius_m(j: f64, fixed: bool) -> f64 {
-    if fixed || j.is_nan() || j <= 0.0 {
-        return MIN_DRAWN_RADIUS_M;
-    }
-    (2.0 * j / (std::f64::consts::PI * STEEL_DENSITY_KG_M3 * DRAWN_THICKNESS_M))
-        .powf(0.25)
-        .clamp(MIN_DRAWN_RADIUS_M, MAX_DRAWN_RADIUS_M)
-}
-
-/// The colour of a coupling in `/scene/couplings`: grey for a gear or a spring, and for a
-/// clutch by mode (free light grey, slipping orange, locked green).
-fn coupling_color(mode: Option<ClutchMode>) -> Option<foxglove::schemas::Color> {
-    match mode {
-        None => rgba(0.55, 0.58, 0.62, 1.0),
-        Some(ClutchMode::Free) => rgba(0.8, 0.8, 0.8, 1.0),
-        Some(ClutchMode::Locked) => rgba(0.1, 0.75, 0.25, 1.0),
-        Some(_) => rgba(1.0, 0.55, 0.0, 1.0),
-    }
-}
 
 /// The name of a tooth impact on `/network/impacts`: a gear mesh's (`body` `None`) its
 /// coupling's name; a pack's disc's or plate's (`body` its index in the pack, discs then
@@ -161,6 +132,8 @@ struct Channels {
     tf: u16,
     scene: u16,
     scene_couplings: u16,
+    /// The `foxglove.SceneUpdate` schema's id (for the status channel added later).
+    scene_schema: u16,
     /// Per resolved pack (by coupling): its joints' channel and its bodies' names.
     pack_joints: BTreeMap<usize, (u16, Vec<String>)>,
     /// Per thermal resolved pack (by coupling): its bodies' temperature channels, then its
@@ -180,10 +153,15 @@ pub struct NetworkRecorder {
     ch: Channels,
     body_names: Vec<String>,
     coupling_names: Vec<String>,
-    /// x of each body's centre in the world frame, m
-    x_m: Vec<f64>,
-    /// the largest drawn radius, m (the couplings' lanes start beyond it)
-    max_radius_m: f64,
+    /// the 3D view's layout, the couplings' diagram and the planetary sets
+    view: View,
+    /// an automatic's gear and shift phase, with the channel it goes on and the line last
+    /// written
+    status: Option<(Status, u16, String)>,
+    /// the couplings' diagram as points (Rerun), redrawn with `/scene/couplings`
+    diagram_points: u16,
+    /// each body's frame (`body/<segment>`)
+    frames: Vec<String>,
     sequences: BTreeMap<u16, u32>,
     buf: Vec<u8>,
     tf: FrameTransforms,
@@ -370,6 +348,7 @@ impl NetworkRecorder {
             )?,
             tf: channel(&mut w, s_tf, topics::TF, "protobuf", none())?,
             scene: channel(&mut w, s_scene, topics::SCENE, "protobuf", none())?,
+            scene_schema: s_scene,
             scene_couplings: channel(
                 &mut w,
                 s_scene,
@@ -389,37 +368,25 @@ impl NetworkRecorder {
             let topic = format!("{}{}", topics::PACK_PREFIX, body_frame(seg));
             clouds.push(channel(&mut w, s_cloud, &topic, "protobuf", none())?);
         }
-        // the bodies side by side along x, a drawn radius apart plus a gap
-        let radii: Vec<f64> = net
-            .bodies
-            .iter()
-            .map(|b| drawn_radius_m(b.inertia_kg_m2, b.fixed))
-            .collect();
-        let mut x_m = Vec::with_capacity(radii.len());
-        let mut x = 0.0;
-        for (i, r) in radii.iter().enumerate() {
-            if i > 0 {
-                x += radii[i - 1] + 0.1 + r;
-            }
-            x_m.push(x);
+        let view = View::new(net);
+        let diagram_points = channel(
+            &mut w,
+            s_cloud,
+            topics::NETWORK_DIAGRAM_POINTS,
+            "protobuf",
+            none(),
+        )?;
+        let mut set_clouds = Vec::new();
+        let packs = crate::network_packs::PacksDrawing::new(net, &view.radii, DRAWN_THICKNESS_M);
+        for (frame, c) in view.set_clouds().into_iter().chain(packs.clouds()) {
+            let topic = format!("{}{frame}", topics::PACK_PREFIX);
+            set_clouds.push((channel(&mut w, s_cloud, &topic, "protobuf", none())?, c));
         }
         let frames: Vec<String> = body_segments.iter().map(|s| body_frame(s)).collect();
-        let tf = FrameTransforms {
-            transforms: frames
-                .iter()
-                .zip(&x_m)
-                .map(|(f, x)| FrameTransform {
-                    timestamp: Some(timestamp(0)),
-                    parent_frame_id: crate::view3d::WORLD_FRAME.into(),
-                    child_frame_id: f.clone(),
-                    translation: Some(v3(*x, 0.0, 0.0)),
-                    rotation: Some(about_z(0.0)),
-                })
-                .collect(),
-        };
+        let mut tf = FrameTransforms::default();
+        view.transforms(&frames, 0, &vec![0.0; frames.len()], &mut tf.transforms);
         let n = body_names.len();
         let m = coupling_names.len();
-        let packs = crate::network_packs::PacksDrawing::new(net, &x_m, &radii, DRAWN_THICKNESS_M);
         let mut rec = NetworkRecorder {
             packs,
             path,
@@ -429,8 +396,10 @@ impl NetworkRecorder {
             ch,
             body_names,
             coupling_names,
-            x_m,
-            max_radius_m: radii.iter().fold(MIN_DRAWN_RADIUS_M, |a, &r| a.max(r)),
+            view,
+            status: None,
+            diagram_points,
+            frames: frames.clone(),
             sequences: BTreeMap::new(),
             buf: Vec::with_capacity(1024),
             tf,
@@ -446,22 +415,25 @@ impl NetworkRecorder {
             started: std::time::Instant::now(),
             failed: false,
         };
-        let scene = rec.static_scene(&frames, &radii);
+        let scene = rec.static_scene(&frames);
         rec.put(rec.ch.scene, 0, &scene, "/scene")?;
+        let radii = rec.view.radii.clone();
         for ((ch, frame), &r) in clouds.into_iter().zip(&frames).zip(&radii) {
             rec.put(ch, 0, &body_points(frame, r), "body points")?;
         }
-        let couplings = rec.coupling_scene(0);
-        rec.put(rec.ch.scene_couplings, 0, &couplings, "/scene/couplings")?;
+        for (ch, c) in set_clouds {
+            rec.put(ch, 0, &c, "planetary set and pack ring points")?;
+        }
+        rec.put_couplings(0)?;
         Ok(rec)
     }
 
     /// Every body as a disc in its frame, with a marker on its rim (so its rotation shows)
     /// and its name above it.
-    fn static_scene(&self, frames: &[String], radii: &[f64]) -> SceneUpdate {
+    fn static_scene(&self, frames: &[String]) -> SceneUpdate {
         let mut entities: Vec<_> = frames
             .iter()
-            .zip(radii)
+            .zip(&self.view.radii)
             .zip(&self.net.bodies)
             .map(|((frame, &r), b)| {
                 let mut e = entity(0, frame, frame);
@@ -490,49 +462,92 @@ impl NetworkRecorder {
             })
             .collect();
         entities.extend(self.packs.entities());
+        entities.extend(self.view.set_entities());
         SceneUpdate {
             deletions: Vec::new(),
             entities,
         }
     }
 
-    /// Every coupling as a wire from body `a`'s centre out to its own lane in front of the
-    /// bodies, along it and back to body `b`'s centre (a diagram of the driveline under the
-    /// turning bodies), coloured by its mode, its name (and a clutch's mode) on its lane.
-    fn coupling_scene(&self, log_time_ns: u64) -> SceneUpdate {
-        let mut e = entity(log_time_ns, crate::view3d::WORLD_FRAME, "couplings");
-        let z = -0.6 * DRAWN_THICKNESS_M;
-        for (k, c) in self.net.couplings.iter().enumerate() {
-            let lane = -(self.max_radius_m + 0.08 + 0.07 * k as f64);
-            let (xa, xb) = (self.x_m[c.a], self.x_m[c.b]);
-            let color = coupling_color(self.drawn_modes[k]);
-            let p = |x: f64, y: f64| Point3 { x, y, z };
-            e.lines.push(LinePrimitive {
-                r#type: line_primitive::Type::LineStrip as i32,
-                pose: pose(0.0, 0.0, 0.0, 0.0),
-                thickness: 4.0,
-                scale_invariant: true,
-                points: vec![p(xa, 0.0), p(xa, lane), p(xb, lane), p(xb, 0.0)],
-                color,
-                ..Default::default()
-            });
-            let label = match self.drawn_modes[k] {
-                Some(mode) => format!("{} ({})", c.name, mode.label()),
-                None => c.name.clone(),
-            };
-            e.texts.push(TextPrimitive {
-                pose: pose(0.5 * (xa + xb), lane, z + 0.01, 0.0),
-                billboard: true,
-                font_size: 12.0,
-                scale_invariant: true,
-                color,
-                text: label,
-            });
+    /// The couplings' diagram at `log_time_ns` as the modes last drawn: `/scene/couplings` and
+    /// its points.
+    fn put_couplings(&mut self, log_time_ns: u64) -> Result<(), RecordError> {
+        let scene = self
+            .view
+            .coupling_scene(&self.net, &self.drawn_modes, log_time_ns);
+        self.put(
+            self.ch.scene_couplings,
+            log_time_ns,
+            &scene,
+            "/scene/couplings",
+        )?;
+        let mut points = self.view.coupling_points(&self.net, &self.drawn_modes);
+        points.timestamp = Some(timestamp(log_time_ns));
+        self.put(
+            self.diagram_points,
+            log_time_ns,
+            &points,
+            "couplings' points",
+        )
+    }
+
+    /// Shows `tr`'s gear and shift phase over the scene from now on (a scene with a
+    /// `[transmission]`): a text on `/scene/status` and a line on `/network/events` at t = 0
+    /// and whenever it changes.
+    pub fn set_transmission(&mut self, tr: &Transmission) -> Result<(), RecordError> {
+        let id = match self.writer.as_mut() {
+            Some(w) => {
+                let s_scene = self.ch.scene_schema;
+                w.add_channel(
+                    s_scene,
+                    topics::NETWORK_SCENE_STATUS,
+                    "protobuf",
+                    &BTreeMap::new(),
+                )
+                .map_err(|cause| RecordError::Write {
+                    path: self.path.clone(),
+                    what: "channel".into(),
+                    cause,
+                })?
+            }
+            None => {
+                return Err(RecordError::AlreadyFailed {
+                    path: self.path.clone(),
+                })
+            }
+        };
+        self.status = Some((Status::new(tr), id, String::new()));
+        self.put_status(self.last_t_s)
+    }
+
+    /// Writes the status line at `t_s` if it changed.
+    fn put_status(&mut self, t_s: f64) -> Result<(), RecordError> {
+        let Some((status, id, last)) = &self.status else {
+            return Ok(());
+        };
+        let label = status.label(t_s, &self.drawn_modes);
+        if label == *last {
+            return Ok(());
         }
-        SceneUpdate {
-            deletions: Vec::new(),
-            entities: vec![e],
+        let id = *id;
+        let ns = log_time_ns(t_s);
+        let y = self.view.lanes_y_m();
+        let z = self.view.bottom_m(self.net.couplings.len()) - 0.35;
+        let scene = Status::scene(&label, y, z, ns);
+        self.put(id, ns, &scene, "/scene/status")?;
+        let log = Log {
+            timestamp: Some(timestamp(ns)),
+            level: foxglove::schemas::log::Level::Info as i32,
+            message: label.clone(),
+            name: "clutchpack".into(),
+            file: String::new(),
+            line: 0,
+        };
+        self.put(self.ch.events, ns, &log, "/network/events")?;
+        if let Some((_, _, last)) = &mut self.status {
+            *last = label;
         }
+        Ok(())
     }
 
     /// The file being written (the temporary file until [`Self::finish`]).
@@ -619,21 +634,18 @@ impl NetworkRecorder {
         torques.copy_from_slice(&s.torque_n_m);
         ros2::joint_state(&mut self.buf, ns, &self.coupling_names, &[], slips, torques);
         self.put_buf(self.ch.coupling_joints, ns, "coupling joints")?;
-        let ts = timestamp(ns);
-        for (tr, angle) in self.tf.transforms.iter_mut().zip(&s.angle_rad) {
-            tr.timestamp = Some(ts);
-            tr.rotation = Some(about_z(*angle));
-        }
+        self.tf.transforms.clear();
+        self.view
+            .transforms(&self.frames, ns, &s.angle_rad, &mut self.tf.transforms);
         let tf = std::mem::take(&mut self.tf);
         let r = self.put(self.ch.tf, ns, &tf, "/tf");
         self.tf = tf;
         r?;
         if s.mode != self.drawn_modes {
             self.drawn_modes.clone_from(&s.mode);
-            let scene = self.coupling_scene(ns);
-            self.put(self.ch.scene_couplings, ns, &scene, "/scene/couplings")?;
+            self.put_couplings(ns)?;
         }
-        Ok(())
+        self.put_status(t)
     }
 
     /// Writes a clutch's mode change as a log line on `/network/events`.

@@ -4,7 +4,7 @@
 //! (`pack/<pack>/<body>`) that turns with the body's absolute angle, so that the discs'
 //! rattle against their carrier and the faces' slip show as the rings' markers drift apart.
 
-use crate::view3d::{about_z, entity, pose, rgba, timestamp, v3, WORLD_FRAME};
+use crate::view3d::{about_z, entity, pose, rgba, timestamp, v3};
 use crate::write::unique_segments;
 use clutchpack_model::network::Network;
 use clutchpack_model::StackBody;
@@ -24,8 +24,8 @@ struct PackDrawing {
     /// Each body's frame (discs, then plates), its height on the axis (m) and its drawn
     /// radius (m).
     rings: Vec<(String, f64, f64)>,
-    /// x of the disc carrier's centre, m.
-    x_m: f64,
+    /// The disc carrier's place on the row ([`crate::network_view::row_frame`]).
+    place: String,
     /// How many of the rings are friction discs (the rest are plates).
     discs: usize,
     /// The pack's label: its name and its discs and plates.
@@ -38,11 +38,11 @@ pub(crate) struct PacksDrawing {
 }
 
 impl PacksDrawing {
-    /// The packs of `net` drawn on their disc carriers at `x_m` (each body's centre, m) with
+    /// The packs of `net` drawn on their disc carriers' places on the row, with the bodies'
     /// drawn radii `radii` (m): a pack's rings a little wider than its carrier's disc (the
     /// plates the wider), stacked in stack order (plate, disc, ..., plate) upwards from just
     /// above it.
-    pub fn new(net: &Network, x_m: &[f64], radii: &[f64], body_thickness_m: f64) -> PacksDrawing {
+    pub fn new(net: &Network, radii: &[f64], body_thickness_m: f64) -> PacksDrawing {
         let packs = net
             .couplings
             .iter()
@@ -78,7 +78,7 @@ impl PacksDrawing {
                     label: format!("{} ({nd} discs, {} plates)", c.name, p.plates.len()),
                     coupling: k,
                     rings,
-                    x_m: x_m[c.a],
+                    place: crate::network_view::row_frame(c.a),
                     discs: nd,
                 })
             })
@@ -131,6 +131,35 @@ impl PacksDrawing {
         out
     }
 
+    /// Every ring as points in its frame (for Rerun, which does not draw scene updates): a
+    /// disc brown, a plate grey, each with a dark marker, as in [`Self::entities`].
+    pub fn clouds(&self) -> Vec<(String, foxglove::schemas::PointCloud)> {
+        let mut out = Vec::new();
+        for p in &self.packs {
+            for (i, (frame, _, r)) in p.rings.iter().enumerate() {
+                let color = if i < p.discs {
+                    [140, 84, 38, 255]
+                } else {
+                    [184, 189, 199, 255]
+                };
+                let mut data = Vec::new();
+                crate::view3d::annulus_points(&mut data, 0.75 * r, *r, RING_THICKNESS_M, color);
+                for k in 0..5 {
+                    let x = r * (0.8 + 0.04 * f64::from(k));
+                    crate::view3d::push_point(
+                        &mut data,
+                        x,
+                        0.0,
+                        RING_THICKNESS_M,
+                        [20, 20, 20, 255],
+                    );
+                }
+                out.push((frame.clone(), crate::view3d::cloud(frame, data)));
+            }
+        }
+        out
+    }
+
     /// The pack of coupling `coupling`'s rings at `log_time_ns` with its bodies' absolute
     /// angles `angle_rad` (rad, discs then plates), or `None` when it is not a pack drawn.
     pub fn transforms(
@@ -148,9 +177,9 @@ impl PacksDrawing {
                 .zip(angle_rad)
                 .map(|((frame, z, _), angle)| FrameTransform {
                     timestamp: Some(ts),
-                    parent_frame_id: WORLD_FRAME.into(),
+                    parent_frame_id: p.place.clone(),
                     child_frame_id: frame.clone(),
-                    translation: Some(v3(p.x_m, 0.0, *z)),
+                    translation: Some(v3(0.0, 0.0, *z)),
                     rotation: Some(about_z(*angle)),
                 })
                 .collect(),

@@ -140,3 +140,11 @@ pub const NETWORK_COUPLING_JOINTS: &str = JOINTS;
 /// The couplings drawn between the bodies, `foxglove.SceneUpdate`: at t = 0, then whenever a
 /// clutch changes mode (each message draws every coupling, coloured by its mode).
 pub const NETWORK_SCENE_COUPLINGS: &str = "/scene/couplings";
+/// An automatic's status over the scene, `foxglove.SceneUpdate`: the gear engaged and, during
+/// a shift, its phase (`gear 1 · shift 1 -> 2: torque phase`), at t = 0 and whenever it
+/// changes (the same line goes to [`NETWORK_EVENTS`]). Only in a recording of a scene with a
+/// `[transmission]`.
+pub const NETWORK_SCENE_STATUS: &str = "/scene/status";
+/// The couplings' diagram as points in the world frame, `foxglove.PointCloud`, for Rerun
+/// (which does not draw scene updates): at t = 0 and with each [`NETWORK_SCENE_COUPLINGS`].
+pub const NETWORK_DIAGRAM_POINTS: &str = "/pack/network/couplings";

@@ -282,9 +282,11 @@ pub(crate) fn start_recording(
     if let Some((driven, stop_time_s)) = co_simulation {
         crate::session::co_simulation_params(&mut info.params, driven, stop_time_s);
     }
-    Ok(Some(NetworkRecorder::create_output(
-        &r.path, r.replace, &info, net, &r.options,
-    )?))
+    let mut recorder = NetworkRecorder::create_output(&r.path, r.replace, &info, net, &r.options)?;
+    if let Some(tr) = &scene.transmission {
+        recorder.set_transmission(tr)?;
+    }
+    Ok(Some(recorder))
 }
 
 /// An engine failure as the error to report, the recording finished first (it holds the run

@@ -85,6 +85,23 @@ pub(crate) struct ShiftProbe {
     rows: Vec<Row>,
 }
 
+/// An automatic's output torque over the samples `history`: `(t s, N m)` per sample, the
+/// torque [`ShiftProbe::output_torque_n_m`] (`None` without a schedule, or when a coupling on
+/// the output does not give its torque there).
+pub fn output_torque_series(
+    net: &Network,
+    tr: &Transmission,
+    history: &[NetworkSample],
+) -> Option<Vec<(f64, f64)>> {
+    let probe = ShiftProbe::new(net, tr)?;
+    Some(
+        history
+            .iter()
+            .map(|s| (s.t_s, probe.output_torque_n_m(s)))
+            .collect(),
+    )
+}
+
 impl ShiftProbe {
     /// The probe of a transmission with a schedule; `None` without shifts, or when a coupling
     /// on the output does not give its torque there (a gear mesh, a resolved pack's other side).
@@ -121,13 +138,19 @@ impl ShiftProbe {
         })
     }
 
-    /// Keeps what the shifts need of a sample.
-    pub fn sample(&mut self, s: &NetworkSample) {
-        let output_torque_n_m = self
-            .output_factors
+    /// The transmission's torque on its output in the sample `s`, N m (its planetary sets'
+    /// and shift elements' torques on the output body, positive in the output's direction of
+    /// positive speed; a final drive or damper on the output is its load, not counted).
+    pub fn output_torque_n_m(&self, s: &NetworkSample) -> f64 {
+        self.output_factors
             .iter()
             .map(|(k, f)| f * s.torque_n_m[*k])
-            .sum();
+            .sum()
+    }
+
+    /// Keeps what the shifts need of a sample.
+    pub fn sample(&mut self, s: &NetworkSample) {
+        let output_torque_n_m = self.output_torque_n_m(s);
         let power_w = self
             .elements
             .iter()
