@@ -3,6 +3,7 @@
 
 mod architecture;
 mod automatics;
+mod automatics_shift;
 mod cosim_hardening;
 mod cross_engine;
 mod fatigue;
