@@ -28,6 +28,10 @@
 //!   carriers move as the constraints dictate to within `h P_ab (R(t + h) - R(t))` per step
 //!   (the change of the pack's mean reaction over one step; a tooth impact's momentum is the
 //!   disc's, not the carrier's). With `P_ab = 0` (carriers in two groups) nothing changes.
+//!   A network step shorter than the times' precision (a step to a sample time the network
+//!   stands at to rounding, `h` about 1e-18 s) does not move the session, and its reaction
+//!   `J dw / h - T` would be `-T`: such a pack keeps its estimate, which its other carrier's
+//!   held torque and the lumped clutches' stick checks read at the next step.
 //! - **The pack's step**: the session's shaft takes `J_a` and the drum `J_b` (inertial
 //!   carriers, eq 4), the held torques as its drive and load inputs, and is advanced to
 //!   `t + h` (a communication point, landed on exactly). Its mean reaction on `a` over the
@@ -245,7 +249,8 @@ impl NetPack {
     /// Advances the pack over `[t, t1]`, its carriers set to the network's speeds `w` (rad/s)
     /// and under the held torques `ta` on its shaft and `tb` on its drum (N m, everything else
     /// in the network's), sending its closed impacts to `obs`; returns its mean reactions on
-    /// `a` and `b` over the step (N m) and keeps them.
+    /// `a` and `b` over the step (N m) and keeps them. With `hold_short`, a step shorter than
+    /// the times' precision keeps the reactions of the step before (the module's method).
     pub fn advance(
         &mut self,
         w: &[f64],
@@ -253,6 +258,7 @@ impl NetPack {
         (ta, tb): (f64, f64),
         name: &str,
         obs: &mut dyn NetworkObserver,
+        hold_short: bool,
     ) -> Result<[f64; 2], EngineError> {
         let h = t1 - self.session.time_s();
         let (wa0, wb0) = (w[self.a], w[self.b]);
@@ -272,6 +278,12 @@ impl NetPack {
             .advance_to(t1, &mut fwd)
             .map_err(|e| in_pack(name, e))?;
         let speed = |drum: bool| self.session.carrier_motion(drum).map_or(0.0, |m| m.1);
+        if hold_short && h <= 1e-12 * (1.0 + t1) {
+            // a step shorter than the times' precision (the network's step to a sample time
+            // it stands at to rounding): the session does not move, and `dw / h - T` would
+            // give -T; the estimate stands
+            return Ok(self.reaction);
+        }
         let ra = (speed(false) - wa0) / (h * self.p_diag[0]) - ta;
         let rb = if self.housing {
             0.0
@@ -399,7 +411,10 @@ impl Run {
             } else {
                 (acc[b] - pb[b] * rb0) / pb[b]
             };
-            let [ra, rb] = p.advance(&self.w, t1, (ta, tb), name, obs)?;
+            // (on separate groups the tiny steps' reactions are kept as they were, so that
+            // those networks' outputs stay bit for bit: docs/DECISIONS.md)
+            let hold_short = !apart;
+            let [ra, rb] = p.advance(&self.w, t1, (ta, tb), name, obs, hold_short)?;
             for (i, x) in acc.iter_mut().enumerate() {
                 *x += pa[i] * (ra - ra0) + pb[i] * (rb - rb0);
             }
