@@ -471,3 +471,108 @@ fn a_pack_shift_element_without_pressure_is_refused_at_its_key() {
         "{err}"
     );
 }
+
+/// Regression test of the multibody engine's refusal, at the step it happened, of a lumped
+/// clutch locking a pack's two carriers into one rigid group (`follow_groups`): K1
+/// (`scenes/dct-k1.toml`, clamped) between a hub geared 3:1 to a load and an engine, clutch C
+/// (200 N m) applied beside it at 50 ms. Both engines run it; measured 2026-12-07: C locks
+/// 6e-14 s apart, the speeds at 0.3 s (one rigid body by then) within 2.3e-10, K1's discs' and
+/// plates' largest tooth loads within 1.8e-6, K1's largest torque within 4.5e-4 (the
+/// multibody engine's is a mean over its network step), both balances within 1.8e-9 J. Bounds:
+/// 1e-9 s, 1e-8, 1e-5, 1e-3, 1e-6 J.
+#[test]
+fn a_clutch_locking_a_packs_carriers_together_runs_on_both_engines() {
+    let d = scratch("locked-packs-beside-a-lock");
+    std::fs::copy("scenes/dct-k1.toml", d.join("k1.toml")).unwrap();
+    let scene = d.join("net.toml");
+    std::fs::write(
+        &scene,
+        r#"
+name = "pack-beside-a-lock"
+[simulation]
+duration_s = 0.3
+record_rate_hz = 2000.0
+max_step_s = 1e-3
+[[bodies]]
+name = "engine"
+inertia_kg_m2 = 0.1
+initial_speed_rad_s = 300.0
+[bodies.drive]
+kind = "constant"
+value_n_m = 100.0
+[[bodies]]
+name = "hub"
+inertia_kg_m2 = 0.02
+initial_speed_rad_s = 300.0
+[[bodies]]
+name = "load"
+inertia_kg_m2 = 0.5
+initial_speed_rad_s = 100.0
+[bodies.road_load]
+constant_n_m = 50.0
+[[couplings]]
+name = "K1"
+kind = "pack"
+a = "hub"
+b = "engine"
+pack = "k1.toml"
+[[couplings]]
+name = "G"
+kind = "ideal_gear"
+a = "hub"
+b = "load"
+ratio = 3.0
+[[couplings]]
+name = "C"
+kind = "clutch"
+a = "hub"
+b = "engine"
+mu = 0.5
+peak = 1.1
+cgeo_m = 0.1
+max_normal_force_n = 4000.0
+[couplings.force]
+kind = "step"
+height = 1.0
+start_s = 0.05
+"#,
+    )
+    .unwrap();
+    let r = run_on(&scene, "reference", &d).unwrap();
+    let m = run_on(&scene, "multibody", &d).unwrap();
+    balanced(&r, &m);
+    let (lr, lm) = (first_lock(&r, "C"), first_lock(&m, "C"));
+    assert!((lr - 0.0502).abs() <= 1e-3, "C locks at {lr} s");
+    assert!((lr - lm).abs() <= 1e-9, "C locks at {lr} s against {lm} s");
+    let speeds = |s: &Value| -> Vec<f64> {
+        s["bodies"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| b["final_speed_rad_s"].as_f64().unwrap())
+            .collect()
+    };
+    for (a, b) in speeds(&r).iter().zip(speeds(&m)) {
+        assert!((a - b).abs() <= 1e-8 * a.abs(), "speeds {a} against {b}");
+    }
+    let k1 = |s: &Value| coupling(s, "K1");
+    let bodies = |s: &Value| k1(s)["pack_bodies"].as_array().unwrap().clone();
+    assert_eq!(bodies(&r).len(), 9);
+    for (a, b) in bodies(&r).iter().zip(&bodies(&m)) {
+        let (pa, pb) = (
+            a["largest_peak_n"].as_f64().unwrap(),
+            b["largest_peak_n"].as_f64().unwrap(),
+        );
+        assert!(
+            (pa - pb).abs() <= 1e-5 * pa.abs(),
+            "{}: {pa} N against {pb} N",
+            a["name"]
+        );
+    }
+    let torque = |s: &Value| k1(s)["max_torque_n_m"].as_f64().unwrap();
+    let (tr, tm) = (torque(&r), torque(&m));
+    assert!(
+        (tr - tm).abs() <= 1e-3 * tr,
+        "K1's torque {tr} against {tm} N m"
+    );
+}
