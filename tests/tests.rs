@@ -11,6 +11,7 @@ mod fit;
 mod fmu;
 mod hardening;
 mod hardening_networks;
+mod locked_packs;
 mod network;
 mod network_engines;
 mod python_package;

@@ -162,7 +162,7 @@ table! {
     RawGear at "transmission.gears[]" {
         /// the gear's name ("1", "R", ...), unique
         name: "", Kind::Text, Dflt::Required;
-        /// the shift elements closed in it: names of [[couplings]] of kind clutch or one_way_clutch (a brake: a clutch to a fixed body)
+        /// the shift elements closed in it: names of [[couplings]] of kind clutch or one_way_clutch (a brake: a clutch to a fixed body), or pack (a resolved pack with a [stack]: the schedule sets its piston's pressure, the normalized level times the largest pressure of its pack file's [stack.pressure])
         closed: "", Kind::Texts, Dflt::Required;
     }
     children {}

@@ -19,12 +19,18 @@
 //! Each profile is linear between these instants (a [`Signal::Table`]), its corners
 //! breakpoints the engines land on.
 //!
+//! A shift element is a lumped clutch (the signal is its normalized force) or a resolved pack
+//! (its discs and plates on their splines): the pack's piston pressure is then the signal times
+//! the pack's **rated pressure**, the largest pressure of its own pack file's profile
+//! ([`rated_pressure_pa`], [`pack_pressure`]), the schedule replacing the profile's shape.
+//!
 //! The null space is taken from the projector `P = I - C^T (C C^T)^+ C` on the moving bodies
 //! ([`super::rows::projected`] with unit inertias): rank one on the input's group means one
 //! degree of freedom, and its column at the input is the speeds per unit input.
 
 use super::rows::{self, Row};
 use super::{ClutchMode, Network, Signal};
+use crate::clutch::PressureProfile;
 use serde::{Deserialize, Serialize};
 
 /// One gear: the elements closed in it.
@@ -125,6 +131,47 @@ pub fn torque_factor(c: &super::Coupling, body: usize) -> Option<f64> {
         CouplingKind::Clutch(_) | CouplingKind::SpringDamper(_) => Some(-1.0),
         CouplingKind::IdealGear { ratio } => Some(-ratio),
         CouplingKind::GearMesh(_) | CouplingKind::Pack(_) | CouplingKind::Planetary(_) => None,
+    }
+}
+
+/// The constraint row of coupling `c` (index `k`) in a gear that closes it (`closed`) or
+/// leaves it open: a clutch's or the gear sets' rows as [`super::Coupling::row`] gives them, and
+/// a resolved pack closed in the gear as a locked clutch (its discs and plates turning with
+/// each other, `w_a - w_b = 0`), so that a gear's kinematics does not depend on whether its
+/// shift elements are lumped or resolved.
+pub fn element_row(c: &super::Coupling, k: usize, closed: bool) -> Option<Row> {
+    match c.kind {
+        super::CouplingKind::Pack(_) if closed => Some(Row::two(k, (c.a, 1.0), (c.b, -1.0))),
+        _ => c.row(k, closed.then_some(ClutchMode::Locked)),
+    }
+}
+
+/// A pack's rated pressure (Pa): the largest pressure of `profile` (a constant's, a ramp's
+/// final, a table's largest row), which a schedule's normalized level 1 stands for.
+pub fn rated_pressure_pa(profile: &PressureProfile) -> f64 {
+    match profile {
+        PressureProfile::Constant { pressure_pa } | PressureProfile::Ramp { pressure_pa, .. } => {
+            *pressure_pa
+        }
+        PressureProfile::Table(t) => t.y.iter().copied().fold(0.0, f64::max),
+    }
+}
+
+/// The piston pressure (Pa) of a resolved pack that a schedule's normalized force `signal`
+/// (0..1, a constant or a table: what [`Transmission::schedule`] gives) sets, with the pack's
+/// rated pressure `rated_pa` (Pa): `p(t) = signal(t) rated_pa`, with the signal's breakpoints.
+/// `None` for a signal of another kind.
+pub fn pack_pressure(signal: &Signal, rated_pa: f64) -> Option<PressureProfile> {
+    match signal {
+        Signal::Constant(level) => Some(PressureProfile::Constant {
+            pressure_pa: level * rated_pa,
+        }),
+        Signal::Table(t) => {
+            let y = t.y.iter().map(|level| level * rated_pa).collect();
+            let table = crate::drive::Table::new(t.t_s.clone(), y).ok()?;
+            Some(PressureProfile::Table(table))
+        }
+        _ => None,
     }
 }
 
@@ -294,7 +341,7 @@ impl Transmission {
             .enumerate()
             .filter_map(|(c, cp)| {
                 let closed = self.gears[self.initial_gear?].closed.contains(&c);
-                cp.row(c, closed.then_some(ClutchMode::Locked))
+                element_row(cp, c, closed)
             })
             .collect();
         let of = rows::groups(&rows, &moving);
@@ -328,10 +375,7 @@ impl Transmission {
             .couplings
             .iter()
             .enumerate()
-            .filter_map(|(k, c)| {
-                let mode = g.closed.contains(&k).then_some(ClutchMode::Locked);
-                c.row(k, mode)
-            })
+            .filter_map(|(k, c)| element_row(c, k, g.closed.contains(&k)))
             .collect();
         let inv: Vec<f64> = net
             .bodies
@@ -459,6 +503,78 @@ mod tests {
     /// falls to 0 over the torque phase; E, the on-coming, fills to 0.1, rises to 0.6 over the
     /// torque phase and to 1 over the inertia phase; A and B hold. A shift to the engaged gear,
     /// one that swaps two elements, or one that starts before the last ends is refused.
+    #[test]
+    fn a_schedule_sets_a_packs_pressure_from_its_rated_pressure() {
+        use super::{pack_pressure, rated_pressure_pa, Shift};
+        use crate::clutch::PressureProfile;
+        use crate::drive::Table;
+        // the rated pressure: a table's largest row, a ramp's final, a constant
+        let table = Table::new(vec![0.0, 0.1, 0.2], vec![0.0, 2e6, 1.5e6]).unwrap();
+        assert_eq!(rated_pressure_pa(&PressureProfile::Table(table)), 2e6);
+        let ramp = PressureProfile::Ramp {
+            start_s: 0.0,
+            rise_s: 0.1,
+            pressure_pa: 1e6,
+        };
+        assert_eq!(rated_pressure_pa(&ramp), 1e6);
+        // the on-coming element E's schedule times 2 MPa, with the schedule's corners
+        let (net, mut tr) = eight_speed();
+        tr.initial_gear = Some(1);
+        tr.shifts = vec![Shift {
+            at_s: 1.0,
+            to: 2,
+            fill_s: 0.05,
+            fill_level: 0.1,
+            torque_phase_s: 0.1,
+            torque_level: 0.6,
+            inertia_phase_s: 0.2,
+        }];
+        let e = net.couplings.iter().position(|c| c.name == "E").unwrap();
+        let sched = tr.schedule().unwrap().unwrap();
+        let signal = &sched.iter().find(|(c, _)| *c == e).unwrap().1;
+        let p = pack_pressure(signal, 2e6).unwrap();
+        for (t, want) in [
+            (0.5, 0.0),
+            (1.05, 0.2e6),
+            (1.15, 1.2e6),
+            (1.25, 1.6e6),
+            (2.0, 2e6),
+        ] {
+            let got = p.pressure_pa(t);
+            assert!(
+                (got - want).abs() < 1e-6,
+                "at {t} s: {got} Pa against {want}"
+            );
+        }
+        let mut corners = Vec::new();
+        p.breakpoints(&mut corners);
+        assert_eq!(corners.len(), 5, "{corners:?}");
+        // an element closed throughout: a constant
+        let a = net.couplings.iter().position(|c| c.name == "A").unwrap();
+        let signal = &sched.iter().find(|(c, _)| *c == a).unwrap().1;
+        assert_eq!(
+            pack_pressure(signal, 2e6),
+            Some(PressureProfile::Constant { pressure_pa: 2e6 })
+        );
+    }
+
+    /// A closed resolved pack ties its carriers as a locked clutch does: the gears' rows are
+    /// the same whichever kind the element is.
+    #[test]
+    fn a_closed_pack_is_a_locked_element() {
+        use super::element_row;
+        let (net, _) = eight_speed();
+        let c = net.couplings.iter().position(|c| c.name == "C").unwrap();
+        let mut pack = net.couplings[c].clone();
+        pack.kind = super::super::CouplingKind::Pack(Box::new(crate::cases::paper_pack(0.0)));
+        for closed in [false, true] {
+            assert_eq!(
+                element_row(&pack, c, closed),
+                element_row(&net.couplings[c], c, closed)
+            );
+        }
+    }
+
     #[test]
     fn a_schedule_compiles_into_each_elements_force() {
         use super::Shift;

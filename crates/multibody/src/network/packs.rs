@@ -8,12 +8,30 @@
 //! method, step 3). The packs' spline reactions are stiff and act within the step (a tooth
 //! contact lasts microseconds), so they are not held: each pack integrates them itself, its
 //! carriers being the network's bodies reduced to one degree of freedom each:
-//! - **Carrier `a` (and `b`)** turns with its rigid group (the bodies the ideal gears and the
-//!   locked clutches tie to it). With `P` the network's inverse inertia projected on the
-//!   constraints (`P = M^-1 - M^-1 C^T (C M^-1 C^T)^-1 C M^-1`, symmetric), a torque `T` on
-//!   the bodies accelerates `a` by `(P T)_a`: the carrier is an inertia `J_a = 1 / P_aa` (the
-//!   group's inertia reflected to `a`) under the held torque `(P T)_a / P_aa` of everything
-//!   else in the network. `a` and `b` in one rigid group (`P_ab != 0`) is refused.
+//! - **Carrier `a` (and `b`)** turns with its rigid group (the bodies the ideal gears, the
+//!   planetary sets and the locked clutches tie to it). With `P` the network's inverse inertia
+//!   projected on the constraints (`P = M^-1 - M^-1 C^T (C M^-1 C^T)^-1 C M^-1`, symmetric), a
+//!   torque `T` on the bodies accelerates `a` by `(P T)_a`: the carrier is an inertia
+//!   `J_a = 1 / P_aa` (the group's inertia reflected to `a`) under the held torque
+//!   `(P T)_a / P_aa` of everything else in the network.
+//! - **Both carriers in one rigid group** (`P_ab != 0`: a shift element of an automatic, whose
+//!   members the gearset ties whether it is open or closed). The carriers' accelerations are
+//!   then `P_aa R_a + P_ab R_b` and `P_ab R_a + P_bb R_b` under the pack's reactions `R`: the
+//!   2x2 block of `P` over `(a, b)` is their inverse inertia, singular when the group has one
+//!   degree of freedom (the drum turning with the shaft at a fixed ratio). The session keeps
+//!   its two carriers apart, each on its diagonal term (`J_a = 1 / P_aa`, `J_b = 1 / P_bb`,
+//!   exact for the pack's own reaction on it), and the cross term goes into the held torques:
+//!   the drum's reaction on the shaft's group `P_ab R_b / P_aa` (and the shaft's on the drum's,
+//!   `P_ab R_a / P_bb`) with `R` the estimate of the step before, as the reactions of another
+//!   pack on the same group are held. The network then applies this step's `R` through the
+//!   whole of `P`, and at the next step every carrier starts from its body's speed, so the
+//!   carriers move as the constraints dictate to within `h P_ab (R(t + h) - R(t))` per step
+//!   (the change of the pack's mean reaction over one step; a tooth impact's momentum is the
+//!   disc's, not the carrier's). With `P_ab = 0` (carriers in two groups) nothing changes.
+//!   A network step shorter than the times' precision (a step to a sample time the network
+//!   stands at to rounding, `h` about 1e-18 s) does not move the session, and its reaction
+//!   `J dw / h - T` would be `-T`: such a pack keeps its estimate, which its other carrier's
+//!   held torque and the lumped clutches' stick checks read at the next step.
 //! - **The pack's step**: the session's shaft takes `J_a` and the drum `J_b` (inertial
 //!   carriers, eq 4), the held torques as its drive and load inputs, and is advanced to
 //!   `t + h` (a communication point, landed on exactly). Its mean reaction on `a` over the
@@ -113,7 +131,7 @@ impl NetPack {
     /// The packs of `net` with their carriers' speeds `w` (rad/s) at t = 0 and the columns
     /// of `P` of each body (`p(i)`), on the engine's steps of at most `options.step_s`.
     /// A thermal pack (`net.pack_thermal`) carries its temperatures. Refused: discs on the
-    /// fixed body, a pack whose carriers are one rigid group, a pack the pack engine refuses.
+    /// fixed body, a pack the pack engine refuses.
     pub fn of(
         net: &Network,
         w: &[f64],
@@ -132,13 +150,6 @@ impl NetPack {
             }
             let (pa, pb) = (p(c.a), p(c.b));
             let housing = net.bodies[c.b].fixed;
-            if !housing && !negligible(pa[c.b], (pa[c.a] * pb[c.b]).sqrt()) {
-                return Err(EngineError::Unsupported(format!(
-                    "coupling \"{}\": its discs' and plates' carriers are one rigid group (gears \
-                     or locked clutches tie them): not on the multibody engine",
-                    c.name
-                )));
-            }
             let mut pack = model.clone();
             pack.shaft = Shaft::Inertial {
                 inertia_kg_m2: 1.0 / pa[c.a],
@@ -218,15 +229,8 @@ impl NetPack {
 
     /// Follows the carriers' rigid groups (`P`'s columns `pa`, `pb`): a clutch locking a body
     /// onto a carrier's group or releasing one changes the carrier's inertia `1 / P_aa`, which
-    /// the session then takes ([`MultibodySession::set_carrier_inertia`]). Refused: the two
-    /// carriers in one rigid group.
+    /// the session then takes ([`MultibodySession::set_carrier_inertia`]).
     pub fn follow_groups(&mut self, pa: &[f64], pb: &[f64], name: &str) -> Result<(), EngineError> {
-        if !self.housing && !negligible(pa[self.b], (pa[self.a] * pb[self.b]).sqrt()) {
-            return Err(EngineError::Unsupported(format!(
-                "coupling \"{name}\": a clutch locked its discs' and plates' carriers into one \
-                 rigid group: not on the multibody engine (--engine reference)"
-            )));
-        }
         if pa[self.a] != self.p_diag[0] {
             self.session
                 .set_carrier_inertia(false, 1.0 / pa[self.a])
@@ -245,7 +249,8 @@ impl NetPack {
     /// Advances the pack over `[t, t1]`, its carriers set to the network's speeds `w` (rad/s)
     /// and under the held torques `ta` on its shaft and `tb` on its drum (N m, everything else
     /// in the network's), sending its closed impacts to `obs`; returns its mean reactions on
-    /// `a` and `b` over the step (N m) and keeps them.
+    /// `a` and `b` over the step (N m) and keeps them. With `hold_short`, a step shorter than
+    /// the times' precision keeps the reactions of the step before (the module's method).
     pub fn advance(
         &mut self,
         w: &[f64],
@@ -253,6 +258,7 @@ impl NetPack {
         (ta, tb): (f64, f64),
         name: &str,
         obs: &mut dyn NetworkObserver,
+        hold_short: bool,
     ) -> Result<[f64; 2], EngineError> {
         let h = t1 - self.session.time_s();
         let (wa0, wb0) = (w[self.a], w[self.b]);
@@ -272,6 +278,12 @@ impl NetPack {
             .advance_to(t1, &mut fwd)
             .map_err(|e| in_pack(name, e))?;
         let speed = |drum: bool| self.session.carrier_motion(drum).map_or(0.0, |m| m.1);
+        if hold_short && h <= 1e-12 * (1.0 + t1) {
+            // a step shorter than the times' precision (the network's step to a sample time
+            // it stands at to rounding): the session does not move, and `dw / h - T` would
+            // give -T; the estimate stands
+            return Ok(self.reaction);
+        }
         let ra = (speed(false) - wa0) / (h * self.p_diag[0]) - ta;
         let rb = if self.housing {
             0.0
@@ -383,14 +395,26 @@ impl Run {
             p.follow_groups(&pa, &pb, name)?;
             let [ra0, rb0] = p.reaction;
             // everything else's torque on each carrier's group, reduced to the carrier:
-            // (P T)_a / P_aa less this pack's own estimate
-            let ta = (acc[a] - pa[a] * ra0 - pb[a] * rb0) / pa[a];
+            // (P T)_a / P_aa less this pack's own estimate on it; with both carriers in one
+            // group the other carrier's estimate stays in (the cross term P_ab R_b, the
+            // module's method)
+            let apart = p.housing || negligible(pa[b], (pa[a] * pb[b]).sqrt());
+            let ta = if apart {
+                (acc[a] - pa[a] * ra0 - pb[a] * rb0) / pa[a]
+            } else {
+                (acc[a] - pa[a] * ra0) / pa[a]
+            };
             let tb = if p.housing {
                 0.0
-            } else {
+            } else if apart {
                 (acc[b] - pa[b] * ra0 - pb[b] * rb0) / pb[b]
+            } else {
+                (acc[b] - pb[b] * rb0) / pb[b]
             };
-            let [ra, rb] = p.advance(&self.w, t1, (ta, tb), name, obs)?;
+            // (on separate groups the tiny steps' reactions are kept as they were, so that
+            // those networks' outputs stay bit for bit: docs/DECISIONS.md)
+            let hold_short = !apart;
+            let [ra, rb] = p.advance(&self.w, t1, (ta, tb), name, obs, hold_short)?;
             for (i, x) in acc.iter_mut().enumerate() {
                 *x += pa[i] * (ra - ra0) + pb[i] * (rb - rb0);
             }

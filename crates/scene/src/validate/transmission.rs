@@ -1,12 +1,25 @@
 //! `[transmission]` of a network scene (MODEL.md section 10): the input and output bodies and
 //! the gears, each the set of shift elements closed in it; every gear's kinematics checked
 //! (one degree of freedom left to the input, the output turning with it), every element
-//! closed in some gear.
+//! closed in some gear. A shift element is a lumped clutch or a resolved pack with a stack:
+//! with a schedule a pack's piston pressure is the schedule's level times its rated pressure,
+//! the largest of its pack file's own profile (`clutchpack_model::network::gears`).
 
 use super::Checker;
 use crate::keys::{RawGear as G, RawNetBody, RawShift as S, RawTransmission as T};
 use crate::schema::{Key, RawTable};
+use clutchpack_model::network::gears::{pack_pressure, rated_pressure_pa};
 use clutchpack_model::network::{CouplingKind, Gear, Network, Shift, Transmission};
+
+/// Whether a gear may close a coupling of kind `kind`: a lumped clutch (or a one-way clutch)
+/// or a resolved pack with a stack (its piston the schedule's).
+fn shift_element(kind: &CouplingKind) -> bool {
+    match kind {
+        CouplingKind::Clutch(_) => true,
+        CouplingKind::Pack(p) => p.stack.is_some(),
+        _ => false,
+    }
+}
 
 /// The names every gear closes, when `[transmission]` has an initial gear or shifts (its
 /// schedule then sets those elements' forces): read from the raw table, before the network is
@@ -90,7 +103,7 @@ pub(super) fn transmission(
         for (j, e) in closed.iter().flatten().enumerate() {
             let path = format!("{}[{j}]", at(&G::closed));
             match net.couplings.iter().position(|c| &c.name == e) {
-                Some(k) if matches!(net.couplings[k].kind, CouplingKind::Clutch(_)) => {
+                Some(k) if shift_element(&net.couplings[k].kind) => {
                     if indices.contains(&k) {
                         ck.report(
                             path,
@@ -105,7 +118,7 @@ pub(super) fn transmission(
                     ck.report(
                         path,
                         Some(format!("\"{e}\"")),
-                        "is not a shift element: a gear closes couplings of kind clutch or one_way_clutch",
+                        "is not a shift element: a gear closes couplings of kind clutch, one_way_clutch or pack (a pack with a [stack] and its piston)",
                     );
                     ok = false;
                 }
@@ -261,8 +274,32 @@ pub(super) fn transmission(
     match tr.schedule() {
         Some(Ok(forces)) => {
             for (k, force) in forces {
-                if let CouplingKind::Clutch(cl) = &mut net.couplings[k].kind {
-                    cl.force = force;
+                match &mut net.couplings[k].kind {
+                    CouplingKind::Clutch(cl) => cl.force = force,
+                    CouplingKind::Pack(pack) => {
+                        // the schedule's level times the pack's rated pressure (its own
+                        // profile's largest; the module's docs)
+                        let Some(stack) = pack.stack.as_mut() else {
+                            continue;
+                        };
+                        let rated = rated_pressure_pa(&stack.piston.pressure);
+                        if rated.is_nan() || rated <= 0.0 {
+                            ck.report(
+                                format!("couplings[{k}].pack"),
+                                None,
+                                format!(
+                                    "\"{}\" is a shift element: its pack file's [stack.pressure] \
+                                     must rise above 0 Pa (its largest pressure is the element's \
+                                     rated pressure, which the schedule scales)",
+                                    net.couplings[k].name
+                                ),
+                            );
+                            ok = false;
+                        } else if let Some(p) = pack_pressure(&force, rated) {
+                            stack.piston.pressure = p;
+                        }
+                    }
+                    _ => {}
                 }
             }
         }
