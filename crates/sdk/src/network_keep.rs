@@ -277,6 +277,9 @@ impl NetworkObserver for Obs<'_, '_> {
         }
     }
     fn pack_faces(&mut self, coupling: usize, t: f64, locked: usize, clamped: usize, faces: usize) {
+        if let Some(p) = &mut self.keep.shifts {
+            p.pack_faces(coupling, t, locked, clamped, faces);
+        }
         let mode = if locked == faces {
             "locked"
         } else if clamped > 0 {

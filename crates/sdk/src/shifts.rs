@@ -81,6 +81,11 @@ pub(crate) struct ShiftProbe {
     output_factors: Vec<(usize, f64)>,
     /// The elements `(coupling, a, b)`.
     elements: Vec<(usize, usize, usize)>,
+    /// Each element's faces' mode as its pack reported it last (`None`: a lumped clutch,
+    /// whose mode is in every sample).
+    pack_modes: Vec<Option<ClutchMode>>,
+    /// The resolved packs' mode changes, as a clutch's ([`Self::pack_faces`]).
+    pack_events: Vec<ClutchEvent>,
     handovers: Vec<Handover>,
     rows: Vec<Row>,
 }
@@ -129,10 +134,17 @@ impl ShiftProbe {
             .into_iter()
             .map(|k| (k, net.couplings[k].a, net.couplings[k].b))
             .collect();
+        let pack_modes = tr
+            .elements()
+            .into_iter()
+            .map(|k| net.couplings[k].pack().map(|_| ClutchMode::Free))
+            .collect();
         Some(ShiftProbe {
             input: tr.input,
             output_factors,
             elements,
+            pack_modes,
+            pack_events: Vec::new(),
             handovers,
             rows: Vec::new(),
         })
@@ -154,7 +166,10 @@ impl ShiftProbe {
         let power_w = self
             .elements
             .iter()
-            .map(|&(k, a, b)| match s.mode[k] {
+            .zip(&self.pack_modes)
+            .map(|(&(k, a, b), pack)| match pack.or(s.mode[k]) {
+                // a pack's torque is its discs' reaction on `a`: its faces' friction torque
+                // while they slip (and the discs' inertia, small beside it)
                 Some(ClutchMode::Slipping(_)) => {
                     s.torque_n_m[k] * (s.speed_rad_s[b] - s.speed_rad_s[a])
                 }
@@ -169,7 +184,43 @@ impl ShiftProbe {
         });
     }
 
-    /// Each shift as the run made it, from the samples kept and the mode changes `events`.
+    /// A resolved pack's faces changed mode at `t_s` (s): `locked` of its `faces` friction faces
+    /// locked and `clamped` clamped. For a shift element it counts as a clutch's mode change:
+    /// all faces locked is `locked`, some clamped `slipping`, none `free`.
+    pub fn pack_faces(
+        &mut self,
+        coupling: usize,
+        t_s: f64,
+        locked: usize,
+        clamped: usize,
+        faces: usize,
+    ) {
+        let Some(e) = self.elements.iter().position(|x| x.0 == coupling) else {
+            return;
+        };
+        let Some(from) = self.pack_modes[e] else {
+            return;
+        };
+        let to = if locked == faces {
+            ClutchMode::Locked
+        } else if clamped > 0 {
+            ClutchMode::Slipping(1)
+        } else {
+            ClutchMode::Free
+        };
+        if to != from {
+            self.pack_modes[e] = Some(to);
+            self.pack_events.push(ClutchEvent {
+                t_s,
+                coupling,
+                from,
+                to,
+            });
+        }
+    }
+
+    /// Each shift as the run made it, from the samples kept, the mode changes `events` and
+    /// the resolved packs' (a pack's faces, [`Self::pack_faces`]).
     pub fn report(
         &self,
         net: &Network,
@@ -177,6 +228,9 @@ impl ShiftProbe {
         events: &[ClutchEvent],
     ) -> Vec<ShiftSummary> {
         let end_s = self.rows.last().map_or(0.0, |r| r.t_s);
+        let mut all: Vec<ClutchEvent> = events.iter().chain(&self.pack_events).copied().collect();
+        all.sort_by(|a, b| a.t_s.total_cmp(&b.t_s));
+        let events = &all;
         let mut out = Vec::new();
         for (i, h) in self.handovers.iter().enumerate() {
             let t0 = h.corners_s[0];
