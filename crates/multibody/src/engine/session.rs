@@ -45,7 +45,8 @@ use crate::world::SHAFT;
 use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::thermal::ThermalModel;
 use clutchpack_model::{
-    EngineError, Observer, PressureProfile, RunStats, Shaft, ShaftExcitation, SpeedProfile,
+    DiscSample, EngineError, ImpactEvent, InterfaceSample, LocalProfile, Observer, PressureProfile,
+    RunStats, Sample, Shaft, ShaftExcitation, SpeedProfile,
 };
 use std::sync::Arc;
 
@@ -105,6 +106,23 @@ pub struct MultibodySession {
     energy: EnergyAudit,
     /// The temperatures of a thermal run (`thermal.rs`); `None`: isothermal.
     pub(super) thermal: Option<Box<Thermal>>,
+    /// The loop's buffers, kept from one call to the next so that a frame allocates nothing
+    /// of its own (issue 46).
+    scratch: Scratch,
+}
+
+/// The buffers of [`MultibodySession`]'s loops: what one step or one sample fills and the
+/// observer reads, cleared before each use (their contents never outlive it).
+#[derive(Clone, Default)]
+struct Scratch {
+    /// The sample being sent and the stack's interfaces at it.
+    sample: Sample,
+    interfaces: Vec<InterfaceSample>,
+    /// The impacts a world step closed, and its contact samples `(coupling, t s, state)`.
+    closed: Vec<ImpactEvent>,
+    contacts: Vec<(usize, f64, DiscSample)>,
+    /// The prescribed shaft's expansion over the world step (the last one's buffer).
+    local: Option<LocalProfile>,
 }
 
 impl MultibodySession {
@@ -170,6 +188,7 @@ impl MultibodySession {
             finished: None,
             energy: EnergyAudit::default(),
             thermal,
+            scratch: Scratch::default(),
         })
     }
 
@@ -259,9 +278,12 @@ impl MultibodySession {
         let run = &self.run;
         let slack = self.slack(1.0 / self.options.record_rate_hz);
         if self.rec_time(self.rec_index) <= run.t + self.half_step + slack {
-            observer.sample(&run.sample(self.options.record_tooth_loads));
+            let sc = &mut self.scratch;
+            run.sample_into(self.options.record_tooth_loads, &mut sc.sample);
+            observer.sample(&sc.sample);
             if let Some(s) = &run.stack {
-                observer.interfaces(run.t, &s.samples());
+                s.samples_into(&mut sc.interfaces);
+                observer.interfaces(run.t, &sc.interfaces);
             }
             while self.rec_time(self.rec_index) <= run.t + self.half_step + slack {
                 self.rec_index += 1;
@@ -405,8 +427,25 @@ impl MultibodySession {
                 return Ok(Advance::Stopped);
             }
         }
-        let mut closed = Vec::new();
-        let mut contacts = Vec::new();
+        let mut closed = std::mem::take(&mut self.scratch.closed);
+        let mut contacts = std::mem::take(&mut self.scratch.contacts);
+        let out = self.multirate_loop(t_s, a, observer, &mut closed, &mut contacts);
+        closed.clear();
+        contacts.clear();
+        (self.scratch.closed, self.scratch.contacts) = (closed, contacts);
+        out
+    }
+
+    /// [`Self::advance_multirate`]'s loop once started, with its buffers of the impacts a
+    /// world step closed and of its contact samples.
+    fn multirate_loop(
+        &mut self,
+        t_s: f64,
+        a: AdaptiveStepping,
+        observer: &mut dyn Observer,
+        closed: &mut Vec<ImpactEvent>,
+        contacts: &mut Vec<(usize, f64, DiscSample)>,
+    ) -> Result<Advance, EngineError> {
         while self.run.t < t_s {
             // the piston may push from now on: the clamped stack integrated as one system
             // (`clamped.rs`)
@@ -426,9 +465,10 @@ impl MultibodySession {
                 Motion::Prescribed(p) => Some(Arc::clone(p)),
                 _ => None,
             };
+            let old = self.scratch.local.take();
             let local = profile
                 .as_deref()
-                .and_then(|p| Prescribed::expand(p, run.t, t1));
+                .and_then(|p| Prescribed::expand(p, run.t, t1, old));
             let mut ws = WorldStep {
                 t1,
                 a: &a,
@@ -437,14 +477,15 @@ impl MultibodySession {
                     local: local.as_ref(),
                 }),
                 counts: &mut self.counts,
-                closed: &mut closed,
-                contacts: &mut contacts,
+                closed,
+                contacts,
             };
             if clamped {
                 run.clamped_step(&mut ws)?;
             } else {
                 run.multirate_step(&mut ws)?;
             }
+            self.scratch.local = local;
             run.update_stack();
             // Events in the order they closed across the couplings.
             closed.sort_by(|x, y| x.t_off_s.total_cmp(&y.t_off_s));
