@@ -10,6 +10,7 @@
 use super::substep::{GapDrag, Node, Rk4, TurnMoment};
 use crate::integrate::{Kick, Load, LoadHistory, Motion};
 use crate::stack::Face;
+use clutchpack_model::{DiscSample, ImpactEvent, InterfaceSample, LocalProfile, Sample};
 
 /// The loads of one body (a disc, a plate, an inertial carrier) and their kick
 /// (`integrate.rs`).
@@ -236,4 +237,18 @@ impl RkBuffers {
 /// locked face).
 pub(super) fn powers(n: usize, n_spin: usize, n_if: usize) -> [usize; 7] {
     [n, n, n_spin, n_spin, n_if, n_if, n_if]
+}
+
+/// The buffers of a session's loops (`session.rs`): what one step or one sample fills and the
+/// observer reads, cleared before each use (their contents never outlive it).
+#[derive(Debug, Clone, Default)]
+pub(super) struct SessionBuffers {
+    /// The sample being sent and the stack's interfaces at it.
+    pub(super) sample: Sample,
+    pub(super) interfaces: Vec<InterfaceSample>,
+    /// The impacts a world step closed, and its contact samples `(coupling, t s, state)`.
+    pub(super) closed: Vec<ImpactEvent>,
+    pub(super) contacts: Vec<(usize, f64, DiscSample)>,
+    /// The prescribed shaft's expansion over the world step (the last one's buffer).
+    pub(super) local: Option<LocalProfile>,
 }

@@ -37,6 +37,7 @@
 
 use super::carriers::{External, Motion};
 use super::energy::EnergyAudit;
+use super::scheme_state::SessionBuffers;
 use super::state::{shaft_accel_bound, Run};
 use super::substep::{split_remainder, Counts, Prescribed, WorldStep};
 use super::thermal::Thermal;
@@ -45,8 +46,7 @@ use crate::world::SHAFT;
 use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::thermal::ThermalModel;
 use clutchpack_model::{
-    DiscSample, EngineError, ImpactEvent, InterfaceSample, LocalProfile, Observer, PressureProfile,
-    RunStats, Sample, Shaft, ShaftExcitation, SpeedProfile,
+    EngineError, Observer, PressureProfile, RunStats, Shaft, ShaftExcitation, SpeedProfile,
 };
 use std::sync::Arc;
 
@@ -108,21 +108,7 @@ pub struct MultibodySession {
     pub(super) thermal: Option<Box<Thermal>>,
     /// The loop's buffers, kept from one call to the next so that a frame allocates nothing
     /// of its own (issue 46).
-    scratch: Scratch,
-}
-
-/// The buffers of [`MultibodySession`]'s loops: what one step or one sample fills and the
-/// observer reads, cleared before each use (their contents never outlive it).
-#[derive(Clone, Default)]
-struct Scratch {
-    /// The sample being sent and the stack's interfaces at it.
-    sample: Sample,
-    interfaces: Vec<InterfaceSample>,
-    /// The impacts a world step closed, and its contact samples `(coupling, t s, state)`.
-    closed: Vec<ImpactEvent>,
-    contacts: Vec<(usize, f64, DiscSample)>,
-    /// The prescribed shaft's expansion over the world step (the last one's buffer).
-    local: Option<LocalProfile>,
+    scratch: SessionBuffers,
 }
 
 impl MultibodySession {
@@ -188,7 +174,7 @@ impl MultibodySession {
             finished: None,
             energy: EnergyAudit::default(),
             thermal,
-            scratch: Scratch::default(),
+            scratch: SessionBuffers::default(),
         })
     }
 
@@ -427,25 +413,6 @@ impl MultibodySession {
                 return Ok(Advance::Stopped);
             }
         }
-        let mut closed = std::mem::take(&mut self.scratch.closed);
-        let mut contacts = std::mem::take(&mut self.scratch.contacts);
-        let out = self.multirate_loop(t_s, a, observer, &mut closed, &mut contacts);
-        closed.clear();
-        contacts.clear();
-        (self.scratch.closed, self.scratch.contacts) = (closed, contacts);
-        out
-    }
-
-    /// [`Self::advance_multirate`]'s loop once started, with its buffers of the impacts a
-    /// world step closed and of its contact samples.
-    fn multirate_loop(
-        &mut self,
-        t_s: f64,
-        a: AdaptiveStepping,
-        observer: &mut dyn Observer,
-        closed: &mut Vec<ImpactEvent>,
-        contacts: &mut Vec<(usize, f64, DiscSample)>,
-    ) -> Result<Advance, EngineError> {
         while self.run.t < t_s {
             // the piston may push from now on: the clamped stack integrated as one system
             // (`clamped.rs`)
@@ -465,10 +432,8 @@ impl MultibodySession {
                 Motion::Prescribed(p) => Some(Arc::clone(p)),
                 _ => None,
             };
-            let old = self.scratch.local.take();
-            let local = profile
-                .as_deref()
-                .and_then(|p| Prescribed::expand(p, run.t, t1, old));
+            let (old, half) = (self.scratch.local.take(), 0.5 * (t1 - run.t));
+            let local = (profile.as_deref()).and_then(|p| p.local_reusing(run.t + half, half, old));
             let mut ws = WorldStep {
                 t1,
                 a: &a,
@@ -477,8 +442,8 @@ impl MultibodySession {
                     local: local.as_ref(),
                 }),
                 counts: &mut self.counts,
-                closed,
-                contacts,
+                closed: &mut self.scratch.closed,
+                contacts: &mut self.scratch.contacts,
             };
             if clamped {
                 run.clamped_step(&mut ws)?;
@@ -488,14 +453,15 @@ impl MultibodySession {
             self.scratch.local = local;
             run.update_stack();
             // Events in the order they closed across the couplings.
-            closed.sort_by(|x, y| x.t_off_s.total_cmp(&y.t_off_s));
-            for e in closed.drain(..) {
+            let sc = &mut self.scratch;
+            sc.closed.sort_by(|x, y| x.t_off_s.total_cmp(&y.t_off_s));
+            for e in sc.closed.drain(..) {
                 observer.impact(&e);
             }
             // The sub-steps' contact samples, all in (t, t1], before the sample at t1; a
             // stable sort keeps each coupling's order and interleaves the couplings in time.
-            contacts.sort_by(|x, y| x.1.total_cmp(&y.1));
-            for (i, t, s) in contacts.drain(..) {
+            sc.contacts.sort_by(|x, y| x.1.total_cmp(&y.1));
+            for (i, t, s) in sc.contacts.drain(..) {
                 observer.contact_sample(i, t, &s);
             }
             self.steps += 1;
