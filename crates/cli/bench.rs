@@ -54,6 +54,9 @@ pub struct BenchArgs {
     /// the medians are reported); 0 skips that part.
     #[arg(long, default_value_t = 3)]
     pub thermal_runs: usize,
+    /// Only the paper case (its time per run; `bench/scipy/paper.py` reads that line).
+    #[arg(long, conflicts_with = "pack_only")]
+    pub paper_only: bool,
     /// Only the staggered-pack, brake-pack and inertial-pack parts (skips the paper case, the sweep, the
     /// recording cost and the shipped whole packs).
     #[arg(long)]
@@ -90,10 +93,20 @@ pub struct BenchArgs {
     /// With `--frames`: the figures as JSON to this file.
     #[arg(long, value_name = "FILE", requires = "frames")]
     pub summary_json: Option<std::path::PathBuf>,
+    /// With `--frames`: each frame of the last round's framed run to this CSV file (its end,
+    /// s; its wall time and the calling thread's CPU time, s; the impacts it closed), to see
+    /// what the slow frames held.
+    #[arg(long, value_name = "FILE", requires = "frames")]
+    pub frames_csv: Option<std::path::PathBuf>,
     /// With `--frames`: rounds, each the whole run then the framed run (the median ratio is
     /// reported).
     #[arg(long, default_value_t = 1, value_name = "N")]
     pub rounds: usize,
+    /// With `--frames`: pace the framed run as a real-time host does (frame k starts k frame
+    /// lengths after the first, the thread sleeping in between; the framed wall time is the
+    /// frames' own).
+    #[arg(long, requires = "frames")]
+    pub paced: bool,
     /// With `--frames`: drive every input the scene has, as an FMU does (held at its value at
     /// t = 0 and set at every call; the whole run is the same driven run in one call).
     #[arg(long, requires = "frames")]
@@ -117,8 +130,10 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
                 duration_s: a.duration,
                 budget_fraction: a.budget_fraction,
                 summary_json: a.summary_json.as_deref(),
+                frames_csv: a.frames_csv.as_deref(),
                 rounds: a.rounds,
                 drive: a.drive,
+                paced: a.paced,
             },
             &crate::signals::flag(),
         );
@@ -184,6 +199,9 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         t / steps as f64 * 1e9,
         if t < 0.030 { "met" } else { "NOT met" }
     );
+    if a.paper_only {
+        return Ok(ExitCode::SUCCESS);
+    }
 
     // 2. A 16-case sweep (4 film thicknesses x 4 ensemble members), 1 thread vs 2.
     let values = [0.0, 25e-6, 50e-6, 75e-6];

@@ -2,7 +2,8 @@
 //! advances it (the sdk's session, `advance_to` every `DT` of simulated time) against the
 //! same scene advanced in one call, in the same process: the wall times and their ratio, the
 //! frames' wall-time distribution and overruns against a budget, the real-time factor, and
-//! whether the outputs (impacts, the final state) are the whole run's. Printed, never
+//! whether the outputs (the impacts' count, each body's largest peak, the last impact, the
+//! final state) are the whole run's. Printed, never
 //! asserted (docs/performance.md, "Frames").
 
 use crate::common::BadInput;
@@ -28,8 +29,15 @@ pub struct FramesRequest<'a> {
     /// The budget of a frame as a fraction of the frame (> 0).
     pub budget_fraction: f64,
     pub summary_json: Option<&'a Path>,
+    /// Each frame of the last round's framed run as CSV.
+    pub frames_csv: Option<&'a Path>,
     /// Rounds, each a whole run then a framed run (the median ratio is reported).
     pub rounds: usize,
+    /// Pace the framed run as a real-time host does: frame `k` starts no earlier than `k`
+    /// frame lengths of wall time after the first (the thread sleeps in between), so that
+    /// the frames meet the caches, the scheduler and a real-time policy's throttling as a
+    /// host's frames do. The framed wall time is then the frames' own (sleeps left out).
+    pub paced: bool,
     /// Drive every input the scene has, as an FMU does, each held at its value at t = 0 and
     /// set again at every call (both sides: the whole run is the driven run in one call).
     pub drive: bool,
@@ -65,6 +73,12 @@ struct Side {
     wall_s: f64,
     /// Each frame's wall time, s (one entry for the whole run).
     frames_s: Vec<f64>,
+    /// Each frame's CPU time on the calling thread, s: its own cost. A frame whose wall time
+    /// is far over its CPU time waited for the core (another process ran, the scheduler's
+    /// noise), not for the engine.
+    frames_cpu_s: Vec<f64>,
+    /// Each frame's impacts closed (pack scenes; 0 for a network).
+    frames_impacts: Vec<u32>,
     outputs: Outputs,
     steps: u64,
 }
@@ -72,9 +86,10 @@ struct Side {
 /// What the two sides are compared on.
 #[derive(Default, Clone)]
 struct Outputs {
-    /// Pack: every impact; network: none (its counts and largest peaks are in `coupling`).
-    impacts: Vec<ImpactEvent>,
-    /// Network: per coupling and pack body `(impacts, largest peak N)`.
+    /// Pack: the impact that closed last; network: none.
+    last_impact: Option<ImpactEvent>,
+    /// Pack: `(every impact, 0)` then per body `(0, largest |peak| N)`; network: per coupling
+    /// and pack body `(impacts, largest peak N)`.
     coupling: Vec<(u64, f64)>,
     /// The final state: each body's speed (rad/s), then angle (rad).
     state: Vec<f64>,
@@ -87,10 +102,10 @@ struct Outputs {
 pub struct Difference {
     pub impacts_whole: usize,
     pub impacts_framed: usize,
-    /// Largest difference of the impacts' peak times, s (matched in order; pack scenes).
-    pub max_peak_time_diff_s: f64,
-    /// Largest difference of the impacts' peak loads, N (pack: matched in order; network:
-    /// the couplings' and bodies' largest peaks).
+    /// The difference of the last impacts' peak times, s (pack scenes).
+    pub last_peak_time_diff_s: f64,
+    /// Largest difference of the bodies' (and a network's couplings') largest peaks and of
+    /// the last impacts' peaks, N.
     pub max_peak_diff_n: f64,
     /// Largest difference of the final speeds (rad/s) and angles (rad).
     pub max_state_diff: f64,
@@ -111,8 +126,16 @@ pub struct Round {
     pub frame_p99_s: f64,
     pub frame_p999_s: f64,
     pub frame_max_s: f64,
+    /// The frames' CPU time on the calling thread (their own cost, without the time the
+    /// core ran something else), s.
+    pub frame_cpu_median_s: f64,
+    pub frame_cpu_p99_s: f64,
+    pub frame_cpu_p999_s: f64,
+    pub frame_cpu_max_s: f64,
     /// Frames whose wall time passed the budget.
     pub overruns: usize,
+    /// Frames whose CPU time passed the budget (the overruns that are the engine's own).
+    pub cpu_overruns: usize,
     /// Framed wall time over simulated time (< 1: faster than real time).
     pub real_time_factor: f64,
     pub difference: Difference,
@@ -126,10 +149,69 @@ struct Summary<'a> {
     frame_s: f64,
     duration_s: f64,
     driven: bool,
+    paced: bool,
     frames: usize,
     budget_s: f64,
     median_ratio: f64,
+    /// Each frame's least CPU time over the rounds (one round: its CPU time).
+    frame_cost: FrameCost,
     rounds: &'a [Round],
+}
+
+/// The distribution of the frames' own cost: each frame's least CPU time over the rounds, s.
+#[derive(Serialize, Clone, Copy)]
+struct FrameCost {
+    median_s: f64,
+    p99_s: f64,
+    p999_s: f64,
+    max_s: f64,
+    /// Frames whose least CPU time passed the budget.
+    overruns: usize,
+}
+
+/// A frame's start: the wall clock and the calling thread's CPU clock.
+struct FrameClock {
+    wall: Instant,
+    cpu: Option<cpu_time::ThreadTime>,
+}
+
+impl FrameClock {
+    fn now() -> FrameClock {
+        FrameClock {
+            wall: Instant::now(),
+            cpu: cpu_time::ThreadTime::try_now().ok(),
+        }
+    }
+
+    /// Pushes the wall time (s) and the thread's CPU time (s; 0 where the clock is missing)
+    /// since [`FrameClock::now`].
+    fn push(&self, wall_s: &mut Vec<f64>, cpu_s: &mut Vec<f64>) {
+        let cpu = self.cpu.as_ref().and_then(|c| c.try_elapsed().ok());
+        wall_s.push(self.wall.elapsed().as_secs_f64());
+        cpu_s.push(cpu.map_or(0.0, |d| d.as_secs_f64()));
+    }
+}
+
+/// Sleeps until frame `k` (from 0) is due, `k` frame lengths `pace` (s) after `t0`; at once
+/// without `pace` or when the frame is late.
+fn wait_for_frame(t0: Instant, k: usize, pace: Option<f64>) {
+    if let Some(dt) = pace {
+        let due = t0 + std::time::Duration::from_secs_f64(k as f64 * dt);
+        let now = Instant::now();
+        if due > now {
+            std::thread::sleep(due - now);
+        }
+    }
+}
+
+/// A side's wall time, s: since `t0`, or when paced the frames' own (`frames_s`, s) without
+/// the sleeps between them.
+fn busy_wall_s(t0: Instant, frames_s: &[f64], pace: Option<f64>) -> f64 {
+    if pace.is_some() {
+        frames_s.iter().sum()
+    } else {
+        t0.elapsed().as_secs_f64()
+    }
 }
 
 /// The `q` quantile (0..=1) of sorted `v` (nearest rank).
@@ -166,14 +248,18 @@ pub fn bench_frames(r: FramesRequest, stop: &AtomicBool) -> Result<ExitCode> {
         .into());
     }
     let engine = scene.engine(r.engine, &scene.name)?;
-    if let Some(p) = r.summary_json {
+    let outputs: Vec<crate::outputs::Output> = [
+        ("--summary-json", r.summary_json),
+        ("--frames-csv", r.frames_csv),
+    ]
+    .into_iter()
+    .filter_map(|(flag, p)| p.map(|p| crate::outputs::Output::file(flag, p)))
+    .collect();
+    if !outputs.is_empty() {
         let inputs: Vec<&Path> = std::iter::once(r.scene_path)
             .chain(scene.inputs.iter().map(|p| p.as_path()))
             .collect();
-        crate::outputs::check_outputs(
-            &[crate::outputs::Output::file("--summary-json", p)],
-            &inputs,
-        )?;
+        crate::outputs::check_outputs(&outputs, &inputs)?;
     }
     // a network's engine refuses the scene (the multibody engine on one rigid group) here
     if scene.network.is_some() {
@@ -197,11 +283,16 @@ pub fn bench_frames(r: FramesRequest, stop: &AtomicBool) -> Result<ExitCode> {
         out!("warning: a debug build; build with --release for meaningful figures");
     }
     out!(
-        "{} on the {} engine{}, {} s in {} frames of {} s (budget {:.3e} s per frame), {} round(s)",
+        "{} on the {} engine{}{}, {} s in {} frames of {} s (budget {:.3e} s per frame), {} round(s)",
         scene.name,
         engine.name(),
         if r.drive {
             ", every input driven (held at t = 0)"
+        } else {
+            ""
+        },
+        if r.paced {
+            ", the frames paced at their wall-clock times"
         } else {
             ""
         },
@@ -212,18 +303,39 @@ pub fn bench_frames(r: FramesRequest, stop: &AtomicBool) -> Result<ExitCode> {
         r.rounds.max(1)
     );
     let mut rounds = Vec::new();
+    let mut last_framed: Option<Side> = None;
+    // each frame's least CPU time over the rounds, s
+    let mut least_cpu_s = vec![f64::INFINITY; n];
     for _ in 0..r.rounds.max(1) {
-        let whole = side(&scene, engine, duration, &[duration], r.drive, stop)?;
+        let whole = side(&scene, engine, duration, &[duration], r.drive, None, stop)?;
         if stop.load(Ordering::SeqCst) {
             return Ok(crate::signals::exit_code());
         }
-        let framed = side(&scene, engine, duration, &ends, r.drive, stop)?;
+        let pace = r.paced.then_some(r.frame_s);
+        let framed = side(&scene, engine, duration, &ends, r.drive, pace, stop)?;
         if stop.load(Ordering::SeqCst) {
             return Ok(crate::signals::exit_code());
         }
         let round = figures(&whole, &framed, budget, duration);
         print_round(&round);
         rounds.push(round);
+        for (m, c) in least_cpu_s.iter_mut().zip(&framed.frames_cpu_s) {
+            *m = m.min(*c);
+        }
+        last_framed = Some(framed);
+    }
+    if let (Some(p), Some(f)) = (r.frames_csv, &last_framed) {
+        let mut text = String::from("frame,t_end_s,wall_s,cpu_s,impacts\n");
+        for (k, t) in ends.iter().enumerate() {
+            text += &format!(
+                "{},{t},{:e},{:e},{}\n",
+                k + 1,
+                f.frames_s[k],
+                f.frames_cpu_s[k],
+                f.frames_impacts[k]
+            );
+        }
+        crate::outputs::write_text(p, &text)?;
     }
     let mut ratios: Vec<f64> = rounds.iter().map(|x| x.ratio).collect();
     ratios.sort_by(f64::total_cmp);
@@ -232,6 +344,28 @@ pub fn bench_frames(r: FramesRequest, stop: &AtomicBool) -> Result<ExitCode> {
         "median framed/whole ratio over {} round(s): {median_ratio:.3}",
         rounds.len()
     );
+    // The frames are the same work in every round (the run is deterministic): a frame's least
+    // CPU time over the rounds is its own cost, with another process's or the hypervisor's
+    // share of the core (which lands on different frames each round) mostly left out.
+    least_cpu_s.sort_by(f64::total_cmp);
+    let cost = FrameCost {
+        median_s: quantile(&least_cpu_s, 0.5),
+        p99_s: quantile(&least_cpu_s, 0.99),
+        p999_s: quantile(&least_cpu_s, 0.999),
+        max_s: least_cpu_s.last().copied().unwrap_or(0.0),
+        overruns: least_cpu_s.iter().filter(|&&x| x > budget).count(),
+    };
+    if rounds.len() > 1 {
+        out!(
+            "frame cost (each frame's least CPU time over the {} rounds): median {:.1} us, p99 {:.1} us, p99.9 {:.1} us, max {:.1} us; {} over the budget",
+            rounds.len(),
+            cost.median_s * 1e6,
+            cost.p99_s * 1e6,
+            cost.p999_s * 1e6,
+            cost.max_s * 1e6,
+            cost.overruns
+        );
+    }
     if let Some(p) = r.summary_json {
         crate::outputs::write_json(
             p,
@@ -241,9 +375,11 @@ pub fn bench_frames(r: FramesRequest, stop: &AtomicBool) -> Result<ExitCode> {
                 frame_s: r.frame_s,
                 duration_s: duration,
                 driven: r.drive,
+                paced: r.paced,
                 frames: n,
                 budget_s: budget,
                 median_ratio,
+                frame_cost: cost,
                 rounds: &rounds,
             },
         )?;
@@ -271,11 +407,19 @@ fn print_round(r: &Round) {
         r.overruns
     );
     out!(
-        "  outputs: {} ({} / {} impacts, peak times within {:.2e} s, peaks within {:.2e} N, final state within {:.2e})",
+        "  frame CPU time (the calling thread's): median {:.1} us, p99 {:.1} us, p99.9 {:.1} us, max {:.1} us; {} overrun(s)",
+        r.frame_cpu_median_s * 1e6,
+        r.frame_cpu_p99_s * 1e6,
+        r.frame_cpu_p999_s * 1e6,
+        r.frame_cpu_max_s * 1e6,
+        r.cpu_overruns
+    );
+    out!(
+        "  outputs: {} ({} / {} impacts, last peak times within {:.2e} s, largest peaks within {:.2e} N, final state within {:.2e})",
         if d.identical { "identical" } else { "differ" },
         d.impacts_whole,
         d.impacts_framed,
-        d.max_peak_time_diff_s,
+        d.last_peak_time_diff_s,
         d.max_peak_diff_n,
         d.max_state_diff
     );
@@ -285,20 +429,21 @@ fn print_round(r: &Round) {
 fn figures(whole: &Side, framed: &Side, budget: f64, duration: f64) -> Round {
     let mut f = framed.frames_s.clone();
     f.sort_by(f64::total_cmp);
+    let mut c = framed.frames_cpu_s.clone();
+    c.sort_by(f64::total_cmp);
     let (w, s) = (&whole.outputs, &framed.outputs);
     let mut d = Difference {
-        impacts_whole: w.impacts.len() + w.coupling.iter().map(|c| c.0 as usize).sum::<usize>(),
-        impacts_framed: s.impacts.len() + s.coupling.iter().map(|c| c.0 as usize).sum::<usize>(),
+        impacts_whole: w.coupling.iter().map(|c| c.0 as usize).sum::<usize>(),
+        impacts_framed: s.coupling.iter().map(|c| c.0 as usize).sum::<usize>(),
         ..Difference::default()
     };
-    let mut same = w.impacts.len() == s.impacts.len()
+    let mut same = w.last_impact == s.last_impact
         && w.coupling.len() == s.coupling.len()
         && w.state.len() == s.state.len()
         && w.t_end_s == s.t_end_s;
-    for (a, b) in w.impacts.iter().zip(&s.impacts) {
-        d.max_peak_time_diff_s = d.max_peak_time_diff_s.max((a.t_peak_s - b.t_peak_s).abs());
-        d.max_peak_diff_n = d.max_peak_diff_n.max((a.peak_n - b.peak_n).abs());
-        same &= a == b;
+    if let (Some(a), Some(b)) = (w.last_impact, s.last_impact) {
+        d.last_peak_time_diff_s = (a.t_peak_s - b.t_peak_s).abs();
+        d.max_peak_diff_n = (a.peak_n - b.peak_n).abs();
     }
     for (a, b) in w.coupling.iter().zip(&s.coupling) {
         d.max_peak_diff_n = d.max_peak_diff_n.max((a.1 - b.1).abs());
@@ -319,7 +464,12 @@ fn figures(whole: &Side, framed: &Side, budget: f64, duration: f64) -> Round {
         frame_p99_s: quantile(&f, 0.99),
         frame_p999_s: quantile(&f, 0.999),
         frame_max_s: f.last().copied().unwrap_or(0.0),
+        frame_cpu_median_s: quantile(&c, 0.5),
+        frame_cpu_p99_s: quantile(&c, 0.99),
+        frame_cpu_p999_s: quantile(&c, 0.999),
+        frame_cpu_max_s: c.last().copied().unwrap_or(0.0),
         overruns: f.iter().filter(|&&x| x > budget).count(),
+        cpu_overruns: c.iter().filter(|&&x| x > budget).count(),
         real_time_factor: framed.wall_s / duration,
         difference: d,
     }
@@ -333,9 +483,12 @@ fn side(
     duration: f64,
     ends: &[f64],
     drive: bool,
+    pace: Option<f64>,
     stop: &AtomicBool,
 ) -> Result<Side> {
     let mut frames_s = Vec::with_capacity(ends.len());
+    let mut frames_cpu_s = Vec::with_capacity(ends.len());
+    let mut frames_impacts = Vec::with_capacity(ends.len());
     if let Some(net) = &scene.network {
         let names: Vec<String> = if drive {
             clutchpack_sdk::network_inputs(net)
@@ -348,17 +501,19 @@ fn side(
         let mut sim = NetworkSimulation::start(scene, Some(engine), &names, None, Some(duration))?;
         let held = sim.input_values();
         let t0 = Instant::now();
-        for &t in ends {
-            let f0 = Instant::now();
+        for (k, &t) in ends.iter().enumerate() {
+            wait_for_frame(t0, k, pace);
+            let f0 = FrameClock::now();
             for (name, v) in &held {
                 sim.set_input(name, *v)?;
             }
             sim.advance_to(t, Some(stop))?;
             // a host reads the outputs at every communication point
             std::hint::black_box(sim.outputs());
-            frames_s.push(f0.elapsed().as_secs_f64());
+            f0.push(&mut frames_s, &mut frames_cpu_s);
+            frames_impacts.push(0);
         }
-        let wall_s = t0.elapsed().as_secs_f64();
+        let wall_s = busy_wall_s(t0, &frames_s, pace);
         let t_end_s = sim.time_s();
         let state = sim
             .outputs()
@@ -379,9 +534,11 @@ fn side(
         return Ok(Side {
             wall_s,
             frames_s,
+            frames_cpu_s,
+            frames_impacts,
             steps: s.steps,
             outputs: Outputs {
-                impacts: Vec::new(),
+                last_impact: None,
                 coupling,
                 state,
                 t_end_s,
@@ -398,12 +555,17 @@ fn side(
     let mut session = sim.start(SessionRequest {
         driven,
         stop_time_s: Some(duration),
-        keep_history: true,
+        // as a host runs it (`CoSimulation`, the FMU): nothing kept but the statistics (the
+        // kept history's doubling vectors were the slowest frames' own cost, 3.6 and 7.2 ms
+        // at frames 3277 and 6554 of `pack-8-brake`'s 10 s)
+        keep_history: false,
         ..SessionRequest::default()
     })?;
     let t0 = Instant::now();
-    for &t in ends {
-        let f0 = Instant::now();
+    let mut impacts = session.impact_count();
+    for (k, &t) in ends.iter().enumerate() {
+        wait_for_frame(t0, k, pace);
+        let f0 = FrameClock::now();
         if drive {
             // what `CoSimulation` does at every call of a driven run
             session.set_inputs(&held)?;
@@ -411,9 +573,12 @@ fn side(
         session.advance_to(t, Some(stop))?;
         // a host reads the outputs at every communication point (`CoSimulation`'s snapshot)
         std::hint::black_box(session.snapshot());
-        frames_s.push(f0.elapsed().as_secs_f64());
+        f0.push(&mut frames_s, &mut frames_cpu_s);
+        let now = session.impact_count();
+        frames_impacts.push((now - impacts) as u32);
+        impacts = now;
     }
-    let wall_s = t0.elapsed().as_secs_f64();
+    let wall_s = busy_wall_s(t0, &frames_s, pace);
     let snap = session.snapshot();
     let mut state: Vec<f64> = vec![snap.sample.shaft_speed_rad_s, snap.sample.shaft_angle_rad];
     for d in &snap.sample.discs {
@@ -423,13 +588,20 @@ fn side(
     let t_end_s = session.time_s();
     let done = session.finish();
     let steps = done.stats()?.steps;
+    // after `finish`, which closes the contacts still open
+    let c = &done.collector;
+    let mut coupling = vec![(c.impact_count() as u64, 0.0)];
+    coupling.extend((0..done.body_names.len()).map(|i| (0, c.peaks.max_abs_n(i))));
+    let last_impact = c.last_impact;
     Ok(Side {
         wall_s,
         frames_s,
+        frames_cpu_s,
+        frames_impacts,
         steps,
         outputs: Outputs {
-            impacts: done.collector.impacts,
-            coupling: Vec::new(),
+            last_impact,
+            coupling,
             state,
             t_end_s,
         },

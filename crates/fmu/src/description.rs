@@ -10,6 +10,42 @@ use quick_xml::Writer;
 /// are not prefixed.
 pub const MODEL_IDENTIFIER: &str = "clutchpack_fmu";
 
+/// The `RealTime` element of the model description's `VendorAnnotations` (tool
+/// `clutchpack`): what a real-time host may count on, each a fact of the implementation
+/// (docs/cosimulation.md, "Real time").
+pub const REAL_TIME: &[(&str, &str)] = &[
+    (
+        "doStep",
+        "synchronous: runs on the calling thread and returns when the step is done",
+    ),
+    (
+        "frameCost",
+        "a communication step costs what its simulated time costs: the engine's state \
+         (step sizes, error history, sub-steps) carries across doStep calls, a pack's steps \
+         landing on each communication point where an input may change; an input set to the \
+         value it holds is not passed to the engine",
+    ),
+    (
+        "communicationStepSize",
+        "any step > 0, varying from call to call (canHandleVariableCommunicationStepSize)",
+    ),
+    (
+        "state",
+        "fmi2GetFMUstate and fmi2SetFMUstate copy the whole run, so that a master may redo a \
+         step (not while recording)",
+    ),
+    (
+        "recording",
+        "written on its own thread through a bounded queue: doStep waits only when the writer \
+         falls behind",
+    ),
+    (
+        "measure",
+        "clutchpack bench --frames 1ms SCENE --drive --paced (the frame time distribution on \
+         this host); examples/python/fmu_realtime.py through the FMU",
+    ),
+];
+
 /// What the model description says besides the variables.
 #[derive(Debug, Clone)]
 pub struct Header<'a> {
@@ -113,6 +149,14 @@ pub fn model_description(header: &Header, vars: &[Variable]) -> String {
             ("stepSize", &header.step_s.to_string()),
         ],
     ));
+    // What the FMU honours in a real-time loop (issue 46), in the tool's own annotation
+    // (FMI 2.0 section 2.2.6): facts of the implementation, true of every FMU it builds; the
+    // frame's cost on a host is measured there (`measure`).
+    events.push(start("VendorAnnotations", &[]));
+    events.push(start("Tool", &[("name", "clutchpack")]));
+    events.push(empty("RealTime", REAL_TIME));
+    events.push(end("Tool"));
+    events.push(end("VendorAnnotations"));
     events.push(start("ModelVariables", &[]));
     for v in vars {
         let vr = v.vr.to_string();

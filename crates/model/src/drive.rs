@@ -288,6 +288,17 @@ impl SpeedProfile {
     /// harmonics too fast for the series within the reach (`2 pi f reach` beyond about 0.7
     /// rad: 0.1 ms reaches 1.1 kHz).
     pub fn local(&self, t_m: f64, reach_s: f64) -> Option<LocalProfile> {
+        self.local_reusing(t_m, reach_s, None)
+    }
+
+    /// [`SpeedProfile::local`] reusing `old`'s buffer (a previous expansion's, `None`: a new
+    /// one), so that a loop expanding the profile at every step does not allocate.
+    pub fn local_reusing(
+        &self,
+        t_m: f64,
+        reach_s: f64,
+        old: Option<LocalProfile>,
+    ) -> Option<LocalProfile> {
         let SpeedProfile::Harmonics {
             omega0_rad_s,
             harmonics,
@@ -309,19 +320,19 @@ impl SpeedProfile {
             next *= x_max * x_max / ((2 * k) as f64 * (2 * k + 1) as f64);
         }
         let (speed_m, angle_m) = self.speed_and_angle(t_m);
+        let mut terms = old.map(|o| o.terms).unwrap_or_default();
+        terms.clear();
+        terms.extend(harmonics.iter().map(|h| {
+            let w = TAU * h.frequency_hz;
+            let (sin_m, cos_m) = (w * t_m + h.phase_rad).sin_cos();
+            [w, h.amplitude_rad_s, h.amplitude_rad_s / w, sin_m, cos_m]
+        }));
         Some(LocalProfile {
             t_m,
             speed_m,
             angle_m,
             omega0: *omega0_rad_s,
-            terms: harmonics
-                .iter()
-                .map(|h| {
-                    let w = TAU * h.frequency_hz;
-                    let (sin_m, cos_m) = (w * t_m + h.phase_rad).sin_cos();
-                    [w, h.amplitude_rad_s, h.amplitude_rad_s / w, sin_m, cos_m]
-                })
-                .collect(),
+            terms,
             series_terms: k,
         })
     }

@@ -82,6 +82,9 @@ pub(crate) struct Stack {
     /// clamped stack's multirate integration knows it ([`Self::record_step`]; empty on the
     /// shared step, whose torque is constant over a step): what the samples report.
     torque_now: Vec<f64>,
+    /// [`Stack::update`]'s buffer of the stack bodies' normal loads (kept so that it does
+    /// not allocate at every step).
+    normal_buf: Vec<f64>,
 }
 
 impl Stack {
@@ -107,6 +110,7 @@ impl Stack {
             locked: vec![false; n_if],
             torque: vec![0.0; n_bodies],
             torque_now: Vec::new(),
+            normal_buf: Vec::with_capacity(n_bodies),
         }
     }
 
@@ -144,9 +148,12 @@ impl Stack {
     /// Updates the clamp forces and slips at `t_s`: `tooth_normal_n[i]` is the normal load
     /// `n |F|` of coupling `i`'s teeth (N), `omega[i]` its body's speed (rad/s).
     pub fn update(&mut self, t_s: f64, tooth_normal_n: &[f64], omega: &[f64]) {
-        let q: Vec<f64> = self.body.iter().map(|&i| tooth_normal_n[i]).collect();
+        let mut q = std::mem::take(&mut self.normal_buf);
+        q.clear();
+        q.extend(self.body.iter().map(|&i| tooth_normal_n[i]));
         self.model
             .clamp_forces_n(self.model.piston.force_n(t_s), &q, &mut self.clamp);
+        self.normal_buf = q;
         for m in 0..self.interfaces() {
             self.slip[m] = omega[self.body[m + 1]] - omega[self.body[m]];
         }
@@ -410,30 +417,36 @@ impl Stack {
     /// What each interface does now (its torque is the one of the last step taken, or the
     /// one at its end where the clamped stack's integration recorded it).
     pub fn samples(&self) -> Vec<InterfaceSample> {
-        (0..self.interfaces())
-            .map(|m| {
-                let clamped = self.clamp[m] > 0.0;
-                InterfaceSample {
-                    slip_rad_s: self.slip[m],
-                    slip_m_s: self.slip[m] * self.r_eff,
-                    mu: if clamped {
-                        self.model.friction_of(m).mu(self.slip[m] * self.r_eff)
-                    } else {
-                        0.0
-                    },
-                    clamp_n: self.clamp[m],
-                    torque_n_m: if !self.torque_now.is_empty() {
-                        self.torque_now[m]
-                    } else if self.h > 0.0 {
-                        self.impulse[m] / self.h
-                    } else {
-                        0.0
-                    },
-                    locked: self.locked[m],
-                    dissipated_j: self.dissipated_j[m],
-                }
-            })
-            .collect()
+        let mut out = Vec::new();
+        self.samples_into(&mut out);
+        out
+    }
+
+    /// [`Stack::samples`] into `out` (its contents replaced).
+    pub fn samples_into(&self, out: &mut Vec<InterfaceSample>) {
+        out.clear();
+        out.extend((0..self.interfaces()).map(|m| {
+            let clamped = self.clamp[m] > 0.0;
+            InterfaceSample {
+                slip_rad_s: self.slip[m],
+                slip_m_s: self.slip[m] * self.r_eff,
+                mu: if clamped {
+                    self.model.friction_of(m).mu(self.slip[m] * self.r_eff)
+                } else {
+                    0.0
+                },
+                clamp_n: self.clamp[m],
+                torque_n_m: if !self.torque_now.is_empty() {
+                    self.torque_now[m]
+                } else if self.h > 0.0 {
+                    self.impulse[m] / self.h
+                } else {
+                    0.0
+                },
+                locked: self.locked[m],
+                dissipated_j: self.dissipated_j[m],
+            }
+        }));
     }
 }
 

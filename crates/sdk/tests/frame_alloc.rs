@@ -1,6 +1,7 @@
 //! Issue 46, item 3: the heap allocations of a host's frame loop once started, counted by a
 //! global allocator (this test binary's only test, so that nothing else allocates while it
-//! counts). The goal is none; this measures where the frame loop stands and keeps it there.
+//! counts). The goal is none; this measures where the frame loop stands and keeps it there
+//! (the multibody engine's are all rapier's own, inside its world step).
 
 use clutchpack_model::session::Advance;
 use clutchpack_scene::{EngineChoice, Override};
@@ -35,14 +36,21 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static COUNTING: Counting = Counting;
 
-/// `pack-8-brake` (record rate 10 kHz: ten samples a frame) through the sdk's session as a
-/// host runs it, nothing kept but the running statistics: 20 frames of 1 ms after 20 of
-/// warm-up, the allocations per frame on each engine. Measured (2026-12-07): 1443 on the
-/// reference engine (its open-pack scheme clones every body's integration at each window of
-/// 1 ms, and queues each sample), 207 on the multibody engine (each sample and the stack's
-/// interface samples built as new vectors, the impacts' and contact samples' lists); far
-/// from the goal of none. Asserted within 25 % of those, so that the frame loop does not
-/// allocate more unnoticed.
+/// `pack-8-brake` (record rate 10 kHz: ten samples a frame, ten world steps of 0.1 ms) through
+/// the sdk's session as a host runs it, nothing kept but the running statistics: 20 frames of
+/// 1 ms after 20 of warm-up, the allocations per frame on each engine.
+///
+/// Multibody engine: 207 per frame before issue 46's frame work (each sample's and interface
+/// sample's vectors, the world step's gap drags, speeds, means and carriers, the shaft's
+/// expansion, the stack's loads, a fatigue buffer per impact); now 60.1, every one of them
+/// inside rapier3d 0.36's world step (`PhysicsPipeline::step`: its modified-body list, taken
+/// at each step and grown again, 4 a step; its solver graph and island cursors, 1 each), 6
+/// per world step, and 0.1 the statistics' amortised growth. Asserted at most 63 (5 %
+/// above): one more allocation per world step of the engine's own is 70 and fails.
+///
+/// Reference engine: 1437.3 per frame (1443 before a fatigue impact's first samples went on
+/// the stack; its open-pack scheme clones every body's integration at each window of 1 ms,
+/// and queues each sample: not yet reworked), asserted within 25 % of 1443.
 #[test]
 fn frame_loop_allocations_per_frame_are_bounded() {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/pack-8-brake.toml");
@@ -69,13 +77,13 @@ fn frame_loop_allocations_per_frame_are_bounded() {
         }
         let per_frame = (ALLOCATIONS.load(Ordering::Relaxed) - before) as f64 / 20.0;
         println!("{engine:?}: {per_frame} allocations per 1 ms frame");
-        let measured = match engine {
-            EngineChoice::Reference => 1443.0,
-            EngineChoice::Multibody => 207.0,
+        let (measured, bound) = match engine {
+            EngineChoice::Reference => (1443.0, 1.25 * 1443.0),
+            EngineChoice::Multibody => (60.1, 63.0),
         };
         assert!(
-            per_frame <= 1.25 * measured,
-            "{engine:?}: {per_frame} allocations per frame (measured {measured})"
+            per_frame <= bound,
+            "{engine:?}: {per_frame} allocations per frame (measured {measured}, bound {bound})"
         );
         drop(s.finish());
     }

@@ -338,7 +338,9 @@ impl FatigueCollector {
         // contact's may be millions, partly on disk): the first few wait until there are
         // enough to count it from its samples, the peak goes in before the first sample
         // after it
-        let mut first: Vec<(f64, f64)> = Vec::with_capacity(SUSTAINED_CONTACT_SAMPLES);
+        // (on the stack: an impact allocates nothing, issue 46's frame loop)
+        let mut first = [(0.0, 0.0); SUSTAINED_CONTACT_SAMPLES];
+        let mut n_first = 0;
         let mut sustained = false;
         let mut peak_in = false;
         let mut feed = |h: &mut HistoryTrack, s: (f64, f64)| {
@@ -352,10 +354,11 @@ impl FatigueCollector {
             if sustained {
                 feed(h, s);
             } else {
-                first.push(s);
-                if first.len() >= SUSTAINED_CONTACT_SAMPLES {
+                first[n_first] = s;
+                n_first += 1;
+                if n_first >= SUSTAINED_CONTACT_SAMPLES {
                     sustained = true;
-                    for s in first.drain(..) {
+                    for &s in &first {
                         feed(h, s);
                     }
                 }

@@ -217,13 +217,16 @@ impl Run {
     /// `n |F| = |torque| / Rb` and the bodies' speeds (no-op without a stack).
     pub(super) fn update_stack(&mut self) {
         if let Some(stack) = self.stack.as_mut() {
-            let normal: Vec<f64> = self
-                .forces
-                .iter()
-                .zip(self.bodies.iter())
-                .map(|(f, d)| f.moment[2].abs() / d.spline.base_radius_m())
-                .collect();
+            let mut normal = std::mem::take(&mut self.normal_buf);
+            normal.clear();
+            normal.extend(
+                self.forces
+                    .iter()
+                    .zip(self.bodies.iter())
+                    .map(|(f, d)| f.moment[2].abs() / d.spline.base_radius_m()),
+            );
             stack.update(self.t, &normal, &self.omega_d);
+            self.normal_buf = normal;
         }
     }
 

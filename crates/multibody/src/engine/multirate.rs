@@ -84,10 +84,12 @@ impl Run {
 
     /// The open gaps' drag on every coupling body over the world step from `t` of length `h`
     /// ([`GapDrag`]; zero without a stack), with the neighbours' speeds affine in time: `w`
-    /// at the step's middle (their mean, rad/s, coupling order) and `slope` (rad/s^2).
-    fn gap_drags(&self, w: &[f64], slope: &[f64], h: f64) -> Vec<GapDrag> {
-        let mut g = vec![GapDrag::default(); self.couplings.len()];
-        let Some(stack) = &self.stack else { return g };
+    /// at the step's middle (their mean, rad/s, coupling order) and `slope` (rad/s^2); into
+    /// `g` (its contents replaced).
+    fn gap_drags(&self, w: &[f64], slope: &[f64], h: f64, g: &mut Vec<GapDrag>) {
+        g.clear();
+        g.resize(self.couplings.len(), GapDrag::default());
+        let Some(stack) = &self.stack else { return };
         let c = self.gap_coefficient();
         for m in 0..stack.interfaces() {
             let (lo, up) = (stack.body[m], stack.body[m + 1]);
@@ -98,10 +100,9 @@ impl Run {
             g[up].slope_n_m_s += c * slope[lo];
             g[up].damping += c;
         }
-        for x in &mut g {
+        for x in g.iter_mut() {
             (x.t_mid_s, x.half_step_s) = (self.t + 0.5 * h, 0.5 * h);
         }
-        g
     }
 
     /// Advances the run from `t` to `t1` by the multirate scheme: the friction discs (each on
@@ -110,8 +111,22 @@ impl Run {
     /// world takes one step of `t1 - t` with each body's impulse. Impact events that closed go
     /// to `closed` (in the order they closed within each coupling), the contact samples
     /// `(coupling, t s, state)` of the sub-steps to `contacts` (in time order within each
-    /// coupling; see `EventBook::update`).
+    /// coupling; see `EventBook::update`). Its buffers are the run's
+    /// ([`OpenStepBuffers`](super::scheme_state::OpenStepBuffers)), taken for the step and put
+    /// back: a step allocates nothing of its own.
     pub(super) fn multirate_step(&mut self, ws: &mut WorldStep) -> Result<(), EngineError> {
+        let mut b = std::mem::take(&mut self.multirate.open);
+        let out = self.multirate_step_in(ws, &mut b);
+        self.multirate.open = b;
+        out
+    }
+
+    /// [`Run::multirate_step`] with its buffers `b`.
+    fn multirate_step_in(
+        &mut self,
+        ws: &mut WorldStep,
+        b: &mut super::scheme_state::OpenStepBuffers,
+    ) -> Result<(), EngineError> {
         let t1 = ws.t1;
         let t0 = self.t;
         let h = t1 - t0;
@@ -126,8 +141,9 @@ impl Run {
         // their mean, 1.65 us with every neighbour held at its speed at t).
         let n_discs = self.pack.discs.len();
         let n = self.couplings.len();
-        let zero = vec![0.0; n];
-        let mut gaps = self.gap_drags(&self.omega_d, &zero, h);
+        b.zero.clear();
+        b.zero.resize(n, 0.0);
+        self.gap_drags(&self.omega_d, &b.zero, h, &mut b.gaps);
         for i in 0..n {
             let theta = self.carrier_angle(i) - self.rel[i].phi;
             self.multirate.moments[i] = TurnMoment::start(t0, theta, self.omega_d[i]);
@@ -136,59 +152,58 @@ impl Run {
             // the plates' predicted mean speeds, for the discs, held over the step (their
             // acceleration at t as a slope too was measured no better: a plate in contact at t
             // does not keep its acceleration over the step)
-            let w: Vec<f64> = (0..n)
-                .map(|j| {
-                    let w = self.omega_d[j];
-                    if j < n_discs {
-                        return w;
-                    }
-                    let d = &self.bodies[j];
-                    let torque = self.forces[j].moment[2] + gaps[j].held_n_m
-                        - (gaps[j].damping + d.drag_n_m_s_rad) * w;
-                    w + 0.5 * h * torque / d.inertia_kg_m2
-                })
-                .collect();
-            gaps = self.gap_drags(&w, &zero, h);
+            b.w.clear();
+            b.w.extend((0..n).map(|j| {
+                let w = self.omega_d[j];
+                if j < n_discs {
+                    return w;
+                }
+                let d = &self.bodies[j];
+                let g = &b.gaps[j];
+                let torque =
+                    self.forces[j].moment[2] + g.held_n_m - (g.damping + d.drag_n_m_s_rad) * w;
+                w + 0.5 * h * torque / d.inertia_kg_m2
+            }));
+            self.gap_drags(&b.w, &b.zero, h, &mut b.gaps);
         }
-        let mut means = vec![0.0; n];
+        b.means.clear();
+        b.means.resize(n, 0.0);
         // the inertial carriers and their states at t and t1, for the world's step
-        let mut carriers = Vec::new();
+        b.carriers.clear();
         // the discs, with an inertial shaft as their carrier or each alone
         let (discs, plates) = (0..n_discs, n_discs..n);
-        self.advance_group(discs, &gaps, &mut means, &mut carriers, ws)?;
+        self.advance_group(discs, b, ws)?;
         if self.stack.is_some() {
             // the discs' speeds over the step, for the plates: the affine function with their
             // mean and their first moment, from their sub-steps
-            let w: Vec<f64> = (0..n)
-                .map(|j| {
-                    if j < n_discs {
-                        means[j]
-                    } else {
-                        self.omega_d[j]
-                    }
-                })
-                .collect();
-            let slope: Vec<f64> = (0..n)
-                .map(|j| {
-                    if j < n_discs {
-                        self.multirate.moments[j].slope()
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
-            gaps = self.gap_drags(&w, &slope, h);
+            b.w.clear();
+            b.w.extend((0..n).map(|j| {
+                if j < n_discs {
+                    b.means[j]
+                } else {
+                    self.omega_d[j]
+                }
+            }));
+            b.slope.clear();
+            b.slope.extend((0..n).map(|j| {
+                if j < n_discs {
+                    self.multirate.moments[j].slope()
+                } else {
+                    0.0
+                }
+            }));
+            self.gap_drags(&b.w, &b.slope, h, &mut b.gaps);
         }
         // the plates: each alone on the housing, then the drum with its own (as an inertial
         // shaft with its discs), their gaps' drag from the discs' speeds as on the housing
-        self.advance_group(plates, &gaps, &mut means, &mut carriers, ws)?;
+        self.advance_group(plates, b, ws)?;
         self.potential_j = self.forces.iter().map(|f| f.potential_j).sum();
         let c = self.gap_coefficient();
         if let Some(s) = self.stack.as_mut() {
             // Each interface's share of the gaps' work, from the bodies' mean speeds over the
             // step (the bodies' own audit is exact along their sub-steps).
             for m in 0..s.interfaces() {
-                let slip = means[s.body[m + 1]] - means[s.body[m]];
+                let slip = b.means[s.body[m + 1]] - b.means[s.body[m]];
                 s.impulse[m] = -c * slip * h;
                 s.dissipated_j[m] += c * slip * slip * h;
             }
@@ -197,7 +212,7 @@ impl Run {
         // The world's step: each body's impulse in two halves, `J (mean - w(t))` applied as a
         // torque over the step (rapier's semi-implicit Euler then drifts the body by
         // exactly `mean h`) and `J (w(t1) - mean)` as the speed set at its end.
-        self.finish_world_step(&means, t1, &carriers);
+        self.finish_world_step_in(&b.means, t1, &b.carriers, &mut b.prescribed);
         Ok(())
     }
 
@@ -212,55 +227,67 @@ impl Run {
         t1: f64,
         carriers: &[(usize, Node, Node)],
     ) {
+        let mut prescribed = Vec::new();
+        self.finish_world_step_in(means, t1, carriers, &mut prescribed);
+    }
+
+    /// [`Run::finish_world_step`] with `prescribed` as its buffer (its contents replaced).
+    fn finish_world_step_in(
+        &mut self,
+        means: &[f64],
+        t1: f64,
+        carriers: &[(usize, Node, Node)],
+        prescribed: &mut Vec<(usize, f64, f64)>,
+    ) {
         self.drive_to_means(means, t1 - self.t);
         // each prescribed carrier's angle and speed at t1
-        let prescribed: Vec<(usize, f64, f64)> = (self.carriers.iter().enumerate())
-            .filter_map(|(c, k)| match &k.motion {
+        prescribed.clear();
+        prescribed.extend((self.carriers.iter().enumerate()).filter_map(
+            |(c, k)| match &k.motion {
                 Motion::Prescribed(p) => {
                     let (speed, angle) = p.speed_and_angle(t1);
                     Some((c, angle, speed))
                 }
                 _ => None,
-            })
-            .collect();
-        for &(c, angle, _) in &prescribed {
+            },
+        ));
+        for &(c, angle, _) in prescribed.iter() {
             let bodies = &mut self.world.physics.bodies;
             bodies[self.world.carriers[c].handle]
                 .set_next_kinematic_rotation(Rotation::from_rotation_z(angle));
         }
         self.step_world_multirate(t1, carriers);
-        for (c, angle, speed) in prescribed {
+        for &(c, angle, speed) in prescribed.iter() {
             self.set_carrier_state(c, angle, speed);
         }
     }
 
     /// Advances the couplings `group` (the discs, or the plates) from `t` to `t1`, the open
-    /// gaps' drag `gaps` on each: every one on a carrier of known motion alone against it
+    /// gaps' drag `b.gaps` on each: every one on a carrier of known motion alone against it
     /// ([`Run::advance_alone`]) first, then each inertial carrier of the group's couplings
     /// (table order) together with those it carries ([`Run::advance_carrier`], its index and
-    /// nodes then pushed onto `carriers` for the world's step). Writes each one's speed at
-    /// `t1` into `omega_d` and its mean speed over the step into `means`.
+    /// nodes then pushed onto `b.carriers` for the world's step). Writes each one's speed at
+    /// `t1` into `omega_d` and its mean speed over the step into `b.means`.
     fn advance_group(
         &mut self,
         group: std::ops::Range<usize>,
-        gaps: &[GapDrag],
-        means: &mut [f64],
-        carriers: &mut Vec<(usize, Node, Node)>,
+        b: &mut super::scheme_state::OpenStepBuffers,
         ws: &mut WorldStep,
     ) -> Result<(), EngineError> {
-        let mut inertial = Vec::new();
+        b.inertial.clear();
         for i in group {
             let c = self.world.carrier_of[i];
             if !self.carriers[c].is_inertial() {
-                self.advance_alone(i, gaps[i], means, ws)?;
-            } else if !inertial.contains(&c) {
-                inertial.push(c);
+                self.advance_alone(i, b.gaps[i], &mut b.means, ws)?;
+            } else if !b.inertial.contains(&c) {
+                b.inertial.push(c);
             }
         }
-        inertial.sort_unstable();
-        for c in inertial {
-            let (start, end) = self.advance_carrier(c, gaps, means, ws)?;
-            carriers.push((c, start, end));
+        b.inertial.sort_unstable();
+        for k in 0..b.inertial.len() {
+            let c = b.inertial[k];
+            let (start, end) = self.advance_carrier(c, &b.gaps, &mut b.means, ws)?;
+            b.carriers.push((c, start, end));
         }
         Ok(())
     }

@@ -7,9 +7,10 @@
 //! keeping them there made `state.rs` -> `scheme_state.rs` -> `clamped.rs` -> `state.rs` an
 //! import cycle.
 
-use super::substep::{Rk4, TurnMoment};
+use super::substep::{GapDrag, Node, Rk4, TurnMoment};
 use crate::integrate::{Kick, Load, LoadHistory, Motion};
 use crate::stack::Face;
+use clutchpack_model::{DiscSample, ImpactEvent, InterfaceSample, LocalProfile, Sample};
 
 /// The loads of one body (a disc, a plate, an inertial carrier) and their kick
 /// (`integrate.rs`).
@@ -79,6 +80,29 @@ pub(super) struct MultirateState {
     pub(super) faces: Vec<Face>,
     /// The clamped stack's step buffers, kept from one world step to the next.
     pub(super) stack_buffers: Option<RkBuffers>,
+    /// The open scheme's per-step buffers (`multirate.rs`), kept so that a world step does
+    /// not allocate (issue 46: a real-time host's frame loop).
+    pub(super) open: OpenStepBuffers,
+}
+
+/// The buffers of one open multirate world step (`Run::multirate_step`), cleared and filled
+/// at every step: their contents never outlive it.
+#[derive(Debug, Clone, Default)]
+pub(super) struct OpenStepBuffers {
+    /// The open gaps' drag on each coupling body.
+    pub(super) gaps: Vec<GapDrag>,
+    /// Per coupling body: zeros, the neighbours' speeds (rad/s) and slopes (rad/s^2) the
+    /// gaps' drag reads, and each body's mean speed over the step (rad/s).
+    pub(super) zero: Vec<f64>,
+    pub(super) w: Vec<f64>,
+    pub(super) slope: Vec<f64>,
+    pub(super) means: Vec<f64>,
+    /// The inertial carriers of the step with their nodes at its start and end.
+    pub(super) carriers: Vec<(usize, Node, Node)>,
+    /// The inertial carriers of a group, in table order.
+    pub(super) inertial: Vec<usize>,
+    /// Each prescribed carrier's (index, angle rad, speed rad/s) at the step's end.
+    pub(super) prescribed: Vec<(usize, f64, f64)>,
 }
 
 impl MultirateState {
@@ -88,6 +112,7 @@ impl MultirateState {
             moments: vec![TurnMoment::default(); n],
             faces: Vec::new(),
             stack_buffers: None,
+            open: OpenStepBuffers::default(),
         }
     }
 }
@@ -212,4 +237,18 @@ impl RkBuffers {
 /// locked face).
 pub(super) fn powers(n: usize, n_spin: usize, n_if: usize) -> [usize; 7] {
     [n, n, n_spin, n_spin, n_if, n_if, n_if]
+}
+
+/// The buffers of a session's loops (`session.rs`): what one step or one sample fills and the
+/// observer reads, cleared before each use (their contents never outlive it).
+#[derive(Debug, Clone, Default)]
+pub(super) struct SessionBuffers {
+    /// The sample being sent and the stack's interfaces at it.
+    pub(super) sample: Sample,
+    pub(super) interfaces: Vec<InterfaceSample>,
+    /// The impacts a world step closed, and its contact samples `(coupling, t s, state)`.
+    pub(super) closed: Vec<ImpactEvent>,
+    pub(super) contacts: Vec<(usize, f64, DiscSample)>,
+    /// The prescribed shaft's expansion over the world step (the last one's buffer).
+    pub(super) local: Option<LocalProfile>,
 }

@@ -37,6 +37,7 @@
 
 use super::carriers::{External, Motion};
 use super::energy::EnergyAudit;
+use super::scheme_state::SessionBuffers;
 use super::state::{shaft_accel_bound, Run};
 use super::substep::{split_remainder, Counts, Prescribed, WorldStep};
 use super::thermal::Thermal;
@@ -105,6 +106,9 @@ pub struct MultibodySession {
     energy: EnergyAudit,
     /// The temperatures of a thermal run (`thermal.rs`); `None`: isothermal.
     pub(super) thermal: Option<Box<Thermal>>,
+    /// The loop's buffers, kept from one call to the next so that a frame allocates nothing
+    /// of its own (issue 46).
+    scratch: SessionBuffers,
 }
 
 impl MultibodySession {
@@ -170,6 +174,7 @@ impl MultibodySession {
             finished: None,
             energy: EnergyAudit::default(),
             thermal,
+            scratch: SessionBuffers::default(),
         })
     }
 
@@ -259,9 +264,12 @@ impl MultibodySession {
         let run = &self.run;
         let slack = self.slack(1.0 / self.options.record_rate_hz);
         if self.rec_time(self.rec_index) <= run.t + self.half_step + slack {
-            observer.sample(&run.sample(self.options.record_tooth_loads));
+            let sc = &mut self.scratch;
+            run.sample_into(self.options.record_tooth_loads, &mut sc.sample);
+            observer.sample(&sc.sample);
             if let Some(s) = &run.stack {
-                observer.interfaces(run.t, &s.samples());
+                s.samples_into(&mut sc.interfaces);
+                observer.interfaces(run.t, &sc.interfaces);
             }
             while self.rec_time(self.rec_index) <= run.t + self.half_step + slack {
                 self.rec_index += 1;
@@ -405,8 +413,6 @@ impl MultibodySession {
                 return Ok(Advance::Stopped);
             }
         }
-        let mut closed = Vec::new();
-        let mut contacts = Vec::new();
         while self.run.t < t_s {
             // the piston may push from now on: the clamped stack integrated as one system
             // (`clamped.rs`)
@@ -426,9 +432,8 @@ impl MultibodySession {
                 Motion::Prescribed(p) => Some(Arc::clone(p)),
                 _ => None,
             };
-            let local = profile
-                .as_deref()
-                .and_then(|p| Prescribed::expand(p, run.t, t1));
+            let (old, half) = (self.scratch.local.take(), 0.5 * (t1 - run.t));
+            let local = (profile.as_deref()).and_then(|p| p.local_reusing(run.t + half, half, old));
             let mut ws = WorldStep {
                 t1,
                 a: &a,
@@ -437,24 +442,26 @@ impl MultibodySession {
                     local: local.as_ref(),
                 }),
                 counts: &mut self.counts,
-                closed: &mut closed,
-                contacts: &mut contacts,
+                closed: &mut self.scratch.closed,
+                contacts: &mut self.scratch.contacts,
             };
             if clamped {
                 run.clamped_step(&mut ws)?;
             } else {
                 run.multirate_step(&mut ws)?;
             }
+            self.scratch.local = local;
             run.update_stack();
             // Events in the order they closed across the couplings.
-            closed.sort_by(|x, y| x.t_off_s.total_cmp(&y.t_off_s));
-            for e in closed.drain(..) {
+            let sc = &mut self.scratch;
+            sc.closed.sort_by(|x, y| x.t_off_s.total_cmp(&y.t_off_s));
+            for e in sc.closed.drain(..) {
                 observer.impact(&e);
             }
             // The sub-steps' contact samples, all in (t, t1], before the sample at t1; a
             // stable sort keeps each coupling's order and interleaves the couplings in time.
-            contacts.sort_by(|x, y| x.1.total_cmp(&y.1));
-            for (i, t, s) in contacts.drain(..) {
+            sc.contacts.sort_by(|x, y| x.1.total_cmp(&y.1));
+            for (i, t, s) in sc.contacts.drain(..) {
                 observer.contact_sample(i, t, &s);
             }
             self.steps += 1;

@@ -98,6 +98,9 @@ pub(super) struct Run {
     pub(super) potential_j: f64,
     /// The energy audit (written through its methods only, `energy.rs`).
     pub(super) energy: EnergyBook,
+    /// [`Run::update_stack`]'s buffer of the teeth's normal loads, N (kept so that a step
+    /// does not allocate).
+    pub(super) normal_buf: Vec<f64>,
 }
 
 /// Each coupling's effective mass along its line of action, kg: the body's, in series with
@@ -250,6 +253,7 @@ impl Run {
             t: 0.0,
             potential_j: 0.0,
             energy: EnergyBook::default(),
+            normal_buf: Vec::with_capacity(nd),
             pack,
         })
     }
@@ -297,6 +301,37 @@ impl Run {
             discs: (0..self.forces.len())
                 .map(|i| self.disc_sample(i, tooth_loads))
                 .collect(),
+        }
+    }
+
+    /// [`Run::sample`] into `out`, reusing its buffers: without per-tooth loads (lumped
+    /// couplings, or `tooth_loads` false) it allocates nothing once `out` has held a sample.
+    pub(super) fn sample_into(&self, tooth_loads: bool, out: &mut Sample) {
+        out.t_s = self.t;
+        out.shaft_angle_rad = self.carriers[SHAFT].angle;
+        out.shaft_speed_rad_s = self.carriers[SHAFT].speed;
+        let n = self.forces.len();
+        out.discs.truncate(n);
+        for i in 0..n {
+            let mut loads = match out.discs.get_mut(i) {
+                Some(d) => std::mem::take(&mut d.tooth_loads_n),
+                None => Vec::new(),
+            };
+            loads.clear();
+            if tooth_loads {
+                loads.extend(self.couplings[i].tooth_loads_n());
+            }
+            let d = disc_sample(
+                &self.forces[i],
+                &self.rel[i],
+                self.carrier_angle(i),
+                self.omega_d[i],
+                loads,
+            );
+            match out.discs.get_mut(i) {
+                Some(slot) => *slot = d,
+                None => out.discs.push(d),
+            }
         }
     }
 

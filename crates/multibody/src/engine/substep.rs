@@ -487,12 +487,6 @@ pub(super) struct Prescribed<'a> {
 }
 
 impl Prescribed<'_> {
-    /// The expansion of `profile` for a world step from `t0` to `t1` (s), if it has one.
-    pub(super) fn expand(profile: &SpeedProfile, t0: f64, t1: f64) -> Option<LocalProfile> {
-        let half = 0.5 * (t1 - t0);
-        profile.local(t0 + half, half)
-    }
-
     /// The shaft at `t` (within the world step of the expansion).
     pub(super) fn at(self, t: f64) -> ShaftAt {
         let (speed, angle) = match self.local {
