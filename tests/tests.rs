@@ -465,6 +465,34 @@ fn deterministic_recordings_are_byte_identical() {
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
 }
 
+/// A network scene's recording is byte-identical between two --deterministic runs too (the
+/// attached summary once kept the run's wall time), here an automatic with its shift status.
+#[test]
+fn deterministic_network_recordings_are_byte_identical() {
+    let d = scratch("deterministic-network");
+    let files: Vec<_> = ["a", "b"]
+        .iter()
+        .map(|n| {
+            let f = d.join(format!("{n}.mcap"));
+            let o = run(&[
+                "run",
+                "scenes/eight-speed.toml",
+                "--duration",
+                "1.3",
+                "--deterministic",
+                "--out",
+                f.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{}", stderr(&o));
+            std::fs::read(f).unwrap()
+        })
+        .collect();
+    assert!(
+        files[0] == files[1],
+        "two deterministic network recordings differ"
+    );
+}
+
 /// A recording read back gives the same per-disc statistics as the run printed, and `plot`
 /// and `export` work from it.
 #[test]

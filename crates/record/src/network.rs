@@ -555,6 +555,12 @@ impl NetworkRecorder {
         &self.path
     }
 
+    /// Whether the recording is deterministic (`RecordOptions::deterministic`: no wall times,
+    /// so that two runs give the same bytes).
+    pub fn deterministic(&self) -> bool {
+        self.deterministic
+    }
+
     /// Messages written so far.
     pub fn messages(&self) -> u64 {
         self.messages
