@@ -91,8 +91,9 @@ pub(crate) struct ShiftProbe {
 }
 
 /// An automatic's output torque over the samples `history`: `(t s, N m)` per sample, the
-/// torque [`ShiftProbe::output_torque_n_m`] (`None` without a schedule, or when a coupling on
-/// the output does not give its torque there).
+/// torque its planetary sets and shift elements put on the output body, positive in the
+/// output's direction of positive speed (`None` without a schedule, or when a coupling on the
+/// output does not give its torque there).
 pub fn output_torque_series(
     net: &Network,
     tr: &Transmission,
