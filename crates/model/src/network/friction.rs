@@ -6,7 +6,43 @@
 //! engine lands its step on it) and in how they compute the holding torques; the rule is
 //! this.
 
-use super::{ClutchMode, LumpedClutch, Network};
+use super::{ClutchMode, LumpedClutch, Mode, Network, SlipEnd};
+
+/// The mode a clutch enters at an event at `t` (s) from `before`, at the speeds `w_a`, `w_b`
+/// (rad/s), the slip's end found as `end` (how each engine finds it): [`entered_mode`] under
+/// its normal force at `t`, with the engine's zero of slip `scale = 1e-10 (1 + |w_a| + |w_b|)`
+/// rad/s. The reference engine ([`SlipEnd::Located`]) takes the slip as ended when the
+/// clutch's guard crossed and the slip is the part of it that did (`s w_rel <= fn` while
+/// slipping; a free one-way clutch's `w_rel` below its engagement); the multibody engine
+/// ([`SlipEnd::Landed`]) when its step landed within the scale of the slip's zero.
+pub fn settled_mode(
+    clutch: &LumpedClutch,
+    t: f64,
+    before: Mode,
+    w_a_rad_s: f64,
+    w_b_rad_s: f64,
+    end: SlipEnd,
+) -> ClutchMode {
+    let w_rel = w_b_rad_s - w_a_rad_s;
+    let scale = 1e-10 * (1.0 + w_a_rad_s.abs() + w_b_rad_s.abs());
+    let f = clutch.normal_force_n(t);
+    let slip_ended = match end {
+        SlipEnd::Located { crossed } => {
+            crossed
+                && match before {
+                    Some(ClutchMode::Slipping(s)) => f64::from(s) * w_rel <= f,
+                    Some(ClutchMode::Free) => {
+                        clutch.one_way && w_rel <= if f > 0.0 { -f } else { 1.0 + f.abs() }
+                    }
+                    _ => false,
+                }
+        }
+        SlipEnd::Landed => {
+            matches!(before, Some(ClutchMode::Slipping(s)) if f64::from(s) * w_rel <= scale)
+        }
+    };
+    entered_mode(clutch, before, f, w_rel, scale, slip_ended)
+}
 
 /// The mode a clutch enters at an event at `t` from the mode `before` (`None` before its
 /// first settling), under the normal force `normal_n` (N) at the relative speed `w_rel`
@@ -81,24 +117,17 @@ pub fn furthest_over(
         if *mode != Some(ClutchMode::Locked) {
             continue;
         }
-        let Some(cl) = net.couplings[k].clutch() else {
+        let Some(margin) = net.couplings[k].law().locked_margin_n_m(t, torque_n_m[k]) else {
             continue;
         };
-        let over = -cl.margin_n_m(torque_n_m[k], cl.normal_force_n(t));
+        let over = -margin;
         if over > 0.0 && worst.is_none_or(|(_, o)| over > o) {
             worst = Some((k, over));
         }
     }
-    worst.map(|(k, _)| {
-        let cl = net.couplings[k].clutch().expect("only clutches lock");
-        let to = if cl.one_way && cl.normal_force_n(t) <= 0.0 {
-            ClutchMode::Free
-        } else if cl.one_way || torque_n_m[k] > 0.0 {
-            ClutchMode::Slipping(1)
-        } else {
-            ClutchMode::Slipping(-1)
-        };
-        (k, to)
+    worst.and_then(|(k, _)| {
+        let to = net.couplings[k].law().released_mode(t, torque_n_m[k])?;
+        Some((k, to))
     })
 }
 

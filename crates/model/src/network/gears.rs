@@ -123,7 +123,7 @@ pub fn torque_factor(c: &super::Coupling, body: usize) -> Option<f64> {
     }
     match &c.kind {
         CouplingKind::Clutch(_) | CouplingKind::SpringDamper(_) => Some(-1.0),
-        CouplingKind::IdealGear { ratio } => Some(-ratio),
+        CouplingKind::IdealGear(g) => Some(-g.ratio),
         CouplingKind::GearMesh(_) | CouplingKind::Pack(_) | CouplingKind::Planetary(_) => None,
     }
 }

@@ -1,0 +1,290 @@
+//! The element law (MODEL.md section 8): what a coupling of a driveline network does, said once
+//! per kind for both engines. Each kind implements [`ElementLaw`] in its own file (the lumped
+//! clutch and the one-way clutch in `clutch.rs`, the ideal gear in `ideal_gear.rs`, the
+//! planetary set in `planetary.rs`, the gear mesh in `gear.rs`, the spring-damper in
+//! `spring_damper.rs`, the resolved pack in `resolved_pack.rs`), and [`super::Coupling::law`]
+//! is the one `match` on the kinds that hands it out. The engines and the layers above ask the
+//! law, never the kind: its ports, its constraint row in a mode, its torque where the engines
+//! share the formula, its state, its event guard and the stick/slip rule at an event, its
+//! share of the energy audit, its co-simulation input and its kind's name.
+//!
+//! What stays an engine's own is what the engines do differently: a gear mesh's contact events
+//! (the law's memory, the impact peaks) and a resolved pack's session (its discs and plates),
+//! which each engine builds from the kind ([`super::Coupling::mesh`],
+//! [`super::Coupling::pack`]); and how an event's instant is found (the reference engine
+//! locates it on its dense output, the multibody engine lands its step on it).
+//!
+//! Conventions: the ports are body indices in [`super::Network::bodies`], port 0 the coupling's
+//! `a`, port 1 its `b` (a planetary set's port 2 its carrier); a two-port force element's
+//! torque is the torque on port 0 (N m), the opposite acting on port 1; `w_rel = w_b - w_a`
+//! (rad/s) as the clutch's.
+
+use super::rows::Row;
+use super::{ClutchMode, Coupling, Network, NetworkInput, NetworkProblem};
+
+/// An element's mode: a clutch's [`ClutchMode`]; `None` for an element without modes.
+pub type Mode = Option<ClutchMode>;
+
+/// Where the counter an engine keeps for an element (the integral of its
+/// [`ElementLaw::power_w`], J) goes in the run's energy audit
+/// ([`super::NetworkEnergy`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EnergyTerm {
+    /// No counter (a rigid element does no work; a resolved pack books its own heat and
+    /// loss in its session).
+    None,
+    /// A clutch's heat (`clutch_heat_j`).
+    ClutchHeat,
+    /// The work done on a gear mesh (`mesh_work_j`: its impact losses and the elastic energy
+    /// of a contact still closed).
+    MeshWork,
+    /// A damper's loss (`damper_loss_j`; the spring's stored energy is
+    /// [`ElementLaw::potential_change_j`]).
+    DamperLoss,
+}
+
+/// How an engine found the end of a slip at an event (the input of the stick/slip rule,
+/// [`super::friction::settled_mode`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SlipEnd {
+    /// The reference engine located the event: whether the element's guard crossed zero there
+    /// (the slip is then the part of the guard that did, not its normal force).
+    Located {
+        /// The element's guard reached `<= 0` at the event.
+        crossed: bool,
+    },
+    /// The multibody engine landed its step: the slip ended if it is within the engine's zero
+    /// of slip (`1e-10 (1 + |w_a| + |w_b|)` rad/s).
+    Landed,
+}
+
+/// A co-simulation input an element takes (the FMU's and the sdk's variable
+/// `couplings.<name>.<suffix>`).
+#[derive(Debug, Clone, Copy)]
+pub struct InputSpec {
+    /// The input of coupling `k` as the engines take it.
+    pub input: fn(usize) -> NetworkInput,
+    /// The last segment of its variable's name (`normal_force_n`).
+    pub suffix: &'static str,
+}
+
+/// The most ports an element has (a planetary set's sun, ring and carrier).
+pub const MAX_PORTS: usize = 3;
+
+/// An element's ports: the bodies it joins, by index in [`super::Network::bodies`] (2, or 3
+/// for a planetary set).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Ports {
+    ids: [usize; MAX_PORTS],
+    len: usize,
+}
+
+impl Ports {
+    /// The two ports `a`, `b`.
+    pub fn two(a: usize, b: usize) -> Ports {
+        Ports {
+            ids: [a, b, 0],
+            len: 2,
+        }
+    }
+
+    /// The three ports `a`, `b`, `c`.
+    pub fn three(a: usize, b: usize, c: usize) -> Ports {
+        Ports {
+            ids: [a, b, c],
+            len: 3,
+        }
+    }
+}
+
+impl std::ops::Deref for Ports {
+    type Target = [usize];
+    fn deref(&self) -> &[usize] {
+        &self.ids[..self.len]
+    }
+}
+
+/// What one kind of element is, for both engines and every layer above (the module's docs).
+/// Every method but [`Self::kind_name`] has the default of an element that does not have the
+/// behaviour (no row, no torque, no state, no modes, no energy, no input).
+pub trait ElementLaw {
+    /// The kind's name in outputs and recordings (`clutch`, `one_way_clutch`, `ideal_gear`,
+    /// `planetary`, `gear_mesh`, `spring_damper`, `pack`).
+    fn kind_name(&self) -> &'static str;
+
+    /// The element's ports (body indices) for the coupling's `a` and `b`: two, unless the
+    /// element names a third body itself (a planetary set's carrier).
+    fn ports(&self, a: usize, b: usize) -> Ports {
+        Ports::two(a, b)
+    }
+
+    /// Its mode at t = 0, before the first settling (`Some(Free)` for a clutch; `None`: an
+    /// element without modes).
+    fn initial_mode(&self) -> Mode {
+        None
+    }
+
+    /// Its constraint row as coupling `k` on the ports `ports` in the mode `mode`, when it is
+    /// rigid there (MODEL.md section 8, [`super::rows`]): an ideal gear and a planetary set
+    /// always, a clutch when locked; `None` for a force element.
+    fn row(&self, _k: usize, _ports: &[usize], _mode: Mode) -> Option<Row> {
+        None
+    }
+
+    /// The `ratio` of a rigid two-port that always ties `w_a = ratio w_b` (an ideal gear), for
+    /// the network's check of loops of such ties.
+    fn fixed_ratio(&self) -> Option<f64> {
+        None
+    }
+
+    /// A two-port force element's torque on port 0 at `t` (s) in the mode `mode`, N m (the
+    /// opposite on port 1), at the twist `twist_rad` (`theta_a - theta_b`, rad: the engine's
+    /// own state of it) and the speeds `w_a`, `w_b` (rad/s); `None` when it applies none
+    /// that the engines share (a rigid element, a free or locked clutch, a gear mesh whose
+    /// contacts are the engine's).
+    fn port_torque_n_m(
+        &self,
+        _t_s: f64,
+        _twist_rad: f64,
+        _w_a_rad_s: f64,
+        _w_b_rad_s: f64,
+        _mode: Mode,
+    ) -> Option<f64> {
+        None
+    }
+
+    /// The scale of its own state (a spring's twist, rad; a mesh's displacement along its
+    /// line of action, m): the adaptive engine's absolute tolerance is the tolerance times
+    /// it. `None`: no state.
+    fn state_scale(&self) -> Option<f64> {
+        None
+    }
+
+    /// Its state at t = 0 (in the unit of [`Self::state_scale`]).
+    fn initial_state(&self) -> f64 {
+        0.0
+    }
+
+    /// Its state's rate at the ports' speeds `w_a`, `w_b` (rad/s).
+    fn state_rate(&self, _w_a_rad_s: f64, _w_b_rad_s: f64) -> f64 {
+        0.0
+    }
+
+    /// Where its counter goes in the energy audit.
+    fn energy_term(&self) -> EnergyTerm {
+        EnergyTerm::None
+    }
+
+    /// The power it takes from the bodies in the mode `mode`, W, under its torque
+    /// `torque_n_m` on port 0 at the speeds `w_a`, `w_b` (rad/s): a slipping clutch's heat
+    /// rate `tau (w_b - w_a)`, a damper's loss `d (w_a - w_b)^2`; `None` when the engine books
+    /// it itself (a mesh's contact work) or there is none.
+    fn power_w(&self, _mode: Mode, _torque_n_m: f64, _w_a: f64, _w_b: f64) -> Option<f64> {
+        None
+    }
+
+    /// The loss over a step of `h` s (J) of the torque held over it, taken at the relative
+    /// speed `w_rel_held` (`w_a - w_b`, rad/s), on the step's mean relative speed `w_rel_mean`
+    /// (rad/s): a damper's `h d w_rel_held w_rel_mean` (the multibody engine's discrete energy
+    /// identity); `None` for an element without a damper.
+    fn damping_loss_j(&self, _h_s: f64, _w_rel_held: f64, _w_rel_mean: f64) -> Option<f64> {
+        None
+    }
+
+    /// The change of its stored energy from a twist of 0 to `twist_rad` (rad), J; `None`: it
+    /// stores none.
+    fn potential_change_j(&self, _twist_rad: f64) -> Option<f64> {
+        None
+    }
+
+    /// Every instant (s) where its own signal jumps or bends, pushed to `out` (the engines
+    /// land a step on each).
+    fn breakpoints(&self, _out: &mut Vec<f64>) {}
+
+    /// Whether its actuation is on at `t` (s): a clutch's normal force above 0; `None`: it has
+    /// none.
+    fn engaged(&self, _t_s: f64) -> Option<bool> {
+        None
+    }
+
+    /// The sense `s` (+1, -1) in the mode `mode` whose slip `s w_rel` reaching zero is an event
+    /// (a slipping clutch's, a free one-way clutch's freewheel); `None`: none.
+    fn slip_sense(&self, _mode: Mode) -> Option<i8> {
+        None
+    }
+
+    /// Its event function at `t` (s) in the mode `mode` at the slip `w_rel` (rad/s) under the
+    /// torque `held_n_m` (N m on port 0) that holds it when locked: positive while the mode
+    /// holds, its crossing of zero an event (the reference engine's guard; 1 for an element
+    /// without events of its own).
+    fn guard(&self, _t_s: f64, _w_rel_rad_s: f64, _mode: Mode, _held_n_m: f64) -> f64 {
+        1.0
+    }
+
+    /// The mode it enters at an event at `t` (s) from `before`, at the speeds `w_a`, `w_b`
+    /// (rad/s), the slip's end found as `end` (the stick/slip rule,
+    /// [`super::friction::settled_mode`]); an element without modes keeps `before`.
+    fn settle(&self, _t_s: f64, before: Mode, _w_a: f64, _w_b: f64, _end: SlipEnd) -> Mode {
+        before
+    }
+
+    /// How far the locked element is from breaking at `t` (s) under the torque `held_n_m` (N
+    /// m on port 0) that holds it, N m (it breaks where this reaches 0); `None`: it does not
+    /// break (a rigid gear).
+    fn locked_margin_n_m(&self, _t_s: f64, _held_n_m: f64) -> Option<f64> {
+        None
+    }
+
+    /// The mode a locked element that broke at `t` (s) under `held_n_m` (N m on port 0) is
+    /// released to.
+    fn released_mode(&self, _t_s: f64, _held_n_m: f64) -> Mode {
+        None
+    }
+
+    /// Its parameters' problems and those it has in the network `net` as coupling `k` on the
+    /// ports `ports` (all in the network), pushed to `out`; whether the element is sound
+    /// enough for the network's checks of its rigid ties (an ideal gear with a good ratio
+    /// between two turning bodies).
+    fn problems(
+        &self,
+        _net: &Network,
+        _k: usize,
+        _ports: &[usize],
+        _out: &mut Vec<NetworkProblem>,
+    ) -> bool {
+        true
+    }
+
+    /// The co-simulation input it takes, if any.
+    fn input(&self) -> Option<InputSpec> {
+        None
+    }
+
+    /// The value of its co-simulation input at `t` (s), in the input's unit.
+    fn input_value(&self, _t_s: f64) -> f64 {
+        0.0
+    }
+}
+
+/// A coupling's problem at its field `field`.
+pub(super) fn problem(k: usize, field: &'static str, message: String) -> NetworkProblem {
+    NetworkProblem::Coupling {
+        index: k,
+        field,
+        message,
+    }
+}
+
+impl Coupling {
+    /// Its ports (body indices; [`ElementLaw::ports`]).
+    pub fn ports(&self) -> Ports {
+        self.law().ports(self.a, self.b)
+    }
+
+    /// Its constraint row as coupling `k` when it is rigid in the mode `mode`
+    /// ([`ElementLaw::row`]): the one place that says which couplings are rigid, for both
+    /// engines.
+    pub fn row(&self, k: usize, mode: Mode) -> Option<Row> {
+        self.law().row(k, &self.ports(), mode)
+    }
+}
