@@ -14,7 +14,7 @@ use crate::network::{
 use crate::network_keep::{Keep, Obs};
 use crate::{Error, RecordingRequest, Result};
 use clutchpack_model::network::{
-    ClutchMode, Network, NetworkInput, NetworkObserver, NetworkRun, NetworkSample,
+    ClutchMode, Network, NetworkInput, NetworkObserver, NetworkRun, NetworkSample, OutputQuantity,
 };
 use clutchpack_model::EngineError;
 use clutchpack_multibody::network::{NetworkStepOptions, NetworkStepper as MultibodyStepper};
@@ -174,29 +174,22 @@ pub fn network_inputs(net: &Network) -> Vec<(String, NetworkInput)> {
                 NetworkInput::Drive(i),
             )
         });
-    let clutches = net
+    // each element's own input (its law's), those of one kind together in the order the
+    // inputs are listed (clutches' forces, then packs' pressures), each kind by coupling
+    let mut elements: Vec<(String, NetworkInput)> = net
         .couplings
         .iter()
         .enumerate()
-        .filter(|(_, c)| c.clutch().is_some())
-        .map(|(k, c)| {
-            (
-                format!("couplings.{}.normal_force_n", segment(&c.name)),
-                NetworkInput::ClutchForce(k),
-            )
-        });
-    let packs = net
-        .couplings
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.pack().is_some_and(|p| p.stack.is_some()))
-        .map(|(k, c)| {
-            (
-                format!("couplings.{}.pressure_pa", segment(&c.name)),
-                NetworkInput::PackPressure(k),
-            )
-        });
-    bodies.chain(clutches).chain(packs).collect()
+        .filter_map(|(k, c)| {
+            let spec = c.law().input()?;
+            Some((
+                format!("couplings.{}.{}", segment(&c.name), spec.suffix),
+                (spec.input)(k),
+            ))
+        })
+        .collect();
+    elements.sort_by_key(|(_, input)| input.rank());
+    bodies.chain(elements).collect()
 }
 
 /// A body's or coupling's name as a segment of a variable's name: the FMI structured name's
@@ -221,13 +214,9 @@ pub fn network_name_problems(net: &Network) -> Vec<String> {
 fn input_value(net: &Network, input: NetworkInput, t: f64) -> f64 {
     match input {
         NetworkInput::Drive(i) => net.bodies[i].drive.as_ref().map_or(0.0, |s| s.value(t)),
-        NetworkInput::ClutchForce(k) => net.couplings[k]
-            .clutch()
-            .map_or(0.0, |c| c.normal_force_n(t).max(0.0)),
-        NetworkInput::PackPressure(k) => net.couplings[k]
-            .pack()
-            .and_then(|p| p.stack.as_ref())
-            .map_or(0.0, |s| s.piston.pressure.pressure_pa(t)),
+        NetworkInput::ClutchForce(k) | NetworkInput::PackPressure(k) => {
+            net.couplings[k].law().input_value(t)
+        }
     }
 }
 
@@ -312,58 +301,37 @@ pub fn network_outputs(net: &Network) -> Vec<NetworkVariable> {
             "N.m",
             format!("torque of {} on its body a, N m", c.name),
         ));
-        if c.clutch().is_some() {
+        for spec in c.law().outputs() {
             out.push(var(
-                format!("couplings.{}.slip_rad_s", segment(&c.name)),
-                "rad/s",
-                format!("slip w_b - w_a of {}, rad/s", c.name),
+                format!("couplings.{}.{}", segment(&c.name), spec.suffix),
+                spec.unit,
+                spec.description.replacen("{}", &c.name, 1),
             ));
+        }
+        if let (Some(p), true) = (c.pack(), net.pack_thermal.contains_key(&k)) {
+            // as a thermal pack scene's own outputs name them, under the coupling
+            let lists = [("discs", p.discs.len()), ("plates", p.plates.len())];
+            for (list, n) in lists {
+                for i in 0..n {
+                    out.push(var(
+                        format!("couplings.{}.{list}[{i}].temperature_k", segment(&c.name)),
+                        "K",
+                        format!(
+                            "{list}[{i}] of pack {}: its lumped temperature at the last \
+                             thermal window's end, K",
+                            c.name
+                        ),
+                    ));
+                }
+            }
             out.push(var(
-                format!("couplings.{}.mode", segment(&c.name)),
-                "1",
+                format!("couplings.{}.oil.temperature_k", segment(&c.name)),
+                "K",
                 format!(
-                    "mode of {} as Modelica's Clutch numbers it: 2 free, 1 slipping forward, \
-                     0 locked, -1 slipping backward",
+                    "the oil of pack {}: its temperature at the last thermal window's end, K",
                     c.name
                 ),
             ));
-            out.push(var(
-                format!("couplings.{}.heat_j", segment(&c.name)),
-                "J",
-                format!("heat {} has made since t = 0, J", c.name),
-            ));
-        }
-        if let Some(p) = c.pack() {
-            out.push(var(
-                format!("couplings.{}.heat_j", segment(&c.name)),
-                "J",
-                format!("heat the faces of pack {} have made since t = 0, J", c.name),
-            ));
-            if net.pack_thermal.contains_key(&k) {
-                // as a thermal pack scene's own outputs name them, under the coupling
-                let lists = [("discs", p.discs.len()), ("plates", p.plates.len())];
-                for (list, n) in lists {
-                    for i in 0..n {
-                        out.push(var(
-                            format!("couplings.{}.{list}[{i}].temperature_k", segment(&c.name)),
-                            "K",
-                            format!(
-                                "{list}[{i}] of pack {}: its lumped temperature at the last \
-                                 thermal window's end, K",
-                                c.name
-                            ),
-                        ));
-                    }
-                }
-                out.push(var(
-                    format!("couplings.{}.oil.temperature_k", segment(&c.name)),
-                    "K",
-                    format!(
-                        "the oil of pack {}: its temperature at the last thermal window's end, K",
-                        c.name
-                    ),
-                ));
-            }
         }
     }
     out
@@ -610,20 +578,21 @@ impl NetworkSimulation {
         }
         for (k, c) in net.couplings.iter().enumerate() {
             values.push(s.torque_n_m[k]);
-            if c.clutch().is_some() {
-                values.push(s.speed_rad_s[c.b] - s.speed_rad_s[c.a]);
-                let mode = s.mode[k].unwrap_or(ClutchMode::Free);
-                values.push(f64::from(mode.modelica_code()));
-                values.push(heat[k]);
-            }
-            if c.pack().is_some() {
-                values.push(heat[k]);
-                if net.pack_thermal.contains_key(&k) {
-                    let bodies = c.pack().map_or(0, |p| p.discs.len() + p.plates.len());
-                    match self.stepper.pack_temperatures_k(k) {
-                        Some(t) => values.extend_from_slice(t),
-                        None => values.extend(std::iter::repeat_n(f64::NAN, bodies + 1)),
+            for spec in c.law().outputs() {
+                values.push(match spec.quantity {
+                    OutputQuantity::Slip => s.speed_rad_s[c.b] - s.speed_rad_s[c.a],
+                    OutputQuantity::Mode => {
+                        f64::from(s.mode[k].unwrap_or(ClutchMode::Free).modelica_code())
                     }
+                    OutputQuantity::Heat => heat[k],
+                });
+            }
+            // a thermal pack's discs', plates' and oil's temperatures
+            if let (Some(p), true) = (c.pack(), net.pack_thermal.contains_key(&k)) {
+                let bodies = p.discs.len() + p.plates.len();
+                match self.stepper.pack_temperatures_k(k) {
+                    Some(t) => values.extend_from_slice(t),
+                    None => values.extend(std::iter::repeat_n(f64::NAN, bodies + 1)),
                 }
             }
         }

@@ -9,7 +9,9 @@
 //! slipping clutch has `tau = sign(w_rel) mu(|w_rel|) cgeo fn`, which brings the two speeds
 //! together.
 
-use super::element::{problem, ElementLaw, EnergyTerm, InputSpec, Mode, SlipEnd};
+use super::element::{
+    problem, ElementLaw, EnergyTerm, InputSpec, Mode, OutputQuantity, OutputSpec, SlipEnd,
+};
 use super::rows::Row;
 use super::signal::Signal;
 use super::{friction, Network, NetworkInput, NetworkProblem};
@@ -306,6 +308,31 @@ impl ElementLaw for LumpedClutch {
     /// `fn(t)`, N (>= 0).
     fn input_value(&self, t_s: f64) -> f64 {
         self.normal_force_n(t_s).max(0.0)
+    }
+
+    /// Its slip, its mode and its heat.
+    fn outputs(&self) -> &'static [OutputSpec] {
+        &[
+            OutputSpec {
+                suffix: "slip_rad_s",
+                unit: "rad/s",
+                description: "slip w_b - w_a of {}, rad/s",
+                quantity: OutputQuantity::Slip,
+            },
+            OutputSpec {
+                suffix: "mode",
+                unit: "1",
+                description: "mode of {} as Modelica's Clutch numbers it: 2 free, 1 slipping \
+                              forward, 0 locked, -1 slipping backward",
+                quantity: OutputQuantity::Mode,
+            },
+            OutputSpec {
+                suffix: "heat_j",
+                unit: "J",
+                description: "heat {} has made since t = 0, J",
+                quantity: OutputQuantity::Heat,
+            },
+        ]
     }
 }
 

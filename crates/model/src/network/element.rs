@@ -68,6 +68,32 @@ pub struct InputSpec {
     pub suffix: &'static str,
 }
 
+/// What a co-simulation output of an element gives ([`OutputSpec`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputQuantity {
+    /// Its slip `w_b - w_a`, rad/s.
+    Slip,
+    /// Its mode as Modelica's `Clutch` numbers it ([`ClutchMode::modelica_code`]; a sample's
+    /// mode `None` as free).
+    Mode,
+    /// Its heat since t = 0, J (the engine's `heat_j` of the coupling).
+    Heat,
+}
+
+/// A co-simulation output an element gives (the variable `couplings.<name>.<suffix>`, after
+/// its torque on body `a`, which every coupling gives).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OutputSpec {
+    /// The last segment of its variable's name (`slip_rad_s`).
+    pub suffix: &'static str,
+    /// Its unit as the FMU writes it (`rad/s`, `1`, `J`).
+    pub unit: &'static str,
+    /// Its description, `{}` standing for the coupling's name.
+    pub description: &'static str,
+    /// What it gives.
+    pub quantity: OutputQuantity,
+}
+
 /// The most ports an element has (a planetary set's sun, ring and carrier).
 pub const MAX_PORTS: usize = 3;
 
@@ -263,6 +289,11 @@ pub trait ElementLaw {
     /// The value of its co-simulation input at `t` (s), in the input's unit.
     fn input_value(&self, _t_s: f64) -> f64 {
         0.0
+    }
+
+    /// The co-simulation outputs it gives besides its torque, in order.
+    fn outputs(&self) -> &'static [OutputSpec] {
+        &[]
     }
 }
 

@@ -24,7 +24,9 @@ pub mod signal;
 pub mod spring_damper;
 
 pub use clutch::{ClutchMode, LumpedClutch};
-pub use element::{ElementLaw, EnergyTerm, Mode, Ports, SlipEnd};
+pub use element::{
+    ElementLaw, EnergyTerm, InputSpec, Mode, OutputQuantity, OutputSpec, Ports, SlipEnd,
+};
 pub use firing::Firing;
 pub use gear::GearMesh;
 pub use gears::{Gear, GearKinematics, Shift, Transmission};

@@ -4,7 +4,7 @@
 //! session ([`super::Coupling::pack`]); the law says what the network needs of it: its
 //! piston's breakpoints, its co-simulation input and its problems as a network's element.
 
-use super::element::{problem, ElementLaw, InputSpec};
+use super::element::{problem, ElementLaw, InputSpec, OutputQuantity, OutputSpec};
 use super::{Network, NetworkInput, NetworkProblem};
 use crate::PackModel;
 
@@ -65,5 +65,15 @@ impl ElementLaw for PackModel {
         self.stack
             .as_ref()
             .map_or(0.0, |s| s.piston.pressure.pressure_pa(t_s))
+    }
+
+    /// Its faces' heat (a thermal pack's temperatures follow it, by its discs and plates).
+    fn outputs(&self) -> &'static [OutputSpec] {
+        &[OutputSpec {
+            suffix: "heat_j",
+            unit: "J",
+            description: "heat the faces of pack {} have made since t = 0, J",
+            quantity: OutputQuantity::Heat,
+        }]
     }
 }
