@@ -11,6 +11,7 @@
 
 use super::element::{
     problem, ElementLaw, EnergyTerm, InputSpec, Mode, OutputQuantity, OutputSpec, SlipEnd,
+    MAX_PORTS,
 };
 use super::rows::Row;
 use super::signal::Signal;
@@ -167,6 +168,10 @@ impl ElementLaw for LumpedClutch {
         } else {
             "clutch"
         }
+    }
+
+    fn torque_factors(&self, _ports: &[usize]) -> Option<[f64; MAX_PORTS]> {
+        Some([1.0, -1.0, 0.0])
     }
 
     fn initial_mode(&self) -> Mode {

@@ -157,6 +157,15 @@ pub trait ElementLaw {
         None
     }
 
+    /// The torque it puts on each of its ports per unit of its torque on port 0 (the samples'
+    /// `torque_n_m`), by port (1 on port 0): a clutch's and a spring-damper's `-1` on port 1,
+    /// an ideal gear's `-ratio`, a planetary set's ring and carrier coefficients over its
+    /// sun's; `None` where its torque on port 0 does not give the others (a gear mesh's
+    /// radii and contacts, a resolved pack's other side).
+    fn torque_factors(&self, _ports: &[usize]) -> Option<[f64; MAX_PORTS]> {
+        None
+    }
+
     /// The `ratio` of a rigid two-port that always ties `w_a = ratio w_b` (an ideal gear), for
     /// the network's check of loops of such ties.
     fn fixed_ratio(&self) -> Option<f64> {

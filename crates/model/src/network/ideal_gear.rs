@@ -3,7 +3,7 @@
 //! `lambda` on `a` is `-ratio lambda` on `b`). It is one constraint row, always
 //! ([`super::rows`]), and takes a degree of freedom from its bodies.
 
-use super::element::{problem, ElementLaw, Mode};
+use super::element::{problem, ElementLaw, Mode, MAX_PORTS};
 use super::rows::Row;
 use super::{Network, NetworkProblem};
 use serde::{Deserialize, Serialize};
@@ -18,6 +18,10 @@ pub struct IdealGear {
 impl ElementLaw for IdealGear {
     fn kind_name(&self) -> &'static str {
         "ideal_gear"
+    }
+
+    fn torque_factors(&self, _ports: &[usize]) -> Option<[f64; MAX_PORTS]> {
+        Some([1.0, -self.ratio, 0.0])
     }
 
     /// `w_a - ratio w_b = 0`.

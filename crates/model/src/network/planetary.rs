@@ -15,7 +15,7 @@
 //! the carrier is named by the set. The coupling's torque (the network's torque "on `a`") is
 //! the torque on the sun, `tau_S = z_S lambda`.
 
-use super::element::{ElementLaw, Mode, Ports};
+use super::element::{ElementLaw, Mode, Ports, MAX_PORTS};
 use super::rows::Row;
 use super::{Network, NetworkProblem};
 use serde::{Deserialize, Serialize};
@@ -110,6 +110,17 @@ impl ElementLaw for PlanetarySet {
             k,
             [(ports[0], zs), (ports[1], zr), (ports[2], -(zs + zr))],
         ))
+    }
+
+    /// Willis' coefficients over the sun's: `1`, `z_R / z_S`, `-(z_S + z_R) / z_S`.
+    fn torque_factors(&self, ports: &[usize]) -> Option<[f64; MAX_PORTS]> {
+        let row = ElementLaw::row(self, 0, ports, None)?;
+        let first = row.terms()[0].1;
+        let mut out = [0.0; MAX_PORTS];
+        for (o, (_, c)) in out.iter_mut().zip(row.terms()) {
+            *o = c / first;
+        }
+        Some(out)
     }
 
     fn problems(

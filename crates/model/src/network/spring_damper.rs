@@ -3,13 +3,17 @@
 //! - theta_b - theta_0) + d (w_a - w_b)` on `b` and `-T` on `a`, its twist the engines' own
 //! state, its damper's loss and its spring's stored energy its share of the energy audit.
 
-use super::element::{problem, ElementLaw, EnergyTerm, Mode};
+use super::element::{problem, ElementLaw, EnergyTerm, Mode, MAX_PORTS};
 use super::{Network, NetworkProblem};
 use crate::spring::SpringDamper;
 
 impl ElementLaw for SpringDamper {
     fn kind_name(&self) -> &'static str {
         "spring_damper"
+    }
+
+    fn torque_factors(&self, _ports: &[usize]) -> Option<[f64; MAX_PORTS]> {
+        Some([1.0, -1.0, 0.0])
     }
 
     /// `-T` on `a` (MODEL.md section 8), at the twist `theta_a - theta_b`.
