@@ -328,3 +328,135 @@ impl Coupling {
         self.law().row(k, &self.ports(), mode)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::network::{CouplingKind, LumpedClutch, PlanetarySet, Signal};
+    use crate::spring::SpringDamper;
+
+    fn clutch(one_way: bool) -> LumpedClutch {
+        LumpedClutch {
+            mu_table: vec![(0.0, 0.5)],
+            peak: 1.1,
+            cgeo_m: 1.0,
+            fn_max_n: 20.0,
+            force: Signal::Constant(0.5),
+            one_way,
+        }
+    }
+
+    fn spring() -> SpringDamper {
+        SpringDamper {
+            stiffness_n_m_per_rad: 400.0,
+            damping_n_m_s_per_rad: 2.0,
+            free_angle_rad: 0.1,
+        }
+    }
+
+    fn planetary(double_pinion: bool) -> PlanetarySet {
+        PlanetarySet {
+            sun_teeth: 30,
+            ring_teeth: 90,
+            carrier: 2,
+            double_pinion,
+        }
+    }
+
+    /// One of every kind (the one-way clutch apart): each names itself, and no two the same
+    /// (the summary's and the recording's `kind`).
+    #[test]
+    fn every_kind_has_its_own_name() {
+        let kinds = [
+            CouplingKind::Clutch(clutch(false)),
+            CouplingKind::Clutch(clutch(true)),
+            CouplingKind::ideal_gear(3.0),
+            CouplingKind::GearMesh(crate::cases::dry_gear_mesh(false)),
+            CouplingKind::SpringDamper(spring()),
+            CouplingKind::Pack(Box::new(crate::cases::paper_pack(1e-5))),
+            CouplingKind::Planetary(planetary(false)),
+        ];
+        let names: Vec<&str> = kinds.iter().map(|k| k.law().kind_name()).collect();
+        assert_eq!(
+            names,
+            [
+                "clutch",
+                "one_way_clutch",
+                "ideal_gear",
+                "gear_mesh",
+                "spring_damper",
+                "pack",
+                "planetary"
+            ]
+        );
+    }
+
+    /// A planetary set's ports are its sun, ring and carrier; its row is Willis' equation on
+    /// them, and its torque factors do no work on any speeds that keep the row (the ideal
+    /// set's power balance `sum_j f_j w_j = 0`, measured 0 to rounding: asserted 1e-12 of
+    /// the speeds' scale), for a simple and a double-pinion set.
+    #[test]
+    fn planetary_ports_row_and_factors_agree() {
+        for double_pinion in [false, true] {
+            let p = planetary(double_pinion);
+            let ports = p.ports(0, 1);
+            assert_eq!(&*ports, &[0, 1, 2]);
+            let row = ElementLaw::row(&p, 7, &ports, None).expect("always rigid");
+            assert_eq!(row.coupling, 7);
+            let (ws, wr) = (400.0, -120.0);
+            let w = [ws, wr, p.carrier_speed_rad_s(ws, wr)];
+            assert!(row.apply(&w).abs() < 1e-12 * 400.0, "{double_pinion}");
+            let f = p.torque_factors(&ports).expect("rigid");
+            assert_eq!(f[0], 1.0);
+            let power: f64 = f.iter().zip(&w).map(|(f, w)| f * w).sum();
+            assert!(power.abs() < 1e-12 * 400.0, "{double_pinion}: {power}");
+        }
+    }
+
+    /// The force torques are the laws': a slipping clutch's `sign(w_rel) mu cgeo fn` on `a`,
+    /// none when it is locked or free (a locked one is a row, `w_a - w_b = 0`); a
+    /// spring-damper's `-T` on `a` at the twist given; an ideal gear a row `w_a - ratio w_b`.
+    #[test]
+    fn force_torques_and_rows_are_the_laws() {
+        let c = clutch(false);
+        let slip = c.port_torque_n_m(0.0, 0.0, 10.0, 4.0, Some(ClutchMode::Slipping(-1)));
+        assert_eq!(slip, Some(-5.0));
+        assert_eq!(
+            c.port_torque_n_m(0.0, 0.0, 1.0, 1.0, Some(ClutchMode::Locked)),
+            None
+        );
+        let locked = c.row(3, &[4, 5], Some(ClutchMode::Locked)).expect("a row");
+        assert_eq!(locked.terms(), &[(4, 1.0), (5, -1.0)]);
+        assert!(c.row(3, &[4, 5], Some(ClutchMode::Free)).is_none());
+        let s = spring();
+        let t = s
+            .port_torque_n_m(0.0, 0.3, 5.0, 2.0, None)
+            .expect("a torque");
+        assert_eq!(t, -(400.0 * (0.3 - 0.1) + 2.0 * 3.0));
+        assert_eq!(s.energy_term(), EnergyTerm::DamperLoss);
+        let g = super::super::IdealGear { ratio: 3.5 };
+        let row = g.row(0, &[1, 2], None).expect("always rigid");
+        assert_eq!(row.terms(), &[(1, 1.0), (2, -3.5)]);
+        assert_eq!(g.torque_factors(&[1, 2]), Some([1.0, -3.5, 0.0]));
+    }
+
+    /// The two engines find a slip's end differently and the rule says how: a slipping clutch
+    /// whose slip is within the engine's zero (1e-12 rad/s against a scale of 1e-10) locks
+    /// when the multibody engine landed there, but stays slipping for the reference engine
+    /// unless its guard crossed (it locates the zero as an event instead).
+    #[test]
+    fn a_slips_end_is_the_engines_own_finding() {
+        let c = clutch(false);
+        let before = Some(ClutchMode::Slipping(1));
+        let (wa, wb) = (0.0, 1e-12);
+        assert_eq!(
+            c.settle(0.0, before, wa, wb, SlipEnd::Landed),
+            Some(ClutchMode::Locked)
+        );
+        let located = |crossed| c.settle(0.0, before, wa, wb, SlipEnd::Located { crossed });
+        assert_eq!(located(false), Some(ClutchMode::Slipping(1)));
+        assert_eq!(located(true), Some(ClutchMode::Locked));
+        // an element without modes keeps its (absent) mode
+        assert_eq!(spring().settle(0.0, None, wa, wb, SlipEnd::Landed), None);
+    }
+}

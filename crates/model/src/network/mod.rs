@@ -178,14 +178,6 @@ impl Coupling {
         }
     }
 
-    /// Its spring-damper, if it is one.
-    pub fn spring(&self) -> Option<&crate::spring::SpringDamper> {
-        match &self.kind {
-            CouplingKind::SpringDamper(s) => Some(s),
-            _ => None,
-        }
-    }
-
     /// Its gear mesh, if it is one.
     pub fn mesh(&self) -> Option<&GearMesh> {
         match &self.kind {

@@ -30,14 +30,14 @@
 //! 2. **Torques at `t`**: each body's drive, road load and drag
 //!    ([`clutchpack_model::network::Body::external_torque_n_m`]), each slipping clutch's
 //!    `tau = sign(w_rel) mu(|w_rel|) cgeo fn` (+tau on `a`, -tau on `b`,
-//!    [`LumpedClutch::slip_torque_n_m`](clutchpack_model::network::LumpedClutch::slip_torque_n_m)), each spring-damper's `T = k (theta_a - theta_b -
+//!    the clutch's law, [`ElementLaw::port_torque_n_m`](clutchpack_model::network::ElementLaw::port_torque_n_m)), each spring-damper's `T = k (theta_a - theta_b -
 //!    theta_0) + d (w_a - w_b)` (-T on `a`, +T on `b`), each gear mesh's force per pair `F`,
 //!    signed as its `x`, from the model's law at `x` and its rate (MODEL.md section 8:
 //!    `-Rb_a F` on `a`, `-Rb_b F` on `b`, internal `+Rb_b F`, times the pairs,
 //!    [`GearMesh::torques_n_m`](clutchpack_model::network::GearMesh::torques_n_m)); then the constraint torques `lambda` of the gears
 //!    and locked clutches that keep every constraint (the model's `rows::constraint_torques`). A locked clutch
 //!    whose `|lambda|` exceeds its static limit `peak mu(0) cgeo fn`
-//!    ([`LumpedClutch::max_static_torque_n_m`](clutchpack_model::network::LumpedClutch::max_static_torque_n_m)) slips towards it; the one furthest over goes
+//!    ([`ElementLaw::locked_margin_n_m`](clutchpack_model::network::ElementLaw::locked_margin_n_m)) slips towards it; the one furthest over goes
 //!    first and the solve repeats (as the reference's `settle`). These are the samples'
 //!    torques.
 //! 3. **The step's torques** (the explicit midpoint rule): the same torques at
