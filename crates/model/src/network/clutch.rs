@@ -9,6 +9,7 @@
 //! slipping clutch has `tau = sign(w_rel) mu(|w_rel|) cgeo fn`, which brings the two speeds
 //! together.
 
+pub use super::element::ClutchMode;
 use super::element::{
     problem, ElementLaw, EnergyTerm, InputSpec, Mode, OutputQuantity, OutputSpec, SlipEnd,
     MAX_PORTS,
@@ -17,39 +18,6 @@ use super::rows::Row;
 use super::signal::Signal;
 use super::{friction, Network, NetworkInput, NetworkProblem};
 use serde::{Deserialize, Serialize};
-
-/// The state of a lumped clutch (Modelica's `mode`: Free 2, Forward 1, Stuck 0, Backward -1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum ClutchMode {
-    /// `fn <= 0`: no torque.
-    Free,
-    /// Slipping with `w_rel > 0` (`+1`) or `w_rel < 0` (`-1`).
-    Slipping(i8),
-    /// Locked: `w_rel = 0`, the torque is what holds the two bodies together.
-    Locked,
-}
-
-impl ClutchMode {
-    /// Modelica's integer for the mode (Free 2, Forward 1, Stuck 0, Backward -1), as in
-    /// the MSL reference results' `clutchN.mode` columns.
-    pub fn modelica_code(self) -> i8 {
-        match self {
-            ClutchMode::Free => 2,
-            ClutchMode::Slipping(s) => s,
-            ClutchMode::Locked => 0,
-        }
-    }
-
-    /// A short name for tables: `free`, `slip+`, `slip-`, `locked`.
-    pub fn label(self) -> &'static str {
-        match self {
-            ClutchMode::Free => "free",
-            ClutchMode::Slipping(s) if s > 0 => "slip+",
-            ClutchMode::Slipping(_) => "slip-",
-            ClutchMode::Locked => "locked",
-        }
-    }
-}
 
 /// A lumped friction clutch (or brake, when one side is a fixed body).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -250,7 +218,15 @@ impl ElementLaw for LumpedClutch {
     }
 
     fn settle(&self, t_s: f64, before: Mode, w_a: f64, w_b: f64, end: SlipEnd) -> Mode {
-        Some(friction::settled_mode(self, t_s, before, w_a, w_b, end))
+        let f = self.normal_force_n(t_s);
+        Some(friction::settled_mode(
+            self.one_way,
+            f,
+            before,
+            w_a,
+            w_b,
+            end,
+        ))
     }
 
     fn locked_margin_n_m(&self, t_s: f64, held_n_m: f64) -> Option<f64> {

@@ -20,7 +20,41 @@
 //! (rad/s) as the clutch's.
 
 use super::rows::Row;
-use super::{ClutchMode, Coupling, Network, NetworkInput, NetworkProblem};
+use super::{Coupling, Network, NetworkInput, NetworkProblem};
+use serde::{Deserialize, Serialize};
+
+/// The state of a friction element, a lumped clutch's (Modelica's `mode`: Free 2, Forward 1, Stuck 0, Backward -1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ClutchMode {
+    /// `fn <= 0`: no torque.
+    Free,
+    /// Slipping with `w_rel > 0` (`+1`) or `w_rel < 0` (`-1`).
+    Slipping(i8),
+    /// Locked: `w_rel = 0`, the torque is what holds the two bodies together.
+    Locked,
+}
+
+impl ClutchMode {
+    /// Modelica's integer for the mode (Free 2, Forward 1, Stuck 0, Backward -1), as in
+    /// the MSL reference results' `clutchN.mode` columns.
+    pub fn modelica_code(self) -> i8 {
+        match self {
+            ClutchMode::Free => 2,
+            ClutchMode::Slipping(s) => s,
+            ClutchMode::Locked => 0,
+        }
+    }
+
+    /// A short name for tables: `free`, `slip+`, `slip-`, `locked`.
+    pub fn label(self) -> &'static str {
+        match self {
+            ClutchMode::Free => "free",
+            ClutchMode::Slipping(s) if s > 0 => "slip+",
+            ClutchMode::Slipping(_) => "slip-",
+            ClutchMode::Locked => "locked",
+        }
+    }
+}
 
 /// An element's mode: a clutch's [`ClutchMode`]; `None` for an element without modes.
 pub type Mode = Option<ClutchMode>;
