@@ -1,7 +1,8 @@
 //! The torsional spring-damper as an element of a driveline network (MODEL.md section 8): the
-//! law of `crate::spring` (shared with a pack's couplings) between two bodies, `T = k (theta_a
-//! - theta_b - theta_0) + d (w_a - w_b)` on `b` and `-T` on `a`, its twist the engines' own
-//! state, its damper's loss and its spring's stored energy its share of the energy audit.
+//! law of `crate::spring` (shared with a pack's couplings) between two bodies,
+//! `T = k (theta_a - theta_b - theta_0) + d (w_a - w_b)` on `b` and `-T` on `a`, its twist the
+//! engines' own state, its damper's loss and its spring's stored energy its share of the
+//! energy audit.
 
 use super::element::{problem, ElementLaw, EnergyTerm, Mode, MAX_PORTS};
 use super::{Network, NetworkProblem};
