@@ -231,21 +231,12 @@ fn input_variable(net: &Network, name: &str, input: NetworkInput) -> NetworkVari
                 net.bodies[i].name
             ),
         ),
-        NetworkInput::ClutchForce(k) => (
-            "N",
-            format!(
-                "normal force of clutch {}, N (>= 0; 0: free)",
-                net.couplings[k].name
-            ),
-        ),
-        NetworkInput::PackPressure(k) => (
-            "Pa",
-            format!(
-                "piston pressure of pack {}, Pa (>= 0; the piston pushes with p A less its \
-                 return spring)",
-                net.couplings[k].name
-            ),
-        ),
+        NetworkInput::ClutchForce(k) | NetworkInput::PackPressure(k) => {
+            let c = &net.couplings[k];
+            c.law().input().map_or(("", String::new()), |spec| {
+                (spec.unit, spec.description.replacen("{}", &c.name, 1))
+            })
+        }
     };
     NetworkVariable {
         name: name.to_string(),

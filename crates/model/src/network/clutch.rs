@@ -283,6 +283,8 @@ impl ElementLaw for LumpedClutch {
         Some(InputSpec {
             input: NetworkInput::ClutchForce,
             suffix: "normal_force_n",
+            unit: "N",
+            description: "normal force of clutch {}, N (>= 0; 0: free)",
         })
     }
 

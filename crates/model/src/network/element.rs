@@ -100,6 +100,10 @@ pub struct InputSpec {
     pub input: fn(usize) -> NetworkInput,
     /// The last segment of its variable's name (`normal_force_n`).
     pub suffix: &'static str,
+    /// Its unit as the FMU writes it (`N`, `Pa`).
+    pub unit: &'static str,
+    /// Its description, `{}` standing for the coupling's name.
+    pub description: &'static str,
 }
 
 /// What a co-simulation output of an element gives ([`OutputSpec`]).

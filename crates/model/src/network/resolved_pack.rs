@@ -58,6 +58,9 @@ impl ElementLaw for PackModel {
         self.stack.as_ref().map(|_| InputSpec {
             input: NetworkInput::PackPressure,
             suffix: "pressure_pa",
+            unit: "Pa",
+            description: "piston pressure of pack {}, Pa (>= 0; the piston pushes with p A less \
+                          its return spring)",
         })
     }
 
