@@ -14,7 +14,8 @@ use crate::network::{
 use crate::network_keep::{Keep, Obs};
 use crate::{Error, RecordingRequest, Result};
 use clutchpack_model::network::{
-    ClutchMode, Network, NetworkInput, NetworkObserver, NetworkRun, NetworkSample, OutputQuantity,
+    ClutchMode, Network, NetworkInput, NetworkObserver, NetworkSample, NetworkSession,
+    OutputQuantity,
 };
 use clutchpack_model::EngineError;
 use clutchpack_multibody::network::{NetworkStepOptions, NetworkStepper as MultibodyStepper};
@@ -22,13 +23,21 @@ use clutchpack_reference::network::NetworkStepper as ReferenceStepper;
 use clutchpack_scene::{EngineChoice, Scene};
 use std::sync::atomic::AtomicBool;
 
-/// A network run on either engine, advanced call by call (both steppers have the same
-/// methods and semantics: MODEL.md section 8, "Inputs"), boxed (1 kB and, with its rapier
-/// world, 7.5 kB).
-#[derive(Clone)]
-enum Stepper {
-    Reference(Box<ReferenceStepper>),
-    Multibody(Box<MultibodyStepper>),
+/// A network run on either engine, advanced call by call: the engine it runs on and its
+/// session ([`NetworkSession`], which both engines' steppers implement with the same
+/// semantics: MODEL.md section 8, "Inputs"), boxed (1 kB and, with its rapier world, 7.5 kB).
+struct Stepper {
+    engine: EngineChoice,
+    run: Box<dyn NetworkSession>,
+}
+
+impl Clone for Stepper {
+    fn clone(&self) -> Self {
+        Stepper {
+            engine: self.engine,
+            run: self.run.boxed_clone(),
+        }
+    }
 }
 
 impl Stepper {
@@ -41,106 +50,38 @@ impl Stepper {
         duration_s: f64,
         obs: &mut dyn NetworkObserver,
     ) -> std::result::Result<Stepper, EngineError> {
-        Ok(match engine {
+        let run: Box<dyn NetworkSession> = match engine {
             EngineChoice::Reference => {
                 let options = reference_options(scene);
-                Stepper::Reference(Box::new(ReferenceStepper::new(
-                    net, duration_s, &options, obs,
-                )?))
+                Box::new(ReferenceStepper::new(net, duration_s, &options, obs)?)
             }
             EngineChoice::Multibody => {
                 let options = NetworkStepOptions {
                     step_s: multibody_step_s(scene),
                     record_rate_hz: scene.simulation.record_rate_hz,
                 };
-                Stepper::Multibody(Box::new(MultibodyStepper::new(
-                    net, duration_s, &options, obs,
-                )?))
+                Box::new(MultibodyStepper::new(net, duration_s, &options, obs)?)
             }
-        })
+        };
+        Ok(Stepper { engine, run })
     }
 
     /// The engine running it.
     fn engine(&self) -> EngineChoice {
-        match self {
-            Stepper::Reference(_) => EngineChoice::Reference,
-            Stepper::Multibody(_) => EngineChoice::Multibody,
-        }
+        self.engine
     }
+}
 
-    /// The time the run stands at, s.
-    fn time_s(&self) -> f64 {
-        match self {
-            Stepper::Reference(s) => s.time_s(),
-            Stepper::Multibody(s) => s.time_s(),
-        }
+impl std::ops::Deref for Stepper {
+    type Target = dyn NetworkSession;
+    fn deref(&self) -> &Self::Target {
+        &*self.run
     }
+}
 
-    /// The network as run (the inputs set in place of the scene's signals).
-    fn network(&self) -> &Network {
-        match self {
-            Stepper::Reference(s) => s.network(),
-            Stepper::Multibody(s) => s.network(),
-        }
-    }
-
-    /// The state now (angles rad, speeds rad/s, torques N m, modes).
-    fn sample_now(&mut self) -> NetworkSample {
-        match self {
-            Stepper::Reference(s) => s.sample_now(),
-            Stepper::Multibody(s) => s.sample_now(),
-        }
-    }
-
-    /// The temperatures of the thermal pack that is coupling `k`, K (its discs', plates',
-    /// then oil's; `None` for another coupling).
-    fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
-        match self {
-            Stepper::Reference(s) => s.pack_temperatures_k(k),
-            Stepper::Multibody(s) => s.pack_temperatures_k(k),
-        }
-    }
-
-    /// Each coupling's heat (a mesh's work, a damper's loss) since t = 0, J.
-    fn heat_j(&self) -> Vec<f64> {
-        match self {
-            Stepper::Reference(s) => s.heat_j(),
-            Stepper::Multibody(s) => s.heat_j(),
-        }
-    }
-
-    /// Sets `input` to `value` (N m or N), held from now on.
-    fn set_input(
-        &mut self,
-        input: NetworkInput,
-        value: f64,
-        obs: &mut dyn NetworkObserver,
-    ) -> std::result::Result<(), EngineError> {
-        match self {
-            Stepper::Reference(s) => s.set_input(input, value, obs),
-            Stepper::Multibody(s) => s.set_input(input, value, obs),
-        }
-    }
-
-    /// Advances to `t_end` s (the reference engine may have taken its step past it, answering
-    /// for `t_end` from its dense output).
-    fn advance_to(
-        &mut self,
-        t_end: f64,
-        obs: &mut dyn NetworkObserver,
-    ) -> std::result::Result<(), EngineError> {
-        match self {
-            Stepper::Reference(s) => s.advance_to(t_end, obs),
-            Stepper::Multibody(s) => s.advance_to(t_end, obs),
-        }
-    }
-
-    /// Ends the run where it stands.
-    fn finish(self, obs: &mut dyn NetworkObserver) -> NetworkRun {
-        match self {
-            Stepper::Reference(s) => s.finish(obs),
-            Stepper::Multibody(s) => s.finish(obs),
-        }
+impl std::ops::DerefMut for Stepper {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut *self.run
     }
 }
 
@@ -654,7 +595,7 @@ impl NetworkSimulation {
         };
         let engine = self.stepper.engine();
         // the engine's finish takes its stepper whole; this one is not used after it
-        let run = self.stepper.clone().finish(&mut obs);
+        let run = self.stepper.clone().run.finish_boxed(&mut obs);
         let wall_s = self.started.elapsed().as_secs_f64();
         conclude(&self.scene, engine, keep, run, wall_s)
     }

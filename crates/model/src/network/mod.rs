@@ -31,7 +31,9 @@ pub use firing::Firing;
 pub use gear::GearMesh;
 pub use gears::{Gear, GearKinematics, Shift, Transmission};
 pub use ideal_gear::IdealGear;
-pub use output::{ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample};
+pub use output::{
+    ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample, NetworkSession,
+};
 pub use planetary::PlanetarySet;
 pub use rows::Row;
 pub use signal::{NetworkInput, Signal};
