@@ -86,15 +86,7 @@ pub fn impact_name(net: &Network, coupling: usize, body: Option<usize>) -> Strin
 
 /// A coupling's kind as the summary names it.
 pub fn coupling_kind_name(kind: &CouplingKind) -> &'static str {
-    match kind {
-        CouplingKind::Clutch(c) if c.one_way => "one_way_clutch",
-        CouplingKind::Clutch(_) => "clutch",
-        CouplingKind::IdealGear { .. } => "ideal_gear",
-        CouplingKind::Planetary(_) => "planetary",
-        CouplingKind::GearMesh(_) => "gear_mesh",
-        CouplingKind::SpringDamper(_) => "spring_damper",
-        CouplingKind::Pack(_) => "pack",
-    }
+    kind.law().kind_name()
 }
 
 /// The `clutchpack.network` metadata: `bodies`, `couplings` (counts), `body.<i>.name`,

@@ -17,7 +17,7 @@
 
 use crate::view3d::{about_z, annulus_points, cloud, entity, pose, push_point, rgba, v3};
 use crate::view3d::{timestamp, WORLD_FRAME};
-use clutchpack_model::network::{ClutchMode, Coupling, CouplingKind, Network, Transmission};
+use clutchpack_model::network::{ClutchMode, CouplingKind, Network, Transmission};
 use foxglove::schemas::{
     line_primitive, CubePrimitive, CylinderPrimitive, FrameTransform, LinePrimitive, Point3,
     PointCloud, SceneEntity, SceneUpdate, TextPrimitive,
@@ -64,14 +64,6 @@ pub(crate) fn coupling_color(mode: Option<ClutchMode>) -> Option<foxglove::schem
         Some(ClutchMode::Free) => rgba(0.8, 0.8, 0.8, 1.0),
         Some(ClutchMode::Locked) => rgba(0.1, 0.75, 0.25, 1.0),
         Some(_) => rgba(1.0, 0.55, 0.0, 1.0),
-    }
-}
-
-/// A coupling's ports (body indices): `a`, `b`, and a planetary set's carrier.
-fn ports(c: &Coupling) -> Vec<usize> {
-    match &c.kind {
-        CouplingKind::Planetary(p) => vec![c.a, c.b, p.carrier],
-        _ => vec![c.a, c.b],
     }
 }
 
@@ -221,7 +213,7 @@ impl View {
             let (y, z) = self.lane(k);
             let color = coupling_color(modes[k]);
             let p = |x: f64, z: f64| Point3 { x, y, z };
-            let xs: Vec<f64> = ports(c).iter().map(|&b| self.x_m[b]).collect();
+            let xs: Vec<f64> = c.ports().iter().map(|&b| self.x_m[b]).collect();
             let (lo, hi) = span(&xs);
             let mut points = vec![p(lo, z), p(hi, z)];
             for &x in &xs {
@@ -263,7 +255,7 @@ impl View {
             let (y, z) = self.lane(k);
             let col = coupling_color(modes[k]).unwrap_or_default();
             let c8 = [col.r, col.g, col.b, 1.0].map(|v| (255.0 * v).round() as u8);
-            let xs: Vec<f64> = ports(c).iter().map(|&b| self.x_m[b]).collect();
+            let xs: Vec<f64> = c.ports().iter().map(|&b| self.x_m[b]).collect();
             let (lo, hi) = span(&xs);
             let mut segment = |x0: f64, z0: f64, x1: f64, z1: f64| {
                 let n = ((((x1 - x0).powi(2) + (z1 - z0).powi(2)).sqrt() / 0.01).ceil() as usize)

@@ -143,7 +143,7 @@ fn dual_clutch_inertia_phase_matches_closed_form() {
         name: name.into(),
         a,
         b: 3,
-        kind: CouplingKind::IdealGear { ratio },
+        kind: CouplingKind::ideal_gear(ratio),
     };
     let net = Network {
         pack_thermal: Default::default(),

@@ -185,7 +185,7 @@ fn dual_clutch_shift_with_resolved_packs_matches_closed_form() {
         name: name.into(),
         a,
         b: 3,
-        kind: CouplingKind::IdealGear { ratio },
+        kind: CouplingKind::ideal_gear(ratio),
     };
     let net = Network {
         pack_thermal: Default::default(),

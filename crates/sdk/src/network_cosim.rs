@@ -14,7 +14,8 @@ use crate::network::{
 use crate::network_keep::{Keep, Obs};
 use crate::{Error, RecordingRequest, Result};
 use clutchpack_model::network::{
-    ClutchMode, Network, NetworkInput, NetworkObserver, NetworkRun, NetworkSample,
+    ClutchMode, Network, NetworkInput, NetworkObserver, NetworkSample, NetworkSession,
+    OutputQuantity,
 };
 use clutchpack_model::EngineError;
 use clutchpack_multibody::network::{NetworkStepOptions, NetworkStepper as MultibodyStepper};
@@ -22,13 +23,21 @@ use clutchpack_reference::network::NetworkStepper as ReferenceStepper;
 use clutchpack_scene::{EngineChoice, Scene};
 use std::sync::atomic::AtomicBool;
 
-/// A network run on either engine, advanced call by call (both steppers have the same
-/// methods and semantics: MODEL.md section 8, "Inputs"), boxed (1 kB and, with its rapier
-/// world, 7.5 kB).
-#[derive(Clone)]
-enum Stepper {
-    Reference(Box<ReferenceStepper>),
-    Multibody(Box<MultibodyStepper>),
+/// A network run on either engine, advanced call by call: the engine it runs on and its
+/// session ([`NetworkSession`], which both engines' steppers implement with the same
+/// semantics: MODEL.md section 8, "Inputs"), boxed (1 kB and, with its rapier world, 7.5 kB).
+struct Stepper {
+    engine: EngineChoice,
+    run: Box<dyn NetworkSession>,
+}
+
+impl Clone for Stepper {
+    fn clone(&self) -> Self {
+        Stepper {
+            engine: self.engine,
+            run: self.run.boxed_clone(),
+        }
+    }
 }
 
 impl Stepper {
@@ -41,106 +50,38 @@ impl Stepper {
         duration_s: f64,
         obs: &mut dyn NetworkObserver,
     ) -> std::result::Result<Stepper, EngineError> {
-        Ok(match engine {
+        let run: Box<dyn NetworkSession> = match engine {
             EngineChoice::Reference => {
                 let options = reference_options(scene);
-                Stepper::Reference(Box::new(ReferenceStepper::new(
-                    net, duration_s, &options, obs,
-                )?))
+                Box::new(ReferenceStepper::new(net, duration_s, &options, obs)?)
             }
             EngineChoice::Multibody => {
                 let options = NetworkStepOptions {
                     step_s: multibody_step_s(scene),
                     record_rate_hz: scene.simulation.record_rate_hz,
                 };
-                Stepper::Multibody(Box::new(MultibodyStepper::new(
-                    net, duration_s, &options, obs,
-                )?))
+                Box::new(MultibodyStepper::new(net, duration_s, &options, obs)?)
             }
-        })
+        };
+        Ok(Stepper { engine, run })
     }
 
     /// The engine running it.
     fn engine(&self) -> EngineChoice {
-        match self {
-            Stepper::Reference(_) => EngineChoice::Reference,
-            Stepper::Multibody(_) => EngineChoice::Multibody,
-        }
+        self.engine
     }
+}
 
-    /// The time the run stands at, s.
-    fn time_s(&self) -> f64 {
-        match self {
-            Stepper::Reference(s) => s.time_s(),
-            Stepper::Multibody(s) => s.time_s(),
-        }
+impl std::ops::Deref for Stepper {
+    type Target = dyn NetworkSession;
+    fn deref(&self) -> &Self::Target {
+        &*self.run
     }
+}
 
-    /// The network as run (the inputs set in place of the scene's signals).
-    fn network(&self) -> &Network {
-        match self {
-            Stepper::Reference(s) => s.network(),
-            Stepper::Multibody(s) => s.network(),
-        }
-    }
-
-    /// The state now (angles rad, speeds rad/s, torques N m, modes).
-    fn sample_now(&mut self) -> NetworkSample {
-        match self {
-            Stepper::Reference(s) => s.sample_now(),
-            Stepper::Multibody(s) => s.sample_now(),
-        }
-    }
-
-    /// The temperatures of the thermal pack that is coupling `k`, K (its discs', plates',
-    /// then oil's; `None` for another coupling).
-    fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
-        match self {
-            Stepper::Reference(s) => s.pack_temperatures_k(k),
-            Stepper::Multibody(s) => s.pack_temperatures_k(k),
-        }
-    }
-
-    /// Each coupling's heat (a mesh's work, a damper's loss) since t = 0, J.
-    fn heat_j(&self) -> Vec<f64> {
-        match self {
-            Stepper::Reference(s) => s.heat_j(),
-            Stepper::Multibody(s) => s.heat_j(),
-        }
-    }
-
-    /// Sets `input` to `value` (N m or N), held from now on.
-    fn set_input(
-        &mut self,
-        input: NetworkInput,
-        value: f64,
-        obs: &mut dyn NetworkObserver,
-    ) -> std::result::Result<(), EngineError> {
-        match self {
-            Stepper::Reference(s) => s.set_input(input, value, obs),
-            Stepper::Multibody(s) => s.set_input(input, value, obs),
-        }
-    }
-
-    /// Advances to `t_end` s (the reference engine may have taken its step past it, answering
-    /// for `t_end` from its dense output).
-    fn advance_to(
-        &mut self,
-        t_end: f64,
-        obs: &mut dyn NetworkObserver,
-    ) -> std::result::Result<(), EngineError> {
-        match self {
-            Stepper::Reference(s) => s.advance_to(t_end, obs),
-            Stepper::Multibody(s) => s.advance_to(t_end, obs),
-        }
-    }
-
-    /// Ends the run where it stands.
-    fn finish(self, obs: &mut dyn NetworkObserver) -> NetworkRun {
-        match self {
-            Stepper::Reference(s) => s.finish(obs),
-            Stepper::Multibody(s) => s.finish(obs),
-        }
+impl std::ops::DerefMut for Stepper {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut *self.run
     }
 }
 
@@ -174,29 +115,22 @@ pub fn network_inputs(net: &Network) -> Vec<(String, NetworkInput)> {
                 NetworkInput::Drive(i),
             )
         });
-    let clutches = net
+    // each element's own input (its law's), those of one kind together in the order the
+    // inputs are listed (clutches' forces, then packs' pressures), each kind by coupling
+    let mut elements: Vec<(String, NetworkInput)> = net
         .couplings
         .iter()
         .enumerate()
-        .filter(|(_, c)| c.clutch().is_some())
-        .map(|(k, c)| {
-            (
-                format!("couplings.{}.normal_force_n", segment(&c.name)),
-                NetworkInput::ClutchForce(k),
-            )
-        });
-    let packs = net
-        .couplings
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.pack().is_some_and(|p| p.stack.is_some()))
-        .map(|(k, c)| {
-            (
-                format!("couplings.{}.pressure_pa", segment(&c.name)),
-                NetworkInput::PackPressure(k),
-            )
-        });
-    bodies.chain(clutches).chain(packs).collect()
+        .filter_map(|(k, c)| {
+            let spec = c.law().input()?;
+            Some((
+                format!("couplings.{}.{}", segment(&c.name), spec.suffix),
+                (spec.input)(k),
+            ))
+        })
+        .collect();
+    elements.sort_by_key(|(_, input)| input.rank());
+    bodies.chain(elements).collect()
 }
 
 /// A body's or coupling's name as a segment of a variable's name: the FMI structured name's
@@ -221,13 +155,9 @@ pub fn network_name_problems(net: &Network) -> Vec<String> {
 fn input_value(net: &Network, input: NetworkInput, t: f64) -> f64 {
     match input {
         NetworkInput::Drive(i) => net.bodies[i].drive.as_ref().map_or(0.0, |s| s.value(t)),
-        NetworkInput::ClutchForce(k) => net.couplings[k]
-            .clutch()
-            .map_or(0.0, |c| c.normal_force_n(t).max(0.0)),
-        NetworkInput::PackPressure(k) => net.couplings[k]
-            .pack()
-            .and_then(|p| p.stack.as_ref())
-            .map_or(0.0, |s| s.piston.pressure.pressure_pa(t)),
+        NetworkInput::ClutchForce(k) | NetworkInput::PackPressure(k) => {
+            net.couplings[k].law().input_value(t)
+        }
     }
 }
 
@@ -242,21 +172,12 @@ fn input_variable(net: &Network, name: &str, input: NetworkInput) -> NetworkVari
                 net.bodies[i].name
             ),
         ),
-        NetworkInput::ClutchForce(k) => (
-            "N",
-            format!(
-                "normal force of clutch {}, N (>= 0; 0: free)",
-                net.couplings[k].name
-            ),
-        ),
-        NetworkInput::PackPressure(k) => (
-            "Pa",
-            format!(
-                "piston pressure of pack {}, Pa (>= 0; the piston pushes with p A less its \
-                 return spring)",
-                net.couplings[k].name
-            ),
-        ),
+        NetworkInput::ClutchForce(k) | NetworkInput::PackPressure(k) => {
+            let c = &net.couplings[k];
+            c.law().input().map_or(("", String::new()), |spec| {
+                (spec.unit, spec.description.replacen("{}", &c.name, 1))
+            })
+        }
     };
     NetworkVariable {
         name: name.to_string(),
@@ -312,58 +233,37 @@ pub fn network_outputs(net: &Network) -> Vec<NetworkVariable> {
             "N.m",
             format!("torque of {} on its body a, N m", c.name),
         ));
-        if c.clutch().is_some() {
+        for spec in c.law().outputs() {
             out.push(var(
-                format!("couplings.{}.slip_rad_s", segment(&c.name)),
-                "rad/s",
-                format!("slip w_b - w_a of {}, rad/s", c.name),
+                format!("couplings.{}.{}", segment(&c.name), spec.suffix),
+                spec.unit,
+                spec.description.replacen("{}", &c.name, 1),
             ));
+        }
+        if let (Some(p), true) = (c.pack(), net.pack_thermal.contains_key(&k)) {
+            // as a thermal pack scene's own outputs name them, under the coupling
+            let lists = [("discs", p.discs.len()), ("plates", p.plates.len())];
+            for (list, n) in lists {
+                for i in 0..n {
+                    out.push(var(
+                        format!("couplings.{}.{list}[{i}].temperature_k", segment(&c.name)),
+                        "K",
+                        format!(
+                            "{list}[{i}] of pack {}: its lumped temperature at the last \
+                             thermal window's end, K",
+                            c.name
+                        ),
+                    ));
+                }
+            }
             out.push(var(
-                format!("couplings.{}.mode", segment(&c.name)),
-                "1",
+                format!("couplings.{}.oil.temperature_k", segment(&c.name)),
+                "K",
                 format!(
-                    "mode of {} as Modelica's Clutch numbers it: 2 free, 1 slipping forward, \
-                     0 locked, -1 slipping backward",
+                    "the oil of pack {}: its temperature at the last thermal window's end, K",
                     c.name
                 ),
             ));
-            out.push(var(
-                format!("couplings.{}.heat_j", segment(&c.name)),
-                "J",
-                format!("heat {} has made since t = 0, J", c.name),
-            ));
-        }
-        if let Some(p) = c.pack() {
-            out.push(var(
-                format!("couplings.{}.heat_j", segment(&c.name)),
-                "J",
-                format!("heat the faces of pack {} have made since t = 0, J", c.name),
-            ));
-            if net.pack_thermal.contains_key(&k) {
-                // as a thermal pack scene's own outputs name them, under the coupling
-                let lists = [("discs", p.discs.len()), ("plates", p.plates.len())];
-                for (list, n) in lists {
-                    for i in 0..n {
-                        out.push(var(
-                            format!("couplings.{}.{list}[{i}].temperature_k", segment(&c.name)),
-                            "K",
-                            format!(
-                                "{list}[{i}] of pack {}: its lumped temperature at the last \
-                                 thermal window's end, K",
-                                c.name
-                            ),
-                        ));
-                    }
-                }
-                out.push(var(
-                    format!("couplings.{}.oil.temperature_k", segment(&c.name)),
-                    "K",
-                    format!(
-                        "the oil of pack {}: its temperature at the last thermal window's end, K",
-                        c.name
-                    ),
-                ));
-            }
         }
     }
     out
@@ -610,20 +510,21 @@ impl NetworkSimulation {
         }
         for (k, c) in net.couplings.iter().enumerate() {
             values.push(s.torque_n_m[k]);
-            if c.clutch().is_some() {
-                values.push(s.speed_rad_s[c.b] - s.speed_rad_s[c.a]);
-                let mode = s.mode[k].unwrap_or(ClutchMode::Free);
-                values.push(f64::from(mode.modelica_code()));
-                values.push(heat[k]);
-            }
-            if c.pack().is_some() {
-                values.push(heat[k]);
-                if net.pack_thermal.contains_key(&k) {
-                    let bodies = c.pack().map_or(0, |p| p.discs.len() + p.plates.len());
-                    match self.stepper.pack_temperatures_k(k) {
-                        Some(t) => values.extend_from_slice(t),
-                        None => values.extend(std::iter::repeat_n(f64::NAN, bodies + 1)),
+            for spec in c.law().outputs() {
+                values.push(match spec.quantity {
+                    OutputQuantity::Slip => s.speed_rad_s[c.b] - s.speed_rad_s[c.a],
+                    OutputQuantity::Mode => {
+                        f64::from(s.mode[k].unwrap_or(ClutchMode::Free).modelica_code())
                     }
+                    OutputQuantity::Heat => heat[k],
+                });
+            }
+            // a thermal pack's discs', plates' and oil's temperatures
+            if let (Some(p), true) = (c.pack(), net.pack_thermal.contains_key(&k)) {
+                let bodies = p.discs.len() + p.plates.len();
+                match self.stepper.pack_temperatures_k(k) {
+                    Some(t) => values.extend_from_slice(t),
+                    None => values.extend(std::iter::repeat_n(f64::NAN, bodies + 1)),
                 }
             }
         }
@@ -694,7 +595,7 @@ impl NetworkSimulation {
         };
         let engine = self.stepper.engine();
         // the engine's finish takes its stepper whole; this one is not used after it
-        let run = self.stepper.clone().finish(&mut obs);
+        let run = self.stepper.clone().run.finish_boxed(&mut obs);
         let wall_s = self.started.elapsed().as_secs_f64();
         conclude(&self.scene, engine, keep, run, wall_s)
     }

@@ -6,9 +6,7 @@
 //! located mode changes.
 
 use clutchpack_model::network::gears::{torque_factor, Handover};
-use clutchpack_model::network::{
-    ClutchEvent, ClutchMode, CouplingKind, Network, NetworkSample, Transmission,
-};
+use clutchpack_model::network::{ClutchEvent, ClutchMode, Network, NetworkSample, Transmission};
 use serde::Serialize;
 
 /// The output torque below which a shift counts as a tie-up: this fraction of the smaller of
@@ -116,12 +114,13 @@ impl ShiftProbe {
         if handovers.is_empty() {
             return None;
         }
-        // the transmission's own couplings: its gear sets and its shift elements (a final
-        // drive or a damper on the output is the output's load, not the transmission)
+        // the transmission's own couplings: its gear sets (its elements of three ports) and its
+        // shift elements (a final drive or a damper on the output is the output's load, not
+        // the transmission)
         let elements_k = tr.elements();
         let mut output_factors = Vec::new();
         for (k, c) in net.couplings.iter().enumerate() {
-            let own = matches!(c.kind, CouplingKind::Planetary(_)) || elements_k.contains(&k);
+            let own = c.ports().len() > 2 || elements_k.contains(&k);
             if !own {
                 continue;
             }

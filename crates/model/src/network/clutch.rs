@@ -9,41 +9,15 @@
 //! slipping clutch has `tau = sign(w_rel) mu(|w_rel|) cgeo fn`, which brings the two speeds
 //! together.
 
+pub use super::element::ClutchMode;
+use super::element::{
+    problem, ElementLaw, EnergyTerm, InputSpec, Mode, OutputQuantity, OutputSpec, SlipEnd,
+    MAX_PORTS,
+};
+use super::rows::Row;
 use super::signal::Signal;
+use super::{friction, Network, NetworkInput, NetworkProblem};
 use serde::{Deserialize, Serialize};
-
-/// The state of a lumped clutch (Modelica's `mode`: Free 2, Forward 1, Stuck 0, Backward -1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum ClutchMode {
-    /// `fn <= 0`: no torque.
-    Free,
-    /// Slipping with `w_rel > 0` (`+1`) or `w_rel < 0` (`-1`).
-    Slipping(i8),
-    /// Locked: `w_rel = 0`, the torque is what holds the two bodies together.
-    Locked,
-}
-
-impl ClutchMode {
-    /// Modelica's integer for the mode (Free 2, Forward 1, Stuck 0, Backward -1), as in
-    /// the MSL reference results' `clutchN.mode` columns.
-    pub fn modelica_code(self) -> i8 {
-        match self {
-            ClutchMode::Free => 2,
-            ClutchMode::Slipping(s) => s,
-            ClutchMode::Locked => 0,
-        }
-    }
-
-    /// A short name for tables: `free`, `slip+`, `slip-`, `locked`.
-    pub fn label(self) -> &'static str {
-        match self {
-            ClutchMode::Free => "free",
-            ClutchMode::Slipping(s) if s > 0 => "slip+",
-            ClutchMode::Slipping(_) => "slip-",
-            ClutchMode::Locked => "locked",
-        }
-    }
-}
 
 /// A lumped friction clutch (or brake, when one side is a fixed body).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -150,6 +124,198 @@ impl LumpedClutch {
             out.push(("force", "has a value that is not finite".to_string()));
         }
         out
+    }
+}
+
+/// The lumped clutch and the one-way clutch as an element (the module's docs; the stick/slip
+/// rule is [`friction`]'s).
+impl ElementLaw for LumpedClutch {
+    fn kind_name(&self) -> &'static str {
+        if self.one_way {
+            "one_way_clutch"
+        } else {
+            "clutch"
+        }
+    }
+
+    fn torque_factors(&self, _ports: &[usize]) -> Option<[f64; MAX_PORTS]> {
+        Some([1.0, -1.0, 0.0])
+    }
+
+    fn initial_mode(&self) -> Mode {
+        Some(ClutchMode::Free)
+    }
+
+    /// Locked: `w_a - w_b = 0`.
+    fn row(&self, k: usize, ports: &[usize], mode: Mode) -> Option<Row> {
+        (mode == Some(ClutchMode::Locked)).then(|| Row::two(k, (ports[0], 1.0), (ports[1], -1.0)))
+    }
+
+    /// Slipping: `tau = sign(w_rel) mu(|w_rel|) cgeo fn` on `a` (MODEL.md section 8).
+    fn port_torque_n_m(
+        &self,
+        t_s: f64,
+        _twist_rad: f64,
+        w_a: f64,
+        w_b: f64,
+        mode: Mode,
+    ) -> Option<f64> {
+        match mode {
+            Some(ClutchMode::Slipping(s)) => {
+                Some(self.slip_torque_n_m(s, w_b - w_a, self.normal_force_n(t_s)))
+            }
+            _ => None,
+        }
+    }
+
+    fn energy_term(&self) -> EnergyTerm {
+        EnergyTerm::ClutchHeat
+    }
+
+    /// Slipping: its heat rate `tau (w_b - w_a)`.
+    fn power_w(&self, mode: Mode, torque_n_m: f64, w_a: f64, w_b: f64) -> Option<f64> {
+        matches!(mode, Some(ClutchMode::Slipping(_))).then(|| torque_n_m * (w_b - w_a))
+    }
+
+    /// Its normal force's.
+    fn breakpoints(&self, out: &mut Vec<f64>) {
+        self.force.breakpoints(out);
+    }
+
+    /// `fn > 0`.
+    fn engaged(&self, t_s: f64) -> Option<bool> {
+        Some(self.normal_force_n(t_s) > 0.0)
+    }
+
+    /// Slipping: its direction; free, a one-way clutch's freewheel: forward.
+    fn slip_sense(&self, mode: Mode) -> Option<i8> {
+        match mode {
+            Some(ClutchMode::Slipping(s)) => Some(s),
+            Some(ClutchMode::Free) if self.one_way => Some(1),
+            _ => None,
+        }
+    }
+
+    /// Slipping `min(s w_rel, fn)`, locked `min(limit - |tau|, fn)` (a one-way clutch:
+    /// `limit - tau`, held without a normal force by its freewheel), free `-fn` (a one-way
+    /// clutch: `min(-fn, w_rel)`, its freewheel locking where the slip reaches zero).
+    fn guard(&self, t_s: f64, w_rel: f64, mode: Mode, held_n_m: f64) -> f64 {
+        let f = self.normal_force_n(t_s);
+        match mode {
+            Some(ClutchMode::Free) => {
+                let engage = if f > 0.0 { -f } else { 1.0 + f.abs() };
+                if self.one_way {
+                    engage.min(w_rel)
+                } else {
+                    engage
+                }
+            }
+            Some(ClutchMode::Slipping(s)) => (f64::from(s) * w_rel).min(f),
+            Some(ClutchMode::Locked) if self.one_way => LumpedClutch::margin_n_m(self, held_n_m, f),
+            Some(ClutchMode::Locked) => LumpedClutch::margin_n_m(self, held_n_m, f).min(f),
+            None => 1.0,
+        }
+    }
+
+    fn settle(&self, t_s: f64, before: Mode, w_a: f64, w_b: f64, end: SlipEnd) -> Mode {
+        let f = self.normal_force_n(t_s);
+        Some(friction::settled_mode(
+            self.one_way,
+            f,
+            before,
+            w_a,
+            w_b,
+            end,
+        ))
+    }
+
+    fn locked_margin_n_m(&self, t_s: f64, held_n_m: f64) -> Option<f64> {
+        Some(LumpedClutch::margin_n_m(
+            self,
+            held_n_m,
+            self.normal_force_n(t_s),
+        ))
+    }
+
+    /// Towards its torque (`+1` when the torque on `a` is positive); a one-way clutch forward,
+    /// or free without a normal force.
+    fn released_mode(&self, t_s: f64, held_n_m: f64) -> Mode {
+        Some(if self.one_way && self.normal_force_n(t_s) <= 0.0 {
+            ClutchMode::Free
+        } else if self.one_way || held_n_m > 0.0 {
+            ClutchMode::Slipping(1)
+        } else {
+            ClutchMode::Slipping(-1)
+        })
+    }
+
+    /// Its parameters'; a one-way clutch's speeds at t = 0 keep `w_b >= w_a`.
+    fn problems(
+        &self,
+        net: &Network,
+        k: usize,
+        ports: &[usize],
+        out: &mut Vec<NetworkProblem>,
+    ) -> bool {
+        for (field, message) in LumpedClutch::problems(self) {
+            out.push(problem(k, field, message));
+        }
+        let (a, b) = (&net.bodies[ports[0]], &net.bodies[ports[1]]);
+        let (wa, wb) = (a.initial_speed_rad_s, b.initial_speed_rad_s);
+        if self.one_way && wb < wa {
+            out.push(problem(
+                k,
+                "b",
+                format!(
+                    "a one-way clutch keeps w_b >= w_a, but at t = 0 \"{}\" turns at {} rad/s, below \"{}\"'s {} rad/s",
+                    b.name,
+                    crate::fmt_num(wb),
+                    a.name,
+                    crate::fmt_num(wa)
+                ),
+            ));
+        }
+        true
+    }
+
+    /// Its normal force (`normal_force_n`, N).
+    fn input(&self) -> Option<InputSpec> {
+        Some(InputSpec {
+            input: NetworkInput::ClutchForce,
+            suffix: "normal_force_n",
+            unit: "N",
+            description: "normal force of clutch {}, N (>= 0; 0: free)",
+        })
+    }
+
+    /// `fn(t)`, N (>= 0).
+    fn input_value(&self, t_s: f64) -> f64 {
+        self.normal_force_n(t_s).max(0.0)
+    }
+
+    /// Its slip, its mode and its heat.
+    fn outputs(&self) -> &'static [OutputSpec] {
+        &[
+            OutputSpec {
+                suffix: "slip_rad_s",
+                unit: "rad/s",
+                description: "slip w_b - w_a of {}, rad/s",
+                quantity: OutputQuantity::Slip,
+            },
+            OutputSpec {
+                suffix: "mode",
+                unit: "1",
+                description: "mode of {} as Modelica's Clutch numbers it: 2 free, 1 slipping \
+                              forward, 0 locked, -1 slipping backward",
+                quantity: OutputQuantity::Mode,
+            },
+            OutputSpec {
+                suffix: "heat_j",
+                unit: "J",
+                description: "heat {} has made since t = 0, J",
+                quantity: OutputQuantity::Heat,
+            },
+        ]
     }
 }
 

@@ -6,7 +6,43 @@
 //! engine lands its step on it) and in how they compute the holding torques; the rule is
 //! this.
 
-use super::{ClutchMode, LumpedClutch, Network};
+use super::{ClutchMode, Mode, Network, SlipEnd};
+
+/// The mode a clutch (`one_way`: a one-way clutch) enters at an event from `before` under the
+/// normal force `normal_n` (N), at the speeds `w_a`, `w_b` (rad/s), the slip's end found as
+/// `end` (how each engine finds it): [`entered_mode`], with the engine's zero of slip `scale = 1e-10 (1 + |w_a| + |w_b|)`
+/// rad/s. The reference engine ([`SlipEnd::Located`]) takes the slip as ended when the
+/// clutch's guard crossed and the slip is the part of it that did (`s w_rel <= fn` while
+/// slipping; a free one-way clutch's `w_rel` below its engagement); the multibody engine
+/// ([`SlipEnd::Landed`]) when its step landed within the scale of the slip's zero.
+pub fn settled_mode(
+    one_way: bool,
+    normal_n: f64,
+    before: Mode,
+    w_a_rad_s: f64,
+    w_b_rad_s: f64,
+    end: SlipEnd,
+) -> ClutchMode {
+    let w_rel = w_b_rad_s - w_a_rad_s;
+    let scale = 1e-10 * (1.0 + w_a_rad_s.abs() + w_b_rad_s.abs());
+    let f = normal_n;
+    let slip_ended = match end {
+        SlipEnd::Located { crossed } => {
+            crossed
+                && match before {
+                    Some(ClutchMode::Slipping(s)) => f64::from(s) * w_rel <= f,
+                    Some(ClutchMode::Free) => {
+                        one_way && w_rel <= if f > 0.0 { -f } else { 1.0 + f.abs() }
+                    }
+                    _ => false,
+                }
+        }
+        SlipEnd::Landed => {
+            matches!(before, Some(ClutchMode::Slipping(s)) if f64::from(s) * w_rel <= scale)
+        }
+    };
+    entered_mode(one_way, before, f, w_rel, scale, slip_ended)
+}
 
 /// The mode a clutch enters at an event at `t` from the mode `before` (`None` before its
 /// first settling), under the normal force `normal_n` (N) at the relative speed `w_rel`
@@ -20,18 +56,18 @@ use super::{ClutchMode, LumpedClutch, Network};
 /// - a locked clutch stays locked (it is released by [`furthest_over`] when the torque that
 ///   holds it exceeds its static limit).
 ///
-/// A one-way clutch ([`LumpedClutch::one_way`]) keeps `w_rel >= 0`: at or below its zero
+/// A one-way clutch (`one_way`, [`super::LumpedClutch::one_way`]) keeps `w_rel >= 0`: at or below its zero
 /// (within the scale) it is tried locked whatever its normal force (the freewheel), above it
 /// it slips forward under a normal force and is free without one.
 pub fn entered_mode(
-    clutch: &LumpedClutch,
+    one_way: bool,
     before: Option<ClutchMode>,
     normal_n: f64,
     w_rel_rad_s: f64,
     scale_rad_s: f64,
     slip_ended: bool,
 ) -> ClutchMode {
-    if clutch.one_way {
+    if one_way {
         let at_zero =
             w_rel_rad_s <= scale_rad_s || slip_ended || before == Some(ClutchMode::Locked);
         return if at_zero {
@@ -66,7 +102,7 @@ pub fn entered_mode(
 
 /// The locked clutch furthest over its static limit `peak mu(0) cgeo fn` at `t` (s) under the
 /// holding torques `torque_n_m` (N m, each coupling's on its body `a`;
-/// [`LumpedClutch::margin_n_m`]), with the mode it is released to: slipping towards its
+/// [`super::ElementLaw::locked_margin_n_m`]), with the mode it is released to: slipping towards its
 /// torque (`+1` when the torque on `a` is positive; a one-way clutch forward, or free without
 /// a normal force); `None` when every locked clutch holds. The engines release it and solve again until none is over (Modelica's
 /// startForward / startBackward, one at a time).
@@ -81,30 +117,24 @@ pub fn furthest_over(
         if *mode != Some(ClutchMode::Locked) {
             continue;
         }
-        let Some(cl) = net.couplings[k].clutch() else {
+        let Some(margin) = net.couplings[k].law().locked_margin_n_m(t, torque_n_m[k]) else {
             continue;
         };
-        let over = -cl.margin_n_m(torque_n_m[k], cl.normal_force_n(t));
+        let over = -margin;
         if over > 0.0 && worst.is_none_or(|(_, o)| over > o) {
             worst = Some((k, over));
         }
     }
-    worst.map(|(k, _)| {
-        let cl = net.couplings[k].clutch().expect("only clutches lock");
-        let to = if cl.one_way && cl.normal_force_n(t) <= 0.0 {
-            ClutchMode::Free
-        } else if cl.one_way || torque_n_m[k] > 0.0 {
-            ClutchMode::Slipping(1)
-        } else {
-            ClutchMode::Slipping(-1)
-        };
-        (k, to)
+    worst.and_then(|(k, _)| {
+        let to = net.couplings[k].law().released_mode(t, torque_n_m[k])?;
+        Some((k, to))
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::network::LumpedClutch;
     use ClutchMode::{Free, Locked, Slipping};
 
     /// Modelica's transitions: free without force; engaging at speed slips, at zero slip
@@ -127,17 +157,23 @@ mod tests {
     fn one_way_clutch_locks_at_zero_and_never_slips_backwards() {
         let c = clutch(true);
         assert_eq!(
-            entered_mode(&c, Some(Free), 0.0, 1e-12, 1e-10, false),
+            entered_mode(c.one_way, Some(Free), 0.0, 1e-12, 1e-10, false),
             Locked
         );
-        assert_eq!(entered_mode(&c, Some(Free), 0.0, 2.0, 1e-10, false), Free);
         assert_eq!(
-            entered_mode(&c, Some(Free), 5.0, 2.0, 1e-10, false),
+            entered_mode(c.one_way, Some(Free), 0.0, 2.0, 1e-10, false),
+            Free
+        );
+        assert_eq!(
+            entered_mode(c.one_way, Some(Free), 5.0, 2.0, 1e-10, false),
             Slipping(1)
         );
-        assert_eq!(entered_mode(&c, None, 5.0, -2.0, 1e-10, false), Locked);
         assert_eq!(
-            entered_mode(&c, Some(Locked), 0.0, 3.0, 1e-10, false),
+            entered_mode(c.one_way, None, 5.0, -2.0, 1e-10, false),
+            Locked
+        );
+        assert_eq!(
+            entered_mode(c.one_way, Some(Locked), 0.0, 3.0, 1e-10, false),
             Locked
         );
         // the freewheel holds any torque <= 0 on a; the clutch up to its limit above it
@@ -148,29 +184,32 @@ mod tests {
     #[test]
     fn modes_follow_modelica_clutch() {
         let c = clutch(false);
-        assert_eq!(entered_mode(&c, Some(Locked), 0.0, 1.0, 1e-10, false), Free);
         assert_eq!(
-            entered_mode(&c, None, 5.0, -2.0, 1e-10, false),
+            entered_mode(c.one_way, Some(Locked), 0.0, 1.0, 1e-10, false),
+            Free
+        );
+        assert_eq!(
+            entered_mode(c.one_way, None, 5.0, -2.0, 1e-10, false),
             Slipping(-1)
         );
         assert_eq!(
-            entered_mode(&c, Some(Free), 5.0, 1e-12, 1e-10, false),
+            entered_mode(c.one_way, Some(Free), 5.0, 1e-12, 1e-10, false),
             Locked
         );
         assert_eq!(
-            entered_mode(&c, Some(Slipping(1)), 5.0, 2.0, 1e-10, false),
+            entered_mode(c.one_way, Some(Slipping(1)), 5.0, 2.0, 1e-10, false),
             Slipping(1)
         );
         assert_eq!(
-            entered_mode(&c, Some(Slipping(1)), 5.0, 2.0, 1e-10, true),
+            entered_mode(c.one_way, Some(Slipping(1)), 5.0, 2.0, 1e-10, true),
             Locked
         );
         assert_eq!(
-            entered_mode(&c, Some(Slipping(1)), 5.0, -1e-3, 1e-10, false),
+            entered_mode(c.one_way, Some(Slipping(1)), 5.0, -1e-3, 1e-10, false),
             Locked
         );
         assert_eq!(
-            entered_mode(&c, Some(Locked), 5.0, 3.0, 1e-10, false),
+            entered_mode(c.one_way, Some(Locked), 5.0, 3.0, 1e-10, false),
             Locked
         );
     }

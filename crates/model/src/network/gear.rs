@@ -107,6 +107,44 @@ impl GearMesh {
     }
 }
 
+impl super::ElementLaw for GearMesh {
+    fn kind_name(&self) -> &'static str {
+        "gear_mesh"
+    }
+
+    /// Its displacement `x` along the line of action, on its backlash's scale.
+    fn state_scale(&self) -> Option<f64> {
+        Some(self.backlash_m)
+    }
+
+    /// `x` at t = 0.
+    fn initial_state(&self) -> f64 {
+        self.initial_offset_m
+    }
+
+    /// `x`'s rate `Rb_a w_a +- Rb_b w_b` (m/s).
+    fn state_rate(&self, w_a: f64, w_b: f64) -> f64 {
+        self.displacement((0.0, 0.0), (w_a, w_b)).1
+    }
+
+    fn energy_term(&self) -> super::EnergyTerm {
+        super::EnergyTerm::MeshWork
+    }
+
+    fn problems(
+        &self,
+        _net: &super::Network,
+        k: usize,
+        _ports: &[usize],
+        out: &mut Vec<super::NetworkProblem>,
+    ) -> bool {
+        for (field, message) in GearMesh::problems(self) {
+            out.push(super::element::problem(k, field, message));
+        }
+        true
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -110,28 +110,14 @@ pub struct GearKinematics {
 /// spring-damper; 0 for a body it does not touch; `None` where the torque on `a` does not
 /// give it (a gear mesh's, a resolved pack's other side).
 pub fn torque_factor(c: &super::Coupling, body: usize) -> Option<f64> {
-    use super::CouplingKind;
-    if let CouplingKind::Planetary(p) = &c.kind {
-        let row = p.row(0, c.a, c.b);
-        let first = row.terms()[0].1;
-        return Some(
-            row.terms()
-                .iter()
-                .find(|(i, _)| *i == body)
-                .map_or(0.0, |(_, ci)| ci / first),
-        );
-    }
-    if body == c.a {
+    let ports = c.ports();
+    let Some(j) = ports.iter().position(|&p| p == body) else {
+        return Some(0.0);
+    };
+    if j == 0 {
         return Some(1.0);
     }
-    if body != c.b {
-        return Some(0.0);
-    }
-    match &c.kind {
-        CouplingKind::Clutch(_) | CouplingKind::SpringDamper(_) => Some(-1.0),
-        CouplingKind::IdealGear { ratio } => Some(-ratio),
-        CouplingKind::GearMesh(_) | CouplingKind::Pack(_) | CouplingKind::Planetary(_) => None,
-    }
+    c.law().torque_factors(&ports).map(|f| f[j])
 }
 
 /// The constraint row of coupling `c` (index `k`) in a gear that closes it (`closed`) or

@@ -10,20 +10,30 @@
 //! conserved: the torque `lambda` on `a` is `-ratio lambda` on `b`).
 
 pub mod clutch;
+pub mod element;
 pub mod firing;
 pub mod friction;
 pub mod gear;
 pub mod gears;
+pub mod ideal_gear;
 pub mod output;
 pub mod planetary;
+pub mod resolved_pack;
 pub mod rows;
 pub mod signal;
+pub mod spring_damper;
 
 pub use clutch::{ClutchMode, LumpedClutch};
+pub use element::{
+    ElementLaw, EnergyTerm, InputSpec, Mode, OutputQuantity, OutputSpec, Ports, SlipEnd,
+};
 pub use firing::Firing;
 pub use gear::GearMesh;
 pub use gears::{Gear, GearKinematics, Shift, Transmission};
-pub use output::{ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample};
+pub use ideal_gear::IdealGear;
+pub use output::{
+    ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample, NetworkSession,
+};
 pub use planetary::PlanetarySet;
 pub use rows::Row;
 pub use signal::{NetworkInput, Signal};
@@ -106,10 +116,7 @@ pub enum CouplingKind {
     /// A lumped friction clutch (a brake when one body is fixed).
     Clutch(LumpedClutch),
     /// An ideal gear: `w_a = ratio w_b` (rigid, no backlash; one degree of freedom fewer).
-    IdealGear {
-        /// `w_a / w_b` (nonzero; negative for an external pair turning the other way).
-        ratio: f64,
-    },
+    IdealGear(IdealGear),
     /// A gear mesh with backlash and a tooth law (gear rattle; MODEL.md section 8).
     GearMesh(GearMesh),
     /// A torsional spring-damper (a damper spring, a dual-mass flywheel; MODEL.md section 8):
@@ -139,37 +146,36 @@ pub struct Coupling {
     pub kind: CouplingKind,
 }
 
+impl CouplingKind {
+    /// An ideal gear of the ratio `w_a / w_b`.
+    pub fn ideal_gear(ratio: f64) -> CouplingKind {
+        CouplingKind::IdealGear(IdealGear { ratio })
+    }
+
+    /// Its law ([`element`]): the one `match` on the kinds, every other part of the tree asks
+    /// the law.
+    pub fn law(&self) -> &dyn ElementLaw {
+        match self {
+            CouplingKind::Clutch(c) => c,
+            CouplingKind::IdealGear(g) => g,
+            CouplingKind::GearMesh(g) => g,
+            CouplingKind::SpringDamper(s) => s,
+            CouplingKind::Pack(p) => &**p,
+            CouplingKind::Planetary(p) => p,
+        }
+    }
+}
+
 impl Coupling {
-    /// Its constraint row when it is rigid in the mode `mode` ([`rows`]; `k` its index):
-    /// an ideal gear always, `w_a - ratio w_b = 0`; a planetary set always, Willis' equation
-    /// ([`PlanetarySet::row`]); a locked clutch, `w_a - w_b = 0`; `None`
-    /// for the others (their torques are forces, not constraints). The one place that says
-    /// which couplings are rigid, for both engines.
-    pub fn row(&self, k: usize, mode: Option<ClutchMode>) -> Option<Row> {
-        let coef_b = match self.kind {
-            CouplingKind::Planetary(ref p) => return Some(p.row(k, self.a, self.b)),
-            CouplingKind::IdealGear { ratio } => -ratio,
-            CouplingKind::Clutch(_) if mode == Some(ClutchMode::Locked) => -1.0,
-            CouplingKind::Clutch(_)
-            | CouplingKind::GearMesh(_)
-            | CouplingKind::SpringDamper(_)
-            | CouplingKind::Pack(_) => return None,
-        };
-        Some(Row::two(k, (self.a, 1.0), (self.b, coef_b)))
+    /// Its law ([`CouplingKind::law`]).
+    pub fn law(&self) -> &dyn ElementLaw {
+        self.kind.law()
     }
 
     /// Its lumped clutch, if it is one.
     pub fn clutch(&self) -> Option<&LumpedClutch> {
         match &self.kind {
             CouplingKind::Clutch(c) => Some(c),
-            _ => None,
-        }
-    }
-
-    /// Its spring-damper, if it is one.
-    pub fn spring(&self) -> Option<&crate::spring::SpringDamper> {
-        match &self.kind {
-            CouplingKind::SpringDamper(s) => Some(s),
             _ => None,
         }
     }
@@ -370,139 +376,54 @@ impl Network {
             }
             let (ta, tb) = (top(&mut linked, c.a), top(&mut linked, c.b));
             linked[ta] = tb;
-            match &c.kind {
-                CouplingKind::Clutch(cl) => {
-                    for (field, message) in cl.problems() {
-                        out.push(coupling(k, field, message));
-                    }
-                    let (wa, wb) = (
-                        self.bodies[c.a].initial_speed_rad_s,
-                        self.bodies[c.b].initial_speed_rad_s,
-                    );
-                    if cl.one_way && wb < wa {
-                        out.push(coupling(
-                            k,
-                            "b",
-                            format!(
-                                "a one-way clutch keeps w_b >= w_a, but at t = 0 \"{}\" turns at {} rad/s, below \"{}\"'s {} rad/s",
-                                self.bodies[c.b].name,
-                                crate::fmt_num(wb),
-                                self.bodies[c.a].name,
-                                crate::fmt_num(wa)
-                            ),
-                        ));
-                    }
+            let (law, ports) = (c.law(), c.ports());
+            let sound = law.problems(self, k, &ports, &mut out);
+            // a further port (a planetary set's carrier) joins the group
+            for &p in &ports[2..] {
+                if p < n {
+                    let (tp, tb) = (top(&mut linked, p), top(&mut linked, c.b));
+                    linked[tp] = tb;
                 }
-                CouplingKind::GearMesh(g) => {
-                    for (field, message) in g.problems() {
-                        out.push(coupling(k, field, message));
-                    }
-                }
-                CouplingKind::SpringDamper(sd) => {
-                    let (kk, d) = (sd.stiffness_n_m_per_rad, sd.damping_n_m_s_per_rad);
-                    let good = kk.is_finite()
-                        && kk >= 0.0
-                        && d.is_finite()
-                        && d >= 0.0
-                        && sd.free_angle_rad.is_finite();
-                    if !good {
-                        out.push(coupling(
-                            k,
-                            "stiffness_n_m_per_rad",
-                            "stiffness and damping must be finite and >= 0".into(),
-                        ));
-                    }
-                }
-                CouplingKind::Pack(p) => {
-                    if self.bodies[c.a].fixed {
-                        out.push(coupling(
-                            k,
-                            "a",
-                            format!(
-                                "\"{}\" is fixed: the friction discs' carrier must turn (the plates' carrier b may be the fixed housing)",
-                                self.bodies[c.a].name
-                            ),
-                        ));
-                    }
-                    if !p.couplings.is_empty() {
-                        out.push(coupling(
-                            k,
-                            "pack",
-                            "the pack's own [[couplings]] join its shaft and drum, which the network's bodies replace: put them in the network's [[couplings]]".into(),
-                        ));
-                    }
-                    if p.discs.is_empty() {
-                        out.push(coupling(k, "pack", "the pack has no friction discs".into()));
-                    }
-                }
-                CouplingKind::Planetary(ps) => {
-                    planetary::network_problems(self, k, c, ps, &mut out);
-                    if ps.carrier < n {
-                        let (tc, tb) = (top(&mut linked, ps.carrier), top(&mut linked, c.b));
-                        linked[tc] = tb;
-                    }
-                }
-                CouplingKind::IdealGear { ratio } => {
-                    if !(ratio.is_finite() && *ratio != 0.0) {
-                        out.push(coupling(
-                            k,
-                            "ratio",
-                            format!("{} must be nonzero", crate::fmt_num(*ratio)),
-                        ));
-                        continue;
-                    }
-                    let (ba, bb) = (&self.bodies[c.a], &self.bodies[c.b]);
-                    if ba.fixed != bb.fixed {
-                        out.push(coupling(
-                            k,
-                            "b",
-                            format!(
-                                "an ideal gear from a fixed body would hold \"{}\" still: make it fixed instead",
-                                if ba.fixed { &bb.name } else { &ba.name }
-                            ),
-                        ));
-                        continue;
-                    }
-                    let (ra, ga) = find(&mut root, &mut factor, c.a);
-                    let (rb, gb) = find(&mut root, &mut factor, c.b);
-                    if ra == rb {
-                        out.push(coupling(
-                            k,
-                            "b",
-                            "closes a loop of ideal gears, which over-constrains the bodies (one gear of the loop is redundant, or the ratios contradict)".into(),
-                        ));
-                        continue;
-                    }
-                    // w_a = ratio w_b: w_rb = (ga / (ratio gb)) w_ra... join rb under ra
-                    root[rb] = ra;
-                    factor[rb] = ga / (ratio * gb);
-                    let (wa, wb) = (ba.initial_speed_rad_s, bb.initial_speed_rad_s);
-                    let want = ratio * wb;
-                    if (wa - want).abs() > 1e-9 * (1.0 + wa.abs().max(want.abs())) {
-                        out.push(coupling(
-                            k,
-                            "ratio",
-                            format!(
-                                "the speeds at t = 0 do not mesh: \"{}\" turns at {} rad/s but ratio x \"{}\"'s {} rad/s is {}",
-                                ba.name,
-                                crate::fmt_num(wa),
-                                bb.name,
-                                crate::fmt_num(wb),
-                                crate::fmt_num(want)
-                            ),
-                        ));
-                    }
-                }
+            }
+            let Some(ratio) = law.fixed_ratio().filter(|_| sound) else {
+                continue;
+            };
+            // a rigid two-port tie `w_a = ratio w_b` (an ideal gear): no loop of them, and
+            // speeds at t = 0 that keep it
+            let (ba, bb) = (&self.bodies[c.a], &self.bodies[c.b]);
+            let (ra, ga) = find(&mut root, &mut factor, c.a);
+            let (rb, gb) = find(&mut root, &mut factor, c.b);
+            if ra == rb {
+                out.push(coupling(
+                    k,
+                    "b",
+                    "closes a loop of ideal gears, which over-constrains the bodies (one gear of the loop is redundant, or the ratios contradict)".into(),
+                ));
+                continue;
+            }
+            // w_a = ratio w_b: w_rb = (ga / (ratio gb)) w_ra... join rb under ra
+            root[rb] = ra;
+            factor[rb] = ga / (ratio * gb);
+            let (wa, wb) = (ba.initial_speed_rad_s, bb.initial_speed_rad_s);
+            let want = ratio * wb;
+            if (wa - want).abs() > 1e-9 * (1.0 + wa.abs().max(want.abs())) {
+                out.push(coupling(
+                    k,
+                    "ratio",
+                    format!(
+                        "the speeds at t = 0 do not mesh: \"{}\" turns at {} rad/s but ratio x \"{}\"'s {} rad/s is {}",
+                        ba.name,
+                        crate::fmt_num(wa),
+                        bb.name,
+                        crate::fmt_num(wb),
+                        crate::fmt_num(want)
+                    ),
+                ));
             }
         }
         // the rigid rows that hold always (gears, planetary sets) independent: a redundant one
         // over-constrains the bodies (the gears' loops are found above with their ratios)
-        if out.is_empty()
-            && self
-                .couplings
-                .iter()
-                .any(|c| matches!(c.kind, CouplingKind::Planetary(_)))
-        {
+        if out.is_empty() && self.couplings.iter().any(|c| c.ports().len() > 2) {
             let rows: Vec<Row> = self
                 .couplings
                 .iter()
@@ -577,15 +498,7 @@ impl Network {
             }
         }
         for c in &self.couplings {
-            match &c.kind {
-                CouplingKind::Clutch(cl) => cl.force.breakpoints(&mut out),
-                CouplingKind::Pack(p) => {
-                    if let Some(s) = &p.stack {
-                        s.piston.pressure.breakpoints(&mut out);
-                    }
-                }
-                _ => {}
-            }
+            c.law().breakpoints(&mut out);
         }
         out.retain(|t| *t > 0.0 && *t < end_s);
         out.sort_by(f64::total_cmp);
@@ -616,7 +529,7 @@ mod tests {
             name: name.into(),
             a,
             b,
-            kind: CouplingKind::IdealGear { ratio },
+            kind: CouplingKind::ideal_gear(ratio),
         }
     }
 
@@ -666,7 +579,7 @@ mod tests {
             "{p:?}"
         );
         net.couplings.pop();
-        net.couplings[0].kind = CouplingKind::IdealGear { ratio: 2.0 };
+        net.couplings[0].kind = CouplingKind::ideal_gear(2.0);
         let p = net.problems();
         assert!(
             matches!(&p[0], NetworkProblem::Coupling { index: 0, field: "ratio", message } if message.contains("do not mesh")),

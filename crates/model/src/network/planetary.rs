@@ -15,8 +15,9 @@
 //! the carrier is named by the set. The coupling's torque (the network's torque "on `a`") is
 //! the torque on the sun, `tau_S = z_S lambda`.
 
+use super::element::{ElementLaw, Mode, Ports, MAX_PORTS};
 use super::rows::Row;
-use super::{Coupling, Network, NetworkProblem};
+use super::{Network, NetworkProblem};
 use serde::{Deserialize, Serialize};
 
 /// The most teeth a sun or a ring may have (a bound on typing errors; an 8HP's largest ring
@@ -44,6 +45,11 @@ impl PlanetarySet {
     pub fn row(&self, k: usize, sun: usize, ring: usize) -> Row {
         let (zs, zr) = self.signed_teeth();
         Row::three(k, [(sun, zs), (ring, zr), (self.carrier, -(zs + zr))])
+    }
+
+    /// Its ports: the sun `sun`, the ring `ring` and its carrier.
+    pub fn members(&self, sun: usize, ring: usize) -> Ports {
+        Ports::three(sun, ring, self.carrier)
     }
 
     /// `(z_S, z_R)` as they enter Willis' equation: `z_R` negative for a double-pinion set.
@@ -87,14 +93,57 @@ impl PlanetarySet {
     }
 }
 
-/// The problems of the planetary set `ps` of coupling `k` (`c`), pushed to `out`: its
-/// gearing, a carrier that is a body of the network other than its sun and ring, at most one
-/// fixed member (two would hold the third: make it fixed instead), and speeds at t = 0 that
-/// keep Willis' equation.
-pub(super) fn network_problems(
+impl ElementLaw for PlanetarySet {
+    fn kind_name(&self) -> &'static str {
+        "planetary"
+    }
+
+    /// The sun, the ring and the carrier.
+    fn ports(&self, a: usize, b: usize) -> Ports {
+        self.members(a, b)
+    }
+
+    /// Willis' row on the sun, the ring and the carrier, always.
+    fn row(&self, k: usize, ports: &[usize], _mode: Mode) -> Option<Row> {
+        let (zs, zr) = self.signed_teeth();
+        Some(Row::three(
+            k,
+            [(ports[0], zs), (ports[1], zr), (ports[2], -(zs + zr))],
+        ))
+    }
+
+    /// Willis' coefficients over the sun's: `1`, `z_R / z_S`, `-(z_S + z_R) / z_S`.
+    fn torque_factors(&self, ports: &[usize]) -> Option<[f64; MAX_PORTS]> {
+        let row = ElementLaw::row(self, 0, ports, None)?;
+        let first = row.terms()[0].1;
+        let mut out = [0.0; MAX_PORTS];
+        for (o, (_, c)) in out.iter_mut().zip(row.terms()) {
+            *o = c / first;
+        }
+        Some(out)
+    }
+
+    fn problems(
+        &self,
+        net: &Network,
+        k: usize,
+        ports: &[usize],
+        out: &mut Vec<NetworkProblem>,
+    ) -> bool {
+        network_problems(net, k, ports[0], ports[1], self, out);
+        true
+    }
+}
+
+/// The problems of the planetary set `ps` of coupling `k` on the sun `a` and the ring `b`,
+/// pushed to `out`: its gearing, a carrier that is a body of the network other than its sun
+/// and ring, at most one fixed member (two would hold the third: make it fixed instead), and
+/// speeds at t = 0 that keep Willis' equation.
+fn network_problems(
     net: &Network,
     k: usize,
-    c: &Coupling,
+    a: usize,
+    b: usize,
     ps: &PlanetarySet,
     out: &mut Vec<NetworkProblem>,
 ) {
@@ -114,14 +163,14 @@ pub(super) fn network_problems(
         ));
         return;
     }
-    if ps.carrier == c.a || ps.carrier == c.b {
+    if ps.carrier == a || ps.carrier == b {
         out.push(problem(
             "carrier",
             "must be a third body, not the sun (a) or the ring (b)".into(),
         ));
         return;
     }
-    let members = [c.a, c.b, ps.carrier];
+    let members = [a, b, ps.carrier];
     let fixed: Vec<&str> = members
         .iter()
         .filter(|&&i| net.bodies[i].fixed)
@@ -141,7 +190,7 @@ pub(super) fn network_problems(
         return;
     }
     let w = |i: usize| net.bodies[i].initial_speed_rad_s;
-    let want = ps.carrier_speed_rad_s(w(c.a), w(c.b));
+    let want = ps.carrier_speed_rad_s(w(a), w(b));
     let wc = w(ps.carrier);
     if (wc - want).abs() > 1e-9 * (1.0 + wc.abs().max(want.abs())) {
         out.push(problem(

@@ -214,6 +214,18 @@ pub enum NetworkInput {
     PackPressure(usize),
 }
 
+impl NetworkInput {
+    /// Its place in a list of inputs: the drives, then the clutches' forces, then the packs'
+    /// pressures (the co-simulation's order).
+    pub fn rank(self) -> u8 {
+        match self {
+            NetworkInput::Drive(_) => 0,
+            NetworkInput::ClutchForce(_) => 1,
+            NetworkInput::PackPressure(_) => 2,
+        }
+    }
+}
+
 impl super::Network {
     /// Replaces the signal of `input` by the constant `value` (N m for a drive, N for a
     /// clutch's normal force, stored normalized by the clutch's `fn_max_n`, Pa for a pack's

@@ -30,14 +30,14 @@
 //! 2. **Torques at `t`**: each body's drive, road load and drag
 //!    ([`clutchpack_model::network::Body::external_torque_n_m`]), each slipping clutch's
 //!    `tau = sign(w_rel) mu(|w_rel|) cgeo fn` (+tau on `a`, -tau on `b`,
-//!    [`LumpedClutch::slip_torque_n_m`](clutchpack_model::network::LumpedClutch::slip_torque_n_m)), each spring-damper's `T = k (theta_a - theta_b -
+//!    the clutch's law, [`ElementLaw::port_torque_n_m`](clutchpack_model::network::ElementLaw::port_torque_n_m)), each spring-damper's `T = k (theta_a - theta_b -
 //!    theta_0) + d (w_a - w_b)` (-T on `a`, +T on `b`), each gear mesh's force per pair `F`,
 //!    signed as its `x`, from the model's law at `x` and its rate (MODEL.md section 8:
 //!    `-Rb_a F` on `a`, `-Rb_b F` on `b`, internal `+Rb_b F`, times the pairs,
 //!    [`GearMesh::torques_n_m`](clutchpack_model::network::GearMesh::torques_n_m)); then the constraint torques `lambda` of the gears
 //!    and locked clutches that keep every constraint (the model's `rows::constraint_torques`). A locked clutch
 //!    whose `|lambda|` exceeds its static limit `peak mu(0) cgeo fn`
-//!    ([`LumpedClutch::max_static_torque_n_m`](clutchpack_model::network::LumpedClutch::max_static_torque_n_m)) slips towards it; the one furthest over goes
+//!    ([`ElementLaw::locked_margin_n_m`](clutchpack_model::network::ElementLaw::locked_margin_n_m)) slips towards it; the one furthest over goes
 //!    first and the solve repeats (as the reference's `settle`). These are the samples'
 //!    torques.
 //! 3. **The step's torques** (the explicit midpoint rule): the same torques at
@@ -85,6 +85,7 @@ use bodies::NetworkWorld;
 pub(crate) use clutchpack_model::network::rows::{self as constraint, Row};
 use clutchpack_model::network::{
     friction, ClutchEvent, ClutchMode, Network, NetworkEnergy, NetworkObserver, NetworkSample,
+    SlipEnd,
 };
 use mesh::Mesh;
 use std::sync::Arc;
@@ -243,22 +244,17 @@ impl Run {
         out.coupling.clear();
         out.coupling.resize(net.couplings.len(), 0.0);
         for (k, c) in net.couplings.iter().enumerate() {
-            if let (Some(cl), Some(ClutchMode::Slipping(s))) =
-                (net.couplings[k].clutch(), self.modes[k])
+            // MODEL.md section 8: a force element's torque on a, the opposite on b (a
+            // slipping clutch's; a spring-damper's at the twist theta_a - theta_b, both bodies
+            // starting at angle 0 as the reference engine's twist state does)
+            let twist = theta[c.a] - theta[c.b];
+            if let Some(ta) = c
+                .law()
+                .port_torque_n_m(t, twist, w[c.a], w[c.b], self.modes[k])
             {
-                // MODEL.md section 8: tau = sign(w_rel) mu(|w_rel|) cgeo fn, +tau on a, -tau on b
-                let tau = cl.slip_torque_n_m(s, w[c.b] - w[c.a], cl.normal_force_n(t));
-                out.coupling[k] = tau;
-                out.body[c.a] += tau;
-                out.body[c.b] -= tau;
-            }
-            if let Some(sd) = net.couplings[k].spring() {
-                // MODEL.md section 8: T on b, -T on a, at the twist theta_a - theta_b (both
-                // bodies start at angle 0, as the reference engine's twist state does)
-                let t = sd.torque_n_m(theta[c.a] - theta[c.b], w[c.a] - w[c.b]);
-                out.coupling[k] = -t;
-                out.body[c.a] -= t;
-                out.body[c.b] += t;
+                out.coupling[k] = ta;
+                out.body[c.a] += ta;
+                out.body[c.b] -= ta;
             }
         }
         // the packs' reactions of the last step: the estimate of this one's (`packs.rs`)
@@ -290,10 +286,11 @@ impl Run {
     ) -> Vec<f64> {
         self.evaluate(t, theta, w, x, scratch);
         (0..self.net.couplings.len())
-            .map(|k| match (self.net.couplings[k].clutch(), self.modes[k]) {
-                (Some(cl), Some(ClutchMode::Locked)) => {
-                    cl.margin_n_m(scratch.coupling[k], cl.normal_force_n(t))
-                }
+            .map(|k| match self.modes[k] {
+                Some(ClutchMode::Locked) => self.net.couplings[k]
+                    .law()
+                    .locked_margin_n_m(t, scratch.coupling[k])
+                    .unwrap_or(f64::INFINITY),
                 _ => f64::INFINITY,
             })
             .collect()
@@ -317,23 +314,10 @@ impl Run {
         let before = self.modes.clone();
         let w_before = self.w.clone();
         for (k, c) in net.couplings.iter().enumerate() {
-            let Some(cl) = net.couplings[k].clutch() else {
-                continue;
-            };
+            // the step landed on the slip's zero: within the scale of it (the stick/slip
+            // rule's `SlipEnd::Landed`)
             let (wa, wb) = (self.w[c.a], self.w[c.b]);
-            let w_rel = wb - wa;
-            let scale = 1e-10 * (1.0 + wa.abs() + wb.abs());
-            // the step landed on the slip's zero: within the scale of it
-            let slip_ended =
-                matches!(before[k], Some(ClutchMode::Slipping(s)) if f64::from(s) * w_rel <= scale);
-            self.modes[k] = Some(friction::entered_mode(
-                cl,
-                before[k],
-                cl.normal_force_n(t),
-                w_rel,
-                scale,
-                slip_ended,
-            ));
+            self.modes[k] = c.law().settle(t, before[k], wa, wb, SlipEnd::Landed);
         }
         let newly_locked = (0..net.couplings.len()).find(|&k| {
             self.modes[k] == Some(ClutchMode::Locked) && before[k] != Some(ClutchMode::Locked)
@@ -396,16 +380,9 @@ impl Run {
             best = mesh::landing(&self.meshes, t, best, &self.w, &acc);
         }
         for (k, c) in net.couplings.iter().enumerate() {
-            let Some(cl) = net.couplings[k].clutch() else {
-                continue;
-            };
+            let law = c.law();
             // a slip reaching zero; a free one-way clutch's too (its freewheel locks there)
-            let slip = match self.modes[k] {
-                Some(ClutchMode::Slipping(s)) => Some(s),
-                Some(ClutchMode::Free) if cl.one_way => Some(1),
-                _ => None,
-            };
-            if let Some(s) = slip {
+            if let Some(s) = law.slip_sense(self.modes[k]) {
                 let (wa, wb) = (self.w[c.a], self.w[c.b]);
                 let s = f64::from(s);
                 let s0 = s * (wb - wa);
@@ -421,8 +398,11 @@ impl Run {
             if self.modes[k] == Some(ClutchMode::Locked) {
                 any_locked = true;
             }
-            let on = |tt: f64| cl.normal_force_n(tt) > 0.0;
-            let on0 = on(t);
+            // its actuation switching on or off (a clutch's normal force crossing zero)
+            let Some(on0) = law.engaged(t) else {
+                continue;
+            };
+            let on = |tt: f64| law.engaged(tt) == Some(true);
             if on(t + h) != on0 {
                 let (mut a, mut b) = (t, t + h);
                 while b - a > 1e-13 * (1.0 + b) {

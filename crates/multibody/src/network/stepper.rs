@@ -103,7 +103,7 @@ impl NetworkStepper {
                 .collect(),
             world,
             modes: (0..m)
-                .map(|k| net.couplings[k].clutch().map(|_| ClutchMode::Free))
+                .map(|k| net.couplings[k].law().initial_mode())
                 .collect(),
             rows: Vec::new(),
             torque: vec![0.0; n],
@@ -349,11 +349,11 @@ impl NetworkStepper {
                 let wrel = 0.5 * (w0[c.b] + run.w[c.b] - w0[c.a] - run.w[c.a]);
                 run.heat[k] += h * run.coupling_torque[k] * wrel;
             }
-            if let Some(sd) = net.couplings[k].spring() {
-                // the damper's share of the torque held over the step, on the step's mean
-                // twist rate (the spring's share is its potential's change, at the end)
-                let rate = 0.5 * (w0[c.a] + run.w[c.a] - w0[c.b] - run.w[c.b]);
-                let loss = h * sd.damping_n_m_s_per_rad * (w_force[c.a] - w_force[c.b]) * rate;
+            // a damper's share of the torque held over the step, on the step's mean twist rate
+            // (a spring's share is its potential's change, at the end)
+            let rate = 0.5 * (w0[c.a] + run.w[c.a] - w0[c.b] - run.w[c.b]);
+            let held = w_force[c.a] - w_force[c.b];
+            if let Some(loss) = c.law().damping_loss_j(h, held, rate) {
                 run.heat[k] += loss;
                 run.energy.damper_loss_j += loss;
             }
@@ -399,10 +399,9 @@ impl NetworkStepper {
         let net = &run.net;
         let angles = run.world.angles();
         run.energy.spring_energy_change_j = (0..net.couplings.len())
-            .filter_map(|k| net.couplings[k].spring().map(|sd| (k, sd)))
-            .map(|(k, sd)| {
+            .filter_map(|k| {
                 let c = &net.couplings[k];
-                sd.potential_j(angles[c.a] - angles[c.b]) - sd.potential_j(0.0)
+                c.law().potential_change_j(angles[c.a] - angles[c.b])
             })
             .sum();
         // per body as J (w - w0) (w + w0) / 2: no cancellation between large energies
@@ -429,5 +428,48 @@ impl NetworkStepper {
             events: run.events,
             pack_thermal,
         }
+    }
+}
+
+impl clutchpack_model::network::NetworkSession for NetworkStepper {
+    fn time_s(&self) -> f64 {
+        NetworkStepper::time_s(self)
+    }
+
+    fn network(&self) -> &Network {
+        NetworkStepper::network(self)
+    }
+
+    fn sample_now(&mut self) -> NetworkSample {
+        NetworkStepper::sample_now(self)
+    }
+
+    fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
+        NetworkStepper::pack_temperatures_k(self, k)
+    }
+
+    fn heat_j(&self) -> Vec<f64> {
+        NetworkStepper::heat_j(self)
+    }
+
+    fn set_input(
+        &mut self,
+        input: NetworkInput,
+        value: f64,
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<(), EngineError> {
+        NetworkStepper::set_input(self, input, value, obs)
+    }
+
+    fn advance_to(&mut self, t_end: f64, obs: &mut dyn NetworkObserver) -> Result<(), EngineError> {
+        NetworkStepper::advance_to(self, t_end, obs)
+    }
+
+    fn finish_boxed(self: Box<Self>, obs: &mut dyn NetworkObserver) -> NetworkRun {
+        NetworkStepper::finish(*self, obs)
+    }
+
+    fn boxed_clone(&self) -> Box<dyn clutchpack_model::network::NetworkSession> {
+        Box::new(self.clone())
     }
 }

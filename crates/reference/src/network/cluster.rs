@@ -261,13 +261,13 @@ mod tests {
                     name: "g1".into(),
                     a: 0,
                     b: 1,
-                    kind: CouplingKind::IdealGear { ratio: 2.0 },
+                    kind: CouplingKind::ideal_gear(2.0),
                 },
                 Coupling {
                     name: "g2".into(),
                     a: 1,
                     b: 2,
-                    kind: CouplingKind::IdealGear { ratio: 3.0 },
+                    kind: CouplingKind::ideal_gear(3.0),
                 },
             ],
         };

@@ -239,23 +239,15 @@ impl Equations {
         }
         for (k, c) in self.net.couplings.iter().enumerate() {
             self.coupling_torque[k] = 0.0;
-            if let (Some(cl), Some(ClutchMode::Slipping(s))) =
-                (self.net.couplings[k].clutch(), self.modes[k])
-            {
-                // MODEL.md section 8: tau = sign(w_rel) mu(|w_rel|) cgeo fn, +tau on a, -tau on b
-                let tau = cl.slip_torque_n_m(s, w[c.b] - w[c.a], cl.normal_force_n(t));
-                self.coupling_torque[k] = tau;
-                self.torque[c.a] += tau;
-                self.torque[c.b] -= tau;
+            // MODEL.md section 8: a force element's torque on a, the opposite on b (a
+            // slipping clutch's, a spring-damper's at its twist, its own state)
+            let law = c.law();
+            if let Some(ta) = law.port_torque_n_m(t, y[2 * n + k], w[c.a], w[c.b], self.modes[k]) {
+                self.coupling_torque[k] = ta;
+                self.torque[c.a] += ta;
+                self.torque[c.b] -= ta;
             }
-            if let Some(sd) = self.net.couplings[k].spring() {
-                // MODEL.md section 8: T on b, -T on a; the twist is its own state
-                let t = sd.torque_n_m(y[2 * n + k], w[c.a] - w[c.b]);
-                self.coupling_torque[k] = -t;
-                self.torque[c.a] -= t;
-                self.torque[c.b] += t;
-            }
-            if let (Some(g), Some(e)) = (self.net.couplings[k].mesh(), self.contacts[k]) {
+            if let (Some(g), Some(e)) = (c.mesh(), self.contacts[k]) {
                 // MODEL.md section 8: F signed as x; -Rb_a F on a, -+Rb_b F on b
                 let f = g.force_n(&mesh_kinematics(&self.net, k, g, y), &e);
                 let (ta, tb) = g.torques_n_m(f);
@@ -309,20 +301,17 @@ impl Equations {
         self.forces(t, y);
         w_dot.copy_from_slice(&self.acc);
         for (k, c) in self.net.couplings.iter().enumerate() {
-            x_dot[k] = match (self.net.couplings[k].mesh(), self.net.couplings[k].spring()) {
-                (Some(g), _) => g.displacement((0.0, 0.0), (w[c.a], w[c.b])).1,
-                (_, Some(_)) => w[c.a] - w[c.b],
-                _ => 0.0,
-            };
+            x_dot[k] = c.law().state_rate(w[c.a], w[c.b]);
         }
-        // counters: [heat per coupling, drive work, load work, drag loss]
+        // counters: [power into each element, drive work, load work, drag loss]
         for k in 0..m {
             let c = &self.net.couplings[k];
-            counters[k] = if matches!(self.modes[k], Some(ClutchMode::Slipping(_))) {
-                self.coupling_torque[k] * (w[c.b] - w[c.a])
-            } else if let Some(sd) = self.net.couplings[k].spring() {
-                sd.loss_rate_w(w[c.a] - w[c.b])
-            } else if let (Some(g), Some(_)) = (self.net.couplings[k].mesh(), self.contacts[k]) {
+            let p = c
+                .law()
+                .power_w(self.modes[k], self.coupling_torque[k], w[c.a], w[c.b]);
+            counters[k] = if let Some(p) = p {
+                p
+            } else if let (Some(g), Some(_)) = (c.mesh(), self.contacts[k]) {
                 // power into the mesh: F v pairs (the torques' work on the bodies, negated)
                 let (_, v) = g.displacement((0.0, 0.0), (w[c.a], w[c.b]));
                 self.mesh_force[k] * v * g.pairs
@@ -352,10 +341,10 @@ impl Equations {
         }
     }
 
-    /// The event functions at `(t, y)`, one per clutch (> 0 while its mode holds; 0 for other
-    /// couplings): slipping `min(s w_rel, fn)`, locked `min(limit - |tau|, fn)` (a one-way
-    /// clutch: `limit - tau`), free `-fn` (a one-way clutch: `min(-fn, w_rel)`)
-    /// (its crossing engages).
+    /// The event functions at `(t, y)`, one per coupling (> 0 while its mode holds): a
+    /// mesh's engagement depth, every other element's own guard
+    /// ([`clutchpack_model::network::ElementLaw::guard`]: a clutch's slip, static margin or
+    /// normal force), then the packs' and the road loads'.
     fn guards(&mut self, t: f64, y: &[f64], out: &mut [f64]) {
         let n = self.net.bodies.len();
         let w = &y[n..2 * n];
@@ -366,7 +355,7 @@ impl Equations {
             self.rigid_torques();
         }
         for (k, c) in self.net.couplings.iter().enumerate() {
-            if let Some(g) = self.net.couplings[k].mesh() {
+            if let Some(g) = c.mesh() {
                 let depth = g
                     .law
                     .engagement_depth_m(&mesh_kinematics(&self.net, k, g, y));
@@ -377,28 +366,8 @@ impl Equations {
                 };
                 continue;
             }
-            let Some(cl) = self.net.couplings[k].clutch() else {
-                out[k] = 1.0;
-                continue;
-            };
-            let f = cl.normal_force_n(t);
-            let w_rel = w[c.b] - w[c.a];
-            out[k] = match self.modes[k] {
-                Some(ClutchMode::Free) => {
-                    let engage = if f > 0.0 { -f } else { 1.0 + f.abs() };
-                    // a free one-way clutch's freewheel locks where its slip reaches zero
-                    if cl.one_way {
-                        engage.min(w_rel)
-                    } else {
-                        engage
-                    }
-                }
-                Some(ClutchMode::Slipping(s)) => (f64::from(s) * w_rel).min(f),
-                // a one-way clutch stays locked without a normal force (its freewheel)
-                Some(ClutchMode::Locked) if cl.one_way => cl.margin_n_m(self.coupling_torque[k], f),
-                Some(ClutchMode::Locked) => cl.margin_n_m(self.coupling_torque[k], f).min(f),
-                None => 1.0,
-            };
+            let (w_rel, held) = (w[c.b] - w[c.a], self.coupling_torque[k]);
+            out[k] = c.law().guard(t, w_rel, self.modes[k], held);
         }
         for p in &self.packs {
             let g = &mut out[p.guard_at..p.guard_at + p.guards()];
@@ -441,5 +410,53 @@ fn sample(eq: &mut Equations, t: f64, y: &[f64]) -> NetworkSample {
         speed_rad_s: y[n..2 * n].to_vec(),
         torque_n_m: eq.coupling_torque.clone(),
         mode: eq.modes.clone(),
+    }
+}
+
+/// The session every engine's network run is to its callers (the sdk holds either engine's).
+impl clutchpack_model::network::NetworkSession for NetworkStepper {
+    fn time_s(&self) -> f64 {
+        NetworkStepper::time_s(self)
+    }
+
+    fn network(&self) -> &Network {
+        NetworkStepper::network(self)
+    }
+
+    fn sample_now(&mut self) -> NetworkSample {
+        NetworkStepper::sample_now(self)
+    }
+
+    fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
+        NetworkStepper::pack_temperatures_k(self, k)
+    }
+
+    fn heat_j(&self) -> Vec<f64> {
+        NetworkStepper::heat_j(self)
+    }
+
+    fn set_input(
+        &mut self,
+        input: stepper::NetworkInput,
+        value: f64,
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<(), clutchpack_model::EngineError> {
+        NetworkStepper::set_input(self, input, value, obs)
+    }
+
+    fn advance_to(
+        &mut self,
+        t_end: f64,
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<(), clutchpack_model::EngineError> {
+        NetworkStepper::advance_to(self, t_end, obs)
+    }
+
+    fn finish_boxed(self: Box<Self>, obs: &mut dyn NetworkObserver) -> NetworkRun {
+        NetworkStepper::finish(*self, obs)
+    }
+
+    fn boxed_clone(&self) -> Box<dyn clutchpack_model::network::NetworkSession> {
+        Box::new(self.clone())
     }
 }

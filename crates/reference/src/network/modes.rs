@@ -3,7 +3,7 @@
 //! made common with its momentum kept.
 
 use super::{sample, ClutchEvent, Equations, Freedom, NetworkObserver};
-use clutchpack_model::network::{friction, ClutchMode};
+use clutchpack_model::network::{friction, SlipEnd};
 
 /// Settles the clutches' modes at an event at `t` (MODEL.md section 8; Modelica's `Clutch`):
 /// free while `fn <= 0`; a clutch whose slip crossed zero (`crossed`: its guard `<= 0`), or
@@ -23,25 +23,11 @@ pub(super) fn settle(
     let state_before = sample(eq, t, y);
     let mut modes = before.clone();
     for (k, c) in net.couplings.iter().enumerate() {
-        let Some(cl) = net.couplings[k].clutch() else {
-            continue;
-        };
-        let w_rel = y[n + c.b] - y[n + c.a];
-        let scale = 1e-10 * (1.0 + y[n + c.a].abs() + y[n + c.b].abs());
-        // the slip's zero located as this event: its guard crossed, and the slip is the part
-        // of the guard that did (not the normal force, nor a free clutch's engagement)
-        let f = cl.normal_force_n(t);
-        let slip_ended = crossed.get(k).is_some_and(|g| *g <= 0.0)
-            && match modes[k] {
-                Some(ClutchMode::Slipping(s)) => f64::from(s) * w_rel <= f,
-                Some(ClutchMode::Free) => {
-                    cl.one_way && w_rel <= if f > 0.0 { -f } else { 1.0 + f.abs() }
-                }
-                _ => false,
-            };
-        modes[k] = Some(friction::entered_mode(
-            cl, modes[k], f, w_rel, scale, slip_ended,
-        ));
+        // the slip's zero located as this event: its guard crossed (the stick/slip rule's
+        // `SlipEnd::Located`)
+        let crossed = crossed.get(k).is_some_and(|g| *g <= 0.0);
+        let end = SlipEnd::Located { crossed };
+        modes[k] = c.law().settle(t, modes[k], y[n + c.a], y[n + c.b], end);
     }
     // lock what locks; release the locked clutch that is furthest over its limit, and again
     for _ in 0..=net.couplings.len() {

@@ -9,7 +9,7 @@ use crate::dopri::{next_step, Dense, Dopri5};
 use crate::thermal::Thermal;
 pub use clutchpack_model::network::NetworkInput;
 use clutchpack_model::network::{
-    ClutchMode, Network, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
+    ClutchMode, EnergyTerm, Network, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
 };
 use clutchpack_model::{guard_state, EngineError, RUNAWAY_SPEED_RAD_S};
 use std::sync::Arc;
@@ -87,7 +87,7 @@ impl NetworkStepper {
         let n = net.bodies.len();
         let m = net.couplings.len();
         let initial_modes: Vec<Option<ClutchMode>> = (0..m)
-            .map(|k| net.couplings[k].clutch().map(|_| ClutchMode::Free))
+            .map(|k| net.couplings[k].law().initial_mode())
             .collect();
         let mut eq = Equations::new(Arc::new(net.clone()), initial_modes);
         // the thermal packs: their parameters at the initial temperatures (MODEL.md section 9)
@@ -104,13 +104,13 @@ impl NetworkStepper {
         let dim = eq.dim();
         let tol = options.tolerance;
         let mut atol = vec![tol; dim];
-        // the meshes' x on their backlash's scale; other slots and the counters out of the norm
+        // each element's state on its own scale (a mesh's x on its backlash, a spring's twist
+        // in rad); other slots and the counters out of the norm
         for k in 0..m {
-            atol[2 * n + k] = match (net.couplings[k].mesh(), net.couplings[k].spring()) {
-                (Some(g), _) => tol * g.backlash_m,
-                (_, Some(_)) => tol,
-                _ => f64::INFINITY,
-            };
+            atol[2 * n + k] = net.couplings[k]
+                .law()
+                .state_scale()
+                .map_or(f64::INFINITY, |s| tol * s);
         }
         atol[2 * n + m..]
             .iter_mut()
@@ -131,9 +131,7 @@ impl NetworkStepper {
             y[n + i] = b.initial_speed_rad_s;
         }
         for k in 0..m {
-            if let Some(g) = net.couplings[k].mesh() {
-                y[2 * n + k] = g.initial_offset_m;
-            }
+            y[2 * n + k] = net.couplings[k].law().initial_state();
         }
         let kinetic0 = eq.kinetic_j(&y);
         let mut events = 0u64;
@@ -235,10 +233,10 @@ impl NetworkStepper {
         (0..m)
             .map(|k| {
                 let c = &self.eq.net.couplings[k];
-                if c.clutch().is_some() || c.mesh().is_some() || c.spring().is_some() {
-                    y[c0 + k]
-                } else {
+                if c.law().energy_term() == EnergyTerm::None {
                     0.0
+                } else {
+                    y[c0 + k]
                 }
             })
             .enumerate()
@@ -592,15 +590,15 @@ impl NetworkStepper {
         let (mut mesh_work, mut damper_loss, mut spring_change) = (0.0, 0.0, 0.0);
         let mut clutch_heat = 0.0;
         for (k, h) in heat.iter_mut().enumerate() {
-            if net.couplings[k].clutch().is_some() {
-                clutch_heat += *h;
-            } else if net.couplings[k].mesh().is_some() {
-                mesh_work += *h;
-            } else if let Some(sd) = net.couplings[k].spring() {
-                damper_loss += *h;
-                spring_change += sd.potential_j(y[2 * n + k]) - sd.potential_j(0.0);
-            } else {
-                *h = 0.0;
+            let law = net.couplings[k].law();
+            match law.energy_term() {
+                EnergyTerm::ClutchHeat => clutch_heat += *h,
+                EnergyTerm::MeshWork => mesh_work += *h,
+                EnergyTerm::DamperLoss => {
+                    damper_loss += *h;
+                    spring_change += law.potential_change_j(y[2 * n + k]).unwrap_or(0.0);
+                }
+                EnergyTerm::None => *h = 0.0,
             }
         }
         for p in &self.eq.packs {

@@ -523,7 +523,7 @@ pub(super) fn network(
             Kind::Gear => ck
                 .num(&p(&C::ratio), r.value(&C::ratio), &C::ratio)
                 .required(ck, &p(&C::ratio), "required for an ideal_gear: w_a / w_b")
-                .map(|ratio| CouplingKind::IdealGear { ratio }),
+                .map(CouplingKind::ideal_gear),
             Kind::Clutch => {
                 let by_schedule = name.as_ref().is_some_and(|n| scheduled.contains(n));
                 clutch(ck, r, k, base_dir, by_schedule).map(CouplingKind::Clutch)

@@ -1,0 +1,82 @@
+//! The resolved pack as an element of a driveline network (MODEL.md sections 2-5 and 8): its
+//! friction discs splined to body `a`, its separator plates to body `b` (a drum; the housing
+//! when `b` is fixed). Its discs, plates, tooth contacts and faces are each engine's pack
+//! session ([`super::Coupling::pack`]); the law says what the network needs of it: its
+//! piston's breakpoints, its co-simulation input and its problems as a network's element.
+
+use super::element::{problem, ElementLaw, InputSpec, OutputQuantity, OutputSpec};
+use super::{Network, NetworkInput, NetworkProblem};
+use crate::PackModel;
+
+impl ElementLaw for PackModel {
+    fn kind_name(&self) -> &'static str {
+        "pack"
+    }
+
+    /// Its piston pressure's.
+    fn breakpoints(&self, out: &mut Vec<f64>) {
+        if let Some(s) = &self.stack {
+            s.piston.pressure.breakpoints(out);
+        }
+    }
+
+    /// A turning disc carrier `a`, no couplings of its own (the network's replace them) and
+    /// at least one friction disc.
+    fn problems(
+        &self,
+        net: &Network,
+        k: usize,
+        ports: &[usize],
+        out: &mut Vec<NetworkProblem>,
+    ) -> bool {
+        let a = ports[0];
+        if net.bodies[a].fixed {
+            out.push(problem(
+                k,
+                "a",
+                format!(
+                    "\"{}\" is fixed: the friction discs' carrier must turn (the plates' carrier b may be the fixed housing)",
+                    net.bodies[a].name
+                ),
+            ));
+        }
+        if !self.couplings.is_empty() {
+            out.push(problem(
+                k,
+                "pack",
+                "the pack's own [[couplings]] join its shaft and drum, which the network's bodies replace: put them in the network's [[couplings]]".into(),
+            ));
+        }
+        if self.discs.is_empty() {
+            out.push(problem(k, "pack", "the pack has no friction discs".into()));
+        }
+        true
+    }
+
+    /// Its piston pressure (`pressure_pa`, Pa), when it has a `[stack]`.
+    fn input(&self) -> Option<InputSpec> {
+        self.stack.as_ref().map(|_| InputSpec {
+            input: NetworkInput::PackPressure,
+            suffix: "pressure_pa",
+            unit: "Pa",
+            description: "piston pressure of pack {}, Pa (>= 0; the piston pushes with p A less \
+                          its return spring)",
+        })
+    }
+
+    fn input_value(&self, t_s: f64) -> f64 {
+        self.stack
+            .as_ref()
+            .map_or(0.0, |s| s.piston.pressure.pressure_pa(t_s))
+    }
+
+    /// Its faces' heat (a thermal pack's temperatures follow it, by its discs and plates).
+    fn outputs(&self) -> &'static [OutputSpec] {
+        &[OutputSpec {
+            suffix: "heat_j",
+            unit: "J",
+            description: "heat the faces of pack {} have made since t = 0, J",
+            quantity: OutputQuantity::Heat,
+        }]
+    }
+}
