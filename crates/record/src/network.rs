@@ -152,6 +152,11 @@ pub struct NetworkRecorder {
     status: Option<(Status, u16, String)>,
     /// the couplings' diagram as points (Rerun), redrawn with `/scene/couplings`
     diagram_points: u16,
+    /// each resolved pack's faces' mode as last told ([`Self::set_pack_mode`]; `None` for
+    /// another coupling), drawn and read for the gear as a clutch's
+    pack_modes: Vec<Option<ClutchMode>>,
+    /// the modes of the sample being written (a clutch's, else a pack's faces')
+    modes_now: Vec<Option<ClutchMode>>,
     /// each body's frame (`body/<segment>`)
     frames: Vec<String>,
     sequences: BTreeMap<u16, u32>,
@@ -392,13 +397,19 @@ impl NetworkRecorder {
             status: None,
             diagram_points,
             frames: frames.clone(),
+            pack_modes: net
+                .couplings
+                .iter()
+                .map(|c| c.pack().map(|_| ClutchMode::Free))
+                .collect(),
+            modes_now: Vec::with_capacity(m),
             sequences: BTreeMap::new(),
             buf: Vec::with_capacity(1024),
             tf,
             drawn_modes: net
                 .couplings
                 .iter()
-                .map(|c| c.clutch().map(|_| ClutchMode::Free))
+                .map(|c| (c.clutch().is_some() || c.pack().is_some()).then_some(ClutchMode::Free))
                 .collect(),
             joint_values: [vec![0.0; n], vec![0.0; n], vec![0.0; m], vec![0.0; m]],
             messages: 0,
@@ -547,6 +558,14 @@ impl NetworkRecorder {
         &self.path
     }
 
+    /// A resolved pack's faces changed mode (as a clutch's: all locked, some clamped, none):
+    /// from the next sample its wire is coloured so and the automatic's gear reads it.
+    pub fn set_pack_mode(&mut self, coupling: usize, mode: ClutchMode) {
+        if let Some(m) = self.pack_modes.get_mut(coupling) {
+            *m = Some(mode);
+        }
+    }
+
     /// Whether the recording is deterministic (`RecordOptions::deterministic`: no wall times,
     /// so that two runs give the same bytes).
     pub fn deterministic(&self) -> bool {
@@ -639,8 +658,12 @@ impl NetworkRecorder {
         let r = self.put(self.ch.tf, ns, &tf, "/tf");
         self.tf = tf;
         r?;
-        if s.mode != self.drawn_modes {
-            self.drawn_modes.clone_from(&s.mode);
+        self.modes_now.clear();
+        let packs = &self.pack_modes;
+        self.modes_now
+            .extend(s.mode.iter().zip(packs).map(|(m, p)| m.or(*p)));
+        if self.modes_now != self.drawn_modes {
+            self.drawn_modes.clone_from(&self.modes_now);
             self.put_couplings(ns)?;
         }
         self.put_status(t)

@@ -452,20 +452,11 @@ impl Status {
         Status { tr: tr.clone() }
     }
 
-    /// The gear engaged with the clutches' modes `modes` (by coupling), if one is.
-    fn gear(&self, modes: &[Option<ClutchMode>]) -> Option<usize> {
-        let locked = |k: usize| modes.get(k).copied().flatten() == Some(ClutchMode::Locked);
-        self.tr
-            .gears
-            .iter()
-            .position(|g| g.closed.iter().all(|&k| locked(k)))
-    }
-
     /// The status line at `t_s` (s) with the modes `modes`: `gear 2`, or during a shift
     /// `gear 1 · shift 1 -> 2: torque phase`.
     pub fn label(&self, t_s: f64, modes: &[Option<ClutchMode>]) -> String {
         let name = |g: Option<usize>| g.map_or("-", |g| self.tr.gears[g].name.as_str());
-        let engaged = self.gear(modes);
+        let engaged = self.tr.engaged(modes);
         let mut from = self.tr.initial_gear;
         for s in &self.tr.shifts {
             let to = Some(s.to);

@@ -15,7 +15,7 @@ use crate::network_keep::{Keep, Obs};
 use crate::{Error, RecordingRequest, Result};
 use clutchpack_model::network::{
     ClutchMode, Network, NetworkInput, NetworkObserver, NetworkSample, NetworkSession,
-    OutputQuantity,
+    OutputQuantity, Transmission,
 };
 use clutchpack_model::EngineError;
 use clutchpack_multibody::network::{NetworkStepOptions, NetworkStepper as MultibodyStepper};
@@ -207,7 +207,7 @@ pub fn network_input_variables(net: &Network) -> Vec<(NetworkVariable, f64)> {
 /// heat and, if it carries temperatures (`[thermal]`), each disc's, plate's and its oil's
 /// (`couplings.<pack>.discs[i].temperature_k`, `.plates[j].temperature_k`,
 /// `.oil.temperature_k`, K).
-pub fn network_outputs(net: &Network) -> Vec<NetworkVariable> {
+pub fn network_outputs(net: &Network, tr: Option<&Transmission>) -> Vec<NetworkVariable> {
     let var = |name: String, unit: &'static str, description: String| NetworkVariable {
         name,
         causality: "output",
@@ -265,6 +265,15 @@ pub fn network_outputs(net: &Network) -> Vec<NetworkVariable> {
                 ),
             ));
         }
+    }
+    if tr.is_some() {
+        out.push(var(
+            "transmission.gear".into(),
+            "1",
+            "the gear engaged: its index in [[transmission.gears]] (0 the first; the 8-speed's \
+             R is 0, its 1st 1), -1 while none is (a shift's inertia phase)"
+                .into(),
+        ));
     }
     out
 }
@@ -390,7 +399,7 @@ impl NetworkSimulation {
             .iter()
             .map(|(name, input)| input_variable(net, name, *input))
             .collect();
-        out.extend(network_outputs(net));
+        out.extend(network_outputs(net, self.scene.transmission.as_ref()));
         out
     }
 
@@ -503,6 +512,10 @@ impl NetworkSimulation {
         let s: NetworkSample = self.stepper.sample_now();
         let heat = self.stepper.heat_j();
         let net = self.stepper.network();
+        // the elements' modes: a clutch's from the sample, a resolved pack's faces' as kept
+        let modes: Vec<Option<ClutchMode>> = (0..net.couplings.len())
+            .map(|k| s.mode[k].or_else(|| self.keep.pack_mode(k)))
+            .collect();
         let mut values = Vec::new();
         for i in 0..net.bodies.len() {
             values.push(s.speed_rad_s[i]);
@@ -514,7 +527,7 @@ impl NetworkSimulation {
                 values.push(match spec.quantity {
                     OutputQuantity::Slip => s.speed_rad_s[c.b] - s.speed_rad_s[c.a],
                     OutputQuantity::Mode => {
-                        f64::from(s.mode[k].unwrap_or(ClutchMode::Free).modelica_code())
+                        f64::from(modes[k].unwrap_or(ClutchMode::Free).modelica_code())
                     }
                     OutputQuantity::Heat => heat[k],
                 });
@@ -528,7 +541,11 @@ impl NetworkSimulation {
                 }
             }
         }
-        network_outputs(net)
+        if let Some(tr) = &self.scene.transmission {
+            let engaged = tr.engaged(&modes);
+            values.push(engaged.map_or(-1.0, |g| g as f64));
+        }
+        network_outputs(net, self.scene.transmission.as_ref())
             .into_iter()
             .map(|v| v.name)
             .zip(values)

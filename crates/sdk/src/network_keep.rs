@@ -5,7 +5,7 @@
 //! the summary from it.
 
 use crate::Result;
-use clutchpack_model::network::{ClutchEvent, NetworkObserver, NetworkSample};
+use clutchpack_model::network::{ClutchEvent, ClutchMode, NetworkObserver, NetworkSample};
 use clutchpack_record::NetworkRecorder;
 use clutchpack_scene::Scene;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -54,6 +54,16 @@ pub(crate) struct Keep {
 }
 
 impl Keep {
+    /// A resolved pack's faces' mode now, as a clutch's (all locked: locked; some clamped:
+    /// slipping; none: free); `None` for another coupling.
+    pub(crate) fn pack_mode(&self, coupling: usize) -> Option<ClutchMode> {
+        self.pack_modes.get(&coupling).map(|m| match m.0 {
+            "locked" => ClutchMode::Locked,
+            "slipping" => ClutchMode::Slipping(1),
+            _ => ClutchMode::Free,
+        })
+    }
+
     /// A fresh keep that records with `recorder` (if any) and keeps every sample if
     /// `keep_history`.
     pub fn new(recorder: Option<NetworkRecorder>, keep_history: bool) -> Keep {
@@ -296,6 +306,12 @@ impl NetworkObserver for Obs<'_, '_> {
             m.1.push(t);
         }
         m.0 = mode;
+        if let Some(mode) = self.keep.pack_mode(coupling) {
+            self.keep.record(|r| {
+                r.set_pack_mode(coupling, mode);
+                Ok(())
+            });
+        }
     }
     fn switched(&mut self, before: &NetworkSample, after: &NetworkSample) {
         let steps = after

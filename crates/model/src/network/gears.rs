@@ -179,6 +179,16 @@ pub struct Handover {
 }
 
 impl Transmission {
+    /// The gear engaged (index in [`Self::gears`]) with the shift elements' modes `modes` (by
+    /// coupling; a resolved pack's its faces', all locked: locked), if one is: the first gear
+    /// whose every closed element is locked.
+    pub fn engaged(&self, modes: &[Option<super::ClutchMode>]) -> Option<usize> {
+        let locked = |k: usize| modes.get(k).copied().flatten() == Some(super::ClutchMode::Locked);
+        self.gears
+            .iter()
+            .position(|g| g.closed.iter().all(|&k| locked(k)))
+    }
+
     /// Each shift's hand-over, in order, or the index of the first shift that is not a
     /// clutch-to-clutch shift from the gear engaged before it, with the reason; `None` without
     /// an initial gear.

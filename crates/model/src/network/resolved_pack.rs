@@ -72,11 +72,20 @@ impl ElementLaw for PackModel {
 
     /// Its faces' heat (a thermal pack's temperatures follow it, by its discs and plates).
     fn outputs(&self) -> &'static [OutputSpec] {
-        &[OutputSpec {
-            suffix: "heat_j",
-            unit: "J",
-            description: "heat the faces of pack {} have made since t = 0, J",
-            quantity: OutputQuantity::Heat,
-        }]
+        &[
+            OutputSpec {
+                suffix: "mode",
+                unit: "1",
+                description: "mode of the faces of pack {} as Modelica's Clutch numbers it: 2 \
+                              free (none clamped), 1 slipping (some clamped), 0 locked (all)",
+                quantity: OutputQuantity::Mode,
+            },
+            OutputSpec {
+                suffix: "heat_j",
+                unit: "J",
+                description: "heat the faces of pack {} have made since t = 0, J",
+                quantity: OutputQuantity::Heat,
+            },
+        ]
     }
 }

@@ -173,7 +173,7 @@ pub fn variables(scene: &Scene, engine: &str, driven: Driven) -> Vec<Variable> {
     let pack = &scene.pack;
     parameters(&mut v, scene, engine);
     if let Some(net) = &scene.network {
-        network_variables(&mut v, net);
+        network_variables(&mut v, net, scene.transmission.as_ref());
         return v.0;
     }
     // every input a host is given, with what it holds when the host connects nothing to it
@@ -448,7 +448,11 @@ fn parameters(v: &mut Table, scene: &Scene, engine: &str) {
 
 /// A network scene's inputs (every turning body's drive torque, every clutch's normal force;
 /// each starting at the scene's value at t = 0) and outputs ([`crate::network_outputs`]).
-fn network_variables(v: &mut Table, net: &clutchpack_model::network::Network) {
+fn network_variables(
+    v: &mut Table,
+    net: &clutchpack_model::network::Network,
+    tr: Option<&clutchpack_model::network::Transmission>,
+) {
     for (j, (var, start)) in crate::network_cosim::network_input_variables(net)
         .into_iter()
         .enumerate()
@@ -468,7 +472,7 @@ fn network_variables(v: &mut Table, net: &clutchpack_model::network::Network) {
             start_string: None,
         });
     }
-    for (j, var) in crate::network_outputs(net).into_iter().enumerate() {
+    for (j, var) in crate::network_outputs(net, tr).into_iter().enumerate() {
         v.push(Variable {
             name: var.name,
             quantity: Quantity::NetworkOutput(j),
