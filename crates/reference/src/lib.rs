@@ -190,6 +190,26 @@
 // Index loops over state components mirror the equations; iterator chains would obscure them.
 #![allow(clippy::needless_range_loop)]
 
+/// `Clone` for a struct of the fields named, whose `clone_from` clones field by field into
+/// the target's own buffers (`Vec::clone_from` keeps its allocation and clones element by
+/// element), so that a scheme that saves and restores its bodies' integrations window by
+/// window (`open.rs`) does not allocate once its buffers have grown. Both methods destructure
+/// the struct whole: a field added and not listed here fails to compile.
+macro_rules! clone_reusing {
+    ($ty:ident { $($f:ident),* $(,)? }) => {
+        impl Clone for $ty {
+            fn clone(&self) -> Self {
+                let $ty { $($f),* } = self;
+                $ty { $($f: $f.clone()),* }
+            }
+            fn clone_from(&mut self, source: &Self) {
+                let $ty { $($f),* } = self;
+                $($f.clone_from(&source.$f);)*
+            }
+        }
+    };
+}
+
 mod coupled;
 mod dopri;
 mod gaps;

@@ -47,7 +47,6 @@ pub(crate) struct StackEval {
 /// (rad/s) when there is a drum, then the heat (J) each open interface has dissipated. A body
 /// of an open pack run on its own (the open-pack multirate scheme, [`System::open_body`])
 /// continues instead with the work (J) the gap below and the gap above have done on it.
-#[derive(Clone)]
 pub(crate) struct System {
     /// The model (shared by a run's steppers; `session.rs` swaps it when an input changes).
     pub pack: Arc<PackModel>,
@@ -79,6 +78,19 @@ pub(crate) struct System {
     /// carriers' motion ([`Self::rhs_with`], [`Self::reactions_n_m`]).
     pub carried: bool,
 }
+
+clone_reusing!(System {
+    pack,
+    off,
+    ids,
+    nd,
+    faces,
+    rb,
+    c_gap,
+    gaps,
+    teeth_work,
+    carried,
+});
 
 impl System {
     /// The shaft and the couplings `ids` of `pack`. A pack with plates, a drum or a stack
@@ -265,7 +277,10 @@ impl System {
     /// Shaft angle (rad) and speed (rad/s) at `t` for state `y`.
     pub fn shaft(&self, t: f64, y: &[f64]) -> (f64, f64) {
         match &self.pack.shaft {
-            Shaft::Prescribed(p) => (p.angle(t), p.speed(t)),
+            Shaft::Prescribed(p) => {
+                let (speed, angle) = p.speed_and_angle(t);
+                (angle, speed)
+            }
             Shaft::Inertial { .. } => (y[0], y[1]),
         }
     }
@@ -298,7 +313,7 @@ impl System {
     /// acts between discs and plates.
     pub fn carriers(&self, t: f64, y: &[f64], modes: &[Option<Engagement>]) -> [f64; 4] {
         let (omega_s, alpha_prescribed) = match &self.pack.shaft {
-            Shaft::Prescribed(p) => (p.speed(t), p.acceleration(t)),
+            Shaft::Prescribed(p) => p.speed_and_acceleration(t),
             Shaft::Inertial { .. } => (y[1], 0.0),
         };
         let inertial = matches!(self.pack.shaft, Shaft::Inertial { .. });
@@ -380,9 +395,14 @@ impl System {
                 unreachable!("an open pack's shaft is prescribed")
             };
             let k = self.off;
-            let omega_s = p.speed(t);
+            // a disc's carrier speed and acceleration in one pass, a plate's carrier at rest
+            // (the shaft's speed only for its neighbours, the discs)
+            let (omega_s, alpha_s) = match self.carrier(0) {
+                Carrier::Shaft => p.speed_and_acceleration(t),
+                _ => (p.speed(t), 0.0),
+            };
             let (omega_c, alpha_c) = match self.carrier(0) {
-                Carrier::Shaft => (omega_s, p.acceleration(t)),
+                Carrier::Shaft => (omega_s, alpha_s),
                 _ => (0.0, 0.0),
             };
             let omega_b = omega_c - y[k + 1];
