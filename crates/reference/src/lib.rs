@@ -452,10 +452,11 @@ pub(crate) fn face_event(
         return None;
     }
     buf.resize(sys.dim(), 0.0);
-    let eval = |t: f64, buf: &mut Vec<f64>| {
+    // whether face `m` switches at `t` (the stack evaluated in the thread's buffers)
+    let switches = |m: usize, t: f64, buf: &mut Vec<f64>| {
         d.eval(t, buf);
         let c = sys.carriers(t, buf, modes);
-        sys.stack_eval(t, buf, modes, &c)
+        sys.with_stack_eval(t, buf, modes, &c, |ev| sys.face_switches(m, ev))
     };
     let mut ta = t0;
     for q in 1..=4 {
@@ -464,18 +465,23 @@ pub(crate) fn face_event(
         } else {
             t0 + (t1 - t0) * q as f64 / 4.0
         };
-        let ev = eval(tq, buf);
-        let fired: Vec<usize> = (0..sys.faces.len())
-            .filter(|&m| sys.face_switches(m, &ev))
-            .collect();
-        if !fired.is_empty() {
+        d.eval(tq, buf);
+        let c = sys.carriers(tq, buf, modes);
+        let any = sys.with_stack_eval(tq, buf, modes, &c, |ev| {
+            (0..sys.faces.len()).any(|m| sys.face_switches(m, ev))
+        });
+        if any {
             // the earliest of the faces that fired in (ta, tq]
+            let fired = |m: usize, buf: &mut Vec<f64>| switches(m, tq, buf);
             let mut best: Option<(f64, usize)> = None;
-            for m in fired {
+            for m in 0..sys.faces.len() {
+                if !fired(m, buf) {
+                    continue;
+                }
                 let (mut a, mut b) = (ta, tq);
                 while b - a > 1e-13 {
                     let mid = 0.5 * (a + b);
-                    if sys.face_switches(m, &eval(mid, buf)) {
+                    if switches(m, mid, buf) {
                         b = mid;
                     } else {
                         a = mid;
