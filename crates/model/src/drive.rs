@@ -283,6 +283,34 @@ impl SpeedProfile {
         }
     }
 
+    /// Shaft speed (rad/s) and angular acceleration (rad/s^2) at `t` s, bit for bit
+    /// [`Self::speed`] and [`Self::acceleration`], in one pass: each harmonic's
+    /// `A sin(theta)` (eq 3) and `2 pi f A cos(theta)` (eq 4) of the one phase
+    /// `theta = 2 pi f t + phase` from one `sincos`, where the two calls paid for two range
+    /// reductions. The reference engine asks for both at every stage of every step (its
+    /// right-hand side: a disc's carrier speed and acceleration; issue 46, 27 % of the paper
+    /// case's time was in `sin` and `cos`).
+    pub fn speed_and_acceleration(&self, t: f64) -> (f64, f64) {
+        match self {
+            SpeedProfile::Harmonics {
+                omega0_rad_s,
+                harmonics,
+            } => {
+                // the sums as `Iterator::sum` forms them (from -0.0, in order), so that both
+                // values are those of `speed` and `acceleration` to the bit
+                let (mut speed, mut accel) = (-0.0, -0.0);
+                for h in harmonics {
+                    let w = TAU * h.frequency_hz;
+                    let (sin, cos) = (w * t + h.phase_rad).sin_cos();
+                    speed += h.amplitude_rad_s * sin;
+                    accel += h.amplitude_rad_s * w * cos;
+                }
+                (omega0_rad_s + speed, accel)
+            }
+            _ => (self.speed(t), self.acceleration(t)),
+        }
+    }
+
     /// The profile expanded about `t_m` (s) for evaluations within `reach_s` of it
     /// ([`LocalProfile`]), or `None` for a table, a held speed (no trigonometry to save) or
     /// harmonics too fast for the series within the reach (`2 pi f reach` beyond about 0.7
@@ -591,7 +619,8 @@ mod tests {
     }
 
     /// `speed_and_angle` is `speed` and `angle` to the bit (the engines' outputs rest on it):
-    /// one and two harmonics with phases, 20 000 times over a second, and the other profiles.
+    /// one and two harmonics with phases, 20 000 times over a second, and the other profiles;
+    /// and so are `speed_and_acceleration`'s of `speed` and `acceleration`.
     #[test]
     fn speed_and_angle_is_speed_and_angle_to_the_bit() {
         let two = SpeedProfile::Harmonics {
@@ -625,6 +654,11 @@ mod tests {
                 assert_eq!(
                     (w.to_bits(), a.to_bits()),
                     (p.speed(t).to_bits(), p.angle(t).to_bits())
+                );
+                let (w, alpha) = p.speed_and_acceleration(t);
+                assert_eq!(
+                    (w.to_bits(), alpha.to_bits()),
+                    (p.speed(t).to_bits(), p.acceleration(t).to_bits())
                 );
             }
         }

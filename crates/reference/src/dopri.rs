@@ -44,7 +44,7 @@ const D6: f64 = -1453857185.0 / 822651844.0;
 const D7: f64 = 69997945.0 / 29380423.0;
 
 /// The 4th-order continuous extension of one accepted step on `[t0, t0 + h]`.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub struct Dense {
     /// Start of the step, s.
     pub t0: f64,
@@ -56,6 +56,16 @@ pub struct Dense {
     r4: Vec<f64>,
     r5: Vec<f64>,
 }
+
+clone_reusing!(Dense {
+    t0,
+    h,
+    r1,
+    r2,
+    r3,
+    r4,
+    r5
+});
 
 impl Dense {
     /// Inserts two components (zero) at index `k`: a disc joins the system at the end of
@@ -139,7 +149,7 @@ fn interpolate(c: &[f64; 5], th: f64) -> f64 {
 }
 
 /// Workspace and stages of the integrator for a system of dimension `n`.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Dopri5 {
     /// Stage derivatives k1..k7 (k1 is f(t, y) at the start of the step; k7 at its end).
     k: [Vec<f64>; 7],
@@ -152,6 +162,14 @@ pub struct Dopri5 {
     /// of the others is exactly what it is without them.
     pub norm_len: Option<usize>,
 }
+
+clone_reusing!(Dopri5 {
+    k,
+    ytmp,
+    y_new,
+    err,
+    norm_len
+});
 
 impl Dopri5 {
     /// Allocates the workspace for dimension `n`.

@@ -21,10 +21,12 @@ struct Segment {
 
 /// A body's relative speed `psi = omega_carrier - omega_body` (rad/s) through one window: the
 /// dense output of its accepted steps, in order.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub(crate) struct Track {
     segments: Vec<Segment>,
 }
+
+clone_reusing!(Track { segments });
 
 impl Track {
     /// Forgets the last window.

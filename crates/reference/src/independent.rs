@@ -18,7 +18,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// One disc's output not yet merged.
-#[derive(Default, Clone)]
+#[derive(Default)]
 pub(crate) struct Buffer {
     /// `(sample number, the disc's sample, the work of its gaps below and above in J (0
     /// without gaps))` in order.
@@ -30,6 +30,13 @@ pub(crate) struct Buffer {
     /// Whether the observer takes contact samples (else none are kept).
     pub wants_contacts: bool,
 }
+
+clone_reusing!(Buffer {
+    samples,
+    impacts,
+    contacts,
+    wants_contacts
+});
 
 impl Sink for Buffer {
     fn sample(&mut self, k: u64, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]) {
@@ -67,7 +74,6 @@ fn send_contacts(runs: &mut [DiscRun], t: f64, obs: &mut dyn Observer) {
 }
 
 /// One body's integration and its unmerged output.
-#[derive(Clone)]
 pub(crate) struct DiscRun {
     pub stepper: Stepper,
     pub out: Buffer,
@@ -75,6 +81,13 @@ pub(crate) struct DiscRun {
     /// Its relative speed through the current window (the open-pack scheme; empty else).
     pub track: Track,
 }
+
+clone_reusing!(DiscRun {
+    stepper,
+    out,
+    error,
+    track
+});
 
 impl DiscRun {
     /// A run of `sys` from t = 0.
@@ -201,7 +214,7 @@ impl IndependentSession {
                 failure = Some(e.clone());
             }
         }
-        self.merger.merge(runs, limit, true, obs, &|_, _| None);
+        self.merger.merge(runs, limit, true, obs, &|_, _, _| false);
         match failure {
             Some(e) => Err(e),
             None => Ok(()),
@@ -277,9 +290,11 @@ impl Session for IndependentSession {
     }
 }
 
-/// The interface samples (if any) of a merged sample from its bodies' samples and their gaps'
-/// work (J, below and above, in the bodies' order).
-pub(crate) type InterfacesOf<'a> = &'a dyn Fn(&Sample, &[[f64; 2]]) -> Option<Vec<InterfaceSample>>;
+/// The interface samples of a merged sample from its bodies' samples and their gaps' work (J,
+/// below and above, in the bodies' order), written into the buffer given (cleared first);
+/// false when the scheme has none.
+pub(crate) type InterfacesOf<'a> =
+    &'a dyn Fn(&Sample, &[[f64; 2]], &mut Vec<InterfaceSample>) -> bool;
 
 /// The merge of the bodies' separately integrated output into one time-ordered stream.
 #[derive(Clone)]
@@ -292,6 +307,8 @@ pub(crate) struct Merger {
     sample: Sample,
     /// Each body's gap work at the sample being merged, J.
     works: Vec<[f64; 2]>,
+    /// The interface samples of the sample being merged (kept: no allocation per sample).
+    interfaces: Vec<InterfaceSample>,
 }
 
 impl Merger {
@@ -306,6 +323,7 @@ impl Merger {
                 ..Sample::default()
             },
             works: vec![[0.0; 2]; n],
+            interfaces: Vec::new(),
         }
     }
 
@@ -361,8 +379,8 @@ impl Merger {
                 }
             }
             obs.sample(sample);
-            if let Some(ifs) = interfaces(sample, &self.works) {
-                obs.interfaces(ts, &ifs);
+            if interfaces(sample, &self.works, &mut self.interfaces) {
+                obs.interfaces(ts, &self.interfaces);
             }
             self.next_k += 1;
         }

@@ -190,6 +190,26 @@
 // Index loops over state components mirror the equations; iterator chains would obscure them.
 #![allow(clippy::needless_range_loop)]
 
+/// `Clone` for a struct of the fields named, whose `clone_from` clones field by field into
+/// the target's own buffers (`Vec::clone_from` keeps its allocation and clones element by
+/// element), so that a scheme that saves and restores its bodies' integrations window by
+/// window (`open.rs`) does not allocate once its buffers have grown. Both methods destructure
+/// the struct whole: a field added and not listed here fails to compile.
+macro_rules! clone_reusing {
+    ($ty:ident { $($f:ident),* $(,)? }) => {
+        impl Clone for $ty {
+            fn clone(&self) -> Self {
+                let $ty { $($f),* } = self;
+                $ty { $($f: $f.clone()),* }
+            }
+            fn clone_from(&mut self, source: &Self) {
+                let $ty { $($f),* } = self;
+                $($f.clone_from(&source.$f);)*
+            }
+        }
+    };
+}
+
 mod coupled;
 mod dopri;
 mod gaps;
@@ -432,10 +452,11 @@ pub(crate) fn face_event(
         return None;
     }
     buf.resize(sys.dim(), 0.0);
-    let eval = |t: f64, buf: &mut Vec<f64>| {
+    // whether face `m` switches at `t` (the stack evaluated in the thread's buffers)
+    let switches = |m: usize, t: f64, buf: &mut Vec<f64>| {
         d.eval(t, buf);
         let c = sys.carriers(t, buf, modes);
-        sys.stack_eval(t, buf, modes, &c)
+        sys.with_stack_eval(t, buf, modes, &c, |ev| sys.face_switches(m, ev))
     };
     let mut ta = t0;
     for q in 1..=4 {
@@ -444,18 +465,23 @@ pub(crate) fn face_event(
         } else {
             t0 + (t1 - t0) * q as f64 / 4.0
         };
-        let ev = eval(tq, buf);
-        let fired: Vec<usize> = (0..sys.faces.len())
-            .filter(|&m| sys.face_switches(m, &ev))
-            .collect();
-        if !fired.is_empty() {
+        d.eval(tq, buf);
+        let c = sys.carriers(tq, buf, modes);
+        let any = sys.with_stack_eval(tq, buf, modes, &c, |ev| {
+            (0..sys.faces.len()).any(|m| sys.face_switches(m, ev))
+        });
+        if any {
             // the earliest of the faces that fired in (ta, tq]
+            let fired = |m: usize, buf: &mut Vec<f64>| switches(m, tq, buf);
             let mut best: Option<(f64, usize)> = None;
-            for m in fired {
+            for m in 0..sys.faces.len() {
+                if !fired(m, buf) {
+                    continue;
+                }
                 let (mut a, mut b) = (ta, tq);
                 while b - a > 1e-13 {
                     let mid = 0.5 * (a + b);
-                    if sys.face_switches(m, &eval(mid, buf)) {
+                    if switches(m, mid, buf) {
                         b = mid;
                     } else {
                         a = mid;

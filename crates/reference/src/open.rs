@@ -5,7 +5,7 @@
 //! relaxation over the two colours of the stack) until what it still changes in any body's
 //! speed is within the allowance the crate docs state.
 
-use crate::gaps::{Gaps, Neighbour};
+use crate::gaps::{Gaps, Neighbour, Track};
 use crate::independent::{hold_in_runs, want_contacts, DiscRun, Merger};
 use crate::session::Clock;
 use crate::system::System;
@@ -42,13 +42,12 @@ pub(crate) fn runs_open(pack: &PackModel, driven: &Driven) -> bool {
         && !driven.piston_pressure
 }
 
-/// `saved` restarted with `gaps` (a body's state at a window's start, its gaps seeing new
-/// inputs).
-fn restarted(saved: &DiscRun, gaps: Gaps) -> DiscRun {
-    let mut r = saved.clone();
+/// `r` set to `saved` (a body's state at a window's start) and restarted with `gaps` (its
+/// gaps seeing new inputs), into `r`'s own buffers.
+fn restart_from(r: &mut DiscRun, saved: &DiscRun, gaps: Gaps) {
+    r.clone_from(saved);
     r.stepper.sys.gaps = Some(gaps);
     r.stepper.restart();
-    r
 }
 
 /// Advances `r` until its time reaches `t` (s), its steps ending at `end` (s), recording its
@@ -88,7 +87,40 @@ pub(crate) struct OpenSession {
     /// The last window: every body's state at its start (to find the state at a time inside
     /// it, [`Self::state_at`]).
     last: Option<Arc<LastWindow>>,
+    /// What a window reuses instead of allocating (issue 46: no allocation in a host's frame
+    /// loop once started).
+    scratch: Scratch,
 }
+
+/// The buffers a window reuses: each holds what it held at the last window, overwritten.
+#[derive(Default)]
+struct Scratch {
+    /// Every body's state at the window's start (then kept as the last window's, whose old
+    /// buffers come back here).
+    saved: Vec<DiscRun>,
+    /// Each body's speed through the window as its neighbours' gaps see it.
+    seen: Vec<Neighbour>,
+    /// The bodies of each colour to run again.
+    redo: [Vec<usize>; 2],
+    /// Each body's tracks published to its neighbours (a track still seen by a neighbour's
+    /// gaps or by the last window's saved state is shared, the others are reused).
+    tracks: Vec<Vec<Arc<Track>>>,
+}
+
+/// A copy of a session starts its own buffers (the kept tracks shared between two sessions
+/// would never be free for either).
+impl Clone for Scratch {
+    fn clone(&self) -> Self {
+        Scratch {
+            tracks: vec![Vec::new(); self.tracks.len()],
+            ..Scratch::default()
+        }
+    }
+}
+
+/// Most tracks a body keeps for reuse (each pass publishes one; the neighbours' gaps, the
+/// `seen` speeds and the last window's saved states hold at most a few at once).
+const KEPT_TRACKS: usize = 8;
 
 /// Where the last window started from: every body's state (its last pass's inputs are in
 /// its gaps) and the window's end, s.
@@ -130,6 +162,10 @@ impl OpenSession {
             c_gap,
             r_eff,
             last: None,
+            scratch: Scratch {
+                tracks: vec![Vec::new(); n],
+                ..Scratch::default()
+            },
         }
     }
 
@@ -168,8 +204,10 @@ impl OpenSession {
     fn motion(&self, b: usize) -> (f64, f64, bool) {
         let st = &self.runs[b].stepper;
         let (t, k) = (st.t, st.sys.off + 1);
-        let mut dy = vec![0.0; st.y.len()];
-        st.sys.rhs(t, &st.y, &st.modes, &mut dy);
+        // an open body's state: its relative angle and speed, its gaps' work, the teeth's work
+        let mut dy = [0.0; 8];
+        let dy = &mut dy[..st.y.len()];
+        st.sys.rhs(t, &st.y, &st.modes, dy);
         let a_c = if self.on_shaft(b) {
             st.sys.carriers(t, &st.y, &st.modes)[1]
         } else {
@@ -183,17 +221,16 @@ impl OpenSession {
     /// its acceleration; a body in contact at its speed, held. (Adding the jerk its gaps give
     /// it as its neighbours accelerate changed no window's outcome on pack-8-brake: its
     /// plates' errors come from their own contacts.)
-    fn predictions(&self) -> Vec<Neighbour> {
-        (0..self.runs.len())
-            .map(|b| {
-                let (omega, alpha, free) = self.motion(b);
-                Neighbour::Predicted {
-                    t0: self.runs[b].stepper.t,
-                    omega,
-                    alpha: if free { alpha } else { 0.0 },
-                }
-            })
-            .collect()
+    fn predict(&self, seen: &mut Vec<Neighbour>) {
+        seen.clear();
+        seen.extend((0..self.runs.len()).map(|b| {
+            let (omega, alpha, free) = self.motion(b);
+            Neighbour::Predicted {
+                t0: self.runs[b].stepper.t,
+                omega,
+                alpha: if free { alpha } else { 0.0 },
+            }
+        }));
     }
 
     /// Runs the bodies `group` from the window's start to `t1` (s) against the neighbours'
@@ -201,23 +238,18 @@ impl OpenSession {
     fn pass(&mut self, group: &[usize], seen: &[Neighbour], saved: &[DiscRun], t1: f64) {
         for &b in group {
             let gaps = self.gaps_seeing(b, seen);
-            self.runs[b] = restarted(&saved[b], gaps);
+            restart_from(&mut self.runs[b], &saved[b], gaps);
         }
-        let run = |r: &mut DiscRun| {
-            r.track.clear();
-            advance(r, t1, t1);
+        let run = |(b, r): (usize, &mut DiscRun)| {
+            if group.contains(&b) {
+                r.track.clear();
+                advance(r, t1, t1);
+            }
         };
-        let mut members: Vec<&mut DiscRun> = self
-            .runs
-            .iter_mut()
-            .enumerate()
-            .filter(|(b, _)| group.contains(b))
-            .map(|(_, r)| r)
-            .collect();
-        if self.parallel && members.len() > 1 {
-            members.par_iter_mut().for_each(|r| run(r));
+        if self.parallel && group.len() > 1 {
+            self.runs.par_iter_mut().enumerate().for_each(run);
         } else {
-            members.iter_mut().for_each(|r| run(r));
+            self.runs.iter_mut().enumerate().for_each(run);
         }
     }
 
@@ -239,7 +271,8 @@ impl OpenSession {
         match (&self.last, st.remembers(t)) {
             (Some(last), false) => {
                 let gaps = st.sys.gaps.clone().expect("an open body");
-                let mut r = restarted(&last.saved[b], gaps);
+                let mut r = last.saved[b].clone();
+                restart_from(&mut r, &last.saved[b], gaps);
                 r.out.wants_contacts = false;
                 advance(&mut r, t, last.t1);
                 r.stepper.state_at(t, y).to_vec()
@@ -248,10 +281,29 @@ impl OpenSession {
         }
     }
 
-    /// The bodies' tracks of their last pass as neighbours' inputs.
-    fn tracks(&self, group: &[usize], seen: &mut [Neighbour]) {
+    /// The bodies' tracks of their last pass as neighbours' inputs, each copied into one of
+    /// the body's kept tracks that nothing sees any more (a new one if none is free).
+    fn tracks(&mut self, group: &[usize], seen: &mut [Neighbour]) {
         for &b in group {
-            seen[b] = Neighbour::track(Arc::new(self.runs[b].track.clone()), self.on_shaft(b));
+            let kept = &mut self.scratch.tracks[b];
+            let track = &self.runs[b].track;
+            let free = kept.iter_mut().position(|k| Arc::get_mut(k).is_some());
+            let psi = match free {
+                Some(i) => {
+                    Arc::get_mut(&mut kept[i])
+                        .expect("unshared")
+                        .clone_from(track);
+                    kept[i].clone()
+                }
+                None => {
+                    let k = Arc::new(track.clone());
+                    if kept.len() < KEPT_TRACKS {
+                        kept.push(k.clone());
+                    }
+                    k
+                }
+            };
+            seen[b] = Neighbour::track(psi, self.on_shaft(b));
         }
     }
 
@@ -287,33 +339,66 @@ impl OpenSession {
     /// ([`Self::unsettled`]) again against the plates' last passes, and its plates again,
     /// until every pass stands.
     fn window(&mut self, t1: f64) -> Result<(), EngineError> {
-        let saved = self.runs.clone();
-        let mut seen: Vec<Neighbour> = self.predictions();
-        let first = self.first.clone();
-        let (mut redo_first, mut redo_second) = (first.clone(), self.second.clone());
+        let mut saved = std::mem::take(&mut self.scratch.saved);
+        saved.clone_from(&self.runs);
+        let mut seen = std::mem::take(&mut self.scratch.seen);
+        let mut redo = std::mem::take(&mut self.scratch.redo);
+        let relaxed = self.relax(&saved, &mut seen, &mut redo, t1);
+        self.scratch.seen = seen;
+        self.scratch.redo = redo;
+        if let Err(e) = relaxed {
+            self.scratch.saved = saved;
+            return Err(e);
+        }
+        self.t_w = t1;
+        // the saved states become the last window's, whose buffers are reused next window
+        // (unless a copy of the session shares them)
+        match self.last.as_mut().and_then(Arc::get_mut) {
+            Some(last) => {
+                std::mem::swap(&mut last.saved, &mut saved);
+                last.t1 = t1;
+                self.scratch.saved = saved;
+            }
+            None => self.last = Some(Arc::new(LastWindow { saved, t1 })),
+        }
+        Ok(())
+    }
+
+    /// The sweeps of [`Self::window`] from the bodies' states `saved` at its start to `t1`
+    /// (s), with the neighbours' speeds in `seen` and the bodies to run again in `redo`.
+    fn relax(
+        &mut self,
+        saved: &[DiscRun],
+        seen: &mut Vec<Neighbour>,
+        redo: &mut [Vec<usize>; 2],
+        t1: f64,
+    ) -> Result<(), EngineError> {
+        self.predict(seen);
+        let [redo_first, redo_second] = redo;
+        redo_first.clone_from(&self.first);
+        redo_second.clone_from(&self.second);
         let mut sweeps = 0;
         loop {
-            self.pass(&redo_first, &seen, &saved, t1);
-            self.tracks(&redo_first, &mut seen);
-            self.pass(&redo_second, &seen, &saved, t1);
-            self.tracks(&redo_second, &mut seen);
+            self.pass(redo_first, seen, saved, t1);
+            self.tracks(redo_first, seen);
+            self.pass(redo_second, seen, saved, t1);
+            self.tracks(redo_second, seen);
             if let Some(e) = self.runs.iter().find_map(|r| r.error.clone()) {
                 return Err(e);
             }
             sweeps += 1;
-            let unsettled: Vec<(usize, f64)> = first
-                .iter()
-                .map(|&b| (b, self.unsettled(b, &seen)))
-                .collect();
-            let worst = unsettled
-                .iter()
-                .copied()
-                .fold((0, 0.0), |a, x| if x.1 > a.1 { x } else { a });
-            redo_first = unsettled
-                .iter()
-                .filter(|x| x.1 > 1.0)
-                .map(|x| x.0)
-                .collect();
+            // the discs to run again, and the one furthest from settled
+            redo_first.clear();
+            let mut worst = (0, 0.0);
+            for &b in &self.first {
+                let u = self.unsettled(b, seen);
+                if u > worst.1 {
+                    worst = (b, u);
+                }
+                if u > 1.0 {
+                    redo_first.push(b);
+                }
+            }
             if redo_first.is_empty() {
                 break;
             }
@@ -327,20 +412,18 @@ impl OpenSession {
                     ),
                 });
             }
-            redo_second = self
-                .second
-                .iter()
-                .copied()
-                .filter(|&q| {
-                    self.neighbours(q)
-                        .iter()
-                        .flatten()
-                        .any(|b| redo_first.contains(b))
-                })
-                .collect();
+            redo_second.clear();
+            for &q in &self.second {
+                if self
+                    .neighbours(q)
+                    .iter()
+                    .flatten()
+                    .any(|b| redo_first.contains(b))
+                {
+                    redo_second.push(q);
+                }
+            }
         }
-        self.t_w = t1;
-        self.last = Some(Arc::new(LastWindow { saved, t1 }));
         Ok(())
     }
 
@@ -349,8 +432,9 @@ impl OpenSession {
         let (at, c, r_eff) = (&self.at, self.c_gap, self.r_eff);
         let whole = limit >= self.t_w;
         self.merger
-            .merge(&mut self.runs, limit, whole, obs, &|s, w| {
-                Some(gap_samples(at, c, r_eff, s, w))
+            .merge(&mut self.runs, limit, whole, obs, &|s, w, out| {
+                gap_samples(at, c, r_eff, s, w, out);
+                true
             });
     }
 }
@@ -358,29 +442,29 @@ impl OpenSession {
 /// The open gaps of a merged sample `s` (bodies at stack positions `at`; each gap's Couette
 /// coefficient `c`, N m s/rad, faces' `R_eff` m): each one's slip, torque on the body above and
 /// the heat it has made, `-(work on the body below + work on the body above)` from the bodies'
-/// gap work `works` (J, below and above; MODEL.md section 5).
+/// gap work `works` (J, below and above; MODEL.md section 5); into `out` (cleared first).
 fn gap_samples(
     at: &[usize],
     c: f64,
     r_eff: f64,
     s: &Sample,
     works: &[[f64; 2]],
-) -> Vec<InterfaceSample> {
-    at.windows(2)
-        .map(|w| {
-            let (lo, hi) = (w[0], w[1]);
-            let slip = s.discs[hi].speed_rad_s - s.discs[lo].speed_rad_s;
-            InterfaceSample {
-                slip_rad_s: slip,
-                slip_m_s: slip * r_eff,
-                mu: 0.0,
-                clamp_n: 0.0,
-                torque_n_m: -c * slip,
-                locked: false,
-                dissipated_j: -(works[lo][1] + works[hi][0]),
-            }
-        })
-        .collect()
+    out: &mut Vec<InterfaceSample>,
+) {
+    out.clear();
+    out.extend(at.windows(2).map(|w| {
+        let (lo, hi) = (w[0], w[1]);
+        let slip = s.discs[hi].speed_rad_s - s.discs[lo].speed_rad_s;
+        InterfaceSample {
+            slip_rad_s: slip,
+            slip_m_s: slip * r_eff,
+            mu: 0.0,
+            clamp_n: 0.0,
+            torque_n_m: -c * slip,
+            locked: false,
+            dissipated_j: -(works[lo][1] + works[hi][0]),
+        }
+    }));
 }
 
 impl Session for OpenSession {
@@ -442,8 +526,17 @@ impl Session for OpenSession {
             works.push(r.stepper.sys.gap_work_j(&y));
         }
         (sample.shaft_angle_rad, sample.shaft_speed_rad_s) = self.runs[0].stepper.sys.shaft(t, &[]);
+        let mut interfaces = Vec::new();
+        gap_samples(
+            &self.at,
+            self.c_gap,
+            self.r_eff,
+            &sample,
+            &works,
+            &mut interfaces,
+        );
         Snapshot {
-            interfaces: gap_samples(&self.at, self.c_gap, self.r_eff, &sample, &works),
+            interfaces,
             sample,
             drum: None,
         }

@@ -339,8 +339,8 @@ impl Session for MonolithicSession {
                 th.book_step(&self.st);
             }
             if let Switch::External(m) = switch {
-                let (ts, modes) = (self.st.t, self.st.modes.clone());
-                self.st.sys.settle_face(m, ts, &mut self.st.y, &modes);
+                let st = &mut self.st;
+                st.sys.settle_face(m, st.t, &mut st.y, &st.modes);
                 self.st.restart();
             }
             if let Some(th) = self.thermal.as_mut() {

@@ -102,7 +102,6 @@ pub(crate) fn check_disc(d: &DiscModel) -> Result<(), EngineError> {
 }
 
 /// The adaptive integration of one system.
-#[derive(Clone)]
 pub(crate) struct Stepper {
     pub sys: System,
     /// Time reached, s.
@@ -135,6 +134,30 @@ pub(crate) struct Stepper {
     /// Time at the start of the current block of [`STALL_BLOCK`] steps, s.
     block_t0: f64,
 }
+
+clone_reusing!(Stepper {
+    sys,
+    t,
+    y,
+    modes,
+    step_modes,
+    tracks,
+    solver,
+    prev,
+    cur,
+    h,
+    atol,
+    tol,
+    max_step,
+    rate,
+    next_sample,
+    buf,
+    quarters,
+    y_new,
+    dy,
+    stats,
+    block_t0,
+});
 
 impl Stepper {
     /// Starts `sys` at t = 0 from its initial state; a disc may start inside a contact event.

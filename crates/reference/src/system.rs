@@ -15,7 +15,7 @@ pub(crate) use clutchpack_model::Face;
 
 /// The stack's forces at one instant ([`System::stack_eval`]); interfaces from the piston,
 /// bodies in stack order.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct StackEval {
     /// `F_p - sum_{b <= m} mu_spline Q_b`, N (the clamp before it is cut at 0).
     pub raw_clamp: Vec<f64>,
@@ -35,6 +35,29 @@ pub(crate) struct StackEval {
     pub teeth_power: f64,
 }
 
+/// A [`StackEval`] with the per-body sums it is built from, reused from one evaluation to
+/// the next ([`System::with_stack_eval`]).
+#[derive(Debug, Default)]
+struct StackScratch {
+    ev: StackEval,
+    omega: Vec<f64>,
+    free: Vec<f64>,
+    inertia: Vec<f64>,
+}
+
+thread_local! {
+    /// Each thread's [`StackScratch`]: the right-hand side and the face probes of a stack
+    /// evaluate it at every stage and every bisection, and allocated its nine vectors each
+    /// time (issue 46: no allocation in a host's frame loop once started).
+    static STACK_SCRATCH: std::cell::RefCell<StackScratch> = std::cell::RefCell::default();
+}
+
+/// `v` as `n` zeros, in its own buffer.
+fn zeroed(v: &mut Vec<f64>, n: usize) {
+    v.clear();
+    v.resize(n, 0.0);
+}
+
 /// The shaft and the couplings in `ids` (global indices: the discs `0..N`, then the plates
 /// `N..N + P`, as the engines number bodies), in slots 0, 1, ...
 ///
@@ -47,7 +70,6 @@ pub(crate) struct StackEval {
 /// (rad/s) when there is a drum, then the heat (J) each open interface has dissipated. A body
 /// of an open pack run on its own (the open-pack multirate scheme, [`System::open_body`])
 /// continues instead with the work (J) the gap below and the gap above have done on it.
-#[derive(Clone)]
 pub(crate) struct System {
     /// The model (shared by a run's steppers; `session.rs` swaps it when an input changes).
     pub pack: Arc<PackModel>,
@@ -79,6 +101,19 @@ pub(crate) struct System {
     /// carriers' motion ([`Self::rhs_with`], [`Self::reactions_n_m`]).
     pub carried: bool,
 }
+
+clone_reusing!(System {
+    pack,
+    off,
+    ids,
+    nd,
+    faces,
+    rb,
+    c_gap,
+    gaps,
+    teeth_work,
+    carried,
+});
 
 impl System {
     /// The shaft and the couplings `ids` of `pack`. A pack with plates, a drum or a stack
@@ -265,7 +300,10 @@ impl System {
     /// Shaft angle (rad) and speed (rad/s) at `t` for state `y`.
     pub fn shaft(&self, t: f64, y: &[f64]) -> (f64, f64) {
         match &self.pack.shaft {
-            Shaft::Prescribed(p) => (p.angle(t), p.speed(t)),
+            Shaft::Prescribed(p) => {
+                let (speed, angle) = p.speed_and_angle(t);
+                (angle, speed)
+            }
             Shaft::Inertial { .. } => (y[0], y[1]),
         }
     }
@@ -298,7 +336,7 @@ impl System {
     /// acts between discs and plates.
     pub fn carriers(&self, t: f64, y: &[f64], modes: &[Option<Engagement>]) -> [f64; 4] {
         let (omega_s, alpha_prescribed) = match &self.pack.shaft {
-            Shaft::Prescribed(p) => (p.speed(t), p.acceleration(t)),
+            Shaft::Prescribed(p) => p.speed_and_acceleration(t),
             Shaft::Inertial { .. } => (y[1], 0.0),
         };
         let inertial = matches!(self.pack.shaft, Shaft::Inertial { .. });
@@ -380,9 +418,14 @@ impl System {
                 unreachable!("an open pack's shaft is prescribed")
             };
             let k = self.off;
-            let omega_s = p.speed(t);
+            // a disc's carrier speed and acceleration in one pass, a plate's carrier at rest
+            // (the shaft's speed only for its neighbours, the discs)
+            let (omega_s, alpha_s) = match self.carrier(0) {
+                Carrier::Shaft => p.speed_and_acceleration(t),
+                _ => (p.speed(t), 0.0),
+            };
             let (omega_c, alpha_c) = match self.carrier(0) {
-                Carrier::Shaft => (omega_s, p.acceleration(t)),
+                Carrier::Shaft => (omega_s, alpha_s),
                 _ => (0.0, 0.0),
             };
             let omega_b = omega_c - y[k + 1];
@@ -422,18 +465,19 @@ impl System {
         let c = *c;
         if self.pack.stack.is_some() {
             // every body is a stack body: its acceleration comes from the stack's balance
-            let ev = self.stack_eval(t, y, modes, &c);
-            for slot in 0..self.ids.len() {
-                let k = self.off + 2 * slot;
-                let alpha_c = self.carrier_of(slot, &c).1;
-                dy[k] = y[k + 1];
-                dy[k + 1] = alpha_c - ev.alpha[self.position(slot)];
-            }
-            let h = self.heat_at();
-            dy[h..h + self.interfaces()].copy_from_slice(&ev.heat_rate);
-            if self.teeth_work {
-                dy[self.dim() - 1] = ev.teeth_power;
-            }
+            self.with_stack_eval(t, y, modes, &c, |ev| {
+                for slot in 0..self.ids.len() {
+                    let k = self.off + 2 * slot;
+                    let alpha_c = self.carrier_of(slot, &c).1;
+                    dy[k] = y[k + 1];
+                    dy[k + 1] = alpha_c - ev.alpha[self.position(slot)];
+                }
+                let h = self.heat_at();
+                dy[h..h + self.interfaces()].copy_from_slice(&ev.heat_rate);
+                if self.teeth_work {
+                    dy[self.dim() - 1] = ev.teeth_power;
+                }
+            });
             return;
         }
         for slot in 0..self.ids.len() {
@@ -503,22 +547,63 @@ impl System {
         modes: &[Option<Engagement>],
         c: &[f64; 4],
     ) -> StackEval {
+        let mut s = StackScratch::default();
+        self.stack_eval_into(t, y, modes, c, &mut s);
+        s.ev
+    }
+
+    /// `f` of [`Self::stack_eval`]'s evaluation, made in this thread's buffers (no allocation
+    /// once they have grown; in new ones if `f` itself asks for another).
+    pub fn with_stack_eval<R>(
+        &self,
+        t: f64,
+        y: &[f64],
+        modes: &[Option<Engagement>],
+        c: &[f64; 4],
+        f: impl FnOnce(&StackEval) -> R,
+    ) -> R {
+        STACK_SCRATCH.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut s) => {
+                self.stack_eval_into(t, y, modes, c, &mut s);
+                f(&s.ev)
+            }
+            Err(_) => f(&self.stack_eval(t, y, modes, c)),
+        })
+    }
+
+    /// [`Self::stack_eval`] into `s`'s buffers.
+    fn stack_eval_into(
+        &self,
+        t: f64,
+        y: &[f64],
+        modes: &[Option<Engagement>],
+        c: &[f64; 4],
+        s: &mut StackScratch,
+    ) {
         let stack = self.pack.stack.as_ref().expect("a stack");
         let n_b = 2 * self.nd + 1;
         let n_if = n_b - 1;
         let r_eff = stack.effective_radius_m();
-        let mut ev = StackEval {
-            raw_clamp: vec![0.0; n_if],
-            clamp: vec![0.0; n_if],
-            slip: vec![0.0; n_if],
-            torque: vec![0.0; n_if],
-            heat_rate: vec![0.0; n_if],
-            alpha: vec![0.0; n_b],
-            teeth_power: 0.0,
-        };
-        let mut omega = vec![0.0; n_b];
-        let mut free = vec![0.0; n_b];
-        let mut inertia = vec![0.0; n_b];
+        let StackScratch {
+            ev,
+            omega,
+            free,
+            inertia,
+        } = s;
+        for v in [
+            &mut ev.raw_clamp,
+            &mut ev.clamp,
+            &mut ev.slip,
+            &mut ev.torque,
+            &mut ev.heat_rate,
+        ] {
+            zeroed(v, n_if);
+        }
+        zeroed(&mut ev.alpha, n_b);
+        ev.teeth_power = 0.0;
+        zeroed(omega, n_b);
+        zeroed(free, n_b);
+        zeroed(inertia, n_b);
         let mut f_p = stack.piston.force_n(t);
         for b in 0..n_b {
             let slot = StackBody::at(b).body_index(self.nd);
@@ -574,7 +659,6 @@ impl System {
             }
             b0 = b1 + 1;
         }
-        ev
     }
 
     /// The interfaces' states at `t` for state `y` (empty without a stack).
@@ -588,22 +672,23 @@ impl System {
             return Vec::new();
         };
         let c = self.carriers(t, y, modes);
-        let ev = self.stack_eval(t, y, modes, &c);
         let r_eff = stack.effective_radius_m();
-        (0..self.interfaces())
-            .map(|m| InterfaceSample {
-                slip_rad_s: ev.slip[m],
-                slip_m_s: ev.slip[m] * r_eff,
-                mu: match self.faces[m] {
-                    Face::Open => 0.0,
-                    _ => stack.friction_of(m).mu(ev.slip[m] * r_eff),
-                },
-                clamp_n: ev.clamp[m],
-                torque_n_m: ev.torque[m],
-                locked: self.faces[m] == Face::Locked,
-                dissipated_j: y[self.heat_at() + m],
-            })
-            .collect()
+        self.with_stack_eval(t, y, modes, &c, |ev| {
+            (0..self.interfaces())
+                .map(|m| InterfaceSample {
+                    slip_rad_s: ev.slip[m],
+                    slip_m_s: ev.slip[m] * r_eff,
+                    mu: match self.faces[m] {
+                        Face::Open => 0.0,
+                        _ => stack.friction_of(m).mu(ev.slip[m] * r_eff),
+                    },
+                    clamp_n: ev.clamp[m],
+                    torque_n_m: ev.torque[m],
+                    locked: self.faces[m] == Face::Locked,
+                    dissipated_j: y[self.heat_at() + m],
+                })
+                .collect()
+        })
     }
 
     /// Whether interface `m` must change its mode at the state `ev` (a stick-slip event):
@@ -647,12 +732,12 @@ impl System {
     ) {
         let c = *c;
         let stack = self.pack.stack.as_ref().expect("a stack");
-        let ev = self.stack_eval(t, y, modes, &c);
-        if ev.raw_clamp[m] <= 0.0 {
+        let (raw_clamp, slip) =
+            self.with_stack_eval(t, y, modes, &c, |ev| (ev.raw_clamp[m], ev.slip[m]));
+        if raw_clamp <= 0.0 {
             self.faces[m] = Face::Open;
             return;
         }
-        let slip = ev.slip[m];
         let reached_zero = match self.faces[m] {
             Face::Slip(dir) => dir * slip <= 0.0,
             Face::Locked => true,
@@ -664,9 +749,10 @@ impl System {
         }
         let was = self.faces[m];
         self.faces[m] = Face::Locked;
-        let held = self.stack_eval(t, y, modes, &c);
-        let bound = stack.friction_of(m).static_mu() * held.clamp[m] * stack.effective_radius_m();
-        if held.torque[m].abs() <= bound && was != Face::Locked {
+        let (clamp, torque) =
+            self.with_stack_eval(t, y, modes, &c, |ev| (ev.clamp[m], ev.torque[m]));
+        let bound = stack.friction_of(m).static_mu() * clamp * stack.effective_radius_m();
+        if torque.abs() <= bound && was != Face::Locked {
             // lock: the upper bodies (and those locked above them) take the lower's speed
             let mut b = m + 1;
             loop {
@@ -677,9 +763,9 @@ impl System {
                 }
                 b += 1;
             }
-        } else if held.torque[m].abs() > bound {
+        } else if torque.abs() > bound {
             // the lock cannot hold: the upper body slips against the torque it would need
-            self.faces[m] = Face::Slip(-held.torque[m].signum());
+            self.faces[m] = Face::Slip(-torque.signum());
         }
     }
 
