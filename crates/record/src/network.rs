@@ -651,7 +651,6 @@ impl NetworkRecorder {
         torques.copy_from_slice(&s.torque_n_m);
         ros2::joint_state(&mut self.buf, ns, &self.coupling_names, &[], slips, torques);
         self.put_buf(self.ch.coupling_joints, ns, "coupling joints")?;
-        self.tf.transforms.clear();
         self.view
             .transforms(&self.frames, ns, &s.angle_rad, &mut self.tf.transforms);
         let tf = std::mem::take(&mut self.tf);

@@ -359,7 +359,8 @@ impl View {
     /// set before), its sun, ring and carrier turning in it with their bodies, and each planet
     /// in the carrier's frame at its place on its orbit, turning at
     /// `theta_C + k (theta_M - theta_C)` (its mesh with the ring, `k = z_R / z_P`, or with the
-    /// sun, `k = -z_S / z_P`; angles measured from the start).
+    /// sun, `k = -z_S / z_P`; angles measured from the start). `out` is updated in place when
+    /// it holds this view's transforms already (from an earlier call), else they are appended.
     pub fn transforms(
         &self,
         frames: &[String],
@@ -368,43 +369,67 @@ impl View {
         out: &mut Vec<FrameTransform>,
     ) {
         let ts = timestamp(log_time_ns);
-        let mut put = |parent: &str, frame: &str, x: f64, y: f64, angle: f64| {
-            out.push(FrameTransform {
-                timestamp: Some(ts),
-                parent_frame_id: parent.into(),
-                child_frame_id: frame.into(),
-                translation: Some(v3(x, y, 0.0)),
-                rotation: Some(about_z(angle)),
-            });
+        // the frames' names are made only when `out` does not hold them yet: a recording's
+        // samples update its transforms in place, without allocating
+        let mut at = 0;
+        let mut put = |names: &dyn Fn() -> (String, String), x: f64, y: f64, angle: f64| {
+            match out.get_mut(at) {
+                Some(t) => {
+                    t.timestamp = Some(ts);
+                    t.translation = Some(v3(x, y, 0.0));
+                    t.rotation = Some(about_z(angle));
+                }
+                None => {
+                    let (parent_frame_id, child_frame_id) = names();
+                    out.push(FrameTransform {
+                        timestamp: Some(ts),
+                        parent_frame_id,
+                        child_frame_id,
+                        translation: Some(v3(x, y, 0.0)),
+                        rotation: Some(about_z(angle)),
+                    });
+                }
+            }
+            at += 1;
         };
         for (i, (frame, &angle)) in frames.iter().zip(angle_rad).enumerate() {
-            put(&row_frame(i), frame, 0.0, 0.0, angle);
+            put(&|| (row_frame(i), frame.clone()), 0.0, 0.0, angle);
         }
         for i in 0..frames.len() {
             match i {
-                0 => put(WORLD_FRAME, &row_frame(0), self.x_m[0], 0.0, 0.0),
-                _ => put(&row_frame(i - 1), &row_frame(i), self.pitch_m, 0.0, 0.0),
+                0 => put(
+                    &|| (WORLD_FRAME.into(), row_frame(0)),
+                    self.x_m[0],
+                    0.0,
+                    0.0,
+                ),
+                _ => put(&|| (row_frame(i - 1), row_frame(i)), self.pitch_m, 0.0, 0.0),
             }
         }
         let mut before: Option<&SetDrawing> = None;
         for s in &self.sets {
             let (ts_, tr, tc) = (angle_rad[s.sun], angle_rad[s.ring], angle_rad[s.carrier]);
+            let named = |parent: &str, child: &str| (parent.to_string(), child.to_string());
             match before {
-                None => put(WORLD_FRAME, &s.frames[3], s.x_m, s.y_m, 0.0),
-                Some(b) => put(&b.frames[3], &s.frames[3], s.x_m - b.x_m, 0.0, 0.0),
+                None => put(&|| named(WORLD_FRAME, &s.frames[3]), s.x_m, s.y_m, 0.0),
+                Some(b) => put(
+                    &|| named(&b.frames[3], &s.frames[3]),
+                    s.x_m - b.x_m,
+                    0.0,
+                    0.0,
+                ),
             }
             before = Some(s);
-            put(&s.frames[3], &s.frames[0], 0.0, 0.0, ts_);
-            put(&s.frames[3], &s.frames[1], 0.0, 0.0, tr);
-            put(&s.frames[3], &s.frames[2], 0.0, 0.0, tc);
+            put(&|| named(&s.frames[3], &s.frames[0]), 0.0, 0.0, ts_);
+            put(&|| named(&s.frames[3], &s.frames[1]), 0.0, 0.0, tr);
+            put(&|| named(&s.frames[3], &s.frames[2]), 0.0, 0.0, tc);
             let per_pair = if s.planets.len() > PLANETS { 2 } else { 1 };
             for (j, &(orbit, _, k, on_ring)) in s.planets.iter().enumerate() {
                 let place = 2.0 * PI * (j / per_pair) as f64 / PLANETS as f64
                     + if per_pair == 2 && on_ring { 0.35 } else { 0.0 };
                 let member = if on_ring { tr } else { ts_ };
                 put(
-                    &s.frames[2],
-                    &s.frames[4 + j],
+                    &|| named(&s.frames[2], &s.frames[4 + j]),
                     orbit * place.cos(),
                     orbit * place.sin(),
                     k * (member - tc),
