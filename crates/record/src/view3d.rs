@@ -590,12 +590,15 @@ pub(crate) fn teeth_scene(
 /// Points round the circle of radius `r` per [`PointCloud`] face ring.
 const CLOUD_AROUND: u32 = 120;
 
-/// One point of a [`PointCloud`]: position in m (f32 x, y, z) and colour (u8 r, g, b, a).
+/// One point of a [`PointCloud`]: position in m (f32 x, y, z) and colour `c` (r, g, b, a),
+/// stored in the order b, g, r, a: as one little-endian `u32` that is `0xAARRGGBB`, the packed
+/// `rgba` field Foxglove colours points by when it finds one (otherwise it paints them with a
+/// colour map of their first field), and as the four named bytes Rerun reads.
 pub(crate) fn push_point(data: &mut Vec<u8>, x: f64, y: f64, z: f64, c: [u8; 4]) {
     for v in [x, y, z] {
         data.extend_from_slice(&(v as f32).to_le_bytes());
     }
-    data.extend_from_slice(&c);
+    data.extend_from_slice(&[c[2], c[1], c[0], c[3]]);
 }
 
 /// A point cloud in `frame` from packed points (16 bytes each, see [`push_point`]).
@@ -615,9 +618,10 @@ pub(crate) fn cloud(frame: &str, data: Vec<u8>) -> PointCloud {
             field("x", 0, NumericType::Float32),
             field("y", 4, NumericType::Float32),
             field("z", 8, NumericType::Float32),
-            field("red", 12, NumericType::Uint8),
+            field("rgba", 12, NumericType::Uint32),
+            field("blue", 12, NumericType::Uint8),
             field("green", 13, NumericType::Uint8),
-            field("blue", 14, NumericType::Uint8),
+            field("red", 14, NumericType::Uint8),
             field("alpha", 15, NumericType::Uint8),
         ],
         data: data.into(),

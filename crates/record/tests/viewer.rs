@@ -182,5 +182,40 @@ fn rerun_topics_carry_the_loads_and_the_pack() {
         assert_eq!(cloud.frame_id, frame);
         assert_eq!(cloud.point_stride, 16);
         assert!(cloud.data.len() > 16 * 100 && cloud.data.len() % 16 == 0);
+        points_coloured_for_both_viewers(topic, &cloud);
     }
+}
+
+/// Each point's colour is readable two ways, and they agree: the packed `rgba` field (a
+/// little-endian `u32` `0xAARRGGBB`, which Foxglove colours points by; without it Foxglove
+/// painted them with a colour map of `x`) and the named bytes `red`, `green`, `blue`, `alpha`
+/// (Rerun). Opaque points, and not all of one grey, so that a swap of red and blue shows.
+fn points_coloured_for_both_viewers(topic: &str, cloud: &foxglove::schemas::PointCloud) {
+    let offset = |name: &str| {
+        cloud
+            .fields
+            .iter()
+            .find(|f| f.name == name)
+            .unwrap_or_else(|| panic!("{topic}: no field {name}"))
+            .offset as usize
+    };
+    let (packed, r, g, b, a) = (
+        offset("rgba"),
+        offset("red"),
+        offset("green"),
+        offset("blue"),
+        offset("alpha"),
+    );
+    let mut coloured = false;
+    for p in cloud.data.chunks(16) {
+        let argb = u32::from_le_bytes(p[packed..packed + 4].try_into().unwrap());
+        let named = (u32::from(p[a]) << 24)
+            | (u32::from(p[r]) << 16)
+            | (u32::from(p[g]) << 8)
+            | u32::from(p[b]);
+        assert_eq!(argb, named, "{topic}");
+        assert_eq!(p[a], 255, "{topic}");
+        coloured |= p[r] != p[b];
+    }
+    assert!(coloured, "{topic}: every point grey");
 }
