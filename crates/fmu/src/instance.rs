@@ -2,7 +2,10 @@
 //! initialisation, stepping, terminated) and the host's communication points over
 //! `clutchpack_sdk::CoSimulation` (the variable table, the inputs held, the outputs), which
 //! Python's `Simulation` shares. The C functions (`ffi.rs`) only translate pointers and
-//! statuses; every FMI rule and its message is here, testable without a host.
+//! statuses; every FMI rule and its message is here, testable without a host. Every refusal
+//! is an [`FmiError`] (FMI's state machine, an argument, the resources, or the sdk's typed
+//! `Error` as it comes), which the C functions log after their name and answer with
+//! `fmi2Error`.
 
 use clutchpack_sdk::cosim::{Stage, Variable};
 use clutchpack_sdk::scene::Scene;
