@@ -13,7 +13,7 @@
 
 #![allow(clippy::missing_safety_doc)]
 
-use crate::instance::{load_resources, Instance, SavedState};
+use crate::instance::{load_resources, FmiError, FmiResult, Instance, SavedState};
 use std::collections::BTreeSet;
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -116,13 +116,9 @@ impl Component {
     }
 }
 
-/// Runs `f` on the component `c`, catching panics; an error is logged and returned as
-/// `fmi2Error`.
-fn with(
-    c: *mut c_void,
-    what: &str,
-    f: impl FnOnce(&mut Component) -> Result<c_int, String>,
-) -> c_int {
+/// Runs `f` on the component `c`, catching panics; an error is logged after `what` (the
+/// function's name) and returned as `fmi2Error`.
+fn with(c: *mut c_void, what: &str, f: impl FnOnce(&mut Component) -> FmiResult<c_int>) -> c_int {
     if c.is_null() || !live().components.contains(&(c as usize)) {
         // null, freed, or never one of ours: nothing to log to
         return ERROR;
@@ -131,8 +127,8 @@ fn with(
     let comp = unsafe { &mut *(c as *mut Component) };
     match catch_unwind(AssertUnwindSafe(|| f(comp))) {
         Ok(Ok(status)) => status,
-        Ok(Err(message)) => {
-            comp.log(ERROR, &format!("{what}: {message}"));
+        Ok(Err(e)) => {
+            comp.log(ERROR, &format!("{what}: {e}"));
             ERROR
         }
         Err(panic) => {
@@ -178,7 +174,12 @@ unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Option<&'a mut [T]> {
     }
 }
 
-const NULL_ARRAY: &str = "a null array with a non-zero length";
+/// The error of a null array with a non-zero length.
+fn null_array<T>() -> FmiResult<T> {
+    Err(FmiError::Argument(
+        "a null array with a non-zero length".into(),
+    ))
+}
 
 /// A NUL-terminated string, or `None` for null or invalid UTF-8.
 ///
@@ -193,16 +194,18 @@ unsafe fn text<'a>(p: *const c_char) -> Option<&'a str> {
 }
 
 /// The folder of `fmuResourceLocation`, a `file:` URI (percent-encoded).
-pub fn resource_folder(uri: &str) -> Result<PathBuf, String> {
+pub fn resource_folder(uri: &str) -> FmiResult<PathBuf> {
     let rest = uri
         .strip_prefix("file://localhost/")
         .map(|r| format!("/{r}"))
         .or_else(|| uri.strip_prefix("file:///").map(|r| format!("/{r}")))
         .or_else(|| uri.strip_prefix("file:/").map(|r| format!("/{r}")))
-        .ok_or_else(|| format!("fmuResourceLocation {uri:?}: expected a file: URI"))?;
+        .ok_or_else(|| {
+            FmiError::Argument(format!("fmuResourceLocation {uri:?}: expected a file: URI"))
+        })?;
     let path = percent_encoding::percent_decode_str(&rest)
         .decode_utf8()
-        .map_err(|e| format!("fmuResourceLocation {uri:?}: {e}"))?;
+        .map_err(|e| FmiError::Argument(format!("fmuResourceLocation {uri:?}: {e}")))?;
     Ok(PathBuf::from(path.as_ref()))
 }
 
@@ -243,13 +246,14 @@ pub unsafe extern "C" fn fmi2Instantiate(
         log_to(logger, env, &cname, ERROR, c"logStatusError", &why);
         std::ptr::null_mut()
     };
-    let made = catch_unwind(AssertUnwindSafe(|| -> Result<Instance, String> {
+    let made = catch_unwind(AssertUnwindSafe(|| -> FmiResult<Instance> {
+        let bad = |why: &str| FmiError::Argument(why.into());
         if fmu_type != CO_SIMULATION {
-            return Err("this FMU is for co-simulation only (fmi2CoSimulation)".into());
+            return Err(bad("this FMU is for co-simulation only (fmi2CoSimulation)"));
         }
-        let guid = unsafe { text(guid) }.ok_or("fmuGUID is null or not UTF-8")?;
-        let uri =
-            unsafe { text(resource_location) }.ok_or("fmuResourceLocation is null or not UTF-8")?;
+        let guid = unsafe { text(guid) }.ok_or_else(|| bad("fmuGUID is null or not UTF-8"))?;
+        let uri = unsafe { text(resource_location) }
+            .ok_or_else(|| bad("fmuResourceLocation is null or not UTF-8"))?;
         let resources = resource_folder(uri)?;
         let scene = load_resources(&resources, guid)?;
         // no recording may be written over the FMU's own files
@@ -331,7 +335,7 @@ pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> c_int {
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Terminate(c: *mut c_void) -> c_int {
     with(c, "fmi2Terminate", |comp| {
-        let warnings = comp.instance.terminate()?;
+        let warnings = comp.instance.terminate();
         for w in &warnings {
             comp.log(WARNING, &format!("fmi2Terminate: {w}"));
         }
@@ -359,7 +363,7 @@ pub unsafe extern "C" fn fmi2GetReal(
     with(c, "fmi2GetReal", |comp| {
         let (vr, out) = unsafe { (slice(vr, n), slice_mut(value, n)) };
         let (Some(vr), Some(out)) = (vr, out) else {
-            return Err(NULL_ARRAY.into());
+            return null_array();
         };
         for (r, o) in vr.iter().zip(out.iter_mut()) {
             *o = comp.instance.get_real(*r)?;
@@ -379,7 +383,7 @@ pub unsafe extern "C" fn fmi2GetInteger(
     with(c, "fmi2GetInteger", |comp| {
         let (vr, out) = unsafe { (slice(vr, n), slice_mut(value, n)) };
         let (Some(vr), Some(out)) = (vr, out) else {
-            return Err(NULL_ARRAY.into());
+            return null_array();
         };
         for (r, o) in vr.iter().zip(out.iter_mut()) {
             *o = comp.instance.get_integer(*r)?;
@@ -410,14 +414,14 @@ pub unsafe extern "C" fn fmi2SetBoolean(
     with(c, "fmi2SetBoolean", |_| no_booleans(vr, n))
 }
 
-fn no_booleans(vr: *const u32, n: usize) -> Result<c_int, String> {
+fn no_booleans(vr: *const u32, n: usize) -> FmiResult<c_int> {
     match unsafe { slice(vr, n) } {
         Some([]) => Ok(OK),
-        Some(v) => Err(format!(
+        Some(v) => Err(FmiError::Argument(format!(
             "no Boolean variable has the value reference {}",
             v[0]
-        )),
-        None => Err(NULL_ARRAY.into()),
+        ))),
+        None => null_array(),
     }
 }
 
@@ -432,7 +436,7 @@ pub unsafe extern "C" fn fmi2GetString(
     with(c, "fmi2GetString", |comp| {
         let (vr, out) = unsafe { (slice(vr, n), slice_mut(value, n)) };
         let (Some(vr), Some(out)) = (vr, out) else {
-            return Err(NULL_ARRAY.into());
+            return null_array();
         };
         comp.strings.clear();
         for r in vr {
@@ -458,7 +462,7 @@ pub unsafe extern "C" fn fmi2SetReal(
     with(c, "fmi2SetReal", |comp| {
         let (vr, values) = unsafe { (slice(vr, n), slice(value, n)) };
         let (Some(vr), Some(values)) = (vr, values) else {
-            return Err(NULL_ARRAY.into());
+            return null_array();
         };
         for (r, v) in vr.iter().zip(values) {
             comp.instance.set_real(*r, *v)?;
@@ -477,8 +481,10 @@ pub unsafe extern "C" fn fmi2SetInteger(
 ) -> c_int {
     with(c, "fmi2SetInteger", |_| match unsafe { slice(vr, n) } {
         Some([]) => Ok(OK),
-        Some(_) => Err("the Integer variables (impacts, last_impact.body) are outputs".into()),
-        None => Err(NULL_ARRAY.into()),
+        Some(_) => Err(FmiError::Argument(
+            "the Integer variables (impacts, last_impact.body) are outputs".into(),
+        )),
+        None => null_array(),
     })
 }
 
@@ -493,10 +499,11 @@ pub unsafe extern "C" fn fmi2SetString(
     with(c, "fmi2SetString", |comp| {
         let (vr, values) = unsafe { (slice(vr, n), slice(value, n)) };
         let (Some(vr), Some(values)) = (vr, values) else {
-            return Err(NULL_ARRAY.into());
+            return null_array();
         };
         for (r, v) in vr.iter().zip(values) {
-            let v = unsafe { text(*v) }.ok_or("a null or non-UTF-8 string")?;
+            let v = unsafe { text(*v) }
+                .ok_or_else(|| FmiError::Argument("a null or non-UTF-8 string".into()))?;
             comp.instance.set_string(*r, v)?;
         }
         Ok(OK)
@@ -508,12 +515,14 @@ pub unsafe extern "C" fn fmi2SetString(
 pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, state: *mut *mut c_void) -> c_int {
     with(c, "fmi2GetFMUstate", |comp| {
         if state.is_null() {
-            return Err("a null state pointer".into());
+            return Err(FmiError::Argument("a null state pointer".into()));
         }
         // SAFETY: a state pointer from the host (null or from fmi2GetFMUstate)
         let old = unsafe { *state };
         if !old.is_null() && !live().states.contains(&(old as usize)) {
-            return Err(format!("the state to overwrite is {NOT_A_STATE}"));
+            return Err(FmiError::Argument(format!(
+                "the state to overwrite is {NOT_A_STATE}"
+            )));
         }
         let saved = comp.instance.save()?;
         if old.is_null() {
@@ -533,10 +542,10 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, state: *mut *mut c_void
 pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, state: *mut c_void) -> c_int {
     with(c, "fmi2SetFMUstate", |comp| {
         if state.is_null() {
-            return Err("a null state".into());
+            return Err(FmiError::Argument("a null state".into()));
         }
         if !live().states.contains(&(state as usize)) {
-            return Err(format!("the state is {NOT_A_STATE}"));
+            return Err(FmiError::Argument(format!("the state is {NOT_A_STATE}")));
         }
         // SAFETY: a live state from fmi2GetFMUstate (the registry says so)
         let saved = unsafe { &*(state as *const SavedState) };
@@ -553,7 +562,7 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(c: *mut c_void, state: *mut *mut c_voi
         }
         let p = unsafe { *state };
         if !live().states.remove(&(p as usize)) {
-            return Err(format!("the state is {NOT_A_STATE}"));
+            return Err(FmiError::Argument(format!("the state is {NOT_A_STATE}")));
         }
         // SAFETY: a live state from fmi2GetFMUstate, now out of the registry: freed once
         drop(unsafe { Box::from_raw(p as *mut SavedState) });
@@ -572,11 +581,9 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     _s: *mut c_void,
     _size: *mut usize,
 ) -> c_int {
-    with(
-        c,
-        "fmi2SerializedFMUstateSize",
-        |_| Err(NO_SERIALIZE.into()),
-    )
+    with(c, "fmi2SerializedFMUstateSize", |_| {
+        Err(FmiError::Unsupported(NO_SERIALIZE))
+    })
 }
 
 /// `fmi2SerializeFMUstate`: not supported.
@@ -587,7 +594,9 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     _b: *mut c_char,
     _n: usize,
 ) -> c_int {
-    with(c, "fmi2SerializeFMUstate", |_| Err(NO_SERIALIZE.into()))
+    with(c, "fmi2SerializeFMUstate", |_| {
+        Err(FmiError::Unsupported(NO_SERIALIZE))
+    })
 }
 
 /// `fmi2DeSerializeFMUstate`: not supported.
@@ -598,7 +607,9 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     _n: usize,
     _s: *mut *mut c_void,
 ) -> c_int {
-    with(c, "fmi2DeSerializeFMUstate", |_| Err(NO_SERIALIZE.into()))
+    with(c, "fmi2DeSerializeFMUstate", |_| {
+        Err(FmiError::Unsupported(NO_SERIALIZE))
+    })
 }
 
 /// `fmi2GetDirectionalDerivative`: not provided.
@@ -613,7 +624,9 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     _du: *mut f64,
 ) -> c_int {
     with(c, "fmi2GetDirectionalDerivative", |_| {
-        Err("not provided (providesDirectionalDerivative = false)".into())
+        Err(FmiError::Unsupported(
+            "not provided (providesDirectionalDerivative = false)",
+        ))
     })
 }
 
@@ -630,7 +643,7 @@ pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
     with(c, "fmi2SetRealInputDerivatives", |comp| {
         let (vr, order, value) = unsafe { (slice(vr, n), slice(order, n), slice(value, n)) };
         let (Some(vr), Some(order), Some(value)) = (vr, order, value) else {
-            return Err(NULL_ARRAY.into());
+            return null_array();
         };
         for ((r, o), v) in vr.iter().zip(order).zip(value) {
             comp.instance.set_real_derivative(*r, *o, *v)?;
@@ -649,7 +662,9 @@ pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
     _value: *mut f64,
 ) -> c_int {
     with(c, "fmi2GetRealOutputDerivatives", |_| {
-        Err("not provided (maxOutputDerivativeOrder = 0)".into())
+        Err(FmiError::Unsupported(
+            "not provided (maxOutputDerivativeOrder = 0)",
+        ))
     })
 }
 
@@ -670,7 +685,9 @@ pub unsafe extern "C" fn fmi2DoStep(
 #[no_mangle]
 pub unsafe extern "C" fn fmi2CancelStep(c: *mut c_void) -> c_int {
     with(c, "fmi2CancelStep", |_| {
-        Err("fmi2DoStep is synchronous (canRunAsynchronuously = false)".into())
+        Err(FmiError::Unsupported(
+            "fmi2DoStep is synchronous (canRunAsynchronuously = false)",
+        ))
     })
 }
 

@@ -32,5 +32,5 @@ pub mod package;
 /// The variable table the model description and the binary read (the sdk's).
 pub use clutchpack_sdk::cosim::{variables, Variable};
 pub use description::MODEL_IDENTIFIER;
-pub use instance::{Instance, Phase};
+pub use instance::{FmiError, FmiResult, Instance, Phase};
 pub use package::{check_representable, write_fmu, PackageError, DEFAULT_STEP_S};

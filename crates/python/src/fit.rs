@@ -60,13 +60,13 @@ pub fn fit(
     let params = params
         .iter()
         .map(|p| p.parse::<FitParam>())
-        .collect::<Result<Vec<_>, String>>()
-        .map_err(bad)?;
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| bad(e.to_string()))?;
     let signals = matches
         .iter()
         .map(|s| s.parse::<FitSignal>())
-        .collect::<Result<Vec<_>, String>>()
-        .map_err(bad)?;
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| bad(e.to_string()))?;
     let wanted = fitted_scene.as_deref();
     if let Some(p) = wanted {
         clutchpack_sdk::record::check_outputs(

@@ -25,8 +25,16 @@ pub struct StepperState {
     state: Mutex<SavedCoSimulation>,
 }
 
-fn value_err(e: String) -> PyErr {
-    PyValueError::new_err(e)
+/// `ValueError` with the sdk's message: what the constructor, `set_input`, `save` and
+/// `restore` raise for any error (a bad value or call, and a run that cannot start).
+fn value_err(e: clutchpack_sdk::Error) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// `RuntimeError` with the sdk's message: what `advance_to` and `outputs` raise for any error
+/// (an engine failure, and a held input past its bound).
+fn runtime_err(e: clutchpack_sdk::Error) -> PyErr {
+    PyRuntimeError::new_err(e.to_string())
 }
 
 impl Stepper {
@@ -141,12 +149,12 @@ impl Stepper {
         if let Some(e) = interrupt {
             return Err(e);
         }
-        out.map(|_| ()).map_err(PyRuntimeError::new_err)
+        out.map(|_| ()).map_err(runtime_err)
     }
 
     /// Every output's `(name, value)` now (the Integer ones as floats).
     fn outputs(&self) -> PyResult<Vec<(String, f64)>> {
-        self.co().outputs().map_err(PyRuntimeError::new_err)
+        self.co().outputs().map_err(runtime_err)
     }
 
     /// Saves the whole state (not while recording: a recording cannot be rewound).

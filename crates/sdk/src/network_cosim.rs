@@ -145,7 +145,11 @@ pub fn network_name_problems(net: &Network) -> Vec<String> {
     let names = net.bodies.iter().map(|b| &b.name);
     names
         .chain(net.couplings.iter().map(|c| &c.name))
-        .filter_map(|n| crate::cosim::fmi_name_segment(n).err())
+        .filter_map(|n| {
+            crate::cosim::fmi_name_segment(n)
+                .err()
+                .map(|e| e.to_string())
+        })
         .collect()
 }
 
@@ -435,7 +439,7 @@ impl NetworkSimulation {
                 names.join(", ")
             )));
         };
-        crate::cosim::inputs::check_network_input(*input, name, value).map_err(Error::BadInput)?;
+        crate::cosim::inputs::check_network_input(*input, name, value)?;
         // held from the start: its value set again is not passed on (docs/DECISIONS.md)
         if input_value(self.stepper.network(), *input, self.time_s()) == value {
             return Ok(());
@@ -582,8 +586,7 @@ impl NetworkSimulation {
     /// Goes back to a state saved by [`Self::save`] of this run; a state of another run (of
     /// this scene or another) is bad input and leaves the run as it was.
     pub fn restore(&mut self, saved: &SavedNetworkSimulation) -> Result<()> {
-        crate::cosim::same_run(saved.run, &saved.scene, self.run, &self.scene.name)
-            .map_err(Error::BadInput)?;
+        crate::cosim::same_run(saved.run, &saved.scene, self.run, &self.scene.name)?;
         if self.keep.recorder.is_some() {
             return Err(Error::BadInput(
                 "restore(): not while recording (a recording cannot go back in time)".into(),

@@ -7,6 +7,7 @@
 //! name variables, so that the network's (`network_cosim.rs`) need not import the pack's
 //! (`variables.rs`), which imports it).
 
+use crate::{Error, Result};
 use clutchpack_model::session::{Driven, Inputs};
 
 /// An input of the pack (`clutchpack_model::session::Inputs`).
@@ -135,20 +136,20 @@ impl Input {
     /// naming the input (`when`: where, e.g. " at 0.1 s"), numbers as every message writes
     /// them (`clutchpack_model::fmt_num`: never hundreds of digits). The one place an input
     /// is checked against its bound.
-    pub fn check(self, value: f64, when: &str) -> Result<(), String> {
+    pub fn check(self, value: f64, when: &str) -> Result<()> {
         let (lo, hi, key) = self.bound();
         if (lo..=hi).contains(&value) {
             return Ok(());
         }
-        let e = clutchpack_model::fmt_num;
-        let (name, unit) = (self.name(), self.unit());
-        Err(format!(
-            "{name} = {} {unit}{when}: expected a value in [{}, {}] {unit}, the bound of the \
-             scene key it stands for ({key})",
-            e(value),
-            e(lo),
-            e(hi)
-        ))
+        Err(Error::InputOutOfBound {
+            name: self.name().to_string(),
+            value,
+            unit: self.unit(),
+            lo,
+            hi,
+            key,
+            when: when.to_string(),
+        })
     }
 }
 
@@ -164,7 +165,7 @@ pub fn check_network_input(
     input: clutchpack_model::network::NetworkInput,
     name: &str,
     value: f64,
-) -> Result<(), String> {
+) -> Result<()> {
     use clutchpack_scene::{MAX_NORMAL_FORCE_N, MAX_PRESSURE_PA, MAX_TORQUE_N_M};
     let (lo, hi, unit, key) = match input {
         clutchpack_model::network::NetworkInput::Drive(_) => (
@@ -186,14 +187,15 @@ pub fn check_network_input(
     if (lo..=hi).contains(&value) {
         return Ok(());
     }
-    let e = clutchpack_model::fmt_num;
-    Err(format!(
-        "{name} = {} {unit}: expected a value in [{}, {}] {unit}, the bound of the scene key it \
-         stands for ({key})",
-        e(value),
-        e(lo),
-        e(hi)
-    ))
+    Err(Error::InputOutOfBound {
+        name: name.to_string(),
+        value,
+        unit,
+        lo,
+        hi,
+        key,
+        when: String::new(),
+    })
 }
 
 /// The public names of the inputs `driven` drives, in the table's order.
@@ -208,7 +210,7 @@ pub fn driven_names(driven: &Driven) -> Vec<&'static str> {
 /// The inputs named in `names` (public names or aliases) as a [`Driven`]; an unknown name is
 /// an error that lists the names, an input named twice (by one name or by its name and its
 /// alias) an error naming it.
-pub fn driven_from_names<S: AsRef<str>>(names: &[S]) -> Result<Driven, String> {
+pub fn driven_from_names<S: AsRef<str>>(names: &[S]) -> Result<Driven> {
     let mut driven = Driven::NONE;
     for n in names {
         let n = n.as_ref();
@@ -221,17 +223,17 @@ pub fn driven_from_names<S: AsRef<str>>(names: &[S]) -> Result<Driven, String> {
                 .iter()
                 .map(|i| format!("{:?}", i.alias()))
                 .collect();
-            format!(
+            Error::BadInput(format!(
                 "drive = {n:?}: expected any of {} (or the older names {})",
                 all.join(", "),
                 old.join(", ")
-            )
+            ))
         })?;
         if i.is_driven(&driven) {
-            return Err(format!(
+            return Err(Error::BadInput(format!(
                 "drive = {n:?}: {} is named twice; name each input once",
                 i.name()
-            ));
+            )));
         }
         i.drive(&mut driven);
     }
@@ -245,7 +247,7 @@ pub fn driven_from_names<S: AsRef<str>>(names: &[S]) -> Result<Driven, String> {
 /// quoting of FMI names: every network variable's name goes through it. A character the
 /// grammar cannot write at all (one outside ASCII, another control character) is an error
 /// naming it.
-pub fn fmi_name_segment(name: &str) -> Result<String, String> {
+pub fn fmi_name_segment(name: &str) -> Result<String, Error> {
     let mut chars = name.chars();
     let identifier = chars
         .next()
@@ -271,10 +273,10 @@ pub fn fmi_name_segment(name: &str) -> Result<String, String> {
             '\u{b}' => out.push_str("\\v"),
             ' '..='~' => out.push(c),
             _ => {
-                return Err(format!(
+                return Err(Error::BadInput(format!(
                     "{name:?}: the character {c:?} cannot be written in an FMI variable name \
                      (ASCII only): rename it in the scene"
-                ))
+                )))
             }
         }
     }
@@ -298,7 +300,7 @@ mod tests {
         }
         let d = driven_from_names(&["piston_pressure", "shaft.speed_rad_s"]).unwrap();
         assert!(d.piston_pressure && d.shaft_speed && !d.drum_load && !d.shaft_torque);
-        let e = driven_from_names(&["pressure"]).unwrap_err();
+        let e = driven_from_names(&["pressure"]).unwrap_err().to_string();
         assert!(
             e.contains("piston.pressure_pa") && e.contains("piston_pressure"),
             "{e}"
@@ -307,7 +309,7 @@ mod tests {
 
     #[test]
     fn inputs_are_checked_against_their_keys_bounds() {
-        let e = Input::ShaftSpeed.check(1e9, "").unwrap_err();
+        let e = Input::ShaftSpeed.check(1e9, "").unwrap_err().to_string();
         assert!(
             e.contains("shaft.speed_rad_s = 1e9 rad/s") && e.contains("100000"),
             "{e}"
@@ -333,7 +335,7 @@ mod name_tests {
         assert_eq!(fmi_name_segment("it's").unwrap(), "'it\\'s'");
         assert_eq!(fmi_name_segment("a\\b?").unwrap(), "'a\\\\b\\?'");
         assert_eq!(fmi_name_segment("").unwrap(), "''");
-        let e = fmi_name_segment("vélo").unwrap_err();
+        let e = fmi_name_segment("vélo").unwrap_err().to_string();
         assert!(e.contains("vélo") && e.contains("'é'"), "{e}");
     }
 }

@@ -16,7 +16,9 @@ pub use variables::{
     Variable, UNCONNECTED, UNITS,
 };
 
-use crate::{RecordingRequest, RunOutcome, Session, SessionRequest, SessionState, Simulation};
+use crate::{
+    Error, RecordingRequest, Result, RunOutcome, Session, SessionRequest, SessionState, Simulation,
+};
 use clutchpack_model::session::{Advance, Driven, Inputs, Snapshot};
 use clutchpack_record::{RecordOptions, Replace};
 use clutchpack_scene::{EngineChoice, Scene};
@@ -37,12 +39,12 @@ pub(crate) fn next_run() -> u64 {
 /// by run `saved` of the scene `saved_scene`, restored into run `run` of `scene` (0: none
 /// started), is refused unless the two runs are one (another instance's, another scene's, or
 /// a state from before a reset would make the run another scene's under its own name).
-pub(crate) fn same_run(saved: u64, saved_scene: &str, run: u64, scene: &str) -> Result<(), String> {
+pub(crate) fn same_run(saved: u64, saved_scene: &str, run: u64, scene: &str) -> Result<()> {
     if saved != run || run == 0 {
-        return Err(format!(
+        return Err(Error::Call(format!(
             "the state was saved by another run (scene {saved_scene:?}; this instance runs \
              {scene:?}): a state restores only into the instance and run that saved it"
-        ));
+        )));
     }
     Ok(())
 }
@@ -127,7 +129,7 @@ pub struct CoSimulation {
 impl CoSimulation {
     /// A co-simulation of `scene` (engine: the scene's choice, as `clutchpack run` makes
     /// it) driving every input the pack has, as an FMU does.
-    pub fn new(scene: Scene) -> Result<CoSimulation, String> {
+    pub fn new(scene: Scene) -> Result<CoSimulation> {
         let driven = Driven::all_for(&scene.pack);
         CoSimulation::driving(scene, driven)
     }
@@ -135,17 +137,17 @@ impl CoSimulation {
     /// A co-simulation of `scene` whose caller drives only `driven` (the other inputs follow
     /// the scene's profiles; Python's `Simulation`). Driving nothing, the run is the scene's
     /// run split into calls. Inputs the pack does not have are an error naming them.
-    pub fn driving(scene: Scene, driven: Driven) -> Result<CoSimulation, String> {
+    pub fn driving(scene: Scene, driven: Driven) -> Result<CoSimulation> {
         // a network drives every input it has (`network_inputs`); a pack, what `driven` names
         let driven = if scene.network.is_some() {
             Driven::NONE
         } else {
             driven
                 .check(&scene.pack)
-                .map_err(|e| format!("{}: {e}", scene.name))?;
+                .map_err(|e| Error::BadInput(format!("{}: {e}", scene.name)))?;
             driven
         };
-        let engine = scene.engine(None, &scene.name).map_err(|e| e.to_string())?;
+        let engine = scene.engine(None, &scene.name)?;
         let vars = variables(&scene, engine.name(), driven);
         let mut co = CoSimulation {
             driven,
@@ -235,16 +237,18 @@ impl CoSimulation {
     }
 
     /// The variable of base type `kind` with the value reference `vr`.
-    pub fn variable(&self, kind: Kind, vr: u32) -> Result<&Variable, String> {
+    pub fn variable(&self, kind: Kind, vr: u32) -> Result<&Variable> {
         self.vars
             .iter()
             .find(|v| v.kind == kind && v.vr == vr)
-            .ok_or_else(|| format!("no {kind:?} variable has the value reference {vr}"))
+            .ok_or_else(|| {
+                Error::Call(format!("no {kind:?} variable has the value reference {vr}"))
+            })
     }
 
     /// The value reference of the input `name` (its public name or its older alias); else an
     /// error that lists the inputs this run has.
-    pub fn input_named(&self, name: &str) -> Result<u32, String> {
+    pub fn input_named(&self, name: &str) -> Result<u32> {
         let wanted = Input::from_name(name);
         self.vars
             .iter()
@@ -261,14 +265,14 @@ impl CoSimulation {
                     .filter(|v| v.causality == Causality::Input)
                     .map(|v| v.name.as_str())
                     .collect();
-                format!(
+                Error::Call(format!(
                     "{name:?} is not an input of this simulation (its inputs: {})",
                     if inputs.is_empty() {
                         "none: it follows the scene's profiles".to_string()
                     } else {
                         inputs.join(", ")
                     }
-                )
+                ))
             })
     }
 
@@ -292,35 +296,35 @@ impl CoSimulation {
     }
 
     /// Sets the String parameter standing for `q` (the engine, the recording's path).
-    pub fn set_string_parameter(&mut self, q: Quantity, value: &str) -> Result<(), String> {
+    pub fn set_string_parameter(&mut self, q: Quantity, value: &str) -> Result<()> {
         let vr = self
             .vars
             .iter()
             .find(|v| v.quantity == q && v.kind == Kind::String)
             .map(|v| v.vr)
-            .ok_or_else(|| format!("no String parameter stands for {q:?}"))?;
+            .ok_or_else(|| Error::Call(format!("no String parameter stands for {q:?}")))?;
         self.set_string(vr, value)
     }
 
     /// Starts the run with the parameters and inputs set; steps land on `stop_time_s` if
     /// given. Bad parameters (the engine, the duration limit, a recording path the output
     /// policy refuses) are an error before any work.
-    pub fn start(&mut self, stop_time_s: Option<f64>) -> Result<(), String> {
+    pub fn start(&mut self, stop_time_s: Option<f64>) -> Result<()> {
         if self.stage() != Stage::Setup {
-            return Err("the run has already started".into());
+            return Err(Error::Call("the run has already started".into()));
         }
         let engine_name = self.string_of(Quantity::Engine);
         let engine = EngineChoice::from_name(&engine_name).ok_or_else(|| {
-            format!(
+            Error::BadInput(format!(
                 "engine = {engine_name:?}: expected one of {}",
                 EngineChoice::names().join(", ")
-            )
+            ))
         })?;
         let limit = self.duration_limit_s();
         if !(limit.is_finite() && limit > 0.0) {
-            return Err(format!(
+            return Err(Error::BadInput(format!(
                 "duration_limit_s = {limit}: expected a positive time in s"
-            ));
+            )));
         }
         let path = self.string_of(Quantity::RecordingPath);
         if !path.is_empty() {
@@ -333,7 +337,11 @@ impl CoSimulation {
                 )],
                 &inputs,
             )
-            .map_err(|e| format!("{e} (leave recording_path empty to run without a recording)"))?;
+            .map_err(|e| {
+                Error::BadInput(format!(
+                    "{e} (leave recording_path empty to run without a recording)"
+                ))
+            })?;
         }
         let recording = (!path.is_empty()).then(|| RecordingRequest {
             path: PathBuf::from(&path),
@@ -344,19 +352,15 @@ impl CoSimulation {
         if self.scene.network.is_some() {
             return self.start_network(engine, recording, stop_time_s);
         }
-        let sim = Simulation::new(self.scene.clone(), Some(engine)).map_err(|e| e.to_string())?;
-        let mut session = sim
-            .start(SessionRequest {
-                driven: self.driven,
-                stop_time_s,
-                recording,
-                keep_history: false,
-            })
-            .map_err(|e| e.to_string())?;
+        let sim = Simulation::new(self.scene.clone(), Some(engine))?;
+        let mut session = sim.start(SessionRequest {
+            driven: self.driven,
+            stop_time_s,
+            recording,
+            keep_history: false,
+        })?;
         if self.driven.any() {
-            session
-                .set_inputs(&self.inputs())
-                .map_err(|e| e.to_string())?;
+            session.set_inputs(&self.inputs())?;
         }
         self.snapshot = session.snapshot();
         self.session = Some(session);
@@ -381,21 +385,25 @@ impl CoSimulation {
 
     /// Sets a Real variable (`fmi2SetReal`): a parameter before the run starts, an input
     /// (within its scene key's bound) until the run ends, never an output.
-    pub fn set_real(&mut self, vr: u32, value: f64) -> Result<(), String> {
+    pub fn set_real(&mut self, vr: u32, value: f64) -> Result<()> {
         let stage = self.stage();
         let v = self.variable(Kind::Real, vr)?;
         match v.causality {
-            Causality::Output => Err(format!("{} is an output: it cannot be set", v.name)),
-            Causality::Parameter if stage != Stage::Setup => Err(format!(
+            Causality::Output => Err(Error::Call(format!(
+                "{} is an output: it cannot be set",
+                v.name
+            ))),
+            Causality::Parameter if stage != Stage::Setup => Err(Error::Call(format!(
                 "{} is a fixed parameter: set it before the run starts \
                  (fmi2ExitInitializationMode)",
                 v.name
-            )),
-            _ if !value.is_finite() => {
-                Err(format!("{} = {value}: expected a finite value", v.name))
-            }
+            ))),
+            _ if !value.is_finite() => Err(Error::BadInput(format!(
+                "{} = {value}: expected a finite value",
+                v.name
+            ))),
             Causality::Input if matches!(stage, Stage::Ended | Stage::Failed) => {
-                Err(format!("{}: the run has ended", v.name))
+                Err(Error::Call(format!("{}: the run has ended", v.name)))
             }
             Causality::Input => {
                 match v.quantity {
@@ -430,7 +438,7 @@ impl CoSimulation {
     /// or, for the shaft's speed, also its second derivative (`order` 2) over the coming
     /// communication steps, until its value is set again (a first- or second-order hold).
     /// Only the shaft's speed and drive torque take derivatives.
-    pub fn set_real_derivative(&mut self, vr: u32, order: i32, value: f64) -> Result<(), String> {
+    pub fn set_real_derivative(&mut self, vr: u32, order: i32, value: f64) -> Result<()> {
         let stage = self.stage();
         let v = self.variable(Kind::Real, vr)?;
         let most = match v.quantity {
@@ -438,25 +446,25 @@ impl CoSimulation {
             _ => 0,
         };
         if most == 0 {
-            return Err(format!(
+            return Err(Error::Call(format!(
                 "{}: only the shaft's speed or drive torque take an input derivative",
                 v.name
-            ));
+            )));
         }
         if !(1..=most).contains(&order) {
-            return Err(format!(
+            return Err(Error::BadInput(format!(
                 "{}: derivative of order {order}: it takes orders 1 to {most}",
                 v.name
-            ));
+            )));
         }
         if !value.is_finite() {
-            return Err(format!(
+            return Err(Error::BadInput(format!(
                 "{}: slope {value}: expected a finite value",
                 v.name
-            ));
+            )));
         }
         if matches!(stage, Stage::Ended | Stage::Failed) {
-            return Err(format!("{}: the run has ended", v.name));
+            return Err(Error::Call(format!("{}: the run has ended", v.name)));
         }
         self.slopes[vr as usize][order as usize - 1] = value;
         Ok(())
@@ -469,7 +477,7 @@ impl CoSimulation {
         name: &str,
         value: f64,
         derivatives: [Option<f64>; 2],
-    ) -> Result<(), String> {
+    ) -> Result<()> {
         let vr = self.input_named(name)?;
         self.set_real(vr, value)?;
         for (order, d) in (1..).zip(derivatives) {
@@ -481,22 +489,22 @@ impl CoSimulation {
     }
 
     /// Sets a String parameter (`fmi2SetString`), before the run starts.
-    pub fn set_string(&mut self, vr: u32, value: &str) -> Result<(), String> {
+    pub fn set_string(&mut self, vr: u32, value: &str) -> Result<()> {
         let stage = self.stage();
         let v = self.variable(Kind::String, vr)?;
         if stage != Stage::Setup {
-            return Err(format!(
+            return Err(Error::Call(format!(
                 "{} is a fixed parameter: set it before the run starts \
                  (fmi2ExitInitializationMode)",
                 v.name
-            ));
+            )));
         }
         self.strings[vr as usize] = value.to_string();
         Ok(())
     }
 
     /// A String variable (`fmi2GetString`).
-    pub fn get_string(&self, vr: u32) -> Result<&str, String> {
+    pub fn get_string(&self, vr: u32) -> Result<&str> {
         self.variable(Kind::String, vr)?;
         Ok(&self.strings[vr as usize])
     }
@@ -511,7 +519,7 @@ impl CoSimulation {
     }
 
     /// An Integer variable (`fmi2GetInteger`: the impacts so far, the last impact's body).
-    pub fn get_integer(&self, vr: u32) -> Result<i32, String> {
+    pub fn get_integer(&self, vr: u32) -> Result<i32> {
         let v = self.variable(Kind::Integer, vr)?;
         if v.quantity == Quantity::LastImpact(ImpactField::Body) {
             return Ok(self.last_impact().map_or(0, |e| e.disc as i32 + 1));
@@ -526,7 +534,7 @@ impl CoSimulation {
 
     /// A Real variable (`fmi2GetReal`): a parameter or input as set, an output as computed
     /// at the run's time (SI units: the variable's).
-    pub fn get_real(&self, vr: u32) -> Result<f64, String> {
+    pub fn get_real(&self, vr: u32) -> Result<f64> {
         let v = self.variable(Kind::Real, vr)?;
         if v.causality != Causality::Output {
             return Ok(self.reals[vr as usize]);
@@ -576,7 +584,7 @@ impl CoSimulation {
     }
 
     /// Every output's `(name, value)` now (the Integer ones as floats), in table order.
-    pub fn outputs(&self) -> Result<Vec<(String, f64)>, String> {
+    pub fn outputs(&self) -> Result<Vec<(String, f64)>> {
         self.vars
             .iter()
             .filter(|v| v.causality == Causality::Output)
@@ -631,7 +639,7 @@ impl CoSimulation {
     /// at the engine's progress polls) ends it early: `Ok(false)`, the run standing at an
     /// earlier time. A bad input leaves the run usable; an engine failure does not
     /// ([`Stage::Failed`]).
-    pub fn advance_to(&mut self, t_end: f64, stop: Option<&AtomicBool>) -> Result<bool, String> {
+    pub fn advance_to(&mut self, t_end: f64, stop: Option<&AtomicBool>) -> Result<bool> {
         self.advance_polled(t_end, stop, None)
     }
 
@@ -642,12 +650,12 @@ impl CoSimulation {
         t_end: f64,
         stop: Option<&'a AtomicBool>,
         progress: Option<&'a mut dyn FnMut(f64)>,
-    ) -> Result<bool, String> {
+    ) -> Result<bool> {
         if self.stage() != Stage::Running {
-            return Err(format!(
+            return Err(Error::Call(format!(
                 "advancing in {:?}: allowed only after the run has started",
                 self.stage()
-            ));
+            )));
         }
         if self.network.is_some() {
             return self.advance_network(t_end, stop);
@@ -656,17 +664,17 @@ impl CoSimulation {
         let inputs = self.inputs();
         let session = self.session.as_mut().expect("a session while running");
         if self.driven.any() {
-            session.set_inputs(&inputs).map_err(|e| e.to_string())?;
+            session.set_inputs(&inputs)?;
         }
         match session.advance_polled(t_end, stop, progress) {
             Ok(a) => {
                 self.snapshot = session.snapshot();
                 Ok(a == Advance::Reached)
             }
-            Err(e) if e.is_bad_input() => Err(e.to_string()),
             Err(e) => {
-                self.failed = true;
-                Err(e.to_string())
+                // a bad input leaves the run usable; an engine failure does not
+                self.failed |= !e.is_bad_input();
+                Err(e)
             }
         }
     }
@@ -674,7 +682,7 @@ impl CoSimulation {
     /// Each input held with its derivatives (a first- or second-order hold) from the run's
     /// time to `t_end` (s) stays within its scene key's bound at `t_end`: a slope cannot
     /// carry an input where its value could not be set.
-    fn check_held_inputs(&self, t_end: f64) -> Result<(), String> {
+    fn check_held_inputs(&self, t_end: f64) -> Result<()> {
         let dt = t_end - self.time_s();
         for v in &self.vars {
             let Quantity::Input(i) = v.quantity else {
@@ -747,7 +755,7 @@ impl CoSimulation {
     }
 
     /// Saves the whole state (not while recording: a recording cannot be rewound).
-    pub fn save(&self) -> Result<SavedCoSimulation, String> {
+    pub fn save(&self) -> Result<SavedCoSimulation> {
         if let Some(n) = self
             .network
             .as_ref()
@@ -756,7 +764,7 @@ impl CoSimulation {
             return Ok(SavedCoSimulation {
                 run: self.run,
                 scene: self.scene.name.clone(),
-                session: SavedRun::Network(Box::new(n.save().map_err(|e| e.to_string())?)),
+                session: SavedRun::Network(Box::new(n.save()?)),
                 reals: self.reals.clone(),
                 slopes: self.slopes.clone(),
                 snapshot: self.snapshot.clone(),
@@ -767,11 +775,16 @@ impl CoSimulation {
             .session
             .as_ref()
             .filter(|_| self.stage() == Stage::Running)
-            .ok_or("a state can be saved while the run goes (after fmi2ExitInitializationMode)")?;
+            .ok_or_else(|| {
+                Error::Call(
+                    "a state can be saved while the run goes (after fmi2ExitInitializationMode)"
+                        .into(),
+                )
+            })?;
         Ok(SavedCoSimulation {
             run: self.run,
             scene: self.scene.name.clone(),
-            session: SavedRun::Pack(Box::new(s.save().map_err(|e| e.to_string())?)),
+            session: SavedRun::Pack(Box::new(s.save()?)),
             reals: self.reals.clone(),
             slopes: self.slopes.clone(),
             snapshot: self.snapshot.clone(),
@@ -782,17 +795,30 @@ impl CoSimulation {
     /// Restores a state this run saved (never another instance's, another scene's, or one
     /// from before a reset; a recorded run saves none, so it is never rewound); a failed run
     /// goes on from the state.
-    pub fn restore(&mut self, state: &SavedCoSimulation) -> Result<(), String> {
+    pub fn restore(&mut self, state: &SavedCoSimulation) -> Result<()> {
         same_run(state.run, &state.scene, self.run, &self.scene.name)?;
-        let going = "a state can be restored while the run goes (after fmi2ExitInitializationMode)";
+        let going = || {
+            Error::Call(
+                "a state can be restored while the run goes (after fmi2ExitInitializationMode)"
+                    .into(),
+            )
+        };
         match &state.session {
             SavedRun::Pack(saved) => {
-                let s = self.session.as_mut().filter(|_| !self.ended).ok_or(going)?;
-                s.restore(saved).map_err(|e| e.to_string())?;
+                let s = self
+                    .session
+                    .as_mut()
+                    .filter(|_| !self.ended)
+                    .ok_or_else(going)?;
+                s.restore(saved)?;
             }
             SavedRun::Network(saved) => {
-                let n = self.network.as_mut().filter(|_| !self.ended).ok_or(going)?;
-                n.restore(saved).map_err(|e| e.to_string())?;
+                let n = self
+                    .network
+                    .as_mut()
+                    .filter(|_| !self.ended)
+                    .ok_or_else(going)?;
+                n.restore(saved)?;
                 (self.network_outputs, self.network_pushed) = state.network.clone();
             }
         }

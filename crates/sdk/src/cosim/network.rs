@@ -3,7 +3,7 @@
 //! read after each advance (docs/DECISIONS.md, "Network recordings and inputs").
 
 use super::{next_run, CoSimulation, Quantity};
-use crate::RecordingRequest;
+use crate::{RecordingRequest, Result};
 use clutchpack_scene::EngineChoice;
 use std::sync::atomic::AtomicBool;
 
@@ -15,7 +15,7 @@ impl CoSimulation {
         engine: EngineChoice,
         recording: Option<RecordingRequest>,
         stop_time_s: Option<f64>,
-    ) -> Result<(), String> {
+    ) -> Result<()> {
         let names: Vec<String> = self
             .vars
             .iter()
@@ -28,8 +28,7 @@ impl CoSimulation {
             &names,
             recording.as_ref(),
             stop_time_s,
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         self.network = Some(sim);
         self.network_pushed = vec![f64::NAN; names.len()];
         self.push_network_inputs()?;
@@ -40,7 +39,7 @@ impl CoSimulation {
 
     /// Hands the network's inputs that changed since the last call to its run (held from
     /// now on).
-    fn push_network_inputs(&mut self) -> Result<(), String> {
+    fn push_network_inputs(&mut self) -> Result<()> {
         let Some(sim) = self.network.as_mut() else {
             return Ok(());
         };
@@ -50,7 +49,7 @@ impl CoSimulation {
             };
             let x = self.reals[v.vr as usize];
             if self.network_pushed.get(j) != Some(&x) {
-                sim.set_input(&v.name, x).map_err(|e| e.to_string())?;
+                sim.set_input(&v.name, x)?;
                 self.network_pushed[j] = x;
             }
         }
@@ -69,7 +68,7 @@ impl CoSimulation {
         &mut self,
         t_end: f64,
         stop: Option<&AtomicBool>,
-    ) -> Result<bool, String> {
+    ) -> Result<bool> {
         self.push_network_inputs()?;
         let sim = self.network.as_mut().expect("a network while running");
         let result = sim.advance_to(t_end, stop);
@@ -77,10 +76,10 @@ impl CoSimulation {
         self.refresh_network_outputs();
         match result {
             Ok(()) => Ok(reached),
-            Err(e @ crate::Error::BadInput(_)) => Err(e.to_string()),
             Err(e) => {
-                self.failed = true;
-                Err(e.to_string())
+                // a bad input (a value, a call) leaves the run usable; an engine failure not
+                self.failed |= !e.is_bad_input();
+                Err(e)
             }
         }
     }

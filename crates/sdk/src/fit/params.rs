@@ -24,27 +24,28 @@ pub struct FitParam {
 }
 
 impl FromStr for FitParam {
-    type Err = String;
+    type Err = Error;
 
-    /// `KEY`, `KEY=START`, `KEY:LO:HI`, `KEY=START:LO:HI`, each optionally ending `:log`.
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
+    /// `KEY`, `KEY=START`, `KEY:LO:HI`, `KEY=START:LO:HI`, each optionally ending `:log`;
+    /// anything else is [`Error::BadInput`] naming the argument.
+    fn from_str(s: &str) -> Result<Self> {
         let mut parts: Vec<&str> = s.split(':').collect();
         let log = parts.len() > 1 && parts.last() == Some(&"log");
         if log {
             parts.pop();
         }
         let num = |t: &str, what: &str| {
-            t.trim()
-                .parse::<f64>()
-                .map_err(|_| format!("--param {s:?}: {what} {t:?} is not a number"))
+            t.trim().parse::<f64>().map_err(|_| {
+                Error::BadInput(format!("--param {s:?}: {what} {t:?} is not a number"))
+            })
         };
         let (lower, upper) = match parts.len() {
             1 => (f64::NEG_INFINITY, f64::INFINITY),
             3 => (num(parts[1], "lower bound")?, num(parts[2], "upper bound")?),
             _ => {
-                return Err(format!(
+                return Err(Error::BadInput(format!(
                     "--param {s:?}: expected KEY[=START][:LO:HI][:log] (bounds come as a pair)"
-                ))
+                )))
             }
         };
         let (key, start) = match parts[0].split_once('=') {
@@ -52,7 +53,7 @@ impl FromStr for FitParam {
             None => (parts[0], None),
         };
         if key.trim().is_empty() {
-            return Err(format!("--param {s:?}: no key"));
+            return Err(Error::BadInput(format!("--param {s:?}: no key")));
         }
         Ok(FitParam {
             key: key.trim().to_string(),
@@ -77,28 +78,31 @@ pub struct FitSignal {
 }
 
 impl FromStr for FitSignal {
-    type Err = String;
+    type Err = Error;
 
     /// `SIGNAL`, `SIGNAL=COLUMN` or `SIGNAL=COLUMN:WEIGHT` (the column defaults to the
-    /// signal's name, the weight to 1).
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
+    /// signal's name, the weight to 1); anything else is [`Error::BadInput`] naming the
+    /// argument.
+    fn from_str(s: &str) -> Result<Self> {
         let (signal, rest) = s.split_once('=').unwrap_or((s, s));
         let (column, weight) = match rest.rsplit_once(':') {
             Some((c, w)) => (
                 c,
-                w.trim()
-                    .parse::<f64>()
-                    .map_err(|_| format!("--match {s:?}: weight {w:?} is not a number"))?,
+                w.trim().parse::<f64>().map_err(|_| {
+                    Error::BadInput(format!("--match {s:?}: weight {w:?} is not a number"))
+                })?,
             ),
             None => (rest, 1.0),
         };
         if !(weight.is_finite() && weight > 0.0) {
-            return Err(format!(
+            return Err(Error::BadInput(format!(
                 "--match {s:?}: the weight must be > 0, got {weight}"
-            ));
+            )));
         }
         if signal.trim().is_empty() || column.trim().is_empty() {
-            return Err(format!("--match {s:?}: expected SIGNAL=COLUMN[:WEIGHT]"));
+            return Err(Error::BadInput(format!(
+                "--match {s:?}: expected SIGNAL=COLUMN[:WEIGHT]"
+            )));
         }
         Ok(FitSignal {
             signal: signal.trim().to_string(),

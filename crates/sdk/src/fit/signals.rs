@@ -213,9 +213,8 @@ pub(crate) fn series(
         return Ok(signals.iter().map(|s| s.at(&outcome.history, t)).collect());
     }
     let bad = Error::BadInput;
-    let mut co = CoSimulation::driving(scene.clone(), Driven::NONE).map_err(bad)?;
-    co.set_string_parameter(crate::cosim::Quantity::Engine, engine.name())
-        .map_err(bad)?;
+    let mut co = CoSimulation::driving(scene.clone(), Driven::NONE)?;
+    co.set_string_parameter(crate::cosim::Quantity::Engine, engine.name())?;
     let vrs = signals
         .iter()
         .map(|s| {
@@ -230,7 +229,7 @@ pub(crate) fn series(
                 .ok_or_else(|| bad(format!("{s:?} is not a series of a pack's run")))
         })
         .collect::<Result<Vec<u32>>>()?;
-    co.start(None).map_err(bad)?;
+    co.start(None)?;
     let mut out = vec![Vec::with_capacity(t.len()); signals.len()];
     for &ti in t {
         if ti > co.time_s() {
@@ -243,12 +242,12 @@ pub(crate) fn series(
                     if let Some(Err(e)) = co.outcome().map(|o| o.stats().map(|_| ())) {
                         return Err(e);
                     }
-                    return Err(bad(e));
+                    return Err(e);
                 }
             }
         }
         for (k, &vr) in vrs.iter().enumerate() {
-            out[k].push(co.get_real(vr).map_err(bad)?);
+            out[k].push(co.get_real(vr)?);
         }
     }
     let _ = co.finish();
