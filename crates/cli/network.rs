@@ -321,7 +321,7 @@ fn plot(
     let bodies: Vec<(&str, bool)> = net
         .bodies
         .iter()
-        .map(|b| (b.name.as_str(), b.fixed))
+        .map(|b| (b.name.as_str(), b.is_fixed()))
         .collect();
     let couplings: Vec<&str> = net.couplings.iter().map(|c| c.name.as_str()).collect();
     // an automatic's output torque (a transmission with a schedule)

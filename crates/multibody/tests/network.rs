@@ -181,7 +181,7 @@ fn geared_dual_clutch_matches_the_reference_engine() {
         inertia_kg_m2: j,
         drag_n_m_s_rad: 0.0,
         initial_speed_rad_s: w,
-        fixed: false,
+        motion: Motion::Free,
         drive,
         firing: None,
         road_load: None,
@@ -297,7 +297,7 @@ fn brake_to_the_ground_stops_and_holds() {
         inertia_kg_m2: 2.0,
         drag_n_m_s_rad: 0.0,
         initial_speed_rad_s: w,
-        fixed,
+        motion: if fixed { Motion::Fixed } else { Motion::Free },
         drive: None,
         firing: None,
         road_load: None,
@@ -345,7 +345,7 @@ fn upshift_handover_converges_to_the_reference_engine() {
         inertia_kg_m2: j,
         drag_n_m_s_rad: 0.0,
         initial_speed_rad_s: w,
-        fixed: false,
+        motion: Motion::Free,
         drive: None,
         firing: None,
         road_load: None,
@@ -476,7 +476,7 @@ fn brake_and_parallel_clutches_match_the_reference_engine() {
         inertia_kg_m2: j,
         drag_n_m_s_rad: 0.0,
         initial_speed_rad_s: w,
-        fixed: false,
+        motion: Motion::Free,
         drive: None,
         firing: None,
         road_load: None,
@@ -495,7 +495,7 @@ fn brake_and_parallel_clutches_match_the_reference_engine() {
         }),
     };
     let mut ground = body("ground", 1.0, 0.0);
-    ground.fixed = true;
+    ground.motion = Motion::Fixed;
     let mut engine = body("engine", 0.3, 30.0);
     engine.drive = Some(Signal::Sum(vec![
         Signal::Constant(40.0),
@@ -693,7 +693,7 @@ fn free_body(name: &str, j: f64, w: f64) -> Body {
         inertia_kg_m2: j,
         drag_n_m_s_rad: 0.0,
         initial_speed_rad_s: w,
-        fixed: false,
+        motion: Motion::Free,
         drive: None,
         firing: None,
         road_load: None,
@@ -1007,7 +1007,7 @@ fn free_impact_on_a_fixed_gear_matches_closed_form() {
         ..cases::dry_gear_mesh(true)
     };
     let mut ground = free_body("ground", 1.0, 0.0);
-    ground.fixed = true;
+    ground.motion = Motion::Fixed;
     let net = meshed(free_body("pinion", j_a, v0 / 0.03), ground, g.clone());
     let (run, obs) = multibody(&net, 1.3e-3, 1e-4);
     assert_eq!(obs.2.len(), 1, "{:?}", obs.2);

@@ -108,7 +108,7 @@ pub fn network_inputs(net: &Network) -> Vec<(String, NetworkInput)> {
         .bodies
         .iter()
         .enumerate()
-        .filter(|(_, b)| !b.fixed && (b.drive.is_some() || b.firing.is_some()))
+        .filter(|(_, b)| !b.is_fixed() && (b.drive.is_some() || b.firing.is_some()))
         .map(|(i, b)| {
             (
                 format!("bodies.{}.drive_torque_n_m", segment(&b.name)),

@@ -92,7 +92,7 @@ pub fn wet_clutch(n: usize, clamp_n: f64) -> PackModel {
 /// unused). `None` unless the shaft is inertial and driven by a harmonic speed profile, and
 /// the pack has no couplings of its own. A network run of it is the pack's own run.
 pub fn pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
-    use crate::network::{Body, Coupling, CouplingKind, Network, Signal};
+    use crate::network::{Body, Coupling, CouplingKind, Motion, Network, Signal};
     let Shaft::Inertial {
         inertia_kg_m2,
         damping_n_m_s_rad,
@@ -125,7 +125,7 @@ pub fn pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
         inertia_kg_m2: *inertia_kg_m2,
         drag_n_m_s_rad: *damping_n_m_s_rad,
         initial_speed_rad_s: pack.shaft.initial_speed_rad_s(),
-        fixed: false,
+        motion: Motion::Free,
         drive: Some(drive),
         firing: None,
         road_load: None,
@@ -136,7 +136,7 @@ pub fn pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
             inertia_kg_m2: d.inertia_kg_m2,
             drag_n_m_s_rad: d.drag_n_m_s_rad,
             initial_speed_rad_s: d.initial_speed_rad_s,
-            fixed: false,
+            motion: Motion::Free,
             drive: Some(Signal::Constant(d.load_torque_n_m)),
             firing: None,
             road_load: None,
@@ -146,7 +146,7 @@ pub fn pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
             inertia_kg_m2: 0.0,
             drag_n_m_s_rad: 0.0,
             initial_speed_rad_s: 0.0,
-            fixed: true,
+            motion: Motion::Fixed,
             drive: None,
             firing: None,
             road_load: None,

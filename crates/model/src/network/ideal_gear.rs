@@ -52,13 +52,13 @@ impl ElementLaw for IdealGear {
             return false;
         }
         let (ba, bb) = (&net.bodies[ports[0]], &net.bodies[ports[1]]);
-        if ba.fixed != bb.fixed {
+        if ba.is_fixed() != bb.is_fixed() {
             out.push(problem(
                 k,
                 "b",
                 format!(
                     "an ideal gear from a fixed body would hold \"{}\" still: make it fixed instead",
-                    if ba.fixed { &bb.name } else { &ba.name }
+                    if ba.is_fixed() { &bb.name } else { &ba.name }
                 ),
             ));
             return false;

@@ -30,7 +30,7 @@ impl ElementLaw for PackModel {
         out: &mut Vec<NetworkProblem>,
     ) -> bool {
         let a = ports[0];
-        if net.bodies[a].fixed {
+        if net.bodies[a].is_fixed() {
             out.push(problem(
                 k,
                 "a",

@@ -87,6 +87,12 @@ pub(super) struct NetPack {
     session: MultibodySession,
     /// Whether the plates sit on the fixed body (no drum).
     pub housing: bool,
+    /// Whether the discs' carrier is a prescribed body: the session's shaft is then
+    /// prescribed by its profile (as a one-pack scene's), and its reaction on it is the teeth's
+    /// work over the step (the session's drive work) on the step's mean speed.
+    pub prescribed: bool,
+    /// The session's drive work at the last step's end, J (a prescribed shaft's).
+    drive_work_j: f64,
     /// The discs' then the plates' inertias, kg m^2.
     inertia: Vec<f64>,
     /// How many of them are friction discs (on `a`).
@@ -141,25 +147,38 @@ impl NetPack {
         let mut out = Vec::new();
         for (k, c) in net.couplings.iter().enumerate() {
             let Some(model) = c.pack() else { continue };
-            if net.bodies[c.a].fixed {
+            if net.bodies[c.a].is_fixed() {
                 return Err(EngineError::Unsupported(format!(
                     "coupling \"{}\": its friction discs' carrier is the fixed body (put the \
                      plates there: body b)",
                     c.name
                 )));
             }
+            if net.bodies[c.b].prescribed().is_some() {
+                return Err(EngineError::Unsupported(format!(
+                    "coupling \"{}\": its plates' carrier is a prescribed body: put the \
+                     friction discs there (body a), the plates on a body that turns freely or \
+                     on the fixed one",
+                    c.name
+                )));
+            }
             let (pa, pb) = (p(c.a), p(c.b));
-            let housing = net.bodies[c.b].fixed;
+            let housing = net.bodies[c.b].is_fixed();
+            let prescribed = net.bodies[c.a].prescribed().cloned();
             let mut pack = model.clone();
-            pack.shaft = Shaft::Inertial {
-                inertia_kg_m2: 1.0 / pa[c.a],
-                damping_n_m_s_rad: 0.0,
-                excitation: ShaftExcitation::Held {
-                    t0_s: 0.0,
-                    torque_n_m: 0.0,
-                    rate_n_m_s: 0.0,
-                    initial_speed_rad_s: w[c.a],
-                },
+            pack.shaft = if let Some(profile) = &prescribed {
+                Shaft::Prescribed(profile.clone())
+            } else {
+                Shaft::Inertial {
+                    inertia_kg_m2: 1.0 / pa[c.a],
+                    damping_n_m_s_rad: 0.0,
+                    excitation: ShaftExcitation::Held {
+                        t0_s: 0.0,
+                        torque_n_m: 0.0,
+                        rate_n_m_s: 0.0,
+                        initial_speed_rad_s: w[c.a],
+                    },
+                }
             };
             pack.drum = (!housing).then(|| DrumModel {
                 inertia_kg_m2: 1.0 / pb[c.b],
@@ -187,7 +206,7 @@ impl NetPack {
             .with_thermal(net.pack_thermal.get(&k).cloned());
             let session = engine
                 .session(Driven {
-                    shaft_torque: true,
+                    shaft_torque: prescribed.is_none(),
                     drum_load: !housing,
                     ..Driven::NONE
                 })
@@ -198,6 +217,8 @@ impl NetPack {
                 b: c.b,
                 session,
                 housing,
+                prescribed: prescribed.is_some(),
+                drive_work_j: 0.0,
                 inertia,
                 n_discs: model.discs.len(),
                 p_diag: [pa[c.a], if housing { 0.0 } else { pb[c.b] }],
@@ -231,7 +252,7 @@ impl NetPack {
     /// onto a carrier's group or releasing one changes the carrier's inertia `1 / P_aa`, which
     /// the session then takes ([`MultibodySession::set_carrier_inertia`]).
     pub fn follow_groups(&mut self, pa: &[f64], pb: &[f64], name: &str) -> Result<(), EngineError> {
-        if pa[self.a] != self.p_diag[0] {
+        if !self.prescribed && pa[self.a] != self.p_diag[0] {
             self.session
                 .set_carrier_inertia(false, 1.0 / pa[self.a])
                 .map_err(|e| in_pack(name, e))?;
@@ -262,17 +283,20 @@ impl NetPack {
     ) -> Result<[f64; 2], EngineError> {
         let h = t1 - self.session.time_s();
         let (wa0, wb0) = (w[self.a], w[self.b]);
-        let shaft = Carried {
+        // a prescribed shaft is the session's own (its profile, as the network's body)
+        let shaft = (!self.prescribed).then_some(Carried {
             speed_rad_s: wa0,
             torque_n_m: ta,
-        };
+        });
         let drum = (!self.housing).then_some(Carried {
             speed_rad_s: wb0,
             torque_n_m: tb,
         });
-        self.session
-            .set_carriers(shaft, drum)
-            .map_err(|e| in_pack(name, e))?;
+        if shaft.is_some() || drum.is_some() {
+            self.session
+                .set_carriers(shaft, drum)
+                .map_err(|e| in_pack(name, e))?;
+        }
         let mut fwd = Forward { k: self.k, obs };
         self.session
             .advance_to(t1, &mut fwd)
@@ -284,7 +308,20 @@ impl NetPack {
             // give -T; the estimate stands
             return Ok(self.reaction);
         }
-        let ra = (speed(false) - wa0) / (h * self.p_diag[0]) - ta;
+        let ra = if self.prescribed {
+            // the teeth's work on the discs over the step, -R_a wbar_a h (the session's
+            // drive work: the shaft's on the teeth)
+            let work = self.session.energy().drive_work_j;
+            let step = work - std::mem::replace(&mut self.drive_work_j, work);
+            let wbar = 0.5 * (wa0 + speed(false));
+            if wbar == 0.0 {
+                0.0
+            } else {
+                -step / (h * wbar)
+            }
+        } else {
+            (speed(false) - wa0) / (h * self.p_diag[0]) - ta
+        };
         let rb = if self.housing {
             0.0
         } else {
@@ -399,7 +436,9 @@ impl Run {
             // group the other carrier's estimate stays in (the cross term P_ab R_b, the
             // module's method)
             let apart = p.housing || negligible(pa[b], (pa[a] * pb[b]).sqrt());
-            let ta = if apart {
+            let ta = if p.prescribed {
+                0.0 // its profile's motion: no torque moves it
+            } else if apart {
                 (acc[a] - pa[a] * ra0 - pb[a] * rb0) / pa[a]
             } else {
                 (acc[a] - pa[a] * ra0) / pa[a]
