@@ -209,7 +209,7 @@ table! {
 table! {
     /// `[drive]`.
     RawDrive at "drive" {
-        /// what drives the shaft
+        /// what drives the shaft (in [bodies.speed], a network body's prescribed speed: sine, harmonics or speed_table)
         kind: "", Kind::Choice(&["sine", "harmonics", "speed_table", "torque_table"]), Dflt::Required;
         /// mean shaft speed
         omega0_rad_s: "rad/s", SPEED, Dflt::When("required for sine and harmonics");
