@@ -130,6 +130,12 @@ impl MultibodySession {
         Ok(())
     }
 
+    /// The drive's work since t = 0 up to now, J (a prescribed shaft's: the teeth's torque on
+    /// the discs on its turn; [`super::energy::EnergyAudit::drive_work_j`] as the run goes).
+    pub fn drive_work_so_far_j(&self) -> f64 {
+        self.run.energy.so_far().drive_work_j
+    }
+
     /// Every tooth contact open now, as it would close at the session's time (its peak the
     /// largest so far; `disc` the coupling's index, discs then plates), left open.
     pub fn open_impacts(&self) -> Vec<clutchpack_model::ImpactEvent> {

@@ -90,9 +90,11 @@ pub(super) struct NetPack {
     /// Whether the discs' carrier is a prescribed body: the session's shaft is then
     /// prescribed by its profile (as a one-pack scene's), and its reaction on it is the teeth's
     /// work over the step (the session's drive work) on the step's mean speed.
-    pub prescribed: bool,
-    /// The session's drive work at the last step's end, J (a prescribed shaft's).
+    pub prescribed: Option<clutchpack_model::SpeedProfile>,
+    /// The session's drive work at the last step's end, J (a prescribed shaft's), and the
+    /// network's time there, s (a session not driven may stand a world step past it).
     drive_work_j: f64,
+    t_last: f64,
     /// The discs' then the plates' inertias, kg m^2.
     inertia: Vec<f64>,
     /// How many of them are friction discs (on `a`).
@@ -217,8 +219,9 @@ impl NetPack {
                 b: c.b,
                 session,
                 housing,
-                prescribed: prescribed.is_some(),
+                prescribed: prescribed.clone(),
                 drive_work_j: 0.0,
+                t_last: 0.0,
                 inertia,
                 n_discs: model.discs.len(),
                 p_diag: [pa[c.a], if housing { 0.0 } else { pb[c.b] }],
@@ -252,7 +255,7 @@ impl NetPack {
     /// onto a carrier's group or releasing one changes the carrier's inertia `1 / P_aa`, which
     /// the session then takes ([`MultibodySession::set_carrier_inertia`]).
     pub fn follow_groups(&mut self, pa: &[f64], pb: &[f64], name: &str) -> Result<(), EngineError> {
-        if !self.prescribed && pa[self.a] != self.p_diag[0] {
+        if self.prescribed.is_none() && pa[self.a] != self.p_diag[0] {
             self.session
                 .set_carrier_inertia(false, 1.0 / pa[self.a])
                 .map_err(|e| in_pack(name, e))?;
@@ -284,7 +287,7 @@ impl NetPack {
         let h = t1 - self.session.time_s();
         let (wa0, wb0) = (w[self.a], w[self.b]);
         // a prescribed shaft is the session's own (its profile, as the network's body)
-        let shaft = (!self.prescribed).then_some(Carried {
+        let shaft = self.prescribed.is_none().then_some(Carried {
             speed_rad_s: wa0,
             torque_n_m: ta,
         });
@@ -308,16 +311,26 @@ impl NetPack {
             // give -T; the estimate stands
             return Ok(self.reaction);
         }
-        let ra = if self.prescribed {
+        let ra = if let Some(profile) = &self.prescribed {
             // the teeth's work on the discs over the step, -R_a wbar_a h (the session's
-            // drive work: the shaft's on the teeth)
-            let work = self.session.energy().drive_work_j;
-            let step = work - std::mem::replace(&mut self.drive_work_j, work);
-            let wbar = 0.5 * (wa0 + speed(false));
-            if wbar == 0.0 {
-                0.0
+            // drive work: the shaft's on the teeth); a step shorter than the times' precision
+            // keeps the estimate (its work, rounding, goes with the next step's)
+            // over the network's step (the session's own may end past it: its work is booked
+            // with the step that reaches it)
+            let h = t1 - std::mem::replace(&mut self.t_last, t1);
+            // the network's mean speed of the step (the session's shaft is booked at its own
+            // world steps' ends)
+            let wbar = 0.5 * (wa0 + profile.speed(t1));
+            if h <= 1e-12 * (1.0 + t1) {
+                self.reaction[0]
             } else {
-                -step / (h * wbar)
+                let work = self.session.drive_work_so_far_j();
+                let step = work - std::mem::replace(&mut self.drive_work_j, work);
+                if wbar == 0.0 {
+                    0.0
+                } else {
+                    -step / (h * wbar)
+                }
             }
         } else {
             (speed(false) - wa0) / (h * self.p_diag[0]) - ta
@@ -436,7 +449,7 @@ impl Run {
             // group the other carrier's estimate stays in (the cross term P_ab R_b, the
             // module's method)
             let apart = p.housing || negligible(pa[b], (pa[a] * pb[b]).sqrt());
-            let ta = if p.prescribed {
+            let ta = if p.prescribed.is_some() {
                 0.0 // its profile's motion: no torque moves it
             } else if apart {
                 (acc[a] - pa[a] * ra0 - pb[a] * rb0) / pa[a]
