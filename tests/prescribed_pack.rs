@@ -145,3 +145,88 @@ fn a_network_body_with_a_prescribed_speed_equals_the_pack_scene_it_replaces() {
         "prescribed work {work:?}"
     );
 }
+
+/// `scenes/pack-8-brake.toml` written as a network scene: its settings, the shaft a body at
+/// the scene's prescribed speed (`[bodies.speed]`, its `[drive]`), the fixed housing, and the
+/// pack file itself as the one resolved pack between them. Returns its path in `dir`.
+fn network_scene(dir: &Path) -> std::path::PathBuf {
+    let pack = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/pack-8-brake.toml");
+    let text = format!(
+        r#"
+name = "pack-8-brake"
+[simulation]
+duration_s = 0.3
+engine = "multibody"
+record_rate_hz = 10000.0
+max_step_s = 1e-4
+[[bodies]]
+name = "shaft"
+[bodies.speed]
+kind = "sine"
+omega0_rad_s = 200.0
+amplitude_rad_s = 4.378
+frequency_hz = 104.0
+[[bodies]]
+name = "housing"
+fixed = true
+[[couplings]]
+name = "brake"
+kind = "pack"
+a = "shaft"
+b = "housing"
+pack = {pack:?}
+"#
+    );
+    let path = dir.join("network.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A network whose only element is one resolved pack between a prescribed shaft and the
+/// housing is that pack's scene (`Network::one_pack`; docs/DECISIONS.md, "A one-pack network
+/// is a pack scene"): `scenes/pack-8-brake.toml` written as such a network gives the pack
+/// scene's impacts CSV byte for byte, its summary JSON (wall time aside) and its printed
+/// tables (the wall time's line aside), on both engines.
+#[test]
+fn a_one_pack_network_runs_the_pack_session_bit_for_bit() {
+    let d = scratch("one-pack-network");
+    let net = network_scene(&d);
+    let wall = |v: &mut serde_json::Value| {
+        v.as_object_mut().unwrap().remove("wall_time_s");
+    };
+    for engine in ["multibody", "reference"] {
+        let mut outputs = Vec::new();
+        for (what, scene) in [
+            ("pack", "scenes/pack-8-brake.toml"),
+            ("net", net.to_str().unwrap()),
+        ] {
+            let (json, csv) = (
+                d.join(format!("{what}-{engine}.json")),
+                d.join(format!("{what}-{engine}.csv")),
+            );
+            let o = run(&[
+                "run",
+                scene,
+                "--engine",
+                engine,
+                "--no-record",
+                "--summary-json",
+                json.to_str().unwrap(),
+                "--impacts-csv",
+                csv.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{}", stderr(&o));
+            let mut summary = super::read_json(&json);
+            wall(&mut summary);
+            let text: Vec<String> = super::stdout(&o)
+                .lines()
+                .filter(|l| !l.contains(" s wall"))
+                .map(String::from)
+                .collect();
+            outputs.push((std::fs::read(&csv).unwrap(), summary, text));
+        }
+        assert!(outputs[0].0 == outputs[1].0, "{engine}: the impacts CSV");
+        assert_eq!(outputs[0].1, outputs[1].1, "{engine}: the summary");
+        assert_eq!(outputs[0].2, outputs[1].2, "{engine}: the printed tables");
+    }
+}

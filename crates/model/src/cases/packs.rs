@@ -268,4 +268,29 @@ mod tests {
         }
         assert_eq!(net.bodies[1].initial_speed_rad_s, 90.0);
     }
+
+    /// A one-pack network is the pack scene it was made from (`Network::one_pack`, the
+    /// inverse of [`pack_as_network`] for a prescribed shaft, on the housing or on a drum with
+    /// a constant load); a network that is not (an inertial shaft, a drum with a road load) is
+    /// none.
+    #[test]
+    fn a_one_pack_network_is_its_pack() {
+        let mut pack = engaging_clutch();
+        let inertial = pack_as_network(&pack).unwrap();
+        assert_eq!(inertial.one_pack(), None, "an inertial shaft");
+        pack.shaft = Shaft::Prescribed(SpeedProfile::sine(100.0, 2.0, 50.0));
+        let mut net = pack_as_network(&pack).unwrap();
+        assert!(net.problems().is_empty(), "{:?}", net.problems());
+        assert_eq!(net.one_pack().as_ref(), Some(&pack), "on a drum");
+        net.bodies[1].road_load = Some(crate::network::RoadLoad {
+            constant_n_m: 1.0,
+            linear_n_m_s_rad: 0.0,
+            quadratic_n_m_s2_rad2: 0.0,
+        });
+        assert_eq!(net.one_pack(), None, "a drum with a road load");
+        let brake = staggered_brake(4);
+        assert!(matches!(brake.shaft, Shaft::Prescribed(_)) && brake.drum.is_none());
+        let net = pack_as_network(&brake).unwrap();
+        assert_eq!(net.one_pack().as_ref(), Some(&brake), "on the housing");
+    }
 }
