@@ -80,7 +80,7 @@ pub enum Motion {
     /// angle, speed and acceleration are the profile's whatever the torques on it (an infinite
     /// inertia in the constraints, as a fixed body's, but turning); what ties other bodies to
     /// it (a locked clutch, a gear) makes them follow it, and the torque it takes to keep the
-    /// profile is its reaction ([`Network::reaction_torque_n_m`]), whose work the energy audit
+    /// profile is its reaction ([`NetworkSample::reaction_n_m`]), whose work the energy audit
     /// counts ([`NetworkEnergy::prescribed_work_j`]).
     Prescribed(crate::SpeedProfile),
 }

@@ -131,7 +131,7 @@ impl MultibodySession {
     }
 
     /// The drive's work since t = 0 up to now, J (a prescribed shaft's: the teeth's torque on
-    /// the discs on its turn; [`super::energy::EnergyAudit::drive_work_j`] as the run goes).
+    /// the discs on its turn; the energy audit's `drive_work_j` as the run goes).
     pub fn drive_work_so_far_j(&self) -> f64 {
         self.run.energy.so_far().drive_work_j
     }

@@ -341,7 +341,7 @@ mod tests {
         assert!((acc[0] - 10.0 / j).abs() < 1e-14);
         assert!((acc[1] - acc[0] / 2.0).abs() < 1e-14);
         let mut lam = [0.0; 2];
-        cl.rigid_torques(&torque, &mut lam);
+        cl.rigid_torques(&torque, &[0.0; 3], &mut lam);
         // body c is driven by g2 alone: -3 lambda2 = J3 a3
         assert!((-3.0 * lam[1] - 3.0 * acc[2]).abs() < 1e-13);
         // body a: J1 a1 = 10 + lambda1
