@@ -231,20 +231,9 @@ fn a_one_pack_network_runs_the_pack_session_bit_for_bit() {
     }
 }
 
-/// `clutchpack run` of a network with a prescribed body (`[bodies.speed]` from a speed table,
-/// `cases::prescribed_clutch` as a scene file) on both engines: the summary's energy names the
-/// prescribed work (474 J by the closed form, `prescribed_work_j`), the balance closes, the
-/// clutch locks at 0.5 s and the printed balance names the prescribed bodies. Measured
-/// 2026-12-07: the work within 1.2e-11 J (reference) and 4.4e-11 J (multibody), the balances
-/// 3.3e-11 and 1.7e-11 J, the lock at 0.5 s to 1e-13 s; asserted 1e-9 J, 1e-9 J and 1e-9 s.
-#[test]
-fn a_prescribed_network_scene_runs_and_counts_its_work() {
-    let d = scratch("prescribed-motor");
-    std::fs::write(d.join("w.csv"), "time_s,speed_rad_s\n0,20\n1,40\n").unwrap();
-    let scene = d.join("motor.toml");
-    std::fs::write(
-        &scene,
-        r#"
+/// `cases::prescribed_clutch` as a scene file: the motor's speed from `w.csv` (20 rad/s at
+/// t = 0 to 40 rad/s at 1 s), the load of 0.5 kg m^2, the clutch of 30 N m.
+const MOTOR: &str = r#"
 name = "motor"
 [simulation]
 duration_s = 0.8
@@ -268,9 +257,20 @@ max_normal_force_n = 1000.0
 [couplings.force]
 kind = "constant"
 value = 1.0
-"#,
-    )
-    .unwrap();
+"#;
+
+/// `clutchpack run` of a network with a prescribed body (`[bodies.speed]` from a speed table,
+/// `cases::prescribed_clutch` as a scene file) on both engines: the summary's energy names the
+/// prescribed work (474 J by the closed form, `prescribed_work_j`), the balance closes, the
+/// clutch locks at 0.5 s and the printed balance names the prescribed bodies. Measured
+/// 2026-12-07: the work within 1.2e-11 J (reference) and 4.4e-11 J (multibody), the balances
+/// 3.3e-11 and 1.7e-11 J, the lock at 0.5 s to 1e-13 s; asserted 1e-9 J, 1e-9 J and 1e-9 s.
+#[test]
+fn a_prescribed_network_scene_runs_and_counts_its_work() {
+    let d = scratch("prescribed-motor");
+    std::fs::write(d.join("w.csv"), "time_s,speed_rad_s\n0,20\n1,40\n").unwrap();
+    let scene = d.join("motor.toml");
+    std::fs::write(&scene, MOTOR).unwrap();
     for engine in ["reference", "multibody"] {
         let json = d.join(format!("{engine}.json"));
         let o = run(&[
@@ -296,4 +296,43 @@ value = 1.0
         assert!(residual.abs() <= 1e-9, "{engine}: residual {residual} J");
         assert!((lock - 0.5).abs() <= 1e-9, "{engine}: locks at {lock} s");
     }
+}
+
+/// A prescribed body's reaction is a co-simulation output (the FMU's and Python's
+/// `Simulation`'s table), named `bodies.<body>.reaction_torque_n_m`, on a prescribed body only:
+/// the motor holds the slipping clutch's 30 N m, then the locked load's `J A` = 10 N m
+/// (measured: exact to the printed digit on the reference engine, the co-simulation's
+/// default; asserted within 1e-9 N m).
+#[test]
+fn a_prescribed_bodys_reaction_is_a_co_simulation_output() {
+    let d = scratch("prescribed-cosim");
+    std::fs::write(d.join("w.csv"), "time_s,speed_rad_s\n0,20\n1,40\n").unwrap();
+    let path = d.join("motor.toml");
+    std::fs::write(&path, MOTOR).unwrap();
+    let scene = clutchpack_scene::load(&path, &[]).unwrap();
+    let mut co = clutchpack_sdk::CoSimulation::new(scene).unwrap();
+    let names: Vec<String> = co.variables().iter().map(|v| v.name.clone()).collect();
+    assert!(
+        names
+            .iter()
+            .any(|n| n == "bodies.motor.reaction_torque_n_m"),
+        "{names:?}"
+    );
+    assert!(!names.iter().any(|n| n == "bodies.load.reaction_torque_n_m"));
+    co.start(None).unwrap();
+    let reaction = |co: &clutchpack_sdk::CoSimulation| {
+        let out = co.outputs().unwrap();
+        out.iter()
+            .find(|(n, _)| n == "bodies.motor.reaction_torque_n_m")
+            .unwrap()
+            .1
+    };
+    co.advance_to(0.25, None).unwrap();
+    let slipping = reaction(&co);
+    co.advance_to(0.7, None).unwrap();
+    let locked = reaction(&co);
+    eprintln!("reaction {slipping} N m slipping, {locked} N m locked");
+    assert!((slipping - 30.0).abs() <= 1e-9, "{slipping}");
+    assert!((locked - 10.0).abs() <= 1e-9, "{locked}");
+    let _ = co.finish();
 }
