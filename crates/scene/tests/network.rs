@@ -251,8 +251,8 @@ value = 1.0
 
 /// `[bodies.speed]` makes a body prescribed (its profile, its speed at t = 0 the profile's);
 /// a prescribed body with an inertia, an initial speed, a drive, a drag, a torque table, or
-/// also fixed is refused at its key; so are a gear tying it to another prescribed body and a
-/// clutch that could lock it to the fixed body (over-constraints).
+/// also fixed is refused at its key; so are a gear tying it to another prescribed body or to
+/// the housing and a clutch that could lock it to the fixed body (over-constraints).
 #[test]
 fn prescribed_bodies_and_their_bad_keys() {
     let ok = parse(PRESCRIBED, "scenes/net.toml", Path::new("."), &[]).unwrap();
@@ -302,4 +302,14 @@ fn prescribed_bodies_and_their_bad_keys() {
     );
     let p = problems(&geared);
     has(&p, "couplings[1].b", "over-constrains its bodies");
+    // and a gear from it to the housing
+    let p = problems(&format!(
+        "{PRESCRIBED}\n[[couplings]]\nname = \"g\"\nkind = \"ideal_gear\"\na = \"motor\"\n\
+         b = \"housing\"\nratio = 1.0\n"
+    ));
+    has(
+        &p,
+        "couplings[1].b",
+        "ties the prescribed body \"motor\" to the fixed one",
+    );
 }

@@ -53,14 +53,20 @@ impl ElementLaw for IdealGear {
         }
         let (ba, bb) = (&net.bodies[ports[0]], &net.bodies[ports[1]]);
         if ba.is_fixed() != bb.is_fixed() {
-            out.push(problem(
-                k,
-                "b",
+            let other = if ba.is_fixed() { bb } else { ba };
+            let why = if other.prescribed().is_some() {
+                format!(
+                    "ties the prescribed body \"{}\" to the fixed one: both motions are given, \
+                     so the gear over-constrains them",
+                    other.name
+                )
+            } else {
                 format!(
                     "an ideal gear from a fixed body would hold \"{}\" still: make it fixed instead",
-                    if ba.is_fixed() { &bb.name } else { &ba.name }
-                ),
-            ));
+                    other.name
+                )
+            };
+            out.push(problem(k, "b", why));
             return false;
         }
         true
