@@ -4,6 +4,7 @@
 mod architecture;
 mod automatics;
 mod automatics_shift;
+mod common;
 mod cosim_hardening;
 mod cross_engine;
 mod fatigue;
@@ -14,6 +15,7 @@ mod hardening_networks;
 mod locked_packs;
 mod network;
 mod network_engines;
+mod prescribed_pack;
 mod python_package;
 mod reliability;
 mod salvage_and_messages;

@@ -143,7 +143,7 @@ fn gear_table(
     }
     let _ = write!(s, "\nspeeds per unit input speed:\n  {:>4}", "gear");
     let moving: Vec<usize> = (0..net.bodies.len())
-        .filter(|&i| !net.bodies[i].fixed)
+        .filter(|&i| !net.bodies[i].is_fixed())
         .collect();
     for &i in &moving {
         let _ = write!(s, " {:>9}", net.bodies[i].name);

@@ -288,8 +288,14 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
         );
     }
     let (e, residual_j) = (&s.energy.terms, s.energy.residual_j);
+    // the prescribed bodies' work, when there is one (other networks print as before)
+    let prescribed = if e.prescribed_work_j != 0.0 {
+        format!(", prescribed bodies {:.6} J", e.prescribed_work_j)
+    } else {
+        String::new()
+    };
     out!(
-        "energy: drives {:.6} J, loads {:.6} J, drag {:.6} J, clutch heat {:.6} J, packs {:.6} J, kinetic change {:.6} J (balance {:.3e} J)",
+        "energy: drives {:.6} J{prescribed}, loads {:.6} J, drag {:.6} J, clutch heat {:.6} J, packs {:.6} J, kinetic change {:.6} J (balance {:.3e} J)",
         e.drive_work_j,
         e.load_work_j,
         e.drag_loss_j,
@@ -321,7 +327,7 @@ fn plot(
     let bodies: Vec<(&str, bool)> = net
         .bodies
         .iter()
-        .map(|b| (b.name.as_str(), b.fixed))
+        .map(|b| (b.name.as_str(), b.is_fixed()))
         .collect();
     let couplings: Vec<&str> = net.couplings.iter().map(|c| c.name.as_str()).collect();
     // an automatic's output torque (a transmission with a schedule)

@@ -16,7 +16,11 @@ use crate::spline::{Flank, SplineGeometry};
 use crate::spring::SpringDamper;
 
 mod packs;
-pub use packs::{engaging_clutch, pack_as_network, wet_clutch};
+pub use packs::{
+    engaging_clutch, pack_as_network, prescribed_clutch, wet_clutch,
+    PRESCRIBED_CLUTCH_ACCEL_RAD_S2, PRESCRIBED_CLUTCH_J_KG_M2, PRESCRIBED_CLUTCH_TORQUE_N_M,
+    PRESCRIBED_CLUTCH_W0_RAD_S,
+};
 
 /// Mean shaft speed of the paper case, rad/s (MODEL.md section 4, assumed).
 pub const PAPER_OMEGA0_RAD_S: f64 = 200.0;
@@ -363,13 +367,13 @@ pub fn spring_pair(spring: SpringDamper, prescribed: bool) -> PackModel {
 /// (clutch2) and one at 0.9 s (clutch3). Its reference results are in
 /// `crates/reference/tests/network.rs`.
 pub fn coupled_clutches() -> crate::network::Network {
-    use crate::network::{Body, Coupling, CouplingKind, LumpedClutch, Network, Signal};
+    use crate::network::{Body, Coupling, CouplingKind, LumpedClutch, Motion, Network, Signal};
     let body = |name: &str, w: f64, drive: Option<Signal>| Body {
         name: name.into(),
         inertia_kg_m2: 1.0,
         drag_n_m_s_rad: 0.0,
         initial_speed_rad_s: w,
-        fixed: false,
+        motion: Motion::Free,
         drive,
         firing: None,
         road_load: None,
@@ -466,14 +470,14 @@ pub fn dry_gear_mesh(internal: bool) -> crate::network::GearMesh {
 /// oscillator's closed form `q(t) = q0 e^(-zeta wn t) (cos wd t + zeta wn / wd sin wd t)` with
 /// `wn^2 = k (1/J_a + 1/J_b)`, `2 zeta wn = d (1/J_a + 1/J_b)`.
 pub fn spring_ring_down() -> crate::network::Network {
-    use crate::network::{Body, Coupling, CouplingKind, Network};
+    use crate::network::{Body, Coupling, CouplingKind, Motion, Network};
     let body = |name: &str, j: f64| Body {
         name: name.into(),
         inertia_kg_m2: j,
         drag_n_m_s_rad: 0.0,
         // a body nothing moves is refused; a speed common to both changes nothing in the twist
         initial_speed_rad_s: 1.0,
-        fixed: false,
+        motion: Motion::Free,
         drive: None,
         firing: None,
         road_load: None,
@@ -518,7 +522,7 @@ pub fn spring_ring_down_twist_rad(t: f64) -> f64 {
 /// rad). Its torque is `-dV/dtheta`, so its speed is known at every angle:
 /// `w(theta)^2 = w0^2 + 2 (V(0) - V(theta)) / J`.
 pub fn firing_engine() -> crate::network::Network {
-    use crate::network::{Body, Firing, Network};
+    use crate::network::{Body, Firing, Motion, Network};
     Network {
         pack_thermal: Default::default(),
         bodies: vec![Body {
@@ -526,7 +530,7 @@ pub fn firing_engine() -> crate::network::Network {
             inertia_kg_m2: 0.25,
             drag_n_m_s_rad: 0.0,
             initial_speed_rad_s: 100.0,
-            fixed: false,
+            motion: Motion::Free,
             drive: None,
             firing: Some(Firing {
                 cylinders: 4,
@@ -549,7 +553,7 @@ pub fn firing_engine() -> crate::network::Network {
 /// without force: the kinematics need only which are closed.
 pub fn eight_speed() -> (crate::network::Network, crate::network::Transmission) {
     use crate::network::{
-        Body, Coupling, CouplingKind, Gear, LumpedClutch, Network, PlanetarySet, Signal,
+        Body, Coupling, CouplingKind, Gear, LumpedClutch, Motion, Network, PlanetarySet, Signal,
         Transmission,
     };
     let names = [
@@ -562,7 +566,11 @@ pub fn eight_speed() -> (crate::network::Network, crate::network::Transmission) 
             inertia_kg_m2: 1.0,
             drag_n_m_s_rad: 0.0,
             initial_speed_rad_s: 0.0,
-            fixed: name == "housing",
+            motion: if name == "housing" {
+                Motion::Fixed
+            } else {
+                Motion::Free
+            },
             drive: None,
             firing: None,
             road_load: None,

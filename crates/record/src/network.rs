@@ -99,7 +99,7 @@ fn network_metadata(net: &Network) -> BTreeMap<String, String> {
     for (i, b) in net.bodies.iter().enumerate() {
         m.insert(format!("body.{i}.name"), b.name.clone());
         m.insert(format!("body.{i}.inertia_kg_m2"), num(b.inertia_kg_m2));
-        m.insert(format!("body.{i}.fixed"), b.fixed.to_string());
+        m.insert(format!("body.{i}.fixed"), b.is_fixed().to_string());
     }
     for (k, c) in net.couplings.iter().enumerate() {
         m.insert(format!("coupling.{k}.name"), c.name.clone());
@@ -440,7 +440,7 @@ impl NetworkRecorder {
             .zip(&self.net.bodies)
             .map(|((frame, &r), b)| {
                 let mut e = entity(0, frame, frame);
-                let grey = if b.fixed { 0.35 } else { 0.62 };
+                let grey = if b.is_fixed() { 0.35 } else { 0.62 };
                 e.cylinders.push(CylinderPrimitive {
                     pose: pose(0.0, 0.0, 0.0, 0.0),
                     size: Some(v3(2.0 * r, 2.0 * r, DRAWN_THICKNESS_M)),

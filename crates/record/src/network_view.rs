@@ -116,7 +116,7 @@ impl View {
         let radii: Vec<f64> = net
             .bodies
             .iter()
-            .map(|b| drawn_radius_m(b.inertia_kg_m2, b.fixed))
+            .map(|b| drawn_radius_m(b.inertia_kg_m2, b.is_fixed()))
             .collect();
         let max_radius_m = radii.iter().fold(MIN_DRAWN_RADIUS_M, |a, &r| a.max(r));
         let pitch = 2.0 * max_radius_m + BODY_GAP_M;

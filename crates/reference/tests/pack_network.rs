@@ -161,7 +161,7 @@ fn dual_clutch_shift_with_resolved_packs_matches_closed_form() {
         inertia_kg_m2: j,
         drag_n_m_s_rad: 0.0,
         initial_speed_rad_s: w,
-        fixed: false,
+        motion: Motion::Free,
         drive,
         firing: None,
         road_load: None,
@@ -255,7 +255,7 @@ fn an_open_brake_on_a_network_is_the_pack_run_impact_for_impact() {
     let (duration, tol) = (0.06, 1e-10);
     let (alone, shaft, heat) = pack_run(&pack, duration, tol);
     let net = pack_as_network(&pack).expect("an inertial shaft");
-    assert!(net.bodies[1].fixed, "the plates on the housing");
+    assert!(net.bodies[1].is_fixed(), "the plates on the housing");
     let mut obs = Packs::default();
     let options = network_options(tol);
     let run = run_network(&net, duration, &options, &mut obs).expect("the network runs");

@@ -209,7 +209,7 @@ table! {
 table! {
     /// `[drive]`.
     RawDrive at "drive" {
-        /// what drives the shaft
+        /// what drives the shaft (in [bodies.speed], a network body's prescribed speed: sine, harmonics or speed_table)
         kind: "", Kind::Choice(&["sine", "harmonics", "speed_table", "torque_table"]), Dflt::Required;
         /// mean shaft speed
         omega0_rad_s: "rad/s", SPEED, Dflt::When("required for sine and harmonics");
@@ -589,20 +589,21 @@ table! {
 const SIGNAL_KINDS: Kind = Kind::Choice(&["constant", "step", "ramp", "sine", "table"]);
 
 table! {
-    /// One `[[bodies]]` entry: a rotational body of a driveline network (MODEL.md section 8). A scene with `[[bodies]]` is a network scene: its bodies and `[[couplings]]` replace `[shaft]`, `[drive]`, `[[discs]]`, `[[plates]]`, `[drum]` and `[stack]`; a resolved pack is a coupling of kind "pack" naming its pack scene file.
+    /// One `[[bodies]]` entry: a rotational body of a driveline network (MODEL.md section 8): free (its inertia), fixed (`fixed = true`) or at a prescribed speed (a `[bodies.speed]` table, the forms of `[drive]`: sine, harmonics, speed_table; its motion given whatever the torques on it, its reaction reported, no inertia, drive, firing, road load or drag). A scene with `[[bodies]]` is a network scene: its bodies and `[[couplings]]` replace `[shaft]`, `[drive]`, `[[discs]]`, `[[plates]]`, `[drum]` and `[stack]`; a resolved pack is a coupling of kind "pack" naming its pack scene file.
     RawNetBody at "" {
         /// the body's name, unique; couplings name their bodies by it
         name: "", Kind::Text, Dflt::Required;
         /// inertia about its axis
-        inertia_kg_m2: "kg m^2", INERTIA, Dflt::When("required, an error for a fixed body");
+        inertia_kg_m2: "kg m^2", INERTIA, Dflt::When("required, an error for a fixed or prescribed body");
         /// viscous drag: the torque -C w
         drag_n_m_s_rad: "N m s/rad", NON_NEGATIVE, Dflt::Num(0.0);
-        /// speed at t = 0 (the speeds of bodies joined by ideal gears must mesh)
+        /// speed at t = 0 (the speeds of bodies joined by ideal gears must mesh; an error for a prescribed body, which starts at its profile's)
         initial_speed_rad_s: "rad/s", SPEED, Dflt::Num(0.0);
         /// a fixed body (the housing): it never turns; a clutch to it is a brake
         fixed: "", Kind::Bool, Dflt::Bool(false);
     }
     children {
+        speed: table RawDrive,
         drive: table RawTorqueSignal,
         firing: table RawFiring,
         road_load: table RawRoadLoad,

@@ -214,3 +214,102 @@ fn firing_keys() {
         "{p:?}"
     );
 }
+
+/// A motor at a prescribed speed engaging a load (`[bodies.speed]`, the forms of `[drive]`).
+const PRESCRIBED: &str = r#"
+[simulation]
+duration_s = 1.0
+
+[[bodies]]
+name = "motor"
+[bodies.speed]
+kind = "sine"
+omega0_rad_s = 100.0
+amplitude_rad_s = 2.0
+frequency_hz = 10.0
+
+[[bodies]]
+name = "load"
+inertia_kg_m2 = 0.5
+
+[[bodies]]
+name = "housing"
+fixed = true
+
+[[couplings]]
+name = "clutch"
+kind = "clutch"
+a = "motor"
+b = "load"
+mu = 0.1
+max_normal_force_n = 5000.0
+cgeo_m = 0.2
+[couplings.force]
+kind = "constant"
+value = 1.0
+"#;
+
+/// `[bodies.speed]` makes a body prescribed (its profile, its speed at t = 0 the profile's);
+/// a prescribed body with an inertia, an initial speed, a drive, a drag, a torque table, or
+/// also fixed is refused at its key; so are a gear tying it to another prescribed body or to
+/// the housing and a clutch that could lock it to the fixed body (over-constraints).
+#[test]
+fn prescribed_bodies_and_their_bad_keys() {
+    let ok = parse(PRESCRIBED, "scenes/net.toml", Path::new("."), &[]).unwrap();
+    let net = ok.network.unwrap();
+    let motor = &net.bodies[0];
+    assert_eq!(
+        motor.motion,
+        clutchpack_model::network::Motion::Prescribed(clutchpack_model::SpeedProfile::sine(
+            100.0, 2.0, 10.0
+        ))
+    );
+    assert_eq!(motor.initial_speed_rad_s, 100.0);
+    let has = |p: &[String], key: &str, what: &str| {
+        assert!(
+            p.iter().any(|m| m.contains(key) && m.contains(what)),
+            "{key} ({what}) not in {p:?}"
+        )
+    };
+    let bad = PRESCRIBED.replace(
+        "name = \"motor\"\n",
+        "name = \"motor\"\ninertia_kg_m2 = 1.0\ninitial_speed_rad_s = 5.0\nfixed = true\n\
+         drag_n_m_s_rad = 0.1\n[bodies.drive]\nkind = \"constant\"\nvalue_n_m = 1.0\n",
+    );
+    let p = problems(&bad);
+    has(&p, "bodies[0].inertia_kg_m2", "no inertia");
+    has(&p, "bodies[0].initial_speed_rad_s", "starts at its");
+    has(&p, "bodies[0].fixed", "not both");
+    let p = problems(&PRESCRIBED.replace(
+        "frequency_hz = 10.0\n",
+        "frequency_hz = 10.0\n[bodies.drive]\nkind = \"constant\"\nvalue_n_m = 1.0\n",
+    ));
+    has(&p, "bodies[0].drive", "prescribed body follows its speed");
+    let p = problems(&PRESCRIBED.replace("kind = \"sine\"", "kind = \"torque_table\""));
+    has(&p, "bodies[0].speed.", "not used by bodies[0].speed.kind");
+    let p = problems(&PRESCRIBED.replace("b = \"load\"", "b = \"housing\""));
+    has(
+        &p,
+        "couplings[0].b",
+        "could lock two bodies whose motions are given",
+    );
+    // two prescribed bodies geared: the gear over-constrains them (their motions are given)
+    let geared = format!(
+        "{PRESCRIBED}\n[[bodies]]\nname = \"motor2\"\n[bodies.speed]\nkind = \"sine\"\n\
+         omega0_rad_s = 100.0\namplitude_rad_s = 2.0\nfrequency_hz = 10.0\n\
+         [[couplings]]\nname = \"g\"\nkind = \"ideal_gear\"\na = \"motor2\"\n\
+         b = \"motor\"\nratio = 1.0\n"
+    );
+    let p = problems(&geared);
+    has(&p, "couplings[1].b", "over-constrains its bodies");
+    // and a gear from it to the housing
+    let p = problems(&format!(
+        "{PRESCRIBED}\n[[couplings]]\nname = \"g\"\nkind = \"ideal_gear\"\na = \"motor\"\n\
+         b = \"housing\"\nratio = 1.0\n"
+    ));
+    has(
+        &p,
+        "couplings[1].b",
+        "ties the prescribed body \"motor\" to the fixed one",
+    );
+}

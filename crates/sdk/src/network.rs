@@ -135,8 +135,8 @@ pub struct EnergySummary {
     /// The balance's terms, J.
     #[serde(flatten)]
     pub terms: clutchpack_model::network::NetworkEnergy,
-    /// `drive + load - drag - heat - mesh work - damper loss - spring energy change - pack
-    /// loss - kinetic change`, J (zero to the integrator's tolerance).
+    /// `drive + prescribed + load - drag - heat - mesh work - damper loss - spring energy
+    /// change - pack loss - kinetic change`, J (zero to the integrator's tolerance).
     pub residual_j: f64,
 }
 

@@ -108,7 +108,7 @@ pub fn network_inputs(net: &Network) -> Vec<(String, NetworkInput)> {
         .bodies
         .iter()
         .enumerate()
-        .filter(|(_, b)| !b.fixed && (b.drive.is_some() || b.firing.is_some()))
+        .filter(|(_, b)| !b.is_fixed() && (b.drive.is_some() || b.firing.is_some()))
         .map(|(i, b)| {
             (
                 format!("bodies.{}.drive_torque_n_m", segment(&b.name)),
@@ -206,7 +206,8 @@ pub fn network_input_variables(net: &Network) -> Vec<(NetworkVariable, f64)> {
 }
 
 /// The outputs of `net`, in the order [`NetworkSimulation::outputs`] gives their values: per
-/// body its speed and angle; per coupling its torque on body a, for a clutch its slip
+/// body its speed and angle (and a prescribed body's reaction torque,
+/// `bodies.<body>.reaction_torque_n_m`, N m); per coupling its torque on body a, for a clutch its slip
 /// `w_b - w_a`, its mode (Modelica's numbers) and its heat, for a resolved pack its faces'
 /// heat and, if it carries temperatures (`[thermal]`), each disc's, plate's and its oil's
 /// (`couplings.<pack>.discs[i].temperature_k`, `.plates[j].temperature_k`,
@@ -230,6 +231,17 @@ pub fn network_outputs(net: &Network, tr: Option<&Transmission>) -> Vec<NetworkV
             "rad",
             format!("angle of {} from t = 0, rad", b.name),
         ));
+        if b.prescribed().is_some() {
+            out.push(var(
+                format!("bodies.{}.reaction_torque_n_m", segment(&b.name)),
+                "N.m",
+                format!(
+                    "torque keeping {} at its prescribed speed, N m, positive in its sense \
+                     of rotation (the couplings' on it, reversed)",
+                    b.name
+                ),
+            ));
+        }
     }
     for (k, c) in net.couplings.iter().enumerate() {
         out.push(var(
@@ -524,6 +536,9 @@ impl NetworkSimulation {
         for i in 0..net.bodies.len() {
             values.push(s.speed_rad_s[i]);
             values.push(s.angle_rad[i]);
+            if net.bodies[i].prescribed().is_some() {
+                values.push(s.reaction_n_m.get(i).copied().unwrap_or(0.0));
+            }
         }
         for (k, c) in net.couplings.iter().enumerate() {
             values.push(s.torque_n_m[k]);

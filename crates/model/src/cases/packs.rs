@@ -1,6 +1,7 @@
 //! Cases of resolved packs with carriers of their own (MODEL.md sections 5 and 8): an engaging
-//! clutch on an inertial shaft, a DCT's wet clutch, and any pack with an inertial shaft as the
-//! network that runs it (a network's run of it is the pack's own run).
+//! clutch on an inertial shaft, a DCT's wet clutch, any pack with an inertial or a prescribed
+//! shaft as the network that runs it (a network's run of it is the pack's own run), and a
+//! prescribed body engaging a free one through a lumped clutch (its closed form).
 
 use super::{bench_disc, paper_drive, staggered_brake, staggered_inertial};
 use crate::clutch::{DrumModel, FrictionCurve, Piston, PressureProfile, StackModel};
@@ -85,14 +86,37 @@ pub fn wet_clutch(n: usize, clamp_n: f64) -> PackModel {
     pack
 }
 
-/// A pack with an inertial shaft as a network (MODEL.md section 8): body `shaft` (the pack's
-/// `J1`, `C1` as drag, its drive torque: `J1 d(omega)/dt` of a harmonic speed profile as a sum
-/// of sines), body `drum` (its inertia, load as a constant drive, drag and speed) or the fixed
-/// `housing` when the plates sit on it, and the pack between them (its shaft and drum then
-/// unused). `None` unless the shaft is inertial and driven by a harmonic speed profile, and
-/// the pack has no couplings of its own. A network run of it is the pack's own run.
+/// A pack with an inertial or a prescribed shaft as a network (MODEL.md section 8): body
+/// `shaft` (a prescribed shaft's profile as its motion; an inertial shaft's `J1`, `C1` as
+/// drag, its drive torque: `J1 d(omega)/dt` of a harmonic speed profile as a sum of sines),
+/// body `drum` (its inertia, load as a constant drive, drag and speed) or the fixed `housing`
+/// when the plates sit on it, and the pack between them (its shaft and drum then unused).
+/// `None` unless the shaft is prescribed, or inertial and driven by a harmonic speed profile,
+/// and the pack has no couplings of its own. A network run of it is the pack's own run.
 pub fn pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
-    use crate::network::{Body, Coupling, CouplingKind, Network, Signal};
+    use crate::network::{Body, Motion};
+    if !pack.couplings.is_empty() {
+        return None;
+    }
+    let Shaft::Prescribed(profile) = &pack.shaft else {
+        return inertial_pack_as_network(pack);
+    };
+    let shaft = Body {
+        name: "shaft".into(),
+        inertia_kg_m2: 0.0,
+        drag_n_m_s_rad: 0.0,
+        initial_speed_rad_s: profile.speed(0.0),
+        motion: Motion::Prescribed(profile.clone()),
+        drive: None,
+        firing: None,
+        road_load: None,
+    };
+    Some(with_carrier(pack, shaft))
+}
+
+/// [`pack_as_network`] of a pack on an inertial shaft.
+fn inertial_pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
+    use crate::network::{Body, Motion, Signal};
     let Shaft::Inertial {
         inertia_kg_m2,
         damping_n_m_s_rad,
@@ -101,9 +125,6 @@ pub fn pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
     else {
         return None;
     };
-    if !pack.couplings.is_empty() {
-        return None;
-    }
     // J1 d/dt (A sin(2 pi f t + phase)) = J1 A 2 pi f sin(2 pi f t + phase + pi / 2)
     let drive = Signal::Sum(
         harmonics
@@ -125,18 +146,25 @@ pub fn pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
         inertia_kg_m2: *inertia_kg_m2,
         drag_n_m_s_rad: *damping_n_m_s_rad,
         initial_speed_rad_s: pack.shaft.initial_speed_rad_s(),
-        fixed: false,
+        motion: Motion::Free,
         drive: Some(drive),
         firing: None,
         road_load: None,
     };
+    Some(with_carrier(pack, shaft))
+}
+
+/// The network of body `shaft`, the pack's drum or the fixed housing, and the pack between
+/// them ([`pack_as_network`]).
+fn with_carrier(pack: &PackModel, shaft: crate::network::Body) -> crate::network::Network {
+    use crate::network::{Body, Coupling, CouplingKind, Motion, Network, Signal};
     let carrier = match &pack.drum {
         Some(d) => Body {
             name: "drum".into(),
             inertia_kg_m2: d.inertia_kg_m2,
             drag_n_m_s_rad: d.drag_n_m_s_rad,
             initial_speed_rad_s: d.initial_speed_rad_s,
-            fixed: false,
+            motion: Motion::Free,
             drive: Some(Signal::Constant(d.load_torque_n_m)),
             firing: None,
             road_load: None,
@@ -146,13 +174,13 @@ pub fn pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
             inertia_kg_m2: 0.0,
             drag_n_m_s_rad: 0.0,
             initial_speed_rad_s: 0.0,
-            fixed: true,
+            motion: Motion::Fixed,
             drive: None,
             firing: None,
             road_load: None,
         },
     };
-    Some(Network {
+    Network {
         pack_thermal: Default::default(),
         bodies: vec![shaft, carrier],
         couplings: vec![Coupling {
@@ -161,7 +189,64 @@ pub fn pack_as_network(pack: &PackModel) -> Option<crate::network::Network> {
             b: 1,
             kind: CouplingKind::Pack(Box::new(pack.clone())),
         }],
-    })
+    }
+}
+
+/// [`prescribed_clutch`]'s motor speed at t = 0, rad/s.
+pub const PRESCRIBED_CLUTCH_W0_RAD_S: f64 = 20.0;
+/// [`prescribed_clutch`]'s motor acceleration, rad/s^2.
+pub const PRESCRIBED_CLUTCH_ACCEL_RAD_S2: f64 = 20.0;
+/// [`prescribed_clutch`]'s load inertia, kg m^2.
+pub const PRESCRIBED_CLUTCH_J_KG_M2: f64 = 0.5;
+/// [`prescribed_clutch`]'s slipping torque `mu cgeo fn`, N m (its static limit 1.2 times it).
+pub const PRESCRIBED_CLUTCH_TORQUE_N_M: f64 = 30.0;
+
+/// A prescribed body engaging a free one (MODEL.md section 8): body `motor` (body 0) turns at
+/// the prescribed `w_p = W + A t` ([`PRESCRIBED_CLUTCH_W0_RAD_S`] and
+/// [`PRESCRIBED_CLUTCH_ACCEL_RAD_S2`], a speed table up to 1 s), body `load` (body 1, inertia
+/// `J` = [`PRESCRIBED_CLUTCH_J_KG_M2`]) starts at rest, and a lumped clutch from the motor (a)
+/// to the load (b), applied from t = 0, slips at `T` = [`PRESCRIBED_CLUTCH_TORQUE_N_M`]
+/// (`mu` 0.3, `cgeo` 0.1 m, 1 kN; static limit 1.2 `T`). Closed form: the load accelerates at
+/// `T / J`, the slip `W - (T / J - A) t` reaches 0 at `t_l = W / (T / J - A)` (0.5 s) and the
+/// clutch locks; the load then follows the motor, held by `J A` (10 N m, below the limit).
+/// The heat is `T W t_l / 2` (150 J), the motor's reaction `T` while slipping and `J A`
+/// locked, its work `T (W t_l + A t_l^2 / 2)` then `J (w_p(t)^2 - w_p(t_l)^2) / 2`.
+pub fn prescribed_clutch() -> crate::network::Network {
+    use crate::network::{Body, Coupling, CouplingKind, LumpedClutch, Motion, Network, Signal};
+    let (w0, a) = (PRESCRIBED_CLUTCH_W0_RAD_S, PRESCRIBED_CLUTCH_ACCEL_RAD_S2);
+    let profile = SpeedProfile::Table(
+        crate::drive::Table::new(vec![0.0, 1.0], vec![w0, w0 + a]).expect("two rows"),
+    );
+    let body = |name: &str, j: f64, w: f64, motion: Motion| Body {
+        name: name.into(),
+        inertia_kg_m2: j,
+        drag_n_m_s_rad: 0.0,
+        initial_speed_rad_s: w,
+        motion,
+        drive: None,
+        firing: None,
+        road_load: None,
+    };
+    Network {
+        pack_thermal: Default::default(),
+        bodies: vec![
+            body("motor", 0.0, w0, Motion::Prescribed(profile)),
+            body("load", PRESCRIBED_CLUTCH_J_KG_M2, 0.0, Motion::Free),
+        ],
+        couplings: vec![Coupling {
+            name: "clutch".into(),
+            a: 0,
+            b: 1,
+            kind: CouplingKind::Clutch(LumpedClutch {
+                mu_table: vec![(0.0, 0.3)],
+                peak: 1.2,
+                cgeo_m: 0.1,
+                fn_max_n: 1000.0,
+                force: Signal::Constant(1.0),
+                one_way: false,
+            }),
+        }],
+    }
 }
 
 #[cfg(test)]
@@ -182,5 +267,30 @@ mod tests {
             assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{t}: {a} {b}");
         }
         assert_eq!(net.bodies[1].initial_speed_rad_s, 90.0);
+    }
+
+    /// A one-pack network is the pack scene it was made from (`Network::one_pack`, the
+    /// inverse of [`pack_as_network`] for a prescribed shaft, on the housing or on a drum with
+    /// a constant load); a network that is not (an inertial shaft, a drum with a road load) is
+    /// none.
+    #[test]
+    fn a_one_pack_network_is_its_pack() {
+        let mut pack = engaging_clutch();
+        let inertial = pack_as_network(&pack).unwrap();
+        assert_eq!(inertial.one_pack(), None, "an inertial shaft");
+        pack.shaft = Shaft::Prescribed(SpeedProfile::sine(100.0, 2.0, 50.0));
+        let mut net = pack_as_network(&pack).unwrap();
+        assert!(net.problems().is_empty(), "{:?}", net.problems());
+        assert_eq!(net.one_pack().as_ref(), Some(&pack), "on a drum");
+        net.bodies[1].road_load = Some(crate::network::RoadLoad {
+            constant_n_m: 1.0,
+            linear_n_m_s_rad: 0.0,
+            quadratic_n_m_s2_rad2: 0.0,
+        });
+        assert_eq!(net.one_pack(), None, "a drum with a road load");
+        let brake = staggered_brake(4);
+        assert!(matches!(brake.shaft, Shaft::Prescribed(_)) && brake.drum.is_none());
+        let net = pack_as_network(&brake).unwrap();
+        assert_eq!(net.one_pack().as_ref(), Some(&brake), "on the housing");
     }
 }

@@ -330,7 +330,7 @@ impl Transmission {
         others: &[f64],
     ) -> Option<Vec<f64>> {
         let k = self.kinematics(net, self.initial_gear?).ok()?;
-        let moving: Vec<bool> = net.bodies.iter().map(|b| !b.fixed).collect();
+        let moving: Vec<bool> = net.bodies.iter().map(|b| !b.is_fixed()).collect();
         let rows: Vec<Row> = net
             .couplings
             .iter()
@@ -376,7 +376,7 @@ impl Transmission {
         let inv: Vec<f64> = net
             .bodies
             .iter()
-            .map(|b| if b.fixed { 0.0 } else { 1.0 })
+            .map(|b| if b.is_fixed() { 0.0 } else { 1.0 })
             .collect();
         if let Some(r) = rows::redundant(&rows, &inv).first() {
             return Err(format!(
@@ -393,7 +393,7 @@ impl Transmission {
                 net.bodies[i].name
             ));
         }
-        let moving: Vec<bool> = net.bodies.iter().map(|b| !b.fixed).collect();
+        let moving: Vec<bool> = net.bodies.iter().map(|b| !b.is_fixed()).collect();
         let of = rows::groups(&rows, &moving);
         let members: Vec<usize> = (0..n).filter(|&j| of[j] == of[i]).collect();
         let v: Vec<f64> = (0..n).map(|j| p[j * n + i] / pin).collect();

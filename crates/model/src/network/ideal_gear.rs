@@ -52,15 +52,21 @@ impl ElementLaw for IdealGear {
             return false;
         }
         let (ba, bb) = (&net.bodies[ports[0]], &net.bodies[ports[1]]);
-        if ba.fixed != bb.fixed {
-            out.push(problem(
-                k,
-                "b",
+        if ba.is_fixed() != bb.is_fixed() {
+            let other = if ba.is_fixed() { bb } else { ba };
+            let why = if other.prescribed().is_some() {
+                format!(
+                    "ties the prescribed body \"{}\" to the fixed one: both motions are given, \
+                     so the gear over-constrains them",
+                    other.name
+                )
+            } else {
                 format!(
                     "an ideal gear from a fixed body would hold \"{}\" still: make it fixed instead",
-                    if ba.fixed { &bb.name } else { &ba.name }
-                ),
-            ));
+                    other.name
+                )
+            };
+            out.push(problem(k, "b", why));
             return false;
         }
         true

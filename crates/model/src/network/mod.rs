@@ -68,6 +68,23 @@ impl RoadLoad {
     }
 }
 
+/// How a body of a network moves.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub enum Motion {
+    /// Under its torques, with its inertia.
+    #[default]
+    Free,
+    /// Fixed (the housing, the ground): it never turns; a clutch to it is a brake.
+    Fixed,
+    /// At a prescribed speed (a test rig's motor, a one-pack scene's prescribed shaft): its
+    /// angle, speed and acceleration are the profile's whatever the torques on it (an infinite
+    /// inertia in the constraints, as a fixed body's, but turning); what ties other bodies to
+    /// it (a locked clutch, a gear) makes them follow it, and the torque it takes to keep the
+    /// profile is its reaction ([`NetworkSample::reaction_n_m`]), whose work the energy audit
+    /// counts ([`NetworkEnergy::prescribed_work_j`]).
+    Prescribed(crate::SpeedProfile),
+}
+
 /// One rotational body of a network.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Body {
@@ -77,10 +94,10 @@ pub struct Body {
     pub inertia_kg_m2: f64,
     /// Viscous drag, N m s/rad (>= 0): the torque `-C w`.
     pub drag_n_m_s_rad: f64,
-    /// Speed at t = 0, rad/s.
+    /// Speed at t = 0, rad/s (a prescribed body's is its profile's at t = 0).
     pub initial_speed_rad_s: f64,
-    /// A fixed body (the housing, the ground): it never turns; a clutch to it is a brake.
-    pub fixed: bool,
+    /// How it moves: free, fixed or at a prescribed speed ([`Motion`]).
+    pub motion: Motion,
     /// The driving torque on it, N m, positive in its sense of rotation (`None`: none).
     pub drive: Option<Signal>,
     /// An engine's firing-order harmonics in its own angle, added to `drive` (`None`: none;
@@ -92,6 +109,34 @@ pub struct Body {
 }
 
 impl Body {
+    /// Whether it is the fixed body.
+    pub fn is_fixed(&self) -> bool {
+        self.motion == Motion::Fixed
+    }
+
+    /// Whether it moves under its torques (neither fixed nor prescribed).
+    pub fn is_free(&self) -> bool {
+        self.motion == Motion::Free
+    }
+
+    /// Its speed profile, if it is prescribed.
+    pub fn prescribed(&self) -> Option<&crate::SpeedProfile> {
+        match &self.motion {
+            Motion::Prescribed(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    /// Its inverse inertia in the constraints, 1/(kg m^2): `1 / J` for a free body, 0 for a
+    /// fixed or prescribed one (an infinite inertia: its motion is given).
+    pub fn inverse_inertia(&self) -> f64 {
+        if self.is_free() {
+            1.0 / self.inertia_kg_m2
+        } else {
+            0.0
+        }
+    }
+
     /// The driving torque at `t` (s) and the body's angle `theta` (rad), N m: its drive
     /// signal and its firing harmonics.
     pub fn drive_torque_n_m(&self, t: f64, theta_rad: f64) -> f64 {
@@ -287,21 +332,52 @@ impl Network {
                 out.push(body(i, "name", format!("\"{}\" names two bodies", b.name)));
             }
             let good_inertia = b.inertia_kg_m2.is_finite() && b.inertia_kg_m2 > 0.0;
-            if !b.fixed && !good_inertia {
+            if b.is_free() && !good_inertia {
                 out.push(body(
                     i,
                     "inertia_kg_m2",
                     format!("{} must be > 0", crate::fmt_num(b.inertia_kg_m2)),
                 ));
             }
-            if b.fixed && b.initial_speed_rad_s != 0.0 {
+            if b.is_fixed() && b.initial_speed_rad_s != 0.0 {
                 out.push(body(
                     i,
                     "initial_speed_rad_s",
                     "a fixed body does not turn: its speed is 0".into(),
                 ));
             }
-            if b.fixed && (b.drive.is_some() || b.firing.is_some() || b.road_load.is_some()) {
+            if let Some(p) = b.prescribed() {
+                let w0 = p.speed(0.0);
+                if (b.initial_speed_rad_s - w0).abs() > 1e-12 * (1.0 + w0.abs()) {
+                    out.push(body(
+                        i,
+                        "initial_speed_rad_s",
+                        format!(
+                            "a prescribed body starts at its profile's speed, {} rad/s",
+                            crate::fmt_num(w0)
+                        ),
+                    ));
+                }
+                let torque = if b.drive.is_some() {
+                    Some("drive")
+                } else if b.firing.is_some() {
+                    Some("firing")
+                } else if b.road_load.is_some() {
+                    Some("road_load")
+                } else if b.drag_n_m_s_rad != 0.0 {
+                    Some("drag_n_m_s_rad")
+                } else {
+                    None
+                };
+                if let Some(field) = torque {
+                    out.push(body(
+                        i,
+                        field,
+                        "a prescribed body follows its speed whatever the torques on it: a torque on it changes only its reaction; remove it".into(),
+                    ));
+                }
+            }
+            if b.is_fixed() && (b.drive.is_some() || b.firing.is_some() || b.road_load.is_some()) {
                 out.push(body(
                     i,
                     if b.drive.is_some() {
@@ -314,7 +390,7 @@ impl Network {
                     "a fixed body does not turn: a torque on it does nothing; remove it".into(),
                 ));
             }
-            if b.fixed && self.bodies[..i].iter().any(|o| o.fixed) {
+            if b.is_fixed() && self.bodies[..i].iter().any(|o| o.is_fixed()) {
                 out.push(body(
                     i,
                     "fixed",
@@ -423,8 +499,11 @@ impl Network {
         }
         // the rigid rows that hold always (gears, planetary sets) independent: a redundant one
         // over-constrains the bodies (the gears' loops are found above with their ratios)
-        if out.is_empty() && self.couplings.iter().any(|c| c.ports().len() > 2) {
-            let rows: Vec<Row> = self
+        // (a prescribed body's motion is given as a fixed body's is: a gear between two
+        // bodies whose motions are given, directly or through other gears, over-constrains)
+        let prescribed = self.bodies.iter().any(|b| b.prescribed().is_some());
+        if out.is_empty() && (prescribed || self.couplings.iter().any(|c| c.ports().len() > 2)) {
+            let mut rows: Vec<Row> = self
                 .couplings
                 .iter()
                 .enumerate()
@@ -433,14 +512,34 @@ impl Network {
             let inv: Vec<f64> = self
                 .bodies
                 .iter()
-                .map(|b| if b.fixed { 0.0 } else { 1.0 })
+                .map(|b| if b.is_free() { 1.0 } else { 0.0 })
                 .collect();
             for r in rows::redundant(&rows, &inv) {
                 out.push(coupling(
-                    r,
+                    rows[r].coupling,
                     "b",
-                    "over-constrains its bodies: with the ideal gears and planetary sets before it, its constraint is redundant or contradicts them (every member it ties is already tied)".into(),
+                    "over-constrains its bodies: with the ideal gears and planetary sets before it, its constraint is redundant or contradicts them (every member it ties is already tied, or held by a fixed or prescribed body)".into(),
                 ));
+            }
+            // a clutch that could lock a prescribed body to the fixed one or to another
+            // prescribed one (directly or through the gears): its lock would over-constrain
+            let always = rows.len();
+            for (k, c) in self.couplings.iter().enumerate() {
+                if !prescribed || c.row(k, None).is_some() {
+                    continue;
+                }
+                let Some(lock) = c.row(k, Some(ClutchMode::Locked)) else {
+                    continue;
+                };
+                rows.push(lock);
+                if rows::redundant(&rows, &inv).contains(&always) {
+                    out.push(coupling(
+                        k,
+                        "b",
+                        "could lock two bodies whose motions are given (a prescribed body and the fixed one, or two prescribed ones, directly or through gears): the lock would over-constrain them; give one of them an inertia".into(),
+                    ));
+                }
+                rows.pop();
             }
         }
         // every group of connected bodies has something that moves it
@@ -452,9 +551,12 @@ impl Network {
             let group: Vec<usize> = (0..n).filter(|&j| top(&mut linked, j) == t).collect();
             let moved = group.iter().any(|&j| {
                 let b = &self.bodies[j];
-                b.drive.is_some() || b.firing.is_some() || b.initial_speed_rad_s != 0.0
+                b.drive.is_some()
+                    || b.firing.is_some()
+                    || b.initial_speed_rad_s != 0.0
+                    || b.prescribed().is_some()
             });
-            if !moved && group.iter().any(|&j| !self.bodies[j].fixed) {
+            if !moved && group.iter().any(|&j| !self.bodies[j].is_fixed()) {
                 out.push(body(
                     i,
                     "drive",
@@ -496,6 +598,10 @@ impl Network {
             if let Some(d) = &b.drive {
                 d.breakpoints(&mut out);
             }
+            if let Some(crate::SpeedProfile::Table(table)) = b.prescribed() {
+                // a prescribed speed table's rows: its slope (or its value, held) jumps
+                out.extend_from_slice(&table.t_s);
+            }
         }
         for c in &self.couplings {
             c.law().breakpoints(&mut out);
@@ -517,7 +623,7 @@ mod tests {
             inertia_kg_m2: 1.0,
             drag_n_m_s_rad: 0.0,
             initial_speed_rad_s: w,
-            fixed: false,
+            motion: Motion::Free,
             drive: None,
             firing: None,
             road_load: None,

@@ -21,6 +21,11 @@ pub struct NetworkSample {
     pub torque_n_m: Vec<f64>,
     /// Each clutch's mode (`None` for another kind of coupling).
     pub mode: Vec<Option<ClutchMode>>,
+    /// Each prescribed body's reaction, N m, positive in its sense of rotation: the torque
+    /// its drive puts on it to keep its profile against every coupling on it (its inertia
+    /// infinite: [`super::Motion::Prescribed`]); 0 for the other bodies. Empty when the
+    /// network has no prescribed body.
+    pub reaction_n_m: Vec<f64>,
 }
 
 /// A clutch changing mode.
@@ -61,13 +66,23 @@ pub struct NetworkEnergy {
     /// Kinetic energy at the end less at the start (the packs' discs and plates with the
     /// bodies), J.
     pub kinetic_change_j: f64,
+    /// Work of the prescribed bodies' reactions, J: what keeping their profiles put in
+    /// (`integral R w dt`, [`NetworkSample::reaction_n_m`]; absent from the JSON without a
+    /// prescribed body).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub prescribed_work_j: f64,
+}
+
+/// Whether `x` is 0 (a field left out of the JSON).
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 impl NetworkEnergy {
-    /// `drive + load - drag - heat - mesh work - damper loss - spring energy change - pack
-    /// loss - kinetic change`, J: zero to the integrator's tolerance.
+    /// `drive + prescribed + load - drag - heat - mesh work - damper loss - spring energy
+    /// change - pack loss - kinetic change`, J: zero to the integrator's tolerance.
     pub fn residual_j(&self) -> f64 {
-        self.drive_work_j + self.load_work_j
+        self.drive_work_j + self.prescribed_work_j + self.load_work_j
             - self.drag_loss_j
             - self.clutch_heat_j
             - self.mesh_work_j

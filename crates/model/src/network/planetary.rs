@@ -173,7 +173,7 @@ fn network_problems(
     let members = [a, b, ps.carrier];
     let fixed: Vec<&str> = members
         .iter()
-        .filter(|&&i| net.bodies[i].fixed)
+        .filter(|&&i| net.bodies[i].is_fixed())
         .map(|&i| net.bodies[i].name.as_str())
         .collect();
     if fixed.len() > 1 {

@@ -30,7 +30,7 @@ impl ElementLaw for PackModel {
         out: &mut Vec<NetworkProblem>,
     ) -> bool {
         let a = ports[0];
-        if net.bodies[a].fixed {
+        if net.bodies[a].is_fixed() {
             out.push(problem(
                 k,
                 "a",
@@ -87,5 +87,54 @@ impl ElementLaw for PackModel {
                 quantity: OutputQuantity::Heat,
             },
         ]
+    }
+}
+
+impl Network {
+    /// The pack scene this network is, if it is one (docs/DECISIONS.md, "A one-pack
+    /// network is a pack scene"): its only element a resolved pack, its friction discs on a
+    /// prescribed body (the pack's prescribed shaft, its profile) and its plates on the fixed
+    /// body (the housing) or on a free body with at most a constant drive and its drag (the
+    /// pack's drum: its inertia, the drive as its load torque, its drag and its speed), and no
+    /// other body. Such a network runs as the pack's own session, to the bit; every other
+    /// network (an inertial shaft, a drum with a varying load or a road load, a second element)
+    /// takes the driveline path. The pack's thermal model, if any, is the network's
+    /// [`Network::pack_thermal`] of its element.
+    pub fn one_pack(&self) -> Option<PackModel> {
+        let [c] = self.couplings.as_slice() else {
+            return None;
+        };
+        let pack = c.pack()?;
+        if self.bodies.len() != 2 || c.a == c.b || !pack.couplings.is_empty() {
+            return None;
+        }
+        let (shaft, carrier) = (&self.bodies[c.a], &self.bodies[c.b]);
+        let profile = shaft.prescribed()?;
+        let drum = match &carrier.motion {
+            super::Motion::Fixed => None,
+            super::Motion::Prescribed(_) => return None,
+            super::Motion::Free => {
+                let load = match &carrier.drive {
+                    None => 0.0,
+                    Some(super::Signal::Constant(v)) => *v,
+                    Some(_) => return None,
+                };
+                if carrier.firing.is_some() || carrier.road_load.is_some() || pack.plates.is_empty()
+                {
+                    return None;
+                }
+                Some(crate::DrumModel {
+                    inertia_kg_m2: carrier.inertia_kg_m2,
+                    load_torque_n_m: load,
+                    drag_n_m_s_rad: carrier.drag_n_m_s_rad,
+                    initial_speed_rad_s: carrier.initial_speed_rad_s,
+                })
+            }
+        };
+        Some(PackModel {
+            shaft: crate::Shaft::Prescribed(profile.clone()),
+            drum,
+            ..pack.clone()
+        })
     }
 }

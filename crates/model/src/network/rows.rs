@@ -207,6 +207,35 @@ pub fn projected(rows: &[Row], inv_inertia: &[f64]) -> (Vec<f64>, Vec<f64>) {
     (p, l)
 }
 
+/// The response to a unit acceleration (1 rad/s^2) of the prescribed body `p` (whose inverse
+/// inertia in `inv_inertia` is 0, as a fixed body's: its motion is given), every other torque
+/// 0: each body's acceleration (rad/s^2; 1 at `p`, the rows' kinematics on the bodies they tie
+/// to it) and each row's torque (N m). The rows' rates vanish with `a = u + M^-1 C^T lambda`,
+/// `u` the unit at `p`: `A lambda = -C u`. Accelerations and torques are linear in `p`'s
+/// acceleration, so the engines add `alpha_p(t)` times this response to `P T` and `L T`; and
+/// the speeds a group held by prescribed bodies alone takes are the same combination of
+/// their speeds.
+pub fn prescribed_response(rows: &[Row], inv_inertia: &[f64], p: usize) -> (Vec<f64>, Vec<f64>) {
+    let n = inv_inertia.len();
+    let rhs: Vec<f64> = rows
+        .iter()
+        .map(|r| {
+            -r.terms()
+                .iter()
+                .filter(|(i, _)| *i == p)
+                .map(|(_, c)| c)
+                .sum::<f64>()
+        })
+        .collect();
+    let mut lambda = Vec::new();
+    solve(rows, inv_inertia, &rhs, &mut lambda);
+    let mut t = vec![0.0; n];
+    add_torques(rows, &lambda, &mut t);
+    let mut acc: Vec<f64> = (0..n).map(|i| inv_inertia[i] * t[i]).collect();
+    acc[p] = 1.0;
+    (acc, lambda)
+}
+
 /// The group of each of `n` bodies: the bodies that move (`moving[i]`) connected by a row's
 /// terms share one; a body that does not move (a fixed body) connects nothing and is a group
 /// of its own. Groups are numbered in the order of their first body.

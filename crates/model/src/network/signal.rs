@@ -244,7 +244,7 @@ impl super::Network {
         }
         match input {
             NetworkInput::Drive(i) => {
-                let Some(b) = self.bodies.get_mut(i).filter(|b| !b.fixed) else {
+                let Some(b) = self.bodies.get_mut(i).filter(|b| b.is_free()) else {
                     return bad(format!("body {i}: no turning body takes a drive there"));
                 };
                 b.drive = Some(Signal::Constant(value));

@@ -28,8 +28,8 @@ impl MultibodySession {
         Some(self.run.carrier_state(c))
     }
 
-    /// Sets the inertial shaft's and the inertial drum's speeds and torques (`drum` `None`
-    /// for plates on the housing) now, their angles and every disc's and plate's motion kept:
+    /// Sets the inertial shaft's and the inertial drum's speeds and torques (`shaft` `None`
+    /// for a prescribed shaft, `drum` `None` for plates on the housing) now, their angles and every disc's and plate's motion kept:
     /// the relative speeds of the bodies on a carrier jump, as at a prescribed shaft's driven
     /// speed jump, and the state is re-evaluated once (tooth loads, clamp forces). The shaft's
     /// torque is its drive input and the drum's its load input ([`Session::set_inputs`]: the
@@ -38,11 +38,11 @@ impl MultibodySession {
     /// inertial, a drum the pack does not have, a value that is not finite.
     pub fn set_carriers(
         &mut self,
-        shaft: Carried,
+        shaft: Option<Carried>,
         drum: Option<Carried>,
     ) -> Result<(), EngineError> {
         let drum_index = self.run.world.drum();
-        let mut targets = vec![(SHAFT, shaft)];
+        let mut targets: Vec<_> = shaft.map(|s| (SHAFT, s)).into_iter().collect();
         match (drum, drum_index) {
             (Some(d), Some(c)) => targets.push((c, d)),
             (None, _) => {}
@@ -74,7 +74,7 @@ impl MultibodySession {
         }
         // the torques as driven inputs: re-evaluates the state once, with the jumps above
         self.set_inputs(&Inputs {
-            shaft_torque_n_m: Some(shaft.torque_n_m),
+            shaft_torque_n_m: shaft.map(|s| s.torque_n_m),
             drum_load_n_m: drum.map(|d| d.torque_n_m),
             ..Inputs::default()
         })
@@ -128,6 +128,12 @@ impl MultibodySession {
         }
         self.run.refresh_effective_masses();
         Ok(())
+    }
+
+    /// The drive's work since t = 0 up to now, J (a prescribed shaft's: the teeth's torque on
+    /// the discs on its turn; the energy audit's `drive_work_j` as the run goes).
+    pub fn drive_work_so_far_j(&self) -> f64 {
+        self.run.energy.so_far().drive_work_j
     }
 
     /// Every tooth contact open now, as it would close at the session's time (its peak the

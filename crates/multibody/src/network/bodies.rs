@@ -2,7 +2,8 @@
 //! per body that turns, turning about the world `+z` axis (its translations and the two other
 //! rotations locked by rapier's locked axes, as the pack's discs are held with
 //! `DiscMount::LockedAxes`, `world.rs`), with the network's inertia about the axis; the fixed
-//! body, if any, a rapier fixed body. No colliders and no joints: the couplings' torques
+//! body, if any, and the prescribed bodies rapier fixed bodies (a prescribed body's angle and
+//! speed are kept here, set from its profile after each step: [`NetworkWorld::set_prescribed`]). No colliders and no joints: the couplings' torques
 //! (`network/mod.rs`) are the only forces.
 //!
 //! With one solver iteration rapier is semi-implicit Euler for these torques (`lib.rs`):
@@ -22,8 +23,10 @@ pub(crate) struct NetworkWorld {
     physics: PhysicsWorld,
     /// The rapier body of each network body (the fixed body's is a rapier fixed body).
     handles: Vec<RigidBodyHandle>,
-    /// Whether each body is the fixed body.
+    /// Whether each body is the fixed body or a prescribed one (not integrated).
     fixed: Vec<bool>,
+    /// Each prescribed body's speed, rad/s (0 for the others).
+    given: Vec<f64>,
     /// Each body's angle, rad, unwrapped (`theta += h w` per step).
     angle: Vec<f64>,
 }
@@ -38,6 +41,7 @@ impl Clone for NetworkWorld {
             physics: crate::world::copy_physics(&self.physics),
             handles: self.handles.clone(),
             fixed: self.fixed.clone(),
+            given: self.given.clone(),
             angle: self.angle.clone(),
         }
     }
@@ -54,7 +58,7 @@ impl NetworkWorld {
         p.max_ccd_substeps = 0;
         let mut handles = Vec::with_capacity(net.bodies.len());
         for b in &net.bodies {
-            let h = if b.fixed {
+            let h = if !b.is_free() {
                 physics.insert_body(RigidBodyBuilder::fixed())
             } else {
                 let j = b.inertia_kg_m2;
@@ -85,7 +89,12 @@ impl NetworkWorld {
         NetworkWorld {
             physics,
             handles,
-            fixed: net.bodies.iter().map(|b| b.fixed).collect(),
+            fixed: net.bodies.iter().map(|b| !b.is_free()).collect(),
+            given: net
+                .bodies
+                .iter()
+                .map(|b| b.prescribed().map_or(0.0, |p| p.speed(0.0)))
+                .collect(),
             angle: vec![0.0; net.bodies.len()],
         }
     }
@@ -95,9 +104,10 @@ impl NetworkWorld {
         self.handles
             .iter()
             .zip(&self.fixed)
-            .map(|(h, f)| {
+            .zip(&self.given)
+            .map(|((h, f), g)| {
                 if *f {
-                    0.0
+                    *g
                 } else {
                     self.physics.bodies[*h].angvel().z
                 }
@@ -108,6 +118,12 @@ impl NetworkWorld {
     /// Each body's angle, rad (unwrapped).
     pub fn angles(&self) -> &[f64] {
         &self.angle
+    }
+
+    /// Sets prescribed body `i`'s speed (rad/s) and angle (rad, unwrapped): its profile's.
+    pub fn set_prescribed(&mut self, i: usize, speed_rad_s: f64, angle_rad: f64) {
+        self.given[i] = speed_rad_s;
+        self.angle[i] = angle_rad;
     }
 
     /// Sets each turning body's speed, rad/s.

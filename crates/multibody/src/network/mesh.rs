@@ -97,7 +97,7 @@ impl Mesh {
     pub fn of(net: &Network) -> Vec<Mesh> {
         let inertia = |i: usize| {
             let b = &net.bodies[i];
-            if b.fixed {
+            if !b.is_free() {
                 f64::INFINITY
             } else {
                 b.inertia_kg_m2

@@ -116,6 +116,8 @@ struct Torques {
     lambda: Vec<f64>,
     coupling: Vec<f64>,
     mesh_force: Vec<f64>,
+    /// Each prescribed body's acceleration, rad/s^2 (empty without one).
+    alpha: Vec<f64>,
 }
 
 /// Columns of `P` (1/(kg m^2)) by body, with the rows they were computed for.
@@ -138,6 +140,9 @@ struct Run {
     torque: Vec<f64>,
     /// Each row's torque, N m.
     lambda: Vec<f64>,
+    /// Each prescribed body's acceleration at the held torques' time, rad/s^2 (0 for the
+    /// others; empty without a prescribed body).
+    alpha: Vec<f64>,
     /// Each coupling's torque on its body `a`, N m.
     coupling_torque: Vec<f64>,
     /// The gear meshes (their `x` and contacts), in the couplings' order.
@@ -177,15 +182,33 @@ impl Run {
         self.lambda = out.lambda;
         self.coupling_torque = out.coupling;
         self.mesh_force = out.mesh_force;
+        self.alpha = out.alpha;
+    }
+
+    /// Sets the prescribed bodies' speeds (rad/s) and angles (rad) in `w` and `theta` to
+    /// their profiles' at `t` (s).
+    fn prescribe(&self, t: f64, w: &mut [f64], theta: &mut [f64]) {
+        for (i, b) in self.net.bodies.iter().enumerate() {
+            if let Some(p) = b.prescribed() {
+                (w[i], theta[i]) = p.speed_and_angle(t);
+            }
+        }
     }
 
     /// Each body's acceleration under the torques `total` (N m), rad/s^2.
     fn accelerations(&self, total: &[f64]) -> Vec<f64> {
-        total
+        let mut acc: Vec<f64> = total
             .iter()
             .zip(&self.inv_inertia)
             .map(|(t, j)| j * t)
-            .collect()
+            .collect();
+        // a prescribed body's is its profile's (its inverse inertia is 0)
+        for (i, a) in self.alpha.iter().enumerate() {
+            if self.net.bodies[i].prescribed().is_some() {
+                acc[i] = *a;
+            }
+        }
+        acc
     }
 
     /// Column `i` of the inverse inertia projected on the rows, `P = M^-1 - M^-1 C^T
@@ -218,9 +241,11 @@ impl Run {
             .collect();
         // the angles there on the same path (the speed affine from w to w_mid: an engine's
         // firing torque is a function of its angle)
-        let theta_mid: Vec<f64> = (0..self.w.len())
+        let mut theta_mid: Vec<f64> = (0..self.w.len())
             .map(|i| self.world.angles()[i] + 0.25 * h * (self.w[i] + w_mid[i]))
             .collect();
+        let mut w_mid = w_mid;
+        self.prescribe(t + 0.5 * h, &mut w_mid, &mut theta_mid);
         // each mesh's x there on the same path
         let x_mid = mesh::positions(&self.meshes, 0.5 * h, &self.w, &self.accelerations(start));
         let mut out = Torques::default();
@@ -235,7 +260,7 @@ impl Run {
         let net = &*self.net;
         out.body.clear();
         out.body.extend(net.bodies.iter().enumerate().map(|(i, b)| {
-            if b.fixed {
+            if !b.is_free() {
                 0.0
             } else {
                 b.external_torque_n_m(t, theta[i], w[i])
@@ -268,6 +293,20 @@ impl Run {
         // A lambda = -C M^-1 T: the rows' rates vanish, so rows that hold at the step's
         // start hold at its end (the speeds are projected after each step against rounding)
         constraint::constraint_torques(&self.rows, &self.inv_inertia, &out.body, &mut out.lambda);
+        // the prescribed bodies' accelerations, and the rows' torques that make the bodies
+        // tied to them follow (`rows::prescribed_response`: linear in each acceleration)
+        out.alpha.clear();
+        if net.bodies.iter().any(|b| b.prescribed().is_some()) {
+            out.alpha.resize(net.bodies.len(), 0.0);
+            for (i, b) in net.bodies.iter().enumerate() {
+                let Some(p) = b.prescribed() else { continue };
+                out.alpha[i] = p.acceleration(t);
+                let (_, lambda) = constraint::prescribed_response(&self.rows, &self.inv_inertia, i);
+                for (l, li) in out.lambda.iter_mut().zip(&lambda) {
+                    *l += li * out.alpha[i];
+                }
+            }
+        }
         for (r, l) in self.rows.iter().zip(&out.lambda) {
             out.coupling[r.coupling] = r.first_torque_n_m(*l);
         }
@@ -301,7 +340,7 @@ impl Run {
             .bodies
             .iter()
             .zip(&self.w)
-            .filter(|(b, _)| !b.fixed)
+            .filter(|(b, _)| b.is_free())
             .map(|(b, w)| 0.5 * b.inertia_kg_m2 * w * w)
             .sum()
     }
@@ -388,8 +427,7 @@ impl Run {
                 let s0 = s * (wb - wa);
                 let scale = 1e-10 * (1.0 + wa.abs() + wb.abs());
                 // the slip's rate, constant over the step (the torques are held)
-                let rate =
-                    s * (self.inv_inertia[c.b] * total[c.b] - self.inv_inertia[c.a] * total[c.a]);
+                let rate = s * (acc[c.b] - acc[c.a]);
                 let s1 = s0 + h * rate;
                 if s0 > scale && s1 <= 0.0 {
                     best = best.min(h * s0 / (s0 - s1));
@@ -420,12 +458,13 @@ impl Run {
             // a break: the holding torque reaching the static limit on the step's own
             // trajectory (the speeds affine in the step's length), bisected to 1e-13 s
             let at = |hh: f64, scratch: &mut Torques| {
-                let w: Vec<f64> = (0..self.w.len())
+                let mut w: Vec<f64> = (0..self.w.len())
                     .map(|i| self.w[i] + hh * self.inv_inertia[i] * total[i])
                     .collect();
-                let theta: Vec<f64> = (0..self.w.len())
+                let mut theta: Vec<f64> = (0..self.w.len())
                     .map(|i| self.world.angles()[i] + 0.5 * hh * (self.w[i] + w[i]))
                     .collect();
+                self.prescribe(t + hh, &mut w, &mut theta);
                 let x = mesh::positions(&self.meshes, hh, &self.w, &acc);
                 self.margins(t + hh, &theta, &w, &x, scratch)
             };
@@ -458,6 +497,25 @@ impl Run {
             speed_rad_s: self.w.clone(),
             torque_n_m: self.coupling_torque.clone(),
             mode: self.modes.clone(),
+            reaction_n_m: self.reactions(),
         }
+    }
+
+    /// Each prescribed body's reaction under the torques held (N m, 0 for the other bodies;
+    /// empty without a prescribed body): `-(T_p + (C^T lambda)_p)`, its inertia infinite.
+    fn reactions(&self) -> Vec<f64> {
+        if self.alpha.is_empty() {
+            return Vec::new();
+        }
+        let total = self.total();
+        (0..total.len())
+            .map(|i| {
+                if self.net.bodies[i].prescribed().is_some() {
+                    -total[i]
+                } else {
+                    0.0
+                }
+            })
+            .collect()
     }
 }

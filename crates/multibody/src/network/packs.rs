@@ -87,6 +87,14 @@ pub(super) struct NetPack {
     session: MultibodySession,
     /// Whether the plates sit on the fixed body (no drum).
     pub housing: bool,
+    /// Whether the discs' carrier is a prescribed body: the session's shaft is then
+    /// prescribed by its profile (as a one-pack scene's), and its reaction on it is the teeth's
+    /// work over the step (the session's drive work) on the step's mean speed.
+    pub prescribed: Option<clutchpack_model::SpeedProfile>,
+    /// The session's drive work at the last step's end, J (a prescribed shaft's), and the
+    /// network's time there, s (a session not driven may stand a world step past it).
+    drive_work_j: f64,
+    t_last: f64,
     /// The discs' then the plates' inertias, kg m^2.
     inertia: Vec<f64>,
     /// How many of them are friction discs (on `a`).
@@ -141,25 +149,38 @@ impl NetPack {
         let mut out = Vec::new();
         for (k, c) in net.couplings.iter().enumerate() {
             let Some(model) = c.pack() else { continue };
-            if net.bodies[c.a].fixed {
+            if net.bodies[c.a].is_fixed() {
                 return Err(EngineError::Unsupported(format!(
                     "coupling \"{}\": its friction discs' carrier is the fixed body (put the \
                      plates there: body b)",
                     c.name
                 )));
             }
+            if net.bodies[c.b].prescribed().is_some() {
+                return Err(EngineError::Unsupported(format!(
+                    "coupling \"{}\": its plates' carrier is a prescribed body: put the \
+                     friction discs there (body a), the plates on a body that turns freely or \
+                     on the fixed one",
+                    c.name
+                )));
+            }
             let (pa, pb) = (p(c.a), p(c.b));
-            let housing = net.bodies[c.b].fixed;
+            let housing = net.bodies[c.b].is_fixed();
+            let prescribed = net.bodies[c.a].prescribed().cloned();
             let mut pack = model.clone();
-            pack.shaft = Shaft::Inertial {
-                inertia_kg_m2: 1.0 / pa[c.a],
-                damping_n_m_s_rad: 0.0,
-                excitation: ShaftExcitation::Held {
-                    t0_s: 0.0,
-                    torque_n_m: 0.0,
-                    rate_n_m_s: 0.0,
-                    initial_speed_rad_s: w[c.a],
-                },
+            pack.shaft = if let Some(profile) = &prescribed {
+                Shaft::Prescribed(profile.clone())
+            } else {
+                Shaft::Inertial {
+                    inertia_kg_m2: 1.0 / pa[c.a],
+                    damping_n_m_s_rad: 0.0,
+                    excitation: ShaftExcitation::Held {
+                        t0_s: 0.0,
+                        torque_n_m: 0.0,
+                        rate_n_m_s: 0.0,
+                        initial_speed_rad_s: w[c.a],
+                    },
+                }
             };
             pack.drum = (!housing).then(|| DrumModel {
                 inertia_kg_m2: 1.0 / pb[c.b],
@@ -187,7 +208,7 @@ impl NetPack {
             .with_thermal(net.pack_thermal.get(&k).cloned());
             let session = engine
                 .session(Driven {
-                    shaft_torque: true,
+                    shaft_torque: prescribed.is_none(),
                     drum_load: !housing,
                     ..Driven::NONE
                 })
@@ -198,6 +219,9 @@ impl NetPack {
                 b: c.b,
                 session,
                 housing,
+                prescribed: prescribed.clone(),
+                drive_work_j: 0.0,
+                t_last: 0.0,
                 inertia,
                 n_discs: model.discs.len(),
                 p_diag: [pa[c.a], if housing { 0.0 } else { pb[c.b] }],
@@ -231,7 +255,7 @@ impl NetPack {
     /// onto a carrier's group or releasing one changes the carrier's inertia `1 / P_aa`, which
     /// the session then takes ([`MultibodySession::set_carrier_inertia`]).
     pub fn follow_groups(&mut self, pa: &[f64], pb: &[f64], name: &str) -> Result<(), EngineError> {
-        if pa[self.a] != self.p_diag[0] {
+        if self.prescribed.is_none() && pa[self.a] != self.p_diag[0] {
             self.session
                 .set_carrier_inertia(false, 1.0 / pa[self.a])
                 .map_err(|e| in_pack(name, e))?;
@@ -262,17 +286,20 @@ impl NetPack {
     ) -> Result<[f64; 2], EngineError> {
         let h = t1 - self.session.time_s();
         let (wa0, wb0) = (w[self.a], w[self.b]);
-        let shaft = Carried {
+        // a prescribed shaft is the session's own (its profile, as the network's body)
+        let shaft = self.prescribed.is_none().then_some(Carried {
             speed_rad_s: wa0,
             torque_n_m: ta,
-        };
+        });
         let drum = (!self.housing).then_some(Carried {
             speed_rad_s: wb0,
             torque_n_m: tb,
         });
-        self.session
-            .set_carriers(shaft, drum)
-            .map_err(|e| in_pack(name, e))?;
+        if shaft.is_some() || drum.is_some() {
+            self.session
+                .set_carriers(shaft, drum)
+                .map_err(|e| in_pack(name, e))?;
+        }
         let mut fwd = Forward { k: self.k, obs };
         self.session
             .advance_to(t1, &mut fwd)
@@ -284,7 +311,30 @@ impl NetPack {
             // give -T; the estimate stands
             return Ok(self.reaction);
         }
-        let ra = (speed(false) - wa0) / (h * self.p_diag[0]) - ta;
+        let ra = if let Some(profile) = &self.prescribed {
+            // the teeth's work on the discs over the step, -R_a wbar_a h (the session's
+            // drive work: the shaft's on the teeth); a step shorter than the times' precision
+            // keeps the estimate (its work, rounding, goes with the next step's)
+            // over the network's step (the session's own may end past it: its work is booked
+            // with the step that reaches it)
+            let h = t1 - std::mem::replace(&mut self.t_last, t1);
+            // the network's mean speed of the step (the session's shaft is booked at its own
+            // world steps' ends)
+            let wbar = 0.5 * (wa0 + profile.speed(t1));
+            if h <= 1e-12 * (1.0 + t1) {
+                self.reaction[0]
+            } else {
+                let work = self.session.drive_work_so_far_j();
+                let step = work - std::mem::replace(&mut self.drive_work_j, work);
+                if wbar == 0.0 {
+                    0.0
+                } else {
+                    -step / (h * wbar)
+                }
+            }
+        } else {
+            (speed(false) - wa0) / (h * self.p_diag[0]) - ta
+        };
         let rb = if self.housing {
             0.0
         } else {
@@ -399,7 +449,9 @@ impl Run {
             // group the other carrier's estimate stays in (the cross term P_ab R_b, the
             // module's method)
             let apart = p.housing || negligible(pa[b], (pa[a] * pb[b]).sqrt());
-            let ta = if apart {
+            let ta = if p.prescribed.is_some() {
+                0.0 // its profile's motion: no torque moves it
+            } else if apart {
                 (acc[a] - pa[a] * ra0 - pb[a] * rb0) / pa[a]
             } else {
                 (acc[a] - pa[a] * ra0) / pa[a]

@@ -8,7 +8,8 @@ use super::mesh::{self, Mesh};
 use super::packs::NetPack;
 use super::{constraint, NetworkStepOptions, Run};
 use clutchpack_model::network::{
-    ClutchMode, Network, NetworkEnergy, NetworkInput, NetworkObserver, NetworkRun, NetworkSample,
+    Body, ClutchMode, Network, NetworkEnergy, NetworkInput, NetworkObserver, NetworkRun,
+    NetworkSample,
 };
 use clutchpack_model::{guard_state, EngineError, RUNAWAY_SPEED_RAD_S};
 use std::sync::Arc;
@@ -96,11 +97,7 @@ impl NetworkStepper {
         let world = NetworkWorld::build(net);
         let mut run = Run {
             w: world.speeds(),
-            inv_inertia: net
-                .bodies
-                .iter()
-                .map(|b| if b.fixed { 0.0 } else { 1.0 / b.inertia_kg_m2 })
-                .collect(),
+            inv_inertia: net.bodies.iter().map(Body::inverse_inertia).collect(),
             world,
             modes: (0..m)
                 .map(|k| net.couplings[k].law().initial_mode())
@@ -108,6 +105,7 @@ impl NetworkStepper {
             rows: Vec::new(),
             torque: vec![0.0; n],
             lambda: Vec::new(),
+            alpha: Vec::new(),
             coupling_torque: vec![0.0; m],
             meshes: Mesh::of(net),
             mesh_force: Vec::new(),
@@ -324,6 +322,14 @@ impl NetworkStepper {
             .map(|mesh| mesh.path(t, h, &w0, &acc))
             .collect();
         run.w = run.world.step(&total, h);
+        // a prescribed body moves as its profile says (its angle too, exactly)
+        for (i, b) in run.net.bodies.iter().enumerate() {
+            if let Some(p) = b.prescribed() {
+                let (w, theta) = p.speed_and_angle(t_new);
+                run.world.set_prescribed(i, w, theta);
+                run.w[i] = w;
+            }
+        }
         // rapier's speeds keep the rows to rounding; remove it (momentum kept)
         constraint::project(&run.rows, &run.inv_inertia, &mut run.w);
         run.world.set_speeds(&run.w);
@@ -334,7 +340,12 @@ impl NetworkStepper {
         let net = Arc::clone(&run.net);
         // the works over the step, with the step's mean speeds (the discrete energy identity)
         for (i, b) in net.bodies.iter().enumerate() {
-            if b.fixed {
+            if b.prescribed().is_some() {
+                // its reaction's work, -T_p (every torque on it, the rows' and the packs'
+                // with them) on its mean speed: the discrete energy identity's share of it
+                run.energy.prescribed_work_j -= h * total[i] * 0.5 * (w0[i] + run.w[i]);
+            }
+            if !b.is_free() {
                 continue;
             }
             let wbar = 0.5 * (w0[i] + run.w[i]);
@@ -409,7 +420,7 @@ impl NetworkStepper {
             .bodies
             .iter()
             .zip(self.w_start.iter().zip(&run.w))
-            .filter(|(b, _)| !b.fixed)
+            .filter(|(b, _)| b.is_free())
             .map(|(b, (w0, w))| 0.5 * b.inertia_kg_m2 * (w - w0) * (w + w0))
             .sum();
         // the packs' discs and plates with the bodies; each pack's loss is the carriers' work

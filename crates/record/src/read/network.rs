@@ -87,6 +87,7 @@ pub fn read_network(reader: &crate::RecordingReader) -> Option<Result<RecordedNe
             speed_rad_s: vec![f64::NAN; n],
             torque_n_m: vec![f64::NAN; m],
             mode: vec![None; m],
+            reaction_n_m: Vec::new(),
         };
         let bad = |e: prost::DecodeError| {
             format!(

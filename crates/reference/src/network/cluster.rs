@@ -17,6 +17,7 @@
 //! module docs of `mod.rs`).
 
 use clutchpack_model::network::rows::{self, Row};
+use clutchpack_model::network::Body;
 use clutchpack_model::network::Network;
 
 /// A group's freedom: how many degrees of freedom its members keep under the rows.
@@ -49,6 +50,9 @@ pub(crate) struct Clusters {
     p: Vec<f64>,
     /// `L`, row-major (rows) x n, dimensionless.
     l: Vec<f64>,
+    /// Each prescribed body with its response to a unit acceleration (rad/s^2) of it: every
+    /// body's acceleration and every row's torque ([`rows::prescribed_response`]).
+    prescribed: Vec<(usize, Vec<f64>, Vec<f64>)>,
 }
 
 impl Clusters {
@@ -56,15 +60,11 @@ impl Clusters {
     /// locked clutches: [`clutchpack_model::network::Coupling::row`]).
     pub fn build(net: &Network, rows: Vec<Row>) -> Clusters {
         let n = net.bodies.len();
-        let inv: Vec<f64> = net
-            .bodies
-            .iter()
-            .map(|b| if b.fixed { 0.0 } else { 1.0 / b.inertia_kg_m2 })
-            .collect();
+        let inv: Vec<f64> = net.bodies.iter().map(Body::inverse_inertia).collect();
         // P and L column by column: the response to a unit torque on each body
         let (p, l) = rows::projected(&rows, &inv);
         // the groups: moving bodies connected by a row's terms
-        let moving: Vec<bool> = net.bodies.iter().map(|b| !b.fixed).collect();
+        let moving: Vec<bool> = net.bodies.iter().map(Body::is_free).collect();
         let of = rows::groups(&rows, &moving);
         let mut members: Vec<Vec<usize>> = vec![Vec::new(); of.iter().max().map_or(0, |m| m + 1)];
         for (i, &c) in of.iter().enumerate() {
@@ -104,7 +104,7 @@ impl Clusters {
             inertia[c] = mem
                 .iter()
                 .map(|&i| {
-                    if net.bodies[i].fixed {
+                    if !net.bodies[i].is_free() {
                         0.0
                     } else {
                         g[i] * g[i] * net.bodies[i].inertia_kg_m2
@@ -113,11 +113,19 @@ impl Clusters {
                 .sum();
         }
         for (i, b) in net.bodies.iter().enumerate() {
-            if b.fixed {
+            if !b.is_free() {
                 g[i] = 0.0;
             }
         }
+        let prescribed = (0..n)
+            .filter(|&i| net.bodies[i].prescribed().is_some())
+            .map(|i| {
+                let (acc, lambda) = rows::prescribed_response(&rows, &inv, i);
+                (i, acc, lambda)
+            })
+            .collect();
         Clusters {
+            prescribed,
             of,
             g,
             inertia,
@@ -155,28 +163,75 @@ impl Clusters {
     }
 
     /// The torque each rigid coupling puts on its body `a` (N m, written to `out` at its
-    /// coupling: [`Row::first_torque_n_m`] of `lambda = L T`) under the other torques `torque`
-    /// on the bodies (N m).
-    pub fn rigid_torques(&self, torque: &[f64], out: &mut [f64]) {
-        let n = torque.len();
+    /// coupling: [`Row::first_torque_n_m`] of `lambda = L T`, plus the prescribed bodies'
+    /// share) under the other torques `torque` on the bodies (N m) and the prescribed bodies'
+    /// accelerations `alpha` (rad/s^2, by body; read at the prescribed bodies only).
+    pub fn rigid_torques(&self, torque: &[f64], alpha: &[f64], out: &mut [f64]) {
         for (r, row) in self.rows.iter().enumerate() {
-            let lambda: f64 = (0..n).map(|j| self.l[r * n + j] * torque[j]).sum();
-            out[row.coupling] = row.first_torque_n_m(lambda);
+            out[row.coupling] = row.first_torque_n_m(self.lambda(r, torque, alpha));
         }
     }
 
+    /// Row `r`'s torque (N m): `(L T)_r` and the prescribed bodies' share.
+    fn lambda(&self, r: usize, torque: &[f64], alpha: &[f64]) -> f64 {
+        let n = torque.len();
+        let mut lambda: f64 = (0..n).map(|j| self.l[r * n + j] * torque[j]).sum();
+        for (p, _, l) in &self.prescribed {
+            lambda += l[r] * alpha[*p];
+        }
+        lambda
+    }
+
+    /// Whether a body's motion is prescribed.
+    pub fn any_prescribed(&self) -> bool {
+        !self.prescribed.is_empty()
+    }
+
+    /// Adds the prescribed bodies' accelerations `alpha` (rad/s^2, by body) and what they
+    /// impose on the bodies tied to them to `acc` (rad/s^2; [`Self::accelerations`] gave the
+    /// torques' share, 0 at a prescribed body).
+    pub fn add_prescribed(&self, alpha: &[f64], acc: &mut [f64]) {
+        for (p, k, _) in &self.prescribed {
+            for (a, ki) in acc.iter_mut().zip(k) {
+                *a += ki * alpha[*p];
+            }
+        }
+    }
+
+    /// The reaction of prescribed body `p` (N m, positive along its rotation): what keeps its
+    /// profile against the torques `torque` on it (N m, all but the rows') and the rows' at the
+    /// accelerations `alpha` (rad/s^2), its inertia infinite: `-(T_p + (C^T lambda)_p)`.
+    pub fn reaction_n_m(&self, p: usize, torque: &[f64], alpha: &[f64]) -> f64 {
+        let mut on = torque[p];
+        for (r, row) in self.rows.iter().enumerate() {
+            for (i, c) in row.terms() {
+                if *i == p {
+                    on += c * self.lambda(r, torque, alpha);
+                }
+            }
+        }
+        -on
+    }
+
     /// Projects the speeds `w` (rad/s) onto the rows, each group's angular momentum kept (a
-    /// lock's merge: [`rows::project`]), the speeds of a group a fixed body holds exactly 0.
+    /// lock's merge: [`rows::project`]), the speeds of a group a fixed body holds exactly 0
+    /// (those the prescribed bodies hold: their speeds times the groups' response to them).
     pub fn project(&self, net: &Network, w: &mut [f64]) {
-        let inv: Vec<f64> = net
-            .bodies
-            .iter()
-            .map(|b| if b.fixed { 0.0 } else { 1.0 / b.inertia_kg_m2 })
-            .collect();
+        let inv: Vec<f64> = net.bodies.iter().map(Body::inverse_inertia).collect();
         rows::project(&self.rows, &inv, w);
-        for (i, v) in w.iter_mut().enumerate() {
-            if self.freedom[self.of[i]] == Freedom::Fixed {
-                *v = 0.0;
+        let given: Vec<(usize, f64)> = self
+            .prescribed
+            .iter()
+            .map(|(p, _, _)| (*p, w[*p]))
+            .collect();
+        for i in 0..w.len() {
+            if self.freedom[self.of[i]] == Freedom::Fixed && net.bodies[i].is_free() {
+                w[i] = 0.0;
+                for ((_, k, _), (_, wp)) in self.prescribed.iter().zip(&given) {
+                    w[i] += k[i] * wp;
+                }
+            } else if net.bodies[i].is_fixed() {
+                w[i] = 0.0;
             }
         }
     }
@@ -191,7 +246,7 @@ fn speed_factors(net: &Network, rows: &[Row], members: &[usize], r: usize) -> Ve
     let mut known: Vec<(usize, f64)> = std::iter::once((r, 1.0))
         .chain(
             (0..net.bodies.len())
-                .filter(|&i| net.bodies[i].fixed)
+                .filter(|&i| !net.bodies[i].is_free())
                 .map(|i| (i, 0.0)),
         )
         .collect();
@@ -225,7 +280,7 @@ fn speed_factors(net: &Network, rows: &[Row], members: &[usize], r: usize) -> Ve
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clutchpack_model::network::{Body, Coupling, CouplingKind};
+    use clutchpack_model::network::{Body, Coupling, CouplingKind, Motion};
 
     fn body(name: &str, j: f64) -> Body {
         Body {
@@ -233,7 +288,7 @@ mod tests {
             inertia_kg_m2: j,
             drag_n_m_s_rad: 0.0,
             initial_speed_rad_s: 0.0,
-            fixed: false,
+            motion: Motion::Free,
             drive: None,
             firing: None,
             road_load: None,
@@ -286,7 +341,7 @@ mod tests {
         assert!((acc[0] - 10.0 / j).abs() < 1e-14);
         assert!((acc[1] - acc[0] / 2.0).abs() < 1e-14);
         let mut lam = [0.0; 2];
-        cl.rigid_torques(&torque, &mut lam);
+        cl.rigid_torques(&torque, &[0.0; 3], &mut lam);
         // body c is driven by g2 alone: -3 lambda2 = J3 a3
         assert!((-3.0 * lam[1] - 3.0 * acc[2]).abs() < 1e-13);
         // body a: J1 a1 = 10 + lambda1

@@ -108,6 +108,12 @@ struct Equations {
     /// [`Equations::forces`] found them (while any body is held).
     hold_torque: Vec<f64>,
     hold_capacity: Vec<f64>,
+    /// Each prescribed body's acceleration at the last [`Equations::forces`], rad/s^2 (0 for
+    /// the other bodies).
+    alpha: Vec<f64>,
+    /// The counters after the couplings': drive work, load work, drag loss, and with a
+    /// prescribed body its reactions' work (3 or 4; docs/DECISIONS.md "A prescribed body").
+    counters: usize,
 }
 
 /// A mesh's tooth kinematics at the state `y = [angles, speeds, ...]`.
@@ -128,8 +134,17 @@ impl Equations {
     fn new(net: Arc<Network>, modes: Vec<Option<ClutchMode>>) -> Self {
         let (n, m) = (net.bodies.len(), net.couplings.len());
         let clusters = Clusters::build(&net, rigid_rows(&net, &modes));
-        let packs = packs::build(&net, 2 * n + 2 * m + 3, m);
+        // a fourth counter only with a prescribed body: the state of every other network
+        // keeps its layout (and its error norm its terms)
+        let counters = if net.bodies.iter().any(|b| b.prescribed().is_some()) {
+            4
+        } else {
+            3
+        };
+        let packs = packs::build(&net, 2 * n + 2 * m + counters, m);
         Equations {
+            alpha: vec![0.0; n],
+            counters,
             packs,
             net,
             modes,
@@ -155,7 +170,7 @@ impl Equations {
     /// The breakaway of body `i`'s road load, N m: its constant part (0: none, or fixed).
     fn breakaway(&self, i: usize) -> f64 {
         let b = &self.net.bodies[i];
-        if b.fixed {
+        if !b.is_free() {
             0.0
         } else {
             b.road_load.map_or(0.0, |l| l.constant_n_m)
@@ -198,7 +213,7 @@ impl Equations {
         net.bodies
             .iter()
             .enumerate()
-            .filter(|(_, b)| !b.fixed)
+            .filter(|(_, b)| b.is_free())
             .map(|(i, b)| 0.5 * b.inertia_kg_m2 * y[n + i] * y[n + i])
             .sum::<f64>()
             + self.packs.iter().map(|p| p.kinetic_j(y, w)).sum::<f64>()
@@ -208,7 +223,7 @@ impl Equations {
     /// the drives', loads' and drag's counters, then every pack's state.
     fn dim(&self) -> usize {
         let (n, m) = (self.net.bodies.len(), self.net.couplings.len());
-        2 * n + 2 * m + 3 + self.packs.iter().map(packs::NetPack::len).sum::<usize>()
+        2 * n + 2 * m + self.counters + self.packs.iter().map(packs::NetPack::len).sum::<usize>()
     }
 
     /// The guards' count: one per coupling, then every pack's.
@@ -228,7 +243,10 @@ impl Equations {
         let n = self.net.bodies.len();
         let w = &y[n..2 * n];
         for (i, b) in self.net.bodies.iter().enumerate() {
-            self.torque[i] = if b.fixed {
+            if let Some(p) = b.prescribed() {
+                self.alpha[i] = p.acceleration(t);
+            }
+            self.torque[i] = if !b.is_free() {
                 0.0
             } else if self.held[i] {
                 // at rest: its load is the holding reaction (`hold`), its drag nothing
@@ -270,6 +288,9 @@ impl Equations {
         }
         self.clusters
             .accelerations(&self.torque, &mut self.acc, &mut self.group);
+        if self.clusters.any_prescribed() {
+            self.clusters.add_prescribed(&self.alpha, &mut self.acc);
+        }
         if any_held {
             // a group held within its breakaway does not move: exactly (the reactions'
             // sum cancels the other torques only to rounding)
@@ -286,7 +307,7 @@ impl Equations {
     /// The rigid couplings' torques at the state of the last [`Self::forces`].
     fn rigid_torques(&mut self) {
         self.clusters
-            .rigid_torques(&self.torque, &mut self.coupling_torque);
+            .rigid_torques(&self.torque, &self.alpha, &mut self.coupling_torque);
     }
 
     /// `dy/dt` of the state `[angles, speeds, meshes' x, counters]`.
@@ -321,7 +342,7 @@ impl Equations {
         }
         let (mut drive, mut load, mut drag) = (0.0, 0.0, 0.0);
         for (i, b) in self.net.bodies.iter().enumerate() {
-            if b.fixed {
+            if !b.is_free() {
                 continue;
             }
             drive += b.drive_torque_n_m(t, y[i]) * w[i];
@@ -331,6 +352,13 @@ impl Equations {
         counters[m] = drive;
         counters[m + 1] = load;
         counters[m + 2] = drag;
+        if self.counters == 4 {
+            // the prescribed bodies' reactions' power, R w (the torques of `forces` above)
+            counters[m + 3] = (0..n)
+                .filter(|&i| self.net.bodies[i].prescribed().is_some())
+                .map(|i| self.clusters.reaction_n_m(i, &self.torque, &self.alpha) * w[i])
+                .sum();
+        }
         for p in &self.packs {
             // packs.rs, pass (3): each pack's bodies against their carriers' motion
             let c = p.carriers(w, &self.acc);
@@ -410,7 +438,25 @@ fn sample(eq: &mut Equations, t: f64, y: &[f64]) -> NetworkSample {
         speed_rad_s: y[n..2 * n].to_vec(),
         torque_n_m: eq.coupling_torque.clone(),
         mode: eq.modes.clone(),
+        reaction_n_m: reactions(eq),
     }
+}
+
+/// Each prescribed body's reaction at the state of the last [`Equations::forces`], N m (0 for
+/// the other bodies); empty without a prescribed body.
+fn reactions(eq: &Equations) -> Vec<f64> {
+    if !eq.clusters.any_prescribed() {
+        return Vec::new();
+    }
+    (0..eq.net.bodies.len())
+        .map(|i| {
+            if eq.net.bodies[i].prescribed().is_some() {
+                eq.clusters.reaction_n_m(i, &eq.torque, &eq.alpha)
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }
 
 /// The session every engine's network run is to its callers (the sdk holds either engine's).

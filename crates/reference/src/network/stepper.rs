@@ -614,6 +614,11 @@ impl NetworkStepper {
             spring_energy_change_j: spring_change,
             pack_loss_j: self.eq.packs.iter().map(|p| p.loss_j(y)).sum(),
             kinetic_change_j: self.eq.kinetic_j(y) - self.kinetic0,
+            prescribed_work_j: if self.eq.counters == 4 {
+                y[c0 + m + 3]
+            } else {
+                0.0
+            },
         };
         NetworkRun {
             last,

@@ -66,17 +66,32 @@ pub(super) fn drive(
     raw: Option<&D>,
     base_dir: &Path,
 ) -> (Field<DriveKind>, Option<Drive>) {
+    drive_at(ck, raw, base_dir, "drive")
+}
+
+/// A `[drive]` table at the path `at` (`drive`, or a network body's `bodies[2].speed`, which
+/// takes the same forms): its kind and the drive, every problem reported under `at`.
+pub(super) fn drive_at(
+    ck: &mut Checker,
+    raw: Option<&D>,
+    base_dir: &Path,
+    at: &str,
+) -> (Field<DriveKind>, Option<Drive>) {
     let empty = D::default();
     let r = raw.unwrap_or(&empty);
-    let num = |ck: &mut Checker, k: &Key| ck.num(&k.rel(), r.value(k), k);
-    let kind_field = ck.choice(&D::kind.rel(), r.kind.as_ref(), &D::kind, &DriveKind::ALL);
+    // the key's path under `at` (the table's own keys are written under "drive")
+    let path = |k: &Key| k.rel().replacen("drive", at, 1);
+    let num = |ck: &mut Checker, k: &Key| ck.num(&path(k), r.value(k), k);
+    let kind_field = ck.choice(&path(&D::kind), r.kind.as_ref(), &D::kind, &DriveKind::ALL);
     let kind = match kind_field.clone() {
         Field::Absent => {
             ck.report(
-                D::kind.rel(),
+                path(&D::kind),
                 None,
-                "missing (required: \"sine\", \"harmonics\", \"speed_table\" or \"torque_table\"; \
-                 set it in [drive])",
+                format!(
+                    "missing (required: \"sine\", \"harmonics\", \"speed_table\" or \
+                     \"torque_table\"; set it in [{at}])"
+                ),
             );
             return (Field::Absent, None);
         }
@@ -113,10 +128,10 @@ pub(super) fn drive(
     for (key, value, present) in given {
         if present && !kind.keys().contains(&key) {
             ck.report(
-                format!("drive.{key}"),
+                format!("{at}.{key}"),
                 value.map(show),
                 format!(
-                    "not used by drive.kind = \"{}\" (it takes: {})",
+                    "not used by {at}.kind = \"{}\" (it takes: {})",
                     kind.name(),
                     kind.keys().join(", ")
                 ),
@@ -126,18 +141,21 @@ pub(super) fn drive(
 
     let required = |what: &str| {
         format!(
-            "required with drive.kind = \"{}\"; set it in [drive]{what}",
+            "required with {at}.kind = \"{}\"; set it in [{at}]{what}",
             kind.name()
         )
     };
     let drive = match kind {
         DriveKind::Sine => {
             let omega0 =
-                num(ck, &D::omega0_rad_s).required(ck, &D::omega0_rad_s.rel(), &required(""));
-            let amplitude =
-                num(ck, &D::amplitude_rad_s).required(ck, &D::amplitude_rad_s.rel(), &required(""));
+                num(ck, &D::omega0_rad_s).required(ck, &path(&D::omega0_rad_s), &required(""));
+            let amplitude = num(ck, &D::amplitude_rad_s).required(
+                ck,
+                &path(&D::amplitude_rad_s),
+                &required(""),
+            );
             let frequency =
-                num(ck, &D::frequency_hz).required(ck, &D::frequency_hz.rel(), &required(""));
+                num(ck, &D::frequency_hz).required(ck, &path(&D::frequency_hz), &required(""));
             let phase = num(ck, &D::phase_deg).or(D::phase_deg.default_num());
             (|| {
                 Some(Drive::Profile(SpeedProfile::Harmonics {
@@ -152,20 +170,22 @@ pub(super) fn drive(
         }
         DriveKind::Harmonics => {
             let omega0 =
-                num(ck, &D::omega0_rad_s).required(ck, &D::omega0_rad_s.rel(), &required(""));
+                num(ck, &D::omega0_rad_s).required(ck, &path(&D::omega0_rad_s), &required(""));
             let raw_harmonics = r.harmonics.as_deref().unwrap_or_default();
             if raw_harmonics.is_empty() {
                 ck.report(
-                    "drive.harmonics",
+                    format!("{at}.harmonics"),
                     None,
-                    "missing (drive.kind = \"harmonics\" needs at least one [[drive.harmonics]] \
-                     entry with amplitude_rad_s and frequency_hz)",
+                    format!(
+                        "missing ({at}.kind = \"harmonics\" needs at least one [[{at}.harmonics]] \
+                         entry with amplitude_rad_s and frequency_hz)"
+                    ),
                 );
             }
             let mut harmonics = Some(Vec::new());
             for (i, h) in raw_harmonics.iter().enumerate() {
-                let key = |k: &Key| format!("drive.harmonics[{i}].{}", k.name);
-                let hint = "required; set it in [[drive.harmonics]]";
+                let key = |k: &Key| format!("{at}.harmonics[{i}].{}", k.name);
+                let hint = &format!("required; set it in [[{at}.harmonics]]");
                 let item = |ck: &mut Checker, k: &Key| ck.num(&key(k), h.value(k), k);
                 let amplitude =
                     item(ck, &H::amplitude_rad_s).required(ck, &key(&H::amplitude_rad_s), hint);
@@ -197,9 +217,9 @@ pub(super) fn drive(
             } else {
                 "torque_n_m"
             };
-            let file = ck.text(&D::file.rel(), r.file.as_ref()).required(
+            let file = ck.text(&path(&D::file), r.file.as_ref()).required(
                 ck,
-                &D::file.rel(),
+                &path(&D::file),
                 &required(&format!(
                     " (a CSV file with columns time_s and {column}, relative to the scene \
                      file's folder)"
@@ -207,7 +227,7 @@ pub(super) fn drive(
             );
             let hold = ck
                 .choice(
-                    &D::interpolation.rel(),
+                    &path(&D::interpolation),
                     r.interpolation.as_ref(),
                     &D::interpolation,
                     &[false, true],
@@ -231,7 +251,7 @@ pub(super) fn drive(
                     }
                     Ok(table) => Some(Drive::Torque(table)),
                     Err(message) => {
-                        ck.report(D::file.rel(), r.file.as_ref().map(show), message);
+                        ck.report(path(&D::file), r.file.as_ref().map(show), message);
                         None
                     }
                 }

@@ -469,6 +469,23 @@ fn network_scene(
         (Some(t), Some(net)) => transmission::transmission(ck, t, net, bodies).map(Some),
         (Some(_), None) => None,
     };
+    // a network that is one pack between a prescribed shaft and the housing or a drum is that
+    // pack's scene: it runs the pack's own session, to the bit (docs/DECISIONS.md, "A
+    // one-pack network is a pack scene")
+    if let (Some(net), Some(None)) = (&network, &transmission) {
+        if let Some(pack) = net.one_pack() {
+            return Some(Validated {
+                name: name?,
+                description: description?,
+                simulation: simulation?,
+                pack,
+                fatigue,
+                thermal: net.pack_thermal.get(&0).cloned(),
+                network: None,
+                transmission: None,
+            });
+        }
+    }
     Some(Validated {
         name: name?,
         description: description?,

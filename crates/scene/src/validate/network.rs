@@ -12,7 +12,7 @@ use crate::keys::{
 use crate::keys::{MAX_FIRING_HARMONICS, MAX_FORCE_SIGNAL, MAX_TORQUE_N_M};
 use crate::schema::{fmt_num, show, Key, RawTable};
 use clutchpack_model::network::{
-    name_problem, Body, Coupling, CouplingKind, Firing, GearMesh, LumpedClutch, Network,
+    name_problem, Body, Coupling, CouplingKind, Firing, GearMesh, LumpedClutch, Motion, Network,
     NetworkProblem, PlanetarySet, RoadLoad, Signal,
 };
 use clutchpack_model::{Hertz, LawKind, OilFilm, ToothLaw};
@@ -235,18 +235,45 @@ pub(super) fn network(
             ok = false;
         }
         let fixed = ck.boolean(&p(&B::fixed), r.value(&B::fixed)).or(false);
+        // a prescribed speed: the forms of [drive] at bodies[i].speed (a torque table is not
+        // a speed)
+        let speed_at = format!("bodies[{i}].speed");
+        let prescribed = match &r.speed {
+            None => Some(None),
+            Some(raw) => match super::drive::drive_at(ck, Some(raw), base_dir, &speed_at).1 {
+                Some(super::drive::Drive::Profile(profile)) => Some(Some(profile)),
+                Some(super::drive::Drive::Torque(_)) => {
+                    ck.report(
+                        format!("{speed_at}.kind"),
+                        Some("\"torque_table\"".into()),
+                        "a prescribed body follows a speed: \"sine\", \"harmonics\" or \
+                         \"speed_table\" (a torque on a body is its [bodies.drive])",
+                    );
+                    None
+                }
+                None => None,
+            },
+        };
+        if r.speed.is_some() && fixed == Some(true) {
+            ck.report(
+                p(&B::fixed),
+                Some("true".into()),
+                "a body is fixed or follows a prescribed speed (its [bodies.speed]), not both",
+            );
+        }
+        let given = r.speed.is_some() || fixed == Some(true);
         let inertia = ck.num(
             &p(&B::inertia_kg_m2),
             r.value(&B::inertia_kg_m2),
             &B::inertia_kg_m2,
         );
-        let inertia = match (fixed, inertia) {
-            (Some(true), f) => {
+        let inertia = match (given, inertia) {
+            (true, f) => {
                 if !matches!(f, Field::Absent) {
                     ck.report(
                         p(&B::inertia_kg_m2),
                         r.value(&B::inertia_kg_m2).map(show),
-                        "a fixed body has no inertia; remove it",
+                        "a fixed or prescribed body has no inertia (its motion is given); remove it",
                     );
                 }
                 Some(0.0)
@@ -257,6 +284,13 @@ pub(super) fn network(
             |ck: &mut Checker, k: &Key| ck.num(&p(k), r.value(k), k).or(k.default_num());
         let drag = or_default(ck, &B::drag_n_m_s_rad);
         let speed = or_default(ck, &B::initial_speed_rad_s);
+        if r.speed.is_some() && r.value(&B::initial_speed_rad_s).is_some() {
+            ck.report(
+                p(&B::initial_speed_rad_s),
+                r.value(&B::initial_speed_rad_s).map(show),
+                "a prescribed body starts at its [bodies.speed]'s speed at t = 0; remove it",
+            );
+        }
         let drive = match &r.drive {
             Some(d) => signal(ck, &TORQUE_SIGNAL, i, |k| d.value(k), base_dir).map(Some),
             None => Some(None),
@@ -287,7 +321,7 @@ pub(super) fn network(
         // (J / b), its quadratic part c one of 2 c |w| at the larger of the body's initial
         // speed and 1e3 rad/s (J / (2 c w), a body at rest speeds up), both under the
         // bodies' rule on a drag's time constant
-        let road_load = match (fixed, inertia, speed, road_load) {
+        let road_load = match (fixed.map(|_| given), inertia, speed, road_load) {
             (Some(false), Some(j), Some(w0), Some(Some(l))) => {
                 let linear_ok = l.linear_n_m_s_rad == 0.0
                     || super::bodies::drag_resolvable(
@@ -320,7 +354,7 @@ pub(super) fn network(
             (_, _, _, l) => l,
         };
         // a drag the engines can integrate: the bodies' rule on its time constant J / C
-        let drag = match (fixed, inertia, drag) {
+        let drag = match (fixed.map(|_| given), inertia, drag) {
             (Some(false), Some(j), Some(c)) if c > 0.0 => super::bodies::drag_resolvable(
                 ck,
                 (&p(&B::inertia_kg_m2), j),
@@ -330,7 +364,9 @@ pub(super) fn network(
             (_, _, c) => c,
         };
         names.push(name.clone());
-        match (name, inertia, fixed, drag, speed, drive, firing, road_load) {
+        match (
+            name, inertia, fixed, drag, speed, drive, firing, road_load, prescribed,
+        ) {
             (
                 Some(name),
                 Some(j),
@@ -340,12 +376,17 @@ pub(super) fn network(
                 Some(drive),
                 Some(firing),
                 Some(road_load),
+                Some(prescribed),
             ) => net.bodies.push(Body {
                 name,
                 inertia_kg_m2: j,
                 drag_n_m_s_rad: c,
-                initial_speed_rad_s: w,
-                fixed,
+                initial_speed_rad_s: prescribed.as_ref().map_or(w, |p| p.speed(0.0)),
+                motion: match prescribed {
+                    Some(p) => Motion::Prescribed(p),
+                    None if fixed => Motion::Fixed,
+                    None => Motion::Free,
+                },
                 drive,
                 firing,
                 road_load,
@@ -592,7 +633,7 @@ pub(super) fn network(
                     let all_bodies = net.bodies.len() == bodies.len();
                     let inertia = |i: Option<usize>| -> Option<f64> {
                         let b = net.bodies.get(i?).filter(|_| all_bodies)?;
-                        Some(if b.fixed {
+                        Some(if b.is_fixed() {
                             f64::INFINITY
                         } else {
                             b.inertia_kg_m2

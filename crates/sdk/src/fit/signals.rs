@@ -305,6 +305,7 @@ mod tests {
             speed_rad_s: vec![w],
             torque_n_m: vec![],
             mode: vec![],
+            reaction_n_m: vec![],
         }
     }
 

@@ -1,0 +1,83 @@
+//! Helpers the integration tests share: the impacts of an `--impacts-csv` and their
+//! comparison impact by impact.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// One tooth impact: onset, separation (s) and peak (N, per tooth, signed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Impact {
+    pub t_on_s: f64,
+    pub t_off_s: f64,
+    pub peak_n: f64,
+}
+
+/// The impacts of an `--impacts-csv` (a pack run's, first column `disc`, or a network run's,
+/// `name`), by body in the order they closed; a network's `<pack>/discs/<disc>` named by its
+/// last part (`<disc>`), as a pack run names it.
+pub fn impacts(csv: &Path) -> BTreeMap<String, Vec<Impact>> {
+    let text = std::fs::read_to_string(csv).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
+    let name = head
+        .iter()
+        .position(|h| *h == "name")
+        .unwrap_or_else(|| col("disc"));
+    let (on, off, peak) = (col("t_on_s"), col("t_off_s"), col("peak_n"));
+    let mut out: BTreeMap<String, Vec<Impact>> = BTreeMap::new();
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let num = |i: usize| f[i].parse::<f64>().unwrap();
+        let body = f[name].rsplit('/').next().unwrap().to_string();
+        out.entry(body).or_default().push(Impact {
+            t_on_s: num(on),
+            t_off_s: num(off),
+            peak_n: num(peak),
+        });
+    }
+    out
+}
+
+/// How far apart two runs' impacts are over those closed before a time: how many were
+/// compared, the largest onset difference (s) and the largest relative peak difference, one
+/// by one on every body, and the bodies whose counts differ `(body, a's, b's)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Apart {
+    pub compared: usize,
+    pub onset_s: f64,
+    pub peak: f64,
+    pub counts: Vec<(String, usize, usize)>,
+}
+
+/// [`Apart`] of the impacts `a` and `b` closed before `until_s` (s).
+pub fn apart(
+    a: &BTreeMap<String, Vec<Impact>>,
+    b: &BTreeMap<String, Vec<Impact>>,
+    until_s: f64,
+) -> Apart {
+    let mut out = Apart {
+        compared: 0,
+        onset_s: 0.0,
+        peak: 0.0,
+        counts: Vec::new(),
+    };
+    let before = |list: Option<&Vec<Impact>>| -> Vec<Impact> {
+        list.map_or(Vec::new(), |l| {
+            l.iter().filter(|e| e.t_off_s < until_s).copied().collect()
+        })
+    };
+    let bodies: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
+    for body in bodies {
+        let (x, y) = (before(a.get(body)), before(b.get(body)));
+        if x.len() != y.len() {
+            out.counts.push((body.clone(), x.len(), y.len()));
+        }
+        for (p, q) in x.iter().zip(&y) {
+            out.compared += 1;
+            out.onset_s = out.onset_s.max((p.t_on_s - q.t_on_s).abs());
+            out.peak = out.peak.max(((p.peak_n - q.peak_n) / p.peak_n).abs());
+        }
+    }
+    out
+}
