@@ -488,51 +488,24 @@ fn a_run_read_set_or_finished_inside_a_step_stands_at_the_call() {
 #[test]
 fn a_prescribed_body_engages_a_free_one_as_the_closed_form() {
     let net = cases::prescribed_clutch();
-    let (w0, a) = (
-        cases::PRESCRIBED_CLUTCH_W0_RAD_S,
-        cases::PRESCRIBED_CLUTCH_ACCEL_RAD_S2,
-    );
-    let (j, t) = (
-        cases::PRESCRIBED_CLUTCH_J_KG_M2,
-        cases::PRESCRIBED_CLUTCH_TORQUE_N_M,
-    );
     let mut obs = Events::default();
-    let run = run_network(&net, 0.8, &NetworkOptions::default(), &mut obs).unwrap();
-    let t_lock = w0 / (t / j - a);
+    let opts = NetworkOptions::default();
+    let run = run_network(&net, cases::PRESCRIBED_CLUTCH_DURATION_S, &opts, &mut obs).unwrap();
     let locks: Vec<f64> = obs
         .0
         .iter()
         .filter(|e| e.to == ClutchMode::Locked && e.t_s > 0.0)
         .map(|e| e.t_s)
         .collect();
-    let (w_end, heat, work) = (
-        w0 + a * 0.8,
-        t * w0 * t_lock / 2.0,
-        t * (w0 * t_lock + a * t_lock * t_lock / 2.0)
-            + j * ((w0 + a * 0.8).powi(2) - (w0 + a * t_lock).powi(2)) / 2.0,
-    );
     let reaction = |at: f64| {
         let s = obs.1.iter().find(|s| (s.t_s - at).abs() < 1e-9).unwrap();
         s.reaction_n_m[0]
     };
-    let e = run.energy;
-    println!(
-        "locks {locks:?} (closed form {t_lock}); load {} rad/s ({w_end}); heat {} J ({heat}); \
-         reactions {} and {} N m; work {} J ({work}); residual {} J",
-        run.last.speed_rad_s[1],
-        run.heat_j[0],
-        reaction(0.25),
-        reaction(0.7),
-        e.prescribed_work_j,
-        e.residual_j()
-    );
-    assert_eq!(locks.len(), 1, "{locks:?}");
-    assert!((locks[0] - t_lock).abs() < 1e-12, "{locks:?}");
-    assert!((run.last.speed_rad_s[0] - w_end).abs() < 1e-9);
-    assert!((run.last.speed_rad_s[1] - w_end).abs() < 1e-9);
-    assert!((run.heat_j[0] - heat).abs() < 1e-9);
-    assert!((reaction(0.25) - t).abs() < 1e-9);
-    assert!((reaction(0.7) - j * a).abs() < 1e-9);
-    assert!((e.prescribed_work_j - work).abs() < 1e-9);
-    assert!(e.residual_j().abs() < 1e-9);
+    let rows =
+        cases::prescribed_clutch_against_closed_form(&run, &locks, [reaction(0.25), reaction(0.7)]);
+    for (what, got, want) in rows {
+        println!("{what}: {got} (closed form {want}, off {:.1e})", got - want);
+        let bound = if what == "lock time s" { 1e-12 } else { 1e-9 };
+        assert!((got - want).abs() < bound, "{what}: {got} against {want}");
+    }
 }

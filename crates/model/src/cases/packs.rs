@@ -249,6 +249,44 @@ pub fn prescribed_clutch() -> crate::network::Network {
     }
 }
 
+/// How long [`prescribed_clutch`] is run for its closed form, s (the lock at 0.5 s, then
+/// 0.3 s locked).
+pub const PRESCRIBED_CLUTCH_DURATION_S: f64 = 0.8;
+
+/// [`prescribed_clutch`]'s run over [`PRESCRIBED_CLUTCH_DURATION_S`] against its closed form
+/// (the formulas of [`prescribed_clutch`]): one `(quantity, got, closed form)` row each for the
+/// number of locks (1), the first lock's time (s), the motor's and the load's speeds at the
+/// end (rad/s), the heat (J), the motor's reaction while slipping (`reactions[0]`, at 0.25 s)
+/// and locked (`reactions[1]`, at 0.7 s; N m), its work (J) and the balance's residual (J),
+/// for each engine's test to bound.
+pub fn prescribed_clutch_against_closed_form(
+    run: &crate::network::NetworkRun,
+    locks_s: &[f64],
+    reactions_n_m: [f64; 2],
+) -> Vec<(&'static str, f64, f64)> {
+    let (w0, a) = (PRESCRIBED_CLUTCH_W0_RAD_S, PRESCRIBED_CLUTCH_ACCEL_RAD_S2);
+    let (j, t) = (PRESCRIBED_CLUTCH_J_KG_M2, PRESCRIBED_CLUTCH_TORQUE_N_M);
+    let t_lock = w0 / (t / j - a);
+    let w_end = w0 + a * PRESCRIBED_CLUTCH_DURATION_S;
+    let work = t * (w0 * t_lock + a * t_lock * t_lock / 2.0)
+        + j * (w_end.powi(2) - (w0 + a * t_lock).powi(2)) / 2.0;
+    vec![
+        ("locks", locks_s.len() as f64, 1.0),
+        (
+            "lock time s",
+            locks_s.first().copied().unwrap_or(f64::NAN),
+            t_lock,
+        ),
+        ("motor speed rad/s", run.last.speed_rad_s[0], w_end),
+        ("load speed rad/s", run.last.speed_rad_s[1], w_end),
+        ("heat J", run.heat_j[0], t * w0 * t_lock / 2.0),
+        ("reaction slipping N m", reactions_n_m[0], t),
+        ("reaction locked N m", reactions_n_m[1], j * a),
+        ("prescribed work J", run.energy.prescribed_work_j, work),
+        ("residual J", run.energy.residual_j(), 0.0),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
