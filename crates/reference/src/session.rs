@@ -51,7 +51,15 @@ pub(crate) struct Queue {
     items: VecDeque<Item>,
     /// Whether the observer takes contact samples (asked at every call).
     pub wants_contacts: bool,
+    /// The samples' and the interface samples' buffers of items sent, for the next items
+    /// (issue 46: no allocation in a host's frame loop once started; they were two a sample).
+    spare_samples: Vec<Sample>,
+    spare_interfaces: Vec<Vec<InterfaceSample>>,
 }
+
+/// Most spare buffers a queue keeps of each kind (a call's steps queue at most a few
+/// samples past the session's time; the rest are sent within the call).
+const SPARE_BUFFERS: usize = 64;
 
 impl Queue {
     /// Drops every item held (a rewound session's: what its last step produced past the
@@ -59,11 +67,20 @@ impl Queue {
     pub fn clear(&mut self) {
         self.items.clear();
     }
+    /// Queues the sample of `sys` at `t` (state `y`, modes `modes`), then its interface
+    /// samples if it has interfaces, in buffers of items sent before.
+    pub fn sample_of(&mut self, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]) {
+        let mut s = self.spare_samples.pop().unwrap_or_default();
+        sys.sample_into(t, y, modes, &mut s);
+        self.items.push_back(Item::Sample(s));
+        if sys.interfaces() > 0 {
+            let mut i = self.spare_interfaces.pop().unwrap_or_default();
+            sys.interface_samples_into(t, y, modes, &mut i);
+            self.items.push_back(Item::Interfaces(t, i));
+        }
+    }
     pub fn sample(&mut self, s: Sample) {
         self.items.push_back(Item::Sample(s));
-    }
-    pub fn interfaces(&mut self, t: f64, i: Vec<InterfaceSample>) {
-        self.items.push_back(Item::Interfaces(t, i));
     }
     pub fn impact(&mut self, e: ImpactEvent) {
         self.items.push_back(Item::Impact(e));
@@ -101,8 +118,18 @@ impl Queue {
     pub fn flush(&mut self, t: f64, obs: &mut dyn Observer) {
         while self.items.front().is_some_and(|i| i.t_s() <= t) {
             match self.items.pop_front().expect("a front") {
-                Item::Sample(s) => obs.sample(&s),
-                Item::Interfaces(t, i) => obs.interfaces(t, &i),
+                Item::Sample(s) => {
+                    obs.sample(&s);
+                    if self.spare_samples.len() < SPARE_BUFFERS {
+                        self.spare_samples.push(s);
+                    }
+                }
+                Item::Interfaces(t, i) => {
+                    obs.interfaces(t, &i);
+                    if self.spare_interfaces.len() < SPARE_BUFFERS {
+                        self.spare_interfaces.push(i);
+                    }
+                }
                 Item::Impact(e) => obs.impact(&e),
                 Item::Contact(d, t, s) => obs.contact_sample(d, t, &s),
                 Item::Temperatures(t, k) => {
@@ -122,10 +149,7 @@ struct QueueSink<'q> {
 
 impl Sink for QueueSink<'_> {
     fn sample(&mut self, _k: u64, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]) {
-        self.queue.sample(sys.sample(t, y, modes));
-        if sys.interfaces() > 0 {
-            self.queue.interfaces(t, sys.interface_samples(t, y, modes));
-        }
+        self.queue.sample_of(t, sys, y, modes);
     }
     fn impact(&mut self, e: ImpactEvent) {
         self.queue.impact(e);
