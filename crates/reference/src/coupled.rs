@@ -168,7 +168,7 @@ pub(crate) struct CoupledSession {
     /// A driven session's integration and free discs before its last step that may pass a
     /// call's end (`crate::session::keep`; [`CoupledSession::rewind`]).
     saved: Option<Box<Stepper>>,
-    saved_free: Option<Box<Vec<Option<Free>>>>,
+    saved_free: Vec<Option<Free>>,
 }
 
 impl CoupledSession {
@@ -193,7 +193,7 @@ impl CoupledSession {
             queue: Queue::default(),
             before: None,
             saved: None,
-            saved_free: None,
+            saved_free: Vec::new(),
         }
     }
 
@@ -208,7 +208,7 @@ impl CoupledSession {
         while self.st.t < t {
             if keeps && self.st.may_pass(t) {
                 keep(&mut self.saved, &self.st);
-                keep(&mut self.saved_free, &self.free);
+                self.saved_free.clone_from(&self.free);
             }
             let step = {
                 let mut sink = PackSink {
@@ -259,14 +259,11 @@ impl CoupledSession {
     /// had produced past it.
     fn rewind(&mut self) -> Result<(), EngineError> {
         let t = self.clock.t;
-        let (Some(saved), Some(free)) = (self.saved.as_deref(), self.saved_free.as_deref()) else {
+        let Some(saved) = self.saved.as_deref().filter(|_| self.st.t > t) else {
             return Ok(());
         };
-        if self.st.t <= t {
-            return Ok(());
-        }
         self.st.clone_from(saved);
-        self.free.clone_from(free);
+        self.free.clone_from(&self.saved_free);
         self.before = None;
         self.queue.clear();
         let done = self.steps(t, t, &mut NullObserver);
