@@ -13,8 +13,10 @@ use crate::stream::{EngineError, Observer, RunStats, Sample};
 /// Which of the pack's inputs a session's caller drives (the others follow the scene's
 /// profiles). A session driven by nothing follows the scene exactly as `Engine::run` does,
 /// and its steps never stop at a communication point (so any split of a run into calls gives
-/// the run's results bit for bit). A driven session ends a step at every communication point,
-/// where an input may change.
+/// the run's results bit for bit). A driven session on the multibody engine ends a world step
+/// at every communication point, where an input may change; on the reference engine it steps
+/// past the point as an undriven one does, and an input set to a new value there ends that
+/// step at the point (docs/DECISIONS.md, "Co-simulation").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Driven {
     /// The prescribed shaft's speed (a shaft with `mode = "prescribed"`).

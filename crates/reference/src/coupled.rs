@@ -3,14 +3,14 @@
 //! the integrated state at their located re-engagement (crate docs, Theory).
 
 use crate::dopri::Dense;
-use crate::session::{Clock, Queue};
+use crate::session::{keep, Clock, Queue};
 use crate::stepper::{Sink, Stepper, Switch};
 use crate::system::{disc_sample, System};
 use crate::ReferenceOptions;
 use clutchpack_model::session::{Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::{
-    DiscModel, DiscSample, Engagement, EngineError, ImpactEvent, Observer, PackModel, RunStats,
-    Sample,
+    DiscModel, DiscSample, Engagement, EngineError, ImpactEvent, NullObserver, Observer, PackModel,
+    RunStats, Sample,
 };
 use std::sync::Arc;
 
@@ -165,6 +165,10 @@ pub(crate) struct CoupledSession {
     /// The integration and the free discs as they were before the last step's change of the
     /// integrated discs, when that step passed the session's time (the snapshot needs them).
     before: Option<Box<(Stepper, Vec<Option<Free>>)>>,
+    /// A driven session's integration and free discs before its last step that may pass a
+    /// call's end (`crate::session::keep`; [`CoupledSession::rewind`]).
+    saved: Option<Box<Stepper>>,
+    saved_free: Vec<Option<Free>>,
 }
 
 impl CoupledSession {
@@ -188,33 +192,24 @@ impl CoupledSession {
             clock: Clock::new(driven),
             queue: Queue::default(),
             before: None,
+            saved: None,
+            saved_free: Vec::new(),
         }
     }
-}
 
-impl Session for CoupledSession {
-    fn time_s(&self) -> f64 {
-        self.clock.t
-    }
-
-    fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
-        // an inertial shaft: its drive torque, no jump of a speed
-        let (pack, _) = self.clock.hold(&self.st.sys.pack, inputs)?;
-        self.st.sys.pack = Arc::new(pack);
-        self.st.restart();
-        Ok(())
-    }
-
-    fn set_stop_time(&mut self, t_s: f64) {
-        self.clock.stop = t_s;
-    }
-
-    fn advance_to(&mut self, t: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
-        self.clock.check_advance(t)?;
-        self.queue.wants_contacts = obs.wants_contact_samples();
-        let end = self.clock.step_end(t);
+    /// Steps until the integration's time reaches `t` (s), the steps ending at `end` (s), the
+    /// discs leaving and joining it; the output queued and sent up to the integration's time
+    /// at every poll of `obs`.
+    fn steps(&mut self, t: f64, end: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
         let mut advance = Advance::Reached;
+        // a copy before a step that may pass `t`, where an input may change (not when the
+        // steps end at `t`)
+        let keeps = self.clock.keeps() && end > t;
         while self.st.t < t {
+            if keeps && self.st.may_pass(t) {
+                keep(&mut self.saved, &self.st);
+                self.saved_free.clone_from(&self.free);
+            }
             let step = {
                 let mut sink = PackSink {
                     queue: &mut self.queue,
@@ -255,6 +250,54 @@ impl Session for CoupledSession {
                 break;
             }
         }
+        Ok(advance)
+    }
+
+    /// Ends the step that passed the session's time there, before an input changes (a driven
+    /// session): the integration and the free discs kept before it stepped again to the
+    /// session's time, what those steps give again (sent before) dropped with what the step
+    /// had produced past it.
+    fn rewind(&mut self) -> Result<(), EngineError> {
+        let t = self.clock.t;
+        let Some(saved) = self.saved.as_deref().filter(|_| self.st.t > t) else {
+            return Ok(());
+        };
+        self.st.clone_from(saved);
+        self.free.clone_from(&self.saved_free);
+        self.before = None;
+        self.queue.clear();
+        let done = self.steps(t, t, &mut NullObserver);
+        self.queue.clear();
+        if done.is_err() {
+            self.clock.failed = true;
+        }
+        done.map(|_| ())
+    }
+}
+
+impl Session for CoupledSession {
+    fn time_s(&self) -> f64 {
+        self.clock.t
+    }
+
+    fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
+        self.rewind()?;
+        // an inertial shaft: its drive torque, no jump of a speed
+        let (pack, _) = self.clock.hold(&self.st.sys.pack, inputs)?;
+        self.st.sys.pack = Arc::new(pack);
+        self.st.restart();
+        Ok(())
+    }
+
+    fn set_stop_time(&mut self, t_s: f64) {
+        self.clock.stop = t_s;
+    }
+
+    fn advance_to(&mut self, t: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
+        self.clock.check_advance(t)?;
+        self.queue.wants_contacts = obs.wants_contact_samples();
+        let end = self.clock.step_end(t);
+        let advance = self.steps(t, end, obs)?;
         let now = self.clock.end_call(advance, self.st.t, t);
         self.queue.flush(now, obs);
         Ok(advance)

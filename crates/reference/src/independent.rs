@@ -3,7 +3,7 @@
 //! time-ordered stream of samples and impacts (crate docs, Theory).
 
 use crate::gaps::Track;
-use crate::session::{shift_disc_speeds, Clock};
+use crate::session::{keep, shift_disc_speeds, Clock};
 use crate::stepper::{Sink, Stepper};
 use crate::system::System;
 use crate::{no_external, ReferenceOptions};
@@ -22,11 +22,11 @@ use std::time::Instant;
 pub(crate) struct Buffer {
     /// `(sample number, the disc's sample, the work of its gaps below and above in J (0
     /// without gaps))` in order.
-    samples: VecDeque<(u64, DiscSample, [f64; 2])>,
+    pub(crate) samples: VecDeque<(u64, DiscSample, [f64; 2])>,
     /// Impacts in the order they closed.
-    impacts: Vec<ImpactEvent>,
+    pub(crate) impacts: Vec<ImpactEvent>,
     /// `(t s, the disc's state)` of its contact samples, in order.
-    contacts: VecDeque<(f64, DiscSample)>,
+    pub(crate) contacts: VecDeque<(f64, DiscSample)>,
     /// Whether the observer takes contact samples (else none are kept).
     pub wants_contacts: bool,
 }
@@ -102,10 +102,24 @@ impl DiscRun {
 
     /// Integrates until the disc's time reaches `t_w` (s), its steps ending at `end` (s), or
     /// until the wall clock passes `deadline` (so that a stop request is seen even when the
-    /// steps become very small).
-    fn advance(&mut self, t_w: f64, end: f64, deadline: Instant) {
+    /// steps become very small). With `saved`, a copy of the integration goes there before a
+    /// step that may pass `call_end` (s), the call's end (`crate::session::keep`).
+    fn advance(
+        &mut self,
+        t_w: f64,
+        end: f64,
+        deadline: Instant,
+        saved: Option<&mut Option<Box<Stepper>>>,
+        call_end: f64,
+    ) {
         let mut n: u32 = 0;
+        let mut saved = saved;
         while self.error.is_none() && self.stepper.t < t_w {
+            if let Some(slot) = saved.as_deref_mut() {
+                if self.stepper.may_pass(call_end) {
+                    keep(slot, &self.stepper);
+                }
+            }
             if let Err(e) = self.stepper.step(end, &mut self.out, &mut no_external) {
                 self.error = Some(e);
             }
@@ -145,6 +159,9 @@ pub(crate) struct IndependentSession {
     /// Time every disc has reached and whose output has been merged, s.
     t_w: f64,
     merger: Merger,
+    /// A driven session's integration of each disc before its last step that may pass a
+    /// call's end (`crate::session::keep`; `IndependentSession::rewind`).
+    saved: Vec<Option<Box<Stepper>>>,
 }
 
 impl IndependentSession {
@@ -169,22 +186,34 @@ impl IndependentSession {
             cap,
             t_w: 0.0,
             merger: Merger::new(rate, nd),
+            saved: vec![None; nd],
         }
     }
 
     /// Runs the discs through one window ending at most at `target` (s), their steps ending
     /// at `end`, and sends what the window completed; returns the error of the earliest disc
     /// that failed.
-    fn window(&mut self, target: f64, end: f64, obs: &mut dyn Observer) -> Result<(), EngineError> {
+    /// A driven session keeps each disc's integration before a step that may pass
+    /// `call_end` (s), the call's end.
+    fn window(
+        &mut self,
+        target: f64,
+        end: f64,
+        call_end: f64,
+        obs: &mut dyn Observer,
+    ) -> Result<(), EngineError> {
         let runs = &mut self.runs;
         let wall = Instant::now();
         let deadline = wall + std::time::Duration::from_secs_f64(WINDOW_WALL_CUT_S);
+        let keeps = self.clock.keeps() && end > call_end;
+        let saved = &mut self.saved;
+        let run = |(r, s): (&mut DiscRun, &mut Option<Box<Stepper>>)| {
+            r.advance(target, end, deadline, keeps.then_some(s), call_end)
+        };
         if self.parallel {
-            runs.par_iter_mut()
-                .for_each(|r| r.advance(target, end, deadline));
+            runs.par_iter_mut().zip(saved.par_iter_mut()).for_each(run);
         } else {
-            runs.iter_mut()
-                .for_each(|r| r.advance(target, end, deadline));
+            runs.iter_mut().zip(saved.iter_mut()).for_each(run);
         }
         // a window cut short by the deadline ends where the slowest disc got to
         self.t_w = runs
@@ -228,6 +257,15 @@ impl Session for IndependentSession {
     }
 
     fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
+        if let Err(e) = rewind_runs(
+            &mut self.runs,
+            &mut self.saved,
+            &mut self.merger,
+            self.clock.t,
+        ) {
+            self.clock.failed = true;
+            return Err(e);
+        }
         self.pack = hold_in_runs(&self.clock, &self.pack, &mut self.runs, inputs)?;
         Ok(())
     }
@@ -242,7 +280,7 @@ impl Session for IndependentSession {
         let end = self.clock.step_end(t);
         while self.t_w < t {
             let target = (self.t_w + self.window).min(t);
-            if let Err(e) = self.window(target, end, obs) {
+            if let Err(e) = self.window(target, end, t, obs) {
                 self.clock.failed = true;
                 return Err(e);
             }
@@ -400,6 +438,12 @@ impl Merger {
         pending.drain(..next_impact);
     }
 
+    /// Drops the impacts held that closed after `t` (s) (a rewound session's: its last steps'
+    /// past its time).
+    pub fn drop_after(&mut self, t: f64) {
+        self.pending.retain(|e| e.t_off_s <= t);
+    }
+
     /// Sends what is left at the end of a run: the impacts closed beyond the last merge (a
     /// stop), the contact samples, then the events still open; returns the bodies' summed
     /// step counts.
@@ -422,6 +466,35 @@ impl Merger {
         }
         stats
     }
+}
+
+/// Ends at the session's time `t` (s) every step of `runs` that passed it, before an input
+/// changes (a driven session whose output is merged up to `t`): each such disc's integration
+/// kept in `saved` stepped again to `t`, what those steps give again (sent before) dropped
+/// with everything the discs and `merger` held past `t` (the last steps' output).
+fn rewind_runs(
+    runs: &mut [DiscRun],
+    saved: &mut [Option<Box<Stepper>>],
+    merger: &mut Merger,
+    t: f64,
+) -> Result<(), EngineError> {
+    merger.drop_after(t);
+    for (r, s) in runs.iter_mut().zip(saved.iter()) {
+        // all merged up to `t`: the samples left are past it, the contact samples at `t`
+        // wait for the next sample
+        r.out.samples.clear();
+        r.out.impacts.clear();
+        r.out.contacts.retain(|&(tc, _)| tc <= t);
+        let Some(s) = s.as_deref().filter(|_| r.stepper.t > t) else {
+            continue;
+        };
+        r.stepper.clone_from(s);
+        let mut again = Buffer::default();
+        while r.stepper.t < t {
+            r.stepper.step(t, &mut again, &mut no_external)?;
+        }
+    }
+    Ok(())
 }
 
 /// Holds `inputs` from the session's time (`clock`) in every run of `runs` on `pack`: the

@@ -427,6 +427,46 @@ impl OpenSession {
         Ok(())
     }
 
+    /// Ends the last window at the session's time, before an input changes (a driven session
+    /// whose window passed its time): every body back at the window's start (its saved
+    /// state), the window run again to the session's time, what it gives again (sent before)
+    /// dropped with everything the bodies and the merge held past the session's time.
+    fn rewind(&mut self) -> Result<(), EngineError> {
+        let t = self.clock.t;
+        if self.t_w <= t {
+            return Ok(());
+        }
+        let Some(last) = self.last.clone() else {
+            return Ok(());
+        };
+        self.merger.drop_after(t);
+        // the contact samples up to `t` still to be sent (they wait for the next sample)
+        let waiting: Vec<_> = self
+            .runs
+            .iter_mut()
+            .map(|r| {
+                let mut c = std::mem::take(&mut r.out.contacts);
+                c.retain(|&(tc, _)| tc <= t);
+                c
+            })
+            .collect();
+        let wants = self.runs.first().is_some_and(|r| r.out.wants_contacts);
+        for (r, s) in self.runs.iter_mut().zip(&last.saved) {
+            r.clone_from(s);
+            r.out.wants_contacts = false;
+        }
+        self.t_w = self.runs.first().map_or(t, |r| r.stepper.t);
+        drop(last);
+        let done = if self.t_w < t { self.window(t) } else { Ok(()) };
+        for (r, c) in self.runs.iter_mut().zip(waiting) {
+            r.out.samples.clear();
+            r.out.impacts.clear();
+            r.out.contacts = c;
+            r.out.wants_contacts = wants;
+        }
+        done
+    }
+
     /// Sends the output up to `limit` (s): the bodies' samples, each followed by the gaps'.
     fn merge(&mut self, limit: f64, obs: &mut dyn Observer) {
         let (at, c, r_eff) = (&self.at, self.c_gap, self.r_eff);
@@ -473,6 +513,10 @@ impl Session for OpenSession {
     }
 
     fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
+        if let Err(e) = self.rewind() {
+            self.clock.failed = true;
+            return Err(e);
+        }
         self.pack = hold_in_runs(&self.clock, &self.pack, &mut self.runs, inputs)?;
         Ok(())
     }
@@ -486,8 +530,8 @@ impl Session for OpenSession {
         want_contacts(&mut self.runs, obs);
         let end = self.clock.step_end(t);
         while self.t_w < t {
-            // windows on a fixed grid (a run split into calls takes the same steps); a driven
-            // session's end at its communication point
+            // windows on a fixed grid (a run split into calls takes the same steps, driven or
+            // not; a window past the call's end is run again to it should an input change)
             let k = (self.t_w / WINDOW_S + 1e-9).floor() + 1.0;
             let t1 = (k * WINDOW_S).min(end);
             if let Err(e) = self.window(t1) {

@@ -3,12 +3,13 @@
 //! the monolithic scheme's session. The multirate schemes' sessions are in `independent.rs`
 //! and `coupled.rs`.
 //!
-//! A session driven by nothing steps exactly as a whole run does (its steps end at the stop
+//! A session steps exactly as a whole run does, driven or not (its steps end at the stop
 //! time, never at a communication point), so that a run split into calls is the run, bit for
 //! bit; a step may then pass the session's time, and what it produced beyond waits in the
-//! [`Queue`] for the next call. A driven session ends a step at every communication point,
-//! where an input may change; the integration restarts there (docs/DECISIONS.md,
-//! "Co-simulation").
+//! [`Queue`] for the next call. A driven session keeps a copy of its integration before a
+//! step that may pass the call's end; an input set to a new value there ends that step at the
+//! session's time (the copy stepped again to it, what it gives again not sent twice) and the
+//! integration restarts with the input (docs/DECISIONS.md, "Co-simulation").
 
 use crate::stepper::{Sink, Stepper, Switch};
 use crate::system::System;
@@ -16,8 +17,8 @@ use crate::thermal::{swap_pack, Thermal};
 use crate::{face_event, no_external, ReferenceOptions};
 use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::{
-    DiscSample, Engagement, EngineError, ImpactEvent, InterfaceSample, Observer, PackModel,
-    RunStats, Sample,
+    DiscSample, Engagement, EngineError, ImpactEvent, InterfaceSample, NullObserver, Observer,
+    PackModel, RunStats, Sample,
 };
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -50,14 +51,36 @@ pub(crate) struct Queue {
     items: VecDeque<Item>,
     /// Whether the observer takes contact samples (asked at every call).
     pub wants_contacts: bool,
+    /// The samples' and the interface samples' buffers of items sent, for the next items
+    /// (issue 46: no allocation in a host's frame loop once started; they were two a sample).
+    spare_samples: Vec<Sample>,
+    spare_interfaces: Vec<Vec<InterfaceSample>>,
 }
 
+/// Most spare buffers a queue keeps of each kind (a call's steps queue at most a few
+/// samples past the session's time; the rest are sent within the call).
+const SPARE_BUFFERS: usize = 64;
+
 impl Queue {
+    /// Drops every item held (a rewound session's: what its last step produced past the
+    /// session's time, or what the same steps taken again produced up to it, sent before).
+    pub fn clear(&mut self) {
+        self.items.clear();
+    }
+    /// Queues the sample of `sys` at `t` (state `y`, modes `modes`), then its interface
+    /// samples if it has interfaces, in buffers of items sent before.
+    pub fn sample_of(&mut self, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]) {
+        let mut s = self.spare_samples.pop().unwrap_or_default();
+        sys.sample_into(t, y, modes, &mut s);
+        self.items.push_back(Item::Sample(s));
+        if sys.interfaces() > 0 {
+            let mut i = self.spare_interfaces.pop().unwrap_or_default();
+            sys.interface_samples_into(t, y, modes, &mut i);
+            self.items.push_back(Item::Interfaces(t, i));
+        }
+    }
     pub fn sample(&mut self, s: Sample) {
         self.items.push_back(Item::Sample(s));
-    }
-    pub fn interfaces(&mut self, t: f64, i: Vec<InterfaceSample>) {
-        self.items.push_back(Item::Interfaces(t, i));
     }
     pub fn impact(&mut self, e: ImpactEvent) {
         self.items.push_back(Item::Impact(e));
@@ -95,8 +118,18 @@ impl Queue {
     pub fn flush(&mut self, t: f64, obs: &mut dyn Observer) {
         while self.items.front().is_some_and(|i| i.t_s() <= t) {
             match self.items.pop_front().expect("a front") {
-                Item::Sample(s) => obs.sample(&s),
-                Item::Interfaces(t, i) => obs.interfaces(t, &i),
+                Item::Sample(s) => {
+                    obs.sample(&s);
+                    if self.spare_samples.len() < SPARE_BUFFERS {
+                        self.spare_samples.push(s);
+                    }
+                }
+                Item::Interfaces(t, i) => {
+                    obs.interfaces(t, &i);
+                    if self.spare_interfaces.len() < SPARE_BUFFERS {
+                        self.spare_interfaces.push(i);
+                    }
+                }
                 Item::Impact(e) => obs.impact(&e),
                 Item::Contact(d, t, s) => obs.contact_sample(d, t, &s),
                 Item::Temperatures(t, k) => {
@@ -116,10 +149,7 @@ struct QueueSink<'q> {
 
 impl Sink for QueueSink<'_> {
     fn sample(&mut self, _k: u64, t: f64, sys: &System, y: &[f64], modes: &[Option<Engagement>]) {
-        self.queue.sample(sys.sample(t, y, modes));
-        if sys.interfaces() > 0 {
-            self.queue.interfaces(t, sys.interface_samples(t, y, modes));
-        }
+        self.queue.sample_of(t, sys, y, modes);
     }
     fn impact(&mut self, e: ImpactEvent) {
         self.queue.impact(e);
@@ -163,14 +193,18 @@ impl Clock {
         self.t
     }
 
-    /// Where the steps of a call to `t` (s) end: at `t` for a driven session, else at the stop
-    /// time (at `t` when the stop time lies before it).
+    /// Where the steps of a call to `t` (s) end: at the stop time (at `t` when the stop time
+    /// lies before it), driven or not: the steps of a run split into calls are the whole
+    /// run's (issue 46: a driven session ended a step at every call, `hu-table2` 3692 steps
+    /// in 1 ms frames against 3497 in one call).
     pub fn step_end(&self, t: f64) -> f64 {
-        if self.driven.any() {
-            t
-        } else {
-            self.stop.max(t)
-        }
+        self.stop.max(t)
+    }
+
+    /// Whether the session keeps a copy of its integration before a step that may pass a
+    /// call's end: a driven one, whose inputs may change there ([`keep`]).
+    pub fn keeps(&self) -> bool {
+        self.driven.any()
     }
 
     /// Checks a call to `t` (s).
@@ -212,6 +246,16 @@ impl Clock {
     }
 }
 
+/// Keeps in `slot` a copy of `now` (into the buffers of the last copy: no allocation once the
+/// copies are as large): a driven session's integration before a step that may pass the
+/// call's end, to end that step at the session's time should an input change there.
+pub(crate) fn keep<T: Clone>(slot: &mut Option<Box<T>>, now: &T) {
+    match slot {
+        Some(b) => b.as_mut().clone_from(now),
+        None => *slot = Some(Box::new(now.clone())),
+    }
+}
+
 /// Adds `jump` (rad/s) to the relative speed of every disc slot of `st` against the shaft
 /// (a jump of the prescribed shaft's speed; the plates' carriers do not move with it).
 pub(crate) fn shift_disc_speeds(st: &mut Stepper, jump: f64) {
@@ -238,6 +282,10 @@ pub(crate) struct MonolithicSession {
     buf: Vec<f64>,
     /// The temperatures of a thermal run (`crate::thermal`); `None`: isothermal.
     thermal: Option<Box<Thermal>>,
+    /// A driven session's integration and temperatures before its last step that may pass a
+    /// call's end ([`keep`]; `MonolithicSession::rewind`).
+    saved: Option<Box<Stepper>>,
+    saved_thermal: Option<Box<Thermal>>,
 }
 
 impl MonolithicSession {
@@ -254,6 +302,8 @@ impl MonolithicSession {
             poll: (1024 / nd.max(1)).max(1) as u64,
             buf: Vec::new(),
             thermal: None,
+            saved: None,
+            saved_thermal: None,
         }
     }
 
@@ -274,47 +324,22 @@ impl MonolithicSession {
         self.thermal = Some(Box::new(th));
         Ok(self)
     }
-}
 
-/// Sets every face of a stack's pack to its mode at the stepper's time (from the piston on)
-/// and restarts the integration; nothing without a stack.
-fn settle_faces(st: &mut Stepper) {
-    if st.sys.pack.stack.is_some() {
-        for m in 0..st.sys.faces.len() {
-            let (t, modes) = (st.t, st.modes.clone());
-            st.sys.settle_face(m, t, &mut st.y, &modes);
-        }
-        st.restart();
-    }
-}
-
-impl Session for MonolithicSession {
-    fn time_s(&self) -> f64 {
-        self.clock.t
-    }
-
-    fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
-        let (pack, jump) = self.clock.hold(&self.st.sys.pack, inputs)?;
-        self.st.sys.pack = Arc::new(pack);
-        shift_disc_speeds(&mut self.st, jump);
-        self.st.restart();
-        if inputs.piston_pressure_pa.is_some() {
-            settle_faces(&mut self.st);
-        }
-        Ok(())
-    }
-
-    fn set_stop_time(&mut self, t_s: f64) {
-        self.clock.stop = t_s;
-    }
-
-    fn advance_to(&mut self, t: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
-        self.clock.check_advance(t)?;
-        self.queue.wants_contacts = obs.wants_contact_samples();
-        let end = self.clock.step_end(t);
+    /// Steps until the stepper's time reaches `t` (s), the steps ending at `end` (s), their
+    /// output queued and sent up to the stepper's time at every poll of `obs`.
+    fn steps(&mut self, t: f64, end: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
         let stack = self.st.sys.pack.stack.is_some();
         let mut advance = Advance::Reached;
+        // a copy before a step that may pass `t`, where an input may change (not when the
+        // steps end at `t`)
+        let keeps = self.clock.keeps() && end > t;
         while self.st.t < t {
+            if keeps && self.st.may_pass(t) {
+                keep(&mut self.saved, &self.st);
+                if let Some(th) = &self.thermal {
+                    keep(&mut self.saved_thermal, th.as_ref());
+                }
+            }
             let mut sink = QueueSink {
                 queue: &mut self.queue,
             };
@@ -364,6 +389,69 @@ impl Session for MonolithicSession {
                 break;
             }
         }
+        Ok(advance)
+    }
+
+    /// Ends the step that passed the session's time there, before an input changes (a driven
+    /// session): the integration (and temperatures) kept before it stepped again to the
+    /// session's time, what those steps give again (sent before) dropped with what the step
+    /// had produced past it.
+    fn rewind(&mut self) -> Result<(), EngineError> {
+        let t = self.clock.t;
+        let Some(saved) = self.saved.as_deref().filter(|_| self.st.t > t) else {
+            return Ok(());
+        };
+        self.st.clone_from(saved);
+        if let (Some(th), Some(kept)) = (self.thermal.as_mut(), self.saved_thermal.as_deref()) {
+            th.as_mut().clone_from(kept);
+        }
+        self.queue.clear();
+        let done = self.steps(t, t, &mut NullObserver);
+        self.queue.clear();
+        if done.is_err() {
+            self.clock.failed = true;
+        }
+        done.map(|_| ())
+    }
+}
+
+/// Sets every face of a stack's pack to its mode at the stepper's time (from the piston on)
+/// and restarts the integration; nothing without a stack.
+fn settle_faces(st: &mut Stepper) {
+    if st.sys.pack.stack.is_some() {
+        for m in 0..st.sys.faces.len() {
+            let (t, modes) = (st.t, st.modes.clone());
+            st.sys.settle_face(m, t, &mut st.y, &modes);
+        }
+        st.restart();
+    }
+}
+
+impl Session for MonolithicSession {
+    fn time_s(&self) -> f64 {
+        self.clock.t
+    }
+
+    fn set_inputs(&mut self, inputs: &Inputs) -> Result<(), EngineError> {
+        self.rewind()?;
+        let (pack, jump) = self.clock.hold(&self.st.sys.pack, inputs)?;
+        self.st.sys.pack = Arc::new(pack);
+        shift_disc_speeds(&mut self.st, jump);
+        self.st.restart();
+        if inputs.piston_pressure_pa.is_some() {
+            settle_faces(&mut self.st);
+        }
+        Ok(())
+    }
+
+    fn set_stop_time(&mut self, t_s: f64) {
+        self.clock.stop = t_s;
+    }
+
+    fn advance_to(&mut self, t: f64, obs: &mut dyn Observer) -> Result<Advance, EngineError> {
+        self.clock.check_advance(t)?;
+        self.queue.wants_contacts = obs.wants_contact_samples();
+        let advance = self.steps(t, self.clock.step_end(t), obs)?;
         let now = self.clock.end_call(advance, self.st.t, t);
         self.queue.flush(now, obs);
         Ok(advance)

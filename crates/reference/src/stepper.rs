@@ -297,6 +297,14 @@ impl Stepper {
         }
     }
 
+    /// Whether the next step may end past `t` (s): the step the controller wants (a rejection
+    /// only shortens it) reaches beyond `t`. A driven session keeps a copy of the stepper
+    /// before such a step, to end it at its communication point should an input change there
+    /// (`crate::session::Rewind`).
+    pub fn may_pass(&self, t: f64) -> bool {
+        self.t + self.h.min(self.max_step) > t
+    }
+
     /// Whether [`Self::state_at`] knows the state at `t` (s): `t` at or after the stepper's
     /// time or inside its last two steps.
     pub fn remembers(&self, t: f64) -> bool {
@@ -383,7 +391,7 @@ impl Stepper {
         self.solver.dense_into(t, &self.y, h, &mut self.cur);
         // A step cut short by `end` lands on it exactly (`t + (end - t)` may round an ulp
         // short, which would leave a step of 1e-18 s), and does not shrink the steps after it
-        // (a driven session's calls end every step at a communication point).
+        // (a driven session's step ends at a communication point where an input changed).
         let cut = h < free;
         let t_end = if cut { end } else { t + h };
         let sys = &self.sys;

@@ -668,26 +668,38 @@ impl System {
         y: &[f64],
         modes: &[Option<Engagement>],
     ) -> Vec<InterfaceSample> {
+        let mut out = Vec::new();
+        self.interface_samples_into(t, y, modes, &mut out);
+        out
+    }
+
+    /// [`Self::interface_samples`] into `out` (its contents replaced; its buffer reused).
+    pub fn interface_samples_into(
+        &self,
+        t: f64,
+        y: &[f64],
+        modes: &[Option<Engagement>],
+        out: &mut Vec<InterfaceSample>,
+    ) {
+        out.clear();
         let Some(stack) = &self.pack.stack else {
-            return Vec::new();
+            return;
         };
         let c = self.carriers(t, y, modes);
         let r_eff = stack.effective_radius_m();
         self.with_stack_eval(t, y, modes, &c, |ev| {
-            (0..self.interfaces())
-                .map(|m| InterfaceSample {
-                    slip_rad_s: ev.slip[m],
-                    slip_m_s: ev.slip[m] * r_eff,
-                    mu: match self.faces[m] {
-                        Face::Open => 0.0,
-                        _ => stack.friction_of(m).mu(ev.slip[m] * r_eff),
-                    },
-                    clamp_n: ev.clamp[m],
-                    torque_n_m: ev.torque[m],
-                    locked: self.faces[m] == Face::Locked,
-                    dissipated_j: y[self.heat_at() + m],
-                })
-                .collect()
+            out.extend((0..self.interfaces()).map(|m| InterfaceSample {
+                slip_rad_s: ev.slip[m],
+                slip_m_s: ev.slip[m] * r_eff,
+                mu: match self.faces[m] {
+                    Face::Open => 0.0,
+                    _ => stack.friction_of(m).mu(ev.slip[m] * r_eff),
+                },
+                clamp_n: ev.clamp[m],
+                torque_n_m: ev.torque[m],
+                locked: self.faces[m] == Face::Locked,
+                dissipated_j: y[self.heat_at() + m],
+            }))
         })
     }
 
@@ -803,16 +815,20 @@ impl System {
     /// The sample of the whole system at `t` (every coupling of the pack in its slot, discs
     /// then plates: only for a system of all the pack's couplings in order).
     pub fn sample(&self, t: f64, y: &[f64], modes: &[Option<Engagement>]) -> Sample {
+        let mut s = Sample::default();
+        self.sample_into(t, y, modes, &mut s);
+        s
+    }
+
+    /// [`Self::sample`] into `out` (its contents replaced; its bodies' buffer reused).
+    pub fn sample_into(&self, t: f64, y: &[f64], modes: &[Option<Engagement>], out: &mut Sample) {
         let (theta_s, omega_s) = self.shaft(t, y);
-        let discs = (0..self.ids.len())
-            .map(|slot| self.disc_sample(t, slot, y, &modes[slot]))
-            .collect();
-        Sample {
-            t_s: t,
-            shaft_angle_rad: theta_s,
-            shaft_speed_rad_s: omega_s,
-            discs,
-        }
+        out.t_s = t;
+        out.shaft_angle_rad = theta_s;
+        out.shaft_speed_rad_s = omega_s;
+        out.discs.clear();
+        out.discs
+            .extend((0..self.ids.len()).map(|slot| self.disc_sample(t, slot, y, &modes[slot])));
     }
 }
 
