@@ -4,6 +4,7 @@
 mod architecture;
 mod automatics;
 mod automatics_shift;
+mod common;
 mod cosim_hardening;
 mod cross_engine;
 mod fatigue;
