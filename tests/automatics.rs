@@ -901,6 +901,9 @@ fn every_shift_of_the_eight_speed_launch_closes_its_energy_on_both_engines() {
             worst = worst.max(residual.abs() / work);
         }
         println!("{engine}: worst {worst:.2e}; the run's {}", s["energy"]);
-        assert!(worst < 1e-8, "{engine}: a shift's balance {worst:.3e} of its work");
+        assert!(
+            worst < 1e-8,
+            "{engine}: a shift's balance {worst:.3e} of its work"
+        );
     }
 }

@@ -189,7 +189,14 @@ const SPRING_N: f64 = 500.0;
 /// kinetic_mu`, no viscous slope), no axial spline friction (every face clamped alike), no
 /// open-gap drag, a constant piston pressure `pressure_pa` (its rated pressure: a schedule's
 /// level 1), the discs and plates starting at `disc_rad` and `plate_rad` in their play.
-fn pack_file(dir: &Path, name: &str, discs: usize, pressure_pa: f64, disc_rad: f64, plate_rad: f64) {
+fn pack_file(
+    dir: &Path,
+    name: &str,
+    discs: usize,
+    pressure_pa: f64,
+    disc_rad: f64,
+    plate_rad: f64,
+) {
     let mut bodies = String::new();
     for i in 1..=discs {
         bodies += &format!("[[discs]]\nname = \"disc-{i}\"\n");
@@ -347,9 +354,15 @@ pack = "b.toml"
             element(&s, "B")["impacts"],
             s["steps"],
         );
-        assert!(rel(locks[0], t_i) < 1e-3, "{engine}: {locks:?} against {t_i}");
+        assert!(
+            rel(locks[0], t_i) < 1e-3,
+            "{engine}: {locks:?} against {t_i}"
+        );
         assert!(rel(heat, e_i) < 4e-3, "{engine}: {heat} against {e_i}");
-        assert!(rel(pack_loss, e_i) < 1.5e-3, "{engine}: {pack_loss} against {e_i}");
+        assert!(
+            rel(pack_loss, e_i) < 1.5e-3,
+            "{engine}: {pack_loss} against {e_i}"
+        );
         assert!(
             e["residual_j"].as_f64().unwrap().abs() < 1e-7 * e["drive_work_j"].as_f64().unwrap(),
             "{engine}: {e}"

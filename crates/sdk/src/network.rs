@@ -240,7 +240,11 @@ pub fn run_network_scene(
     };
     let start = std::time::Instant::now();
     // the shifts' starts, where each shift's energy balance is taken
-    let stops = obs.keep.shifts.as_ref().map_or_else(Vec::new, |p| p.starts_s());
+    let stops = obs
+        .keep
+        .shifts
+        .as_ref()
+        .map_or_else(Vec::new, |p| p.starts_s());
     let run = match engine {
         EngineChoice::Reference => clutchpack_reference::network::NetworkStepper::new(
             net,
