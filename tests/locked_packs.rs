@@ -5,7 +5,7 @@
 //! drive, `K` open and slipping across the locked set, then slipping with the set free (two
 //! degrees of freedom), then locked.
 
-use super::common::{impacts, impacts_apart};
+use super::common::{impacts_apart, network_impacts};
 use super::{read_json, run, scratch, stderr};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -136,8 +136,8 @@ struct Apart {
 
 fn apart(d: &Path, r: &Value, m: &Value, name: &str) -> Apart {
     let (ri, mi) = (
-        impacts(&d.join("reference.csv")),
-        impacts(&d.join("multibody.csv")),
+        network_impacts(&d.join("reference.csv")),
+        network_impacts(&d.join("multibody.csv")),
     );
     for (body, list) in &ri {
         assert_eq!(list.len(), mi[body].len(), "{body}: impacts");
@@ -334,8 +334,8 @@ fn the_eight_speeds_upshift_with_resolved_packs_agrees_on_both_engines() {
         "E's heat {hr} J against {hm} J"
     );
     let (n, onset, peak) = impacts_apart(
-        &impacts(&d.join("reference.csv")),
-        &impacts(&d.join("multibody.csv")),
+        &network_impacts(&d.join("reference.csv")),
+        &network_impacts(&d.join("multibody.csv")),
         0.03,
     );
     eprintln!("{n} impacts before 30 ms: onsets within {onset:.2e} s, peaks {peak:.2e}");
@@ -401,8 +401,8 @@ fn the_eight_speeds_upshift_with_resolved_packs_converges_at_a_short_step() {
         "E locks at {lr} s against {lm} s"
     );
     let (n, onset, peak) = impacts_apart(
-        &impacts(&d.join("reference.csv")),
-        &impacts(&d.join("multibody.csv")),
+        &network_impacts(&d.join("reference.csv")),
+        &network_impacts(&d.join("multibody.csv")),
         0.03,
     );
     eprintln!("{n} impacts before 30 ms: onsets within {onset:.2e} s, peaks {peak:.2e}");

@@ -2,7 +2,7 @@
 //! resolved packs (issue 34's cross-engine must-show): the disc and plate impacts before the
 //! shift one by one, every pack's lock times, the speeds and the heat at the end.
 
-use super::common::{impacts, impacts_apart, Impact};
+use super::common::{impacts_apart, network_impacts, Impact};
 use super::{read_json, run, scratch, stderr};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -49,7 +49,7 @@ fn dct_upshift(engine: &str, dir: &Path) -> (Value, BTreeMap<String, Vec<Impact>
     let csv = dir.join(format!("{engine}.csv"));
     let more = ["--impacts-csv", csv.to_str().unwrap()];
     let s = summary_on("scenes/dct-upshift.toml", engine, dir, &more);
-    (s, impacts(&csv))
+    (s, network_impacts(&csv))
 }
 
 /// The multibody engine (each pack's discs and plates rapier bodies, advanced inside the

@@ -1,22 +1,20 @@
-//! What several test modules share: the tooth impacts of a network run's `--impacts-csv` and
-//! their comparison one by one between two runs (two engines, or two steps).
+//! Helpers the integration tests share: the impacts of an `--impacts-csv` and their
+//! comparison impact by impact.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// One tooth impact of a row of `--impacts-csv`.
+/// One tooth impact: onset, separation (s) and peak (N, per tooth, signed).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Impact {
-    /// Onset, s.
     pub t_on_s: f64,
-    /// Separation, s.
     pub t_off_s: f64,
-    /// Peak per tooth, N (signed as the CSV gives it).
     pub peak_n: f64,
 }
 
 /// The impacts of an `--impacts-csv` of a network run, by body name in the order they
-/// closed.
-pub fn impacts(csv: &Path) -> BTreeMap<String, Vec<Impact>> {
+/// closed (the whole name: `<pack>/discs/<disc>`, so that two packs' `disc-1` stay apart).
+pub fn network_impacts(csv: &Path) -> BTreeMap<String, Vec<Impact>> {
     let text = std::fs::read_to_string(csv).unwrap();
     let mut lines = text.lines();
     let head: Vec<&str> = lines.next().unwrap().split(',').collect();
