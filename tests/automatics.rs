@@ -95,8 +95,9 @@ fn willis_accelerations(t: [f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|i| (t[i] + c[i] * lambda) / J[i])
 }
 
-/// Runs `scene` on `engine`: its summary.
-fn summary(scene: &Path, engine: &str, dir: &Path) -> Value {
+/// Runs `scene` on `engine` without a recording: its summary (`--summary-json`, written into
+/// `dir` as `<engine>.json`).
+pub(super) fn summary(scene: &Path, engine: &str, dir: &Path) -> Value {
     let json = dir.join(format!("{engine}.json"));
     let o = run(&[
         "run",
@@ -868,4 +869,41 @@ fn an_eight_speed_in_a_car_shifts_through_all_gears_alike_on_both_engines() {
     }
     let (x, y) = (speeds(&runs[0])["vehicle"], speeds(&runs[1])["vehicle"]);
     assert!((x - y).abs() < 1e-6 * x, "{x} {y}");
+}
+
+/// `scenes/eight-speed-drive.toml`'s 1 -> 8 launch closes its energy balance shift by shift
+/// (issue 45: "energy closed through every shift of the 1 -> 8 launch to 1e-6 of the work
+/// in"): each shift's `energy_residual_j` in the summary, the balance from its start to the
+/// next shift's start (the last one's to the run's end: the engine's balance at the two
+/// instants, MODEL.md section 8 "Energy"), against its `work_in_j`, the engine's work over
+/// that interval (65 to 112 kJ). Measured (2026-12-07): within 5.1e-10 of it on the reference
+/// engine and 1.4e-9 on the multibody engine (5e-5 to 9e-5 J, the whole run's 2.9e-4 and
+/// 6.1e-4 J spread over its shifts). Asserted 1e-8 (7x; the issue's 1e-6).
+#[test]
+fn every_shift_of_the_eight_speed_launch_closes_its_energy_on_both_engines() {
+    let d = scratch("eight-speed-drive-balance");
+    for engine in ["reference", "multibody"] {
+        let s = summary(Path::new("scenes/eight-speed-drive.toml"), engine, &d);
+        let shifts = s["shifts"].as_array().unwrap();
+        assert_eq!(shifts.len(), 7, "{engine}: {s}");
+        let mut worst = 0.0f64;
+        for sh in shifts {
+            let work = sh["work_in_j"].as_f64().unwrap();
+            let residual = sh["energy_residual_j"].as_f64().unwrap();
+            println!(
+                "{engine}: {} -> {} at {} s: work in {work} J, residual {residual:e} J ({:.2e})",
+                sh["from"],
+                sh["to"],
+                sh["start_s"],
+                residual.abs() / work
+            );
+            assert!(work > 0.0, "{engine}: {sh}");
+            worst = worst.max(residual.abs() / work);
+        }
+        println!("{engine}: worst {worst:.2e}; the run's {}", s["energy"]);
+        assert!(
+            worst < 1e-8,
+            "{engine}: a shift's balance {worst:.3e} of its work"
+        );
+    }
 }

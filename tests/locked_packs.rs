@@ -5,9 +5,9 @@
 //! drive, `K` open and slipping across the locked set, then slipping with the set free (two
 //! degrees of freedom), then locked.
 
+use super::common::{impacts_apart, network_impacts};
 use super::{read_json, run, scratch, stderr};
 use serde_json::Value;
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Writes the pack `k.toml` (`scenes/dct-k2.toml` with its piston applied from 20 ms: 0.45 MPa
@@ -121,25 +121,6 @@ fn coupling(s: &Value, name: &str) -> Value {
         .clone()
 }
 
-/// The impacts of an `--impacts-csv` of a network run by body name, in the order they
-/// closed: `(onset s, separation s, peak N)`.
-fn impacts(csv: &Path) -> BTreeMap<String, Vec<[f64; 3]>> {
-    let text = std::fs::read_to_string(csv).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
-    let (name, on, off, peak) = (col("name"), col("t_on_s"), col("t_off_s"), col("peak_n"));
-    let mut out: BTreeMap<String, Vec<[f64; 3]>> = BTreeMap::new();
-    for line in lines {
-        let f: Vec<&str> = line.split(',').collect();
-        let num = |i: usize| f[i].parse::<f64>().unwrap();
-        out.entry(f[name].to_string())
-            .or_default()
-            .push([num(on), num(off), num(peak)]);
-    }
-    out
-}
-
 /// How far apart two runs of one scene are: `(impacts closed before 30 ms, the largest onset
 /// difference s, the largest relative peak difference)` over the impacts one by one, every
 /// lock time's largest relative difference, the heat's relative difference of coupling `name`
@@ -155,19 +136,13 @@ struct Apart {
 
 fn apart(d: &Path, r: &Value, m: &Value, name: &str) -> Apart {
     let (ri, mi) = (
-        impacts(&d.join("reference.csv")),
-        impacts(&d.join("multibody.csv")),
+        network_impacts(&d.join("reference.csv")),
+        network_impacts(&d.join("multibody.csv")),
     );
-    let (mut n, mut onset_s, mut peak) = (0, 0.0f64, 0.0f64);
     for (body, list) in &ri {
-        let other = &mi[body];
-        assert_eq!(list.len(), other.len(), "{body}: impacts");
-        for (e, o) in list.iter().zip(other).filter(|(e, _)| e[1] < 0.03) {
-            onset_s = onset_s.max((e[0] - o[0]).abs());
-            peak = peak.max(((e[2] - o[2]) / e[2]).abs());
-            n += 1;
-        }
+        assert_eq!(list.len(), mi[body].len(), "{body}: impacts");
     }
+    let (n, onset_s, peak) = impacts_apart(&ri, &mi, 0.03);
     let times = |s: &Value| -> Vec<f64> {
         coupling(s, name)["lock_times_s"]
             .as_array()
@@ -358,17 +333,11 @@ fn the_eight_speeds_upshift_with_resolved_packs_agrees_on_both_engines() {
         (hr - hm).abs() <= 2e-3 * hr,
         "E's heat {hr} J against {hm} J"
     );
-    let impacts_r = impacts(&d.join("reference.csv"));
-    let impacts_m = impacts(&d.join("multibody.csv"));
-    let (mut n, mut onset, mut peak) = (0, 0.0f64, 0.0f64);
-    for (body, list) in &impacts_r {
-        for (i, e) in list.iter().enumerate().filter(|(_, e)| e[1] < 0.03) {
-            let o = impacts_m[body][i];
-            onset = onset.max((e[0] - o[0]).abs());
-            peak = peak.max(((e[2] - o[2]) / e[2]).abs());
-            n += 1;
-        }
-    }
+    let (n, onset, peak) = impacts_apart(
+        &network_impacts(&d.join("reference.csv")),
+        &network_impacts(&d.join("multibody.csv")),
+        0.03,
+    );
     eprintln!("{n} impacts before 30 ms: onsets within {onset:.2e} s, peaks {peak:.2e}");
     assert!(n >= 40, "{n} impacts before 30 ms");
     assert!(onset <= 3e-4, "onsets {onset} s");
@@ -431,17 +400,11 @@ fn the_eight_speeds_upshift_with_resolved_packs_converges_at_a_short_step() {
         (lr - lm).abs() <= 1e-4 * lr,
         "E locks at {lr} s against {lm} s"
     );
-    let impacts_r = impacts(&d.join("reference.csv"));
-    let impacts_m = impacts(&d.join("multibody.csv"));
-    let (mut n, mut onset, mut peak) = (0, 0.0f64, 0.0f64);
-    for (body, list) in &impacts_r {
-        for (i, e) in list.iter().enumerate().filter(|(_, e)| e[1] < 0.03) {
-            let o = impacts_m[body][i];
-            onset = onset.max((e[0] - o[0]).abs());
-            peak = peak.max(((e[2] - o[2]) / e[2]).abs());
-            n += 1;
-        }
-    }
+    let (n, onset, peak) = impacts_apart(
+        &network_impacts(&d.join("reference.csv")),
+        &network_impacts(&d.join("multibody.csv")),
+        0.03,
+    );
     eprintln!("{n} impacts before 30 ms: onsets within {onset:.2e} s, peaks {peak:.2e}");
     assert!(n >= 40, "{n} impacts before 30 ms");
     assert!(onset <= 1.5e-5, "onsets {onset} s");

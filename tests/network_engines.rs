@@ -2,38 +2,11 @@
 //! resolved packs (issue 34's cross-engine must-show): the disc and plate impacts before the
 //! shift one by one, every pack's lock times, the speeds and the heat at the end.
 
+use super::common::{impacts_apart, network_impacts, Impact};
 use super::{read_json, run, scratch, stderr};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
-
-/// One tooth impact of a row of `--impacts-csv`: onset (s) and peak (N, per tooth).
-struct Impact {
-    t_on_s: f64,
-    t_off_s: f64,
-    peak_n: f64,
-}
-
-/// The impacts of an `--impacts-csv` of a network run, by body name in the order they
-/// closed.
-fn impacts(csv: &Path) -> BTreeMap<String, Vec<Impact>> {
-    let text = std::fs::read_to_string(csv).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
-    let (name, on, off, peak) = (col("name"), col("t_on_s"), col("t_off_s"), col("peak_n"));
-    let mut out: BTreeMap<String, Vec<Impact>> = BTreeMap::new();
-    for line in lines {
-        let f: Vec<&str> = line.split(',').collect();
-        let num = |i: usize| f[i].parse::<f64>().unwrap();
-        out.entry(f[name].to_string()).or_default().push(Impact {
-            t_on_s: num(on),
-            t_off_s: num(off),
-            peak_n: num(peak),
-        });
-    }
-    out
-}
 
 /// The largest relative difference of the bodies' final speeds of two network summaries.
 fn speeds_apart(a: &Value, b: &Value) -> f64 {
@@ -76,7 +49,7 @@ fn dct_upshift(engine: &str, dir: &Path) -> (Value, BTreeMap<String, Vec<Impact>
     let csv = dir.join(format!("{engine}.csv"));
     let more = ["--impacts-csv", csv.to_str().unwrap()];
     let s = summary_on("scenes/dct-upshift.toml", engine, dir, &more);
-    (s, impacts(&csv))
+    (s, network_impacts(&csv))
 }
 
 /// The multibody engine (each pack's discs and plates rapier bodies, advanced inside the
@@ -95,18 +68,7 @@ fn dct_upshift_impacts_and_locks_agree_on_both_engines() {
     let (ref_sum, ref_imp) = dct_upshift("reference", &d);
     let (mb_sum, mb_imp) = dct_upshift("multibody", &d);
     // the impacts closed in the first 30 ms, one by one, on every body of both packs
-    let (mut n, mut worst_on, mut worst_peak) = (0, 0.0f64, 0.0f64);
-    for (body, list) in &ref_imp {
-        let other = mb_imp
-            .get(body)
-            .unwrap_or_else(|| panic!("{body}: no impacts"));
-        for (i, e) in list.iter().enumerate().filter(|(_, e)| e.t_off_s < 0.03) {
-            let m = &other[i];
-            worst_on = worst_on.max((m.t_on_s - e.t_on_s).abs());
-            worst_peak = worst_peak.max(((m.peak_n - e.peak_n) / e.peak_n).abs());
-            n += 1;
-        }
-    }
+    let (n, worst_on, worst_peak) = impacts_apart(&ref_imp, &mb_imp, 0.03);
     eprintln!(
         "first 30 ms: {n} impacts, onsets within {worst_on:.2e} s, peaks within {worst_peak:.2e}"
     );

@@ -7,7 +7,10 @@
 
 use crate::network_keep::{pack_fatigue, Keep, Obs};
 use crate::{Error, Result};
-use clutchpack_model::network::{ClutchMode, NetworkSample};
+use clutchpack_model::network::{
+    ClutchMode, NetworkEnergy, NetworkRun, NetworkSample, NetworkSession,
+};
+use clutchpack_model::EngineError;
 use clutchpack_record::NetworkRecorder;
 use clutchpack_reference::network::NetworkOptions;
 use clutchpack_scene::{EngineChoice, Scene};
@@ -236,23 +239,65 @@ pub fn run_network_scene(
         progress: req.progress,
     };
     let start = std::time::Instant::now();
+    // the shifts' starts, where each shift's energy balance is taken
+    let stops = obs
+        .keep
+        .shifts
+        .as_ref()
+        .map_or_else(Vec::new, |p| p.starts_s());
     let run = match engine {
-        EngineChoice::Reference => clutchpack_reference::network::run_network(
+        EngineChoice::Reference => clutchpack_reference::network::NetworkStepper::new(
             net,
             sim.duration_s,
             &reference_options(scene),
             &mut obs,
-        ),
+        )
+        .map(|s| Box::new(s) as Box<dyn NetworkSession>),
         EngineChoice::Multibody => {
             let options = clutchpack_multibody::network::NetworkStepOptions {
                 step_s: multibody_step_s(scene),
                 record_rate_hz: sim.record_rate_hz,
             };
-            clutchpack_multibody::network::run_network(net, sim.duration_s, &options, &mut obs)
+            clutchpack_multibody::network::NetworkStepper::new(
+                net,
+                sim.duration_s,
+                &options,
+                &mut obs,
+            )
+            .map(|s| Box::new(s) as Box<dyn NetworkSession>)
         }
-    };
-    let run = run.map_err(|source| engine_failed(scene, engine, &mut keep, source))?;
+    }
+    .and_then(|run| run_stopping(run, sim.duration_s, &stops, &mut obs));
+    let (run, energies) = run.map_err(|source| engine_failed(scene, engine, &mut keep, source))?;
+    if let Some(p) = keep.shifts.as_mut() {
+        p.set_energies(energies);
+    }
     conclude(scene, engine, keep, run, start.elapsed().as_secs_f64())
+}
+
+/// Runs `run` to `duration_s` (s), stopping at each of `stops_s` (s, increasing) to take the
+/// energy balance there: from a copy of the run finished at that instant, its output to no
+/// observer. The reference engine's run is the same bit for bit whatever its calls; the
+/// multibody engine's lands a step on each call's end, which the shifts' starts already are
+/// (breakpoints of the schedule's signals), so that both give the run without stops. A run
+/// stopped (`obs`'s stop or recording error) takes no more balances.
+fn run_stopping(
+    mut run: Box<dyn NetworkSession>,
+    duration_s: f64,
+    stops_s: &[f64],
+    obs: &mut Obs,
+) -> std::result::Result<(NetworkRun, Vec<(f64, NetworkEnergy)>), EngineError> {
+    let mut energies = Vec::new();
+    for &t in stops_s.iter().filter(|t| **t < duration_s) {
+        run.advance_to(t, obs)?;
+        if obs.keep.stopped || obs.keep.record_error.is_some() {
+            // stopped there: no step more
+            return Ok((run.finish_boxed(obs), energies));
+        }
+        energies.push((t, run.boxed_clone().finish_boxed(&mut ()).energy));
+    }
+    run.advance_to(duration_s, obs)?;
+    Ok((run.finish_boxed(obs), energies))
 }
 
 /// The reference engine's settings for a network scene: its tolerance, longest step and
@@ -437,7 +482,7 @@ pub(crate) fn conclude(
             residual_j: e.residual_j(),
         },
         shifts: match (&keep.shifts, &scene.transmission) {
-            (Some(p), Some(tr)) => p.report(net, tr, &keep.events),
+            (Some(p), Some(tr)) => p.report(net, tr, &keep.events, &run.energy),
             _ => Vec::new(),
         },
     };

@@ -6,7 +6,9 @@
 //! located mode changes.
 
 use clutchpack_model::network::gears::{torque_factor, Handover};
-use clutchpack_model::network::{ClutchEvent, ClutchMode, Network, NetworkSample, Transmission};
+use clutchpack_model::network::{
+    ClutchEvent, ClutchMode, Network, NetworkEnergy, NetworkSample, Transmission,
+};
 use serde::Serialize;
 
 /// The output torque below which a shift counts as a tie-up: this fraction of the smaller of
@@ -59,6 +61,16 @@ pub struct ShiftSummary {
     pub tie_up: bool,
     /// The input sped up by more than [`FLARE_FRACTION`] between the release and the lock.
     pub flare: bool,
+    /// The drives' work from the shift's start to the next shift's start (or the run's end),
+    /// J (`None` when the run did not take the balance there: a co-simulation, a stopped run).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub work_in_j: Option<f64>,
+    /// The energy balance over that interval, J (MODEL.md section 8, "Energy": the work of
+    /// the drives and loads less the change of kinetic energy, the heat, the drag, mesh,
+    /// damper and pack losses and the springs' energy change over it; zero to the engine's
+    /// tolerance), from the run's balance at the two instants.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub energy_residual_j: Option<f64>,
 }
 
 /// One sample as a shift needs it.
@@ -86,6 +98,8 @@ pub(crate) struct ShiftProbe {
     pack_events: Vec<ClutchEvent>,
     handovers: Vec<Handover>,
     rows: Vec<Row>,
+    /// The run's energy balance at each shift's start (`(t s, balance)`, [`Self::starts_s`]).
+    energies: Vec<(f64, NetworkEnergy)>,
 }
 
 /// An automatic's output torque over the samples `history`: `(t s, N m)` per sample, the
@@ -147,7 +161,20 @@ impl ShiftProbe {
             pack_events: Vec::new(),
             handovers,
             rows: Vec::new(),
+            energies: Vec::new(),
         })
+    }
+
+    /// The shifts' starts, s, in time order: where a run takes its energy balance for
+    /// [`Self::set_energies`].
+    pub fn starts_s(&self) -> Vec<f64> {
+        self.handovers.iter().map(|h| h.corners_s[0]).collect()
+    }
+
+    /// The run's energy balance at the shifts' starts (`(t s, balance)`, those of
+    /// [`Self::starts_s`] the run reached), so that [`Self::report`] gives each shift's.
+    pub fn set_energies(&mut self, energies: Vec<(f64, NetworkEnergy)>) {
+        self.energies = energies;
     }
 
     /// The transmission's torque on its output in the sample `s`, N m (its planetary sets'
@@ -220,12 +247,15 @@ impl ShiftProbe {
     }
 
     /// Each shift as the run made it, from the samples kept, the mode changes `events` and
-    /// the resolved packs' (a pack's faces, [`Self::pack_faces`]).
+    /// the resolved packs' (a pack's faces, [`Self::pack_faces`]), and each shift's energy
+    /// balance from those at the shifts' starts ([`Self::set_energies`]) and `end`, the run's
+    /// at its end.
     pub fn report(
         &self,
         net: &Network,
         tr: &Transmission,
         events: &[ClutchEvent],
+        end: &NetworkEnergy,
     ) -> Vec<ShiftSummary> {
         let end_s = self.rows.last().map_or(0.0, |r| r.t_s);
         let mut all: Vec<ClutchEvent> = events.iter().chain(&self.pack_events).copied().collect();
@@ -294,6 +324,14 @@ impl ShiftProbe {
                 (None, _) => false,
             };
             let floor = before.min(after);
+            // the balance over [t0, until]: every term is counted from t = 0, so the
+            // interval's is the difference of the run's balances at its ends
+            let at = |t: f64| self.energies.iter().find(|e| e.0 == t).map(|e| e.1);
+            let ends = match self.handovers.get(i + 1) {
+                Some(n) if n.corners_s[0] <= end_s => at(n.corners_s[0]),
+                _ => Some(*end),
+            };
+            let interval = at(t0).zip(ends);
             out.push(ShiftSummary {
                 from: tr.gears[h.from].name.clone(),
                 to: tr.gears[h.to].name.clone(),
@@ -315,6 +353,8 @@ impl ShiftProbe {
                 output_torque_after_n_m: after,
                 tie_up: floor > 0.0 && min < TIE_UP_FRACTION * floor,
                 flare,
+                work_in_j: interval.map(|(a, b)| b.drive_work_j - a.drive_work_j),
+                energy_residual_j: interval.map(|(a, b)| b.residual_j() - a.residual_j()),
             });
         }
         out

@@ -111,63 +111,148 @@ pub fn redundant(rows: &[Row], inv_inertia: &[f64]) -> Vec<usize> {
 
 /// [`solve`]'s elimination into `x` (sized to the rows); returns which rows it kept.
 fn eliminate(rows: &[Row], inv_inertia: &[f64], rhs: &[f64], x: &mut [f64]) -> Vec<bool> {
-    let m = rows.len();
-    // A_rs = sum_i C_ri C_si / J_i: only the bodies the two rows share
-    let mut a = vec![0.0; m * m];
-    for (r, p) in rows.iter().enumerate() {
-        for (s, q) in rows.iter().enumerate() {
-            let mut v = 0.0;
-            for (i, ci) in p.terms() {
-                for (j, cj) in q.terms() {
-                    if i == j {
-                        v += ci * cj * inv_inertia[*i];
+    let e = Elimination::new(rows, inv_inertia);
+    x.copy_from_slice(rhs);
+    e.solve_in_place(x);
+    e.active
+}
+
+/// The symmetric elimination of `A = C M^-1 C^T` for some rows and inverse inertias, kept to
+/// solve for one right-hand side after another ([`Elimination::constraint_torques`]): the same
+/// operations in the same order as [`solve`], so the same results to the bit, without
+/// building and eliminating `A` again while the rows stand (a network's rows change only
+/// where a clutch locks or releases).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Elimination {
+    /// The rows it eliminated.
+    rows: Vec<Row>,
+    /// Their count.
+    m: usize,
+    /// `A` eliminated (row-major `m x m`; its upper triangle is the back substitution's).
+    a: Vec<f64>,
+    /// The multiplier of row `k` subtracted from row `r > k` (`f[r * m + k]`; 0: none).
+    f: Vec<f64>,
+    /// Which rows it kept (the others depend on the rows before them).
+    active: Vec<bool>,
+}
+
+impl Elimination {
+    /// The elimination of `rows` with the inverse inertias `inv_inertia` (1/(kg m^2) per body,
+    /// 0 for a fixed body).
+    pub fn new(rows: &[Row], inv_inertia: &[f64]) -> Elimination {
+        let m = rows.len();
+        // A_rs = sum_i C_ri C_si / J_i: only the bodies the two rows share
+        let mut a = vec![0.0; m * m];
+        for (r, p) in rows.iter().enumerate() {
+            for (s, q) in rows.iter().enumerate() {
+                let mut v = 0.0;
+                for (i, ci) in p.terms() {
+                    for (j, cj) in q.terms() {
+                        if i == j {
+                            v += ci * cj * inv_inertia[*i];
+                        }
                     }
                 }
+                a[r * m + s] = v;
             }
-            a[r * m + s] = v;
         }
-    }
-    // symmetric elimination in the rows' order (A is symmetric positive semi-definite): a
-    // row whose pivot falls below 1e-12 of its own diagonal depends on the rows before it
-    // and is dropped (its torque 0: the earlier coupling carries the load)
-    let mut b = rhs.to_vec();
-    let mut active = vec![false; m];
-    for k in 0..m {
-        let piv = a[k * m + k];
-        let diag: f64 = rows[k]
-            .terms()
-            .iter()
-            .map(|(i, c)| c * c * inv_inertia[*i])
-            .sum();
-        if piv.is_nan() || piv <= 1e-12 * diag {
-            continue;
-        }
-        active[k] = true;
-        for r in k + 1..m {
-            let f = a[r * m + k] / piv;
-            if f == 0.0 {
+        // symmetric elimination in the rows' order (A is symmetric positive semi-definite): a
+        // row whose pivot falls below 1e-12 of its own diagonal depends on the rows before it
+        // and is dropped (its torque 0: the earlier coupling carries the load)
+        let mut f = vec![0.0; m * m];
+        let mut active = vec![false; m];
+        for k in 0..m {
+            let piv = a[k * m + k];
+            let diag: f64 = rows[k]
+                .terms()
+                .iter()
+                .map(|(i, c)| c * c * inv_inertia[*i])
+                .sum();
+            if piv.is_nan() || piv <= 1e-12 * diag {
                 continue;
             }
-            for c in k..m {
-                a[r * m + c] -= f * a[k * m + c];
-            }
-            b[r] -= f * b[k];
-        }
-    }
-    // back substitution on the independent rows; the others are 0
-    for k in (0..m).rev() {
-        if !active[k] {
-            continue;
-        }
-        let mut v = b[k];
-        for c in k + 1..m {
-            if active[c] {
-                v -= a[k * m + c] * x[c];
+            active[k] = true;
+            for r in k + 1..m {
+                let fr = a[r * m + k] / piv;
+                f[r * m + k] = fr;
+                if fr == 0.0 {
+                    continue;
+                }
+                for c in k..m {
+                    a[r * m + c] -= fr * a[k * m + c];
+                }
             }
         }
-        x[k] = v / a[k * m + k];
+        Elimination {
+            rows: rows.to_vec(),
+            m,
+            a,
+            f,
+            active,
+        }
     }
-    active
+
+    /// The rows it eliminated (a caller keeps it while its rows are these).
+    pub fn rows(&self) -> &[Row] {
+        &self.rows
+    }
+
+    /// Solves `A x = rhs` in place: `x` holds `rhs` (one entry per row) and is left with the
+    /// solution, 0 for the rows dropped, as [`solve`] gives it.
+    fn solve_in_place(&self, x: &mut [f64]) {
+        let (m, a) = (self.m, &self.a);
+        // the right-hand side through the elimination's steps, in their order
+        for k in (0..m).filter(|&k| self.active[k]) {
+            for r in k + 1..m {
+                let f = self.f[r * m + k];
+                if f == 0.0 {
+                    continue;
+                }
+                x[r] -= f * x[k];
+            }
+        }
+        // back substitution on the independent rows (each reads the solution of the
+        // independent rows after it); the others are 0
+        for k in (0..m).rev() {
+            if !self.active[k] {
+                continue;
+            }
+            let mut v = x[k];
+            for c in k + 1..m {
+                if self.active[c] {
+                    v -= a[k * m + c] * x[c];
+                }
+            }
+            x[k] = v / a[k * m + k];
+        }
+        for k in (0..m).filter(|&k| !self.active[k]) {
+            x[k] = 0.0;
+        }
+    }
+
+    /// [`project`] onto its rows with the inverse inertias `inv_inertia` it was made with
+    /// (1/(kg m^2)): the speeds `w` (rad/s) closest to them in the kinetic metric that keep
+    /// the rows, momentum kept.
+    pub fn project(&self, inv_inertia: &[f64], w: &mut [f64]) {
+        if self.m == 0 {
+            return;
+        }
+        let mut mu: Vec<f64> = self.rows.iter().map(|r| r.apply(w)).collect();
+        self.solve_in_place(&mut mu);
+        let mut dw = vec![0.0; w.len()];
+        add_torques(&self.rows, &mu, &mut dw);
+        for (i, v) in w.iter_mut().enumerate() {
+            *v -= inv_inertia[i] * dw[i];
+        }
+    }
+
+    /// [`constraint_torques`] of its rows with the inverse inertias `inv_inertia` it was made
+    /// with (1/(kg m^2)) under the torques `torque` (N m), into `lambda` (N m, one per row).
+    pub fn constraint_torques(&self, inv_inertia: &[f64], torque: &[f64], lambda: &mut Vec<f64>) {
+        lambda.clear();
+        lambda.extend(self.rows.iter().map(|r| -r.rate(inv_inertia, torque)));
+        self.solve_in_place(lambda);
+    }
 }
 
 /// The constraint torques `lambda` (N m, one per row) that keep the rows' rates at 0 under
@@ -289,14 +374,7 @@ pub fn project(rows: &[Row], inv_inertia: &[f64], w: &mut [f64]) {
     if rows.is_empty() {
         return;
     }
-    let rhs: Vec<f64> = rows.iter().map(|r| r.apply(w)).collect();
-    let mut mu = Vec::new();
-    solve(rows, inv_inertia, &rhs, &mut mu);
-    let mut dw = vec![0.0; w.len()];
-    add_torques(rows, &mu, &mut dw);
-    for (i, v) in w.iter_mut().enumerate() {
-        *v -= inv_inertia[i] * dw[i];
-    }
+    Elimination::new(rows, inv_inertia).project(inv_inertia, w);
 }
 
 #[cfg(test)]
@@ -324,6 +402,30 @@ mod tests {
         assert!((acc[0] - 10.0 / j).abs() < 1e-13, "{acc:?}");
         assert!((acc[1] - acc[0] / 2.0).abs() < 1e-13);
         assert!((acc[2] - acc[1] / 3.0).abs() < 1e-13);
+    }
+
+    /// An elimination kept over several torques (a network step's evaluations) gives each
+    /// time what a fresh solve gives, to the bit, on rows with a redundant one and a
+    /// three-term one; its rows are the ones it was made for.
+    #[test]
+    fn a_kept_elimination_solves_as_a_fresh_one() {
+        let rows = [
+            Row::three(0, [(0, 30.0), (1, 90.0), (2, -120.0)]),
+            row(1, 0, 1, -1.0),
+            row(2, 1, 0, -1.0),
+            row(3, 2, 3, -2.5),
+        ];
+        let inv = [100.0, 20.0, 2.0, 0.7];
+        let kept = Elimination::new(&rows, &inv);
+        assert_eq!(kept.rows(), &rows[..]);
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for t in [[20.0, 0.0, 0.0, -3.0], [-1.5, 7.25, 0.1, 0.0], [0.0; 4]] {
+            kept.constraint_torques(&inv, &t, &mut a);
+            constraint_torques(&rows, &inv, &t, &mut b);
+            assert_eq!(a.len(), 4);
+            assert_eq!(a, b, "{t:?}");
+            assert_eq!(a[2], 0.0, "the redundant row carries nothing");
+        }
     }
 
     /// Two clutches locked in parallel between the same bodies are one redundant row: the

@@ -136,6 +136,10 @@ struct Run {
     inv_inertia: Vec<f64>,
     /// The active constraint rows (gears and locked clutches).
     rows: Vec<Row>,
+    /// Their elimination with `inv_inertia`, made again only where they change
+    /// ([`Run::build_rows`]): every evaluation's constraint torques solved without eliminating
+    /// `A` again.
+    elimination: constraint::Elimination,
     /// Each body's torque but the constraints', N m.
     torque: Vec<f64>,
     /// Each row's torque, N m.
@@ -164,6 +168,9 @@ impl Run {
         self.rows.clear();
         for (k, c) in self.net.couplings.iter().enumerate() {
             self.rows.extend(c.row(k, self.modes[k]));
+        }
+        if self.elimination.rows() != self.rows.as_slice() {
+            self.elimination = constraint::Elimination::new(&self.rows, &self.inv_inertia);
         }
     }
 
@@ -292,7 +299,10 @@ impl Run {
         mesh::add_torques(&self.meshes, x, w, body, coupling, &mut out.mesh_force);
         // A lambda = -C M^-1 T: the rows' rates vanish, so rows that hold at the step's
         // start hold at its end (the speeds are projected after each step against rounding)
-        constraint::constraint_torques(&self.rows, &self.inv_inertia, &out.body, &mut out.lambda);
+        // (with the rows' elimination kept: the same operations, the same torques to the bit)
+        debug_assert_eq!(self.elimination.rows(), self.rows.as_slice());
+        self.elimination
+            .constraint_torques(&self.inv_inertia, &out.body, &mut out.lambda);
         // the prescribed bodies' accelerations, and the rows' torques that make the bodies
         // tied to them follow (`rows::prescribed_response`: linear in each acceleration)
         out.alpha.clear();
@@ -367,7 +377,7 @@ impl Run {
             if round == 0 {
                 if let Some(k) = newly_locked {
                     let k0 = self.kinetic();
-                    constraint::project(&self.rows, &self.inv_inertia, &mut self.w);
+                    self.elimination.project(&self.inv_inertia, &mut self.w);
                     self.world.set_speeds(&self.w);
                     // the merge's loss (rounding after a landed step) is the lock's heat
                     self.heat[k] += k0 - self.kinetic();

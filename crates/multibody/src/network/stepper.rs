@@ -6,7 +6,7 @@
 use super::bodies::NetworkWorld;
 use super::mesh::{self, Mesh};
 use super::packs::NetPack;
-use super::{constraint, NetworkStepOptions, Run};
+use super::{NetworkStepOptions, Run};
 use clutchpack_model::network::{
     Body, ClutchMode, Network, NetworkEnergy, NetworkInput, NetworkObserver, NetworkRun,
     NetworkSample,
@@ -103,6 +103,7 @@ impl NetworkStepper {
                 .map(|k| net.couplings[k].law().initial_mode())
                 .collect(),
             rows: Vec::new(),
+            elimination: Default::default(),
             torque: vec![0.0; n],
             lambda: Vec::new(),
             alpha: Vec::new(),
@@ -331,7 +332,7 @@ impl NetworkStepper {
             }
         }
         // rapier's speeds keep the rows to rounding; remove it (momentum kept)
-        constraint::project(&run.rows, &run.inv_inertia, &mut run.w);
+        run.elimination.project(&run.inv_inertia, &mut run.w);
         run.world.set_speeds(&run.w);
         // the engines' one guard (issue 48, item 2): a fixed step past its stability limit
         // grows the speeds geometrically; stop with the reference engine's divergence error
