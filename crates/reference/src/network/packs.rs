@@ -167,15 +167,17 @@ impl NetPack {
             return;
         }
         // the faces' conditions need the carriers' speeds only
+        // (in this thread's buffers: no allocation per evaluation, the same values)
         let c = [w[self.a], 0.0, w[self.b], 0.0];
-        let ev = self.sys.stack_eval(t, part, &self.modes, &c);
-        for m in 0..self.sys.faces.len() {
-            out[nb + m] = if self.sys.face_switches(m, &ev) {
-                -1.0
-            } else {
-                1.0
-            };
-        }
+        self.sys.with_stack_eval(t, part, &self.modes, &c, |ev| {
+            for m in 0..self.sys.faces.len() {
+                out[nb + m] = if self.sys.face_switches(m, ev) {
+                    -1.0
+                } else {
+                    1.0
+                };
+            }
+        });
     }
 
     /// Opens and closes contact events at an event at `t` (`crossed[slot] <= 0`: the body's
