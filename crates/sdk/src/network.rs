@@ -15,32 +15,13 @@ use clutchpack_record::NetworkRecorder;
 use clutchpack_reference::network::NetworkOptions;
 use clutchpack_scene::{EngineChoice, Scene};
 use serde::Serialize;
-use std::sync::atomic::AtomicBool;
 
-/// What a network run keeps beside its summary.
-#[derive(Default)]
-pub struct NetworkRequest<'a> {
-    /// Keep every sample (the figure's data; memory grows with the run).
-    pub keep_history: bool,
-    /// Record the run (MCAP: every body, coupling and clutch event, the 3D view;
-    /// [`clutchpack_record::NetworkRecorder`]). Of the options the compression, chunk size and
-    /// determinism apply.
-    pub recording: Option<crate::RecordingRequest>,
-    /// Set to stop the run (a signal); the outcome then holds what ran.
-    pub stop: Option<&'a AtomicBool>,
-    /// Called with the simulated time reached, s.
-    pub progress: Option<&'a mut dyn FnMut(f64)>,
-    /// Write every tooth impact (a gear mesh's, a pack's disc's or plate's) to this CSV file
-    /// as it comes: `name,t_on_s,t_peak_s,t_off_s,flank,v_on_m_s,peak_n`, named as
-    /// [`NetworkOutcome::impacts`] names them; complete up to a stop or a failure.
-    pub impacts_csv: Option<std::path::PathBuf>,
-    /// Keep every resolved pack body's counted load cycles for [`NetworkOutcome::cycles`]
-    /// (memory grows with the run; without, the fatigue is summed as it is counted).
-    pub keep_cycles: bool,
-    /// Give every resolved pack's figures window by window, windows of this length in s
-    /// (`run --windows S`; [`CouplingSummary::windows`]).
-    pub windows_s: Option<f64>,
-}
+/// What a network run keeps and writes beside its summary: the pack run's request, the same
+/// seven options (a network's recording applies the compression, chunk size and determinism
+/// of its [`crate::RecordingRequest`]; its impacts CSV names each body as
+/// [`NetworkOutcome::impacts`] does; its cycles feed [`NetworkOutcome::cycles`]; its windows
+/// each resolved pack's [`CouplingSummary::windows`]).
+pub type NetworkRequest<'a> = crate::RunRequest<'a>;
 
 /// One mode change of a clutch.
 #[derive(Debug, Clone, PartialEq, Serialize)]
