@@ -14,7 +14,12 @@
 //!   duration (the contact steps just before it are shortened alike).
 //! - **Driven** (any [`Driven`] flag): every call's time is a communication point where an
 //!   input may change; the step that would pass it is shortened to land on it exactly, and
-//!   `time_s() == t` after every call.
+//!   `time_s() == t` after every call. A session started through `Engine::start` lands a
+//!   call's time within rounding of a grid point (the record grid's, or the fixed steps') on
+//!   that point, as one call's steps land ([`MultibodySession::land_calls_on_grid`]): a host's
+//!   frames on the grid then take the whole run's steps bit for bit on the multirate scheme
+//!   and the fixed steps (issue 46); a contact step of the adaptive shared step that passes a
+//!   call is still shortened there.
 //!
 //! # Inputs
 //! A driven input is held (zero-order hold) from the session's start at the scene's value at
@@ -109,6 +114,13 @@ pub struct MultibodySession {
     /// The loop's buffers, kept from one call to the next so that a frame allocates nothing
     /// of its own (issue 46).
     scratch: SessionBuffers,
+    /// Whether a driven call's time within rounding of a point of the steps' grid is that
+    /// point ([`MultibodySession::landing`]): sessions started through `Engine::start`.
+    calls_on_grid: bool,
+    /// The time of the last call that reached a grid point standing for it, s (what
+    /// [`Session::time_s`] reports when the session stands on the point, a rounding error
+    /// before it; 0 until then).
+    called_s: f64,
 }
 
 impl MultibodySession {
@@ -175,6 +187,8 @@ impl MultibodySession {
             energy: EnergyAudit::default(),
             thermal,
             scratch: SessionBuffers::default(),
+            calls_on_grid: false,
+            called_s: 0.0,
         })
     }
 
@@ -185,6 +199,40 @@ impl MultibodySession {
     /// step past its time (module docs).
     pub fn set_end(&mut self, end_s: f64) {
         self.end_s = end_s;
+    }
+
+    /// Lands a driven session's calls on the whole run's grid points (issue 46): a call's time
+    /// within rounding ([`Self::slack`]) of a point of the record grid (adaptive steps) or of
+    /// the fixed steps' grid is that point, so that the steps end where one call's steps end
+    /// (a host's frame end `k T`, 9e-3, and the grid's `j / rate`, 9.000000000000001e-3, are
+    /// the same instant; a step landing on the former instead of the latter changed the run's
+    /// outputs in their last bits, `hu-table2` and `pack-8-brake` in 1 ms frames). A call's
+    /// time inside a step (off the grid) still ends that step there. What `Engine::start`
+    /// does; the network's pack sessions, whose calls are its own steps, land on them.
+    pub fn land_calls_on_grid(&mut self) {
+        self.calls_on_grid = true;
+    }
+
+    /// Where a call to `t_s` (s) lands: the grid point `t_s` stands for
+    /// ([`Self::land_calls_on_grid`]) or `t_s` itself (a session driven by nothing, a call at
+    /// or past the declared end, a time off the grid).
+    fn landing(&self, t_s: f64) -> f64 {
+        if !self.calls_on_grid || !self.driven.any() || t_s >= self.end_s || !(t_s >= 0.0) {
+            return t_s;
+        }
+        let (g, interval) = match self.options.stepping {
+            // the fixed steps' grid as `advance_shared` computes it
+            Stepping::Fixed { dt_s } => ((t_s / dt_s).round() * dt_s, dt_s),
+            Stepping::Adaptive(_) => {
+                let j = (t_s * self.options.record_rate_hz).round() as u64;
+                (self.rec_time(j), 1.0 / self.options.record_rate_hz)
+            }
+        };
+        if (g - t_s).abs() <= self.slack(interval) {
+            g
+        } else {
+            t_s
+        }
     }
 
     /// The energy audit: complete after [`Session::finish`], the work so far before.
@@ -555,7 +603,7 @@ impl MultibodySession {
 
 impl Session for MultibodySession {
     fn time_s(&self) -> f64 {
-        self.run.t
+        self.run.t.max(self.called_s)
     }
 
     fn set_stop_time(&mut self, t_s: f64) {
@@ -603,11 +651,16 @@ impl Session for MultibodySession {
         self.run
             .events
             .take_contact_samples(observer.wants_contact_samples());
+        let to = self.landing(t_s);
         let out = match self.scheme {
-            Loop::Shared => self.advance_shared(t_s, observer),
-            Loop::Multirate(a) => self.advance_multirate(t_s, a, observer),
+            Loop::Shared => self.advance_shared(to, observer),
+            Loop::Multirate(a) => self.advance_multirate(to, a, observer),
         };
         self.failed = out.is_err();
+        if to != t_s && matches!(out, Ok(Advance::Reached)) {
+            // on the grid point standing for `t_s`: the session is at the call's time
+            self.called_s = self.called_s.max(t_s);
+        }
         out
     }
 
