@@ -117,10 +117,10 @@ pub struct MultibodySession {
     /// Whether a driven call's time within rounding of a point of the steps' grid is that
     /// point ([`MultibodySession::landing`]): sessions started through `Engine::start`.
     calls_on_grid: bool,
-    /// The time of the last call that reached a grid point standing for it, s (what
-    /// [`Session::time_s`] reports when the session stands on the point, a rounding error
-    /// before it; 0 until then).
-    called_s: f64,
+    /// The grid point the last call landed on and the call's time, s: while the session
+    /// stands on the point, [`Session::time_s`] is the call's time (the two one instant but
+    /// for rounding; `(0, 0)` until a call lands on a point other than its time).
+    called_s: (f64, f64),
 }
 
 impl MultibodySession {
@@ -188,7 +188,7 @@ impl MultibodySession {
             thermal,
             scratch: SessionBuffers::default(),
             calls_on_grid: false,
-            called_s: 0.0,
+            called_s: (0.0, 0.0),
         })
     }
 
@@ -603,7 +603,11 @@ impl MultibodySession {
 
 impl Session for MultibodySession {
     fn time_s(&self) -> f64 {
-        self.run.t.max(self.called_s)
+        if self.run.t == self.called_s.0 {
+            self.called_s.1
+        } else {
+            self.run.t
+        }
     }
 
     fn set_stop_time(&mut self, t_s: f64) {
@@ -657,9 +661,9 @@ impl Session for MultibodySession {
             Loop::Multirate(a) => self.advance_multirate(to, a, observer),
         };
         self.failed = out.is_err();
-        if to != t_s && matches!(out, Ok(Advance::Reached)) {
+        if to != t_s && self.run.t == to {
             // on the grid point standing for `t_s`: the session is at the call's time
-            self.called_s = self.called_s.max(t_s);
+            self.called_s = (to, t_s);
         }
         out
     }
