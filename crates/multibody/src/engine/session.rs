@@ -14,12 +14,8 @@
 //!   duration (the contact steps just before it are shortened alike).
 //! - **Driven** (any [`Driven`] flag): every call's time is a communication point where an
 //!   input may change; the step that would pass it is shortened to land on it exactly, and
-//!   `time_s() == t` after every call. A session started through `Engine::start` lands a
-//!   call's time within rounding of a grid point (the record grid's, or the fixed steps') on
-//!   that point, as one call's steps land ([`MultibodySession::land_calls_on_grid`]): a host's
-//!   frames on the grid then take the whole run's steps bit for bit on the multirate scheme
-//!   and the fixed steps (issue 46); a contact step of the adaptive shared step that passes a
-//!   call is still shortened there.
+//!   `time_s() == t` after every call. A call's time on a grid point but for rounding lands
+//!   on that point, as the whole run's steps do (`calls.rs`, issue 46).
 //!
 //! # Inputs
 //! A driven input is held (zero-order hold) from the session's start at the scene's value at
@@ -54,6 +50,8 @@ use clutchpack_model::{
     EngineError, Observer, PressureProfile, RunStats, Shaft, ShaftExcitation, SpeedProfile,
 };
 use std::sync::Arc;
+
+mod calls;
 
 /// How often the observer's `progress` is polled by the shared step: every this many steps
 /// of one coupled body (a step of `n` discs and plates counts `n`: every 1000 steps of one
@@ -114,12 +112,9 @@ pub struct MultibodySession {
     /// The loop's buffers, kept from one call to the next so that a frame allocates nothing
     /// of its own (issue 46).
     scratch: SessionBuffers,
-    /// Whether a driven call's time within rounding of a point of the steps' grid is that
-    /// point ([`MultibodySession::landing`]): sessions started through `Engine::start`.
+    /// Whether a driven call lands on the grid point its time stands for (`calls.rs`).
     calls_on_grid: bool,
-    /// The grid point the last call landed on and the call's time, s: while the session
-    /// stands on the point, [`Session::time_s`] is the call's time (the two one instant but
-    /// for rounding; `(0, 0)` until a call lands on a point other than its time).
+    /// The grid point the last call landed on and the call's time, s (`calls.rs`).
     called_s: (f64, f64),
 }
 
@@ -199,40 +194,6 @@ impl MultibodySession {
     /// step past its time (module docs).
     pub fn set_end(&mut self, end_s: f64) {
         self.end_s = end_s;
-    }
-
-    /// Lands a driven session's calls on the whole run's grid points (issue 46): a call's time
-    /// within rounding ([`Self::slack`]) of a point of the record grid (adaptive steps) or of
-    /// the fixed steps' grid is that point, so that the steps end where one call's steps end
-    /// (a host's frame end `k T`, 9e-3, and the grid's `j / rate`, 9.000000000000001e-3, are
-    /// the same instant; a step landing on the former instead of the latter changed the run's
-    /// outputs in their last bits, `hu-table2` and `pack-8-brake` in 1 ms frames). A call's
-    /// time inside a step (off the grid) still ends that step there. What `Engine::start`
-    /// does; the network's pack sessions, whose calls are its own steps, land on them.
-    pub fn land_calls_on_grid(&mut self) {
-        self.calls_on_grid = true;
-    }
-
-    /// Where a call to `t_s` (s) lands: the grid point `t_s` stands for
-    /// ([`Self::land_calls_on_grid`]) or `t_s` itself (a session driven by nothing, a call at
-    /// or past the declared end, a time off the grid).
-    fn landing(&self, t_s: f64) -> f64 {
-        if !self.calls_on_grid || !self.driven.any() || t_s >= self.end_s || !(t_s >= 0.0) {
-            return t_s;
-        }
-        let (g, interval) = match self.options.stepping {
-            // the fixed steps' grid as `advance_shared` computes it
-            Stepping::Fixed { dt_s } => ((t_s / dt_s).round() * dt_s, dt_s),
-            Stepping::Adaptive(_) => {
-                let j = (t_s * self.options.record_rate_hz).round() as u64;
-                (self.rec_time(j), 1.0 / self.options.record_rate_hz)
-            }
-        };
-        if (g - t_s).abs() <= self.slack(interval) {
-            g
-        } else {
-            t_s
-        }
     }
 
     /// The energy audit: complete after [`Session::finish`], the work so far before.
@@ -603,11 +564,7 @@ impl MultibodySession {
 
 impl Session for MultibodySession {
     fn time_s(&self) -> f64 {
-        if self.run.t == self.called_s.0 {
-            self.called_s.1
-        } else {
-            self.run.t
-        }
+        self.call_time()
     }
 
     fn set_stop_time(&mut self, t_s: f64) {
@@ -661,10 +618,7 @@ impl Session for MultibodySession {
             Loop::Multirate(a) => self.advance_multirate(to, a, observer),
         };
         self.failed = out.is_err();
-        if to != t_s && self.run.t == to {
-            // on the grid point standing for `t_s`: the session is at the call's time
-            self.called_s = (to, t_s);
-        }
+        self.landed(to, t_s);
         out
     }
 
