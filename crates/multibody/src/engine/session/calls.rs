@@ -7,7 +7,7 @@ use crate::options::Stepping;
 
 impl MultibodySession {
     /// Lands a driven session's calls on the whole run's grid points (issue 46): a call's time
-    /// within rounding ([`Self::slack`]) of a point of the record grid (adaptive steps) or of
+    /// within rounding (a billionth of the grid's interval) of a point of the record grid (adaptive steps) or of
     /// the fixed steps' grid is that point, so that the steps end where one call's steps end
     /// (a host's frame end `k T`, 9e-3, and the grid's `j / rate`, 9.000000000000001e-3, are
     /// the same instant; a step landing on the former instead of the latter changed the run's
@@ -22,7 +22,7 @@ impl MultibodySession {
     /// ([`Self::land_calls_on_grid`]) or `t_s` itself (a session driven by nothing, a call at
     /// or past the declared end, a time off the grid).
     pub(super) fn landing(&self, t_s: f64) -> f64 {
-        if !self.calls_on_grid || !self.driven.any() || t_s >= self.end_s || !(t_s >= 0.0) {
+        if !self.calls_on_grid || !self.driven.any() || t_s >= self.end_s || t_s < 0.0 {
             return t_s;
         }
         let (g, interval) = match self.options.stepping {
