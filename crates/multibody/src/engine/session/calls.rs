@@ -7,8 +7,9 @@ use crate::options::Stepping;
 
 impl MultibodySession {
     /// Lands a driven session's calls on the whole run's grid points (issue 46): a call's time
-    /// within rounding (a billionth of the grid's interval) of a point of the record grid (adaptive steps) or of
-    /// the fixed steps' grid is that point, so that the steps end where one call's steps end
+    /// within rounding (a billionth of the grid's interval) of a point of the record grid
+    /// (adaptive steps) or of the fixed steps' grid is that point, so that the steps end where
+    /// one call's steps end
     /// (a host's frame end `k T`, 9e-3, and the grid's `j / rate`, 9.000000000000001e-3, are
     /// the same instant; a step landing on the former instead of the latter changed the run's
     /// outputs in their last bits, `hu-table2` and `pack-8-brake` in 1 ms frames). A call's
