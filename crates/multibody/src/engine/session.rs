@@ -13,9 +13,11 @@
 //!   `Engine::run` does with its duration), and steps then land on it as `run`'s land on its
 //!   duration (the contact steps just before it are shortened alike).
 //! - **Driven** (any [`Driven`] flag): every call's time is a communication point where an
-//!   input may change; the step that would pass it is shortened to land on it exactly, and
-//!   `time_s() == t` after every call. A call's time on a grid point but for rounding lands
-//!   on that point, as the whole run's steps do (`calls.rs`, issue 46).
+//!   input may change, and `time_s() == t` after every call. A call's time on a grid point
+//!   but for rounding lands on that point, as the whole run's steps do; a step that would
+//!   pass it is shortened to land on it exactly, or, on the adaptive shared step of a session
+//!   started through `Engine::start`, passes it as the whole run's does and is stepped again
+//!   to it should an input change there (`calls.rs`, issue 46).
 //!
 //! # Inputs
 //! A driven input is held (zero-order hold) from the session's start at the scene's value at
@@ -115,6 +117,10 @@ pub struct MultibodySession {
     calls_on_grid: bool,
     /// The grid point the last call landed on and the call's time, s (`calls.rs`).
     called_s: (f64, f64),
+    /// A driven shared step that passed the last call's time: the session before it, the
+    /// call (`calls.rs`); what it produced waits in `held` for the next call.
+    passed: Option<Box<calls::Passed>>,
+    held: calls::Held,
 }
 
 impl MultibodySession {
@@ -183,6 +189,8 @@ impl MultibodySession {
             scratch: SessionBuffers::default(),
             calls_on_grid: false,
             called_s: (0.0, 0.0),
+            passed: None,
+            held: calls::Held::default(),
         })
     }
 
@@ -290,6 +298,7 @@ impl MultibodySession {
     fn advance_shared(
         &mut self,
         t_s: f64,
+        carry: bool,
         observer: &mut dyn Observer,
     ) -> Result<Advance, EngineError> {
         let steps_per_contact = match self.options.stepping {
@@ -309,7 +318,8 @@ impl MultibodySession {
             self.sample_if_due(observer);
         }
         while self.run.t < t_s {
-            let end = self.step_end(t_s);
+            // a carried step ends where an undriven one does (`calls.rs`)
+            let end = self.step_end(if carry { f64::INFINITY } else { t_s });
             let t = self.run.t;
             let t_next = match self.options.stepping {
                 Stepping::Fixed { dt_s } => {
@@ -326,6 +336,14 @@ impl MultibodySession {
                 }
                 Stepping::Adaptive(a) => self.adaptive_step_end(&a, end)?,
             };
+            // a step passing the call: the session kept before it, its outputs held
+            let mut held = std::mem::take(&mut self.held);
+            let obs: &mut dyn Observer = if carry && t_next > t_s {
+                self.keep_before();
+                &mut held
+            } else {
+                &mut *observer
+            };
             // (Re)solve the stack for the step actually taken.
             let run = &mut self.run;
             let h = t_next - t;
@@ -337,11 +355,12 @@ impl MultibodySession {
             self.steps += 1;
             run.evaluate(self.t_last_good)?;
             self.t_last_good = run.t;
-            run.track_events(steps_per_contact, observer);
-            self.sample_if_due(observer);
+            run.track_events(steps_per_contact, obs);
+            self.sample_if_due(obs);
             if let Some(th) = self.thermal.as_mut() {
-                th.after_step(&mut self.run, observer)?;
+                th.after_step(&mut self.run, obs)?;
             }
+            self.held = held;
             let steps = self.steps;
             let stopped = steps.is_multiple_of(progress_every) && observer.progress(self.run.t);
             if steps.is_multiple_of(clutchpack_model::STALL_STEPS)
@@ -515,6 +534,7 @@ impl Session for MultibodySession {
             ));
         }
         if *inputs != Inputs::default() {
+            self.rewind()?;
             self.apply_inputs(inputs);
         }
         Ok(())
@@ -537,8 +557,11 @@ impl Session for MultibodySession {
             .events
             .take_contact_samples(observer.wants_contact_samples());
         let to = self.landing(t_s);
+        if self.resume(to, t_s, observer) {
+            return Ok(Advance::Reached);
+        }
         let out = match self.scheme {
-            Loop::Shared => self.advance_shared(to, observer),
+            Loop::Shared => self.advance_shared(to, self.carries(), observer),
             Loop::Multirate(a) => self.advance_multirate(to, a, observer),
         };
         self.failed = out.is_err();
@@ -559,6 +582,8 @@ impl Session for MultibodySession {
         if let Some(stats) = &self.finished {
             return stats.clone();
         }
+        self.passed = None;
+        self.held.send(observer);
         let run = &mut self.run;
         for e in run.events.finish(run.t) {
             observer.impact(&e);
