@@ -458,3 +458,26 @@ fn driven_multibody_shared_step_ended_a_step_at_every_frame() {
     assert_eq!(whole.0, framed.0, "the impacts");
     assert_eq!(whole.1, framed.1, "the state at the end");
 }
+
+/// Issue 46: a host's frame end inside a world step of a driven multibody session ended that
+/// step there (the multirate scheme's world steps are 1e-4 s; a hardware-in-the-loop host runs
+/// 25 us frames), so the framed run took other steps than the whole run. Now the step that
+/// passes a frame's end is the whole run's (a copy kept before it, its outputs held for the
+/// next call). `hu-table2`, `pack-8-brake` (multirate) and `pack-4-damper` (shared step),
+/// every input driven and set again before every call, for 0.05 s in 25 us frames (accumulated,
+/// off the record grid) give the driven run in one call bit for bit.
+#[test]
+fn driven_multibody_session_ended_a_world_step_at_a_frame_inside_it() {
+    let end = 0.05;
+    let ends = frames(None, 2.5e-5, end);
+    for name in ["hu-table2", "pack-8-brake", "pack-4-damper"] {
+        let scene = scene_file(name);
+        let driven = Driven::all_for(&scene.pack);
+        let whole = host_run(&scene, EngineChoice::Multibody, end, &[end], driven, true);
+        let framed = host_run(&scene, EngineChoice::Multibody, end, &ends, driven, true);
+        assert!(!whole.0.is_empty(), "{name}: no impacts");
+        assert_eq!(whole.2, framed.2, "{name}: the steps");
+        assert_eq!(whole.0, framed.0, "{name}: the impacts");
+        assert_eq!(whole.1, framed.1, "{name}: the state at the end");
+    }
+}

@@ -15,9 +15,9 @@
 //! - **Driven** (any [`Driven`] flag): every call's time is a communication point where an
 //!   input may change, and `time_s() == t` after every call. A call's time on a grid point
 //!   but for rounding lands on that point, as the whole run's steps do; a step that would
-//!   pass it is shortened to land on it exactly, or, on the adaptive shared step of a session
-//!   started through `Engine::start`, passes it as the whole run's does and is stepped again
-//!   to it should an input change there (`calls.rs`, issue 46).
+//!   pass it is shortened to land on it exactly, or, in a session started through
+//!   `Engine::start` on adaptive steps, passes it as the whole run's does and is stepped again
+//!   to it should an input change there or the run finish (`calls.rs`, issue 46).
 //!
 //! # Inputs
 //! A driven input is held (zero-order hold) from the session's start at the scene's value at
@@ -427,6 +427,7 @@ impl MultibodySession {
         &mut self,
         t_s: f64,
         a: AdaptiveStepping,
+        carry: bool,
         observer: &mut dyn Observer,
     ) -> Result<Advance, EngineError> {
         if !self.started {
@@ -444,14 +445,24 @@ impl MultibodySession {
             // the piston may push from now on: the clamped stack integrated as one system
             // (`clamped.rs`)
             let clamped = self.run.t >= self.clamped_from_s;
+            // a carried step ends where an undriven one does (`calls.rs`)
+            let to = if carry { f64::INFINITY } else { t_s };
             let end = if clamped {
-                self.step_end(t_s)
+                self.step_end(to)
             } else {
-                self.step_end(t_s).min(self.clamped_from_s)
+                self.step_end(to).min(self.clamped_from_s)
             };
             let grid = self.grid_target(end);
+            let t1 = world_step_end(self.run.t, a.max_step_s, grid, end);
+            // a step passing the call: the session kept before it, its outputs held
+            let mut held = std::mem::take(&mut self.held);
+            let observer: &mut dyn Observer = if carry && t1 > t_s {
+                self.keep_before();
+                &mut held
+            } else {
+                &mut *observer
+            };
             let run = &mut self.run;
-            let t1 = world_step_end(run.t, a.max_step_s, grid, end);
             run.read_relative_states();
             // the prescribed shaft over the step, expanded about its middle once for every
             // sub-step's stages
@@ -497,7 +508,9 @@ impl MultibodySession {
             if let Some(th) = self.thermal.as_mut() {
                 th.after_step(&mut self.run, observer)?;
             }
-            if observer.progress(self.run.t) {
+            let stopped = observer.progress(self.run.t);
+            self.held = held;
+            if stopped {
                 return Ok(Advance::Stopped);
             }
         }
@@ -562,7 +575,7 @@ impl Session for MultibodySession {
         }
         let out = match self.scheme {
             Loop::Shared => self.advance_shared(to, self.carries(), observer),
-            Loop::Multirate(a) => self.advance_multirate(to, a, observer),
+            Loop::Multirate(a) => self.advance_multirate(to, a, self.carries(), observer),
         };
         self.failed = out.is_err();
         self.landed(to, t_s);
@@ -582,7 +595,11 @@ impl Session for MultibodySession {
         if let Some(stats) = &self.finished {
             return stats.clone();
         }
-        self.passed = None;
+        // a step that passed the last call ended there, as the run ends at the call's time
+        // (a failure to step again marks the session failed; the state is then the step's)
+        if self.rewind().is_err() {
+            self.failed = true;
+        }
         self.held.send(observer);
         let run = &mut self.run;
         for e in run.events.finish(run.t) {

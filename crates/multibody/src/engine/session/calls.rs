@@ -2,15 +2,17 @@
 //! points when a call's time is one of them but for rounding, so that a host's frames take
 //! the whole run's steps ([`MultibodySession::land_calls_on_grid`]).
 //!
-//! The adaptive shared step's contact steps keep their length and do not land on the grid:
-//! a driven session (started through `Engine::start`) then takes the step that passes a call
-//! as a session driven by nothing does (the whole run's step), keeping a copy of itself
-//! before it ([`Passed`]) and holding what the step produced ([`Held`]) for the next call.
-//! The call stands at its time ([`MultibodySession::call_time`]; the snapshot is the state
-//! at the step's end, past it by less than a contact step). An input set to a new value at
-//! the call's time rewinds ([`MultibodySession::rewind`]): the copy steps again to the call's
-//! time, as every driven call's step ended there before, what the passing step produced is
-//! dropped and what the shortened one produces goes out with the next call.
+//! A call's time may still fall inside a step: a contact step of the adaptive shared step
+//! (which keeps its length), a world step of the multirate scheme off the grid (a host's
+//! 25 us frames against 1e-4 s world steps). A driven session started through `Engine::start`
+//! then takes the step that passes the call as a session driven by nothing does (the whole
+//! run's step), keeping a copy of itself before it ([`Passed`]) and holding what the step
+//! produced ([`Held`]) for the next call. The call stands at its time
+//! ([`MultibodySession::call_time`]; the snapshot is the state at the step's end, past it by
+//! less than a step). An input set to a new value at the call's time, and `finish`, rewind
+//! ([`MultibodySession::rewind`]): the copy steps again to the call's time, as every driven
+//! call's step ended there before, what the passing step produced is dropped and what the
+//! shortened one produces goes out with the next call.
 
 use super::{Loop, MultibodySession};
 use crate::options::Stepping;
@@ -121,12 +123,12 @@ impl MultibodySession {
         }
     }
 
-    /// Whether the shared step carries its steps past a call: a driven session started
-    /// through `Engine::start` on adaptive steps.
+    /// Whether the session carries its steps past a call: a driven session started through
+    /// `Engine::start` on adaptive steps (the multirate scheme's world steps, the shared
+    /// step's).
     pub(super) fn carries(&self) -> bool {
         self.calls_on_grid
             && self.driven.any()
-            && matches!(self.scheme, Loop::Shared)
             && matches!(self.options.stepping, Stepping::Adaptive(_))
     }
 
@@ -155,7 +157,8 @@ impl MultibodySession {
         false
     }
 
-    /// Ends a step that passed the session's time there, before an input changes: the copy
+    /// Ends a step that passed the session's time there, before an input changes or the run
+    /// finishes: the copy
     /// kept before it steps again to the call's time (the step shortened to it), what the
     /// passing step produced dropped, what the shortened one produces held for the next call.
     pub(super) fn rewind(&mut self) -> Result<(), EngineError> {
@@ -168,7 +171,10 @@ impl MultibodySession {
         };
         *self = before;
         let mut held = Held::default();
-        let out = self.advance_shared(to, false, &mut held);
+        let out = match self.scheme {
+            Loop::Shared => self.advance_shared(to, false, &mut held),
+            Loop::Multirate(a) => self.advance_multirate(to, a, false, &mut held),
+        };
         self.held = held;
         self.failed = out.is_err();
         self.landed(to, t_s);
