@@ -3,7 +3,7 @@
 //! the total angular momentum of an undriven, undamped pack. Run in release:
 //! `cargo test -p clutchpack_multibody --release --test inertial_multirate -- --nocapture`.
 
-use clutchpack_model::session::{Driven, Session};
+use clutchpack_model::session::{Driven, Inputs, Session};
 use clutchpack_model::{
     cases, Collector, Engine, ImpactEvent, PackModel, Shaft, ShaftExcitation, Table,
 };
@@ -215,4 +215,52 @@ fn undriven_inertial_pack_conserves_angular_momentum() {
         c.impacts.len()
     );
     assert!(worst <= 1e-12, "{worst}");
+}
+
+/// Issue 46: a driven session started through `Engine::start` takes the world step that
+/// passes a call as the whole run does, keeping a copy before it; an input set to a new value
+/// at the call's time steps the copy again to the call. Its run is then the one of a session
+/// that ends a world step at every call (`MultibodyEngine::session`, the network's): the
+/// staggered pack on an inertial shaft, its drive torque eq (4)'s (5700 N m at 104 Hz) sampled
+/// and held at 200 calls 2.5e-4 s apart, off the record grid (inside world steps of 1e-4 s): the same
+/// steps, impacts and samples, bit for bit, the held outputs sent one call later.
+#[test]
+fn an_input_changed_inside_a_world_step_ends_the_step_there() {
+    let e =
+        MultibodyEngine::new(inertial_staggered(4), MultibodyOptions::default()).expect("engine");
+    assert!(e.is_multirate());
+    let driven = Driven {
+        shaft_torque: true,
+        ..Driven::NONE
+    };
+    let drive = |s: &mut dyn Session| {
+        let mut c = Collector::default();
+        for k in 1..=200 {
+            let t = k as f64 * 2.5e-4 + 3e-6;
+            // eq (4)'s drive torque sampled at the call before
+            let torque = 5700.0 * (std::f64::consts::TAU * 104.0 * (t - 2.5e-4)).cos();
+            s.set_inputs(&Inputs {
+                shaft_torque_n_m: Some(torque),
+                ..Inputs::default()
+            })
+            .expect("inputs");
+            s.advance_to(t, &mut c).expect("advance");
+            assert_eq!(s.time_s(), t);
+        }
+        let steps = s.finish(&mut c).steps;
+        (c, steps)
+    };
+    let (carried, n_carried) = drive(e.start(driven).expect("start").as_mut());
+    let (landing, n_landing) = drive(&mut e.session(driven).expect("session"));
+    assert!(!carried.impacts.is_empty(), "no impacts");
+    assert_eq!(n_carried, n_landing, "the steps");
+    assert_eq!(carried.impacts, landing.impacts, "the impacts");
+    let first = (carried.samples.iter().zip(&landing.samples)).position(|(a, b)| a != b);
+    assert_eq!(
+        carried.samples,
+        landing.samples,
+        "the samples: {} against {}, first apart {first:?}",
+        carried.samples.len(),
+        landing.samples.len()
+    );
 }

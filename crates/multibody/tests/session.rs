@@ -272,7 +272,8 @@ fn a_cloned_session_advances_as_the_original() {
 /// steps then land on every communication point (and the held angle `angle0 + w (t - t0)`
 /// rounds differently from the profile's `w t`), so the impacts are the scene-driven run's to
 /// the integration error, not bit for bit. The snapshot at a communication point on the
-/// record grid is the sample sent there.
+/// record grid is the sample sent there, stamped with the grid's time (`j / rate`, the call's
+/// time but for rounding: `MultibodySession::land_calls_on_grid`).
 #[test]
 fn a_driven_shaft_held_at_the_scene_speed_is_the_scene_run() {
     let mut pack = prescribed();
@@ -305,7 +306,9 @@ fn a_driven_shaft_held_at_the_scene_speed_is_the_scene_run() {
             assert_eq!(s.time_s(), t);
             let snap = s.snapshot();
             let last = c.samples.last().expect("a sample");
-            assert_eq!(last.t_s, t);
+            // the record grid's point the call stands for, as the whole run stamps it
+            // (`11 * 1e-4` is 0.011000000000000001 where the call's time is 0.011)
+            assert_eq!(last.t_s, (t * 1e4).round() * (1.0 / 1e4));
             assert_eq!(&snap.sample, last, "snapshot at {t}");
         }
         s.finish(&mut c);
@@ -512,14 +515,13 @@ fn worst_speed(a: &Collector, b: &Collector) -> f64 {
 /// the engaging clutch's drum load of -200 N m, each driven at that same value. A held torque
 /// is integrated exactly (its kick split at the communication point) where the scene's goes
 /// through the same exact ramps (the drive) or the drum's polynomial kick (its load): in one
-/// call both give the scene's run (measured: the same impacts and speeds, bit for bit; the
-/// bound allows rounding). Both run the multirate scheme, which holds the load exactly in
-/// either case (the clutch's clamped stack too, since issue 20; when the shared step took
-/// over at the piston's start its two kicks differed by rounding).
-/// At 20 communication points the steps land on each: on the shaft, impacts within
-/// 6.5e-11 s and 7.9e-7 of the peak (measured); the clutch's engagement is chaotic (a load 1e-12
-/// off moves its bodies' speeds by 0.3 rad/s and its impact count from 191 to 167 within 20
-/// ms, measured), so there only the run's completion is checked and the spread printed.
+/// call both give the scene's run (measured: bit for bit; the bound allows rounding). The
+/// multirate scheme holds the load exactly in either case (the clamped stack too, issue 20);
+/// the shaft runs the shared step too. At 20 communication points the steps land on each (the
+/// shared step's passing one rewound to it, issue 46): on the shaft, impacts within 2.2e-10 s
+/// and 7.6e-7 of the peak (shared step; multirate bit for bit, measured); the clutch's
+/// engagement is chaotic (a load 1e-12 off moves its bodies' speeds by 0.3 rad/s and its
+/// impact count from 191 to 167 within 20 ms, measured): only its completion is checked.
 #[test]
 fn held_torques_at_the_scene_values_are_the_scene_run() {
     let mut shaft = inertial();
@@ -534,18 +536,30 @@ fn held_torques_at_the_scene_values_are_the_scene_run() {
     for (i, d) in shaft.discs.iter_mut().enumerate() {
         d.initial_rel_speed_rad_s = if i % 2 == 0 { 0.4 } else { -0.3 };
     }
+    let torque = (
+        Driven {
+            shaft_torque: true,
+            ..Driven::NONE
+        },
+        Inputs {
+            shaft_torque_n_m: Some(2.0),
+            ..Default::default()
+        },
+    );
     let cases = [
+        (
+            "inertial shaft torque, shared step",
+            shaft.clone(),
+            torque.0,
+            torque.1,
+            Scheme::Shared,
+            true,
+        ),
         (
             "inertial shaft torque",
             shaft,
-            Driven {
-                shaft_torque: true,
-                ..Driven::NONE
-            },
-            Inputs {
-                shaft_torque_n_m: Some(2.0),
-                ..Default::default()
-            },
+            torque.0,
+            torque.1,
             Scheme::Auto,
             true,
         ),
@@ -583,7 +597,7 @@ fn held_torques_at_the_scene_values_are_the_scene_run() {
         if tame {
             let (dt, dpeak) = worst(&c.impacts, &whole.impacts);
             println!("  worst onset/separation {dt:.3e} s, peak {dpeak:.3e}");
-            assert!(dt < 2e-10 && dpeak < 2e-6, "{name}: {dt:e} s, {dpeak:e}");
+            assert!(dt < 4e-10 && dpeak < 2e-6, "{name}: {dt:e} s, {dpeak:e}");
         }
     }
 }

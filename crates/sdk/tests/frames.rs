@@ -410,3 +410,74 @@ fn driven_pack_session_ended_a_step_at_every_frame() {
         assert_eq!(whole.1, framed.1, "{name}: the state at the end");
     }
 }
+
+/// Issue 46: a driven pack session on the multibody engine landed its steps on a host's frame
+/// ends `k T` rather than on the record grid's `j / rate` the whole run lands on, the same
+/// instants but for rounding (9e-3 against 9.000000000000001e-3), so its outputs differed in
+/// their last bits (`hu-table2` in 1 ms frames over 0.3 s: the final state within 4.3e-8,
+/// the peaks within 3.2e-6 N; `pack-8-brake` within 5.8e-7 and 5.2e-9 N). Through the sdk's
+/// session as a host runs it (every input driven, held at its value at t = 0 and set again
+/// before every call): `hu-table2` and `pack-8-brake` (the multirate scheme, a prescribed
+/// shaft) for 0.05 s in 1 ms frames give the driven run in one call bit for bit: the steps,
+/// every impact, the state at the end.
+#[test]
+fn driven_multibody_session_landed_on_the_frames_off_the_grid() {
+    let end = 0.05;
+    let ends = frames(None, 1e-3, end);
+    for name in ["hu-table2", "pack-8-brake"] {
+        let scene = scene_file(name);
+        let driven = Driven::all_for(&scene.pack);
+        assert!(driven.any(), "{name}");
+        let whole = host_run(&scene, EngineChoice::Multibody, end, &[end], driven, true);
+        let framed = host_run(&scene, EngineChoice::Multibody, end, &ends, driven, true);
+        assert!(!whole.0.is_empty(), "{name}: no impacts");
+        assert_eq!(whole.2, framed.2, "{name}: the steps");
+        assert_eq!(whole.0, framed.0, "{name}: the impacts");
+        assert_eq!(whole.1, framed.1, "{name}: the state at the end");
+    }
+}
+
+/// Issue 46: a driven pack session on the multibody engine's adaptive shared step ended a
+/// contact step at every call, where an input may change (`pack-4-damper` in 1 ms frames over
+/// 0.3 s: 54559 steps against 54426 in one call, its peaks within 3.8e-5 N). Now the step
+/// that passes a call is the whole run's, a copy kept before it for an input changed there.
+/// `pack-4-damper` (an inertial shaft driven by a torque, a drum) for 0.05 s in 1 ms frames,
+/// every input set again before every call, gives the driven run in one call bit for bit: the
+/// steps, every impact, the state at the end.
+#[test]
+fn driven_multibody_shared_step_ended_a_step_at_every_frame() {
+    let end = 0.05;
+    let ends = frames(None, 1e-3, end);
+    let scene = scene_file("pack-4-damper");
+    let driven = Driven::all_for(&scene.pack);
+    assert!(driven.any());
+    let whole = host_run(&scene, EngineChoice::Multibody, end, &[end], driven, true);
+    let framed = host_run(&scene, EngineChoice::Multibody, end, &ends, driven, true);
+    assert!(!whole.0.is_empty(), "no impacts");
+    assert_eq!(whole.2, framed.2, "the steps");
+    assert_eq!(whole.0, framed.0, "the impacts");
+    assert_eq!(whole.1, framed.1, "the state at the end");
+}
+
+/// Issue 46: a host's frame end inside a world step of a driven multibody session ended that
+/// step there (the multirate scheme's world steps are 1e-4 s; a hardware-in-the-loop host runs
+/// 25 us frames), so the framed run took other steps than the whole run. Now the step that
+/// passes a frame's end is the whole run's (a copy kept before it, its outputs held for the
+/// next call). `hu-table2`, `pack-8-brake` (multirate) and `pack-4-damper` (shared step),
+/// every input driven and set again before every call, for 0.05 s in 25 us frames (accumulated,
+/// off the record grid) give the driven run in one call bit for bit.
+#[test]
+fn driven_multibody_session_ended_a_world_step_at_a_frame_inside_it() {
+    let end = 0.05;
+    let ends = frames(None, 2.5e-5, end);
+    for name in ["hu-table2", "pack-8-brake", "pack-4-damper"] {
+        let scene = scene_file(name);
+        let driven = Driven::all_for(&scene.pack);
+        let whole = host_run(&scene, EngineChoice::Multibody, end, &[end], driven, true);
+        let framed = host_run(&scene, EngineChoice::Multibody, end, &ends, driven, true);
+        assert!(!whole.0.is_empty(), "{name}: no impacts");
+        assert_eq!(whole.2, framed.2, "{name}: the steps");
+        assert_eq!(whole.0, framed.0, "{name}: the impacts");
+        assert_eq!(whole.1, framed.1, "{name}: the state at the end");
+    }
+}

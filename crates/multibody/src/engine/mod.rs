@@ -311,8 +311,12 @@ impl Engine for MultibodyEngine {
             .collect()
     }
 
+    /// [`MultibodyEngine::session`], its driven calls landing on the whole run's grid
+    /// points ([`MultibodySession::land_calls_on_grid`]).
     fn start(&self, driven: Driven) -> Result<Box<dyn Session>, EngineError> {
-        Ok(Box::new(self.session(driven)?))
+        let mut session = self.session(driven)?;
+        session.land_calls_on_grid();
+        Ok(Box::new(session))
     }
 
     /// One session driven by nothing, its end declared ([`MultibodySession::set_end`]),

@@ -13,8 +13,11 @@
 //!   `Engine::run` does with its duration), and steps then land on it as `run`'s land on its
 //!   duration (the contact steps just before it are shortened alike).
 //! - **Driven** (any [`Driven`] flag): every call's time is a communication point where an
-//!   input may change; the step that would pass it is shortened to land on it exactly, and
-//!   `time_s() == t` after every call.
+//!   input may change, and `time_s() == t` after every call. A call's time on a grid point
+//!   but for rounding lands on that point, as the whole run's steps do; a step that would
+//!   pass it is shortened to land on it exactly, or, in a session started through
+//!   `Engine::start` on adaptive steps, passes it as the whole run's does and is stepped again
+//!   to it should an input change there or the run finish (`calls.rs`, issue 46).
 //!
 //! # Inputs
 //! A driven input is held (zero-order hold) from the session's start at the scene's value at
@@ -35,20 +38,21 @@
 //! until an input changes it. A copy advanced as the original gives the same outputs bit
 //! for bit (`tests/session.rs`).
 
-use super::carriers::{External, Motion};
+use super::carriers::Motion;
 use super::energy::EnergyAudit;
 use super::scheme_state::SessionBuffers;
-use super::state::{shaft_accel_bound, Run};
+use super::state::Run;
 use super::substep::{split_remainder, Counts, Prescribed, WorldStep};
 use super::thermal::Thermal;
 use crate::options::{AdaptiveStepping, MultibodyOptions, Stepping};
 use crate::world::SHAFT;
 use clutchpack_model::session::{hold_inputs, Advance, Driven, Inputs, Session, Snapshot};
 use clutchpack_model::thermal::ThermalModel;
-use clutchpack_model::{
-    EngineError, Observer, PressureProfile, RunStats, Shaft, ShaftExcitation, SpeedProfile,
-};
+use clutchpack_model::{EngineError, Observer, RunStats};
 use std::sync::Arc;
+
+mod calls;
+mod inputs;
 
 /// How often the observer's `progress` is polled by the shared step: every this many steps
 /// of one coupled body (a step of `n` discs and plates counts `n`: every 1000 steps of one
@@ -109,6 +113,14 @@ pub struct MultibodySession {
     /// The loop's buffers, kept from one call to the next so that a frame allocates nothing
     /// of its own (issue 46).
     scratch: SessionBuffers,
+    /// Whether a driven call lands on the grid point its time stands for (`calls.rs`).
+    calls_on_grid: bool,
+    /// The grid point the last call landed on and the call's time, s (`calls.rs`).
+    called_s: (f64, f64),
+    /// A driven shared step that passed the last call's time: the session before it, the
+    /// call (`calls.rs`); what it produced waits in `held` for the next call.
+    passed: Option<Box<calls::Passed>>,
+    held: calls::Held,
 }
 
 impl MultibodySession {
@@ -175,6 +187,10 @@ impl MultibodySession {
             energy: EnergyAudit::default(),
             thermal,
             scratch: SessionBuffers::default(),
+            calls_on_grid: false,
+            called_s: (0.0, 0.0),
+            passed: None,
+            held: calls::Held::default(),
         })
     }
 
@@ -282,6 +298,7 @@ impl MultibodySession {
     fn advance_shared(
         &mut self,
         t_s: f64,
+        carry: bool,
         observer: &mut dyn Observer,
     ) -> Result<Advance, EngineError> {
         let steps_per_contact = match self.options.stepping {
@@ -301,7 +318,8 @@ impl MultibodySession {
             self.sample_if_due(observer);
         }
         while self.run.t < t_s {
-            let end = self.step_end(t_s);
+            // a carried step ends where an undriven one does (`calls.rs`)
+            let end = self.step_end(if carry { f64::INFINITY } else { t_s });
             let t = self.run.t;
             let t_next = match self.options.stepping {
                 Stepping::Fixed { dt_s } => {
@@ -318,6 +336,14 @@ impl MultibodySession {
                 }
                 Stepping::Adaptive(a) => self.adaptive_step_end(&a, end)?,
             };
+            // a step passing the call: the session kept before it, its outputs held
+            let mut held = std::mem::take(&mut self.held);
+            let obs: &mut dyn Observer = if carry && t_next > t_s {
+                self.keep_before();
+                &mut held
+            } else {
+                &mut *observer
+            };
             // (Re)solve the stack for the step actually taken.
             let run = &mut self.run;
             let h = t_next - t;
@@ -329,11 +355,12 @@ impl MultibodySession {
             self.steps += 1;
             run.evaluate(self.t_last_good)?;
             self.t_last_good = run.t;
-            run.track_events(steps_per_contact, observer);
-            self.sample_if_due(observer);
+            run.track_events(steps_per_contact, obs);
+            self.sample_if_due(obs);
             if let Some(th) = self.thermal.as_mut() {
-                th.after_step(&mut self.run, observer)?;
+                th.after_step(&mut self.run, obs)?;
             }
+            self.held = held;
             let steps = self.steps;
             let stopped = steps.is_multiple_of(progress_every) && observer.progress(self.run.t);
             if steps.is_multiple_of(clutchpack_model::STALL_STEPS)
@@ -400,6 +427,7 @@ impl MultibodySession {
         &mut self,
         t_s: f64,
         a: AdaptiveStepping,
+        carry: bool,
         observer: &mut dyn Observer,
     ) -> Result<Advance, EngineError> {
         if !self.started {
@@ -417,14 +445,24 @@ impl MultibodySession {
             // the piston may push from now on: the clamped stack integrated as one system
             // (`clamped.rs`)
             let clamped = self.run.t >= self.clamped_from_s;
+            // a carried step ends where an undriven one does (`calls.rs`)
+            let to = if carry { f64::INFINITY } else { t_s };
             let end = if clamped {
-                self.step_end(t_s)
+                self.step_end(to)
             } else {
-                self.step_end(t_s).min(self.clamped_from_s)
+                self.step_end(to).min(self.clamped_from_s)
             };
             let grid = self.grid_target(end);
+            let t1 = world_step_end(self.run.t, a.max_step_s, grid, end);
+            // a step passing the call: the session kept before it, its outputs held
+            let mut held = std::mem::take(&mut self.held);
+            let observer: &mut dyn Observer = if carry && t1 > t_s {
+                self.keep_before();
+                &mut held
+            } else {
+                &mut *observer
+            };
             let run = &mut self.run;
-            let t1 = world_step_end(run.t, a.max_step_s, grid, end);
             run.read_relative_states();
             // the prescribed shaft over the step, expanded about its middle once for every
             // sub-step's stages
@@ -470,92 +508,19 @@ impl MultibodySession {
             if let Some(th) = self.thermal.as_mut() {
                 th.after_step(&mut self.run, observer)?;
             }
-            if observer.progress(self.run.t) {
+            let stopped = observer.progress(self.run.t);
+            self.held = held;
+            if stopped {
                 return Ok(Advance::Stopped);
             }
         }
         Ok(Advance::Reached)
     }
-
-    /// Applies `inputs` (checked) at the current time and re-evaluates what they change.
-    pub(super) fn apply_inputs(&mut self, inputs: &Inputs) {
-        let multirate = self.is_multirate();
-        let run = &mut self.run;
-        let t = run.t;
-        let mut shaft_jump = 0.0;
-        if inputs.shaft_speed_rad_s.is_some()
-            || inputs.shaft_speed_slope_rad_s2.is_some()
-            || inputs.shaft_speed_curvature_rad_s3.is_some()
-        {
-            let (angle, speed) = run.carrier_state(SHAFT);
-            let w = inputs.shaft_speed_rad_s.unwrap_or(speed);
-            let held = SpeedProfile::Held {
-                t0_s: t,
-                angle0_rad: angle,
-                speed_rad_s: w,
-                accel_rad_s2: inputs.shaft_speed_slope_rad_s2.unwrap_or(0.0),
-                jerk_rad_s3: inputs.shaft_speed_curvature_rad_s3.unwrap_or(0.0),
-            };
-            Arc::make_mut(&mut run.pack).shaft = Shaft::Prescribed(held.clone());
-            let shaft = &mut run.carriers[SHAFT];
-            shaft.motion = Motion::Prescribed(Arc::new(held));
-            shaft_jump = w - shaft.speed;
-            shaft.speed = w;
-        }
-        if inputs.shaft_torque_n_m.is_some() || inputs.shaft_torque_slope_n_m_s.is_some() {
-            let before = run.drive_torque(t);
-            let torque = inputs.shaft_torque_n_m.unwrap_or(before);
-            let shaft = &mut run.carriers[SHAFT];
-            if shaft.switch.is_none_or(|(ts, _)| ts != t) {
-                shaft.switch = Some((t, before));
-            }
-            if let Shaft::Inertial { excitation, .. } = &mut Arc::make_mut(&mut run.pack).shaft {
-                let initial_speed_rad_s = excitation.initial_speed_rad_s();
-                *excitation = ShaftExcitation::Held {
-                    t0_s: t,
-                    torque_n_m: torque,
-                    rate_n_m_s: inputs.shaft_torque_slope_n_m_s.unwrap_or(0.0),
-                    initial_speed_rad_s,
-                };
-            }
-        }
-        if let Some(load) = inputs.drum_load_n_m {
-            if let Some(d) = run.world.drum() {
-                let drum = &mut run.carriers[d];
-                if let External::Load(before) = drum.external {
-                    if drum.switch.is_none_or(|(ts, _)| ts != t) {
-                        drum.switch = Some((t, before));
-                    }
-                }
-                drum.external = External::Load(load);
-            }
-            if let Some(d) = Arc::make_mut(&mut run.pack).drum.as_mut() {
-                d.load_torque_n_m = load;
-            }
-        }
-        if let Some(pressure_pa) = inputs.piston_pressure_pa {
-            let p = PressureProfile::Constant { pressure_pa };
-            if let Some(st) = Arc::make_mut(&mut run.pack).stack.as_mut() {
-                st.piston.pressure = p.clone();
-                // A held pressure over the return spring may push from now on: the multirate
-                // scheme integrates the clamped stack as one system from this call (and for
-                // the rest of the run, as after a scene's ramp starts; a later release is the
-                // clamped system's open faces). Below the spring the hand-over stays where it
-                // was (never, or a call that pushed before).
-                self.clamped_from_s = self.clamped_from_s.min(st.piston.open_until_s().max(t));
-            }
-            if let Some(s) = run.stack.as_mut() {
-                s.set_pressure(p);
-            }
-        }
-        run.carriers[SHAFT].drive_bound = shaft_accel_bound(&run.pack.shaft);
-        run.input_changed(SHAFT, shaft_jump, multirate);
-    }
 }
 
 impl Session for MultibodySession {
     fn time_s(&self) -> f64 {
-        self.run.t
+        self.call_time()
     }
 
     fn set_stop_time(&mut self, t_s: f64) {
@@ -582,6 +547,7 @@ impl Session for MultibodySession {
             ));
         }
         if *inputs != Inputs::default() {
+            self.rewind()?;
             self.apply_inputs(inputs);
         }
         Ok(())
@@ -603,11 +569,16 @@ impl Session for MultibodySession {
         self.run
             .events
             .take_contact_samples(observer.wants_contact_samples());
+        let to = self.landing(t_s);
+        if self.resume(to, t_s, observer) {
+            return Ok(Advance::Reached);
+        }
         let out = match self.scheme {
-            Loop::Shared => self.advance_shared(t_s, observer),
-            Loop::Multirate(a) => self.advance_multirate(t_s, a, observer),
+            Loop::Shared => self.advance_shared(to, self.carries(), observer),
+            Loop::Multirate(a) => self.advance_multirate(to, a, self.carries(), observer),
         };
         self.failed = out.is_err();
+        self.landed(to, t_s);
         out
     }
 
@@ -624,6 +595,12 @@ impl Session for MultibodySession {
         if let Some(stats) = &self.finished {
             return stats.clone();
         }
+        // a step that passed the last call ended there, as the run ends at the call's time
+        // (a failure to step again marks the session failed; the state is then the step's)
+        if self.rewind().is_err() {
+            self.failed = true;
+        }
+        self.held.send(observer);
         let run = &mut self.run;
         for e in run.events.finish(run.t) {
             observer.impact(&e);
