@@ -231,7 +231,14 @@ impl Equations {
         self.body_guard_at() + self.net.bodies.len()
     }
 
+    /// Sets the couplings' modes and builds their rigid groups, kept when the modes are
+    /// those they were built for (the groups follow from the modes alone: an input set in a
+    /// session changes a signal, never a row; most events, a pack's tooth contacts among
+    /// them, leave the modes as they were).
     fn set_modes(&mut self, modes: &[Option<ClutchMode>]) {
+        if self.modes == modes {
+            return;
+        }
         self.modes.copy_from_slice(modes);
         self.clusters = Clusters::build(&self.net, rigid_rows(&self.net, &self.modes));
     }
@@ -374,15 +381,37 @@ impl Equations {
     /// ([`clutchpack_model::network::ElementLaw::guard`]: a clutch's slip, static margin or
     /// normal force), then the packs' and the road loads'.
     fn guards(&mut self, t: f64, y: &[f64], out: &mut [f64]) {
+        self.guards_where(t, y, out, None);
+    }
+
+    /// [`Self::guards`] of the guards `want` marks only (the others in `out` left as they
+    /// were), each the same value: the forces computed only for a marked coupling's or
+    /// road load's guard, a pack's stack only for a marked face, a disc's or plate's depth
+    /// only where marked (the events' location, `stepper.rs`).
+    fn guards_of(&mut self, t: f64, y: &[f64], out: &mut [f64], want: &[bool]) {
+        self.guards_where(t, y, out, Some(want));
+    }
+
+    /// [`Self::guards`] (`want` `None`) or [`Self::guards_of`].
+    fn guards_where(&mut self, t: f64, y: &[f64], out: &mut [f64], want: Option<&[bool]>) {
         let n = self.net.bodies.len();
+        let m = self.net.couplings.len();
         let w = &y[n..2 * n];
+        let at = self.body_guard_at();
+        let wanted = |i: usize| want.is_none_or(|x| x[i]);
+        // the couplings' and the road loads' guards need the forces when a clutch is locked
+        // or a body held; the packs' never do
+        let any_own = want.is_none_or(|x| x[..m].contains(&true) || x[at..at + n].contains(&true));
         let any_locked = self.modes.contains(&Some(ClutchMode::Locked));
         let any_held = self.held.contains(&true);
-        if any_locked || any_held {
+        if any_own && (any_locked || any_held) {
             self.forces(t, y);
             self.rigid_torques();
         }
         for (k, c) in self.net.couplings.iter().enumerate() {
+            if !wanted(k) {
+                continue;
+            }
             if let Some(g) = c.mesh() {
                 let depth = g
                     .law
@@ -398,13 +427,15 @@ impl Equations {
             out[k] = c.law().guard(t, w_rel, self.modes[k], held);
         }
         for p in &self.packs {
-            let g = &mut out[p.guard_at..p.guard_at + p.guards()];
-            p.guard_values(t, y, w, g);
+            let r = p.guard_at..p.guard_at + p.guards();
+            p.guard_values(t, y, w, &mut out[r.clone()], want.map(|x| &x[r]));
         }
         // the road loads: a held group's breakaway less its torque, a moving body's speed
         // along its direction
-        let at = self.body_guard_at();
         for i in 0..n {
+            if !wanted(at + i) {
+                continue;
+            }
             out[at + i] = if self.held[i] {
                 let c = self.clusters.of[i];
                 self.hold_capacity[c] - self.hold_torque[c].abs()

@@ -137,10 +137,22 @@ impl NetPack {
     /// The guards at the network state `y` with the bodies' speeds `w`, into `out` (its
     /// slice): per body its engagement depth (m; negated in free flight, so that an onset and
     /// a separation both cross from above), per face -1 where its mode must change, else 1.
-    pub fn guard_values(&self, t: f64, y: &[f64], w: &[f64], out: &mut [f64]) {
+    /// With `want` (its slice of the marks), only the marked ones (the others left as they
+    /// were; the stack evaluated only for a marked face).
+    pub fn guard_values(
+        &self,
+        t: f64,
+        y: &[f64],
+        w: &[f64],
+        out: &mut [f64],
+        want: Option<&[bool]>,
+    ) {
         let part = self.part(y);
         let nb = self.sys.ids.len();
         for slot in 0..nb {
+            if want.is_some_and(|x| !x[slot]) {
+                continue;
+            }
             let depth = self.sys.depth(slot, part);
             out[slot] = if self.modes[slot].is_some() {
                 depth
@@ -148,7 +160,7 @@ impl NetPack {
                 -depth
             };
         }
-        if self.sys.faces.is_empty() {
+        if self.sys.faces.is_empty() || want.is_some_and(|x| !x[nb..].contains(&true)) {
             return;
         }
         let open = self.sys.faces.iter().all(|f| *f == Face::Open);
