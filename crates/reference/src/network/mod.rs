@@ -92,6 +92,9 @@ struct Equations {
     clusters: Clusters,
     /// The resolved packs, in coupling order (their state after the network's counters).
     packs: Vec<packs::NetPack>,
+    /// Each pack's bodies' loads at the state of the last [`Equations::forces`], N (by slot;
+    /// [`crate::system::System::loads_into`]): its reactions' and then its stack's.
+    loads: Vec<Vec<f64>>,
     // scratch
     torque: Vec<f64>,
     acc: Vec<f64>,
@@ -143,6 +146,7 @@ impl Equations {
         };
         let packs = packs::build(&net, 2 * n + 2 * m + counters, m);
         Equations {
+            loads: vec![Vec::new(); packs.len()],
             alpha: vec![0.0; n],
             counters,
             packs,
@@ -282,9 +286,11 @@ impl Equations {
                 self.torque[c.b] += tb;
             }
         }
-        for p in &self.packs {
-            // packs.rs, pass (1): the spline reactions (Hu et al. eq 4) on both carriers
-            let [ta, tb] = p.sys.reactions_n_m(p.part(y), &p.modes);
+        for (p, loads) in self.packs.iter().zip(self.loads.iter_mut()) {
+            // packs.rs, pass (1): the spline reactions (Hu et al. eq 4) on both carriers,
+            // from the bodies' loads (kept for the stack's balance at the same state)
+            p.sys.loads_into(p.part(y), &p.modes, loads);
+            let [ta, tb] = p.sys.reactions_from_n_m(loads, &p.modes);
             self.coupling_torque[p.k] = ta;
             self.torque[p.a] += ta;
             self.torque[p.b] += tb;
@@ -366,12 +372,14 @@ impl Equations {
                 .map(|i| self.clusters.reaction_n_m(i, &self.torque, &self.alpha) * w[i])
                 .sum();
         }
-        for p in &self.packs {
-            // packs.rs, pass (3): each pack's bodies against their carriers' motion
+        for (p, loads) in self.packs.iter().zip(&self.loads) {
+            // packs.rs, pass (3): each pack's bodies against their carriers' motion (the
+            // loads of pass (1), at this state)
             let c = p.carriers(w, &self.acc);
             let (at, d) = (p.at, p.sys.dim());
+            let (part, rate) = (&y[at..at + d], &mut dy[at..at + d]);
             p.sys
-                .rhs_with(t, &y[at..at + d], &p.modes, &c, &mut dy[at..at + d]);
+                .rhs_with_loads(t, part, &p.modes, &c, Some(loads), rate);
             dy[at + d] = p.drag_power_w(y, w);
         }
     }
@@ -404,7 +412,9 @@ impl Equations {
         let any_own = want.is_none_or(|x| x[..m].contains(&true) || x[at..at + n].contains(&true));
         let any_locked = self.modes.contains(&Some(ClutchMode::Locked));
         let any_held = self.held.contains(&true);
-        if any_own && (any_locked || any_held) {
+        // the forces at this state give the packs' loads too
+        let forced = any_own && (any_locked || any_held);
+        if forced {
             self.forces(t, y);
             self.rigid_torques();
         }
@@ -426,9 +436,10 @@ impl Equations {
             let (w_rel, held) = (w[c.b] - w[c.a], self.coupling_torque[k]);
             out[k] = c.law().guard(t, w_rel, self.modes[k], held);
         }
-        for p in &self.packs {
+        for (p, loads) in self.packs.iter().zip(&self.loads) {
             let r = p.guard_at..p.guard_at + p.guards();
-            p.guard_values(t, y, w, &mut out[r.clone()], want.map(|x| &x[r]));
+            let known = forced.then_some(&loads[..]);
+            p.guard_values(t, y, w, &mut out[r.clone()], want.map(|x| &x[r]), known);
         }
         // the road loads: a held group's breakaway less its torque, a moving body's speed
         // along its direction

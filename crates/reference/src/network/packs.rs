@@ -138,7 +138,8 @@ impl NetPack {
     /// slice): per body its engagement depth (m; negated in free flight, so that an onset and
     /// a separation both cross from above), per face -1 where its mode must change, else 1.
     /// With `want` (its slice of the marks), only the marked ones (the others left as they
-    /// were; the stack evaluated only for a marked face).
+    /// were; the stack evaluated only for a marked face); `loads` its bodies' loads at `y`
+    /// if known (N, by slot).
     pub fn guard_values(
         &self,
         t: f64,
@@ -146,6 +147,7 @@ impl NetPack {
         w: &[f64],
         out: &mut [f64],
         want: Option<&[bool]>,
+        loads: Option<&[f64]>,
     ) {
         let part = self.part(y);
         let nb = self.sys.ids.len();
@@ -181,15 +183,16 @@ impl NetPack {
         // the faces' conditions need the carriers' speeds only
         // (in this thread's buffers: no allocation per evaluation, the same values)
         let c = [w[self.a], 0.0, w[self.b], 0.0];
-        self.sys.with_stack_eval(t, part, &self.modes, &c, |ev| {
-            for m in 0..self.sys.faces.len() {
-                out[nb + m] = if self.sys.face_switches(m, ev) {
-                    -1.0
-                } else {
-                    1.0
-                };
-            }
-        });
+        self.sys
+            .with_stack_eval_loads(t, part, &self.modes, &c, loads, |ev| {
+                for m in 0..self.sys.faces.len() {
+                    out[nb + m] = if self.sys.face_switches(m, ev) {
+                        -1.0
+                    } else {
+                        1.0
+                    };
+                }
+            });
     }
 
     /// Opens and closes contact events at an event at `t` (`crossed[slot] <= 0`: the body's
