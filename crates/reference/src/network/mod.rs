@@ -393,9 +393,12 @@ impl Equations {
     }
 
     /// [`Self::guards`] of the guards `want` marks only (the others in `out` left as they
-    /// were), each the same value: the forces computed only for a marked coupling's or
+    /// were, but a pack's faces written together), each the same value: the forces computed only for a marked coupling's or
     /// road load's guard, a pack's stack only for a marked face, a disc's or plate's depth
-    /// only where marked (the events' location, `stepper.rs`).
+    /// only where marked. An event's bisection evaluates those that crossed by its bracket's
+    /// end (`stepper.rs`): another guard could only have moved it by dipping to <= 0 and back
+    /// between two probes with a trial landing in the dip (docs/DECISIONS.md, "The resolved
+    /// shift's event guards").
     fn guards_of(&mut self, t: f64, y: &[f64], out: &mut [f64], want: &[bool]) {
         self.guards_where(t, y, out, Some(want));
     }
@@ -546,5 +549,104 @@ impl clutchpack_model::network::NetworkSession for NetworkStepper {
 
     fn boxed_clone(&self) -> Box<dyn clutchpack_model::network::NetworkSession> {
         Box::new(self.clone())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::system::Face;
+
+    /// The guards of `scenes/eight-speed-packs.toml` (C and E resolved; the lumped brakes A
+    /// and B locked, as in first gear, so that the guards take the forces) at 0.15 s of a state in
+    /// which every other disc and plate is pressed into its spline beyond its play (in
+    /// contact) and the faces are locked, slipping and open in turn: the event bisection
+    /// evaluated every guard at each trial (issue 45); now only those asked, each to the bit of
+    /// the whole evaluation, and the stacks take the loads of the carriers' reactions, the same
+    /// stacks to the bit as those that take the loads themselves.
+    #[test]
+    fn event_bisection_evaluated_every_guard_at_each_trial() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenes/eight-speed-packs.toml");
+        let net = clutchpack_scene::load(&path, &[]).unwrap().network.unwrap();
+        // first gear's lumped brakes locked (as the run settles them at t = 0)
+        let modes: Vec<_> = (net.couplings.iter())
+            .map(|c| match c.name.as_str() {
+                "A" | "B" => Some(ClutchMode::Locked),
+                _ => c.law().initial_mode(),
+            })
+            .collect();
+        let mut eq = Equations::new(Arc::new(net.clone()), modes);
+        assert!(eq.modes.contains(&Some(ClutchMode::Locked)));
+        let n = net.bodies.len();
+        let mut y = vec![0.0; eq.dim()];
+        for (i, b) in net.bodies.iter().enumerate() {
+            y[n + i] = b.initial_speed_rad_s;
+        }
+        let (mut in_contact, faces) = (0, [Face::Locked, Face::Slip(1.0), Face::Open]);
+        for p in eq.packs.iter_mut() {
+            let d = p.sys.dim();
+            y[p.at..p.at + d].copy_from_slice(&p.sys.initial_state());
+            for slot in 0..p.sys.ids.len() {
+                let half = p.sys.disc(slot).spline.half_play_rad();
+                let sign = if slot % 4 == 0 { 1.0 } else { -1.0 };
+                let push = if slot % 2 == 0 { 1.02 } else { 0.5 };
+                y[p.at + 2 * slot] = sign * push * half;
+                y[p.at + 2 * slot + 1] = 0.3 * sign;
+                let part = &y[p.at..p.at + d];
+                if p.sys.depth(slot, part) > 0.0 {
+                    p.modes[slot] = Some(p.sys.disc(slot).law.engage(&p.sys.kin(slot, part)));
+                    in_contact += 1;
+                }
+            }
+            for m in 0..p.sys.faces.len() {
+                p.sys.faces[m] = faces[m % 3];
+            }
+        }
+        assert!(in_contact >= 4, "{in_contact} bodies in contact");
+        let t = 0.15;
+        let mut full = vec![0.0; eq.guard_len()];
+        eq.guards(t, &y, &mut full);
+        assert!(full.iter().any(|g| *g < 0.0) && full.iter().any(|g| *g > 0.0));
+        // every guard alone, then each pack's faces, each pack's bodies, the couplings
+        let mut masks: Vec<Vec<bool>> = (0..full.len())
+            .map(|i| (0..full.len()).map(|j| j == i).collect())
+            .collect();
+        for p in &eq.packs {
+            let (at, nb, all) = (p.guard_at, p.sys.ids.len(), p.guards());
+            masks.push(
+                (0..full.len())
+                    .map(|j| j >= at + nb && j < at + all)
+                    .collect(),
+            );
+            masks.push((0..full.len()).map(|j| j >= at && j < at + nb).collect());
+        }
+        masks.push((0..full.len()).map(|j| j < net.couplings.len()).collect());
+        for want in &masks {
+            let mut some = vec![f64::NAN; full.len()];
+            eq.guards_of(t, &y, &mut some, want);
+            for j in 0..full.len() {
+                if want[j] {
+                    assert_eq!(some[j].to_bits(), full[j].to_bits(), "guard {j}");
+                } else {
+                    // left as it was, or a face of a pack with a face asked (its stack's)
+                    let same = some[j].to_bits() == full[j].to_bits();
+                    assert!(some[j].is_nan() || same, "guard {j}");
+                }
+            }
+        }
+        // the loads of the reactions (`forces`) against the stack's own
+        eq.forces(t, &y);
+        for (p, loads) in eq.packs.iter().zip(&eq.loads) {
+            let (part, c) = (p.part(&y), [y[n + p.a], 0.0, y[n + p.b], 0.0]);
+            let own = p.sys.stack_eval(t, part, &p.modes, &c, None);
+            let given = p.sys.stack_eval(t, part, &p.modes, &c, Some(loads));
+            assert_eq!(format!("{own:?}"), format!("{given:?}"));
+            let r = p.sys.reactions_n_m(part, &p.modes);
+            assert_eq!(
+                r.map(f64::to_bits),
+                p.sys.reactions_from_n_m(loads, &p.modes).map(f64::to_bits)
+            );
+        }
     }
 }

@@ -138,7 +138,7 @@ impl NetPack {
     /// slice): per body its engagement depth (m; negated in free flight, so that an onset and
     /// a separation both cross from above), per face -1 where its mode must change, else 1.
     /// With `want` (its slice of the marks), only the marked ones (the others left as they
-    /// were; the stack evaluated only for a marked face); `loads` its bodies' loads at `y`
+    /// were; the faces all, from one stack, when one is marked); `loads` its bodies' loads at `y`
     /// if known (N, by slot).
     pub fn guard_values(
         &self,

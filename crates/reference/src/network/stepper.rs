@@ -409,15 +409,12 @@ impl NetworkStepper {
         }
         let (t_new, at_event) = match event {
             Some((mut a, mut b)) => {
-                // bisect the earliest crossing: the guards that were > 0 at t, of which
-                // only those that crossed by the bracket's end are evaluated inside it (a
-                // guard that crosses and crosses back between two probes is not an event:
-                // docs/DECISIONS.md, "The resolved shift's event guards")
+                // bisect the earliest crossing of the guards > 0 at t (`Equations::guards_of`)
                 let armed: Vec<bool> = g0.iter().map(|g| *g > 0.0).collect();
                 let crossed: Vec<bool> = g1
                     .iter()
                     .zip(&armed)
-                    .map(|(g, on)| *on && *g <= 0.0)
+                    .map(|(g, a)| *a && *g <= 0.0)
                     .collect();
                 while b - a > 1e-13 * (1.0 + b) {
                     let mid = 0.5 * (a + b);
