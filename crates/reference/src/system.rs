@@ -382,13 +382,31 @@ impl System {
     /// compliant: the reactions follow from the state alone, so a network (MODEL.md section
     /// 8) takes them before it solves its bodies' accelerations.
     pub fn reactions_n_m(&self, y: &[f64], modes: &[Option<Engagement>]) -> [f64; 2] {
+        self.reactions_by(modes, |slot| self.load(slot, y, &modes[slot]))
+    }
+
+    /// Each body's signed per-tooth load ([`Self::load`], N; 0 in free flight) at state `y`
+    /// with contact modes `modes`, into `out` by slot (its contents replaced).
+    pub fn loads_into(&self, y: &[f64], modes: &[Option<Engagement>], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend((0..self.ids.len()).map(|slot| self.load(slot, y, &modes[slot])));
+    }
+
+    /// [`Self::reactions_n_m`] from the loads [`Self::loads_into`] gave at the same state
+    /// (the same sums in the same order).
+    pub fn reactions_from_n_m(&self, loads: &[f64], modes: &[Option<Engagement>]) -> [f64; 2] {
+        self.reactions_by(modes, |slot| loads[slot])
+    }
+
+    /// [`Self::reactions_n_m`] with each body's load in contact from `load`.
+    fn reactions_by(&self, modes: &[Option<Engagement>], load: impl Fn(usize) -> f64) -> [f64; 2] {
         let (mut shaft_torque, mut drum_torque) = (0.0, 0.0);
         for slot in 0..self.ids.len() {
             if modes[slot].is_none() {
                 continue;
             }
             let d = self.disc(slot);
-            let f = self.load(slot, y, &modes[slot]);
+            let f = load(slot);
             // Hu et al. eq (4): the spline reaction n F Rb acts back on the carrier
             let reaction = d.spline.teeth as f64 * f * self.rb[self.ids[slot]];
             match self.carrier(slot) {
@@ -462,10 +480,25 @@ impl System {
         c: &[f64; 4],
         dy: &mut [f64],
     ) {
+        self.rhs_with_loads(t, y, modes, c, None, dy);
+    }
+
+    /// [`Self::rhs_with`] with the bodies' loads at `y` already known (`loads`, from
+    /// [`Self::loads_into`]: a network has them from its carriers' reactions), each taken
+    /// once instead of again for the stack.
+    pub fn rhs_with_loads(
+        &self,
+        t: f64,
+        y: &[f64],
+        modes: &[Option<Engagement>],
+        c: &[f64; 4],
+        loads: Option<&[f64]>,
+        dy: &mut [f64],
+    ) {
         let c = *c;
         if self.pack.stack.is_some() {
             // every body is a stack body: its acceleration comes from the stack's balance
-            self.with_stack_eval(t, y, modes, &c, |ev| {
+            self.with_stack_eval_loads(t, y, modes, &c, loads, |ev| {
                 for slot in 0..self.ids.len() {
                     let k = self.off + 2 * slot;
                     let alpha_c = self.carrier_of(slot, &c).1;
@@ -499,23 +532,26 @@ impl System {
         mode: &Option<Engagement>,
         omega_c: f64,
     ) -> f64 {
-        self.free_and_teeth_n_m(slot, y, mode, omega_c).0
+        self.free_and_teeth_n_m(slot, y, mode, omega_c, None).0
     }
 
-    /// [`Self::free_torque_n_m`] and its teeth's part `-n F Rb` (eq 5), N m.
+    /// [`Self::free_torque_n_m`] and its teeth's part `-n F Rb` (eq 5), N m (`load` the
+    /// body's load if known, N).
     fn free_and_teeth_n_m(
         &self,
         slot: usize,
         y: &[f64],
         mode: &Option<Engagement>,
         omega_c: f64,
+        load: Option<f64>,
     ) -> (f64, f64) {
         let d = self.disc(slot);
         let omega_b = omega_c - y[self.off + 2 * slot + 1];
         let teeth = match mode {
             // eq (5): -n F Rb
             Some(_) => {
-                -(d.spline.teeth as f64) * self.load(slot, y, mode) * self.rb[self.ids[slot]]
+                let f = load.unwrap_or_else(|| self.load(slot, y, mode));
+                -(d.spline.teeth as f64) * f * self.rb[self.ids[slot]]
             }
             None => 0.0,
         };
@@ -539,16 +575,18 @@ impl System {
     /// Couette law; a slipping one with `mu(|v|) F R_eff` against its slip direction; the
     /// bodies joined by locked interfaces move as one (one acceleration, from their summed
     /// free torques), and each locked interface carries the torque that holds it,
-    /// `X_m = sum over the group's bodies below it of (T_b - J_b alpha)`.
+    /// `X_m = sum over the group's bodies below it of (T_b - J_b alpha)`. The bodies' loads
+    /// from `loads` if known at `y` (N, by slot: [`Self::loads_into`]), else taken here.
     pub fn stack_eval(
         &self,
         t: f64,
         y: &[f64],
         modes: &[Option<Engagement>],
         c: &[f64; 4],
+        loads: Option<&[f64]>,
     ) -> StackEval {
         let mut s = StackScratch::default();
-        self.stack_eval_into(t, y, modes, c, &mut s);
+        self.stack_eval_into(t, y, modes, c, loads, &mut s);
         s.ev
     }
 
@@ -562,22 +600,37 @@ impl System {
         c: &[f64; 4],
         f: impl FnOnce(&StackEval) -> R,
     ) -> R {
+        self.with_stack_eval_loads(t, y, modes, c, None, f)
+    }
+
+    /// [`Self::with_stack_eval`] with the bodies' loads at `y` already known (`loads`, from
+    /// [`Self::loads_into`]; `None`: taken here), the same values.
+    pub fn with_stack_eval_loads<R>(
+        &self,
+        t: f64,
+        y: &[f64],
+        modes: &[Option<Engagement>],
+        c: &[f64; 4],
+        loads: Option<&[f64]>,
+        f: impl FnOnce(&StackEval) -> R,
+    ) -> R {
         STACK_SCRATCH.with(|cell| match cell.try_borrow_mut() {
             Ok(mut s) => {
-                self.stack_eval_into(t, y, modes, c, &mut s);
+                self.stack_eval_into(t, y, modes, c, loads, &mut s);
                 f(&s.ev)
             }
-            Err(_) => f(&self.stack_eval(t, y, modes, c)),
+            Err(_) => f(&self.stack_eval(t, y, modes, c, loads)),
         })
     }
 
-    /// [`Self::stack_eval`] into `s`'s buffers.
+    /// [`Self::stack_eval`] into `s`'s buffers (the bodies' loads from `loads` if given).
     fn stack_eval_into(
         &self,
         t: f64,
         y: &[f64],
         modes: &[Option<Engagement>],
         c: &[f64; 4],
+        loads: Option<&[f64]>,
         s: &mut StackScratch,
     ) {
         let stack = self.pack.stack.as_ref().expect("a stack");
@@ -609,7 +662,8 @@ impl System {
             let slot = StackBody::at(b).body_index(self.nd);
             let (omega_c, _) = self.carrier_of(slot, c);
             omega[b] = omega_c - y[self.off + 2 * slot + 1];
-            let (f, teeth) = self.free_and_teeth_n_m(slot, y, &modes[slot], omega_c);
+            let known = loads.map(|l| l[slot]);
+            let (f, teeth) = self.free_and_teeth_n_m(slot, y, &modes[slot], omega_c, known);
             free[b] = f;
             // the teeth's torque on the body times psi = omega_c - omega_b: -n F Rb psi
             ev.teeth_power += teeth * y[self.off + 2 * slot + 1];
@@ -617,7 +671,8 @@ impl System {
             if b < n_if {
                 // MODEL.md section 5: each body holds back mu_spline n |F| of the clamp
                 let d = self.disc(slot);
-                let q = d.spline.teeth as f64 * self.load(slot, y, &modes[slot]).abs();
+                let load = known.unwrap_or_else(|| self.load(slot, y, &modes[slot]));
+                let q = d.spline.teeth as f64 * load.abs();
                 f_p -= stack.spline_friction * q;
                 ev.raw_clamp[b] = f_p;
                 ev.clamp[b] = f_p.max(0.0);

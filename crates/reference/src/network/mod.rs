@@ -92,6 +92,9 @@ struct Equations {
     clusters: Clusters,
     /// The resolved packs, in coupling order (their state after the network's counters).
     packs: Vec<packs::NetPack>,
+    /// Each pack's bodies' loads at the state of the last [`Equations::forces`], N (by slot;
+    /// [`crate::system::System::loads_into`]): its reactions' and then its stack's.
+    loads: Vec<Vec<f64>>,
     // scratch
     torque: Vec<f64>,
     acc: Vec<f64>,
@@ -143,6 +146,7 @@ impl Equations {
         };
         let packs = packs::build(&net, 2 * n + 2 * m + counters, m);
         Equations {
+            loads: vec![Vec::new(); packs.len()],
             alpha: vec![0.0; n],
             counters,
             packs,
@@ -231,7 +235,14 @@ impl Equations {
         self.body_guard_at() + self.net.bodies.len()
     }
 
+    /// Sets the couplings' modes and builds their rigid groups, kept when the modes are
+    /// those they were built for (the groups follow from the modes alone: an input set in a
+    /// session changes a signal, never a row; most events, a pack's tooth contacts among
+    /// them, leave the modes as they were).
     fn set_modes(&mut self, modes: &[Option<ClutchMode>]) {
+        if self.modes == modes {
+            return;
+        }
         self.modes.copy_from_slice(modes);
         self.clusters = Clusters::build(&self.net, rigid_rows(&self.net, &self.modes));
     }
@@ -275,9 +286,11 @@ impl Equations {
                 self.torque[c.b] += tb;
             }
         }
-        for p in &self.packs {
-            // packs.rs, pass (1): the spline reactions (Hu et al. eq 4) on both carriers
-            let [ta, tb] = p.sys.reactions_n_m(p.part(y), &p.modes);
+        for (p, loads) in self.packs.iter().zip(self.loads.iter_mut()) {
+            // packs.rs, pass (1): the spline reactions (Hu et al. eq 4) on both carriers,
+            // from the bodies' loads (kept for the stack's balance at the same state)
+            p.sys.loads_into(p.part(y), &p.modes, loads);
+            let [ta, tb] = p.sys.reactions_from_n_m(loads, &p.modes);
             self.coupling_torque[p.k] = ta;
             self.torque[p.a] += ta;
             self.torque[p.b] += tb;
@@ -359,12 +372,14 @@ impl Equations {
                 .map(|i| self.clusters.reaction_n_m(i, &self.torque, &self.alpha) * w[i])
                 .sum();
         }
-        for p in &self.packs {
-            // packs.rs, pass (3): each pack's bodies against their carriers' motion
+        for (p, loads) in self.packs.iter().zip(&self.loads) {
+            // packs.rs, pass (3): each pack's bodies against their carriers' motion (the
+            // loads of pass (1), at this state)
             let c = p.carriers(w, &self.acc);
             let (at, d) = (p.at, p.sys.dim());
+            let (part, rate) = (&y[at..at + d], &mut dy[at..at + d]);
             p.sys
-                .rhs_with(t, &y[at..at + d], &p.modes, &c, &mut dy[at..at + d]);
+                .rhs_with_loads(t, part, &p.modes, &c, Some(loads), rate);
             dy[at + d] = p.drag_power_w(y, w);
         }
     }
@@ -374,15 +389,42 @@ impl Equations {
     /// ([`clutchpack_model::network::ElementLaw::guard`]: a clutch's slip, static margin or
     /// normal force), then the packs' and the road loads'.
     fn guards(&mut self, t: f64, y: &[f64], out: &mut [f64]) {
+        self.guards_where(t, y, out, None);
+    }
+
+    /// [`Self::guards`] of the guards `want` marks only (the others in `out` left as they
+    /// were, but a pack's faces written together), each the same value: the forces computed only for a marked coupling's or
+    /// road load's guard, a pack's stack only for a marked face, a disc's or plate's depth
+    /// only where marked. An event's bisection evaluates those that crossed by its bracket's
+    /// end (`stepper.rs`): another guard could only have moved it by dipping to <= 0 and back
+    /// between two probes with a trial landing in the dip (docs/DECISIONS.md, "The resolved
+    /// shift's event guards").
+    fn guards_of(&mut self, t: f64, y: &[f64], out: &mut [f64], want: &[bool]) {
+        self.guards_where(t, y, out, Some(want));
+    }
+
+    /// [`Self::guards`] (`want` `None`) or [`Self::guards_of`].
+    fn guards_where(&mut self, t: f64, y: &[f64], out: &mut [f64], want: Option<&[bool]>) {
         let n = self.net.bodies.len();
+        let m = self.net.couplings.len();
         let w = &y[n..2 * n];
+        let at = self.body_guard_at();
+        let wanted = |i: usize| want.is_none_or(|x| x[i]);
+        // the couplings' and the road loads' guards need the forces when a clutch is locked
+        // or a body held; the packs' never do
+        let any_own = want.is_none_or(|x| x[..m].contains(&true) || x[at..at + n].contains(&true));
         let any_locked = self.modes.contains(&Some(ClutchMode::Locked));
         let any_held = self.held.contains(&true);
-        if any_locked || any_held {
+        // the forces at this state give the packs' loads too
+        let forced = any_own && (any_locked || any_held);
+        if forced {
             self.forces(t, y);
             self.rigid_torques();
         }
         for (k, c) in self.net.couplings.iter().enumerate() {
+            if !wanted(k) {
+                continue;
+            }
             if let Some(g) = c.mesh() {
                 let depth = g
                     .law
@@ -397,14 +439,17 @@ impl Equations {
             let (w_rel, held) = (w[c.b] - w[c.a], self.coupling_torque[k]);
             out[k] = c.law().guard(t, w_rel, self.modes[k], held);
         }
-        for p in &self.packs {
-            let g = &mut out[p.guard_at..p.guard_at + p.guards()];
-            p.guard_values(t, y, w, g);
+        for (p, loads) in self.packs.iter().zip(&self.loads) {
+            let r = p.guard_at..p.guard_at + p.guards();
+            let known = forced.then_some(&loads[..]);
+            p.guard_values(t, y, w, &mut out[r.clone()], want.map(|x| &x[r]), known);
         }
         // the road loads: a held group's breakaway less its torque, a moving body's speed
         // along its direction
-        let at = self.body_guard_at();
         for i in 0..n {
+            if !wanted(at + i) {
+                continue;
+            }
             out[at + i] = if self.held[i] {
                 let c = self.clusters.of[i];
                 self.hold_capacity[c] - self.hold_torque[c].abs()
@@ -504,5 +549,104 @@ impl clutchpack_model::network::NetworkSession for NetworkStepper {
 
     fn boxed_clone(&self) -> Box<dyn clutchpack_model::network::NetworkSession> {
         Box::new(self.clone())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::system::Face;
+
+    /// The guards of `scenes/eight-speed-packs.toml` (C and E resolved; the lumped brakes A
+    /// and B locked, as in first gear, so that the guards take the forces) at 0.15 s of a state in
+    /// which every other disc and plate is pressed into its spline beyond its play (in
+    /// contact) and the faces are locked, slipping and open in turn: the event bisection
+    /// evaluated every guard at each trial (issue 45); now only those asked, each to the bit of
+    /// the whole evaluation, and the stacks take the loads of the carriers' reactions, the same
+    /// stacks to the bit as those that take the loads themselves.
+    #[test]
+    fn event_bisection_evaluated_every_guard_at_each_trial() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenes/eight-speed-packs.toml");
+        let net = clutchpack_scene::load(&path, &[]).unwrap().network.unwrap();
+        // first gear's lumped brakes locked (as the run settles them at t = 0)
+        let modes: Vec<_> = (net.couplings.iter())
+            .map(|c| match c.name.as_str() {
+                "A" | "B" => Some(ClutchMode::Locked),
+                _ => c.law().initial_mode(),
+            })
+            .collect();
+        let mut eq = Equations::new(Arc::new(net.clone()), modes);
+        assert!(eq.modes.contains(&Some(ClutchMode::Locked)));
+        let n = net.bodies.len();
+        let mut y = vec![0.0; eq.dim()];
+        for (i, b) in net.bodies.iter().enumerate() {
+            y[n + i] = b.initial_speed_rad_s;
+        }
+        let (mut in_contact, faces) = (0, [Face::Locked, Face::Slip(1.0), Face::Open]);
+        for p in eq.packs.iter_mut() {
+            let d = p.sys.dim();
+            y[p.at..p.at + d].copy_from_slice(&p.sys.initial_state());
+            for slot in 0..p.sys.ids.len() {
+                let half = p.sys.disc(slot).spline.half_play_rad();
+                let sign = if slot % 4 == 0 { 1.0 } else { -1.0 };
+                let push = if slot % 2 == 0 { 1.02 } else { 0.5 };
+                y[p.at + 2 * slot] = sign * push * half;
+                y[p.at + 2 * slot + 1] = 0.3 * sign;
+                let part = &y[p.at..p.at + d];
+                if p.sys.depth(slot, part) > 0.0 {
+                    p.modes[slot] = Some(p.sys.disc(slot).law.engage(&p.sys.kin(slot, part)));
+                    in_contact += 1;
+                }
+            }
+            for m in 0..p.sys.faces.len() {
+                p.sys.faces[m] = faces[m % 3];
+            }
+        }
+        assert!(in_contact >= 4, "{in_contact} bodies in contact");
+        let t = 0.15;
+        let mut full = vec![0.0; eq.guard_len()];
+        eq.guards(t, &y, &mut full);
+        assert!(full.iter().any(|g| *g < 0.0) && full.iter().any(|g| *g > 0.0));
+        // every guard alone, then each pack's faces, each pack's bodies, the couplings
+        let mut masks: Vec<Vec<bool>> = (0..full.len())
+            .map(|i| (0..full.len()).map(|j| j == i).collect())
+            .collect();
+        for p in &eq.packs {
+            let (at, nb, all) = (p.guard_at, p.sys.ids.len(), p.guards());
+            masks.push(
+                (0..full.len())
+                    .map(|j| j >= at + nb && j < at + all)
+                    .collect(),
+            );
+            masks.push((0..full.len()).map(|j| j >= at && j < at + nb).collect());
+        }
+        masks.push((0..full.len()).map(|j| j < net.couplings.len()).collect());
+        for want in &masks {
+            let mut some = vec![f64::NAN; full.len()];
+            eq.guards_of(t, &y, &mut some, want);
+            for j in 0..full.len() {
+                if want[j] {
+                    assert_eq!(some[j].to_bits(), full[j].to_bits(), "guard {j}");
+                } else {
+                    // left as it was, or a face of a pack with a face asked (its stack's)
+                    let same = some[j].to_bits() == full[j].to_bits();
+                    assert!(some[j].is_nan() || same, "guard {j}");
+                }
+            }
+        }
+        // the loads of the reactions (`forces`) against the stack's own
+        eq.forces(t, &y);
+        for (p, loads) in eq.packs.iter().zip(&eq.loads) {
+            let (part, c) = (p.part(&y), [y[n + p.a], 0.0, y[n + p.b], 0.0]);
+            let own = p.sys.stack_eval(t, part, &p.modes, &c, None);
+            let given = p.sys.stack_eval(t, part, &p.modes, &c, Some(loads));
+            assert_eq!(format!("{own:?}"), format!("{given:?}"));
+            let r = p.sys.reactions_n_m(part, &p.modes);
+            assert_eq!(
+                r.map(f64::to_bits),
+                p.sys.reactions_from_n_m(loads, &p.modes).map(f64::to_bits)
+            );
+        }
     }
 }

@@ -137,10 +137,24 @@ impl NetPack {
     /// The guards at the network state `y` with the bodies' speeds `w`, into `out` (its
     /// slice): per body its engagement depth (m; negated in free flight, so that an onset and
     /// a separation both cross from above), per face -1 where its mode must change, else 1.
-    pub fn guard_values(&self, t: f64, y: &[f64], w: &[f64], out: &mut [f64]) {
+    /// With `want` (its slice of the marks), only the marked ones (the others left as they
+    /// were; the faces all, from one stack, when one is marked); `loads` its bodies' loads at `y`
+    /// if known (N, by slot).
+    pub fn guard_values(
+        &self,
+        t: f64,
+        y: &[f64],
+        w: &[f64],
+        out: &mut [f64],
+        want: Option<&[bool]>,
+        loads: Option<&[f64]>,
+    ) {
         let part = self.part(y);
         let nb = self.sys.ids.len();
         for slot in 0..nb {
+            if want.is_some_and(|x| !x[slot]) {
+                continue;
+            }
             let depth = self.sys.depth(slot, part);
             out[slot] = if self.modes[slot].is_some() {
                 depth
@@ -148,7 +162,7 @@ impl NetPack {
                 -depth
             };
         }
-        if self.sys.faces.is_empty() {
+        if self.sys.faces.is_empty() || want.is_some_and(|x| !x[nb..].contains(&true)) {
             return;
         }
         let open = self.sys.faces.iter().all(|f| *f == Face::Open);
@@ -169,15 +183,16 @@ impl NetPack {
         // the faces' conditions need the carriers' speeds only
         // (in this thread's buffers: no allocation per evaluation, the same values)
         let c = [w[self.a], 0.0, w[self.b], 0.0];
-        self.sys.with_stack_eval(t, part, &self.modes, &c, |ev| {
-            for m in 0..self.sys.faces.len() {
-                out[nb + m] = if self.sys.face_switches(m, ev) {
-                    -1.0
-                } else {
-                    1.0
-                };
-            }
-        });
+        self.sys
+            .with_stack_eval_loads(t, part, &self.modes, &c, loads, |ev| {
+                for m in 0..self.sys.faces.len() {
+                    out[nb + m] = if self.sys.face_switches(m, ev) {
+                        -1.0
+                    } else {
+                        1.0
+                    };
+                }
+            });
     }
 
     /// Opens and closes contact events at an event at `t` (`crossed[slot] <= 0`: the body's

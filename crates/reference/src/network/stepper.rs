@@ -409,13 +409,18 @@ impl NetworkStepper {
         }
         let (t_new, at_event) = match event {
             Some((mut a, mut b)) => {
-                // bisect the earliest crossing: the guards that were > 0 at t
+                // bisect the earliest crossing of the guards > 0 at t (`Equations::guards_of`)
                 let armed: Vec<bool> = g0.iter().map(|g| *g > 0.0).collect();
+                let crossed: Vec<bool> = g1
+                    .iter()
+                    .zip(&armed)
+                    .map(|(g, a)| *a && *g <= 0.0)
+                    .collect();
                 while b - a > 1e-13 * (1.0 + b) {
                     let mid = 0.5 * (a + b);
                     dense.eval(mid, ybuf);
-                    eq.guards(mid, ybuf, g1);
-                    if g1.iter().zip(&armed).any(|(g, on)| *on && *g <= 0.0) {
+                    eq.guards_of(mid, ybuf, g1, &crossed);
+                    if g1.iter().zip(&crossed).any(|(g, on)| *on && *g <= 0.0) {
                         b = mid;
                     } else {
                         a = mid;
