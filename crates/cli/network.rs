@@ -97,10 +97,8 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
     });
     let pb = common::time_progress(scene.simulation.duration_s, &scene.name);
     let mut progress = |t: f64| common::show_time(&pb, t);
-    let done = clutchpack_sdk::run_network_scene(
-        &scene,
-        a.engine,
-        NetworkRequest {
+    let done = clutchpack_sdk::Simulation::new(scene.clone(), a.engine)?
+        .run(NetworkRequest {
             keep_history: a.plot.is_some(),
             recording,
             stop: Some(interrupted),
@@ -108,8 +106,8 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
             impacts_csv: a.impacts_csv.map(Path::to_path_buf),
             keep_cycles: a.fatigue_json.is_some(),
             windows_s: a.windows_s,
-        },
-    )?;
+        })?
+        .into_network()?;
     pb.finish_and_clear();
     if let Some(p) = &done.recording {
         eprintln!("recording: {}", p.display());

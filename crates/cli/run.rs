@@ -206,7 +206,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     let pb = common::time_progress(scene.simulation.duration_s, &scene.name);
     let mut progress = |t: f64| common::show_time(&pb, t);
     let done = sim
-        .run(RunRequest {
+        .run_pack(RunRequest {
             keep_history: a.plot.is_some(),
             keep_cycles: a.fatigue_json.is_some(),
             impacts_csv: a.impacts_csv.clone(),

@@ -59,9 +59,9 @@ impl Simulation {
     /// not have, a recording that cannot be created) is an error before any work.
     pub fn start(&self, request: SessionRequest) -> Result<Session> {
         let scene = self.scene();
-        let names = self.body_names();
+        let names = self.body_names()?;
         let mut inner = self
-            .engine()
+            .engine()?
             .start(request.driven)
             .map_err(|e| Error::BadInput(format!("{}: {e}", scene.name)))?;
         if let Some(t) = request.stop_time_s {
