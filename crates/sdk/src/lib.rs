@@ -30,7 +30,9 @@ pub mod fit;
 mod network;
 mod network_cosim;
 mod network_keep;
+mod outcome;
 mod recording;
+mod request;
 mod run;
 mod scene_file;
 mod session;
@@ -71,8 +73,10 @@ pub use network_cosim::{
     network_inputs, network_name_problems, network_outputs, NetworkSimulation, NetworkVariable,
     SavedNetworkSimulation,
 };
+pub use outcome::{Outcome, Summary};
 pub use recording::open_recording;
-pub use run::{Outcome, RecordingRequest, RunOutcome, RunRequest, Summary};
+pub use request::{RecordingRequest, RunRequest};
+pub use run::RunOutcome;
 pub use scene_file::{load_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TEXT};
 pub use session::{Session, SessionRequest, SessionState};
 pub use simulation::{PackEngine, Simulation};

@@ -183,13 +183,6 @@ pub fn multibody_step_s(scene: &Scene) -> f64 {
 /// The longest fixed step of the multibody engine on a network, s.
 pub const MULTIBODY_NETWORK_STEP_S: f64 = 1e-4;
 
-/// A pack scene where a network was expected: bad input naming the scene.
-pub(crate) fn not_a_network(scene: &str) -> Error {
-    Error::BadInput(format!(
-        "{scene} is a pack scene, not a network ([[bodies]])"
-    ))
-}
-
 /// Runs a network scene on `engine` ([`crate::Simulation::run`] of a network, which chose
 /// it): the reference engine at the scene's tolerance and longest step, the multibody engine
 /// at the fixed step [`multibody_step_s`]. A pack scene is bad input.
@@ -199,7 +192,7 @@ pub(crate) fn run(
     req: NetworkRequest,
 ) -> Result<NetworkOutcome> {
     let Some(net) = &scene.network else {
-        return Err(not_a_network(&scene.name));
+        return Err(crate::simulation::not_a_network(&scene.name));
     };
     let sim = &scene.simulation;
     if req.windows_s.is_some() && !net.couplings.iter().any(|c| c.pack().is_some()) {
@@ -348,7 +341,7 @@ pub(crate) fn conclude(
     wall_time_s: f64,
 ) -> Result<NetworkOutcome> {
     let Some(net) = &scene.network else {
-        return Err(not_a_network(&scene.name));
+        return Err(crate::simulation::not_a_network(&scene.name));
     };
     if let Some(e) = keep.record_error.take() {
         return Err(e.into());

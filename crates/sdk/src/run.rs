@@ -1,56 +1,18 @@
-//! One run of a scene, a pack or a network, and its outcome, either kind (`Outcome`); a pack's
-//! run: the engine on the caller's thread feeding the collector, the recording (if asked) on
-//! its own thread, both finished whatever stops the run (a network's: `network.rs`).
+//! One run of a pack scene: the engine on the caller's thread feeding the collector, the
+//! recording (if asked) on its own thread, both finished whatever stops the run; its
+//! `RunOutcome`.
 
 use crate::collector::RunCollector;
 use crate::summary::{friction_interfaces, run_info, RunSummary};
-use crate::{Error, NetworkOutcome, NetworkSummary, Result, Simulation};
+use crate::{Error, Result, RunRequest, Simulation};
 use clutchpack_analysis::{DiscCycles, DiscFatigue, DiscStats};
 use clutchpack_model::{
     DiscSample, Engine, EngineError, ImpactEvent, InterfaceSample, Observer, RunStats, Sample,
 };
-use clutchpack_record::{RecordError, RecordOptions, Recorder, Replace, ThreadedRecorder};
-use serde::Serialize;
-use std::path::{Path, PathBuf};
+use clutchpack_record::{RecordError, Recorder, ThreadedRecorder};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
-
-/// Where and how a run is recorded (MCAP).
-#[derive(Debug, Clone)]
-pub struct RecordingRequest {
-    /// The recording's path; written as a `.partial` sibling and renamed when complete.
-    pub path: PathBuf,
-    /// Whether an existing file at `path` is replaced.
-    pub replace: Replace,
-    /// What is recorded (per-tooth loads, contact samples, determinism).
-    pub options: RecordOptions,
-    /// The scene file the run was loaded from (its name goes into the recording).
-    pub scene_path: Option<PathBuf>,
-}
-
-/// What a run keeps and writes besides its statistics (the peak statistics, the interfaces'
-/// figures and the teeth's fatigue as running sums are always kept, in bounded memory).
-#[derive(Default)]
-pub struct RunRequest<'a> {
-    /// Keep every sample's per-tooth load and every impact (for a plot); memory grows with
-    /// the run.
-    pub keep_history: bool,
-    /// Keep every counted load cycle (for the cycle spectra of `--fatigue-json`); memory
-    /// grows with the run.
-    pub keep_cycles: bool,
-    /// Write one CSV row per impact to this file as the impacts close.
-    pub impacts_csv: Option<PathBuf>,
-    /// Record the run.
-    pub recording: Option<RecordingRequest>,
-    /// Stops the run cleanly (at the engine's next progress poll, within milliseconds) once
-    /// set; the outcome then holds the run up to there.
-    pub stop: Option<&'a AtomicBool>,
-    /// Also the figures window by window, of this length in s (`None`: none;
-    /// [`RunOutcome::windows`]).
-    pub windows_s: Option<f64>,
-    /// Called at the engine's progress polls with the simulated time reached, s.
-    pub progress: Option<&'a mut dyn FnMut(f64)>,
-}
 
 /// What a run gave: the engine's result and everything kept, complete up to where the run
 /// ended (its end, a stop or a failure).
@@ -144,152 +106,9 @@ impl RunOutcome {
     }
 }
 
-/// What a run of a scene gave ([`Simulation::run`]): a pack's outcome or a network's.
-// a pack's outcome is the larger, and the common one: boxing it would cost every pack run
-#[allow(clippy::large_enum_variant)]
-pub enum Outcome {
-    /// A pack scene's run.
-    Pack(RunOutcome),
-    /// A network scene's run (`[[bodies]]`).
-    Network(NetworkOutcome),
-}
-
-/// A run's summary (what `--summary-json` writes): a pack's or a network's, serialised as
-/// the summary itself (untagged: the JSON of either kind is its summary's own).
-#[derive(Debug, Serialize)]
-#[serde(untagged)]
-pub enum Summary {
-    /// A pack scene's summary.
-    Pack(RunSummary),
-    /// A network scene's summary.
-    Network(NetworkSummary),
-}
-
-impl Outcome {
-    /// The scene's name.
-    pub fn scene(&self) -> &str {
-        match self {
-            Outcome::Pack(o) => &o.scene,
-            Outcome::Network(o) => &o.summary.scene,
-        }
-    }
-
-    /// The engine that ran (`reference` or `multibody`).
-    pub fn engine(&self) -> &'static str {
-        match self {
-            Outcome::Pack(o) => o.engine,
-            Outcome::Network(o) => o.summary.engine,
-        }
-    }
-
-    /// The simulated time the run reached, s; a pack's engine failure as [`Error::Engine`]
-    /// ([`RunOutcome::stats`]; a network's came back from [`Simulation::run`]).
-    pub fn simulated_s(&self) -> Result<f64> {
-        match self {
-            Outcome::Pack(o) => Ok(o.stats()?.simulated_s),
-            Outcome::Network(o) => Ok(o.summary.simulated_s),
-        }
-    }
-
-    /// Whether the run stopped before its duration (a stop flag, or a pack's failed
-    /// recording).
-    pub fn stopped_early(&self) -> bool {
-        match self {
-            Outcome::Pack(o) => o.stopped_early(),
-            Outcome::Network(o) => o.summary.stopped,
-        }
-    }
-
-    /// What went wrong without stopping the run (a pack's; a network's problems come back
-    /// from [`Simulation::run`]).
-    pub fn warnings(&self) -> &[String] {
-        match self {
-            Outcome::Pack(o) => &o.warnings,
-            Outcome::Network(_) => &[],
-        }
-    }
-
-    /// The finished recording's path, or why a pack's could not be finished (a network's
-    /// came back from [`Simulation::run`]); `None`: not asked.
-    pub fn recording(&self) -> Option<std::result::Result<&Path, &RecordError>> {
-        match self {
-            Outcome::Pack(o) => o.recording.as_ref().map(|r| r.as_deref()),
-            Outcome::Network(o) => o.recording.as_deref().map(Ok),
-        }
-    }
-
-    /// Why a pack's impacts CSV could not be finished (a network's came back from
-    /// [`Simulation::run`]).
-    pub fn impacts_csv_error(&self) -> Option<&Error> {
-        match self {
-            Outcome::Pack(o) => o.impacts_csv.as_ref().and_then(|r| r.as_ref().err()),
-            Outcome::Network(_) => None,
-        }
-    }
-
-    /// The run's summary; a pack's engine failure is an error ([`RunOutcome::summary`]).
-    pub fn summary(&self) -> Result<Summary> {
-        Ok(match self {
-            Outcome::Pack(o) => Summary::Pack(o.summary()?),
-            Outcome::Network(o) => Summary::Network(o.summary.clone()),
-        })
-    }
-
-    /// Every body's counted load cycles and spectra (`run --fatigue-json`, kept when
-    /// [`RunRequest::keep_cycles`] asked for them): a pack's discs and plates, or every
-    /// resolved pack's on a network ([`NetworkOutcome::cycles`]).
-    pub fn cycles(&self) -> Vec<DiscCycles> {
-        match self {
-            Outcome::Pack(o) => o.cycles(),
-            Outcome::Network(o) => o.cycles.clone(),
-        }
-    }
-
-    /// A pack's outcome; a network's is bad input naming the scene.
-    pub fn into_pack(self) -> Result<RunOutcome> {
-        match self {
-            Outcome::Pack(o) => Ok(o),
-            Outcome::Network(o) => Err(Error::BadInput(format!(
-                "{} is a network scene ([[bodies]]), not a pack",
-                o.summary.scene
-            ))),
-        }
-    }
-
-    /// A network's outcome; a pack's is bad input naming the scene.
-    pub fn into_network(self) -> Result<NetworkOutcome> {
-        match self {
-            Outcome::Network(o) => Ok(o),
-            Outcome::Pack(o) => Err(crate::network::not_a_network(&o.scene)),
-        }
-    }
-}
-
 impl Simulation {
-    /// Runs the scene, a pack or a network, for its `simulation.duration_s` as `request`
-    /// asks. Outputs that cannot be created (the impacts CSV, the recording) are errors
-    /// before any work; after that, whatever ends the run, every output is complete up to
-    /// there. A pack's outcome holds an engine failure ([`RunOutcome::result`]); a network's
-    /// is an [`Error::Engine`], its recording and impacts CSV finished first.
-    pub fn run(&mut self, request: RunRequest<'_>) -> Result<Outcome> {
-        crate::windows::check(request.windows_s, self.scene().simulation.duration_s)?;
-        match self.network_engine() {
-            Some(engine) => {
-                crate::network::run(self.scene(), engine, request).map(Outcome::Network)
-            }
-            None => self.run_engine(request).map(Outcome::Pack),
-        }
-    }
-
-    /// [`Simulation::run`] for a caller that takes pack scenes only: a network scene is
-    /// refused before any work ([`Simulation::pack_only`]).
-    pub fn run_pack(&mut self, request: RunRequest<'_>) -> Result<RunOutcome> {
-        self.pack_only()?;
-        self.run(request)?.into_pack()
-    }
-
-    /// A pack's run on its engine.
-    fn run_engine(&mut self, request: RunRequest<'_>) -> Result<RunOutcome> {
+    /// A pack's run on its engine ([`Simulation::run`] of a pack scene).
+    pub(crate) fn run_engine(&mut self, request: RunRequest<'_>) -> Result<RunOutcome> {
         let names = self.body_names()?;
         let scene = self.scene();
         let mut collector = RunCollector::new(names.len(), request.keep_history)

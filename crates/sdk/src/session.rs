@@ -3,7 +3,8 @@
 //! and recording as [`Simulation::run`], finished into the same [`RunOutcome`].
 
 use crate::collector::RunCollector;
-use crate::run::{finish_recording, RecordingRequest, RunObserver, RunOutcome};
+use crate::request::RecordingRequest;
+use crate::run::{finish_recording, RunObserver, RunOutcome};
 use crate::summary::{friction_interfaces, run_info};
 use crate::{Error, Result, Simulation};
 use clutchpack_model::session::{Advance, Driven, Inputs, Snapshot};

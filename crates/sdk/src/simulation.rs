@@ -117,7 +117,7 @@ impl Simulation {
     /// the scene, before any work.
     pub fn network_only(&self) -> Result<()> {
         match self.engine {
-            Built::Pack(_) => Err(crate::network::not_a_network(&self.scene.name)),
+            Built::Pack(_) => Err(not_a_network(&self.scene.name)),
             Built::Network(_) => Ok(()),
         }
     }
@@ -184,6 +184,13 @@ impl Simulation {
             self.scene.name
         ))
     }
+}
+
+/// A pack scene where a network was expected: bad input naming the scene.
+pub(crate) fn not_a_network(scene: &str) -> Error {
+    Error::BadInput(format!(
+        "{scene} is a pack scene, not a network ([[bodies]])"
+    ))
 }
 
 /// An engine configuration for a pack built in code rather than read from a scene (the
