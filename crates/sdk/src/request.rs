@@ -36,7 +36,7 @@ pub struct RunRequest<'a> {
     /// set; the outcome then holds the run up to there.
     pub stop: Option<&'a AtomicBool>,
     /// Also the figures window by window, of this length in s (`None`: none;
-    /// [`RunOutcome::windows`]).
+    /// [`crate::RunOutcome::windows`]).
     pub windows_s: Option<f64>,
     /// Called at the engine's progress polls with the simulated time reached, s.
     pub progress: Option<&'a mut dyn FnMut(f64)>,
