@@ -224,14 +224,14 @@ fn long_runs_keep_a_flat_memory() {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/pack-8-brake.toml");
     let scene = clutchpack_scene::load(&file, &[]).unwrap();
     let mut sim = clutchpack_sdk::Simulation::new(scene, None).unwrap();
-    let bodies = sim.body_names().len();
+    let bodies = sim.body_names().unwrap().len();
     let mut w = Watch {
         collector: FatigueCollector::new(),
         most_held: 0,
         unclaimed: vec![0; bodies],
         most_unclaimed: 0,
     };
-    sim.engine_mut().run(1.5, &mut w).unwrap();
+    sim.engine_mut().unwrap().run(1.5, &mut w).unwrap();
     let bound = bodies * PENDING_IN_MEMORY;
     assert!(
         w.most_unclaimed > bound,

@@ -9,7 +9,7 @@
 //! values are known exactly. Noise (normal, seeded) is added where the intervals are checked.
 
 use super::{read_json, run, scratch, stderr, stdout};
-use clutchpack_sdk::{load_scene, run_network_scene, NetworkRequest};
+use clutchpack_sdk::{load_scene, NetworkRequest, Simulation};
 use std::path::{Path, PathBuf};
 
 const SCENE: &str = "scenes/coupled-clutches.toml";
@@ -32,15 +32,15 @@ fn normal(seed: u64, k: u64) -> f64 {
 /// shipped, every sample (1 ms), with normal noise of standard deviation `sd` rad/s.
 fn trace(dir: &Path, sd: f64, seed: u64) -> PathBuf {
     let scene = load_scene(Some(Path::new(SCENE)), &[]).unwrap();
-    let out = run_network_scene(
-        &scene,
-        None,
-        NetworkRequest {
+    let out = Simulation::new(scene, None)
+        .unwrap()
+        .run(NetworkRequest {
             keep_history: true,
             ..NetworkRequest::default()
-        },
-    )
-    .unwrap();
+        })
+        .unwrap()
+        .into_network()
+        .unwrap();
     let mut text = String::from("time_s,w1,w2,w3,w4\n");
     let mut last = f64::NEG_INFINITY;
     let mut k = 0;

@@ -21,10 +21,10 @@ fn simulation(file: &str, engine: EngineChoice, duration_s: f64) -> Simulation {
 /// calls: everything they send, in order.
 fn whole_and_split(sim: &mut Simulation, duration: f64, calls: usize) -> (Collector, Collector) {
     let mut whole = Collector::default();
-    sim.engine_mut().run(duration, &mut whole).unwrap();
+    sim.engine_mut().unwrap().run(duration, &mut whole).unwrap();
     let mut split = Collector::default();
     let reference = sim.engine_name() == "reference";
-    let mut s = sim.engine_mut().start(Driven::NONE).unwrap();
+    let mut s = sim.engine_mut().unwrap().start(Driven::NONE).unwrap();
     s.set_stop_time(duration);
     for k in 1..=calls {
         let t = if k == calls {
@@ -196,6 +196,7 @@ fn a_driven_shaft_is_the_run_of_the_same_held_table() {
     let times: Vec<f64> = (0..n).map(|k| k as f64 * h).collect();
     let mut s = sim
         .engine_mut()
+        .unwrap()
         .start(Driven {
             shaft_speed: true,
             ..Driven::NONE
@@ -236,7 +237,7 @@ fn a_driven_shaft_is_the_run_of_the_same_held_table() {
     assert_eq!(driven.impacts, table.impacts);
     // against the continuous sine: the hold delays the speed by h/2 on average
     let mut whole = Collector::default();
-    sim.engine_mut().run(duration, &mut whole).unwrap();
+    sim.engine_mut().unwrap().run(duration, &mut whole).unwrap();
     let worst = whole
         .impacts
         .iter()
@@ -257,8 +258,8 @@ fn a_driven_shaft_is_the_run_of_the_same_held_table() {
 fn reference_snapshots_inside_an_open_packs_window_are_the_run() {
     let mut sim = simulation("scenes/pack-8-brake.toml", EngineChoice::Reference, 0.02);
     let mut whole = Collector::default();
-    sim.engine_mut().run(0.02, &mut whole).unwrap();
-    let mut s = sim.engine_mut().start(Driven::NONE).unwrap();
+    sim.engine_mut().unwrap().run(0.02, &mut whole).unwrap();
+    let mut s = sim.engine_mut().unwrap().start(Driven::NONE).unwrap();
     s.set_stop_time(0.02);
     let mut split = Collector::default();
     for k in 1..=200u32 {

@@ -179,7 +179,7 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
         if stopped() {
             return Ok(crate::signals::exit_code());
         }
-        let done = Simulation::new(scene.clone(), None)?.run(RunRequest {
+        let done = Simulation::new(scene.clone(), None)?.run_pack(RunRequest {
             stop: Some(&*stop),
             ..RunRequest::default()
         })?;
@@ -304,7 +304,7 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
                         options: RecordOptions::default(),
                         scene_path: path.clone(),
                     });
-                    let done = Simulation::new(scene.clone(), None)?.run(RunRequest {
+                    let done = Simulation::new(scene.clone(), None)?.run_pack(RunRequest {
                         recording,
                         stop: Some(&*stop),
                         ..RunRequest::default()
@@ -400,7 +400,7 @@ fn whole_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
         for _ in 0..runs {
             let mut round = [0.0; 3];
             for (k, (scene, engine)) in configs.into_iter().enumerate() {
-                let done = Simulation::new(scene.clone(), Some(engine))?.run(RunRequest {
+                let done = Simulation::new(scene.clone(), Some(engine))?.run_pack(RunRequest {
                     stop: Some(&**stop),
                     ..RunRequest::default()
                 })?;
@@ -489,10 +489,11 @@ fn thermal_packs(runs: usize, stop: &Arc<AtomicBool>) -> Result<()> {
             for _ in 0..runs {
                 let mut round = [0.0; 3];
                 for (k, scene) in [&thermal, &isothermal, &held].into_iter().enumerate() {
-                    let done = Simulation::new(scene.clone(), Some(engine))?.run(RunRequest {
-                        stop: Some(&**stop),
-                        ..RunRequest::default()
-                    })?;
+                    let done =
+                        Simulation::new(scene.clone(), Some(engine))?.run_pack(RunRequest {
+                            stop: Some(&**stop),
+                            ..RunRequest::default()
+                        })?;
                     done.stats()?;
                     if stop.load(Ordering::SeqCst) {
                         return Ok(());
@@ -573,18 +574,16 @@ fn packs_on_a_network_on(engine: EngineChoice, runs: usize, stop: &Arc<AtomicBoo
     let (mut network, mut alone, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
     let mut steps = 0;
     for _ in 0..runs {
-        let done = clutchpack_sdk::run_network_scene(
-            &scenes[0],
-            Some(engine),
-            clutchpack_sdk::NetworkRequest {
+        let done = Simulation::new(scenes[0].clone(), Some(engine))?
+            .run(RunRequest {
                 stop: Some(&**stop),
                 ..Default::default()
-            },
-        )?;
+            })?
+            .into_network()?;
         steps = done.summary.steps;
         let mut packs = 0.0;
         for scene in &scenes[1..] {
-            let run = Simulation::new(scene.clone(), Some(engine))?.run(RunRequest {
+            let run = Simulation::new(scene.clone(), Some(engine))?.run_pack(RunRequest {
                 stop: Some(&**stop),
                 ..RunRequest::default()
             })?;
@@ -625,14 +624,12 @@ fn network_scene(file: &str, runs: usize, stop: &Arc<AtomicBool>) -> Result<()> 
     for _ in 0..runs {
         last.clear();
         for (k, engine) in engines.into_iter().enumerate() {
-            let done = clutchpack_sdk::run_network_scene(
-                &scene,
-                Some(engine),
-                clutchpack_sdk::NetworkRequest {
+            let done = Simulation::new(scene.clone(), Some(engine))?
+                .run(RunRequest {
                     stop: Some(&**stop),
                     ..Default::default()
-                },
-            )?;
+                })?
+                .into_network()?;
             if stop.load(Ordering::SeqCst) {
                 return Ok(());
             }

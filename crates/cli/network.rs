@@ -1,144 +1,30 @@
-//! `clutchpack run` of a network scene (`[[bodies]]`, MODEL.md section 8): the clutches' mode
-//! changes and heat, the bodies' final speeds and the energy balance; the recording (MCAP, as
-//! for a pack: `--out`, `--no-record`, a default name under `recordings/`), `--summary-json`
-//! and `--plot` (speeds and coupling torques against time). The pack-only options are
-//! refused before any work (exit 2).
+//! What `clutchpack run` prints and draws of a network scene's run (`[[bodies]]`, MODEL.md
+//! section 8; the run itself is `run.rs`'s, as any scene's): the clutches' mode changes and
+//! heat, the bodies' final speeds and the energy balance, each resolved pack's bodies,
+//! temperatures and windows; `--plot` (speeds and coupling torques against time); and `plot`
+//! of a network recording (its figure, or its packs' load spectra).
 
-use crate::common::{self, BadInput};
-use crate::outputs::Output;
+use crate::common::BadInput;
 use anyhow::{Context, Result};
 use clutchpack_sdk::scene::Scene;
-use clutchpack_sdk::NetworkRequest;
+use clutchpack_sdk::NetworkSummary;
 use std::path::Path;
 use std::process::ExitCode;
-use std::sync::atomic::AtomicBool;
 
-/// What `run` passes on for a network scene.
-pub struct NetworkArgs<'a> {
-    /// The scene file (an input no output may name).
-    pub scene_path: Option<&'a Path>,
-    /// `--engine` (else the scene's `simulation.engine`, else the reference engine).
-    pub engine: Option<clutchpack_sdk::EngineChoice>,
-    /// `--summary-json`.
-    pub summary_json: Option<&'a Path>,
-    /// `--impacts-csv`: every tooth impact of the gear meshes and the packs' bodies.
-    pub impacts_csv: Option<&'a Path>,
-    /// `--fatigue-json`: every pack body's counted cycles and spectra.
-    pub fatigue_json: Option<&'a Path>,
-    /// `--windows S`: every pack's figures window by window.
-    pub windows_s: Option<f64>,
-    /// `--windows-plot FILE`: those figures against time, every pack's bodies.
-    pub windows_plot: Option<&'a Path>,
-    /// `--plot`.
-    pub plot: Option<&'a Path>,
-    /// The recording (`--out`, or the default name; `None` with `--no-record`).
-    pub recording: Option<&'a Path>,
-    /// Whether `--out` named the recording (it then replaces an existing file; a default
-    /// name never does).
-    pub out_given: bool,
-    /// `--deterministic`.
-    pub deterministic: bool,
-    /// Each pack-only option given (its flag), refused.
-    pub pack_only: Vec<&'static str>,
+/// The windows of every resolved pack of a network's run (`--windows-plot`), each named by
+/// its pack.
+pub fn windows(s: &NetworkSummary) -> Vec<(Option<&str>, &[clutchpack_sdk::WindowRow])> {
+    s.couplings
+        .iter()
+        .filter(|c| !c.windows.is_empty())
+        .map(|c| (Some(c.name.as_str()), c.windows.as_slice()))
+        .collect()
 }
 
-/// Runs the network scene `scene` with the options of `a`.
-pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<ExitCode> {
-    if let Some(flag) = a.pack_only.first() {
-        return Err(BadInput(format!(
-            "{flag}: not for a network scene ({} has [[bodies]]); a network run gives its \
-             table, its recording (--out), --summary-json, --impacts-csv, --fatigue-json, \
-             --windows, --windows-plot and --plot",
-            scene.name
-        ))
-        .into());
-    }
-    let mut outs = Vec::new();
-    if let Some(p) = a.summary_json {
-        outs.push(Output::file("--summary-json", p));
-    }
-    if let Some(p) = a.impacts_csv {
-        outs.push(Output::file("--impacts-csv", p));
-    }
-    if let Some(p) = a.fatigue_json {
-        outs.push(Output::file("--fatigue-json", p));
-    }
-    if let Some(p) = a.plot {
-        outs.push(Output::figure("--plot", p));
-    }
-    if let Some(p) = a.windows_plot {
-        outs.push(Output::figure("--windows-plot", p));
-    }
-    // the scene file and every file it read (its packs' files, its tables)
-    let inputs: Vec<&Path> = a
-        .scene_path
-        .into_iter()
-        .chain(scene.inputs.iter().map(|p| p.as_path()))
-        .collect();
-    // the other outputs first, so that a refused one leaves no recording folder behind
-    crate::outputs::check_outputs(&outs, &inputs)?;
-    if let Some(p) = a.recording {
-        crate::outputs::create_folder("--out", p)?;
-        outs.push(Output::file("--out", p));
-        crate::outputs::check_outputs(&outs, &inputs)?;
-    }
-    let recording = a.recording.map(|path| clutchpack_sdk::RecordingRequest {
-        path: path.to_path_buf(),
-        replace: if a.out_given {
-            clutchpack_sdk::record::Replace::Existing
-        } else {
-            clutchpack_sdk::record::Replace::Never
-        },
-        options: clutchpack_sdk::record::RecordOptions {
-            deterministic: a.deterministic,
-            ..Default::default()
-        },
-        scene_path: a.scene_path.map(Path::to_path_buf),
-    });
-    let pb = common::time_progress(scene.simulation.duration_s, &scene.name);
-    let mut progress = |t: f64| common::show_time(&pb, t);
-    let done = clutchpack_sdk::run_network_scene(
-        &scene,
-        a.engine,
-        NetworkRequest {
-            keep_history: a.plot.is_some(),
-            recording,
-            stop: Some(interrupted),
-            progress: Some(&mut progress),
-            impacts_csv: a.impacts_csv.map(Path::to_path_buf),
-            keep_cycles: a.fatigue_json.is_some(),
-            windows_s: a.windows_s,
-        },
-    )?;
-    pb.finish_and_clear();
-    if let Some(p) = &done.recording {
-        eprintln!("recording: {}", p.display());
-    }
-    let s = &done.summary;
-    if let Some(path) = a.plot {
-        plot(path, &scene, s.engine, &done)?;
-    }
-    if let Some(path) = a.windows_plot {
-        let groups: Vec<(Option<&str>, &[clutchpack_sdk::WindowRow])> = s
-            .couplings
-            .iter()
-            .filter(|c| !c.windows.is_empty())
-            .map(|c| (Some(c.name.as_str()), c.windows.as_slice()))
-            .collect();
-        let title = format!(
-            "{}: every pack by window of {} s ({} engine)",
-            s.scene,
-            clutchpack_sdk::model::fmt_num(a.windows_s.unwrap_or(0.0)),
-            s.engine
-        );
-        crate::windows_plot::write(path, &title, &groups)?;
-    }
-    if let Some(path) = a.summary_json {
-        crate::outputs::write_json(path, s)?;
-    }
-    if let Some(path) = a.fatigue_json {
-        crate::outputs::write_json(path, &done.cycles)?;
-    }
+/// The tables of a network's run: its line, the bodies' final speeds, the couplings (heat,
+/// torques, locks; gear meshes' and packs' impacts, packs' bodies, temperatures and
+/// windows), the mode changes, an automatic's shifts and the energy balance.
+pub fn print(s: &NetworkSummary) {
     out!(
         "{}: {:.3} s simulated with the {} engine (network of {} bodies, {} couplings) in {:.3} s wall ({} steps, {} events)",
         s.scene,
@@ -304,25 +190,11 @@ pub fn run(a: &NetworkArgs, scene: Scene, interrupted: &AtomicBool) -> Result<Ex
         e.kinetic_change_j,
         residual_j
     );
-    if s.stopped {
-        eprintln!(
-            "interrupted ({}) at t = {:.6} s: the outputs hold the run up to there",
-            crate::signals::received_name(),
-            s.simulated_s
-        );
-        return Ok(crate::signals::exit_code());
-    }
-    Ok(ExitCode::SUCCESS)
 }
 
 /// The figure: the bodies' speeds and the couplings' torques against time, and the packs'
 /// tooth impacts.
-fn plot(
-    path: &Path,
-    scene: &Scene,
-    engine: &str,
-    outcome: &clutchpack_sdk::NetworkOutcome,
-) -> Result<()> {
+pub fn plot(path: &Path, scene: &Scene, outcome: &clutchpack_sdk::NetworkOutcome) -> Result<()> {
     let net = scene.network.as_ref().expect("a network scene");
     let bodies: Vec<(&str, bool)> = net
         .bodies
@@ -338,7 +210,7 @@ fn plot(
     plot_samples(
         path,
         &scene.name,
-        engine,
+        outcome.summary.engine,
         &bodies,
         &couplings,
         &outcome.history,

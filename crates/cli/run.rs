@@ -1,13 +1,19 @@
-//! `clutchpack run`.
+//! `clutchpack run`: one path for every scene, a pack or a driveline network (`[[bodies]]`):
+//! the scene loaded, every output checked before any work, one [`Simulation`] run with the
+//! progress bar and the stop signals, its recording, plots and JSON written, then the
+//! outcome's tables printed (a pack's here, a network's in `network.rs`) and the exit code.
 
-use crate::common;
+use crate::common::{self, BadInput};
 use crate::outputs::Output;
 use anyhow::{Context, Result};
 use clutchpack_sdk::analysis::{stats_table, TableFormat};
 use clutchpack_sdk::record::{RecordOptions, Replace};
-use clutchpack_sdk::scene::Override;
-use clutchpack_sdk::{EngineChoice, RecordingRequest, RunRequest, Simulation};
-use std::path::PathBuf;
+use clutchpack_sdk::scene::{Override, Scene};
+use clutchpack_sdk::{
+    EngineChoice, Outcome, RecordingRequest, RunOutcome, RunRequest, RunSummary, Simulation,
+    Summary,
+};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Arguments of `clutchpack run`.
@@ -130,29 +136,159 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             ("--per-tooth", a.per_tooth),
             ("--no-contact-samples", a.no_contact_samples),
         ];
-        let args = crate::network::NetworkArgs {
-            scene_path: a.scene.as_deref(),
-            engine: a.engine,
-            summary_json: a.summary_json.as_deref(),
-            impacts_csv: a.impacts_csv.as_deref(),
-            fatigue_json: a.fatigue_json.as_deref(),
-            windows_s: a.windows,
-            windows_plot: a.windows_plot.as_deref(),
-            plot: a.plot.as_deref(),
-            recording: record_path.as_deref(),
-            out_given: a.out.is_some(),
-            deterministic: a.deterministic,
-            pack_only: pack_only
-                .iter()
-                .filter(|(_, on)| *on)
-                .map(|(f, _)| *f)
-                .collect(),
-        };
-        return crate::network::run(&args, scene, &interrupted);
+        if let Some((flag, _)) = pack_only.iter().find(|(_, on)| *on) {
+            return Err(BadInput(format!(
+                "{flag}: not for a network scene ({} has [[bodies]]); a network run gives its \
+                 table, its recording (--out), --summary-json, --impacts-csv, --fatigue-json, \
+                 --windows, --windows-plot and --plot",
+                scene.name
+            ))
+            .into());
+        }
     }
+    check_outputs(&a, &scene, record_path.as_deref())?;
+    let mut sim = Simulation::new(scene, a.engine)?;
+    let scene = sim.scene().clone();
+    let recording = record_path.map(|path| RecordingRequest {
+        // an explicit --out replaces an existing file (documented); a default name never does
+        replace: if a.out.is_some() {
+            Replace::Existing
+        } else {
+            Replace::Never
+        },
+        // a network's recording applies the determinism (and compression and chunks) alone
+        options: RecordOptions {
+            deterministic: a.deterministic,
+            per_tooth: a.per_tooth || scene.simulation.record_per_tooth,
+            contact_samples: !a.no_contact_samples && scene.simulation.record_contact_samples,
+            ..RecordOptions::default()
+        },
+        scene_path: a.scene.clone(),
+        path,
+    });
+    let pb = common::time_progress(scene.simulation.duration_s, &scene.name);
+    let mut progress = |t: f64| common::show_time(&pb, t);
+    let run = sim.run(RunRequest {
+        keep_history: a.plot.is_some(),
+        keep_cycles: a.fatigue_json.is_some(),
+        impacts_csv: a.impacts_csv.clone(),
+        recording,
+        windows_s: a.windows,
+        stop: Some(&*interrupted),
+        progress: Some(&mut progress),
+    });
+    let done = match run {
+        // a pack's run fails only before any work; a network's also when its engine fails
+        // (the error names the scene and the engine, the recording finished first)
+        Err(e) if !sim.is_network() => {
+            return Err(anyhow::Error::new(e).context(format!("starting the run of {}", scene.name)))
+        }
+        run => run?,
+    };
+    pb.finish_and_clear();
+    for w in done.warnings() {
+        eprintln!("warning: {w}");
+    }
+    // A recording that could not be finished is reported after the other outputs are written.
+    let recording_error = match done.recording() {
+        Some(Ok(path)) => {
+            eprintln!("recording: {}", path.display());
+            None
+        }
+        Some(Err(e)) => Some(anyhow::anyhow!("finishing the recording: {e}")),
+        None => None,
+    };
+
+    // Write what we have even when the run failed, then report the failure.
+    if let Some(e) = done.impacts_csv_error() {
+        return Err(anyhow::anyhow!("{e}"));
+    }
+    if let Some(path) = &a.plot {
+        match &done {
+            Outcome::Pack(o) => plot(path, o)?,
+            Outcome::Network(o) => crate::network::plot(path, &scene, o)?,
+        }
+    }
+    if let Some(path) = &a.windows_plot {
+        let len = clutchpack_sdk::model::fmt_num(a.windows.unwrap_or(0.0));
+        let (what, groups) = match &done {
+            Outcome::Pack(o) => ("", vec![(None, o.windows.as_slice())]),
+            Outcome::Network(o) => ("every pack ", crate::network::windows(&o.summary)),
+        };
+        let title = format!(
+            "{}: {what}by window of {len} s ({} engine)",
+            scene.name,
+            done.engine()
+        );
+        crate::windows_plot::write(path, &title, &groups)?;
+    }
+    let simulated_s = match done.simulated_s() {
+        Ok(t) => t,
+        Err(e) => {
+            if let Some(r) = recording_error {
+                eprintln!("error: {r:#}");
+            }
+            return Err(e.into());
+        }
+    };
+    if done.stopped_early() {
+        if crate::signals::received().is_none() && recording_error.is_some() {
+            // the recorder failed (a full disk): the run stopped for that, not a signal
+            eprintln!(
+                "stopped at t = {simulated_s:.6} s because the recording failed (below): the \
+                 other outputs hold the run up to there"
+            );
+        } else {
+            eprintln!(
+                "interrupted ({}) at t = {simulated_s:.6} s: the outputs hold the run up to there",
+                crate::signals::received_name(),
+            );
+        }
+    }
+    let summary = done.summary()?;
+    if let Some(path) = &a.fatigue_json {
+        crate::outputs::write_json(path, &done.cycles())?;
+    }
+    if let Some(path) = &a.summary_json {
+        crate::outputs::write_json(path, &summary)?;
+    }
+    match &summary {
+        Summary::Pack(s) => print(s, sim.engine_line()),
+        Summary::Network(s) => crate::network::print(s),
+    }
+    if let Some(e) = recording_error {
+        return Err(e);
+    }
+    if let Summary::Pack(s) = &summary {
+        if let Some((disc, what)) = s
+            .fatigue
+            .iter()
+            .find_map(|f| f.non_finite().map(|w| (&f.name, w)))
+        {
+            // every output is written; the figures that overflowed are not a result
+            eprintln!(
+                "error: the fatigue of {disc} overflowed ({what} is not finite): the loads or \
+                 the S-N curve are outside what the assessment can represent; check [fatigue] \
+                 and [material]"
+            );
+            return Ok(ExitCode::from(1));
+        }
+    }
+    if done.stopped_early() {
+        // 128 + signal, as a shell reports a command stopped by that signal
+        return Ok(crate::signals::exit_code());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Checks every output of `a` before any work (`crate::outputs`): the recording's
+/// (`record`: `--out` or the default name) folder made once the others passed, so that a
+/// refused one leaves no recording folder behind; no output may name the scene file or a
+/// file it read (its tables, a network's pack files).
+fn check_outputs(a: &RunArgs, scene: &Scene, record: Option<&Path>) -> Result<()> {
     let mut outs = Vec::new();
     for (flag, p) in [
-        ("--out", record_path.as_deref()),
+        ("--out", record),
         ("--summary-json", a.summary_json.as_deref()),
         ("--fatigue-json", a.fatigue_json.as_deref()),
         ("--impacts-csv", a.impacts_csv.as_deref()),
@@ -167,143 +303,52 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             });
         }
     }
-    // the scene file and every file it read (its tables): never overwritten by an output
-    let inputs: Vec<&std::path::Path> = a
+    let inputs: Vec<&Path> = a
         .scene
         .as_deref()
         .into_iter()
         .chain(scene.inputs.iter().map(|p| p.as_path()))
         .collect();
-    // the other outputs first, so that a refused one leaves no recording folder behind
     let others: Vec<Output> = outs
         .iter()
         .filter(|o| o.label != "--out")
         .cloned()
         .collect();
     crate::outputs::check_outputs(&others, &inputs)?;
-    if let Some(p) = record_path.as_deref() {
+    if let Some(p) = record {
         crate::outputs::create_folder("--out", p)?;
     }
-    crate::outputs::check_outputs(&outs, &inputs)?;
-    let mut sim = Simulation::new(scene, a.engine)?;
-    let scene = sim.scene().clone();
-    let recording = record_path.map(|path| RecordingRequest {
-        // an explicit --out replaces an existing file (documented); a default name never does
-        replace: if a.out.is_some() {
-            Replace::Existing
-        } else {
-            Replace::Never
-        },
-        options: RecordOptions {
-            deterministic: a.deterministic,
-            per_tooth: a.per_tooth || scene.simulation.record_per_tooth,
-            contact_samples: !a.no_contact_samples && scene.simulation.record_contact_samples,
-            ..RecordOptions::default()
-        },
-        scene_path: a.scene.clone(),
-        path,
-    });
-    let pb = common::time_progress(scene.simulation.duration_s, &scene.name);
-    let mut progress = |t: f64| common::show_time(&pb, t);
-    let done = sim
-        .run(RunRequest {
-            keep_history: a.plot.is_some(),
-            keep_cycles: a.fatigue_json.is_some(),
-            impacts_csv: a.impacts_csv.clone(),
-            recording,
-            windows_s: a.windows,
-            stop: Some(&*interrupted),
-            progress: Some(&mut progress),
-        })
-        .with_context(|| format!("starting the run of {}", scene.name))?;
-    pb.finish_and_clear();
-    for w in &done.warnings {
-        eprintln!("warning: {w}");
-    }
-    // A recording that could not be finished is reported after the other outputs are written.
-    let recording_error = match &done.recording {
-        Some(Ok(path)) => {
-            eprintln!("recording: {}", path.display());
-            None
-        }
-        Some(Err(e)) => Some(anyhow::anyhow!("finishing the recording: {e}")),
-        None => None,
-    };
+    crate::outputs::check_outputs(&outs, &inputs)
+}
 
-    // Write what we have even when the run failed, then report the failure.
-    if let Some(Err(e)) = &done.impacts_csv {
-        return Err(anyhow::anyhow!("{e}"));
-    }
-    let names = &done.body_names;
-    if let Some(path) = &a.plot {
-        let series: Vec<(String, Vec<(f64, f64)>)> = names
-            .iter()
-            .cloned()
-            .zip(done.collector.histories_with_peaks())
-            .collect();
-        let title = format!("{}: per-tooth load ({} engine)", scene.name, done.engine);
-        crate::outputs::write_with(path, |tmp| {
-            clutchpack_sdk::analysis::plot_load_history(tmp, &title, &series)
-                .with_context(|| format!("plotting {}", path.display()))
-        })?;
-    }
-    if let Some(path) = &a.windows_plot {
-        let title = format!(
-            "{}: by window of {} s ({} engine)",
-            scene.name,
-            clutchpack_sdk::model::fmt_num(a.windows.unwrap_or(0.0)),
-            done.engine
-        );
-        crate::windows_plot::write(path, &title, &[(None, &done.windows)])?;
-    }
-    let run_stats = match done.stats() {
-        Ok(s) if s.stopped_early => {
-            if crate::signals::received().is_none() && recording_error.is_some() {
-                // the recorder failed (a full disk): the run stopped for that, not a signal
-                eprintln!(
-                    "stopped at t = {:.6} s because the recording failed (below): the other \
-                     outputs hold the run up to there",
-                    s.simulated_s
-                );
-            } else {
-                eprintln!(
-                    "interrupted ({}) at t = {:.6} s: the outputs hold the run up to there",
-                    crate::signals::received_name(),
-                    s.simulated_s
-                );
-            }
-            s.clone()
-        }
-        Ok(s) => s.clone(),
-        Err(e) => {
-            if let Some(r) = recording_error {
-                eprintln!("error: {r:#}");
-            }
-            return Err(e.into());
-        }
-    };
-    let summary = done.summary()?;
-    if let Some(path) = &a.fatigue_json {
-        let histories = done.collector.fatigue.clone().finish(names.len());
-        let cycles: Vec<_> = names
-            .iter()
-            .zip(&histories)
-            .map(|(n, h)| clutchpack_sdk::analysis::disc_cycles(n, h, run_stats.simulated_s))
-            .collect();
-        crate::outputs::write_json(path, &cycles)?;
-    }
-    if let Some(path) = &a.summary_json {
-        crate::outputs::write_json(path, &summary)?;
-    }
+/// `--plot` of a pack: every body's per-tooth load against time, with its impacts' peaks.
+fn plot(path: &Path, done: &RunOutcome) -> Result<()> {
+    let series: Vec<(String, Vec<(f64, f64)>)> = done
+        .body_names
+        .iter()
+        .cloned()
+        .zip(done.collector.histories_with_peaks())
+        .collect();
+    let title = format!("{}: per-tooth load ({} engine)", done.scene, done.engine);
+    crate::outputs::write_with(path, |tmp| {
+        clutchpack_sdk::analysis::plot_load_history(tmp, &title, &series)
+            .with_context(|| format!("plotting {}", path.display()))
+    })
+}
+
+/// The tables of a pack's run: the run's line and the engine's, the bodies' impact
+/// statistics, the teeth's fatigue, the friction interfaces, a thermal run's temperatures
+/// and the windows.
+fn print(summary: &RunSummary, engine_line: &str) {
     out!(
         "{}: {:.3} s simulated with the {} engine in {:.3} s wall ({} steps)",
-        scene.name,
-        run_stats.simulated_s,
+        summary.scene,
+        summary.duration_s,
         summary.engine,
-        done.wall_time_s,
-        run_stats.steps
+        summary.wall_time_s,
+        summary.steps
     );
-    out!("{}", sim.engine_line());
+    out!("{engine_line}");
     out!("per-tooth impact loads (negative: the shaft leads; positive: the disc leads)");
     let stats = &summary.discs;
     out!("{}", stats_table(stats, TableFormat::Text).trim_end());
@@ -342,25 +387,4 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         crate::tables::print_thermal(th);
     }
     crate::tables::print_windows(&summary.windows);
-    if let Some(e) = recording_error {
-        return Err(e);
-    }
-    if let Some((disc, what)) = summary
-        .fatigue
-        .iter()
-        .find_map(|f| f.non_finite().map(|w| (&f.name, w)))
-    {
-        // every output is written; the figures that overflowed are not a result
-        eprintln!(
-            "error: the fatigue of {disc} overflowed ({what} is not finite): the loads or the \
-             S-N curve are outside what the assessment can represent; check [fatigue] and \
-             [material]"
-        );
-        return Ok(ExitCode::from(1));
-    }
-    if run_stats.stopped_early {
-        // 128 + signal, as a shell reports a command stopped by that signal
-        return Ok(crate::signals::exit_code());
-    }
-    Ok(ExitCode::SUCCESS)
 }

@@ -150,9 +150,10 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         })?;
         scenes.push(scene);
     }
-    let engine_name = Simulation::new(scenes[0].clone(), a.engine)?
-        .engine_name()
-        .to_string();
+    // sweeps take pack scenes only: a network is refused before any case runs
+    let sim = Simulation::new(scenes[0].clone(), a.engine)?;
+    sim.pack_only()?;
+    let engine_name = sim.engine_name().to_string();
     let show = indicatif::ProgressBar::new(0);
     show.set_style(
         indicatif::ProgressStyle::with_template("sweep [{bar:30}] {pos}/{len} cases, eta {eta}")

@@ -325,7 +325,7 @@ fn run(
     let mut interrupt: Option<PyErr> = None;
     let outcome = py.detach(|| {
         let mut progress = signal_poll(&stop, &mut interrupt);
-        sim.run(RunRequest {
+        sim.run_pack(RunRequest {
             keep_history: true,
             keep_cycles: false,
             impacts_csv,
@@ -456,9 +456,10 @@ fn sweep(
         })
         .collect::<PyResult<Vec<_>>>()?;
     let jobs = threads(jobs);
-    let engine_name = Simulation::new(scenes[0].clone(), engine)
-        .map_err(py_err)?
-        .engine_name();
+    // sweeps take pack scenes only: a network is refused before any case runs
+    let sim = Simulation::new(scenes[0].clone(), engine).map_err(py_err)?;
+    sim.pack_only().map_err(py_err)?;
+    let engine_name = sim.engine_name();
     let stop = AtomicBool::new(false);
     let runs = interruptible(py, &stop, || {
         clutchpack_sdk::run_cases(

@@ -112,23 +112,22 @@ pub fn run_network(
         },
         scene_path: scene.path.clone(),
     });
-    let engine = engine_choice(engine)?;
+    let mut sim = clutchpack_sdk::Simulation::new(scene.inner.clone(), engine_choice(engine)?)
+        .map_err(py_err)?;
+    sim.network_only().map_err(py_err)?;
     let stop = AtomicBool::new(false);
     let mut interrupt: Option<PyErr> = None;
     let outcome = py.detach(|| {
         let mut progress = signal_poll(&stop, &mut interrupt);
-        clutchpack_sdk::run_network_scene(
-            &scene.inner,
-            engine,
-            clutchpack_sdk::NetworkRequest {
-                keep_history: true,
-                recording,
-                stop: Some(&stop),
-                progress: Some(&mut progress),
-                impacts_csv,
-                ..Default::default()
-            },
-        )
+        sim.run(clutchpack_sdk::NetworkRequest {
+            keep_history: true,
+            recording,
+            stop: Some(&stop),
+            progress: Some(&mut progress),
+            impacts_csv,
+            ..Default::default()
+        })
+        .and_then(clutchpack_sdk::Outcome::into_network)
     });
     let outcome = outcome.map_err(py_err)?;
     if let Some(e) = interrupt {

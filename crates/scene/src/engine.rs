@@ -80,11 +80,13 @@ impl Scene {
     }
 
     /// Why [`Scene::engine`] chooses what it does, for `run`'s engine line: "asked by
-    /// --engine", "chosen by the scene (simulation.engine)", or the default's reason.
+    /// --engine", "chosen by the scene (simulation.engine)", or the default's reason (a
+    /// network's, a torsional pack's or a pack's with per-tooth effects).
     pub fn engine_reason(&self, asked: Option<EngineChoice>) -> &'static str {
         match (asked, self.simulation.engine) {
             (Some(_), _) => "asked by --engine",
             (None, Some(_)) => "chosen by the scene (simulation.engine)",
+            (None, None) if self.network.is_some() => "the default for a driveline network",
             (None, None) if self.pack.non_torsional_parts().is_empty() => {
                 "the default for a torsional pack (concentric bodies: discs, plates, drum, stack)"
             }

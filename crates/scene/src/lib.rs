@@ -254,7 +254,7 @@ pub struct Scene {
     pub thermal: Option<clutchpack_model::thermal::ThermalModel>,
     /// The driveline network of a network scene (`[[bodies]]` and `[[couplings]]`, MODEL.md
     /// section 8); `None` for a pack scene. A network scene's `pack` is an empty placeholder
-    /// that no pack engine runs (`clutchpack_sdk::Simulation::new` refuses the scene).
+    /// that no pack engine runs (`clutchpack_sdk::Simulation` runs the network instead).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub network: Option<clutchpack_model::network::Network>,
     /// An automatic transmission's gears on the network (`[transmission]`, MODEL.md section

@@ -87,7 +87,7 @@ pub fn run_cases(
                     return Ok(None);
                 }
                 let member = ensemble_member(&scenes[c], k as u64, ensemble as u64);
-                let outcome = Simulation::new(member, engine)?.run(RunRequest {
+                let outcome = Simulation::new(member, engine)?.run_pack(RunRequest {
                     stop: Some(stop),
                     ..RunRequest::default()
                 })?;
@@ -161,7 +161,7 @@ pub fn run_case(scene: &Scene, engine: Option<EngineChoice>, stop: &AtomicBool) 
     let text = |e: Error| e.to_string();
     let outcome = Simulation::new(scene.clone(), engine)
         .map_err(text)?
-        .run(RunRequest {
+        .run_pack(RunRequest {
             stop: Some(stop),
             ..RunRequest::default()
         })

@@ -15,7 +15,7 @@
 //! use clutchpack_sdk::{load_scene, RunRequest, Simulation};
 //! let scene = load_scene(None, &[])?; // the paper's case, built in
 //! let mut sim = Simulation::new(scene, None)?;
-//! let outcome = sim.run(RunRequest::default())?;
+//! let outcome = sim.run_pack(RunRequest::default())?; // `run` takes a network too
 //! let summary = outcome.summary()?;
 //! println!("{}: largest + load {:.1} N", summary.scene, summary.discs[0].max_positive_n);
 //! # Ok::<(), clutchpack_sdk::Error>(())
@@ -30,7 +30,9 @@ pub mod fit;
 mod network;
 mod network_cosim;
 mod network_keep;
+mod outcome;
 mod recording;
+mod request;
 mod run;
 mod scene_file;
 mod session;
@@ -64,15 +66,17 @@ pub use error::{Error, Result};
 pub use fatigue::{assess_fatigue, assess_histories, fatigue_params, RecordedFatigue};
 pub use fit::{Fit, FitOptions, FitParam, FitRequest, FitResult, FitSignal};
 pub use network::{
-    multibody_step_s, run_network_scene, BodySummary, CouplingSummary, EnergySummary, ModeChange,
-    NetworkOutcome, NetworkRequest, NetworkSummary, PackBodySummary, MULTIBODY_NETWORK_STEP_S,
+    multibody_step_s, BodySummary, CouplingSummary, EnergySummary, ModeChange, NetworkOutcome,
+    NetworkRequest, NetworkSummary, PackBodySummary, MULTIBODY_NETWORK_STEP_S,
 };
 pub use network_cosim::{
     network_inputs, network_name_problems, network_outputs, NetworkSimulation, NetworkVariable,
     SavedNetworkSimulation,
 };
+pub use outcome::{Outcome, Summary};
 pub use recording::open_recording;
-pub use run::{RecordingRequest, RunOutcome, RunRequest};
+pub use request::{RecordingRequest, RunRequest};
+pub use run::RunOutcome;
 pub use scene_file::{load_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TEXT};
 pub use session::{Session, SessionRequest, SessionState};
 pub use simulation::{PackEngine, Simulation};

@@ -1,6 +1,6 @@
-//! A network scene's run (`[[bodies]]`, MODEL.md section 8): the reference engine or the
-//! multibody engine on the scene's driveline (the engine asked, else `simulation.engine`, else
-//! the reference), its clutches' mode changes and heat, the bodies' speeds and the energy
+//! A network scene's run (`[[bodies]]`, MODEL.md section 8; [`crate::Simulation::run`] of a
+//! network scene): the reference engine or the multibody engine on the scene's driveline
+//! (the engine asked, else `simulation.engine`, else the reference), its clutches' mode changes and heat, the bodies' speeds and the energy
 //! balance, as one serializable summary (`run --summary-json`) and, if asked, the sampled
 //! history (for the figure). Both engines give the model's output types
 //! ([`clutchpack_model::network::NetworkRun`]), so the summary is built the same way.
@@ -183,24 +183,18 @@ pub fn multibody_step_s(scene: &Scene) -> f64 {
 /// The longest fixed step of the multibody engine on a network, s.
 pub const MULTIBODY_NETWORK_STEP_S: f64 = 1e-4;
 
-/// Runs a network scene on the engine `asked` (e.g. `--engine`), else the scene's
-/// `simulation.engine`, else the reference engine: the reference engine at the scene's
-/// tolerance and longest step, the multibody engine at the fixed step
-/// [`multibody_step_s`]. A pack scene is bad input.
-pub fn run_network_scene(
+/// Runs a network scene on `engine` ([`crate::Simulation::run`] of a network, which chose
+/// it): the reference engine at the scene's tolerance and longest step, the multibody engine
+/// at the fixed step [`multibody_step_s`]. A pack scene is bad input.
+pub(crate) fn run(
     scene: &Scene,
-    asked: Option<EngineChoice>,
+    engine: EngineChoice,
     req: NetworkRequest,
 ) -> Result<NetworkOutcome> {
     let Some(net) = &scene.network else {
-        return Err(Error::BadInput(format!(
-            "{} is a pack scene, not a network ([[bodies]])",
-            scene.name
-        )));
+        return Err(crate::simulation::not_a_network(&scene.name));
     };
-    let engine = scene.engine(asked, &scene.name)?;
     let sim = &scene.simulation;
-    crate::windows::check(req.windows_s, sim.duration_s)?;
     if req.windows_s.is_some() && !net.couplings.iter().any(|c| c.pack().is_some()) {
         return Err(Error::BadInput(format!(
             "windows (`--windows`, `windows_s`): {} has no resolved pack (kind = \"pack\") \
@@ -347,7 +341,7 @@ pub(crate) fn conclude(
     wall_time_s: f64,
 ) -> Result<NetworkOutcome> {
     let Some(net) = &scene.network else {
-        return Err(Error::BadInput(format!("{} is not a network", scene.name)));
+        return Err(crate::simulation::not_a_network(&scene.name));
     };
     if let Some(e) = keep.record_error.take() {
         return Err(e.into());

@@ -42,7 +42,7 @@ impl Clone for Stepper {
 
 impl Stepper {
     /// Starts `net` at t = 0 on `engine` for a run of `duration_s` s, at the scene's settings
-    /// (as [`crate::network::run_network_scene`] runs it whole).
+    /// (as [`crate::Simulation::run`] runs it whole).
     fn new(
         scene: &Scene,
         net: &Network,

@@ -1,54 +1,18 @@
-//! One run of a scene: the engine on the caller's thread feeding the collector, the
-//! recording (if asked) on its own thread, both finished whatever stops the run.
+//! One run of a pack scene: the engine on the caller's thread feeding the collector, the
+//! recording (if asked) on its own thread, both finished whatever stops the run; its
+//! `RunOutcome`.
 
 use crate::collector::RunCollector;
 use crate::summary::{friction_interfaces, run_info, RunSummary};
-use crate::{Error, Result, Simulation};
-use clutchpack_analysis::{DiscFatigue, DiscStats};
+use crate::{Error, Result, RunRequest, Simulation};
+use clutchpack_analysis::{DiscCycles, DiscFatigue, DiscStats};
 use clutchpack_model::{
     DiscSample, Engine, EngineError, ImpactEvent, InterfaceSample, Observer, RunStats, Sample,
 };
-use clutchpack_record::{RecordError, RecordOptions, Recorder, Replace, ThreadedRecorder};
+use clutchpack_record::{RecordError, Recorder, ThreadedRecorder};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
-
-/// Where and how a run is recorded (MCAP).
-#[derive(Debug, Clone)]
-pub struct RecordingRequest {
-    /// The recording's path; written as a `.partial` sibling and renamed when complete.
-    pub path: PathBuf,
-    /// Whether an existing file at `path` is replaced.
-    pub replace: Replace,
-    /// What is recorded (per-tooth loads, contact samples, determinism).
-    pub options: RecordOptions,
-    /// The scene file the run was loaded from (its name goes into the recording).
-    pub scene_path: Option<PathBuf>,
-}
-
-/// What a run keeps and writes besides its statistics (the peak statistics, the interfaces'
-/// figures and the teeth's fatigue as running sums are always kept, in bounded memory).
-#[derive(Default)]
-pub struct RunRequest<'a> {
-    /// Keep every sample's per-tooth load and every impact (for a plot); memory grows with
-    /// the run.
-    pub keep_history: bool,
-    /// Keep every counted load cycle (for the cycle spectra of `--fatigue-json`); memory
-    /// grows with the run.
-    pub keep_cycles: bool,
-    /// Write one CSV row per impact to this file as the impacts close.
-    pub impacts_csv: Option<PathBuf>,
-    /// Record the run.
-    pub recording: Option<RecordingRequest>,
-    /// Stops the run cleanly (at the engine's next progress poll, within milliseconds) once
-    /// set; the outcome then holds the run up to there.
-    pub stop: Option<&'a AtomicBool>,
-    /// Also the figures window by window, of this length in s (`None`: none;
-    /// [`RunOutcome::windows`]).
-    pub windows_s: Option<f64>,
-    /// Called at the engine's progress polls with the simulated time reached, s.
-    pub progress: Option<&'a mut dyn FnMut(f64)>,
-}
 
 /// What a run gave: the engine's result and everything kept, complete up to where the run
 /// ended (its end, a stop or a failure).
@@ -111,6 +75,19 @@ impl RunOutcome {
         self.collector.assess_fatigue(&self.body_names, t)
     }
 
+    /// Every body's counted load cycles and load spectra over the simulated time that ran
+    /// (`run --fatigue-json`); its cycles are kept only when [`RunRequest::keep_cycles`]
+    /// asked for them.
+    pub fn cycles(&self) -> Vec<DiscCycles> {
+        let t = self.result.as_ref().map_or(0.0, |s| s.simulated_s);
+        let histories = self.collector.fatigue.clone().finish(self.body_names.len());
+        self.body_names
+            .iter()
+            .zip(&histories)
+            .map(|(n, h)| clutchpack_analysis::disc_cycles(n, h, t))
+            .collect()
+    }
+
     /// The run's summary (what `--summary-json` writes): statistics, interfaces, fatigue.
     /// An error when the engine failed.
     pub fn summary(&self) -> Result<RunSummary> {
@@ -130,12 +107,9 @@ impl RunOutcome {
 }
 
 impl Simulation {
-    /// Runs the scene for its `simulation.duration_s` as `request` asks. Outputs that cannot
-    /// be created (the impacts CSV, the recording) are errors before any work; after that,
-    /// whatever ends the run, the outcome holds it and every output is complete up to there.
-    pub fn run(&mut self, request: RunRequest<'_>) -> Result<RunOutcome> {
-        crate::windows::check(request.windows_s, self.scene().simulation.duration_s)?;
-        let names = self.body_names();
+    /// A pack's run on its engine ([`Simulation::run`] of a pack scene).
+    pub(crate) fn run_engine(&mut self, request: RunRequest<'_>) -> Result<RunOutcome> {
+        let names = self.body_names()?;
         let scene = self.scene();
         let mut collector = RunCollector::new(names.len(), request.keep_history)
             .with_interfaces(friction_interfaces(scene).into_iter().map(|f| f.name()))
@@ -160,7 +134,7 @@ impl Simulation {
         let engine_name = self.engine_name();
         let t0 = Instant::now();
         let done = run_recorded(
-            self.engine_mut(),
+            self.engine_mut()?,
             duration,
             collector,
             recorder,

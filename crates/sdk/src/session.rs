@@ -3,7 +3,8 @@
 //! and recording as [`Simulation::run`], finished into the same [`RunOutcome`].
 
 use crate::collector::RunCollector;
-use crate::run::{finish_recording, RecordingRequest, RunObserver, RunOutcome};
+use crate::request::RecordingRequest;
+use crate::run::{finish_recording, RunObserver, RunOutcome};
 use crate::summary::{friction_interfaces, run_info};
 use crate::{Error, Result, Simulation};
 use clutchpack_model::session::{Advance, Driven, Inputs, Snapshot};
@@ -59,9 +60,9 @@ impl Simulation {
     /// not have, a recording that cannot be created) is an error before any work.
     pub fn start(&self, request: SessionRequest) -> Result<Session> {
         let scene = self.scene();
-        let names = self.body_names();
+        let names = self.body_names()?;
         let mut inner = self
-            .engine()
+            .engine()?
             .start(request.driven)
             .map_err(|e| Error::BadInput(format!("{}: {e}", scene.name)))?;
         if let Some(t) = request.stop_time_s {

@@ -1,33 +1,50 @@
-//! The engine a scene runs on, chosen once, with the reason.
+//! The engine a scene runs on, chosen once, with the reason: a pack scene's engine built,
+//! or a network scene's engine chosen (its run builds it, `network.rs`).
 
 use crate::{Error, Result};
 use clutchpack_model::{Engine, PackModel};
 use clutchpack_reference::{ReferenceEngine, Scheme};
 use clutchpack_scene::{EngineChoice, Scene, SchemeChoice};
 
-/// A validated scene and the engine that runs it. The engine is the one asked for, else the
-/// scene's `simulation.engine`, else the reference engine for a torsional pack and the
-/// multibody engine for one with per-tooth effects (`Scene::engine`); an engine that cannot
-/// run the scene is bad input, refused here before any work.
+/// A validated scene, a pack or a driveline network (`[[bodies]]`), and the engine that runs
+/// it. The engine is the one asked for, else the scene's `simulation.engine`, else the
+/// reference engine for a torsional pack or a network and the multibody engine for a pack
+/// with per-tooth effects (`Scene::engine`); an engine that cannot run the scene is bad
+/// input, refused here before any work. [`Simulation::run`] runs either kind; what only a
+/// pack has (its engine, its bodies, a steppable [`crate::Session`]) refuses a network
+/// ([`Simulation::pack_only`]).
 pub struct Simulation {
     scene: Scene,
-    engine: Box<dyn Engine + Send>,
+    engine: Built,
     line: String,
+}
+
+/// What [`Simulation::new`] made of the scene.
+enum Built {
+    /// A pack scene's engine.
+    Pack(Box<dyn Engine + Send>),
+    /// A network scene's engine, chosen (a network's run builds its stepper).
+    Network(EngineChoice),
 }
 
 impl Simulation {
     /// The engine for `scene` (`asked`: an explicit choice, e.g. `--engine`).
     pub fn new(scene: Scene, asked: Option<EngineChoice>) -> Result<Simulation> {
-        if scene.network.is_some() {
-            return Err(crate::Error::BadInput(format!(
-                "{} is a network scene ([[bodies]]): `clutchpack run`, `check`, `fmu` and \
-                 Python's `run` and `Simulation` take it; sweeps and studies take pack scenes \
-                 only, for now",
-                scene.name
-            )));
-        }
         let choice = scene.engine(asked, &scene.name)?;
         let why = scene.engine_reason(asked);
+        if let Some(net) = &scene.network {
+            let line = format!(
+                "engine: {} (a driveline network of {} bodies and {} couplings), {why}",
+                choice.name(),
+                net.bodies.len(),
+                net.couplings.len()
+            );
+            return Ok(Simulation {
+                scene,
+                engine: Built::Network(choice),
+                line,
+            });
+        }
         let sim = &scene.simulation;
         let (engine, line): (Box<dyn Engine + Send>, String) = match choice {
             EngineChoice::Reference => {
@@ -79,9 +96,30 @@ impl Simulation {
         };
         Ok(Simulation {
             scene,
-            engine,
+            engine: Built::Pack(engine),
             line,
         })
+    }
+
+    /// Whether the scene is a driveline network (`[[bodies]]`).
+    pub fn is_network(&self) -> bool {
+        matches!(self.engine, Built::Network(_))
+    }
+
+    /// Refuses a network scene, for the callers that take pack scenes only (sweeps, studies,
+    /// ensembles, a fit's impact statistics, benchmarks of packs, a pack's engine or
+    /// session): bad input naming the scene and what takes a network, before any work.
+    pub fn pack_only(&self) -> Result<()> {
+        self.engine().map(|_| ())
+    }
+
+    /// Refuses a pack scene, for the callers that take network scenes only: bad input naming
+    /// the scene, before any work.
+    pub fn network_only(&self) -> Result<()> {
+        match self.engine {
+            Built::Pack(_) => Err(not_a_network(&self.scene.name)),
+            Built::Network(_) => Ok(()),
+        }
     }
 
     /// The scene.
@@ -91,7 +129,18 @@ impl Simulation {
 
     /// The engine's name (`reference` or `multibody`).
     pub fn engine_name(&self) -> &'static str {
-        self.engine.name()
+        match &self.engine {
+            Built::Pack(e) => e.name(),
+            Built::Network(choice) => choice.name(),
+        }
+    }
+
+    /// The network scene's engine (`None` for a pack scene).
+    pub(crate) fn network_engine(&self) -> Option<EngineChoice> {
+        match self.engine {
+            Built::Pack(_) => None,
+            Built::Network(choice) => Some(choice),
+        }
     }
 
     /// One line saying which engine and scheme run and why, e.g. `engine: reference
@@ -100,21 +149,48 @@ impl Simulation {
         &self.line
     }
 
-    /// The bodies whose teeth are loaded, in the engines' order: the friction discs, then the
-    /// separator plates.
-    pub fn body_names(&self) -> Vec<String> {
-        self.engine.disc_names()
+    /// A pack's bodies whose teeth are loaded, in the engines' order: the friction discs,
+    /// then the separator plates. A network scene is refused ([`Simulation::pack_only`]; its
+    /// resolved packs' bodies are in its outcome).
+    pub fn body_names(&self) -> Result<Vec<String>> {
+        Ok(self.engine()?.disc_names())
     }
 
-    /// The engine (to start sessions from).
-    pub(crate) fn engine(&self) -> &(dyn Engine + Send) {
-        self.engine.as_ref()
+    /// A pack's engine (to start sessions from); a network scene is refused.
+    pub(crate) fn engine(&self) -> Result<&(dyn Engine + Send)> {
+        match &self.engine {
+            Built::Pack(e) => Ok(e.as_ref()),
+            Built::Network(_) => Err(self.not_a_pack()),
+        }
     }
 
-    /// The engine itself (for callers that drive it with their own observer).
-    pub fn engine_mut(&mut self) -> &mut (dyn Engine + Send) {
-        self.engine.as_mut()
+    /// A pack's engine itself (for callers that drive it with their own observer); a network
+    /// scene is refused ([`Simulation::pack_only`]).
+    pub fn engine_mut(&mut self) -> Result<&mut (dyn Engine + Send)> {
+        let refused = self.not_a_pack();
+        match &mut self.engine {
+            Built::Pack(e) => Ok(e.as_mut()),
+            Built::Network(_) => Err(refused),
+        }
     }
+
+    /// The refusal of a network scene by what takes packs only: the scene, and what takes a
+    /// network.
+    fn not_a_pack(&self) -> Error {
+        Error::BadInput(format!(
+            "{} is a network scene ([[bodies]]): `clutchpack run`, `check`, `fmu` and \
+             Python's `run` and `Simulation` take it; sweeps and studies take pack scenes \
+             only, for now",
+            self.scene.name
+        ))
+    }
+}
+
+/// A pack scene where a network was expected: bad input naming the scene.
+pub(crate) fn not_a_network(scene: &str) -> Error {
+    Error::BadInput(format!(
+        "{scene} is a pack scene, not a network ([[bodies]])"
+    ))
 }
 
 /// An engine configuration for a pack built in code rather than read from a scene (the

@@ -13,6 +13,20 @@ fn scene(name: &str) -> clutchpack_scene::Scene {
     clutchpack_scene::load(&file, &[]).unwrap()
 }
 
+/// The network scene `s`'s whole run on `engine` (else the scene's choice), kept as `run`
+/// keeps it by default.
+fn whole_run(
+    s: &clutchpack_scene::Scene,
+    engine: Option<clutchpack_scene::EngineChoice>,
+) -> clutchpack_sdk::NetworkOutcome {
+    clutchpack_sdk::Simulation::new(s.clone(), engine)
+        .unwrap()
+        .run(Default::default())
+        .unwrap()
+        .into_network()
+        .unwrap()
+}
+
 /// An FMU's table (every input driven) names each input by its public name, and each input's
 /// description says that an unconnected input holds its start value.
 #[test]
@@ -190,8 +204,7 @@ fn a_network_simulation_runs_on_the_multibody_engine() {
     use clutchpack_scene::EngineChoice;
     let s = scene("dct-upshift-lumped.toml");
     let engine = Some(EngineChoice::Multibody);
-    let request = clutchpack_sdk::NetworkRequest::default();
-    let whole = clutchpack_sdk::run_network_scene(&s, engine, request).unwrap();
+    let whole = whole_run(&s, engine);
     let mut sim = clutchpack_sdk::NetworkSimulation::start(&s, engine, &[], None, None).unwrap();
     assert_eq!(sim.engine(), EngineChoice::Multibody);
     let calls = (s.simulation.duration_s / 1e-3).round() as u32;
@@ -263,7 +276,7 @@ fn thermal_pack_outputs_on(engine: clutchpack_scene::EngineChoice) {
     let set: clutchpack_scene::Override = "couplings[2].pack=dct-k2-thermal.toml".parse().unwrap();
     let s = clutchpack_scene::load(&file, &[set]).unwrap();
     let engine = Some(engine);
-    let whole = clutchpack_sdk::run_network_scene(&s, engine, Default::default()).unwrap();
+    let whole = whole_run(&s, engine);
     let k2 = whole
         .summary
         .couplings
@@ -309,7 +322,7 @@ fn the_multibody_engine_drives_a_packs_pressure_by_name() {
     use clutchpack_scene::EngineChoice;
     let s = scene("dct-upshift.toml");
     let engine = Some(EngineChoice::Multibody);
-    let whole = clutchpack_sdk::run_network_scene(&s, engine, Default::default()).unwrap();
+    let whole = whole_run(&s, engine);
     let names = [
         "couplings.K1.pressure_pa".to_string(),
         "couplings.K2.pressure_pa".to_string(),

@@ -76,9 +76,9 @@ fn pack_breakpoints(scene: &Scene) -> Vec<f64> {
 fn pack_frames(name: &str, scene: &Scene, engine: EngineChoice, end: f64, ends: &[f64]) {
     let mut sim = Simulation::new(scene.clone(), Some(engine)).unwrap();
     let mut whole = Collector::default();
-    sim.engine_mut().run(end, &mut whole).unwrap();
+    sim.engine_mut().unwrap().run(end, &mut whole).unwrap();
     let mut split = Collector::default();
-    let mut s = sim.engine_mut().start(Driven::NONE).unwrap();
+    let mut s = sim.engine_mut().unwrap().start(Driven::NONE).unwrap();
     s.set_stop_time(end);
     for &t in ends {
         let got = s

@@ -66,7 +66,7 @@ fn a_run_gives_its_summary() {
         "{}",
         sim.engine_line()
     );
-    let outcome = sim.run(RunRequest::default()).unwrap();
+    let outcome = sim.run_pack(RunRequest::default()).unwrap();
     let s = outcome.summary().unwrap();
     assert_eq!(s.discs.len(), 1);
     assert_eq!(s.fatigue.len(), 1);
@@ -85,7 +85,7 @@ fn a_stopped_run_and_a_refused_engine() {
     let scene = load_scene(Some(&scene_file("pack-4-rattle.toml")), &[]).unwrap();
     let outcome = Simulation::new(scene, None)
         .unwrap()
-        .run(RunRequest {
+        .run_pack(RunRequest {
             stop: Some(&stop),
             ..RunRequest::default()
         })
@@ -118,7 +118,7 @@ fn a_thermal_recording_carries_every_temperature() {
         let mut sim = Simulation::new(scene, None).unwrap();
         let path = dir.join(out);
         let outcome = sim
-            .run(RunRequest {
+            .run_pack(RunRequest {
                 recording: Some(clutchpack_sdk::RecordingRequest {
                     path: path.clone(),
                     replace: clutchpack_record::Replace::Existing,
@@ -180,7 +180,7 @@ fn windows_tile_the_run_and_add_up_to_it() {
         let scene = load_scene(scene.as_deref(), &sets).unwrap();
         let mut sim = Simulation::new(scene, None).unwrap();
         let outcome = sim
-            .run(RunRequest {
+            .run_pack(RunRequest {
                 windows_s: Some(w),
                 ..Default::default()
             })
@@ -234,4 +234,77 @@ fn windows_tile_the_run_and_add_up_to_it() {
             "{e}"
         );
     }
+}
+
+/// Issue 44 item 4: one `Simulation` for every scene. A network scene (`coupled-clutches`)
+/// is built and run by `Simulation::run` as a pack scene is; its summary, either kind's
+/// `Summary`, serialises to the network summary's own JSON byte for byte (untagged: the
+/// `--summary-json` of a network is what it was). What takes packs only refuses it before
+/// any work with one message naming the scene and what takes a network (`run_pack`, the
+/// engine, the bodies, a session), and a pack is refused where a network is expected.
+#[test]
+fn one_simulation_runs_a_network_and_pack_only_calls_refuse_it() {
+    let short: Override = "simulation.duration_s=0.05".parse().unwrap();
+    let net = load_scene(Some(&scene_file("coupled-clutches.toml")), &[short]).unwrap();
+    let mut sim = Simulation::new(net, None).unwrap();
+    assert!(sim.is_network());
+    assert_eq!(sim.engine_name(), "reference");
+    assert!(
+        sim.engine_line()
+            .contains("network of 4 bodies and 3 couplings), the default for a driveline network"),
+        "{}",
+        sim.engine_line()
+    );
+    let outcome = sim.run(RunRequest::default()).unwrap();
+    assert_eq!(
+        (outcome.scene(), outcome.engine()),
+        ("coupled-clutches", "reference")
+    );
+    let summary = outcome.summary().unwrap();
+    let network = outcome.into_network().unwrap();
+    assert!((network.summary.simulated_s - 0.05).abs() < 1e-12);
+    assert_eq!(
+        serde_json::to_string_pretty(&summary).unwrap(),
+        serde_json::to_string_pretty(&network.summary).unwrap()
+    );
+    sim.network_only().unwrap();
+    let refusals = [
+        sim.pack_only().err(),
+        sim.body_names().err(),
+        sim.engine_mut().err(),
+        sim.run_pack(RunRequest::default()).err(),
+        sim.start(Default::default()).err(),
+    ];
+    for e in refusals {
+        let e = e.expect("a pack-only call refuses a network");
+        assert!(e.is_bad_input(), "{e}");
+        let text = e.to_string();
+        assert!(
+            text.starts_with("coupled-clutches is a network scene ([[bodies]])")
+                && text.contains("sweeps and studies take pack scenes only"),
+            "{text}"
+        );
+    }
+
+    let mut pack = Simulation::new(load_scene(None, &[]).unwrap(), None).unwrap();
+    assert!(!pack.is_network());
+    let e = pack.network_only().unwrap_err();
+    assert!(e.is_bad_input(), "{e}");
+    assert!(
+        e.to_string().contains("is a pack scene, not a network"),
+        "{e}"
+    );
+    let stop = AtomicBool::new(true);
+    let outcome = pack
+        .run(RunRequest {
+            stop: Some(&stop),
+            ..RunRequest::default()
+        })
+        .unwrap();
+    let summary = outcome.summary().unwrap();
+    let run = outcome.into_pack().unwrap();
+    assert_eq!(
+        serde_json::to_string_pretty(&summary).unwrap(),
+        serde_json::to_string_pretty(&run.summary().unwrap()).unwrap()
+    );
 }

@@ -5,7 +5,7 @@
 //! do, and the shifts' starts are already breakpoints of the schedule's signals).
 
 use clutchpack_scene::{EngineChoice, Override, Scene};
-use clutchpack_sdk::{multibody_step_s, run_network_scene, NetworkRequest};
+use clutchpack_sdk::{multibody_step_s, NetworkRequest, Simulation};
 use std::path::Path;
 
 fn scene_file(name: &str, duration_s: f64) -> Scene {
@@ -26,7 +26,12 @@ fn taking_each_shifts_energy_balance_leaves_the_run_bit_for_bit() {
         let net = scene.network.as_ref().unwrap();
         let sim = &scene.simulation;
         for engine in [EngineChoice::Reference, EngineChoice::Multibody] {
-            let out = run_network_scene(&scene, Some(engine), NetworkRequest::default()).unwrap();
+            let out = Simulation::new(scene.clone(), Some(engine))
+                .unwrap()
+                .run(NetworkRequest::default())
+                .unwrap()
+                .into_network()
+                .unwrap();
             let run = match engine {
                 EngineChoice::Reference => {
                     let options = clutchpack_sdk::reference::network::NetworkOptions {

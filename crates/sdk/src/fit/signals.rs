@@ -201,15 +201,13 @@ pub(crate) fn series(
     stop: Option<&AtomicBool>,
 ) -> Result<Vec<Vec<f64>>> {
     if scene.network.is_some() {
-        let outcome = crate::run_network_scene(
-            scene,
-            asked,
-            NetworkRequest {
+        let outcome = Simulation::new(scene.clone(), asked)?
+            .run(NetworkRequest {
                 keep_history: true,
                 stop,
                 ..NetworkRequest::default()
-            },
-        )?;
+            })?
+            .into_network()?;
         return Ok(signals.iter().map(|s| s.at(&outcome.history, t)).collect());
     }
     let bad = Error::BadInput;
@@ -271,7 +269,7 @@ pub(crate) fn statistics(
         .map(|k| {
             let member = crate::ensemble_member(scene, k, ensemble);
             let mut sim = Simulation::new(member, asked)?;
-            let outcome = sim.run(RunRequest {
+            let outcome = sim.run_pack(RunRequest {
                 stop,
                 ..RunRequest::default()
             })?;
