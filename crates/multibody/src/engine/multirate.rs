@@ -1,8 +1,10 @@
 //! The multirate scheme (crate docs, "Theory"): the rapier world steps at free-flight length
 //! and every spline coupling integrates its own relative motion inside the world's step, with
 //! its own contact-aware sub-steps; the tooth impulse of the step is handed to the disc's
-//! rapier body, which carries the disc's state from one world step to the next (a coupling's
-//! sub-steps go through the one landing loop, `landing.rs`, as [`Alone`]).
+//! rapier body, which carries the disc's state from one world step to the next, or, on an
+//! open pack where rapier would do nothing else, the run carries it without rapier's step
+//! ([`Run::carry_bodies`]) (a coupling's sub-steps go through the one landing loop,
+//! `landing.rs`, as [`Alone`]).
 
 use super::carriers::Motion;
 use super::landing::SubSteps;
