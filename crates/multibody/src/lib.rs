@@ -171,7 +171,12 @@
 //!   the disc's mean speed over the step enters as a torque (rapier's semi-implicit Euler then
 //!   turns the disc by exactly the sub-steps' turn) and the end speed is set after it. The
 //!   round trip through rapier is exact to rounding (measured 4e-16 rad, 6e-15 rad/s), so the
-//!   scheme's error is the sub-steps' alone: fourth order away from the kinks.
+//!   scheme's error is the sub-steps' alone: fourth order away from the kinks. Where that is
+//!   all rapier does (an open pack: every carrier fixed or prescribed, every body concentric)
+//!   the run carries the bodies itself (issue 46): each coupling keeps its sub-steps' state at
+//!   the world step's end, its relative angle moved to the carrier's exact angle as the
+//!   poses' read-back moved it, without the quaternions' rounding; rapier's poses are brought
+//!   up to date only before the clamped stack, which reads them (`Run::carry_bodies`).
 //! - *Energy.* The classical Runge-Kutta method is not symplectic: it dissipates slightly,
 //!   `|R(i w h)| = 1 - (w h)^6 / 144` per step of an oscillation of frequency `w`, about
 //!   2.5e-5 of a sustained contact's vibration energy per period at its 32 steps per period,

@@ -371,6 +371,23 @@ impl World {
     pub fn disc_turn_owed_z(&self, i: usize) -> f64 {
         self.owed[i].z
     }
+
+    /// Places disc (or plate) `i` at `angle` about `+z` (rad, unwrapped) turning at `speed`
+    /// (rad/s), with no turn owed: its pose brought up to date by the run that carried it
+    /// (`Run::catch_up_world`).
+    pub(crate) fn place_disc(&mut self, i: usize, angle: f64, speed: f64) {
+        let body = &mut self.physics.bodies[self.discs[i]];
+        body.set_rotation(Rotation::from_rotation_z(angle), false);
+        body.set_angvel(Vector::new(0.0, 0.0, speed), false);
+        self.owed[i] = Vector::ZERO;
+    }
+
+    /// Places carrier `c` (a kinematic shaft) at `angle` about `+z` (rad, unwrapped): its
+    /// pose and its next pose.
+    pub(crate) fn place_carrier(&mut self, c: usize, angle: f64) {
+        let body = &mut self.physics.bodies[self.carriers[c].handle];
+        body.set_rotation(Rotation::from_rotation_z(angle), false);
+    }
 }
 
 /// Turns a body by the scaled axis `turn` (world frame).

@@ -1,8 +1,10 @@
 //! The multirate scheme (crate docs, "Theory"): the rapier world steps at free-flight length
 //! and every spline coupling integrates its own relative motion inside the world's step, with
 //! its own contact-aware sub-steps; the tooth impulse of the step is handed to the disc's
-//! rapier body, which carries the disc's state from one world step to the next (a coupling's
-//! sub-steps go through the one landing loop, `landing.rs`, as [`Alone`]).
+//! rapier body, which carries the disc's state from one world step to the next, or, on an
+//! open pack where rapier would do nothing else, the run carries it without rapier's step
+//! ([`Run::carry_bodies`]) (a coupling's sub-steps go through the one landing loop,
+//! `landing.rs`, as [`Alone`]).
 
 use super::carriers::Motion;
 use super::landing::SubSteps;
@@ -211,9 +213,76 @@ impl Run {
         }
         // The world's step: each body's impulse in two halves, `J (mean - w(t))` applied as a
         // torque over the step (rapier's semi-implicit Euler then drifts the body by
-        // exactly `mean h`) and `J (w(t1) - mean)` as the speed set at its end.
-        self.finish_world_step_in(&b.means, t1, &b.carriers, &mut b.prescribed);
+        // exactly `mean h`) and `J (w(t1) - mean)` as the speed set at its end; or, where
+        // that is all rapier would do, the bodies carried without it.
+        if self.carries_bodies {
+            self.carry_bodies(t1, ws.drive);
+        } else {
+            self.finish_world_step_in(&b.means, t1, &b.carriers, &mut b.prescribed);
+        }
         Ok(())
+    }
+
+    /// The world's step of the open pack from `t` to `t1` without rapier, where every carrier
+    /// is fixed or prescribed and every body concentric (`Run::carries_bodies`): rapier's step
+    /// would only turn each body by its mean speed over the step and set its speed at `t1`,
+    /// and the next world step read the relative states back from the poses. Each coupling's
+    /// state at `t1` is taken from its sub-steps instead: its relative angle `phi(t1)` moved
+    /// to the carrier's exact angle as the poses' read-back moves it, by
+    /// `(theta(t1) - theta~(t1)) - (theta(t) - theta~(t))` (`theta` the profile's angle in the
+    /// carriers' table, `theta~` the sub-steps' expansion of it about the world step's
+    /// middle); its relative speed the carrier's exact speed less the body's. That is the
+    /// read-back's value without the rounding of the quaternions (1e-16 of the angle a step);
+    /// the poses are brought up to date when something needs them
+    /// ([`Run::catch_up_world`]). Measured: a sixth of the 16-disc brake pack's run was
+    /// rapier's step and the read-back (docs/performance.md, "Against MuJoCo").
+    fn carry_bodies(&mut self, t1: f64, drive: Option<Prescribed<'_>>) {
+        let t0 = self.t;
+        for c in 0..self.carriers.len() {
+            let Motion::Prescribed(p) = &self.carriers[c].motion else {
+                continue;
+            };
+            let (speed, angle) = p.speed_and_angle(t1);
+            let shift = match drive {
+                Some(d) => {
+                    let path = Path::Profile(d);
+                    (angle - path.at(t1).angle) - (self.carriers[c].angle - path.at(t0).angle)
+                }
+                None => 0.0,
+            };
+            self.set_carrier_state(c, angle, speed);
+            for i in 0..self.couplings.len() {
+                if self.world.carrier_of[i] == c {
+                    self.rel[i].phi += shift;
+                }
+            }
+        }
+        for i in 0..self.couplings.len() {
+            self.rel[i].dphi = self.carrier_speed(i) - self.omega_d[i];
+        }
+        self.t_prev = Some(t0);
+        self.t = t1;
+        self.world_behind = true;
+    }
+
+    /// Brings rapier's poses up to date after world steps taken without it
+    /// ([`Run::carry_bodies`]): each prescribed carrier at its angle, each body at its
+    /// carrier's angle less its relative angle, turning at its speed. Before anything reads
+    /// the poses (the clamped stack's world steps).
+    pub(super) fn catch_up_world(&mut self) {
+        if !self.world_behind {
+            return;
+        }
+        for c in 0..self.carriers.len() {
+            if matches!(self.carriers[c].motion, Motion::Prescribed(_)) {
+                self.world.place_carrier(c, self.carriers[c].angle);
+            }
+        }
+        for i in 0..self.couplings.len() {
+            let angle = self.carrier_angle(i) - self.rel[i].phi;
+            self.world.place_disc(i, angle, self.omega_d[i]);
+        }
+        self.world_behind = false;
     }
 
     /// The world's step of the multirate schemes from `t` to `t1` after the couplings'
@@ -334,6 +403,10 @@ impl Run {
     /// Reads every coupling's relative state at `t` from the rapier bodies (the state each
     /// coupling's sub-steps start from).
     pub(super) fn read_relative_states(&mut self) {
+        if self.world_behind {
+            // carried without rapier: the states are the sub-steps' ([`Run::carry_bodies`])
+            return;
+        }
         let bodies = &self.world.physics.bodies;
         for i in 0..self.couplings.len() {
             let disc = &bodies[self.world.discs[i]];

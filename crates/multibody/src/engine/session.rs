@@ -463,6 +463,10 @@ impl MultibodySession {
                 &mut *observer
             };
             let run = &mut self.run;
+            if clamped {
+                // the clamped stack's world steps read rapier's poses
+                run.catch_up_world();
+            }
             run.read_relative_states();
             // the prescribed shaft over the step, expanded about its middle once for every
             // sub-step's stages

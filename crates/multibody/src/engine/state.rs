@@ -101,6 +101,14 @@ pub(super) struct Run {
     /// [`Run::update_stack`]'s buffer of the teeth's normal loads, N (kept so that a step
     /// does not allocate).
     pub(super) normal_buf: Vec<f64>,
+    /// Whether the open pack's multirate step carries the bodies from one world step to the
+    /// next itself, without rapier's step (`Run::carry_bodies`, `multirate.rs`): every carrier
+    /// fixed or prescribed, every body concentric, so that rapier would only turn each body
+    /// by its mean speed over the step.
+    pub(super) carries_bodies: bool,
+    /// Whether rapier's poses lag the run's state (carried without rapier since);
+    /// `Run::catch_up_world` brings them up to date.
+    pub(super) world_behind: bool,
 }
 
 /// Each coupling's effective mass along its line of action, kg: the body's, in series with
@@ -236,6 +244,11 @@ impl Run {
             .stack
             .as_ref()
             .map(|st| Stack::new(st, pack.discs.len()));
+        let carries_bodies = multirate
+            && carriers.iter().all(|k| !k.is_inertial())
+            && bodies
+                .iter()
+                .all(|d| !d.radial_float && d.initial_offset_m == [0.0; 2]);
         Ok(Run {
             bodies,
             world,
@@ -254,6 +267,8 @@ impl Run {
             potential_j: 0.0,
             energy: EnergyBook::default(),
             normal_buf: Vec::with_capacity(nd),
+            carries_bodies,
+            world_behind: false,
             pack,
         })
     }
