@@ -5,7 +5,7 @@
 #![allow(clippy::excessive_precision)]
 
 use clutchpack_model::cases;
-use clutchpack_model::network::ClutchMode;
+use clutchpack_model::network::{ClutchMode, NetworkSession};
 use clutchpack_model::ImpactEvent;
 use clutchpack_reference::network::{
     run_network, ClutchEvent, NetworkObserver, NetworkOptions, NetworkSample,
