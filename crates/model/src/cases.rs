@@ -18,8 +18,9 @@ use crate::spring::SpringDamper;
 mod packs;
 pub use packs::{
     engaging_clutch, pack_as_network, prescribed_clutch, prescribed_clutch_against_closed_form,
-    wet_clutch, PRESCRIBED_CLUTCH_ACCEL_RAD_S2, PRESCRIBED_CLUTCH_DURATION_S,
-    PRESCRIBED_CLUTCH_J_KG_M2, PRESCRIBED_CLUTCH_TORQUE_N_M, PRESCRIBED_CLUTCH_W0_RAD_S,
+    wet_clutch, PrescribedClutchObserver, PRESCRIBED_CLUTCH_ACCEL_RAD_S2,
+    PRESCRIBED_CLUTCH_DURATION_S, PRESCRIBED_CLUTCH_J_KG_M2, PRESCRIBED_CLUTCH_TORQUE_N_M,
+    PRESCRIBED_CLUTCH_W0_RAD_S,
 };
 
 /// Mean shaft speed of the paper case, rad/s (MODEL.md section 4, assumed).

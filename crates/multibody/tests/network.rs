@@ -1345,21 +1345,10 @@ fn vehicle_at_rest_under_road_load_takes_ordinary_steps() {
 #[test]
 fn a_prescribed_body_engages_a_free_one_as_the_closed_form() {
     let net = cases::prescribed_clutch();
-    let mut obs = Keep::default();
+    let mut obs = cases::PrescribedClutchObserver::default();
     let opts = NetworkStepOptions::default();
     let run = run_network(&net, cases::PRESCRIBED_CLUTCH_DURATION_S, &opts, &mut obs).unwrap();
-    let locks: Vec<f64> = obs
-        .0
-        .iter()
-        .filter(|e| e.to == ClutchMode::Locked && e.t_s > 0.0)
-        .map(|e| e.t_s)
-        .collect();
-    let reaction = |at: f64| {
-        let s = obs.1.iter().find(|s| (s.t_s - at).abs() < 1e-9).unwrap();
-        s.reaction_n_m[0]
-    };
-    let rows =
-        cases::prescribed_clutch_against_closed_form(&run, &locks, [reaction(0.25), reaction(0.7)]);
+    let rows = cases::prescribed_clutch_against_closed_form(&run, &obs);
     for (what, got, want) in rows {
         println!("{what}: {got} (closed form {want}, off {:.1e})", got - want);
         let bound = if what == "lock time s" { 1e-12 } else { 1e-9 };

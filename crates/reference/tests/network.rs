@@ -5,7 +5,7 @@
 #![allow(clippy::excessive_precision)]
 
 use clutchpack_model::cases;
-use clutchpack_model::network::ClutchMode;
+use clutchpack_model::network::{ClutchMode, NetworkSession};
 use clutchpack_model::ImpactEvent;
 use clutchpack_reference::network::{
     run_network, ClutchEvent, NetworkObserver, NetworkOptions, NetworkSample,
@@ -488,21 +488,10 @@ fn a_run_read_set_or_finished_inside_a_step_stands_at_the_call() {
 #[test]
 fn a_prescribed_body_engages_a_free_one_as_the_closed_form() {
     let net = cases::prescribed_clutch();
-    let mut obs = Events::default();
+    let mut obs = cases::PrescribedClutchObserver::default();
     let opts = NetworkOptions::default();
     let run = run_network(&net, cases::PRESCRIBED_CLUTCH_DURATION_S, &opts, &mut obs).unwrap();
-    let locks: Vec<f64> = obs
-        .0
-        .iter()
-        .filter(|e| e.to == ClutchMode::Locked && e.t_s > 0.0)
-        .map(|e| e.t_s)
-        .collect();
-    let reaction = |at: f64| {
-        let s = obs.1.iter().find(|s| (s.t_s - at).abs() < 1e-9).unwrap();
-        s.reaction_n_m[0]
-    };
-    let rows =
-        cases::prescribed_clutch_against_closed_form(&run, &locks, [reaction(0.25), reaction(0.7)]);
+    let rows = cases::prescribed_clutch_against_closed_form(&run, &obs);
     for (what, got, want) in rows {
         println!("{what}: {got} (closed form {want}, off {:.1e})", got - want);
         let bound = if what == "lock time s" { 1e-12 } else { 1e-9 };

@@ -387,6 +387,22 @@ fn unchanged_network_inputs_set_at_every_frame_keep_the_whole_runs_steps() {
     }
 }
 
+/// The shipped scene `name` on `engine`, every input driven (held at its value at t = 0 and
+/// set again before every call, as a host sets them) for `end` s: the driven run in calls to
+/// `ends` gives the driven run in one call bit for bit: the steps, every impact (at least one),
+/// the state at the end.
+fn driven_frames_match_whole_run(name: &str, engine: EngineChoice, end: f64, ends: &[f64]) {
+    let scene = scene_file(name);
+    let driven = Driven::all_for(&scene.pack);
+    assert!(driven.any(), "{name}");
+    let whole = host_run(&scene, engine, end, &[end], driven, true);
+    let framed = host_run(&scene, engine, end, ends, driven, true);
+    assert!(!whole.0.is_empty(), "{name} {engine:?}: no impacts");
+    assert_eq!(whole.2, framed.2, "{name} {engine:?}: the steps");
+    assert_eq!(whole.0, framed.0, "{name} {engine:?}: the impacts");
+    assert_eq!(whole.1, framed.1, "{name} {engine:?}: the state at the end");
+}
+
 /// Issue 46: a driven pack session on the reference engine ended a step at every call, where
 /// an input may change, so a host's 1 ms frames took other steps than the driven whole run
 /// (`hu-table2` 3692 against 3497 over 0.3 s, its peaks within 3.4e-6 N). Through the sdk's
@@ -399,15 +415,7 @@ fn driven_pack_session_ended_a_step_at_every_frame() {
     let end = 0.05;
     let ends = frames(None, 1e-3, end);
     for name in ["hu-table2", "pack-4-damper"] {
-        let scene = scene_file(name);
-        let driven = Driven::all_for(&scene.pack);
-        assert!(driven.any(), "{name}");
-        let whole = host_run(&scene, EngineChoice::Reference, end, &[end], driven, true);
-        let framed = host_run(&scene, EngineChoice::Reference, end, &ends, driven, true);
-        assert!(!whole.0.is_empty(), "{name}: no impacts");
-        assert_eq!(whole.2, framed.2, "{name}: the steps");
-        assert_eq!(whole.0, framed.0, "{name}: the impacts");
-        assert_eq!(whole.1, framed.1, "{name}: the state at the end");
+        driven_frames_match_whole_run(name, EngineChoice::Reference, end, &ends);
     }
 }
 
@@ -425,15 +433,7 @@ fn driven_multibody_session_landed_on_the_frames_off_the_grid() {
     let end = 0.05;
     let ends = frames(None, 1e-3, end);
     for name in ["hu-table2", "pack-8-brake"] {
-        let scene = scene_file(name);
-        let driven = Driven::all_for(&scene.pack);
-        assert!(driven.any(), "{name}");
-        let whole = host_run(&scene, EngineChoice::Multibody, end, &[end], driven, true);
-        let framed = host_run(&scene, EngineChoice::Multibody, end, &ends, driven, true);
-        assert!(!whole.0.is_empty(), "{name}: no impacts");
-        assert_eq!(whole.2, framed.2, "{name}: the steps");
-        assert_eq!(whole.0, framed.0, "{name}: the impacts");
-        assert_eq!(whole.1, framed.1, "{name}: the state at the end");
+        driven_frames_match_whole_run(name, EngineChoice::Multibody, end, &ends);
     }
 }
 
@@ -448,15 +448,7 @@ fn driven_multibody_session_landed_on_the_frames_off_the_grid() {
 fn driven_multibody_shared_step_ended_a_step_at_every_frame() {
     let end = 0.05;
     let ends = frames(None, 1e-3, end);
-    let scene = scene_file("pack-4-damper");
-    let driven = Driven::all_for(&scene.pack);
-    assert!(driven.any());
-    let whole = host_run(&scene, EngineChoice::Multibody, end, &[end], driven, true);
-    let framed = host_run(&scene, EngineChoice::Multibody, end, &ends, driven, true);
-    assert!(!whole.0.is_empty(), "no impacts");
-    assert_eq!(whole.2, framed.2, "the steps");
-    assert_eq!(whole.0, framed.0, "the impacts");
-    assert_eq!(whole.1, framed.1, "the state at the end");
+    driven_frames_match_whole_run("pack-4-damper", EngineChoice::Multibody, end, &ends);
 }
 
 /// Issue 46: a host's frame end inside a world step of a driven multibody session ended that
@@ -471,13 +463,6 @@ fn driven_multibody_session_ended_a_world_step_at_a_frame_inside_it() {
     let end = 0.05;
     let ends = frames(None, 2.5e-5, end);
     for name in ["hu-table2", "pack-8-brake", "pack-4-damper"] {
-        let scene = scene_file(name);
-        let driven = Driven::all_for(&scene.pack);
-        let whole = host_run(&scene, EngineChoice::Multibody, end, &[end], driven, true);
-        let framed = host_run(&scene, EngineChoice::Multibody, end, &ends, driven, true);
-        assert!(!whole.0.is_empty(), "{name}: no impacts");
-        assert_eq!(whole.2, framed.2, "{name}: the steps");
-        assert_eq!(whole.0, framed.0, "{name}: the impacts");
-        assert_eq!(whole.1, framed.1, "{name}: the state at the end");
+        driven_frames_match_whole_run(name, EngineChoice::Multibody, end, &ends);
     }
 }

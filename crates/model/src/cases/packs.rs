@@ -253,17 +253,57 @@ pub fn prescribed_clutch() -> crate::network::Network {
 /// 0.3 s locked).
 pub const PRESCRIBED_CLUTCH_DURATION_S: f64 = 0.8;
 
+/// The instants at which [`PrescribedClutchObserver`] reads the motor's reaction, s: slipping
+/// (0.25 s) and locked (0.7 s).
+const PRESCRIBED_CLUTCH_REACTIONS_AT_S: [f64; 2] = [0.25, 0.7];
+
+/// What [`prescribed_clutch_against_closed_form`] reads of a run of [`prescribed_clutch`],
+/// collected as the run goes (either engine's observer): the times the clutch locks after
+/// t = 0, s, and the motor's (body 0's) reaction in the first sample within 1e-9 s of 0.25 s
+/// (slipping) and of 0.7 s (locked), N m (`None` while no sample has come there).
+#[derive(Debug, Clone, Default)]
+pub struct PrescribedClutchObserver {
+    /// The clutch's locks after t = 0, s.
+    pub locks_s: Vec<f64>,
+    /// The motor's reaction slipping and locked, N m ([`NetworkSample::reaction_n_m`]).
+    ///
+    /// [`NetworkSample::reaction_n_m`]: crate::network::NetworkSample::reaction_n_m
+    pub reactions_n_m: [Option<f64>; 2],
+}
+
+impl crate::network::NetworkObserver for PrescribedClutchObserver {
+    fn sample(&mut self, sample: &crate::network::NetworkSample) {
+        for (at, r) in PRESCRIBED_CLUTCH_REACTIONS_AT_S
+            .iter()
+            .zip(self.reactions_n_m.iter_mut())
+        {
+            if r.is_none() && (sample.t_s - at).abs() < 1e-9 {
+                *r = sample.reaction_n_m.first().copied();
+            }
+        }
+    }
+
+    fn clutch_event(&mut self, event: &crate::network::ClutchEvent) {
+        if event.to == crate::network::ClutchMode::Locked && event.t_s > 0.0 {
+            self.locks_s.push(event.t_s);
+        }
+    }
+}
+
 /// [`prescribed_clutch`]'s run over [`PRESCRIBED_CLUTCH_DURATION_S`] against its closed form
-/// (the formulas of [`prescribed_clutch`]): one `(quantity, got, closed form)` row each for the
-/// number of locks (1), the first lock's time (s), the motor's and the load's speeds at the
-/// end (rad/s), the heat (J), the motor's reaction while slipping (`reactions[0]`, at 0.25 s)
-/// and locked (`reactions[1]`, at 0.7 s; N m), its work (J) and the balance's residual (J),
-/// for each engine's test to bound.
+/// (the formulas of [`prescribed_clutch`]), with what `seen` collected of it: one
+/// `(quantity, got, closed form)` row each for the number of locks (1), the first lock's time
+/// (s), the motor's and the load's speeds at the end (rad/s), the heat (J), the motor's
+/// reaction while slipping (at 0.25 s) and locked (at 0.7 s; N m; NaN where no sample came),
+/// its work (J) and the balance's residual (J), for each engine's test to bound.
 pub fn prescribed_clutch_against_closed_form(
     run: &crate::network::NetworkRun,
-    locks_s: &[f64],
-    reactions_n_m: [f64; 2],
+    seen: &PrescribedClutchObserver,
 ) -> Vec<(&'static str, f64, f64)> {
+    let (locks_s, reactions_n_m) = (
+        &seen.locks_s,
+        seen.reactions_n_m.map(|r| r.unwrap_or(f64::NAN)),
+    );
     let (w0, a) = (PRESCRIBED_CLUTCH_W0_RAD_S, PRESCRIBED_CLUTCH_ACCEL_RAD_S2);
     let (j, t) = (PRESCRIBED_CLUTCH_J_KG_M2, PRESCRIBED_CLUTCH_TORQUE_N_M);
     let t_lock = w0 / (t / j - a);

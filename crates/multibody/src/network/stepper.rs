@@ -9,7 +9,7 @@ use super::packs::NetPack;
 use super::{NetworkStepOptions, Run};
 use clutchpack_model::network::{
     Body, ClutchMode, Network, NetworkEnergy, NetworkInput, NetworkObserver, NetworkRun,
-    NetworkSample,
+    NetworkSample, NetworkSession,
 };
 use clutchpack_model::{guard_state, EngineError, RUNAWAY_SPEED_RAD_S};
 use std::sync::Arc;
@@ -144,104 +144,6 @@ impl NetworkStepper {
         }
         stepper.start_step(obs);
         Ok(stepper)
-    }
-
-    /// The time the run stands at, s.
-    pub fn time_s(&self) -> f64 {
-        self.t
-    }
-
-    /// The network as run (with the inputs set so far in place of the scene's signals).
-    pub fn network(&self) -> &Network {
-        &self.run.net
-    }
-
-    /// The temperatures of the thermal pack that is coupling `k`, K (its discs', plates',
-    /// then oil's, as at its last thermal window's end); `None` for another coupling.
-    pub fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
-        self.run.packs.iter().find(|p| p.k == k)?.temperatures_k()
-    }
-
-    /// The state now as a sample (every body's angle, rad, and speed, rad/s, every
-    /// coupling's torque on its body `a`, N m, and a clutch's mode).
-    pub fn sample_now(&mut self) -> NetworkSample {
-        self.run.sample(self.t)
-    }
-
-    /// Heat of each clutch or resolved pack's faces, work done on each gear mesh, or each
-    /// damper's loss, since t = 0, J, by coupling (0 for an ideal gear or a spring-damper's
-    /// spring).
-    pub fn heat_j(&self) -> Vec<f64> {
-        let mut heat = self.run.heat.clone();
-        // a resolved pack's: its faces' (and open gaps') heat so far
-        for p in &self.run.packs {
-            heat[p.k] = p.face_heat_j();
-        }
-        heat
-    }
-
-    /// Sets `input` to `value` from now on (N m or N; [`Network::hold_input`]): the scene's
-    /// signal is replaced by the held value in the stepper's own network, its breakpoints
-    /// after now taken again, and the run restarts here as at a jump of a signal (counted as
-    /// an event; the clutches' modes settled at once, MODEL.md section 8, events sent to
-    /// `obs`). A value that is not finite, a negative force, or an input naming a body or
-    /// coupling that cannot take it is refused, the run unchanged.
-    pub fn set_input(
-        &mut self,
-        input: NetworkInput,
-        value: f64,
-        obs: &mut dyn NetworkObserver,
-    ) -> Result<(), EngineError> {
-        Arc::make_mut(&mut self.run.net).hold_input(input, value)?;
-        if let NetworkInput::PackPressure(k) = input {
-            // the pack's session holds it too (the network's copy keeps the breakpoints)
-            if let Some(p) = self.run.packs.iter_mut().find(|p| p.k == k) {
-                p.hold_pressure(value)?;
-            }
-        }
-        let t = self.t;
-        self.breakpoints = self.run.net.breakpoints(self.duration_s);
-        self.next_bp = self
-            .breakpoints
-            .partition_point(|&b| b <= t + 1e-12 * (1.0 + t));
-        self.run.events += 1;
-        self.run.settle(t, obs);
-        Ok(())
-    }
-
-    /// Advances to `t_end` s (at most the run's end), a step ending there (within the
-    /// events' precision, `1e-12 (1 + t)` s, as the run's end); samples, clutch events and
-    /// mesh impacts go to `obs` as they happen. Stops early (without error) when `obs` asks
-    /// to ([`NetworkObserver::progress`]).
-    pub fn advance_to(
-        &mut self,
-        t_end: f64,
-        obs: &mut dyn NetworkObserver,
-    ) -> Result<(), EngineError> {
-        let t_end = t_end.min(self.duration_s);
-        loop {
-            if !self.started {
-                self.start_step(obs);
-            }
-            if self.t >= t_end || near(self.t, t_end) {
-                return Ok(());
-            }
-            self.step(t_end, obs)?;
-            if obs.wants_open_contacts(self.t) {
-                let mut open = Vec::new();
-                for m in &self.run.meshes {
-                    open.extend(m.open(self.t).map(|e| (m.coupling, None, e)));
-                }
-                for p in &self.run.packs {
-                    p.open(&mut open);
-                }
-                obs.open_contacts(self.t, &open);
-            }
-            if !obs.progress(self.t) {
-                self.run.settle(self.t, obs);
-                return Ok(());
-            }
-        }
     }
 
     /// The start of a step at `t` (the module's method, steps 0 and 1): the breakpoints
@@ -443,45 +345,107 @@ impl NetworkStepper {
     }
 }
 
-impl clutchpack_model::network::NetworkSession for NetworkStepper {
+/// The session every engine's network run is to its callers (the sdk holds either engine's).
+impl NetworkSession for NetworkStepper {
+    /// The time the run stands at, s.
     fn time_s(&self) -> f64 {
-        NetworkStepper::time_s(self)
+        self.t
     }
 
+    /// The network as run (with the inputs set so far in place of the scene's signals).
     fn network(&self) -> &Network {
-        NetworkStepper::network(self)
+        &self.run.net
     }
 
-    fn sample_now(&mut self) -> NetworkSample {
-        NetworkStepper::sample_now(self)
-    }
-
+    /// The temperatures of the thermal pack that is coupling `k`, K (its discs', plates',
+    /// then oil's, as at its last thermal window's end); `None` for another coupling.
     fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
-        NetworkStepper::pack_temperatures_k(self, k)
+        self.run.packs.iter().find(|p| p.k == k)?.temperatures_k()
     }
 
+    /// The state now as a sample (every body's angle, rad, and speed, rad/s, every
+    /// coupling's torque on its body `a`, N m, and a clutch's mode).
+    fn sample_now(&mut self) -> NetworkSample {
+        self.run.sample(self.t)
+    }
+
+    /// Heat of each clutch or resolved pack's faces, work done on each gear mesh, or each
+    /// damper's loss, since t = 0, J, by coupling (0 for an ideal gear or a spring-damper's
+    /// spring).
     fn heat_j(&self) -> Vec<f64> {
-        NetworkStepper::heat_j(self)
+        let mut heat = self.run.heat.clone();
+        // a resolved pack's: its faces' (and open gaps') heat so far
+        for p in &self.run.packs {
+            heat[p.k] = p.face_heat_j();
+        }
+        heat
     }
 
+    /// Sets `input` to `value` from now on (N m or N; [`Network::hold_input`]): the scene's
+    /// signal is replaced by the held value in the stepper's own network, its breakpoints
+    /// after now taken again, and the run restarts here as at a jump of a signal (counted as
+    /// an event; the clutches' modes settled at once, MODEL.md section 8, events sent to
+    /// `obs`). A value that is not finite, a negative force, or an input naming a body or
+    /// coupling that cannot take it is refused, the run unchanged.
     fn set_input(
         &mut self,
         input: NetworkInput,
         value: f64,
         obs: &mut dyn NetworkObserver,
     ) -> Result<(), EngineError> {
-        NetworkStepper::set_input(self, input, value, obs)
+        Arc::make_mut(&mut self.run.net).hold_input(input, value)?;
+        if let NetworkInput::PackPressure(k) = input {
+            // the pack's session holds it too (the network's copy keeps the breakpoints)
+            if let Some(p) = self.run.packs.iter_mut().find(|p| p.k == k) {
+                p.hold_pressure(value)?;
+            }
+        }
+        let t = self.t;
+        self.breakpoints = self.run.net.breakpoints(self.duration_s);
+        self.next_bp = self
+            .breakpoints
+            .partition_point(|&b| b <= t + 1e-12 * (1.0 + t));
+        self.run.events += 1;
+        self.run.settle(t, obs);
+        Ok(())
     }
 
+    /// Advances to `t_end` s (at most the run's end), a step ending there (within the
+    /// events' precision, `1e-12 (1 + t)` s, as the run's end); samples, clutch events and
+    /// mesh impacts go to `obs` as they happen. Stops early (without error) when `obs` asks
+    /// to ([`NetworkObserver::progress`]).
     fn advance_to(&mut self, t_end: f64, obs: &mut dyn NetworkObserver) -> Result<(), EngineError> {
-        NetworkStepper::advance_to(self, t_end, obs)
+        let t_end = t_end.min(self.duration_s);
+        loop {
+            if !self.started {
+                self.start_step(obs);
+            }
+            if self.t >= t_end || near(self.t, t_end) {
+                return Ok(());
+            }
+            self.step(t_end, obs)?;
+            if obs.wants_open_contacts(self.t) {
+                let mut open = Vec::new();
+                for m in &self.run.meshes {
+                    open.extend(m.open(self.t).map(|e| (m.coupling, None, e)));
+                }
+                for p in &self.run.packs {
+                    p.open(&mut open);
+                }
+                obs.open_contacts(self.t, &open);
+            }
+            if !obs.progress(self.t) {
+                self.run.settle(self.t, obs);
+                return Ok(());
+            }
+        }
     }
 
     fn finish_boxed(self: Box<Self>, obs: &mut dyn NetworkObserver) -> NetworkRun {
         NetworkStepper::finish(*self, obs)
     }
 
-    fn boxed_clone(&self) -> Box<dyn clutchpack_model::network::NetworkSession> {
+    fn boxed_clone(&self) -> Box<dyn NetworkSession> {
         Box::new(self.clone())
     }
 }

@@ -504,54 +504,6 @@ fn reactions(eq: &Equations) -> Vec<f64> {
         .collect()
 }
 
-/// The session every engine's network run is to its callers (the sdk holds either engine's).
-impl clutchpack_model::network::NetworkSession for NetworkStepper {
-    fn time_s(&self) -> f64 {
-        NetworkStepper::time_s(self)
-    }
-
-    fn network(&self) -> &Network {
-        NetworkStepper::network(self)
-    }
-
-    fn sample_now(&mut self) -> NetworkSample {
-        NetworkStepper::sample_now(self)
-    }
-
-    fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
-        NetworkStepper::pack_temperatures_k(self, k)
-    }
-
-    fn heat_j(&self) -> Vec<f64> {
-        NetworkStepper::heat_j(self)
-    }
-
-    fn set_input(
-        &mut self,
-        input: stepper::NetworkInput,
-        value: f64,
-        obs: &mut dyn NetworkObserver,
-    ) -> Result<(), clutchpack_model::EngineError> {
-        NetworkStepper::set_input(self, input, value, obs)
-    }
-
-    fn advance_to(
-        &mut self,
-        t_end: f64,
-        obs: &mut dyn NetworkObserver,
-    ) -> Result<(), clutchpack_model::EngineError> {
-        NetworkStepper::advance_to(self, t_end, obs)
-    }
-
-    fn finish_boxed(self: Box<Self>, obs: &mut dyn NetworkObserver) -> NetworkRun {
-        NetworkStepper::finish(*self, obs)
-    }
-
-    fn boxed_clone(&self) -> Box<dyn clutchpack_model::network::NetworkSession> {
-        Box::new(self.clone())
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -453,3 +453,29 @@ pub(super) fn emit_samples(
         obs.pack_sample(p.k, t, &angles, &speeds, &loads);
     }
 }
+
+/// Closes the thermal windows of every thermal pack that ended by `t` (s), sending the new
+/// temperatures to `obs` and swapping in each pack's new parameters; whether any pack's
+/// parameters changed (the integration then restarts).
+pub(super) fn close_thermal_windows(
+    eq: &mut super::Equations,
+    t: f64,
+    obs: &mut dyn NetworkObserver,
+) -> Result<bool, clutchpack_model::EngineError> {
+    let mut swapped = false;
+    for p in eq.packs.iter_mut() {
+        let Some(th) = p.thermal.as_mut() else {
+            continue;
+        };
+        let windows = th.windows();
+        let closed = th.close_windows(t, &p.sys.pack)?;
+        if th.windows() != windows {
+            obs.pack_temperatures(p.k, t, th.temperatures_k());
+        }
+        if let Some(pack) = closed {
+            p.sys.set_pack(Arc::new(pack));
+            swapped = true;
+        }
+    }
+    Ok(swapped)
+}

@@ -10,6 +10,7 @@ use crate::thermal::Thermal;
 pub use clutchpack_model::network::NetworkInput;
 use clutchpack_model::network::{
     ClutchMode, EnergyTerm, Network, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
+    NetworkSession,
 };
 use clutchpack_model::{guard_state, EngineError, RUNAWAY_SPEED_RAD_S};
 use std::sync::Arc;
@@ -180,38 +181,6 @@ impl NetworkStepper {
         })
     }
 
-    /// The time the run stands at, s: the last call's end (the integration may have taken
-    /// its step past it: the type's docs).
-    pub fn time_s(&self) -> f64 {
-        self.now
-    }
-
-    /// The network as run (with the inputs set so far in place of the scene's signals).
-    pub fn network(&self) -> &Network {
-        &self.eq.net
-    }
-
-    /// The temperatures of the thermal resolved pack that is coupling `k` at its last thermal
-    /// window's end, K: its discs', its plates', then its oil's (`None` for another
-    /// coupling). A window closes at the end of the integration's step that reaches it, as
-    /// in the whole run (with a step taken past the session's time, a window ending inside
-    /// it closes when the step is applied).
-    pub fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
-        let p = self.eq.packs.iter().find(|p| p.k == k)?;
-        p.thermal.as_ref().map(|th| th.temperatures_k())
-    }
-
-    /// The state now as a sample (every body's angle and speed, every coupling's torque and
-    /// a clutch's mode), at the session's time: from the pending step's dense output when
-    /// the integration has taken its step past it.
-    pub fn sample_now(&mut self) -> NetworkSample {
-        if self.pending.is_some() {
-            self.dense.eval(self.now, &mut self.ybuf);
-            return sample(&mut self.eq, self.now, &self.ybuf);
-        }
-        sample(&mut self.eq, self.t, &self.y)
-    }
-
     /// The state at the session's time: the integration's, or the pending step's dense
     /// output there.
     fn state_now(&self) -> std::borrow::Cow<'_, [f64]> {
@@ -222,111 +191,6 @@ impl NetworkStepper {
         } else {
             std::borrow::Cow::Borrowed(&self.y)
         }
-    }
-
-    /// Heat of each clutch, work done on each gear mesh, or each damper's loss, since t = 0,
-    /// J, by coupling (0 for an ideal gear), at the session's time.
-    pub fn heat_j(&self) -> Vec<f64> {
-        let y = self.state_now();
-        let (n, m) = (self.eq.net.bodies.len(), self.eq.net.couplings.len());
-        let c0 = 2 * n + m;
-        (0..m)
-            .map(|k| {
-                let c = &self.eq.net.couplings[k];
-                if c.law().energy_term() == EnergyTerm::None {
-                    0.0
-                } else {
-                    y[c0 + k]
-                }
-            })
-            .enumerate()
-            .map(|(k, h)| {
-                self.eq
-                    .packs
-                    .iter()
-                    .find(|p| p.k == k)
-                    .map_or(h, |p| p.face_heat_j(&y))
-            })
-            .collect()
-    }
-
-    /// Sets `input` to `value` from now on (N m or N): the scene's signal is replaced by the
-    /// held value, and the run restarts here as at a jump of a signal (a step taken past the
-    /// session's time ended at it from its dense output, the clutches' modes settled, events
-    /// sent to `obs`). A value that is not finite, a negative force, or an input naming a
-    /// body or coupling that cannot take it is refused, the run's state and inputs as they
-    /// were (the step in progress is ended at the session's time all the same).
-    pub fn set_input(
-        &mut self,
-        input: NetworkInput,
-        value: f64,
-        obs: &mut dyn NetworkObserver,
-    ) -> Result<(), EngineError> {
-        if let Some(p) = self.pending.take() {
-            // the old input holds up to the session's time: the step ends there
-            self.apply(p, Some(self.now), obs)?;
-        }
-        Arc::make_mut(&mut self.eq.net).hold_input(input, value)?;
-        if let NetworkInput::PackPressure(k) = input {
-            // the pack's equations carry their own model: its piston's pressure held too
-            let pack = self.eq.net.couplings[k].pack().expect("a pack").clone();
-            if let Some(p) = self.eq.packs.iter_mut().find(|p| p.k == k) {
-                p.sys.set_pack(Arc::new(pack));
-            }
-        }
-        // the signal's breakpoints after now are those of the network as it is now
-        let t = self.t;
-        self.breakpoints = self.eq.net.breakpoints(self.duration_s);
-        self.next_bp = self.breakpoints.partition_point(|&b| b <= t);
-        self.g1.iter_mut().for_each(|g| *g = 1.0);
-        self.g0_at = f64::NAN;
-        settle(
-            &mut self.eq,
-            t,
-            &mut self.y,
-            &self.g1,
-            obs,
-            &mut self.events,
-        );
-        heal_faces(&mut self.eq, t, &mut self.y, obs);
-        self.eq.rhs(t, &self.y, &mut self.dy);
-        self.stepper.set_start_derivative(&self.dy);
-        Ok(())
-    }
-
-    /// Advances to `t_end` s (at most the run's end); samples, clutch events and mesh impacts
-    /// go to `obs` as the steps are applied. The steps are the whole run's: the one that
-    /// passes `t_end` waits (the type's docs), unless it ends within the events' precision
-    /// of `t_end` (frames added up by a host: 0.1 after ten of 0.01 is 0.09999999999999999;
-    /// the run then stands at the step's end). Stops early (without error) when `obs` asks
-    /// to ([`NetworkObserver::progress`]).
-    pub fn advance_to(
-        &mut self,
-        t_end: f64,
-        obs: &mut dyn NetworkObserver,
-    ) -> Result<(), EngineError> {
-        let t_end = t_end.min(self.duration_s);
-        loop {
-            if let Some(p) = self.pending {
-                if p.end > t_end + 1e-13 * (1.0 + t_end) {
-                    // the call ends inside the step: it waits for a later call
-                    self.now = self.now.max(t_end);
-                    return Ok(());
-                }
-                self.pending = None;
-                self.apply(p, None, obs)?;
-                if !obs.progress(self.t) {
-                    break;
-                }
-                continue;
-            }
-            if self.t >= t_end {
-                break;
-            }
-            self.pending = self.propose(obs)?;
-        }
-        self.now = self.t;
-        Ok(())
     }
 
     /// The integration's next step from its time, its events located (`None`: no step to
@@ -539,7 +403,7 @@ impl NetworkStepper {
             stepper.accept();
             *h = next_step(p.h_try, p.err);
         }
-        if close_thermal_windows(eq, *t, obs)? {
+        if packs::close_thermal_windows(eq, *t, obs)? {
             // new viscosity-dependent parameters: the integration restarts from the state
             *g0_at = f64::NAN;
             heal_faces(eq, *t, y, obs);
@@ -636,6 +500,150 @@ impl NetworkStepper {
     }
 }
 
+/// The session every engine's network run is to its callers (the sdk holds either engine's).
+impl NetworkSession for NetworkStepper {
+    /// The time the run stands at, s: the last call's end (the integration may have taken
+    /// its step past it: the type's docs).
+    fn time_s(&self) -> f64 {
+        self.now
+    }
+
+    /// The network as run (with the inputs set so far in place of the scene's signals).
+    fn network(&self) -> &Network {
+        &self.eq.net
+    }
+
+    /// The temperatures of the thermal resolved pack that is coupling `k` at its last thermal
+    /// window's end, K: its discs', its plates', then its oil's (`None` for another
+    /// coupling). A window closes at the end of the integration's step that reaches it, as
+    /// in the whole run (with a step taken past the session's time, a window ending inside
+    /// it closes when the step is applied).
+    fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]> {
+        let p = self.eq.packs.iter().find(|p| p.k == k)?;
+        p.thermal.as_ref().map(|th| th.temperatures_k())
+    }
+
+    /// The state now as a sample (every body's angle and speed, every coupling's torque and
+    /// a clutch's mode), at the session's time: from the pending step's dense output when
+    /// the integration has taken its step past it.
+    fn sample_now(&mut self) -> NetworkSample {
+        if self.pending.is_some() {
+            self.dense.eval(self.now, &mut self.ybuf);
+            return sample(&mut self.eq, self.now, &self.ybuf);
+        }
+        sample(&mut self.eq, self.t, &self.y)
+    }
+
+    /// Heat of each clutch, work done on each gear mesh, or each damper's loss, since t = 0,
+    /// J, by coupling (0 for an ideal gear), at the session's time.
+    fn heat_j(&self) -> Vec<f64> {
+        let y = self.state_now();
+        let (n, m) = (self.eq.net.bodies.len(), self.eq.net.couplings.len());
+        let c0 = 2 * n + m;
+        (0..m)
+            .map(|k| {
+                let c = &self.eq.net.couplings[k];
+                if c.law().energy_term() == EnergyTerm::None {
+                    0.0
+                } else {
+                    y[c0 + k]
+                }
+            })
+            .enumerate()
+            .map(|(k, h)| {
+                self.eq
+                    .packs
+                    .iter()
+                    .find(|p| p.k == k)
+                    .map_or(h, |p| p.face_heat_j(&y))
+            })
+            .collect()
+    }
+
+    /// Sets `input` to `value` from now on (N m or N): the scene's signal is replaced by the
+    /// held value, and the run restarts here as at a jump of a signal (a step taken past the
+    /// session's time ended at it from its dense output, the clutches' modes settled, events
+    /// sent to `obs`). A value that is not finite, a negative force, or an input naming a
+    /// body or coupling that cannot take it is refused, the run's state and inputs as they
+    /// were (the step in progress is ended at the session's time all the same).
+    fn set_input(
+        &mut self,
+        input: NetworkInput,
+        value: f64,
+        obs: &mut dyn NetworkObserver,
+    ) -> Result<(), EngineError> {
+        if let Some(p) = self.pending.take() {
+            // the old input holds up to the session's time: the step ends there
+            self.apply(p, Some(self.now), obs)?;
+        }
+        Arc::make_mut(&mut self.eq.net).hold_input(input, value)?;
+        if let NetworkInput::PackPressure(k) = input {
+            // the pack's equations carry their own model: its piston's pressure held too
+            let pack = self.eq.net.couplings[k].pack().expect("a pack").clone();
+            if let Some(p) = self.eq.packs.iter_mut().find(|p| p.k == k) {
+                p.sys.set_pack(Arc::new(pack));
+            }
+        }
+        // the signal's breakpoints after now are those of the network as it is now
+        let t = self.t;
+        self.breakpoints = self.eq.net.breakpoints(self.duration_s);
+        self.next_bp = self.breakpoints.partition_point(|&b| b <= t);
+        self.g1.iter_mut().for_each(|g| *g = 1.0);
+        self.g0_at = f64::NAN;
+        settle(
+            &mut self.eq,
+            t,
+            &mut self.y,
+            &self.g1,
+            obs,
+            &mut self.events,
+        );
+        heal_faces(&mut self.eq, t, &mut self.y, obs);
+        self.eq.rhs(t, &self.y, &mut self.dy);
+        self.stepper.set_start_derivative(&self.dy);
+        Ok(())
+    }
+
+    /// Advances to `t_end` s (at most the run's end); samples, clutch events and mesh impacts
+    /// go to `obs` as the steps are applied. The steps are the whole run's: the one that
+    /// passes `t_end` waits (the type's docs), unless it ends within the events' precision
+    /// of `t_end` (frames added up by a host: 0.1 after ten of 0.01 is 0.09999999999999999;
+    /// the run then stands at the step's end). Stops early (without error) when `obs` asks
+    /// to ([`NetworkObserver::progress`]).
+    fn advance_to(&mut self, t_end: f64, obs: &mut dyn NetworkObserver) -> Result<(), EngineError> {
+        let t_end = t_end.min(self.duration_s);
+        loop {
+            if let Some(p) = self.pending {
+                if p.end > t_end + 1e-13 * (1.0 + t_end) {
+                    // the call ends inside the step: it waits for a later call
+                    self.now = self.now.max(t_end);
+                    return Ok(());
+                }
+                self.pending = None;
+                self.apply(p, None, obs)?;
+                if !obs.progress(self.t) {
+                    break;
+                }
+                continue;
+            }
+            if self.t >= t_end {
+                break;
+            }
+            self.pending = self.propose(obs)?;
+        }
+        self.now = self.t;
+        Ok(())
+    }
+
+    fn finish_boxed(self: Box<Self>, obs: &mut dyn NetworkObserver) -> NetworkRun {
+        NetworkStepper::finish(*self, obs)
+    }
+
+    fn boxed_clone(&self) -> Box<dyn NetworkSession> {
+        Box::new(self.clone())
+    }
+}
+
 /// A step taken and its events located, not yet applied ([`NetworkStepper::propose`],
 /// [`NetworkStepper::apply`]).
 #[derive(Clone, Copy)]
@@ -654,32 +662,6 @@ struct Pending {
     at_bp: bool,
     /// Whether the run restarts at its end (an event, or a landing).
     at_event: bool,
-}
-
-/// Closes the thermal windows of every thermal pack that ended by `t` (s), sending the new
-/// temperatures to `obs` and swapping in each pack's new parameters; whether any pack's
-/// parameters changed (the integration then restarts).
-fn close_thermal_windows(
-    eq: &mut Equations,
-    t: f64,
-    obs: &mut dyn NetworkObserver,
-) -> Result<bool, EngineError> {
-    let mut swapped = false;
-    for p in eq.packs.iter_mut() {
-        let Some(th) = p.thermal.as_mut() else {
-            continue;
-        };
-        let windows = th.windows();
-        let closed = th.close_windows(t, &p.sys.pack)?;
-        if th.windows() != windows {
-            obs.pack_temperatures(p.k, t, th.temperatures_k());
-        }
-        if let Some(pack) = closed {
-            p.sys.set_pack(Arc::new(pack));
-            swapped = true;
-        }
-    }
-    Ok(swapped)
 }
 
 /// Settles the packs' faces that an event or a settling left switching (their guards not
