@@ -442,10 +442,15 @@ impl System {
         modes: &[Option<Engagement>],
         f: impl FnOnce(&[f64; 4], &StackEval) -> R,
     ) -> R {
-        self.with_loads(y, modes, |loads| {
-            let c = self.carriers_with_loads(t, y, modes, Some(loads));
-            self.with_stack_eval_loads(t, y, modes, &c, Some(loads), |ev| f(&c, ev))
-        })
+        let eval = |loads: Option<&[f64]>| {
+            let c = self.carriers_with_loads(t, y, modes, loads);
+            self.with_stack_eval_loads(t, y, modes, &c, loads, |ev| f(&c, ev))
+        };
+        if self.reuses_loads(modes) {
+            self.with_loads(y, modes, |loads| eval(Some(loads)))
+        } else {
+            eval(None)
+        }
     }
 
     /// [`Self::reactions_n_m`] from the loads [`Self::loads_into`] gave at the same state
@@ -512,10 +517,10 @@ impl System {
             dy[h + 1] = above * omega_b;
             return;
         }
-        // each body's load taken once: the carriers' reactions, then the teeth (and the
-        // stack's clamp) take the same values
-        self.with_loads(y, modes, |loads| {
-            let c = self.carriers_with_loads(t, y, modes, Some(loads));
+        // each body's load taken once where it would be taken again: the carriers'
+        // reactions, then the teeth (and the stack's clamp) take the same values
+        let rhs = |loads: Option<&[f64]>, dy: &mut [f64]| {
+            let c = self.carriers_with_loads(t, y, modes, loads);
             if matches!(self.pack.shaft, Shaft::Inertial { .. }) {
                 dy[0] = c[0];
                 dy[1] = c[1];
@@ -524,8 +529,23 @@ impl System {
                 dy[self.drum_at()] = c[2];
                 dy[self.drum_at() + 1] = c[3];
             }
-            self.rhs_with_loads(t, y, modes, &c, Some(loads), dy);
-        });
+            self.rhs_with_loads(t, y, modes, &c, loads, dy);
+        };
+        if self.reuses_loads(modes) {
+            self.with_loads(y, modes, |loads| rhs(Some(loads), dy));
+        } else {
+            rhs(None, dy);
+        }
+    }
+
+    /// Whether an evaluation at contact modes `modes` would take a body's load more than
+    /// once (a body in contact, and a stack or the carriers' reactions besides the teeth):
+    /// else the loads are left to be taken where needed, with no buffer to fill.
+    fn reuses_loads(&self, modes: &[Option<Engagement>]) -> bool {
+        (self.pack.stack.is_some()
+            || matches!(self.pack.shaft, Shaft::Inertial { .. })
+            || self.pack.drum.is_some())
+            && modes.iter().any(Option::is_some)
     }
 
     /// The couplings' part of [`Self::rhs`] (every slot's relative angle and speed, the
