@@ -455,8 +455,7 @@ pub(crate) fn face_event(
     // whether face `m` switches at `t` (the stack evaluated in the thread's buffers)
     let switches = |m: usize, t: f64, buf: &mut Vec<f64>| {
         d.eval(t, buf);
-        let c = sys.carriers(t, buf, modes);
-        sys.with_stack_eval(t, buf, modes, &c, |ev| sys.face_switches(m, ev))
+        sys.with_carriers_and_stack(t, buf, modes, |_, ev| sys.face_switches(m, ev))
     };
     let mut ta = t0;
     for q in 1..=4 {
@@ -466,8 +465,7 @@ pub(crate) fn face_event(
             t0 + (t1 - t0) * q as f64 / 4.0
         };
         d.eval(tq, buf);
-        let c = sys.carriers(tq, buf, modes);
-        let any = sys.with_stack_eval(tq, buf, modes, &c, |ev| {
+        let any = sys.with_carriers_and_stack(tq, buf, modes, |_, ev| {
             (0..sys.faces.len()).any(|m| sys.face_switches(m, ev))
         });
         if any {

@@ -50,6 +50,10 @@ thread_local! {
     /// evaluate it at every stage and every bisection, and allocated its nine vectors each
     /// time (issue 46: no allocation in a host's frame loop once started).
     static STACK_SCRATCH: std::cell::RefCell<StackScratch> = std::cell::RefCell::default();
+    /// Each thread's bodies' loads for one evaluation ([`System::with_loads`]): the pack's
+    /// right-hand side and face probes take them once for the carriers' reactions and the
+    /// stack's teeth and clamp (issue 46).
+    static LOADS: std::cell::RefCell<Vec<f64>> = std::cell::RefCell::default();
 }
 
 /// `v` as `n` zeros, in its own buffer.
@@ -98,7 +102,7 @@ pub(crate) struct System {
     /// Whether the carriers are bodies outside the system (a pack on a network, MODEL.md
     /// section 8; [`System::carried`]): the state holds neither the shaft nor the drum, the
     /// discs ride on carrier `a` and every plate on carrier `b`, and the caller gives the
-    /// carriers' motion ([`Self::rhs_with`], [`Self::reactions_n_m`]).
+    /// carriers' motion ([`Self::rhs_with_loads`], [`Self::reactions_n_m`]).
     pub carried: bool,
 }
 
@@ -335,6 +339,18 @@ impl System {
     /// couplings between them (a spring-damper, MODEL.md section 8), never the stack, which
     /// acts between discs and plates.
     pub fn carriers(&self, t: f64, y: &[f64], modes: &[Option<Engagement>]) -> [f64; 4] {
+        self.carriers_with_loads(t, y, modes, None)
+    }
+
+    /// [`Self::carriers`] with the bodies' loads at `y` already known (`loads`, from
+    /// [`Self::loads_into`]; `None`: taken here for the reactions), the same values.
+    pub fn carriers_with_loads(
+        &self,
+        t: f64,
+        y: &[f64],
+        modes: &[Option<Engagement>],
+        loads: Option<&[f64]>,
+    ) -> [f64; 4] {
         let (omega_s, alpha_prescribed) = match &self.pack.shaft {
             Shaft::Prescribed(p) => p.speed_and_acceleration(t),
             Shaft::Inertial { .. } => (y[1], 0.0),
@@ -342,7 +358,10 @@ impl System {
         let inertial = matches!(self.pack.shaft, Shaft::Inertial { .. });
         let (mut shaft_torque, mut drum_torque) = (0.0, 0.0);
         if inertial || self.pack.drum.is_some() {
-            [shaft_torque, drum_torque] = self.reactions_n_m(y, modes);
+            [shaft_torque, drum_torque] = match loads {
+                Some(loads) => self.reactions_from_n_m(loads, modes),
+                None => self.reactions_n_m(y, modes),
+            };
         }
         if !self.pack.couplings.is_empty() {
             // MODEL.md section 8: the couplings between the shaft and the drum (a spring-damper:
@@ -390,6 +409,48 @@ impl System {
     pub fn loads_into(&self, y: &[f64], modes: &[Option<Engagement>], out: &mut Vec<f64>) {
         out.clear();
         out.extend((0..self.ids.len()).map(|slot| self.load(slot, y, &modes[slot])));
+    }
+
+    /// `f` given the bodies' loads at `y` ([`Self::loads_into`], in this thread's buffer: no
+    /// allocation per evaluation; a fresh one if `f` asks again), N by slot.
+    pub fn with_loads<R>(
+        &self,
+        y: &[f64],
+        modes: &[Option<Engagement>],
+        f: impl FnOnce(&[f64]) -> R,
+    ) -> R {
+        LOADS.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut loads) => {
+                self.loads_into(y, modes, &mut loads);
+                f(&loads)
+            }
+            Err(_) => {
+                let mut loads = Vec::new();
+                self.loads_into(y, modes, &mut loads);
+                f(&loads)
+            }
+        })
+    }
+
+    /// The carriers' motion ([`Self::carriers`]) and the stack at `(t, y)` ([`Self::stack_eval`])
+    /// given to `f`, each body's load taken once for both (the carriers' reactions, the stack's
+    /// teeth and clamp): the same values, to the bit, as each taking them itself.
+    pub fn with_carriers_and_stack<R>(
+        &self,
+        t: f64,
+        y: &[f64],
+        modes: &[Option<Engagement>],
+        f: impl FnOnce(&[f64; 4], &StackEval) -> R,
+    ) -> R {
+        let eval = |loads: Option<&[f64]>| {
+            let c = self.carriers_with_loads(t, y, modes, loads);
+            self.with_stack_eval_loads(t, y, modes, &c, loads, |ev| f(&c, ev))
+        };
+        if self.reuses_loads(modes) {
+            self.with_loads(y, modes, |loads| eval(Some(loads)))
+        } else {
+            eval(None)
+        }
     }
 
     /// [`Self::reactions_n_m`] from the loads [`Self::loads_into`] gave at the same state
@@ -456,36 +517,44 @@ impl System {
             dy[h + 1] = above * omega_b;
             return;
         }
-        let c = self.carriers(t, y, modes);
-        if matches!(self.pack.shaft, Shaft::Inertial { .. }) {
-            dy[0] = c[0];
-            dy[1] = c[1];
+        // each body's load taken once where it would be taken again: the carriers'
+        // reactions, then the teeth (and the stack's clamp) take the same values
+        let rhs = |loads: Option<&[f64]>, dy: &mut [f64]| {
+            let c = self.carriers_with_loads(t, y, modes, loads);
+            if matches!(self.pack.shaft, Shaft::Inertial { .. }) {
+                dy[0] = c[0];
+                dy[1] = c[1];
+            }
+            if self.pack.drum.is_some() {
+                dy[self.drum_at()] = c[2];
+                dy[self.drum_at() + 1] = c[3];
+            }
+            self.rhs_with_loads(t, y, modes, &c, loads, dy);
+        };
+        if self.reuses_loads(modes) {
+            self.with_loads(y, modes, |loads| rhs(Some(loads), dy));
+        } else {
+            rhs(None, dy);
         }
-        if self.pack.drum.is_some() {
-            dy[self.drum_at()] = c[2];
-            dy[self.drum_at() + 1] = c[3];
-        }
-        self.rhs_with(t, y, modes, &c, dy);
+    }
+
+    /// Whether an evaluation at contact modes `modes` would take a body's load more than
+    /// once (a body in contact, and a stack or the carriers' reactions besides the teeth):
+    /// else the loads are left to be taken where needed, with no buffer to fill.
+    fn reuses_loads(&self, modes: &[Option<Engagement>]) -> bool {
+        (self.pack.stack.is_some()
+            || matches!(self.pack.shaft, Shaft::Inertial { .. })
+            || self.pack.drum.is_some())
+            && modes.iter().any(Option::is_some)
     }
 
     /// The couplings' part of [`Self::rhs`] (every slot's relative angle and speed, the
     /// faces' heat, the teeth's work) with the carriers' speeds and accelerations `c`
     /// (`[omega_s, alpha_s, omega_r, alpha_r]`, rad/s and rad/s^2, as [`Self::carriers`]
-    /// gives them; a network's bodies for a [`Self::carried`] system).
-    pub fn rhs_with(
-        &self,
-        t: f64,
-        y: &[f64],
-        modes: &[Option<Engagement>],
-        c: &[f64; 4],
-        dy: &mut [f64],
-    ) {
-        self.rhs_with_loads(t, y, modes, c, None, dy);
-    }
-
-    /// [`Self::rhs_with`] with the bodies' loads at `y` already known (`loads`, from
-    /// [`Self::loads_into`]: a network has them from its carriers' reactions), each taken
-    /// once instead of again for the stack.
+    /// gives them; a network's bodies for a [`Self::carried`] system) and the bodies' loads
+    /// at `y` if already known (`loads`, from [`Self::loads_into`]: a network has them from
+    /// its carriers' reactions, [`Self::rhs`] from its own; `None`: taken here), each taken
+    /// once instead of again for the teeth and the stack's clamp.
     pub fn rhs_with_loads(
         &self,
         t: f64,
@@ -516,7 +585,10 @@ impl System {
         for slot in 0..self.ids.len() {
             let k = self.off + 2 * slot;
             let (omega_c, alpha_c) = self.carrier_of(slot, &c);
-            let alpha_b = self.free_torque_n_m(slot, y, &modes[slot], omega_c)
+            let known = loads.map(|l| l[slot]);
+            let alpha_b = self
+                .free_and_teeth_n_m(slot, y, &modes[slot], omega_c, known)
+                .0
                 / self.disc(slot).inertia_kg_m2;
             dy[k] = y[k + 1];
             dy[k + 1] = alpha_c - alpha_b;
@@ -740,9 +812,8 @@ impl System {
         let Some(stack) = &self.pack.stack else {
             return;
         };
-        let c = self.carriers(t, y, modes);
         let r_eff = stack.effective_radius_m();
-        self.with_stack_eval(t, y, modes, &c, |ev| {
+        self.with_carriers_and_stack(t, y, modes, |_, ev| {
             out.extend((0..self.interfaces()).map(|m| InterfaceSample {
                 slip_rad_s: ev.slip[m],
                 slip_m_s: ev.slip[m] * r_eff,
@@ -1059,6 +1130,92 @@ mod tests {
                     <= 1e-11 * (teeth.abs() + heat + v_rate.abs()),
                 "{power} {teeth} {heat} {v_rate}"
             );
+        }
+    }
+
+    /// The pack path took each body's tooth load three times per right-hand side and face
+    /// probe: for the carriers' reactions, the teeth's torque and the stack's clamp (issue
+    /// 46); now once. At two states of [`free_pack`] pressed by the piston (2 kN) with bodies
+    /// in contact on both carriers and the faces locked, slipping and open in turn (three
+    /// rotations), the right-hand side ([`System::rhs`]) and the face probes' carriers and
+    /// stack ([`System::with_carriers_and_stack`]) are those of the carriers and the stack
+    /// each taking the loads themselves, to the bit (no margin: the same operations in the
+    /// same order); and so for the same pack without a stack (the teeth from the same loads).
+    #[test]
+    fn pack_rhs_took_each_load_three_times() {
+        for stacked in [true, false] {
+            let mut pack = free_pack();
+            match &mut pack.stack {
+                Some(stack) if stacked => {
+                    stack.piston.pressure = PressureProfile::Constant { pressure_pa: 2e5 };
+                }
+                _ => pack.stack = None,
+            }
+            let g0 = pack.discs[0].spline.half_play_rad();
+            let mut sys = System::new(std::sync::Arc::new(pack), (0..5).collect());
+            let faces = [Face::Locked, Face::Slip(1.0), Face::Open];
+            let mut clamped = 0;
+            for (k, contact) in [
+                [0.3, 1.02, -0.7, -1.01, 0.2],
+                [1.01, 0.1, 1.03, -0.5, -1.02],
+            ]
+            .iter()
+            .enumerate()
+            {
+                let mut y = sys.initial_state();
+                y[1] = 100.0 + k as f64;
+                for slot in 0..5 {
+                    y[2 + 2 * slot] = contact[slot] * g0;
+                    y[2 + 2 * slot + 1] = 3.0 - 1.7 * slot as f64 + k as f64;
+                }
+                y[sys.drum_at()] = 0.03 - 0.05 * k as f64;
+                y[sys.drum_at() + 1] = -4.0;
+                let modes: Vec<Option<Engagement>> = (0..5)
+                    .map(|slot| {
+                        (sys.depth(slot, &y) > 0.0)
+                            .then(|| sys.disc(slot).law.engage(&sys.kin(slot, &y)))
+                    })
+                    .collect();
+                // in contact on the shaft (slots 0, 1) and on the drum (slots 2 to 4)
+                assert!(modes[..2].iter().any(Option::is_some));
+                assert!(modes[2..].iter().any(Option::is_some));
+                for turn in 0..3 {
+                    for m in 0..sys.faces.len() {
+                        sys.faces[m] = faces[(m + turn) % 3];
+                    }
+                    let t = 0.01 * turn as f64;
+                    let mut once = vec![7.0; sys.dim()];
+                    sys.rhs(t, &y, &modes, &mut once);
+                    // the carriers' reactions and the stack each taking the loads themselves
+                    let c = sys.carriers(t, &y, &modes);
+                    let mut own = vec![7.0; sys.dim()];
+                    own[..2].copy_from_slice(&c[..2]);
+                    let r = sys.drum_at();
+                    own[r..r + 2].copy_from_slice(&c[2..]);
+                    sys.rhs_with_loads(t, &y, &modes, &c, None, &mut own);
+                    assert_eq!(
+                        once.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                        own.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                        "stacked {stacked}, state {k}, turn {turn}"
+                    );
+                    if !stacked {
+                        continue;
+                    }
+                    let own_ev = sys.stack_eval(t, &y, &modes, &c, None);
+                    sys.with_carriers_and_stack(t, &y, &modes, |c_once, ev| {
+                        assert_eq!(c_once.map(f64::to_bits), c.map(f64::to_bits));
+                        assert_eq!(format!("{ev:?}"), format!("{own_ev:?}"));
+                        // the clamp is reduced by the teeth's spline friction (the loads')
+                        clamped += ev.clamp.iter().filter(|f| **f > 0.0).count();
+                        assert!(
+                            ev.raw_clamp[ev.raw_clamp.len() - 1] < 2000.0,
+                            "{:?}",
+                            ev.raw_clamp
+                        );
+                    });
+                }
+            }
+            assert!(!stacked || clamped > 0);
         }
     }
 }

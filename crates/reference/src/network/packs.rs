@@ -8,7 +8,7 @@
 //! spline reactions on its two carriers ([`System::reactions_n_m`]) join the other torques on
 //! the network's bodies; (2) the network solves its bodies' accelerations (its rigid groups as
 //! without packs); (3) each pack's own relative accelerations follow with its carriers'
-//! speeds and accelerations given ([`System::rhs_with`]).
+//! speeds and accelerations given ([`System::rhs_with_loads`]).
 //!
 //! # Events
 //! Every disc's and plate's engagement depth (a tooth contact's onset and separation) and every
@@ -82,7 +82,7 @@ impl NetPack {
         &y[self.at..self.at + self.sys.dim()]
     }
 
-    /// The carriers' speeds and accelerations as [`System::rhs_with`] takes them, from the
+    /// The carriers' speeds and accelerations as [`System::rhs_with_loads`] takes them, from the
     /// bodies' speeds `w` (rad/s) and accelerations `acc` (rad/s^2).
     pub fn carriers(&self, w: &[f64], acc: &[f64]) -> [f64; 4] {
         [w[self.a], acc[self.a], w[self.b], acc[self.b]]
