@@ -94,6 +94,16 @@ fn run(pack: &PackModel, duration: f64) -> Collector {
     c
 }
 
+/// The wet brake's rising friction curve: 0.10 at rest to 0.13, plus 0.0002 s/m.
+fn rising_mu() -> FrictionCurve {
+    FrictionCurve::Stribeck {
+        static_mu: 0.10,
+        kinetic_mu: 0.13,
+        stribeck_speed_m_s: 1.0,
+        viscous_slope_s_m: 2e-4,
+    }
+}
+
 /// A wet brake slipping: two discs on a shaft at 200 rad/s, three plates on the housing,
 /// clamped by `p A - F_rs = 1e6 * 0.01 - 500 = 9500 N`, a rising `mu(v)` (0.10 at rest to 0.13,
 /// plus 0.0002 s/m). The housing must take, through the plates' teeth, the torque of the
@@ -102,12 +112,7 @@ fn run(pack: &PackModel, duration: f64) -> Collector {
 /// (mean over the last 20 of 100 ms; measured within 2e-5).
 #[test]
 fn slipping_faces_transmit_faces_mu_clamp_r_eff() {
-    let friction = FrictionCurve::Stribeck {
-        static_mu: 0.10,
-        kinetic_mu: 0.13,
-        stribeck_speed_m_s: 1.0,
-        viscous_slope_s_m: 2e-4,
-    };
+    let friction = rising_mu();
     let p = pack(
         2,
         200.0,
@@ -607,12 +612,7 @@ fn engagement_locks_and_heats_as_the_shared_step(what: &str, scene: &clutchpack_
 /// hand-over would move a relative angle by a part of the half play (1.6e-3 rad).
 #[test]
 fn brake_carried_without_rapier_hands_over_to_the_clamped_stack() {
-    let friction = FrictionCurve::Stribeck {
-        static_mu: 0.10,
-        kinetic_mu: 0.13,
-        stribeck_speed_m_s: 1.0,
-        viscous_slope_s_m: 2e-4,
-    };
+    let friction = rising_mu();
     let p = pack(
         2,
         200.0,

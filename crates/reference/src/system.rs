@@ -1057,6 +1057,31 @@ mod tests {
         pack
     }
 
+    /// The `k`-th test state of [`free_pack`]'s five bodies: each body's relative angle at
+    /// `contact` times the half play `g0` (beyond 1: in contact), its relative speed, the
+    /// shaft's and the drum's, and the modes engaged where a body is in contact.
+    fn contact_state(
+        sys: &System,
+        k: usize,
+        contact: &[f64; 5],
+        g0: f64,
+    ) -> (Vec<f64>, Vec<Option<Engagement>>) {
+        let mut y = sys.initial_state();
+        y[1] = 100.0 + k as f64;
+        for slot in 0..5 {
+            y[2 + 2 * slot] = contact[slot] * g0;
+            y[2 + 2 * slot + 1] = 3.0 - 1.7 * slot as f64 + k as f64;
+        }
+        y[sys.drum_at()] = 0.03 - 0.05 * k as f64;
+        y[sys.drum_at() + 1] = -4.0;
+        let modes: Vec<Option<Engagement>> = (0..5)
+            .map(|slot| {
+                (sys.depth(slot, &y) > 0.0).then(|| sys.disc(slot).law.engage(&sys.kin(slot, &y)))
+            })
+            .collect();
+        (y, modes)
+    }
+
     /// At states with some couplings in contact and every gap slipping, the right-hand side
     /// conserves angular momentum exactly (`sum J alpha = 0`: every spline reaction, gap
     /// torque and the spring-damper's torque is paired) and power (`sum J omega alpha = sum n
@@ -1076,20 +1101,7 @@ mod tests {
         .iter()
         .enumerate()
         {
-            let mut y = sys.initial_state();
-            y[1] = 100.0 + k as f64;
-            for slot in 0..5 {
-                y[2 + 2 * slot] = contact[slot] * g0;
-                y[2 + 2 * slot + 1] = 3.0 - 1.7 * slot as f64 + k as f64;
-            }
-            y[sys.drum_at()] = 0.03 - 0.05 * k as f64;
-            y[sys.drum_at() + 1] = -4.0;
-            let modes: Vec<Option<Engagement>> = (0..5)
-                .map(|slot| {
-                    (sys.depth(slot, &y) > 0.0)
-                        .then(|| sys.disc(slot).law.engage(&sys.kin(slot, &y)))
-                })
-                .collect();
+            let (y, modes) = contact_state(&sys, k, contact, g0);
             assert!(modes.iter().filter(|m| m.is_some()).count() >= 2);
             let mut dy = vec![0.0; sys.dim()];
             sys.rhs(0.0, &y, &modes, &mut dy);
@@ -1162,20 +1174,7 @@ mod tests {
             .iter()
             .enumerate()
             {
-                let mut y = sys.initial_state();
-                y[1] = 100.0 + k as f64;
-                for slot in 0..5 {
-                    y[2 + 2 * slot] = contact[slot] * g0;
-                    y[2 + 2 * slot + 1] = 3.0 - 1.7 * slot as f64 + k as f64;
-                }
-                y[sys.drum_at()] = 0.03 - 0.05 * k as f64;
-                y[sys.drum_at() + 1] = -4.0;
-                let modes: Vec<Option<Engagement>> = (0..5)
-                    .map(|slot| {
-                        (sys.depth(slot, &y) > 0.0)
-                            .then(|| sys.disc(slot).law.engage(&sys.kin(slot, &y)))
-                    })
-                    .collect();
+                let (y, modes) = contact_state(&sys, k, contact, g0);
                 // in contact on the shaft (slots 0, 1) and on the drum (slots 2 to 4)
                 assert!(modes[..2].iter().any(Option::is_some));
                 assert!(modes[2..].iter().any(Option::is_some));
