@@ -537,6 +537,18 @@ impl NetworkSimulation {
     /// Every output now, by name, in [`network_outputs`]' order (SI units; [`Self::variables`]
     /// gives each unit).
     pub fn outputs(&mut self) -> Vec<(String, f64)> {
+        let values = self.output_values();
+        network_outputs(self.stepper.network(), self.scene.transmission.as_ref())
+            .into_iter()
+            .map(|v| v.name)
+            .zip(values)
+            .collect()
+    }
+
+    /// [`Self::outputs`]' values alone, in their order (a co-simulation reads them at every
+    /// communication point; their names, formatted, cost more than the values on a small
+    /// network).
+    pub fn output_values(&mut self) -> Vec<f64> {
         let s: NetworkSample = self.stepper.sample_now();
         let heat = self.stepper.heat_j();
         let net = self.stepper.network();
@@ -576,11 +588,7 @@ impl NetworkSimulation {
             let engaged = tr.engaged(&modes);
             values.push(engaged.map_or(-1.0, |g| g as f64));
         }
-        network_outputs(net, self.scene.transmission.as_ref())
-            .into_iter()
-            .map(|v| v.name)
-            .zip(values)
-            .collect()
+        values
     }
 
     /// The value now of each driven input, by name (N m or N).

@@ -65,7 +65,7 @@ impl CoSimulation {
     /// Reads the network's outputs now.
     fn refresh_network_outputs(&mut self) {
         if let Some(sim) = self.network.as_mut() {
-            self.network_outputs = sim.outputs().into_iter().map(|(_, x)| x).collect();
+            self.network_outputs = sim.output_values();
         }
     }
 
