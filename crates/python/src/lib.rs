@@ -11,11 +11,11 @@
 //! finished), and then raises `KeyboardInterrupt`.
 
 mod fit;
-mod network;
+mod recording;
 mod stepper;
 
 use clutchpack_sdk::scene::{EngineChoice, Override};
-use clutchpack_sdk::{Error, RecordingRequest, RunRequest, Simulation};
+use clutchpack_sdk::{Error, Outcome, RecordingRequest, RunRequest, Simulation};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
@@ -251,18 +251,21 @@ impl ImpactColumns {
     }
 }
 
-/// What one run gave, for the Python half.
+/// What one run of a scene, a pack or a network, gave, for the Python half.
 #[pyclass(name = "RawRun", module = "clutchpack", frozen, get_all)]
 struct RawRun {
-    /// `--summary-json`'s content (JSON text).
+    /// `--summary-json`'s content (JSON text), a pack's or a network's.
     summary_json: String,
     /// The engine line (`engine: ... , why`).
     engine_line: String,
-    /// The impacts, as columns.
+    /// A pack's impacts, as columns (a network's: none; its packs' go to `impacts_csv`).
     impacts: ImpactColumns,
-    /// Sample times, s, and each body's per-tooth load at them, N (empty unless kept).
+    /// Sample times, s (empty unless kept).
     sample_t_s: Vec<f64>,
-    sample_load_n: Vec<(String, Vec<f64>)>,
+    /// The columns at those times, by name: a pack's per-tooth load of each body, N (named
+    /// by the body); a network's `<body>.speed_rad_s` (rad/s) and `<coupling>.torque_n_m`
+    /// (N m, on its body a).
+    sample_columns: Vec<(String, Vec<f64>)>,
     /// The recording's path, if recorded.
     recording: Option<PathBuf>,
     /// Whether the run stopped before its duration.
@@ -271,10 +274,6 @@ struct RawRun {
     warnings: Vec<String>,
 }
 
-/// Runs `scene` (engine: `engine`, else the scene's choice), optionally recording to
-/// `record` and writing `impacts_csv`; keeps the load history when `keep_samples`. The GIL
-/// is released while the engine runs; Ctrl-C stops it with its outputs complete and raises
-/// `KeyboardInterrupt`.
 /// A progress callback for a run with the GIL released: every [`SIGNAL_POLL`] it takes the GIL
 /// to check Python's signals; a pending one (Ctrl-C) is kept in `interrupt` and sets `stop`,
 /// which ends the run with its outputs complete.
@@ -291,6 +290,11 @@ fn signal_poll<'a>(stop: &'a AtomicBool, interrupt: &'a mut Option<PyErr>) -> im
     }
 }
 
+/// Runs `scene`, a pack or a network (engine: `engine`, else the scene's choice), as
+/// `clutchpack run` does, through the sdk's one `Simulation::run`: optionally recording to
+/// `record` and writing every impact to `impacts_csv` (each replaced if it exists); keeps the
+/// sampled history when `keep_samples`. The GIL is released while the engine runs; Ctrl-C
+/// stops it with its outputs complete and raises `KeyboardInterrupt`.
 #[pyfunction]
 #[pyo3(signature = (scene, engine=None, record=None, impacts_csv=None, keep_samples=true, deterministic=false))]
 fn run(
@@ -310,6 +314,7 @@ fn run(
         scene,
     )?;
     let mut sim = Simulation::new(scene.inner.clone(), engine_choice(engine)?).map_err(py_err)?;
+    // as `clutchpack run --out` asks (a network's recording applies the determinism alone)
     let recording = record.map(|path| RecordingRequest {
         path,
         replace: clutchpack_sdk::record::Replace::Existing,
@@ -325,7 +330,7 @@ fn run(
     let mut interrupt: Option<PyErr> = None;
     let outcome = py.detach(|| {
         let mut progress = signal_poll(&stop, &mut interrupt);
-        sim.run_pack(RunRequest {
+        sim.run(RunRequest {
             keep_history: true,
             keep_cycles: false,
             impacts_csv,
@@ -336,11 +341,11 @@ fn run(
         })
     });
     let outcome = outcome.map_err(py_err)?;
-    if let Some(Err(e)) = &outcome.impacts_csv {
+    if let Some(e) = outcome.impacts_csv_error() {
         return Err(PyRuntimeError::new_err(e.to_string()));
     }
-    let recording = match &outcome.recording {
-        Some(Ok(p)) => Some(p.clone()),
+    let recording = match outcome.recording() {
+        Some(Ok(p)) => Some(p.to_path_buf()),
         Some(Err(e)) => return Err(PyRuntimeError::new_err(format!("the recording: {e}"))),
         None => None,
     };
@@ -349,20 +354,15 @@ fn run(
         return Err(e);
     }
     let summary = outcome.summary().map_err(py_err)?;
-    let names = &outcome.body_names;
-    let impacts = &outcome.collector.impacts;
-    let (sample_t_s, sample_load_n) = if keep_samples {
-        let h = &outcome.collector.history;
-        let t = h
-            .first()
-            .map(|v| v.iter().map(|p| p.0).collect())
-            .unwrap_or_default();
-        let loads = names
-            .iter()
-            .zip(h)
-            .map(|(n, v)| (n.clone(), v.iter().map(|p| p.1).collect()))
-            .collect();
-        (t, loads)
+    let (impacts, (sample_t_s, sample_columns)) = match &outcome {
+        Outcome::Pack(o) => (
+            ImpactColumns::of(&o.collector.impacts, &o.body_names),
+            pack_columns(o),
+        ),
+        Outcome::Network(o) => (ImpactColumns::of(&[], &[]), network_columns(o)),
+    };
+    let (sample_t_s, sample_columns) = if keep_samples {
+        (sample_t_s, sample_columns)
     } else {
         (Vec::new(), Vec::new())
     };
@@ -370,13 +370,50 @@ fn run(
         summary_json: serde_json::to_string(&summary)
             .map_err(|e| PyRuntimeError::new_err(e.to_string()))?,
         engine_line: sim.engine_line().to_string(),
-        impacts: ImpactColumns::of(impacts, names),
+        impacts,
         sample_t_s,
-        sample_load_n,
+        sample_columns,
         recording,
         stopped_early: outcome.stopped_early(),
-        warnings: outcome.warnings.clone(),
+        warnings: outcome.warnings().to_vec(),
     })
+}
+
+/// A pack run's sample times, s, and each body's per-tooth load at them, N, by body.
+fn pack_columns(o: &clutchpack_sdk::RunOutcome) -> (Vec<f64>, Vec<(String, Vec<f64>)>) {
+    let h = &o.collector.history;
+    let t = h
+        .first()
+        .map(|v| v.iter().map(|p| p.0).collect())
+        .unwrap_or_default();
+    let loads = o
+        .body_names
+        .iter()
+        .zip(h)
+        .map(|(n, v)| (n.clone(), v.iter().map(|p| p.1).collect()))
+        .collect();
+    (t, loads)
+}
+
+/// A network run's sample times, s, and its columns at them: each body's speed
+/// (`<body>.speed_rad_s`, rad/s), then each coupling's torque on its body a
+/// (`<coupling>.torque_n_m`, N m).
+fn network_columns(o: &clutchpack_sdk::NetworkOutcome) -> (Vec<f64>, Vec<(String, Vec<f64>)>) {
+    let h = &o.history;
+    let column = |f: &dyn Fn(&clutchpack_sdk::NetworkSample) -> f64| h.iter().map(f).collect();
+    let s = &o.summary;
+    let speeds = s.bodies.iter().enumerate().map(|(i, b)| {
+        let name = format!("{}.speed_rad_s", b.name);
+        (name, column(&|x| x.speed_rad_s[i]))
+    });
+    let torques = s.couplings.iter().enumerate().map(|(k, c)| {
+        let name = format!("{}.torque_n_m", c.name);
+        (name, column(&|x| x.torque_n_m[k]))
+    });
+    (
+        h.iter().map(|x| x.t_s).collect(),
+        speeds.chain(torques).collect(),
+    )
 }
 
 /// Runs `f` on a worker thread with the GIL released, polling Ctrl-C on this (the main)
@@ -506,88 +543,6 @@ fn sweep(
     Ok(out.to_string())
 }
 
-/// What a recording holds, for the Python half.
-#[pyclass(name = "RawRecording", module = "clutchpack", frozen, get_all)]
-pub struct RawRecording {
-    /// The summary (JSON text): scene, engine, duration, per-body statistics and fatigue.
-    summary_json: String,
-    /// The scene's TOML text and overrides, as run.
-    scene_text: Option<String>,
-    overrides: Vec<String>,
-    /// The impacts, as columns.
-    impacts: ImpactColumns,
-    /// Each body's load history: (name, times s, per-tooth load N).
-    loads: Vec<(String, Vec<f64>, Vec<f64>)>,
-    /// Why the file was salvaged, if it was damaged.
-    warning: Option<String>,
-    /// A network recording's sample times, s (empty for a pack's).
-    sample_t_s: Vec<f64>,
-    /// A network recording's columns at those times: `<body>.speed_rad_s` (rad/s) and
-    /// `<coupling>.torque_n_m` (N m), as `run_network` gives them.
-    sample_columns: Vec<(String, Vec<f64>)>,
-}
-
-/// Reads the recording at `path`; a damaged one only with `salvage` (what could be read).
-#[pyfunction]
-#[pyo3(signature = (path, salvage=false))]
-fn read(py: Python<'_>, path: PathBuf, salvage: bool) -> PyResult<RawRecording> {
-    py.detach(|| read_recording(&path, salvage)).map_err(py_err)
-}
-
-fn read_recording(path: &Path, salvage: bool) -> Result<RawRecording, Error> {
-    let (reader, warning) = clutchpack_sdk::open_recording(path, salvage)?;
-    if let Some(net) = clutchpack_sdk::record::read_network(&reader) {
-        let net = net.map_err(|e| Error::BadInput(format!("{}: {e}", path.display())))?;
-        if let Some(e) = reader.reread_error() {
-            return Err(Error::BadInput(e.to_string()));
-        }
-        return Ok(network::raw_network_recording(&reader, net, warning));
-    }
-    let names = reader.disc_names();
-    let impacts = reader.impacts();
-    let summary = reader.summary_or_recomputed();
-    let info = reader.run_info();
-    let fatigue: Vec<serde_json::Value> = summary
-        .fatigue
-        .iter()
-        .map(|f| match f {
-            Some(f) => serde_json::json!({
-                "damage_rate_per_h": f.damage_rate_per_h,
-                "life_h": f.life_h,
-                "eq_load_range_n": f.eq_load_range_n,
-                "max_root_stress_pa": f.max_root_stress_pa,
-            }),
-            None => serde_json::Value::Null,
-        })
-        .collect();
-    let summary_json = serde_json::json!({
-        "scene": info.as_ref().map(|i| i.scene_name.clone()),
-        "engine": info.as_ref().map(|i| i.engine.clone()),
-        "duration_s": summary.t_end_s,
-        "discs": summary.discs,
-        "fatigue": fatigue,
-    })
-    .to_string();
-    let loads = reader
-        .load_histories()
-        .into_iter()
-        .map(|h| (h.name, h.t_s, h.load_n))
-        .collect();
-    if let Some(e) = reader.reread_error() {
-        return Err(Error::BadInput(e.to_string()));
-    }
-    Ok(RawRecording {
-        summary_json,
-        scene_text: info.as_ref().map(|i| i.scene_text.clone()),
-        overrides: info.map(|i| i.overrides).unwrap_or_default(),
-        impacts: ImpactColumns::of(&impacts, &names),
-        loads,
-        warning,
-        sample_t_s: Vec::new(),
-        sample_columns: Vec::new(),
-    })
-}
-
 /// Runs shard `shard` of `shards` of the study file `study` (all of it by default) into the
 /// folder `out` on `jobs` threads: the cases its part lacks, as `clutchpack study run`.
 /// Returns (part file, cases, skipped, ran, failed, complete). Ctrl-C stops it between
@@ -644,20 +599,16 @@ fn _clutchpack(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
     m.add_class::<ImpactColumns>()?;
     m.add_class::<RawRun>()?;
-    m.add_class::<network::RawNetworkRun>()?;
-    m.add_class::<RawRecording>()?;
+    m.add_class::<recording::RawRecording>()?;
     m.add_class::<fit::RawFit>()?;
     m.add_class::<stepper::Stepper>()?;
     m.add_class::<stepper::StepperState>()?;
-    m.add_class::<network::NetworkStepper>()?;
-    m.add_class::<network::NetworkStepperState>()?;
     m.add_function(wrap_pyfunction!(load_scene, m)?)?;
     m.add_function(wrap_pyfunction!(scene_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
-    m.add_function(wrap_pyfunction!(network::run_network, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
-    m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(recording::read, m)?)?;
     m.add_function(wrap_pyfunction!(study_run, m)?)?;
     m.add_function(wrap_pyfunction!(study_merge, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -1,11 +1,13 @@
 //! `clutchpack._clutchpack.Stepper`: a steppable run for controllers and co-simulation written
-//! in Python, over the sdk's co-simulation layer (`clutchpack_sdk::CoSimulation`, which the FMU
-//! wraps too), so its inputs, outputs and their names are the FMU's (`discs[1].load_n`,
-//! `piston.pressure_pa`, ...). The Python half wraps it as `clutchpack.Simulation`.
+//! in Python, of a pack or a network scene alike, over the sdk's one co-simulation layer
+//! (`clutchpack_sdk::CoSimulation`, which the FMU wraps too), so its inputs, outputs and their
+//! names are the FMU's (`discs[1].load_n`, `piston.pressure_pa`,
+//! `couplings.K2.normal_force_n`, `bodies.crank.speed_rad_s`, ...). The Python half wraps it
+//! as `clutchpack.Simulation`.
 
-use crate::{check_outputs, engine_choice, signal_poll, Scene};
-use clutchpack_sdk::cosim::{driven_from_names, Causality, Quantity};
-use clutchpack_sdk::{CoSimulation, SavedCoSimulation};
+use crate::{check_outputs, engine_choice, py_err, signal_poll, Scene};
+use clutchpack_sdk::cosim::{Causality, Quantity};
+use clutchpack_sdk::{CoSimulation, SavedCoSimulation, Summary};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use std::path::PathBuf;
@@ -31,12 +33,6 @@ fn value_err(e: clutchpack_sdk::Error) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
-/// `RuntimeError` with the sdk's message: what `advance_to` and `outputs` raise for any error
-/// (an engine failure, and a held input past its bound).
-fn runtime_err(e: clutchpack_sdk::Error) -> PyErr {
-    PyRuntimeError::new_err(e.to_string())
-}
-
 impl Stepper {
     fn co(&self) -> MutexGuard<'_, CoSimulation> {
         // a panic inside a call is a bug; the run stays usable for reading
@@ -47,11 +43,13 @@ impl Stepper {
 #[pymethods]
 impl Stepper {
     /// Starts the run of `scene` at t = 0 with the engine `engine` (else the scene's
-    /// choice), the caller driving the inputs named in `drive` (their public names,
-    /// "shaft.speed_rad_s", "shaft.drive_torque_n_m", "drum.load_torque_n_m",
-    /// "piston.pressure_pa", or the older "shaft_speed", "shaft_torque", "drum_load",
-    /// "piston_pressure"; the rest follow the scene), recording to `record` if given, steps
-    /// landing on `stop_time` (s) if given.
+    /// choice), the caller driving the inputs named in `drive` (the rest follow the scene):
+    /// a pack's by their public names ("shaft.speed_rad_s", "shaft.drive_torque_n_m",
+    /// "drum.load_torque_n_m", "piston.pressure_pa") or the older "shaft_speed",
+    /// "shaft_torque", "drum_load", "piston_pressure"; a network's as
+    /// "bodies.<body>.drive_torque_n_m", "couplings.<clutch>.normal_force_n" or
+    /// "couplings.<pack>.pressure_pa". Records to `record` if given; steps land on
+    /// `stop_time` (s) if given (a network's run ends there).
     #[new]
     #[pyo3(signature = (scene, engine=None, drive=Vec::new(), record=None, stop_time=None))]
     fn new(
@@ -66,11 +64,11 @@ impl Stepper {
                 "stop_time = {t}: expected a finite number of seconds > 0"
             )));
         }
-        let driven = driven_from_names(&drive).map_err(value_err)?;
         check_outputs(&[("record =", record.as_deref())], scene)?;
-        let mut co = CoSimulation::driving(scene.inner.clone(), driven)
+        let mut co = CoSimulation::driving_named(scene.inner.clone(), &drive)
             .map_err(value_err)?
-            .reading(scene.path.iter().cloned().collect());
+            .reading(scene.path.iter().cloned().collect())
+            .loaded_from(scene.path.clone());
         if let Some(e) = engine_choice(engine)? {
             co.set_string_parameter(Quantity::Engine, e.name())
                 .map_err(value_err)?;
@@ -89,7 +87,8 @@ impl Stepper {
         self.co().time_s()
     }
 
-    /// `(name, causality, unit, description)` of every variable (the FMU's).
+    /// `(name, causality, unit, description)` of every variable (the FMU's): the parameters,
+    /// the driven inputs, the outputs.
     fn variables(&self) -> Vec<(String, String, String, String)> {
         self.co()
             .variables()
@@ -112,7 +111,7 @@ impl Stepper {
 
     /// Sets the input `name` (e.g. "shaft.speed_rad_s"; an older name too) to `value`, held
     /// from now on; with `slope` (per s) and `curvature` (per s^2) as a first- or
-    /// second-order hold.
+    /// second-order hold (a pack's shaft; a network's inputs take none).
     #[pyo3(signature = (name, value, slope=None, curvature=None))]
     fn set_input(
         &mut self,
@@ -127,7 +126,9 @@ impl Stepper {
     }
 
     /// Advances to `t` (s) with the GIL released; Ctrl-C stops it (the run then stands at
-    /// an earlier time, everything before kept) and raises `KeyboardInterrupt`.
+    /// an earlier time, everything before kept) and raises `KeyboardInterrupt`. Bad input (a
+    /// held input carried past its bound) raises `ValueError`, an engine failure
+    /// `RuntimeError`.
     fn advance_to(&mut self, py: Python<'_>, t: f64) -> PyResult<()> {
         let mut guard = self.co();
         let now = guard.time_s();
@@ -149,12 +150,12 @@ impl Stepper {
         if let Some(e) = interrupt {
             return Err(e);
         }
-        out.map(|_| ()).map_err(runtime_err)
+        out.map(|_| ()).map_err(py_err)
     }
 
     /// Every output's `(name, value)` now (the Integer ones as floats).
     fn outputs(&self) -> PyResult<Vec<(String, f64)>> {
-        self.co().outputs().map_err(runtime_err)
+        self.co().outputs().map_err(py_err)
     }
 
     /// Saves the whole state (not while recording: a recording cannot be rewound).
@@ -167,26 +168,31 @@ impl Stepper {
             .map_err(value_err)
     }
 
-    /// Restores a state saved by `save`.
+    /// Restores a state saved by `save` of this run.
     fn restore(&mut self, state: &StepperState) -> PyResult<()> {
         let saved = state.state.lock().unwrap_or_else(|p| p.into_inner());
         self.co().restore(&saved).map_err(value_err)
     }
 
     /// Ends the run (its recording finished) and returns its summary (`--summary-json`'s
-    /// content, JSON text).
+    /// content, a pack's or a network's, JSON text).
     fn finish(&mut self) -> PyResult<String> {
         let mut co = self.co();
-        // the warnings (a recording's summary) are in the outcome; a recording that could not
-        // be finished is an error
-        let _ = co.finish();
-        let outcome = co
-            .outcome()
-            .ok_or_else(|| PyRuntimeError::new_err("the run was never started"))?;
-        if let Some(Err(e)) = &outcome.recording {
-            return Err(PyRuntimeError::new_err(format!("the recording: {e}")));
-        }
-        let summary = outcome.summary().map_err(crate::py_err)?;
+        // a pack's warnings (a recording's summary) are in its outcome; a network's run that
+        // could not be finished comes back as a warning alone
+        let warnings = co.finish();
+        let summary = if let Some(outcome) = co.outcome() {
+            if let Some(Err(e)) = &outcome.recording {
+                return Err(PyRuntimeError::new_err(format!("the recording: {e}")));
+            }
+            Summary::Pack(outcome.summary().map_err(py_err)?)
+        } else if let Some(outcome) = co.network_outcome() {
+            Summary::Network(outcome.summary.clone())
+        } else if warnings.is_empty() {
+            return Err(PyRuntimeError::new_err("the run was never started"));
+        } else {
+            return Err(PyRuntimeError::new_err(warnings.join("; ")));
+        };
         serde_json::to_string(&summary).map_err(|e| PyRuntimeError::new_err(e.to_string()))
     }
 }

@@ -266,6 +266,36 @@ def test_sigint_stops_a_long_run_within_a_second(tmp_path):
     assert len(back.impacts) > 0
 
 
+def test_sigint_stops_a_network_simulations_call_within_a_second():
+    """Issue 44, item 4: a network scene's Simulation runs through the one co-simulation layer
+    of a pack's (the sdk's CoSimulation), which polls Ctrl-C from the engine's progress for
+    either kind: SIGINT during one `advance_to(60)` of the DCT upshift with resolved packs
+    (about 0.5 s of wall time per simulated s here) raises KeyboardInterrupt within a second,
+    the run standing at an earlier time (0 < t < 60 s)."""
+    code = (
+        "import clutchpack\n"
+        "sim = clutchpack.Simulation('scenes/dct-upshift.toml',"
+        " set={'simulation.duration_s': 60.0})\n"
+        "try:\n"
+        "    sim.advance_to(60.0)\n"
+        "except KeyboardInterrupt:\n"
+        "    print(sim.time, flush=True)\n"
+        "    raise\n"
+    )
+    p = subprocess.Popen(
+        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    time.sleep(3.0)
+    assert p.poll() is None, "the call ended before the signal"
+    t0 = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=30)
+    took = time.monotonic() - t0
+    assert took < 1.0, f"stopped {took:.2f} s after SIGINT"
+    assert p.returncode != 0 and "KeyboardInterrupt" in err, err
+    assert 0.0 < float(out.strip()) < 60.0, out
+
+
 def test_fig3_example_is_the_cli_sweep(tmp_path):
     """examples/python/fig3.py reproduces `clutchpack sweep`'s ensemble means, number for
     number."""

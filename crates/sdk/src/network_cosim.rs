@@ -2,8 +2,9 @@
 //! torque and clutch normal force has one public name, the caller sets the inputs it drives
 //! between calls (each held from the instant it is set, as the pack's co-simulation holds its
 //! inputs: docs/DECISIONS.md "Co-simulation"), and the outputs (every body's speed and angle,
-//! every coupling's torque, a clutch's slip, mode and heat) are read by name. Python's
-//! `Simulation` of a network scene wraps it. Either engine runs it: the reference engine's
+//! every coupling's torque, a clutch's slip, mode and heat) are read by name. The one
+//! co-simulation layer ([`crate::CoSimulation`]: the FMU, Python's `Simulation`) runs a
+//! network scene through it. Either engine runs it: the reference engine's
 //! [`clutchpack_reference::network::NetworkStepper`] or the multibody engine's
 //! [`clutchpack_multibody::network::NetworkStepper`] (at the fixed step
 //! [`crate::network::multibody_step_s`], as a whole run of the scene).
@@ -191,6 +192,30 @@ fn input_variable(net: &Network, name: &str, input: NetworkInput) -> NetworkVari
     }
 }
 
+/// The inputs named in `drive` (public names, [`network_inputs`]) of the network `net` of the
+/// scene `scene`, as indices into [`network_inputs`]' list, in the order named: a name that
+/// is not one of its inputs, or one named twice, is bad input naming it (and the inputs).
+pub(crate) fn driven_inputs(scene: &str, net: &Network, drive: &[String]) -> Result<Vec<usize>> {
+    let all_inputs = network_inputs(net);
+    let mut driven = Vec::with_capacity(drive.len());
+    for name in drive {
+        let Some(j) = all_inputs.iter().position(|(n, _)| n == name) else {
+            let names: Vec<&str> = all_inputs.iter().map(|(n, _)| n.as_str()).collect();
+            return Err(Error::BadInput(format!(
+                "drive: {name:?} is not an input of {scene}; its inputs are {}",
+                names.join(", ")
+            )));
+        };
+        if driven.contains(&j) {
+            return Err(Error::BadInput(format!(
+                "drive: {name:?} is named twice; name each input once"
+            )));
+        }
+        driven.push(j);
+    }
+    Ok(driven)
+}
+
 /// Every input of `net` as a variable, with its value at t = 0 in the scene (what an FMU's
 /// input holds until its host sets it).
 pub fn network_input_variables(net: &Network) -> Vec<(NetworkVariable, f64)> {
@@ -343,23 +368,10 @@ impl NetworkSimulation {
         };
         let engine = scene.engine(engine, &scene.name)?;
         let all_inputs = network_inputs(net);
-        let mut driven = Vec::with_capacity(drive.len());
-        for name in drive {
-            let Some(found) = all_inputs.iter().find(|(n, _)| n == name) else {
-                let names: Vec<&str> = all_inputs.iter().map(|(n, _)| n.as_str()).collect();
-                return Err(Error::BadInput(format!(
-                    "drive: {name:?} is not an input of {}; its inputs are {}",
-                    scene.name,
-                    names.join(", ")
-                )));
-            };
-            if driven.iter().any(|(n, _)| n == name) {
-                return Err(Error::BadInput(format!(
-                    "drive: {name:?} is named twice; name each input once"
-                )));
-            }
-            driven.push(found.clone());
-        }
+        let driven: Vec<(String, NetworkInput)> = driven_inputs(&scene.name, net, drive)?
+            .into_iter()
+            .map(|j| all_inputs[j].clone())
+            .collect();
         let duration = match stop_time_s {
             Some(t) if t.is_finite() && t > 0.0 => t,
             Some(t) => {
@@ -525,6 +537,18 @@ impl NetworkSimulation {
     /// Every output now, by name, in [`network_outputs`]' order (SI units; [`Self::variables`]
     /// gives each unit).
     pub fn outputs(&mut self) -> Vec<(String, f64)> {
+        let values = self.output_values();
+        network_outputs(self.stepper.network(), self.scene.transmission.as_ref())
+            .into_iter()
+            .map(|v| v.name)
+            .zip(values)
+            .collect()
+    }
+
+    /// [`Self::outputs`]' values alone, in their order (a co-simulation reads them at every
+    /// communication point; their names, formatted, cost more than the values on a small
+    /// network).
+    pub fn output_values(&mut self) -> Vec<f64> {
         let s: NetworkSample = self.stepper.sample_now();
         let heat = self.stepper.heat_j();
         let net = self.stepper.network();
@@ -564,11 +588,7 @@ impl NetworkSimulation {
             let engaged = tr.engaged(&modes);
             values.push(engaged.map_or(-1.0, |g| g as f64));
         }
-        network_outputs(net, self.scene.transmission.as_ref())
-            .into_iter()
-            .map(|v| v.name)
-            .zip(values)
-            .collect()
+        values
     }
 
     /// The value now of each driven input, by name (N m or N).

@@ -524,3 +524,57 @@ fn a_recorded_run_dropped_without_finish_leaves_a_complete_recording() {
     let reader = clutchpack_sdk::record::open(&pack.path).unwrap();
     assert!(reader.summary().is_some());
 }
+
+/// Issue 44, item 4: one co-simulation for Python's `Simulation` of either kind. A network's
+/// caller drives the inputs it names ([`CoSimulation::driving_named`]), the others follow the
+/// scene: driving K2's force alone, it is the one input; K1's force is refused as not driven,
+/// a slope as a network input takes none, an unknown or twice-named input when the run is
+/// made. Driving nothing, `dct-upshift-lumped` in calls of 10 ms (reference engine) gives the
+/// whole run's summary but the wall time, figure for figure (before, the co-simulation drove
+/// every input of a network, each held at its value at t = 0, and Python went around it).
+#[test]
+fn a_co_simulation_drives_the_network_inputs_it_names() {
+    let s = scene("dct-upshift-lumped.toml");
+    let k2 = "couplings.K2.normal_force_n";
+    let mut co = CoSimulation::driving_named(s.clone(), &[k2]).unwrap();
+    let inputs: Vec<&str> = co
+        .variables()
+        .iter()
+        .filter(|v| v.causality == Causality::Input)
+        .map(|v| v.name.as_str())
+        .collect();
+    assert_eq!(inputs, [k2]);
+    co.start(None).unwrap();
+    let e = co
+        .set_input("couplings.K1.normal_force_n", 0.0, [None, None])
+        .unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("is not driven"),
+        "{e}"
+    );
+    let e = co.set_input(k2, 10.0, [Some(1.0), None]).unwrap_err();
+    assert!(e.to_string().contains("takes no slope"), "{e}");
+    co.set_input(k2, 1000.0, [None, None]).unwrap();
+    assert!(co.advance_to(0.01, None).unwrap());
+    for (names, words) in [
+        (vec!["couplings.K3.normal_force_n"], "is not an input of"),
+        (vec![k2, k2], "is named twice"),
+    ] {
+        let e = CoSimulation::driving_named(s.clone(), &names)
+            .err()
+            .expect("refused");
+        assert!(e.is_bad_input() && e.to_string().contains(words), "{e}");
+    }
+
+    let whole = whole_run(&s, None);
+    let mut co = CoSimulation::driving_named(s.clone(), &[] as &[&str]).unwrap();
+    co.start(None).unwrap();
+    let calls = (s.simulation.duration_s / 1e-2).round() as u32;
+    for k in 1..=calls {
+        co.advance_to(f64::from(k) * 1e-2, None).unwrap();
+    }
+    let _ = co.finish();
+    let mut called = co.network_outcome().unwrap().summary.clone();
+    called.wall_time_s = whole.summary.wall_time_s;
+    assert_eq!(called, whole.summary);
+}

@@ -165,13 +165,20 @@ def run(
     """Runs a scene (a path, a dict, a ``Scene`` or ``None`` for the paper's case) as
     ``clutchpack run`` does. ``engine``: ``"reference"`` or ``"multibody"`` (default: the
     scene's choice); ``duration``: simulated time in s; ``set``: key overrides; ``record``:
-    write the MCAP recording there; ``impacts_csv``: also write the impacts CSV."""
+    write the MCAP recording there; ``impacts_csv``: also write the impacts CSV.
+
+    A driveline network (``[[bodies]]``) gives its summary (``couplings`` with each clutch's
+    mode changes, lock times and heat; ``bodies``; ``energy``), ``samples`` with ``t_s``,
+    ``<body>.speed_rad_s`` and ``<coupling>.torque_n_m`` columns, and every tooth impact (a
+    gear mesh's, a resolved pack's disc's or plate's) in the CSV file ``impacts_csv`` if given
+    (as ``--impacts-csv``: its first column ``name``, ``<pack>/discs/<disc>``; ``impacts`` is
+    empty)."""
     s = dict(_sets(set))
     if duration is not None:
         s["simulation.duration_s"] = _time("duration", duration)
     sc = load_scene(scene, s)
-    if sc.is_network:
-        return _run_network(sc, engine, record, impacts_csv, deterministic)
+    # one native run for either kind: a pack's samples are each body's per-tooth load (N), a
+    # network's each body's speed and each coupling's torque
     raw = _clutchpack.run(
         sc,
         engine=engine,
@@ -181,8 +188,8 @@ def run(
         deterministic=deterministic,
     )
     samples = pd.DataFrame({"t_s": np.asarray(raw.sample_t_s, dtype=float)})
-    for name, loads in raw.sample_load_n:
-        samples[name] = np.asarray(loads, dtype=float)
+    for name, values in raw.sample_columns:
+        samples[name] = np.asarray(values, dtype=float)
     return Result(
         summary=json.loads(raw.summary_json),
         impacts=_impacts(raw),
@@ -192,40 +199,6 @@ def run(
         scene_text=sc.text,
         overrides=list(sc.overrides),
         warnings=list(raw.warnings),
-    )
-
-
-def _run_network(
-    sc: Scene, engine: Optional[str], record: Any, impacts_csv: Any, deterministic: bool
-) -> Result:
-    """A network scene's run (``[[bodies]]``) on ``engine`` (else the scene's, else the
-    reference engine): the summary (``couplings`` with each clutch's mode changes, lock times
-    and heat; ``bodies``; ``energy``), ``samples`` with ``t_s``, ``<body>.speed_rad_s`` and
-    ``<coupling>.torque_n_m`` columns, the recording at ``record`` if given (as
-    ``clutchpack run --out``), and every tooth impact (a gear mesh's, a resolved pack's disc's
-    or plate's) in the CSV file ``impacts_csv`` if given (as ``--impacts-csv``: its first
-    column ``name``, ``<pack>/discs/<disc>``)."""
-    raw = _clutchpack.run_network(
-        sc,
-        engine,
-        None if record is None else os.fspath(record),
-        deterministic=deterministic,
-        impacts_csv=None if impacts_csv is None else os.fspath(impacts_csv),
-    )
-    samples = pd.DataFrame({"t_s": np.asarray(raw.sample_t_s, dtype=float)})
-    for name, values in raw.speed_rad_s:
-        samples[f"{name}.speed_rad_s"] = np.asarray(values, dtype=float)
-    for name, values in raw.torque_n_m:
-        samples[f"{name}.torque_n_m"] = np.asarray(values, dtype=float)
-    return Result(
-        summary=json.loads(raw.summary_json),
-        impacts=pd.DataFrame(columns=IMPACT_COLUMNS),
-        samples=samples,
-        recording=None if raw.recording is None else os.fspath(raw.recording),
-        engine_line=f"engine: {json.loads(raw.summary_json)['engine']} (a driveline network)",
-        scene_text=sc.text,
-        overrides=list(sc.overrides),
-        warnings=[],
     )
 
 
@@ -471,9 +444,8 @@ class Simulation:
             drive = [drive]
         sc = load_scene(scene, set)
         self.scene: Scene = sc
-        # a network scene's run has its own stepper, with the same methods
-        stepper = _clutchpack.NetworkStepper if sc.is_network else _clutchpack.Stepper
-        self._s = stepper(
+        # one native stepper for a pack or a network scene (the sdk's co-simulation)
+        self._s = _clutchpack.Stepper(
             sc, engine, list(drive), os.fspath(record) if record is not None else None, stop_time
         )
         #: Every variable: name -> (causality, unit, description).

@@ -41,21 +41,18 @@ class ImpactColumns:
     peak_n: List[float]
 
 class RawRun:
+    """A run of a pack or a network scene: its summary (JSON text), engine line, a pack's
+    impacts, the sample times (s) and the columns at them (a pack's per-tooth load per body,
+    N; a network's ``<body>.speed_rad_s``, rad/s, and ``<coupling>.torque_n_m``, N m)."""
+
     summary_json: str
     engine_line: str
     impacts: ImpactColumns
     sample_t_s: List[float]
-    sample_load_n: List[Tuple[str, List[float]]]
+    sample_columns: List[Tuple[str, List[float]]]
     recording: Optional[str]
     stopped_early: bool
     warnings: List[str]
-
-class RawNetworkRun:
-    summary_json: str
-    sample_t_s: List[float]
-    speed_rad_s: List[Tuple[str, List[float]]]
-    torque_n_m: List[Tuple[str, List[float]]]
-    recording: Optional[str]
 
 class RawRecording:
     summary_json: str
@@ -82,12 +79,6 @@ def run(
     keep_samples: bool = True,
     deterministic: bool = False,
 ) -> RawRun: ...
-def run_network(
-    scene: Scene,
-    engine: Optional[str] = None,
-    record: Optional[_Path] = None,
-    deterministic: bool = False,
-) -> RawNetworkRun: ...
 def sweep(
     scene: Scene,
     param: str,
@@ -129,8 +120,11 @@ class StepperState:
     """A saved state of a Stepper."""
 
 class Stepper:
-    """A run advanced call by call (``clutchpack.Simulation`` wraps it); ``drive``: the inputs'
-    FMU names (``"piston.pressure_pa"``, ...) or their older aliases (``"piston_pressure"``)."""
+    """A pack or a network scene's run advanced call by call (``clutchpack.Simulation`` wraps
+    it); ``drive``: a pack's inputs by their FMU names (``"piston.pressure_pa"``, ...) or
+    their older aliases (``"piston_pressure"``), a network's
+    (``"bodies.<body>.drive_torque_n_m"``, ``"couplings.<clutch>.normal_force_n"``,
+    ``"couplings.<pack>.pressure_pa"``)."""
     def __init__(
         self,
         scene: Scene,
@@ -152,33 +146,4 @@ class Stepper:
     def save(self) -> StepperState: ...
     def restore(self, state: StepperState) -> None: ...
     def finish(self) -> str:
-        """The run's summary (JSON text)."""
-
-class NetworkStepperState:
-    """A saved state of a NetworkStepper."""
-
-class NetworkStepper:
-    """A network scene's run advanced call by call (``clutchpack.Simulation`` wraps it);
-    ``drive``: ``"bodies.<body>.drive_torque_n_m"``, ``"couplings.<clutch>.normal_force_n"``."""
-    def __init__(
-        self,
-        scene: Scene,
-        engine: Optional[str] = None,
-        drive: Sequence[str] = ...,
-        record: Optional[str] = None,
-        stop_time: Optional[float] = None,
-    ) -> None: ...
-    @property
-    def time(self) -> float:
-        """The run's time, s."""
-    def variables(self) -> List[Tuple[str, str, str, str]]:
-        """(name, causality, unit, description) of every variable."""
-    def set_input(
-        self, name: str, value: float, slope: Optional[float] = None, curvature: Optional[float] = None
-    ) -> None: ...
-    def advance_to(self, t: float) -> None: ...
-    def outputs(self) -> List[Tuple[str, float]]: ...
-    def save(self) -> NetworkStepperState: ...
-    def restore(self, state: NetworkStepperState) -> None: ...
-    def finish(self) -> str:
-        """The network run's summary (JSON text)."""
+        """The run's summary, a pack's or a network's (JSON text)."""

@@ -122,8 +122,11 @@ pub struct CoSimulation {
     network_outcome: Option<crate::NetworkOutcome>,
     /// A network's outputs as last computed, in [`crate::network_outputs`]' order.
     network_outputs: Vec<f64>,
-    /// A network's inputs as last handed to its run, in [`crate::network_inputs`]' order.
+    /// A network's inputs as last handed to its run, in [`crate::network_inputs`]' order
+    /// (NaN: never, or not driven).
     network_pushed: Vec<f64>,
+    /// The scene file, named in a recording ([`CoSimulation::loaded_from`]).
+    scene_path: Option<PathBuf>,
 }
 
 impl CoSimulation {
@@ -149,6 +152,28 @@ impl CoSimulation {
         };
         let engine = scene.engine(None, &scene.name)?;
         let vars = variables(&scene, engine.name(), driven);
+        Ok(CoSimulation::with_table(scene, driven, vars))
+    }
+
+    /// A co-simulation of `scene` whose caller drives the inputs named in `drive`, the others
+    /// following the scene (Python's `Simulation`): a pack's by the FMU's names or their older
+    /// aliases ([`driven_from_names`]), a network's by their public names
+    /// ([`crate::network_inputs`]: `bodies.<body>.drive_torque_n_m`,
+    /// `couplings.<clutch>.normal_force_n`, `couplings.<pack>.pressure_pa`). A name the scene
+    /// has no input for, or one named twice, is bad input naming it.
+    pub fn driving_named<S: AsRef<str>>(scene: Scene, drive: &[S]) -> Result<CoSimulation> {
+        let Some(net) = &scene.network else {
+            return CoSimulation::driving(scene, driven_from_names(drive)?);
+        };
+        let names: Vec<String> = drive.iter().map(|n| n.as_ref().to_string()).collect();
+        let driven = crate::network_cosim::driven_inputs(&scene.name, net, &names)?;
+        let engine = scene.engine(None, &scene.name)?;
+        let vars = variables::network_variables_driving(&scene, engine.name(), &driven);
+        Ok(CoSimulation::with_table(scene, Driven::NONE, vars))
+    }
+
+    /// A co-simulation of `scene` with the variable table `vars`, before its start.
+    fn with_table(scene: Scene, driven: Driven, vars: Vec<Variable>) -> CoSimulation {
         let mut co = CoSimulation {
             driven,
             reals: Vec::new(),
@@ -168,14 +193,22 @@ impl CoSimulation {
             network_outcome: None,
             network_outputs: Vec::new(),
             network_pushed: Vec::new(),
+            scene_path: None,
         };
         co.reset();
-        Ok(co)
+        co
     }
 
     /// The files the run reads (the FMU's resources, a scene file), which no output may name.
     pub fn reading(mut self, inputs: Vec<PathBuf>) -> CoSimulation {
         self.inputs = inputs;
+        self
+    }
+
+    /// The scene file the scene was loaded from, named in a recording of the run (as
+    /// `clutchpack run` names it).
+    pub fn loaded_from(mut self, path: Option<PathBuf>) -> CoSimulation {
+        self.scene_path = path;
         self
     }
 
@@ -265,8 +298,18 @@ impl CoSimulation {
                     .filter(|v| v.causality == Causality::Input)
                     .map(|v| v.name.as_str())
                     .collect();
+                // a network's input its caller chose not to drive (`driving_named`)
+                let undriven =
+                    self.scene.network.as_ref().is_some_and(|net| {
+                        crate::network_inputs(net).iter().any(|(n, _)| n == name)
+                    });
+                let why = if undriven {
+                    "is not driven: name it in `drive` when the simulation starts"
+                } else {
+                    "is not an input of this simulation"
+                };
                 Error::Call(format!(
-                    "{name:?} is not an input of this simulation (its inputs: {})",
+                    "{name:?} {why} (its inputs: {})",
                     if inputs.is_empty() {
                         "none: it follows the scene's profiles".to_string()
                     } else {
@@ -347,7 +390,7 @@ impl CoSimulation {
             path: PathBuf::from(&path),
             replace: Replace::Existing,
             options: RecordOptions::default(),
-            scene_path: None,
+            scene_path: self.scene_path.clone(),
         });
         if self.scene.network.is_some() {
             return self.start_network(engine, recording, stop_time_s);
@@ -443,6 +486,12 @@ impl CoSimulation {
         let v = self.variable(Kind::Real, vr)?;
         let most = match v.quantity {
             Quantity::Input(i) => i.max_derivative_order(),
+            Quantity::NetworkInput(_) => {
+                return Err(Error::Call(format!(
+                    "{}: a network's input is held (zero-order); it takes no slope",
+                    v.name
+                )))
+            }
             _ => 0,
         };
         if most == 0 {
@@ -644,7 +693,7 @@ impl CoSimulation {
     }
 
     /// [`CoSimulation::advance_to`] with `progress` called at the engine's progress polls
-    /// ([`Session::advance_polled`]; a network's run does not call it).
+    /// ([`Session::advance_polled`], [`crate::NetworkSimulation::advance_polled`]).
     pub fn advance_polled<'a>(
         &mut self,
         t_end: f64,
@@ -658,7 +707,7 @@ impl CoSimulation {
             )));
         }
         if self.network.is_some() {
-            return self.advance_network(t_end, stop);
+            return self.advance_network(t_end, stop, progress);
         }
         self.check_held_inputs(t_end)?;
         let inputs = self.inputs();

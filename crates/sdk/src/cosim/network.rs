@@ -30,7 +30,13 @@ impl CoSimulation {
             stop_time_s,
         )?;
         self.network = Some(sim);
-        self.network_pushed = vec![f64::NAN; names.len()];
+        // by the index of every input the network has: a caller may drive a few
+        let all = self
+            .scene
+            .network
+            .as_ref()
+            .map_or(0, |n| crate::network_inputs(n).len());
+        self.network_pushed = vec![f64::NAN; all];
         self.push_network_inputs()?;
         self.refresh_network_outputs();
         self.run = next_run();
@@ -59,19 +65,20 @@ impl CoSimulation {
     /// Reads the network's outputs now.
     fn refresh_network_outputs(&mut self) {
         if let Some(sim) = self.network.as_mut() {
-            self.network_outputs = sim.outputs().into_iter().map(|(_, x)| x).collect();
+            self.network_outputs = sim.output_values();
         }
     }
 
     /// [`CoSimulation::advance_to`] of a network scene.
-    pub(super) fn advance_network(
+    pub(super) fn advance_network<'a>(
         &mut self,
         t_end: f64,
-        stop: Option<&AtomicBool>,
+        stop: Option<&'a AtomicBool>,
+        progress: Option<&'a mut dyn FnMut(f64)>,
     ) -> Result<bool> {
         self.push_network_inputs()?;
         let sim = self.network.as_mut().expect("a network while running");
-        let result = sim.advance_to(t_end, stop);
+        let result = sim.advance_polled(t_end, stop, progress);
         let reached = (sim.time_s() - t_end).abs() <= 1e-12 * t_end.abs().max(1.0);
         self.refresh_network_outputs();
         match result {

@@ -169,11 +169,33 @@ pub fn uses_unit(name: &str, vars: &[Variable]) -> bool {
 /// `multibody`) makes with the inputs `driven` (an FMU drives what [`Driven::all_for`] gives
 /// the pack): parameters, then inputs, then outputs.
 pub fn variables(scene: &Scene, engine: &str, driven: Driven) -> Vec<Variable> {
+    table(scene, engine, driven, None)
+}
+
+/// [`variables`] of a network scene whose caller drives only the inputs `driven` (indices
+/// into [`crate::network_inputs`]' list; Python's `Simulation`), the others following the
+/// scene: only those are inputs.
+pub(crate) fn network_variables_driving(
+    scene: &Scene,
+    engine: &str,
+    driven: &[usize],
+) -> Vec<Variable> {
+    table(scene, engine, Driven::NONE, Some(driven))
+}
+
+/// [`variables`], a network's inputs all (`network_driven` `None`) or those listed.
+fn table(
+    scene: &Scene,
+    engine: &str,
+    driven: Driven,
+    network_driven: Option<&[usize]>,
+) -> Vec<Variable> {
     let mut v = Table::default();
     let pack = &scene.pack;
     parameters(&mut v, scene, engine);
     if let Some(net) = &scene.network {
-        network_variables(&mut v, net, scene.transmission.as_ref());
+        let driven = |j: usize| network_driven.is_none_or(|d| d.contains(&j));
+        network_variables(&mut v, net, scene.transmission.as_ref(), &driven);
         return v.0;
     }
     // every input a host is given, with what it holds when the host connects nothing to it
@@ -447,15 +469,18 @@ fn parameters(v: &mut Table, scene: &Scene, engine: &str) {
 }
 
 /// A network scene's inputs (every turning body's drive torque, every clutch's normal force;
-/// each starting at the scene's value at t = 0) and outputs ([`crate::network_outputs`]).
+/// each starting at the scene's value at t = 0), those `driven`, and outputs
+/// ([`crate::network_outputs`]).
 fn network_variables(
     v: &mut Table,
     net: &clutchpack_model::network::Network,
     tr: Option<&clutchpack_model::network::Transmission>,
+    driven: &dyn Fn(usize) -> bool,
 ) {
     for (j, (var, start)) in crate::network_cosim::network_input_variables(net)
         .into_iter()
         .enumerate()
+        .filter(|(j, _)| driven(*j))
     {
         v.push(Variable {
             name: var.name,
