@@ -70,13 +70,13 @@ pub fn impact_name(net: &Network, coupling: usize, body: Option<usize>) -> Strin
     let Some(c) = net.couplings.get(coupling) else {
         return format!("coupling {coupling}");
     };
-    match (body, c.pack()) {
-        (Some(i), Some(p)) => {
-            let role = if i < p.discs.len() { "discs" } else { "plates" };
-            let body = p.bodies().nth(i);
+    match (body, c.law().own_bodies()) {
+        (Some(i), Some(own)) => {
+            let body = own.iter().nth(i);
             format!(
-                "{}/{role}/{}",
+                "{}/{}/{}",
                 c.name,
+                own.role(i),
                 body.map_or("?", |d| d.name.as_str())
             )
         }
@@ -285,10 +285,10 @@ impl NetworkRecorder {
         let none = BTreeMap::new;
         let mut pack_joints = BTreeMap::new();
         for (k, (c, seg)) in net.couplings.iter().zip(&coupling_segments).enumerate() {
-            if let Some(p) = c.pack() {
+            if let Some(own) = c.law().own_bodies() {
                 let topic = topics::network_pack_joints(seg);
                 let id = channel(&mut w, s_joints, &topic, "cdr", none())?;
-                pack_joints.insert(k, (id, p.body_names()));
+                pack_joints.insert(k, (id, own.names()));
             }
         }
         let mut pack_temperatures = BTreeMap::new();
@@ -299,10 +299,10 @@ impl NetworkRecorder {
                 .keys()
                 .zip(net.pack_thermal.keys().map(|&k| &coupling_segments[k]))
             {
-                let Some(p) = net.couplings[k].pack() else {
+                let Some(own) = net.couplings[k].law().own_bodies() else {
                     continue;
                 };
-                let names = p.body_names();
+                let names = own.names();
                 let mut ids = Vec::with_capacity(names.len() + 1);
                 for body in unique_segments(&names)
                     .iter()

@@ -6,7 +6,9 @@
 //! is the one `match` on the kinds that hands it out. The engines and the layers above ask the
 //! law, never the kind: its ports, its constraint row in a mode, its torque where the engines
 //! share the formula, its state, its event guard and the stick/slip rule at an event, its
-//! share of the energy audit, its co-simulation input and its kind's name.
+//! share of the energy audit, its co-simulation input and its kind's name, and what the layers
+//! above show of it: the bodies it carries of its own (a resolved pack's discs and plates,
+//! [`OwnBodies`]).
 //!
 //! What stays an engine's own is what the engines do differently: a gear mesh's contact events
 //! (the law's memory, the impact peaks) and a resolved pack's session (its discs and plates),
@@ -130,6 +132,67 @@ pub struct OutputSpec {
     pub description: &'static str,
     /// What it gives.
     pub quantity: OutputQuantity,
+}
+
+/// The bodies an element carries of its own besides its ports, each engine's to integrate with
+/// their tooth contacts (a resolved pack's friction discs, splined to port 0, and its
+/// separator plates, splined to port 1): what the layers above name, count, draw, record and
+/// summarise of them ([`ElementLaw::own_bodies`]). Indices run over the discs, then the plates,
+/// as the engines number them.
+#[derive(Debug, Clone, Copy)]
+pub struct OwnBodies<'a> {
+    /// The bodies on port 0 (friction discs), in order.
+    pub discs: &'a [crate::DiscModel],
+    /// The bodies on port 1 (separator plates), in order.
+    pub plates: &'a [crate::DiscModel],
+    /// Whether they are clamped in a stack (plate, disc, ..., plate along the axis).
+    pub stacked: bool,
+}
+
+impl<'a> OwnBodies<'a> {
+    /// How many: discs and plates.
+    pub fn len(&self) -> usize {
+        self.discs.len() + self.plates.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Every body, the discs then the plates.
+    pub fn iter(&self) -> impl Iterator<Item = &'a crate::DiscModel> {
+        self.discs.iter().chain(self.plates)
+    }
+
+    /// Their names, in [`Self::iter`]'s order.
+    pub fn names(&self) -> Vec<String> {
+        self.iter().map(|d| d.name.clone()).collect()
+    }
+
+    /// The list body `i` is in, as outputs name it: `discs` or `plates`.
+    pub fn role(&self, i: usize) -> &'static str {
+        if i < self.discs.len() {
+            "discs"
+        } else {
+            "plates"
+        }
+    }
+
+    /// Body `i`'s level along the axis from the bottom (0, 1, ...): its place in the stack
+    /// when they are stacked ([`crate::StackBody::position`]), else its index.
+    pub fn level(&self, i: usize) -> usize {
+        if !self.stacked {
+            return i;
+        }
+        let nd = self.discs.len();
+        let body = if i < nd {
+            crate::StackBody::Disc(i)
+        } else {
+            crate::StackBody::Plate(i - nd)
+        };
+        body.position()
+    }
 }
 
 /// The most ports an element has (a planetary set's sun, ring and carrier).
@@ -341,6 +404,12 @@ pub trait ElementLaw {
     /// The co-simulation outputs it gives besides its torque, in order.
     fn outputs(&self) -> &'static [OutputSpec] {
         &[]
+    }
+
+    /// The bodies it carries of its own ([`OwnBodies`]: a resolved pack's discs and plates);
+    /// `None` for an element that carries none.
+    fn own_bodies(&self) -> Option<OwnBodies<'_>> {
+        None
     }
 }
 

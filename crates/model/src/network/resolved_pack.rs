@@ -2,9 +2,11 @@
 //! friction discs splined to body `a`, its separator plates to body `b` (a drum; the housing
 //! when `b` is fixed). Its discs, plates, tooth contacts and faces are each engine's pack
 //! session ([`super::Coupling::pack`]); the law says what the network needs of it: its
-//! piston's breakpoints, its co-simulation input and its problems as a network's element.
+//! piston's breakpoints, its co-simulation input and outputs, its problems as a network's
+//! element and its own bodies (the discs and plates the layers above name, draw and
+//! summarise).
 
-use super::element::{problem, ElementLaw, InputSpec, OutputQuantity, OutputSpec};
+use super::element::{problem, ElementLaw, InputSpec, OutputQuantity, OutputSpec, OwnBodies};
 use super::{Network, NetworkInput, NetworkProblem};
 use crate::PackModel;
 
@@ -68,6 +70,16 @@ impl ElementLaw for PackModel {
         self.stack
             .as_ref()
             .map_or(0.0, |s| s.piston.pressure.pressure_pa(t_s))
+    }
+
+    /// Its friction discs (on `a`) and separator plates (on `b`), stacked when it has a
+    /// `[stack]`.
+    fn own_bodies(&self) -> Option<OwnBodies<'_>> {
+        Some(OwnBodies {
+            discs: &self.discs,
+            plates: &self.plates,
+            stacked: self.stack.is_some(),
+        })
     }
 
     /// Its faces' heat (a thermal pack's temperatures follow it, by its discs and plates).
