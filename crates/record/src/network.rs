@@ -400,7 +400,7 @@ impl NetworkRecorder {
             pack_modes: net
                 .couplings
                 .iter()
-                .map(|c| c.pack().map(|_| ClutchMode::Free))
+                .map(|c| c.law().session_mode())
                 .collect(),
             modes_now: Vec::with_capacity(m),
             sequences: BTreeMap::new(),
@@ -409,7 +409,7 @@ impl NetworkRecorder {
             drawn_modes: net
                 .couplings
                 .iter()
-                .map(|c| (c.clutch().is_some() || c.pack().is_some()).then_some(ClutchMode::Free))
+                .map(|c| c.law().initial_mode().or(c.law().session_mode()))
                 .collect(),
             joint_values: [vec![0.0; n], vec![0.0; n], vec![0.0; m], vec![0.0; m]],
             messages: 0,

@@ -8,7 +8,7 @@
 //! share the formula, its state, its event guard and the stick/slip rule at an event, its
 //! share of the energy audit, its co-simulation input and its kind's name, and what the layers
 //! above show of it: the bodies it carries of its own (a resolved pack's discs and plates,
-//! [`OwnBodies`]).
+//! [`OwnBodies`]), the mode its session reports.
 //!
 //! What stays an engine's own is what the engines do differently: a gear mesh's contact events
 //! (the law's memory, the impact peaks) and a resolved pack's session (its discs and plates),
@@ -409,6 +409,15 @@ pub trait ElementLaw {
     /// The bodies it carries of its own ([`OwnBodies`]: a resolved pack's discs and plates);
     /// `None` for an element that carries none.
     fn own_bodies(&self) -> Option<OwnBodies<'_>> {
+        None
+    }
+
+    /// The mode at t = 0 of faces whose modes its own session reports rather than the
+    /// engines' network equations (a resolved pack's faces: `Some(Free)`; their changes then
+    /// come through [`super::NetworkObserver::pack_faces`]), for the layers that follow
+    /// modes (the recording's colours, an automatic's gear and shifts); `None` when its mode,
+    /// if any, is the samples' ([`Self::initial_mode`]).
+    fn session_mode(&self) -> Mode {
         None
     }
 }

@@ -3,10 +3,12 @@
 //! when `b` is fixed). Its discs, plates, tooth contacts and faces are each engine's pack
 //! session ([`super::Coupling::pack`]); the law says what the network needs of it: its
 //! piston's breakpoints, its co-simulation input and outputs, its problems as a network's
-//! element and its own bodies (the discs and plates the layers above name, draw and
-//! summarise).
+//! element, its own bodies (the discs and plates the layers above name, draw and summarise)
+//! and the mode its faces start in.
 
-use super::element::{problem, ElementLaw, InputSpec, OutputQuantity, OutputSpec, OwnBodies};
+use super::element::{
+    problem, ClutchMode, ElementLaw, InputSpec, Mode, OutputQuantity, OutputSpec, OwnBodies,
+};
 use super::{Network, NetworkInput, NetworkProblem};
 use crate::PackModel;
 
@@ -80,6 +82,11 @@ impl ElementLaw for PackModel {
             plates: &self.plates,
             stacked: self.stack.is_some(),
         })
+    }
+
+    /// Its faces start free; its session reports their changes.
+    fn session_mode(&self) -> Mode {
+        Some(ClutchMode::Free)
     }
 
     /// Its faces' heat (a thermal pack's temperatures follow it, by its discs and plates).
