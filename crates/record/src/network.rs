@@ -634,7 +634,7 @@ impl NetworkRecorder {
                 slip_rad_s: clutch_slip_rad_s(s, c, k),
                 mode: mode.map(|m| m.label().to_string()).unwrap_or_default(),
                 locked: mode == Some(ClutchMode::Locked),
-                normal_force_n: c.clutch().map_or(0.0, |cl| cl.normal_force_n(t)),
+                normal_force_n: c.law().clamp_force_n(t).unwrap_or(0.0),
                 coupling_index: k as u32,
             };
             self.put(self.ch.couplings[k], ns, &msg, "coupling state")?;

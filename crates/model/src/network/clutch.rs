@@ -293,6 +293,11 @@ impl ElementLaw for LumpedClutch {
         self.normal_force_n(t_s).max(0.0)
     }
 
+    /// `fn(t)`, N, as its signal gives it.
+    fn clamp_force_n(&self, t_s: f64) -> Option<f64> {
+        Some(self.normal_force_n(t_s))
+    }
+
     /// Its slip, its mode and its heat.
     fn outputs(&self) -> &'static [OutputSpec] {
         &[

@@ -8,7 +8,7 @@
 //! share the formula, its state, its event guard and the stick/slip rule at an event, its
 //! share of the energy audit, its co-simulation input and its kind's name, and what the layers
 //! above show of it: the bodies it carries of its own (a resolved pack's discs and plates,
-//! [`OwnBodies`]), the mode its session reports.
+//! [`OwnBodies`]), the mode its session reports, its faces' normal force.
 //!
 //! What stays an engine's own is what the engines do differently: a gear mesh's contact events
 //! (the law's memory, the impact peaks) and a resolved pack's session (its discs and plates),
@@ -420,6 +420,14 @@ pub trait ElementLaw {
     fn session_mode(&self) -> Mode {
         None
     }
+
+    /// The normal force on its friction faces at `t` (s), N, as the recording's coupling
+    /// state carries it (a lumped clutch's `fn(t)`, as its signal gives it); `None` for an
+    /// element without one there (the recording writes 0; a resolved pack's clamp forces are
+    /// its session's).
+    fn clamp_force_n(&self, _t_s: f64) -> Option<f64> {
+        None
+    }
 }
 
 /// A coupling's problem at its field `field`.
@@ -554,6 +562,44 @@ mod tests {
         let row = g.row(0, &[1, 2], None).expect("always rigid");
         assert_eq!(row.terms(), &[(1, 1.0), (2, -3.5)]);
         assert_eq!(g.torque_factors(&[1, 2]), Some([1.0, -3.5, 0.0]));
+    }
+
+    /// What the layers above (recorder, sdk, CLI) ask through the law instead of the kind: a
+    /// resolved pack carries its discs then its plates (the 3-disc brake's 3 and 4, named as
+    /// the pack names them, stacked plate, disc, ..., plate: levels 1, 3, 5 and 0, 2, 4, 6),
+    /// its faces start free in its session, and it has no lumped normal force; a clutch carries
+    /// no bodies, its mode is the samples' and its normal force its signal's (0.5 of 20 N);
+    /// a spring-damper has none of these.
+    #[test]
+    fn own_bodies_session_mode_and_clamp_force_are_the_kinds() {
+        let pack = crate::cases::staggered_brake(3);
+        let own = pack
+            .own_bodies()
+            .expect("a pack carries its discs and plates");
+        assert_eq!((own.discs.len(), own.plates.len(), own.len()), (3, 4, 7));
+        assert_eq!(own.names(), pack.body_names());
+        let roles: Vec<&str> = (0..own.len()).map(|i| own.role(i)).collect();
+        assert_eq!(
+            roles,
+            ["discs", "discs", "discs", "plates", "plates", "plates", "plates"]
+        );
+        let levels: Vec<usize> = (0..own.len()).map(|i| own.level(i)).collect();
+        assert_eq!(levels, [1, 3, 5, 0, 2, 4, 6]);
+        let loose = OwnBodies {
+            stacked: false,
+            ..own
+        };
+        assert_eq!(loose.level(4), 4);
+        assert_eq!(pack.session_mode(), Some(ClutchMode::Free));
+        assert_eq!(pack.initial_mode(), None);
+        assert_eq!(pack.clamp_force_n(0.0), None);
+        let c = clutch(false);
+        assert!(c.own_bodies().is_none());
+        assert_eq!(c.session_mode(), None);
+        assert_eq!(c.clamp_force_n(0.0), Some(10.0));
+        let s = spring();
+        assert!(s.own_bodies().is_none() && s.session_mode().is_none());
+        assert_eq!(s.clamp_force_n(0.0), None);
     }
 
     /// The two engines find a slip's end differently and the rule says how: a slipping clutch
