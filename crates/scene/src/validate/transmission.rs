@@ -11,14 +11,11 @@ use crate::schema::{Key, RawTable};
 use clutchpack_model::network::gears::{pack_pressure, rated_pressure_pa};
 use clutchpack_model::network::{CouplingKind, Gear, Network, Shift, Transmission};
 
-/// Whether a gear may close a coupling of kind `kind`: a lumped clutch (or a one-way clutch)
-/// or a resolved pack with a stack (its piston the schedule's).
+/// Whether a gear may close a coupling of kind `kind`: one its schedule can actuate, an element
+/// with an actuation input of its own (`ElementLaw::input`: a lumped clutch's or a one-way
+/// clutch's normal force, a resolved pack's piston pressure when it has a stack).
 fn shift_element(kind: &CouplingKind) -> bool {
-    match kind {
-        CouplingKind::Clutch(_) => true,
-        CouplingKind::Pack(p) => p.stack.is_some(),
-        _ => false,
-    }
+    kind.law().input().is_some()
 }
 
 /// The names every gear closes, when `[transmission]` has an initial gear or shifts (its
