@@ -8,7 +8,8 @@
 //! share the formula, its state, its event guard and the stick/slip rule at an event, its
 //! share of the energy audit, its co-simulation input and its kind's name, and what the layers
 //! above show of it: the bodies it carries of its own (a resolved pack's discs and plates,
-//! [`OwnBodies`]), the mode its session reports, its faces' normal force.
+//! [`OwnBodies`]), the mode its session reports, its faces' normal force; and how a shift
+//! schedule actuates it.
 //!
 //! What stays an engine's own is what the engines do differently: a gear mesh's contact events
 //! (the law's memory, the impact peaks) and a resolved pack's session (its discs and plates),
@@ -22,7 +23,7 @@
 //! (rad/s) as the clutch's.
 
 use super::rows::Row;
-use super::{Coupling, Network, NetworkInput, NetworkProblem};
+use super::{Coupling, CouplingKind, Network, NetworkInput, NetworkProblem, Signal};
 use serde::{Deserialize, Serialize};
 
 /// The state of a friction element, a lumped clutch's (Modelica's `mode`: Free 2, Forward 1, Stuck 0, Backward -1).
@@ -406,6 +407,17 @@ pub trait ElementLaw {
         &[]
     }
 
+    /// This element as a shift schedule's normalized force `level` (0 open, 1 closed: what
+    /// [`super::Transmission::schedule`] gives each element a gear closes) actuates it, as its
+    /// coupling's new kind: a clutch's normal force follows the level (`fn_max` scales it), a
+    /// stacked pack's piston pressure is the level times the pack's rated pressure
+    /// ([`super::gears::pack_pressure`]); `Ok(None)` when the schedule leaves it as it is (an
+    /// element no schedule actuates, a level of a kind it cannot follow); `Err` with its field
+    /// and what is wrong (said of the element, after its name) when it cannot be actuated.
+    fn scheduled(&self, _level: &Signal) -> Result<Option<CouplingKind>, (&'static str, String)> {
+        Ok(None)
+    }
+
     /// The bodies it carries of its own ([`OwnBodies`]: a resolved pack's discs and plates);
     /// `None` for an element that carries none.
     fn own_bodies(&self) -> Option<OwnBodies<'_>> {
@@ -600,6 +612,35 @@ mod tests {
         let s = spring();
         assert!(s.own_bodies().is_none() && s.session_mode().is_none());
         assert_eq!(s.clamp_force_n(0.0), None);
+    }
+
+    /// A schedule's level actuates each kind as its law says: a clutch's normal force follows
+    /// it (0.25 of 20 N: 5 N), a stacked pack's pressure is it times the rated pressure (0.5
+    /// of 2e5 Pa: 1e5 Pa), a released pack (rated 0 Pa) is refused at its `pack`, a pack
+    /// without a stack and a spring-damper are left as they are.
+    #[test]
+    fn a_schedule_actuates_each_kind_through_its_law() {
+        let level = Signal::Constant(0.25);
+        let Ok(Some(CouplingKind::Clutch(c))) = clutch(false).scheduled(&level) else {
+            panic!("a clutch takes the level");
+        };
+        assert_eq!(c.normal_force_n(1.0), 5.0);
+        let mut pack = crate::cases::staggered_brake(3);
+        let Err((field, why)) = pack.scheduled(&level) else {
+            panic!("a released pack has no rated pressure");
+        };
+        assert_eq!(field, "pack");
+        assert!(why.contains("rated pressure"), "{why}");
+        let stack = pack.stack.as_mut().expect("stacked");
+        stack.piston.pressure = crate::PressureProfile::Constant { pressure_pa: 2e5 };
+        let Ok(Some(CouplingKind::Pack(p))) = pack.scheduled(&Signal::Constant(0.5)) else {
+            panic!("a stacked pack takes the level");
+        };
+        let s = p.stack.as_ref().expect("stacked");
+        assert_eq!(s.piston.pressure.pressure_pa(1.0), 1e5);
+        pack.stack = None;
+        assert!(matches!(pack.scheduled(&level), Ok(None)));
+        assert!(matches!(spring().scheduled(&level), Ok(None)));
     }
 
     /// The two engines find a slip's end differently and the rule says how: a slipping clutch
