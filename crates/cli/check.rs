@@ -52,12 +52,12 @@ pub fn check(a: CheckArgs) -> Result<ExitCode> {
                     .couplings
                     .iter()
                     .filter_map(|c| {
-                        let pk = c.pack()?;
+                        let own = c.law().own_bodies()?;
                         Some(format!(
                             "{} ({} discs, {} plates)",
                             c.name,
-                            pk.discs.len(),
-                            pk.plates.len()
+                            own.discs.len(),
+                            own.plates.len()
                         ))
                     })
                     .collect();

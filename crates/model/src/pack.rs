@@ -198,6 +198,18 @@ impl PackCoupling {
             PackCouplingKind::SpringDamper(s) => s.loss_rate_w(omega_a - omega_b),
         }
     }
+
+    /// The period of its own oscillation between bodies of the inertias `j_a`, `j_b` (kg m^2;
+    /// infinite for a body whose motion is given), s: the time scale a multirate scheme's
+    /// coupling step resolves. Spring-damper: `2 pi / w_n`, its undamped natural frequency
+    /// (`SpringDamper::natural_frequency_rad_s`).
+    pub fn period_s(&self, j_a_kg_m2: f64, j_b_kg_m2: f64) -> f64 {
+        match &self.kind {
+            PackCouplingKind::SpringDamper(s) => {
+                2.0 * std::f64::consts::PI / s.natural_frequency_rad_s(j_a_kg_m2, j_b_kg_m2)
+            }
+        }
+    }
 }
 
 /// The couplings' effect on the pack's shaft and drum at one instant
@@ -448,7 +460,8 @@ mod tests {
 
     /// A spring-damper from the shaft (a) to the drum (b): equal and opposite torques, `T`
     /// on the drum; its potential and loss; with a and b swapped, the same pair of torques
-    /// for the opposite twist convention.
+    /// for the opposite twist convention; its period between two inertias and against a
+    /// prescribed body (the closed forms to rounding, 1e-12).
     #[test]
     fn coupling_loads_are_equal_and_opposite() {
         let spring = SpringDamper {
@@ -478,5 +491,12 @@ mod tests {
         // k (0.1 - 0.3 - 0.1) + d (4 - 5) = -30 - 2 on the shaft
         assert!((l.shaft_n_m + 32.0).abs() < 1e-12);
         assert_eq!(l.drum_n_m, -l.shaft_n_m);
+        // its period: 2 pi / sqrt(k (1/J_a + 1/J_b)), k = 100 N m/rad, J = 1 and 4 kg m^2
+        // (sqrt(125) rad/s), and with a prescribed (infinite) a, sqrt(25) = 5 rad/s
+        let c = &pack.couplings[0];
+        let period = c.period_s(1.0, 4.0);
+        assert!((period - 2.0 * std::f64::consts::PI / 125f64.sqrt()).abs() < 1e-12);
+        let period = c.period_s(f64::INFINITY, 4.0);
+        assert!((period - 2.0 * std::f64::consts::PI / 5.0).abs() < 1e-12);
     }
 }

@@ -70,13 +70,13 @@ pub fn impact_name(net: &Network, coupling: usize, body: Option<usize>) -> Strin
     let Some(c) = net.couplings.get(coupling) else {
         return format!("coupling {coupling}");
     };
-    match (body, c.pack()) {
-        (Some(i), Some(p)) => {
-            let role = if i < p.discs.len() { "discs" } else { "plates" };
-            let body = p.bodies().nth(i);
+    match (body, c.law().own_bodies()) {
+        (Some(i), Some(own)) => {
+            let body = own.iter().nth(i);
             format!(
-                "{}/{role}/{}",
+                "{}/{}/{}",
                 c.name,
+                own.role(i),
                 body.map_or("?", |d| d.name.as_str())
             )
         }
@@ -285,10 +285,10 @@ impl NetworkRecorder {
         let none = BTreeMap::new;
         let mut pack_joints = BTreeMap::new();
         for (k, (c, seg)) in net.couplings.iter().zip(&coupling_segments).enumerate() {
-            if let Some(p) = c.pack() {
+            if let Some(own) = c.law().own_bodies() {
                 let topic = topics::network_pack_joints(seg);
                 let id = channel(&mut w, s_joints, &topic, "cdr", none())?;
-                pack_joints.insert(k, (id, p.body_names()));
+                pack_joints.insert(k, (id, own.names()));
             }
         }
         let mut pack_temperatures = BTreeMap::new();
@@ -299,10 +299,10 @@ impl NetworkRecorder {
                 .keys()
                 .zip(net.pack_thermal.keys().map(|&k| &coupling_segments[k]))
             {
-                let Some(p) = net.couplings[k].pack() else {
+                let Some(own) = net.couplings[k].law().own_bodies() else {
                     continue;
                 };
-                let names = p.body_names();
+                let names = own.names();
                 let mut ids = Vec::with_capacity(names.len() + 1);
                 for body in unique_segments(&names)
                     .iter()
@@ -400,7 +400,7 @@ impl NetworkRecorder {
             pack_modes: net
                 .couplings
                 .iter()
-                .map(|c| c.pack().map(|_| ClutchMode::Free))
+                .map(|c| c.law().session_mode())
                 .collect(),
             modes_now: Vec::with_capacity(m),
             sequences: BTreeMap::new(),
@@ -409,7 +409,7 @@ impl NetworkRecorder {
             drawn_modes: net
                 .couplings
                 .iter()
-                .map(|c| (c.clutch().is_some() || c.pack().is_some()).then_some(ClutchMode::Free))
+                .map(|c| c.law().initial_mode().or(c.law().session_mode()))
                 .collect(),
             joint_values: [vec![0.0; n], vec![0.0; n], vec![0.0; m], vec![0.0; m]],
             messages: 0,
@@ -634,7 +634,7 @@ impl NetworkRecorder {
                 slip_rad_s: clutch_slip_rad_s(s, c, k),
                 mode: mode.map(|m| m.label().to_string()).unwrap_or_default(),
                 locked: mode == Some(ClutchMode::Locked),
-                normal_force_n: c.clutch().map_or(0.0, |cl| cl.normal_force_n(t)),
+                normal_force_n: c.law().clamp_force_n(t).unwrap_or(0.0),
                 coupling_index: k as u32,
             };
             self.put(self.ch.couplings[k], ns, &msg, "coupling state")?;

@@ -7,7 +7,6 @@
 use crate::view3d::{about_z, entity, pose, rgba, timestamp, v3};
 use crate::write::unique_segments;
 use clutchpack_model::network::Network;
-use clutchpack_model::StackBody;
 use foxglove::schemas::{
     CubePrimitive, CylinderPrimitive, FrameTransform, FrameTransforms, SceneEntity, TextPrimitive,
 };
@@ -48,34 +47,25 @@ impl PacksDrawing {
             .iter()
             .enumerate()
             .filter_map(|(k, c)| {
-                let p = c.pack()?;
-                let names = p.body_names();
+                let own = c.law().own_bodies()?;
+                let names = own.names();
                 let pack_segment = unique_segments(std::slice::from_ref(&c.name)).remove(0);
                 let segments = unique_segments(&names);
-                let nd = p.discs.len();
+                let nd = own.discs.len();
                 let r = radii[c.a];
                 let rings = segments
                     .iter()
                     .enumerate()
                     .map(|(i, seg)| {
                         // stack order when the pack has a stack; else discs, then plates
-                        let level = if p.stack.is_some() {
-                            let body = if i < nd {
-                                StackBody::Disc(i)
-                            } else {
-                                StackBody::Plate(i - nd)
-                            };
-                            body.position()
-                        } else {
-                            i
-                        };
+                        let level = own.level(i);
                         let z = 0.5 * body_thickness_m + RING_PITCH_M * (level as f64 + 1.0);
                         let radius = if i < nd { 1.2 * r } else { 1.35 * r };
                         (format!("pack/{pack_segment}/{seg}"), z, radius)
                     })
                     .collect();
                 Some(PackDrawing {
-                    label: format!("{} ({nd} discs, {} plates)", c.name, p.plates.len()),
+                    label: format!("{} ({nd} discs, {} plates)", c.name, own.plates.len()),
                     coupling: k,
                     rings,
                     place: crate::network_view::row_frame(c.a),

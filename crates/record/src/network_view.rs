@@ -616,7 +616,7 @@ mod tests {
         let mut modes: Vec<Option<ClutchMode>> = net
             .couplings
             .iter()
-            .map(|c| c.clutch().map(|_| ClutchMode::Free))
+            .map(|c| c.law().initial_mode())
             .collect();
         for &k in &tr.gears[first].closed {
             modes[k] = Some(ClutchMode::Locked);

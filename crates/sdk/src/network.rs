@@ -195,7 +195,7 @@ pub(crate) fn run(
         return Err(crate::simulation::not_a_network(&scene.name));
     };
     let sim = &scene.simulation;
-    if req.windows_s.is_some() && !net.couplings.iter().any(|c| c.pack().is_some()) {
+    if req.windows_s.is_some() && !net.couplings.iter().any(|c| c.law().own_bodies().is_some()) {
         return Err(Error::BadInput(format!(
             "windows (`--windows`, `windows_s`): {} has no resolved pack (kind = \"pack\") \
              whose bodies' figures they would give",
@@ -407,11 +407,11 @@ pub(crate) fn conclude(
                     .iter()
                     .find(|(j, _)| *j == k)
                     .map(|(_, r)| {
-                        let names = c.pack().map_or_else(Vec::new, |p| p.body_names());
+                        let names = c.law().own_bodies().map_or_else(Vec::new, |o| o.names());
                         crate::ThermalSummary::new(r, &names)
                     }),
-                pack_bodies: c.pack().map_or_else(Vec::new, |p| {
-                    p.bodies()
+                pack_bodies: c.law().own_bodies().map_or_else(Vec::new, |own| {
+                    own.iter()
                         .enumerate()
                         .map(|(i, d)| {
                             let m = keep.pack_bodies.get(&(k, i)).copied().unwrap_or((0, 0.0));

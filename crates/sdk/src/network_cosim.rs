@@ -281,9 +281,9 @@ pub fn network_outputs(net: &Network, tr: Option<&Transmission>) -> Vec<NetworkV
                 spec.description.replacen("{}", &c.name, 1),
             ));
         }
-        if let (Some(p), true) = (c.pack(), net.pack_thermal.contains_key(&k)) {
+        if let (Some(own), true) = (c.law().own_bodies(), net.pack_thermal.contains_key(&k)) {
             // as a thermal pack scene's own outputs name them, under the coupling
-            let lists = [("discs", p.discs.len()), ("plates", p.plates.len())];
+            let lists = [("discs", own.discs.len()), ("plates", own.plates.len())];
             for (list, n) in lists {
                 for i in 0..n {
                     out.push(var(
@@ -576,8 +576,8 @@ impl NetworkSimulation {
                 });
             }
             // a thermal pack's discs', plates' and oil's temperatures
-            if let (Some(p), true) = (c.pack(), net.pack_thermal.contains_key(&k)) {
-                let bodies = p.discs.len() + p.plates.len();
+            if let (Some(own), true) = (c.law().own_bodies(), net.pack_thermal.contains_key(&k)) {
+                let bodies = own.len();
                 match self.stepper.pack_temperatures_k(k) {
                     Some(t) => values.extend_from_slice(t),
                     None => values.extend(std::iter::repeat_n(f64::NAN, bodies + 1)),

@@ -107,10 +107,9 @@ impl Keep {
         let (mut names, mut first) = (Vec::new(), Vec::new());
         for (k, c) in net.couplings.iter().enumerate() {
             first.push(names.len());
-            match c.pack() {
-                Some(p) => names.extend(
-                    (0..p.discs.len() + p.plates.len())
-                        .map(|i| clutchpack_record::impact_name(net, k, Some(i))),
+            match c.law().own_bodies() {
+                Some(own) => names.extend(
+                    (0..own.len()).map(|i| clutchpack_record::impact_name(net, k, Some(i))),
                 ),
                 None => names.push(clutchpack_record::impact_name(net, k, None)),
             }
@@ -355,8 +354,10 @@ pub(crate) fn pack_params(
     let mut out = std::collections::BTreeMap::new();
     let mut offset = 0;
     for (k, c) in net.couplings.iter().enumerate() {
-        let Some(p) = c.pack() else { continue };
-        let bodies: Vec<&clutchpack_model::DiscModel> = p.bodies().collect();
+        let Some(own) = c.law().own_bodies() else {
+            continue;
+        };
+        let bodies: Vec<&clutchpack_model::DiscModel> = own.iter().collect();
         let params: Vec<_> = bodies
             .iter()
             .enumerate()

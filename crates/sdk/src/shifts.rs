@@ -151,7 +151,7 @@ impl ShiftProbe {
         let pack_modes = tr
             .elements()
             .into_iter()
-            .map(|k| net.couplings[k].pack().map(|_| ClutchMode::Free))
+            .map(|k| net.couplings[k].law().session_mode())
             .collect();
         Some(ShiftProbe {
             input: tr.input,

@@ -16,7 +16,7 @@ use super::element::{
 };
 use super::rows::Row;
 use super::signal::Signal;
-use super::{friction, Network, NetworkInput, NetworkProblem};
+use super::{friction, CouplingKind, Network, NetworkInput, NetworkProblem};
 use serde::{Deserialize, Serialize};
 
 /// A lumped friction clutch (or brake, when one side is a fixed body).
@@ -291,6 +291,19 @@ impl ElementLaw for LumpedClutch {
     /// `fn(t)`, N (>= 0).
     fn input_value(&self, t_s: f64) -> f64 {
         self.normal_force_n(t_s).max(0.0)
+    }
+
+    /// Its normal force signal is the level (`fn = level fn_max`).
+    fn scheduled(&self, level: &Signal) -> Result<Option<CouplingKind>, (&'static str, String)> {
+        Ok(Some(CouplingKind::Clutch(LumpedClutch {
+            force: level.clone(),
+            ..self.clone()
+        })))
+    }
+
+    /// `fn(t)`, N, as its signal gives it.
+    fn clamp_force_n(&self, t_s: f64) -> Option<f64> {
+        Some(self.normal_force_n(t_s))
     }
 
     /// Its slip, its mode and its heat.

@@ -6,7 +6,10 @@
 //! is the one `match` on the kinds that hands it out. The engines and the layers above ask the
 //! law, never the kind: its ports, its constraint row in a mode, its torque where the engines
 //! share the formula, its state, its event guard and the stick/slip rule at an event, its
-//! share of the energy audit, its co-simulation input and its kind's name.
+//! share of the energy audit, its co-simulation input and its kind's name, and what the layers
+//! above show of it: the bodies it carries of its own (a resolved pack's discs and plates,
+//! [`OwnBodies`]), the mode its session reports, its faces' normal force; and how a shift
+//! schedule actuates it.
 //!
 //! What stays an engine's own is what the engines do differently: a gear mesh's contact events
 //! (the law's memory, the impact peaks) and a resolved pack's session (its discs and plates),
@@ -20,7 +23,7 @@
 //! (rad/s) as the clutch's.
 
 use super::rows::Row;
-use super::{Coupling, Network, NetworkInput, NetworkProblem};
+use super::{Coupling, CouplingKind, Network, NetworkInput, NetworkProblem, Signal};
 use serde::{Deserialize, Serialize};
 
 /// The state of a friction element, a lumped clutch's (Modelica's `mode`: Free 2, Forward 1, Stuck 0, Backward -1).
@@ -130,6 +133,67 @@ pub struct OutputSpec {
     pub description: &'static str,
     /// What it gives.
     pub quantity: OutputQuantity,
+}
+
+/// The bodies an element carries of its own besides its ports, each engine's to integrate with
+/// their tooth contacts (a resolved pack's friction discs, splined to port 0, and its
+/// separator plates, splined to port 1): what the layers above name, count, draw, record and
+/// summarise of them ([`ElementLaw::own_bodies`]). Indices run over the discs, then the plates,
+/// as the engines number them.
+#[derive(Debug, Clone, Copy)]
+pub struct OwnBodies<'a> {
+    /// The bodies on port 0 (friction discs), in order.
+    pub discs: &'a [crate::DiscModel],
+    /// The bodies on port 1 (separator plates), in order.
+    pub plates: &'a [crate::DiscModel],
+    /// Whether they are clamped in a stack (plate, disc, ..., plate along the axis).
+    pub stacked: bool,
+}
+
+impl<'a> OwnBodies<'a> {
+    /// How many: discs and plates.
+    pub fn len(&self) -> usize {
+        self.discs.len() + self.plates.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Every body, the discs then the plates.
+    pub fn iter(&self) -> impl Iterator<Item = &'a crate::DiscModel> {
+        self.discs.iter().chain(self.plates)
+    }
+
+    /// Their names, in [`Self::iter`]'s order.
+    pub fn names(&self) -> Vec<String> {
+        self.iter().map(|d| d.name.clone()).collect()
+    }
+
+    /// The list body `i` is in, as outputs name it: `discs` or `plates`.
+    pub fn role(&self, i: usize) -> &'static str {
+        if i < self.discs.len() {
+            "discs"
+        } else {
+            "plates"
+        }
+    }
+
+    /// Body `i`'s level along the axis from the bottom (0, 1, ...): its place in the stack
+    /// when they are stacked ([`crate::StackBody::position`]), else its index.
+    pub fn level(&self, i: usize) -> usize {
+        if !self.stacked {
+            return i;
+        }
+        let nd = self.discs.len();
+        let body = if i < nd {
+            crate::StackBody::Disc(i)
+        } else {
+            crate::StackBody::Plate(i - nd)
+        };
+        body.position()
+    }
 }
 
 /// The most ports an element has (a planetary set's sun, ring and carrier).
@@ -342,6 +406,40 @@ pub trait ElementLaw {
     fn outputs(&self) -> &'static [OutputSpec] {
         &[]
     }
+
+    /// This element as a shift schedule's normalized force `level` (0 open, 1 closed: what
+    /// [`super::Transmission::schedule`] gives each element a gear closes) actuates it, as its
+    /// coupling's new kind: a clutch's normal force follows the level (`fn_max` scales it), a
+    /// stacked pack's piston pressure is the level times the pack's rated pressure
+    /// ([`super::gears::pack_pressure`]); `Ok(None)` when the schedule leaves it as it is (an
+    /// element no schedule actuates, a level of a kind it cannot follow); `Err` with its field
+    /// and what is wrong (said of the element, after its name) when it cannot be actuated.
+    fn scheduled(&self, _level: &Signal) -> Result<Option<CouplingKind>, (&'static str, String)> {
+        Ok(None)
+    }
+
+    /// The bodies it carries of its own ([`OwnBodies`]: a resolved pack's discs and plates);
+    /// `None` for an element that carries none.
+    fn own_bodies(&self) -> Option<OwnBodies<'_>> {
+        None
+    }
+
+    /// The mode at t = 0 of faces whose modes its own session reports rather than the
+    /// engines' network equations (a resolved pack's faces: `Some(Free)`; their changes then
+    /// come through [`super::NetworkObserver::pack_faces`]), for the layers that follow
+    /// modes (the recording's colours, an automatic's gear and shifts); `None` when its mode,
+    /// if any, is the samples' ([`Self::initial_mode`]).
+    fn session_mode(&self) -> Mode {
+        None
+    }
+
+    /// The normal force on its friction faces at `t` (s), N, as the recording's coupling
+    /// state carries it (a lumped clutch's `fn(t)`, as its signal gives it); `None` for an
+    /// element without one there (the recording writes 0; a resolved pack's clamp forces are
+    /// its session's).
+    fn clamp_force_n(&self, _t_s: f64) -> Option<f64> {
+        None
+    }
 }
 
 /// A coupling's problem at its field `field`.
@@ -476,6 +574,73 @@ mod tests {
         let row = g.row(0, &[1, 2], None).expect("always rigid");
         assert_eq!(row.terms(), &[(1, 1.0), (2, -3.5)]);
         assert_eq!(g.torque_factors(&[1, 2]), Some([1.0, -3.5, 0.0]));
+    }
+
+    /// What the layers above (recorder, sdk, CLI) ask through the law instead of the kind: a
+    /// resolved pack carries its discs then its plates (the 3-disc brake's 3 and 4, named as
+    /// the pack names them, stacked plate, disc, ..., plate: levels 1, 3, 5 and 0, 2, 4, 6),
+    /// its faces start free in its session, and it has no lumped normal force; a clutch carries
+    /// no bodies, its mode is the samples' and its normal force its signal's (0.5 of 20 N);
+    /// a spring-damper has none of these.
+    #[test]
+    fn own_bodies_session_mode_and_clamp_force_are_the_kinds() {
+        let pack = crate::cases::staggered_brake(3);
+        let own = pack
+            .own_bodies()
+            .expect("a pack carries its discs and plates");
+        assert_eq!((own.discs.len(), own.plates.len(), own.len()), (3, 4, 7));
+        assert_eq!(own.names(), pack.body_names());
+        let roles: Vec<&str> = (0..own.len()).map(|i| own.role(i)).collect();
+        assert_eq!(
+            roles,
+            ["discs", "discs", "discs", "plates", "plates", "plates", "plates"]
+        );
+        let levels: Vec<usize> = (0..own.len()).map(|i| own.level(i)).collect();
+        assert_eq!(levels, [1, 3, 5, 0, 2, 4, 6]);
+        let loose = OwnBodies {
+            stacked: false,
+            ..own
+        };
+        assert_eq!(loose.level(4), 4);
+        assert_eq!(pack.session_mode(), Some(ClutchMode::Free));
+        assert_eq!(pack.initial_mode(), None);
+        assert_eq!(pack.clamp_force_n(0.0), None);
+        let c = clutch(false);
+        assert!(c.own_bodies().is_none());
+        assert_eq!(c.session_mode(), None);
+        assert_eq!(c.clamp_force_n(0.0), Some(10.0));
+        let s = spring();
+        assert!(s.own_bodies().is_none() && s.session_mode().is_none());
+        assert_eq!(s.clamp_force_n(0.0), None);
+    }
+
+    /// A schedule's level actuates each kind as its law says: a clutch's normal force follows
+    /// it (0.25 of 20 N: 5 N), a stacked pack's pressure is it times the rated pressure (0.5
+    /// of 2e5 Pa: 1e5 Pa), a released pack (rated 0 Pa) is refused at its `pack`, a pack
+    /// without a stack and a spring-damper are left as they are.
+    #[test]
+    fn a_schedule_actuates_each_kind_through_its_law() {
+        let level = Signal::Constant(0.25);
+        let Ok(Some(CouplingKind::Clutch(c))) = clutch(false).scheduled(&level) else {
+            panic!("a clutch takes the level");
+        };
+        assert_eq!(c.normal_force_n(1.0), 5.0);
+        let mut pack = crate::cases::staggered_brake(3);
+        let Err((field, why)) = pack.scheduled(&level) else {
+            panic!("a released pack has no rated pressure");
+        };
+        assert_eq!(field, "pack");
+        assert!(why.contains("rated pressure"), "{why}");
+        let stack = pack.stack.as_mut().expect("stacked");
+        stack.piston.pressure = crate::PressureProfile::Constant { pressure_pa: 2e5 };
+        let Ok(Some(CouplingKind::Pack(p))) = pack.scheduled(&Signal::Constant(0.5)) else {
+            panic!("a stacked pack takes the level");
+        };
+        let s = p.stack.as_ref().expect("stacked");
+        assert_eq!(s.piston.pressure.pressure_pa(1.0), 1e5);
+        pack.stack = None;
+        assert!(matches!(pack.scheduled(&level), Ok(None)));
+        assert!(matches!(spring().scheduled(&level), Ok(None)));
     }
 
     /// The two engines find a slip's end differently and the rule says how: a slipping clutch

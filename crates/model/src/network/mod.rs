@@ -25,7 +25,7 @@ pub mod spring_damper;
 
 pub use clutch::{ClutchMode, LumpedClutch};
 pub use element::{
-    ElementLaw, EnergyTerm, InputSpec, Mode, OutputQuantity, OutputSpec, Ports, SlipEnd,
+    ElementLaw, EnergyTerm, InputSpec, Mode, OutputQuantity, OutputSpec, OwnBodies, Ports, SlipEnd,
 };
 pub use firing::Firing;
 pub use gear::GearMesh;

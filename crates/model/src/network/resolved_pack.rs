@@ -2,10 +2,15 @@
 //! friction discs splined to body `a`, its separator plates to body `b` (a drum; the housing
 //! when `b` is fixed). Its discs, plates, tooth contacts and faces are each engine's pack
 //! session ([`super::Coupling::pack`]); the law says what the network needs of it: its
-//! piston's breakpoints, its co-simulation input and its problems as a network's element.
+//! piston's breakpoints, its co-simulation input and outputs, its problems as a network's
+//! element, its own bodies (the discs and plates the layers above name, draw and summarise),
+//! the mode its faces start in, and its pressure under a shift schedule.
 
-use super::element::{problem, ElementLaw, InputSpec, OutputQuantity, OutputSpec};
-use super::{Network, NetworkInput, NetworkProblem};
+use super::element::{
+    problem, ClutchMode, ElementLaw, InputSpec, Mode, OutputQuantity, OutputSpec, OwnBodies,
+};
+use super::gears::{pack_pressure, rated_pressure_pa};
+use super::{CouplingKind, Network, NetworkInput, NetworkProblem, Signal};
 use crate::PackModel;
 
 impl ElementLaw for PackModel {
@@ -68,6 +73,46 @@ impl ElementLaw for PackModel {
         self.stack
             .as_ref()
             .map_or(0.0, |s| s.piston.pressure.pressure_pa(t_s))
+    }
+
+    /// With a stack, its piston pressure the level times its rated pressure (its own
+    /// profile's largest, [`super::gears::rated_pressure_pa`]), which must be above 0.
+    fn scheduled(&self, level: &Signal) -> Result<Option<CouplingKind>, (&'static str, String)> {
+        let Some(stack) = &self.stack else {
+            return Ok(None);
+        };
+        let rated = rated_pressure_pa(&stack.piston.pressure);
+        if rated.is_nan() || rated <= 0.0 {
+            return Err((
+                "pack",
+                "is a shift element: its pack file's [stack.pressure] must rise above 0 Pa (its \
+                 largest pressure is the element's rated pressure, which the schedule scales)"
+                    .into(),
+            ));
+        }
+        let Some(pressure) = pack_pressure(level, rated) else {
+            return Ok(None);
+        };
+        let mut pack = self.clone();
+        if let Some(s) = pack.stack.as_mut() {
+            s.piston.pressure = pressure;
+        }
+        Ok(Some(CouplingKind::Pack(Box::new(pack))))
+    }
+
+    /// Its friction discs (on `a`) and separator plates (on `b`), stacked when it has a
+    /// `[stack]`.
+    fn own_bodies(&self) -> Option<OwnBodies<'_>> {
+        Some(OwnBodies {
+            discs: &self.discs,
+            plates: &self.plates,
+            stacked: self.stack.is_some(),
+        })
+    }
+
+    /// Its faces start free; its session reports their changes.
+    fn session_mode(&self) -> Mode {
+        Some(ClutchMode::Free)
     }
 
     /// Its faces' heat (a thermal pack's temperatures follow it, by its discs and plates).

@@ -115,12 +115,7 @@ impl Run {
         self.pack
             .couplings
             .iter()
-            .map(|c| match &c.kind {
-                clutchpack_model::PackCouplingKind::SpringDamper(s) => {
-                    2.0 * std::f64::consts::PI
-                        / s.natural_frequency_rad_s(inertia(c.a), inertia(c.b))
-                }
-            })
+            .map(|c| c.period_s(inertia(c.a), inertia(c.b)))
             .fold(f64::INFINITY, f64::min)
     }
 

@@ -8,17 +8,13 @@
 use super::Checker;
 use crate::keys::{RawGear as G, RawNetBody, RawShift as S, RawTransmission as T};
 use crate::schema::{Key, RawTable};
-use clutchpack_model::network::gears::{pack_pressure, rated_pressure_pa};
 use clutchpack_model::network::{CouplingKind, Gear, Network, Shift, Transmission};
 
-/// Whether a gear may close a coupling of kind `kind`: a lumped clutch (or a one-way clutch)
-/// or a resolved pack with a stack (its piston the schedule's).
+/// Whether a gear may close a coupling of kind `kind`: one its schedule can actuate, an element
+/// with an actuation input of its own (`ElementLaw::input`: a lumped clutch's or a one-way
+/// clutch's normal force, a resolved pack's piston pressure when it has a stack).
 fn shift_element(kind: &CouplingKind) -> bool {
-    match kind {
-        CouplingKind::Clutch(_) => true,
-        CouplingKind::Pack(p) => p.stack.is_some(),
-        _ => false,
-    }
+    kind.law().input().is_some()
 }
 
 /// The names every gear closes, when `[transmission]` has an initial gear or shifts (its
@@ -274,32 +270,20 @@ pub(super) fn transmission(
     match tr.schedule() {
         Some(Ok(forces)) => {
             for (k, force) in forces {
-                match &mut net.couplings[k].kind {
-                    CouplingKind::Clutch(cl) => cl.force = force,
-                    CouplingKind::Pack(pack) => {
-                        // the schedule's level times the pack's rated pressure (its own
-                        // profile's largest; the module's docs)
-                        let Some(stack) = pack.stack.as_mut() else {
-                            continue;
-                        };
-                        let rated = rated_pressure_pa(&stack.piston.pressure);
-                        if rated.is_nan() || rated <= 0.0 {
-                            ck.report(
-                                format!("couplings[{k}].pack"),
-                                None,
-                                format!(
-                                    "\"{}\" is a shift element: its pack file's [stack.pressure] \
-                                     must rise above 0 Pa (its largest pressure is the element's \
-                                     rated pressure, which the schedule scales)",
-                                    net.couplings[k].name
-                                ),
-                            );
-                            ok = false;
-                        } else if let Some(p) = pack_pressure(&force, rated) {
-                            stack.piston.pressure = p;
-                        }
+                // each element takes the schedule's level as its law says (a clutch's normal
+                // force, a pack's pressure as the level times its rated pressure: the module's
+                // docs)
+                match net.couplings[k].law().scheduled(&force) {
+                    Ok(Some(kind)) => net.couplings[k].kind = kind,
+                    Ok(None) => {}
+                    Err((field, why)) => {
+                        ck.report(
+                            format!("couplings[{k}].{field}"),
+                            None,
+                            format!("\"{}\" {why}", net.couplings[k].name),
+                        );
+                        ok = false;
                     }
-                    _ => {}
                 }
             }
         }
