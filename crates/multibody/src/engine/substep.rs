@@ -18,6 +18,9 @@ pub(super) struct WorldStep<'a> {
     pub(super) t1: f64,
     /// The step controller's settings.
     pub(super) a: &'a AdaptiveStepping,
+    /// ... and those of a coupling alone against a carrier of known motion
+    /// ([`AdaptiveStepping::alone`]).
+    pub(super) alone: &'a AdaptiveStepping,
     /// The prescribed shaft over the world step (`None`: the shaft is inertial).
     pub(super) drive: Option<Prescribed<'a>>,
     /// What the multirate loop counts in the run.
