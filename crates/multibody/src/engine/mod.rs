@@ -265,8 +265,11 @@ impl MultibodyEngine {
                 format!(
                     "multirate scheme ({how}: {bodies}): the rapier world steps at up to {} s, \
                      each body's spline coupling sub-steps its own contacts ({} steps per \
-                     contact, classical Runge-Kutta){until}",
-                    a.max_step_s, a.steps_per_contact
+                     contact, {} for a body alone against a prescribed shaft or the housing, \
+                     classical Runge-Kutta){until}",
+                    a.max_step_s,
+                    a.steps_per_contact,
+                    a.alone().steps_per_contact
                 )
             }
             (Some(why), _) if self.options.scheme == Scheme::Shared => {
