@@ -491,6 +491,7 @@ pub(super) struct Prescribed<'a> {
 
 impl Prescribed<'_> {
     /// The shaft at `t` (within the world step of the expansion).
+    #[inline]
     pub(super) fn at(self, t: f64) -> ShaftAt {
         let (speed, angle) = match self.local {
             Some(l) => l.speed_and_angle(t),
@@ -524,7 +525,9 @@ pub(super) enum Path<'a> {
 }
 
 impl Path<'_> {
-    /// The carrier at `t`.
+    /// The carrier at `t` (inlined into the sub-step: the housing's is two zeros, and the
+    /// call spilled the step's registers).
+    #[inline]
     pub(super) fn at(self, t: f64) -> ShaftAt {
         match self {
             Path::Profile(p) => p.at(t),
