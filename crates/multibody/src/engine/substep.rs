@@ -166,6 +166,7 @@ pub(super) fn graded_step(want: f64, f: &CouplingForces, age_s: Option<f64>) -> 
 
 /// The sub-step `want` (s) a controller asked for at `t` (s), or the run's failure when it
 /// collapsed below the smallest step (or is not a number); `who()` names what asked.
+#[inline]
 pub(super) fn checked_sub_step(
     want: f64,
     a: &AdaptiveStepping,
