@@ -45,6 +45,11 @@ pub fn time_progress(duration_s: f64, label: &str) -> indicatif::ProgressBar {
 /// thousandth of the bar (engines poll every step; formatting the message each time cost 3 %
 /// of a network run).
 pub fn show_time(pb: &indicatif::ProgressBar, t_s: f64) {
+    if pb.is_hidden() {
+        // nothing is drawn (stderr is no terminal): no message to format (formatting it at
+        // every world step was 1 % of the 16-disc brake pack's run)
+        return;
+    }
     let at = (t_s * 1e6) as u64;
     let tick = pb.length().unwrap_or(0) / 1000;
     if at < pb.position().saturating_add(tick.max(1)) {

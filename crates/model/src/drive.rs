@@ -451,13 +451,30 @@ impl LocalProfile {
     /// The profile's speed (rad/s) and angle (rad) at `t` (s), within the reach the expansion
     /// was made for.
     pub fn speed_and_angle(&self, t: f64) -> (f64, f64) {
+        // the series' length a constant of each arm: the loops unrolled (the count was a
+        // tenth of an evaluation's instructions), the sums the same
+        match self.series_terms {
+            1 => self.speed_and_angle_in::<1>(t),
+            2 => self.speed_and_angle_in::<2>(t),
+            3 => self.speed_and_angle_in::<3>(t),
+            4 => self.speed_and_angle_in::<4>(t),
+            5 => self.speed_and_angle_in::<5>(t),
+            6 => self.speed_and_angle_in::<6>(t),
+            7 => self.speed_and_angle_in::<7>(t),
+            _ => self.speed_and_angle_in::<SERIES_TERMS_MAX>(t),
+        }
+    }
+
+    /// [`Self::speed_and_angle`] with `N` terms of each series (`series_terms`).
+    #[inline(always)]
+    fn speed_and_angle_in<const N: usize>(&self, t: f64) -> (f64, f64) {
         let tau = t - self.t_m;
         let (mut speed, mut angle) = (0.0, 0.0);
         for &[w, a, a_w, sin_m, cos_m] in &self.terms {
             let x = w * tau;
             let y = x * x;
             let (mut s, mut v) = (0.0, 0.0);
-            for k in (0..self.series_terms).rev() {
+            for k in (0..N).rev() {
                 s = SIN_SERIES[k] + y * s;
                 v = VERSINE_SERIES[k] + y * v;
             }

@@ -182,6 +182,21 @@ fn tooth_load(
     (load, depth)
 }
 
+/// One tooth's signed load (N) at `kin` as a probe takes it ([`Coupling::probe_torque`]):
+/// zero unless engaged, else the law's with the tooth's event in progress `state` if it is on
+/// the same flank, or an event engaging at `kin`; the contact memory is not advanced.
+#[inline]
+fn probe_load(law: &ToothLaw, state: &ContactState, kin: &ToothKinematics) -> f64 {
+    if law.engagement_depth_m(kin) <= 0.0 {
+        return 0.0;
+    }
+    let e = match state.engagement {
+        Some(e) if e.flank == kin.flank => e,
+        _ => law.engage(kin),
+    };
+    law.load_n(kin, &e)
+}
+
 impl Coupling {
     /// The base radius `Rb`, m (kept: a cosine per call is dear in the inner loops).
     pub fn base_radius_m(&self) -> f64 {
@@ -257,22 +272,22 @@ impl Coupling {
     /// advancing the contact memories: each tooth's event in progress if it is on the same
     /// flank, else an event engaging at `dphi`. Used to integrate the teeth's torque along a
     /// step (`integrate.rs`).
+    ///
+    /// Inlined where it is called (the multirate sub-steps probe a lumped coupling three
+    /// times a step: the call and the registers it spilled were a third of a probe's cost);
+    /// a per-tooth coupling's loop is its own function, [`Self::probe_torque_per_tooth`].
+    #[inline]
     pub fn probe_torque(&self, phi: f64, dphi: f64) -> f64 {
-        let law = &self.law;
-        let load = |state: &ContactState, kin: &ToothKinematics| {
-            if law.engagement_depth_m(kin) <= 0.0 {
-                return 0.0;
-            }
-            let e = match state.engagement {
-                Some(e) if e.flank == kin.flank => e,
-                _ => law.engage(kin),
-            };
-            law.load_n(kin, &e)
-        };
         if self.teeth.is_empty() {
             let kin = self.kinematics(phi, dphi);
-            return self.disc_torque_n_m(load(&self.lumped, &kin));
+            return self.disc_torque_n_m(probe_load(&self.law, &self.lumped, &kin));
         }
+        self.probe_torque_per_tooth(phi, dphi)
+    }
+
+    /// [`Self::probe_torque`] of a per-tooth coupling.
+    fn probe_torque_per_tooth(&self, phi: f64, dphi: f64) -> f64 {
+        let load = |state: &ContactState, kin: &ToothKinematics| probe_load(&self.law, state, kin);
         let r = self.spline.pitch_radius_m;
         let ([ex, ey], [ex_dot, ey_dot]) = self.last_offset;
         if self.none_can_touch(phi, (ex * ex + ey * ey).sqrt()) {

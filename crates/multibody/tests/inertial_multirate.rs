@@ -264,3 +264,57 @@ fn an_input_changed_inside_a_world_step_ends_the_step_there() {
         landing.samples.len()
     );
 }
+
+/// Issue 46: a coupling alone on a prescribed shaft or the housing takes
+/// `AdaptiveStepping::alone_contact_fraction` of the steps per contact (0.75 by default), a
+/// coupling integrated with an inertial carrier the full count. The staggered 4-disc brake
+/// (`cases::staggered_brake`: discs on the prescribed shaft, plates on the housing) over
+/// 20 ms takes fewer coupling sub-steps at the default than at the full count (measured
+/// 8957 against 10568, 0.848 of them; bound 0.80-0.88: not the full 0.75, as the approaches,
+/// the free flights and the graded kinks' steps stay); the staggered 4-disc pack on an inertial shaft
+/// takes the same sub-steps and impacts to the bit whatever the fraction (its couplings go
+/// with their carrier, or fly free against its nodes); a fraction outside (0, 1] is refused
+/// before any work.
+#[test]
+fn only_couplings_alone_take_fewer_steps_per_contact() {
+    let with = |fraction: f64| MultibodyOptions {
+        stepping: Stepping::Adaptive(AdaptiveStepping {
+            alone_contact_fraction: fraction,
+            ..Default::default()
+        }),
+        ..Default::default()
+    };
+    assert_eq!(
+        MultibodyOptions::default().stepping,
+        with(0.75).stepping,
+        "the default fraction"
+    );
+    let brake = cases::staggered_brake(4);
+    let (fewer_c, fewer) = run(&brake, MultibodyOptions::default(), 0.02);
+    let (full_c, full) = run(&brake, with(1.0), 0.02);
+    assert!(fewer.is_multirate() && full.is_multirate());
+    let ratio = fewer.coupling_substeps() as f64 / full.coupling_substeps() as f64;
+    println!(
+        "staggered brake 4, 20 ms: {} sub-steps against {} ({ratio:.4}); {} and {} impacts",
+        fewer.coupling_substeps(),
+        full.coupling_substeps(),
+        fewer_c.impacts.len(),
+        full_c.impacts.len()
+    );
+    assert!(ratio > 0.80 && ratio < 0.88, "{ratio}");
+    let pack = inertial_staggered(4);
+    let (a, ea) = run(&pack, MultibodyOptions::default(), 0.02);
+    let (b, eb) = run(&pack, with(1.0), 0.02);
+    assert!(ea.is_multirate());
+    assert_eq!(ea.coupling_substeps(), eb.coupling_substeps());
+    assert!(!a.impacts.is_empty());
+    assert_eq!(a.impacts, b.impacts);
+    for bad in [0.0, -0.5, 1.5, f64::NAN] {
+        let r = MultibodyEngine::new(brake.clone(), with(bad));
+        assert!(
+            matches!(&r, Err(clutchpack_model::EngineError::Unsupported(m)) if m.contains("alone_contact_fraction")),
+            "{bad}: {:?}",
+            r.err()
+        );
+    }
+}

@@ -13,9 +13,22 @@ use clutchpack_model::Observer;
 
 impl Run {
     /// Feeds the impact trackers with the state at `t` and sends the impacts that closed and
-    /// the contact samples due.
-    pub(super) fn track_events(&mut self, steps_per_contact: f64, observer: &mut dyn Observer) {
+    /// the contact samples due: a new event's step its predicted duration over
+    /// `steps_per_contact`, or over `alone_steps_per_contact` for a coupling on a carrier of
+    /// known motion (the multirate scheme's couplings alone, `AdaptiveStepping::alone`; the
+    /// same count for the shared step).
+    pub(super) fn track_events(
+        &mut self,
+        steps_per_contact: f64,
+        alone_steps_per_contact: f64,
+        observer: &mut dyn Observer,
+    ) {
         for i in 0..self.couplings.len() {
+            let steps_per_contact = if self.carriers[self.world.carrier_of[i]].is_inertial() {
+                steps_per_contact
+            } else {
+                alone_steps_per_contact
+            };
             let law = &self.bodies[i].law;
             let f = &self.forces[i];
             let m = self.m_eff[i];

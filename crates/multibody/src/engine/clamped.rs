@@ -717,7 +717,7 @@ impl SubSteps for StackSteps {
                 },
             };
             let dphi = at.speed - self.u[i];
-            run.end_sub_step(i, t, self.phi[i], dphi, at, ws)?;
+            run.end_sub_step(i, t, self.phi[i], dphi, at, ws.a.steps_per_contact, ws)?;
         }
         self.evaluated_here = true;
         run.break_faces(&self.sys, t, &self.u, &self.w, &mut self.s0);

@@ -12,6 +12,7 @@ impl Run {
     /// evaluated `forces`, its relative angle and speed `rel` (rad, rad/s), and the bound
     /// of `|d dphi / dt|` in free flight `accel_bound` (rad/s^2), taken 1 % over (rounding
     /// must not make it optimistic).
+    #[inline]
     pub(super) fn coupling_view<'a>(
         &'a self,
         i: usize,

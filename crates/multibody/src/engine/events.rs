@@ -162,6 +162,7 @@ impl EventBook {
     /// Feeds coupling `i`'s state at `t` (`contact_step` gives the step of a new event from
     /// its closing speed, [`EventTrack::update`]); says whether an impact closed and whether a
     /// contact sample is due ([`EventTrack::contact_sample_due`]).
+    #[inline]
     pub(super) fn update(
         &mut self,
         i: usize,

@@ -454,7 +454,15 @@ impl SubSteps for CarrierSteps<'_> {
         self.nodes.push(Node { t, angle, speed: w });
         let at = ShaftAt { speed: w, angle };
         for (k, &i) in self.cluster.iter().enumerate() {
-            run.end_sub_step(i, t, self.phi[k], self.dphi[k], at, ws)?;
+            run.end_sub_step(
+                i,
+                t,
+                self.phi[k],
+                self.dphi[k],
+                at,
+                ws.a.steps_per_contact,
+                ws,
+            )?;
         }
         Ok(())
     }

@@ -69,13 +69,16 @@ impl MultibodyEngine {
             Stepping::Adaptive(a)
                 if !(a.max_step_s > 0.0
                     && a.steps_per_contact > 1.0
+                    && a.alone_contact_fraction > 0.0
+                    && a.alone_contact_fraction <= 1.0
+                    && a.alone().steps_per_contact > 1.0
                     && a.approach_fraction > 0.0
                     && a.approach_fraction < 1.0
                     && a.min_step_s > 0.0
                     && a.sustained_steps_per_period > std::f64::consts::PI
                     && a.sustained_after > 1.0) =>
             {
-                return bad(format!("adaptive stepping {a:?}: needs max_step_s > 0, steps_per_contact > 1, approach_fraction in (0, 1), min_step_s > 0, sustained_steps_per_period > pi, sustained_after > 1"));
+                return bad(format!("adaptive stepping {a:?}: needs max_step_s > 0, steps_per_contact > 1, alone_contact_fraction in (0, 1] with steps_per_contact times it > 1, approach_fraction in (0, 1), min_step_s > 0, sustained_steps_per_period > pi, sustained_after > 1"));
             }
             _ => {}
         }
@@ -262,8 +265,11 @@ impl MultibodyEngine {
                 format!(
                     "multirate scheme ({how}: {bodies}): the rapier world steps at up to {} s, \
                      each body's spline coupling sub-steps its own contacts ({} steps per \
-                     contact, classical Runge-Kutta){until}",
-                    a.max_step_s, a.steps_per_contact
+                     contact, {} for a body alone against a prescribed shaft or the housing, \
+                     classical Runge-Kutta){until}",
+                    a.max_step_s,
+                    a.steps_per_contact,
+                    a.alone().steps_per_contact
                 )
             }
             (Some(why), _) if self.options.scheme == Scheme::Shared => {

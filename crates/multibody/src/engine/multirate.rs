@@ -13,7 +13,7 @@ use super::substep::{
     checked_sub_step, graded_step, GapDrag, Node, Path, Prescribed, Relative, ShaftAt, SubStep,
     TurnMoment, WorldStep,
 };
-use crate::hook::{CouplingForces, RelativeState, FLANKS};
+use crate::hook::{RelativeState, FLANKS};
 use crate::options::{MultibodyOptions, Stepping};
 use crate::stepping::{bracketed_root, contact_duration_s, coupling_step};
 use clutchpack_model::{EngineError, PackModel};
@@ -453,6 +453,7 @@ impl Run {
             evaluated_here: false,
             start_torque_n_m: 0.0,
             missed: false,
+            known: !matches!(path, Path::Nodes(_)),
         };
         self.land_sub_steps(&mut alone, ws)
     }
@@ -499,8 +500,11 @@ impl Run {
 
     /// Ends a sub-step of coupling `i` at `t` in the relative state `(phi, dphi)` with its
     /// carrier at `shaft`: checks the state, evaluates the teeth there (advancing their
-    /// contact memory) into `forces[i]` and `rel[i]`, and feeds the events and the contact
-    /// samples.
+    /// contact memory) into `forces[i]` and `rel[i]`, and feeds the events (a new one's step
+    /// its predicted duration over `steps_per_contact`, the count of the settings the
+    /// coupling steps by) and the contact samples. Returns the coupling's engagement depth
+    /// there, m.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn end_sub_step(
         &mut self,
         i: usize,
@@ -508,8 +512,9 @@ impl Run {
         phi: f64,
         dphi: f64,
         shaft: ShaftAt,
+        steps_per_contact: f64,
         ws: &mut WorldStep,
-    ) -> Result<CouplingForces, EngineError> {
+    ) -> Result<f64, EngineError> {
         let d = &self.bodies[i];
         let limit = std::f64::consts::PI / d.spline.teeth as f64;
         if !(phi.abs() <= limit && dphi.is_finite()) {
@@ -527,20 +532,20 @@ impl Run {
             dphi,
             ..self.rel[i]
         };
-        let f = self.couplings[i].evaluate(&rel_state);
+        // evaluated in place (the forces are not copied through the call)
+        self.forces[i] = self.couplings[i].evaluate(&rel_state);
+        let f = &self.forces[i];
         if !(f.load_n.is_finite() && f.moment[2].is_finite()) {
             return Err(EngineError::Diverged {
                 t_s: t,
                 reason: format!("disc {i}: tooth load {:.6e} N", f.load_n),
             });
         }
-        self.forces[i] = f;
         self.rel[i] = rel_state;
         self.multirate.moments[i].add(t, shaft.angle - phi, shaft.speed - dphi);
-        let steps_per_contact = ws.a.steps_per_contact;
         let m_eff = self.m_eff[i];
         let step_of = |v| contact_duration_s(&d.law, f.kin.flank, v, m_eff) / steps_per_contact;
-        let tracked = self.events.update(i, t, &f, steps_per_contact, step_of);
+        let tracked = self.events.update(i, t, f, steps_per_contact, step_of);
         if let Some(e) = tracked.closed {
             ws.closed.push(e);
         }
@@ -550,10 +555,10 @@ impl Run {
             ws.contacts.push((
                 i,
                 at,
-                disc_sample(&f, &rel_state, shaft.angle, omega_d, Vec::new()),
+                disc_sample(f, &rel_state, shaft.angle, omega_d, Vec::new()),
             ));
         }
-        Ok(f)
+        Ok(f.depth_m)
     }
 }
 
@@ -582,6 +587,9 @@ struct Alone<'a> {
     start_torque_n_m: f64,
     /// Whether it touched on an inertial carrier (counted once per world step).
     missed: bool,
+    /// Whether its carrier's motion is known (a prescribed shaft, the housing): it steps by
+    /// `WorldStep::alone`, else (an inertial carrier's nodes) by `WorldStep::a`.
+    known: bool,
 }
 
 impl SubSteps for Alone<'_> {
@@ -600,14 +608,15 @@ impl SubSteps for Alone<'_> {
     }
 
     fn want(&mut self, run: &mut Run, ws: &mut WorldStep) -> Result<f64, EngineError> {
-        let (i, a, t, gap) = (self.i, ws.a, self.t, self.gap);
-        let f = run.forces[i];
+        let a = if self.known { ws.alone } else { ws.a };
+        let (i, t, gap) = (self.i, self.t, self.gap);
+        let f = &run.forces[i];
         let wd = self.shaft.speed - self.dphi;
         let bound = self.carrier_accel_bound
             + ((self.c2 + gap.damping) * wd.abs() + gap.bound_n_m()) * self.inv_j;
-        let view = run.coupling_view(i, &f, (self.phi, self.dphi), bound, t);
+        let view = run.coupling_view(i, f, (self.phi, self.dphi), bound, t);
         let (want, _) = coupling_step(&view, a);
-        let want = graded_step(want, &f, run.events.event_age_s(i, t));
+        let want = graded_step(want, f, run.events.event_age_s(i, t));
         let want = checked_sub_step(want, a, t, || format!("disc {i}"))?;
         self.start_torque_n_m = if self.evaluated_here {
             f.moment[2]
@@ -657,9 +666,22 @@ impl SubSteps for Alone<'_> {
         run.energy
             .add_sub_step(if inertial { 0.0 } else { step.drive_j }, step.drag_j);
         run.energy.add_stack_work(step.gap_j);
-        let f = run.end_sub_step(self.i, t, self.phi, self.dphi, self.shaft, ws)?;
+        let steps_per_contact = if self.known {
+            ws.alone.steps_per_contact
+        } else {
+            ws.a.steps_per_contact
+        };
+        let depth = run.end_sub_step(
+            self.i,
+            t,
+            self.phi,
+            self.dphi,
+            self.shaft,
+            steps_per_contact,
+            ws,
+        )?;
         self.evaluated_here = true;
-        if inertial && f.depth_m > 0.0 && !self.missed {
+        if inertial && depth > 0.0 && !self.missed {
             self.missed = true;
             ws.counts.missed += 1;
         }

@@ -314,7 +314,8 @@ impl MultibodySession {
             if let Some(th) = self.thermal.as_mut() {
                 th.start(&self.run, observer);
             }
-            self.run.track_events(steps_per_contact, observer);
+            self.run
+                .track_events(steps_per_contact, steps_per_contact, observer);
             self.sample_if_due(observer);
         }
         while self.run.t < t_s {
@@ -355,7 +356,7 @@ impl MultibodySession {
             self.steps += 1;
             run.evaluate(self.t_last_good)?;
             self.t_last_good = run.t;
-            run.track_events(steps_per_contact, obs);
+            run.track_events(steps_per_contact, steps_per_contact, obs);
             self.sample_if_due(obs);
             if let Some(th) = self.thermal.as_mut() {
                 th.after_step(&mut self.run, obs)?;
@@ -435,12 +436,14 @@ impl MultibodySession {
             if let Some(th) = self.thermal.as_mut() {
                 th.start(&self.run, observer);
             }
-            self.run.track_events(a.steps_per_contact, observer);
+            self.run
+                .track_events(a.steps_per_contact, a.alone().steps_per_contact, observer);
             self.sample_if_due(observer);
             if observer.progress(self.run.t) {
                 return Ok(Advance::Stopped);
             }
         }
+        let alone = a.alone();
         while self.run.t < t_s {
             // the piston may push from now on: the clamped stack integrated as one system
             // (`clamped.rs`)
@@ -479,6 +482,7 @@ impl MultibodySession {
             let mut ws = WorldStep {
                 t1,
                 a: &a,
+                alone: &alone,
                 drive: profile.as_deref().map(|profile| Prescribed {
                     profile,
                     local: local.as_ref(),

@@ -18,6 +18,9 @@ pub(super) struct WorldStep<'a> {
     pub(super) t1: f64,
     /// The step controller's settings.
     pub(super) a: &'a AdaptiveStepping,
+    /// ... and those of a coupling alone against a carrier of known motion
+    /// ([`AdaptiveStepping::alone`]).
+    pub(super) alone: &'a AdaptiveStepping,
     /// The prescribed shaft over the world step (`None`: the shaft is inertial).
     pub(super) drive: Option<Prescribed<'a>>,
     /// What the multirate loop counts in the run.
@@ -163,6 +166,7 @@ pub(super) fn graded_step(want: f64, f: &CouplingForces, age_s: Option<f64>) -> 
 
 /// The sub-step `want` (s) a controller asked for at `t` (s), or the run's failure when it
 /// collapsed below the smallest step (or is not a number); `who()` names what asked.
+#[inline]
 pub(super) fn checked_sub_step(
     want: f64,
     a: &AdaptiveStepping,
@@ -488,6 +492,7 @@ pub(super) struct Prescribed<'a> {
 
 impl Prescribed<'_> {
     /// The shaft at `t` (within the world step of the expansion).
+    #[inline]
     pub(super) fn at(self, t: f64) -> ShaftAt {
         let (speed, angle) = match self.local {
             Some(l) => l.speed_and_angle(t),
@@ -521,7 +526,9 @@ pub(super) enum Path<'a> {
 }
 
 impl Path<'_> {
-    /// The carrier at `t`.
+    /// The carrier at `t` (inlined into the sub-step: the housing's is two zeros, and the
+    /// call spilled the step's registers).
+    #[inline]
     pub(super) fn at(self, t: f64) -> ShaftAt {
         match self {
             Path::Profile(p) => p.at(t),
