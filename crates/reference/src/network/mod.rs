@@ -251,6 +251,16 @@ impl Equations {
     /// slipping clutches' and the meshes' torques into `coupling_torque` (and each mesh's
     /// force per pair, N, into `mesh_force`).
     fn forces(&mut self, t: f64, y: &[f64]) {
+        self.torques(t, y);
+        self.accelerations();
+    }
+
+    /// [`Self::forces`] without the accelerations (`acc` left as it was): what the guards,
+    /// the samples and the modes' settling read (the rigid couplings' torques, the holds'
+    /// margins), the same values. Only the right-hand side reads `acc`, after its own
+    /// [`Self::forces`]; the guards' probes and bisections took the accelerations for nothing
+    /// (issue 45: the resolved shift's cost).
+    fn torques(&mut self, t: f64, y: &[f64]) {
         let n = self.net.bodies.len();
         let w = &y[n..2 * n];
         for (i, b) in self.net.bodies.iter().enumerate() {
@@ -295,10 +305,14 @@ impl Equations {
             self.torque[p.a] += ta;
             self.torque[p.b] += tb;
         }
-        let any_held = self.held.contains(&true);
-        if any_held {
+        if self.held.contains(&true) {
             self.hold();
         }
+    }
+
+    /// The bodies' accelerations from the torques of the last [`Self::torques`], rad/s^2.
+    fn accelerations(&mut self) {
+        let any_held = self.held.contains(&true);
         self.clusters
             .accelerations(&self.torque, &mut self.acc, &mut self.group);
         if self.clusters.any_prescribed() {
@@ -403,6 +417,38 @@ impl Equations {
         self.guards_where(t, y, out, Some(want));
     }
 
+    /// The state's components every guard reads: the bodies' angles and speeds, the
+    /// elements' own states and the packs' discs' and plates' relative angles and speeds (not
+    /// the counters, the faces' heat, the teeth's work or the drag's): a step's probes
+    /// interpolate those alone (issue 45, the resolved shift's cost).
+    fn probe_inputs(&self) -> Vec<std::ops::Range<usize>> {
+        let (n, m) = (self.net.bodies.len(), self.net.couplings.len());
+        let mut ranges = vec![0..2 * n + m];
+        ranges.extend((self.packs.iter()).map(|p| p.at..p.at + 2 * p.sys.ids.len()));
+        ranges
+    }
+
+    /// The state's components the guards `want` marks read, when they are only packs'
+    /// (their discs' and plates' relative angles and speeds, and the bodies' speeds for
+    /// their faces): an event's bisection between two probes then interpolates those alone
+    /// (issue 45, the resolved shift's cost: most events are a disc's or a plate's tooth
+    /// contact). `None` (the whole state) when a coupling's or a road load's guard is marked:
+    /// they take the network's forces, which read every body and element.
+    fn guard_inputs(&self, want: &[bool]) -> Option<Vec<std::ops::Range<usize>>> {
+        let (n, m) = (self.net.bodies.len(), self.net.couplings.len());
+        let at = self.body_guard_at();
+        if want[..m].contains(&true) || want[at..].contains(&true) {
+            return None;
+        }
+        let mut ranges = vec![n..2 * n];
+        for p in &self.packs {
+            if want[p.guard_at..p.guard_at + p.guards()].contains(&true) {
+                ranges.push(p.at..p.at + 2 * p.sys.ids.len());
+            }
+        }
+        Some(ranges)
+    }
+
     /// [`Self::guards`] (`want` `None`) or [`Self::guards_of`].
     fn guards_where(&mut self, t: f64, y: &[f64], out: &mut [f64], want: Option<&[bool]>) {
         let n = self.net.bodies.len();
@@ -418,7 +464,7 @@ impl Equations {
         // the forces at this state give the packs' loads too
         let forced = any_own && (any_locked || any_held);
         if forced {
-            self.forces(t, y);
+            self.torques(t, y);
             self.rigid_torques();
         }
         for (k, c) in self.net.couplings.iter().enumerate() {
@@ -475,7 +521,7 @@ fn rigid_rows(net: &Network, modes: &[Option<ClutchMode>]) -> Vec<Row> {
 /// The state at `t` as a sample (the couplings' torques computed there).
 fn sample(eq: &mut Equations, t: f64, y: &[f64]) -> NetworkSample {
     let n = eq.net.bodies.len();
-    eq.forces(t, y);
+    eq.torques(t, y);
     eq.rigid_torques();
     NetworkSample {
         t_s: t,
@@ -587,7 +633,9 @@ mod tests {
                 }
             }
         }
-        // the loads of the reactions (`forces`) against the stack's own
+        // the loads of the reactions (`forces`) against the stack's own; the carried packs'
+        // reactions from the loads (their own loop, `System::reactions_from_n_m`) against
+        // the general sum taking each load itself
         eq.forces(t, &y);
         for (p, loads) in eq.packs.iter().zip(&eq.loads) {
             let (part, c) = (p.part(&y), [y[n + p.a], 0.0, y[n + p.b], 0.0]);
@@ -599,6 +647,95 @@ mod tests {
                 r.map(f64::to_bits),
                 p.sys.reactions_from_n_m(loads, &p.modes).map(f64::to_bits)
             );
+            assert!(
+                r.iter().all(|x| *x != 0.0),
+                "{r:?}: in contact on both carriers"
+            );
+        }
+    }
+
+    /// The shift's evaluations took, at every guard probe, bisection trial, sample and
+    /// settling, the bodies' accelerations that only the right-hand side reads, and at every
+    /// right-hand side each carried pack's drag power body by body with no drag to sum
+    /// (issue 45: the resolved-pack shift's cost against its packs run alone). At the state
+    /// of [`event_bisection_evaluated_every_guard_at_each_trial`]'s kind (bodies in contact,
+    /// the lumped brakes A and B locked, the faces in every mode), for every gear's modes:
+    /// [`Equations::torques`] leaves every torque, load and reaction that
+    /// [`Equations::forces`] computes, to the bit (no margin: the same operations), and the
+    /// accelerations are those of the right-hand side; the packs' drag power without drag
+    /// is the general sum's +0 and, with a drag, the general sum.
+    #[test]
+    fn guard_probes_took_the_accelerations_and_the_drag_for_nothing() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenes/eight-speed-packs.toml");
+        let net = clutchpack_scene::load(&path, &[]).unwrap().network.unwrap();
+        let n = net.bodies.len();
+        for locked in [&["A", "B"][..], &["A", "B", "D"], &["B"]] {
+            let modes: Vec<_> = (net.couplings.iter())
+                .map(|c| match c.name.as_str() {
+                    name if locked.contains(&name) => Some(ClutchMode::Locked),
+                    _ => c.law().initial_mode(),
+                })
+                .collect();
+            let mut eq = Equations::new(Arc::new(net.clone()), modes);
+            let mut y = vec![0.0; eq.dim()];
+            for (i, b) in net.bodies.iter().enumerate() {
+                y[n + i] = b.initial_speed_rad_s + 3.0 * i as f64;
+            }
+            let faces = [Face::Locked, Face::Slip(-1.0), Face::Open];
+            let mut in_contact = 0;
+            for p in eq.packs.iter_mut() {
+                let d = p.sys.dim();
+                for slot in 0..p.sys.ids.len() {
+                    let half = p.sys.disc(slot).spline.half_play_rad();
+                    let sign = if slot % 3 == 0 { 1.0 } else { -1.0 };
+                    y[p.at + 2 * slot] = sign * if slot % 2 == 0 { 1.03 } else { 0.4 } * half;
+                    y[p.at + 2 * slot + 1] = -0.2 * sign;
+                    let part = &y[p.at..p.at + d];
+                    if p.sys.depth(slot, part) > 0.0 {
+                        p.modes[slot] = Some(p.sys.disc(slot).law.engage(&p.sys.kin(slot, part)));
+                        in_contact += 1;
+                    }
+                }
+                for m in 0..p.sys.faces.len() {
+                    p.sys.faces[m] = faces[(m + 1) % 3];
+                }
+            }
+            assert!(in_contact >= 4, "{in_contact} bodies in contact");
+            let t = 0.12;
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            eq.forces(t, &y);
+            eq.rigid_torques();
+            let (torque, coupling, acc) =
+                (bits(&eq.torque), bits(&eq.coupling_torque), bits(&eq.acc));
+            let loads: Vec<_> = eq.loads.iter().map(|l| bits(l)).collect();
+            let mut dy = vec![0.0; eq.dim()];
+            eq.rhs(t, &y, &mut dy);
+            assert_eq!(bits(&dy[n..2 * n]), acc, "{locked:?}");
+            eq.acc.iter_mut().for_each(|a| *a = f64::NAN);
+            eq.torques(t, &y);
+            eq.rigid_torques();
+            assert_eq!(bits(&eq.torque), torque, "{locked:?}");
+            assert_eq!(bits(&eq.coupling_torque), coupling, "{locked:?}");
+            assert_eq!(eq.loads.iter().map(|l| bits(l)).collect::<Vec<_>>(), loads);
+            assert!(
+                eq.acc.iter().all(|a| a.is_nan()),
+                "torques left acc as it was"
+            );
+            // the packs' drag power: +0 without drag, the general sum with one
+            let w = &y[n..2 * n];
+            for p in eq.packs.iter_mut() {
+                assert!(!p.drag);
+                assert_eq!(p.drag_power_w(&y, w).to_bits(), 0.0f64.to_bits());
+                p.drag = true;
+                assert_eq!(p.drag_power_w(&y, w).to_bits(), 0.0f64.to_bits());
+                let mut pack = (*p.sys.pack).clone();
+                pack.discs[0].drag_n_m_s_rad = 1e-3;
+                p.set_pack(Arc::new(pack));
+                assert!(p.drag);
+                let wb = w[p.a] - y[p.at + 1];
+                assert_eq!(p.drag_power_w(&y, w), 1e-3 * wb * wb);
+            }
         }
     }
 }
