@@ -312,7 +312,6 @@ impl System {
         }
     }
 
-    #[inline]
     pub fn kin(&self, slot: usize, y: &[f64]) -> ToothKinematics {
         let k = self.off + 2 * slot;
         let id = self.ids[slot];
@@ -322,7 +321,6 @@ impl System {
     }
 
     /// Signed per-tooth load of the disc in `slot`, N, for its mode.
-    #[inline]
     pub fn load(&self, slot: usize, y: &[f64], mode: &Option<Engagement>) -> f64 {
         match mode {
             Some(e) => self.disc(slot).law.load_n(&self.kin(slot, y), e),
