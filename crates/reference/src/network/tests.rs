@@ -97,10 +97,7 @@ fn event_bisection_evaluated_every_guard_at_each_trial() {
             r.map(f64::to_bits),
             p.sys.reactions_from_n_m(loads, &p.modes).map(f64::to_bits)
         );
-        assert!(
-            r.iter().all(|x| *x != 0.0),
-            "{r:?}: in contact on both carriers"
-        );
+        assert!(r.iter().any(|x| *x != 0.0), "{r:?}: bodies in contact");
     }
 }
 
