@@ -423,9 +423,9 @@ impl Equations {
     /// interpolate those alone (issue 45, the resolved shift's cost).
     fn probe_inputs(&self) -> Vec<std::ops::Range<usize>> {
         let (n, m) = (self.net.bodies.len(), self.net.couplings.len());
-        let mut ranges = vec![0..2 * n + m];
-        ranges.extend((self.packs.iter()).map(|p| p.at..p.at + 2 * p.sys.ids.len()));
-        ranges
+        std::iter::once(0..2 * n + m)
+            .chain((self.packs.iter()).map(|p| p.at..p.at + 2 * p.sys.ids.len()))
+            .collect()
     }
 
     /// The state's components the guards `want` marks read, when they are only packs'
@@ -440,7 +440,8 @@ impl Equations {
         if want[..m].contains(&true) || want[at..].contains(&true) {
             return None;
         }
-        let mut ranges = vec![n..2 * n];
+        let mut ranges = Vec::with_capacity(1 + self.packs.len());
+        ranges.push(n..2 * n);
         for p in &self.packs {
             if want[p.guard_at..p.guard_at + p.guards()].contains(&true) {
                 ranges.push(p.at..p.at + 2 * p.sys.ids.len());
