@@ -121,7 +121,6 @@ impl Body {
     }
 
     /// Its speed profile, if it is prescribed.
-    #[inline]
     pub fn prescribed(&self) -> Option<&crate::SpeedProfile> {
         match &self.motion {
             Motion::Prescribed(p) => Some(p),
@@ -232,7 +231,6 @@ impl Coupling {
     }
 
     /// Its gear mesh, if it is one.
-    #[inline]
     pub fn mesh(&self) -> Option<&GearMesh> {
         match &self.kind {
             CouplingKind::GearMesh(g) => Some(g),
