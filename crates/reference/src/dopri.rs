@@ -111,11 +111,11 @@ impl Dense {
         }
     }
 
-    /// Interpolated components `from..out.len()` at `t` (within the step) into `out` (the
-    /// others left as they are).
-    pub fn eval_from(&self, t: f64, from: usize, out: &mut [f64]) {
+    /// Interpolated components `range` at `t` (within the step) into `out` (the others left
+    /// as they are): each the value [`Self::eval`] gives it.
+    pub fn eval_range(&self, t: f64, range: std::ops::Range<usize>, out: &mut [f64]) {
         let th = fraction(self.t0, self.h, t);
-        for i in from..out.len() {
+        for i in range {
             let c = [self.r1[i], self.r2[i], self.r3[i], self.r4[i], self.r5[i]];
             out[i] = interpolate(&c, th);
         }

@@ -456,6 +456,24 @@ impl System {
     /// [`Self::reactions_n_m`] from the loads [`Self::loads_into`] gave at the same state
     /// (the same sums in the same order).
     pub fn reactions_from_n_m(&self, loads: &[f64], modes: &[Option<Engagement>]) -> [f64; 2] {
+        if self.carried {
+            // a pack on a network ([`Self::carried`]: every body in its own slot): its discs'
+            // reactions on carrier a, its plates' on b, each sum in slot order as
+            // `reactions_by` adds them, without looking up each slot's body and carrier
+            // (the network takes them at every evaluation; issue 45, the resolved shift's cost)
+            let side = |bodies: &[DiscModel], first: usize| {
+                let mut sum = 0.0;
+                for (j, d) in bodies.iter().enumerate() {
+                    let slot = first + j;
+                    if modes[slot].is_some() {
+                        // Hu et al. eq (4), as in `reactions_by`
+                        sum += d.spline.teeth as f64 * loads[slot] * self.rb[slot];
+                    }
+                }
+                sum
+            };
+            return [side(&self.pack.discs, 0), side(&self.pack.plates, self.nd)];
+        }
         self.reactions_by(modes, |slot| loads[slot])
     }
 

@@ -115,6 +115,7 @@ impl Body {
     }
 
     /// Whether it moves under its torques (neither fixed nor prescribed).
+    #[inline]
     pub fn is_free(&self) -> bool {
         self.motion == Motion::Free
     }
@@ -139,6 +140,7 @@ impl Body {
 
     /// The driving torque at `t` (s) and the body's angle `theta` (rad), N m: its drive
     /// signal and its firing harmonics.
+    #[inline]
     pub fn drive_torque_n_m(&self, t: f64, theta_rad: f64) -> f64 {
         self.drive.as_ref().map_or(0.0, |s| s.value(t))
             + self
@@ -149,6 +151,7 @@ impl Body {
 
     /// The external torque on the body at `t` (s), angle `theta` (rad) and speed `w`
     /// (rad/s), N m: its drive ([`Self::drive_torque_n_m`]), its road load and its drag.
+    #[inline]
     pub fn external_torque_n_m(&self, t: f64, theta_rad: f64, w_rad_s: f64) -> f64 {
         let load = self.road_load.map_or(0.0, |l| l.torque_n_m(w_rad_s));
         self.drive_torque_n_m(t, theta_rad) + load - self.drag_n_m_s_rad * w_rad_s
@@ -199,6 +202,7 @@ impl CouplingKind {
 
     /// Its law ([`element`]): the one `match` on the kinds, every other part of the tree asks
     /// the law.
+    #[inline]
     pub fn law(&self) -> &dyn ElementLaw {
         match self {
             CouplingKind::Clutch(c) => c,
@@ -213,6 +217,7 @@ impl CouplingKind {
 
 impl Coupling {
     /// Its law ([`CouplingKind::law`]).
+    #[inline]
     pub fn law(&self) -> &dyn ElementLaw {
         self.kind.law()
     }

@@ -157,7 +157,12 @@ impl Clusters {
             *a = match self.freedom[c] {
                 Freedom::Fixed => 0.0,
                 Freedom::One => self.g[i] * group[c],
-                Freedom::Many => (0..n).map(|j| self.p[i * n + j] * torque[j]).sum(),
+                // row i of P against T: the same products summed in the same order as
+                // indexing them, without a bounds check per term
+                Freedom::Many => (self.p[i * n..(i + 1) * n].iter())
+                    .zip(torque)
+                    .map(|(p, t)| p * t)
+                    .sum(),
             };
         }
     }
@@ -175,7 +180,11 @@ impl Clusters {
     /// Row `r`'s torque (N m): `(L T)_r` and the prescribed bodies' share.
     fn lambda(&self, r: usize, torque: &[f64], alpha: &[f64]) -> f64 {
         let n = torque.len();
-        let mut lambda: f64 = (0..n).map(|j| self.l[r * n + j] * torque[j]).sum();
+        // the same products summed in the same order as indexing them
+        let mut lambda: f64 = (self.l[r * n..(r + 1) * n].iter())
+            .zip(torque)
+            .map(|(l, t)| l * t)
+            .sum();
         for (p, _, l) in &self.prescribed {
             lambda += l[r] * alpha[*p];
         }

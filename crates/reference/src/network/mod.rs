@@ -251,6 +251,16 @@ impl Equations {
     /// slipping clutches' and the meshes' torques into `coupling_torque` (and each mesh's
     /// force per pair, N, into `mesh_force`).
     fn forces(&mut self, t: f64, y: &[f64]) {
+        self.torques(t, y);
+        self.accelerations();
+    }
+
+    /// [`Self::forces`] without the accelerations (`acc` left as it was): what the guards,
+    /// the samples and the modes' settling read (the rigid couplings' torques, the holds'
+    /// margins), the same values. Only the right-hand side reads `acc`, after its own
+    /// [`Self::forces`]; the guards' probes and bisections took the accelerations for nothing
+    /// (issue 45: the resolved shift's cost).
+    fn torques(&mut self, t: f64, y: &[f64]) {
         let n = self.net.bodies.len();
         let w = &y[n..2 * n];
         for (i, b) in self.net.bodies.iter().enumerate() {
@@ -295,10 +305,14 @@ impl Equations {
             self.torque[p.a] += ta;
             self.torque[p.b] += tb;
         }
-        let any_held = self.held.contains(&true);
-        if any_held {
+        if self.held.contains(&true) {
             self.hold();
         }
+    }
+
+    /// The bodies' accelerations from the torques of the last [`Self::torques`], rad/s^2.
+    fn accelerations(&mut self) {
+        let any_held = self.held.contains(&true);
         self.clusters
             .accelerations(&self.torque, &mut self.acc, &mut self.group);
         if self.clusters.any_prescribed() {
@@ -403,6 +417,39 @@ impl Equations {
         self.guards_where(t, y, out, Some(want));
     }
 
+    /// The state's components every guard reads: the bodies' angles and speeds, the
+    /// elements' own states and the packs' discs' and plates' relative angles and speeds (not
+    /// the counters, the faces' heat, the teeth's work or the drag's): a step's probes
+    /// interpolate those alone (issue 45, the resolved shift's cost).
+    fn probe_inputs(&self) -> Vec<std::ops::Range<usize>> {
+        let (n, m) = (self.net.bodies.len(), self.net.couplings.len());
+        std::iter::once(0..2 * n + m)
+            .chain((self.packs.iter()).map(|p| p.at..p.at + 2 * p.sys.ids.len()))
+            .collect()
+    }
+
+    /// The state's components the guards `want` marks read, when they are only packs'
+    /// (their discs' and plates' relative angles and speeds, and the bodies' speeds for
+    /// their faces): an event's bisection between two probes then interpolates those alone
+    /// (issue 45, the resolved shift's cost: most events are a disc's or a plate's tooth
+    /// contact). `None` (the whole state) when a coupling's or a road load's guard is marked:
+    /// they take the network's forces, which read every body and element.
+    fn guard_inputs(&self, want: &[bool]) -> Option<Vec<std::ops::Range<usize>>> {
+        let (n, m) = (self.net.bodies.len(), self.net.couplings.len());
+        let at = self.body_guard_at();
+        if want[..m].contains(&true) || want[at..].contains(&true) {
+            return None;
+        }
+        let mut ranges = Vec::with_capacity(1 + self.packs.len());
+        ranges.push(n..2 * n);
+        for p in &self.packs {
+            if want[p.guard_at..p.guard_at + p.guards()].contains(&true) {
+                ranges.push(p.at..p.at + 2 * p.sys.ids.len());
+            }
+        }
+        Some(ranges)
+    }
+
     /// [`Self::guards`] (`want` `None`) or [`Self::guards_of`].
     fn guards_where(&mut self, t: f64, y: &[f64], out: &mut [f64], want: Option<&[bool]>) {
         let n = self.net.bodies.len();
@@ -418,7 +465,7 @@ impl Equations {
         // the forces at this state give the packs' loads too
         let forced = any_own && (any_locked || any_held);
         if forced {
-            self.forces(t, y);
+            self.torques(t, y);
             self.rigid_torques();
         }
         for (k, c) in self.net.couplings.iter().enumerate() {
@@ -475,7 +522,7 @@ fn rigid_rows(net: &Network, modes: &[Option<ClutchMode>]) -> Vec<Row> {
 /// The state at `t` as a sample (the couplings' torques computed there).
 fn sample(eq: &mut Equations, t: f64, y: &[f64]) -> NetworkSample {
     let n = eq.net.bodies.len();
-    eq.forces(t, y);
+    eq.torques(t, y);
     eq.rigid_torques();
     NetworkSample {
         t_s: t,
@@ -505,100 +552,4 @@ fn reactions(eq: &Equations) -> Vec<f64> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::system::Face;
-
-    /// The guards of `scenes/eight-speed-packs.toml` (C and E resolved; the lumped brakes A
-    /// and B locked, as in first gear, so that the guards take the forces) at 0.15 s of a state in
-    /// which every other disc and plate is pressed into its spline beyond its play (in
-    /// contact) and the faces are locked, slipping and open in turn: the event bisection
-    /// evaluated every guard at each trial (issue 45); now only those asked, each to the bit of
-    /// the whole evaluation, and the stacks take the loads of the carriers' reactions, the same
-    /// stacks to the bit as those that take the loads themselves.
-    #[test]
-    fn event_bisection_evaluated_every_guard_at_each_trial() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../scenes/eight-speed-packs.toml");
-        let net = clutchpack_scene::load(&path, &[]).unwrap().network.unwrap();
-        // first gear's lumped brakes locked (as the run settles them at t = 0)
-        let modes: Vec<_> = (net.couplings.iter())
-            .map(|c| match c.name.as_str() {
-                "A" | "B" => Some(ClutchMode::Locked),
-                _ => c.law().initial_mode(),
-            })
-            .collect();
-        let mut eq = Equations::new(Arc::new(net.clone()), modes);
-        assert!(eq.modes.contains(&Some(ClutchMode::Locked)));
-        let n = net.bodies.len();
-        let mut y = vec![0.0; eq.dim()];
-        for (i, b) in net.bodies.iter().enumerate() {
-            y[n + i] = b.initial_speed_rad_s;
-        }
-        let (mut in_contact, faces) = (0, [Face::Locked, Face::Slip(1.0), Face::Open]);
-        for p in eq.packs.iter_mut() {
-            let d = p.sys.dim();
-            y[p.at..p.at + d].copy_from_slice(&p.sys.initial_state());
-            for slot in 0..p.sys.ids.len() {
-                let half = p.sys.disc(slot).spline.half_play_rad();
-                let sign = if slot % 4 == 0 { 1.0 } else { -1.0 };
-                let push = if slot % 2 == 0 { 1.02 } else { 0.5 };
-                y[p.at + 2 * slot] = sign * push * half;
-                y[p.at + 2 * slot + 1] = 0.3 * sign;
-                let part = &y[p.at..p.at + d];
-                if p.sys.depth(slot, part) > 0.0 {
-                    p.modes[slot] = Some(p.sys.disc(slot).law.engage(&p.sys.kin(slot, part)));
-                    in_contact += 1;
-                }
-            }
-            for m in 0..p.sys.faces.len() {
-                p.sys.faces[m] = faces[m % 3];
-            }
-        }
-        assert!(in_contact >= 4, "{in_contact} bodies in contact");
-        let t = 0.15;
-        let mut full = vec![0.0; eq.guard_len()];
-        eq.guards(t, &y, &mut full);
-        assert!(full.iter().any(|g| *g < 0.0) && full.iter().any(|g| *g > 0.0));
-        // every guard alone, then each pack's faces, each pack's bodies, the couplings
-        let mut masks: Vec<Vec<bool>> = (0..full.len())
-            .map(|i| (0..full.len()).map(|j| j == i).collect())
-            .collect();
-        for p in &eq.packs {
-            let (at, nb, all) = (p.guard_at, p.sys.ids.len(), p.guards());
-            masks.push(
-                (0..full.len())
-                    .map(|j| j >= at + nb && j < at + all)
-                    .collect(),
-            );
-            masks.push((0..full.len()).map(|j| j >= at && j < at + nb).collect());
-        }
-        masks.push((0..full.len()).map(|j| j < net.couplings.len()).collect());
-        for want in &masks {
-            let mut some = vec![f64::NAN; full.len()];
-            eq.guards_of(t, &y, &mut some, want);
-            for j in 0..full.len() {
-                if want[j] {
-                    assert_eq!(some[j].to_bits(), full[j].to_bits(), "guard {j}");
-                } else {
-                    // left as it was, or a face of a pack with a face asked (its stack's)
-                    let same = some[j].to_bits() == full[j].to_bits();
-                    assert!(some[j].is_nan() || same, "guard {j}");
-                }
-            }
-        }
-        // the loads of the reactions (`forces`) against the stack's own
-        eq.forces(t, &y);
-        for (p, loads) in eq.packs.iter().zip(&eq.loads) {
-            let (part, c) = (p.part(&y), [y[n + p.a], 0.0, y[n + p.b], 0.0]);
-            let own = p.sys.stack_eval(t, part, &p.modes, &c, None);
-            let given = p.sys.stack_eval(t, part, &p.modes, &c, Some(loads));
-            assert_eq!(format!("{own:?}"), format!("{given:?}"));
-            let r = p.sys.reactions_n_m(part, &p.modes);
-            assert_eq!(
-                r.map(f64::to_bits),
-                p.sys.reactions_from_n_m(loads, &p.modes).map(f64::to_bits)
-            );
-        }
-    }
-}
+mod tests;

@@ -33,7 +33,7 @@ pub(super) fn settle(
     for _ in 0..=net.couplings.len() {
         eq.set_modes(&modes);
         project_speeds(eq, y);
-        eq.forces(t, y);
+        eq.torques(t, y);
         eq.rigid_torques();
         match friction::furthest_over(&net, &modes, &eq.coupling_torque, t) {
             Some((k, to)) => modes[k] = Some(to),
@@ -113,7 +113,7 @@ fn hold_road_loads(eq: &mut Equations, t: f64, y: &mut [f64], crossed: &[f64]) {
         return;
     }
     // the groups' torques without the reactions; a group over its breakaway starts
-    eq.forces(t, y);
+    eq.torques(t, y);
     for &i in &loaded {
         let c = eq.clusters.of[i];
         let (gt, cap) = (eq.hold_torque[c], eq.hold_capacity[c]);
@@ -129,5 +129,5 @@ fn hold_road_loads(eq: &mut Equations, t: f64, y: &mut [f64], crossed: &[f64]) {
             (gt * eq.clusters.g[i]).signum()
         };
     }
-    eq.forces(t, y);
+    eq.torques(t, y);
 }

@@ -60,6 +60,9 @@ pub(super) struct NetPack {
     best: Vec<f64>,
     /// Per body: the largest probe of the step being observed, `(t s, signed F N)`.
     top: Vec<(f64, f64)>,
+    /// Whether any of its discs and plates has an oil drag (`drag_n_m_s_rad != 0`), for the
+    /// model its system holds ([`Self::set_pack`]).
+    pub(super) drag: bool,
     /// Its temperatures, if its pack file has `[thermal]` (MODEL.md section 9): the heat of
     /// every accepted step booked, the pack's viscosity-dependent parameters swapped at each
     /// thermal window's end ([`crate::thermal::Thermal`], as a pack run).
@@ -67,6 +70,12 @@ pub(super) struct NetPack {
 }
 
 impl NetPack {
+    /// Sets its system's model (an input held, or a thermal window's parameters).
+    pub fn set_pack(&mut self, pack: Arc<clutchpack_model::PackModel>) {
+        self.drag = has_drag(&pack);
+        self.sys.set_pack(pack);
+    }
+
     /// Its state's length: the system's, then the drag's work.
     pub fn len(&self) -> usize {
         self.sys.dim() + 1
@@ -101,6 +110,13 @@ impl NetPack {
 
     /// The power of its bodies' oil drag (W, >= 0): `sum C w_b^2`.
     pub fn drag_power_w(&self, y: &[f64], w: &[f64]) -> f64 {
+        if !self.drag {
+            // every term `0 w_b^2` is +0 (a finite speed; a speed that is not finite fails
+            // the step's error norm first): the sum's value, without the bodies' speeds (the
+            // right-hand side takes it at every evaluation; issue 45, the resolved shift's
+            // cost)
+            return 0.0;
+        }
         (0..self.sys.ids.len())
             .map(|slot| {
                 let wb = self.body_speed(slot, y, w);
@@ -278,6 +294,11 @@ impl NetPack {
     }
 }
 
+/// Whether any disc or plate of `pack` has an oil drag.
+fn has_drag(pack: &clutchpack_model::PackModel) -> bool {
+    (pack.discs.iter().chain(&pack.plates)).any(|d| d.drag_n_m_s_rad != 0.0)
+}
+
 /// The network's packs, their state from `first` on and their guards from `first_guard` on,
 /// in coupling order.
 pub(super) fn build(net: &Network, first: usize, first_guard: usize) -> Vec<NetPack> {
@@ -286,6 +307,7 @@ pub(super) fn build(net: &Network, first: usize, first_guard: usize) -> Vec<NetP
     for (k, c) in net.couplings.iter().enumerate() {
         let Some(pack) = c.pack() else { continue };
         let sys = System::carried(Arc::new(pack.clone()));
+        let drag = has_drag(&sys.pack);
         let nb = sys.ids.len();
         let p = NetPack {
             k,
@@ -298,6 +320,7 @@ pub(super) fn build(net: &Network, first: usize, first_guard: usize) -> Vec<NetP
             best: vec![0.0; nb],
             top: vec![(0.0, 0.0); nb],
             thermal: None,
+            drag,
             sys,
         };
         at += p.len();
@@ -339,9 +362,6 @@ pub(super) fn switch(
 /// golden-section search on the step when it lies inside it (a peak), as it is at the step's
 /// end (still rising).
 pub(super) fn observe(packs: &mut [NetPack], dense: &Dense, t0: f64, t1: f64, ybuf: &mut [f64]) {
-    let Some(from) = packs.first().map(|p| p.at) else {
-        return;
-    };
     if packs.iter().all(|p| p.modes.iter().all(Option::is_none)) {
         return;
     }
@@ -354,7 +374,10 @@ pub(super) fn observe(packs: &mut [NetPack], dense: &Dense, t0: f64, t1: f64, yb
         } else {
             t0 + (t1 - t0) * j as f64 / PROBES as f64
         };
-        dense.eval_from(t, from, ybuf);
+        // each pack's discs' and plates' relative angles and speeds (what the loads read)
+        for p in packs.iter() {
+            dense.eval_range(t, p.at..p.at + 2 * p.sys.ids.len(), ybuf);
+        }
         for p in packs.iter_mut() {
             let part = &ybuf[p.at..p.at + p.sys.dim()];
             for slot in 0..p.sys.ids.len() {
@@ -379,7 +402,8 @@ pub(super) fn observe(packs: &mut [NetPack], dense: &Dense, t0: f64, t1: f64, yb
                 let (at, dim) = (p.at, p.sys.dim());
                 let (sys, mode) = (&p.sys, &p.modes[slot]);
                 golden_peak((t - span).max(t0), (t + span).min(t1), |tt| {
-                    dense.eval_from(tt, from, ybuf);
+                    // the body's relative angle and speed, what its load reads
+                    dense.eval_range(tt, at + 2 * slot..at + 2 * slot + 2, ybuf);
                     sys.load(slot, &ybuf[at..at + dim], mode)
                 })
             } else {
@@ -473,7 +497,7 @@ pub(super) fn close_thermal_windows(
             obs.pack_temperatures(p.k, t, th.temperatures_k());
         }
         if let Some(pack) = closed {
-            p.sys.set_pack(Arc::new(pack));
+            p.set_pack(Arc::new(pack));
             swapped = true;
         }
     }

@@ -96,7 +96,7 @@ impl NetworkStepper {
             if let Some(model) = net.pack_thermal.get(&p.k) {
                 let th = Thermal::new(model.clone(), &p.sys.pack)?;
                 if let Some(pack) = th.initial_pack(&p.sys.pack) {
-                    p.sys.set_pack(Arc::new(pack));
+                    p.set_pack(Arc::new(pack));
                 }
                 obs.pack_temperatures(p.k, 0.0, th.temperatures_k());
                 p.thermal = Some(Box::new(th));
@@ -260,10 +260,15 @@ impl NetworkStepper {
         }
         let mut event: Option<(f64, f64)> = None; // (ta, tb) bracketing the first crossing
         let mut ta = *t;
+        // what the guards read (`Equations::probe_inputs`), each the value the whole state's
+        // interpolation gives it
+        let inputs = eq.probe_inputs();
         for q in 1..=4 {
             let tq = *t + h_try * f64::from(q) / 4.0;
             let tq = if q == 4 { *t + h_try } else { tq };
-            dense.eval(tq, ybuf);
+            for r in &inputs {
+                dense.eval_range(tq, r.clone(), ybuf);
+            }
             eq.guards(tq, ybuf, g1);
             if g0.iter().zip(g1.iter()).any(|(a, b)| *a > 0.0 && *b <= 0.0) {
                 event = Some((ta, tq));
@@ -280,9 +285,19 @@ impl NetworkStepper {
                     .zip(&armed)
                     .map(|(g, a)| *a && *g <= 0.0)
                     .collect();
+                // the components those guards read (`Equations::guard_inputs`), each the
+                // value the whole state's interpolation gives it
+                let inputs = eq.guard_inputs(&crossed);
                 while b - a > 1e-13 * (1.0 + b) {
                     let mid = 0.5 * (a + b);
-                    dense.eval(mid, ybuf);
+                    match &inputs {
+                        Some(ranges) => {
+                            for r in ranges {
+                                dense.eval_range(mid, r.clone(), ybuf);
+                            }
+                        }
+                        None => dense.eval(mid, ybuf),
+                    }
                     eq.guards_of(mid, ybuf, g1, &crossed);
                     if g1.iter().zip(&crossed).any(|(g, on)| *on && *g <= 0.0) {
                         b = mid;
@@ -581,7 +596,7 @@ impl NetworkSession for NetworkStepper {
             // the pack's equations carry their own model: its piston's pressure held too
             let pack = self.eq.net.couplings[k].pack().expect("a pack").clone();
             if let Some(p) = self.eq.packs.iter_mut().find(|p| p.k == k) {
-                p.sys.set_pack(Arc::new(pack));
+                p.set_pack(Arc::new(pack));
             }
         }
         // the signal's breakpoints after now are those of the network as it is now
