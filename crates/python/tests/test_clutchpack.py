@@ -244,6 +244,23 @@ def test_a_scene_from_a_dict_runs_as_its_file():
     assert a.summary["steps"] == b.summary["steps"]
 
 
+def interrupted_within_a_second(code):
+    """Runs `code` in a child Python, sends SIGINT 3 s in (while it still runs) and checks
+    that it ended within a second by KeyboardInterrupt; returns its stdout."""
+    p = subprocess.Popen(
+        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    time.sleep(3.0)
+    assert p.poll() is None, "the call ended before the signal"
+    t0 = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=30)
+    took = time.monotonic() - t0
+    assert took < 1.0, f"stopped {took:.2f} s after SIGINT"
+    assert p.returncode != 0 and "KeyboardInterrupt" in err, err
+    return out
+
+
 def test_sigint_stops_a_long_run_within_a_second(tmp_path):
     """Ctrl-C (SIGINT to the Python process) during a 60 s run: KeyboardInterrupt within a
     second, the recording complete (it reads without salvage)."""
@@ -252,15 +269,7 @@ def test_sigint_stops_a_long_run_within_a_second(tmp_path):
         "import clutchpack\n"
         f"clutchpack.run('scenes/pack-4-rattle.toml', duration=60, record={str(rec)!r})\n"
     )
-    p = subprocess.Popen([sys.executable, "-c", code], stderr=subprocess.PIPE, text=True)
-    time.sleep(3.0)
-    assert p.poll() is None, "the run ended before the signal"
-    t0 = time.monotonic()
-    p.send_signal(signal.SIGINT)
-    _, err = p.communicate(timeout=30)
-    took = time.monotonic() - t0
-    assert took < 1.0, f"stopped {took:.2f} s after SIGINT"
-    assert p.returncode != 0 and "KeyboardInterrupt" in err, err
+    interrupted_within_a_second(code)
     back = clutchpack.read(rec)
     assert 0.0 < back.summary["duration_s"] < 60.0
     assert len(back.impacts) > 0
@@ -282,17 +291,7 @@ def test_sigint_stops_a_network_simulations_call_within_a_second():
         "    print(sim.time, flush=True)\n"
         "    raise\n"
     )
-    p = subprocess.Popen(
-        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
-    )
-    time.sleep(3.0)
-    assert p.poll() is None, "the call ended before the signal"
-    t0 = time.monotonic()
-    p.send_signal(signal.SIGINT)
-    out, err = p.communicate(timeout=30)
-    took = time.monotonic() - t0
-    assert took < 1.0, f"stopped {took:.2f} s after SIGINT"
-    assert p.returncode != 0 and "KeyboardInterrupt" in err, err
+    out = interrupted_within_a_second(code)
     assert 0.0 < float(out.strip()) < 60.0, out
 
 
