@@ -1075,6 +1075,13 @@ mod tests {
         pack
     }
 
+    /// The relative angles of [`contact_state`]'s two test states, in half plays (beyond 1:
+    /// in contact; at least two bodies in contact in each, on the shaft and on the drum).
+    const CONTACTS: [[f64; 5]; 2] = [
+        [0.3, 1.02, -0.7, -1.01, 0.2],
+        [1.01, 0.1, 1.03, -0.5, -1.02],
+    ];
+
     /// The `k`-th test state of [`free_pack`]'s five bodies: each body's relative angle at
     /// `contact` times the half play `g0` (beyond 1: in contact), its relative speed, the
     /// shaft's and the drum's, and the modes engaged where a body is in contact.
@@ -1112,13 +1119,7 @@ mod tests {
         let g0 = pack.discs[0].spline.half_play_rad();
         let sys = System::new(std::sync::Arc::new(pack), (0..5).collect());
         assert_eq!(sys.dim(), 2 + 2 * 5 + 2 + 4);
-        for (k, contact) in [
-            [0.3, 1.02, -0.7, -1.01, 0.2],
-            [1.01, 0.1, 1.03, -0.5, -1.02],
-        ]
-        .iter()
-        .enumerate()
-        {
+        for (k, contact) in CONTACTS.iter().enumerate() {
             let (y, modes) = contact_state(&sys, k, contact, g0);
             assert!(modes.iter().filter(|m| m.is_some()).count() >= 2);
             let mut dy = vec![0.0; sys.dim()];
@@ -1185,13 +1186,7 @@ mod tests {
             let mut sys = System::new(std::sync::Arc::new(pack), (0..5).collect());
             let faces = [Face::Locked, Face::Slip(1.0), Face::Open];
             let mut clamped = 0;
-            for (k, contact) in [
-                [0.3, 1.02, -0.7, -1.01, 0.2],
-                [1.01, 0.1, 1.03, -0.5, -1.02],
-            ]
-            .iter()
-            .enumerate()
-            {
+            for (k, contact) in CONTACTS.iter().enumerate() {
                 let (y, modes) = contact_state(&sys, k, contact, g0);
                 // in contact on the shaft (slots 0, 1) and on the drum (slots 2 to 4)
                 assert!(modes[..2].iter().any(Option::is_some));
