@@ -436,6 +436,12 @@ impl NetworkSimulation {
         self.stepper.time_s()
     }
 
+    /// Tooth impacts closed so far: the gear meshes' and the resolved packs' bodies'
+    /// together (a pack session's [`crate::Session::impact_count`], for a network).
+    pub fn impact_count(&self) -> u64 {
+        self.keep.impacts.values().map(|m| m.0).sum()
+    }
+
     /// The engine running it.
     pub fn engine(&self) -> EngineChoice {
         self.stepper.engine()

@@ -131,7 +131,20 @@ fn network_frames(name: &str, scene: &Scene, engine: EngineChoice, end: f64, end
             .filter(|(n, _)| n.ends_with(".speed_rad_s"))
             .map(|(_, v)| v)
             .collect();
+        let running = sim.impact_count();
         let outcome = sim.finish().unwrap();
+        // the running count (what `bench --frames` tallies per frame) is the summary's,
+        // but for the contacts still open at the end, which `finish` closes: at most one
+        // per gear mesh and per pack body
+        let couplings = &outcome.summary.couplings;
+        let total: u64 = couplings.iter().map(|c| c.impacts).sum();
+        let open_at_most: usize = couplings.iter().map(|c| c.pack_bodies.len().max(1)).sum();
+        assert!(
+            running <= total && total - running <= open_at_most as u64,
+            "{name} {engine:?}: {running} impacts counted as the run went, {total} in the \
+             summary (at most {open_at_most} open at the end)"
+        );
+        println!("{name} {engine:?}: {running} impacts counted in frames, {total} in the summary");
         (speeds, outcome.impacts.len())
     };
     let (w_whole, n_whole) = run(&[end]);
