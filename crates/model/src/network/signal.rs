@@ -227,8 +227,16 @@ mod tests {
         let before = net.clone();
         let angles = [profile.angle(0.01), 0.0, 0.0];
         for (input, value, why) in [
-            (NetworkInput::Speed(1), 1.0, "body \"load\": its speed cannot be set: it is free"),
-            (NetworkInput::Speed(2), 1.0, "body \"housing\": its speed cannot be set: it is fixed"),
+            (
+                NetworkInput::Speed(1),
+                1.0,
+                "body \"load\": its speed cannot be set: it is free",
+            ),
+            (
+                NetworkInput::Speed(2),
+                1.0,
+                "body \"housing\": its speed cannot be set: it is fixed",
+            ),
             (NetworkInput::Speed(0), f64::NAN, "expected a finite number"),
             (NetworkInput::Speed(9), 1.0, "body 9: no such body"),
         ] {

@@ -511,7 +511,13 @@ pub(super) fn close_thermal_windows(
 /// (`psi = w_a - w_disc`) shifted by the jump, as a pack's session shifts them at a jump of
 /// its shaft's (`crate::session::shift_disc_speeds`). What a clutch or gear ties to it
 /// follows when the modes are settled next (their speeds projected).
-pub(super) fn jump_speed(packs: &[NetPack], y: &mut [f64], n: usize, input: NetworkInput, value: f64) {
+pub(super) fn jump_speed(
+    packs: &[NetPack],
+    y: &mut [f64],
+    n: usize,
+    input: NetworkInput,
+    value: f64,
+) {
     let NetworkInput::Speed(i) = input else {
         return;
     };
