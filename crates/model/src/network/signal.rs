@@ -294,8 +294,8 @@ impl super::Network {
     /// rad, as [`crate::session::hold_inputs`] holds a pack's shaft): the engines'
     /// `set_input`, which then restart at that instant as at a signal's jump (a prescribed
     /// body's speed in their state set to the value, what follows it moved with it). A value
-    /// that is not finite, a negative force, or an input naming a body or coupling that cannot take it
-    /// (a speed for a free or fixed body) is refused, the network unchanged.
+    /// that is not finite, a negative force, or an input naming a body or coupling that
+    /// cannot take it (a speed for a free or fixed body) is refused, the network unchanged.
     pub fn hold_input(
         &mut self,
         input: NetworkInput,

@@ -381,11 +381,11 @@ impl NetworkSession for NetworkStepper {
         heat
     }
 
-    /// Sets `input` to `value` from now on (N m, N, Pa or rad/s; [`Network::hold_input`]): the scene's
-    /// signal is replaced by the held value in the stepper's own network, its breakpoints
-    /// after now taken again, and the run restarts here as at a jump of a signal (counted as
-    /// an event; the clutches' modes settled at once, MODEL.md section 8, events sent to
-    /// `obs`). A value that is not finite, a negative force, or an input naming a body or
+    /// Sets `input` to `value` from now on (N m, N, Pa or rad/s; [`Network::hold_input`]): the
+    /// scene's signal is replaced by the held value in the stepper's own network, its
+    /// breakpoints after now taken again, and the run restarts here as at a jump of a signal
+    /// (a speed's jump given to the state, `run_speed_jump`; counted as an event; the
+    /// clutches' modes settled at once, MODEL.md section 8, events sent to `obs`). A value that is not finite, a negative force, or an input naming a body or
     /// coupling that cannot take it is refused, the run unchanged.
     fn set_input(
         &mut self,
