@@ -33,7 +33,9 @@ Every result is JSON on stdout; the assertions and their bounds are in tests/fmu
 """
 
 import argparse
+import contextlib
 import csv
+import io
 import json
 import math
 import os
@@ -457,11 +459,14 @@ def check_network_speed(args):
     }
     outputs = [v.name for v in md.modelVariables if v.causality == "output"]
     fmu_slave = Slave(fmu)
-    try:
-        fmu_slave.set("bodies.motor.speed_rad_s", float("nan"))
-        nan_refused = False
-    except Exception:  # FMPy raises on fmi2Error
-        nan_refused = True
+    log = io.StringIO()
+    # the FMU logs its reason through FMPy's logger, which prints it: kept off stdout
+    with contextlib.redirect_stdout(log):
+        try:
+            fmu_slave.set("bodies.motor.speed_rad_s", float("nan"))
+            nan_refused = False
+        except Exception:  # FMPy raises on fmi2Error
+            nan_refused = True
     fmu_slave.set("bodies.motor.speed_rad_s", 30.0)
     fmu_slave.s.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.1)
     a1 = fmu_slave.get("bodies.motor.angle_rad")
@@ -473,6 +478,7 @@ def check_network_speed(args):
         "units": sorted(units),
         "speed_is_output": "bodies.motor.speed_rad_s" in outputs,
         "nan_refused": nan_refused,
+        "nan_log": log.getvalue(),
         "angles": [a1, a2],
         "problems": validate_fmu(fmu),
     }
