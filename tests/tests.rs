@@ -16,6 +16,7 @@ mod locked_packs;
 mod network;
 mod network_engines;
 mod prescribed_pack;
+mod prescribed_speed;
 mod python_package;
 mod reliability;
 mod salvage_and_messages;

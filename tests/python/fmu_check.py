@@ -19,6 +19,10 @@ CHECK is one of:
 - network_packs: the same with both clutches resolved packs, driven by their pistons' pressures
 - network: the DCT upshift's FMU (a network scene): its inputs, FMPy's validation, the shift
   driven by the clutch forces' schedule through FMPy against `clutchpack run`
+- network_speed: the FMU of a network with a prescribed motor (tests/prescribed_pack.rs's
+  MOTOR, given on the command line's --scene-text): its inputs with their units and start
+  values, a NaN speed refused (fmi2Error), the motor's angle after its speed is set to
+  30 rad/s at t = 0 and advanced 0.1 s twice.
 - thermal: pack-8-idle-thermal with a steady drive (drive.amplitude_rad_s = 0, so the FMU's
   inputs held at their start values are the scene's own profiles) for 0.5 s: FMPy's
   simulate_fmu reads every temperature output at the end; `clutchpack run` of the same
@@ -29,7 +33,9 @@ Every result is JSON on stdout; the assertions and their bounds are in tests/fmu
 """
 
 import argparse
+import contextlib
 import csv
+import io
 import json
 import math
 import os
@@ -430,6 +436,54 @@ def check_network_packs(args):
     return out
 
 
+def check_network_speed(args):
+    """A prescribed network body's speed through the FMU (issue 44): the model description's
+    inputs (name, unit, start), a NaN refused by fmi2SetReal, the body's angle after 0.1 s
+    and 0.2 s at 30 rad/s set at t = 0."""
+    work = args.work
+    with open(os.path.join(work, "w.csv"), "w") as f:
+        f.write("time_s,speed_rad_s\n0,20\n1,40\n")
+    scene = os.path.join(work, "motor.toml")
+    with open(scene, "w") as f:
+        f.write(args.scene_text)
+    fmu = os.path.join(work, "motor.fmu")
+    p = build(args, scene, fmu)
+    if p.returncode != 0:
+        raise SystemExit(p.stderr)
+    md = read_model_description(fmu)
+    units = {u.name: u for u in md.unitDefinitions}
+    inputs = {
+        v.name: [v.unit, float(v.start)]
+        for v in md.modelVariables
+        if v.causality == "input"
+    }
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    fmu_slave = Slave(fmu)
+    log = io.StringIO()
+    # the FMU logs its reason through FMPy's logger, which prints it: kept off stdout
+    with contextlib.redirect_stdout(log):
+        try:
+            fmu_slave.set("bodies.motor.speed_rad_s", float("nan"))
+            nan_refused = False
+        except Exception:  # FMPy raises on fmi2Error
+            nan_refused = True
+    fmu_slave.set("bodies.motor.speed_rad_s", 30.0)
+    fmu_slave.s.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.1)
+    a1 = fmu_slave.get("bodies.motor.angle_rad")
+    fmu_slave.s.doStep(currentCommunicationPoint=0.1, communicationStepSize=0.1)
+    a2 = fmu_slave.get("bodies.motor.angle_rad")
+    fmu_slave.close()
+    return {
+        "inputs": inputs,
+        "units": sorted(units),
+        "speed_is_output": "bodies.motor.speed_rad_s" in outputs,
+        "nan_refused": nan_refused,
+        "nan_log": log.getvalue(),
+        "angles": [a1, a2],
+        "problems": validate_fmu(fmu),
+    }
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", required=True)
@@ -437,8 +491,10 @@ def main():
     ap.add_argument("--work", required=True)
     ap.add_argument(
         "check",
-        choices=["validate", "paper", "coupling", "rollback", "thermal", "network", "network_packs"],
+        choices=["validate", "paper", "coupling", "rollback", "thermal", "network", "network_packs",
+                 "network_speed"],
     )
+    ap.add_argument("--scene-text", default="")
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
     result = {
@@ -449,6 +505,7 @@ def main():
         "thermal": check_thermal,
         "network": check_network,
         "network_packs": check_network_packs,
+        "network_speed": check_network_speed,
     }[args.check](args)
     json.dump(result, sys.stdout)
 

@@ -47,7 +47,8 @@ impl Stepper {
     /// a pack's by their public names ("shaft.speed_rad_s", "shaft.drive_torque_n_m",
     /// "drum.load_torque_n_m", "piston.pressure_pa") or the older "shaft_speed",
     /// "shaft_torque", "drum_load", "piston_pressure"; a network's as
-    /// "bodies.<body>.drive_torque_n_m", "couplings.<clutch>.normal_force_n" or
+    /// "bodies.<body>.speed_rad_s" (a prescribed body), "bodies.<body>.drive_torque_n_m",
+    /// "couplings.<clutch>.normal_force_n" or
     /// "couplings.<pack>.pressure_pa". Records to `record` if given; steps land on
     /// `stop_time` (s) if given (a network's run ends there).
     #[new]

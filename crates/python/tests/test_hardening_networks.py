@@ -43,3 +43,63 @@ def test_network_record_over_a_pack_file_is_refused(tmp_path):
         with pytest.raises(ValueError, match="is an input of this run"):
             clutchpack.run(str(tmp_path / scene), record=tmp_path / target)
         assert (tmp_path / target).read_bytes() == before
+
+
+MOTOR = """
+name = "motor"
+[simulation]
+duration_s = 0.8
+[[bodies]]
+name = "motor"
+[bodies.speed]
+kind = "speed_table"
+file = "w.csv"
+[[bodies]]
+name = "load"
+inertia_kg_m2 = 0.5
+[[couplings]]
+name = "clutch"
+kind = "clutch"
+a = "motor"
+b = "load"
+mu = 0.3
+peak = 1.2
+cgeo_m = 0.1
+max_normal_force_n = 1000.0
+[couplings.force]
+kind = "constant"
+value = 1.0
+"""
+
+
+@pytest.mark.parametrize("engine", ["reference", "multibody"])
+def test_network_prescribed_speed_is_an_input_and_bad_speeds_are_refused(tmp_path, engine):
+    """Issue 44: a prescribed network body's speed is an input by the one-pack scene's name
+    (``bodies.motor.speed_rad_s``, rad/s), no output of that name beside it; a free body's speed is
+    no input, and a speed that is not finite or beyond the scene key's 1e5 rad/s raises
+    ValueError naming it, the run unchanged; a value set holds the speed from the body's
+    angle then (the angle continuous, the speed the value; the angles to 1e-9 rad, measured
+    within rounding, 1e-15)."""
+    (tmp_path / "w.csv").write_text("time_s,speed_rad_s\n0,20\n1,40\n")
+    (tmp_path / "motor.toml").write_text(MOTOR)
+    name = "bodies.motor.speed_rad_s"
+    with pytest.raises(ValueError, match=r"bodies.load.speed_rad_s.*not an input"):
+        clutchpack.Simulation(str(tmp_path / "motor.toml"), engine=engine,
+                              drive=["bodies.load.speed_rad_s"])
+    sim = clutchpack.Simulation(str(tmp_path / "motor.toml"), engine=engine, drive=[name])
+    assert sim.inputs == [name]
+    assert sim.variables[name][:2] == ("input", "rad/s")
+    with pytest.raises(ValueError, match=name):
+        sim.advance_to(0.1, **{name: float("nan")})
+    with pytest.raises(ValueError, match=r"bodies\[\]\.speed\.omega0_rad_s"):
+        sim.advance_to(0.1, **{name: 1e6})
+    assert sim.time == 0.0
+    assert name not in sim.outputs
+    sim.advance_to(0.1)
+    angle = sim.outputs["bodies.motor.angle_rad"]
+    # held at its start value, 20 rad/s, until set
+    assert abs(angle - 20.0 * 0.1) < 1e-9
+    # set where the run stands (0.1 s to rounding), held to 0.2 s from the angle there
+    sim.advance_to(0.2, **{name: 30.0})
+    assert abs(sim.outputs["bodies.motor.angle_rad"] - (angle + 30.0 * 0.1)) < 1e-9
+    sim.finish()

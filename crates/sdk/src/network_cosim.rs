@@ -99,23 +99,29 @@ pub struct NetworkVariable {
     pub description: String,
 }
 
-/// The inputs of `net` by their public names: the drive torque of each turning body the scene
+/// The inputs of `net` by their public names: each prescribed body's speed
+/// (`bodies.<body>.speed_rad_s`, rad/s: a body with `[bodies.speed]`, as a one-pack scene's
+/// `shaft.speed_rad_s`), the drive torque of each turning body the scene
 /// drives (`bodies.<body>.drive_torque_n_m`, N m: a body with `[bodies.drive]` or
 /// `[bodies.firing]`; give a body `drive = 0` to make it an input), each clutch's normal
 /// force (`couplings.<clutch>.normal_force_n`, N) and each resolved pack's piston pressure
 /// (`couplings.<pack>.pressure_pa`, Pa; a pack with a `[stack]`).
 pub fn network_inputs(net: &Network) -> Vec<(String, NetworkInput)> {
-    let bodies = net
-        .bodies
-        .iter()
-        .enumerate()
-        .filter(|(_, b)| !b.is_fixed() && (b.drive.is_some() || b.firing.is_some()))
-        .map(|(i, b)| {
+    let bodies = net.bodies.iter().enumerate().flat_map(|(i, b)| {
+        let speed = b.prescribed().map(|_| {
+            (
+                format!("bodies.{}.speed_rad_s", segment(&b.name)),
+                NetworkInput::Speed(i),
+            )
+        });
+        let drive = (!b.is_fixed() && (b.drive.is_some() || b.firing.is_some())).then(|| {
             (
                 format!("bodies.{}.drive_torque_n_m", segment(&b.name)),
                 NetworkInput::Drive(i),
             )
         });
+        speed.into_iter().chain(drive)
+    });
     // each element's own input (its law's), those of one kind together in the order the
     // inputs are listed (clutches' forces, then packs' pressures), each kind by coupling
     let mut elements: Vec<(String, NetworkInput)> = net
@@ -154,12 +160,13 @@ pub fn network_name_problems(net: &Network) -> Vec<String> {
         .collect()
 }
 
-/// The value of `input` in `net` at `t` (s): a drive signal's torque (N m, without the
-/// firing harmonics, which stay locked to the angle), a clutch's normal force (N) or a pack's
-/// piston pressure (Pa).
+/// The value of `input` in `net` at `t` (s): a prescribed body's speed (rad/s), a drive
+/// signal's torque (N m, without the firing harmonics, which stay locked to the angle), a
+/// clutch's normal force (N) or a pack's piston pressure (Pa).
 fn input_value(net: &Network, input: NetworkInput, t: f64) -> f64 {
     match input {
         NetworkInput::Drive(i) => net.bodies[i].drive.as_ref().map_or(0.0, |s| s.value(t)),
+        NetworkInput::Speed(i) => net.bodies[i].prescribed().map_or(0.0, |p| p.speed(t)),
         NetworkInput::ClutchForce(k) | NetworkInput::PackPressure(k) => {
             net.couplings[k].law().input_value(t)
         }
@@ -174,6 +181,14 @@ fn input_variable(net: &Network, name: &str, input: NetworkInput) -> NetworkVari
             format!(
                 "drive torque on {}, N m (positive in its sense of rotation; its firing \
                  harmonics add to it)",
+                net.bodies[i].name
+            ),
+        ),
+        NetworkInput::Speed(i) => (
+            "rad/s",
+            format!(
+                "speed of the prescribed {} (positive in its sense of rotation); its angle \
+                 integrates it",
                 net.bodies[i].name
             ),
         ),
@@ -419,7 +434,8 @@ impl NetworkSimulation {
         })
     }
 
-    /// Every variable: the driven inputs, then the outputs ([`Self::outputs`]'s names).
+    /// Every variable: the driven inputs, then the outputs ([`Self::outputs`]'s names, but a
+    /// driven prescribed body's speed, which is its input's).
     pub fn variables(&self) -> Vec<NetworkVariable> {
         let net = self.stepper.network();
         let mut out: Vec<NetworkVariable> = self
@@ -427,7 +443,13 @@ impl NetworkSimulation {
             .iter()
             .map(|(name, input)| input_variable(net, name, *input))
             .collect();
-        out.extend(network_outputs(net, self.scene.transmission.as_ref()));
+        // a driven prescribed body's speed is its input (as a one-pack scene's shaft's)
+        let outputs = network_outputs(net, self.scene.transmission.as_ref());
+        out.extend(
+            outputs
+                .into_iter()
+                .filter(|o| !self.driven.iter().any(|(n, _)| *n == o.name)),
+        );
         out
     }
 
@@ -452,9 +474,11 @@ impl NetworkSimulation {
         &self.scene
     }
 
-    /// Sets the driven input `name` to `value` (N m or N), held from now on. An input that is
+    /// Sets the driven input `name` to `value` (N m, N, Pa or rad/s), held from now on (a
+    /// prescribed body's speed from its angle now: [`Network::hold_input`]). An input that is
     /// not driven (or not one of the network's), a value that is not finite, or a negative
-    /// force is bad input; the run is unchanged then.
+    /// force is bad input; the run is unchanged then. A value equal to the input's now (a
+    /// held speed set again) changes nothing: the run goes on as if it had not been set.
     pub fn set_input(&mut self, name: &str, value: f64) -> Result<()> {
         self.usable()?;
         let Some((_, input)) = self.driven.iter().find(|(n, _)| n == name) else {

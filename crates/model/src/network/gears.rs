@@ -373,6 +373,10 @@ impl Transmission {
             .enumerate()
             .filter_map(|(k, c)| element_row(c, k, g.closed.contains(&k)))
             .collect();
+        // a prescribed body moves as a free one here: its speed is imposed but not zero, and
+        // the ratio is the kinematics of the closed elements whatever drives them (a rig's
+        // motor at the input, a dynamometer at the output); held as the fixed body's, a
+        // prescribed input would read as held still
         let inv: Vec<f64> = net
             .bodies
             .iter()
@@ -476,6 +480,26 @@ mod tests {
             first.open_slips.iter().all(|(_, s)| s.abs() > 0.01),
             "{first:?}"
         );
+    }
+
+    /// A prescribed body is moving to the gear check, not given as the fixed body is: the
+    /// 8HP with its input (a rig's motor) or its output (a dynamometer) at a prescribed speed
+    /// has every gear's ratio, speeds per input and open slips of the free one, bit for bit
+    /// (held like the fixed body, a prescribed input reads as "holds the input still").
+    #[test]
+    fn a_prescribed_input_or_output_keeps_every_gears_kinematics() {
+        let (net, tr) = eight_speed();
+        let free: Vec<_> = (0..tr.gears.len())
+            .map(|g| tr.kinematics(&net, g).unwrap())
+            .collect();
+        for body in [tr.input, tr.output] {
+            let mut rig = net.clone();
+            rig.bodies[body].motion =
+                crate::network::Motion::Prescribed(crate::SpeedProfile::sine(100.0, 5.0, 30.0));
+            for (g, k) in free.iter().enumerate() {
+                assert_eq!(tr.kinematics(&rig, g).as_ref(), Ok(k), "gear {g}");
+            }
+        }
     }
 
     /// A gear of two elements leaves a degree of freedom too many, one of four holds the input

@@ -197,6 +197,61 @@ mod tests {
         assert!(sum.is_valid());
         assert!(!Signal::Constant(f64::NAN).is_valid());
     }
+
+    /// A prescribed body's speed held at `t` (`NetworkInput::Speed`): its profile becomes
+    /// `Held` from `t` at the body's angle there (the angle continuous, the speed the value,
+    /// exactly); a free body, the fixed body and a value that is not finite are refused with
+    /// the body named, the network unchanged.
+    #[test]
+    fn a_held_speed_keeps_the_angle_and_refuses_what_is_not_prescribed() {
+        use crate::network::{Body, Motion, Network, NetworkInput};
+        let body = |name: &str, motion| Body {
+            name: name.into(),
+            inertia_kg_m2: 1.0,
+            drag_n_m_s_rad: 0.0,
+            initial_speed_rad_s: 0.0,
+            motion,
+            drive: None,
+            firing: None,
+            road_load: None,
+        };
+        let profile = crate::SpeedProfile::sine(100.0, 5.0, 30.0);
+        let mut net = Network {
+            bodies: vec![
+                body("motor", Motion::Prescribed(profile.clone())),
+                body("load", Motion::Free),
+                body("housing", Motion::Fixed),
+            ],
+            ..Network::default()
+        };
+        let before = net.clone();
+        let angles = [profile.angle(0.01), 0.0, 0.0];
+        for (input, value, why) in [
+            (
+                NetworkInput::Speed(1),
+                1.0,
+                "body \"load\": its speed cannot be set: it is free",
+            ),
+            (
+                NetworkInput::Speed(2),
+                1.0,
+                "body \"housing\": its speed cannot be set: it is fixed",
+            ),
+            (NetworkInput::Speed(0), f64::NAN, "expected a finite number"),
+            (NetworkInput::Speed(9), 1.0, "body 9: no such body"),
+        ] {
+            let e = net.hold_input(input, value, 0.01, &angles).unwrap_err();
+            assert!(e.to_string().contains(why), "{e}");
+            assert_eq!(net, before);
+        }
+        net.hold_input(NetworkInput::Speed(0), 120.0, 0.01, &angles)
+            .unwrap();
+        let held = net.bodies[0].prescribed().unwrap();
+        assert_eq!(held.speed(0.01), 120.0);
+        assert_eq!(held.angle(0.01), angles[0]);
+        assert_eq!(held.speed(0.5), 120.0);
+        assert_eq!(held.angle(0.02), angles[0] + 120.0 * (0.02 - 0.01));
+    }
 }
 
 /// An input of a network that a session's caller may set (MODEL.md section 8, "Inputs"): the
@@ -212,14 +267,19 @@ pub enum NetworkInput {
     /// The piston pressure of the resolved pack that is coupling `k`, Pa (>= 0; its piston
     /// force is `p A - F_return`, MODEL.md section 5).
     PackPressure(usize),
+    /// The speed of the prescribed body `i`, rad/s (positive in its sense of rotation): a
+    /// one-pack scene's `shaft.speed_rad_s` for a network body (a test rig's motor). Held
+    /// from the instant it is set as [`crate::SpeedProfile::Held`] from the body's angle
+    /// there, so that its angle stays continuous and its speed jumps to the value.
+    Speed(usize),
 }
 
 impl NetworkInput {
-    /// Its place in a list of inputs: the drives, then the clutches' forces, then the packs'
-    /// pressures (the co-simulation's order).
+    /// Its place in a list of inputs: the bodies' (a prescribed body's speed, a drive), then
+    /// the clutches' forces, then the packs' pressures (the co-simulation's order).
     pub fn rank(self) -> u8 {
         match self {
-            NetworkInput::Drive(_) => 0,
+            NetworkInput::Drive(_) | NetworkInput::Speed(_) => 0,
             NetworkInput::ClutchForce(_) => 1,
             NetworkInput::PackPressure(_) => 2,
         }
@@ -227,16 +287,21 @@ impl NetworkInput {
 }
 
 impl super::Network {
-    /// Replaces the signal of `input` by the constant `value` (N m for a drive, N for a
-    /// clutch's normal force, stored normalized by the clutch's `fn_max_n`, Pa for a pack's
-    /// piston pressure): the engines'
-    /// `set_input`, which then restart at that instant as at a signal's jump. A value that
-    /// is not finite, a negative force, or an input naming a body or coupling that cannot
-    /// take it is refused, the network unchanged.
+    /// Replaces the signal of `input` by the constant `value` from `t_s` (s) on (N m for a
+    /// drive, N for a clutch's normal force, stored normalized by the clutch's `fn_max_n`,
+    /// Pa for a pack's piston pressure, rad/s for a prescribed body's speed, held as
+    /// [`crate::SpeedProfile::Held`] from `t_s` and the body's angle there, `angles_rad[i]`,
+    /// rad, as [`crate::session::hold_inputs`] holds a pack's shaft): the engines'
+    /// `set_input`, which then restart at that instant as at a signal's jump (a prescribed
+    /// body's speed in their state set to the value, what follows it moved with it). A value
+    /// that is not finite, a negative force, or an input naming a body or coupling that
+    /// cannot take it (a speed for a free or fixed body) is refused, the network unchanged.
     pub fn hold_input(
         &mut self,
         input: NetworkInput,
         value: f64,
+        t_s: f64,
+        angles_rad: &[f64],
     ) -> Result<(), crate::EngineError> {
         let bad = |why: String| Err(crate::EngineError::Unsupported(why));
         if !value.is_finite() {
@@ -272,6 +337,26 @@ impl super::Network {
                     return bad(format!("piston pressure {value} Pa: expected >= 0"));
                 }
                 stack.piston.pressure = crate::PressureProfile::Constant { pressure_pa: value };
+            }
+            NetworkInput::Speed(i) => {
+                let Some(b) = self.bodies.get_mut(i) else {
+                    return bad(format!("body {i}: no such body"));
+                };
+                let super::Motion::Prescribed(p) = &mut b.motion else {
+                    let what = if b.is_fixed() { "fixed" } else { "free" };
+                    return bad(format!(
+                        "body \"{}\": its speed cannot be set: it is {what}, not prescribed \
+                         (give it [bodies.speed])",
+                        b.name
+                    ));
+                };
+                *p = crate::SpeedProfile::Held {
+                    t0_s: t_s,
+                    angle0_rad: angles_rad.get(i).copied().unwrap_or_else(|| p.angle(t_s)),
+                    speed_rad_s: value,
+                    accel_rad_s2: 0.0,
+                    jerk_rad_s3: 0.0,
+                };
             }
         }
         Ok(())

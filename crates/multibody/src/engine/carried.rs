@@ -176,4 +176,28 @@ impl MultibodySession {
         });
         Ok(())
     }
+
+    /// Holds the prescribed shaft's speed at `speed_rad_s` (rad/s) from now on, from its
+    /// angle now, in place of its profile (a network's input, `NetworkInput::Speed`, on the
+    /// body carrying the discs): as a driven shaft speed of a pack session
+    /// ([`Session::set_inputs`]), without the session having been started with it driven, so
+    /// that the profile runs until the first value is held. Refused: an inertial shaft, a
+    /// speed that is not finite.
+    pub fn hold_shaft_speed(&mut self, speed_rad_s: f64) -> Result<(), EngineError> {
+        if !matches!(self.run.pack.shaft, clutchpack_model::Shaft::Prescribed(_)) {
+            return Err(EngineError::Unsupported(
+                "the pack's shaft is inertial: its speed cannot be held".into(),
+            ));
+        }
+        if !speed_rad_s.is_finite() {
+            return Err(EngineError::Unsupported(format!(
+                "shaft speed {speed_rad_s} rad/s: must be finite"
+            )));
+        }
+        self.apply_inputs(&Inputs {
+            shaft_speed_rad_s: Some(speed_rad_s),
+            ..Inputs::default()
+        });
+        Ok(())
+    }
 }

@@ -349,6 +349,20 @@ impl NetPack {
         self.session.hold_pressure(pressure_pa)
     }
 
+    /// Holds its prescribed carrier's speed: `profile` the network body's new one
+    /// ([`clutchpack_model::SpeedProfile::Held`] from now), `speed_rad_s` its value (rad/s),
+    /// which the session's shaft takes from its own angle now
+    /// ([`MultibodySession::hold_shaft_speed`]).
+    pub fn hold_speed(
+        &mut self,
+        profile: &clutchpack_model::SpeedProfile,
+        speed_rad_s: f64,
+    ) -> Result<(), EngineError> {
+        self.session.hold_shaft_speed(speed_rad_s)?;
+        self.prescribed = Some(profile.clone());
+        Ok(())
+    }
+
     /// Sends the faces' new locked and clamped counts to `obs` at `t` (s) if they changed, or
     /// whatever they are at t = 0 (as the reference engine does).
     pub fn faces_to(&mut self, t: f64, obs: &mut dyn NetworkObserver) {

@@ -381,11 +381,11 @@ impl NetworkSession for NetworkStepper {
         heat
     }
 
-    /// Sets `input` to `value` from now on (N m or N; [`Network::hold_input`]): the scene's
-    /// signal is replaced by the held value in the stepper's own network, its breakpoints
-    /// after now taken again, and the run restarts here as at a jump of a signal (counted as
-    /// an event; the clutches' modes settled at once, MODEL.md section 8, events sent to
-    /// `obs`). A value that is not finite, a negative force, or an input naming a body or
+    /// Sets `input` to `value` from now on (N m, N, Pa or rad/s; [`Network::hold_input`]): the
+    /// scene's signal is replaced by the held value in the stepper's own network, its
+    /// breakpoints after now taken again, and the run restarts here as at a jump of a signal
+    /// (a speed's jump given to the state, `run_speed_jump`; counted as an event; the
+    /// clutches' modes settled at once, MODEL.md section 8, events sent to `obs`). A value that is not finite, a negative force, or an input naming a body or
     /// coupling that cannot take it is refused, the run unchanged.
     fn set_input(
         &mut self,
@@ -393,14 +393,20 @@ impl NetworkSession for NetworkStepper {
         value: f64,
         obs: &mut dyn NetworkObserver,
     ) -> Result<(), EngineError> {
-        Arc::make_mut(&mut self.run.net).hold_input(input, value)?;
+        let t = self.t;
+        let angles = self.run.world.angles().to_vec();
+        Arc::make_mut(&mut self.run.net).hold_input(input, value, t, &angles)?;
         if let NetworkInput::PackPressure(k) = input {
             // the pack's session holds it too (the network's copy keeps the breakpoints)
             if let Some(p) = self.run.packs.iter_mut().find(|p| p.k == k) {
                 p.hold_pressure(value)?;
             }
         }
-        let t = self.t;
+        if let NetworkInput::Speed(i) = input {
+            // the body's speed jumps to the value, its angle kept; what a row ties to it
+            // follows (momentum kept, as after a step); a pack it carries holds it too
+            run_speed_jump(&mut self.run, i, value)?;
+        }
         self.breakpoints = self.run.net.breakpoints(self.duration_s);
         self.next_bp = self
             .breakpoints
@@ -448,4 +454,23 @@ impl NetworkSession for NetworkStepper {
     fn boxed_clone(&self) -> Box<dyn NetworkSession> {
         Box::new(self.clone())
     }
+}
+
+/// Sets the prescribed body `i`'s speed in `run` to `value` (rad/s; its profile already held,
+/// [`Network::hold_input`]), its angle kept: what a row ties to it follows (the speeds
+/// projected, momentum kept, as after a step), and a pack carried by it holds the speed too
+/// (its session's shaft, from its own angle).
+fn run_speed_jump(run: &mut Run, i: usize, value: f64) -> Result<(), EngineError> {
+    let angle = run.world.angles()[i];
+    run.world.set_prescribed(i, value, angle);
+    run.w[i] = value;
+    run.elimination.project(&run.inv_inertia, &mut run.w);
+    run.world.set_speeds(&run.w);
+    let profile = run.net.bodies[i].prescribed().cloned();
+    for p in run.packs.iter_mut().filter(|p| p.a == i) {
+        if let Some(profile) = &profile {
+            p.hold_speed(profile, value)?;
+        }
+    }
+    Ok(())
 }

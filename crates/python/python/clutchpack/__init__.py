@@ -416,11 +416,14 @@ class Simulation:
     ``KeyboardInterrupt``.
 
     A network scene (``[[bodies]]``, on either engine) has the inputs
-    ``bodies.<body>.drive_torque_n_m`` (N m) and ``couplings.<clutch>.normal_force_n`` (N),
+    ``bodies.<body>.drive_torque_n_m`` (N m), ``couplings.<clutch>.normal_force_n`` (N),
+    ``couplings.<pack>.pressure_pa`` (Pa) and a prescribed body's ``bodies.<body>.speed_rad_s``
+    (rad/s, as a pack's ``shaft.speed_rad_s``: its angle continuous, its speed the value),
     held from the instant they are set (no slopes), and the outputs
-    ``bodies.<body>.speed_rad_s`` and ``.angle_rad``, ``couplings.<name>.torque_n_m`` and, for
-    a clutch, ``.slip_rad_s`` (w_b - w_a), ``.mode`` (Modelica's numbers: 2 free, 1 and -1
-    slipping, 0 locked) and ``.heat_j``; ``finish`` returns the network's summary:
+    ``bodies.<body>.speed_rad_s`` (a driven prescribed body's is its input, not an output)
+    and ``.angle_rad``, ``couplings.<name>.torque_n_m`` and, for a clutch, ``.slip_rad_s``
+    (w_b - w_a), ``.mode`` (Modelica's numbers: 2 free, 1 and -1 slipping, 0 locked) and
+    ``.heat_j``; ``finish`` returns the network's summary:
 
         >>> sim = clutchpack.Simulation("scenes/dct-upshift-lumped.toml",
         ...     drive=["couplings.K1.normal_force_n", "couplings.K2.normal_force_n"])

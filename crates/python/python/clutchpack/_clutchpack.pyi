@@ -123,7 +123,8 @@ class Stepper:
     """A pack or a network scene's run advanced call by call (``clutchpack.Simulation`` wraps
     it); ``drive``: a pack's inputs by their FMU names (``"piston.pressure_pa"``, ...) or
     their older aliases (``"piston_pressure"``), a network's
-    (``"bodies.<body>.drive_torque_n_m"``, ``"couplings.<clutch>.normal_force_n"``,
+    (``"bodies.<body>.speed_rad_s"`` of a prescribed body, ``"bodies.<body>.drive_torque_n_m"``,
+    ``"couplings.<clutch>.normal_force_n"``,
     ``"couplings.<pack>.pressure_pa"``)."""
     def __init__(
         self,

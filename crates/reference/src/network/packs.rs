@@ -29,7 +29,7 @@ use super::NetworkObserver;
 use crate::dopri::Dense;
 use crate::stepper::golden_peak;
 use crate::system::{Face, System};
-use clutchpack_model::network::Network;
+use clutchpack_model::network::{Network, NetworkInput};
 use clutchpack_model::{Engagement, ImpactTracker};
 use std::sync::Arc;
 
@@ -502,4 +502,30 @@ pub(super) fn close_thermal_windows(
         }
     }
     Ok(swapped)
+}
+
+/// For a prescribed body's speed held (`input` `NetworkInput::Speed(i)`; nothing for the
+/// other inputs): sets body `i`'s speed in the network state `y` (`n` bodies) to `value`
+/// (rad/s), its angle kept; the discs of each
+/// pack of `packs` it carries keep their own speeds, their speeds relative to it
+/// (`psi = w_a - w_disc`) shifted by the jump, as a pack's session shifts them at a jump of
+/// its shaft's (`crate::session::shift_disc_speeds`). What a clutch or gear ties to it
+/// follows when the modes are settled next (their speeds projected).
+pub(super) fn jump_speed(
+    packs: &[NetPack],
+    y: &mut [f64],
+    n: usize,
+    input: NetworkInput,
+    value: f64,
+) {
+    let NetworkInput::Speed(i) = input else {
+        return;
+    };
+    let jump = value - y[n + i];
+    y[n + i] = value;
+    for p in packs.iter().filter(|p| p.a == i) {
+        for slot in 0..p.sys.pack.discs.len().min(p.sys.ids.len()) {
+            y[p.at + 2 * slot + 1] += jump;
+        }
+    }
 }

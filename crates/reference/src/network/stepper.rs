@@ -575,12 +575,12 @@ impl NetworkSession for NetworkStepper {
             .collect()
     }
 
-    /// Sets `input` to `value` from now on (N m or N): the scene's signal is replaced by the
-    /// held value, and the run restarts here as at a jump of a signal (a step taken past the
-    /// session's time ended at it from its dense output, the clutches' modes settled, events
-    /// sent to `obs`). A value that is not finite, a negative force, or an input naming a
-    /// body or coupling that cannot take it is refused, the run's state and inputs as they
-    /// were (the step in progress is ended at the session's time all the same).
+    /// Sets `input` to `value` from now on (N m, N, Pa or rad/s): the scene's signal is replaced
+    /// by the held value, and the run restarts here as at a jump of a signal (a step taken past
+    /// the session's time ended at it from its dense output, a speed's jump given to the state,
+    /// the modes settled, events sent to `obs`). A value that is not finite, a negative force,
+    /// or an input naming a body or coupling that cannot take it is refused, the run's state
+    /// and inputs as they were (the step in progress is ended at the session's time all the same).
     fn set_input(
         &mut self,
         input: NetworkInput,
@@ -591,7 +591,9 @@ impl NetworkSession for NetworkStepper {
             // the old input holds up to the session's time: the step ends there
             self.apply(p, Some(self.now), obs)?;
         }
-        Arc::make_mut(&mut self.eq.net).hold_input(input, value)?;
+        let n = self.eq.net.bodies.len();
+        Arc::make_mut(&mut self.eq.net).hold_input(input, value, self.t, &self.y[..n])?;
+        super::packs::jump_speed(&self.eq.packs, &mut self.y, n, input, value);
         if let NetworkInput::PackPressure(k) = input {
             // the pack's equations carry their own model: its piston's pressure held too
             let pack = self.eq.net.couplings[k].pack().expect("a pack").clone();

@@ -158,7 +158,8 @@ impl Input {
 /// a scene cannot (a drive torque of 1e30 N m made the first 1 ms step run for minutes).
 /// A drive torque within +-`MAX_TORQUE_N_M` (`bodies[].drive.value_n_m`), a clutch's normal
 /// force within `[0, MAX_NORMAL_FORCE_N]` (`couplings[].max_normal_force_n`), a pack's
-/// piston pressure within `[0, MAX_PRESSURE_PA]` (`stack.pressure.pressure_pa`). The one
+/// piston pressure within `[0, MAX_PRESSURE_PA]` (`stack.pressure.pressure_pa`), a
+/// prescribed body's speed within +-`MAX_SPEED_RAD_S` (`bodies[].speed.omega0_rad_s`). The one
 /// place a network input is checked against its bound (the FMU's `fmi2SetReal` and every
 /// `set_input` call it).
 pub fn check_network_input(
@@ -166,7 +167,7 @@ pub fn check_network_input(
     name: &str,
     value: f64,
 ) -> Result<()> {
-    use clutchpack_scene::{MAX_NORMAL_FORCE_N, MAX_PRESSURE_PA, MAX_TORQUE_N_M};
+    use clutchpack_scene::{MAX_NORMAL_FORCE_N, MAX_PRESSURE_PA, MAX_SPEED_RAD_S, MAX_TORQUE_N_M};
     let (lo, hi, unit, key) = match input {
         clutchpack_model::network::NetworkInput::Drive(_) => (
             -MAX_TORQUE_N_M,
@@ -183,6 +184,12 @@ pub fn check_network_input(
         clutchpack_model::network::NetworkInput::PackPressure(_) => {
             (0.0, MAX_PRESSURE_PA, "Pa", "stack.pressure.pressure_pa")
         }
+        clutchpack_model::network::NetworkInput::Speed(_) => (
+            -MAX_SPEED_RAD_S,
+            MAX_SPEED_RAD_S,
+            "rad/s",
+            "bodies[].speed.omega0_rad_s",
+        ),
     };
     if (lo..=hi).contains(&value) {
         return Ok(());

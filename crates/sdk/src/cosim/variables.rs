@@ -477,11 +477,13 @@ fn network_variables(
     tr: Option<&clutchpack_model::network::Transmission>,
     driven: &dyn Fn(usize) -> bool,
 ) {
+    let mut inputs = Vec::new();
     for (j, (var, start)) in crate::network_cosim::network_input_variables(net)
         .into_iter()
         .enumerate()
         .filter(|(j, _)| driven(*j))
     {
+        inputs.push(var.name.clone());
         v.push(Variable {
             name: var.name,
             quantity: Quantity::NetworkInput(j),
@@ -498,6 +500,10 @@ fn network_variables(
         });
     }
     for (j, var) in crate::network_outputs(net, tr).into_iter().enumerate() {
+        if inputs.contains(&var.name) {
+            // a driven prescribed body's speed is its input (a one-pack scene's shaft's is)
+            continue;
+        }
         v.push(Variable {
             name: var.name,
             quantity: Quantity::NetworkOutput(j),
