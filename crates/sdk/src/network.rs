@@ -269,7 +269,12 @@ fn run_stopping(
             // stopped there: no step more
             return Ok((run.finish_boxed(obs), energies));
         }
-        energies.push((t, run.boxed_clone().finish_boxed(&mut ()).energy));
+        energies.push((
+            t,
+            run.boxed_clone()
+                .finish_boxed(&mut clutchpack_model::NullObserver)
+                .energy,
+        ));
     }
     run.advance_to(duration_s, obs)?;
     Ok((run.finish_boxed(obs), energies))

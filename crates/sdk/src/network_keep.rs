@@ -1,11 +1,12 @@
 //! What a network run keeps as it goes (`Keep`, fed by the engines through `Obs`, the
-//! [`NetworkObserver`] of one call): the clutches' events and torque ranges, the tooth impacts'
+//! [`Observer`] of one call): the clutches' events and torque ranges, the tooth impacts'
 //! tallies, the resolved packs' fatigue collectors, windows and impacts CSV, the samples when
 //! asked, the recording; and the packs' fatigue at the run's end. `crate::network` builds
 //! the summary from it.
 
 use crate::Result;
-use clutchpack_model::network::{ClutchEvent, ClutchMode, NetworkObserver, NetworkSample};
+use clutchpack_model::network::{ClutchEvent, ClutchMode, NetworkSample};
+use clutchpack_model::Observer;
 use clutchpack_record::NetworkRecorder;
 use clutchpack_scene::Scene;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -195,8 +196,8 @@ pub(crate) struct Obs<'k, 'a> {
     pub progress: Option<&'a mut dyn FnMut(f64)>,
 }
 
-impl NetworkObserver for Obs<'_, '_> {
-    fn sample(&mut self, s: &NetworkSample) {
+impl Observer for Obs<'_, '_> {
+    fn network_sample(&mut self, s: &NetworkSample) {
         let k = &mut *self.keep;
         k.record(|r| r.write_sample(s));
         k.range
@@ -340,7 +341,7 @@ impl NetworkObserver for Obs<'_, '_> {
         }
         let stop = self.stop.is_some_and(|s| s.load(Ordering::Relaxed));
         self.keep.stopped |= stop;
-        !stop && self.keep.record_error.is_none()
+        stop || self.keep.record_error.is_some()
     }
 }
 
