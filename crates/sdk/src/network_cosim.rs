@@ -515,7 +515,7 @@ impl NetworkSimulation {
             let engine = self.stepper.engine();
             return Err(engine_failed(&self.scene, engine, &mut self.keep, source));
         }
-        if let Some(e) = self.keep.record_error.take() {
+        if let Some(e) = self.keep.take_record_error() {
             self.failed = true;
             return Err(e.into());
         }
