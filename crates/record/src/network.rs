@@ -31,7 +31,7 @@
 
 use crate::info::{num, RunInfo};
 use crate::network_view::{Status, View, DRAWN_THICKNESS_M};
-use crate::sink::Sink;
+use crate::sink::{MoreMetadata, Sink};
 use crate::view3d::{entity, pose, rgba, timestamp, v3};
 use crate::write::{unique_segments, RecordError, RecordOptions};
 use crate::{log_time_ns, proto, ros2, topics};
@@ -176,7 +176,7 @@ impl NetworkPart {
         info: &RunInfo,
         net: &Network,
         options: &RecordOptions,
-    ) -> (RunInfo, u64, Vec<(String, BTreeMap<String, String>)>) {
+    ) -> (RunInfo, u64, MoreMetadata) {
         let mut kinds = info.clone();
         kinds.params.insert("kind".into(), "network".into());
         let chunk = options.chunk_size_bytes.unwrap_or(1 << 20);

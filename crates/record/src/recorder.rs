@@ -33,7 +33,7 @@ pub struct Recorder {
 
 /// What the recording is of.
 enum Part {
-    Pack(PackPart),
+    Pack(Box<PackPart>),
     Network(Box<NetworkPart>),
 }
 
@@ -58,9 +58,8 @@ impl Recorder {
         let file = std::fs::File::create(&path).map_err(create_err)?;
         let chunk = pack_chunk_size_bytes(info, options);
         let sink = Sink::open(path, file, None, info, options, chunk, Vec::new())?;
-        Ok(Recorder::of(Part::Pack(PackPart::start(
-            sink, info, options,
-        )?)))
+        let pack = PackPart::start(sink, info, options)?;
+        Ok(Recorder::of(Part::Pack(Box::new(pack))))
     }
 
     /// Creates the recording of a pack run as an output written whole: into a new temporary
@@ -77,9 +76,8 @@ impl Recorder {
     ) -> Result<Recorder, RecordError> {
         let chunk = pack_chunk_size_bytes(info, options);
         let sink = Sink::create_output(target.as_ref(), replace, info, options, chunk, Vec::new())?;
-        Ok(Recorder::of(Part::Pack(PackPart::start(
-            sink, info, options,
-        )?)))
+        let pack = PackPart::start(sink, info, options)?;
+        Ok(Recorder::of(Part::Pack(Box::new(pack))))
     }
 
     /// Creates the recording of a run of the network `net` as an output written whole (as
@@ -384,7 +382,7 @@ impl Observer for Recorder {
     /// A pack's recording flushes when its interval has passed; either returns `true` (stop
     /// the run) once writing has failed.
     fn progress(&mut self, _t_s: f64) -> bool {
-        self.on_pack(PackPart::maybe_flush);
+        self.on_pack(|p| p.maybe_flush());
         self.sink().failed
     }
 }

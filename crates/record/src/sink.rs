@@ -14,6 +14,10 @@ use std::io::{BufWriter, Write as _};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
+/// Metadata records written after the run's own (`clutchpack.network`): each a name and its
+/// key-value pairs.
+pub(crate) type MoreMetadata = Vec<(String, BTreeMap<String, String>)>;
+
 /// An MCAP file being written: the state both parts of the recorder share.
 pub(crate) struct Sink {
     /// The file being written (the temporary file of an output written whole).
@@ -45,7 +49,7 @@ impl Sink {
         info: &RunInfo,
         options: &RecordOptions,
         chunk_size_bytes: u64,
-        more_metadata: Vec<(String, BTreeMap<String, String>)>,
+        more_metadata: MoreMetadata,
     ) -> Result<Sink, RecordError> {
         let (pending, file) =
             PendingFile::create(target, replace).map_err(|cause| RecordError::Create {
@@ -73,7 +77,7 @@ impl Sink {
         info: &RunInfo,
         options: &RecordOptions,
         chunk_size_bytes: u64,
-        more_metadata: Vec<(String, BTreeMap<String, String>)>,
+        more_metadata: MoreMetadata,
     ) -> Result<Sink, RecordError> {
         let w = open_mcap(&path, file, info, options, chunk_size_bytes, more_metadata)?;
         Ok(Sink {
@@ -187,7 +191,7 @@ pub(crate) fn open_mcap(
     info: &RunInfo,
     options: &RecordOptions,
     chunk_size_bytes: u64,
-    more_metadata: Vec<(String, BTreeMap<String, String>)>,
+    more_metadata: MoreMetadata,
 ) -> Result<mcap::Writer<BufWriter<File>>, RecordError> {
     let write_err = |what: &str, cause| RecordError::Write {
         path: path.to_path_buf(),
