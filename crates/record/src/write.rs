@@ -56,7 +56,7 @@ pub struct RecordOptions {
     /// Default `None`.
     pub temperature_color_range_k: Option<(f64, f64)>,
     /// Write `/discs/<name>/load`: each disc's load at the engine's contact samples
-    /// ([`Observer::contact_sample`]) and at the samples with a load (and the first; in
+    /// ([`clutchpack_model::Observer::contact_sample`]) and at the samples with a load (and the first; in
     /// between the load is 0), the series that shows the contact pulses and their peaks.
     /// Default `true`: on `pack-4-rattle` over 3 s it made the file 68 % larger (23.4 MB
     /// against 13.9 MB) and the run about 15 % longer (docs/DECISIONS.md).
@@ -193,7 +193,7 @@ pub enum RecordError {
 /// `recordings/paper-20261122T022900.250Z.mcap` for `now` = 2026-11-22 02:29:00.25 UTC; the
 /// scene name is made file-safe as a topic segment ([`topic_segment`](crate::topic_segment)).
 /// Two runs in the same millisecond get the same name here: write default names with
-/// [`Recorder::create_output`] and [`Replace::Never`], which takes the next free
+/// [`crate::Recorder::create_output`] and [`crate::Replace::Never`], which takes the next free
 /// `<name>-2.mcap`, ... atomically.
 pub fn default_path(dir: impl AsRef<Path>, scene_name: &str, now: SystemTime) -> PathBuf {
     let since = now.duration_since(UNIX_EPOCH).unwrap_or_default();
