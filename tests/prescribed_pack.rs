@@ -7,8 +7,8 @@
 
 use super::common::{apart, impacts, Impact};
 use super::{run, scratch, stderr};
-use clutchpack_model::network::{NetworkObserver, NetworkRun};
-use clutchpack_model::ImpactEvent;
+use clutchpack_model::network::NetworkRun;
+use clutchpack_model::{ImpactEvent, Observer};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -20,7 +20,7 @@ struct PackImpacts {
     impacts: BTreeMap<String, Vec<Impact>>,
 }
 
-impl NetworkObserver for PackImpacts {
+impl Observer for PackImpacts {
     fn pack_impact(&mut self, _coupling: usize, e: &ImpactEvent) {
         self.impacts
             .entry(self.names[e.disc].clone())

@@ -5,7 +5,8 @@
 
 use super::common::{apart, Impact};
 use super::scratch;
-use clutchpack_model::network::{NetworkInput, NetworkObserver, NetworkSession};
+use clutchpack_model::network::{NetworkInput, NetworkSession};
+use clutchpack_model::Observer;
 use clutchpack_model::session::{Driven, Inputs};
 use clutchpack_model::ImpactEvent;
 use clutchpack_scene::EngineChoice;
@@ -31,7 +32,7 @@ struct PackImpacts {
     impacts: BTreeMap<String, Vec<Impact>>,
 }
 
-impl NetworkObserver for PackImpacts {
+impl Observer for PackImpacts {
     fn pack_impact(&mut self, _coupling: usize, e: &ImpactEvent) {
         push(&mut self.impacts, &self.names[e.disc], e);
     }

@@ -7,6 +7,8 @@
 
 use crate::clutch::{InterfaceSample, PressureProfile};
 use crate::drive::{Shaft, ShaftExcitation, SpeedProfile, Table};
+use crate::network::output::{NetworkRun, NetworkSample};
+use crate::network::{Network, NetworkInput};
 use crate::pack::PackModel;
 use crate::stream::{EngineError, Observer, RunStats, Sample};
 
@@ -409,4 +411,43 @@ pub trait Engine {
     ) -> Result<RunStats, EngineError> {
         run_engine(self, duration_s, observer)
     }
+}
+
+/// A network run advanced call by call, on either engine (both engines' `NetworkStepper`s
+/// implement it with the same semantics, MODEL.md section 8, "Inputs"): what a caller that
+/// does not care which engine runs the network holds, boxed.
+pub trait NetworkSession: Send {
+    /// The time the run stands at, s.
+    fn time_s(&self) -> f64;
+
+    /// The network as run (the inputs set so far in place of the scene's signals).
+    fn network(&self) -> &Network;
+
+    /// The state now (angles rad, speeds rad/s, torques N m, modes), at the session's time.
+    fn sample_now(&mut self) -> NetworkSample;
+
+    /// The temperatures of the thermal resolved pack that is coupling `k`, K (its discs',
+    /// plates', then oil's; `None` for another coupling).
+    fn pack_temperatures_k(&self, k: usize) -> Option<&[f64]>;
+
+    /// Each coupling's heat (a mesh's work, a damper's loss) since t = 0, J.
+    fn heat_j(&self) -> Vec<f64>;
+
+    /// Sets `input` to `value` (N m, N or Pa), held from now on; a refused value leaves the
+    /// run's inputs as they were.
+    fn set_input(
+        &mut self,
+        input: NetworkInput,
+        value: f64,
+        obs: &mut dyn Observer,
+    ) -> Result<(), EngineError>;
+
+    /// Advances to `t_end` s (at most the run's end).
+    fn advance_to(&mut self, t_end: f64, obs: &mut dyn Observer) -> Result<(), EngineError>;
+
+    /// Ends the run where it stands: its last sample, heat, energy balance and counts.
+    fn finish_boxed(self: Box<Self>, obs: &mut dyn Observer) -> NetworkRun;
+
+    /// A copy of the whole run (a saved state).
+    fn boxed_clone(&self) -> Box<dyn NetworkSession>;
 }

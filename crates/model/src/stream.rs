@@ -1,8 +1,10 @@
-//! What every engine emits (samples, impact events, a run report) to an [`Observer`]; the
-//! `Engine` trait itself is in `crate::session`.
+//! What every engine emits (samples, impact events, a run report) to an [`Observer`], the one
+//! observer of every run (a pack's and a driveline network's); the `Engine` trait and the
+//! network's `NetworkSession` are in `crate::session`.
 
 use crate::clutch::InterfaceSample;
 use crate::impact::ImpactEvent;
+use crate::network::output::{ClutchEvent, NetworkSample};
 use serde::{Deserialize, Serialize};
 
 /// State of one disc's coupling at one instant.
@@ -48,9 +50,13 @@ pub struct Sample {
     pub discs: Vec<DiscSample>,
 }
 
-/// Receives what an engine produces, in time order.
+/// Receives what an engine produces, in time order: the one observer of every run. A pack run
+/// sends the pack's methods ([`Observer::sample`] to [`Observer::wants_contact_samples`]), a
+/// driveline network's run the network's ([`Observer::network_sample`] to
+/// [`Observer::open_contacts`]); both poll [`Observer::progress`]. Every method has a default
+/// that keeps nothing.
 pub trait Observer {
-    /// A sample at the recording rate.
+    /// A pack run's sample at the recording rate.
     fn sample(&mut self, _sample: &Sample) {}
     /// A completed impact event.
     fn impact(&mut self, _event: &ImpactEvent) {}
@@ -85,8 +91,67 @@ pub trait Observer {
     fn wants_contact_samples(&self) -> bool {
         false
     }
-    /// Called now and then with the simulated time in s; returning `true` stops the run
-    /// early and cleanly (used for Ctrl-C).
+    /// A driveline network's sample at the record rate (and at t = 0 and the end; MODEL.md
+    /// section 8).
+    fn network_sample(&mut self, _sample: &NetworkSample) {}
+    /// A network's clutch changed mode.
+    fn clutch_event(&mut self, _event: &ClutchEvent) {}
+    /// A network's state just before and just after an instant where clutches changed mode
+    /// (sent before their [`Observer::clutch_event`]s): the couplings' torques jump there (the
+    /// output torque's step at a lock).
+    fn switched(&mut self, _before: &NetworkSample, _after: &NetworkSample) {}
+    /// A network's gear mesh's tooth contact closed (its `disc` is the coupling's index; the
+    /// peak is the force per tooth pair in N, negative when body `a` leads: `x > 0`).
+    fn mesh_impact(&mut self, _impact: &ImpactEvent) {}
+    /// A tooth contact of a network's resolved pack's disc or plate closed: `coupling` is the
+    /// pack's coupling index, the impact's `disc` the body's index in the pack (its discs,
+    /// then its plates), its peak the per-tooth load in N as the pack engines sign it.
+    fn pack_impact(&mut self, _coupling: usize, _impact: &ImpactEvent) {}
+    /// A network's resolved pack's discs and plates at a sample's instant `t_s` (s), sent
+    /// after the [`Observer::network_sample`] of that instant: each body's absolute angle
+    /// (rad), speed (rad/s) and per-tooth load (N, signed as in Hu et al. eq (6): negative when
+    /// its carrier leads), its discs then its plates.
+    fn pack_sample(
+        &mut self,
+        _coupling: usize,
+        _t_s: f64,
+        _angle_rad: &[f64],
+        _speed_rad_s: &[f64],
+        _load_n: &[f64],
+    ) {
+    }
+    /// A network's thermal resolved pack's temperatures at `t_s` (s), K: its discs', then its
+    /// plates', then its oil's; at t = 0 and at the end of each thermal window (MODEL.md
+    /// section 9).
+    fn pack_temperatures(&mut self, _coupling: usize, _t_s: f64, _temperatures_k: &[f64]) {}
+    /// A network's resolved pack's faces changed mode at `t_s` (s): `locked` of its `faces`
+    /// friction faces are locked now (all of them: the pack has locked, its carriers turn as
+    /// one but for the splines' play), `clamped` are clamped (locked or slipping).
+    fn pack_faces(
+        &mut self,
+        _coupling: usize,
+        _t_s: f64,
+        _locked: usize,
+        _clamped: usize,
+        _faces: usize,
+    ) {
+    }
+    /// Whether it wants a network's tooth contacts open at `t_s` (s, the end of an accepted
+    /// step) through [`Observer::open_contacts`]: asked after every step, so it answers
+    /// cheaply; no by default.
+    fn wants_open_contacts(&mut self, _t_s: f64) -> bool {
+        false
+    }
+    /// A network's tooth contacts open at `t_s` (s), when [`Observer::wants_open_contacts`]
+    /// asked: each as `(coupling, body in a pack, event)`, the event as it would close at
+    /// `t_s` (its onset, its peak located so far, `t_off_s = t_s`), as
+    /// [`Observer::mesh_impact`] (`body` `None`) and [`Observer::pack_impact`] give closed
+    /// ones. A contact stays open for seconds where a locked pack's teeth carry its torque:
+    /// what a run cut short would otherwise lose.
+    fn open_contacts(&mut self, _t_s: f64, _open: &[(usize, Option<usize>, ImpactEvent)]) {}
+    /// Called now and then with the simulated time in s (a network run: after every step);
+    /// returning `true` stops the run early and cleanly, where it stands (used for Ctrl-C and
+    /// a recording's first error). Every run, pack or network, reads it the same way.
     fn progress(&mut self, _t_s: f64) -> bool {
         false
     }

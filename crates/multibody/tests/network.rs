@@ -11,18 +11,18 @@
 
 use clutchpack_model::cases;
 use clutchpack_model::network::*;
-use clutchpack_model::ImpactEvent;
+use clutchpack_model::{ImpactEvent, NullObserver, Observer};
 use clutchpack_multibody::network::{run_network, NetworkStepOptions};
 use clutchpack_reference::network as reference;
 
 #[derive(Default)]
 struct Keep(Vec<ClutchEvent>, Vec<NetworkSample>, Vec<ImpactEvent>);
 
-impl NetworkObserver for Keep {
+impl Observer for Keep {
     fn clutch_event(&mut self, e: &ClutchEvent) {
         self.0.push(*e);
     }
-    fn sample(&mut self, s: &NetworkSample) {
+    fn network_sample(&mut self, s: &NetworkSample) {
         self.1.push(s.clone());
     }
     fn mesh_impact(&mut self, e: &ImpactEvent) {
@@ -440,7 +440,7 @@ fn bad_input_is_refused() {
             step_s,
             record_rate_hz,
         };
-        run_network(net, d, &o, &mut ())
+        run_network(net, d, &o, &mut NullObserver)
     };
     assert!(run(&net, 0.1, 1e-4, 1e3).is_ok());
     assert!(run(&net, f64::NAN, 1e-4, 1e3).is_err());

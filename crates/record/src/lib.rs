@@ -6,8 +6,8 @@
 //! typed values for `replay`, `compare`, `export` and `plot`.
 //!
 //! ## What this crate does
-//! - [`Recorder`]: an [`Observer`](clutchpack_model::Observer) that streams a run into an
-//!   MCAP file: protobuf messages with embedded schemas, zstd chunks, message and chunk
+//! - [`Recorder`]: the one recorder, an [`Observer`](clutchpack_model::Observer) that streams
+//!   a run (a pack's or a network's) into an MCAP file: protobuf messages with embedded schemas, zstd chunks, message and chunk
 //!   indexes, a summary section; chunks flushed every [`RecordOptions::flush_messages`]
 //!   messages and at least every [`RecordOptions::flush_interval`] of wall time, so a killed
 //!   run leaves a file readable up to the last flush. [`RunInfo`] goes in as metadata
@@ -19,9 +19,10 @@
 //!   [`RecordingReader::disc_series`]. Truncated, corrupted, empty and foreign files give a
 //!   one-line reason ([`ReadError`], [`Damage`]) and never a panic; a killed run's file is
 //!   read up to its last complete chunk.
-//! - [`NetworkRecorder`] / [`read_network`]: a driveline network's run (MODEL.md section 8)
-//!   as a recording with the same header, metadata and scene attachment: each body's and
-//!   coupling's state, the clutches' mode changes, a 3D view; read back into its samples.
+//! - [`Recorder::create_network_output`] / [`read_network`]: the same recorder records a
+//!   driveline network's run (MODEL.md section 8) with the same header, metadata and scene
+//!   attachment: each body's and coupling's state, the clutches' mode changes, a 3D view;
+//!   read back into its samples.
 //! - [`export_csv`]: one CSV per topic of ours.
 //! - `serve` (feature `serve`): plays a recording to Foxglove over its WebSocket protocol.
 //!
@@ -114,11 +115,14 @@ mod network;
 mod network_packs;
 mod network_view;
 pub mod output;
+mod pack;
 pub mod proto;
 mod read;
+mod recorder;
 mod ros2;
 #[cfg(feature = "serve")]
 mod serve;
+mod sink;
 mod summary;
 mod view3d;
 // Test fixture for this crate's tests, benches and examples (integration tests are other
@@ -135,8 +139,8 @@ mod write;
 pub use export::{export_csv, export_csv_until};
 pub use info::{sha256_hex, DiscGeometry, FrictionInterface, RunInfo, ShaftGeometry};
 pub use network::{
-    body_frame, coupling_kind_name, impact_name, NetworkRecorder, META_NETWORK,
-    OPEN_CONTACTS_EVERY_S, SUMMARY_ATTACHMENT,
+    body_frame, coupling_kind_name, impact_name, META_NETWORK, OPEN_CONTACTS_EVERY_S,
+    SUMMARY_ATTACHMENT,
 };
 pub use output::{
     check_outputs, partial_path, write_whole, OutputPath, OutputRefused, PendingFile, Replace,
@@ -147,13 +151,12 @@ pub use read::{
     Damage, DamageKind, DiscSeries, InterfaceSeries, LoadHistory, MessageView, ReadError,
     ReadOptions, RecordedNetwork, RecordingInfo, RecordingReader, TopicInfo,
 };
+pub use recorder::Recorder;
 #[cfg(feature = "serve")]
 pub use serve::{serve, ServeError, ServeOptions};
 pub use summary::{DiscStats, FatigueSummary, RecordedSummary, MAX_EXTRA_DISCS, TOP_N};
 pub use threaded::ThreadedRecorder;
-pub use write::{
-    auto_chunk_size_bytes, default_path, log_time_ns, RecordError, RecordOptions, Recorder,
-};
+pub use write::{auto_chunk_size_bytes, default_path, log_time_ns, RecordError, RecordOptions};
 
 /// A disc name made safe for a topic and frame name: every character other than
 /// `A-Z a-z 0-9 _ -` becomes `_` (an empty name becomes `_`). Repeated segments in one

@@ -1,9 +1,9 @@
-//! Recording a driveline network's run (MODEL.md section 8): [`NetworkRecorder`] writes an
-//! MCAP file with every body's angle and speed, every coupling's torque (a clutch's slip,
+//! Recording a driveline network's run (MODEL.md section 8): the network part of the
+//! [`crate::Recorder`] writes an MCAP file with every body's angle and speed, every coupling's torque (a clutch's slip,
 //! mode and normal force too), the clutches' mode changes as log lines, the gear meshes'
 //! impacts, and a 3D view of the bodies turning side by side with the couplings drawn between
 //! them and coloured by mode. The file's header, scene attachment and metadata are the pack
-//! recordings' ([`crate::write::open_mcap`]), so `clutchpack replay` tells its provenance the
+//! recordings' ([`crate::sink::Sink`]), so `clutchpack replay` tells its provenance the
 //! same way; `clutchpack.run` has `kind = network`, and `clutchpack.network` names the bodies
 //! and couplings.
 //!
@@ -31,11 +31,9 @@
 
 use crate::info::{num, RunInfo};
 use crate::network_view::{Status, View, DRAWN_THICKNESS_M};
-use crate::output::{PendingFile, Replace};
+use crate::sink::{MoreMetadata, Sink};
 use crate::view3d::{entity, pose, rgba, timestamp, v3};
-use crate::write::{
-    close_mcap, open_mcap, unique_segments, write_message, RecordError, RecordOptions,
-};
+use crate::write::{unique_segments, RecordError, RecordOptions};
 use crate::{log_time_ns, proto, ros2, topics};
 use clutchpack_model::network::{
     ClutchEvent, ClutchMode, CouplingKind, Network, NetworkSample, Transmission,
@@ -46,9 +44,7 @@ use foxglove::schemas::{
 };
 use std::borrow::Cow;
 use std::collections::BTreeMap;
-use std::fs::File;
-use std::io::BufWriter;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// How often a network recording logs its open tooth contacts (`/network/contacts`), s of
 /// simulated time: a killed run's recording then holds every contact to within this of its
@@ -59,8 +55,8 @@ pub const OPEN_CONTACTS_EVERY_S: f64 = 0.05;
 
 /// Name of the `clutchpack.network` metadata record (bodies and couplings, in scene order).
 pub const META_NETWORK: &str = "clutchpack.network";
-/// Name of the attachment holding the run's summary (JSON), written by
-/// [`NetworkRecorder::finish`].
+/// Name of the attachment holding a network run's summary (JSON), written by
+/// [`crate::Recorder::finish`] ([`crate::Recorder::set_summary_json`]).
 pub const SUMMARY_ATTACHMENT: &str = "summary.json";
 
 /// The name of a tooth impact on `/network/impacts`: a gear mesh's (`body` `None`) its
@@ -133,14 +129,12 @@ struct Channels {
     pack_temperatures: BTreeMap<usize, Vec<u16>>,
 }
 
-/// Streams a network run into an MCAP file: call [`Self::write_sample`],
-/// [`Self::write_clutch_event`] and [`Self::write_mesh_impact`] as the engine gives them,
-/// then [`Self::finish`] (also after a stop or an engine error: the file then holds what
-/// ran). The first error is returned and nothing more is written after it.
-pub struct NetworkRecorder {
-    path: PathBuf,
-    pending: Option<PendingFile>,
-    writer: Option<mcap::Writer<BufWriter<File>>>,
+/// The network part of the [`crate::Recorder`]: a network run streamed into an MCAP file
+/// (its [`clutchpack_model::Observer`] methods call the `write_*` methods here), then
+/// [`Self::finish`] (also after a stop or an engine error: the file then holds what ran).
+pub(crate) struct NetworkPart {
+    /// The file, its writer and the messages' bookkeeping (shared with the pack part).
+    pub(crate) sink: Sink,
     net: Network,
     ch: Channels,
     body_names: Vec<String>,
@@ -159,8 +153,6 @@ pub struct NetworkRecorder {
     modes_now: Vec<Option<ClutchMode>>,
     /// each body's frame (`body/<segment>`)
     frames: Vec<String>,
-    sequences: BTreeMap<u16, u32>,
-    buf: Vec<u8>,
     tf: FrameTransforms,
     /// the resolved packs' discs and plates in 3D
     packs: crate::network_packs::PacksDrawing,
@@ -169,42 +161,49 @@ pub struct NetworkRecorder {
     /// `/network/joints/*` values, reused: the bodies' angles and speeds, the couplings'
     /// slips and torques
     joint_values: [Vec<f64>; 4],
-    messages: u64,
     last_t_s: f64,
     deterministic: bool,
-    started: std::time::Instant,
-    failed: bool,
+    /// When the open tooth contacts are logged next, s ([`OPEN_CONTACTS_EVERY_S`]).
+    open_contacts_at_s: f64,
+    /// The run's summary (JSON) attached by [`Self::finish`], if given.
+    pub(crate) summary_json: Option<Vec<u8>>,
 }
 
-impl NetworkRecorder {
-    /// Creates the recording of `net` as an output written whole (as
-    /// [`crate::Recorder::create_output`]: a temporary file beside `target`, moved into place
-    /// by [`Self::finish`]). `info` gives the scene, engine and settings (its discs are
-    /// empty); of `options` the compression, determinism and chunk size apply.
-    pub fn create_output(
-        target: impl AsRef<Path>,
-        replace: Replace,
+impl NetworkPart {
+    /// What a network's recording opens its [`Sink`] with: `info` with `kind = network`,
+    /// the chunk size (`options`' or 1 MiB) and the `clutchpack.network` metadata of `net`.
+    pub fn sink_setup(
         info: &RunInfo,
         net: &Network,
         options: &RecordOptions,
-    ) -> Result<NetworkRecorder, RecordError> {
-        let target = target.as_ref();
-        let (pending, file) =
-            PendingFile::create(target, replace).map_err(|cause| RecordError::Create {
-                path: target.to_path_buf(),
-                cause,
-            })?;
-        let path = pending.tmp_path().to_path_buf();
+    ) -> (RunInfo, u64, MoreMetadata) {
+        let mut kinds = info.clone();
+        kinds.params.insert("kind".into(), "network".into());
+        let chunk = options.chunk_size_bytes.unwrap_or(1 << 20);
+        (
+            kinds,
+            chunk,
+            vec![(META_NETWORK.to_string(), network_metadata(net))],
+        )
+    }
+
+    /// Writes the channels and the static scene of `net` into `sink` (opened with
+    /// [`Self::sink_setup`]); of `options` the determinism applies here.
+    pub fn start(
+        mut sink: Sink,
+        net: &Network,
+        options: &RecordOptions,
+    ) -> Result<NetworkPart, RecordError> {
+        let path = sink.path.clone();
+        // the writer is put back once the channels are added
+        let Some(mut w) = sink.writer.take() else {
+            return Err(sink.failed_err());
+        };
         let write_err = |what: &str, cause| RecordError::Write {
             path: path.clone(),
             what: what.to_string(),
             cause,
         };
-        let mut kinds = info.clone();
-        kinds.params.insert("kind".into(), "network".into());
-        let chunk = options.chunk_size_bytes.unwrap_or(1 << 20);
-        let meta = vec![(META_NETWORK.to_string(), network_metadata(net))];
-        let mut w = open_mcap(&path, file, &kinds, options, chunk, meta)?;
         let fds = proto::file_descriptor_set();
         use foxglove::Encode as _;
         let fx = |s: Option<foxglove::Schema>| s.map(|s| s.data.into_owned()).unwrap_or_default();
@@ -384,11 +383,10 @@ impl NetworkRecorder {
         view.transforms(&frames, 0, &vec![0.0; frames.len()], &mut tf.transforms);
         let n = body_names.len();
         let m = coupling_names.len();
-        let mut rec = NetworkRecorder {
+        sink.writer = Some(w);
+        let mut rec = NetworkPart {
             packs,
-            path,
-            pending: Some(pending),
-            writer: Some(w),
+            sink,
             net: net.clone(),
             ch,
             body_names,
@@ -403,8 +401,6 @@ impl NetworkRecorder {
                 .map(|c| c.law().session_mode())
                 .collect(),
             modes_now: Vec::with_capacity(m),
-            sequences: BTreeMap::new(),
-            buf: Vec::with_capacity(1024),
             tf,
             drawn_modes: net
                 .couplings
@@ -412,20 +408,20 @@ impl NetworkRecorder {
                 .map(|c| c.law().initial_mode().or(c.law().session_mode()))
                 .collect(),
             joint_values: [vec![0.0; n], vec![0.0; n], vec![0.0; m], vec![0.0; m]],
-            messages: 0,
             last_t_s: 0.0,
             deterministic: options.deterministic,
-            started: std::time::Instant::now(),
-            failed: false,
+            open_contacts_at_s: 0.0,
+            summary_json: None,
         };
         let scene = rec.static_scene(&frames);
-        rec.put(rec.ch.scene, 0, &scene, "/scene")?;
+        rec.sink.put(rec.ch.scene, 0, &scene, "/scene")?;
         let radii = rec.view.radii.clone();
         for ((ch, frame), &r) in clouds.into_iter().zip(&frames).zip(&radii) {
-            rec.put(ch, 0, &body_points(frame, r), "body points")?;
+            rec.sink.put(ch, 0, &body_points(frame, r), "body points")?;
         }
         for (ch, c) in set_clouds {
-            rec.put(ch, 0, &c, "planetary set and pack ring points")?;
+            rec.sink
+                .put(ch, 0, &c, "planetary set and pack ring points")?;
         }
         rec.put_couplings(0)?;
         Ok(rec)
@@ -478,7 +474,7 @@ impl NetworkRecorder {
         let scene = self
             .view
             .coupling_scene(&self.net, &self.drawn_modes, log_time_ns);
-        self.put(
+        self.sink.put(
             self.ch.scene_couplings,
             log_time_ns,
             &scene,
@@ -486,7 +482,7 @@ impl NetworkRecorder {
         )?;
         let mut points = self.view.coupling_points(&self.net, &self.drawn_modes);
         points.timestamp = Some(timestamp(log_time_ns));
-        self.put(
+        self.sink.put(
             self.diagram_points,
             log_time_ns,
             &points,
@@ -498,7 +494,7 @@ impl NetworkRecorder {
     /// `[transmission]`): a text on `/scene/status` and a line on `/network/events` at t = 0
     /// and whenever it changes.
     pub fn set_transmission(&mut self, tr: &Transmission) -> Result<(), RecordError> {
-        let id = match self.writer.as_mut() {
+        let id = match self.sink.writer.as_mut() {
             Some(w) => {
                 let s_scene = self.ch.scene_schema;
                 w.add_channel(
@@ -508,14 +504,14 @@ impl NetworkRecorder {
                     &BTreeMap::new(),
                 )
                 .map_err(|cause| RecordError::Write {
-                    path: self.path.clone(),
+                    path: self.sink.path.clone(),
                     what: "channel".into(),
                     cause,
                 })?
             }
             None => {
                 return Err(RecordError::AlreadyFailed {
-                    path: self.path.clone(),
+                    path: self.sink.path.clone(),
                 })
             }
         };
@@ -537,7 +533,7 @@ impl NetworkRecorder {
         let y = self.view.lanes_y_m();
         let z = self.view.bottom_m(self.net.couplings.len()) - 0.35;
         let scene = Status::scene(&label, y, z, ns);
-        self.put(id, ns, &scene, "/scene/status")?;
+        self.sink.put(id, ns, &scene, "/scene/status")?;
         let log = Log {
             timestamp: Some(timestamp(ns)),
             level: foxglove::schemas::log::Level::Info as i32,
@@ -546,16 +542,11 @@ impl NetworkRecorder {
             file: String::new(),
             line: 0,
         };
-        self.put(self.ch.events, ns, &log, "/network/events")?;
+        self.sink.put(self.ch.events, ns, &log, "/network/events")?;
         if let Some((_, _, last)) = &mut self.status {
             *last = label;
         }
         Ok(())
-    }
-
-    /// The file being written (the temporary file until [`Self::finish`]).
-    pub fn path(&self) -> &Path {
-        &self.path
     }
 
     /// A resolved pack's faces changed mode (as a clutch's: all locked, some clamped, none):
@@ -572,46 +563,6 @@ impl NetworkRecorder {
         self.deterministic
     }
 
-    /// Messages written so far.
-    pub fn messages(&self) -> u64 {
-        self.messages
-    }
-
-    fn put<M: prost::Message>(
-        &mut self,
-        channel: u16,
-        log_time: u64,
-        msg: &M,
-        what: &str,
-    ) -> Result<(), RecordError> {
-        self.buf.clear();
-        // encoding into a Vec cannot run out of space
-        let _ = msg.encode(&mut self.buf);
-        self.put_buf(channel, log_time, what)
-    }
-
-    fn put_buf(&mut self, channel: u16, log_time: u64, what: &str) -> Result<(), RecordError> {
-        let failed = RecordError::AlreadyFailed {
-            path: self.path.clone(),
-        };
-        if self.failed {
-            return Err(failed);
-        }
-        let Some(w) = self.writer.as_mut() else {
-            return Err(failed);
-        };
-        if let Err(cause) = write_message(w, &mut self.sequences, channel, log_time, &self.buf) {
-            self.failed = true;
-            return Err(RecordError::Write {
-                path: self.path.clone(),
-                what: what.to_string(),
-                cause,
-            });
-        }
-        self.messages += 1;
-        Ok(())
-    }
-
     /// Writes one sample: each body's and coupling's topic, the joints, `/tf`.
     pub fn write_sample(&mut self, s: &NetworkSample) -> Result<(), RecordError> {
         let t = s.t_s;
@@ -623,7 +574,7 @@ impl NetworkRecorder {
                 angle_rad: s.angle_rad[i],
                 speed_rad_s: s.speed_rad_s[i],
             };
-            self.put(self.ch.bodies[i], ns, &msg, "body state")?;
+            self.sink.put(self.ch.bodies[i], ns, &msg, "body state")?;
         }
         for k in 0..self.ch.couplings.len() {
             let c = &self.net.couplings[k];
@@ -637,24 +588,40 @@ impl NetworkRecorder {
                 normal_force_n: c.law().clamp_force_n(t).unwrap_or(0.0),
                 coupling_index: k as u32,
             };
-            self.put(self.ch.couplings[k], ns, &msg, "coupling state")?;
+            self.sink
+                .put(self.ch.couplings[k], ns, &msg, "coupling state")?;
         }
         let [angles, speeds, _, _] = &mut self.joint_values;
         angles.copy_from_slice(&s.angle_rad);
         speeds.copy_from_slice(&s.speed_rad_s);
-        ros2::joint_state(&mut self.buf, ns, &self.body_names, angles, speeds, &[]);
-        self.put_buf(self.ch.body_joints, ns, "body joints")?;
+        ros2::joint_state(
+            &mut self.sink.buf,
+            ns,
+            &self.body_names,
+            angles,
+            speeds,
+            &[],
+        );
+        self.sink.put_buf(self.ch.body_joints, ns, "body joints")?;
         let [_, _, slips, torques] = &mut self.joint_values;
         for (k, c) in self.net.couplings.iter().enumerate() {
             slips[k] = clutch_slip_rad_s(s, c, k);
         }
         torques.copy_from_slice(&s.torque_n_m);
-        ros2::joint_state(&mut self.buf, ns, &self.coupling_names, &[], slips, torques);
-        self.put_buf(self.ch.coupling_joints, ns, "coupling joints")?;
+        ros2::joint_state(
+            &mut self.sink.buf,
+            ns,
+            &self.coupling_names,
+            &[],
+            slips,
+            torques,
+        );
+        self.sink
+            .put_buf(self.ch.coupling_joints, ns, "coupling joints")?;
         self.view
             .transforms(&self.frames, ns, &s.angle_rad, &mut self.tf.transforms);
         let tf = std::mem::take(&mut self.tf);
-        let r = self.put(self.ch.tf, ns, &tf, "/tf");
+        let r = self.sink.put(self.ch.tf, ns, &tf, "/tf");
         self.tf = tf;
         r?;
         self.modes_now.clear();
@@ -687,7 +654,7 @@ impl NetworkRecorder {
             file: String::new(),
             line: 0,
         };
-        self.put(self.ch.events, ns, &msg, "/network/events")
+        self.sink.put(self.ch.events, ns, &msg, "/network/events")
     }
 
     /// Writes the tooth impact of a resolved pack's disc or plate on `/network/impacts`,
@@ -700,7 +667,7 @@ impl NetworkRecorder {
         e: &ImpactEvent,
     ) -> Result<(), RecordError> {
         let msg = proto::Impact::of(e, impact_name(&self.net, coupling, Some(e.disc)));
-        self.put(
+        self.sink.put(
             self.ch.impacts,
             log_time_ns(e.t_off_s),
             &msg,
@@ -722,11 +689,18 @@ impl NetworkRecorder {
         let ns = log_time_ns(t_s);
         if let Some((id, names)) = self.ch.pack_joints.get(&coupling) {
             let id = *id;
-            ros2::joint_state(&mut self.buf, ns, names, angle_rad, speed_rad_s, load_n);
-            self.put_buf(id, ns, "pack joints")?;
+            ros2::joint_state(
+                &mut self.sink.buf,
+                ns,
+                names,
+                angle_rad,
+                speed_rad_s,
+                load_n,
+            );
+            self.sink.put_buf(id, ns, "pack joints")?;
         }
         match self.packs.transforms(coupling, ns, angle_rad) {
-            Some(tf) => self.put(self.ch.tf, ns, &tf, "/tf"),
+            Some(tf) => self.sink.put(self.ch.tf, ns, &tf, "/tf"),
             None => Ok(()),
         }
     }
@@ -750,7 +724,7 @@ impl NetworkRecorder {
                 temperature_k,
                 body_index: i as u32,
             };
-            self.put(id, ns, &msg, "pack temperature")?;
+            self.sink.put(id, ns, &msg, "pack temperature")?;
         }
         Ok(())
     }
@@ -766,7 +740,8 @@ impl NetworkRecorder {
         let ns = log_time_ns(t_s);
         for (coupling, body, e) in open {
             let msg = proto::Impact::of(e, impact_name(&self.net, *coupling, *body));
-            self.put(self.ch.contacts, ns, &msg, "/network/contacts")?;
+            self.sink
+                .put(self.ch.contacts, ns, &msg, "/network/contacts")?;
         }
         Ok(())
     }
@@ -775,7 +750,7 @@ impl NetworkRecorder {
     /// closes (`disc` of the event is the coupling's index).
     pub fn write_mesh_impact(&mut self, e: &ImpactEvent) -> Result<(), RecordError> {
         let msg = proto::Impact::of(e, impact_name(&self.net, e.disc, None));
-        self.put(
+        self.sink.put(
             self.ch.impacts,
             log_time_ns(e.t_off_s),
             &msg,
@@ -783,17 +758,51 @@ impl NetworkRecorder {
         )
     }
 
-    /// Attaches `summary_json` (the run's summary, if given) and closes the file, moving it
-    /// into place. Call it after a stop or an engine error too: the file then holds what ran.
-    pub fn finish(mut self, summary_json: Option<&[u8]>) -> Result<PathBuf, RecordError> {
-        let failed = RecordError::AlreadyFailed {
-            path: self.path.clone(),
+    /// Whether it wants the open tooth contacts at `t_s` (s): on the grid of
+    /// [`OPEN_CONTACTS_EVERY_S`], whatever the steps.
+    pub fn wants_open_contacts(&self, t_s: f64) -> bool {
+        t_s >= self.open_contacts_at_s
+    }
+
+    /// [`Self::write_open_contacts`], and the next time the open contacts are due.
+    pub fn open_contacts(
+        &mut self,
+        t_s: f64,
+        open: &[(usize, Option<usize>, ImpactEvent)],
+    ) -> Result<(), RecordError> {
+        let every = OPEN_CONTACTS_EVERY_S;
+        self.open_contacts_at_s = ((t_s / every).floor() + 1.0) * every;
+        self.write_open_contacts(t_s, open)
+    }
+
+    /// A resolved pack's faces changed mode at `t_s` (s): `locked` of its `faces` friction
+    /// faces are locked, `clamped` are clamped; drawn and read as a clutch's mode (all
+    /// locked: locked; some clamped: slipping; none: free) from the next sample.
+    pub fn pack_faces(&mut self, coupling: usize, locked: usize, clamped: usize, faces: usize) {
+        let mode = if locked == faces {
+            ClutchMode::Locked
+        } else if clamped > 0 {
+            ClutchMode::Slipping(1)
+        } else {
+            ClutchMode::Free
         };
-        let Some(mut w) = self.writer.take().filter(|_| !self.failed) else {
-            return Err(failed);
-        };
-        let path = self.path.clone();
-        if let Some(json) = summary_json {
+        self.set_pack_mode(coupling, mode);
+    }
+
+    /// Attaches the run's summary (JSON, if given: [`Self::summary_json`]) and closes the
+    /// file, moving it into place. Call it after a stop or an engine error too: the file then
+    /// holds what ran.
+    pub fn finish(mut self) -> Result<PathBuf, RecordError> {
+        let r = self.finish_inner();
+        self.sink.discard_if_disk_full(&r);
+        r
+    }
+
+    fn finish_inner(&mut self) -> Result<PathBuf, RecordError> {
+        if self.sink.failed {
+            return Err(self.sink.failed_err());
+        }
+        if let (Some(json), Some(w)) = (&self.summary_json, self.sink.writer.as_mut()) {
             w.attach(&mcap::Attachment {
                 log_time: log_time_ns(self.last_t_s),
                 create_time: 0,
@@ -802,26 +811,21 @@ impl NetworkRecorder {
                 data: Cow::Borrowed(json),
             })
             .map_err(|cause| RecordError::Write {
-                path: path.clone(),
+                path: self.sink.path.clone(),
                 what: "summary attachment".into(),
                 cause,
             })?;
         }
         let mut stats = BTreeMap::new();
         stats.insert("simulated_s".into(), num(self.last_t_s));
-        stats.insert("messages".into(), self.messages.to_string());
+        stats.insert("messages".into(), self.sink.messages.to_string());
         if !self.deterministic {
-            stats.insert("wall_s".into(), num(self.started.elapsed().as_secs_f64()));
+            stats.insert(
+                "wall_s".into(),
+                num(self.sink.started.elapsed().as_secs_f64()),
+            );
         }
-        let r = close_mcap(w, &path, stats, &mut self.pending);
-        if let Err(e) = &r {
-            if e.is_disk_full() {
-                if let Some(p) = self.pending.take() {
-                    p.discard();
-                }
-            }
-        }
-        r
+        self.sink.close(stats)
     }
 }
 

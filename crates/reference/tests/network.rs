@@ -6,22 +6,20 @@
 
 use clutchpack_model::cases;
 use clutchpack_model::network::{ClutchMode, NetworkSession};
-use clutchpack_model::ImpactEvent;
-use clutchpack_reference::network::{
-    run_network, ClutchEvent, NetworkObserver, NetworkOptions, NetworkSample,
-};
+use clutchpack_model::{ImpactEvent, NullObserver, Observer};
+use clutchpack_reference::network::{run_network, ClutchEvent, NetworkOptions, NetworkSample};
 
 #[derive(Default)]
 struct Events(Vec<ClutchEvent>, Vec<NetworkSample>, Vec<ImpactEvent>);
 
-impl NetworkObserver for Events {
+impl Observer for Events {
     fn mesh_impact(&mut self, e: &ImpactEvent) {
         self.2.push(*e);
     }
     fn clutch_event(&mut self, e: &ClutchEvent) {
         self.0.push(*e);
     }
-    fn sample(&mut self, s: &NetworkSample) {
+    fn network_sample(&mut self, s: &NetworkSample) {
         self.1.push(s.clone());
     }
 }
@@ -277,7 +275,7 @@ fn spring_damper_rings_down_as_the_closed_form() {
     let net = cases::spring_ring_down();
     let q0 = cases::RING_DOWN_TWIST_RAD;
     let t_end = 0.4;
-    let run = run_network(&net, t_end, &NetworkOptions::default(), &mut ()).unwrap();
+    let run = run_network(&net, t_end, &NetworkOptions::default(), &mut NullObserver).unwrap();
     let q = cases::spring_ring_down_twist_rad(t_end);
     let a = &run.last.angle_rad;
     let twist = a[0] - a[1] + q0;

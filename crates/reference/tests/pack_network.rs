@@ -3,8 +3,8 @@
 //! scene with an inertial shaft and a drum, impact for impact.
 
 use clutchpack_model::cases::{engaging_clutch, pack_as_network};
-use clutchpack_model::{Collector, Engine, ImpactEvent, PackModel};
-use clutchpack_reference::network::{run_network, NetworkObserver, NetworkOptions, NetworkSample};
+use clutchpack_model::{Collector, Engine, ImpactEvent, Observer, PackModel};
+use clutchpack_reference::network::{run_network, NetworkOptions, NetworkSample};
 use clutchpack_reference::{ReferenceEngine, ReferenceOptions};
 
 #[derive(Default)]
@@ -13,11 +13,11 @@ struct Packs {
     samples: Vec<NetworkSample>,
 }
 
-impl NetworkObserver for Packs {
+impl Observer for Packs {
     fn pack_impact(&mut self, coupling: usize, e: &ImpactEvent) {
         self.impacts.push((coupling, *e));
     }
-    fn sample(&mut self, s: &NetworkSample) {
+    fn network_sample(&mut self, s: &NetworkSample) {
         self.samples.push(s.clone());
     }
 }
@@ -204,7 +204,7 @@ fn dual_clutch_shift_with_resolved_packs_matches_closed_form() {
     };
     #[derive(Default)]
     struct Faces(Vec<(usize, f64, usize, usize)>, usize);
-    impl NetworkObserver for Faces {
+    impl Observer for Faces {
         fn pack_faces(&mut self, k: usize, t: f64, locked: usize, _c: usize, faces: usize) {
             self.0.push((k, t, locked, faces));
         }

@@ -11,7 +11,7 @@ use clutchpack_model::network::{
     ClutchMode, NetworkEnergy, NetworkRun, NetworkSample, NetworkSession,
 };
 use clutchpack_model::EngineError;
-use clutchpack_record::NetworkRecorder;
+use clutchpack_record::Recorder;
 use clutchpack_reference::network::NetworkOptions;
 use clutchpack_scene::{EngineChoice, Scene};
 use serde::Serialize;
@@ -265,11 +265,16 @@ fn run_stopping(
     let mut energies = Vec::new();
     for &t in stops_s.iter().filter(|t| **t < duration_s) {
         run.advance_to(t, obs)?;
-        if obs.keep.stopped || obs.keep.record_error.is_some() {
+        if obs.keep.stopped || obs.keep.record_failed() {
             // stopped there: no step more
             return Ok((run.finish_boxed(obs), energies));
         }
-        energies.push((t, run.boxed_clone().finish_boxed(&mut ()).energy));
+        energies.push((
+            t,
+            run.boxed_clone()
+                .finish_boxed(&mut clutchpack_model::NullObserver)
+                .energy,
+        ));
     }
     run.advance_to(duration_s, obs)?;
     Ok((run.finish_boxed(obs), energies))
@@ -294,7 +299,7 @@ pub(crate) fn start_recording(
     engine: EngineChoice,
     request: Option<&crate::RecordingRequest>,
     co_simulation: Option<(&[String], Option<f64>)>,
-) -> Result<Option<NetworkRecorder>> {
+) -> Result<Option<Recorder>> {
     let (Some(r), Some(net)) = (request, &scene.network) else {
         return Ok(None);
     };
@@ -302,7 +307,7 @@ pub(crate) fn start_recording(
     if let Some((driven, stop_time_s)) = co_simulation {
         crate::session::co_simulation_params(&mut info.params, driven, stop_time_s);
     }
-    let mut recorder = NetworkRecorder::create_output(&r.path, r.replace, &info, net, &r.options)?;
+    let mut recorder = Recorder::create_network_output(&r.path, r.replace, &info, net, &r.options)?;
     if let Some(tr) = &scene.transmission {
         recorder.set_transmission(tr)?;
     }
@@ -343,7 +348,7 @@ pub(crate) fn conclude(
     let Some(net) = &scene.network else {
         return Err(crate::simulation::not_a_network(&scene.name));
     };
-    if let Some(e) = keep.record_error.take() {
+    if let Some(e) = keep.take_record_error() {
         return Err(e.into());
     }
     keep.finish_csv()?;
@@ -462,7 +467,7 @@ pub(crate) fn conclude(
         },
     };
     let recording = match keep.recorder.take() {
-        Some(r) => {
+        Some(mut r) => {
             // a deterministic recording holds no wall time (two runs give the same bytes)
             let wall_time_s = if r.deterministic() {
                 0.0
@@ -476,7 +481,8 @@ pub(crate) fn conclude(
             let json = serde_json::to_vec_pretty(&recorded).map_err(|e| {
                 Error::BadInput(format!("the summary of {} as JSON: {e}", scene.name))
             })?;
-            Some(r.finish(Some(&json))?)
+            r.set_summary_json(json);
+            Some(r.finish(None)?)
         }
         None => None,
     };

@@ -15,10 +15,9 @@ use crate::network::{
 use crate::network_keep::{Keep, Obs};
 use crate::{Error, RecordingRequest, Result};
 use clutchpack_model::network::{
-    ClutchMode, Network, NetworkInput, NetworkObserver, NetworkSample, NetworkSession,
-    OutputQuantity, Transmission,
+    ClutchMode, Network, NetworkInput, NetworkSample, NetworkSession, OutputQuantity, Transmission,
 };
-use clutchpack_model::EngineError;
+use clutchpack_model::{EngineError, Observer};
 use clutchpack_multibody::network::{NetworkStepOptions, NetworkStepper as MultibodyStepper};
 use clutchpack_reference::network::NetworkStepper as ReferenceStepper;
 use clutchpack_scene::{EngineChoice, Scene};
@@ -49,7 +48,7 @@ impl Stepper {
         net: &Network,
         engine: EngineChoice,
         duration_s: f64,
-        obs: &mut dyn NetworkObserver,
+        obs: &mut dyn Observer,
     ) -> std::result::Result<Stepper, EngineError> {
         let run: Box<dyn NetworkSession> = match engine {
             EngineChoice::Reference => {
@@ -546,7 +545,7 @@ impl NetworkSimulation {
             let engine = self.stepper.engine();
             return Err(engine_failed(&self.scene, engine, &mut self.keep, source));
         }
-        if let Some(e) = self.keep.record_error.take() {
+        if let Some(e) = self.keep.take_record_error() {
             self.failed = true;
             return Err(e.into());
         }

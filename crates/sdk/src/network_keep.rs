@@ -1,12 +1,14 @@
 //! What a network run keeps as it goes (`Keep`, fed by the engines through `Obs`, the
-//! [`NetworkObserver`] of one call): the clutches' events and torque ranges, the tooth impacts'
+//! [`Observer`] of one call): the clutches' events and torque ranges, the tooth impacts'
 //! tallies, the resolved packs' fatigue collectors, windows and impacts CSV, the samples when
-//! asked, the recording; and the packs' fatigue at the run's end. `crate::network` builds
+//! asked; the recording (the one [`Recorder`], which observes the run beside it); and the
+//! packs' fatigue at the run's end. `crate::network` builds
 //! the summary from it.
 
 use crate::Result;
-use clutchpack_model::network::{ClutchEvent, ClutchMode, NetworkObserver, NetworkSample};
-use clutchpack_record::NetworkRecorder;
+use clutchpack_model::network::{ClutchEvent, ClutchMode, NetworkSample};
+use clutchpack_model::Observer;
+use clutchpack_record::Recorder;
 use clutchpack_scene::Scene;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -42,13 +44,8 @@ pub(crate) struct Keep {
     /// With the history: every impact as (coupling, body in a pack, t_peak s, peak N).
     pub(crate) impact_log: Vec<(usize, Option<usize>, f64, f64)>,
     pub(crate) stopped: bool,
-    /// When the recording logs the open tooth contacts next, s
-    /// ([`clutchpack_record::OPEN_CONTACTS_EVERY_S`]).
-    pub(crate) open_contacts_at_s: f64,
-    /// The recording, until its first error.
-    pub recorder: Option<NetworkRecorder>,
-    /// The recording's first error (it then stops the run).
-    pub record_error: Option<clutchpack_record::RecordError>,
+    /// The recording (its first error stops the run: [`Keep::record_failed`]).
+    pub recorder: Option<Recorder>,
     /// What an automatic's shifts need of the samples (a transmission with a schedule).
     pub(crate) shifts: Option<crate::shifts::ShiftProbe>,
 }
@@ -66,7 +63,7 @@ impl Keep {
 
     /// A fresh keep that records with `recorder` (if any) and keeps every sample if
     /// `keep_history`.
-    pub fn new(recorder: Option<NetworkRecorder>, keep_history: bool) -> Keep {
+    pub fn new(recorder: Option<Recorder>, keep_history: bool) -> Keep {
         Keep {
             keep_history,
             recorder,
@@ -138,19 +135,14 @@ impl Keep {
         }
     }
 
-    /// Runs `write` on the recorder, keeping its first error (after which nothing more is
-    /// recorded and the run stops).
-    fn record(
-        &mut self,
-        write: impl FnOnce(
-            &mut NetworkRecorder,
-        ) -> std::result::Result<(), clutchpack_record::RecordError>,
-    ) {
-        if let Some(r) = self.recorder.as_mut() {
-            if let Err(e) = write(r) {
-                self.record_error = Some(e);
-            }
-        }
+    /// Whether the recording met an error (the run then stops).
+    pub(crate) fn record_failed(&self) -> bool {
+        self.recorder.as_ref().is_some_and(|r| r.error().is_some())
+    }
+
+    /// The recording's first error, taken (nothing more is recorded).
+    pub(crate) fn take_record_error(&mut self) -> Option<clutchpack_record::RecordError> {
+        self.recorder.as_mut().and_then(Recorder::take_error)
     }
 
     /// A copy without the recording (a saved state of a session that does not record).
@@ -170,9 +162,7 @@ impl Keep {
             history: self.history.clone(),
             impact_log: self.impact_log.clone(),
             stopped: self.stopped,
-            open_contacts_at_s: self.open_contacts_at_s,
             recorder: None,
-            record_error: None,
             shifts: self.shifts.clone(),
         }
     }
@@ -187,18 +177,20 @@ fn tally(m: &mut (u64, f64), peak_n: f64) {
     }
 }
 
-/// The observer of one call of an engine: what it gives goes into `keep`; `stop` and
-/// `progress` are the call's.
+/// The observer of one call of an engine: what it gives goes into `keep` and its recorder;
+/// `stop` and `progress` are the call's.
 pub(crate) struct Obs<'k, 'a> {
     pub keep: &'k mut Keep,
     pub stop: Option<&'a AtomicBool>,
     pub progress: Option<&'a mut dyn FnMut(f64)>,
 }
 
-impl NetworkObserver for Obs<'_, '_> {
-    fn sample(&mut self, s: &NetworkSample) {
+impl Observer for Obs<'_, '_> {
+    fn network_sample(&mut self, s: &NetworkSample) {
         let k = &mut *self.keep;
-        k.record(|r| r.write_sample(s));
+        if let Some(r) = &mut k.recorder {
+            r.network_sample(s);
+        }
         k.range
             .resize(s.torque_n_m.len(), (f64::INFINITY, f64::NEG_INFINITY));
         for (r, t) in k.range.iter_mut().zip(&s.torque_n_m) {
@@ -212,11 +204,15 @@ impl NetworkObserver for Obs<'_, '_> {
         }
     }
     fn clutch_event(&mut self, e: &ClutchEvent) {
-        self.keep.record(|r| r.write_clutch_event(e));
+        if let Some(r) = &mut self.keep.recorder {
+            r.clutch_event(e);
+        }
         self.keep.events.push(*e);
     }
     fn mesh_impact(&mut self, e: &clutchpack_model::ImpactEvent) {
-        self.keep.record(|r| r.write_mesh_impact(e));
+        if let Some(r) = &mut self.keep.recorder {
+            r.mesh_impact(e);
+        }
         self.keep.csv_row(e.disc, None, e);
         if self.keep.keep_history {
             self.keep
@@ -226,7 +222,9 @@ impl NetworkObserver for Obs<'_, '_> {
         tally(self.keep.impacts.entry(e.disc).or_default(), e.peak_n);
     }
     fn pack_impact(&mut self, coupling: usize, e: &clutchpack_model::ImpactEvent) {
-        self.keep.record(|r| r.write_pack_impact(coupling, e));
+        if let Some(r) = &mut self.keep.recorder {
+            r.pack_impact(coupling, e);
+        }
         self.keep.csv_row(coupling, Some(e.disc), e);
         if let Some((w, _)) = self.keep.windows.get_mut(&coupling) {
             w.impact(e);
@@ -253,8 +251,9 @@ impl NetworkObserver for Obs<'_, '_> {
         speed_rad_s: &[f64],
         load_n: &[f64],
     ) {
-        self.keep
-            .record(|r| r.write_pack_sample(coupling, t, angle_rad, speed_rad_s, load_n));
+        if let Some(r) = &mut self.keep.recorder {
+            r.pack_sample(coupling, t, angle_rad, speed_rad_s, load_n);
+        }
         let sample = clutchpack_model::Sample {
             t_s: t,
             discs: load_n
@@ -277,8 +276,9 @@ impl NetworkObserver for Obs<'_, '_> {
         collector.sample(&sample);
     }
     fn pack_temperatures(&mut self, coupling: usize, t: f64, temperatures_k: &[f64]) {
-        self.keep
-            .record(|r| r.write_pack_temperatures(coupling, t, temperatures_k));
+        if let Some(r) = &mut self.keep.recorder {
+            r.pack_temperatures(coupling, t, temperatures_k);
+        }
         if let Some((w, _)) = self.keep.windows.get_mut(&coupling) {
             if let Some((oil, bodies)) = temperatures_k.split_last() {
                 w.temperatures(bodies, *oil);
@@ -305,11 +305,8 @@ impl NetworkObserver for Obs<'_, '_> {
             m.1.push(t);
         }
         m.0 = mode;
-        if let Some(mode) = self.keep.pack_mode(coupling) {
-            self.keep.record(|r| {
-                r.set_pack_mode(coupling, mode);
-                Ok(())
-            });
+        if let Some(r) = &mut self.keep.recorder {
+            r.pack_faces(coupling, t, locked, clamped, faces);
         }
     }
     fn switched(&mut self, before: &NetworkSample, after: &NetworkSample) {
@@ -322,17 +319,19 @@ impl NetworkObserver for Obs<'_, '_> {
         self.keep.steps.push((after.t_s, steps));
     }
     fn wants_open_contacts(&mut self, t: f64) -> bool {
-        self.keep.recorder.is_some() && t >= self.keep.open_contacts_at_s
+        self.keep
+            .recorder
+            .as_mut()
+            .is_some_and(|r| r.wants_open_contacts(t))
     }
     fn open_contacts(
         &mut self,
         t: f64,
         open: &[(usize, Option<usize>, clutchpack_model::ImpactEvent)],
     ) {
-        // on the grid of OPEN_CONTACTS_EVERY_S, whatever the steps
-        let every = clutchpack_record::OPEN_CONTACTS_EVERY_S;
-        self.keep.open_contacts_at_s = ((t / every).floor() + 1.0) * every;
-        self.keep.record(|r| r.write_open_contacts(t, open));
+        if let Some(r) = &mut self.keep.recorder {
+            r.open_contacts(t, open);
+        }
     }
     fn progress(&mut self, t: f64) -> bool {
         if let Some(p) = self.progress.as_mut() {
@@ -340,7 +339,8 @@ impl NetworkObserver for Obs<'_, '_> {
         }
         let stop = self.stop.is_some_and(|s| s.load(Ordering::Relaxed));
         self.keep.stopped |= stop;
-        !stop && self.keep.record_error.is_none()
+        let failed = self.keep.recorder.as_mut().is_some_and(|r| r.progress(t));
+        stop || failed
     }
 }
 

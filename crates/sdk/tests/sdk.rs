@@ -308,3 +308,43 @@ fn one_simulation_runs_a_network_and_pack_only_calls_refuse_it() {
         serde_json::to_string_pretty(&run.summary().unwrap()).unwrap()
     );
 }
+
+/// One observer, one meaning of `progress` (`true` stops; a network's was `false` stops until
+/// issue 44 folded its observer into the pack's): a stop flag set before a network run stops
+/// it at its first poll on both engines, and an unset flag lets it run to its end. Bounds: the
+/// DCT upshift runs 0.05 s here; stopped, it stands at most one record interval and a step
+/// in (the reference engine's first step, the multibody engine's 0.1 ms steps), far below
+/// 0.01 s; run whole it reaches 0.05 s to 1e-9 s.
+#[test]
+fn a_stop_flag_stops_a_network_run_and_an_unset_one_does_not() {
+    let set: [Override; 1] = ["simulation.duration_s=0.05".parse().unwrap()];
+    let scene = load_scene(Some(&scene_file("dct-upshift.toml")), &set).unwrap();
+    for engine in [
+        clutchpack_sdk::EngineChoice::Reference,
+        clutchpack_sdk::EngineChoice::Multibody,
+    ] {
+        for stop_now in [true, false] {
+            let stop = AtomicBool::new(stop_now);
+            let out = Simulation::new(scene.clone(), Some(engine))
+                .unwrap()
+                .run(RunRequest {
+                    stop: Some(&stop),
+                    ..RunRequest::default()
+                })
+                .unwrap()
+                .into_network()
+                .unwrap();
+            let s = &out.summary;
+            assert_eq!(s.stopped, stop_now, "{engine:?}");
+            if stop_now {
+                assert!(s.simulated_s < 0.01, "{engine:?}: {} s", s.simulated_s);
+            } else {
+                assert!(
+                    (s.simulated_s - 0.05).abs() < 1e-9,
+                    "{engine:?}: {}",
+                    s.simulated_s
+                );
+            }
+        }
+    }
+}

@@ -43,7 +43,7 @@ fn taking_each_shifts_energy_balance_leaves_the_run_bit_for_bit() {
                         net,
                         duration_s,
                         &options,
-                        &mut (),
+                        &mut clutchpack_model::NullObserver,
                     )
                 }
                 EngineChoice::Multibody => {
@@ -55,7 +55,7 @@ fn taking_each_shifts_energy_balance_leaves_the_run_bit_for_bit() {
                         net,
                         duration_s,
                         &options,
-                        &mut (),
+                        &mut clutchpack_model::NullObserver,
                     )
                 }
             }

@@ -271,8 +271,8 @@ pub struct PrescribedClutchObserver {
     pub reactions_n_m: [Option<f64>; 2],
 }
 
-impl crate::network::NetworkObserver for PrescribedClutchObserver {
-    fn sample(&mut self, sample: &crate::network::NetworkSample) {
+impl crate::Observer for PrescribedClutchObserver {
+    fn network_sample(&mut self, sample: &crate::network::NetworkSample) {
         for (at, r) in PRESCRIBED_CLUTCH_REACTIONS_AT_S
             .iter()
             .zip(self.reactions_n_m.iter_mut())

@@ -426,7 +426,7 @@ pub trait ElementLaw {
 
     /// The mode at t = 0 of faces whose modes its own session reports rather than the
     /// engines' network equations (a resolved pack's faces: `Some(Free)`; their changes then
-    /// come through [`super::NetworkObserver::pack_faces`]), for the layers that follow
+    /// come through [`crate::Observer::pack_faces`]), for the layers that follow
     /// modes (the recording's colours, an automatic's gear and shifts); `None` when its mode,
     /// if any, is the samples' ([`Self::initial_mode`]).
     fn session_mode(&self) -> Mode {

@@ -23,6 +23,7 @@ pub mod rows;
 pub mod signal;
 pub mod spring_damper;
 
+pub use crate::session::NetworkSession;
 pub use clutch::{ClutchMode, LumpedClutch};
 pub use element::{
     ElementLaw, EnergyTerm, InputSpec, Mode, OutputQuantity, OutputSpec, OwnBodies, Ports, SlipEnd,
@@ -31,9 +32,7 @@ pub use firing::Firing;
 pub use gear::GearMesh;
 pub use gears::{Gear, GearKinematics, Shift, Transmission};
 pub use ideal_gear::IdealGear;
-pub use output::{
-    ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample, NetworkSession,
-};
+pub use output::{ClutchEvent, NetworkEnergy, NetworkRun, NetworkSample};
 pub use planetary::PlanetarySet;
 pub use rows::Row;
 pub use signal::{NetworkInput, Signal};

@@ -4,7 +4,7 @@
 //! tooth law of section 2 on the penetration `|x| - b/2` through the model's
 //! [`GearMesh`] (never re-implemented here), the step a contact allows, the landing of a step
 //! on a contact's onset and separation, and the contact events
-//! ([`clutchpack_model::ImpactEvent`], through [`NetworkObserver::mesh_impact`]).
+//! ([`clutchpack_model::ImpactEvent`], through [`Observer::mesh_impact`]).
 //!
 //! Over a step the engine holds every torque (`mod.rs`), so each body's speed is affine in
 //! time and a mesh's `x` is quadratic: its [`Path`]. The engine lands on the first instant the
@@ -12,7 +12,8 @@
 //! path, bisected to 1e-13 s on a piece where `x` is monotone, as it lands on a slip's zero.
 
 use clutchpack_model::law::{damping_factor, squeeze_load};
-use clutchpack_model::network::{GearMesh, Network, NetworkObserver};
+use clutchpack_model::network::{GearMesh, Network};
+use clutchpack_model::Observer;
 use clutchpack_model::{Engagement, ImpactTracker, LawKind, ToothKinematics};
 
 /// Steps per predicted contact duration (dimensionless): a contact's step is its predicted
@@ -232,7 +233,7 @@ impl Mesh {
     /// an onset (the depth above 0 in free flight) takes the law's memory
     /// ([`clutchpack_model::ToothLaw::engage`]) and predicts the contact's duration; a
     /// separation (the depth at or below 0, or the other flank) sends the event.
-    pub fn switch(&mut self, t: f64, w: &[f64], obs: &mut dyn NetworkObserver) {
+    pub fn switch(&mut self, t: f64, w: &[f64], obs: &mut dyn Observer) {
         let v = self.speed(w);
         let kin = self.gear.kinematics(self.x, v);
         let depth = self.gear.law.engagement_depth_m(&kin);
@@ -302,7 +303,7 @@ impl Mesh {
 
     /// Closes the open contact at `t`: its peak refined by golden-section search on the best
     /// step's path, the event sent.
-    fn close(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
+    fn close(&mut self, t: f64, obs: &mut dyn Observer) {
         if let Some((path, tau, _)) = self.best.take() {
             let span = path.h / PROBES as f64;
             let (lo, hi) = ((tau - span).max(0.0), (tau + span).min(path.h));
@@ -323,7 +324,7 @@ impl Mesh {
     }
 
     /// Closes an open contact at the end of the run, `t` s (its separation then).
-    pub fn finish(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
+    pub fn finish(&mut self, t: f64, obs: &mut dyn Observer) {
         if self.contact.is_some() {
             self.close(t, obs);
         }
@@ -333,12 +334,7 @@ impl Mesh {
 /// Opens and closes the contacts of `meshes` at the start of a step at `t` (s), the bodies
 /// at speeds `w` (rad/s; [`Mesh::switch`]); returns the longest step the open contacts allow,
 /// s ([`Mesh::step_bound`]; `INFINITY` with none).
-pub(super) fn start_step(
-    meshes: &mut [Mesh],
-    t: f64,
-    w: &[f64],
-    obs: &mut dyn NetworkObserver,
-) -> f64 {
+pub(super) fn start_step(meshes: &mut [Mesh], t: f64, w: &[f64], obs: &mut dyn Observer) -> f64 {
     let mut h = f64::INFINITY;
     for m in meshes {
         m.switch(t, w, obs);

@@ -18,7 +18,7 @@
 //!    the penetration `|x| - b/2`) is above 0 opens a contact event there (the law's memory
 //!    taken, its Hertz duration predicted at the closing speed), one whose depth is at or
 //!    below 0 closes it (an [`clutchpack_model::ImpactEvent`] to
-//!    [`NetworkObserver::mesh_impact`]). While in contact the step is at most the predicted
+//!    [`Observer::mesh_impact`]). While in contact the step is at most the predicted
 //!    duration over 256 and the local period of the linearised law over 256 (over 64 once
 //!    the contact outlasts four predicted durations: a loaded mesh).
 //! 1. **Modes** (Modelica's `Clutch`, as the reference engine settles them; MODEL.md section
@@ -84,9 +84,9 @@ pub use stepper::{run_network, NetworkStepper};
 use bodies::NetworkWorld;
 pub(crate) use clutchpack_model::network::rows::{self as constraint, Row};
 use clutchpack_model::network::{
-    friction, ClutchEvent, ClutchMode, Network, NetworkEnergy, NetworkObserver, NetworkSample,
-    SlipEnd,
+    friction, ClutchEvent, ClutchMode, Network, NetworkEnergy, NetworkSample, SlipEnd,
 };
+use clutchpack_model::Observer;
 use mesh::Mesh;
 use std::sync::Arc;
 
@@ -358,7 +358,7 @@ impl Run {
     /// Settles the clutches' modes at the start of a step at `t` (MODEL.md section 8; the
     /// rules of the reference engine's `settle`), merges the new rigid groups' speeds and
     /// leaves the step's torques computed.
-    fn settle(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
+    fn settle(&mut self, t: f64, obs: &mut dyn Observer) {
         let net = Arc::clone(&self.net);
         let before = self.modes.clone();
         let w_before = self.w.clone();

@@ -51,12 +51,12 @@
 //!   The angles are the pack's own (its teeth's loads depend only on its relative angles).
 //!
 //! # Outputs
-//! Each closed tooth contact goes to [`NetworkObserver::pack_impact`] as it closes; at each
-//! network sample the pack's discs and plates to [`NetworkObserver::pack_sample`] (their
+//! Each closed tooth contact goes to [`Observer::pack_impact`] as it closes; at each
+//! network sample the pack's discs and plates to [`Observer::pack_sample`] (their
 //! angles shifted by the carrier's network angle less its pack angle); a change of the
 //! faces' locked or clamped count, seen at the end of a network step, to
-//! [`NetworkObserver::pack_faces`] at that time (a lock is timed to a network step); a thermal
-//! pack's temperatures at each window's end to [`NetworkObserver::pack_temperatures`] (the
+//! [`Observer::pack_faces`] at that time (a lock is timed to a network step); a thermal
+//! pack's temperatures at each window's end to [`Observer::pack_temperatures`] (the
 //! session's thermal run: its heat booked world step by world step, as in a pack run; a
 //! carrier's speed set by the network is not booked as the teeth's work).
 //!
@@ -69,7 +69,7 @@ use super::{NetworkStepOptions, Run};
 use crate::engine::{Carried, MultibodySession};
 use crate::options::MultibodyOptions;
 use crate::MultibodyEngine;
-use clutchpack_model::network::{Network, NetworkObserver};
+use clutchpack_model::network::Network;
 use clutchpack_model::session::{Driven, Session, Snapshot};
 use clutchpack_model::thermal::ThermalReport;
 use clutchpack_model::{DrumModel, EngineError, ImpactEvent, Observer, Shaft, ShaftExcitation};
@@ -116,7 +116,7 @@ pub(super) struct NetPack {
 /// observer as the pack's, the rest is read from snapshots.
 struct Forward<'a> {
     k: usize,
-    obs: &'a mut dyn NetworkObserver,
+    obs: &'a mut dyn Observer,
 }
 
 impl Observer for Forward<'_> {
@@ -281,7 +281,7 @@ impl NetPack {
         t1: f64,
         (ta, tb): (f64, f64),
         name: &str,
-        obs: &mut dyn NetworkObserver,
+        obs: &mut dyn Observer,
         hold_short: bool,
     ) -> Result<[f64; 2], EngineError> {
         let h = t1 - self.session.time_s();
@@ -365,7 +365,7 @@ impl NetPack {
 
     /// Sends the faces' new locked and clamped counts to `obs` at `t` (s) if they changed, or
     /// whatever they are at t = 0 (as the reference engine does).
-    pub fn faces_to(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
+    pub fn faces_to(&mut self, t: f64, obs: &mut dyn Observer) {
         let faces = self.session.interfaces();
         if faces.is_empty() {
             return;
@@ -385,7 +385,7 @@ impl NetPack {
 
     /// Sends the discs and plates at `t` (s) to `obs`, their angles shifted by the carriers'
     /// network angles `theta` (rad) less the pack's own.
-    pub fn sample_to(&self, t: f64, theta: &[f64], obs: &mut dyn NetworkObserver) {
+    pub fn sample_to(&self, t: f64, theta: &[f64], obs: &mut dyn Observer) {
         let snap = self.session.snapshot();
         let shaft = self.session.carrier_motion(false).map_or(0.0, |m| m.0);
         let drum = self.session.carrier_motion(true).map_or(0.0, |m| m.0);
@@ -432,7 +432,7 @@ impl NetPack {
 
     /// Ends the pack's session at the run's end: its open contacts closed and sent to `obs`,
     /// a thermal pack's last window closed (its temperatures sent); its temperatures' report.
-    pub fn finish(&mut self, obs: &mut dyn NetworkObserver) -> Option<ThermalReport> {
+    pub fn finish(&mut self, obs: &mut dyn Observer) -> Option<ThermalReport> {
         let mut fwd = Forward { k: self.k, obs };
         self.session.finish(&mut fwd).thermal
     }
@@ -448,7 +448,7 @@ impl Run {
         t1: f64,
         total: &mut [f64],
         acc: &mut [f64],
-        obs: &mut dyn NetworkObserver,
+        obs: &mut dyn Observer,
     ) -> Result<(), EngineError> {
         let net = Arc::clone(&self.net);
         for j in 0..self.packs.len() {

@@ -8,10 +8,10 @@ use super::mesh::{self, Mesh};
 use super::packs::NetPack;
 use super::{NetworkStepOptions, Run};
 use clutchpack_model::network::{
-    Body, ClutchMode, Network, NetworkEnergy, NetworkInput, NetworkObserver, NetworkRun,
-    NetworkSample, NetworkSession,
+    Body, ClutchMode, Network, NetworkEnergy, NetworkInput, NetworkRun, NetworkSample,
+    NetworkSession,
 };
-use clutchpack_model::{guard_state, EngineError, RUNAWAY_SPEED_RAD_S};
+use clutchpack_model::{guard_state, EngineError, Observer, RUNAWAY_SPEED_RAD_S};
 use std::sync::Arc;
 
 /// Runs `net` on the multibody engine for `duration_s` seconds; samples and clutch events go
@@ -21,7 +21,7 @@ pub fn run_network(
     net: &Network,
     duration_s: f64,
     options: &NetworkStepOptions,
-    obs: &mut dyn NetworkObserver,
+    obs: &mut dyn Observer,
 ) -> Result<NetworkRun, EngineError> {
     let mut run = NetworkStepper::new(net, duration_s, options, obs)?;
     run.advance_to(duration_s, obs)?;
@@ -77,7 +77,7 @@ impl NetworkStepper {
         net: &Network,
         duration_s: f64,
         options: &NetworkStepOptions,
-        obs: &mut dyn NetworkObserver,
+        obs: &mut dyn Observer,
     ) -> Result<NetworkStepper, EngineError> {
         net.check_run(duration_s)?;
         let h_max = options.step_s;
@@ -149,7 +149,7 @@ impl NetworkStepper {
     /// The start of a step at `t` (the module's method, steps 0 and 1): the breakpoints
     /// reached passed (each an event), the mesh contacts opened or closed and the step they
     /// allow taken, the modes settled, and the sample due at `t` sent to `obs`.
-    fn start_step(&mut self, obs: &mut dyn NetworkObserver) {
+    fn start_step(&mut self, obs: &mut dyn Observer) {
         let t = self.t;
         let bps = &self.breakpoints;
         while self.next_bp < bps.len() && bps[self.next_bp] <= t + 1e-12 * (1.0 + t) {
@@ -168,7 +168,7 @@ impl NetworkStepper {
         let t_sample = self.t_sample;
         if (near(t, t_sample) || t_sample <= t) && t_sample < self.duration_s && t < self.duration_s
         {
-            obs.sample(&self.run.sample(t));
+            obs.network_sample(&self.run.sample(t));
             let theta = self.run.world.angles();
             for p in &self.run.packs {
                 p.sample_to(t, theta, obs);
@@ -180,7 +180,7 @@ impl NetworkStepper {
 
     /// One step from `t` (the module's method, steps 2 to 5), ending at `t_end` s at the
     /// latest, and its works counted (the module's "Energy").
-    fn step(&mut self, t_end: f64, obs: &mut dyn NetworkObserver) -> Result<(), EngineError> {
+    fn step(&mut self, t_end: f64, obs: &mut dyn Observer) -> Result<(), EngineError> {
         let t = self.t;
         let t_sample = self.t_sample;
         let stop = self
@@ -291,7 +291,7 @@ impl NetworkStepper {
 
     /// Ends the run where it stands: the open mesh contacts closed, the last sample sent to
     /// `obs`, and the run's heat (J), energy balance (the module's "Energy") and counts.
-    pub fn finish(mut self, obs: &mut dyn NetworkObserver) -> NetworkRun {
+    pub fn finish(mut self, obs: &mut dyn Observer) -> NetworkRun {
         let t = self.t;
         let run = &mut self.run;
         for mesh in &mut run.meshes {
@@ -304,7 +304,7 @@ impl NetworkStepper {
             }
         }
         let last = run.sample(t);
-        obs.sample(&last);
+        obs.network_sample(&last);
         for p in &run.packs {
             p.sample_to(t, run.world.angles(), obs);
         }
@@ -391,7 +391,7 @@ impl NetworkSession for NetworkStepper {
         &mut self,
         input: NetworkInput,
         value: f64,
-        obs: &mut dyn NetworkObserver,
+        obs: &mut dyn Observer,
     ) -> Result<(), EngineError> {
         let t = self.t;
         let angles = self.run.world.angles().to_vec();
@@ -419,8 +419,8 @@ impl NetworkSession for NetworkStepper {
     /// Advances to `t_end` s (at most the run's end), a step ending there (within the
     /// events' precision, `1e-12 (1 + t)` s, as the run's end); samples, clutch events and
     /// mesh impacts go to `obs` as they happen. Stops early (without error) when `obs` asks
-    /// to ([`NetworkObserver::progress`]).
-    fn advance_to(&mut self, t_end: f64, obs: &mut dyn NetworkObserver) -> Result<(), EngineError> {
+    /// to ([`Observer::progress`]).
+    fn advance_to(&mut self, t_end: f64, obs: &mut dyn Observer) -> Result<(), EngineError> {
         let t_end = t_end.min(self.duration_s);
         loop {
             if !self.started {
@@ -440,14 +440,14 @@ impl NetworkSession for NetworkStepper {
                 }
                 obs.open_contacts(self.t, &open);
             }
-            if !obs.progress(self.t) {
+            if obs.progress(self.t) {
                 self.run.settle(self.t, obs);
                 return Ok(());
             }
         }
     }
 
-    fn finish_boxed(self: Box<Self>, obs: &mut dyn NetworkObserver) -> NetworkRun {
+    fn finish_boxed(self: Box<Self>, obs: &mut dyn Observer) -> NetworkRun {
         NetworkStepper::finish(*self, obs)
     }
 

@@ -1,4 +1,4 @@
-//! Reading a network recording back ([`crate::NetworkRecorder`]'s file) into the samples the
+//! Reading a network recording back ([`crate::Recorder::create_network_output`]'s file) into the samples the
 //! engine gave: every body's angle and speed, every coupling's torque and a clutch's mode.
 
 use crate::network::{META_NETWORK, SUMMARY_ATTACHMENT};

@@ -4,10 +4,11 @@
 //! that holds it, and the separation, which closes a [`clutchpack_model::ImpactEvent`] (the spline's type:
 //! the same statistics and fatigue apply).
 
-use super::{mesh_kinematics, Equations, NetworkObserver};
+use super::{mesh_kinematics, Equations};
 use crate::dopri::Dense;
 use crate::stepper::golden_peak;
 use clutchpack_model::ImpactTracker;
+use clutchpack_model::Observer;
 
 /// Samples of the force per step in contact, beside the step's end, before the refinement.
 const PROBES: usize = 16;
@@ -83,7 +84,7 @@ impl Meshes {
         t: f64,
         y: &[f64],
         crossed: Option<&[f64]>,
-        obs: &mut dyn NetworkObserver,
+        obs: &mut dyn Observer,
     ) {
         for k in 0..self.trackers.len() {
             let Some(g) = eq.net.couplings[k].mesh() else {
@@ -110,7 +111,7 @@ impl Meshes {
     }
 
     /// Closes `k`'s open event at `t`: its peak refined on the best step's dense output.
-    fn close(&mut self, eq: &mut Equations, k: usize, t: f64, obs: &mut dyn NetworkObserver) {
+    fn close(&mut self, eq: &mut Equations, k: usize, t: f64, obs: &mut dyn Observer) {
         if let Some((dense, tb, _)) = self.best[k].take() {
             let span = dense.h / PROBES as f64;
             let (a, b) = (
@@ -127,7 +128,7 @@ impl Meshes {
     }
 
     /// Closes every open event at the end of the run (`t_off` the end).
-    pub fn finish(&mut self, eq: &mut Equations, t: f64, obs: &mut dyn NetworkObserver) {
+    pub fn finish(&mut self, eq: &mut Equations, t: f64, obs: &mut dyn Observer) {
         for k in 0..self.trackers.len() {
             if eq.contacts[k].is_some() {
                 self.close(eq, k, t, obs);

@@ -53,9 +53,7 @@ pub use stepper::{run_network, NetworkInput, NetworkStepper};
 use cluster::{Clusters, Freedom};
 use clutchpack_model::network::{ClutchMode, GearMesh, Network, Row};
 // the output types are the model's, shared with the multibody engine
-pub use clutchpack_model::network::{
-    ClutchEvent, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
-};
+pub use clutchpack_model::network::{ClutchEvent, NetworkEnergy, NetworkRun, NetworkSample};
 use clutchpack_model::Engagement;
 use std::sync::Arc;
 

@@ -2,8 +2,9 @@
 //! which clutches lock, slip or go free, settled together, and the speeds of a new rigid group
 //! made common with its momentum kept.
 
-use super::{sample, ClutchEvent, Equations, Freedom, NetworkObserver};
+use super::{sample, ClutchEvent, Equations, Freedom};
 use clutchpack_model::network::{friction, SlipEnd};
+use clutchpack_model::Observer;
 
 /// Settles the clutches' modes at an event at `t` (MODEL.md section 8; Modelica's `Clutch`):
 /// free while `fn <= 0`; a clutch whose slip crossed zero (`crossed`: its guard `<= 0`), or
@@ -14,7 +15,7 @@ pub(super) fn settle(
     t: f64,
     y: &mut [f64],
     crossed: &[f64],
-    obs: &mut dyn NetworkObserver,
+    obs: &mut dyn Observer,
     events: &mut u64,
 ) {
     let net = std::sync::Arc::clone(&eq.net);

@@ -18,19 +18,18 @@
 //! the dense output of the step that holds it: the load probed at the quarter points of every
 //! step in contact (the state interpolated once per point for every pack), and a largest probe
 //! inside the step above the event's largest so far refined there by golden-section search;
-//! its separation sends the impact ([`super::NetworkObserver::pack_impact`]).
+//! its separation sends the impact ([`clutchpack_model::Observer::pack_impact`]).
 //!
 //! # State
 //! Per pack, after the network's own state: its [`System`]'s (each body's relative angle and
 //! speed against its carrier, each face's heat, the teeth's work), then the work of its
 //! bodies' oil drag (J).
 
-use super::NetworkObserver;
 use crate::dopri::Dense;
 use crate::stepper::golden_peak;
 use crate::system::{Face, System};
 use clutchpack_model::network::{Network, NetworkInput};
-use clutchpack_model::{Engagement, ImpactTracker};
+use clutchpack_model::{Engagement, ImpactTracker, Observer};
 use std::sync::Arc;
 
 /// Samples of a load per step in contact before the refinement: the step's quarter points
@@ -218,7 +217,7 @@ impl NetPack {
         t: f64,
         y: &[f64],
         crossed: Option<&[f64]>,
-        obs: &mut dyn NetworkObserver,
+        obs: &mut dyn Observer,
     ) {
         for slot in 0..self.sys.ids.len() {
             if crossed.is_some_and(|c| c[slot] > 0.0) {
@@ -266,7 +265,7 @@ impl NetPack {
     }
 
     /// Closes `slot`'s open event at `t` (its peak was located as the steps went).
-    fn close(&mut self, slot: usize, t: f64, obs: &mut dyn NetworkObserver) {
+    fn close(&mut self, slot: usize, t: f64, obs: &mut dyn Observer) {
         if let Some(e) = self.trackers[slot].end(t) {
             obs.pack_impact(self.k, &e);
         }
@@ -285,7 +284,7 @@ impl NetPack {
     }
 
     /// Closes every open event at the end of the run at `t`.
-    pub fn finish(&mut self, t: f64, obs: &mut dyn NetworkObserver) {
+    pub fn finish(&mut self, t: f64, obs: &mut dyn Observer) {
         for slot in 0..self.sys.ids.len() {
             if self.modes[slot].is_some() {
                 self.close(slot, t, obs);
@@ -339,7 +338,7 @@ pub(super) fn switch(
     t: f64,
     y: &mut [f64],
     crossed: Option<&[f64]>,
-    obs: &mut dyn NetworkObserver,
+    obs: &mut dyn Observer,
 ) {
     for p in packs {
         let mine = crossed.map(|g| &g[p.guard_at..p.guard_at + p.guards()]);
@@ -426,7 +425,7 @@ pub(super) fn heal(
     t: f64,
     y: &mut [f64],
     g: &[f64],
-    obs: &mut dyn NetworkObserver,
+    obs: &mut dyn Observer,
 ) -> bool {
     let mut changed = false;
     for p in packs.iter_mut() {
@@ -454,13 +453,7 @@ pub(super) fn heal(
 /// Sends every pack's discs and plates at the network state `y` at `t` (s) to `obs`: each
 /// body's absolute angle (its carrier's less its relative angle, rad), speed (rad/s) and
 /// per-tooth load (N).
-pub(super) fn emit_samples(
-    packs: &[NetPack],
-    n: usize,
-    t: f64,
-    y: &[f64],
-    obs: &mut dyn NetworkObserver,
-) {
+pub(super) fn emit_samples(packs: &[NetPack], n: usize, t: f64, y: &[f64], obs: &mut dyn Observer) {
     for p in packs {
         let nd = p.sys.pack.discs.len();
         let (angles, speeds): (Vec<f64>, Vec<f64>) = (0..p.sys.ids.len())
@@ -484,7 +477,7 @@ pub(super) fn emit_samples(
 pub(super) fn close_thermal_windows(
     eq: &mut super::Equations,
     t: f64,
-    obs: &mut dyn NetworkObserver,
+    obs: &mut dyn Observer,
 ) -> Result<bool, clutchpack_model::EngineError> {
     let mut swapped = false;
     for p in eq.packs.iter_mut() {

@@ -9,10 +9,9 @@ use crate::dopri::{next_step, Dense, Dopri5};
 use crate::thermal::Thermal;
 pub use clutchpack_model::network::NetworkInput;
 use clutchpack_model::network::{
-    ClutchMode, EnergyTerm, Network, NetworkEnergy, NetworkObserver, NetworkRun, NetworkSample,
-    NetworkSession,
+    ClutchMode, EnergyTerm, Network, NetworkEnergy, NetworkRun, NetworkSample, NetworkSession,
 };
-use clutchpack_model::{guard_state, EngineError, RUNAWAY_SPEED_RAD_S};
+use clutchpack_model::{guard_state, EngineError, Observer, RUNAWAY_SPEED_RAD_S};
 use std::sync::Arc;
 
 /// Runs `net` for `duration_s` seconds; samples and clutch events go to `obs` as they happen.
@@ -21,7 +20,7 @@ pub fn run_network(
     net: &Network,
     duration_s: f64,
     options: &NetworkOptions,
-    obs: &mut dyn NetworkObserver,
+    obs: &mut dyn Observer,
 ) -> Result<NetworkRun, EngineError> {
     let mut run = NetworkStepper::new(net, duration_s, options, obs)?;
     run.advance_to(duration_s, obs)?;
@@ -82,7 +81,7 @@ impl NetworkStepper {
         net: &Network,
         duration_s: f64,
         options: &NetworkOptions,
-        obs: &mut dyn NetworkObserver,
+        obs: &mut dyn Observer,
     ) -> Result<NetworkStepper, EngineError> {
         net.check_run(duration_s)?;
         let n = net.bodies.len();
@@ -151,7 +150,7 @@ impl NetworkStepper {
         } else {
             f64::INFINITY
         };
-        obs.sample(&sample(&mut eq, 0.0, &y));
+        obs.network_sample(&sample(&mut eq, 0.0, &y));
         packs::emit_samples(&eq.packs, n, 0.0, &y, obs);
         Ok(NetworkStepper {
             breakpoints: net.breakpoints(duration_s),
@@ -196,7 +195,7 @@ impl NetworkStepper {
     /// The integration's next step from its time, its events located (`None`: no step to
     /// apply: a rejected try, or the run moved onto a breakpoint or its end). Its steps land
     /// on the signals' breakpoints and the run's end, never on a call's end.
-    fn propose(&mut self, obs: &mut dyn NetworkObserver) -> Result<Option<Pending>, EngineError> {
+    fn propose(&mut self, obs: &mut dyn Observer) -> Result<Option<Pending>, EngineError> {
         let tol = self.options.tolerance;
         let Self {
             eq,
@@ -345,7 +344,7 @@ impl NetworkStepper {
         &mut self,
         p: Pending,
         cut: Option<f64>,
-        obs: &mut dyn NetworkObserver,
+        obs: &mut dyn Observer,
     ) -> Result<(), EngineError> {
         let Self {
             eq,
@@ -371,7 +370,7 @@ impl NetworkStepper {
         {
             let ts = self.next_sample as f64 * self.period;
             dense.eval(ts, ybuf);
-            obs.sample(&sample(eq, ts, ybuf));
+            obs.network_sample(&sample(eq, ts, ybuf));
             packs::emit_samples(&eq.packs, eq.net.bodies.len(), ts, ybuf, obs);
             self.next_sample += 1;
         }
@@ -440,7 +439,7 @@ impl NetworkStepper {
     /// Ends the run where it stands (a step taken past the session's time ended there, as
     /// [`Self::set_input`] ends it): the open mesh contacts closed, the last sample sent to
     /// `obs`, and the run's heat, energy balance and counts.
-    pub fn finish(mut self, obs: &mut dyn NetworkObserver) -> NetworkRun {
+    pub fn finish(mut self, obs: &mut dyn Observer) -> NetworkRun {
         if let Some(p) = self.pending.take() {
             let now = self.now;
             // a state failing the runaway guard here would fail the next step: the run
@@ -466,7 +465,7 @@ impl NetworkStepper {
             }
         }
         let last = sample(&mut self.eq, t, &self.y);
-        obs.sample(&last);
+        obs.network_sample(&last);
         packs::emit_samples(&self.eq.packs, n, t, &self.y, obs);
         let y = &self.y;
         let c0 = 2 * n + m; // the counters
@@ -585,7 +584,7 @@ impl NetworkSession for NetworkStepper {
         &mut self,
         input: NetworkInput,
         value: f64,
-        obs: &mut dyn NetworkObserver,
+        obs: &mut dyn Observer,
     ) -> Result<(), EngineError> {
         if let Some(p) = self.pending.take() {
             // the old input holds up to the session's time: the step ends there
@@ -626,8 +625,8 @@ impl NetworkSession for NetworkStepper {
     /// passes `t_end` waits (the type's docs), unless it ends within the events' precision
     /// of `t_end` (frames added up by a host: 0.1 after ten of 0.01 is 0.09999999999999999;
     /// the run then stands at the step's end). Stops early (without error) when `obs` asks
-    /// to ([`NetworkObserver::progress`]).
-    fn advance_to(&mut self, t_end: f64, obs: &mut dyn NetworkObserver) -> Result<(), EngineError> {
+    /// to ([`Observer::progress`]).
+    fn advance_to(&mut self, t_end: f64, obs: &mut dyn Observer) -> Result<(), EngineError> {
         let t_end = t_end.min(self.duration_s);
         loop {
             if let Some(p) = self.pending {
@@ -638,7 +637,7 @@ impl NetworkSession for NetworkStepper {
                 }
                 self.pending = None;
                 self.apply(p, None, obs)?;
-                if !obs.progress(self.t) {
+                if obs.progress(self.t) {
                     break;
                 }
                 continue;
@@ -652,7 +651,7 @@ impl NetworkSession for NetworkStepper {
         Ok(())
     }
 
-    fn finish_boxed(self: Box<Self>, obs: &mut dyn NetworkObserver) -> NetworkRun {
+    fn finish_boxed(self: Box<Self>, obs: &mut dyn Observer) -> NetworkRun {
         NetworkStepper::finish(*self, obs)
     }
 
@@ -684,7 +683,7 @@ struct Pending {
 /// Settles the packs' faces that an event or a settling left switching (their guards not
 /// positive: `packs::heal`), until none is (at most a few rounds: each settles faces whose
 /// neighbours' changes moved them).
-fn heal_faces(eq: &mut Equations, t: f64, y: &mut [f64], obs: &mut dyn NetworkObserver) {
+fn heal_faces(eq: &mut Equations, t: f64, y: &mut [f64], obs: &mut dyn Observer) {
     if eq.packs.iter().all(|p| p.sys.faces.is_empty()) {
         return;
     }
