@@ -526,9 +526,7 @@ pub(super) enum Path<'a> {
 }
 
 impl Path<'_> {
-    /// The carrier at `t`, inlined into the sub-step (the housing's is two zeros and the
-    /// profile's its series; the call spilled the step's registers), an inertial carrier's
-    /// interpolation out of line ([`Path::nodes_at`]).
+    /// The carrier at `t` (inlined: the call spilled the step's registers; nodes out of line).
     #[inline(always)]
     pub(super) fn at(self, t: f64) -> ShaftAt {
         match self {
@@ -538,8 +536,7 @@ impl Path<'_> {
         }
     }
 
-    /// An inertial carrier at `t` from its nodes `n`: exact at a node, the cubic Hermite
-    /// interpolant of angle and speed between two.
+    /// An inertial carrier at `t` from its nodes: exact at one, cubic Hermite between two.
     #[inline(never)]
     fn nodes_at(n: &[Node], t: f64) -> ShaftAt {
         let k = n.partition_point(|x| x.t < t);
