@@ -450,6 +450,7 @@ const SERIES_TRUNCATION: f64 = 1e-17;
 impl LocalProfile {
     /// The profile's speed (rad/s) and angle (rad) at `t` (s), within the reach the expansion
     /// was made for.
+    #[inline]
     pub fn speed_and_angle(&self, t: f64) -> (f64, f64) {
         // the series' length a constant of each arm: the loops unrolled (the count was a
         // tenth of an evaluation's instructions), the sums the same

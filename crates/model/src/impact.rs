@@ -48,6 +48,7 @@ impl ImpactTracker {
     }
 
     /// Whether a contact event is open.
+    #[inline]
     pub fn is_open(&self) -> bool {
         self.open.is_some()
     }
@@ -66,6 +67,7 @@ impl ImpactTracker {
     }
 
     /// Offers a signed load `load_n` at `t_s`; kept if its magnitude is the largest so far.
+    #[inline]
     pub fn observe(&mut self, t_s: f64, load_n: f64) {
         if let Some(e) = self.open.as_mut() {
             if load_n.abs() > e.peak_n.abs() {
@@ -181,6 +183,7 @@ pub const MIN_PEAK_SPACING_RATIO: f64 = 1e-6;
 /// samples' span and the samples are not a rounding error apart ([`MIN_PEAK_SPACING_RATIO`]).
 /// Used by [`ImpactTracker`] and by the engines that feed [`ImpactTracker::observe`]
 /// themselves.
+#[inline]
 pub fn parabolic_peak(
     (t0, a0): (f64, f64),
     (t1, a1): (f64, f64),

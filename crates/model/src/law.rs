@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 ///
 /// `modulus_pa` is the equivalent modulus `E` as the paper writes it (Pa), `curvature_radius_m`
 /// the equivalent curvature radius `r` (m).
+#[inline]
 pub fn hertz_coefficient(modulus_pa: f64, curvature_radius_m: f64) -> f64 {
     // Hu et al. eq (2)
     4.0 / 3.0 * modulus_pa * curvature_radius_m.sqrt()
@@ -48,12 +49,14 @@ pub fn series_stiffness(film_stiffness: f64, hertz: f64) -> f64 {
 ///
 /// `p` is the impact energy loss coefficient in s/m, `v_n` the closing speed in m/s. The clamp
 /// at zero keeps the law from pulling during fast separation.
+#[inline]
 pub fn damping_factor(loss_coefficient_s_m: f64, v_n_m_s: f64) -> f64 {
     (1.0 + loss_coefficient_s_m * v_n_m_s).max(0.0)
 }
 
 /// Hertz load magnitude with impact damping, `max(0, 1 + p v_n) k s^1.5` for `s > 0`, else 0
 /// (Hu et al. eqs (1), (6), (10)). `k` in N/m^1.5, `s` in m, result in N.
+#[inline]
 pub fn hertz_load(k: f64, s_m: f64, loss_coefficient_s_m: f64, v_n_m_s: f64) -> f64 {
     if s_m <= 0.0 {
         return 0.0;
@@ -101,6 +104,7 @@ pub struct Hertz {
 
 impl Hertz {
     /// `H` in N/m^1.5 (eq 2).
+    #[inline]
     pub fn coefficient(&self) -> f64 {
         hertz_coefficient(self.modulus_pa, self.curvature_radius_m)
     }
@@ -153,6 +157,7 @@ pub struct Engagement {
 
 impl ToothLaw {
     /// Film thickness that shifts the start of contact, m: `h_o` for the oil laws, 0 for dry.
+    #[inline]
     pub fn engagement_offset_m(&self) -> f64 {
         match self.kind {
             LawKind::Dry => 0.0,
@@ -162,12 +167,14 @@ impl ToothLaw {
 
     /// Engagement depth in m: the compression `s = delta + h_o` (paper, squeeze) or `delta`
     /// (dry). A contact event lasts while this is positive; engines locate its zero crossings.
+    #[inline]
     pub fn engagement_depth_m(&self, kin: &ToothKinematics) -> f64 {
         kin.delta_m + self.engagement_offset_m()
     }
 
     /// Starts a contact event at the instant the engagement depth crosses zero (MODEL.md 2):
     /// holds `dv = max(v_n, v_floor)` and the stiffness `K` for the whole event.
+    #[inline]
     pub fn engage(&self, kin: &ToothKinematics) -> Engagement {
         let h = self.hertz.coefficient();
         match self.kind {
@@ -198,6 +205,7 @@ impl ToothLaw {
     }
 
     /// Per-tooth load magnitude in N during a contact event (`engagement` from [`Self::engage`]).
+    #[inline]
     pub fn load_magnitude(&self, kin: &ToothKinematics, engagement: &Engagement) -> f64 {
         let p = self.hertz.loss_coefficient_s_m;
         match self.kind {
@@ -223,6 +231,7 @@ impl ToothLaw {
     }
 
     /// Signed per-tooth load in N (eq 6 sign: negative when the shaft leads).
+    #[inline]
     pub fn load_n(&self, kin: &ToothKinematics, engagement: &Engagement) -> f64 {
         engagement.flank.load_sign() * self.load_magnitude(kin, engagement)
     }

@@ -18,6 +18,7 @@ pub enum Flank {
 
 impl Flank {
     /// The flank on whose side a relative angle `phi` (rad) lies. `phi = 0` counts as `ShaftLeads`.
+    #[inline]
     pub fn of(phi_rad: f64) -> Flank {
         if phi_rad >= 0.0 {
             Flank::ShaftLeads
@@ -27,6 +28,7 @@ impl Flank {
     }
 
     /// `+1` for `ShaftLeads`, `-1` for `DiscLeads`: the sign of `phi` on this flank.
+    #[inline]
     pub fn phi_sign(self) -> f64 {
         match self {
             Flank::ShaftLeads => 1.0,
@@ -36,6 +38,7 @@ impl Flank {
 
     /// The sign of the per-tooth load on this flank (eq 6): `-1` when the shaft leads, `+1` when
     /// the disc leads.
+    #[inline]
     pub fn load_sign(self) -> f64 {
         -self.phi_sign()
     }

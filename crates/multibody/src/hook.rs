@@ -133,6 +133,9 @@ pub(crate) struct Coupling {
     g0: f64,
     /// The sine and cosine of the pressure angle (per-tooth lines of action).
     sin_cos_alpha: (f64, f64),
+    /// Half a tooth pitch, `pi / n`, rad, kept as `rb` (the sub-steps check every relative
+    /// angle against it: a division per sub-step).
+    half_pitch_rad: f64,
 }
 
 /// The lumped tooth's kinematics at `(phi, dphi)` with the half play `g0` (rad) and the base
@@ -185,7 +188,7 @@ fn tooth_load(
 /// One tooth's signed load (N) at `kin` as a probe takes it ([`Coupling::probe_torque`]):
 /// zero unless engaged, else the law's with the tooth's event in progress `state` if it is on
 /// the same flank, or an event engaging at `kin`; the contact memory is not advanced.
-#[inline]
+#[inline(always)]
 fn probe_load(law: &ToothLaw, state: &ContactState, kin: &ToothKinematics) -> f64 {
     if law.engagement_depth_m(kin) <= 0.0 {
         return 0.0;
@@ -206,6 +209,12 @@ impl Coupling {
     /// The half play `g0`, rad ([`SplineGeometry::half_play_rad`], kept).
     pub fn half_play_rad(&self) -> f64 {
         self.g0
+    }
+
+    /// Half a tooth pitch, `pi / n`, rad (kept): the largest relative angle a coupling's
+    /// state can have.
+    pub fn half_pitch_rad(&self) -> f64 {
+        self.half_pitch_rad
     }
 
     /// The lumped tooth's kinematics at `(phi, dphi)` ([`kinematics`]).
@@ -244,6 +253,7 @@ impl Coupling {
             rb: spline.base_radius_m(),
             g0: spline.half_play_rad(),
             sin_cos_alpha: spline.pressure_angle_rad.sin_cos(),
+            half_pitch_rad: std::f64::consts::PI / spline.teeth as f64,
             spline,
             law,
             teeth,
@@ -276,7 +286,7 @@ impl Coupling {
     /// Inlined where it is called (the multirate sub-steps probe a lumped coupling three
     /// times a step: the call and the registers it spilled were a third of a probe's cost);
     /// a per-tooth coupling's loop is its own function, [`Self::probe_torque_per_tooth`].
-    #[inline]
+    #[inline(always)]
     pub fn probe_torque(&self, phi: f64, dphi: f64) -> f64 {
         if self.teeth.is_empty() {
             let kin = self.kinematics(phi, dphi);

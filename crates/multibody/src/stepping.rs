@@ -70,6 +70,7 @@ pub(crate) struct CouplingView<'a> {
 /// The step the coupling allows, s, and whether it is a contact step (the coupling is in
 /// contact or will touch within it); contact steps are not shortened to land on sampling
 /// times, since varying the step within a contact spoils the symplectic step's energy.
+#[inline]
 pub(crate) fn coupling_step(c: &CouplingView<'_>, a: &AdaptiveStepping) -> (f64, bool) {
     let n = a.steps_per_contact;
     let f = c.forces;

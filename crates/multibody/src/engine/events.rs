@@ -97,6 +97,7 @@ impl EventTrack {
 
     /// Observes a load sample and, when the previous sample was a local maximum of `|F|`, the
     /// vertex of the parabola through the three samples around it (the peak between steps).
+    #[inline]
     fn push(&mut self, t: f64, load: f64) {
         self.tracker.observe(t, load);
         if let (Some((t0, f0)), Some((t1, f1))) = (self.before_last, self.last) {

@@ -516,7 +516,7 @@ impl Run {
         ws: &mut WorldStep,
     ) -> Result<f64, EngineError> {
         let d = &self.bodies[i];
-        let limit = std::f64::consts::PI / d.spline.teeth as f64;
+        let limit = self.couplings[i].half_pitch_rad();
         if !(phi.abs() <= limit && dphi.is_finite()) {
             return Err(EngineError::Diverged {
                 t_s: t,

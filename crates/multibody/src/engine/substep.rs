@@ -526,44 +526,47 @@ pub(super) enum Path<'a> {
 }
 
 impl Path<'_> {
-    /// The carrier at `t` (inlined into the sub-step: the housing's is two zeros, and the
-    /// call spilled the step's registers).
-    #[inline]
+    /// The carrier at `t` (inlined: the call spilled the step's registers; nodes out of line).
+    #[inline(always)]
     pub(super) fn at(self, t: f64) -> ShaftAt {
         match self {
             Path::Profile(p) => p.at(t),
             Path::Housing => ShaftAt::of(None, t),
-            Path::Nodes(n) => {
-                let k = n.partition_point(|x| x.t < t);
-                if k < n.len() && n[k].t == t {
-                    return ShaftAt {
-                        speed: n[k].speed,
-                        angle: n[k].angle,
-                    };
-                }
-                let k = k.clamp(1, n.len() - 1);
-                let (a, b) = (n[k - 1], n[k]);
-                let h = b.t - a.t;
-                let s = (t - a.t) / h;
-                let (s2, s3) = (s * s, s * s * s);
-                let (h00, h10, h01, h11) = (
-                    2.0 * s3 - 3.0 * s2 + 1.0,
-                    s3 - 2.0 * s2 + s,
-                    -2.0 * s3 + 3.0 * s2,
-                    s3 - s2,
-                );
-                // the derivative of the cubic, per unit time
-                let (d00, d10, d01, d11) = (
-                    6.0 * (s2 - s),
-                    3.0 * s2 - 4.0 * s + 1.0,
-                    6.0 * (s - s2),
-                    3.0 * s2 - 2.0 * s,
-                );
-                ShaftAt {
-                    angle: h00 * a.angle + h10 * h * a.speed + h01 * b.angle + h11 * h * b.speed,
-                    speed: (d00 * a.angle + d01 * b.angle) / h + d10 * a.speed + d11 * b.speed,
-                }
-            }
+            Path::Nodes(n) => Path::nodes_at(n, t),
+        }
+    }
+
+    /// An inertial carrier at `t` from its nodes: exact at one, cubic Hermite between two.
+    #[inline(never)]
+    fn nodes_at(n: &[Node], t: f64) -> ShaftAt {
+        let k = n.partition_point(|x| x.t < t);
+        if k < n.len() && n[k].t == t {
+            return ShaftAt {
+                speed: n[k].speed,
+                angle: n[k].angle,
+            };
+        }
+        let k = k.clamp(1, n.len() - 1);
+        let (a, b) = (n[k - 1], n[k]);
+        let h = b.t - a.t;
+        let s = (t - a.t) / h;
+        let (s2, s3) = (s * s, s * s * s);
+        let (h00, h10, h01, h11) = (
+            2.0 * s3 - 3.0 * s2 + 1.0,
+            s3 - 2.0 * s2 + s,
+            -2.0 * s3 + 3.0 * s2,
+            s3 - s2,
+        );
+        // the derivative of the cubic, per unit time
+        let (d00, d10, d01, d11) = (
+            6.0 * (s2 - s),
+            3.0 * s2 - 4.0 * s + 1.0,
+            6.0 * (s - s2),
+            3.0 * s2 - 2.0 * s,
+        );
+        ShaftAt {
+            angle: h00 * a.angle + h10 * h * a.speed + h01 * b.angle + h11 * h * b.speed,
+            speed: (d00 * a.angle + d01 * b.angle) / h + d10 * a.speed + d11 * b.speed,
         }
     }
 }
