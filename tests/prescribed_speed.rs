@@ -6,9 +6,9 @@
 use super::common::{apart, Impact};
 use super::scratch;
 use clutchpack_model::network::{NetworkInput, NetworkSession};
-use clutchpack_model::Observer;
 use clutchpack_model::session::{Driven, Inputs};
 use clutchpack_model::ImpactEvent;
+use clutchpack_model::Observer;
 use clutchpack_scene::EngineChoice;
 use clutchpack_sdk::{CoSimulation, NetworkSimulation, Simulation};
 use std::collections::BTreeMap;

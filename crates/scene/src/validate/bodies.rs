@@ -290,10 +290,10 @@ impl Body<'_> {
         get: impl Fn(&Params, &Key) -> Field<T>,
     ) -> Option<T> {
         pick(&get(self.own, k), &get(self.defaults, k))
-            .required(
+            .required_with(
                 ck,
-                &k.at(&self.item),
-                &format!("required; set it in {}", where_to_set(self.sec, k)),
+                || k.at(&self.item),
+                || format!("required; set it in {}", where_to_set(self.sec, k)),
             )
             .map(|(v, _)| v)
     }
@@ -363,10 +363,10 @@ impl Body<'_> {
         let teeth = self.required(ck, &Sp::teeth, Params::count);
         let pitch = self.required(ck, &Sp::pitch_radius_m, Params::num);
         let alpha_deg = self.required(ck, &Sp::pressure_angle_deg, Params::num);
-        let backlash = pick(&own.num(&Sp::backlash_m), &d.num(&Sp::backlash_m)).required(
+        let backlash = pick(&own.num(&Sp::backlash_m), &d.num(&Sp::backlash_m)).required_with(
             ck,
-            &Sp::backlash_m.at(item),
-            &format!("required; set it in {}", where_to_set(sec, &Sp::backlash_m)),
+            || Sp::backlash_m.at(item),
+            || format!("required; set it in {}", where_to_set(sec, &Sp::backlash_m)),
         );
         let laws = [LawKind::Paper, LawKind::Dry, LawKind::Squeeze];
         let law = pick(&own.choice(&C::law), &d.choice(&C::law))
@@ -383,14 +383,16 @@ impl Body<'_> {
         let oil_param = |ck: &mut Checker, k: &Key| {
             if needs_oil {
                 pick(&own.num(k), &d.num(k))
-                    .required(
+                    .required_with(
                         ck,
-                        &k.at(item),
-                        &format!(
-                            "required when oil.film_thickness_m > 0 and contact.law is not \
-                             \"dry\"; set it in {}",
-                            where_to_set(sec, k)
-                        ),
+                        || k.at(item),
+                        || {
+                            format!(
+                                "required when oil.film_thickness_m > 0 and contact.law is not \
+                                 \"dry\"; set it in {}",
+                                where_to_set(sec, k)
+                            )
+                        },
                     )
                     .map(|(v, _)| v)
             } else {

@@ -61,6 +61,21 @@ impl<T> Field<T> {
         }
     }
 
+    /// [`Field::required`] with the key's path and the hint built only when reported (a
+    /// pack's bodies ask for hundreds of required keys, nearly always present).
+    pub fn required_with(
+        self,
+        ck: &mut Checker,
+        key: impl FnOnce() -> String,
+        hint: impl FnOnce() -> String,
+    ) -> Option<T> {
+        match self {
+            Field::Absent => self.required(ck, &key(), &hint()),
+            Field::Invalid => None,
+            Field::Valid(v) => Some(v),
+        }
+    }
+
     /// The value; reports `key: missing (hint)` if absent; `None` if absent or invalid.
     pub fn required(self, ck: &mut Checker, key: &str, hint: &str) -> Option<T> {
         match self {
