@@ -233,31 +233,7 @@ fn a_one_pack_network_runs_the_pack_session_bit_for_bit() {
 
 /// `cases::prescribed_clutch` as a scene file: the motor's speed from `w.csv` (20 rad/s at
 /// t = 0 to 40 rad/s at 1 s), the load of 0.5 kg m^2, the clutch of 30 N m.
-pub(super) const MOTOR: &str = r#"
-name = "motor"
-[simulation]
-duration_s = 0.8
-[[bodies]]
-name = "motor"
-[bodies.speed]
-kind = "speed_table"
-file = "w.csv"
-[[bodies]]
-name = "load"
-inertia_kg_m2 = 0.5
-[[couplings]]
-name = "clutch"
-kind = "clutch"
-a = "motor"
-b = "load"
-mu = 0.3
-peak = 1.2
-cgeo_m = 0.1
-max_normal_force_n = 1000.0
-[couplings.force]
-kind = "constant"
-value = 1.0
-"#;
+pub(super) const MOTOR: &str = include_str!("data/motor-clutch.toml");
 
 /// `clutchpack run` of a network with a prescribed body (`[bodies.speed]` from a speed table,
 /// `cases::prescribed_clutch` as a scene file) on both engines: the summary's energy names the

@@ -3,6 +3,7 @@ and the output policy the pack Simulation keeps. Run by tests/python_package.rs 
 other pytest files (the working folder is the repository root)."""
 
 import shutil
+from pathlib import Path
 
 import pytest
 
@@ -45,31 +46,9 @@ def test_network_record_over_a_pack_file_is_refused(tmp_path):
         assert (tmp_path / target).read_bytes() == before
 
 
-MOTOR = """
-name = "motor"
-[simulation]
-duration_s = 0.8
-[[bodies]]
-name = "motor"
-[bodies.speed]
-kind = "speed_table"
-file = "w.csv"
-[[bodies]]
-name = "load"
-inertia_kg_m2 = 0.5
-[[couplings]]
-name = "clutch"
-kind = "clutch"
-a = "motor"
-b = "load"
-mu = 0.3
-peak = 1.2
-cgeo_m = 0.1
-max_normal_force_n = 1000.0
-[couplings.force]
-kind = "constant"
-value = 1.0
-"""
+# `cases::prescribed_clutch` as a scene file, shared with the Rust tests (run from the
+# repository root, as every test here)
+MOTOR = Path("tests/data/motor-clutch.toml").read_text()
 
 
 @pytest.mark.parametrize("engine", ["reference", "multibody"])
