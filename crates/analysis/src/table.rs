@@ -229,16 +229,24 @@ fn range(s: &Spread) -> String {
     }
 }
 
-/// Renders text or markdown with columns padded to their widest cell.
+/// Renders text or markdown with columns padded to their widest cell (in characters), written
+/// into one string: numbers right-aligned, a markdown cell's `|` escaped, a text line's
+/// trailing spaces trimmed (a table of a 33-body pack's figures was a tenth of a short run's
+/// instructions when every cell and line was formatted on its own).
 pub(crate) fn render(format: TableFormat, cols: &[Col], rows: &[Vec<String>]) -> String {
-    let escape = |s: &str| match format {
-        TableFormat::Markdown => s.replace('|', "\\|"),
-        _ => s.to_string(),
-    };
-    let header: Vec<String> = cols.iter().map(|c| escape(&c.header)).collect();
-    let rows: Vec<Vec<String>> = rows
+    use std::borrow::Cow;
+    let md = matches!(format, TableFormat::Markdown);
+    fn escape(md: bool, s: &str) -> Cow<'_, str> {
+        if md && s.contains('|') {
+            Cow::Owned(s.replace('|', "\\|"))
+        } else {
+            Cow::Borrowed(s)
+        }
+    }
+    let header: Vec<Cow<'_, str>> = cols.iter().map(|c| escape(md, &c.header)).collect();
+    let rows: Vec<Vec<Cow<'_, str>>> = rows
         .iter()
-        .map(|r| r.iter().map(|s| escape(s)).collect())
+        .map(|r| r.iter().map(|s| escape(md, s)).collect())
         .collect();
     let width = |s: &str| s.chars().count();
     let widths: Vec<usize> = (0..cols.len())
@@ -250,44 +258,54 @@ pub(crate) fn render(format: TableFormat, cols: &[Col], rows: &[Vec<String>]) ->
                 .unwrap_or(3)
         })
         .collect();
-    let pad = |s: &str, i: usize| {
-        let fill = " ".repeat(widths[i] - width(s));
-        if cols[i].right {
-            format!("{fill}{s}")
+    let spaces = |out: &mut String, n: usize| out.extend(std::iter::repeat_n(' ', n));
+    let line = |out: &mut String, cells: &[Cow<'_, str>]| {
+        let start = out.len();
+        if md {
+            out.push_str("| ");
+        }
+        for (i, s) in cells.iter().enumerate() {
+            if i > 0 {
+                out.push_str(if md { " | " } else { "  " });
+            }
+            let fill = widths[i] - width(s);
+            if cols[i].right {
+                spaces(out, fill);
+                out.push_str(s);
+            } else {
+                out.push_str(s);
+                spaces(out, fill);
+            }
+        }
+        if md {
+            out.push_str(" |");
         } else {
-            format!("{s}{fill}")
+            let kept = out[start..].trim_end().len();
+            out.truncate(start + kept);
         }
+        out.push('\n');
     };
-    let line = |cells: &[String]| -> String {
-        let padded: Vec<String> = cells.iter().enumerate().map(|(i, s)| pad(s, i)).collect();
-        match format {
-            TableFormat::Markdown => format!("| {} |\n", padded.join(" | ")),
-            _ => format!("{}\n", padded.join("  ").trim_end()),
+    let line_len = widths.iter().sum::<usize>() + 3 * widths.len() + 4;
+    let mut out = String::with_capacity(line_len * (rows.len() + 2));
+    line(&mut out, &header);
+    if md {
+        out.push('|');
+        for (&w, c) in widths.iter().zip(cols) {
+            out.push(' ');
+            out.extend(std::iter::repeat_n('-', if c.right { w - 1 } else { w }));
+            if c.right {
+                out.push(':');
+            }
+            out.push_str(" |");
         }
-    };
-    let mut out = line(&header);
-    match format {
-        TableFormat::Markdown => {
-            let rules: Vec<String> = widths
-                .iter()
-                .zip(cols)
-                .map(|(&w, c)| {
-                    if c.right {
-                        format!("{}:", "-".repeat(w - 1))
-                    } else {
-                        "-".repeat(w)
-                    }
-                })
-                .collect();
-            let _ = writeln!(out, "| {} |", rules.join(" | "));
-        }
-        _ => {
-            let total = widths.iter().sum::<usize>() + 2 * widths.len().saturating_sub(1);
-            let _ = writeln!(out, "{}", "-".repeat(total));
-        }
+        out.push('\n');
+    } else {
+        let total = widths.iter().sum::<usize>() + 2 * widths.len().saturating_sub(1);
+        out.extend(std::iter::repeat_n('-', total));
+        out.push('\n');
     }
     for r in &rows {
-        out.push_str(&line(r));
+        line(&mut out, r);
     }
     out
 }
@@ -512,6 +530,101 @@ pub fn fatigue_spread_table(
 mod tests {
     use super::*;
     use crate::sweep::{sweep_rows, SweepCase};
+
+    /// The formatting `render` replaced, cell by cell and line by line: the reference its output
+    /// must equal.
+    fn render_formatted(format: TableFormat, cols: &[Col], rows: &[Vec<String>]) -> String {
+        let escape = |s: &str| match format {
+            TableFormat::Markdown => s.replace('|', "\\|"),
+            _ => s.to_string(),
+        };
+        let header: Vec<String> = cols.iter().map(|c| escape(&c.header)).collect();
+        let rows: Vec<Vec<String>> = rows
+            .iter()
+            .map(|r| r.iter().map(|s| escape(s)).collect())
+            .collect();
+        let width = |s: &str| s.chars().count();
+        let widths: Vec<usize> = (0..cols.len())
+            .map(|i| {
+                rows.iter()
+                    .map(|r| width(&r[i]))
+                    .chain([width(&header[i]), 3])
+                    .max()
+                    .unwrap_or(3)
+            })
+            .collect();
+        let pad = |s: &str, i: usize| {
+            let fill = " ".repeat(widths[i] - width(s));
+            if cols[i].right {
+                format!("{fill}{s}")
+            } else {
+                format!("{s}{fill}")
+            }
+        };
+        let line = |cells: &[String]| -> String {
+            let padded: Vec<String> = cells.iter().enumerate().map(|(i, s)| pad(s, i)).collect();
+            match format {
+                TableFormat::Markdown => format!("| {} |\n", padded.join(" | ")),
+                _ => format!("{}\n", padded.join("  ").trim_end()),
+            }
+        };
+        let mut out = line(&header);
+        match format {
+            TableFormat::Markdown => {
+                let rules: Vec<String> = widths
+                    .iter()
+                    .zip(cols)
+                    .map(|(&w, c)| {
+                        if c.right {
+                            format!("{}:", "-".repeat(w - 1))
+                        } else {
+                            "-".repeat(w)
+                        }
+                    })
+                    .collect();
+                let _ = writeln!(out, "| {} |", rules.join(" | "));
+            }
+            _ => {
+                let total = widths.iter().sum::<usize>() + 2 * widths.len().saturating_sub(1);
+                let _ = writeln!(out, "{}", "-".repeat(total));
+            }
+        }
+        for r in &rows {
+            out.push_str(&line(r));
+        }
+        out
+    }
+
+    /// `render` equals the cell-by-cell formatting it replaced, byte for byte, in text and
+    /// markdown: left and right columns, a cell wider than its header, an empty cell, a cell
+    /// that is all spaces (a text line's trailing spaces trimmed), a `|` (escaped in markdown),
+    /// multi-byte characters (widths in characters) and a column narrower than 3.
+    #[test]
+    fn render_writes_what_the_formatting_wrote() {
+        let cols = [
+            col("name", false),
+            col("max + [N]", true),
+            col("x", true),
+            col("note", false),
+        ];
+        let rows: Vec<Vec<String>> = [
+            ["disc 1", "1234.5", "1", "a | b"],
+            ["plate éé", "-250", "", "   "],
+            ["", "20", "123456", "°C"],
+        ]
+        .iter()
+        .map(|r| r.iter().map(|s| s.to_string()).collect())
+        .collect();
+        for format in [TableFormat::Text, TableFormat::Markdown] {
+            for n in 0..=rows.len() {
+                let (a, b) = (
+                    render(format, &cols, &rows[..n]),
+                    render_formatted(format, &cols, &rows[..n]),
+                );
+                assert_eq!(a, b, "{format:?}, {n} rows");
+            }
+        }
+    }
 
     fn two_discs() -> Vec<DiscStats> {
         vec![
