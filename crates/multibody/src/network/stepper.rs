@@ -394,8 +394,8 @@ impl NetworkSession for NetworkStepper {
         obs: &mut dyn Observer,
     ) -> Result<(), EngineError> {
         let t = self.t;
-        let angles = self.run.world.angles().to_vec();
-        Arc::make_mut(&mut self.run.net).hold_input(input, value, t, &angles)?;
+        let run = &mut self.run;
+        Arc::make_mut(&mut run.net).hold_input(input, value, t, run.world.angles())?;
         if let NetworkInput::PackPressure(k) = input {
             // the pack's session holds it too (the network's copy keeps the breakpoints)
             if let Some(p) = self.run.packs.iter_mut().find(|p| p.k == k) {
