@@ -163,7 +163,8 @@
 //! - *The kinks.* The `s^1.5` law's load grows as `t^1.5` from an onset (and falls as
 //!   `(t_off - t)^1.5` to a separation), so the step touching a kink is only of order `h^2.5`
 //!   in the impulse; sub-steps are graded there (at most a quarter of the time from the onset
-//!   or to the predicted separation, at least 1/64 of the contact step), which restores the
+//!   or to the predicted separation, at least 1/64 of the contact step, 1/8 for a coupling
+//!   alone on a carrier of known motion), which restores the
 //!   convergence: measured on the 8-disc staggered pack against the reference engine at
 //!   tolerance 1e-12, early onsets 2.6e-11 s off at 128 sub-steps per contact (1.7e-9 s
 //!   ungraded), 1.9e-12 s at 256.

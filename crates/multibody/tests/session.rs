@@ -446,15 +446,19 @@ fn a_driven_pressure_runs_the_multirate_scheme_like_the_scenes() {
         "drum's angle at {DURATION_S} s: driven multirate {multirate:.9} rad ({n_multirate} impacts), \
          driven shared {shared:.9} ({n_shared}), scene table {table:.9}"
     );
-    // measured 3.5e-5 against the table (the same scheme; the table's 1 ns ramp and the
-    // rattle's chaos apart) and 1.07e-3 against the shared step (its velocity-level friction,
-    // the less accurate integration; 178 impacts against 152)
+    // against the table (the same scheme; the table's 1 ns ramp and the rattle's chaos
+    // apart): 1.1e-4 here; over twelve realisations of the rattle (the first disc's inertia
+    // moved by -5.5e-12 to 5.5e-12 of itself) median 6.4e-5, largest 1.6e-4, and with the
+    // kinks' floor at 1/64 of the contact step (before issue 46 took 1/8 for a coupling
+    // alone) median 1.2e-4, largest 1.9e-4: the bound is 1.5 times the largest. Against the
+    // shared step 1.07e-3 (its velocity-level friction, the less accurate integration; 178
+    // impacts against 152)
     assert!(
         multirate > 0.1,
         "the drum was dragged round: {multirate} rad"
     );
     assert!(
-        (multirate / table - 1.0).abs() < 1e-4,
+        (multirate / table - 1.0).abs() < 3e-4,
         "{multirate} against {table}"
     );
     assert!(
@@ -698,3 +702,4 @@ fn the_multirate_scheme_hands_over_where_the_piston_may_push() {
     let (_, last) = c.interfaces.last().expect("interface samples");
     assert!(last.iter().all(|x| x.clamp_n > 0.0), "{last:?}");
 }
+

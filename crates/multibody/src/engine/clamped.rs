@@ -21,7 +21,9 @@ use super::carriers::{External, Motion};
 use super::landing::SubSteps;
 use super::scheme_state::{powers, RkBuffers, Stage};
 use super::state::Run;
-use super::substep::{checked_sub_step, cut, graded_step, Node, Prescribed, ShaftAt, WorldStep};
+use super::substep::{
+    checked_sub_step, cut, graded_step, Node, Prescribed, ShaftAt, WorldStep, KINK_FLOOR_DIVISOR,
+};
 use crate::stack::Face;
 use crate::stepping::{bracketed_root, coupling_step};
 use clutchpack_model::{EngineError, LocalProfile, SpeedProfile};
@@ -584,7 +586,12 @@ impl SubSteps for StackSteps {
             let f = run.forces[i];
             let view = run.coupling_view(i, &f, (self.phi[i], run.rel[i].dphi), bound, t);
             let (w, _) = coupling_step(&view, a);
-            want = want.min(graded_step(w, &f, run.events.event_age_s(i, t)));
+            want = want.min(graded_step(
+                w,
+                &f,
+                run.events.event_age_s(i, t),
+                KINK_FLOOR_DIVISOR,
+            ));
         }
         let want = checked_sub_step(want, a, t, || "the clamped stack".into())?;
         self.faces.clone_from(&run.multirate.faces);

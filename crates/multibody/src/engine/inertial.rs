@@ -8,6 +8,7 @@ use super::landing::SubSteps;
 use super::state::Run;
 use super::substep::{
     checked_sub_step, cut, graded_step, Carried, GapDrag, Node, Path, Rk4, ShaftAt, WorldStep,
+    KINK_FLOOR_DIVISOR,
 };
 use crate::stepping::coupling_step;
 use clutchpack_model::EngineError;
@@ -400,7 +401,12 @@ impl SubSteps for CarrierSteps<'_> {
                 + ((d.drag_n_m_s_rad + g.damping) * wd.abs() + g.bound_n_m()) * self.inv_j[k];
             let view = run.coupling_view(i, &f, (self.phi[k], self.dphi[k]), bound, t);
             let (wk, _) = coupling_step(&view, a);
-            want = want.min(graded_step(wk, &f, run.events.event_age_s(i, t)));
+            want = want.min(graded_step(
+                wk,
+                &f,
+                run.events.event_age_s(i, t),
+                KINK_FLOOR_DIVISOR,
+            ));
         }
         let who = run.carriers[self.c].name;
         checked_sub_step(want, a, t, || who.into())

@@ -11,7 +11,7 @@ use super::landing::SubSteps;
 use super::state::{disc_sample, relative_state, Run};
 use super::substep::{
     checked_sub_step, graded_step, GapDrag, Node, Path, Prescribed, Relative, ShaftAt, SubStep,
-    TurnMoment, WorldStep,
+    TurnMoment, WorldStep, ALONE_KINK_FLOOR_DIVISOR, KINK_FLOOR_DIVISOR,
 };
 use crate::hook::{RelativeState, FLANKS};
 use crate::options::{MultibodyOptions, Stepping};
@@ -616,7 +616,12 @@ impl SubSteps for Alone<'_> {
             + ((self.c2 + gap.damping) * wd.abs() + gap.bound_n_m()) * self.inv_j;
         let view = run.coupling_view(i, f, (self.phi, self.dphi), bound, t);
         let (want, _) = coupling_step(&view, a);
-        let want = graded_step(want, f, run.events.event_age_s(i, t));
+        let floor_divisor = if self.known {
+            ALONE_KINK_FLOOR_DIVISOR
+        } else {
+            KINK_FLOOR_DIVISOR
+        };
+        let want = graded_step(want, f, run.events.event_age_s(i, t), floor_divisor);
         let want = checked_sub_step(want, a, t, || format!("disc {i}"))?;
         self.start_torque_n_m = if self.evaluated_here {
             f.moment[2]
