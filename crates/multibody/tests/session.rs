@@ -702,4 +702,3 @@ fn the_multirate_scheme_hands_over_where_the_piston_may_push() {
     let (_, last) = c.interfaces.last().expect("interface samples");
     assert!(last.iter().all(|x| x.clamp_n > 0.0), "{last:?}");
 }
-
