@@ -732,12 +732,16 @@ fn sigkill_leaves_a_file_readable_up_to_the_last_flush() {
 /// but for micro-slips: its faces are clamped right at their static capacity (DECISIONS,
 /// "Whole packs in the reference engine"), and at the drive's peaks (every 9.6 ms) a face may
 /// slip by 1e-5 to 1e-3 rad/s and re-lock within a millisecond. So from 90 ms on every
-/// interface is locked in at least 75 % of the samples and gains less than 5e-3 J of heat
-/// (measured since the clamped stack runs multirate, issue 20: interface 8 locked in 84 of
-/// 101 samples, 2.2e-3 J, the others in all; the reference engine's exact stick-slip events
-/// on the same run 80 of 101 and 3.8e-3 J on interface 8, 98 of 101 on interface 4; the
-/// shared step's velocity-level friction missed these micro-slips, all 101 locked).
-/// `run` prints the interfaces' table.
+/// interface is locked in at least half the samples and gains less than 0.05 J of heat (of
+/// the 3000 J or so each dissipates in the engagement). How much the faces micro-slip is
+/// chaotic: over ten realisations of the run (the discs' inertia moved by -4.5e-12 to
+/// 4.5e-12 of itself; issue 46) the least locked interface held in 68-100 % of the samples
+/// from 90 ms on the reference engine (exact stick-slip events; median 74 %, at most
+/// 1.05e-2 J since), 56-100 % on the multibody engine (median 80 %, at most 3.7e-2 J), and
+/// 73-100 % before issue 46 took the kinks' floor at 1/8 for a coupling alone (median 95 %,
+/// at most 7.2e-3 J). This run: interface 8 locked in 75 of 101 samples, 4.6e-3 J (84 and
+/// 2.2e-3 J before; the shared step's velocity-level friction missed these micro-slips, all
+/// 101 locked). `run` prints the interfaces' table.
 #[test]
 fn stack_recordings_carry_the_friction_interfaces() {
     let d = scratch("interfaces");
@@ -805,7 +809,7 @@ fn stack_recordings_carry_the_friction_interfaces() {
             locked.len()
         );
         assert!(
-            held as f64 >= 0.75 * locked.len() as f64 && gained < 5e-3,
+            held as f64 >= 0.5 * locked.len() as f64 && gained < 0.05,
             "interface {m}: locked in {held} of {} samples from 90 ms, {gained} J since",
             locked.len()
         );
