@@ -68,11 +68,13 @@ impl Params {
         Params(out)
     }
 
-    /// The checked value of `k`.
+    /// The checked value of `k` (the names compared first: most differ in length, and the
+    /// tables of a body's keys are few and long; a scene of 33 bodies looked its keys up
+    /// some 27 000 times, table first, each equal table a `memcmp`).
     fn get(&self, k: &Key) -> Field<Val> {
         self.0
             .iter()
-            .find(|(p, _)| p.table == k.table && p.name == k.name)
+            .find(|(p, _)| p.name == k.name && p.table == k.table)
             .map(|(_, f)| f.clone())
             .unwrap_or_else(|| unreachable!("{} is not a body key", k.rel()))
     }
