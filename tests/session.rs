@@ -361,4 +361,32 @@ fn bench_frames_runs_and_finds_the_frames_outputs_identical() {
         round["difference"]["impacts_whole"].as_u64().unwrap() > 0,
         "{v}"
     );
+    assert_eq!((&v["paced"], &v["spin"]), (&false.into(), &false.into()));
+    // paced, spinning between the frames: 20 frames take at least their 20 ms of wall time
+    // and give the same outputs; `--spin` without `--paced` is refused
+    let t0 = std::time::Instant::now();
+    let o = super::run(&[
+        "bench",
+        "--frames",
+        "1ms",
+        &super::hardening::repo("scenes/hu-table2.toml"),
+        "--duration",
+        "0.02",
+        "--paced",
+        "--spin",
+        "--summary-json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", super::stderr(&o));
+    assert!(t0.elapsed().as_secs_f64() >= 0.019);
+    let v = super::read_json(&json);
+    assert_eq!((&v["paced"], &v["spin"]), (&true.into(), &true.into()));
+    assert_eq!(v["rounds"][0]["difference"]["identical"], true, "{v}");
+    let o = super::run(&["bench", "--frames", "1ms", "--spin"]);
+    assert_eq!(o.status.code(), Some(2), "{}", super::stderr(&o));
+    assert!(
+        super::stderr(&o).contains("--paced"),
+        "{}",
+        super::stderr(&o)
+    );
 }

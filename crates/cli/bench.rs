@@ -107,6 +107,12 @@ pub struct BenchArgs {
     /// frames' own).
     #[arg(long, requires = "frames")]
     pub paced: bool,
+    /// With `--paced`: wait for each frame spinning on the clock instead of sleeping, as a
+    /// rig's loop on a core of its own does (the core never idles: its caches and clock stay
+    /// warm between the frames; on this project's virtual machines a sleeping thread's next
+    /// frame cost about 250 us more).
+    #[arg(long, requires = "paced")]
+    pub spin: bool,
     /// With `--frames`: drive every input the scene has, as an FMU does (held at its value at
     /// t = 0 and set at every call; the whole run is the same driven run in one call).
     #[arg(long, requires = "frames")]
@@ -134,6 +140,7 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
                 rounds: a.rounds,
                 drive: a.drive,
                 paced: a.paced,
+                spin: a.spin,
             },
             &crate::signals::flag(),
         );

@@ -38,6 +38,10 @@ pub struct FramesRequest<'a> {
     /// the frames meet the caches, the scheduler and a real-time policy's throttling as a
     /// host's frames do. The framed wall time is then the frames' own (sleeps left out).
     pub paced: bool,
+    /// With `paced`: wait for each frame spinning on the clock instead of sleeping, as a rig's
+    /// loop on a core of its own does (the core never idles, so its caches and clock stay
+    /// warm between the frames).
+    pub spin: bool,
     /// Drive every input the scene has, as an FMU does, each held at its value at t = 0 and
     /// set again at every call (both sides: the whole run is the driven run in one call).
     pub drive: bool,
@@ -150,6 +154,8 @@ struct Summary<'a> {
     duration_s: f64,
     driven: bool,
     paced: bool,
+    /// Whether the paced frames were waited for by spinning (else by sleeping).
+    spin: bool,
     frames: usize,
     budget_s: f64,
     median_ratio: f64,
@@ -192,11 +198,25 @@ impl FrameClock {
     }
 }
 
-/// Sleeps until frame `k` (from 0) is due, `k` frame lengths `pace` (s) after `t0`; at once
-/// without `pace` or when the frame is late.
-fn wait_for_frame(t0: Instant, k: usize, pace: Option<f64>) {
-    if let Some(dt) = pace {
-        let due = t0 + std::time::Duration::from_secs_f64(k as f64 * dt);
+/// How a paced run waits for its frames: each frame `frame_s` (s) after the last, by
+/// sleeping or by spinning on the clock.
+#[derive(Clone, Copy)]
+struct Pace {
+    frame_s: f64,
+    spin: bool,
+}
+
+/// Waits until frame `k` (from 0) is due, `k` frame lengths after `t0`; at once without
+/// `pace` or when the frame is late.
+fn wait_for_frame(t0: Instant, k: usize, pace: Option<Pace>) {
+    if let Some(p) = pace {
+        let due = t0 + std::time::Duration::from_secs_f64(k as f64 * p.frame_s);
+        if p.spin {
+            while Instant::now() < due {
+                std::hint::spin_loop();
+            }
+            return;
+        }
         let now = Instant::now();
         if due > now {
             std::thread::sleep(due - now);
@@ -206,7 +226,7 @@ fn wait_for_frame(t0: Instant, k: usize, pace: Option<f64>) {
 
 /// A side's wall time, s: since `t0`, or when paced the frames' own (`frames_s`, s) without
 /// the sleeps between them.
-fn busy_wall_s(t0: Instant, frames_s: &[f64], pace: Option<f64>) -> f64 {
+fn busy_wall_s(t0: Instant, frames_s: &[f64], pace: Option<Pace>) -> f64 {
     if pace.is_some() {
         frames_s.iter().sum()
     } else {
@@ -291,10 +311,10 @@ pub fn bench_frames(r: FramesRequest, stop: &AtomicBool) -> Result<ExitCode> {
         } else {
             ""
         },
-        if r.paced {
-            ", the frames paced at their wall-clock times"
-        } else {
-            ""
+        match (r.paced, r.spin) {
+            (true, false) => ", the frames paced at their wall-clock times (sleeping between)",
+            (true, true) => ", the frames paced at their wall-clock times (spinning between)",
+            _ => "",
         },
         duration,
         n,
@@ -311,7 +331,10 @@ pub fn bench_frames(r: FramesRequest, stop: &AtomicBool) -> Result<ExitCode> {
         if stop.load(Ordering::SeqCst) {
             return Ok(crate::signals::exit_code());
         }
-        let pace = r.paced.then_some(r.frame_s);
+        let pace = r.paced.then_some(Pace {
+            frame_s: r.frame_s,
+            spin: r.spin,
+        });
         let framed = side(&scene, engine, duration, &ends, r.drive, pace, stop)?;
         if stop.load(Ordering::SeqCst) {
             return Ok(crate::signals::exit_code());
@@ -376,6 +399,7 @@ pub fn bench_frames(r: FramesRequest, stop: &AtomicBool) -> Result<ExitCode> {
                 duration_s: duration,
                 driven: r.drive,
                 paced: r.paced,
+                spin: r.paced && r.spin,
                 frames: n,
                 budget_s: budget,
                 median_ratio,
@@ -483,7 +507,7 @@ fn side(
     duration: f64,
     ends: &[f64],
     drive: bool,
-    pace: Option<f64>,
+    pace: Option<Pace>,
     stop: &AtomicBool,
 ) -> Result<Side> {
     let mut frames_s = Vec::with_capacity(ends.len());
