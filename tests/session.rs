@@ -336,16 +336,15 @@ fn bench_frames_refuses_bad_frames_before_any_work() {
 fn bench_frames_runs_and_finds_the_frames_outputs_identical() {
     let dir = super::scratch("bench-frames");
     let json = dir.join("frames.json");
-    let o = super::run(&[
-        "bench",
-        "--frames",
-        "1ms",
-        &super::hardening::repo("scenes/hu-table2.toml"),
-        "--duration",
-        "0.02",
-        "--summary-json",
-        json.to_str().unwrap(),
-    ]);
+    // `bench --frames 1ms` on hu-table2 for 0.02 s with `extra`, its summary into `json`
+    let bench = |extra: &[&str]| {
+        let scene = super::hardening::repo("scenes/hu-table2.toml");
+        let mut args = vec!["bench", "--frames", "1ms", &scene, "--duration", "0.02"];
+        args.extend_from_slice(extra);
+        args.extend(["--summary-json", json.to_str().unwrap()]);
+        super::run(&args)
+    };
+    let o = bench(&[]);
     assert!(o.status.success(), "{}", super::stderr(&o));
     assert!(
         super::stdout(&o).contains("outputs: identical"),
@@ -365,18 +364,7 @@ fn bench_frames_runs_and_finds_the_frames_outputs_identical() {
     // paced, spinning between the frames: 20 frames take at least their 20 ms of wall time
     // and give the same outputs; `--spin` without `--paced` is refused
     let t0 = std::time::Instant::now();
-    let o = super::run(&[
-        "bench",
-        "--frames",
-        "1ms",
-        &super::hardening::repo("scenes/hu-table2.toml"),
-        "--duration",
-        "0.02",
-        "--paced",
-        "--spin",
-        "--summary-json",
-        json.to_str().unwrap(),
-    ]);
+    let o = bench(&["--paced", "--spin"]);
     assert!(o.status.success(), "{}", super::stderr(&o));
     assert!(t0.elapsed().as_secs_f64() >= 0.019);
     let v = super::read_json(&json);
